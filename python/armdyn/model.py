@@ -1,0 +1,422 @@
+"""The robot description: one model shared by the symbolic and the numeric engines.
+
+Conventions (see DESIGN.md):
+
+* SI units, radians.
+* A joint sits at a fixed placement in its parent link's frame: a translation ``xyz``
+  (3,) and a rotation ``rotation`` (3x3, the placement frame's axes expressed in the
+  parent frame, as URDF's ``origin``). It then moves about (revolute) or along
+  (prismatic) its unit ``axis``, given in the placement frame. The child link's frame is
+  the placement frame after that motion:
+
+      revolute:   R_parent_child = rotation * Rot(axis, q),   p = xyz
+      prismatic:  R_parent_child = rotation,                  p = xyz + rotation * axis * q
+      fixed:      R_parent_child = rotation,                  p = xyz
+
+* A link's inertia: ``mass``, centre of mass ``com`` (3,) in the link frame, and the
+  inertia tensor ``inertia`` (3x3) about the centre of mass, in the link frame's
+  orientation (as URDF). A point mass has a zero tensor.
+* Gravity is a vector (3,) in the base frame, part of the model.
+* Joints are kept in tree order (every joint's parent link is the base or the child of an
+  earlier joint). The joint coordinates ``q`` are those of the movable (non-fixed) joints
+  in that order.
+
+Any number may be a SymPy expression of named parameters (``Robot.parameters``). A robot
+with parameters is bound to numbers with :meth:`Robot.bind`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Iterable, Mapping
+
+import sympy as sp
+
+from .errors import ModelError
+
+JOINT_TYPES = ("revolute", "prismatic", "fixed")
+
+
+def _vec3(value, what: str) -> sp.Matrix:
+    try:
+        m = sp.Matrix(value)
+    except Exception as exc:  # noqa: BLE001 - re-raised with context
+        raise ModelError(f"{what} is not a 3-vector ({exc})") from None
+    if m.shape == (1, 3):
+        m = m.T
+    if m.shape != (3, 1):
+        raise ModelError(f"{what} must have 3 components, got shape {m.shape}")
+    return m.applyfunc(sp.sympify)
+
+
+def _mat3(value, what: str) -> sp.Matrix:
+    try:
+        m = sp.Matrix(value)
+    except Exception as exc:  # noqa: BLE001
+        raise ModelError(f"{what} is not a 3x3 matrix ({exc})") from None
+    if m.shape != (3, 3):
+        raise ModelError(f"{what} must be 3x3, got shape {m.shape}")
+    return m.applyfunc(sp.sympify)
+
+
+def _is_zero(expr) -> bool | None:
+    """True/False if decidable, None if it depends on free symbols."""
+    expr = sp.sympify(expr)
+    if expr.free_symbols:
+        return None
+    return bool(abs(complex(expr.evalf())) < 1e-12)
+
+
+def rot_x(a) -> sp.Matrix:
+    """Rotation (3x3) by angle ``a`` about x."""
+    c, s = sp.cos(a), sp.sin(a)
+    return sp.Matrix([[1, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def rot_y(a) -> sp.Matrix:
+    """Rotation (3x3) by angle ``a`` about y."""
+    c, s = sp.cos(a), sp.sin(a)
+    return sp.Matrix([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+
+
+def rot_z(a) -> sp.Matrix:
+    """Rotation (3x3) by angle ``a`` about z."""
+    c, s = sp.cos(a), sp.sin(a)
+    return sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def rpy_matrix(roll, pitch, yaw) -> sp.Matrix:
+    """URDF roll-pitch-yaw: ``Rz(yaw) * Ry(pitch) * Rx(roll)`` (fixed axes x, y, z)."""
+    return rot_z(yaw) * rot_y(pitch) * rot_x(roll)
+
+
+def axis_angle_matrix(axis, angle) -> sp.Matrix:
+    """Rodrigues' rotation (3x3) by ``angle`` about the unit vector ``axis``.
+
+    The coordinate axes give the exact ``rot_x/rot_y/rot_z`` forms, so symbolic
+    results stay as simple as a hand derivation.
+    """
+    a = sp.Matrix(axis)
+    for i, rot in enumerate((rot_x, rot_y, rot_z)):
+        unit = [0, 0, 0]
+        unit[i] = 1
+        if list(a) == unit:
+            return rot(angle)
+        unit[i] = -1
+        if list(a) == unit:
+            return rot(-angle)
+    c, s = sp.cos(angle), sp.sin(angle)
+    k = skew(a)
+    return sp.eye(3) + s * k + (1 - c) * k * k
+
+
+def skew(v) -> sp.Matrix:
+    """Cross-product matrix (3x3): ``skew(v) * w == v x w``."""
+    x, y, z = v
+    return sp.Matrix([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+
+
+@dataclass(frozen=True)
+class Link:
+    """A rigid body.
+
+    mass:    scalar (kg).
+    com:     (3, 1) centre of mass in the link frame (m).
+    inertia: (3, 3) inertia tensor about the centre of mass, link-frame axes (kg m^2).
+    """
+
+    name: str
+    mass: sp.Expr = sp.Integer(0)
+    com: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))
+    inertia: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 3))
+
+    def __post_init__(self):
+        where = f"link '{self.name}'"
+        try:
+            object.__setattr__(self, "mass", sp.sympify(self.mass))
+            object.__setattr__(self, "com", _vec3(self.com, "com"))
+            object.__setattr__(self, "inertia", _mat3(self.inertia, "inertia"))
+        except ModelError as err:
+            raise err.located(element=where)
+        except (sp.SympifyError, TypeError) as exc:
+            raise ModelError(f"bad value ({exc})", where) from None
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A joint between ``parent`` and ``child`` links.
+
+    type:     "revolute", "prismatic" or "fixed".
+    xyz:      (3, 1) placement translation in the parent link frame (m).
+    rotation: (3, 3) placement rotation: placement-frame axes in the parent frame.
+    axis:     (3, 1) unit axis of motion in the placement frame (ignored when fixed).
+    lower, upper, velocity, effort, damping, friction: optional limits and
+              joint-space friction, kept on the model (None when not given).
+    """
+
+    name: str
+    type: str
+    parent: str
+    child: str
+    xyz: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))
+    rotation: sp.Matrix = field(default_factory=lambda: sp.eye(3))
+    axis: sp.Matrix = field(default_factory=lambda: sp.Matrix([0, 0, 1]))
+    lower: sp.Expr | None = None
+    upper: sp.Expr | None = None
+    velocity: sp.Expr | None = None
+    effort: sp.Expr | None = None
+    damping: sp.Expr | None = None
+    friction: sp.Expr | None = None
+
+    def __post_init__(self):
+        where = f"joint '{self.name}'"
+        if self.type not in JOINT_TYPES:
+            raise ModelError(
+                f"unknown joint type '{self.type}' (expected one of {', '.join(JOINT_TYPES)})",
+                where,
+            )
+        try:
+            object.__setattr__(self, "xyz", _vec3(self.xyz, "xyz"))
+            object.__setattr__(self, "rotation", _mat3(self.rotation, "rotation"))
+            object.__setattr__(self, "axis", _vec3(self.axis, "axis"))
+            for name in ("lower", "upper", "velocity", "effort", "damping", "friction"):
+                value = getattr(self, name)
+                if value is not None:
+                    object.__setattr__(self, name, sp.sympify(value))
+        except ModelError as err:
+            raise err.located(element=where)
+        except (sp.SympifyError, TypeError) as exc:
+            raise ModelError(f"bad value ({exc})", where) from None
+        if self.type != "fixed":
+            norm2 = sp.expand(sum(c**2 for c in self.axis))
+            zero = _is_zero(norm2)
+            if zero:
+                raise ModelError("axis is zero", where)
+            if zero is False and _is_zero(norm2 - 1) is False:
+                raise ModelError(
+                    f"axis {list(self.axis)} is not a unit vector (norm {sp.sqrt(norm2).evalf(6)})",
+                    where,
+                )
+
+    @property
+    def movable(self) -> bool:
+        return self.type != "fixed"
+
+    def transform(self, q=0) -> tuple[sp.Matrix, sp.Matrix]:
+        """Child frame in the parent frame at coordinate ``q``: ``(R (3x3), p (3x1))``.
+
+        ``R`` has the child frame's axes as columns, in parent coordinates; ``p`` is the
+        child frame's origin in the parent frame.
+        """
+        if self.type == "revolute":
+            return self.rotation * axis_angle_matrix(self.axis, q), self.xyz
+        if self.type == "prismatic":
+            return self.rotation, self.xyz + self.rotation * self.axis * q
+        return self.rotation, self.xyz
+
+
+def coordinate_symbols(names: Iterable[str]) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
+    """Joint coordinates ``q``, velocities ``qd`` and accelerations ``qdd`` as (n, 1)
+    column vectors of plain symbols named ``<joint>``, ``<joint>_dot``, ``<joint>_ddot``.
+    """
+    names = list(names)
+    q = sp.Matrix([sp.Symbol(n) for n in names])
+    qd = sp.Matrix([sp.Symbol(f"{n}_dot") for n in names])
+    qdd = sp.Matrix([sp.Symbol(f"{n}_ddot") for n in names])
+    return q, qd, qdd
+
+
+class Robot:
+    """A fixed-base robot: links and joints in tree order, and gravity.
+
+    Attributes
+    ----------
+    name:        the robot's name.
+    base:        name of the base link (the root, fixed in the world).
+    links:       dict name -> :class:`Link`, base first, then each joint's child in order.
+    joints:      list of :class:`Joint` in tree order (fixed ones included).
+    gravity:     (3, 1) gravity vector in the base frame (m/s^2).
+    parameters:  dict name -> sympy Symbol of the model's named parameters.
+    meta:        free-form description (source, convention, ...).
+
+    Derived:
+    movable_joints: the non-fixed joints, in order; ``dof`` is their number.
+    q, qd, qdd:     (dof, 1) symbol vectors named after the movable joints.
+    """
+
+    def __init__(
+        self,
+        name: str,
+        links: Iterable[Link],
+        joints: Iterable[Joint],
+        gravity=(0, 0, -9.81),
+        parameters: Mapping[str, sp.Symbol] | Iterable[sp.Symbol] | None = None,
+        meta: Mapping | None = None,
+        base: str | None = None,
+    ):
+        self.name = name
+        links = list(links)
+        joints = list(joints)
+        self.meta = dict(meta or {})
+        try:
+            self.gravity = _vec3(gravity, "gravity")
+        except ModelError as err:
+            raise err.located(element=f"robot '{name}'")
+
+        self.links: dict[str, Link] = {}
+        for link in links:
+            if link.name in self.links:
+                raise ModelError("duplicate link name", f"link '{link.name}'")
+            self.links[link.name] = link
+
+        children = {j.child for j in joints}
+        if base is None:
+            roots = [ln.name for ln in links if ln.name not in children]
+            if len(roots) != 1:
+                raise ModelError(
+                    f"expected exactly one root link (not the child of any joint), found {roots or 'none'}",
+                    f"robot '{name}'",
+                )
+            base = roots[0]
+        self.base = base
+        self.joints = self._tree_order(joints)
+        # links ordered base first, then children in joint order
+        self.links = {base: self.links[base], **{j.child: self.links[j.child] for j in self.joints}}
+
+        if parameters is None:
+            parameters = {}
+        if not isinstance(parameters, Mapping):
+            parameters = {s.name: s for s in parameters}
+        self.parameters: dict[str, sp.Symbol] = dict(parameters)
+
+        self.movable_joints = [j for j in self.joints if j.movable]
+        self.dof = len(self.movable_joints)
+        self.coordinate_names = [j.name for j in self.movable_joints]
+        self.q, self.qd, self.qdd = coordinate_symbols(self.coordinate_names)
+        clash = set(self.coordinate_names) & set(self.parameters)
+        if clash:
+            raise ModelError(f"names used both as joint and as parameter: {sorted(clash)}", f"robot '{name}'")
+        # index of each movable joint's coordinate, None for fixed joints
+        self._coord_index = {}
+        for j in self.joints:
+            self._coord_index[j.name] = self.coordinate_names.index(j.name) if j.movable else None
+
+    def _tree_order(self, joints: list[Joint]) -> list[Joint]:
+        names, child_of = set(), {}
+        for j in joints:
+            where = f"joint '{j.name}'"
+            if j.name in names:
+                raise ModelError("duplicate joint name", where)
+            names.add(j.name)
+            if j.parent not in self.links:
+                raise ModelError(f"parent link '{j.parent}' does not exist", where)
+            if j.child not in self.links:
+                raise ModelError(f"child link '{j.child}' does not exist", where)
+            if j.child in child_of:
+                raise ModelError(
+                    f"link '{j.child}' is already the child of joint '{child_of[j.child].name}'", where
+                )
+            if j.child == self.base:
+                raise ModelError(f"the base link '{self.base}' cannot be a child", where)
+            child_of[j.child] = j
+        # breadth-first from the base keeps the given order among siblings
+        ordered, reached = [], {self.base}
+        by_parent: dict[str, list[Joint]] = {}
+        for j in joints:
+            by_parent.setdefault(j.parent, []).append(j)
+        frontier = [self.base]
+        while frontier:
+            nxt = []
+            for link in frontier:
+                for j in by_parent.get(link, []):
+                    ordered.append(j)
+                    reached.add(j.child)
+                    nxt.append(j.child)
+            frontier = nxt
+        # keep the user's order where it already is a tree order (stable for DH chains)
+        if len(ordered) != len(joints):
+            stray = [j.name for j in joints if j not in ordered]
+            raise ModelError(f"joints not connected to the base '{self.base}' (a cycle?): {stray}", f"robot '{self.name}'")
+        position = {j.name: i for i, j in enumerate(joints)}
+        if all(position[a.name] < position[b.name] or a.child != b.parent for a in ordered for b in ordered):
+            return list(joints)
+        return ordered
+
+    # ------------------------------------------------------------------ queries
+    def coordinate_index(self, joint: str | Joint) -> int | None:
+        """Index of a joint's coordinate in ``q`` (None for a fixed joint)."""
+        name = joint.name if isinstance(joint, Joint) else joint
+        return self._coord_index[name]
+
+    def joint_coordinate(self, joint: Joint):
+        """The joint's coordinate symbol (0 for a fixed joint)."""
+        i = self._coord_index[joint.name]
+        return sp.Integer(0) if i is None else self.q[i]
+
+    def parent_joint(self, link: str) -> Joint | None:
+        for j in self.joints:
+            if j.child == link:
+                return j
+        return None
+
+    def children(self, link: str) -> list[Joint]:
+        return [j for j in self.joints if j.parent == link]
+
+    def free_symbols(self) -> set[sp.Symbol]:
+        """Symbols the model's numbers depend on (the joint coordinates excluded)."""
+        out: set = set(self.gravity.free_symbols)
+        for link in self.links.values():
+            out |= sp.sympify(link.mass).free_symbols | link.com.free_symbols | link.inertia.free_symbols
+        for j in self.joints:
+            out |= j.xyz.free_symbols | j.rotation.free_symbols | j.axis.free_symbols
+        return out
+
+    @property
+    def is_numeric(self) -> bool:
+        return not self.free_symbols()
+
+    # ----------------------------------------------------------- transformations
+    def subs(self, values: Mapping) -> "Robot":
+        """A copy with ``values`` (symbol or name -> number/expression) substituted."""
+        table = {}
+        for key, val in values.items():
+            sym = self.parameters.get(key, sp.Symbol(key)) if isinstance(key, str) else key
+            table[sym] = sp.sympify(val)
+
+        def s(x):
+            return None if x is None else sp.sympify(x).xreplace(table)
+
+        links = [
+            Link(ln.name, s(ln.mass), ln.com.xreplace(table), ln.inertia.xreplace(table))
+            for ln in self.links.values()
+        ]
+        joints = [
+            replace(
+                j,
+                xyz=j.xyz.xreplace(table),
+                rotation=j.rotation.xreplace(table),
+                axis=j.axis.xreplace(table),
+                **{k: s(getattr(j, k)) for k in ("lower", "upper", "velocity", "effort", "damping", "friction")},
+            )
+            for j in self.joints
+        ]
+        remaining = {n: p for n, p in self.parameters.items() if p not in table}
+        return Robot(self.name, links, joints, self.gravity.xreplace(table), remaining, self.meta, self.base)
+
+    def bind(self, values: Mapping) -> "Robot":
+        """A copy with parameters bound to numbers: ``robot.bind({"m1": 2.0, ...})``.
+
+        Keys are parameter names or symbols. Unknown names are an error, so typos do
+        not silently leave a parameter free.
+        """
+        unknown = [k for k in values if isinstance(k, str) and k not in self.parameters]
+        if unknown:
+            raise ModelError(
+                f"unknown parameter(s) {unknown}; the model has {sorted(self.parameters)}",
+                f"robot '{self.name}'",
+            )
+        return self.subs(values)
+
+    def __repr__(self) -> str:
+        kinds = "".join({"revolute": "R", "prismatic": "P", "fixed": "F"}[j.type] for j in self.joints)
+        return f"Robot({self.name!r}, dof={self.dof}, joints={kinds}, parameters={sorted(self.parameters)})"
