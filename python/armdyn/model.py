@@ -237,6 +237,8 @@ class Robot:
     joints:      list of :class:`Joint` in tree order (fixed ones included).
     gravity:     (3, 1) gravity vector in the base frame (m/s^2).
     parameters:  dict name -> sympy Symbol of the model's named parameters.
+    defaults:    dict name -> number: the model file's published values of its parameters
+                 (may be empty or partial); ``bind()`` with no argument uses them.
     meta:        free-form description (source, convention, ...).
 
     Derived:
@@ -253,6 +255,7 @@ class Robot:
         parameters: Mapping[str, sp.Symbol] | Iterable[sp.Symbol] | None = None,
         meta: Mapping | None = None,
         base: str | None = None,
+        defaults: Mapping[str, float] | None = None,
     ):
         self.name = name
         links = list(links)
@@ -288,6 +291,10 @@ class Robot:
         if not isinstance(parameters, Mapping):
             parameters = {s.name: s for s in parameters}
         self.parameters: dict[str, sp.Symbol] = dict(parameters)
+        self.defaults: dict[str, float] = dict(defaults or {})
+        stray = set(self.defaults) - set(self.parameters)
+        if stray:
+            raise ModelError(f"default values given for unknown parameters {sorted(stray)}", f"robot '{name}'")
 
         self.movable_joints = [j for j in self.joints if j.movable]
         self.dof = len(self.movable_joints)
@@ -401,21 +408,30 @@ class Robot:
             for j in self.joints
         ]
         remaining = {n: p for n, p in self.parameters.items() if p not in table}
-        return Robot(self.name, links, joints, self.gravity.xreplace(table), remaining, self.meta, self.base)
+        defaults = {n: v for n, v in self.defaults.items() if n in remaining}
+        return Robot(
+            self.name, links, joints, self.gravity.xreplace(table), remaining, self.meta, self.base, defaults
+        )
 
-    def bind(self, values: Mapping) -> "Robot":
-        """A copy with parameters bound to numbers: ``robot.bind({"m1": 2.0, ...})``.
+    def bind(self, values: Mapping | None = None) -> "Robot":
+        """A copy with parameters bound to numbers.
 
-        Keys are parameter names or symbols. Unknown names are an error, so typos do
-        not silently leave a parameter free.
+        ``robot.bind()`` uses the model's ``defaults`` (its published values);
+        ``robot.bind({"m1": 2.0})`` overrides some of them (keys: names or symbols).
+        Unknown names are an error, so typos do not silently leave a parameter free.
+        Parameters with neither a default nor a given value stay symbolic.
         """
+        values = dict(values or {})
         unknown = [k for k in values if isinstance(k, str) and k not in self.parameters]
         if unknown:
             raise ModelError(
                 f"unknown parameter(s) {unknown}; the model has {sorted(self.parameters)}",
                 f"robot '{self.name}'",
             )
-        return self.subs(values)
+        given = {k if isinstance(k, str) else k.name for k in values}
+        merged = {k: v for k, v in self.defaults.items() if k not in given}
+        merged.update(values)
+        return self.subs(merged)
 
     def __repr__(self) -> str:
         kinds = "".join({"revolute": "R", "prismatic": "P", "fixed": "F"}[j.type] for j in self.joints)
