@@ -1,0 +1,99 @@
+"""Equations of motion by Lagrange's method, symbolically.
+
+Energies (kinematics by a velocity recursion in link frames, no differentiation)::
+
+    w_i  = R^T w_p [+ qd z  (revolute)]            angular velocity, frame i
+    v_i  = R^T (v_p + w_p x p_i) [+ qd z  (prismatic)]   frame origin velocity, frame i
+    v_Ci = v_i + w_i x c_i                          centre-of-mass velocity, frame i
+    T_i  = 1/2 m_i v_Ci . v_Ci  +  1/2 w_i^T I_i w_i   (translational + rotational)
+    V_i  = - m_i gravity . p_Ci                      p_Ci: centre of mass in the base frame
+    L = sum_i T_i - V_i
+
+Euler-Lagrange equations, with the time derivative taken by the chain rule::
+
+    tau_k = d/dt (dL/dqd_k) - dL/dq_k
+          = sum_j (d2T/dqd_k dqd_j) qdd_j + (d2T/dqd_k dq_j) qd_j  -  dT/dq_k + dV/dq_k
+
+T is a quadratic form in qd, so ``M[k, j] = d2T/dqd_k dqd_j`` exactly; it is kept and
+reused by :class:`~armdyn.symbolic.terms.EquationsOfMotion`.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ..model import Robot
+from .terms import EquationsOfMotion, Step
+
+
+def _energies(robot: Robot):
+    """Per-link (T_trans, T_rot, V) and the steps showing them."""
+    zero = sp.zeros(3, 1)
+    w, v = {robot.base: zero}, {robot.base: zero}
+    R0, p0 = {robot.base: sp.eye(3)}, {robot.base: zero}
+    T_trans, T_rot, V, steps = {}, {}, {}, []
+    for joint in robot.joints:
+        name, link = joint.child, robot.links[joint.child]
+        i = str(list(robot.links).index(name))
+        k = robot.coordinate_index(joint)
+        R, p = joint.transform(robot.joint_coordinate(joint))
+        Rt = R.T
+        w_i = Rt * w[joint.parent]
+        v_i = Rt * (v[joint.parent] + w[joint.parent].cross(p))
+        if joint.type == "revolute":
+            w_i = w_i + robot.qd[k] * joint.axis
+        elif joint.type == "prismatic":
+            v_i = v_i + robot.qd[k] * joint.axis
+        w[name], v[name] = w_i, v_i
+        R0[name] = R0[joint.parent] * R
+        p0[name] = p0[joint.parent] + R0[joint.parent] * p
+
+        vc = v_i + w_i.cross(link.com)
+        pc = p0[name] + R0[name] * link.com
+        T_trans[name] = sp.Rational(1, 2) * link.mass * vc.dot(vc)
+        T_rot[name] = sp.Rational(1, 2) * (w_i.T * link.inertia * w_i)[0, 0]
+        V[name] = -link.mass * robot.gravity.dot(pc)
+        steps += [
+            Step("energy", name, "omega", rf"{{}}^{{{i}}}\omega_{{{i}}}", w_i, "angular velocity"),
+            Step("energy", name, "vc", rf"{{}}^{{{i}}}v_{{C_{i}}}", vc, "velocity of the centre of mass"),
+            Step("energy", name, "pc", rf"{{}}^{{0}}p_{{C_{i}}}", pc, "centre of mass in the base frame"),
+            Step("energy", name, "T_trans", rf"T_{{{i},\mathrm{{trans}}}}", T_trans[name],
+                 "translational kinetic energy 1/2 m vc.vc"),
+            Step("energy", name, "T_rot", rf"T_{{{i},\mathrm{{rot}}}}", T_rot[name],
+                 "rotational kinetic energy 1/2 w^T I w"),
+            Step("energy", name, "V", rf"V_{{{i}}}", V[name], "potential energy -m gravity.pc"),
+        ]
+    return T_trans, T_rot, V, steps
+
+
+def lagrange(robot: Robot) -> EquationsOfMotion:
+    """Derive ``tau`` by the Euler-Lagrange equations; steps show T (trans/rot), V and L."""
+    q, qd, qdd, n = robot.q, robot.qd, robot.qdd, robot.dof
+    T_trans, T_rot, V_links, steps = _energies(robot)
+    T = sum(T_trans.values(), sp.Integer(0)) + sum(T_rot.values(), sp.Integer(0))
+    V = sum(V_links.values(), sp.Integer(0))
+    steps += [
+        Step("energy", "", "T", "T", T, "total kinetic energy"),
+        Step("energy", "", "V", "V", V, "total potential energy"),
+        Step("energy", "", "L", "L", T - V, "Lagrangian T - V"),
+    ]
+
+    dT_dqd = [sp.diff(T, qd[k]) for k in range(n)]  # generalised momenta p_k = dL/dqd_k
+    M = sp.zeros(n, n)
+    for k in range(n):
+        for j in range(k, n):
+            M[k, j] = M[j, k] = sp.diff(dT_dqd[k], qd[j])
+    tau = []
+    for k in range(n):
+        ddt_p = sum((M[k, j] * qdd[j] + sp.diff(dT_dqd[k], q[j]) * qd[j] for j in range(n)), sp.Integer(0))
+        dL_dq = sp.diff(T, q[k]) - sp.diff(V, q[k])
+        tau_k = ddt_p - dL_dq
+        tau.append(tau_k)
+        steps += [
+            Step("equations", robot.coordinate_names[k], "dL_dqd", rf"\partial L/\partial \dot q_{{{k + 1}}}",
+                 dT_dqd[k], "generalised momentum"),
+            Step("equations", robot.coordinate_names[k], "dL_dq", rf"\partial L/\partial q_{{{k + 1}}}", dL_dq, ""),
+            Step("equations", robot.coordinate_names[k], "tau", rf"\tau_{{{k + 1}}}", tau_k,
+                 "d/dt dL/dqd - dL/dq"),
+        ]
+    return EquationsOfMotion(robot, "lagrange", sp.Matrix(tau), steps, _M=M)

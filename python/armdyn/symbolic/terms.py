@@ -1,0 +1,141 @@
+"""The equations of motion ``M(q) qdd + C(q, qd) qd + g(q) = tau`` and their terms.
+
+Both derivations (Newton-Euler, Lagrange) return an :class:`EquationsOfMotion`. Its
+``tau`` is what the method produced; ``M``, ``C`` and ``g`` are split off ``tau`` on
+first use (so timing ``tau`` does not pay for them):
+
+* ``M[i, j] = d tau_i / d qdd_j``     (tau is linear in qdd)
+* ``g = tau(qd = 0, qdd = 0)``
+* ``C`` from the Christoffel symbols of the first kind of ``M``:
+  ``C[k, j] = sum_i 1/2 (dM[k, j]/dq_i + dM[k, i]/dq_j - dM[i, j]/dq_k) qd_i``,
+  the one choice for which ``Mdot - 2 C`` is skew-symmetric.
+
+All vectors are SymPy column matrices of shape (n, 1); matrices are (n, n).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import sympy as sp
+
+from ..model import Robot
+
+
+@dataclass(frozen=True)
+class Step:
+    """One intermediate result of a derivation, for reports.
+
+    stage:  "outward" / "inward" (Newton-Euler), "energy" / "equations" (Lagrange).
+    link:   link (or joint) the quantity belongs to, "" for whole-robot quantities.
+    name:   short key, e.g. "omega", "vc_dot", "T_rot", "tau".
+    label:  LaTeX of the quantity, e.g. r"{}^{1}\\omega_{1}".
+    value:  SymPy expression or (3, 1) matrix, in the frame the label says.
+    """
+
+    stage: str
+    link: str
+    name: str
+    label: str
+    value: object
+    note: str = ""
+
+
+def christoffel_coriolis(M: sp.Matrix, q: sp.Matrix, qd: sp.Matrix) -> sp.Matrix:
+    """Coriolis/centrifugal matrix C (n x n) from the Christoffel symbols of M (n x n)."""
+    n = M.shape[0]
+    # dM[i][k, j] = dM[k, j]/dq_i, using symmetry to differentiate each entry once
+    dM = []
+    for i in range(n):
+        d = sp.zeros(n, n)
+        for k in range(n):
+            for j in range(k, n):
+                d[k, j] = d[j, k] = sp.diff(M[k, j], q[i])
+        dM.append(d)
+    C = sp.zeros(n, n)
+    for k in range(n):
+        for j in range(n):
+            C[k, j] = sum(
+                (sp.Rational(1, 2) * (dM[i][k, j] + dM[j][k, i] - dM[k][i, j]) * qd[i] for i in range(n)),
+                sp.Integer(0),
+            )
+    return C
+
+
+def time_derivative(expr, q: sp.Matrix, qd: sp.Matrix, qdd: sp.Matrix | None = None):
+    """d/dt of an expression (or matrix) of q and qd, by the chain rule."""
+    if isinstance(expr, sp.MatrixBase):
+        return expr.applyfunc(lambda e: time_derivative(e, q, qd, qdd))
+    out = sum((sp.diff(expr, q[i]) * qd[i] for i in range(len(q))), sp.Integer(0))
+    if qdd is not None:
+        out += sum((sp.diff(expr, qd[i]) * qdd[i] for i in range(len(q))), sp.Integer(0))
+    return out
+
+
+@dataclass
+class EquationsOfMotion:
+    """Closed-form equations of motion of a robot, ``M qdd + C qd + g = tau``.
+
+    robot:      the :class:`~armdyn.model.Robot` they describe.
+    method:     "newton-euler" or "lagrange".
+    q, qd, qdd: (n, 1) joint coordinates, velocities, accelerations (plain symbols).
+    tau:        (n, 1) joint torques/forces as the method produced them (not simplified).
+    steps:      list of :class:`Step`, every intermediate result in order.
+    parameters: dict name -> Symbol of the model parameters.
+    """
+
+    robot: Robot
+    method: str
+    tau: sp.Matrix
+    steps: list[Step] = field(default_factory=list)
+    _M: sp.Matrix | None = None  # a method may supply M directly (Lagrange: Hessian of T)
+
+    @property
+    def q(self) -> sp.Matrix:
+        return self.robot.q
+
+    @property
+    def qd(self) -> sp.Matrix:
+        return self.robot.qd
+
+    @property
+    def qdd(self) -> sp.Matrix:
+        return self.robot.qdd
+
+    @property
+    def parameters(self) -> dict[str, sp.Symbol]:
+        return self.robot.parameters
+
+    @cached_property
+    def M(self) -> sp.Matrix:
+        """Joint-space inertia matrix (n x n), d tau / d qdd."""
+        if self._M is not None:
+            return self._M
+        n = self.robot.dof
+        return sp.Matrix(n, n, lambda i, j: sp.diff(self.tau[i], self.qdd[j]))
+
+    @cached_property
+    def g(self) -> sp.Matrix:
+        """Gravity torques (n x 1): tau at qd = qdd = 0."""
+        zero = {s: 0 for s in list(self.qd) + list(self.qdd)}
+        return self.tau.xreplace(zero)
+
+    @cached_property
+    def C(self) -> sp.Matrix:
+        """Coriolis/centrifugal matrix (n x n) from the Christoffel symbols of M."""
+        return christoffel_coriolis(self.M, self.q, self.qd)
+
+    def steps_of(self, name: str) -> dict[str, object]:
+        """The values of one kind of step by link, e.g. ``eom.steps_of("omega")``."""
+        return {s.link: s.value for s in self.steps if s.name == name}
+
+    def step(self, name: str, link: str):
+        """The value of one step, e.g. ``eom.step("vc_dot", "link2")``."""
+        for s in self.steps:
+            if s.name == name and s.link == link:
+                return s.value
+        raise KeyError(f"no step {name!r} for {link!r} in the {self.method} derivation")
+
+    def __repr__(self) -> str:
+        return f"EquationsOfMotion({self.robot.name!r}, method={self.method!r}, dof={self.robot.dof})"
