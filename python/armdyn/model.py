@@ -33,6 +33,7 @@ from typing import Iterable, Mapping
 import sympy as sp
 
 from .errors import ModelError
+from .inertia import check_physical
 
 JOINT_TYPES = ("revolute", "prismatic", "fixed")
 
@@ -240,6 +241,10 @@ class Robot:
     defaults:    dict name -> number: the model file's published values of its parameters
                  (may be empty or partial); ``bind()`` with no argument uses them.
     meta:        free-form description (source, convention, ...).
+    strict:      True (default): a link whose mass/inertia is not physical (mass < 0,
+                 inertia not symmetric or not positive semi-definite, principal moments
+                 breaking the triangle inequality) is a ModelError; False: a warning.
+                 Symbolic values are checked once bound.
 
     Derived:
     movable_joints: the non-fixed joints, in order; ``dof`` is their number.
@@ -256,6 +261,7 @@ class Robot:
         meta: Mapping | None = None,
         base: str | None = None,
         defaults: Mapping[str, float] | None = None,
+        strict: bool = True,
     ):
         self.name = name
         links = list(links)
@@ -266,10 +272,12 @@ class Robot:
         except ModelError as err:
             raise err.located(element=f"robot '{name}'")
 
+        self.strict = strict
         self.links: dict[str, Link] = {}
         for link in links:
             if link.name in self.links:
                 raise ModelError("duplicate link name", f"link '{link.name}'")
+            check_physical(link.mass, link.inertia, f"link '{link.name}'", strict=strict)
             self.links[link.name] = link
 
         children = {j.child for j in joints}
@@ -410,7 +418,8 @@ class Robot:
         remaining = {n: p for n, p in self.parameters.items() if p not in table}
         defaults = {n: v for n, v in self.defaults.items() if n in remaining}
         return Robot(
-            self.name, links, joints, self.gravity.xreplace(table), remaining, self.meta, self.base, defaults
+            self.name, links, joints, self.gravity.xreplace(table), remaining, self.meta, self.base, defaults,
+            strict=self.strict,
         )
 
     def bind(self, values: Mapping | None = None) -> "Robot":

@@ -92,7 +92,7 @@ def lagrange(robot: Robot) -> EquationsOfMotion:
         steps += [
             Step("equations", robot.coordinate_names[k], "dL_dqd", rf"\partial L/\partial \dot q_{{{k + 1}}}",
                  dT_dqd[k], "generalised momentum"),
-            Step("equations", robot.coordinate_names[k], "dL_dq", rf"\partial L/\partial q_{{{k + 1}}}", dL_dq, ""),
+            Step("equations", robot.coordinate_names[k], "dL_dq", rf"\partial L/\partial q_{{{k + 1}}}", dL_dq, "dL/dq"),
             Step("equations", robot.coordinate_names[k], "tau", rf"\tau_{{{k + 1}}}", tau_k,
                  "d/dt dL/dqd - dL/dq"),
         ]

@@ -1,0 +1,214 @@
+"""Readable reports of derivations: plain text, LaTeX or Markdown.
+
+Small expressions are shown tidied the way one writes them by hand: sin^2 + cos^2
+reduced, terms collected by joint accelerations, then velocity products, then the
+rest (gravity), each coefficient factored. Large ones (a 6-dof arm with symbolic
+inertia) are shown as common subexpressions ``x0 = ...`` followed by the results,
+which is what one would compile anyway. Tidying is for display only: the
+derivations themselves never call ``simplify``.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from .agreement import _too_big, trig_reduce
+from .terms import EquationsOfMotion, Step
+
+#: expressions with more nodes than this are printed via common subexpressions
+TIDY_NODE_LIMIT = 3000
+FORMATS = ("text", "latex", "markdown")
+
+_SUB = str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉")
+_TEXT_NAMES = {
+    "omega": "ω", "omega_dot": "ω̇", "v_dot": "v̇", "vc_dot": "v̇_C", "F": "F", "N": "N",
+    "f": "f", "n": "n", "vc": "v_C", "pc": "p_C", "T_trans": "T_trans", "T_rot": "T_rot", "V": "V",
+}
+
+
+def _untrig(expr, q):
+    """Inverse of the S/C substitution done by trig_reduce."""
+    table = {}
+    for s in expr.free_symbols:
+        if isinstance(s, sp.Dummy) and s.name[:2] in ("S_", "C_"):
+            qi = next(x for x in q if x.name == s.name[2:])
+            table[s] = sp.sin(qi) if s.name[0] == "S" else sp.cos(qi)
+    return expr.xreplace(table)
+
+
+def tidy_terms(expr, q, qd, qdd) -> list[tuple]:
+    """``expr`` as an ordered list of ``(coefficient, monomial)``: joint-acceleration
+    terms, velocity-product terms, then the rest (gravity), coefficients factored.
+    Empty list for zero."""
+    e = _untrig(trig_reduce(expr, q), q)
+    if e == 0:
+        return []
+    motion = list(qdd) + [qd[i] * qd[j] for i in range(len(qd)) for j in range(i, len(qd))]
+    parts = sp.collect(e, motion, evaluate=False)
+    terms = [(sp.factor(parts[m]), m) for m in motion if m in parts]
+    rest = parts.get(sp.S.One, 0)
+    if rest != 0:
+        trig = [f(qi) for qi in q for f in (sp.sin, sp.cos)]
+        for mono, coef in sp.collect(sp.expand(rest), trig, evaluate=False).items():
+            terms.append((sp.factor(coef), mono))
+    return terms
+
+
+def _join(terms, render) -> str:
+    """Render ``(coefficient, monomial)`` terms coefficient first, signs folded."""
+    if not terms:
+        return "0"
+    out = []
+    for coef, mono in terms:
+        negative = coef.could_extract_minus_sign()
+        if negative:
+            coef = -coef
+        if mono == 1:
+            body = render(coef)
+        elif coef == 1:
+            body = render(mono)
+        else:
+            c = render(coef)
+            if isinstance(coef, sp.Add):
+                c = f"({c})"
+            body = f"{c}*{render(mono)}" if render is str else f"{c} {render(mono)}"
+        out.append(("-" if negative else "+", body))
+    text = ("-" if out[0][0] == "-" else "") + out[0][1]
+    for sign, body in out[1:]:
+        text += f" {sign} {body}"
+    return text
+
+
+class Renderer:
+    """Renders expressions of one derivation in one format."""
+
+    def __init__(self, eom: EquationsOfMotion, fmt: str = "text"):
+        if fmt not in FORMATS:
+            raise ValueError(f"unknown format {fmt!r}; choose one of {', '.join(FORMATS)}")
+        self.eom, self.fmt = eom, fmt
+        names = {}
+        for q, qd, qdd in zip(eom.q, eom.qd, eom.qdd):
+            base = sp.latex(q)
+            names[qd] = rf"\dot{{{base}}}"
+            names[qdd] = rf"\ddot{{{base}}}"
+        self._latex_names = names
+
+    def atom(self, expr) -> str:
+        if self.fmt == "text":
+            return str(expr)
+        return sp.latex(expr, symbol_names=self._latex_names)
+
+    def scalar(self, expr) -> str:
+        eom = self.eom
+        if _too_big(expr, TIDY_NODE_LIMIT):
+            return self.atom(expr)
+        render = str if self.fmt == "text" else self.atom
+        return _join(tidy_terms(expr, eom.q, eom.qd, eom.qdd), render)
+
+    def value(self, value) -> str:
+        if isinstance(value, sp.MatrixBase):
+            parts = [self.scalar(v) for v in value]
+            if self.fmt == "text":
+                return "[" + ", ".join(parts) + "]"
+            return r"\begin{pmatrix}" + r" \\ ".join(parts) + r"\end{pmatrix}"
+        return self.scalar(value)
+
+    def label(self, step: Step) -> str:
+        if self.fmt != "text":
+            return step.label
+        i = str(list(self.eom.robot.links).index(step.link)) if step.link in self.eom.robot.links else ""
+        if step.name in _TEXT_NAMES:
+            return f"{_TEXT_NAMES[step.name]}{i.translate(_SUB)}"
+        if step.link in self.eom.robot.coordinate_names:  # Lagrange equation steps are per coordinate
+            k = self.eom.robot.coordinate_names.index(step.link)
+            q, qd = self.eom.q[k], self.eom.qd[k]
+            return {"tau": f"τ{str(k + 1).translate(_SUB)}", "dL_dqd": f"∂L/∂{qd}", "dL_dq": f"∂L/∂{q}"}[step.name]
+        if step.name == "tau":
+            return "τ" + str(self.eom.robot.coordinate_index(self._joint_of(step.link)) + 1).translate(_SUB)
+        return step.name
+
+    def _joint_of(self, link: str):
+        return self.eom.robot.parent_joint(link)
+
+    def equation(self, lhs: str, rhs: str) -> str:
+        if self.fmt == "text":
+            return f"  {lhs} = {rhs}"
+        if self.fmt == "latex":
+            return f"{lhs} &= {rhs} \\\\"
+        return f"$${lhs} = {rhs}$$"
+
+
+def _big(eom: EquationsOfMotion) -> bool:
+    return any(_too_big(t, TIDY_NODE_LIMIT) for t in eom.tau)
+
+
+def tau_lines(eom: EquationsOfMotion, fmt: str = "text") -> list[str]:
+    """The joint torques/forces as equations, one per joint (CSE form for big ones)."""
+    r = Renderer(eom, fmt)
+    lines = []
+    tau_name = (lambda k: f"tau{k + 1}") if fmt == "text" else (lambda k: rf"\tau_{{{k + 1}}}")
+    if _big(eom):
+        subexprs, reduced = sp.cse(list(eom.tau), optimizations="basic")
+        lines.append(
+            f"  ({len(subexprs)} common subexpressions x0..x{len(subexprs) - 1}, then tau)"
+            if fmt == "text" else "% common subexpressions, then tau"
+        )
+        for sym, sub in subexprs:
+            lines.append(r.equation(r.atom(sym), r.atom(sub)))
+        exprs = reduced
+        render = r.atom
+    else:
+        exprs = list(eom.tau)
+        render = r.scalar
+    for k, t in enumerate(exprs):
+        coord = eom.robot.coordinate_names[k]
+        eq = r.equation(tau_name(k), render(t))
+        lines.append(f"{eq}    ({coord})" if fmt == "text" else eq)
+    return lines
+
+
+def steps_lines(eom: EquationsOfMotion, fmt: str = "text") -> list[str]:
+    """Every intermediate step, grouped by stage, each in the frame its label names."""
+    r = Renderer(eom, fmt)
+    lines, stage = [], None
+    titles = {
+        "outward": "outward pass (each vector in its own link's frame)",
+        "inward": "inward pass (force/moment exerted on each link by its parent, in the link's frame)",
+        "energy": "energies (velocities in each link's frame, positions in the base frame)",
+        "equations": "Euler-Lagrange equations",
+    }
+    for s in eom.steps:
+        if s.stage != stage:
+            stage = s.stage
+            head = titles.get(stage, stage)
+            lines.append(f" {head}:" if fmt == "text" else (rf"\intertext{{{head}}}" if fmt == "latex" else f"**{head}**"))
+        eq = r.equation(r.label(s), r.value(s.value))
+        where = f"{s.link}: {s.note}" if s.link else s.note
+        lines.append(f"{eq}    # {where}" if fmt == "text" else eq)
+    return lines
+
+
+def derivation_report(eoms: list[EquationsOfMotion], fmt: str = "text", steps: bool = False,
+                      agreement=None) -> str:
+    """A whole report: the robot, for each method its (steps and) tau, then agreement."""
+    robot = eoms[0].robot
+    joints = ", ".join(f"{j.name} {j.type}" for j in robot.movable_joints)
+    params = ", ".join(sorted(robot.parameters)) or "none"
+    head = f"{robot.name}: {robot.dof} dof ({joints}); parameters: {params}"
+    out = [head if fmt == "text" else (f"% {head}" if fmt == "latex" else f"# {robot.name}\n\n{head}")]
+    for eom in eoms:
+        title = {"newton-euler": "Newton-Euler", "lagrange": "Lagrange"}[eom.method]
+        out.append("")
+        out.append(f"{title}:" if fmt == "text" else (f"% {title}" if fmt == "latex" else f"## {title}"))
+        if fmt == "latex":
+            out.append(r"\begin{align*}")
+        if steps:
+            out += steps_lines(eom, fmt)
+            out.append({"text": " result:", "latex": r"\intertext{result}", "markdown": "**result**"}[fmt])
+        out += tau_lines(eom, fmt)
+        if fmt == "latex":
+            out.append(r"\end{align*}")
+    if agreement is not None:
+        out.append("")
+        out.append(agreement.text() if fmt != "latex" else "\n".join("% " + s for s in agreement.text().split("\n")))
+    return "\n".join(out)
