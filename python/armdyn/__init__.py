@@ -1,6 +1,21 @@
-"""armdyn: dynamics of robot arms, derived symbolically and computed numerically."""
-from .errors import ModelError, UnboundParameterError
-from . import inertia
-from .model import Joint, Link, Robot
+"""armdyn: dynamics of robot arms, derived symbolically and computed numerically.
 
-__all__ = ["inertia", "ModelError", "UnboundParameterError", "Joint", "Link", "Robot"]
+    import armdyn
+    robot = armdyn.load("rp-arm")                  # a bundled model, or a .yaml/.urdf file
+    eom = armdyn.derive(robot, "newton-euler")     # or "lagrange": tau, M, C, g, steps
+    print(armdyn.prove_agreement(robot).text())    # Newton-Euler == Lagrange, M sym., Mdot-2C skew
+
+Conventions: SI units, radians, ``M(q) qdd + C(q, qd) qd + g(q) = tau``; frames as in
+:mod:`armdyn.model`.
+"""
+
+from . import inertia, io
+from .errors import ModelError, UnboundParameterError
+from .io import bundled_robots, load
+from .model import Joint, Link, Robot
+from .symbolic import EquationsOfMotion, check, derive, prove_agreement
+
+__all__ = [
+    "inertia", "io", "ModelError", "UnboundParameterError", "Joint", "Link", "Robot",
+    "load", "bundled_robots", "derive", "check", "prove_agreement", "EquationsOfMotion",
+]

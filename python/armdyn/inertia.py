@@ -311,7 +311,11 @@ def physical_violations(mass, inertia, rtol: float = 1e-6) -> list[str]:
         if abs(I[i, j] - I[j, i]) > tol:
             a, b = names[i] + names[j], names[j] + names[i]
             out.append(f"inertia is not symmetric: I{a} {_fmt(I[i, j])} != I{b} {_fmt(I[j, i])}")
-    moments = np.linalg.eigvalsh((I + I.T) / 2)  # ascending
+    scale = np.abs(I).max()
+    if scale == 0:
+        return out
+    # eigenvalues of the scaled tensor: entries near 1e308 must not overflow to inf
+    moments = np.linalg.eigvalsh((I / scale + I.T / scale) / 2) * scale  # ascending
     listed = ", ".join(_fmt(x) for x in moments)
     if moments[0] < -tol:
         out.append(f"inertia is not positive semi-definite (principal moments {listed})")

@@ -30,6 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from typing import Iterable, Mapping
 
+import numpy as np
 import sympy as sp
 
 from .errors import ModelError
@@ -188,6 +189,10 @@ class Joint:
             raise err.located(element=where)
         except (sp.SympifyError, TypeError) as exc:
             raise ModelError(f"bad value ({exc})", where) from None
+        if not self.rotation.free_symbols:
+            R = np.array(self.rotation.evalf(), dtype=float)
+            if not (np.allclose(R.T @ R, np.eye(3), atol=1e-9) and np.linalg.det(R) > 0):
+                raise ModelError(f"rotation {R.tolist()} is not a proper rotation matrix", where)
         if self.type != "fixed":
             norm2 = sp.expand(sum(c**2 for c in self.axis))
             zero = _is_zero(norm2)
@@ -266,7 +271,7 @@ class Robot:
         self.name = name
         links = list(links)
         joints = list(joints)
-        self.meta = dict(meta or {})
+        self.meta = dict(meta or {})  # "file" (if any) names the model file in messages
         try:
             self.gravity = _vec3(gravity, "gravity")
         except ModelError as err:
@@ -277,7 +282,7 @@ class Robot:
         for link in links:
             if link.name in self.links:
                 raise ModelError("duplicate link name", f"link '{link.name}'")
-            check_physical(link.mass, link.inertia, f"link '{link.name}'", strict=strict)
+            check_physical(link.mass, link.inertia, f"link '{link.name}'", self.meta.get("file"), strict=strict)
             self.links[link.name] = link
 
         children = {j.child for j in joints}
@@ -285,7 +290,7 @@ class Robot:
             roots = [ln.name for ln in links if ln.name not in children]
             if len(roots) != 1:
                 raise ModelError(
-                    f"expected exactly one root link (not the child of any joint), found {roots or 'none'}",
+                    f"expected exactly one root link (not the child of any joint), found {roots or 'none (a cycle?)'}",
                     f"robot '{name}'",
                 )
             base = roots[0]
@@ -386,6 +391,13 @@ class Robot:
             out |= j.xyz.free_symbols | j.rotation.free_symbols | j.axis.free_symbols
         return out
 
+    @classmethod
+    def from_urdf(cls, source, strict: bool = True) -> "Robot":
+        """A robot from a URDF file path or XML string (see :mod:`armdyn.io.urdf`)."""
+        from .io.urdf import load_urdf
+
+        return load_urdf(source, strict=strict)
+
     @property
     def is_numeric(self) -> bool:
         return not self.free_symbols()
@@ -417,10 +429,13 @@ class Robot:
         ]
         remaining = {n: p for n, p in self.parameters.items() if p not in table}
         defaults = {n: v for n, v in self.defaults.items() if n in remaining}
-        return Robot(
-            self.name, links, joints, self.gravity.xreplace(table), remaining, self.meta, self.base, defaults,
-            strict=self.strict,
-        )
+        try:
+            return Robot(
+                self.name, links, joints, self.gravity.xreplace(table), remaining, self.meta, self.base, defaults,
+                strict=self.strict,
+            )
+        except ModelError as err:  # e.g. a bound value that is not physical: name the model file
+            raise err.located(source=self.meta.get("file")) from None
 
     def bind(self, values: Mapping | None = None) -> "Robot":
         """A copy with parameters bound to numbers.

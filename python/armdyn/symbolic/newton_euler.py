@@ -39,21 +39,23 @@ def _frame_label(robot: Robot, link: str) -> str:
     return str(list(robot.links).index(link))
 
 
-def newton_euler(robot: Robot) -> EquationsOfMotion:
-    """Derive ``tau`` by iterated Newton-Euler; steps as in Craig's outward/inward passes."""
+def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | None = None) -> sp.Matrix:
+    """tau (n x 1) for joint velocities ``qd`` and accelerations ``qdd`` (sequences of
+    length n, symbols or numbers) with the base accelerating at ``base_acceleration``
+    (3 x 1; ``-gravity`` for the equations of motion). Appends the steps if given."""
     zero = sp.zeros(3, 1)
     w = {robot.base: zero}
     wd = {robot.base: zero}
-    vd = {robot.base: -robot.gravity}
+    vd = {robot.base: base_acceleration}
     F, N, placement = {}, {}, {}
-    steps: list[Step] = []
+    record = steps is not None
+    outward: list[Step] = []
 
     for joint in robot.joints:
         link = robot.links[joint.child]
         parent, i = joint.parent, _frame_label(robot, joint.child)
-        q = robot.joint_coordinate(joint)
         k = robot.coordinate_index(joint)
-        R, p = joint.transform(q)
+        R, p = joint.transform(robot.joint_coordinate(joint))
         placement[joint.child] = (R, p)
         Rt = R.T
         z = joint.axis
@@ -62,29 +64,30 @@ def newton_euler(robot: Robot) -> EquationsOfMotion:
         wd_in = Rt * wd[parent]
         vd_c = Rt * (wd[parent].cross(p) + w[parent].cross(w[parent].cross(p)) + vd[parent])
         if joint.type == "revolute":
-            w_i = w_in + robot.qd[k] * z
-            wd_i = wd_in + w_in.cross(robot.qd[k] * z) + robot.qdd[k] * z
+            w_i = w_in + qd[k] * z
+            wd_i = wd_in + w_in.cross(qd[k] * z) + qdd[k] * z
         else:
             w_i, wd_i = w_in, wd_in
         if joint.type == "prismatic":
-            vd_c = vd_c + 2 * w_i.cross(robot.qd[k] * z) + robot.qdd[k] * z
+            vd_c = vd_c + 2 * w_i.cross(qd[k] * z) + qdd[k] * z
         c = link.com
         vcd = wd_i.cross(c) + w_i.cross(w_i.cross(c)) + vd_c
         w[joint.child], wd[joint.child], vd[joint.child] = w_i, wd_i, vd_c
         F[joint.child] = link.mass * vcd
         N[joint.child] = link.inertia * wd_i + w_i.cross(link.inertia * w_i)
 
-        name = joint.child
-        steps += [
-            Step("outward", name, "omega", rf"{{}}^{{{i}}}\omega_{{{i}}}", w_i, "angular velocity"),
-            Step("outward", name, "omega_dot", rf"{{}}^{{{i}}}\dot\omega_{{{i}}}", wd_i, "angular acceleration"),
-            Step("outward", name, "v_dot", rf"{{}}^{{{i}}}\dot v_{{{i}}}", vd_c,
-                 "linear acceleration of the frame origin (gravity included as base acceleration)"),
-            Step("outward", name, "vc_dot", rf"{{}}^{{{i}}}\dot v_{{C_{i}}}", vcd,
-                 "linear acceleration of the centre of mass"),
-            Step("outward", name, "F", rf"{{}}^{{{i}}}F_{{{i}}}", F[name], "inertial force m vcd"),
-            Step("outward", name, "N", rf"{{}}^{{{i}}}N_{{{i}}}", N[name], "inertial moment I wd + w x I w"),
-        ]
+        if record:
+            name = joint.child
+            outward += [
+                Step("outward", name, "omega", rf"{{}}^{{{i}}}\omega_{{{i}}}", w_i, "angular velocity"),
+                Step("outward", name, "omega_dot", rf"{{}}^{{{i}}}\dot\omega_{{{i}}}", wd_i, "angular acceleration"),
+                Step("outward", name, "v_dot", rf"{{}}^{{{i}}}\dot v_{{{i}}}", vd_c,
+                     "linear acceleration of the frame origin (gravity included as base acceleration)"),
+                Step("outward", name, "vc_dot", rf"{{}}^{{{i}}}\dot v_{{C_{i}}}", vcd,
+                     "linear acceleration of the centre of mass"),
+                Step("outward", name, "F", rf"{{}}^{{{i}}}F_{{{i}}}", F[name], "inertial force m vcd"),
+                Step("outward", name, "N", rf"{{}}^{{{i}}}N_{{{i}}}", N[name], "inertial moment I wd + w x I w"),
+            ]
 
     f, n = {}, {}
     tau = [sp.Integer(0)] * robot.dof
@@ -101,13 +104,36 @@ def newton_euler(robot: Robot) -> EquationsOfMotion:
             n_i = n_i + Rc * n[child.child] + pc.cross(f_c)
         f[name], n[name] = f_i, n_i
         k = robot.coordinate_index(joint)
-        here = [
-            Step("inward", name, "f", rf"{{}}^{{{i}}}f_{{{i}}}", f_i, "force exerted on the link by its parent"),
-            Step("inward", name, "n", rf"{{}}^{{{i}}}n_{{{i}}}", n_i, "moment exerted on the link by its parent"),
-        ]
         if k is not None:
             tau[k] = (n_i if joint.type == "revolute" else f_i).dot(joint.axis)
-            kind = "torque" if joint.type == "revolute" else "force"
-            here.append(Step("inward", name, "tau", rf"\tau_{{{k + 1}}}", tau[k], f"joint {kind} of '{joint.name}'"))
-        inward += here  # in the order computed: last link first, as in the exercise
-    return EquationsOfMotion(robot, "newton-euler", sp.Matrix(tau), steps + inward)
+        if record:
+            inward += [
+                Step("inward", name, "f", rf"{{}}^{{{i}}}f_{{{i}}}", f_i, "force exerted on the link by its parent"),
+                Step("inward", name, "n", rf"{{}}^{{{i}}}n_{{{i}}}", n_i, "moment exerted on the link by its parent"),
+            ]
+            if k is not None:
+                kind = "torque" if joint.type == "revolute" else "force"
+                inward.append(Step("inward", name, "tau", rf"\tau_{{{k + 1}}}", tau[k], f"joint {kind} of '{joint.name}'"))
+    if record:
+        steps += outward + inward  # inward in the order computed: last link first, as in the exercise
+    return sp.Matrix(tau)
+
+
+def mass_matrix(robot: Robot) -> sp.Matrix:
+    """M (n x n) column by column: tau with qd = 0, no gravity and qdd = e_j is M e_j
+    (Walker and Orin, 1982, method 1). Zeros make these passes far cheaper than
+    differentiating tau."""
+    n = robot.dof
+    M = sp.zeros(n, n)
+    zeros = [0] * n
+    for j in range(n):
+        unit = [int(i == j) for i in range(n)]
+        M[:, j] = _recursion(robot, zeros, unit, sp.zeros(3, 1))
+    return M
+
+
+def newton_euler(robot: Robot) -> EquationsOfMotion:
+    """Derive ``tau`` by iterated Newton-Euler; steps as in Craig's outward/inward passes."""
+    steps: list[Step] = []
+    tau = _recursion(robot, list(robot.qd), list(robot.qdd), -robot.gravity, steps)
+    return EquationsOfMotion(robot, "newton-euler", tau, steps, _M_builder=lambda: mass_matrix(robot))

@@ -4,7 +4,8 @@ Both derivations (Newton-Euler, Lagrange) return an :class:`EquationsOfMotion`. 
 ``tau`` is what the method produced; ``M``, ``C`` and ``g`` are split off ``tau`` on
 first use (so timing ``tau`` does not pay for them):
 
-* ``M[i, j] = d tau_i / d qdd_j``     (tau is linear in qdd)
+* ``M[i, j] = d tau_i / d qdd_j``     (tau is linear in qdd; a method may supply M more
+  cheaply: Lagrange's Hessian of T, Newton-Euler's unit-acceleration passes)
 * ``g = tau(qd = 0, qdd = 0)``
 * ``C`` from the Christoffel symbols of the first kind of ``M``:
   ``C[k, j] = sum_i 1/2 (dM[k, j]/dq_i + dM[k, i]/dq_j - dM[i, j]/dq_k) qd_i``,
@@ -18,9 +19,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from functools import cached_property
 
+import symengine as se
 import sympy as sp
 
 from ..model import Robot
+from . import dag
 
 
 @dataclass(frozen=True)
@@ -43,34 +46,36 @@ class Step:
 
 
 def christoffel_coriolis(M: sp.Matrix, q: sp.Matrix, qd: sp.Matrix) -> sp.Matrix:
-    """Coriolis/centrifugal matrix C (n x n) from the Christoffel symbols of M (n x n)."""
+    """Coriolis/centrifugal matrix C (n x n) from the Christoffel symbols of M (n x n).
+
+    Differentiated by SymEngine (see lagrange.py), returned as SymPy."""
     n = M.shape[0]
-    # dM[i][k, j] = dM[k, j]/dq_i, using symmetry to differentiate each entry once
-    dM = []
+    q_, qd_ = list(se.sympify(list(q))), list(se.sympify(list(qd)))
+    M_ = [[se.sympify(M[k, j]) for j in range(n)] for k in range(n)]
+    # dM[i][k][j] = dM[k, j]/dq_i, each entry differentiated once (M is symmetric)
+    dM = [[[None] * n for _ in range(n)] for _ in range(n)]
     for i in range(n):
-        d = sp.zeros(n, n)
         for k in range(n):
             for j in range(k, n):
-                d[k, j] = d[j, k] = sp.diff(M[k, j], q[i])
-        dM.append(d)
+                dM[i][k][j] = dM[i][j][k] = M_[k][j].diff(q_[i])
+    half = se.Rational(1, 2)
     C = sp.zeros(n, n)
     for k in range(n):
         for j in range(n):
-            C[k, j] = sum(
-                (sp.Rational(1, 2) * (dM[i][k, j] + dM[j][k, i] - dM[k][i, j]) * qd[i] for i in range(n)),
-                sp.Integer(0),
-            )
+            c = sum((half * (dM[i][k][j] + dM[j][k][i] - dM[k][i][j]) * qd_[i] for i in range(n)), se.Integer(0))
+            C[k, j] = sp.sympify(c)
     return C
 
 
 def time_derivative(expr, q: sp.Matrix, qd: sp.Matrix, qdd: sp.Matrix | None = None):
-    """d/dt of an expression (or matrix) of q and qd, by the chain rule."""
+    """d/dt of an expression (or matrix) of q and qd, by the chain rule (SymEngine)."""
     if isinstance(expr, sp.MatrixBase):
         return expr.applyfunc(lambda e: time_derivative(e, q, qd, qdd))
-    out = sum((sp.diff(expr, q[i]) * qd[i] for i in range(len(q))), sp.Integer(0))
+    e = se.sympify(expr)
+    pairs = list(zip(se.sympify(list(q)), se.sympify(list(qd))))
     if qdd is not None:
-        out += sum((sp.diff(expr, qd[i]) * qdd[i] for i in range(len(q))), sp.Integer(0))
-    return out
+        pairs += list(zip(se.sympify(list(qd)), se.sympify(list(qdd))))
+    return sp.sympify(sum((e.diff(x) * xd for x, xd in pairs), se.Integer(0)))
 
 
 @dataclass
@@ -89,7 +94,10 @@ class EquationsOfMotion:
     method: str
     tau: sp.Matrix
     steps: list[Step] = field(default_factory=list)
-    _M: sp.Matrix | None = None  # a method may supply M directly (Lagrange: Hessian of T)
+    # a method may supply M (Lagrange: the Hessian of T) or a function computing it on
+    # first use (Newton-Euler: Walker-Orin unit-acceleration passes); otherwise d tau/d qdd
+    _M: sp.Matrix | None = None
+    _M_builder: object = None
 
     @property
     def q(self) -> sp.Matrix:
@@ -112,6 +120,8 @@ class EquationsOfMotion:
         """Joint-space inertia matrix (n x n), d tau / d qdd."""
         if self._M is not None:
             return self._M
+        if self._M_builder is not None:
+            return self._M_builder()
         n = self.robot.dof
         return sp.Matrix(n, n, lambda i, j: sp.diff(self.tau[i], self.qdd[j]))
 
@@ -119,7 +129,7 @@ class EquationsOfMotion:
     def g(self) -> sp.Matrix:
         """Gravity torques (n x 1): tau at qd = qdd = 0."""
         zero = {s: 0 for s in list(self.qd) + list(self.qdd)}
-        return self.tau.xreplace(zero)
+        return dag.xreplace(self.tau, zero)
 
     @cached_property
     def C(self) -> sp.Matrix:

@@ -1,0 +1,459 @@
+"""Numbers and expressions in model files, turned into SymPy.
+
+A value in a model file is a number (``0.4318``, ``2``) or a string holding an
+arithmetic expression of the model's declared parameters::
+
+    "l1"   "-g"   "pi/2"   "m2*l1**2/12"   "sqrt(2)/2"   "0.5*a^2"   "1e-3"
+
+Grammar (``^`` is a synonym of ``**``; ``-a**2`` is ``-(a**2)``; ``**`` is
+right-associative, as in Python)::
+
+    expr   := term (("+" | "-") term)*
+    term   := unary (("*" | "/") unary)*
+    unary  := ("+" | "-") unary | power
+    power  := atom (("**" | "^") unary)?
+    atom   := NUMBER | NAME | FUNCTION "(" expr ("," expr)* ")" | "(" expr ")"
+
+Names are looked up in two tables only: the declared parameters (each a plain
+``sp.Symbol(name)`` with no assumptions, so ``sp.Symbol("m1")`` written by a user
+matches) and the whitelist :data:`FUNCTIONS` / :data:`CONSTANTS`. Nothing is ever
+passed to ``eval`` or ``sympy.parse_expr``: the string is tokenised and parsed here,
+so attribute access, dunders, string literals, lambdas and SymPy's special one-letter
+names (``S``, ``N``, ``E``, ``I``, ``Q``, ``O``) cannot reach the interpreter; a
+parameter called ``E``, ``beta`` or ``lambda`` is just a Symbol of that name.
+
+Integers stay exact (``1/12`` is ``Rational(1, 12)``); decimals become ``sp.Float``
+(as a YAML float would).
+
+This module also converts the shaped values of a model (scalars, 3-vectors,
+3x3 matrices, inertia tensors, rotations) with the same rules; every failure is a
+:class:`~armdyn.errors.ModelError` naming the offending expression.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import re
+import reprlib
+from typing import Mapping
+
+import sympy as sp
+
+from ..errors import ModelError
+
+#: Functions an expression may call (name -> SymPy function, number of arguments).
+FUNCTIONS = {
+    "sin": (sp.sin, 1),
+    "cos": (sp.cos, 1),
+    "tan": (sp.tan, 1),
+    "asin": (sp.asin, 1),
+    "acos": (sp.acos, 1),
+    "atan": (sp.atan, 1),
+    "atan2": (sp.atan2, 2),
+    "sinh": (sp.sinh, 1),
+    "cosh": (sp.cosh, 1),
+    "tanh": (sp.tanh, 1),
+    "sqrt": (sp.sqrt, 1),
+    "exp": (sp.exp, 1),
+    "log": (sp.log, 1),
+    "abs": (sp.Abs, 1),
+}
+
+#: Named constants.
+CONSTANTS = {"pi": sp.pi}
+
+#: Names a parameter may not take (they already mean something in an expression).
+RESERVED = frozenset(FUNCTIONS) | frozenset(CONSTANTS)
+
+_NAME_RE = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+_TOKEN_RE = re.compile(
+    r"""\s*(?:
+        (?P<number>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)
+      | (?P<name>[A-Za-z_][A-Za-z0-9_]*)
+      | (?P<op>\*\*|[-+*/^(),])
+    )""",
+    re.VERBOSE,
+)
+
+
+_SHORT = reprlib.Repr()
+_SHORT.maxlevel, _SHORT.maxlist, _SHORT.maxdict, _SHORT.maxstring, _SHORT.maxother = 2, 4, 4, 40, 40
+
+
+def shown(value) -> str:
+    """A short ``repr`` of a user's value for messages (nested or huge values cut)."""
+    return _SHORT.repr(value)
+
+
+def quoted(text) -> str:
+    """``'text'`` for messages; ``repr`` when it holds newlines or control characters,
+    so that an error stays one line."""
+    text = str(text)
+    return f"'{text}'" if text.isprintable() else repr(text)
+
+
+def check_name(name, what: str, element=None, source=None) -> str:
+    """Return ``name`` if it is a non-empty one-line string, else raise ModelError."""
+    if not isinstance(name, str) or not name or not name.isprintable():
+        raise ModelError(f"{what}: expected a name (a one-line string), got {shown(name)}", element, source)
+    return name
+
+
+def check_parameter_name(name, element: str | None = "parameters", source: str | None = None) -> str:
+    """Return ``name`` if it may name a parameter, else raise ModelError."""
+    if not isinstance(name, str) or not _NAME_RE.match(name):
+        raise ModelError(
+            f"parameter name {shown(name)} is not an identifier (letters, digits, '_'; starting with a letter)",
+            element,
+            source,
+        )
+    if name in RESERVED:
+        raise ModelError(f"parameter name '{name}' is reserved (a function or constant)", element, source)
+    return name
+
+
+def make_parameters(names, element: str | None = "parameters", source: str | None = None) -> dict[str, sp.Symbol]:
+    """Plain symbols (no assumptions) for the declared parameter names, in order."""
+    out: dict[str, sp.Symbol] = {}
+    for name in names:
+        check_parameter_name(name, element, source)
+        if name in out:
+            raise ModelError(f"parameter '{name}' declared twice", element, source)
+        out[name] = sp.Symbol(name)
+    return out
+
+
+def _tokens(text: str):
+    """Split ``text`` into (kind, string) tokens; anything else is an error."""
+    pos, out = 0, []
+    text = text.rstrip()
+    while pos < len(text):
+        m = _TOKEN_RE.match(text, pos)
+        if not m or m.end() == pos:
+            bad = text[pos:].lstrip()[:1]
+            raise _ParseError(f"unexpected character {bad!r}")
+        kind = m.lastgroup
+        out.append((kind, m.group(kind)))
+        pos = m.end()
+    return out
+
+
+class _ParseError(Exception):
+    pass
+
+
+class _UnknownName(Exception):
+    pass
+
+
+class _Parser:
+    """Recursive descent over the token list (grammar in the module docstring)."""
+
+    def __init__(self, tokens, parameters: Mapping[str, sp.Symbol]):
+        self.tokens = tokens
+        self.i = 0
+        self.parameters = parameters
+
+    def peek(self):
+        return self.tokens[self.i] if self.i < len(self.tokens) else (None, None)
+
+    def take(self, op=None):
+        kind, tok = self.peek()
+        if kind is None:
+            raise _ParseError(f"missing '{op}'" if op else "unexpected end")
+        if op is not None and tok != op:
+            raise _ParseError(f"expected '{op}', found '{tok}'")
+        self.i += 1
+        return kind, tok
+
+    def parse(self):
+        if not self.tokens:
+            raise _ParseError("empty expression")
+        value = self.expr()
+        if self.i != len(self.tokens):
+            raise _ParseError(f"unexpected '{self.tokens[self.i][1]}'")
+        return value
+
+    def expr(self):
+        value = self.term()
+        while self.peek()[1] in ("+", "-"):
+            _, op = self.take()
+            rhs = self.term()
+            value = value + rhs if op == "+" else value - rhs
+        return value
+
+    def term(self):
+        value = self.unary()
+        while self.peek()[1] in ("*", "/"):
+            _, op = self.take()
+            rhs = self.unary()
+            value = value * rhs if op == "*" else value / rhs
+        return value
+
+    def unary(self):
+        if self.peek()[1] in ("+", "-"):
+            _, op = self.take()
+            value = self.unary()
+            return value if op == "+" else -value
+        return self.power()
+
+    def power(self):
+        base = self.atom()
+        if self.peek()[1] in ("**", "^"):
+            self.take()
+            return base ** self.unary()
+        return base
+
+    def atom(self):
+        kind, tok = self.take()
+        if kind == "number":
+            return sp.Float(tok) if any(c in tok for c in ".eE") else sp.Integer(tok)
+        if tok == "(":
+            value = self.expr()
+            self.take(")")
+            return value
+        if kind == "name":
+            if tok in self.parameters:
+                return self.parameters[tok]
+            if tok in CONSTANTS:
+                return CONSTANTS[tok]
+            if tok in FUNCTIONS:
+                func, nargs = FUNCTIONS[tok]
+                self.take("(")
+                args = [self.expr()]
+                while self.peek()[1] == ",":
+                    self.take()
+                    args.append(self.expr())
+                self.take(")")
+                if len(args) != nargs:
+                    raise _ParseError(f"{tok}() takes {nargs} argument(s), got {len(args)}")
+                return func(*args)
+            raise _UnknownName(tok)
+        raise _ParseError(f"unexpected '{tok}'")
+
+
+def parse_expression(
+    value,
+    parameters: Mapping[str, sp.Symbol],
+    element: str | None = None,
+    source: str | None = None,
+    what: str | None = None,
+) -> sp.Expr:
+    """A model-file value as a SymPy expression.
+
+    value:      int, float, SymPy expression, or a string (grammar in the module docstring).
+    parameters: name -> Symbol of the declared parameters (the only names allowed
+                besides :data:`FUNCTIONS` and :data:`CONSTANTS`).
+    element, source: where the value sits, for the error message.
+    what:       the field's name (e.g. ``"xyz"``), prefixed to error messages.
+
+    Raises ModelError for an unknown name, an unparseable string, a value of the wrong
+    type (bool, None, list...) or a result that is not finite (``1/0``).
+    """
+    prefix = f"{what}: " if what else ""
+    if isinstance(value, bool) or value is None:
+        raise ModelError(f"{prefix}expected a number or expression, got {shown(value)}", element, source)
+    if isinstance(value, numbers.Integral):
+        return sp.Integer(int(value))
+    if isinstance(value, numbers.Real) and not isinstance(value, sp.Basic):
+        if not math.isfinite(value):  # YAML's .nan / .inf
+            raise ModelError(f"{prefix}the value {value} is not finite", element, source)
+        result = sp.Float(float(value))
+    elif isinstance(value, sp.Basic):
+        stray = value.free_symbols - set(parameters.values())
+        if stray:
+            names = ", ".join(sorted(str(s) for s in stray))
+            raise ModelError(f"{prefix}unknown parameter(s) {names} in expression '{value}'", element, source)
+        result = value
+    elif isinstance(value, str):
+        try:
+            result = _Parser(_tokens(value), parameters).parse()
+        except _UnknownName as exc:
+            message = f"{prefix}unknown parameter '{exc}' in expression {quoted(value)}"
+            raise ModelError(message, element, source) from None
+        except _ParseError as exc:
+            raise ModelError(f"{prefix}cannot parse expression {quoted(value)} ({exc})", element, source) from None
+        except (TypeError, ValueError, ZeroDivisionError) as exc:
+            raise ModelError(f"{prefix}cannot evaluate expression {quoted(value)} ({exc})", element, source) from None
+    else:
+        raise ModelError(
+            f"{prefix}expected a number or expression, got {type(value).__name__} {shown(value)}", element, source
+        )
+    if result.has(sp.zoo, sp.nan, sp.oo, -sp.oo):
+        raise ModelError(f"{prefix}expression {quoted(value)} is not finite ({result})", element, source)
+    if result.has(sp.I) or result.is_real is False:
+        raise ModelError(f"{prefix}expression {quoted(value)} is not real ({result})", element, source)
+    return result
+
+
+def is_zero(expr) -> bool:
+    """True if ``expr`` is identically zero (``0``, ``0.0``); False for symbols."""
+    return sp.sympify(expr).is_zero is True
+
+
+# ------------------------------------------------------------------ shaped values
+def parse_vector(value, parameters, element=None, source=None, what=None, length=3) -> sp.Matrix:
+    """A list of ``length`` values -> (length, 1) column Matrix."""
+    prefix = f"{what}: " if what else ""
+    if not isinstance(value, sp.MatrixBase) and hasattr(value, "tolist"):  # a NumPy array
+        value = value.tolist()
+    if not isinstance(value, (list, tuple, sp.MatrixBase)):
+        raise ModelError(f"{prefix}expected a list of {length} values, got {shown(value)}", element, source)
+    items = list(value)
+    if len(items) != length:
+        raise ModelError(f"{prefix}expected {length} values, got {len(items)}", element, source)
+    return sp.Matrix([parse_expression(v, parameters, element, source, what) for v in items])
+
+
+def parse_matrix3(value, parameters, element=None, source=None, what="matrix") -> sp.Matrix:
+    """A list of 3 rows of 3 values -> 3x3 Matrix."""
+    if isinstance(value, sp.MatrixBase):
+        value = value.tolist()
+    if not isinstance(value, (list, tuple)) or len(value) != 3 or not all(
+        isinstance(r, (list, tuple)) and len(r) == 3 for r in value
+    ):
+        raise ModelError(f"{what}: expected a 3x3 matrix (3 rows of 3 values), got {shown(value)}", element, source)
+    return sp.Matrix([[parse_expression(v, parameters, element, source, what) for v in row] for row in value])
+
+
+INERTIA_KEYS = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+
+
+def parse_inertia(value, parameters, element=None, source=None, what="inertia") -> sp.Matrix:
+    """An inertia tensor (3x3 Matrix) from one of three forms:
+
+    * ``0``: a point mass (zero tensor). No other scalar is accepted.
+    * a 3x3 matrix (must be symmetric);
+    * a mapping ``{ixx, iyy, izz, ixy, ixz, iyz}``: the diagonal is required, missing
+      products of inertia are 0 (principal axes). ``I = [[ixx, ixy, ixz], [ixy, iyy, iyz],
+      [ixz, iyz, izz]]`` (URDF's convention: products enter the tensor with a + sign).
+    """
+    if isinstance(value, Mapping):
+        unknown = [k for k in value if k not in INERTIA_KEYS]
+        if unknown:
+            raise ModelError(
+                f"{what}: unknown key(s) {', '.join(map(shown, unknown))} (expected {', '.join(INERTIA_KEYS)})",
+                element,
+                source,
+            )
+        missing = [k for k in ("ixx", "iyy", "izz") if k not in value]
+        if missing:
+            raise ModelError(f"{what}: missing {', '.join(missing)}", element, source)
+        c = {k: parse_expression(value.get(k, 0), parameters, element, source, f"{what}.{k}") for k in INERTIA_KEYS}
+        return sp.Matrix(
+            [
+                [c["ixx"], c["ixy"], c["ixz"]],
+                [c["ixy"], c["iyy"], c["iyz"]],
+                [c["ixz"], c["iyz"], c["izz"]],
+            ]
+        )
+    if isinstance(value, (list, tuple, sp.MatrixBase)):
+        tensor = parse_matrix3(value, parameters, element, source, what)
+        if any(sp.simplify(tensor[i, j] - tensor[j, i]) != 0 for i, j in ((0, 1), (0, 2), (1, 2))):
+            raise ModelError(f"{what}: the matrix is not symmetric", element, source)
+        return tensor
+    scalar = parse_expression(value, parameters, element, source, what)
+    if not is_zero(scalar):
+        raise ModelError(
+            f"{what}: a scalar inertia must be 0 (a point mass); give a 3x3 matrix or "
+            "{ixx, iyy, izz, ixy, ixz, iyz} otherwise",
+            element,
+            source,
+        )
+    return sp.zeros(3, 3)
+
+
+def check_rotation(rotation: sp.Matrix, element=None, source=None, what="rotation", tol=1e-9) -> sp.Matrix:
+    """Raise ModelError unless ``rotation`` (3x3) is a proper rotation (R^T R = I, det R = +1).
+
+    Numeric matrices are checked to ``tol``; symbolic ones must simplify exactly.
+    Typing 0.7071 for sqrt(2)/2 fails on purpose: write ``sqrt(2)/2``.
+    """
+    gram = rotation.T * rotation - sp.eye(3)
+    det = rotation.det() - 1
+    if rotation.free_symbols:
+        ok = all(sp.simplify(e) == 0 for e in list(gram) + [det])
+        if not ok:
+            raise ModelError(f"{what}: cannot show the matrix is a rotation (R^T R = I, det R = 1)", element, source)
+        return rotation
+    err = max(abs(float(e)) for e in list(gram))
+    if err > tol:
+        raise ModelError(f"{what}: the matrix is not orthonormal (max |R^T R - I| = {err:.3g})", element, source)
+    if abs(float(det)) > 1e-6:
+        raise ModelError(
+            f"{what}: the matrix is a reflection (det = {float(det) + 1:.3g}), not a rotation", element, source
+        )
+    return rotation
+
+
+def parse_inertials(data: Mapping, parameters, element=None, source=None):
+    """``(mass, com, inertia)`` from the ``mass``, ``com`` and ``inertia`` keys of ``data``.
+
+    mass:    default 0.
+    com:     (3, 1), default 0.
+    inertia: (3, 3) about the centre of mass (see :func:`parse_inertia`). Required when
+             the mass is not identically zero: a massive link never gets a guessed tensor;
+             write ``inertia: 0`` for a point mass.
+    """
+    mass = parse_expression(data.get("mass", 0), parameters, element, source, "mass")
+    com = parse_vector(data.get("com", [0, 0, 0]), parameters, element, source, "com")
+    if "inertia" in data:
+        inertia = parse_inertia(data["inertia"], parameters, element, source)
+    elif not is_zero(mass):
+        raise ModelError(
+            "the link has a mass but no inertia (write 'inertia: 0' for a point mass)", element, source
+        )
+    else:
+        inertia = sp.zeros(3, 3)
+    return mass, com, inertia
+
+
+LIMIT_KEYS = ("lower", "upper", "velocity", "effort")
+
+
+def parse_joint_extras(data: Mapping, parameters, element=None, source=None) -> dict:
+    """Keyword arguments for :class:`armdyn.Joint` from the optional ``limits``
+    (mapping with keys ``lower, upper, velocity, effort``), ``damping`` and ``friction``
+    entries of ``data``. Absent values are left out (the Joint keeps None)."""
+    out = {}
+    limits = data.get("limits")
+    if limits is not None:
+        if not isinstance(limits, Mapping):
+            raise ModelError(f"limits: expected a mapping with keys {', '.join(LIMIT_KEYS)}", element, source)
+        unknown = [k for k in limits if k not in LIMIT_KEYS]
+        if unknown:
+            raise ModelError(
+                f"limits: unknown key(s) {', '.join(map(shown, unknown))} (expected {', '.join(LIMIT_KEYS)})",
+                element,
+                source,
+            )
+        for key, value in limits.items():
+            if value is not None:
+                out[key] = parse_expression(value, parameters, element, source, f"limits.{key}")
+    for key in ("damping", "friction"):
+        if data.get(key) is not None:
+            out[key] = parse_expression(data[key], parameters, element, source, key)
+    return out
+
+
+__all__ = [
+    "FUNCTIONS",
+    "CONSTANTS",
+    "RESERVED",
+    "INERTIA_KEYS",
+    "check_parameter_name",
+    "check_name",
+    "quoted",
+    "shown",
+    "make_parameters",
+    "parse_expression",
+    "is_zero",
+    "parse_vector",
+    "parse_matrix3",
+    "parse_inertia",
+    "check_rotation",
+    "parse_inertials",
+    "parse_joint_extras",
+    "LIMIT_KEYS",
+]

@@ -1,0 +1,224 @@
+"""Look at a robot: a text table of its joints and links, and a 3-D picture of the arm.
+
+``show(robot, q=None, out=None)`` returns the table (a string) and, when ``out`` is a
+file name, saves a matplotlib picture of the arm at the joint coordinates ``q``
+(default all zero) to it (PNG, SVG or PDF, by the name's extension).
+
+The picture, in the base frame (metres, z up as the model has it):
+
+* every link frame's origin is a dot, and a grey segment joins each joint's parent
+  frame origin to its child frame origin (so the "links" are drawn between frame
+  origins, which for DH models need not follow the physical links);
+* each movable joint's axis is an arrow at the child frame origin (orange: revolute,
+  purple: prismatic), with the joint's name;
+* each link frame is a small triad (x red, y green, z blue);
+* each centre of mass is a black dot whose area grows with the mass; the base is a
+  black square.
+
+Forward kinematics chains :meth:`armdyn.model.Joint.transform` with numbers. A model
+with parameters is first bound to its published defaults (``robot.bind()``); a
+parameter still free after that is a :class:`ModelError` naming it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import sympy as sp
+
+from .errors import ModelError
+from .model import Robot
+
+__all__ = ["show", "table", "frame_poses", "numeric_robot"]
+
+AXIS_COLOURS = {"revolute": "tab:orange", "prismatic": "tab:purple"}
+
+
+# ----------------------------------------------------------------- kinematics
+
+
+def numeric_robot(robot: Robot) -> Robot:
+    """``robot`` with every parameter bound to a number (its defaults), or a
+    :class:`ModelError` naming the parameters that have no default value."""
+    if robot.free_symbols():
+        robot = robot.bind()
+    free = sorted(s.name for s in robot.free_symbols())
+    if free:
+        raise ModelError(
+            f"parameters {free} have no default value: bind them first (robot.bind({{...}}))",
+            f"robot '{robot.name}'",
+        )
+    return robot
+
+
+def _coordinates(robot: Robot, q) -> np.ndarray:
+    if q is None:
+        return np.zeros(robot.dof)
+    q = np.asarray(q, dtype=float).reshape(-1)
+    if q.shape != (robot.dof,):
+        raise ValueError(f"q must have {robot.dof} values (one per movable joint), got {q.size}")
+    if not np.all(np.isfinite(q)):
+        raise ValueError("q contains NaN or inf")
+    return q
+
+
+def _floats(m: sp.Matrix) -> np.ndarray:
+    return np.array(m.evalf(), dtype=float)
+
+
+def frame_poses(robot: Robot, q=None) -> dict[str, np.ndarray]:
+    """Pose of every link frame in the base frame at ``q`` (dof,): dict link name ->
+    (4, 4) homogeneous transform, base first, then in joint (tree) order.
+
+    ``robot`` must be numeric (see :func:`numeric_robot`). Each pose is the parent's
+    pose times the joint's ``Joint.transform(q_i)``.
+    """
+    q = _coordinates(robot, q)
+    poses = {robot.base: np.eye(4)}
+    for joint in robot.joints:
+        i = robot.coordinate_index(joint)
+        R, p = joint.transform(0 if i is None else q[i])
+        local = np.eye(4)
+        local[:3, :3], local[:3, 3] = _floats(R), _floats(p).reshape(3)
+        poses[joint.child] = poses[joint.parent] @ local
+    return poses
+
+
+# ---------------------------------------------------------------------- table
+
+
+def _num(x) -> str:
+    x = sp.sympify(x)
+    if x.free_symbols:
+        return str(x)
+    v = float(x)
+    return "0" if abs(v) < 5e-13 else f"{v:.6g}"
+
+
+def _vec(v) -> str:
+    return "(" + ", ".join(_num(c) for c in v) + ")"
+
+
+def rpy(R: sp.Matrix) -> tuple:
+    """URDF roll, pitch, yaw of a numeric rotation (inverse of ``rpy_matrix``)."""
+    r = _floats(R)
+    pitch = math.atan2(-r[2, 0], math.hypot(r[2, 1], r[2, 2]))
+    if math.hypot(r[2, 1], r[2, 2]) < 1e-12:  # gimbal lock: put it all in yaw
+        return 0.0, pitch, math.atan2(-r[0, 1], r[1, 1])
+    return math.atan2(r[2, 1], r[2, 2]), pitch, math.atan2(r[1, 0], r[0, 0])
+
+
+def _rows(header: list[str], rows: list[list[str]]) -> list[str]:
+    widths = [max(len(r[i]) for r in [header] + rows) for i in range(len(header))]
+    line = lambda r: "  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip()  # noqa: E731
+    return [line(header), line(["-" * w for w in widths])] + [line(r) for r in rows]
+
+
+def table(robot: Robot) -> str:
+    """A text table of the joints (name, type, parent, child, placement xyz and rpy,
+    axis, limits) and the links (mass, centre of mass, inertia diagonal)."""
+    lines = [f"{robot.name}: {robot.dof} dof, base '{robot.base}', gravity {_vec(robot.gravity)}"]
+    if robot.meta.get("source"):
+        lines.append(f"source: {robot.meta['source']}")
+    rows = []
+    for j in robot.joints:
+        angles = "(" + ", ".join(_num(a) for a in rpy(j.rotation)) + ")" if not j.rotation.free_symbols else "symbolic"
+        if j.lower is not None or j.upper is not None:
+            bounds = [_num(b) if b is not None else "-" for b in (j.lower, j.upper)]
+            limits = f"[{bounds[0]}, {bounds[1]}]"
+        else:
+            limits = ""
+        axis = _vec(j.axis) if j.movable else ""
+        rows.append([j.name, j.type, j.parent, j.child, _vec(j.xyz), angles, axis, limits])
+    lines += ["", "joints"] + _rows(["name", "type", "parent", "child", "xyz", "rpy", "axis", "limits"], rows)
+    massless = set(robot.meta.get("massless_links", ()))
+    rows = []
+    for link in robot.links.values():
+        note = "no <inertial>" if link.name in massless else ""
+        if link.name == robot.base:
+            note = (note + ", " if note else "") + "base (fixed)"
+        diag = _vec([link.inertia[0, 0], link.inertia[1, 1], link.inertia[2, 2]])
+        rows.append([link.name, _num(link.mass), _vec(link.com), diag, note])
+    lines += ["", "links"] + _rows(["name", "mass", "com", "inertia (ixx, iyy, izz)", ""], rows)
+    return "\n".join(lines)
+
+
+# -------------------------------------------------------------------- picture
+
+
+def _reach(points: np.ndarray) -> float:
+    span = np.ptp(points, axis=0).max() if len(points) > 1 else 0.0
+    return span if span > 1e-9 else 1.0
+
+
+def draw(robot: Robot, q=None, out=None, title: str | None = None):
+    """The picture of the (numeric) ``robot`` at ``q``; saved to ``out`` if given.
+    Returns the matplotlib figure."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    q = _coordinates(robot, q)
+    poses = frame_poses(robot, q)
+    origins = np.array([T[:3, 3] for T in poses.values()])
+    size = _reach(origins)
+    triad, arrow = 0.08 * size, 0.12 * size
+
+    fig = plt.figure(figsize=(7, 7))
+    ax = fig.add_subplot(projection="3d")
+    for j in robot.joints:
+        a, b = poses[j.parent][:3, 3], poses[j.child][:3, 3]
+        ax.plot(*zip(a, b), color="0.45", linewidth=3, solid_capstyle="round")
+    ax.scatter(*origins.T, color="0.2", s=12, depthshade=False)
+    ax.scatter(*poses[robot.base][:3, 3], marker="s", color="black", s=60, depthshade=False)
+
+    for T in poses.values():
+        for k, colour in enumerate(("red", "green", "blue")):
+            ax.quiver(*T[:3, 3], *(triad * T[:3, k]), color=colour, linewidth=1)
+
+    for j in robot.movable_joints:
+        T = poses[j.child]
+        axis = T[:3, :3] @ _floats(j.axis).reshape(3)
+        ax.quiver(*T[:3, 3], *(arrow * axis), color=AXIS_COLOURS[j.type], linewidth=2.5, arrow_length_ratio=0.3)
+        ax.text(*(T[:3, 3] + 1.15 * arrow * axis), j.name, fontsize=7, color=AXIS_COLOURS[j.type])
+
+    masses = {n: float(ln.mass) for n, ln in robot.links.items() if n != robot.base}
+    heaviest = max(masses.values(), default=0.0)
+    for name, m in masses.items():
+        if m > 0:
+            c = poses[name][:3, :3] @ _floats(robot.links[name].com).reshape(3) + poses[name][:3, 3]
+            ax.scatter(*c, color="black", s=10 + 80 * m / heaviest, alpha=0.6, depthshade=False)
+
+    # equal scales on the three axes, so the arm is not distorted
+    centre = (origins.max(axis=0) + origins.min(axis=0)) / 2
+    half = 0.6 * size
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_zlim(centre[2] - half, centre[2] + half)
+    ax.set_box_aspect((1, 1, 1))
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_zlabel("z (m)")
+    qtext = ", ".join(f"{v:.3g}" for v in q)
+    ax.set_title(title or f"{robot.name} at q = [{qtext}]", fontsize=10)
+    if out is not None:
+        fig.savefig(out, dpi=110, bbox_inches="tight")
+        plt.close(fig)
+    return fig
+
+
+def show(robot, q=None, out=None) -> str:
+    """The joint/link table of ``robot`` (a :class:`Robot`, or a model file or bundled
+    robot name for :func:`armdyn.io.load`); with ``out``, also save the picture of
+    the arm at ``q`` (dof,) there. Returns the table."""
+    if not isinstance(robot, Robot):
+        from .io import load
+
+        robot = load(robot)
+    robot = numeric_robot(robot)
+    text = table(robot)
+    if out is not None:
+        draw(robot, q, out)
+    return text
