@@ -354,3 +354,14 @@ def test_physical_checks_are_the_strict_ones(filename):
         robot = load(BAD / filename, strict=False)
     assert robot.dof == 2
 
+
+
+def test_bundled_models_keep_their_names():
+    """Each bundled file's `name:` is the robot's name (a DH table must not overwrite it)."""
+    import yaml as pyyaml
+
+    for entry in bundled_robots():
+        if str(entry["path"]).endswith(".yaml"):
+            with open(entry["path"]) as fh:
+                declared = pyyaml.safe_load(fh)["name"]
+            assert load(entry["name"], strict=False).name == declared

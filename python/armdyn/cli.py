@@ -57,13 +57,14 @@ def cmd_robots(args) -> int:
 
     rows = bundled_robots()
     w = max(len(r["name"]) for r in rows)
-    print(f"{'name':<{w}}  dof  {'convention':<12} description / source")
+    print(f"{'name':<{w}}  dof  {'convention':<12} description")
     for r in rows:
-        desc = r.get("description") or ""
-        src = r.get("source") or ""
+        desc = r.get("description") or "(no description)"
         print(f"{r['name']:<{w}}  {r['dof']:>3}  {r.get('convention') or '':<12} {desc}")
+        src = " ".join((r.get("source") or "").split())
         if src:
-            print(f"{'':<{w}}            {'':<12} source: {src.splitlines()[0]}")
+            src = src if len(src) <= 110 else src[:107] + "..."
+            print(f"{'':<{w}}       {'':<12} source: {src}")
     return 0
 
 

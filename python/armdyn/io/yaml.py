@@ -314,9 +314,9 @@ def _dh_robot(data, name, params, defaults, gravity, base, meta, source, strict,
     lines = {}
     for i, row in enumerate(rows, start=1):
         if isinstance(row, Mapping):
-            for kind, name in (("joint", row.get("name")), ("link", row.get("link", f"link{i}"))):
-                if isinstance(name, str):
-                    lines[f"{kind} '{name}'"] = _at(source, row)
+            for kind, label in (("joint", row.get("name")), ("link", row.get("link", f"link{i}"))):
+                if isinstance(label, str):
+                    lines[f"{kind} '{label}'"] = _at(source, row)
     try:
         return from_dh(
             name, rows, convention, gravity, list(params), defaults, base, meta, strict=strict, source=None

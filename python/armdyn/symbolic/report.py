@@ -10,6 +10,7 @@ derivations themselves never call ``simplify``.
 
 from __future__ import annotations
 
+import symengine as se
 import sympy as sp
 
 from .agreement import _too_big, trig_reduce
@@ -148,7 +149,10 @@ def tau_lines(eom: EquationsOfMotion, fmt: str = "text") -> list[str]:
     lines = []
     tau_name = (lambda k: f"tau{k + 1}") if fmt == "text" else (lambda k: rf"\tau_{{{k + 1}}}")
     if _big(eom):
-        subexprs, reduced = sp.cse(list(eom.tau), optimizations="basic")
+        # SymEngine's CSE: SymPy's walks the expanded tree and takes minutes on a 6-dof arm
+        subexprs, reduced = se.cse(se.sympify(list(eom.tau)))
+        subexprs = [(sp.sympify(a), sp.sympify(b)) for a, b in subexprs]
+        reduced = [sp.sympify(e) for e in reduced]
         lines.append(
             f"  ({len(subexprs)} common subexpressions x0..x{len(subexprs) - 1}, then tau)"
             if fmt == "text" else "% common subexpressions, then tau"
