@@ -15,7 +15,24 @@ from .io import bundled_robots, load
 from .model import Joint, Link, Robot
 from .symbolic import EquationsOfMotion, check, derive, prove_agreement
 
+_NUMERIC = (
+    "rnea", "crba", "aba", "gravity", "bias", "coriolis_matrix", "kinetic_energy",
+    "potential_energy", "forward_kinematics", "jacobian", "NumericModel", "compile_model",
+)
+
+
+def __getattr__(name):
+    # the numeric API lives in armdyn.numeric (over the compiled Rust core), imported on
+    # first use so that symbolic work does not load the extension
+    if name in _NUMERIC:
+        from . import numeric
+
+        return getattr(numeric, name)
+    raise AttributeError(f"module 'armdyn' has no attribute {name!r}")
+
+
 __all__ = [
+    *_NUMERIC,
     "inertia", "io", "ModelError", "UnboundParameterError", "Joint", "Link", "Robot",
     "load", "bundled_robots", "derive", "check", "prove_agreement", "EquationsOfMotion",
 ]

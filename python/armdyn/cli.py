@@ -127,6 +127,9 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except KeyboardInterrupt:
         return 130
+    except BrokenPipeError:  # e.g. `armdyn robots | head`
+        sys.stderr.close()
+        return 0
     except Exception as err:  # noqa: BLE001 - a bug: one line unless debugging
         if os.environ.get("ARMDYN_DEBUG"):
             raise

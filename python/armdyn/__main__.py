@@ -1,0 +1,7 @@
+"""``python -m armdyn ...`` is the ``armdyn`` command."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())
