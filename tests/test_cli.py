@@ -1,0 +1,89 @@
+"""The command line as a user meets it: the main job, formats, checks, and bad input."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from armdyn.cli import main
+
+HERE = Path(__file__).resolve().parent
+BAD = sorted((HERE / "models" / "bad").glob("*.yaml"))
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_main_job_prints_both_methods_and_agreement(capsys):
+    code, out, err = run(capsys, "derive", "rp-arm")
+    assert code == 0 and err == ""
+    assert "Newton-Euler:" in out and "Lagrange:" in out
+    assert out.count("tau1 =") == 2 and out.count("tau2 =") == 2
+    assert "[OK  ] tau: newton-euler == lagrange (exact)" in out
+
+
+def test_steps_show_every_quantity_per_link(capsys):
+    code, out, _ = run(capsys, "derive", "rp-arm", "--steps", "--method", "newton-euler")
+    assert code == 0
+    for label in ("ω₁", "ω̇₁", "v̇₁", "v̇_C₁", "F₁", "N₁", "ω₂", "v̇_C₂", "f₂", "n₂", "f₁", "n₁", "τ₁", "τ₂"):
+        assert f"  {label} = " in out, label
+    # the centripetal term the exercise drops from link 2's acceleration is there
+    line = next(s for s in out.splitlines() if s.startswith("  v̇_C₂ = "))
+    assert "l1*theta1_dot**2" in line
+
+
+def test_lagrange_steps_show_energies(capsys):
+    code, out, _ = run(capsys, "derive", "rp-arm", "--steps", "--method", "lagrange")
+    assert code == 0
+    for label in ("T_trans₁", "T_rot₁", "V₁", "T_trans₂", "T =", "V =", "L ="):
+        assert label in out, label
+
+
+@pytest.mark.parametrize("fmt,marker", [("latex", r"\ddot{\theta_{1}}"), ("markdown", "$$\\tau_{1} =")])
+def test_formats(capsys, fmt, marker):
+    code, out, _ = run(capsys, "derive", "rp-arm", "--format", fmt, "--steps")
+    assert code == 0 and marker in out
+
+
+def test_check_command(capsys):
+    code, out, _ = run(capsys, "check", "planar-2r")
+    assert code == 0
+    assert "Mdot - 2C skew-symmetric" in out and "FAIL" not in out
+
+
+def test_robots_lists_bundled_models(capsys):
+    code, out, _ = run(capsys, "robots")
+    assert code == 0
+    for name in ("rp-arm", "planar-2r", "puma560", "puma560-craig"):
+        assert f"\n{name} " in out
+
+
+def test_unknown_robot_is_one_clear_line(capsys):
+    code, out, err = run(capsys, "derive", "no-such-arm")
+    assert code == 2 and out == ""
+    assert err.startswith("armdyn: error:") and "no-such-arm" in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("path", BAD, ids=[p.name for p in BAD])
+def test_bad_model_file_one_line_nonzero(capsys, path):
+    code, out, err = run(capsys, "derive", str(path))
+    assert code == 2, err
+    assert err.count("\n") == 1 and path.name in err and "Traceback" not in err
+
+
+def test_bad_input_in_a_real_process_has_no_traceback():
+    env = dict(os.environ)
+    proc = subprocess.run(
+        [sys.executable, "-m", "armdyn", "derive", str(HERE / "models" / "bad" / "zero-axis.yaml")],
+        capture_output=True, text=True, timeout=120, env=env,
+    )
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines() == [proc.stderr.strip()]
+    assert "zero-axis.yaml" in proc.stderr and "joint 'j2'" in proc.stderr and "axis is zero" in proc.stderr
