@@ -27,7 +27,9 @@ def __getattr__(name):
     if name in _NUMERIC:
         from . import numeric
 
-        return getattr(numeric, name)
+        value = getattr(numeric, name)
+        globals()[name] = value  # later lookups skip __getattr__ (it costs ~1 us a call)
+        return value
     raise AttributeError(f"module 'armdyn' has no attribute {name!r}")
 
 

@@ -1,0 +1,58 @@
+//! Inverse dynamics by the recursive Newton-Euler algorithm (RBDA Table 5.1).
+
+use crate::data::Data;
+use crate::model::Model;
+use crate::real::Real;
+use crate::spatial::{Motion, RigidInertia};
+
+/// `tau = M(q) qdd + C(q, qd) qd + g(q)`.
+///
+/// `q`, `qd`, `qdd`, `tau`: (nv,). Gravity enters as the base acceleration
+/// `a_0 = [0; -g]` (RBDA 5.3). Writes `data.xup`, `data.v`, `data.a`, `data.f`.
+#[inline(always)]
+pub fn rnea<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd: &[T], tau: &mut [T]) {
+    let n = model.nv;
+    assert!(q.len() == n && qd.len() == n && qdd.len() == n && tau.len() == n, "state length");
+    let a0 = Motion::new(crate::spatial::V3::splat(model.a0.w), crate::spatial::V3::splat(model.a0.v));
+    // Forward pass: velocities, accelerations, and the net force on each body
+    // f_i = I_i a_i + v_i x* I_i v_i (RBDA eq. 5.9).
+    for i in 0..n {
+        let kind = model.kind[i];
+        let xup = kind.xup(&model.xtree[i], q[i]);
+        let vj = kind.s_times(qd[i]);
+        let (v, a) = match model.parent[i] {
+            Some(p) => (xup.apply_motion(&data.v[p]) + vj, xup.apply_motion(&data.a[p])),
+            None => (vj, xup.apply_motion(&a0)),
+        };
+        let a = a + kind.s_times(qdd[i]) + kind.v_cross_s(&v, qd[i]);
+        let inertia = RigidInertia::splat(&model.inertia[i]);
+        data.f[i] = inertia.mul_motion(&a) + v.cross_force(&inertia.mul_motion(&v));
+        data.xup[i] = xup;
+        data.v[i] = v;
+        data.a[i] = a;
+    }
+    // Backward pass: tau_i = S_i^T f_i; f_lambda += ^i X_lambda^T f_i.
+    for i in (0..n).rev() {
+        tau[i] = model.kind[i].s_dot(&data.f[i]);
+        if let Some(p) = model.parent[i] {
+            let fp = data.xup[i].tr_apply_force(&data.f[i]);
+            data.f[p] += fp;
+        }
+    }
+}
+
+/// Gravity torques `g(q) = rnea(q, 0, 0)`. `q`, `g`: (nv,).
+#[inline(always)]
+pub fn gravity<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], g: &mut [T]) {
+    let zeros = std::mem::take(&mut data.zeros);
+    rnea(model, data, q, &zeros, &zeros, g);
+    data.zeros = zeros;
+}
+
+/// Nonlinear effects `h(q, qd) = C(q, qd) qd + g(q) = rnea(q, qd, 0)`. All (nv,).
+#[inline(always)]
+pub fn bias<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], h: &mut [T]) {
+    let zeros = std::mem::take(&mut data.zeros);
+    rnea(model, data, q, qd, &zeros, h);
+    data.zeros = zeros;
+}

@@ -1,0 +1,325 @@
+//! Many states at once: row `k` of each `(N, nv)` input is one state, row `k` of the
+//! output its result (same order as a loop of single calls, and bit-for-bit equal).
+//!
+//! Rows are split into chunks that rayon spreads over the threads; each chunk gets its
+//! own workspace (allocated once per chunk, never per state). Inside a chunk `rnea`,
+//! `aba`, `crba`, `gravity` and `bias` run several states per step in SIMD lanes: the
+//! algorithms are generic over the lane type ([`Real`]), so a lane performs exactly the
+//! operations of a single call. Which kernels run is decided at run time ([`kernels`]):
+//!
+//! * AVX-512F CPUs: 8 states per step ([`F64x8`], one 512-bit register);
+//! * AVX2 CPUs: 4 states per step ([`F64x4`], one 256-bit register);
+//! * any other x86-64 (and other architectures): 4 states per step compiled for the
+//!   baseline (SSE2 on x86-64: two 128-bit registers per `F64x4`).
+//!
+//! FMA is never used (Rust does not contract `a * b + c`), which keeps every kernel's
+//! bits identical to the scalar path. No `-C target-cpu` is needed: the shipped build
+//! runs on any x86-64 and picks the widest kernels the CPU runs.
+
+use crate::algo;
+use crate::algo::coriolis::CoriolisWork;
+use crate::data::Data;
+use crate::model::Model;
+use crate::real::{F64x4, F64x8, Real};
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicU8, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// The SIMD kernels of the batch path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kernels {
+    /// 4 lanes, compiled for the target's baseline features.
+    Baseline,
+    /// 4 lanes, compiled for AVX2.
+    Avx2,
+    /// 8 lanes, compiled for AVX-512F.
+    Avx512,
+}
+
+/// 0: not decided yet, else `1 + Kernels as u8`.
+static KERNELS: AtomicU8 = AtomicU8::new(0);
+
+/// The kernels that run: the widest the CPU supports, capped by the environment
+/// variable `ARMDYN_SIMD` (`baseline`, `avx2`, `avx512`) or by [`set_kernels`].
+pub fn kernels() -> Kernels {
+    const ALL: [Kernels; 3] = [Kernels::Baseline, Kernels::Avx2, Kernels::Avx512];
+    match KERNELS.load(Ordering::Relaxed) {
+        k @ 1..=3 => ALL[k as usize - 1],
+        _ => {
+            #[cfg(target_arch = "x86_64")]
+            let best = if std::is_x86_feature_detected!("avx512f") {
+                Kernels::Avx512
+            } else if std::is_x86_feature_detected!("avx2") {
+                Kernels::Avx2
+            } else {
+                Kernels::Baseline
+            };
+            #[cfg(not(target_arch = "x86_64"))]
+            let best = Kernels::Baseline;
+            let cap = match std::env::var("ARMDYN_SIMD").as_deref() {
+                Ok("baseline") => Kernels::Baseline,
+                Ok("avx2") => Kernels::Avx2,
+                _ => Kernels::Avx512,
+            };
+            let k = best.min_with(cap);
+            KERNELS.store(1 + k as u8, Ordering::Relaxed);
+            k
+        }
+    }
+}
+
+impl Kernels {
+    fn min_with(self, cap: Kernels) -> Kernels {
+        if (cap as u8) < (self as u8) {
+            cap
+        } else {
+            self
+        }
+    }
+}
+
+/// Use at most `cap` (`None`: detect again). Results are bit-for-bit the same with any
+/// kernels; this exists to test and time that.
+pub fn set_kernels(cap: Option<Kernels>) {
+    KERNELS.store(0, Ordering::Relaxed);
+    if let Some(cap) = cap {
+        let k = kernels().min_with(cap);
+        KERNELS.store(1 + k as u8, Ordering::Relaxed);
+    }
+}
+
+/// Rows below which a batch runs on the calling thread (spawning costs more).
+const MIN_PARALLEL_ROWS: usize = 128;
+
+/// A rayon pool with `n` threads, built once per `n` and kept.
+fn pool(n: usize) -> Arc<rayon::ThreadPool> {
+    static POOLS: OnceLock<Mutex<HashMap<usize, Arc<rayon::ThreadPool>>>> = OnceLock::new();
+    let mut pools = POOLS.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
+    pools
+        .entry(n)
+        .or_insert_with(|| Arc::new(rayon::ThreadPoolBuilder::new().num_threads(n).build().expect("thread pool")))
+        .clone()
+}
+
+/// The number of threads `threads` means: `None` = all cores (rayon's global pool).
+pub fn thread_count(threads: Option<usize>) -> usize {
+    threads.unwrap_or_else(rayon::current_num_threads).max(1)
+}
+
+/// Run `body(workspace, first_row, out_chunk)` over chunks of `rows` rows whose outputs
+/// (`out_per_row` values each) tile `out`. Chunks start at multiples of 4 rows.
+fn par_rows<W, M, B>(rows: usize, out: &mut [f64], out_per_row: usize, threads: Option<usize>, make: M, body: B)
+where
+    M: Fn() -> W + Sync + Send,
+    B: Fn(&mut W, usize, &mut [f64]) + Sync + Send,
+{
+    assert_eq!(out.len(), rows * out_per_row, "output size");
+    let nthreads = thread_count(threads);
+    if nthreads == 1 || rows < MIN_PARALLEL_ROWS || out_per_row == 0 {
+        body(&mut make(), 0, out);
+        return;
+    }
+    // ~8 chunks per thread balance the load when cores are shared.
+    let chunk_rows = rows.div_ceil(8 * nthreads).max(32).next_multiple_of(4);
+    let mut run = move || {
+        out.par_chunks_mut(chunk_rows * out_per_row)
+            .enumerate()
+            .for_each_init(&make, |w, (k, chunk)| body(w, k * chunk_rows, chunk))
+    };
+    match threads {
+        None => run(),
+        Some(n) => pool(n).install(run),
+    }
+}
+
+/// Workspace of a chunk: a scalar one for the leftover rows, an `L`-lane one, and the
+/// lane-transposed arguments/results of one group of rows.
+pub struct Work<L> {
+    pub d1: Data<f64>,
+    pub dl: Data<L>,
+    args: [Vec<L>; 3],
+    res: Vec<L>,
+}
+
+impl<L: Real> Work<L> {
+    pub fn new(model: &Model) -> Self {
+        let n = model.nv;
+        Work {
+            d1: Data::new(model),
+            dl: Data::new(model),
+            args: [vec![L::zero(); n], vec![L::zero(); n], vec![L::zero(); n]],
+            res: vec![L::zero(); n * n],
+        }
+    }
+}
+
+/// Defines a batched lane kernel `$name` from a call `$call` generic over the lane type
+/// `T` (`f64` for one state, `F64x4`/`F64x8` for a group), and its AVX2/AVX-512
+/// instantiations.
+macro_rules! lanes_kernel {
+    ($(#[$doc:meta])* $name:ident, nargs = $nargs:literal, out = |$m:ident| $out:expr,
+     |$model:ident, $data:ident, $a:ident, $o:ident| $call:expr) => {
+        $(#[$doc])*
+        pub fn $name(model: &Model, args: [&[f64]; $nargs], out: &mut [f64], threads: Option<usize>) {
+            fn kernel<T: Real>($model: &Model, $data: &mut Data<T>, $a: [&[T]; 3], $o: &mut [T]) {
+                $call
+            }
+
+            /// The rows `first..first + out.len() / per_row` of the batch.
+            #[inline(always)]
+            fn rows<L: Real>(model: &Model, w: &mut Work<L>, args: [&[f64]; 3], first: usize, out: &mut [f64]) {
+                let n = model.nv;
+                let per_row = { let $m = model; $out };
+                let rows = out.len() / per_row;
+                let mut r = 0;
+                // Groups of L::LANES rows: transpose into lanes, run, transpose back.
+                while r + L::LANES <= rows {
+                    for (slot, arg) in w.args.iter_mut().zip(args).take($nargs) {
+                        for j in 0..n {
+                            for k in 0..L::LANES {
+                                slot[j].set_lane(k, arg[(first + r + k) * n + j]);
+                            }
+                        }
+                    }
+                    let [a0, a1, a2] = &w.args;
+                    kernel(model, &mut w.dl, [a0, a1, a2], &mut w.res[..per_row]);
+                    for j in 0..per_row {
+                        for k in 0..L::LANES {
+                            out[(r + k) * per_row + j] = w.res[j].lane(k);
+                        }
+                    }
+                    r += L::LANES;
+                }
+                // Leftover rows one by one.
+                for r in r..rows {
+                    let a = args.map(|a| if a.is_empty() { a } else { row(a, n, first + r) });
+                    kernel(model, &mut w.d1, a, &mut out[r * per_row..(r + 1) * per_row]);
+                }
+            }
+
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx2")]
+            unsafe fn rows_avx2(model: &Model, w: &mut Work<F64x4>, args: [&[f64]; 3], first: usize, out: &mut [f64]) {
+                rows(model, w, args, first, out)
+            }
+
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx512f")]
+            unsafe fn rows_avx512(model: &Model, w: &mut Work<F64x8>, args: [&[f64]; 3], first: usize, out: &mut [f64]) {
+                rows(model, w, args, first, out)
+            }
+
+            let n = model.nv;
+            let per_row = { let $m = model; $out };
+            let nrows = if per_row == 0 { 0 } else { out.len() / per_row };
+            for a in &args {
+                assert_eq!(a.len(), nrows * n, "argument size");
+            }
+            let mut all: [&[f64]; 3] = [&[], &[], &[]];
+            all[..$nargs].copy_from_slice(&args);
+            match kernels() {
+                #[cfg(target_arch = "x86_64")]
+                Kernels::Avx512 => par_rows(nrows, out, per_row, threads, || Work::new(model), |w, first, chunk| {
+                    // SAFETY: the CPU supports AVX-512F (checked by `kernels`).
+                    unsafe { rows_avx512(model, w, all, first, chunk) }
+                }),
+                #[cfg(target_arch = "x86_64")]
+                Kernels::Avx2 => par_rows(nrows, out, per_row, threads, || Work::new(model), |w, first, chunk| {
+                    // SAFETY: the CPU supports AVX2 (checked by `kernels`).
+                    unsafe { rows_avx2(model, w, all, first, chunk) }
+                }),
+                _ => par_rows(nrows, out, per_row, threads, || Work::<F64x4>::new(model), |w, first, chunk| {
+                    rows(model, w, all, first, chunk)
+                }),
+            }
+        }
+    };
+}
+
+lanes_kernel!(
+    /// Batched [`algo::rnea`]: `args = [q, qd, qdd]` (N, nv) each, `out` = tau (N, nv).
+    rnea, nargs = 3, out = |m| m.nv,
+    |model, data, a, o| algo::rnea(model, data, a[0], a[1], a[2], o)
+);
+lanes_kernel!(
+    /// Batched [`algo::aba`]: `args = [q, qd, tau]` (N, nv) each, `out` = qdd (N, nv).
+    aba, nargs = 3, out = |m| m.nv,
+    |model, data, a, o| algo::aba(model, data, a[0], a[1], a[2], o)
+);
+lanes_kernel!(
+    /// Batched [`algo::crba`]: `args = [q]` (N, nv), `out` = M (N, nv, nv).
+    crba, nargs = 1, out = |m| m.nv * m.nv,
+    |model, data, a, o| algo::crba(model, data, a[0], o)
+);
+lanes_kernel!(
+    /// Batched [`algo::gravity`]: `args = [q]` (N, nv), `out` = g (N, nv).
+    gravity, nargs = 1, out = |m| m.nv,
+    |model, data, a, o| algo::gravity(model, data, a[0], o)
+);
+lanes_kernel!(
+    /// Batched [`algo::bias`]: `args = [q, qd]` (N, nv) each, `out` = h (N, nv).
+    bias, nargs = 2, out = |m| m.nv,
+    |model, data, a, o| algo::bias(model, data, a[0], a[1], o)
+);
+
+/// Row `r` of an (N, n) array.
+fn row(a: &[f64], n: usize, r: usize) -> &[f64] {
+    &a[r * n..(r + 1) * n]
+}
+
+/// Batched [`algo::coriolis_matrix`]: `q`, `qd` (N, nv), `out` = C (N, nv, nv).
+pub fn coriolis_matrix(model: &Model, q: &[f64], qd: &[f64], out: &mut [f64], threads: Option<usize>) {
+    let n = model.nv;
+    let make = || (Data::new(model), CoriolisWork::new(model));
+    par_rows(q.len() / n.max(1), out, n * n, threads, make, |(d, cw), first, chunk| {
+        for (k, o) in chunk.chunks_exact_mut(n * n).enumerate() {
+            let r = first + k;
+            algo::coriolis_matrix(model, d, cw, row(q, n, r), row(qd, n, r), o);
+        }
+    });
+}
+
+/// Batched [`algo::kinetic_energy`]: `q`, `qd` (N, nv), `out` (N,).
+pub fn kinetic_energy(model: &Model, q: &[f64], qd: &[f64], out: &mut [f64], threads: Option<usize>) {
+    let n = model.nv;
+    assert!(q.len() == out.len() * n && qd.len() == q.len(), "argument size");
+    par_rows(out.len(), out, 1, threads, || Data::new(model), |d, first, chunk| {
+        for (k, o) in chunk.iter_mut().enumerate() {
+            *o = algo::kinetic_energy(model, d, row(q, n, first + k), row(qd, n, first + k));
+        }
+    });
+}
+
+/// Batched [`algo::potential_energy`]: `q` (N, nv), `out` (N,).
+pub fn potential_energy(model: &Model, q: &[f64], out: &mut [f64], threads: Option<usize>) {
+    let n = model.nv;
+    assert!(q.len() == out.len() * n, "argument size");
+    par_rows(out.len(), out, 1, threads, || Data::new(model), |d, first, chunk| {
+        for (k, o) in chunk.iter_mut().enumerate() {
+            *o = algo::potential_energy(model, d, row(q, n, first + k));
+        }
+    });
+}
+
+/// Batched [`algo::forward_kinematics`]: `q` (N, nv), `out` (N, nlinks, 4, 4).
+pub fn forward_kinematics(model: &Model, q: &[f64], out: &mut [f64], threads: Option<usize>) {
+    let (n, per) = (model.nv, model.nlinks() * 16);
+    assert!(q.len() * per == out.len() * n || n == 0, "argument size");
+    par_rows(out.len() / per, out, per, threads, || Data::new(model), |d, first, chunk| {
+        for (k, o) in chunk.chunks_exact_mut(per).enumerate() {
+            algo::forward_kinematics(model, d, row(q, n, first + k), o);
+        }
+    });
+}
+
+/// Batched [`algo::jacobian`] of link `link`: `q` (N, nv), `out` (N, 6, nv).
+pub fn jacobian(model: &Model, q: &[f64], link: usize, out: &mut [f64], threads: Option<usize>) {
+    let n = model.nv;
+    let per = 6 * n;
+    par_rows(q.len() / n.max(1), out, per, threads, || Data::new(model), |d, first, chunk| {
+        for (k, o) in chunk.chunks_exact_mut(per).enumerate() {
+            algo::jacobian(model, d, row(q, n, first + k), link, o);
+        }
+    });
+}

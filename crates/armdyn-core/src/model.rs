@@ -1,0 +1,253 @@
+//! The immutable model: built once from a robot description, then shared (read-only)
+//! by any number of threads, each with its own [`crate::Data`] workspace.
+
+use crate::joint::JointKind;
+use crate::spatial::{Motion, RigidInertia, Sym3, Xform, M3, V3};
+use std::fmt;
+
+/// A joint's type in the description.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JointType {
+    Revolute,
+    Prismatic,
+    Fixed,
+}
+
+/// One joint of the description, with its child link's inertia (the convention of
+/// armdyn's `model.py`).
+///
+/// * `parent`: index of the joint whose child link is this joint's parent link, or
+///   `None` for the base. Joints are in tree order: `parent < ` this joint's index.
+/// * `rotation` (3x3, row-major) and `translation` (3): the placement frame in the parent
+///   link's frame (the placement's axes as columns, in parent coordinates; its origin).
+/// * `axis` (3): unit axis of motion in the placement frame (ignored when fixed).
+///   Revolute: child frame = placement * Rot(axis, q); prismatic: placement translated
+///   by `q axis`; fixed: the placement.
+/// * `mass`, `com` (3, child link frame), `inertia` (3x3 about the centre of mass, child
+///   link axes): the child link.
+#[derive(Clone, Debug)]
+pub struct JointSpec {
+    pub parent: Option<usize>,
+    pub jtype: JointType,
+    pub rotation: [[f64; 3]; 3],
+    pub translation: [f64; 3],
+    pub axis: [f64; 3],
+    pub mass: f64,
+    pub com: [f64; 3],
+    pub inertia: [[f64; 3]; 3],
+}
+
+/// An invalid description: which joint (if any) and what is wrong.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelError {
+    pub joint: Option<usize>,
+    pub message: String,
+}
+
+impl fmt::Display for ModelError {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        match self.joint {
+            Some(k) => write!(f, "joint {k}: {}", self.message),
+            None => write!(f, "{}", self.message),
+        }
+    }
+}
+impl std::error::Error for ModelError {}
+
+/// Where a link frame sits: rigidly attached to a movable body (or the base), at a
+/// constant pose in that body's frame.
+#[derive(Clone, Copy, Debug)]
+pub struct LinkFrame {
+    /// The movable body carrying the link, `None` for links welded to the base.
+    pub body: Option<usize>,
+    /// Orientation of the link frame in the body frame (link axes as columns).
+    pub rotation: M3<f64>,
+    /// Origin of the link frame in the body frame.
+    pub translation: V3<f64>,
+}
+
+/// The dynamics model: one body per movable joint, fixed joints merged away.
+///
+/// Body `i` (0..nv) is the child of the i-th movable joint; its frame is the joint's
+/// placement frame re-oriented so that the joint axis is z (see `joint.rs`), after the
+/// joint's motion. Links rigidly attached to it by fixed joints have their inertia
+/// added to it and keep their frames in `links` for kinematics.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// Number of movable joints (= dof = bodies).
+    pub nv: usize,
+    /// `lambda(i)`: the parent body, `None` for the base. Always `< i`.
+    pub parent: Vec<Option<usize>>,
+    /// Joint type of body i, after re-framing (`S` along z).
+    pub kind: Vec<JointKind>,
+    /// `X_T(i)`: from the parent body's frame to joint i's placement frame.
+    pub xtree: Vec<Xform<f64>>,
+    /// Body i's spatial inertia (merged with its fixed descendants), body frame.
+    pub inertia: Vec<RigidInertia<f64>>,
+    /// Gravity, base frame (m/s^2).
+    pub gravity: V3<f64>,
+    /// `a_0 = -a_g = [0; -gravity]`: the base acceleration that makes the RNEA and ABA
+    /// include gravity (RBDA 5.3).
+    pub a0: Motion<f64>,
+    /// Every link of the description, base first then each joint's child in order.
+    pub links: Vec<LinkFrame>,
+    /// For each description joint, its body index (`None` for fixed joints).
+    pub joint_body: Vec<Option<usize>>,
+    /// Potential energy of the links welded to the base (constant, `-sum m g . p_c`).
+    pub welded_potential: f64,
+}
+
+const TOL: f64 = 1e-9;
+
+/// A rotation `Ra` (columns: an orthonormal right-handed basis) with `Ra e_z = axis`.
+/// Exact for the coordinate axes, so axis-aligned models stay exact.
+fn frame_with_z(a: V3<f64>) -> M3<f64> {
+    let exact = |ra: [[f64; 3]; 3]| M3::from_rows(V3::from_array(ra[0]), V3::from_array(ra[1]), V3::from_array(ra[2]));
+    match a.to_array() {
+        [0.0, 0.0, 1.0] => exact([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
+        [0.0, 0.0, -1.0] => exact([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]]),
+        [1.0, 0.0, 0.0] => exact([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]),
+        [-1.0, 0.0, 0.0] => exact([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]),
+        [0.0, 1.0, 0.0] => exact([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]),
+        [0.0, -1.0, 0.0] => exact([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]),
+        _ => {
+            // x: the coordinate axis least aligned with `a`, made orthogonal to it.
+            let ab = [a.x.abs(), a.y.abs(), a.z.abs()];
+            let k = (0..3).min_by(|&i, &j| ab[i].total_cmp(&ab[j])).unwrap();
+            let mut e = [0.0; 3];
+            e[k] = 1.0;
+            let x = V3::from_array(e) - a.scale(a.to_array()[k]);
+            let x = x.scale(1.0 / x.dot(x).sqrt());
+            let y = a.cross(x);
+            M3::from_rows(x, y, a).transpose()
+        }
+    }
+}
+
+fn m3(a: &[[f64; 3]; 3]) -> M3<f64> {
+    M3::from_rows(V3::from_array(a[0]), V3::from_array(a[1]), V3::from_array(a[2]))
+}
+
+impl Model {
+    /// Build the model from joints in tree order (see [`JointSpec`]) and gravity (3,)
+    /// in the base frame. Checks the tree order, finiteness, orthonormal rotations,
+    /// unit axes (to 1e-9, then normalised), non-negative masses and symmetric
+    /// inertia tensors.
+    pub fn new(joints: &[JointSpec], gravity: [f64; 3]) -> Result<Model, ModelError> {
+        let err = |joint: Option<usize>, message: String| Err(ModelError { joint, message });
+        if !gravity.iter().all(|g| g.is_finite()) {
+            return err(None, format!("gravity {gravity:?} is not finite"));
+        }
+        let mut links = vec![LinkFrame { body: None, rotation: M3::identity(), translation: V3::zero() }];
+        let mut m = Model {
+            nv: 0,
+            parent: vec![],
+            kind: vec![],
+            xtree: vec![],
+            inertia: vec![],
+            gravity: V3::from_array(gravity),
+            a0: Motion::new(V3::zero(), -V3::from_array(gravity)),
+            links: vec![],
+            joint_body: vec![],
+            welded_potential: 0.0,
+        };
+        for (k, j) in joints.iter().enumerate() {
+            let numbers = j.rotation.iter().flatten().chain(&j.translation).chain(&j.axis);
+            let numbers = numbers.chain(std::iter::once(&j.mass)).chain(&j.com).chain(j.inertia.iter().flatten());
+            if !numbers.clone().all(|x| x.is_finite()) {
+                return err(Some(k), "a number is NaN or infinite".into());
+            }
+            if let Some(p) = j.parent {
+                if p >= k {
+                    return err(Some(k), format!("parent joint {p} does not come before it (tree order)"));
+                }
+            }
+            let rot = m3(&j.rotation);
+            let rtr = rot.transpose().mul_m(&rot);
+            let ortho_err = (0..3)
+                .flat_map(|a| (0..3).map(move |b| (a, b)))
+                .map(|(a, b)| (rtr.at(a, b) - if a == b { 1.0 } else { 0.0 }).abs())
+                .fold(0.0, f64::max);
+            let det = rot.rows[0].dot(rot.rows[1].cross(rot.rows[2]));
+            if ortho_err > TOL || det < 0.0 {
+                return err(Some(k), "rotation is not a proper orthonormal matrix".into());
+            }
+            if j.mass < 0.0 {
+                return err(Some(k), format!("negative mass {}", j.mass));
+            }
+            let ic = m3(&j.inertia);
+            if (0..3).any(|a| (0..3).any(|b| (ic.at(a, b) - ic.at(b, a)).abs() > TOL * (1.0 + ic.at(a, b).abs()))) {
+                return err(Some(k), "inertia tensor is not symmetric".into());
+            }
+
+            // The placement frame in the frame of the body carrying the parent link.
+            let parent_link = links[j.parent.map_or(0, |p| p + 1)];
+            let r_place = parent_link.rotation.mul_m(&rot);
+            let p_place = parent_link.translation + parent_link.rotation.mul_v(V3::from_array(j.translation));
+
+            let link = match j.jtype {
+                JointType::Fixed => {
+                    m.joint_body.push(None);
+                    LinkFrame { body: parent_link.body, rotation: r_place, translation: p_place }
+                }
+                JointType::Revolute | JointType::Prismatic => {
+                    let axis = V3::from_array(j.axis);
+                    let norm = axis.dot(axis).sqrt();
+                    if (norm - 1.0).abs() > TOL {
+                        return err(Some(k), format!("axis {:?} is not a unit vector", j.axis));
+                    }
+                    let ra = frame_with_z(axis.scale(1.0 / norm));
+                    let b = m.nv;
+                    m.nv += 1;
+                    m.parent.push(parent_link.body);
+                    m.kind.push(if j.jtype == JointType::Revolute { JointKind::RevoluteZ } else { JointKind::PrismaticZ });
+                    m.xtree.push(Xform::from_pose(&r_place.mul_m(&ra), p_place));
+                    m.inertia.push(RigidInertia::zero());
+                    m.joint_body.push(Some(b));
+                    // child link frame = body frame * Ra^T (Rot(axis, q) = Ra Rz(q) Ra^T)
+                    LinkFrame { body: Some(b), rotation: ra.transpose(), translation: V3::zero() }
+                }
+            };
+            links.push(link);
+
+            // The child link's inertia, moved into its body's frame (parallel axis in
+            // spatial form, RBDA eq. 2.63). Links welded to the base only add a constant
+            // potential energy.
+            let i_link = RigidInertia::from_mass_com(j.mass, V3::from_array(j.com), Sym3::from_m3(&ic));
+            let link_x_body = Xform::from_pose(&link.rotation, link.translation);
+            let i_body = i_link.tr_transform(&link_x_body);
+            match link.body {
+                Some(b) => m.inertia[b] += i_body,
+                None => m.welded_potential -= m.gravity.dot(i_body.h),
+            }
+        }
+        m.links = links;
+        Ok(m)
+    }
+
+    /// Count a point of mass `mass` at `com` (base frame) fixed to the base, e.g. the
+    /// base link itself, in the potential energy (a constant; no other effect).
+    pub fn add_base_mass(&mut self, mass: f64, com: [f64; 3]) {
+        self.welded_potential -= mass * self.gravity.dot(V3::from_array(com));
+    }
+
+    /// Number of link frames (base included): joints + 1.
+    pub fn nlinks(&self) -> usize {
+        self.links.len()
+    }
+
+    /// Whether body `a` is `b` or one of its ancestors.
+    pub fn supports(&self, a: usize, b: usize) -> bool {
+        let mut j = Some(b);
+        while let Some(k) = j {
+            if k == a {
+                return true;
+            }
+            if k < a {
+                return false;
+            }
+            j = self.parent[k];
+        }
+        false
+    }
+}

@@ -1,0 +1,84 @@
+//! No allocation per state: a counting global allocator around the single-state
+//! algorithms (with a preallocated workspace) and the batch path.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+struct Counting;
+
+thread_local! {
+    static ALLOCS: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCS.with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, size: usize) -> *mut u8 {
+        ALLOCS.with(|c| c.set(c.get() + 1));
+        unsafe { System.realloc(ptr, layout, size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// Allocations made by `f` on this thread.
+fn count(f: impl FnOnce()) -> usize {
+    let before = ALLOCS.with(|c| c.get());
+    f();
+    ALLOCS.with(|c| c.get()) - before
+}
+
+mod common;
+use armdyn_core::{algo, algo::coriolis::CoriolisWork, batch, Data, Model};
+use common::*;
+
+#[test]
+fn single_state_algorithms_do_not_allocate() {
+    let mut rng = Rng::new(2);
+    let model = random_model(&mut rng, 9, true);
+    let n = model.nv;
+    let (q, qd, qdd) = (rng.vec(n, -1.0, 1.0), rng.vec(n, -1.0, 1.0), rng.vec(n, -1.0, 1.0));
+    let mut d = Data::new(&model);
+    let mut cw = CoriolisWork::new(&model);
+    let (mut v, mut m, mut x, mut j) = (vec![0.0; n], vec![0.0; n * n], vec![0.0; 16 * model.nlinks()], vec![0.0; 6 * n]);
+    let allocs = count(|| {
+        for _ in 0..100 {
+            algo::rnea(&model, &mut d, &q, &qd, &qdd, &mut v);
+            algo::aba(&model, &mut d, &q, &qd, &qdd, &mut v);
+            algo::crba(&model, &mut d, &q, &mut m);
+            algo::gravity(&model, &mut d, &q, &mut v);
+            algo::bias(&model, &mut d, &q, &qd, &mut v);
+            algo::coriolis_matrix(&model, &mut d, &mut cw, &q, &qd, &mut m);
+            std::hint::black_box(algo::kinetic_energy(&model, &mut d, &q, &qd));
+            std::hint::black_box(algo::potential_energy(&model, &mut d, &q));
+            algo::forward_kinematics(&model, &mut d, &q, &mut x);
+            algo::jacobian(&model, &mut d, &q, model.nlinks() - 1, &mut j);
+        }
+    });
+    assert_eq!(allocs, 0);
+}
+
+#[test]
+fn batch_allocations_do_not_grow_with_the_number_of_states() {
+    let model = Model::new(&ur5_joints(), [0.0, 0.0, -9.81]).unwrap();
+    let n = model.nv;
+    let run = |rows: usize| {
+        let mut rng = Rng::new(1);
+        let (q, qd, qdd) = (rng.vec(rows * n, -1.0, 1.0), rng.vec(rows * n, -1.0, 1.0), rng.vec(rows * n, -1.0, 1.0));
+        let (mut out, mut m) = (vec![0.0; rows * n], vec![0.0; rows * n * n]);
+        count(|| {
+            batch::rnea(&model, [&q, &qd, &qdd], &mut out, Some(1));
+            batch::aba(&model, [&q, &qd, &qdd], &mut out, Some(1));
+            batch::crba(&model, [&q], &mut m, Some(1));
+        })
+    };
+    let (small, large) = (run(5), run(5000));
+    assert_eq!(small, large, "allocations: {small} for 5 states, {large} for 5000");
+    assert!(small <= 3 * 30, "{small} allocations (workspaces only)");
+}

@@ -1,0 +1,604 @@
+//! `armdyn._core`: thin Python bindings of armdyn-core.
+//!
+//! One class, `NumericModel`: built once from a robot's numeric description (see
+//! `python/armdyn/numeric.py`, which is the user-facing API and documents every
+//! function), holding the immutable model and a workspace for single calls.
+//!
+//! Every method takes one state `(n,)` or a batch `(N, n)` of float64 (anything else is
+//! converted once with `numpy.ascontiguousarray`) and answers in the same shape. Shape
+//! errors and NaN/inf raise `ValueError` naming the argument. Batches run on `threads`
+//! threads (None = all cores) with the GIL released. A Rust panic becomes a
+//! `RuntimeError`, never a crash.
+
+use armdyn_core::algo::coriolis::CoriolisWork;
+use armdyn_core::{algo, batch, Data, JointSpec, JointType, Model};
+use numpy::{PyArray, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyFloat, PyString};
+use std::collections::HashMap;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Mutex;
+
+/// Run `f`, turning a Rust panic into a Python `RuntimeError`.
+fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|payload| {
+        let msg = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".into());
+        Err(PyRuntimeError::new_err(format!("armdyn internal error (please report): {msg}")))
+    })
+}
+
+/// `obj` as a C-contiguous float64 array: as is when it already is one (no copy),
+/// else converted once by `numpy.ascontiguousarray(obj, dtype=float64)`.
+fn as_f64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
+        if a.is_c_contiguous() {
+            return Ok(a.clone());
+        }
+    }
+    static ASCONTIGUOUS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+    let py = obj.py();
+    let conv = ASCONTIGUOUS.import(py, "numpy", "ascontiguousarray")?;
+    let float64 = py.import("numpy")?.getattr("float64")?;
+    let converted = conv
+        .call1((obj, float64))
+        .map_err(|e| PyValueError::new_err(format!("{name}: cannot be read as a float64 array ({e})")))?;
+    Ok(converted.cast_into::<PyArrayDyn<f64>>()?)
+}
+
+/// The data of a C-contiguous array.
+///
+/// SAFETY (callers): the array is not written while the slice lives. Our inputs are
+/// only read, and our outputs are fresh arrays nobody else has seen; Python code could
+/// only write them concurrently if the user does so from another thread during a
+/// batch (with the GIL released), as with NumPy's own GIL-free functions.
+unsafe fn slice<'a>(a: &'a Bound<'_, PyArrayDyn<f64>>) -> &'a [f64] {
+    unsafe { a.as_slice().expect("C-contiguous") }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Shape {
+    /// One state, `(n,)`.
+    Single,
+    /// `N` states, `(N, n)`.
+    Batch(usize),
+}
+
+/// Convert and check state arguments `(name, object)`: each `(n,)` or `(N, n)`, all of
+/// the same shape, finite.
+fn states<'py, const K: usize>(
+    n: usize,
+    args: [(&str, &Bound<'py, PyAny>); K],
+) -> PyResult<(Shape, [Bound<'py, PyArrayDyn<f64>>; K])> {
+    let arrays: [Bound<'py, PyArrayDyn<f64>>; K] = {
+        let mut v = Vec::with_capacity(K);
+        for (name, obj) in args {
+            v.push(as_f64(obj, name)?);
+        }
+        v.try_into().map_err(|_| PyRuntimeError::new_err("argument count"))?
+    };
+    let mut shape = None;
+    for ((name, _), a) in args.iter().zip(&arrays) {
+        let s = match a.shape() {
+            [m] if *m == n => Shape::Single,
+            [rows, m] if *m == n => Shape::Batch(*rows),
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "{name}: expected shape ({n},) for one state or (N, {n}) for a batch, got {other:?}"
+                )))
+            }
+        };
+        match shape {
+            None => shape = Some(s),
+            Some(s0) if s0 != s => {
+                return Err(PyValueError::new_err(format!(
+                    "{name}: shape {:?} does not match {}'s {:?}",
+                    a.shape(),
+                    args[0].0,
+                    arrays[0].shape()
+                )))
+            }
+            _ => {}
+        }
+        // SAFETY: read-only, GIL held.
+        let values = unsafe { slice(a) };
+        if !all_finite(values) {
+            let k = values.iter().position(|x| !x.is_finite()).unwrap_or(0);
+            let at = match s {
+                Shape::Single => format!("[{k}]"),
+                Shape::Batch(_) => format!("[{}, {}]", k / n.max(1), k % n.max(1)),
+            };
+            return Err(PyValueError::new_err(format!("{name} contains NaN or inf (at {name}{at})")));
+        }
+    }
+    Ok((shape.expect("at least one argument"), arrays))
+}
+
+/// Whether no element is NaN or inf: `x - x` is 0 for finite `x` and NaN otherwise;
+/// eight independent sums let the loop vectorise (no early exit).
+#[allow(clippy::eq_op)]
+fn all_finite(values: &[f64]) -> bool {
+    let mut acc = [0.0f64; 8];
+    let chunks = values.chunks_exact(8);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for k in 0..8 {
+            acc[k] += c[k] - c[k];
+        }
+    }
+    acc.iter().chain(rest).all(|x| (x - x) == 0.0)
+}
+
+/// A fresh uninitialised float64 array of shape `dims`.
+fn new_array<'py>(py: Python<'py>, dims: &[usize]) -> Bound<'py, PyArrayDyn<f64>> {
+    // SAFETY: every element is written before the array is returned to Python.
+    unsafe { PyArray::<f64, _>::new(py, dims, false) }
+}
+
+/// `threads` as given from Python: None (all cores) or a positive count.
+fn thread_arg(threads: Option<i64>) -> PyResult<Option<usize>> {
+    match threads {
+        None => Ok(None),
+        Some(k) if k >= 1 => Ok(Some(k as usize)),
+        Some(k) => Err(PyValueError::new_err(format!("threads must be None or a positive integer, got {k}"))),
+    }
+}
+
+/// Workspaces for single calls.
+struct Scratch {
+    data: Data<f64>,
+    coriolis: CoriolisWork,
+}
+
+/// A robot's dynamics model compiled for numeric evaluation (see armdyn.numeric).
+#[pyclass(name = "NumericModel", module = "armdyn._core", frozen)]
+pub struct NumericModel {
+    model: Model,
+    scratch: Mutex<Scratch>,
+    name: String,
+    link_names: Vec<String>,
+    link_index: HashMap<String, usize>,
+    coordinate_names: Vec<String>,
+}
+
+impl NumericModel {
+    /// Index of a link given by name or index.
+    fn link_arg(&self, link: &Bound<'_, PyAny>) -> PyResult<usize> {
+        if let Ok(s) = link.cast::<PyString>() {
+            let s = s.to_str()?;
+            return self.link_index.get(s).copied().ok_or_else(|| {
+                PyValueError::new_err(format!("link: no link named '{s}' (links: {})", self.link_names.join(", ")))
+            });
+        }
+        match link.extract::<i64>() {
+            Ok(k) if k >= 0 && (k as usize) < self.model.nlinks() => Ok(k as usize),
+            Ok(k) => Err(PyValueError::new_err(format!("link: index {k} out of range 0..{}", self.model.nlinks()))),
+            Err(_) => Err(PyValueError::new_err("link: expected a link name or index")),
+        }
+    }
+
+    /// Run `f` with the single-call workspace (a fresh one if another thread holds it).
+    fn with_scratch<R>(&self, f: impl FnOnce(&mut Scratch) -> R) -> R {
+        match self.scratch.try_lock() {
+            Ok(mut s) => f(&mut s),
+            Err(std::sync::TryLockError::Poisoned(p)) => f(&mut p.into_inner()),
+            Err(std::sync::TryLockError::WouldBlock) => {
+                f(&mut Scratch { data: Data::new(&self.model), coriolis: CoriolisWork::new(&self.model) })
+            }
+        }
+    }
+
+    /// The shared body of the `(n,) -> (n,)` style methods whose batch path is a
+    /// lane kernel: `single(data, args, out)` or `batched(model, args, out, threads)`.
+    fn vector_op<'py, const K: usize>(
+        &self,
+        py: Python<'py>,
+        args: [(&str, &Bound<'py, PyAny>); K],
+        out_shape: &[usize],
+        threads: Option<i64>,
+        single: impl FnOnce(&Model, &mut Scratch, [&[f64]; K], &mut [f64]),
+        batched: impl FnOnce(&Model, [&[f64]; K], &mut [f64], Option<usize>) + Send,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        guard(|| {
+            let threads = thread_arg(threads)?;
+            let (shape, arrays) = states(self.model.nv, args)?;
+            match shape {
+                Shape::Single => {
+                    let out = new_array(py, out_shape);
+                    // SAFETY: inputs read-only and `out` fresh, GIL held throughout.
+                    let ins: [&[f64]; K] = std::array::from_fn(|k| unsafe { slice(&arrays[k]) });
+                    let o = unsafe { out.as_slice_mut().expect("fresh array") };
+                    self.with_scratch(|s| single(&self.model, s, ins, o));
+                    Ok(out)
+                }
+                Shape::Batch(rows) => {
+                    let dims: Vec<usize> = std::iter::once(rows).chain(out_shape.iter().copied()).collect();
+                    let out = new_array(py, &dims);
+                    let readonly: Vec<_> = arrays.iter().map(|a| a.readonly()).collect();
+                    let ins: [&[f64]; K] = std::array::from_fn(|k| readonly[k].as_slice().expect("contiguous"));
+                    // SAFETY: `out` is fresh and not visible to Python until returned.
+                    let o = unsafe { out.as_slice_mut().expect("fresh array") };
+                    let model = &self.model;
+                    py.detach(|| batched(model, ins, o, threads));
+                    Ok(out)
+                }
+            }
+        })
+    }
+}
+
+#[pymethods]
+impl NumericModel {
+    /// Build from the numeric description of a robot, joints in tree order (all of
+    /// them, fixed ones included), lists of length `nj`:
+    ///
+    /// parents[k]: index of the joint whose child link is joint k's parent (-1: base);
+    /// types[k]: 0 revolute, 1 prismatic, 2 fixed; rotations[k] (3x3): placement axes in
+    /// the parent link frame; translations[k] (3); axes[k] (3): unit axis in the placement
+    /// frame; masses[k], coms[k] (3), inertias[k] (3x3 about the com): joint k's child
+    /// link, in its frame; gravity (3) in the base frame. link_names: nj + 1 names (base
+    /// first); coordinate_names: the movable joints' names. base_mass and base_com (3,):
+    /// the base link, which only enters the potential energy (a constant).
+    #[new]
+    #[pyo3(signature = (parents, types, rotations, translations, axes, masses, coms, inertias, gravity, link_names, coordinate_names, name = String::new(), base_mass = 0.0, base_com = [0.0; 3]))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        parents: Vec<i64>,
+        types: Vec<i64>,
+        rotations: Vec<[[f64; 3]; 3]>,
+        translations: Vec<[f64; 3]>,
+        axes: Vec<[f64; 3]>,
+        masses: Vec<f64>,
+        coms: Vec<[f64; 3]>,
+        inertias: Vec<[[f64; 3]; 3]>,
+        gravity: [f64; 3],
+        link_names: Vec<String>,
+        coordinate_names: Vec<String>,
+        name: String,
+        base_mass: f64,
+        base_com: [f64; 3],
+    ) -> PyResult<Self> {
+        guard(|| {
+            let nj = parents.len();
+            let lens = [types.len(), rotations.len(), translations.len(), axes.len(), masses.len(), coms.len(), inertias.len()];
+            if lens.iter().any(|&l| l != nj) || link_names.len() != nj + 1 {
+                return Err(PyValueError::new_err(format!(
+                    "inconsistent lengths: {nj} parents, {lens:?} per-joint arrays, {} link names",
+                    link_names.len()
+                )));
+            }
+            let mut joints = Vec::with_capacity(nj);
+            for k in 0..nj {
+                let jtype = match types[k] {
+                    0 => JointType::Revolute,
+                    1 => JointType::Prismatic,
+                    2 => JointType::Fixed,
+                    t => return Err(PyValueError::new_err(format!("joint {k}: unknown joint type code {t}"))),
+                };
+                let parent = match parents[k] {
+                    -1 => None,
+                    p if p >= 0 => Some(p as usize),
+                    p => return Err(PyValueError::new_err(format!("joint {k}: bad parent index {p}"))),
+                };
+                joints.push(JointSpec {
+                    parent,
+                    jtype,
+                    rotation: rotations[k],
+                    translation: translations[k],
+                    axis: axes[k],
+                    mass: masses[k],
+                    com: coms[k],
+                    inertia: inertias[k],
+                });
+            }
+            if !(base_mass.is_finite() && base_com.iter().all(|x| x.is_finite())) {
+                return Err(PyValueError::new_err("base link: mass or com is not finite"));
+            }
+            let mut model = Model::new(&joints, gravity).map_err(|e| {
+                let what = match e.joint {
+                    Some(k) => format!("joint {k} (link '{}')", link_names[k + 1]),
+                    None => "model".into(),
+                };
+                PyValueError::new_err(format!("{what}: {}", e.message))
+            })?;
+            model.add_base_mass(base_mass, base_com);
+            if coordinate_names.len() != model.nv {
+                return Err(PyValueError::new_err(format!(
+                    "{} coordinate names for {} movable joints",
+                    coordinate_names.len(),
+                    model.nv
+                )));
+            }
+            let link_index = link_names.iter().enumerate().map(|(k, s)| (s.clone(), k)).collect();
+            let scratch = Mutex::new(Scratch { data: Data::new(&model), coriolis: CoriolisWork::new(&model) });
+            Ok(NumericModel { model, scratch, name, link_names, link_index, coordinate_names })
+        })
+    }
+
+    /// Number of movable joints.
+    #[getter]
+    fn dof(&self) -> usize {
+        self.model.nv
+    }
+    /// Number of link frames (base included).
+    #[getter]
+    fn nlinks(&self) -> usize {
+        self.model.nlinks()
+    }
+    #[getter]
+    fn name(&self) -> &str {
+        &self.name
+    }
+    /// Link names, base first (the order of forward_kinematics).
+    #[getter]
+    fn link_names(&self) -> Vec<String> {
+        self.link_names.clone()
+    }
+    /// Names of the movable joints (the order of q).
+    #[getter]
+    fn coordinate_names(&self) -> Vec<String> {
+        self.coordinate_names.clone()
+    }
+    /// Gravity (3,) in the base frame.
+    #[getter]
+    fn gravity(&self) -> [f64; 3] {
+        self.model.gravity.to_array()
+    }
+    /// The model itself, so that `obj._numeric_model` is the compiled model for a
+    /// Robot (where it is cached) and for a NumericModel alike.
+    #[getter(_numeric_model)]
+    fn compiled_self(slf: Bound<'_, Self>) -> Bound<'_, Self> {
+        slf
+    }
+
+    fn __repr__(&self) -> String {
+        format!("NumericModel({:?}, dof={}, nlinks={})", self.name, self.model.nv, self.model.nlinks())
+    }
+
+    /// Inverse dynamics tau = M qdd + C qd + g. q, qd, qdd: (n,) or (N, n).
+    #[pyo3(signature = (q, qd, qdd, threads = None))]
+    fn rnea<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        qd: &Bound<'py, PyAny>,
+        qdd: &Bound<'py, PyAny>,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        self.vector_op(
+            py,
+            [("q", q), ("qd", qd), ("qdd", qdd)],
+            &[self.model.nv],
+            threads,
+            |m, s, [q, qd, qdd], o| algo::rnea(m, &mut s.data, q, qd, qdd, o),
+            batch::rnea,
+        )
+    }
+
+    /// Forward dynamics qdd = M^-1 (tau - C qd - g). q, qd, tau: (n,) or (N, n).
+    #[pyo3(signature = (q, qd, tau, threads = None))]
+    fn aba<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        qd: &Bound<'py, PyAny>,
+        tau: &Bound<'py, PyAny>,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        self.vector_op(
+            py,
+            [("q", q), ("qd", qd), ("tau", tau)],
+            &[self.model.nv],
+            threads,
+            |m, s, [q, qd, tau], o| algo::aba(m, &mut s.data, q, qd, tau, o),
+            batch::aba,
+        )
+    }
+
+    /// Joint-space inertia matrix M (n, n) (or (N, n, n)).
+    #[pyo3(signature = (q, threads = None))]
+    fn crba<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.model.nv;
+        self.vector_op(
+            py,
+            [("q", q)],
+            &[n, n],
+            threads,
+            |m, s, [q], o| algo::crba(m, &mut s.data, q, o),
+            batch::crba,
+        )
+    }
+
+    /// Gravity torques g(q) = rnea(q, 0, 0).
+    #[pyo3(signature = (q, threads = None))]
+    fn gravity_torques<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        self.vector_op(
+            py,
+            [("q", q)],
+            &[self.model.nv],
+            threads,
+            |m, s, [q], o| algo::gravity(m, &mut s.data, q, o),
+            batch::gravity,
+        )
+    }
+
+    /// Nonlinear effects h = C qd + g = rnea(q, qd, 0).
+    #[pyo3(signature = (q, qd, threads = None))]
+    fn bias<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        qd: &Bound<'py, PyAny>,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        self.vector_op(
+            py,
+            [("q", q), ("qd", qd)],
+            &[self.model.nv],
+            threads,
+            |m, s, [q, qd], o| algo::bias(m, &mut s.data, q, qd, o),
+            batch::bias,
+        )
+    }
+
+    /// The Christoffel-consistent Coriolis matrix C (n, n) (or (N, n, n)).
+    #[pyo3(signature = (q, qd, threads = None))]
+    fn coriolis_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        qd: &Bound<'py, PyAny>,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let n = self.model.nv;
+        self.vector_op(
+            py,
+            [("q", q), ("qd", qd)],
+            &[n, n],
+            threads,
+            |m, s, [q, qd], o| algo::coriolis_matrix(m, &mut s.data, &mut s.coriolis, q, qd, o),
+            |m, [q, qd], o, t| batch::coriolis_matrix(m, q, qd, o, t),
+        )
+    }
+
+    /// Kinetic energy 1/2 qd^T M qd: a float (or (N,)).
+    #[pyo3(signature = (q, qd, threads = None))]
+    fn kinetic_energy<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        qd: &Bound<'py, PyAny>,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let out = self.vector_op(
+            py,
+            [("q", q), ("qd", qd)],
+            &[],
+            threads,
+            |m, s, [q, qd], o| o[0] = algo::kinetic_energy(m, &mut s.data, q, qd),
+            |m, [q, qd], o, t| batch::kinetic_energy(m, q, qd, o, t),
+        )?;
+        scalar_if_0d(out)
+    }
+
+    /// Potential energy -sum m_i g . p_ci: a float (or (N,)).
+    #[pyo3(signature = (q, threads = None))]
+    fn potential_energy<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let out = self.vector_op(
+            py,
+            [("q", q)],
+            &[],
+            threads,
+            |m, s, [q], o| o[0] = algo::potential_energy(m, &mut s.data, q),
+            |m, [q], o, t| batch::potential_energy(m, q, o, t),
+        )?;
+        scalar_if_0d(out)
+    }
+
+    /// Poses of all link frames in the base frame: (nlinks, 4, 4) (or (N, nlinks, 4, 4)).
+    #[pyo3(signature = (q, threads = None))]
+    fn forward_kinematics<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        self.vector_op(
+            py,
+            [("q", q)],
+            &[self.model.nlinks(), 4, 4],
+            threads,
+            |m, s, [q], o| algo::forward_kinematics(m, &mut s.data, q, o),
+            |m, [q], o, t| batch::forward_kinematics(m, q, o, t),
+        )
+    }
+
+    /// Geometric Jacobian (6, n) (or (N, 6, n)) of link `link` (name or index in
+    /// link_names), rows [v; w] in base-frame axes.
+    #[pyo3(signature = (q, link, threads = None))]
+    fn jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        link: &Bound<'py, PyAny>,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let index = self.link_arg(link)?;
+        self.vector_op(
+            py,
+            [("q", q)],
+            &[6, self.model.nv],
+            threads,
+            |m, s, [q], o| algo::jacobian(m, &mut s.data, q, index, o),
+            |m, [q], o, t| batch::jacobian(m, q, index, o, t),
+        )
+    }
+}
+
+/// A 0-d result as a Python float, else the array.
+fn scalar_if_0d(a: Bound<'_, PyArrayDyn<f64>>) -> PyResult<Bound<'_, PyAny>> {
+    if a.ndim() == 0 {
+        // SAFETY: a fresh 0-d array holds one element.
+        let x = unsafe { slice(&a) }[0];
+        Ok(PyFloat::new(a.py(), x).into_any())
+    } else {
+        Ok(a.into_any())
+    }
+}
+
+/// Panic on purpose (inside a batch call, with the GIL released, when `in_batch`), to
+/// test that panics surface as RuntimeError. Not part of the API.
+#[pyfunction]
+#[pyo3(signature = (in_batch = false))]
+fn _test_panic(py: Python<'_>, in_batch: bool) -> PyResult<()> {
+    guard(|| {
+        if in_batch {
+            let mut out = vec![0.0; 1000];
+            let model = Model::new(&[], [0.0; 3]).expect("empty model");
+            // rows of width 0 with a non-empty output: the batch driver's size check fails
+            py.detach(|| batch::crba(&model, [&[]], &mut out, Some(2)));
+        }
+        panic!("deliberate test panic")
+    })
+}
+
+/// The SIMD kernels batches run with on this CPU: "avx512" (8 states per step),
+/// "avx2" (4) or "baseline" (4; SSE2 on x86-64). The environment variable ARMDYN_SIMD
+/// (read once) caps them.
+#[pyfunction]
+fn simd_kernels() -> &'static str {
+    match batch::kernels() {
+        batch::Kernels::Avx512 => "avx512",
+        batch::Kernels::Avx2 => "avx2",
+        batch::Kernels::Baseline => "baseline",
+    }
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<NumericModel>()?;
+    m.add_function(wrap_pyfunction!(_test_panic, m)?)?;
+    m.add_function(wrap_pyfunction!(simd_kernels, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
