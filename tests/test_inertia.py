@@ -15,7 +15,9 @@ from armdyn.errors import ModelError
 from armdyn.model import rot_x, rot_y, rot_z, rpy_matrix
 
 RNG = np.random.default_rng(7)
-URDF = Path("/work/shared/data/iiwa14_dynamics_only.urdf")
+from armdyn.io import ROBOTS_DIR
+
+URDF = Path(ROBOTS_DIR) / "iiwa14.urdf"  # the KUKA iiwa 14 of shared/data, bundled
 
 
 # ---------------------------------------------------------------- oracles
