@@ -51,6 +51,7 @@ import warnings
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import numpy as np
 import sympy as sp
 
 from ..errors import ModelError
@@ -176,6 +177,17 @@ def _sym(value: float) -> sp.Expr:
     return sp.Integer(int(value)) if value.is_integer() and abs(value) < 2**53 else sp.Float(value)
 
 
+def _angle(value: float) -> sp.Expr:
+    """An rpy angle as SymPy: a multiple of pi/2 written to full double precision
+    (1.5707963267948966, 3.14159265359 is not) becomes exact, so that axis-aligned
+    rotations have exact 0/1 entries and symbolic derivations stay small; the number
+    changes by less than 1e-12 rad, below what the file states."""
+    k = round(value / (np.pi / 2))
+    if k != 0 and abs(value - k * np.pi / 2) < 1e-12:
+        return k * sp.pi / 2
+    return _sym(value)
+
+
 def _optional(elem: ET.Element | None, name: str, where: str) -> float | None:
     if elem is None or elem.get(name) is None:
         return None
@@ -191,7 +203,7 @@ def _origin(parent: ET.Element, where: str) -> tuple[sp.Matrix, sp.Matrix]:
             xyz = _numbers(origin.get("xyz"), 3, "<origin> xyz", where)
         if origin.get("rpy") is not None:
             rpy = _numbers(origin.get("rpy"), 3, "<origin> rpy", where)
-    rotation = sp.eye(3) if not any(rpy) else rpy_matrix(*(_sym(a) for a in rpy))
+    rotation = sp.eye(3) if not any(rpy) else rpy_matrix(*(_angle(a) for a in rpy))
     return sp.Matrix([_sym(v) for v in xyz]), rotation
 
 
