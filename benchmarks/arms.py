@@ -31,7 +31,7 @@ Franka Emika Panda, 7 R + hand.
     there ARE the Craig frames. The hand (0.73 kg) and two fingers (0.015 kg each, closed)
     are rigidly attached (fixed joints), as Pinocchio's reduced model with the fingers locked.
 KUKA LBR iiwa 14, 7 R.
-    /work/shared/data/iiwa14_dynamics_only.urdf (transcribed from Drake's
+    shared/data/iiwa14_dynamics_only.urdf (the bundled iiwa14.urdf holds the same numbers; transcribed from Drake's
     iiwa14_no_collision.urdf, BSD-3-Clause), read by the tiny loader below (joint origins,
     axes and inertials only; the project's URDF reader is not used here on purpose).
 """
@@ -44,13 +44,16 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
+from armdyn.io import ROBOTS_DIR
 from armdyn.model import Joint, Link, Robot
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "tests"))
 from pinocchio_bridge import PinocchioRobot  # noqa: E402
 
-IIWA_URDF = "/work/shared/data/iiwa14_dynamics_only.urdf"
+# shared/data/iiwa14_dynamics_only.urdf beside the repository; the bundled copy otherwise
+_SHARED = os.path.join(HERE, "..", "..", "shared", "data", "iiwa14_dynamics_only.urdf")
+IIWA_URDF = _SHARED if os.path.exists(_SHARED) else os.path.join(ROBOTS_DIR, "iiwa14.urdf")
 
 
 # --------------------------------------------------------------------------- small helpers
