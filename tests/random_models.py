@@ -99,3 +99,14 @@ def random_robot(
 def random_state(rng: np.random.Generator, n: int, scale: float = 1.0) -> np.ndarray:
     """A random (n,) vector with entries in [-scale*pi, scale*pi]."""
     return rng.uniform(-np.pi, np.pi, size=n) * scale
+
+
+def random_case(seed: int, tree: bool, max_joints: int):
+    """A random robot of 3..max_joints-1 joints, its Pinocchio twin and two random
+    (q, qd, qdd) states: the shared fixture of the reference and numeric tests."""
+    from pinocchio_bridge import PinocchioRobot
+
+    rng = np.random.default_rng(seed)
+    robot = random_robot(rng, n_joints=int(rng.integers(3, max_joints)), tree=tree)
+    states = [tuple(random_state(rng, robot.dof) for _ in range(3)) for _ in range(2)]
+    return robot, PinocchioRobot(robot), states

@@ -15,8 +15,7 @@ import sympy as sp
 from armdyn import reference as ref
 from armdyn.errors import UnboundParameterError
 from armdyn.model import Joint, Link, Robot
-from pinocchio_bridge import PinocchioRobot
-from random_models import random_robot, random_state
+from random_models import random_case, random_robot, random_state
 
 RTOL = 1e-12
 
@@ -42,10 +41,7 @@ CASES = [(seed, False) for seed in range(4)] + [(seed, True) for seed in range(4
 @pytest.fixture(scope="module", params=CASES, ids=[f"{'tree' if t else 'chain'}{s}" for s, t in CASES])
 def case(request):
     seed, tree = request.param
-    rng = np.random.default_rng(seed)
-    robot = random_robot(rng, n_joints=int(rng.integers(3, 10)), tree=tree)
-    states = [tuple(random_state(rng, robot.dof) for _ in range(3)) for _ in range(2)]
-    return robot, PinocchioRobot(robot), states
+    return random_case(seed, tree, max_joints=10)
 
 
 def test_random_models_cover_the_cases():
