@@ -30,9 +30,12 @@ def _too_big(expr, limit: int = EXACT_NODE_LIMIT) -> bool:
     return False
 
 
-def trig_reduce(expr, q: sp.Matrix):
+def trig_reduce(expr, q: sp.Matrix, keep_trig: bool = False):
     """``expr`` as an expanded polynomial in sin(q_i) -> S_i, cos(q_i) -> C_i with
-    every S_i^2 replaced by 1 - C_i^2, so that an identity reduces to exactly 0."""
+    every S_i^2 replaced by 1 - C_i^2, so that an identity reduces to exactly 0.
+
+    keep_trig: give the result back in sin(q_i), cos(q_i) (for display) instead of the
+    polynomial variables."""
     S = {qi: sp.Dummy(f"S_{qi}") for qi in q}
     C = {qi: sp.Dummy(f"C_{qi}") for qi in q}
     table = {sp.sin(qi): S[qi] for qi in q}
@@ -45,6 +48,8 @@ def trig_reduce(expr, q: sp.Matrix):
             if not powers:
                 break
             e = sp.expand(e.xreplace({p: s ** (p.exp - 2) * (1 - c**2) for p in powers}))
+    if keep_trig:
+        e = e.xreplace({v: k for k, v in table.items()})
     return e
 
 

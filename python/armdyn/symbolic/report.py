@@ -27,21 +27,11 @@ _TEXT_NAMES = {
 }
 
 
-def _untrig(expr, q):
-    """Inverse of the S/C substitution done by trig_reduce."""
-    table = {}
-    for s in expr.free_symbols:
-        if isinstance(s, sp.Dummy) and s.name[:2] in ("S_", "C_"):
-            qi = next(x for x in q if x.name == s.name[2:])
-            table[s] = sp.sin(qi) if s.name[0] == "S" else sp.cos(qi)
-    return expr.xreplace(table)
-
-
 def tidy_terms(expr, q, qd, qdd) -> list[tuple]:
     """``expr`` as an ordered list of ``(coefficient, monomial)``: joint-acceleration
     terms, velocity-product terms, then the rest (gravity), coefficients factored.
     Empty list for zero."""
-    e = _untrig(trig_reduce(expr, q), q)
+    e = trig_reduce(expr, q, keep_trig=True)
     if e == 0:
         return []
     motion = list(qdd) + [qd[i] * qd[j] for i in range(len(qd)) for j in range(i, len(qd))]
