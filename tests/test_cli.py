@@ -87,3 +87,11 @@ def test_bad_input_in_a_real_process_has_no_traceback():
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == [proc.stderr.strip()]
     assert "zero-axis.yaml" in proc.stderr and "joint 'j2'" in proc.stderr and "axis is zero" in proc.stderr
+
+
+def test_exercise_example_runs():
+    """examples/rp_arm_exercise.py asserts the exercise's identities itself."""
+    script = HERE.parent / "examples" / "rp_arm_exercise.py"
+    proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert "checks for 'rp-arm': all passed" in proc.stdout
