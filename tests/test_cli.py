@@ -95,3 +95,22 @@ def test_exercise_example_runs():
     proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     assert "checks for 'rp-arm': all passed" in proc.stdout
+
+
+def test_printed_tau_is_the_exercise_result(capsys):
+    """What the user reads, parsed back, is exactly the exercise's final tau1, tau2."""
+    import sympy as sp
+
+    _, out, _ = run(capsys, "derive", "rp-arm", "--method", "lagrange")
+    printed = {}
+    for line in out.splitlines():
+        if line.startswith("  tau"):
+            lhs, rhs = line.split(" = ", 1)
+            printed[lhs.strip()] = sp.sympify(rhs.rsplit("    (", 1)[0])
+    m1, m2, l1, g, th, d, thd, dd, thdd, ddd = sp.symbols(
+        "m1 m2 l1 g theta1 d2 theta1_dot d2_dot theta1_ddot d2_ddot")
+    tau1 = ((m1 + m2) * l1**2 * thdd + m2 * l1 * ddd + 2 * m2 * d * thd * dd + m2 * thdd * d**2
+            + (m1 + m2) * g * l1 * sp.cos(th) - m2 * g * d * sp.sin(th))
+    tau2 = m2 * (l1 * thdd - thd**2 * d + ddd + g * sp.cos(th))
+    assert sp.expand(printed["tau1"] - tau1) == 0
+    assert sp.expand(printed["tau2"] - tau2) == 0

@@ -37,6 +37,10 @@ def _energies(robot: Robot):
     w, v = {robot.base: zero}, {robot.base: zero}
     R0, p0 = {robot.base: sp.eye(3)}, {robot.base: zero}
     T_trans, T_rot, V, steps = {}, {}, {}, []
+    base = robot.links[robot.base]
+    if base.mass != 0:  # a constant, kept so that V is the total potential energy (as numeric V)
+        V[robot.base] = -base.mass * robot.gravity.dot(base.com)
+        steps.append(Step("energy", robot.base, "V", "V_{0}", V[robot.base], "potential energy of the base (constant)"))
     for joint in robot.joints:
         name, link = joint.child, robot.links[joint.child]
         i = str(list(robot.links).index(name))

@@ -56,13 +56,12 @@ def _join(terms, render) -> str:
             coef = -coef
         if mono == 1:
             body = render(coef)
-        elif coef == 1:
-            body = render(mono)
-        else:
-            c = render(coef)
-            if isinstance(coef, sp.Add):
-                c = f"({c})"
-            body = f"{c}*{render(mono)}" if render is str else f"{c} {render(mono)}"
+        elif isinstance(coef, sp.Add):  # a factored sum stays in front, in parentheses
+            body = f"({render(coef)})*{render(mono)}" if render is str else f"\\left({render(coef)}\\right) {render(mono)}"
+        elif any((f.is_Rational and f.q != 1) or (f.is_Pow and f.exp.is_negative) for f in sp.Mul.make_args(coef)):
+            body = render(coef * mono)  # a fraction reads best as SymPy writes it: l1*cos(q1)/2
+        else:  # coefficient first, as by hand: l1*m2*d2_ddot
+            body = f"{render(coef)}*{render(mono)}" if render is str else f"{render(coef)} {render(mono)}"
         out.append(("-" if negative else "+", body))
     text = ("-" if out[0][0] == "-" else "") + out[0][1]
     for sign, body in out[1:]:
@@ -194,6 +193,9 @@ def derivation_report(eoms: list[EquationsOfMotion], fmt: str = "text", steps: b
         title = {"newton-euler": "Newton-Euler", "lagrange": "Lagrange"}[eom.method]
         out.append("")
         out.append(f"{title}:" if fmt == "text" else (f"% {title}" if fmt == "latex" else f"## {title}"))
+        if steps and robot.meta.get("frames"):
+            note = " ".join(str(robot.meta["frames"]).split())
+            out.append(f" frames: {note}" if fmt == "text" else (f"% frames: {note}" if fmt == "latex" else f"*Frames:* {note}"))
         if fmt == "latex":
             out.append(r"\begin{align*}")
         if steps:
