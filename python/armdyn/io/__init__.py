@@ -86,7 +86,7 @@ def bundled_robots() -> list[dict]:
             entry.update(
                 dof=robot.dof,
                 convention=robot.meta.get("convention", "urdf" if path.suffix == ".urdf" else None),
-                description=robot.meta.get("description", ""),
+                description=robot.meta.get("description") or f"{robot.name} ({path.suffix[1:].upper()} file)",
                 source=robot.meta.get("source", ""),
             )
         out.append(entry)
