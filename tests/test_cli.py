@@ -114,3 +114,11 @@ def test_printed_tau_is_the_exercise_result(capsys):
     tau2 = m2 * (l1 * thdd - thd**2 * d + ddd + g * sp.cos(th))
     assert sp.expand(printed["tau1"] - tau1) == 0
     assert sp.expand(printed["tau2"] - tau2) == 0
+
+
+def test_allow_nonphysical_loads_with_one_warning_line(capsys):
+    path = HERE / "models" / "bad" / "triangle-inequality.yaml"
+    code, out, err = run(capsys, "derive", str(path), "--allow-nonphysical", "--method", "newton-euler")
+    assert code == 0 and "tau1 =" in out
+    assert err.startswith("armdyn: warning: ") and err.count("\n") == 1
+    assert "triangle-inequality.yaml" in err and "link 'l2'" in err and "triangle inequality" in err

@@ -15,6 +15,7 @@ import argparse
 import os
 import sys
 import time
+import warnings
 
 from .errors import ModelError
 
@@ -118,8 +119,14 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _one_line_warning(message, category, filename, lineno, file=None, line=None):
+    print(f"armdyn: warning: {message}", file=sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    shown = warnings.showwarning
+    warnings.showwarning = _one_line_warning  # e.g. --allow-nonphysical: one line, no source dump
     try:
         return args.func(args)
     except (ModelError, ValueError, FileNotFoundError) as err:
@@ -136,6 +143,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"armdyn: internal error: {type(err).__name__}: {err} (set ARMDYN_DEBUG=1 for a traceback)",
               file=sys.stderr)
         return 3
+    finally:
+        warnings.showwarning = shown
 
 
 if __name__ == "__main__":

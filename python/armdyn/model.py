@@ -282,7 +282,10 @@ class Robot:
         for link in links:
             if link.name in self.links:
                 raise ModelError("duplicate link name", f"link '{link.name}'")
-            check_physical(link.mass, link.inertia, f"link '{link.name}'", self.meta.get("file"), strict=strict)
+            # an error is located by the loader (which knows the line); a warning cannot be
+            # located later, so it names the model file itself
+            source = None if strict else self.meta.get("file")
+            check_physical(link.mass, link.inertia, f"link '{link.name}'", source, strict=strict)
             self.links[link.name] = link
 
         children = {j.child for j in joints}

@@ -343,6 +343,8 @@ def robot_from_dict(data, source: str = "<model>", strict: bool = True, default_
     gravity = parse_vector(data.get("gravity", [0, 0, -9.81]), params, "gravity", source)
     meta = {k: data[k] for k in ("description", "source", "notes") if k in data}
     meta["convention"] = convention
+    if source:
+        meta["file"] = source  # so that warnings during construction name the file
 
     if convention == "frames":
         if "dh" in data:
