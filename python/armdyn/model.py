@@ -319,6 +319,7 @@ class Robot:
         clash = set(self.coordinate_names) & set(self.parameters)
         if clash:
             raise ModelError(f"names used both as joint and as parameter: {sorted(clash)}", f"robot '{name}'")
+        self._link_index = {name: i for i, name in enumerate(self.links)}
         # index of each movable joint's coordinate, None for fixed joints
         self._coord_index = {}
         for j in self.joints:
@@ -370,6 +371,10 @@ class Robot:
         """Index of a joint's coordinate in ``q`` (None for a fixed joint)."""
         name = joint.name if isinstance(joint, Joint) else joint
         return self._coord_index[name]
+
+    def link_index(self, link: str) -> int:
+        """Frame number of a link: 0 for the base, then tree order (as in ``links``)."""
+        return self._link_index[link]
 
     def joint_coordinate(self, joint: Joint):
         """The joint's coordinate symbol (0 for a fixed joint)."""

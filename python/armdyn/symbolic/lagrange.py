@@ -43,7 +43,7 @@ def _energies(robot: Robot):
         steps.append(Step("energy", robot.base, "V", "V_{0}", V[robot.base], "potential energy of the base (constant)"))
     for joint in robot.joints:
         name, link = joint.child, robot.links[joint.child]
-        i = str(list(robot.links).index(name))
+        i = robot.link_index(name)
         k = robot.coordinate_index(joint)
         R, p = joint.transform(robot.joint_coordinate(joint))
         Rt = R.T

@@ -35,9 +35,6 @@ from ..model import Robot
 from .terms import EquationsOfMotion, Step
 
 
-def _frame_label(robot: Robot, link: str) -> str:
-    return str(list(robot.links).index(link))
-
 
 def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | None = None) -> sp.Matrix:
     """tau (n x 1) for joint velocities ``qd`` and accelerations ``qdd`` (sequences of
@@ -53,7 +50,7 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
 
     for joint in robot.joints:
         link = robot.links[joint.child]
-        parent, i = joint.parent, _frame_label(robot, joint.child)
+        parent, i = joint.parent, robot.link_index(joint.child)
         k = robot.coordinate_index(joint)
         R, p = joint.transform(robot.joint_coordinate(joint))
         placement[joint.child] = (R, p)
@@ -93,7 +90,7 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
     tau = [sp.Integer(0)] * robot.dof
     inward: list[Step] = []
     for joint in reversed(robot.joints):
-        name, i = joint.child, _frame_label(robot, joint.child)
+        name, i = joint.child, robot.link_index(joint.child)
         link = robot.links[name]
         f_i = F[name]
         n_i = N[name] + link.com.cross(F[name])

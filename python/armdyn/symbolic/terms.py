@@ -94,9 +94,8 @@ class EquationsOfMotion:
     method: str
     tau: sp.Matrix
     steps: list[Step] = field(default_factory=list)
-    # a method may supply M (Lagrange: the Hessian of T) or a function computing it on
-    # first use (Newton-Euler: Walker-Orin unit-acceleration passes); otherwise d tau/d qdd
-    _M: sp.Matrix | None = None
+    # a method may supply a function computing M on first use (Lagrange: the Hessian of
+    # T; Newton-Euler: Walker-Orin unit-acceleration passes); otherwise d tau/d qdd
     _M_builder: object = None
 
     @property
@@ -118,8 +117,6 @@ class EquationsOfMotion:
     @cached_property
     def M(self) -> sp.Matrix:
         """Joint-space inertia matrix (n x n), d tau / d qdd."""
-        if self._M is not None:
-            return self._M
         if self._M_builder is not None:
             return self._M_builder()
         n = self.robot.dof
