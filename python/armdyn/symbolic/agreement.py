@@ -23,13 +23,6 @@ from .terms import EquationsOfMotion, time_derivative
 EXACT_NODE_LIMIT = 4000
 
 
-def _too_big(expr, limit: int = EXACT_NODE_LIMIT) -> bool:
-    for count, _ in enumerate(sp.preorder_traversal(expr)):
-        if count > limit:
-            return True
-    return False
-
-
 def trig_reduce(expr, q: sp.Matrix, keep_trig: bool = False):
     """``expr`` as an expanded polynomial in sin(q_i) -> S_i, cos(q_i) -> C_i with
     every S_i^2 replaced by 1 - C_i^2, so that an identity reduces to exactly 0.
@@ -119,7 +112,7 @@ class _NumericSampler:
 def _compare(name, a: sp.Matrix, b: sp.Matrix, q, sampler, exact: bool | None, tol: float) -> CheckResult:
     diff = a - b
     if exact is None:
-        exact = not any(_too_big(e) for e in diff)
+        exact = not any(dag.larger_than(e, EXACT_NODE_LIMIT) for e in diff)
     if exact:
         return CheckResult(name, all(_exactly_zero(e, q) for e in diff), "exact")
     va, vb = sampler().evaluate(a), sampler().evaluate(b)

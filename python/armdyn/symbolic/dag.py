@@ -13,6 +13,16 @@ import numpy as np
 import sympy as sp
 
 
+def larger_than(expr, limit: int) -> bool:
+    """True if the expanded tree of ``expr`` has more than ``limit`` nodes; stops
+    counting at the limit, so it is cheap on huge expressions. Used to decide whether
+    an exact check or a hand-style display is affordable."""
+    for count, _ in enumerate(sp.preorder_traversal(expr)):
+        if count > limit:
+            return True
+    return False
+
+
 def free_symbols(exprs) -> set:
     """Union of the free symbols of ``exprs`` (an expression, a matrix or an iterable)."""
     seen, out = set(), set()

@@ -13,7 +13,8 @@ from __future__ import annotations
 import symengine as se
 import sympy as sp
 
-from .agreement import _too_big, trig_reduce
+from . import dag
+from .agreement import trig_reduce
 from .terms import EquationsOfMotion, Step
 
 #: expressions with more nodes than this are printed via common subexpressions
@@ -90,7 +91,7 @@ class Renderer:
 
     def scalar(self, expr) -> str:
         eom = self.eom
-        if _too_big(expr, TIDY_NODE_LIMIT):
+        if dag.larger_than(expr, TIDY_NODE_LIMIT):
             return self.atom(expr)
         render = str if self.fmt == "text" else self.atom
         return _join(tidy_terms(expr, eom.q, eom.qd, eom.qdd), render)
@@ -106,7 +107,8 @@ class Renderer:
     def label(self, step: Step) -> str:
         if self.fmt != "text":
             return step.label
-        i = str(list(self.eom.robot.links).index(step.link)) if step.link in self.eom.robot.links else ""
+        robot = self.eom.robot
+        i = str(robot.link_index(step.link)) if step.link in robot.links else ""
         if step.name in _TEXT_NAMES:
             return f"{_TEXT_NAMES[step.name]}{i.translate(_SUB)}"
         if step.link in self.eom.robot.coordinate_names:  # Lagrange equation steps are per coordinate
@@ -129,7 +131,7 @@ class Renderer:
 
 
 def _big(eom: EquationsOfMotion) -> bool:
-    return any(_too_big(t, TIDY_NODE_LIMIT) for t in eom.tau)
+    return any(dag.larger_than(t, TIDY_NODE_LIMIT) for t in eom.tau)
 
 
 def tau_lines(eom: EquationsOfMotion, fmt: str = "text") -> list[str]:
