@@ -102,22 +102,13 @@ def _row_values(row, x):
     return _f(row["a"]), _f(row["alpha"]), d, theta
 
 
-def standard_product(rows, q):
-    """DH frames 1..n of a standard table (list of 4x4)."""
+def dh_product(rows, q, link_transform):
+    """DH frames 1..n (list of 4x4): the running product of ``link_transform`` per row,
+    ``standard_A(a, alpha, d, theta)`` or ``modified_T(alpha, a, d, theta)``."""
     T, out = np.eye(4), []
     for row, x in zip(rows, q):
         a, alpha, d, theta = _row_values(row, x)
-        T = T @ standard_A(a, alpha, d, theta)
-        out.append(T)
-    return out
-
-
-def modified_product(rows, q):
-    """Craig's frames 1..n of a modified table (list of 4x4)."""
-    T, out = np.eye(4), []
-    for row, x in zip(rows, q):
-        a, alpha, d, theta = _row_values(row, x)
-        T = T @ modified_T(alpha, a, d, theta)
+        T = T @ link_transform(a=a, alpha=alpha, d=d, theta=theta)
         out.append(T)
     return out
 
@@ -208,7 +199,7 @@ def test_random_tables_match_the_dh_products(convention, seed):
     q = rng.uniform(-2, 2, 5)
     poses = link_poses(robot, q)
     if convention == "standard":
-        frames = standard_product(rows, q)
+        frames = dh_product(rows, q, standard_A)
         for i, row in enumerate(rows):
             dh_frame = poses[f"link{i + 1}"] @ Tx(_f(row["a"])) @ Rx(_f(row["alpha"]))
             np.testing.assert_allclose(dh_frame, frames[i], atol=1e-12)
@@ -216,7 +207,7 @@ def test_random_tables_match_the_dh_products(convention, seed):
         np.testing.assert_allclose(poses["flange"], frames[-1], atol=1e-12)
         assert robot.joints[-1].type == "fixed" and robot.dof == 5
     else:
-        frames = modified_product(rows, q)
+        frames = dh_product(rows, q, modified_T)
         for i in range(5):
             np.testing.assert_allclose(poses[f"link{i + 1}"], frames[i], atol=1e-12)
         assert "flange" not in robot.links
