@@ -1,0 +1,115 @@
+"""What grading a derivation produces: one verdict per step, and the report around them.
+
+A student's derivation is a list of equations ``LHS = ... = RHS``. Each one whose LHS
+names a step of the method (``\\dot{v}_1^1``, ``F_2^2``, ``\\tau_1``, ``T``...) gets a
+:class:`StepVerdict`; the :class:`GradeReport` holds them in the student's order with
+the summary (first wrong step, which final torques are right).
+
+Statuses (``StepVerdict.status``):
+
+* ``correct``: the student's value equals the expected one (exactly, up to
+  ``sin^2 + cos^2 = 1``).
+* ``correct-by-convention``: equal up to a named convention (``convention`` says which:
+  the d'Alembert sign ``F = -m vcd``; force on link i by link i-1 versus by link i on
+  i+1; gravity as a base acceleration versus as a force).
+* ``wrong``: neither; ``difference`` = got - expected (in the student's convention) and
+  ``components`` the wrong components.
+* ``follows-from-earlier-error``: wrong, but exactly what the method gives from the
+  student's own earlier values (``caused_by`` names the earliest wrong step it inherits).
+* ``correct-but-unsupported``: right, but not what the student's own earlier steps give.
+* ``unrecognised``: the LHS could not be mapped to a step (shown, skipped).
+
+Values are SymPy: a (3, 1) ``Matrix`` for vectors, an expression for scalars, in the
+robot model's symbols (``theta1``, ``theta1_dot``, ``l1``...); ``symbol_latex`` maps those
+symbols to the student's LaTeX (``\\dot{\\theta}_1``) for printing in their notation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+STATUSES = (
+    "correct",
+    "correct-by-convention",
+    "wrong",
+    "follows-from-earlier-error",
+    "correct-but-unsupported",
+    "unrecognised",
+)
+
+#: statuses that count as right for the exit status (0 when all steps are one of these)
+PASSING = ("correct", "correct-by-convention")
+
+
+@dataclass
+class StepVerdict:
+    """The verdict on one equation of the student's derivation.
+
+    name:        display name of the step, e.g. ``"v_dot_1"``, ``"F_2"``, ``"tau_1"``, ``"T"``
+    key:         the method's step key (``"v_dot"``, ``"F"``, ``"tau"``, ``"T"``...), "" if unrecognised
+    link:        the model's link (or joint, for tau) name, "" for whole-robot quantities
+    status:      one of :data:`STATUSES`
+    label:       LaTeX of the student's left-hand side as written
+    source:      the student's whole equation as written (LaTeX or YAML text)
+    line:        1-based line number of the equation in the submission
+    expected:    the correct value (SymPy Matrix (3, 1) or expression) in the student's
+                 convention, or None (unrecognised)
+    got:         the student's value, parsed, or None
+    difference:  got - expected, or None when they agree
+    components:  0-based indices of the wrong components of a vector ([] for scalars / none)
+    convention:  the convention the student used, named, or None
+    caused_by:   name of the earlier step an inherited error comes from, or None
+    message:     one readable sentence, e.g. "missing term −l1·θ̇1² in the x component"
+    frame:       the frame the value is expressed in, e.g. "1" (text), "" for scalars
+    """
+
+    name: str
+    key: str
+    link: str
+    status: str
+    label: str
+    source: str
+    line: int
+    expected: object = None
+    got: object = None
+    difference: object = None
+    components: list[int] = field(default_factory=list)
+    convention: str | None = None
+    caused_by: str | None = None
+    message: str = ""
+    frame: str = ""
+
+    @property
+    def passed(self) -> bool:
+        return self.status in PASSING
+
+
+@dataclass
+class GradeReport:
+    """The result of grading one submission.
+
+    robot:         name of the model the student's frames follow
+    method:        "newton-euler" or "lagrange"
+    submission:    path (or "<string>") of the graded file
+    steps:         one verdict per recognised or unrecognised equation, in the student's order
+    first_wrong:   ``name`` of the first step whose status is wrong (``wrong`` or
+                   ``follows-from-earlier-error`` cannot be first: the first wrong step is
+                   always ``wrong``), or None
+    tau_correct:   per joint: the student's final tau_i is right (supported or not);
+                   False where the student gave no tau_i
+    symbol_latex:  SymPy symbol -> the student's LaTeX for it, for printing
+    notes:         general remarks (mapping used, steps the method has that the student skipped)
+    """
+
+    robot: str
+    method: str
+    submission: str
+    steps: list[StepVerdict]
+    first_wrong: str | None
+    tau_correct: list[bool]
+    symbol_latex: dict = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def passed(self) -> bool:
+        return all(s.status in PASSING for s in self.steps if s.status != "unrecognised")
