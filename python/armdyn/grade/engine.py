@@ -1,0 +1,256 @@
+"""Grading: one verdict per step, errors carried forward.
+
+For each step the student wrote, in their order:
+
+1. **Right?** Their value is compared with the expected one in each named convention
+   (the usual one first). Equal in the usual one: ``correct``; in another:
+   ``correct-by-convention`` (named).
+2. **Supported?** The method's formula for the step is re-applied to the student's own
+   earlier values (where they wrote an input step, their value; where they did not, what
+   the method gives from theirs). A right value that none of these reproduces is
+   ``correct-but-unsupported``.
+3. **Carried forward?** A wrong value that one of those reproduces, with an earlier
+   error in its inputs, ``follows-from-earlier-error`` (``caused_by`` names the earliest
+   such error). Otherwise it is ``wrong``, explained against what the student's own
+   earlier values give (so a slip is described by itself, not mixed with inherited ones).
+
+Downstream, a step stands for the student's value; a step that is wrong on its own also
+for what it should have been from their inputs (a slip that the student did not carry on
+does not make every later step "wrong").
+
+Equality is decided numerically at a few random points of every symbol (coordinates,
+velocities, accelerations, parameters) with a relative tolerance of 1e-8, so exactness
+modulo ``sin^2 + cos^2 = 1`` and any arrangement of terms count as equal; NaN never does.
+Symbolic values are only built for what is shown (expected values, differences).
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+import symengine as se
+import sympy as sp
+
+from .methods import Method, evaluate_context
+
+#: sample points for the numeric comparison
+SAMPLES = 4
+RTOL = 1e-8
+#: candidate combinations tried per step (inputs x conventions), beyond which the rest is skipped
+MAX_COMBINATIONS = 64
+
+
+def as_matrix(value) -> sp.Matrix:
+    return value if isinstance(value, sp.MatrixBase) else sp.Matrix([[value]])
+
+
+class Sampler:
+    """Random points of every symbol and fingerprints (values at those points)."""
+
+    def __init__(self, symbols, robot, seed: int = 20261201):
+        rng = np.random.default_rng(seed)
+        self.symbols = sorted(set(symbols), key=str)
+        q = set(robot.q)
+        self.points = []
+        for _ in range(SAMPLES):
+            pt = {}
+            for s in self.symbols:
+                pt[s] = float(rng.uniform(-2.5, 2.5)) if s in q else float(rng.uniform(0.4, 1.6))
+            self.points.append(pt)
+        self._se_symbols = [se.Symbol(s.name) for s in self.symbols]
+
+    def fingerprint(self, value) -> np.ndarray:
+        """(SAMPLES, rows, cols) values of a SymPy expression or matrix."""
+        M = as_matrix(value)
+        stray = M.free_symbols - set(self.symbols)
+        if stray:
+            raise ValueError(f"unexpected symbols {sorted(map(str, stray))}")
+        flat = [se.sympify(x) for x in M]
+        f = se.Lambdify(self._se_symbols, flat, real=True, backend="lambda") if self._se_symbols else None
+        out = np.empty((SAMPLES, len(flat)))
+        for k, pt in enumerate(self.points):
+            if f is None:
+                out[k] = [float(x) for x in flat]
+            else:
+                out[k] = np.asarray(f([pt[s] for s in self.symbols]), dtype=float).ravel()
+        return out.reshape(SAMPLES, *M.shape)
+
+
+def equal(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Per component (rows, cols): True where equal at every sample point."""
+    if a.shape != b.shape:
+        return np.zeros(a.shape[1:], dtype=bool)
+    scale = np.maximum(1.0, np.maximum(np.abs(a), np.abs(b)).max(axis=0))
+    ok = np.abs(a - b) <= RTOL * scale
+    ok &= np.isfinite(a) & np.isfinite(b)
+    return ok.all(axis=0)
+
+
+@dataclass
+class Value:
+    """A candidate value of a step: numbers at the sample points, a way to build it
+    symbolically, and the student's wrong steps it inherits (``origins``)."""
+
+    fp: np.ndarray
+    build: object  # callable () -> sympy value
+    origins: frozenset = frozenset()
+
+    def sym(self):
+        if callable(self.build):
+            self.build = self.build()
+        return self.build
+
+
+class World:
+    """A method's steps with the student's values put in as they are given."""
+
+    def __init__(self, method: Method, ctx: dict, sampler: Sampler, numeric: bool):
+        self.method = method
+        self.sampler = sampler
+        self.numeric = numeric  # formulas evaluate at points (True) or symbolically (False)
+        self.ctx = ctx
+        self.ctx_points = [evaluate_context(ctx, pt) for pt in sampler.points] if numeric else None
+        exp_sym = method.expected(ctx)
+        self.expected: dict = {}
+        for ref in method.refs:
+            self.expected[ref] = Value(self._fp_of(ref, exp_sym), exp_sym[ref])
+        self.given: dict = {}  # ref -> list[Value]
+        self._computed: dict = {}
+
+    def _fp_of(self, ref, exp_sym):
+        if self.numeric:
+            if not hasattr(self, "_exp_points"):
+                self._exp_points = [self.method.expected(c) for c in self.ctx_points]
+            return np.stack([np.array(as_matrix(e[ref]).evalf(), dtype=float) for e in self._exp_points])
+        return self.sampler.fingerprint(exp_sym[ref])
+
+    # -- applying formulas and conventions to candidate values
+    def apply(self, fn, values: list[Value], extra_ctx_fn=None) -> Value:
+        """fn(ctx, *inputs) on candidate values: numbers at the points, symbols lazily."""
+        origins = frozenset().union(*(v.origins for v in values)) if values else frozenset()
+        if self.numeric:
+            fp = np.stack([
+                np.array(as_matrix(fn(c, *(_as_input(v.fp[k]) for v in values))).evalf(), dtype=float)
+                for k, c in enumerate(self.ctx_points)
+            ])
+            return Value(fp, lambda: fn(self.ctx, *(v.sym() for v in values)), origins)
+        sym = fn(self.ctx, *(v.sym() for v in values))
+        return Value(self.sampler.fingerprint(sym), sym, origins)
+
+    def candidates(self, ref) -> list[Value]:
+        """What the student's work gives for ``ref``: their value(s) if they wrote it,
+        else the method's formula over their inputs' candidates."""
+        if ref in self.given:
+            return self.given[ref]
+        if ref in self._computed:
+            return self._computed[ref]
+        if ref not in self.method.formulas:
+            out = [self.expected[ref]]
+        else:
+            out = self.carried(ref)
+        self._computed[ref] = out
+        return out
+
+    def carried(self, ref, extra_refs=()) -> list[Value]:
+        """The formula for ``ref`` over every combination of its inputs' candidates
+        (and of ``extra_refs``, returned alongside as the last inputs)."""
+        out = []
+        for formula in self.method.formulas.get(ref, []):
+            pools = [self.candidates(r) for r in formula.inputs]
+            for combo in itertools.islice(itertools.product(*pools), MAX_COMBINATIONS):
+                out.append(self.apply(formula.fn, list(combo)))
+        return _dedupe(out)
+
+    def invalidate(self):
+        self._computed.clear()
+
+
+def _as_input(fp_k: np.ndarray):
+    if fp_k.shape == (1, 1):
+        return sp.Float(fp_k[0, 0])
+    return sp.Matrix(fp_k)
+
+
+def _dedupe(values: list[Value]) -> list[Value]:
+    out: list[Value] = []
+    for v in values:
+        for j, w in enumerate(out):
+            if equal(v.fp, w.fp).all():
+                if len(v.origins) < len(w.origins):
+                    out[j] = v
+                break
+        else:
+            out.append(v)
+    return out
+
+
+@dataclass
+class Judgement:
+    status: str
+    convention: str | None
+    origins: frozenset
+    reference: Value | None  # what the student's value is compared with when wrong
+    conv: object = None
+    canon: Value | None = None  # the reference in canonical form
+
+
+def judge(world: World, ref, got: Value, extra_candidates) -> Judgement:
+    """The status of the student's value ``got`` (fingerprinted, shown form) of ``ref``."""
+    method = world.method
+    conventions = method.conventions_of(ref)
+    exp = world.expected[ref]
+
+    def shown(conv, value: Value, extras: list[Value]) -> Value:
+        return world.apply(lambda c, v, *x: conv.forward(v, c, *x), [value, *extras])
+
+    def extras_of(conv):
+        return [extra_candidates(r) for r in conv.extra]
+
+    # 1. right in some convention?
+    for conv in conventions:
+        for extras in itertools.product(*([world.expected[r]] for r in conv.extra)):
+            if equal(got.fp, shown(conv, exp, list(extras)).fp).all():
+                supported = _supported(world, ref, got, conv, extras_of)
+                status = ("correct" if not conv.name else "correct-by-convention") if supported \
+                    else "correct-but-unsupported"
+                return Judgement(status, conv.name or None, frozenset(), None, conv)
+    # 2. carried forward from the student's own earlier values?
+    carried = world.carried(ref) if ref in method.formulas else []
+    best, best_key = None, None
+    for conv in conventions:
+        for value in carried:
+            for extras in itertools.product(*extras_of(conv)):
+                s = shown(conv, value, list(extras))
+                ok = equal(got.fp, s.fp)
+                if ok.all() and s.origins:
+                    return Judgement("follows-from-earlier-error", conv.name or None, s.origins, s, conv, value)
+                key = (int((~ok).sum()), len(s.origins), conventions.index(conv))
+                if best_key is None or key < best_key:
+                    best, best_key = Judgement("wrong", conv.name or None, s.origins, s, conv, value), key
+    if best is None:  # a leaf (given data) or no formula: compare with the expected value
+        for conv in conventions:
+            s = shown(conv, exp, [world.expected[r] for r in conv.extra])
+            key = (int((~equal(got.fp, s.fp)).sum()), 0, conventions.index(conv))
+            if best_key is None or key < best_key:
+                best, best_key = Judgement("wrong", conv.name or None, frozenset(), s, conv, exp), key
+    return best
+
+
+def _supported(world: World, ref, got: Value, conv, extras_of) -> bool:
+    """Does the formula over the student's own values give ``got``? (Leaves: yes.)"""
+    if ref not in world.method.formulas:
+        return True
+    for value in world.carried(ref):
+        for extras in itertools.product(*extras_of(conv)):
+            s = world.apply(lambda c, v, *x: conv.forward(v, c, *x), [value, *extras])
+            if equal(got.fp, s.fp).all():
+                return True
+    return False
+
+
+def canonical(world: World, conv, got: Value, extras: list[Value], origins) -> Value:
+    """The student's shown value back in canonical form (for later steps)."""
+    v = world.apply(lambda c, s, *x: conv.inverse(s, c, *x), [got, *extras])
+    return Value(v.fp, v.build, frozenset(origins))
