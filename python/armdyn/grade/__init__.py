@@ -19,13 +19,14 @@ import os
 import sys
 import types
 
+import symengine as se
 import sympy as sp
 
 from ..errors import ModelError
 from ..model import Robot
-from .engine import Sampler, Value, World, canonical, judge
+from .engine import Sampler, Value, World, canonical, judge, to_sympy
 from .explain import component_name, describe, pretty, tidy
-from .latex import LatexError, UnknownSymbol, parse
+from .latex import LatexError, UnknownSymbol, parse, parse_sympy_syntax
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .reader import Submission, read
@@ -97,16 +98,13 @@ class _Grader:
                 else:
                     value = parse(str(raw), self.symbols)
             else:
-                from ..io.expressions import parse_expression
-
                 names = dict(self.symbols.names)
-                names.update({k: sp.Symbol(k) for k in self.symbols.steps})
+                names.update({k: v for k, v in self.symbols.steps.items() if not isinstance(v, sp.MatrixBase)})
                 raw = eq.value
                 items = raw if isinstance(raw, list) else [raw]
-                parsed = [parse_expression(v, names) for v in items]
-                parsed = [p.xreplace({sp.Symbol(k): v for k, v in self.symbols.steps.items()
-                                      if not isinstance(v, sp.MatrixBase)}) for p in parsed]
-                value = sp.Matrix(parsed) if isinstance(raw, list) else parsed[0]
+                parsed = [se.sympify(v) if isinstance(v, (int, float)) else
+                          parse_sympy_syntax(str(v), names, symengine=True) for v in items]
+                value = se.DenseMatrix(len(parsed), 1, parsed) if isinstance(raw, list) else parsed[0]
         except UnknownSymbol as err:
             raise ModelError(f"{ref.name}: {err}", source=self.where(eq)) from None
         except ModelError as err:
@@ -125,6 +123,15 @@ class _Grader:
             want = (3, 1)
         else:
             want = None
+        if isinstance(value, se.DenseMatrix) and (want is None or value.shape == (1, 1) or value.shape[1] != 1):
+            value = to_sympy(value)  # small: shaped by the SymPy rules below
+        elif isinstance(value, se.Basic) and not isinstance(value, se.DenseMatrix) and want is not None:
+            value = to_sympy(value)
+        if isinstance(value, se.DenseMatrix):
+            if value.shape != want:
+                raise ModelError(f"{ref.name} must be a vector of 3 components, but it has {value.shape[0]}",
+                                 source=self.where(eq))
+            return value
         if want is None:
             if isinstance(value, sp.MatrixBase):
                 if value.shape == (1, 1):
@@ -248,6 +255,7 @@ class _Grader:
         if ref.key in VECTOR_KEYS:
             link = list(self.robot.links)[ref.index]
             if ref.frame is not None and ref.frame != ref.index:
+                value = own = to_sympy(value)
                 own = rotation_between(world.ctx, ref.frame, ref.index) * value  # into the link's own frame
         got = Value(self.sampler.fingerprint(own), own)
         candidates = lambda r: world.candidates(r)  # noqa: E731
@@ -276,6 +284,7 @@ class _Grader:
             exp_shown = rotation_between(world.ctx, ref.index, ref.frame) * exp_shown
         difference, components, message = None, [], ""
         if j.status in ("wrong", "follows-from-earlier-error", "correct-but-unsupported"):
+            value = to_sympy(value)
             ref_value = j.reference.sym() if j.status != "correct-but-unsupported" else exp_shown
             if j.status == "correct-but-unsupported":
                 carried = world.carried(key)
@@ -374,6 +383,11 @@ def grade(submission, robot: str | Robot | None = None, symbols: dict | None = N
         if not name:
             raise ModelError("no robot named: give --robot MODEL or 'robot:' in the front matter", source=sub.path)
         model = _load_robot(name, sub)
+    if sub.values is not None:
+        try:
+            model = model.bind(None if sub.values == "published" else sub.values)
+        except ModelError as err:
+            raise err.located(source=sub.path) from None
     hint = sub.method if sub.method in ("newton-euler", "lagrange") else None
     return _Grader(sub, model, symbols).run(hint)
 

@@ -46,6 +46,22 @@ def as_matrix(value) -> sp.Matrix:
     return value if isinstance(value, sp.MatrixBase) else sp.Matrix([[value]])
 
 
+def entries(value) -> tuple[list, tuple]:
+    """The entries (row-major) and shape of a SymPy or SymEngine scalar or matrix."""
+    if isinstance(value, (sp.MatrixBase, se.DenseMatrix)):
+        return list(value), tuple(value.shape)
+    return [value], (1, 1)
+
+
+def to_sympy(value):
+    """A SymEngine value (a generated derivation's step) as SymPy; SymPy unchanged."""
+    if isinstance(value, se.DenseMatrix):
+        return sp.Matrix(value.tolist())
+    if isinstance(value, se.Basic):
+        return sp.sympify(value)
+    return value
+
+
 class Sampler:
     """Random points of every symbol and fingerprints (values at those points)."""
 
@@ -59,23 +75,18 @@ class Sampler:
             for s in self.symbols:
                 pt[s] = float(rng.uniform(-2.5, 2.5)) if s in q else float(rng.uniform(0.4, 1.6))
             self.points.append(pt)
-        self._se_symbols = [se.Symbol(s.name) for s in self.symbols]
+        self._se_points = [{se.Symbol(s.name): se.RealDouble(v) for s, v in pt.items()} for pt in self.points]
 
     def fingerprint(self, value) -> np.ndarray:
-        """(SAMPLES, rows, cols) values of a SymPy expression or matrix."""
-        M = as_matrix(value)
-        stray = M.free_symbols - set(self.symbols)
-        if stray:
-            raise ValueError(f"unexpected symbols {sorted(map(str, stray))}")
-        flat = [se.sympify(x) for x in M]
-        f = se.Lambdify(self._se_symbols, flat, real=True, backend="lambda") if self._se_symbols else None
+        """(SAMPLES, rows, cols) values of a SymPy or SymEngine expression or matrix."""
+        items, shape = entries(value)
+        flat = [x if isinstance(x, se.Basic) else se.sympify(x) for x in items]
         out = np.empty((SAMPLES, len(flat)))
-        for k, pt in enumerate(self.points):
-            if f is None:
-                out[k] = [float(x) for x in flat]
-            else:
-                out[k] = np.asarray(f([pt[s] for s in self.symbols]), dtype=float).ravel()
-        return out.reshape(SAMPLES, *M.shape)
+        # substitution, not Lambdify: building a Lambdify grows faster than linearly with
+        # the expression (minutes for a generated 6-dof step), substituting is linear
+        for k, pt in enumerate(self._se_points):
+            out[k] = [float(x.subs(pt)) if x.free_symbols else float(x) for x in flat]
+        return out.reshape(SAMPLES, *shape)
 
 
 def equal(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -100,6 +111,8 @@ class Value:
     def sym(self):
         if callable(self.build):
             self.build = self.build()
+        if isinstance(self.build, (se.DenseMatrix, se.Basic)):
+            self.build = to_sympy(self.build)
         return self.build
 
 
@@ -135,7 +148,7 @@ class World:
                 np.array(as_matrix(fn(c, *(_as_input(v.fp[k]) for v in values))).evalf(), dtype=float)
                 for k, c in enumerate(self.ctx_points)
             ])
-            return Value(fp, lambda: fn(self.ctx, *(v.sym() for v in values)), origins)
+            return Value(fp, lambda: to_sympy(fn(self.ctx, *(v.sym() for v in values))), origins)
         sym = fn(self.ctx, *(v.sym() for v in values))
         return Value(self.sampler.fingerprint(sym), sym, origins)
 

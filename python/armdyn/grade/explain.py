@@ -43,6 +43,22 @@ def display_name(name: str, ascii_only: bool = False) -> str:
     return base + accent + digits
 
 
+_LATIN = {v: k for k, v in _GREEK.items()}
+
+
+def to_ascii(text: str) -> str:
+    """A message printed with :func:`pretty` back in plain ASCII (``θ̇1`` -> ``theta1_dot``)."""
+    def name(m):
+        base, accent, digits = m.groups()
+        dots = {"\u0307": "_dot", "\u0308": "_ddot"}.get(accent or "", "")
+        return _LATIN.get(base, base) + digits + dots
+
+    text = re.sub("([A-Za-z\u0370-\u03ff])([\u0307\u0308])?(\\d*)", name, text)
+    for a, b in (("·", "*"), ("−", "-"), ("²", "**2"), ("³", "**3"), ("→", "->"), ("×", "x")):
+        text = text.replace(a, b)
+    return text.encode("ascii", "replace").decode()
+
+
 def pretty(expr, ascii_only: bool = False) -> str:
     """One line, ``−l1·θ̇1²`` style."""
     expr = sp.sympify(expr)

@@ -484,3 +484,59 @@ def sides(equation: str) -> list[str]:
         out.append(equation[start:cut].strip())
         start = cut + 1
     return out
+
+
+# ------------------------------------------------------------------ SymPy syntax
+
+#: functions a value in SymPy syntax may call
+SYMPY_FUNCTIONS = {"sin", "cos", "tan", "exp", "log", "sqrt", "Abs", "sec", "csc", "cot"}
+_BIG_POWER = re.compile(r"(\*\*|\^)\s*\(?\s*\d{4,}|\d+\s*(\*\*|\^)\s*\d+\s*(\*\*|\^)")
+_SYNTAX = re.compile(r"[A-Za-z_][A-Za-z_0-9]*|\d+(?:\.\d*)?(?:[eE][-+]?\d+)?|\.\d+(?:[eE][-+]?\d+)?|\*\*|[-+*/^(),\s]")
+
+
+def parse_sympy_syntax(text: str, names: dict, symengine: bool = False):
+    """An expression in SymPy syntax (``l1*theta1_dot**2 + g*sin(theta1)``) as SymPy.
+
+    Parsed by SymEngine's C++ parser (no Python ``eval``) after checks that keep it
+    bounded: only names, numbers, ``+ - * / ** ^ ( ) ,``; parentheses nested at most
+    :data:`MAX_DEPTH` deep; no exact power with a huge exponent; then every name must be
+    one of ``names`` (name -> SymPy symbol) or a whitelisted function. ``symengine``:
+    return the SymEngine expression (no conversion: large generated derivations)."""
+    import symengine as se
+
+    if len(text) > 50 * MAX_LENGTH:
+        raise LatexError(f"expression too long ({len(text)} characters)")
+    pos, depth = 0, 0
+    for m in _SYNTAX.finditer(text):
+        if m.start() != pos:
+            raise LatexError(f"unexpected character {text[pos]!r}")
+        pos = m.end()
+        tok = m.group(0)
+        if tok == "(":
+            depth += 1
+            if depth > MAX_DEPTH:
+                raise LatexError(f"parentheses nested deeper than {MAX_DEPTH} levels")
+        elif tok == ")":
+            depth -= 1
+            if depth < 0:
+                raise LatexError("unbalanced ')'")
+    if pos != len(text):
+        raise LatexError(f"unexpected character {text[pos]!r}")
+    if depth:
+        raise LatexError("unbalanced '('")
+    if _BIG_POWER.search(text):
+        raise LatexError("an exact power with a huge exponent")
+    try:
+        value = se.sympify(text)
+    except Exception as exc:  # noqa: BLE001 - SymEngine's parse errors have several types
+        raise LatexError(f"cannot parse {text[:60]!r} ({exc})") from None
+    for fn in value.atoms(se.FunctionSymbol) if hasattr(se, "FunctionSymbol") else ():
+        raise LatexError(f"unknown function {fn}")
+    table = {}
+    for sym in value.free_symbols:
+        name = str(sym)
+        if name not in names:
+            raise UnknownSymbol(f"unknown symbol {name}")
+        table[sym] = se.sympify(names[name])
+    value = value.xreplace(table) if table else value
+    return value if symengine else sp.sympify(value)

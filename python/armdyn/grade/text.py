@@ -6,9 +6,10 @@ from __future__ import annotations
 import json
 import unicodedata
 
+import symengine as se
 import sympy as sp
 
-from .explain import display_name, pretty
+from .explain import display_name, pretty, to_ascii
 from .verdict import GradeReport, StepVerdict
 
 _MARK = {
@@ -101,12 +102,17 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
     lines.append("final torques: " + "; ".join(taus))
     for note in report.notes:
         lines.append(f"note: {note}")
-    return "\n".join(lines)
+    out = "\n".join(lines)
+    return to_ascii(out) if ascii_only else out
 
 
 def _str(value):
     if value is None:
         return None
+    if isinstance(value, se.DenseMatrix):
+        return [str(x) for x in value]
+    if isinstance(value, se.Basic):
+        return str(value)
     if isinstance(value, sp.MatrixBase):
         return [str(x) for x in value] if value.shape[1] == 1 else [[str(x) for x in value.row(i)]
                                                                     for i in range(value.rows)]
