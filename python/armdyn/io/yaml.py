@@ -205,7 +205,7 @@ def _rotation(item, rpy_key, matrix_key, params, element, where):
         raise ModelError(f"give either {rpy_key} or {matrix_key}, not both", element, where)
     if matrix_key in item:
         rotation = parse_matrix3(item[matrix_key], params, element, where, matrix_key)
-        check_rotation(rotation, element, where)
+        check_rotation(rotation, element, where, what=matrix_key)
         return rotation
     return rpy_matrix(*parse_vector(item.get(rpy_key, [0, 0, 0]), params, element, where, rpy_key))
 
