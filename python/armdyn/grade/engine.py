@@ -85,8 +85,17 @@ class Sampler:
         # substitution, not Lambdify: building a Lambdify grows faster than linearly with
         # the expression (minutes for a generated 6-dof step), substituting is linear
         for k, pt in enumerate(self._se_points):
-            out[k] = [float(x.subs(pt)) if x.free_symbols else float(x) for x in flat]
+            out[k] = [_real(x.subs(pt) if x.free_symbols else x) for x in flat]
         return out.reshape(SAMPLES, *shape)
+
+
+def _real(x) -> float:
+    """A number as a float; NaN for what is not a finite real (0/0, log(-1)): NaN never
+    compares equal, so such a value is never judged right."""
+    try:
+        return float(x)
+    except (RuntimeError, TypeError, ValueError, OverflowError):
+        return float("nan")
 
 
 def equal(a: np.ndarray, b: np.ndarray) -> np.ndarray:
