@@ -62,6 +62,77 @@ def to_sympy(value):
     return value
 
 
+class NumMat:
+    """A float matrix with SymPy's matrix interface (``*`` multiplies matrices, ``.T``,
+    ``.cross``, ``.dot``), so the Newton-Euler step formulas written for SymPy run on
+    numbers at the sample points at NumPy speed."""
+
+    __slots__ = ("a",)
+    __array_priority__ = 100  # numpy scalars defer to our __rmul__
+
+    def __init__(self, a):
+        self.a = np.asarray(a, dtype=float)
+
+    @staticmethod
+    def of(x):
+        if isinstance(x, NumMat):
+            return x.a
+        if isinstance(x, sp.MatrixBase):
+            return np.array(x.evalf(), dtype=float)
+        return float(x)
+
+    @property
+    def T(self):
+        return NumMat(self.a.T)
+
+    def __mul__(self, o):
+        o = self.of(o)
+        return NumMat(self.a @ o) if isinstance(o, np.ndarray) else NumMat(self.a * o)
+
+    def __rmul__(self, o):
+        o = self.of(o)
+        return NumMat(o @ self.a) if isinstance(o, np.ndarray) else NumMat(o * self.a)
+
+    def __add__(self, o):
+        return NumMat(self.a + self.of(o))
+
+    __radd__ = __add__
+
+    def __sub__(self, o):
+        return NumMat(self.a - self.of(o))
+
+    def __rsub__(self, o):
+        return NumMat(self.of(o) - self.a)
+
+    def __neg__(self):
+        return NumMat(-self.a)
+
+    def cross(self, o):
+        return NumMat(np.cross(self.a.ravel(), self.of(o).ravel()).reshape(3, 1))
+
+    def dot(self, o):
+        return float(self.a.ravel() @ self.of(o).ravel())
+
+
+def _to_num(x):
+    """A context entry evaluated at a point as NumMat / float (strings, lists as they are)."""
+    if isinstance(x, sp.MatrixBase):
+        return NumMat(np.array(x.evalf(), dtype=float))
+    if isinstance(x, sp.Basic):
+        return float(x)
+    if isinstance(x, dict):
+        return {k: _to_num(v) for k, v in x.items()}
+    return x
+
+
+def _from_num(x) -> np.ndarray:
+    if isinstance(x, NumMat):
+        return x.a.reshape(x.a.shape if x.a.ndim == 2 else (-1, 1))
+    if isinstance(x, sp.MatrixBase):
+        return np.array(x.evalf(), dtype=float)
+    return np.array([[float(x)]])
+
+
 class Sampler:
     """Random points of every symbol and fingerprints (values at those points)."""
 
@@ -133,7 +204,7 @@ class World:
         self.sampler = sampler
         self.numeric = numeric  # formulas evaluate at points (True) or symbolically (False)
         self.ctx = ctx
-        self.ctx_points = [evaluate_context(ctx, pt) for pt in sampler.points] if numeric else None
+        self.ctx_points = [_to_num(evaluate_context(ctx, pt)) for pt in sampler.points] if numeric else None
         exp_sym = method.expected(ctx)
         self.expected: dict = {}
         for ref in method.refs:
@@ -145,7 +216,7 @@ class World:
         if self.numeric:
             if not hasattr(self, "_exp_points"):
                 self._exp_points = [self.method.expected(c) for c in self.ctx_points]
-            return np.stack([np.array(as_matrix(e[ref]).evalf(), dtype=float) for e in self._exp_points])
+            return np.stack([_from_num(e[ref]) for e in self._exp_points])
         return self.sampler.fingerprint(exp_sym[ref])
 
     # -- applying formulas and conventions to candidate values
@@ -154,8 +225,7 @@ class World:
         origins = frozenset().union(*(v.origins for v in values)) if values else frozenset()
         if self.numeric:
             fp = np.stack([
-                np.array(as_matrix(fn(c, *(_as_input(v.fp[k]) for v in values))).evalf(), dtype=float)
-                for k, c in enumerate(self.ctx_points)
+                _from_num(fn(c, *(_as_input(v.fp[k]) for v in values))) for k, c in enumerate(self.ctx_points)
             ])
             return Value(fp, lambda: to_sympy(fn(self.ctx, *(v.sym() for v in values))), origins)
         sym = fn(self.ctx, *(v.sym() for v in values))
@@ -191,8 +261,8 @@ class World:
 
 def _as_input(fp_k: np.ndarray):
     if fp_k.shape == (1, 1):
-        return sp.Float(fp_k[0, 0])
-    return sp.Matrix(fp_k)
+        return float(fp_k[0, 0])
+    return NumMat(fp_k)
 
 
 def _dedupe(values: list[Value]) -> list[Value]:

@@ -85,7 +85,7 @@ class Method:
 
 def _link_context(robot: Robot):
     """Symbolic model quantities per link index (1..n), base = 0."""
-    ctx = {"gravity": robot.gravity, "R0": {0: sp.eye(3)}}
+    ctx = {"gravity": robot.gravity, "R0": {0: sp.eye(3)}, "zero": sp.zeros(3, 1)}
     for joint in robot.joints:
         i = robot.link_index(joint.child)
         p = robot.link_index(joint.parent)
@@ -130,8 +130,8 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
     n = len(robot.links) - 1
     zero = sp.zeros(3, 1)
     m = Method("newton-euler", robot, [])
-    m.leaves[("omega", 0)] = lambda c: zero
-    m.leaves[("omega_dot", 0)] = lambda c: zero
+    m.leaves[("omega", 0)] = lambda c: c["zero"]
+    m.leaves[("omega_dot", 0)] = lambda c: c["zero"]
     m.leaves[("v_dot", 0)] = lambda c: -c["gravity"]
     m.refs += [("omega", 0), ("omega_dot", 0), ("v_dot", 0)]
 
@@ -208,7 +208,7 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
         k = robot.coordinate_index(robot.parent_joint(robot_link(robot, i)))
         if k is not None:
             def tau_fn(c, nv, fv, i=i):
-                point = c[i]["o"] if c[i]["kind"] == "revolute" else sp.zeros(3, 1)
+                point = c[i]["o"] if c[i]["kind"] == "revolute" else c["zero"]
                 return ne.joint_torque(c[i]["kind"], c[i]["z"], ne.moment_about(nv, fv, point), fv)
 
             m.formulas[("tau", k + 1)] = [Formula((("n", i), ("f", i)), tau_fn)]

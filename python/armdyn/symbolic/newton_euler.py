@@ -83,7 +83,10 @@ def inertial_moment(I, w, wd):
 
 def joint_force(F, children):
     """f_i from F_i and the children's ``(R_c, f_c)``."""
-    return sp.Matrix(F) + sum((Rc * fc for Rc, fc in children), sp.zeros(3, 1))
+    out = F
+    for Rc, fc in children:
+        out = out + Rc * fc
+    return out
 
 
 def joint_moment(N, c, F, children):
