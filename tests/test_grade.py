@@ -233,3 +233,18 @@ def test_latex_reader_pieces():
 
 def test_armdyn_grade_is_callable():
     assert armdyn.grade(EXAMPLES / "rp-arm-dalembert.md").passed
+
+
+def test_hostile_values_are_refused_in_bounded_time(tmp_path):
+    import time
+
+    path = tmp_path / "hostile.md"
+    path.write_text("---\nrobot: rp-arm\n---\n"
+                    "$$\\tau_1 = 10^{10^{10}}$$\n"
+                    "$$\\tau_2 = " + "\\dot{" * 3000 + "x" + "}" * 3000 + "$$\n"
+                    "$$T = " + "{" * 5000 + "m_1" + "}" * 5000 + "$$\n")
+    t0 = time.perf_counter()
+    r = grade(path)
+    assert time.perf_counter() - t0 < 20
+    assert [v.status for v in r.steps] == ["unrecognised"] * 3
+    assert "exponent" in r.steps[0].message

@@ -184,7 +184,7 @@ class _Grader:
                 self._step(self.world(method), ref, eq, value, method)
             if ref.key in ("T", "V", "L"):
                 self.symbols.steps[ref.key] = value
-        recognised = [v for v in self.verdicts if v.status != "unrecognised"]
+        recognised = [v for v in self.verdicts if v.key]  # a step named, even if its value was unreadable
         if not recognised:
             raise ModelError("no step of Newton-Euler or Lagrange recognised (expected equations such as "
                              "\\omega_1^1 = ..., F_2^2 = ..., \\tau_1 = ..., T = ...)", source=self.sub.path)

@@ -30,6 +30,8 @@ import sympy as sp
 
 #: nesting depth (parentheses, groups, fractions, matrices) beyond which input is refused
 MAX_DEPTH = 60
+#: largest numeric exponent accepted (10^{10^{10}} must not make SymPy compute)
+MAX_EXPONENT = 100
 #: characters in one equation beyond which it is refused
 MAX_LENGTH = 200_000
 
@@ -190,7 +192,10 @@ class _Parser:
         base = self.atom()
         if self.peek() == ("char", "^"):
             self.take()
-            base = base ** self.script_value()
+            exponent = self.script_value()
+            if exponent.is_Number and abs(exponent) > MAX_EXPONENT:
+                raise LatexError(f"an exponent of {exponent} (at most {MAX_EXPONENT})")
+            base = base ** exponent
         return base
 
     def script_value(self):
