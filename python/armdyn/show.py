@@ -77,8 +77,8 @@ def frame_poses(robot: Robot, q=None) -> dict[str, np.ndarray]:
     q = _coordinates(robot, q)
     poses = {robot.base: np.eye(4)}
     for joint in robot.joints:
-        i = robot.coordinate_index(joint)
-        R, p = joint.transform(0 if i is None else q[i])
+        f = robot.follows(joint)  # (coordinate, multiplier, offset); mimic joints follow a leader
+        R, p = joint.transform(0 if f is None else float(f[1]) * q[f[0]] + float(f[2]))
         local = np.eye(4)
         local[:3, :3], local[:3, 3] = _floats(R), _floats(p).reshape(3)
         poses[joint.child] = poses[joint.parent] @ local

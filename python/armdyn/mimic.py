@@ -1,0 +1,183 @@
+"""Numeric dynamics of robots with mimic joints, over the Rust core's unconstrained model.
+
+A mimic joint (URDF ``<mimic>``, :class:`armdyn.model.Mimic`) follows its leader:
+``q_m = multiplier * q_leader + offset``. The constraint is linear with constant
+coefficients, so the coordinates of every non-fixed joint (``n_full`` of them, mimic
+joints included, in tree order) are an affine function of the robot's ``dof``
+independent coordinates::
+
+    q_full = G q + o,      qd_full = G qd,      qdd_full = G qdd
+
+with ``G`` (n_full, dof) holding one entry per row: 1 in the joint's own column, or
+the multiplier in its leader's (chains composed). By the principle of virtual work
+(d'Alembert), the generalised forces of the reduced system are ``G^T`` times the full
+ones, which gives every quantity from the Rust core's algorithms run unchanged on the
+full tree (the model where mimic joints are ordinary joints):
+
+    tau = G^T rnea_full(q_full, qd_full, qdd_full)         inverse dynamics
+    M   = G^T M_full(q_full) G                              T = 1/2 qd^T M qd
+    h   = G^T h_full(q_full, qd_full),  g = G^T g_full
+    C   = G^T C_full(q_full, qd_full) G                     Christoffel symbols of M
+    J   = J_full(q_full) G                                  [v; w] = J qd
+
+(the Christoffel symbols of ``M`` transform as a tensor under a linear map with
+constant coefficients, so ``C`` stays the one with ``Mdot - 2C`` skew-symmetric).
+Forward dynamics cannot run Featherstone's ABA on the full tree (the constraint couples
+bodies in different branches); it solves the reduced equations instead,
+
+    (G^T M_full G) qdd = tau - G^T h_full,
+
+by a Cholesky factorisation of the (dof, dof) mass matrix, O(dof^3) per state instead
+of ABA's O(dof). Pinocchio 4.1 builds the same constrained model
+(``buildModelFromUrdf(path, mimic=True)``) and likewise has no ABA for it.
+
+The mapping runs in NumPy over the Rust core's batched calls (one call per quantity for
+a whole batch); robots without mimic joints never come here, so their path is unchanged.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _core
+from .model import Robot
+
+__all__ = ["MimicModel"]
+
+
+class MimicModel:
+    """A compiled robot with mimic joints: the methods of :class:`armdyn.numeric.NumericModel`
+    (same names, arguments, shapes and errors) in the robot's ``dof`` independent
+    coordinates.
+
+    Attributes: ``dof``, ``nlinks``, ``name``, ``link_names``, ``coordinate_names``,
+    ``gravity`` (3,); ``full``: the NumericModel of the whole tree with every non-fixed
+    joint free (coordinates ``full.coordinate_names``); ``G`` (n_full, dof) and
+    ``offset`` (n_full,): ``q_full = G q + offset``.
+    """
+
+    def __init__(self, full: _core.NumericModel, robot: Robot):
+        moving = [j for j in robot.joints if j.movable]  # mimic joints included, tree order
+        if [j.name for j in moving] != list(full.coordinate_names):
+            raise ValueError("the full model's coordinates are not the robot's non-fixed joints")
+        self.full = full
+        self.dof = robot.dof
+        self.coordinate_names = list(robot.coordinate_names)
+        self.G = np.zeros((len(moving), robot.dof))
+        self.offset = np.zeros(len(moving))
+        for a, joint in enumerate(moving):
+            k, multiplier, offset = robot.follows(joint)
+            self.G[a, k] = float(multiplier)
+            self.offset[a] = float(offset)
+
+    # ---------------------------------------------------------------- description
+    @property
+    def nlinks(self) -> int:
+        return self.full.nlinks
+
+    @property
+    def name(self) -> str:
+        return self.full.name
+
+    @property
+    def link_names(self) -> list[str]:
+        return self.full.link_names
+
+    @property
+    def gravity(self):
+        return self.full.gravity
+
+    @property
+    def _numeric_model(self) -> "MimicModel":
+        return self
+
+    def __repr__(self) -> str:
+        return f"MimicModel({self.name!r}, dof={self.dof}, mimic joints={len(self.offset) - self.dof}, nlinks={self.nlinks})"
+
+    # ---------------------------------------------------------------- input
+    def _states(self, **args: object) -> list[np.ndarray]:
+        """Each argument as float64 of shape (dof,) or (N, dof), all of one shape, finite;
+        else ValueError naming it (as the Rust bindings do)."""
+        n, out, first = self.dof, [], None
+        for name, x in args.items():
+            a = np.asarray(x)
+            if a.dtype.kind not in "fiu":
+                raise ValueError(f"{name}: expected real numbers, got an array of dtype {a.dtype}")
+            a = np.ascontiguousarray(a, dtype=np.float64)
+            if not (a.ndim in (1, 2) and a.shape[-1] == n):
+                raise ValueError(f"{name}: expected shape ({n},) for one state or (N, {n}) for a batch, got {a.shape}")
+            if first is None:
+                first = (name, a.shape)
+            elif a.shape != first[1]:
+                raise ValueError(f"{name}: shape {a.shape} does not match {first[0]}'s {first[1]}")
+            if not np.isfinite(a).all():
+                at = np.argwhere(~np.isfinite(a))[0]
+                raise ValueError(f"{name} contains NaN or inf (at {name}[{', '.join(map(str, at))}])")
+            out.append(a)
+        return out
+
+    def _position(self, q: np.ndarray) -> np.ndarray:
+        return q @ self.G.T + self.offset  # (..., n_full)
+
+    def _rate(self, x: np.ndarray) -> np.ndarray:
+        return x @ self.G.T
+
+    def _reduce(self, tau_full: np.ndarray) -> np.ndarray:
+        return tau_full @ self.G  # G^T tau, row by row
+
+    def _reduce_matrix(self, A_full: np.ndarray) -> np.ndarray:
+        return self.G.T @ A_full @ self.G  # broadcasts over a batch (N, n_full, n_full)
+
+    # ---------------------------------------------------------------- dynamics
+    def rnea(self, q, qd, qdd, threads=None):
+        q, qd, qdd = self._states(q=q, qd=qd, qdd=qdd)
+        return self._reduce(self.full.rnea(self._position(q), self._rate(qd), self._rate(qdd), threads))
+
+    def crba(self, q, threads=None):
+        (q,) = self._states(q=q)
+        return self._reduce_matrix(self.full.crba(self._position(q), threads))
+
+    def gravity_torques(self, q, threads=None):
+        (q,) = self._states(q=q)
+        return self._reduce(self.full.gravity_torques(self._position(q), threads))
+
+    def bias(self, q, qd, threads=None):
+        q, qd = self._states(q=q, qd=qd)
+        return self._reduce(self.full.bias(self._position(q), self._rate(qd), threads))
+
+    def aba(self, q, qd, tau, threads=None):
+        """qdd solving ``(G^T M_full G) qdd = tau - G^T h_full`` (Cholesky; see the module)."""
+        q, qd, tau = self._states(q=q, qd=qd, tau=tau)
+        qf = self._position(q)
+        M = self._reduce_matrix(self.full.crba(qf, threads))
+        rhs = tau - self._reduce(self.full.bias(qf, self._rate(qd), threads))
+        try:
+            L = np.linalg.cholesky(M)
+        except np.linalg.LinAlgError:
+            raise ValueError(
+                f"aba: the mass matrix of '{self.name}' is not positive definite at this state "
+                "(a coordinate that moves no mass or inertia?)"
+            ) from None
+        y = np.linalg.solve(L, rhs[..., None])
+        return np.linalg.solve(np.swapaxes(L, -1, -2), y)[..., 0]
+
+    def coriolis_matrix(self, q, qd, threads=None):
+        q, qd = self._states(q=q, qd=qd)
+        return self._reduce_matrix(self.full.coriolis_matrix(self._position(q), self._rate(qd), threads))
+
+    def kinetic_energy(self, q, qd, threads=None):
+        q, qd = self._states(q=q, qd=qd)
+        return self.full.kinetic_energy(self._position(q), self._rate(qd), threads)
+
+    def potential_energy(self, q, threads=None):
+        (q,) = self._states(q=q)
+        return self.full.potential_energy(self._position(q), threads)
+
+    # ---------------------------------------------------------------- kinematics
+    def forward_kinematics(self, q, threads=None):
+        (q,) = self._states(q=q)
+        return self.full.forward_kinematics(self._position(q), threads)
+
+    def jacobian(self, q, link, threads=None):
+        (q,) = self._states(q=q)
+        return self.full.jacobian(self._position(q), link, threads) @ self.G
