@@ -15,6 +15,10 @@ in frame p), joint axis ``z`` (in frame i) and coordinate ``q``::
     vcd_i = wd_i x c_i + w_i x (w_i x c_i) + vd_i
     F_i = m_i vcd_i,   N_i = I_i wd_i + w_i x I_i w_i
 
+A mimic joint (``q_m = c q_l + o``, :meth:`armdyn.model.Robot.follows`) moves with
+``qd = c qd_l``, ``qdd = c qdd_l``, and its ``tau`` is added ``c`` times to ``tau_l``
+(virtual work: ``delta q_m = c delta q_l``).
+
 Gravity enters as the base's acceleration ``vd_0 = -gravity``. Inward, over the children
 c of link i (``R_c``, ``p_c`` the child's placement in frame i)::
 
@@ -28,6 +32,8 @@ writes the d'Alembert inertial force ``-m vcd``).
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import sympy as sp
 
@@ -51,7 +57,10 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
     for joint in robot.joints:
         link = robot.links[joint.child]
         parent, i = joint.parent, robot.link_index(joint.child)
-        k = robot.coordinate_index(joint)
+        follow = robot.follows(joint)  # (k, c, o): this joint's coordinate is c q_k + o
+        if follow is not None:
+            k, mult, _ = follow
+            qd_j, qdd_j = mult * qd[k], mult * qdd[k]
         R, p = joint.transform(robot.joint_coordinate(joint))
         placement[joint.child] = (R, p)
         Rt = R.T
@@ -61,12 +70,12 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
         wd_in = Rt * wd[parent]
         vd_c = Rt * (wd[parent].cross(p) + w[parent].cross(w[parent].cross(p)) + vd[parent])
         if joint.type == "revolute":
-            w_i = w_in + qd[k] * z
-            wd_i = wd_in + w_in.cross(qd[k] * z) + qdd[k] * z
+            w_i = w_in + qd_j * z
+            wd_i = wd_in + w_in.cross(qd_j * z) + qdd_j * z
         else:
             w_i, wd_i = w_in, wd_in
         if joint.type == "prismatic":
-            vd_c = vd_c + 2 * w_i.cross(qd[k] * z) + qdd[k] * z
+            vd_c = vd_c + 2 * w_i.cross(qd_j * z) + qdd_j * z
         c = link.com
         vcd = wd_i.cross(c) + w_i.cross(w_i.cross(c)) + vd_c
         w[joint.child], wd[joint.child], vd[joint.child] = w_i, wd_i, vd_c
@@ -89,6 +98,7 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
     f, n = {}, {}
     tau = [sp.Integer(0)] * robot.dof
     inward: list[Step] = []
+    tau_steps = []  # (position in inward, k): filled in with the final tau_k at the end
     for joint in reversed(robot.joints):
         name, i = joint.child, robot.link_index(joint.child)
         link = robot.links[name]
@@ -100,17 +110,26 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
             f_i = f_i + f_c
             n_i = n_i + Rc * n[child.child] + pc.cross(f_c)
         f[name], n[name] = f_i, n_i
-        k = robot.coordinate_index(joint)
-        if k is not None:
-            tau[k] = (n_i if joint.type == "revolute" else f_i).dot(joint.axis)
+        follow = robot.follows(joint)
+        if follow is not None:
+            k, mult, _ = follow
+            tau_j = (n_i if joint.type == "revolute" else f_i).dot(joint.axis)
+            tau[k] = tau[k] + mult * tau_j  # a mimic joint's torque is carried to its leader
         if record:
             inward += [
                 Step("inward", name, "f", rf"{{}}^{{{i}}}f_{{{i}}}", f_i, "force exerted on the link by its parent"),
                 Step("inward", name, "n", rf"{{}}^{{{i}}}n_{{{i}}}", n_i, "moment exerted on the link by its parent"),
             ]
-            if k is not None:
-                kind = "torque" if joint.type == "revolute" else "force"
+            kind = "torque" if joint.type == "revolute" else "force"
+            if joint.mimic is not None:
+                tex = joint.name.replace("_", r"\_")
+                inward.append(Step("inward", name, "tau_mimic", rf"\tau_{{\mathrm{{{tex}}}}}", tau_j,
+                                   f"joint {kind} of mimic joint '{joint.name}', added {mult} times to tau{k + 1}"))
+            elif follow is not None:
+                tau_steps.append((len(inward), k))
                 inward.append(Step("inward", name, "tau", rf"\tau_{{{k + 1}}}", tau[k], f"joint {kind} of '{joint.name}'"))
+    for pos, k in tau_steps:  # with mimic joints, tau_k is complete only now
+        inward[pos] = replace(inward[pos], value=tau[k])
     if record:
         steps += outward + inward  # inward in the order computed: last link first, as in the exercise
     return sp.Matrix(tau)
