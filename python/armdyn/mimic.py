@@ -65,10 +65,20 @@ class MimicModel:
         self.coordinate_names = list(robot.coordinate_names)
         self.G = np.zeros((len(moving), robot.dof))
         self.offset = np.zeros(len(moving))
+        source = np.zeros(len(moving), dtype=np.intp)  # the coordinate each full joint follows
         for a, joint in enumerate(moving):
             k, multiplier, offset = robot.follows(joint)
             self.G[a, k] = float(multiplier)
             self.offset[a] = float(offset)
+            source[a] = k
+        # G has one entry per row: products by G are gathers, and products by G^T sums
+        # over the full joints of each coordinate (np.add.reduceat over them, grouped),
+        # elementwise, so that a batch gives the single calls' results bit for bit.
+        self._source = source
+        self._multiplier = self.G[np.arange(len(moving)), source]
+        self._order = np.argsort(source, kind="stable")
+        self._starts = np.searchsorted(source[self._order], np.arange(robot.dof))  # every group holds its own joint
+        self._order_multiplier = self._multiplier[self._order]
 
     # ---------------------------------------------------------------- description
     @property
@@ -117,16 +127,21 @@ class MimicModel:
         return out
 
     def _position(self, q: np.ndarray) -> np.ndarray:
-        return q @ self.G.T + self.offset  # (..., n_full)
+        """``G q + o`` (..., n_full)."""
+        return q[..., self._source] * self._multiplier + self.offset
 
     def _rate(self, x: np.ndarray) -> np.ndarray:
-        return x @ self.G.T
+        """``G x`` (..., n_full)."""
+        return x[..., self._source] * self._multiplier
 
-    def _reduce(self, tau_full: np.ndarray) -> np.ndarray:
-        return tau_full @ self.G  # G^T tau, row by row
+    def _reduce(self, x: np.ndarray) -> np.ndarray:
+        """``x G`` over the last axis, (..., n_full) -> (..., dof): ``G^T tau`` row by row."""
+        return np.add.reduceat(x[..., self._order] * self._order_multiplier, self._starts, axis=-1)
 
-    def _reduce_matrix(self, A_full: np.ndarray) -> np.ndarray:
-        return self.G.T @ A_full @ self.G  # broadcasts over a batch (N, n_full, n_full)
+    def _reduce_matrix(self, A: np.ndarray) -> np.ndarray:
+        """``G^T A G`` for each (n_full, n_full) matrix of ``A`` (..., n_full, n_full)."""
+        AG = self._reduce(A)  # (..., n_full, dof)
+        return np.swapaxes(self._reduce(np.swapaxes(AG, -1, -2)), -1, -2)
 
     # ---------------------------------------------------------------- dynamics
     def rnea(self, q, qd, qdd, threads=None):
@@ -180,4 +195,4 @@ class MimicModel:
 
     def jacobian(self, q, link, threads=None):
         (q,) = self._states(q=q)
-        return self.full.jacobian(self._position(q), link, threads) @ self.G
+        return self._reduce(self.full.jacobian(self._position(q), link, threads))
