@@ -136,11 +136,12 @@ def test_mimic_joints_are_read_and_add_no_coordinate(arm):
 
 def _chain(*mimics):
     """Three revolute joints on one body: b mimics a, c mimics b (as given)."""
-    links = [Link("base"), *(Link(n, 1, [0.1, 0, 0], np.diag([0.01, 0.02, 0.02])) for n in "ABC")]
+    r = sp.Rational
+    links = [Link("base"), *(Link(n, 1, [r(1, 10), 0, 0], sp.diag(r(1, 100), r(2, 100), r(2, 100))) for n in "ABC")]
     joints = [
         Joint("a", "revolute", "base", "A"),
-        Joint("b", "revolute", "A", "B", xyz=[0.2, 0, 0], mimic=mimics[0]),
-        Joint("c", "revolute", "B", "C", xyz=[0.2, 0, 0], axis=[0, 1, 0], mimic=mimics[1]),
+        Joint("b", "revolute", "A", "B", xyz=[r(1, 5), 0, 0], mimic=mimics[0]),
+        Joint("c", "revolute", "B", "C", xyz=[r(1, 5), 0, 0], axis=[0, 1, 0], mimic=mimics[1]),
     ]
     return Robot("chain", links, joints)
 
@@ -422,3 +423,18 @@ def test_newton_euler_steps_show_the_mimic_rates():
 
     text = derivation_report([eom], steps=True)
     assert "tau_mimic" in text and "mimic joint 'm1'" in text
+
+
+def test_prove_agreement_picks_numeric_checks_for_mimic_angles():
+    """sin(2 q1 + 0.5) is no polynomial in sin q1, cos q1, so the default check compares
+    at random points (and passes); mimics of +-q_leader stay exact."""
+    report = armdyn.prove_agreement(load_urdf(SMALL))
+    assert report, report.text()
+    assert all(r.how.startswith("numeric") for r in report.results)
+    report = armdyn.prove_agreement(_chain(Mimic("a", 2, sp.Rational(1, 2)), Mimic("a", 1, 0)))
+    assert report, report.text()
+    assert all(r.how.startswith("numeric") for r in report.results)
+    mirror = _chain(Mimic("a", -1, 0), Mimic("b", 1, 0))  # exact numbers (URDF floats defeat exact checks)
+    report = armdyn.prove_agreement(mirror)
+    assert report, report.text()
+    assert [r.how for r in report.results] == ["exact"] * len(report.results)
