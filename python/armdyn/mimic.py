@@ -105,26 +105,42 @@ class MimicModel:
         return f"MimicModel({self.name!r}, dof={self.dof}, mimic joints={len(self.offset) - self.dof}, nlinks={self.nlinks})"
 
     # ---------------------------------------------------------------- input
-    def _states(self, **args: object) -> list[np.ndarray]:
-        """Each argument as float64 of shape (dof,) or (N, dof), all of one shape, finite;
-        else ValueError naming it (as the Rust bindings do)."""
+    def _states(self, *named: tuple[str, object]) -> list[np.ndarray]:
+        """Each ``(name, value)`` as a float64 array of shape (dof,) or (N, dof), all of
+        one shape; else ValueError naming it (as the Rust bindings do). NaN and inf are
+        caught by the Rust core on the full arrays (a gather copies them), and named in
+        these coordinates by :meth:`_finite` when it refuses them."""
         n, out, first = self.dof, [], None
-        for name, x in args.items():
-            a = np.asarray(x)
-            if a.dtype.kind not in "fiu":
-                raise ValueError(f"{name}: expected real numbers, got an array of dtype {a.dtype}")
-            a = np.ascontiguousarray(a, dtype=np.float64)
+        for name, x in named:
+            a = x
+            if type(a) is not np.ndarray or a.dtype != np.float64:
+                a = np.asarray(x)
+                if a.dtype.kind not in "fiu":
+                    raise ValueError(f"{name}: expected real numbers, got an array of dtype {a.dtype}")
+                a = a.astype(np.float64)
             if not (a.ndim in (1, 2) and a.shape[-1] == n):
                 raise ValueError(f"{name}: expected shape ({n},) for one state or (N, {n}) for a batch, got {a.shape}")
             if first is None:
                 first = (name, a.shape)
             elif a.shape != first[1]:
                 raise ValueError(f"{name}: shape {a.shape} does not match {first[0]}'s {first[1]}")
+            out.append(a)
+        return out
+
+    @staticmethod
+    def _finite(named: dict[str, np.ndarray]) -> None:
+        for name, a in named.items():
             if not np.isfinite(a).all():
                 at = np.argwhere(~np.isfinite(a))[0]
                 raise ValueError(f"{name} contains NaN or inf (at {name}[{', '.join(map(str, at))}])")
-            out.append(a)
-        return out
+
+    def _call(self, method: str, named: dict[str, np.ndarray], *args):
+        """``self.full.<method>(*args)``; a refusal of NaN/inf is re-worded for ``named``."""
+        try:
+            return getattr(self.full, method)(*args)
+        except ValueError:
+            self._finite(named)
+            raise
 
     def _position(self, q: np.ndarray) -> np.ndarray:
         """``G q + o`` (..., n_full)."""
@@ -145,27 +161,31 @@ class MimicModel:
 
     # ---------------------------------------------------------------- dynamics
     def rnea(self, q, qd, qdd, threads=None):
-        q, qd, qdd = self._states(q=q, qd=qd, qdd=qdd)
-        return self._reduce(self.full.rnea(self._position(q), self._rate(qd), self._rate(qdd), threads))
+        q, qd, qdd = self._states(("q", q), ("qd", qd), ("qdd", qdd))
+        named = {"q": q, "qd": qd, "qdd": qdd}
+        return self._reduce(self._call("rnea", named, self._position(q), self._rate(qd), self._rate(qdd), threads))
 
     def crba(self, q, threads=None):
-        (q,) = self._states(q=q)
-        return self._reduce_matrix(self.full.crba(self._position(q), threads))
+        (q,) = self._states(("q", q))
+        return self._reduce_matrix(self._call("crba", {"q": q}, self._position(q), threads))
 
     def gravity_torques(self, q, threads=None):
-        (q,) = self._states(q=q)
-        return self._reduce(self.full.gravity_torques(self._position(q), threads))
+        (q,) = self._states(("q", q))
+        return self._reduce(self._call("gravity_torques", {"q": q}, self._position(q), threads))
 
     def bias(self, q, qd, threads=None):
-        q, qd = self._states(q=q, qd=qd)
-        return self._reduce(self.full.bias(self._position(q), self._rate(qd), threads))
+        q, qd = self._states(("q", q), ("qd", qd))
+        return self._reduce(self._call("bias", {"q": q, "qd": qd}, self._position(q), self._rate(qd), threads))
 
     def aba(self, q, qd, tau, threads=None):
         """qdd solving ``(G^T M_full G) qdd = tau - G^T h_full`` (Cholesky; see the module)."""
-        q, qd, tau = self._states(q=q, qd=qd, tau=tau)
+        q, qd, tau = self._states(("q", q), ("qd", qd), ("tau", tau))
+        if not np.isfinite(tau).all():  # tau does not go through the Rust core
+            self._finite({"tau": tau})
+        named = {"q": q, "qd": qd}
         qf = self._position(q)
-        M = self._reduce_matrix(self.full.crba(qf, threads))
-        rhs = tau - self._reduce(self.full.bias(qf, self._rate(qd), threads))
+        M = self._reduce_matrix(self._call("crba", named, qf, threads))
+        rhs = tau - self._reduce(self._call("bias", named, qf, self._rate(qd), threads))
         try:
             L = np.linalg.cholesky(M)
         except np.linalg.LinAlgError:
@@ -177,22 +197,23 @@ class MimicModel:
         return np.linalg.solve(np.swapaxes(L, -1, -2), y)[..., 0]
 
     def coriolis_matrix(self, q, qd, threads=None):
-        q, qd = self._states(q=q, qd=qd)
-        return self._reduce_matrix(self.full.coriolis_matrix(self._position(q), self._rate(qd), threads))
+        q, qd = self._states(("q", q), ("qd", qd))
+        C = self._call("coriolis_matrix", {"q": q, "qd": qd}, self._position(q), self._rate(qd), threads)
+        return self._reduce_matrix(C)
 
     def kinetic_energy(self, q, qd, threads=None):
-        q, qd = self._states(q=q, qd=qd)
-        return self.full.kinetic_energy(self._position(q), self._rate(qd), threads)
+        q, qd = self._states(("q", q), ("qd", qd))
+        return self._call("kinetic_energy", {"q": q, "qd": qd}, self._position(q), self._rate(qd), threads)
 
     def potential_energy(self, q, threads=None):
-        (q,) = self._states(q=q)
-        return self.full.potential_energy(self._position(q), threads)
+        (q,) = self._states(("q", q))
+        return self._call("potential_energy", {"q": q}, self._position(q), threads)
 
     # ---------------------------------------------------------------- kinematics
     def forward_kinematics(self, q, threads=None):
-        (q,) = self._states(q=q)
-        return self.full.forward_kinematics(self._position(q), threads)
+        (q,) = self._states(("q", q))
+        return self._call("forward_kinematics", {"q": q}, self._position(q), threads)
 
     def jacobian(self, q, link, threads=None):
-        (q,) = self._states(q=q)
-        return self._reduce(self.full.jacobian(self._position(q), link, threads))
+        (q,) = self._states(("q", q))
+        return self._reduce(self._call("jacobian", {"q": q}, self._position(q), link, threads))
