@@ -3,13 +3,14 @@ full tree, mapped by G in NumPy) vs Pinocchio's mimic model
 (``buildModelFromUrdf(path, mimic=True)``), side by side in one process.
 
     PYTHONPATH=python python3 benchmarks/bench_mimic.py            # Panda with its hand, PR2, TIAGo Pro
-    PYTHONPATH=python python3 benchmarks/bench_mimic.py --quick    # fewer repeats, N = 2e4
+    PYTHONPATH=python python3 benchmarks/bench_mimic.py --quick    # fewer repeats, N = 5e3
 
 1. Per call from Python, one state: rnea and crba; forward dynamics: ``armdyn.aba`` vs
    Pinocchio's crba + nonLinearEffects + a NumPy Cholesky solve (Pinocchio 4.1 has no aba
    with mimic joints). Also armdyn's rnea on the same URDF read without ``<mimic>`` (every
    joint free: the Rust model alone), to show what the G mapping costs.
-2. Batches of N states, 2 threads: armdyn's batched rnea vs ``pin.rneaInParallel``.
+2. Batches of N = 2e4 states, 2 threads: armdyn's batched rnea vs ``pin.rneaInParallel``;
+   armdyn's batched forward dynamics alone (it holds N full mass matrices at once).
 
 Each time is the median of ``--repeat`` runs; the two libraries' runs alternate. Before
 timing, armdyn == Pinocchio (rnea) is checked at a random state. Ratios are armdyn time /
@@ -73,7 +74,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true")
     args = parser.parse_args()
-    number, repeat, N, batch_repeat = (2000, 5, 20_000, 3) if args.quick else (5000, 9, 100_000, 5)
+    number, repeat, N, batch_repeat = (2000, 5, 5_000, 3) if args.quick else (5000, 9, 20_000, 5)
     root = Path(importlib.metadata.distribution("example-robot-data").locate_file(
         "cmeel.prefix/share/example-robot-data/robots"))
     rng = np.random.default_rng(0)
