@@ -438,3 +438,12 @@ def test_prove_agreement_picks_numeric_checks_for_mimic_angles():
     report = armdyn.prove_agreement(mirror)
     assert report, report.text()
     assert [r.how for r in report.results] == ["exact"] * len(report.results)
+
+
+def test_show_table_says_whom_mimic_joints_follow(arm):
+    from armdyn.show import table
+
+    text = table(arm)
+    assert "3 dof" in text
+    assert "mimic: wrist = 1.5 * elbow + 0.2" in text and "mimic: finger_right = -1 * finger_left + 0.01" in text
+    assert "mimic: side = -0.7 * elbow\n" in text + "\n"

@@ -132,6 +132,9 @@ def table(robot: Robot) -> str:
         axis = _vec(j.axis) if j.movable else ""
         rows.append([j.name, j.type, j.parent, j.child, _vec(j.xyz), angles, axis, limits])
     lines += ["", "joints"] + _rows(["name", "type", "parent", "child", "xyz", "rpy", "axis", "limits"], rows)
+    for j in robot.mimic_joints:  # no coordinate of their own: say whom they follow
+        m, o = j.mimic.multiplier, j.mimic.offset
+        lines.append(f"mimic: {j.name} = {_num(m)} * {j.mimic.joint}" + (f" + {_num(o)}" if o != 0 else ""))
     massless = set(robot.meta.get("massless_links", ()))
     rows = []
     for link in robot.links.values():
