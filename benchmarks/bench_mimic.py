@@ -125,7 +125,7 @@ def main() -> None:
         print(f"  batch rnea, 2 threads: armdyn {N / ta / 1e6:6.2f} M states/s   "
               f"Pinocchio rneaInParallel {N / tb / 1e6:6.2f} M states/s   time ratio {ta / tb:5.2f}")
         ta = median_time(lambda: num.aba(robot, Q, QD, ours, threads=2), 1, batch_repeat)
-        print(f"  batch forward dynamics, 2 threads: armdyn {N / ta / 1e6:6.2f} M states/s (no Pinocchio counterpart)")
+        print(f"  batch forward dynamics, 2 threads: armdyn {N / ta / 1e3:6.1f} k states/s (no Pinocchio counterpart)")
 
 
 if __name__ == "__main__":

@@ -71,14 +71,14 @@ class MimicModel:
             self.G[a, k] = float(multiplier)
             self.offset[a] = float(offset)
             source[a] = k
-        # G has one entry per row: products by G are gathers, and products by G^T sums
-        # over the full joints of each coordinate (np.add.reduceat over them, grouped),
-        # elementwise, so that a batch gives the single calls' results bit for bit.
+        # G has one entry per row: products by G are gathers, and products by G^T the
+        # coordinates' own entries plus, one mimic joint at a time, multiplier times its
+        # entry: elementwise, in a fixed order, so that a batch gives the single calls'
+        # results bit for bit.
         self._source = source
         self._multiplier = self.G[np.arange(len(moving)), source]
-        self._order = np.argsort(source, kind="stable")
-        self._starts = np.searchsorted(source[self._order], np.arange(robot.dof))  # every group holds its own joint
-        self._order_multiplier = self._multiplier[self._order]
+        self._own = np.array([a for a, j in enumerate(moving) if j.mimic is None], dtype=np.intp)  # (dof,)
+        self._terms = [(a, int(source[a]), float(self._multiplier[a])) for a, j in enumerate(moving) if j.mimic is not None]
 
     # ---------------------------------------------------------------- description
     @property
@@ -152,12 +152,24 @@ class MimicModel:
 
     def _reduce(self, x: np.ndarray) -> np.ndarray:
         """``x G`` over the last axis, (..., n_full) -> (..., dof): ``G^T tau`` row by row."""
-        return np.add.reduceat(x[..., self._order] * self._order_multiplier, self._starts, axis=-1)
+        out = np.take(x, self._own, axis=-1)
+        for a, k, m in self._terms:
+            out[..., k] += m * x[..., a]
+        return out
+
+    def _reduce_rows(self, A: np.ndarray) -> np.ndarray:
+        """``G^T A`` for each matrix of ``A`` (..., n_full, m) -> (..., dof, m); rows are
+        contiguous, which makes this pass the fast one."""
+        out = np.take(A, self._own, axis=-2)
+        for a, k, m in self._terms:
+            out[..., k, :] += m * A[..., a, :]
+        return out
 
     def _reduce_matrix(self, A: np.ndarray) -> np.ndarray:
         """``G^T A G`` for each (n_full, n_full) matrix of ``A`` (..., n_full, n_full)."""
-        AG = self._reduce(A)  # (..., n_full, dof)
-        return np.swapaxes(self._reduce(np.swapaxes(AG, -1, -2)), -1, -2)
+        GA = self._reduce_rows(A)  # (..., dof, n_full)
+        GAG_T = self._reduce_rows(np.ascontiguousarray(np.swapaxes(GA, -1, -2)))  # (G^T A G)^T
+        return np.ascontiguousarray(np.swapaxes(GAG_T, -1, -2))
 
     # ---------------------------------------------------------------- dynamics
     def rnea(self, q, qd, qdd, threads=None):
