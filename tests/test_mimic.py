@@ -447,3 +447,10 @@ def test_show_table_says_whom_mimic_joints_follow(arm):
     assert "3 dof" in text
     assert "mimic: wrist = 1.5 * elbow + 0.2" in text and "mimic: finger_right = -1 * finger_left + 0.01" in text
     assert "mimic: side = -0.7 * elbow\n" in text + "\n"
+
+
+def test_overflowing_mimic_coordinate_is_a_clear_error():
+    robot = _chain(Mimic("a", sp.Float(1e308), 0), Mimic("a", 1, 0))
+    with pytest.raises(ValueError, match="mimic joint's coordinate .* overflows"):
+        numeric.rnea(robot, [10.0], [0.0], [0.0])
+    assert np.all(np.isfinite(numeric.rnea(robot, [1e-300], [0.0], [0.0])))

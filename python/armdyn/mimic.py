@@ -138,9 +138,14 @@ class MimicModel:
         """``self.full.<method>(*args)``; a refusal of NaN/inf is re-worded for ``named``."""
         try:
             return getattr(self.full, method)(*args)
-        except ValueError:
+        except ValueError as err:
             self._finite(named)
-            raise
+            if "NaN or inf" not in str(err):
+                raise
+            raise ValueError(
+                f"{method}: a mimic joint's coordinate (multiplier * q + offset) or rate overflows to inf "
+                f"at this state of '{self.name}'"
+            ) from None
 
     def _position(self, q: np.ndarray) -> np.ndarray:
         """``G q + o`` (..., n_full)."""
