@@ -449,6 +449,7 @@ def test_show_table_says_whom_mimic_joints_follow(arm):
     assert "mimic: side = -0.7 * elbow\n" in text + "\n"
 
 
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")  # NumPy's, on the way to the error
 def test_overflowing_mimic_coordinate_is_a_clear_error():
     robot = _chain(Mimic("a", sp.Float(1e308), 0), Mimic("a", 1, 0))
     with pytest.raises(ValueError, match="mimic joint's coordinate .* overflows"):
