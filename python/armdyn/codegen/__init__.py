@@ -1,0 +1,288 @@
+"""Generated code for the dynamics of a robot: C99, Python or NumPy.
+
+    code = armdyn.codegen(robot, what=("tau", "M", "C", "g"), lang="c")   # GeneratedCode
+    print(code.source)              # readable: named temporaries, op counts in the header
+    code.op_counts["tau"]           # {'mul': ..., 'add': ..., 'sin_cos': ..., 'total': ...}
+    lib = armdyn.codegen.compile(robot.bind(), what=("tau", "M"))   # system C compiler
+    tau = lib.tau(q, qd, qdd)       # q, qd, qdd: (dof,) or (N, dof) float64
+
+Where each quantity comes from (all with the barycentric / standard inertial parameters
+of each link, DESIGN.md's order: mass, first moment m c, inertia about the link origin):
+
+* tau: customized Newton-Euler (:mod:`armdyn.symbolic.customized_ne`);
+* g:   the same recursion with ``qd = qdd = 0``;
+* M:   composite links (:mod:`armdyn.symbolic.composite_mass_matrix`);
+* C:   the Christoffel symbols of that M (:func:`armdyn.symbolic.terms.christoffel_coriolis`),
+  then SymPy's common-subexpression elimination;
+* regressor: ``armdyn.identification.regressor(robot).Y`` (dof x P); with ``base=True``
+  the base regressor, and tau, g, M, C as ``Y_base beta`` with the base parameters
+  ``beta`` as inputs.
+
+A model whose parameters are bound to numbers gives code with the numbers folded in (the
+inertial constants included); otherwise every free symbol is an entry of the parameter
+vector ``p``, in :attr:`GeneratedCode.parameters` order (the header lists them, with the
+definition of each barycentric one in the model's parameters).
+
+Conventions: ``M(q) qdd + C(q, qd) qd + g(q) = tau``, SI units, radians, joints in
+``robot.coordinate_names`` order; batches are ``(N, dof)`` row-major.
+"""
+
+from __future__ import annotations
+
+import sys
+import types
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy as sp
+
+from ..model import Robot
+from .program import Builder, Program, from_expressions
+from .printers import INPUTS, Names, print_c, print_python
+
+QUANTITIES = ("tau", "M", "C", "g", "regressor")
+LANGUAGES = ("c", "python", "numpy")
+_SUFFIX = {"c": ".c", "python": ".py", "numpy": ".py"}
+
+
+@dataclass
+class GeneratedCode:
+    """Generated source for some quantities of one robot.
+
+    source:      the whole source text (one file).
+    lang:        "c", "python" or "numpy".
+    functions:   quantity -> function name (C: also ``<name>_batch``).
+    op_counts:   quantity -> {'mul', 'add', 'sin_cos', 'other', 'total'} per state.
+    parameters:  Symbols of the parameter vector ``p``, in order (empty for numbers).
+    definitions: [(Symbol, expression of the model's parameters)] of the barycentric ones.
+    programs:    quantity -> :class:`~armdyn.codegen.program.Program`.
+    """
+
+    robot_name: str
+    lang: str
+    dof: int
+    coordinate_names: list
+    q: sp.Matrix
+    qd: sp.Matrix
+    qdd: sp.Matrix
+    programs: dict
+    sources: dict
+    parameters: list
+    definitions: list
+    base: bool = False
+    source: str = ""
+    functions: dict = field(default_factory=dict)
+    op_counts: dict = field(default_factory=dict)
+    names: Names | None = None
+
+    def output_size(self, what: str) -> int:
+        return int(np.prod(self.programs[what].shape))
+
+    def describe(self, what: str) -> str:
+        shape = " x ".join(str(d) for d in self.programs[what].shape)
+        return f"({shape}) of {', '.join(INPUTS[what])}; {self.sources[what]}"
+
+    @property
+    def filename(self) -> str:
+        return f"{_identifier(self.robot_name)}_dynamics{_SUFFIX[self.lang]}"
+
+    def parameter_values(self, values: dict | None = None) -> np.ndarray:
+        """The vector ``p`` (len(parameters),) from values of the model's parameters
+        (name or Symbol -> number); barycentric entries are computed from their
+        definitions. Missing values are an error naming them."""
+        table = {}
+        for k, v in (values or {}).items():
+            table[k if isinstance(k, str) else k.name] = float(v)
+        defs = dict(self.definitions)
+        out, missing = [], []
+        for s in self.parameters:
+            expr = defs.get(s, s)
+            subs = {f: table[f.name] for f in expr.free_symbols if f.name in table}
+            absent = [f.name for f in expr.free_symbols if f.name not in table]
+            if absent:
+                missing += absent
+                continue
+            out.append(float(expr.xreplace(subs)))
+        if missing:
+            raise ValueError(f"parameter_values: no value for {sorted(set(missing))}")
+        return np.array(out)
+
+    def write(self, directory) -> str:
+        """Write :attr:`source` to ``directory/filename`` (all or nothing); returns the path."""
+        return write_files([self], directory)[0]
+
+
+def _identifier(name: str) -> str:
+    import re
+
+    s = re.sub(r"\W", "_", name)
+    return s if s and not s[0].isdigit() else "robot_" + s
+
+
+def write_files(codes, directory) -> list[str]:
+    """Write each code's source into ``directory`` atomically: every file is written to
+    a temporary name first, then all are renamed, so a failure leaves nothing half-written."""
+    import os
+    import tempfile
+
+    os.makedirs(directory, exist_ok=True)
+    staged = []
+    try:
+        for code in codes:
+            fd, tmp = tempfile.mkstemp(prefix=".armdyn-", dir=directory)
+            with os.fdopen(fd, "w") as fh:
+                fh.write(code.source)
+            staged.append((tmp, os.path.join(directory, code.filename)))
+    except BaseException:
+        for tmp, _ in staged:
+            os.unlink(tmp)
+        raise
+    for tmp, final in staged:
+        os.replace(tmp, final)
+    return [final for _, final in staged]
+
+
+def _identification(what: str):
+    try:
+        from .. import identification  # provided by the regressor/base-parameter work
+    except ImportError:
+        raise ValueError(f"codegen: {what} is not available: armdyn.identification is not installed in this "
+                         "version of armdyn") from None
+    return identification
+
+
+def _parse_what(what) -> list[str]:
+    if isinstance(what, str):
+        what = [w.strip() for w in what.split(",") if w.strip()]
+    what = list(what)
+    if not what:
+        raise ValueError("codegen: 'what' is empty; choose from " + ", ".join(QUANTITIES))
+    bad = [w for w in what if w not in QUANTITIES]
+    if bad:
+        raise ValueError(f"codegen: unknown quantity {bad[0]!r} in 'what'; choose from {', '.join(QUANTITIES)}")
+    return list(dict.fromkeys(what))
+
+
+def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
+    from ..symbolic.composite_mass_matrix import composite_mass_matrix
+    from ..symbolic.customized_ne import customized_newton_euler, standard_parameters
+    from ..symbolic.coriolis_program import christoffel_program
+
+    params, definitions = standard_parameters(robot)
+    reserved = robot.free_symbols() | {s for s, _ in definitions}
+    programs, sources = {}, {}
+    n = robot.dof
+    M_prog = None
+    for w in what:
+        if w == "tau":
+            programs[w], _ = customized_newton_euler(robot, parameters=params)
+            sources[w] = "customized Newton-Euler"
+        elif w == "g":
+            programs[w], _ = customized_newton_euler(robot, [0] * n, [0] * n, parameters=params)
+            sources[w] = "customized Newton-Euler at qd = qdd = 0"
+        elif w in ("M", "C"):
+            if M_prog is None:
+                builder = Builder(reserved=reserved | set(robot.q) | set(robot.qd))
+                M_prog, _ = composite_mass_matrix(robot, parameters=params, builder=builder)
+            if w == "M":
+                programs[w] = M_prog
+                sources[w] = "composite links"
+            else:
+                programs[w] = christoffel_program(robot, M_prog, builder)
+                sources[w] = "Christoffel symbols of the composite-link M, differentiated line by line"
+        elif w == "regressor":
+            ident = _identification("the regressor")
+            reg = ident.regressor(robot)
+            Y = sp.Matrix(reg.Y)
+            programs[w] = from_expressions(list(Y), Y.shape, reserved=reserved)
+            sources[w] = "armdyn.identification.regressor, CSE"
+    return programs, sources, definitions
+
+
+def _base_programs(robot: Robot, what) -> tuple[dict, dict, list]:
+    from ..symbolic.terms import christoffel_coriolis
+
+    ident = _identification("base parameters (--base)")
+    bp = ident.base_parameters(robot)
+    Y = sp.Matrix(bp.Y)
+    beta = [sp.Symbol(str(nm)) for nm in bp.names]
+    definitions = list(zip(beta, list(sp.Matrix(bp.beta))))
+    n = robot.dof
+    reserved = robot.free_symbols() | set(beta)
+    tau = Y * sp.Matrix(beta)
+    programs, sources = {}, {}
+    for w in what:
+        if w == "tau":
+            expr, shape = list(tau), (n,)
+        elif w == "g":
+            expr, shape = list(tau.xreplace({s: 0 for s in list(robot.qd) + list(robot.qdd)})), (n,)
+        elif w == "M":
+            expr, shape = list(tau.jacobian(robot.qdd)), (n, n)
+        elif w == "C":
+            expr, shape = list(christoffel_coriolis(tau.jacobian(robot.qdd), robot.q, robot.qd)), (n, n)
+        else:
+            expr, shape = list(Y), Y.shape
+        programs[w] = from_expressions(expr, shape, reserved=reserved)
+        sources[w] = "base regressor x base parameters, CSE" if w != "regressor" else "base regressor, CSE"
+    return programs, sources, definitions
+
+
+def codegen(robot: Robot | str, what=("tau", "M", "C", "g"), lang: str = "c", base: bool = False) -> GeneratedCode:
+    """Generate code for ``what`` (quantities from ``QUANTITIES``, a sequence or a
+    comma-separated string) of ``robot`` (a Robot, bundled name or model file) in
+    ``lang`` ("c", "python", "numpy"). ``base=True``: in the base parameters
+    (needs :mod:`armdyn.identification`). Returns a :class:`GeneratedCode`.
+
+    Raises ValueError for an unknown quantity or language, or a robot of 0 dof.
+    """
+    if isinstance(robot, str):
+        from ..io import load
+
+        robot = load(robot)
+    if not isinstance(robot, Robot):
+        raise TypeError(f"codegen: expected an armdyn.Robot or a model name, got {type(robot).__name__}")
+    what = _parse_what(what)
+    if lang not in LANGUAGES:
+        raise ValueError(f"codegen: unknown language {lang!r}; choose from {', '.join(LANGUAGES)}")
+    if robot.dof == 0:
+        raise ValueError(f"codegen: robot '{robot.name}' has no movable joint")
+    programs, sources, definitions = (_base_programs if base else _standard_programs)(robot, what)
+
+    states = set(robot.q) | set(robot.qd) | set(robot.qdd)
+    used = set()
+    for prog in programs.values():
+        for e in [e for _, e in prog.assignments] + list(prog.outputs):
+            used |= sp.sympify(e).free_symbols
+        used -= {s for s, _ in prog.assignments}
+    free = used - states
+    order = [s for s in robot.parameters.values() if s in free] + [s for s, _ in definitions if s in free]
+    order += sorted(free - set(order), key=str)
+    defs = [(s, e) for s, e in definitions if s in free]
+
+    temps = [s for prog in programs.values() for s, _ in prog.assignments]
+    names = Names(list(dict.fromkeys([*robot.q, *robot.qd, *robot.qdd, *order, *temps])))
+    prefix = _identifier(robot.name)
+    code = GeneratedCode(
+        robot.name, lang, robot.dof, list(robot.coordinate_names), robot.q, robot.qd, robot.qdd, programs, sources,
+        order, defs, base,
+        functions={w: f"{prefix}_{w}" for w in programs},
+        op_counts={w: p.operation_counts() for w, p in programs.items()},
+        names=names,
+    )
+    code.source = print_c(code) if lang == "c" else print_python(code, numpy=(lang == "numpy"))
+    return code
+
+
+from .compile import CompiledCode, compile  # noqa: E402  (uses GeneratedCode)
+
+
+class _CallableModule(types.ModuleType):
+    """``armdyn.codegen(...)`` calls :func:`codegen`; the module stays importable."""
+
+    def __call__(self, *args, **kwargs):
+        return codegen(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule
+
+__all__ = ["codegen", "compile", "GeneratedCode", "CompiledCode", "Program", "QUANTITIES", "LANGUAGES"]
