@@ -4,6 +4,7 @@
     armdyn check ROBOT [--exact | --numeric] [--samples N]
     armdyn robots
     armdyn show ROBOT [--q Q1,Q2,...] [--out arm.png]
+    armdyn codegen ROBOT [--what tau,M,C,g,regressor] [--base] [--lang c|python|numpy] [--bind] [--out DIR]
 
 ROBOT is a bundled model's name (see ``armdyn robots``) or a model file (.yaml, .urdf).
 Bad input prints one line ``armdyn: error: ...`` and exits with status 2, no traceback.
@@ -83,6 +84,25 @@ def cmd_show(args) -> int:
     return 0
 
 
+def cmd_codegen(args) -> int:
+    from .codegen import codegen, write_files
+
+    robot = _load(args.robot, args.allow_nonphysical)
+    if args.bind:
+        robot = robot.bind()
+    code = codegen(robot, what=args.what, lang=args.lang, base=args.base)
+    if args.out is None:
+        print(code.source)
+        return 0
+    (path,) = write_files([code], args.out)
+    print(f"wrote {path}")
+    for what, c in code.op_counts.items():
+        print(f"  {code.functions[what]}: {c['mul']} mul, {c['add']} add, {c['sin_cos']} sin/cos")
+    if code.parameters:
+        print(f"  parameters p[0..{len(code.parameters) - 1}]: {', '.join(s.name for s in code.parameters)}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="armdyn", description="Dynamics of robot arms: derive and check equations of motion.")
     sub = p.add_subparsers(dest="command", required=True)
@@ -116,6 +136,14 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--q", help="joint values, comma-separated (default: zeros)")
     s.add_argument("--out", help="write a PNG picture of the arm here")
     s.set_defaults(func=cmd_show)
+    cg = sub.add_parser("codegen", help="generate C, Python or NumPy code for tau, M, C, g, the regressor")
+    robot_arg(cg)
+    cg.add_argument("--what", default="tau,M,C,g", help="comma-separated: tau,M,C,g,regressor (default tau,M,C,g)")
+    cg.add_argument("--base", action="store_true", help="in the base parameters (needs armdyn.identification)")
+    cg.add_argument("--lang", choices=["c", "python", "numpy"], default="c")
+    cg.add_argument("--bind", action="store_true", help="bind the model's published parameter values first")
+    cg.add_argument("--out", help="directory to write the source file into (default: print it)")
+    cg.set_defaults(func=cmd_codegen)
     return p
 
 

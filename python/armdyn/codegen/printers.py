@@ -183,6 +183,8 @@ def print_python(code, numpy: bool = False) -> str:
         lines.append(f'    """{what}: {code.describe(what)}"""')
         if numpy:
             lines += [f"    {a} = numpy.asarray({a}, dtype=float)" for a in INPUTS[what]]
+            if code.parameters:
+                lines.append("    p = numpy.asarray(p, dtype=float)")
             lines += _unpack(code, what, names, lambda n, a, k: f"    {n} = {a}[..., {k}]")
         else:
             lines += _unpack(code, what, names, lambda n, a, k: f"    {n} = {a}[{k}]")

@@ -121,6 +121,28 @@ def _skew2(b: Builder, w, wd, tag) -> sp.Matrix:
     return sp.Matrix(3, 3, lambda r, s: b.let(U[r, s], f"U{tag}_{r + 1}{s + 1}"))
 
 
+def _euler_moment(b: Builder, J, w, wd, U, tag) -> sp.Matrix:
+    """J wd + w x (J w) (3x1) for a symmetric J, as linear in J's six entries, with the
+    coefficients taken from U (whose off-diagonal entries are wd_k +- w_i w_j) and the
+    squares of w::
+
+        x: XX wdx + XY (wdy - wx wz) + XZ (wdz + wx wy) + YZ (wy^2 - wz^2) + (ZZ - YY) wy wz
+        y: XY (wdx + wy wz) + YY wdy + YZ (wdz - wx wy) + XZ (wz^2 - wx^2) + (XX - ZZ) wx wz
+        z: XZ (wdx - wy wz) + YZ (wdy + wx wz) + ZZ wdz + XY (wx^2 - wy^2) + (YY - XX) wx wy
+
+    (15 products instead of the 24 of J wd, J w and the cross product.)"""
+    XX, XY, XZ, YY, YZ, ZZ = J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2]
+    wx, wy, wz = w
+    sq = [b.let(wx * wx, f"w{tag}xx"), b.let(wy * wy, f"w{tag}yy"), b.let(wz * wz, f"w{tag}zz")]
+    wxy, wxz, wyz = b.let(wx * wy, f"w{tag}xy"), b.let(wx * wz, f"w{tag}xz"), b.let(wy * wz, f"w{tag}yz")
+    d = [b.let(sq[1] - sq[2], f"w{tag}_yy_zz"), b.let(sq[2] - sq[0], f"w{tag}_zz_xx"), b.let(sq[0] - sq[1], f"w{tag}_xx_yy")]
+    return sp.Matrix([
+        XX * wd[0] - XY * U[2, 0] + XZ * U[1, 0] + YZ * d[0] + b.let(ZZ - YY, f"ZZ_YY{tag}") * wyz,
+        XY * U[2, 1] + YY * wd[1] - YZ * U[0, 1] + XZ * d[1] + b.let(XX - ZZ, f"XX_ZZ{tag}") * wxz,
+        -XZ * U[1, 2] + YZ * U[0, 2] + ZZ * wd[2] + XY * d[2] + b.let(YY - XX, f"YY_XX{tag}") * wxy,
+    ])
+
+
 def _matvec(b: Builder, A, v, hint) -> sp.Matrix:
     return b.vector(A * v, hint)
 
@@ -171,9 +193,8 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         vd_j = b.vector(vd_j, f"vd{tag}")
         U_j = _skew2(b, w_j, wd_j, tag)
         M, MS, J = parameters[name]
-        Jw = _matvec(b, J, w_j, f"Jw{tag}")
         F[name] = b.vector(M * vd_j + U_j * MS, f"F{tag}")
-        N[name] = b.vector(J * wd_j + w_j.cross(Jw) + MS.cross(vd_j), f"N{tag}")
+        N[name] = b.vector(_euler_moment(b, J, w_j, wd_j, U_j, tag) + MS.cross(vd_j), f"N{tag}")
         w[name], wd[name], vd[name], U[name] = w_j, wd_j, vd_j, U_j
 
     f, nm = {}, {}
