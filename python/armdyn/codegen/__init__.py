@@ -163,6 +163,12 @@ def _parse_what(what) -> list[str]:
     return list(dict.fromkeys(what))
 
 
+def _in_model_parameters(extra, definitions) -> list:
+    """New definitions with the barycentric symbols in them replaced by theirs."""
+    table = dict(definitions)
+    return [(s, sp.expand(e.xreplace(table))) for s, e in extra if s not in table]
+
+
 def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
     from ..symbolic.composite_mass_matrix import composite_mass_matrix
     from ..symbolic.customized_ne import customized_newton_euler, standard_parameters
@@ -175,10 +181,12 @@ def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
     M_prog = None
     for w in what:
         if w == "tau":
-            programs[w], _ = customized_newton_euler(robot, parameters=params)
+            programs[w], extra = customized_newton_euler(robot, parameters=params)
+            definitions += _in_model_parameters(extra, definitions)
             sources[w] = "customized Newton-Euler"
         elif w == "g":
-            programs[w], _ = customized_newton_euler(robot, [0] * n, [0] * n, parameters=params)
+            programs[w], extra = customized_newton_euler(robot, [0] * n, [0] * n, parameters=params)
+            definitions += _in_model_parameters(extra, definitions)
             sources[w] = "customized Newton-Euler at qd = qdd = 0"
         elif w in ("M", "C"):
             if M_prog is None:

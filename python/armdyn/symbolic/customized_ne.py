@@ -90,6 +90,35 @@ def standard_parameters(robot: Robot):
     return out, definitions
 
 
+def moment_differences(robot: Robot, parameters: dict, definitions: list) -> tuple[dict, list]:
+    """``{link: (ZZ - YY, XX - ZZ, YY - XX)}`` of the inertias about the link origins,
+    each a number, a symbol, or a new parameter ``ZZmYY2, XXmZZ2, YYmXX2`` whose
+    definition (in the model's parameters) is returned: like the barycentric parameters,
+    they are computed once per parameter set, not per state (Khalil's grouped
+    parameters have the same form, e.g. ``XXR = XX - YY``)."""
+    taken = {str(s) for s in robot.free_symbols()} | {str(s) for s, _ in definitions} | {str(s) for s in robot.q}
+    table = dict(definitions)
+    out, new = {}, []
+    for link, (_, _, J) in parameters.items():
+        i = robot.link_index(link)
+        XX, YY, ZZ = J[0, 0], J[1, 1], J[2, 2]
+        diffs = []
+        for (a, b_), label in (((ZZ, YY), "ZZmYY"), ((XX, ZZ), "XXmZZ"), ((YY, XX), "YYmXX")):
+            value = a - b_
+            if value.is_Atom:
+                diffs.append(value)
+                continue
+            name = f"{label}{i}"
+            while name in taken:
+                name += "_"
+            taken.add(name)
+            sym = sp.Symbol(name)
+            new.append((sym, sp.expand(value.xreplace(table))))
+            diffs.append(sym)
+        out[link] = tuple(diffs)
+    return out, new
+
+
 def joint_frames(robot: Robot, b: Builder) -> dict:
     """``{child link: (R, p)}`` of every joint, with ``cos q``, ``sin q`` named once
     (``c1, s1``; 1-based like the joints) and non-trivial entries of ``R`` named."""
@@ -121,7 +150,7 @@ def _skew2(b: Builder, w, wd, tag) -> sp.Matrix:
     return sp.Matrix(3, 3, lambda r, s: b.let(U[r, s], f"U{tag}_{r + 1}{s + 1}"))
 
 
-def _euler_moment(b: Builder, J, w, wd, U, tag) -> sp.Matrix:
+def _euler_moment(b: Builder, J, differences, w, wd, U, tag) -> sp.Matrix:
     """J wd + w x (J w) (3x1) for a symmetric J, as linear in J's six entries, with the
     coefficients taken from U (whose off-diagonal entries are wd_k +- w_i w_j) and the
     squares of w::
@@ -130,16 +159,18 @@ def _euler_moment(b: Builder, J, w, wd, U, tag) -> sp.Matrix:
         y: XY (wdx + wy wz) + YY wdy + YZ (wdz - wx wy) + XZ (wz^2 - wx^2) + (XX - ZZ) wx wz
         z: XZ (wdx - wy wz) + YZ (wdy + wx wz) + ZZ wdz + XY (wx^2 - wy^2) + (YY - XX) wx wy
 
-    (15 products instead of the 24 of J wd, J w and the cross product.)"""
+    (15 products instead of the 24 of J wd, J w and the cross product). ``differences``
+    are (ZZ - YY, XX - ZZ, YY - XX), parameters of their own (:func:`moment_differences`)."""
     XX, XY, XZ, YY, YZ, ZZ = J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2]
+    ZZ_YY, XX_ZZ, YY_XX = differences
     wx, wy, wz = w
     sq = [b.let(wx * wx, f"w{tag}xx"), b.let(wy * wy, f"w{tag}yy"), b.let(wz * wz, f"w{tag}zz")]
     wxy, wxz, wyz = b.let(wx * wy, f"w{tag}xy"), b.let(wx * wz, f"w{tag}xz"), b.let(wy * wz, f"w{tag}yz")
     d = [b.let(sq[1] - sq[2], f"w{tag}_yy_zz"), b.let(sq[2] - sq[0], f"w{tag}_zz_xx"), b.let(sq[0] - sq[1], f"w{tag}_xx_yy")]
     return sp.Matrix([
-        XX * wd[0] - XY * U[2, 0] + XZ * U[1, 0] + YZ * d[0] + b.let(ZZ - YY, f"ZZ_YY{tag}") * wyz,
-        XY * U[2, 1] + YY * wd[1] - YZ * U[0, 1] + XZ * d[1] + b.let(XX - ZZ, f"XX_ZZ{tag}") * wxz,
-        -XZ * U[1, 2] + YZ * U[0, 2] + ZZ * wd[2] + XY * d[2] + b.let(YY - XX, f"YY_XX{tag}") * wxy,
+        XX * wd[0] - XY * U[2, 0] + XZ * U[1, 0] + YZ * d[0] + ZZ_YY * wyz,
+        XY * U[2, 1] + YY * wd[1] - YZ * U[0, 1] + XZ * d[1] + XX_ZZ * wxz,
+        -XZ * U[1, 2] + YZ * U[0, 2] + ZZ * wd[2] + XY * d[2] + YY_XX * wxy,
     ])
 
 
@@ -154,7 +185,9 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     gravity torques) and the barycentric parameters.
 
     parameters: ``{link: (M, MS, J)}`` to use (default :func:`standard_parameters`).
-    Returns ``(program, definitions)``: definitions as :func:`standard_parameters`.
+    Returns ``(program, definitions)``: the definitions of the new parameter symbols, as
+    :func:`standard_parameters` (those only when ``parameters`` is None) and
+    :func:`moment_differences` (always).
     """
     n = robot.dof
     qd = list(robot.qd) if qd is None else [sp.sympify(x) for x in qd]
@@ -162,6 +195,8 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     definitions = []
     if parameters is None:
         parameters, definitions = standard_parameters(robot)
+    differences, extra = moment_differences(robot, parameters, definitions)
+    definitions = definitions + extra
     b = builder or Builder(reserved=robot.free_symbols() | set(robot.q) | set(robot.qd) | set(robot.qdd)
                            | {s for s, _ in definitions})
     frames = joint_frames(robot, b)
@@ -194,7 +229,7 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         U_j = _skew2(b, w_j, wd_j, tag)
         M, MS, J = parameters[name]
         F[name] = b.vector(M * vd_j + U_j * MS, f"F{tag}")
-        N[name] = b.vector(_euler_moment(b, J, w_j, wd_j, U_j, tag) + MS.cross(vd_j), f"N{tag}")
+        N[name] = b.vector(_euler_moment(b, J, differences[name], w_j, wd_j, U_j, tag) + MS.cross(vd_j), f"N{tag}")
         w[name], wd[name], vd[name], U[name] = w_j, wd_j, vd_j, U_j
 
     f, nm = {}, {}
