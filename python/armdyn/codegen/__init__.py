@@ -37,6 +37,7 @@ import numpy as np
 import sympy as sp
 
 from ..model import Robot
+from ..symbolic import dag
 from .program import Builder, Program, from_expressions
 from .printers import INPUTS, Names, print_c, print_python
 
@@ -212,14 +213,20 @@ def _base_programs(robot: Robot, what) -> tuple[dict, dict, list]:
 
     ident = _identification("base parameters (--base)")
     bp = ident.base_parameters(robot)
-    Y = sp.Matrix(bp.Y)
+    Yb = sp.Matrix(bp.Y)
     beta = [sp.Symbol(str(nm)) for nm in bp.names]
     definitions = list(zip(beta, list(sp.Matrix(bp.beta))))
     n = robot.dof
     reserved = robot.free_symbols() | set(beta)
-    tau = Y * sp.Matrix(beta)
     programs, sources = {}, {}
+    custom = _customized_base_programs(robot, ident, Yb, beta, definitions, [w for w in what if w != "regressor"])
+    if custom is not None:
+        programs, sources, extra_defs = custom
+        definitions = definitions + extra_defs
+    tau = Yb * sp.Matrix(beta)
     for w in what:
+        if w in programs:
+            continue
         if w == "tau":
             expr, shape = list(tau), (n,)
         elif w == "g":
@@ -229,10 +236,66 @@ def _base_programs(robot: Robot, what) -> tuple[dict, dict, list]:
         elif w == "C":
             expr, shape = list(christoffel_coriolis(tau.jacobian(robot.qdd), robot.q, robot.qd)), (n, n)
         else:
-            expr, shape = list(Y), Y.shape
+            expr, shape = list(Yb), Yb.shape
         programs[w] = from_expressions(expr, shape, reserved=reserved)
         sources[w] = "base regressor x base parameters, CSE" if w != "regressor" else "base regressor, CSE"
     return programs, sources, definitions
+
+
+def _customized_base_programs(robot, ident, Yb, beta, definitions, what):
+    """tau, g, M, C by the customized algorithms at the base-parameter point
+    (:mod:`armdyn.codegen.base`), checked against ``Yb beta`` at random points; None if
+    the base parameters are not a grouping onto standard columns."""
+    from ..symbolic.composite_mass_matrix import composite_mass_matrix
+    from ..symbolic.coriolis_program import christoffel_program
+    from ..symbolic.customized_ne import customized_newton_euler
+    from .base import base_inertials
+
+    if not what:
+        return None
+    reg = ident.regressor(robot)
+    found = base_inertials(robot, sp.Matrix(reg.Y), list(sp.Matrix(reg.pi)), Yb, beta)
+    if found is None:
+        return None
+    params, extra = found
+    n = robot.dof
+    states = list(robot.qd) + list(robot.qdd)
+    programs, sources, defs = {}, {}, []
+    M_prog = builder = None
+    reserved = robot.free_symbols() | set(beta) | set(robot.q) | set(robot.qd) | set(robot.qdd)
+    tau_prog, d = customized_newton_euler(robot, parameters=params)
+    defs += d
+    tau_prog.outputs = [o + extra[i] for i, o in enumerate(tau_prog.outputs)]
+    # the check: tau of the program == Yb beta at random points (q, qd, qdd, parameters)
+    rng = np.random.default_rng(11)
+    free = sorted(dag.free_symbols(Yb) | set(beta) | set(robot.q) | set(states), key=str)
+    for _ in range(2):
+        env = {s: float(rng.uniform(-1.2, 1.2)) for s in free}
+        env.update({s: float(e.xreplace(env)) for s, e in d})
+        want = np.array((Yb * sp.Matrix(beta)).xreplace(env), dtype=float).ravel()
+        got = np.array(tau_prog.evaluate(env))
+        if not np.allclose(got, want, rtol=1e-9, atol=1e-9 * max(1.0, np.abs(want).max())):
+            return None
+    for w in what:
+        if w == "tau":
+            programs[w] = tau_prog
+        elif w == "g":
+            programs[w], _ = customized_newton_euler(robot, [0] * n, [0] * n, parameters=params)
+            g_extra = extra.xreplace({s: 0 for s in states})
+            programs[w].outputs = [o + g_extra[i] for i, o in enumerate(programs[w].outputs)]
+        elif w in ("M", "C") and M_prog is None:
+            builder = Builder(reserved=reserved | {s for s, _ in defs})
+            M_prog, _ = composite_mass_matrix(robot, parameters=params, builder=builder)
+            M_extra = extra.jacobian(robot.qdd)
+            M_prog.outputs = [o + M_extra[k // n, k % n] for k, o in enumerate(M_prog.outputs)]
+        if w == "M":
+            programs[w] = M_prog
+        elif w == "C":
+            programs[w] = christoffel_program(robot, M_prog, builder)
+        sources[w] = {"tau": "customized Newton-Euler", "g": "customized Newton-Euler at qd = qdd = 0",
+                      "M": "composite links", "C": "Christoffel symbols of the composite-link M"}[w] + \
+            ", at the base parameters"
+    return programs, sources, _in_model_parameters(defs, definitions)
 
 
 def codegen(robot: Robot | str, what=("tau", "M", "C", "g"), lang: str = "c", base: bool = False) -> GeneratedCode:

@@ -204,6 +204,7 @@ static inline void armdyn_sincos_kernel(double x, double *s, double *c)
 """
 
 LANES = 4
+_CHUNK = 48
 
 
 class _LaneNames:
@@ -260,22 +261,28 @@ def _c_batch(code, what, prog, fn, args, size) -> list[str]:
     out.append(f"            for (size_t l = 0; l < {L}; ++l) {fn}({call}, p, out + (k + l) * {size});")
     out.append("            continue;")
     out.append("        }")
-    done = set()
+    done, body, declared = set(), [], []
     for s, e in prog.assignments:
         if s in done:
             continue
         if isinstance(e, (sp.sin, sp.cos)) and e.args[0] in trig and len(trig[e.args[0]]) == 2:
             pair = trig[e.args[0]]
             sn, cn = names.name(pair["sin"]), names.name(pair["cos"])
-            out.append(f"        double {sn}[{L}], {cn}[{L}];")
-            out.append(f"        for (int l = 0; l < {L}; ++l) armdyn_sincos_kernel({names.name(e.args[0])}[l], "
-                       f"&{sn}[l], &{cn}[l]);")
+            declared += [sn, cn]
+            body.append(f"armdyn_sincos_kernel({names.name(e.args[0])}[l], &{sn}[l], &{cn}[l]);")
             done |= {pair["sin"], pair["cos"]}
             continue
-        out.append(f"        double {names.name(s)}[{L}];")
-        out.append(f"        for (int l = 0; l < {L}; ++l) {names.name(s)}[l] = {printer(e)};")
-    for j, e in enumerate(prog.outputs):
-        out.append(f"        for (int l = 0; l < {L}; ++l) out[(k + l) * {size} + {j}] = {printer(e)};")
+        declared.append(names.name(s))
+        body.append(f"{names.name(s)}[l] = {printer(e)};")
+    body += [f"out[(k + l) * {size} + {j}] = {printer(e)};" for j, e in enumerate(prog.outputs)]
+    for i in range(0, len(declared), 8):
+        out.append("        double " + ", ".join(f"{d}[{L}]" for d in declared[i:i + 8]) + ";")
+    # a few dozen lines per loop over the lanes: each loop is vectorised as a whole, and
+    # the compiler has far fewer loops to analyse than with one loop per line
+    for i in range(0, len(body), _CHUNK):
+        out.append(f"        for (int l = 0; l < {L}; ++l) {{")
+        out += [f"            {b}" for b in body[i:i + _CHUNK]]
+        out.append("        }")
     out.append("    }")
     call = ", ".join(f"{a} + k * {dof}" for a in INPUTS[what])
     out.append(f"    for (; k < n; ++k) {fn}({call}, p, out + k * {size});")
