@@ -15,7 +15,7 @@
    ``armdyn.derive(robot).tau`` (Craig's Newton-Euler) alone.
 3. The generated C for the PUMA's tau, numeric parameters (Corke's puma560 values),
    compiled with ``cc -O2``, one thread over 1e5 states, vs armdyn's Rust
-   ``rnea(..., threads=1)`` on the same batch, alternating, median of 7.
+   ``rnea(..., threads=1)`` on the same batch, alternating, 15 runs each (median and best).
 """
 
 from __future__ import annotations
@@ -133,19 +133,27 @@ def numeric(n_states: int, repeat: int) -> None:
     got = lib.tau(Q, QD, QDD)
     err = np.abs(got - ref).max() / np.abs(ref).max()
     assert err < 1e-12, err
-    t_c, t_rust = [], []
+    # the same code with the AVX2 clone switched off: SSE2 only, like the Rust core's build
+    sse2 = codegen.compile(lib.code, flags=["-DARMDYN_NO_CLONES"])
+    assert np.abs(sse2.tau(Q, QD, QDD) - got).max() == 0.0
+    t_c, t_rust, t_sse2 = [], [], []
     for _ in range(repeat):
-        t0 = time.perf_counter()
-        lib.tau(Q, QD, QDD)
-        t_c.append(time.perf_counter() - t0)
-        t0 = time.perf_counter()
-        armdyn.rnea(robot, Q, QD, QDD, threads=1)
-        t_rust.append(time.perf_counter() - t0)
+        for fn, runs in ((lambda: lib.tau(Q, QD, QDD), t_c), (lambda: armdyn.rnea(robot, Q, QD, QDD, threads=1), t_rust),
+                         (lambda: sse2.tau(Q, QD, QDD), t_sse2)):
+            t0 = time.perf_counter()
+            fn()
+            runs.append(time.perf_counter() - t0)
     c, r = statistics.median(t_c), statistics.median(t_rust)
-    print(f"## Generated C vs the Rust core, puma560 tau, {n_states:.0e} states, one thread (median of {repeat})\n")
-    print(f"generated C (cc -O2, ctypes): {c * 1e9 / n_states:7.1f} ns/state")
-    print(f"armdyn.rnea(threads=1):       {r * 1e9 / n_states:7.1f} ns/state")
-    print(f"ratio generated C / Rust rnea: {c / r:.2f}  (max rel. difference {err:.1e})")
+    print(f"## Generated C vs the Rust core, puma560 tau, {n_states:.0e} states, one thread "
+          f"(runs alternating, {repeat} each)\n")
+    print("                               median        best")
+    print(f"generated C (cc -O2, ctypes): {c * 1e9 / n_states:7.1f} ns/state {min(t_c) * 1e9 / n_states:7.1f} ns/state")
+    print(f"armdyn.rnea(threads=1):       {r * 1e9 / n_states:7.1f} ns/state {min(t_rust) * 1e9 / n_states:7.1f} ns/state")
+    s2 = statistics.median(t_sse2)
+    print(f"generated C, SSE2 only:       {s2 * 1e9 / n_states:7.1f} ns/state {min(t_sse2) * 1e9 / n_states:7.1f} ns/state"
+          f"   (-DARMDYN_NO_CLONES; ratio to Rust: median {s2 / r:.2f}, best {min(t_sse2) / min(t_rust):.2f})")
+    print(f"ratio generated C / Rust rnea: median {c / r:.2f}, best {min(t_c) / min(t_rust):.2f}"
+          f"  (max rel. difference {err:.1e})")
 
 
 def main() -> None:
@@ -153,12 +161,13 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--states", type=int, default=100_000)
     ap.add_argument("--skip-numeric", action="store_true")
+    ap.add_argument("--numeric-repeat", type=int, default=15)
     args = ap.parse_args()
     have_identification = importlib.util.find_spec("armdyn.identification") is not None
     generation_times(have_identification, args.repeat)  # first: SymPy's caches still cold
     op_count_table(have_identification)
     if not args.skip_numeric:
-        numeric(args.states, 7)
+        numeric(args.states, args.numeric_repeat)
 
 
 if __name__ == "__main__":

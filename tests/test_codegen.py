@@ -383,3 +383,13 @@ def test_base_parameter_code_equals_rust_core(monkeypatch, tmp_path):
     _close(lib.g(q, p=p), armdyn.gravity(bound, q))
     _close(lib.M(q, p=p), armdyn.crba(bound, q))
     _close(lib.C(q, qd, p=p), armdyn.coriolis_matrix(bound, q, qd))
+
+
+@pytest.mark.skipif(importlib.util.find_spec("armdyn.identification") is not None,
+                    reason="armdyn.identification present: the regressor is generated")
+def test_cli_regressor_without_identification_is_one_line(tmp_path):
+    res = _cli("codegen", "rp-arm", "--what", "tau,regressor", "--out", str(tmp_path / "gen"))
+    assert res.returncode == 2
+    assert res.stderr.startswith("armdyn: error:") and "not available" in res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "gen").exists()

@@ -12,11 +12,16 @@ of each link, DESIGN.md's order: mass, first moment m c, inertia about the link 
 * tau: customized Newton-Euler (:mod:`armdyn.symbolic.customized_ne`);
 * g:   the same recursion with ``qd = qdd = 0``;
 * M:   composite links (:mod:`armdyn.symbolic.composite_mass_matrix`);
-* C:   the Christoffel symbols of that M (:func:`armdyn.symbolic.terms.christoffel_coriolis`),
-  then SymPy's common-subexpression elimination;
-* regressor: ``armdyn.identification.regressor(robot).Y`` (dof x P); with ``base=True``
-  the base regressor, and tau, g, M, C as ``Y_base beta`` with the base parameters
-  ``beta`` as inputs.
+* C:   the Christoffel symbols of that M, its program differentiated line by line
+  (:mod:`armdyn.symbolic.coriolis_program`);
+* regressor: ``armdyn.identification.regressor(robot).Y`` (dof x P) through SymPy's
+  common-subexpression elimination.
+
+``base=True`` (needs :mod:`armdyn.identification`): the base parameters ``beta`` are the
+inputs. When each groups standard parameters onto one whose regressor column it keeps
+(Khalil's grouping), tau, g, M and C come from the same customized algorithms evaluated
+at that point (:mod:`armdyn.codegen.base`); otherwise from ``Y_base beta`` through CSE.
+The regressor becomes the base regressor.
 
 A model whose parameters are bound to numbers gives code with the numbers folded in (the
 inertial constants included); otherwise every free symbol is an entry of the parameter

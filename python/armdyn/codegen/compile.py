@@ -40,18 +40,20 @@ def _find_compiler(cc: str | None) -> str:
     )
 
 
-def build_shared_library(source: str, directory=None, cc: str | None = None, name: str = "armdyn_generated") -> str:
+def build_shared_library(source: str, directory=None, cc: str | None = None, name: str = "armdyn_generated",
+                         flags=()) -> str:
     """Compile C ``source`` into a shared library in ``directory`` (a new temporary
-    directory if None); returns its path. Raises CompilerError."""
+    directory if None); returns its path. ``flags``: extra compiler arguments (e.g.
+    ``["-DARMDYN_NO_CLONES"]`` for baseline SIMD only). Raises CompilerError."""
     compiler = _find_compiler(cc)
     directory = directory or tempfile.mkdtemp(prefix="armdyn-codegen-")
     os.makedirs(directory, exist_ok=True)
-    digest = hashlib.sha1(source.encode()).hexdigest()[:12]  # a new path per source: dlopen caches by path
+    digest = hashlib.sha1((source + "\0".join(flags)).encode()).hexdigest()[:12]  # a new path per source: dlopen caches by path
     c_path = os.path.join(directory, f"{name}_{digest}.c")
     so_path = os.path.join(directory, f"lib{name}_{digest}.so")
     with open(c_path, "w") as fh:
         fh.write(source)
-    cmd = [compiler, "-std=c99", "-O2", "-fPIC", "-shared", c_path, "-o", so_path, "-lm"]
+    cmd = [compiler, "-std=c99", "-O2", "-fPIC", "-shared", *flags, c_path, "-o", so_path, "-lm"]
     try:
         res = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     except subprocess.TimeoutExpired:
@@ -135,13 +137,14 @@ class CompiledCode:
         return f"CompiledCode({self.code.robot_name!r}, {list(self.functions)}, path={self.path!r})"
 
 
-def compile(code, what=("tau", "M", "C", "g"), *, base: bool = False, directory=None, cc: str | None = None) -> CompiledCode:
+def compile(code, what=("tau", "M", "C", "g"), *, base: bool = False, directory=None, cc: str | None = None,
+            flags=()) -> CompiledCode:
     """Build C code into a shared library and load it.
 
     code: a :class:`~armdyn.codegen.GeneratedCode` in C, or a Robot / model name (then
           :func:`armdyn.codegen.codegen` generates ``what`` in C, with ``base``).
     directory: where the .c and .so go (a new temporary directory if None).
-    cc: the compiler (default ``$CC``, then cc, gcc, clang).
+    cc: the compiler (default ``$CC``, then cc, gcc, clang); flags: extra arguments.
     Raises CompilerError when no compiler is found or it fails.
     """
     from . import GeneratedCode, codegen
@@ -152,5 +155,5 @@ def compile(code, what=("tau", "M", "C", "g"), *, base: bool = False, directory=
         raise ValueError(f"compile needs C code, got lang={code.lang!r}; generate it with lang='c'")
     from . import _identifier
 
-    path = build_shared_library(code.source, directory, cc, name=_identifier(code.robot_name))
+    path = build_shared_library(code.source, directory, cc, name=_identifier(code.robot_name), flags=list(flags))
     return CompiledCode(code, path)
