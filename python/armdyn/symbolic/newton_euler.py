@@ -35,6 +35,21 @@ from ..model import Robot
 from .terms import EquationsOfMotion, Step
 
 
+def _mul(A, v) -> sp.Matrix:
+    """``A * v`` (A a matrix or a scalar, v a column) skipping zero factors: SymPy's
+    ``0 * x`` asks whether ``x`` is finite, which walks the whole of a large ``x`` (most of
+    the derivation's time before this)."""
+    if not isinstance(A, sp.MatrixBase):
+        return sp.zeros(*v.shape) if A == 0 else A * v
+    return sp.Matrix([sp.Add(*[a * x for a, x in zip(A.row(r), v) if a != 0 and x != 0]) for r in range(A.rows)])
+
+
+def _cross(a, b) -> sp.Matrix:
+    """``a x b`` (3-vectors), skipping zero factors as :func:`_mul`."""
+    def m(x, y):
+        return 0 if x == 0 or y == 0 else x * y
+    return sp.Matrix([m(a[1], b[2]) - m(a[2], b[1]), m(a[2], b[0]) - m(a[0], b[2]), m(a[0], b[1]) - m(a[1], b[0])])
+
 
 def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | None = None) -> sp.Matrix:
     """tau (n x 1) for joint velocities ``qd`` and accelerations ``qdd`` (sequences of
@@ -57,21 +72,21 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
         Rt = R.T
         z = joint.axis
 
-        w_in = Rt * w[parent]
-        wd_in = Rt * wd[parent]
-        vd_c = Rt * (wd[parent].cross(p) + w[parent].cross(w[parent].cross(p)) + vd[parent])
+        w_in = _mul(Rt, w[parent])
+        wd_in = _mul(Rt, wd[parent])
+        vd_c = _mul(Rt, _cross(wd[parent], p) + _cross(w[parent], _cross(w[parent], p)) + vd[parent])
         if joint.type == "revolute":
             w_i = w_in + qd[k] * z
-            wd_i = wd_in + w_in.cross(qd[k] * z) + qdd[k] * z
+            wd_i = wd_in + _cross(w_in, qd[k] * z) + qdd[k] * z
         else:
             w_i, wd_i = w_in, wd_in
         if joint.type == "prismatic":
-            vd_c = vd_c + 2 * w_i.cross(qd[k] * z) + qdd[k] * z
+            vd_c = vd_c + 2 * _cross(w_i, qd[k] * z) + qdd[k] * z
         c = link.com
-        vcd = wd_i.cross(c) + w_i.cross(w_i.cross(c)) + vd_c
+        vcd = _cross(wd_i, c) + _cross(w_i, _cross(w_i, c)) + vd_c
         w[joint.child], wd[joint.child], vd[joint.child] = w_i, wd_i, vd_c
-        F[joint.child] = link.mass * vcd
-        N[joint.child] = link.inertia * wd_i + w_i.cross(link.inertia * w_i)
+        F[joint.child] = _mul(link.mass, vcd)
+        N[joint.child] = _mul(link.inertia, wd_i) + _cross(w_i, _mul(link.inertia, w_i))
 
         if record:
             name = joint.child
@@ -93,12 +108,12 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
         name, i = joint.child, robot.link_index(joint.child)
         link = robot.links[name]
         f_i = F[name]
-        n_i = N[name] + link.com.cross(F[name])
+        n_i = N[name] + _cross(link.com, F[name])
         for child in robot.children(name):
             Rc, pc = placement[child.child]
-            f_c = Rc * f[child.child]
+            f_c = _mul(Rc, f[child.child])
             f_i = f_i + f_c
-            n_i = n_i + Rc * n[child.child] + pc.cross(f_c)
+            n_i = n_i + _mul(Rc, n[child.child]) + _cross(pc, f_c)
         f[name], n[name] = f_i, n_i
         k = robot.coordinate_index(joint)
         if k is not None:
