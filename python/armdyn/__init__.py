@@ -15,6 +15,7 @@ from .errors import ModelError, UnboundParameterError
 from .io import bundled_robots, load
 from .model import Joint, Link, Robot
 from .symbolic import EquationsOfMotion, check, derive, prove_agreement
+from . import codegen  # armdyn.codegen(robot, ...) and armdyn.codegen.compile(...)
 
 _NUMERIC = (
     "rnea", "crba", "aba", "gravity", "bias", "coriolis_matrix", "kinetic_energy",
@@ -42,4 +43,5 @@ __all__ = [
     *_NUMERIC,
     "inertia", "io", "ModelError", "UnboundParameterError", "Joint", "Link", "Robot",
     "load", "bundled_robots", "derive", "check", "prove_agreement", "EquationsOfMotion", "grade",
+    "codegen",
 ]

@@ -5,6 +5,7 @@
     armdyn robots
     armdyn show ROBOT [--q Q1,Q2,...] [--out arm.png]
     armdyn grade SUBMISSION [--robot MODEL] [--json] [--html OUT.html] [--ascii] [--to-yaml]
+    armdyn codegen ROBOT [--what tau,M,C,g,regressor] [--base] [--lang c|python|numpy] [--bind] [--out DIR]
 
 ROBOT is a bundled model's name (see ``armdyn robots``) or a model file (.yaml, .urdf).
 Bad input prints one line ``armdyn: error: ...`` and exits with status 2, no traceback.
@@ -116,6 +117,23 @@ def cmd_grade(args) -> int:
     else:
         print(report.text(ascii_only=args.ascii))
     return 0 if report.passed else 1
+def cmd_codegen(args) -> int:
+    from .codegen import codegen, write_files
+
+    robot = _load(args.robot, args.allow_nonphysical)
+    if args.bind:
+        robot = robot.bind()
+    code = codegen(robot, what=args.what, lang=args.lang, base=args.base)
+    if args.out is None:
+        print(code.source)
+        return 0
+    (path,) = write_files([code], args.out)
+    print(f"wrote {path}")
+    for what, c in code.op_counts.items():
+        print(f"  {code.functions[what]}: {c['mul']} mul, {c['add']} add, {c['sin_cos']} sin/cos")
+    if code.parameters:
+        print(f"  parameters p[0..{len(code.parameters) - 1}]: {', '.join(s.name for s in code.parameters)}")
+    return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -162,6 +180,14 @@ def build_parser() -> argparse.ArgumentParser:
     gr.add_argument("--ascii", action="store_true", help="plain ASCII text (no Unicode dots and marks)")
     gr.add_argument("--to-yaml", action="store_true", help="print the steps as read (the YAML format) and stop")
     gr.set_defaults(func=cmd_grade)
+    cg = sub.add_parser("codegen", help="generate C, Python or NumPy code for tau, M, C, g, the regressor")
+    robot_arg(cg)
+    cg.add_argument("--what", default="tau,M,C,g", help="comma-separated: tau,M,C,g,regressor (default tau,M,C,g)")
+    cg.add_argument("--base", action="store_true", help="in the base parameters (needs armdyn.identification)")
+    cg.add_argument("--lang", choices=["c", "python", "numpy"], default="c")
+    cg.add_argument("--bind", action="store_true", help="bind the model's published parameter values first")
+    cg.add_argument("--out", help="directory to write the source file into (default: print it)")
+    cg.set_defaults(func=cmd_codegen)
     return p
 
 

@@ -1,0 +1,364 @@
+"""Generated code for the dynamics of a robot: C99, Python or NumPy.
+
+    code = armdyn.codegen(robot, what=("tau", "M", "C", "g"), lang="c")   # GeneratedCode
+    print(code.source)              # readable: named temporaries, op counts in the header
+    code.op_counts["tau"]           # {'mul': ..., 'add': ..., 'sin_cos': ..., 'total': ...}
+    lib = armdyn.codegen.compile(robot.bind(), what=("tau", "M"))   # system C compiler
+    tau = lib.tau(q, qd, qdd)       # q, qd, qdd: (dof,) or (N, dof) float64
+
+Where each quantity comes from (all with the barycentric / standard inertial parameters
+of each link, DESIGN.md's order: mass, first moment m c, inertia about the link origin):
+
+* tau: customized Newton-Euler (:mod:`armdyn.symbolic.customized_ne`);
+* g:   the same recursion with ``qd = qdd = 0``;
+* M:   composite links (:mod:`armdyn.symbolic.composite_mass_matrix`);
+* C:   the Christoffel symbols of that M, its program differentiated line by line
+  (:mod:`armdyn.symbolic.coriolis_program`);
+* regressor: ``armdyn.identification.regressor(robot).Y`` (dof x P) through SymPy's
+  common-subexpression elimination.
+
+``base=True`` (needs :mod:`armdyn.identification`): the base parameters ``beta`` are the
+inputs. When each groups standard parameters onto one whose regressor column it keeps
+(Khalil's grouping), tau, g, M and C come from the same customized algorithms evaluated
+at that point (:mod:`armdyn.codegen.base`); otherwise from ``Y_base beta`` through CSE.
+The regressor becomes the base regressor.
+
+A model whose parameters are bound to numbers gives code with the numbers folded in (the
+inertial constants included); otherwise every free symbol is an entry of the parameter
+vector ``p``, in :attr:`GeneratedCode.parameters` order (the header lists them, with the
+definition of each barycentric one in the model's parameters).
+
+Conventions: ``M(q) qdd + C(q, qd) qd + g(q) = tau``, SI units, radians, joints in
+``robot.coordinate_names`` order; batches are ``(N, dof)`` row-major.
+"""
+
+from __future__ import annotations
+
+import sys
+import types
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy as sp
+
+from ..model import Robot
+from ..symbolic import dag
+from .program import Builder, Program, from_expressions
+from .printers import INPUTS, Names, print_c, print_python
+
+QUANTITIES = ("tau", "M", "C", "g", "regressor")
+LANGUAGES = ("c", "python", "numpy")
+_SUFFIX = {"c": ".c", "python": ".py", "numpy": ".py"}
+
+
+@dataclass
+class GeneratedCode:
+    """Generated source for some quantities of one robot.
+
+    source:      the whole source text (one file).
+    lang:        "c", "python" or "numpy".
+    functions:   quantity -> function name (C: also ``<name>_batch``).
+    op_counts:   quantity -> {'mul', 'add', 'sin_cos', 'other', 'total'} per state.
+    parameters:  Symbols of the parameter vector ``p``, in order (empty for numbers).
+    definitions: [(Symbol, expression of the model's parameters)] of the barycentric ones.
+    programs:    quantity -> :class:`~armdyn.codegen.program.Program`.
+    """
+
+    robot_name: str
+    lang: str
+    dof: int
+    coordinate_names: list
+    q: sp.Matrix
+    qd: sp.Matrix
+    qdd: sp.Matrix
+    programs: dict
+    sources: dict
+    parameters: list
+    definitions: list
+    base: bool = False
+    source: str = ""
+    functions: dict = field(default_factory=dict)
+    op_counts: dict = field(default_factory=dict)
+    names: Names | None = None
+
+    def output_size(self, what: str) -> int:
+        return int(np.prod(self.programs[what].shape))
+
+    def describe(self, what: str) -> str:
+        shape = " x ".join(str(d) for d in self.programs[what].shape)
+        return f"({shape}) of {', '.join(INPUTS[what])}; {self.sources[what]}"
+
+    @property
+    def filename(self) -> str:
+        return f"{_identifier(self.robot_name)}_dynamics{_SUFFIX[self.lang]}"
+
+    def parameter_values(self, values: dict | None = None) -> np.ndarray:
+        """The vector ``p`` (len(parameters),) from values of the model's parameters
+        (name or Symbol -> number); barycentric entries are computed from their
+        definitions. Missing values are an error naming them."""
+        table = {}
+        for k, v in (values or {}).items():
+            table[k if isinstance(k, str) else k.name] = float(v)
+        defs = dict(self.definitions)
+        out, missing = [], []
+        for s in self.parameters:
+            expr = defs.get(s, s)
+            subs = {f: table[f.name] for f in expr.free_symbols if f.name in table}
+            absent = [f.name for f in expr.free_symbols if f.name not in table]
+            if absent:
+                missing += absent
+                continue
+            out.append(float(expr.xreplace(subs)))
+        if missing:
+            raise ValueError(f"parameter_values: no value for {sorted(set(missing))}")
+        return np.array(out)
+
+    def write(self, directory) -> str:
+        """Write :attr:`source` to ``directory/filename`` (all or nothing); returns the path."""
+        return write_files([self], directory)[0]
+
+
+def _identifier(name: str) -> str:
+    import re
+
+    s = re.sub(r"\W", "_", name)
+    return s if s and not s[0].isdigit() else "robot_" + s
+
+
+def write_files(codes, directory) -> list[str]:
+    """Write each code's source into ``directory`` atomically: every file is written to
+    a temporary name first, then all are renamed, so a failure leaves nothing half-written."""
+    import os
+    import tempfile
+
+    os.makedirs(directory, exist_ok=True)
+    staged = []
+    try:
+        for code in codes:
+            fd, tmp = tempfile.mkstemp(prefix=".armdyn-", dir=directory)
+            with os.fdopen(fd, "w") as fh:
+                fh.write(code.source)
+            staged.append((tmp, os.path.join(directory, code.filename)))
+    except BaseException:
+        for tmp, _ in staged:
+            os.unlink(tmp)
+        raise
+    for tmp, final in staged:
+        os.replace(tmp, final)
+    return [final for _, final in staged]
+
+
+def _identification(what: str):
+    try:
+        from .. import identification  # provided by the regressor/base-parameter work
+    except ImportError:
+        raise ValueError(f"codegen: {what} is not available: armdyn.identification is not installed in this "
+                         "version of armdyn") from None
+    return identification
+
+
+def _parse_what(what) -> list[str]:
+    if isinstance(what, str):
+        what = [w.strip() for w in what.split(",") if w.strip()]
+    what = list(what)
+    if not what:
+        raise ValueError("codegen: 'what' is empty; choose from " + ", ".join(QUANTITIES))
+    bad = [w for w in what if w not in QUANTITIES]
+    if bad:
+        raise ValueError(f"codegen: unknown quantity {bad[0]!r} in 'what'; choose from {', '.join(QUANTITIES)}")
+    return list(dict.fromkeys(what))
+
+
+def _in_model_parameters(extra, definitions) -> list:
+    """New definitions with the barycentric symbols in them replaced by theirs."""
+    table = dict(definitions)
+    return [(s, sp.expand(e.xreplace(table))) for s, e in extra if s not in table]
+
+
+def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
+    from ..symbolic.composite_mass_matrix import composite_mass_matrix
+    from ..symbolic.customized_ne import customized_newton_euler, standard_parameters
+    from ..symbolic.coriolis_program import christoffel_program
+
+    params, definitions = standard_parameters(robot)
+    reserved = robot.free_symbols() | {s for s, _ in definitions}
+    programs, sources = {}, {}
+    n = robot.dof
+    M_prog = None
+    for w in what:
+        if w == "tau":
+            programs[w], extra = customized_newton_euler(robot, parameters=params)
+            definitions += _in_model_parameters(extra, definitions)
+            sources[w] = "customized Newton-Euler"
+        elif w == "g":
+            programs[w], extra = customized_newton_euler(robot, [0] * n, [0] * n, parameters=params)
+            definitions += _in_model_parameters(extra, definitions)
+            sources[w] = "customized Newton-Euler at qd = qdd = 0"
+        elif w in ("M", "C"):
+            if M_prog is None:
+                builder = Builder(reserved=reserved | set(robot.q) | set(robot.qd))
+                M_prog, _ = composite_mass_matrix(robot, parameters=params, builder=builder)
+            if w == "M":
+                programs[w] = M_prog
+                sources[w] = "composite links"
+            else:
+                programs[w] = christoffel_program(robot, M_prog, builder)
+                sources[w] = "Christoffel symbols of the composite-link M, differentiated line by line"
+        elif w == "regressor":
+            ident = _identification("the regressor")
+            reg = ident.regressor(robot)
+            Y = sp.Matrix(reg.Y)
+            programs[w] = from_expressions(list(Y), Y.shape, reserved=reserved)
+            sources[w] = "armdyn.identification.regressor, CSE"
+    return programs, sources, definitions
+
+
+def _base_programs(robot: Robot, what) -> tuple[dict, dict, list]:
+    from ..symbolic.terms import christoffel_coriolis
+
+    ident = _identification("base parameters (--base)")
+    bp = ident.base_parameters(robot)
+    Yb = sp.Matrix(bp.Y)
+    beta = [sp.Symbol(str(nm)) for nm in bp.names]
+    definitions = list(zip(beta, list(sp.Matrix(bp.beta))))
+    n = robot.dof
+    reserved = robot.free_symbols() | set(beta)
+    programs, sources = {}, {}
+    custom = _customized_base_programs(robot, ident, Yb, beta, definitions, [w for w in what if w != "regressor"])
+    if custom is not None:
+        programs, sources, extra_defs = custom
+        definitions = definitions + extra_defs
+    tau = Yb * sp.Matrix(beta)
+    for w in what:
+        if w in programs:
+            continue
+        if w == "tau":
+            expr, shape = list(tau), (n,)
+        elif w == "g":
+            expr, shape = list(tau.xreplace({s: 0 for s in list(robot.qd) + list(robot.qdd)})), (n,)
+        elif w == "M":
+            expr, shape = list(tau.jacobian(robot.qdd)), (n, n)
+        elif w == "C":
+            expr, shape = list(christoffel_coriolis(tau.jacobian(robot.qdd), robot.q, robot.qd)), (n, n)
+        else:
+            expr, shape = list(Yb), Yb.shape
+        programs[w] = from_expressions(expr, shape, reserved=reserved)
+        sources[w] = "base regressor x base parameters, CSE" if w != "regressor" else "base regressor, CSE"
+    return programs, sources, definitions
+
+
+def _customized_base_programs(robot, ident, Yb, beta, definitions, what):
+    """tau, g, M, C by the customized algorithms at the base-parameter point
+    (:mod:`armdyn.codegen.base`), checked against ``Yb beta`` at random points; None if
+    the base parameters are not a grouping onto standard columns."""
+    from ..symbolic.composite_mass_matrix import composite_mass_matrix
+    from ..symbolic.coriolis_program import christoffel_program
+    from ..symbolic.customized_ne import customized_newton_euler
+    from .base import base_inertials
+
+    if not what:
+        return None
+    reg = ident.regressor(robot)
+    found = base_inertials(robot, sp.Matrix(reg.Y), list(sp.Matrix(reg.pi)), Yb, beta)
+    if found is None:
+        return None
+    params, extra = found
+    n = robot.dof
+    states = list(robot.qd) + list(robot.qdd)
+    programs, sources, defs = {}, {}, []
+    M_prog = builder = None
+    reserved = robot.free_symbols() | set(beta) | set(robot.q) | set(robot.qd) | set(robot.qdd)
+    tau_prog, d = customized_newton_euler(robot, parameters=params)
+    defs += d
+    tau_prog.outputs = [o + extra[i] for i, o in enumerate(tau_prog.outputs)]
+    # the check: tau of the program == Yb beta at random points (q, qd, qdd, parameters)
+    rng = np.random.default_rng(11)
+    free = sorted(dag.free_symbols(Yb) | set(beta) | set(robot.q) | set(states), key=str)
+    for _ in range(2):
+        env = {s: float(rng.uniform(-1.2, 1.2)) for s in free}
+        env.update({s: float(e.xreplace(env)) for s, e in d})
+        want = np.array((Yb * sp.Matrix(beta)).xreplace(env), dtype=float).ravel()
+        got = np.array(tau_prog.evaluate(env))
+        if not np.allclose(got, want, rtol=1e-9, atol=1e-9 * max(1.0, np.abs(want).max())):
+            return None
+    for w in what:
+        if w == "tau":
+            programs[w] = tau_prog
+        elif w == "g":
+            programs[w], _ = customized_newton_euler(robot, [0] * n, [0] * n, parameters=params)
+            g_extra = extra.xreplace({s: 0 for s in states})
+            programs[w].outputs = [o + g_extra[i] for i, o in enumerate(programs[w].outputs)]
+        elif w in ("M", "C") and M_prog is None:
+            builder = Builder(reserved=reserved | {s for s, _ in defs})
+            M_prog, _ = composite_mass_matrix(robot, parameters=params, builder=builder)
+            M_extra = extra.jacobian(robot.qdd)
+            M_prog.outputs = [o + M_extra[k // n, k % n] for k, o in enumerate(M_prog.outputs)]
+        if w == "M":
+            programs[w] = M_prog
+        elif w == "C":
+            programs[w] = christoffel_program(robot, M_prog, builder)
+        sources[w] = {"tau": "customized Newton-Euler", "g": "customized Newton-Euler at qd = qdd = 0",
+                      "M": "composite links", "C": "Christoffel symbols of the composite-link M"}[w] + \
+            ", at the base parameters"
+    return programs, sources, _in_model_parameters(defs, definitions)
+
+
+def codegen(robot: Robot | str, what=("tau", "M", "C", "g"), lang: str = "c", base: bool = False) -> GeneratedCode:
+    """Generate code for ``what`` (quantities from ``QUANTITIES``, a sequence or a
+    comma-separated string) of ``robot`` (a Robot, bundled name or model file) in
+    ``lang`` ("c", "python", "numpy"). ``base=True``: in the base parameters
+    (needs :mod:`armdyn.identification`). Returns a :class:`GeneratedCode`.
+
+    Raises ValueError for an unknown quantity or language, or a robot of 0 dof.
+    """
+    if isinstance(robot, str):
+        from ..io import load
+
+        robot = load(robot)
+    if not isinstance(robot, Robot):
+        raise TypeError(f"codegen: expected an armdyn.Robot or a model name, got {type(robot).__name__}")
+    what = _parse_what(what)
+    if lang not in LANGUAGES:
+        raise ValueError(f"codegen: unknown language {lang!r}; choose from {', '.join(LANGUAGES)}")
+    if robot.dof == 0:
+        raise ValueError(f"codegen: robot '{robot.name}' has no movable joint")
+    programs, sources, definitions = (_base_programs if base else _standard_programs)(robot, what)
+
+    states = set(robot.q) | set(robot.qd) | set(robot.qdd)
+    used = set()
+    for prog in programs.values():
+        for e in [e for _, e in prog.assignments] + list(prog.outputs):
+            used |= sp.sympify(e).free_symbols
+        used -= {s for s, _ in prog.assignments}
+    free = used - states
+    order = [s for s in robot.parameters.values() if s in free] + [s for s, _ in definitions if s in free]
+    order += sorted(free - set(order), key=str)
+    defs = [(s, e) for s, e in definitions if s in free]
+
+    temps = [s for prog in programs.values() for s, _ in prog.assignments]
+    names = Names(list(dict.fromkeys([*robot.q, *robot.qd, *robot.qdd, *order, *temps])))
+    prefix = _identifier(robot.name)
+    code = GeneratedCode(
+        robot.name, lang, robot.dof, list(robot.coordinate_names), robot.q, robot.qd, robot.qdd, programs, sources,
+        order, defs, base,
+        functions={w: f"{prefix}_{w}" for w in programs},
+        op_counts={w: p.operation_counts() for w, p in programs.items()},
+        names=names,
+    )
+    code.source = print_c(code) if lang == "c" else print_python(code, numpy=(lang == "numpy"))
+    return code
+
+
+from .compile import CompiledCode, compile  # noqa: E402  (uses GeneratedCode)
+
+
+class _CallableModule(types.ModuleType):
+    """``armdyn.codegen(...)`` calls :func:`codegen`; the module stays importable."""
+
+    def __call__(self, *args, **kwargs):
+        return codegen(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule
+
+__all__ = ["codegen", "compile", "GeneratedCode", "CompiledCode", "Program", "QUANTITIES", "LANGUAGES"]

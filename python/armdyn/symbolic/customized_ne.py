@@ -1,0 +1,250 @@
+"""Customized Newton-Euler: inverse dynamics as a short straight-line program.
+
+Khalil and Kleinfinger's customized Newton-Euler (W. Khalil, E. Dombre, *Modeling,
+Identification and Control of Robots*, 2002, sec. 9.5 and 9.3.3): the same recursion
+as :mod:`armdyn.symbolic.newton_euler`, but
+
+* every intermediate quantity that is not a number, a symbol or its negative becomes a
+  named temporary, so nothing is computed twice and nothing is expanded;
+* zeros and ones propagate (SymPy drops ``0*x`` and ``1*x`` on construction): the
+  sparse DH frames and the zero velocity of the base cost nothing;
+* the inertial parameters are the barycentric (standard) ones of each link ``j``:
+  mass ``M``, first moment ``MS = M c`` and inertia ``J`` about the link frame's origin
+  (DESIGN.md's standard parameters), so that no parallel-axis term is computed per state;
+* ``U_j = skew(wd_j) + skew(w_j)^2`` is formed once per link and used both for the link's
+  own force and its children's accelerations (Khalil eq. 9.79).
+
+All vectors of link j are in link j's frame. Outward, with ``(R, p)`` link j's frame in
+its parent's and ``z`` the joint axis (Khalil eqs. 9.77-9.82)::
+
+    w_j  = R^T w_p + qd z                               (revolute; R^T w_p if prismatic)
+    wd_j = R^T wd_p + qdd z + (R^T w_p) x qd z          (revolute; R^T wd_p if prismatic)
+    vd_j = R^T (U_p p + vd_p)     [+ 2 w_j x qd z + qdd z  if prismatic],  vd_0 = -gravity
+    F_j  = M_j vd_j + U_j MS_j
+    N_j  = J_j wd_j + w_j x (J_j w_j) + MS_j x vd_j
+
+Inward, over the children c of link j (``R_c``, ``p_c`` their frames)::
+
+    f_j = F_j + sum_c R_c f_c
+    n_j = N_j + sum_c (R_c n_c + p_c x R_c f_c)
+    tau = z . n_j (revolute), z . f_j (prismatic)
+
+Dead code (quantities no torque needs, e.g. the first link's force) is removed at the end.
+"""
+
+from __future__ import annotations
+
+import re
+
+import sympy as sp
+
+from ..codegen.program import Builder, Program
+from ..model import Robot
+
+#: per link, in DESIGN.md's (Pinocchio's) order of the standard parameters
+STANDARD_NAMES = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")
+
+
+def _safe(name: str) -> str:
+    return re.sub(r"\W", "_", name)
+
+
+def standard_parameters(robot: Robot):
+    """Barycentric parameters of every link: ``{link: (M, MS (3x1), J (3x3))}`` and the
+    definitions ``[(Symbol, expression of the model's parameters)]`` of the symbols that
+    stand for them.
+
+    ``MS = m c``, ``J = I_c + m (c.c 1 - c c^T)`` (inertia about the link origin, link
+    axes; parallel axis theorem). A value that is zero or a number stays as it is, a
+    plain symbol (e.g. the mass ``m2``) too; any other expression is named
+    ``MX2, XX2, ...`` (Khalil's names, the number is the link's frame index).
+    """
+    taken = {str(s) for s in robot.free_symbols()} | {str(s) for s in (*robot.q, *robot.qd, *robot.qdd)}
+    definitions = []
+    out = {}
+
+    def named(value, kind, index):
+        value = sp.expand(value) if value.free_symbols else value
+        if value.is_Atom:
+            return value
+        name = f"{kind}{index}"
+        while name in taken:
+            name += "_"
+        taken.add(name)
+        s = sp.Symbol(name)
+        definitions.append((s, value))
+        return s
+
+    for link_name, link in robot.links.items():
+        if link_name == robot.base:
+            continue
+        i = robot.link_index(link_name)
+        m, c, Ic = sp.sympify(link.mass), link.com, link.inertia
+        J = Ic + m * ((c.T * c)[0] * sp.eye(3) - c * c.T)
+        M = named(m, "M", i)
+        MS = sp.Matrix([named(m * c[k], "M" + "XYZ"[k], i) for k in range(3)])
+        Jn = sp.zeros(3, 3)
+        for a, b in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):
+            Jn[a, b] = Jn[b, a] = named(J[a, b], "XYZ"[a] + "XYZ"[b], i)
+        out[link_name] = (M, MS, Jn)
+    return out, definitions
+
+
+def moment_differences(robot: Robot, parameters: dict, definitions: list) -> tuple[dict, list]:
+    """``{link: (ZZ - YY, XX - ZZ, YY - XX)}`` of the inertias about the link origins,
+    each a number, a symbol, or a new parameter ``ZZmYY2, XXmZZ2, YYmXX2`` whose
+    definition (in the model's parameters) is returned: like the barycentric parameters,
+    they are computed once per parameter set, not per state (Khalil's grouped
+    parameters have the same form, e.g. ``XXR = XX - YY``)."""
+    taken = {str(s) for s in robot.free_symbols()} | {str(s) for s, _ in definitions} | {str(s) for s in robot.q}
+    table = dict(definitions)
+    out, new = {}, []
+    for link, (_, _, J) in parameters.items():
+        i = robot.link_index(link)
+        XX, YY, ZZ = J[0, 0], J[1, 1], J[2, 2]
+        diffs = []
+        for (a, b_), label in (((ZZ, YY), "ZZmYY"), ((XX, ZZ), "XXmZZ"), ((YY, XX), "YYmXX")):
+            value = a - b_
+            if value.is_Atom:
+                diffs.append(value)
+                continue
+            name = f"{label}{i}"
+            while name in taken:
+                name += "_"
+            taken.add(name)
+            sym = sp.Symbol(name)
+            new.append((sym, sp.expand(value.xreplace(table))))
+            diffs.append(sym)
+        out[link] = tuple(diffs)
+    return out, new
+
+
+def joint_frames(robot: Robot, b: Builder) -> dict:
+    """``{child link: (R, p)}`` of every joint, with ``cos q``, ``sin q`` named once
+    (``c1, s1``; 1-based like the joints) and non-trivial entries of ``R`` named."""
+    frames = {}
+    for joint in robot.joints:
+        k = robot.coordinate_index(joint)
+        R, p = joint.transform(robot.joint_coordinate(joint))
+        if joint.type == "revolute":
+            q = robot.q[k]
+            trig = {sp.cos(q): b.let(sp.cos(q), f"c{k + 1}"), sp.sin(q): b.let(sp.sin(q), f"s{k + 1}")}
+            R = R.xreplace(trig)
+        tag = _safe(str(robot.link_index(joint.child)))
+        R = sp.Matrix(3, 3, lambda r, s: b.let(R[r, s], f"R{tag}_{r + 1}{s + 1}"))
+        p = sp.Matrix([b.let(p[r], f"p{tag}_{'xyz'[r]}") for r in range(3)])
+        frames[joint.child] = (R, p)
+    return frames
+
+
+def _skew2(b: Builder, w, wd, tag) -> sp.Matrix:
+    """U = skew(wd) + skew(w) skew(w) (3x3), Khalil eq. 9.79, with the products named."""
+    w1, w2, w3 = w
+    sq = [b.let(w1 * w1, f"w{tag}xx"), b.let(w2 * w2, f"w{tag}yy"), b.let(w3 * w3, f"w{tag}zz")]
+    xy, xz, yz = b.let(w1 * w2, f"w{tag}xy"), b.let(w1 * w3, f"w{tag}xz"), b.let(w2 * w3, f"w{tag}yz")
+    U = sp.Matrix([
+        [-sq[1] - sq[2], xy - wd[2], xz + wd[1]],
+        [xy + wd[2], -sq[0] - sq[2], yz - wd[0]],
+        [xz - wd[1], yz + wd[0], -sq[0] - sq[1]],
+    ])
+    return sp.Matrix(3, 3, lambda r, s: b.let(U[r, s], f"U{tag}_{r + 1}{s + 1}"))
+
+
+def _euler_moment(b: Builder, J, differences, w, wd, U, tag) -> sp.Matrix:
+    """J wd + w x (J w) (3x1) for a symmetric J, as linear in J's six entries, with the
+    coefficients taken from U (whose off-diagonal entries are wd_k +- w_i w_j) and the
+    squares of w::
+
+        x: XX wdx + XY (wdy - wx wz) + XZ (wdz + wx wy) + YZ (wy^2 - wz^2) + (ZZ - YY) wy wz
+        y: XY (wdx + wy wz) + YY wdy + YZ (wdz - wx wy) + XZ (wz^2 - wx^2) + (XX - ZZ) wx wz
+        z: XZ (wdx - wy wz) + YZ (wdy + wx wz) + ZZ wdz + XY (wx^2 - wy^2) + (YY - XX) wx wy
+
+    (15 products instead of the 24 of J wd, J w and the cross product). ``differences``
+    are (ZZ - YY, XX - ZZ, YY - XX), parameters of their own (:func:`moment_differences`)."""
+    XX, XY, XZ, YY, YZ, ZZ = J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2]
+    ZZ_YY, XX_ZZ, YY_XX = differences
+    wx, wy, wz = w
+    sq = [b.let(wx * wx, f"w{tag}xx"), b.let(wy * wy, f"w{tag}yy"), b.let(wz * wz, f"w{tag}zz")]
+    wxy, wxz, wyz = b.let(wx * wy, f"w{tag}xy"), b.let(wx * wz, f"w{tag}xz"), b.let(wy * wz, f"w{tag}yz")
+    d = [b.let(sq[1] - sq[2], f"w{tag}_yy_zz"), b.let(sq[2] - sq[0], f"w{tag}_zz_xx"), b.let(sq[0] - sq[1], f"w{tag}_xx_yy")]
+    return sp.Matrix([
+        XX * wd[0] - XY * U[2, 0] + XZ * U[1, 0] + YZ * d[0] + ZZ_YY * wyz,
+        XY * U[2, 1] + YY * wd[1] - YZ * U[0, 1] + XZ * d[1] + XX_ZZ * wxz,
+        -XZ * U[1, 2] + YZ * U[0, 2] + ZZ * wd[2] + XY * d[2] + YY_XX * wxy,
+    ])
+
+
+def _matvec(b: Builder, A, v, hint) -> sp.Matrix:
+    return b.vector(A * v, hint)
+
+
+def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, parameters=None,
+                            builder: Builder | None = None) -> tuple[Program, list]:
+    """tau (n,) of ``robot`` as a :class:`Program` of the joint coordinates, velocities
+    ``qd`` and accelerations ``qdd`` (default: the robot's symbols; pass zeros for the
+    gravity torques) and the barycentric parameters.
+
+    parameters: ``{link: (M, MS, J)}`` to use (default :func:`standard_parameters`).
+    Returns ``(program, definitions)``: the definitions of the new parameter symbols, as
+    :func:`standard_parameters` (those only when ``parameters`` is None) and
+    :func:`moment_differences` (always).
+    """
+    n = robot.dof
+    qd = list(robot.qd) if qd is None else [sp.sympify(x) for x in qd]
+    qdd = list(robot.qdd) if qdd is None else [sp.sympify(x) for x in qdd]
+    definitions = []
+    if parameters is None:
+        parameters, definitions = standard_parameters(robot)
+    differences, extra = moment_differences(robot, parameters, definitions)
+    definitions = definitions + extra
+    b = builder or Builder(reserved=robot.free_symbols() | set(robot.q) | set(robot.qd) | set(robot.qdd)
+                           | {s for s, _ in definitions})
+    frames = joint_frames(robot, b)
+    zero = sp.zeros(3, 1)
+    base_acc = -robot.gravity if gravity else zero
+    w, wd = {robot.base: zero}, {robot.base: zero}
+    vd = {robot.base: b.vector(base_acc, "g")}
+    U = {robot.base: sp.zeros(3, 3)}
+    F, N = {}, {}
+    for joint in robot.joints:
+        name, parent = joint.child, joint.parent
+        tag = _safe(str(robot.link_index(name)))
+        k = robot.coordinate_index(joint)
+        R, p = frames[name]
+        Rt = R.T
+        z = joint.axis
+        w_in = _matvec(b, Rt, w[parent], f"wi{tag}")
+        wd_j = Rt * wd[parent]
+        if joint.type == "revolute":
+            w_j = w_in + qd[k] * z
+            wd_j = wd_j + qdd[k] * z + w_in.cross(qd[k] * z)
+        else:
+            w_j = w_in
+        w_j, wd_j = b.vector(w_j, f"w{tag}"), b.vector(wd_j, f"wd{tag}")
+        Up_p = _matvec(b, U[parent], p, f"Up{tag}")
+        vd_j = Rt * b.vector(Up_p + vd[parent], f"a{tag}")  # named: both rows of R^T use it
+        if joint.type == "prismatic":
+            vd_j = vd_j + 2 * w_j.cross(qd[k] * z) + qdd[k] * z
+        vd_j = b.vector(vd_j, f"vd{tag}")
+        U_j = _skew2(b, w_j, wd_j, tag)
+        M, MS, J = parameters[name]
+        F[name] = b.vector(M * vd_j + U_j * MS, f"F{tag}")
+        N[name] = b.vector(_euler_moment(b, J, differences[name], w_j, wd_j, U_j, tag) + MS.cross(vd_j), f"N{tag}")
+        w[name], wd[name], vd[name], U[name] = w_j, wd_j, vd_j, U_j
+
+    f, nm = {}, {}
+    tau = [sp.Integer(0)] * n
+    for joint in reversed(robot.joints):
+        name = joint.child
+        tag = _safe(str(robot.link_index(name)))
+        f_j, n_j = F[name], N[name]
+        for child in robot.children(name):
+            Rc, pc = frames[child.child]
+            f_c = _matvec(b, Rc, f[child.child], f"Rf{_safe(str(robot.link_index(child.child)))}")
+            f_j = f_j + f_c
+            n_j = n_j + Rc * nm[child.child] + pc.cross(f_c)
+        f[name], nm[name] = b.vector(f_j, f"f{tag}"), b.vector(n_j, f"n{tag}")
+        k = robot.coordinate_index(joint)
+        if k is not None:
+            tau[k] = (nm[name] if joint.type == "revolute" else f[name]).dot(joint.axis)
+    return b.program(tau, (n,)), definitions
