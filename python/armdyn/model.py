@@ -548,6 +548,9 @@ class Robot:
         The dynamics are unchanged (tau does not depend on where link frames sit); only the
         link frames differ. The numeric engines use this form. ``self`` if nothing moves.
         """
+        cached = self.__dict__.get("_canonical")
+        if cached is not None:
+            return cached
         offsets = {j.child: (j.frame_rotation, j.frame_xyz) for j in self.joints if j.has_frame_offset}
         if not offsets:
             return self
@@ -564,10 +567,12 @@ class Robot:
                 Rf, pf = offsets[j.parent]
                 changes.update(xyz=pf + Rf * j.xyz, rotation=Rf * j.rotation)
             joints.append(replace(j, **changes))
-        return Robot(
+        out = Robot(
             self.name, links, joints, self.gravity, self.parameters, self.meta, self.base, self.defaults,
             strict=self.strict,
         )
+        self.__dict__["_canonical"] = out  # built once: the numeric engines and codegen share it
+        return out
 
     @classmethod
     def from_urdf(cls, source, strict: bool = True) -> "Robot":

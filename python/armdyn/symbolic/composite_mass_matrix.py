@@ -49,6 +49,7 @@ def composite_mass_matrix(robot: Robot, parameters=None, builder: Builder | None
     """M (n x n, row-major outputs) as a :class:`Program` of q and the barycentric
     parameters. Returns ``(program, definitions)`` as
     :func:`~armdyn.symbolic.customized_ne.customized_newton_euler`."""
+    robot = robot.canonical()  # link frames on their joints (frames off the axis: same dynamics)
     n = robot.dof
     definitions = []
     if parameters is None:

@@ -59,6 +59,7 @@ def standard_parameters(robot: Robot):
     plain symbol (e.g. the mass ``m2``) too; any other expression is named
     ``MX2, XX2, ...`` (Khalil's names, the number is the link's frame index).
     """
+    robot = robot.canonical()  # link frames on their joints (frames off the axis: same dynamics)
     taken = {str(s) for s in robot.free_symbols()} | {str(s) for s in (*robot.q, *robot.qd, *robot.qdd)}
     definitions = []
     out = {}
@@ -189,6 +190,7 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     :func:`standard_parameters` (those only when ``parameters`` is None) and
     :func:`moment_differences` (always).
     """
+    robot = robot.canonical()  # link frames on their joints (frames off the axis: same dynamics)
     n = robot.dof
     qd = list(robot.qd) if qd is None else [sp.sympify(x) for x in qd]
     qdd = list(robot.qdd) if qdd is None else [sp.sympify(x) for x in qdd]
