@@ -18,6 +18,7 @@ from .symbolic import EquationsOfMotion, check, derive, prove_agreement
 _NUMERIC = (
     "rnea", "crba", "aba", "gravity", "bias", "coriolis_matrix", "kinetic_energy",
     "potential_energy", "forward_kinematics", "jacobian", "NumericModel", "compile_model",
+    "rnea_derivatives", "aba_derivatives", "minverse", "gravity_derivatives", "jacobian_dot",
 )
 
 
