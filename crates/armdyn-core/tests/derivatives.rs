@@ -12,7 +12,8 @@ fn cases() -> Vec<(Model, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)> {
     let mut rng = Rng::new(11);
     (0..40)
         .map(|trial| {
-            let model = random_model(&mut rng, 1 + rng.below(10), trial % 3 != 0);
+            let njoints = 1 + rng.below(10);
+            let model = random_model(&mut rng, njoints, trial % 3 != 0);
             let n = model.nv;
             let w = rng.vec(6 * model.nlinks(), -3.0, 3.0);
             (rng.vec(n, -3.0, 3.0), rng.vec(n, -2.0, 2.0), rng.vec(n, -2.0, 2.0), w, model)
