@@ -15,6 +15,12 @@ Every function has the signature of its counterpart in ``armdyn.numeric``:
     forward_kinematics(robot, q)  -> (nlinks, 4, 4) pose of every link frame in the base frame,
                                                     order list(robot.links) (base first)
     jacobian(robot, q, link)      -> J (6, n)       rows [v; w] of the link frame's origin, base axes
+    rnea_ext / aba_ext(..., f_ext, frame)           rnea / aba with one wrench [f; n] per link
+    rnea_derivatives(robot, q, qd, qdd[, f_ext, frame]) -> (dtau_dq, dtau_dqd, M)   forward mode
+    aba_derivatives(robot, q, qd, tau[, f_ext, frame])  -> (dqdd_dq, dqdd_dqd, Minv) forward mode
+    minverse(robot, q)            -> M^-1 (n, n)    (NumPy's inverse of crba)
+    gravity_derivatives(robot, q) -> dg/dq (n, n)
+    jacobian_dot(robot, q, qd, link) -> dJ/dt (6, n)  product rule on the pose chain
 
 Conventions
 -----------
