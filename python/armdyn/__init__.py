@@ -20,6 +20,7 @@ from . import codegen  # armdyn.codegen(robot, ...) and armdyn.codegen.compile(.
 _NUMERIC = (
     "rnea", "crba", "aba", "gravity", "bias", "coriolis_matrix", "kinetic_energy",
     "potential_energy", "forward_kinematics", "jacobian", "NumericModel", "compile_model",
+    "rnea_derivatives", "aba_derivatives", "minverse", "gravity_derivatives", "jacobian_dot",
 )
 
 

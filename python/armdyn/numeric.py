@@ -42,6 +42,11 @@ __all__ = [
     "potential_energy",
     "forward_kinematics",
     "jacobian",
+    "rnea_derivatives",
+    "aba_derivatives",
+    "minverse",
+    "gravity_derivatives",
+    "jacobian_dot",
 ]
 
 #: A robot compiled for numeric evaluation (built by :func:`compile_model`). Its
@@ -118,6 +123,19 @@ def compile_model(robot: Robot | NumericModel) -> NumericModel:
     return model
 
 
+def _core_model(robot, what: str, link_frames: bool = False) -> NumericModel:
+    """The compiled model for the functions that exist only in the plain Rust core: not
+    (yet) for robots with mimic joints, nor, where a link frame is involved (wrenches in
+    link frames, jacobian_dot), for link frames off their joint's axis."""
+    model = _model(robot)
+    if not isinstance(model, NumericModel):
+        raise ValueError(f"{what} is not available yet for robots with mimic joints")
+    if link_frames and _frame_offsets(robot) is not None:
+        raise ValueError(f"{what}: link frames off their joint's axis are not supported here yet; "
+                         "pass robot.canonical() (frames on the joints, same dynamics)")
+    return model
+
+
 def _frame_offsets(robot) -> np.ndarray | None:
     """(nlinks, 4, 4) each link frame in its canonical (on-joint) frame, or None when
     every link frame sits on its joint (see :meth:`armdyn.model.Robot.canonical`)."""
@@ -140,11 +158,14 @@ def _model(robot) -> NumericModel:
         return compile_model(robot)
 
 
-def rnea(robot, q, qd, qdd, *, threads=None):
+def rnea(robot, q, qd, qdd, *, f_ext=None, frame="local", threads=None):
     """Inverse dynamics by the recursive Newton-Euler algorithm.
 
-    q, qd, qdd: (n,) or (N, n). Returns tau = M(q) qdd + C(q, qd) qd + g(q), same shape.
+    q, qd, qdd: (n,) or (N, n). Returns tau = M(q) qdd + C(q, qd) qd + g(q), same shape;
+    with external wrenches ``f_ext`` (see :func:`rnea_derivatives`), minus sum J^T w.
     """
+    if f_ext is not None:
+        return _core.rnea_ext(_core_model(robot, "rnea with f_ext", frame == "local"), q, qd, qdd, f_ext, frame, threads)
     return _model(robot).rnea(q, qd, qdd, threads)
 
 
@@ -156,11 +177,14 @@ def crba(robot, q, *, threads=None):
     return _model(robot).crba(q, threads)
 
 
-def aba(robot, q, qd, tau, *, threads=None):
+def aba(robot, q, qd, tau, *, f_ext=None, frame="local", threads=None):
     """Forward dynamics by the articulated-body algorithm.
 
-    q, qd, tau: (n,) or (N, n). Returns qdd = M^-1 (tau - C qd - g), same shape.
+    q, qd, tau: (n,) or (N, n). Returns qdd = M^-1 (tau - C qd - g), same shape; with
+    external wrenches ``f_ext`` (see :func:`rnea_derivatives`), M^-1 (tau + sum J^T w - C qd - g).
     """
+    if f_ext is not None:
+        return _core.aba_ext(_core_model(robot, "aba with f_ext", frame == "local"), q, qd, tau, f_ext, frame, threads)
     return _model(robot).aba(q, qd, tau, threads)
 
 
@@ -234,3 +258,57 @@ def jacobian(robot, q, link, *, threads=None):
     r = R @ offsets[k, :3, 3]
     Jv, Jw = J[..., :3, :], J[..., 3:, :]
     return np.concatenate([Jv - np.cross(r[..., None, :], Jw.swapaxes(-1, -2)).swapaxes(-1, -2), Jw], axis=-2)
+
+
+# --------------------------------------------------------------------------- derivatives
+
+
+def rnea_derivatives(robot, q, qd, qdd, *, f_ext=None, frame="local", threads=None):
+    """Partial derivatives of inverse dynamics, analytically (Carpentier & Mansard, RSS 2018).
+
+    q, qd, qdd: (n,) or (N, n). Returns ``(dtau_dq, dtau_dqd, M)``, each (n, n) or
+    (N, n, n), row = output, column = input: ``dtau_dq[i, j] = d tau_i / d q_j``;
+    ``M = d tau / d qdd``.
+
+    f_ext: external wrenches, one per link: shape (nlinks, 6) (or (N, nlinks, 6) for a
+    batch), rows in ``list(robot.links)`` order (base first; the base's row does not act
+    on the joints), each ``[fx, fy, fz, nx, ny, nz]`` (force, then moment). ``frame``
+    says where: ``"local"``: in the link's frame, moment about its origin (the wrench
+    moves with the link; Pinocchio's LOCAL ``fext``); ``"world"``: in base axes, moment
+    about the base frame's origin (the wrench stays fixed in space). Then
+    ``tau = M qdd + C qd + g - sum_L J_L^T w_L``.
+    """
+    model = _core_model(robot, "rnea_derivatives", f_ext is not None and frame == "local")
+    return _core.rnea_derivatives(model, q, qd, qdd, f_ext, frame, threads)
+
+
+def aba_derivatives(robot, q, qd, tau, *, f_ext=None, frame="local", threads=None):
+    """Partial derivatives of forward dynamics (Carpentier & Mansard, RSS 2018, IV.C).
+
+    q, qd, tau: (n,) or (N, n). Returns ``(dqdd_dq, dqdd_dqd, Minv)``, each (n, n) or
+    (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
+    f_ext, frame: as in :func:`rnea_derivatives`.
+    """
+    model = _core_model(robot, "aba_derivatives", f_ext is not None and frame == "local")
+    return _core.aba_derivatives(model, q, qd, tau, f_ext, frame, threads)
+
+
+def minverse(robot, q, *, threads=None):
+    """The inverse of the joint-space inertia matrix, by the articulated-body recursion
+    (without forming or factorising M). q: (n,) or (N, n). Returns (n, n) or (N, n, n)."""
+    return _core.minverse(_core_model(robot, "minverse"), q, threads)
+
+
+def gravity_derivatives(robot, q, *, threads=None):
+    """``dg/dq`` of the gravity torques: (n, n) or (N, n, n), ``[i, j] = d g_i / d q_j``."""
+    return _core.gravity_derivatives(_core_model(robot, "gravity_derivatives"), q, threads)
+
+
+def jacobian_dot(robot, q, qd, link, *, threads=None):
+    """Time derivative of :func:`jacobian`: ``dJ/dt`` (6, n) or (N, 6, n), same rows
+    ``[v; w]`` in base-frame axes (Pinocchio's LOCAL_WORLD_ALIGNED), so that the link
+    origin's acceleration and the link's angular acceleration are ``J qdd + Jdot qd``.
+    link: a link name, index in ``list(robot.links)``, or Link."""
+    if isinstance(link, Link):
+        link = link.name
+    return _core.jacobian_dot(_core_model(robot, "jacobian_dot", True), q, qd, link, threads)

@@ -18,12 +18,15 @@
 
 pub mod algo;
 pub mod batch;
+pub mod batch_derivatives;
 pub mod data;
+pub mod deriv_data;
 pub mod joint;
 pub mod model;
 pub mod real;
 pub mod spatial;
 
 pub use data::Data;
+pub use deriv_data::DerivData;
 pub use model::{JointSpec, JointType, Model, ModelError};
 pub use real::{F64x4, F64x8, Real};

@@ -35,7 +35,7 @@ fn count(f: impl FnOnce()) -> usize {
 }
 
 mod common;
-use armdyn_core::{algo, algo::coriolis::CoriolisWork, batch, Data, Model};
+use armdyn_core::{algo, algo::coriolis::CoriolisWork, batch, batch_derivatives, Data, DerivData, Model};
 use common::*;
 
 #[test]
@@ -81,4 +81,57 @@ fn batch_allocations_do_not_grow_with_the_number_of_states() {
     let (small, large) = (run(5), run(5000));
     assert_eq!(small, large, "allocations: {small} for 5 states, {large} for 5000");
     assert!(small <= 3 * 30, "{small} allocations (workspaces only)");
+}
+
+#[test]
+fn derivative_algorithms_do_not_allocate() {
+    let mut rng = Rng::new(3);
+    let model = random_model(&mut rng, 9, true);
+    let (n, nl) = (model.nv, model.nlinks());
+    let (q, qd, qdd) = (rng.vec(n, -1.0, 1.0), rng.vec(n, -1.0, 1.0), rng.vec(n, -1.0, 1.0));
+    let w = rng.vec(6 * nl, -1.0, 1.0);
+    let mut d = Data::new(&model);
+    let mut dd = DerivData::new(&model);
+    let (mut a, mut b, mut c, mut v, mut j) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n], vec![0.0; 6 * n]);
+    let allocs = count(|| {
+        for frame in [algo::ForceFrame::Local, algo::ForceFrame::World] {
+            let ext = algo::ExternalForces { wrenches: &w, frame };
+            for _ in 0..50 {
+                algo::rnea_derivatives(&model, &mut d, &mut dd, &q, &qd, &qdd, None, &mut a, &mut b, &mut c);
+                algo::rnea_derivatives(&model, &mut d, &mut dd, &q, &qd, &qdd, Some(&ext), &mut a, &mut b, &mut c);
+                algo::aba_derivatives(&model, &mut d, &mut dd, &q, &qd, &qdd, None, &mut a, &mut b, &mut c);
+                algo::aba_derivatives(&model, &mut d, &mut dd, &q, &qd, &qdd, Some(&ext), &mut a, &mut b, &mut c);
+                algo::minverse(&model, &mut d, &mut dd, &q, &mut a);
+                algo::gravity_derivatives(&model, &mut d, &mut dd, &q, &mut a);
+                algo::rnea_ext(&model, &mut d, &mut dd, &q, &qd, &qdd, &ext, &mut v);
+                algo::aba_ext(&model, &mut d, &mut dd, &q, &qd, &qdd, &ext, &mut v);
+                algo::jacobian_dot(&model, &mut d, &q, &qd, nl - 1, &mut j);
+            }
+        }
+    });
+    assert_eq!(allocs, 0);
+}
+
+#[test]
+fn derivative_batch_allocations_do_not_grow_with_the_number_of_states() {
+    let model = Model::new(&ur5_joints(), [0.0, 0.0, -9.81]).unwrap();
+    let (n, nl) = (model.nv, model.nlinks());
+    let run = |rows: usize| {
+        let mut rng = Rng::new(1);
+        let (q, qd, qdd) = (rng.vec(rows * n, -1.0, 1.0), rng.vec(rows * n, -1.0, 1.0), rng.vec(rows * n, -1.0, 1.0));
+        let w = rng.vec(rows * 6 * nl, -1.0, 1.0);
+        let (mut a, mut b, mut c, mut v, mut j) =
+            (vec![0.0; rows * n * n], vec![0.0; rows * n * n], vec![0.0; rows * n * n], vec![0.0; rows * n], vec![0.0; rows * 6 * n]);
+        let ext = Some((&w[..], algo::ForceFrame::Local));
+        count(|| {
+            batch_derivatives::rnea_derivatives(&model, [&q, &qd, &qdd], None, [&mut a, &mut b, &mut c], Some(1));
+            batch_derivatives::aba_derivatives(&model, [&q, &qd, &qdd], ext, [&mut a, &mut b, &mut c], Some(1));
+            batch_derivatives::minverse(&model, &q, &mut a, Some(1));
+            batch_derivatives::gravity_derivatives(&model, &q, &mut a, Some(1));
+            batch_derivatives::rnea_ext(&model, [&q, &qd, &qdd], ext.unwrap(), &mut v, Some(1));
+            batch_derivatives::jacobian_dot(&model, &q, &qd, nl - 1, &mut j, Some(1));
+        })
+    };
+    let (small, large) = (run(5), run(5000));
+    assert_eq!(small, large, "allocations: {small} for 5 states, {large} for 5000");
 }

@@ -21,6 +21,8 @@ use std::collections::HashMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 
+mod derivatives;
+
 /// Run `f`, turning a Rust panic into a Python `RuntimeError`.
 fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
     catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|payload| {
@@ -153,6 +155,13 @@ fn thread_arg(threads: Option<i64>) -> PyResult<Option<usize>> {
 struct Scratch {
     data: Data<f64>,
     coriolis: CoriolisWork,
+    deriv: armdyn_core::DerivData<f64>,
+}
+
+impl Scratch {
+    fn new(model: &Model) -> Self {
+        Scratch { data: Data::new(model), coriolis: CoriolisWork::new(model), deriv: armdyn_core::DerivData::new(model) }
+    }
 }
 
 /// A robot's dynamics model compiled for numeric evaluation (see armdyn.numeric).
@@ -188,7 +197,7 @@ impl NumericModel {
             Ok(mut s) => f(&mut s),
             Err(std::sync::TryLockError::Poisoned(p)) => f(&mut p.into_inner()),
             Err(std::sync::TryLockError::WouldBlock) => {
-                f(&mut Scratch { data: Data::new(&self.model), coriolis: CoriolisWork::new(&self.model) })
+                f(&mut Scratch::new(&self.model))
             }
         }
     }
@@ -315,7 +324,7 @@ impl NumericModel {
                 )));
             }
             let link_index = link_names.iter().enumerate().map(|(k, s)| (s.clone(), k)).collect();
-            let scratch = Mutex::new(Scratch { data: Data::new(&model), coriolis: CoriolisWork::new(&model) });
+            let scratch = Mutex::new(Scratch::new(&model));
             Ok(NumericModel { model, scratch, name, link_names, link_index, coordinate_names })
         })
     }
@@ -599,6 +608,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<NumericModel>()?;
     m.add_function(wrap_pyfunction!(_test_panic, m)?)?;
     m.add_function(wrap_pyfunction!(simd_kernels, m)?)?;
+    derivatives::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -5,12 +5,18 @@
 //! tree order); matrices are row-major; spatial vectors `[angular; linear]` inside.
 
 pub mod aba;
+pub mod aba_derivatives;
 pub mod coriolis;
 pub mod crba;
 pub mod energy;
+pub mod external;
+pub mod gravity_derivatives;
 pub mod jacobian;
+pub mod jacobian_dot;
 pub mod kinematics;
+pub mod minverse;
 pub mod rnea;
+pub mod rnea_derivatives;
 
 pub use aba::aba;
 pub use coriolis::coriolis_matrix;
@@ -19,3 +25,9 @@ pub use energy::{kinetic_energy, potential_energy};
 pub use jacobian::jacobian;
 pub use kinematics::forward_kinematics;
 pub use rnea::{bias, gravity, rnea};
+pub use aba_derivatives::aba_derivatives;
+pub use external::{aba_ext, generalized_forces, rnea_ext, ExternalForces, ForceFrame};
+pub use gravity_derivatives::gravity_derivatives;
+pub use jacobian_dot::jacobian_dot;
+pub use minverse::minverse;
+pub use rnea_derivatives::rnea_derivatives;

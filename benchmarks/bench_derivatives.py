@@ -1,0 +1,147 @@
+"""armdyn's derivatives of the dynamics vs Pinocchio's, side by side in one process, on
+UR5, Panda and iiwa14.
+
+    python benchmarks/bench_derivatives.py            # full run
+    python benchmarks/bench_derivatives.py --quick    # smoke run: fewer repeats, N = 2e4
+
+(with armdyn importable: ``PYTHONPATH=python`` after a release build.)
+
+1. Per call from Python, one state: ``armdyn.rnea_derivatives(robot, q, qd, qdd)`` vs
+   ``pin.computeRNEADerivatives(model, data, q, v, a)``; likewise ``aba_derivatives`` vs
+   ``computeABADerivatives`` and ``minverse`` vs ``computeMinverse``. Each time is the median
+   over ``--repeat`` runs of ``timeit`` with ``--number`` calls; the two libraries' runs
+   alternate, so both see the same machine load. Both return fresh arrays (Pinocchio returns
+   its result matrices as new NumPy arrays; armdyn allocates (n, n) outputs per call; neither
+   symmetrises its M or Minv (armdyn's are full, Pinocchio fills the upper triangle).
+2. Batch throughput: ``armdyn.rnea_derivatives(robot, Q, QD, QDD, threads=t)`` on (N, n)
+   arrays (outputs (N, n, n) allocated per call), t = 1 and 2, in million states per second,
+   compared with the rate of Pinocchio's per-call time (Pinocchio has no batched derivatives):
+   ``1 / t_call`` for its Python call measured here (an upper bound on its C++ call time, so
+   a lower bound on its rate), and ``2 / t_call`` ("both cores") — the issue's target is
+   ``>= 4 x`` that rate of its C++ call.
+
+Before timing, each arm is checked: armdyn == Pinocchio to 1e-10. Ratios are armdyn time /
+Pinocchio time: below 1 means armdyn is faster. Not a test: timings depend on the machine
+and its load.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import sys
+import time
+import timeit
+
+import numpy as np
+import pinocchio as pin
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import arms  # noqa: E402  (also puts tests/ on sys.path for the Pinocchio bridge)
+from pinocchio_derivatives import PinocchioDerivatives  # noqa: E402
+
+from armdyn import numeric as num  # noqa: E402
+
+
+def per_call_run(f, args, number: int):
+    names = [f"a{i}" for i in range(len(args))]
+    timer = timeit.Timer(f"f({', '.join(names)})", globals={"f": f, **dict(zip(names, args))})
+    return lambda: timer.timeit(number) / number
+
+
+def batch_run(f):
+    def run():
+        t0 = time.perf_counter()
+        f()
+        return time.perf_counter() - t0
+
+    return run
+
+
+def paired_medians(run_mine, run_theirs, repeat: int):
+    run_mine(), run_theirs()
+    mine, theirs = [], []
+    for _ in range(repeat):
+        mine.append(run_mine())
+        theirs.append(run_theirs())
+    return statistics.median(mine), statistics.median(theirs)
+
+
+def check(robot, P, rng):
+    q, v, a = (rng.uniform(-np.pi, np.pi, robot.dof) for _ in range(3))
+    for mine, theirs in (
+        (num.rnea_derivatives(robot, q, v, a), P.rnea_derivatives(q, v, a)),
+        (num.aba_derivatives(robot, q, v, a), P.aba_derivatives(q, v, a)),
+        ((num.minverse(robot, q),), (P.minverse(q),)),
+    ):
+        for x, y in zip(mine, theirs):
+            err = np.max(np.abs(x - y)) / np.max(np.abs(y))
+            assert err <= 1e-10, err
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--arms", default="ur5,panda,iiwa14")
+    parser.add_argument("--number", type=int, default=20000)
+    parser.add_argument("--repeat", type=int, default=11)
+    parser.add_argument("--batch", type=float, default=1e5)
+    parser.add_argument("--batch-repeat", type=int, default=5)
+    parser.add_argument("--threads", default="1,2")
+    args = parser.parse_args(argv)
+    if args.quick:
+        args.number, args.repeat, args.batch, args.batch_repeat = 2000, 5, 2e4, 3
+    N = int(args.batch)
+    threads = [int(t) for t in args.threads.split(",")]
+    print(f"armdyn vs Pinocchio {pin.__version__}; Python {platform.python_version()}; {os.cpu_count()} CPUs; "
+          f"SIMD kernels {num._core.simd_kernels()}; load average {os.getloadavg()[0]:.2f}")
+    print(f"per call: median of {args.repeat} x {args.number} calls; batch: N = {N}, median of {args.batch_repeat}\n")
+    rows, batch_rows = [], []
+    for name in args.arms.split(","):
+        robot = arms.ARMS[name]()
+        P = PinocchioDerivatives(robot)
+        assert np.array_equal(P.perm, np.arange(robot.dof))
+        rng = np.random.default_rng(0)
+        check(robot, P, rng)
+        model, data = P.model, P.data
+        q, v, a = (np.ascontiguousarray(rng.uniform(-np.pi, np.pi, robot.dof)) for _ in range(3))
+        tau = pin.rnea(model, data, q, v, a)
+        pin_call = {}
+        for fn, mine, theirs in (
+            ("rnea_derivatives", (num.rnea_derivatives, (robot, q, v, a)),
+             (pin.computeRNEADerivatives, (model, data, q, v, a))),
+            ("aba_derivatives", (num.aba_derivatives, (robot, q, v, tau)),
+             (pin.computeABADerivatives, (model, data, q, v, tau))),
+            ("minverse", (num.minverse, (robot, q)), (pin.computeMinverse, (model, data, q))),
+        ):
+            t_mine, t_pin = paired_medians(per_call_run(*mine, args.number), per_call_run(*theirs, args.number),
+                                           args.repeat)
+            rows.append((name, fn, t_mine, t_pin))
+            pin_call[fn] = t_pin
+        Q, V, A = (np.ascontiguousarray(rng.uniform(-np.pi, np.pi, (N, robot.dof))) for _ in range(3))
+        TAU = num.rnea(robot, Q, V, A)
+        for fn, f, X in (("rnea_derivatives", num.rnea_derivatives, A), ("aba_derivatives", num.aba_derivatives, TAU),
+                         ("minverse", None, None)):
+            for t in threads:
+                call = (lambda: num.minverse(robot, Q, threads=t)) if f is None else (lambda: f(robot, Q, V, X, threads=t))
+                times = [batch_run(call)() for _ in range(args.batch_repeat + 1)][1:]
+                batch_rows.append((name, fn, t, statistics.median(times), pin_call[fn]))
+
+    print(f"{'arm':7} {'function':17} {'armdyn':>9} {'Pinocchio':>10} {'ratio':>6}")
+    for name, fn, t_mine, t_pin in rows:
+        print(f"{name:7} {fn:17} {t_mine * 1e6:7.2f}us {t_pin * 1e6:8.2f}us {t_mine / t_pin:6.2f}")
+    print(f"\nbatch of N = {N}: armdyn M states/s vs the rate of Pinocchio's per-call time (Python call: 1 core, 2 cores)")
+    print(f"{'arm':7} {'function':17} {'thr':>3} {'armdyn':>9} {'M/s':>6} {'pin 1 core':>10} {'pin 2 cores':>11} {'x (2 cores)':>11}")
+    for name, fn, t, tb, t_pin in batch_rows:
+        rate = N / tb / 1e6
+        r1 = 1 / t_pin / 1e6
+        print(f"{name:7} {fn:17} {t:3d} {tb * 1e3:7.1f}ms {rate:6.2f} {r1:10.2f} {2 * r1:11.2f} {rate / (2 * r1):11.2f}")
+    print(f"\nload average at the end: {os.getloadavg()[0]:.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

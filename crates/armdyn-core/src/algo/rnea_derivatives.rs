@@ -1,0 +1,199 @@
+//! Analytical derivatives of inverse dynamics, after J. Carpentier and N. Mansard,
+//! "Analytical Derivatives of Rigid Body Dynamics Algorithms", RSS 2018 (Algorithm 1
+//! and its Section IV.B), written in base-frame ("world") quantities.
+//!
+//! Everything below is in base coordinates. `J_i` is joint i's axis (`^0X_i S_i`), `v_i`,
+//! `a_i` body i's velocity and acceleration (`a_0 = [0; -g]`), `I_i` its inertia,
+//! `f_i = I_i a_i + v_i x* I_i v_i - f^ext_i`, and `F_i`, `I^c_i`, `B^c_i` the sums of
+//! `f_k`, `I_k`, `B_k` over the subtree of i. In base coordinates a joint's axis only
+//! changes when an ancestor moves: `dJ_j/dq_i = J_i x J_j` for i supporting j.
+//!
+//! Moving q_i turns the subtree of i rigidly about `J_i`; a quantity attached to it then
+//! changes by `J_i x` (motions) or `J_i x*` (forces), except for what the subtree
+//! inherits from its (unmoved) parent lambda: with
+//!
+//! ```text
+//! dV_i = v_lambda x J_i,    dA_i = a_lambda x J_i + v_lambda x dV_i      (paper eq. 9-10)
+//! dv_k/dq_i = J_i x v_k + dV_i,   and   df_k/dq_i = J_i x* f_k + I_k dA_i + B_k dV_i
+//! df_k/dqd_i = I_k (2 dV_i) + B_k J_i                                      (paper eq. 12)
+//! B_k = v_k x* I_k - I_k (v_k x) + (I_k v_k) xbar,    (h xbar) m := m x* h
+//! ```
+//!
+//! for every body k in the subtree of i. `tau_j = J_j^T F_j` then gives, for j an
+//! ancestor of i or i itself (`J_j` does not move with q_i),
+//! `dtau_j/dq_i = J_j^T (J_i x* F_i + I^c_i dA_i + B^c_i dV_i)`, and for j a descendant
+//! of i (the `J_i x` terms of `J_j` and `F_j` cancel, as `crf = -crm^T`)
+//! `dtau_j/dq_i = J_j^T (I^c_j dA_i + B^c_j dV_i)`; likewise for qd with
+//! `(2 dV_i, J_i)` in place of `(dA_i, dV_i)`, and `M_ji = J_j^T I^c_max(i,j) J_i`.
+//!
+//! `B_k` has a sparse closed form (our derivation, expanding the three products with
+//! `I = [Ibar h^x; -h^x m]`): only its left column of 3x3 blocks is non-zero,
+//!
+//! ```text
+//! B_k = [ S - N^x   0 ]     S = w^x Ibar - Ibar w^x - v^x h^x - h^x v^x  (symmetric)
+//!       [ -2 P^x    0 ]     [N; P] = I_k v_k  (angular and linear momentum)
+//! ```
+//!
+//! so the subtree sums are one symmetric 3x3 and two 3-vectors per body.
+
+use crate::algo::external::{world_forces, ExternalForces, ForceFrame};
+use crate::algo::kinematics::{update_x0, update_xup};
+use crate::data::Data;
+use crate::deriv_data::DerivData;
+use crate::model::Model;
+use crate::real::Real;
+use crate::spatial::{Force, Motion, RigidInertia, Sym3, V3};
+
+/// `B^c_i m` for the subtree sums of body i (only `m`'s angular part matters).
+#[inline(always)]
+fn b_apply<T: Real>(dd: &DerivData<T>, i: usize, m: &Motion<T>) -> Force<T> {
+    let w = m.w;
+    let p2 = dd.bp[i] + dd.bp[i];
+    Force::new(dd.bs[i].mul_v(w) - dd.bn[i].cross(w), w.cross(p2))
+}
+
+/// The angular part of `B^c_i^T m = [(S + N^x) m_w + 2 P x m_v; 0]`.
+#[inline(always)]
+fn b_tr_apply<T: Real>(dd: &DerivData<T>, i: usize, m: &Motion<T>) -> V3<T> {
+    let p2 = dd.bp[i] + dd.bp[i];
+    dd.bs[i].mul_v(m.w) + dd.bn[i].cross(m.w) + p2.cross(m.v)
+}
+
+/// The symmetric block `S = w^x Ibar - Ibar w^x - (v^x h^x + h^x v^x)` of `B` for a
+/// body of base-frame inertia `i` moving with base-frame velocity `v`:
+/// `w^x Ibar + (w^x Ibar)^T - (v h^T + h v^T) + 2 (v . h) 1`.
+#[inline(always)]
+fn b_sym<T: Real>(i: &RigidInertia<T>, v: &Motion<T>) -> Sym3<T> {
+    let w = v.w;
+    // columns of w^x Ibar
+    let (k0, k1, k2) = (w.cross(i.ibar.col(0)), w.cross(i.ibar.col(1)), w.cross(i.ibar.col(2)));
+    let s = Sym3 {
+        xx: k0.x + k0.x,
+        yy: k1.y + k1.y,
+        zz: k2.z + k2.z,
+        xy: k1.x + k0.y,
+        xz: k2.x + k0.z,
+        yz: k2.y + k1.z,
+    };
+    let vh = v.v.dot(i.h);
+    (s - Sym3::sym_outer(v.v, i.h)).add_diag(vh + vh)
+}
+
+/// The forward and backward passes shared by `rnea_derivatives` and `aba_derivatives`:
+/// fills `dd.s`, `dd.v`, `dd.a`, `dd.dvdq`, `dd.dadq` and the subtree sums `dd.ic`,
+/// `dd.bs`, `dd.bn`, `dd.bp`, `dd.f`, `dd.fx`.
+#[inline(always)]
+fn passes<T: Real>(
+    model: &Model,
+    data: &mut Data<T>,
+    dd: &mut DerivData<T>,
+    q: &[T],
+    qd: &[T],
+    qdd: &[T],
+    ext: Option<&ExternalForces<T>>,
+) {
+    let n = model.nv;
+    update_xup(model, data, q);
+    update_x0(model, data);
+    match ext {
+        Some(e) => world_forces(model, data, e, &mut dd.fx),
+        None => dd.fx.iter_mut().for_each(|f| *f = Force::zero()),
+    }
+    let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
+    for i in 0..n {
+        let x0 = data.x0[i];
+        let s = x0.inv_apply_motion(&model.kind[i].s());
+        let (vp, ap) = match model.parent[i] {
+            Some(p) => (dd.v[p], dd.a[p]),
+            None => (Motion::zero(), a0),
+        };
+        let v = vp + s.scale(qd[i]);
+        let a = ap + s.scale(qdd[i]) + v.cross_motion(&s).scale(qd[i]);
+        let dvdq = vp.cross_motion(&s);
+        dd.dadq[i] = ap.cross_motion(&s) + vp.cross_motion(&dvdq);
+        dd.dvdq[i] = dvdq;
+        let inertia = RigidInertia::splat(&model.inertia[i]).tr_transform(&x0);
+        let h = inertia.mul_motion(&v);
+        dd.f[i] = inertia.mul_motion(&a) + v.cross_force(&h) - dd.fx[i];
+        dd.bs[i] = b_sym(&inertia, &v);
+        dd.bn[i] = h.n;
+        dd.bp[i] = h.f;
+        dd.ic[i] = inertia;
+        dd.s[i] = s;
+        dd.v[i] = v;
+        dd.a[i] = a;
+    }
+    if !matches!(ext, Some(e) if e.frame == ForceFrame::World) {
+        // forces given in link frames move with their links like the inertial forces
+        dd.fx.iter_mut().for_each(|f| *f = Force::zero());
+    }
+    for i in (0..n).rev() {
+        if let Some(p) = model.parent[i] {
+            let (ic, bs, bn, bp, f, fx) = (dd.ic[i], dd.bs[i], dd.bn[i], dd.bp[i], dd.f[i], dd.fx[i]);
+            dd.ic[p] += ic;
+            dd.bs[p] = dd.bs[p] + bs;
+            dd.bn[p] += bn;
+            dd.bp[p] += bp;
+            dd.f[p] += f;
+            dd.fx[p] += fx;
+        }
+    }
+}
+
+/// Partial derivatives of `tau = rnea(q, qd, qdd)` (with external wrenches `ext`, if
+/// any: `tau = M qdd + C qd + g - sum_L J_L^T w_L`).
+///
+/// `q`, `qd`, `qdd`: (nv,). Writes `dtau_dq`, `dtau_dqd` and `m` = `dtau/dqdd` = M(q),
+/// each (nv, nv) row-major, `[i * nv + j] = d tau_i / d x_j`. Uses `data.xup`, `data.x0`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn rnea_derivatives<T: Real>(
+    model: &Model,
+    data: &mut Data<T>,
+    dd: &mut DerivData<T>,
+    q: &[T],
+    qd: &[T],
+    qdd: &[T],
+    ext: Option<&ExternalForces<T>>,
+    dtau_dq: &mut [T],
+    dtau_dqd: &mut [T],
+    m: &mut [T],
+) {
+    let n = model.nv;
+    assert!(q.len() == n && qd.len() == n && qdd.len() == n, "state length");
+    assert!(dtau_dq.len() == n * n && dtau_dqd.len() == n * n && m.len() == n * n, "output size");
+    passes(model, data, dd, q, qd, qdd, ext);
+    let world_ext = matches!(ext, Some(e) if e.frame == ForceFrame::World);
+    dtau_dq.fill(T::zero());
+    dtau_dqd.fill(T::zero());
+    m.fill(T::zero());
+    for i in 0..n {
+        let s = dd.s[i];
+        let ic = dd.ic[i];
+        let (dvdq, dadq) = (dd.dvdq[i], dd.dadq[i]);
+        let fa = ic.mul_motion(&s);
+        let fq = s.cross_force(&(dd.f[i] + dd.fx[i])) + ic.mul_motion(&dadq) + b_apply(dd, i, &dvdq);
+        let fv = ic.mul_motion(&(dvdq + dvdq)) + b_apply(dd, i, &s);
+        let bt = b_tr_apply(dd, i, &s);
+        // row i: the columns of i and its ancestors j (the motion of j moves body i's subtree)
+        m[i * n + i] = s.dot(&fa);
+        dtau_dq[i * n + i] = s.dot(&fq);
+        dtau_dqd[i * n + i] = s.dot(&fv);
+        let mut a = model.parent[i];
+        while let Some(j) = a {
+            let (sj, dvj, daj) = (dd.s[j], dd.dvdq[j], dd.dadq[j]);
+            let mji = sj.dot(&fa);
+            m[j * n + i] = mji;
+            m[i * n + j] = mji;
+            dtau_dq[j * n + i] = sj.dot(&fq);
+            dtau_dqd[j * n + i] = sj.dot(&fv);
+            dtau_dq[i * n + j] = daj.dot(&fa) + bt.dot(dvj.w);
+            if world_ext {
+                // forces fixed in space do not turn with joint j: J_i^T (J_j x* FX_i)
+                dtau_dq[i * n + j] += s.dot(&sj.cross_force(&dd.fx[i]));
+            }
+            dtau_dqd[i * n + j] = (dvj + dvj).dot(&fa) + bt.dot(sj.w);
+            a = model.parent[j];
+        }
+    }
+}

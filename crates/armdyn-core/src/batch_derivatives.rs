@@ -1,0 +1,361 @@
+//! Batches of the derivative algorithms, M^-1 and the external-force variants: row `k`
+//! of each `(N, nv)` input is one state; each output is its own array with `N` rows
+//! (`(N, nv, nv)` matrices, `(N, nv)` vectors, `(N, 6, nv)` Jacobians). External
+//! wrenches are `(N, nlinks, 6)`.
+//!
+//! As in `batch.rs`: rayon over chunks of rows, one workspace per chunk (never per
+//! state), and inside a chunk groups of 4 or 8 states in SIMD lanes (the algorithms are
+//! generic over [`Real`]), so a state computed in a batch is bit-for-bit the state
+//! computed alone. `jacobian_dot` runs one state at a time.
+
+use crate::algo;
+use crate::algo::{ExternalForces, ForceFrame};
+use crate::batch::{kernels, pool, thread_count, Kernels};
+use crate::data::Data;
+use crate::deriv_data::DerivData;
+use crate::model::Model;
+use crate::real::{F64x4, F64x8, Real};
+use rayon::prelude::*;
+
+/// Rows below which a batch runs on the calling thread.
+const MIN_PARALLEL_ROWS: usize = 64;
+
+/// Run `body(workspace, first_row, outputs)` over chunks of `rows` rows; output `k` has
+/// `per_row[k]` values per row.
+fn par_rows<const R: usize, W, M, B>(
+    rows: usize,
+    outs: [&mut [f64]; R],
+    per_row: [usize; R],
+    threads: Option<usize>,
+    make: M,
+    body: B,
+) where
+    M: Fn() -> W + Sync + Send,
+    B: Fn(&mut W, usize, [&mut [f64]; R]) + Sync + Send,
+{
+    for k in 0..R {
+        assert_eq!(outs[k].len(), rows * per_row[k], "output size");
+    }
+    let nthreads = thread_count(threads);
+    if nthreads == 1 || rows < MIN_PARALLEL_ROWS {
+        body(&mut make(), 0, outs);
+        return;
+    }
+    let chunk_rows = rows.div_ceil(8 * nthreads).max(16).next_multiple_of(8);
+    let mut rest = outs;
+    let mut pieces = Vec::with_capacity(rows.div_ceil(chunk_rows));
+    let mut first = 0;
+    while first < rows {
+        let take = chunk_rows.min(rows - first);
+        let heads: [&mut [f64]; R] = std::array::from_fn(|k| {
+            let (h, t) = std::mem::take(&mut rest[k]).split_at_mut(take * per_row[k]);
+            rest[k] = t;
+            h
+        });
+        pieces.push((first, heads));
+        first += take;
+    }
+    let run = move || pieces.into_par_iter().for_each_init(&make, |w, (first, o)| body(w, first, o));
+    match threads {
+        None => run(),
+        Some(n) => pool(n).install(run),
+    }
+}
+
+/// One algorithm as a batch kernel, generic over the lane type.
+trait Kernel: Sync {
+    /// Number of (N, nv) arguments.
+    const NARGS: usize;
+    /// Number of outputs and their sizes per state.
+    const NOUT: usize;
+    fn out_len(model: &Model) -> usize;
+    #[allow(clippy::too_many_arguments)]
+    fn run<T: Real>(
+        &self,
+        model: &Model,
+        data: &mut Data<T>,
+        dd: &mut DerivData<T>,
+        args: [&[T]; 3],
+        ext: Option<&ExternalForces<T>>,
+        outs: [&mut [T]; 3],
+    );
+}
+
+struct Work<L> {
+    d1: Data<f64>,
+    dd1: DerivData<f64>,
+    dl: Data<L>,
+    ddl: DerivData<L>,
+    args: [Vec<L>; 3],
+    ext: Vec<L>,
+    res: [Vec<L>; 3],
+    res1: [Vec<f64>; 3],
+}
+
+impl<L: Real> Work<L> {
+    fn new(model: &Model, out_len: usize) -> Self {
+        let n = model.nv;
+        Work {
+            d1: Data::new(model),
+            dd1: DerivData::new(model),
+            dl: Data::new(model),
+            ddl: DerivData::new(model),
+            args: std::array::from_fn(|_| vec![L::zero(); n]),
+            ext: vec![L::zero(); 6 * model.nlinks()],
+            res: std::array::from_fn(|_| vec![L::zero(); out_len]),
+            res1: std::array::from_fn(|_| vec![0.0; out_len]),
+        }
+    }
+}
+
+/// The rows `first..first + rows` of the batch, `L::LANES` at a time, then one by one.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn rows<L: Real, K: Kernel>(
+    k: &K,
+    model: &Model,
+    w: &mut Work<L>,
+    args: [&[f64]; 3],
+    ext: Option<(&[f64], ForceFrame)>,
+    first: usize,
+    mut outs: [&mut [f64]; 3],
+) {
+    let n = model.nv;
+    let per = K::out_len(model);
+    let ne = 6 * model.nlinks();
+    let rows = if per == 0 { 0 } else { outs[0].len() / per };
+    let mut r = 0;
+    while r + L::LANES <= rows {
+        for (slot, arg) in w.args.iter_mut().zip(args).take(K::NARGS) {
+            for j in 0..n {
+                for l in 0..L::LANES {
+                    slot[j].set_lane(l, arg[(first + r + l) * n + j]);
+                }
+            }
+        }
+        if let Some((e, _)) = ext {
+            for j in 0..ne {
+                for l in 0..L::LANES {
+                    w.ext[j].set_lane(l, e[(first + r + l) * ne + j]);
+                }
+            }
+        }
+        let e = ext.map(|(_, frame)| ExternalForces { wrenches: &w.ext[..], frame });
+        let [a0, a1, a2] = &w.args;
+        let [r0, r1, r2] = &mut w.res;
+        k.run(model, &mut w.dl, &mut w.ddl, [a0, a1, a2], e.as_ref(), [r0, r1, r2]);
+        for (o, res) in outs.iter_mut().zip(&w.res).take(K::NOUT) {
+            for j in 0..per {
+                for l in 0..L::LANES {
+                    o[(r + l) * per + j] = res[j].lane(l);
+                }
+            }
+        }
+        r += L::LANES;
+    }
+    for r in r..rows {
+        let a = args.map(|a| if a.is_empty() { a } else { &a[(first + r) * n..(first + r + 1) * n] });
+        let e = ext.map(|(e, frame)| ExternalForces { wrenches: &e[(first + r) * ne..(first + r + 1) * ne], frame });
+        let [r0, r1, r2] = &mut w.res1;
+        k.run(model, &mut w.d1, &mut w.dd1, a, e.as_ref(), [r0, r1, r2]);
+        for (o, res) in outs.iter_mut().zip(&w.res1).take(K::NOUT) {
+            o[r * per..(r + 1) * per].copy_from_slice(res);
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn rows_avx2<K: Kernel>(
+    k: &K,
+    model: &Model,
+    w: &mut Work<F64x4>,
+    args: [&[f64]; 3],
+    ext: Option<(&[f64], ForceFrame)>,
+    first: usize,
+    outs: [&mut [f64]; 3],
+) {
+    rows(k, model, w, args, ext, first, outs)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn rows_avx512<K: Kernel>(
+    k: &K,
+    model: &Model,
+    w: &mut Work<F64x8>,
+    args: [&[f64]; 3],
+    ext: Option<(&[f64], ForceFrame)>,
+    first: usize,
+    outs: [&mut [f64]; 3],
+) {
+    rows(k, model, w, args, ext, first, outs)
+}
+
+/// Check sizes and run kernel `k` over the batch with the CPU's widest lanes.
+fn drive<K: Kernel>(
+    k: &K,
+    model: &Model,
+    args: &[&[f64]],
+    ext: Option<(&[f64], ForceFrame)>,
+    outs: [&mut [f64]; 3],
+    threads: Option<usize>,
+) {
+    assert_eq!(args.len(), K::NARGS, "argument count");
+    let (n, per) = (model.nv, K::out_len(model));
+    let nrows = if per == 0 { 0 } else { outs[0].len() / per };
+    for a in args {
+        assert_eq!(a.len(), nrows * n, "argument size");
+    }
+    if let Some((e, _)) = ext {
+        assert_eq!(e.len(), nrows * 6 * model.nlinks(), "f_ext size");
+    }
+    let mut all: [&[f64]; 3] = [&[], &[], &[]];
+    all[..K::NARGS].copy_from_slice(args);
+    // unused output slots are empty slices
+    let per_row: [usize; 3] = std::array::from_fn(|j| if j < K::NOUT { per } else { 0 });
+    match kernels() {
+        #[cfg(target_arch = "x86_64")]
+        Kernels::Avx512 => par_rows(nrows, outs, per_row, threads, || Work::<F64x8>::new(model, per), |w, first, o| {
+            // SAFETY: the CPU supports AVX-512F (checked by `kernels`).
+            unsafe { rows_avx512(k, model, w, all, ext, first, o) }
+        }),
+        #[cfg(target_arch = "x86_64")]
+        Kernels::Avx2 => par_rows(nrows, outs, per_row, threads, || Work::<F64x4>::new(model, per), |w, first, o| {
+            // SAFETY: the CPU supports AVX2 (checked by `kernels`).
+            unsafe { rows_avx2(k, model, w, all, ext, first, o) }
+        }),
+        _ => par_rows(nrows, outs, per_row, threads, || Work::<F64x4>::new(model, per), |w, first, o| {
+            rows(k, model, w, all, ext, first, o)
+        }),
+    }
+}
+
+struct RneaDerivatives;
+impl Kernel for RneaDerivatives {
+    const NARGS: usize = 3;
+    const NOUT: usize = 3;
+    fn out_len(m: &Model) -> usize {
+        m.nv * m.nv
+    }
+    #[inline(always)]
+    fn run<T: Real>(&self, m: &Model, d: &mut Data<T>, dd: &mut DerivData<T>, a: [&[T]; 3], e: Option<&ExternalForces<T>>, o: [&mut [T]; 3]) {
+        let [o0, o1, o2] = o;
+        algo::rnea_derivatives(m, d, dd, a[0], a[1], a[2], e, o0, o1, o2)
+    }
+}
+
+struct AbaDerivatives;
+impl Kernel for AbaDerivatives {
+    const NARGS: usize = 3;
+    const NOUT: usize = 3;
+    fn out_len(m: &Model) -> usize {
+        m.nv * m.nv
+    }
+    #[inline(always)]
+    fn run<T: Real>(&self, m: &Model, d: &mut Data<T>, dd: &mut DerivData<T>, a: [&[T]; 3], e: Option<&ExternalForces<T>>, o: [&mut [T]; 3]) {
+        let [o0, o1, o2] = o;
+        algo::aba_derivatives(m, d, dd, a[0], a[1], a[2], e, o0, o1, o2)
+    }
+}
+
+struct Minverse;
+impl Kernel for Minverse {
+    const NARGS: usize = 1;
+    const NOUT: usize = 1;
+    fn out_len(m: &Model) -> usize {
+        m.nv * m.nv
+    }
+    #[inline(always)]
+    fn run<T: Real>(&self, m: &Model, d: &mut Data<T>, dd: &mut DerivData<T>, a: [&[T]; 3], _: Option<&ExternalForces<T>>, o: [&mut [T]; 3]) {
+        let [o0, _, _] = o;
+        algo::minverse(m, d, dd, a[0], o0)
+    }
+}
+
+struct GravityDerivatives;
+impl Kernel for GravityDerivatives {
+    const NARGS: usize = 1;
+    const NOUT: usize = 1;
+    fn out_len(m: &Model) -> usize {
+        m.nv * m.nv
+    }
+    #[inline(always)]
+    fn run<T: Real>(&self, m: &Model, d: &mut Data<T>, dd: &mut DerivData<T>, a: [&[T]; 3], _: Option<&ExternalForces<T>>, o: [&mut [T]; 3]) {
+        let [o0, _, _] = o;
+        algo::gravity_derivatives(m, d, dd, a[0], o0)
+    }
+}
+
+struct RneaExt;
+impl Kernel for RneaExt {
+    const NARGS: usize = 3;
+    const NOUT: usize = 1;
+    fn out_len(m: &Model) -> usize {
+        m.nv
+    }
+    #[inline(always)]
+    fn run<T: Real>(&self, m: &Model, d: &mut Data<T>, dd: &mut DerivData<T>, a: [&[T]; 3], e: Option<&ExternalForces<T>>, o: [&mut [T]; 3]) {
+        let [o0, _, _] = o;
+        algo::rnea_ext(m, d, dd, a[0], a[1], a[2], e.expect("external forces"), o0)
+    }
+}
+
+struct AbaExt;
+impl Kernel for AbaExt {
+    const NARGS: usize = 3;
+    const NOUT: usize = 1;
+    fn out_len(m: &Model) -> usize {
+        m.nv
+    }
+    #[inline(always)]
+    fn run<T: Real>(&self, m: &Model, d: &mut Data<T>, dd: &mut DerivData<T>, a: [&[T]; 3], e: Option<&ExternalForces<T>>, o: [&mut [T]; 3]) {
+        let [o0, _, _] = o;
+        algo::aba_ext(m, d, dd, a[0], a[1], a[2], e.expect("external forces"), o0)
+    }
+}
+
+/// Batched [`algo::rnea_derivatives`]: `args = [q, qd, qdd]` (N, nv) each; `ext`:
+/// wrenches (N, nlinks, 6) and their frame; `outs = [dtau_dq, dtau_dqd, M]` (N, nv, nv) each.
+pub fn rnea_derivatives(model: &Model, args: [&[f64]; 3], ext: Option<(&[f64], ForceFrame)>, outs: [&mut [f64]; 3], threads: Option<usize>) {
+    drive(&RneaDerivatives, model, &args, ext, outs, threads)
+}
+
+/// Batched [`algo::aba_derivatives`]: `args = [q, qd, tau]` (N, nv) each; `ext` as for
+/// `rnea_derivatives`; `outs = [dqdd_dq, dqdd_dqd, Minv]` (N, nv, nv) each.
+pub fn aba_derivatives(model: &Model, args: [&[f64]; 3], ext: Option<(&[f64], ForceFrame)>, outs: [&mut [f64]; 3], threads: Option<usize>) {
+    drive(&AbaDerivatives, model, &args, ext, outs, threads)
+}
+
+/// Batched [`algo::minverse`]: `q` (N, nv), `out` = M^-1 (N, nv, nv).
+pub fn minverse(model: &Model, q: &[f64], out: &mut [f64], threads: Option<usize>) {
+    drive(&Minverse, model, &[q], None, [out, &mut [], &mut []], threads)
+}
+
+/// Batched [`algo::gravity_derivatives`]: `q` (N, nv), `out` = dg/dq (N, nv, nv).
+pub fn gravity_derivatives(model: &Model, q: &[f64], out: &mut [f64], threads: Option<usize>) {
+    drive(&GravityDerivatives, model, &[q], None, [out, &mut [], &mut []], threads)
+}
+
+/// Batched [`algo::rnea_ext`]: `args = [q, qd, qdd]` (N, nv), `ext` (N, nlinks, 6), `out` tau (N, nv).
+pub fn rnea_ext(model: &Model, args: [&[f64]; 3], ext: (&[f64], ForceFrame), out: &mut [f64], threads: Option<usize>) {
+    drive(&RneaExt, model, &args, Some(ext), [out, &mut [], &mut []], threads)
+}
+
+/// Batched [`algo::aba_ext`]: `args = [q, qd, tau]` (N, nv), `ext` (N, nlinks, 6), `out` qdd (N, nv).
+pub fn aba_ext(model: &Model, args: [&[f64]; 3], ext: (&[f64], ForceFrame), out: &mut [f64], threads: Option<usize>) {
+    drive(&AbaExt, model, &args, Some(ext), [out, &mut [], &mut []], threads)
+}
+
+/// Batched [`algo::jacobian_dot`] of link `link`: `q`, `qd` (N, nv), `out` (N, 6, nv).
+pub fn jacobian_dot(model: &Model, q: &[f64], qd: &[f64], link: usize, out: &mut [f64], threads: Option<usize>) {
+    let (n, per) = (model.nv, 6 * model.nv);
+    let rows = if per == 0 { 0 } else { out.len() / per };
+    assert!(q.len() == rows * n && qd.len() == rows * n, "argument size");
+    par_rows(rows, [out], [per], threads, || Data::new(model), |d, first, [o]| {
+        for (k, o) in o.chunks_exact_mut(per).enumerate() {
+            let r = first + k;
+            algo::jacobian_dot(model, d, &q[r * n..(r + 1) * n], &qd[r * n..(r + 1) * n], link, o);
+        }
+    });
+}

@@ -1,0 +1,87 @@
+//! The workspace of the derivative algorithms (`rnea_derivatives`, `aba_derivatives`,
+//! `minverse`, `gravity_derivatives`) and of the external-force wrappers, beside
+//! [`crate::Data`]: allocated once for a model, reused by every call.
+
+use crate::model::Model;
+use crate::real::Real;
+use crate::spatial::{Force, Motion, RigidInertia, Sym3, V3};
+
+/// Per-thread scratch of the derivative algorithms. Per-body vectors are indexed by body
+/// (0..nv) and hold base-frame ("world", Carpentier & Mansard's `o` frame) quantities;
+/// `(nv, nv)` blocks are row-major.
+#[derive(Clone, Debug)]
+pub struct DerivData<T> {
+    /// `J_i = ^0X_i S_i`: joint i's motion axis in base coordinates.
+    pub s: Vec<Motion<T>>,
+    /// Body velocity `v_i` and acceleration `a_i` (gravity included: `a_0 = [0; -g]`), base frame.
+    pub v: Vec<Motion<T>>,
+    pub a: Vec<Motion<T>>,
+    /// `dV/dq_i = v_lambda(i) x J_i` and `dA/dq_i = a_lambda x J_i + v_lambda x dV/dq_i`
+    /// (the parts of the motion derivatives that do not follow the subtree's rigid motion).
+    pub dvdq: Vec<Motion<T>>,
+    pub dadq: Vec<Motion<T>>,
+    /// Composite (subtree) rigid-body inertia, base frame.
+    pub ic: Vec<RigidInertia<T>>,
+    /// The subtree sum of `B_k = v_k x* I_k - I_k v_k x + (I_k v_k) xbar` as its three
+    /// non-zero blocks `B = [S - N^x, 0; -2 P^x, 0]`: `S` symmetric, `N`, `P` the
+    /// subtree's angular and linear momentum (see `rnea_derivatives.rs`).
+    pub bs: Vec<Sym3<T>>,
+    pub bn: Vec<V3<T>>,
+    pub bp: Vec<V3<T>>,
+    /// Subtree sum of the net forces `f_k = I_k a_k + v_k x* I_k v_k - f^ext_k`.
+    pub f: Vec<Force<T>>,
+    /// Subtree sum of the external forces that stay fixed in space (`ForceFrame::World`).
+    pub fx: Vec<Force<T>>,
+    /// Minverse: `F_i` (nv x nv forces, row i = body, column = unit torque) and the
+    /// accelerations `P_i` (nv x nv motions).
+    pub fm: Vec<Force<T>>,
+    pub pm: Vec<Motion<T>>,
+    /// Bodies of the subtree of i (i first, ascending): `sub[sub_start[i]..sub_start[i + 1]]`.
+    pub sub: Vec<usize>,
+    pub sub_start: Vec<usize>,
+    /// Joint-space vectors (nv,) and matrices (nv, nv) between steps.
+    pub qdd: Vec<T>,
+    pub tau: Vec<T>,
+    pub dq: Vec<T>,
+    pub dqd: Vec<T>,
+}
+
+impl<T: Real> DerivData<T> {
+    pub fn new(model: &Model) -> Self {
+        let n = model.nv;
+        let mut sub = Vec::new();
+        let mut sub_start = Vec::with_capacity(n + 1);
+        for i in 0..n {
+            sub_start.push(sub.len());
+            sub.extend((i..n).filter(|&c| model.supports(i, c)));
+        }
+        sub_start.push(sub.len());
+        DerivData {
+            s: vec![Motion::zero(); n],
+            v: vec![Motion::zero(); n],
+            a: vec![Motion::zero(); n],
+            dvdq: vec![Motion::zero(); n],
+            dadq: vec![Motion::zero(); n],
+            ic: vec![RigidInertia::zero(); n],
+            bs: vec![Sym3::zero(); n],
+            bn: vec![V3::zero(); n],
+            bp: vec![V3::zero(); n],
+            f: vec![Force::zero(); n],
+            fx: vec![Force::zero(); n],
+            fm: vec![Force::zero(); n * n],
+            pm: vec![Motion::zero(); n * n],
+            sub,
+            sub_start,
+            qdd: vec![T::zero(); n],
+            tau: vec![T::zero(); n],
+            dq: vec![T::zero(); n * n],
+            dqd: vec![T::zero(); n * n],
+        }
+    }
+
+    /// The bodies of the subtree rooted at `i`, `i` first.
+    #[inline(always)]
+    pub fn subtree(&self, i: usize) -> &[usize] {
+        &self.sub[self.sub_start[i]..self.sub_start[i + 1]]
+    }
+}

@@ -1,0 +1,141 @@
+//! The derivative algorithms on random branched trees (revolute, prismatic and fixed
+//! joints, arbitrary frames and axes) against central differences of the existing
+//! rnea/aba/jacobian, and M Minv = I. (Pinocchio and the NumPy forward-mode oracle are
+//! the other opinions, in tests/test_derivatives.py.)
+
+mod common;
+use armdyn_core::algo::{self, ExternalForces, ForceFrame};
+use armdyn_core::{batch_derivatives, Data, DerivData, Model};
+use common::*;
+
+fn cases() -> Vec<(Model, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)> {
+    let mut rng = Rng::new(11);
+    (0..40)
+        .map(|trial| {
+            let njoints = 1 + rng.below(10);
+            let model = random_model(&mut rng, njoints, trial % 3 != 0);
+            let n = model.nv;
+            let w = rng.vec(6 * model.nlinks(), -3.0, 3.0);
+            (rng.vec(n, -3.0, 3.0), rng.vec(n, -2.0, 2.0), rng.vec(n, -2.0, 2.0), w, model)
+        })
+        .map(|(q, qd, x, w, m)| (m, q, qd, x, w))
+        .collect()
+}
+
+/// Central differences of `f` along each coordinate: column j of the (m, n) result.
+fn central(f: &dyn Fn(&[f64]) -> Vec<f64>, x: &[f64]) -> Vec<f64> {
+    let (n, h) = (x.len(), 1e-6);
+    let m = f(x).len();
+    let mut out = vec![0.0; m * n];
+    for j in 0..n {
+        let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
+        xp[j] += h;
+        xm[j] -= h;
+        let (fp, fm) = (f(&xp), f(&xm));
+        for i in 0..m {
+            out[i * n + j] = (fp[i] - fm[i]) / (2.0 * h);
+        }
+    }
+    out
+}
+
+#[test]
+fn rnea_and_aba_derivatives_match_central_differences() {
+    for (model, q, qd, x, w) in cases() {
+        let n = model.nv;
+        for ext in [None, Some(ForceFrame::Local), Some(ForceFrame::World)] {
+            let e = ext.map(|frame| ExternalForces { wrenches: &w[..], frame });
+            let rnea = |q: &[f64], qd: &[f64], qdd: &[f64]| {
+                let (mut d, mut dd, mut t) = (Data::new(&model), DerivData::new(&model), vec![0.0; n]);
+                match &e {
+                    Some(e) => algo::rnea_ext(&model, &mut d, &mut dd, q, qd, qdd, e, &mut t),
+                    None => algo::rnea(&model, &mut d, q, qd, qdd, &mut t),
+                }
+                t
+            };
+            let aba = |q: &[f64], qd: &[f64], tau: &[f64]| {
+                let (mut d, mut dd, mut t) = (Data::new(&model), DerivData::new(&model), vec![0.0; n]);
+                match &e {
+                    Some(e) => algo::aba_ext(&model, &mut d, &mut dd, q, qd, tau, e, &mut t),
+                    None => algo::aba(&model, &mut d, q, qd, tau, &mut t),
+                }
+                t
+            };
+            let (mut d, mut dd) = (Data::new(&model), DerivData::new(&model));
+            let (mut a, mut b, mut c) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
+            algo::rnea_derivatives(&model, &mut d, &mut dd, &q, &qd, &x, e.as_ref(), &mut a, &mut b, &mut c);
+            assert_close(&a, &central(&|y| rnea(y, &qd, &x), &q), 1e-6, "dtau_dq");
+            assert_close(&b, &central(&|y| rnea(&q, y, &x), &qd), 1e-6, "dtau_dqd");
+            assert_close(&c, &central(&|y| rnea(&q, &qd, y), &x), 1e-6, "M");
+            algo::aba_derivatives(&model, &mut d, &mut dd, &q, &qd, &x, e.as_ref(), &mut a, &mut b, &mut c);
+            assert_close(&a, &central(&|y| aba(y, &qd, &x), &q), 1e-6, "dqdd_dq");
+            assert_close(&b, &central(&|y| aba(&q, y, &x), &qd), 1e-6, "dqdd_dqd");
+            assert_close(&c, &central(&|y| aba(&q, &qd, y), &x), 1e-6, "Minv");
+        }
+    }
+}
+
+#[test]
+fn minverse_inverts_crba_and_gravity_derivatives_match_differences() {
+    for (model, q, qd, _, _) in cases() {
+        let n = model.nv;
+        let (mut d, mut dd) = (Data::new(&model), DerivData::new(&model));
+        let (mut minv, mut m) = (vec![0.0; n * n], vec![0.0; n * n]);
+        algo::minverse(&model, &mut d, &mut dd, &q, &mut minv);
+        algo::crba(&model, &mut d, &q, &mut m);
+        let mut prod = vec![0.0; n * n];
+        let mut eye = vec![0.0; n * n];
+        for i in 0..n {
+            eye[i * n + i] = 1.0;
+            for j in 0..n {
+                prod[i * n + j] = (0..n).map(|k| m[i * n + k] * minv[k * n + j]).sum();
+            }
+        }
+        assert_close(&prod, &eye, 1e-10, "M Minv = I");
+        let mut dg = vec![0.0; n * n];
+        algo::gravity_derivatives(&model, &mut d, &mut dd, &q, &mut dg);
+        let g = |y: &[f64]| {
+            let mut out = vec![0.0; n];
+            algo::gravity(&model, &mut Data::new(&model), y, &mut out);
+            out
+        };
+        assert_close(&dg, &central(&g, &q), 1e-6, "dg/dq");
+        // dJ/dt = sum_k dJ/dq_k qd_k: central differences along qd
+        let link = model.nlinks() - 1;
+        let mut jd = vec![0.0; 6 * n];
+        algo::jacobian_dot(&model, &mut d, &q, &qd, link, &mut jd);
+        let jac = |t: &[f64]| {
+            let y: Vec<f64> = q.iter().zip(&qd).map(|(a, b)| a + t[0] * b).collect();
+            let mut out = vec![0.0; 6 * n];
+            algo::jacobian(&model, &mut Data::new(&model), &y, link, &mut out);
+            out
+        };
+        assert_close(&jd, &central(&jac, &[0.0]), 1e-6, "jacobian_dot");
+    }
+}
+
+#[test]
+fn batches_equal_single_calls_bitwise_with_every_kernel() {
+    let mut rng = Rng::new(5);
+    let model = random_model(&mut rng, 8, true);
+    let (n, nl, rows) = (model.nv, model.nlinks(), 37);
+    let (q, qd, x) = (rng.vec(rows * n, -3.0, 3.0), rng.vec(rows * n, -2.0, 2.0), rng.vec(rows * n, -2.0, 2.0));
+    let w = rng.vec(rows * 6 * nl, -2.0, 2.0);
+    for kernels in [armdyn_core::batch::Kernels::Baseline, armdyn_core::batch::Kernels::Avx2, armdyn_core::batch::Kernels::Avx512] {
+        armdyn_core::batch::set_kernels(Some(kernels));
+        for threads in [Some(1), Some(2)] {
+            let (mut a, mut b, mut c) = (vec![0.0; rows * n * n], vec![0.0; rows * n * n], vec![0.0; rows * n * n]);
+            batch_derivatives::aba_derivatives(&model, [&q, &qd, &x], Some((&w, ForceFrame::World)), [&mut a, &mut b, &mut c], threads);
+            let (mut d, mut dd) = (Data::new(&model), DerivData::new(&model));
+            for r in 0..rows {
+                let (mut a1, mut b1, mut c1) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
+                let e = ExternalForces { wrenches: &w[r * 6 * nl..(r + 1) * 6 * nl], frame: ForceFrame::World };
+                let s = |v: &[f64]| v[r * n..(r + 1) * n].to_vec();
+                algo::aba_derivatives(&model, &mut d, &mut dd, &s(&q), &s(&qd), &s(&x), Some(&e), &mut a1, &mut b1, &mut c1);
+                let nn = n * n;
+                assert!(a[r * nn..(r + 1) * nn] == a1[..] && b[r * nn..(r + 1) * nn] == b1[..] && c[r * nn..(r + 1) * nn] == c1[..], "row {r}");
+            }
+        }
+    }
+    armdyn_core::batch::set_kernels(None);
+}

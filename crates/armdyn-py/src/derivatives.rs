@@ -1,0 +1,335 @@
+//! Bindings of the derivative algorithms, M^-1, jacobian_dot and the external-force
+//! variants of rnea/aba: module-level functions taking the NumericModel first (called by
+//! `python/armdyn/numeric.py`, which documents them). Same rules as the methods in
+//! `lib.rs`: one state `(n,)` or a batch `(N, n)`, ValueError naming the argument.
+
+use crate::{as_f64, guard, new_array, slice, states, thread_arg, NumericModel, Scratch, Shape};
+use armdyn_core::algo::{self, ExternalForces, ForceFrame};
+use armdyn_core::{batch_derivatives as bd, Model};
+use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+
+fn parse_frame(frame: &str) -> PyResult<ForceFrame> {
+    match frame {
+        "local" => Ok(ForceFrame::Local),
+        "world" => Ok(ForceFrame::World),
+        other => Err(PyValueError::new_err(format!("frame: expected 'local' or 'world', got '{other}'"))),
+    }
+}
+
+/// `f_ext` converted and checked against the states' shape: (nlinks, 6) for one state,
+/// (N, nlinks, 6) for N states, finite.
+fn check_f_ext<'py>(m: &NumericModel, obj: &Bound<'py, PyAny>, shape: Shape) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let a = as_f64(obj, "f_ext")?;
+    let nl = m.model.nlinks();
+    let ok = match (shape, a.shape()) {
+        (Shape::Single, [l, 6]) => *l == nl,
+        (Shape::Batch(rows), [r, l, 6]) => *r == rows && *l == nl,
+        _ => false,
+    };
+    if !ok {
+        let want = match shape {
+            Shape::Single => format!("({nl}, 6)"),
+            Shape::Batch(rows) => format!("({rows}, {nl}, 6)"),
+        };
+        return Err(PyValueError::new_err(format!(
+            "f_ext: expected shape {want} (one wrench [fx, fy, fz, nx, ny, nz] per link, links in link_names order: {}), got {:?}",
+            m.link_names.join(", "),
+            a.shape()
+        )));
+    }
+    // SAFETY: read-only, GIL held.
+    let values = unsafe { slice(&a) };
+    if let Some(k) = values.iter().position(|x| !x.is_finite()) {
+        let (row, rest) = (k / (6 * nl), k % (6 * nl));
+        let (link, c) = (rest / 6, rest % 6);
+        let at = match shape {
+            Shape::Single => format!("f_ext[{link}, {c}]"),
+            Shape::Batch(_) => format!("f_ext[{row}, {link}, {c}]"),
+        };
+        return Err(PyValueError::new_err(format!(
+            "f_ext contains NaN or inf (at {at}, link '{}')",
+            m.link_names[link]
+        )));
+    }
+    Ok(a)
+}
+
+type Ext<'a> = Option<(&'a [f64], ForceFrame)>;
+
+/// The shared body: check the states (and `f_ext`), then run `single` on the model's
+/// workspace or `batched` with the GIL released; `R` fresh outputs of shape `out_shape`
+/// (with a leading N for batches).
+#[allow(clippy::too_many_arguments)]
+fn run<'py, const K: usize, const R: usize>(
+    m: &NumericModel,
+    py: Python<'py>,
+    args: [(&str, &Bound<'py, PyAny>); K],
+    f_ext: Option<&Bound<'py, PyAny>>,
+    frame: &str,
+    out_shape: &[usize],
+    threads: Option<i64>,
+    single: impl FnOnce(&Model, &mut Scratch, [&[f64]; K], Ext<'_>, [&mut [f64]; R]),
+    batched: impl FnOnce(&Model, [&[f64]; K], Ext<'_>, [&mut [f64]; R], Option<usize>) + Send,
+) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; R]> {
+    guard(|| {
+        let threads = thread_arg(threads)?;
+        let frame = parse_frame(frame)?;
+        let (shape, arrays) = states(m.model.nv, args)?;
+        let ext_arr = f_ext.map(|f| check_f_ext(m, f, shape)).transpose()?;
+        let dims: Vec<usize> = match shape {
+            Shape::Single => out_shape.to_vec(),
+            Shape::Batch(rows) => std::iter::once(rows).chain(out_shape.iter().copied()).collect(),
+        };
+        let outs: [Bound<'py, PyArrayDyn<f64>>; R] = std::array::from_fn(|_| new_array(py, &dims));
+        // SAFETY: the outputs are fresh and not visible to Python until returned.
+        let os: [&mut [f64]; R] = {
+            let mut it = outs.iter().map(|o| unsafe { o.as_slice_mut().expect("fresh array") });
+            std::array::from_fn(|_| it.next().expect("R outputs"))
+        };
+        match shape {
+            Shape::Single => {
+                // SAFETY: inputs read-only, GIL held throughout.
+                let ins: [&[f64]; K] = std::array::from_fn(|k| unsafe { slice(&arrays[k]) });
+                let ext = ext_arr.as_ref().map(|a| (unsafe { slice(a) }, frame));
+                m.with_scratch(|s| single(&m.model, s, ins, ext, os));
+            }
+            Shape::Batch(_) => {
+                let readonly: Vec<_> = arrays.iter().map(|a| a.readonly()).collect();
+                let ins: [&[f64]; K] = std::array::from_fn(|k| readonly[k].as_slice().expect("contiguous"));
+                let ext_ro = ext_arr.as_ref().map(|a| a.readonly());
+                let ext = ext_ro.as_ref().map(|a| (a.as_slice().expect("contiguous"), frame));
+                let model = &m.model;
+                py.detach(|| batched(model, ins, ext, os, threads));
+            }
+        }
+        Ok(outs)
+    })
+}
+
+fn ext_forces(e: Ext<'_>) -> Option<ExternalForces<'_, f64>> {
+    e.map(|(wrenches, frame)| ExternalForces { wrenches, frame })
+}
+
+fn tuple3<'py>(py: Python<'py>, o: [Bound<'py, PyArrayDyn<f64>>; 3]) -> PyResult<Bound<'py, PyTuple>> {
+    PyTuple::new(py, o)
+}
+
+/// (dtau_dq, dtau_dqd, M): the partial derivatives of rnea, each (n, n) or (N, n, n).
+#[pyfunction]
+#[pyo3(signature = (model, q, qd, qdd, f_ext = None, frame = "local", threads = None))]
+#[allow(clippy::too_many_arguments)]
+fn rnea_derivatives<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, NumericModel>,
+    q: &Bound<'py, PyAny>,
+    qd: &Bound<'py, PyAny>,
+    qdd: &Bound<'py, PyAny>,
+    f_ext: Option<&Bound<'py, PyAny>>,
+    frame: &str,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let m = model.get();
+    let n = m.model.nv;
+    let o = run(
+        m,
+        py,
+        [("q", q), ("qd", qd), ("qdd", qdd)],
+        f_ext,
+        frame,
+        &[n, n],
+        threads,
+        |md, s, [q, qd, qdd], e, [o0, o1, o2]| {
+            algo::rnea_derivatives(md, &mut s.data, &mut s.deriv, q, qd, qdd, ext_forces(e).as_ref(), o0, o1, o2)
+        },
+        |md, a, e, o, t| bd::rnea_derivatives(md, a, e, o, t),
+    )?;
+    tuple3(py, o)
+}
+
+/// (dqdd_dq, dqdd_dqd, Minv): the partial derivatives of aba, each (n, n) or (N, n, n).
+#[pyfunction]
+#[pyo3(signature = (model, q, qd, tau, f_ext = None, frame = "local", threads = None))]
+#[allow(clippy::too_many_arguments)]
+fn aba_derivatives<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, NumericModel>,
+    q: &Bound<'py, PyAny>,
+    qd: &Bound<'py, PyAny>,
+    tau: &Bound<'py, PyAny>,
+    f_ext: Option<&Bound<'py, PyAny>>,
+    frame: &str,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let m = model.get();
+    let n = m.model.nv;
+    let o = run(
+        m,
+        py,
+        [("q", q), ("qd", qd), ("tau", tau)],
+        f_ext,
+        frame,
+        &[n, n],
+        threads,
+        |md, s, [q, qd, tau], e, [o0, o1, o2]| {
+            algo::aba_derivatives(md, &mut s.data, &mut s.deriv, q, qd, tau, ext_forces(e).as_ref(), o0, o1, o2)
+        },
+        |md, a, e, o, t| bd::aba_derivatives(md, a, e, o, t),
+    )?;
+    tuple3(py, o)
+}
+
+/// M(q)^-1, (n, n) or (N, n, n).
+#[pyfunction]
+#[pyo3(signature = (model, q, threads = None))]
+fn minverse<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, NumericModel>,
+    q: &Bound<'py, PyAny>,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let m = model.get();
+    let n = m.model.nv;
+    let [o] = run(
+        m,
+        py,
+        [("q", q)],
+        None,
+        "local",
+        &[n, n],
+        threads,
+        |md, s, [q], _, [o]| algo::minverse(md, &mut s.data, &mut s.deriv, q, o),
+        |md, [q], _, [o], t| bd::minverse(md, q, o, t),
+    )?;
+    Ok(o)
+}
+
+/// dg/dq, (n, n) or (N, n, n).
+#[pyfunction]
+#[pyo3(signature = (model, q, threads = None))]
+fn gravity_derivatives<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, NumericModel>,
+    q: &Bound<'py, PyAny>,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let m = model.get();
+    let n = m.model.nv;
+    let [o] = run(
+        m,
+        py,
+        [("q", q)],
+        None,
+        "local",
+        &[n, n],
+        threads,
+        |md, s, [q], _, [o]| algo::gravity_derivatives(md, &mut s.data, &mut s.deriv, q, o),
+        |md, [q], _, [o], t| bd::gravity_derivatives(md, q, o, t),
+    )?;
+    Ok(o)
+}
+
+/// dJ/dt of link `link`'s Jacobian, (6, n) or (N, 6, n).
+#[pyfunction]
+#[pyo3(signature = (model, q, qd, link, threads = None))]
+fn jacobian_dot<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, NumericModel>,
+    q: &Bound<'py, PyAny>,
+    qd: &Bound<'py, PyAny>,
+    link: &Bound<'py, PyAny>,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let m = model.get();
+    let index = m.link_arg(link)?;
+    let [o] = run(
+        m,
+        py,
+        [("q", q), ("qd", qd)],
+        None,
+        "local",
+        &[6, m.model.nv],
+        threads,
+        |md, s, [q, qd], _, [o]| algo::jacobian_dot(md, &mut s.data, q, qd, index, o),
+        |md, [q, qd], _, [o], t| bd::jacobian_dot(md, q, qd, index, o, t),
+    )?;
+    Ok(o)
+}
+
+/// rnea with external wrenches, (n,) or (N, n).
+#[pyfunction]
+#[pyo3(signature = (model, q, qd, qdd, f_ext, frame = "local", threads = None))]
+#[allow(clippy::too_many_arguments)]
+fn rnea_ext<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, NumericModel>,
+    q: &Bound<'py, PyAny>,
+    qd: &Bound<'py, PyAny>,
+    qdd: &Bound<'py, PyAny>,
+    f_ext: &Bound<'py, PyAny>,
+    frame: &str,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let m = model.get();
+    let [o] = run(
+        m,
+        py,
+        [("q", q), ("qd", qd), ("qdd", qdd)],
+        Some(f_ext),
+        frame,
+        &[m.model.nv],
+        threads,
+        |md, s, [q, qd, qdd], e, [o]| {
+            let e = ext_forces(e).expect("f_ext");
+            algo::rnea_ext(md, &mut s.data, &mut s.deriv, q, qd, qdd, &e, o)
+        },
+        |md, a, e, [o], t| bd::rnea_ext(md, a, e.expect("f_ext"), o, t),
+    )?;
+    Ok(o)
+}
+
+/// aba with external wrenches, (n,) or (N, n).
+#[pyfunction]
+#[pyo3(signature = (model, q, qd, tau, f_ext, frame = "local", threads = None))]
+#[allow(clippy::too_many_arguments)]
+fn aba_ext<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, NumericModel>,
+    q: &Bound<'py, PyAny>,
+    qd: &Bound<'py, PyAny>,
+    tau: &Bound<'py, PyAny>,
+    f_ext: &Bound<'py, PyAny>,
+    frame: &str,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let m = model.get();
+    let [o] = run(
+        m,
+        py,
+        [("q", q), ("qd", qd), ("tau", tau)],
+        Some(f_ext),
+        frame,
+        &[m.model.nv],
+        threads,
+        |md, s, [q, qd, tau], e, [o]| {
+            let e = ext_forces(e).expect("f_ext");
+            algo::aba_ext(md, &mut s.data, &mut s.deriv, q, qd, tau, &e, o)
+        },
+        |md, a, e, [o], t| bd::aba_ext(md, a, e.expect("f_ext"), o, t),
+    )?;
+    Ok(o)
+}
+
+/// Register the functions above in the `_core` module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(rnea_derivatives, m)?)?;
+    m.add_function(wrap_pyfunction!(aba_derivatives, m)?)?;
+    m.add_function(wrap_pyfunction!(minverse, m)?)?;
+    m.add_function(wrap_pyfunction!(gravity_derivatives, m)?)?;
+    m.add_function(wrap_pyfunction!(jacobian_dot, m)?)?;
+    m.add_function(wrap_pyfunction!(rnea_ext, m)?)?;
+    m.add_function(wrap_pyfunction!(aba_ext, m)?)?;
+    Ok(())
+}
