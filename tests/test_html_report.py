@@ -206,3 +206,69 @@ def test_derive_html_renders_in_chromium(tmp_path):
     shot = render(page, chromium, screenshot=SHOTS / "derive-rp-arm.png")
     assert_math_rendered(shot, min_count=30)
     assert shot.width <= 1000, shot.width
+
+
+# ------------------------------------------------------------------ derive --format html, Jupyter
+
+
+def _maths(markup: str) -> list:
+    import xml.etree.ElementTree as ET
+
+    return [ET.fromstring(m) for m in re.findall(r"<math\b.*?</math>", markup, re.S)]
+
+
+@pytest.fixture(scope="module")
+def rp_arm():
+    from armdyn.io import load
+    from armdyn.symbolic import check, derive
+
+    robot = load("rp-arm")
+    ne, la = derive(robot, "newton-euler"), derive(robot, "lagrange")
+    return robot, ne, la, check(ne, la, structure=False)
+
+
+def test_derive_html_page_structure(rp_arm):
+    from armdyn.symbolic.report import derivation_report
+
+    robot, ne, la, agreement = rp_arm
+    page = derivation_report([ne, la], "html", steps=True, agreement=agreement)
+    assert page.startswith("<!DOCTYPE html>") and "<script" not in page.lower()
+    maths = _maths(page)  # every formula is well-formed XML
+    # one equation per step and per tau of each method, plus M, C, g and the model tables
+    eqs = page.count('<div class="eq">')
+    assert eqs == len(ne.steps) + len(la.steps) + 2 * robot.dof + 3
+    assert len(maths) > eqs
+    # steps grouped per link: one group per (stage, link) run of the derivation
+    runs = sum(1 for eom in (ne, la) for k, s in enumerate(eom.steps)
+               if k == 0 or (s.stage, s.link) != (eom.steps[k - 1].stage, eom.steps[k - 1].link))
+    assert page.count('<div class="group">') == runs
+    assert "all passed" in page
+
+
+def test_jupyter_reprs(rp_arm):
+    robot, ne, la, agreement = rp_arm
+    html_robot = robot._repr_html_()
+    assert html_robot.startswith('<div class="armdyn')
+    for j in robot.joints:
+        assert f"<td>{j.name}</td>" in html_robot
+    assert len(_maths(html_robot)) >= 2 * robot.dof
+    html_eom = la._repr_html_()
+    assert len(re.findall(r'<div class="eq">', html_eom)) == robot.dof
+    _maths(html_eom)
+    latex = ne._repr_latex_()
+    assert latex.startswith("$$\\begin{aligned}") and latex.endswith("\\end{aligned}$$")
+    assert latex.count("&=") == robot.dof and "%" not in latex
+    html_check = agreement._repr_html_()
+    assert html_check.count('<span class="ok">OK</span>') == len(agreement.results) >= 1
+
+
+def test_jupyter_reprs_render_in_chromium(rp_arm, tmp_path):
+    chromium = require_chromium()
+    robot, ne, la, agreement = rp_arm
+    from armdyn.htmlpage import page as html_page
+
+    body = robot._repr_html_() + ne._repr_html_() + agreement._repr_html_() + repr_html(exercise_like_report())
+    path = tmp_path / "jupyter.html"
+    path.write_text(html_page("reprs", body), encoding="utf-8")
+    shot = render(path, chromium, screenshot=SHOTS / "jupyter-reprs.png")
+    assert_math_rendered(shot, min_count=20)

@@ -188,6 +188,11 @@ class _Printer(MathMLPresentationPrinter):
         doc = parseString(f'<mrow xmlns="{MATHML_NS}">{markup}</mrow>')
         node = self.dom.importNode(doc.documentElement, True)
         node.removeAttribute("xmlns")
+        while node.tagName == "mrow":  # unwrap single-child rows, so a power can see an msub
+            kids = [k for k in node.childNodes if k.nodeType == k.ELEMENT_NODE or k.nodeValue.strip()]
+            if len(kids) != 1 or kids[0].nodeType != kids[0].ELEMENT_NODE:
+                break
+            node = kids[0]
         return node
 
     def _apply(self, head, arg):

@@ -207,7 +207,7 @@ def _summary(report: GradeReport, anchors: dict, labels: dict) -> str:
         if ok:
             word, cls = "right", "right"
             if step is not None and step.status == "correct-but-unsupported":
-                word = "right, but not from your steps"
+                word, cls = "right, but not from your steps", "right unsupported"
         else:
             word, cls = ("not given" if step is None else "not right"), "notright"
         taus.append(f'<span class="tau {cls}">{math_element(_tau_label(i))}<span class="word">{escape(word)}</span></span>')
