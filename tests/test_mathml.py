@@ -173,3 +173,8 @@ def test_power_of_symbol_in_student_notation_stacks_too():
     qd = sym("theta1_dot")
     e = body(parse(to_mathml(qd**2, symbol_latex={qd: r"\dot{\theta}_1"})))
     assert e.tag == "msubsup" and e[0].tag == "mover" and shape(e[2]) == ("mn", "2")
+
+
+def test_multi_letter_names_are_italic_letters():
+    e = body(parse(to_mathml(sym("Ixx1"))))
+    assert shape(e) == ("msub", (("mrow", (("mi", "I"), ("mi", "x"), ("mi", "x"))), ("mn", "1")))

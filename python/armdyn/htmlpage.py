@@ -108,7 +108,7 @@ CSS = """
 .armdyn .eq { display:flex; align-items:center; justify-content:space-between; gap:6px 24px;
   overflow-x:auto; padding:5px 0; }
 .armdyn .eq math { margin:2px 0; }
-.armdyn .eq .note { flex:0 1 auto; color:var(--muted); font-size:0.84em; text-align:right; }
+.armdyn .eq .note { flex:0 0 auto; max-width:45%; color:var(--muted); font-size:0.84em; text-align:right; }
 .armdyn .group { border:1px solid var(--rule); border-radius:8px; padding:6px 16px 10px; margin:0 0 10px;
   break-inside:avoid; }
 .armdyn .group > h3 { margin-top:6px; }

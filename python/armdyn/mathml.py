@@ -7,8 +7,8 @@ expression layout; this module teaches it the field's notation:
 * model symbols follow :func:`armdyn.model.coordinate_symbols` and the model files:
   ``theta1`` -> θ₁, ``theta1_dot`` -> θ̇₁ (``<msub><mover accent="true"><mi>θ</mi>
   <mo>˙</mo></mover><mn>1</mn></msub>``: the accent sits on the letter, the index
-  outside), ``d2_ddot`` -> d̈₂, ``l1`` -> l₁, ``I1xx`` -> I₁ₓₓ; Greek names become
-  Greek letters; ``a_b`` / ``a^b`` subscripts and superscripts as SymPy splits them;
+  outside), ``d2_ddot`` -> d̈₂, ``l1`` -> l₁, ``I1xx`` -> I₁ₓₓ, ``Ixx1`` -> Ixx₁
+  (letters in italic, as TeX sets them); Greek names become Greek letters; ``a_b`` / ``a^b`` subscripts and superscripts as SymPy splits them;
 * ``sin``/``cos`` are function names applied with U+2061, with parentheses only
   around compound arguments (``sin θ₁``, ``cos(θ₁ + θ₂)``), powers written
   ``sin²θ₁``;
@@ -147,6 +147,9 @@ class _Printer(MathMLPresentationPrinter):
         if m:
             return self._el("mrow", self._el("mn", text=m.group(1)),
                             *[self._el("mi", text=ch) for ch in m.group(2)])
+        if len(text) > 1 and text.isascii() and text.isalpha():
+            # Ixx, cx: italic letters as TeX sets them (a multi-letter <mi> would be upright)
+            return self._el("mrow", *[self._el("mi", text=ch) for ch in text])
         return self._el("mi", text=text)
 
     def _print_Symbol(self, sym, style="plain"):
@@ -249,6 +252,31 @@ class _Printer(MathMLPresentationPrinter):
         return _numeric_entities(out).replace("<mo>-</mo>", "<mo>&#x2212;</mo>")
 
 
+def typeset_width(expr) -> float:
+    """A rough width of ``expr`` as typeset, in letters-with-index units: enough to
+    decide where to break a long sum into lines."""
+    e = sp.sympify(expr)
+    if e.is_Symbol:
+        return 1.0
+    if e.is_Number:
+        return max(1.0, 0.6 * len(str(abs(e))))
+    if isinstance(e, sp.Function):
+        args = sum(typeset_width(a) for a in e.args)
+        return 2.2 + args + (0 if all(a.is_Atom for a in e.args) else 1.0)
+    if e.is_Pow:
+        if e.exp.is_negative:
+            return typeset_width(e.base ** -e.exp)
+        return typeset_width(e.base) + 0.5
+    if e.is_Mul:
+        num, den = sp.fraction(e)
+        if den != 1:
+            return max(typeset_width(num), typeset_width(den)) + 0.5
+        return sum(typeset_width(a) for a in e.args if a != -1)
+    if e.is_Add:
+        return sum(typeset_width(a) for a in e.args) + 1.5 * len(e.args) + 1.0
+    return float(len(str(e)))
+
+
 class MathWriter:
     """Writes expressions of one report as MathML strings (content of ``<math>``).
 
@@ -281,12 +309,17 @@ class MathWriter:
         return ('<mrow><mo stretchy="true">(</mo><mtable>' + "".join(rows)
                 + '</mtable><mo stretchy="true">)</mo></mrow>')
 
-    def terms(self, terms: list[tuple]) -> str:
+    def terms(self, terms: list[tuple], width: float | None = None) -> str:
         """``(coefficient, monomial)`` terms (see :func:`armdyn.symbolic.report.tidy_terms`)
-        written coefficient first with folded signs: ``(m₁ + m₂) l₁² θ̈₁ − m₂ g d₂ sin θ₁``."""
+        written coefficient first with folded signs: ``(m₁ + m₂) l₁² θ̈₁ − m₂ g d₂ sin θ₁``.
+
+        width: break into lines (a left-aligned ``mtable``, continuation lines starting
+        with their sign) where the sum is wider than this many units of
+        :func:`typeset_width` (about one letter with its index each); None: one line.
+        MathML Core has no automatic line breaking."""
         if not terms:
             return "<mn>0</mn>"
-        out = []
+        pieces = []  # (sign or "", body, width estimate)
         for k, (coef, mono) in enumerate(terms):
             negative = coef.could_extract_minus_sign()
             if negative:
@@ -302,11 +335,26 @@ class MathWriter:
                 body = self.expr(coef * mono)
             else:
                 body = f"{self.expr(coef)}<mo>{_TIMES}</mo>{self.expr(mono)}"
-            if k == 0:
-                out.append(f"<mo>\u2212</mo>{body}" if negative else body)
-            else:
-                out.append(f"<mo>{chr(0x2212) if negative else '+'}</mo>{body}")
-        return "<mrow>" + "".join(out) + "</mrow>"
+            sign = "\u2212" if negative else ("+" if k else "")
+            pieces.append((sign, body, typeset_width(coef * mono) + 1.5))
+        if width is None or sum(p[2] for p in pieces) <= width:
+            return "<mrow>" + "".join((f"<mo>{sg}</mo>" if sg else "") + b for sg, b, _ in pieces) + "</mrow>"
+        lines, line, used = [], [], 0.0
+        for sg, b, w in pieces:
+            if line and used + w > width:
+                lines.append(line)
+                line, used = [], 0.0
+            line.append((sg, b))
+            used += w
+        lines.append(line)
+        rows = []
+        for k, line in enumerate(lines):
+            # a line's leading sign is a prefix operator (no gap as after a binary one)
+            cells = "".join((f'<mo form="{"prefix" if i == 0 else "infix"}">{sg}</mo>' if sg else "") + b
+                            for i, (sg, b) in enumerate(line))
+            indent = '<mspace width="1.5em"/>' if k else ""
+            rows.append(f'<mtr><mtd style="text-align:left">{indent}<mrow>{cells}</mrow></mtd></mtr>')
+        return "<mtable>" + "".join(rows) + "</mtable>"
 
     def value(self, value, highlight=(), scalar=None) -> str:
         """A scalar or an (n, 1) vector; ``scalar`` (optional) writes each component

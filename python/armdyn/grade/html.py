@@ -42,6 +42,8 @@ STATUS_TEXT = {
 _AXES = "xyz"
 #: expressions larger than this (nodes) are printed as they are, not tidied
 _TIDY_NODE_LIMIT = 3000
+#: break sums wider than this (units of mathml.typeset_width): half a 1000 px page
+LINE_WIDTH = 28
 
 
 def _coordinates(values) -> tuple[list, list, list]:
@@ -82,7 +84,7 @@ class _Writer:
         expr = sp.sympify(expr)
         if expr.free_symbols and not dag.larger_than(expr, _TIDY_NODE_LIMIT):
             try:
-                return self.w.terms(tidy_terms(expr, self.q, self.qd, self.qdd))
+                return self.w.terms(tidy_terms(expr, self.q, self.qd, self.qdd), width=LINE_WIDTH)
             except Exception:  # noqa: BLE001 - display only: fall back to SymPy's order
                 pass
         return self.w.expr(expr)

@@ -25,6 +25,8 @@ from . import dag
 #: show M, C and g on the page for arms with at most this many joints (C costs O(n^3)
 #: derivatives of M)
 TERMS_MAX_DOF = 3
+#: break sums wider than this (units of mathml.typeset_width, ~ one letter with its index)
+LINE_WIDTH = 46
 _STAGE_TITLES = {
     "outward": "Outward pass",
     "inward": "Inward pass",
@@ -53,7 +55,7 @@ class _Writer:
         if not expr.free_symbols or dag.larger_than(expr, self.limit):
             return self.w.expr(expr)
         eom = self.eom
-        return self.w.terms(tidy_terms(expr, eom.q, eom.qd, eom.qdd))
+        return self.w.terms(tidy_terms(expr, eom.q, eom.qd, eom.qdd), width=LINE_WIDTH)
 
     def value(self, value) -> str:
         if isinstance(value, sp.MatrixBase) and value.shape[1] != 1:
@@ -131,11 +133,34 @@ def _steps_block(eom, wr: _Writer) -> str:
 
 
 def _terms_block(eom, wr: _Writer) -> str:
-    """M, g and C of a small arm (``M qdd + C qd + g = tau``)."""
-    out = ['<h3>Terms: M(q) q\u0308 + C(q, q\u0307) q\u0307 + g(q) = \u03c4</h3>']
-    out.append(_equation("<mi>M</mi>", wr.value(eom.M)))
-    out.append(_equation("<mi>C</mi>", wr.value(eom.C)))
-    out.append(_equation("<mi>g</mi>", wr.value(eom.g)))
+    """M, g and C of a small arm (``M qdd + C qd + g = tau``): as matrices when their
+    rows fit a line, else entry by entry (M's upper triangle: it is symmetric; C's
+    non-zero entries)."""
+    from ..mathml import typeset_width
+
+    out = ["<h3>Terms: M(q) q\u0308 + C(q, q\u0307) q\u0307 + g(q) = \u03c4</h3>"]
+    n = eom.robot.dof
+
+    def fits(mat):
+        return all(sum(typeset_width(mat[i, j]) for j in range(mat.cols)) <= LINE_WIDTH for i in range(mat.rows))
+
+    def entry(name, i, j=None):
+        idx = f"<mn>{i + 1}</mn>" if j is None else f"<mrow><mn>{i + 1}</mn><mn>{j + 1}</mn></mrow>"
+        return f"<msub><mi>{name}</mi>{idx}</msub>"
+
+    for name, mat in (("M", eom.M), ("C", eom.C), ("g", eom.g)):
+        if fits(mat):
+            out.append(_equation(f"<mi>{name}</mi>", wr.value(mat)))
+            continue
+        for i in range(n):
+            if name == "g":
+                out.append(_equation(entry(name, i), wr.scalar(mat[i])))
+                continue
+            for j in range(i if name == "M" else 0, n):
+                if name == "C" and mat[i, j] == 0:
+                    continue
+                note = "= M" + f"{j + 1}{i + 1}" if name == "M" and j > i else ""
+                out.append(_equation(entry(name, i, j), wr.scalar(mat[i, j]), note))
     return "".join(out)
 
 
