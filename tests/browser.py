@@ -60,7 +60,17 @@ _MEASURE = """
     var b = box(m); b.text = m.textContent.slice(0, 80); return b; });
   var hl = Array.prototype.map.call(document.querySelectorAll("mtd.hl"), function (c) {
     var b = box(c); b.background = getComputedStyle(c).backgroundColor; return b; });
+  // a column vector: stretchy parentheses around an mtable of 3 rows or more
+  var fences = [];
+  Array.prototype.forEach.call(document.querySelectorAll("mrow > mtable"), function (t) {
+    var open = t.previousElementSibling;
+    if (open && open.tagName.toLowerCase() === "mo" && open.getAttribute("stretchy") === "true"
+        && t.querySelectorAll(":scope > mtr").length >= 3) {
+      fences.push({paren: open.getBoundingClientRect().height, table: t.getBoundingClientRect().height});
+    }
+  });
   var out = {
+    fences: fences,
     math: maths,
     merror: document.querySelectorAll("merror").length,
     latex: maths.filter(function (m) { return m.text.indexOf("\\\\") >= 0; }).map(function (m) { return m.text; }),
@@ -87,6 +97,8 @@ class Rendered:
     merror:     number of ``<merror>`` elements
     latex:      texts of math elements that still contain a backslash (unconverted LaTeX)
     hl:         one dict per highlighted cell (``mtd.hl``): w, h, x, y, background
+    fences:     one dict per column vector of 3+ rows in stretchy parentheses: the
+                heights (CSS px) of its opening parenthesis and of its table
     height, width: the page's scroll size in CSS px
     body_text:  the page's visible text (first 20000 characters)
     screenshot: the PNG written, or None
@@ -96,6 +108,7 @@ class Rendered:
     merror: int = 0
     latex: list = field(default_factory=list)
     hl: list = field(default_factory=list)
+    fences: list = field(default_factory=list)
     height: int = 0
     width: int = 0
     title: str = ""
@@ -148,7 +161,7 @@ def render(page: str | Path, chromium: str, screenshot: str | Path | None = None
     if m is None:
         raise AssertionError(f"Chromium produced no measurement (exit {done.returncode}); stderr:\n{done.stderr[-2000:]}")
     data = json.loads(html.unescape(m.group(1)))
-    out = Rendered(math=data["math"], merror=data["merror"], latex=data["latex"], hl=data["hl"],
+    out = Rendered(math=data["math"], merror=data["merror"], latex=data["latex"], hl=data["hl"], fences=data["fences"],
                    height=data["height"], width=data["width"], title=data["title"], body_text=data["bodyText"])
     if screenshot is not None:
         shot = Path(screenshot).resolve()
@@ -171,3 +184,12 @@ def assert_math_rendered(r: Rendered, min_count: int = 1) -> None:
     assert not empty, f"{len(empty)} math elements rendered with zero size, e.g. {empty[:3]}"
     assert r.merror == 0, f"{r.merror} <merror> elements in the page"
     assert not r.latex, f"math showing LaTeX source (not converted): {r.latex[:3]}"
+
+
+def assert_parentheses_stretch(r: Rendered, min_count: int = 1) -> None:
+    """The parentheses of column vectors grow to the vector's height (this needs a font
+    with an OpenType MATH table: Debian's fonts-dejavu-extra has DejaVu Math TeX Gyre)."""
+    assert len(r.fences) >= min_count, f"expected at least {min_count} column vectors, found {len(r.fences)}"
+    short = [f for f in r.fences if not f["paren"] >= 0.8 * f["table"] > 0]
+    assert not short, (f"{len(short)} parentheses do not stretch around their vector, e.g. {short[:3]}: "
+                       "is a math font installed? (apt-get install -y fonts-dejavu-extra)")

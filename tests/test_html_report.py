@@ -25,7 +25,7 @@ import sympy as sp
 from armdyn.grade.html import report_html, repr_html
 from armdyn.grade.verdict import STATUSES, GradeReport, StepVerdict
 
-from browser import assert_math_rendered, render, require_chromium
+from browser import assert_math_rendered, assert_parentheses_stretch, render, require_chromium
 
 ROOT = Path(__file__).resolve().parents[1]
 SHOTS = Path(os.environ.get("ARMDYN_SCREENSHOTS", ROOT / "target" / "screenshots"))
@@ -179,6 +179,7 @@ def test_grade_page_renders_in_chromium(tmp_path):
     page.write_text(report_html(exercise_like_report()), encoding="utf-8")
     shot = render(page, chromium, screenshot=SHOTS / "grade-exercise-like.png")
     assert_math_rendered(shot, min_count=20)
+    assert_parentheses_stretch(shot, min_count=10)
     assert "alert('x')" in shot.body_text  # the hostile source shows as text
     # highlighted rows are painted (not transparent) and have a size
     assert len(shot.hl) == 9
@@ -201,6 +202,7 @@ def test_derive_html_renders_in_chromium(tmp_path, capsys):
     page.write_text(html_text, encoding="utf-8")
     shot = render(page, chromium, screenshot=SHOTS / "derive-rp-arm.png")
     assert_math_rendered(shot, min_count=30)
+    assert_parentheses_stretch(shot, min_count=20)
     assert shot.width <= 1000, shot.width
 
 
@@ -268,3 +270,26 @@ def test_jupyter_reprs_render_in_chromium(rp_arm, tmp_path):
     path.write_text(html_page("reprs", body), encoding="utf-8")
     shot = render(path, chromium, screenshot=SHOTS / "jupyter-reprs.png")
     assert_math_rendered(shot, min_count=20)
+
+
+def test_browser_check_can_fail(tmp_path):
+    """The browser check catches what it is meant to: an <merror>, a math element of
+    zero size, LaTeX left unconverted, parentheses that do not stretch."""
+    chromium = require_chromium()
+    cases = {
+        "merror": "<math><merror><mtext>bad</mtext></merror></math>",
+        "zero size": '<math style="display:none"><mi>x</mi></math><math><mi>y</mi></math>',
+        "latex": "<math><mtext>\\dot{\\theta}_1</mtext></math>",
+    }
+    for what, body in cases.items():
+        path = tmp_path / "bad.html"
+        path.write_text(f"<!DOCTYPE html><html><body>{body}</body></html>", encoding="utf-8")
+        with pytest.raises(AssertionError):
+            assert_math_rendered(render(path, chromium))
+    # a vector in a text font: its parentheses keep the height of one line
+    vec = '<mrow><mo stretchy="true">(</mo><mtable>' + "<mtr><mtd><mi>x</mi></mtd></mtr>" * 3 + \
+          '</mtable><mo stretchy="true">)</mo></mrow>'
+    path.write_text(f'<!DOCTYPE html><html><body><math style="font-family:\'Liberation Serif\',serif">{vec}</math>'
+                    "</body></html>", encoding="utf-8")
+    with pytest.raises(AssertionError, match="do not stretch"):
+        assert_parentheses_stretch(render(path, chromium))

@@ -178,3 +178,23 @@ def test_power_of_symbol_in_student_notation_stacks_too():
 def test_multi_letter_names_are_italic_letters():
     e = body(parse(to_mathml(sym("Ixx1"))))
     assert shape(e) == ("msub", (("mrow", (("mi", "I"), ("mi", "x"), ("mi", "x"))), ("mn", "1")))
+
+
+def test_long_sums_break_into_lines_with_leading_signs():
+    syms = sp.symbols("a0:12")
+    terms = [((-1) ** k * syms[k], sp.Integer(1)) for k in range(12)]
+    w = MathWriter()
+    one = body(parse(w.terms(terms)))
+    assert one.tag == "mrow" and one.find("mtable") is None
+    table = body(parse(w.terms(terms, width=10)))
+    assert table.tag == "mtable"
+    rows = table.findall("mtr")
+    assert len(rows) >= 3
+    # every term is printed exactly once, and each continuation line starts with its sign
+    indices = sorted(int(e[1].text) for e in table.iter("msub"))
+    assert indices == list(range(12))
+    for r in rows[1:]:
+        cell = r.find("mtd")
+        assert cell[0].tag == "mspace"
+        first = cell[1][0]
+        assert first.tag == "mo" and first.text in ("+", "\u2212") and first.get("form") == "prefix"

@@ -299,13 +299,15 @@ class MathWriter:
         p = self._printer
         return p.to_string(p._print(sp.sympify(expr)))
 
-    def column(self, cells: list[str], highlight=()) -> str:
+    def column(self, cells: list[str], highlight=(), muted=()) -> str:
         """A column vector from already-written cells, in stretchy parentheses;
-        rows whose 0-based index is in ``highlight`` get ``class="hl"``."""
+        rows whose 0-based index is in ``highlight`` get ``class="hl"``, cells in
+        ``muted`` ``class="zero"`` (drawn grey)."""
         rows = []
         for i, cell in enumerate(cells):
             cls = ' class="hl"' if i in highlight else ""
-            rows.append(f"<mtr{cls}><mtd{cls}>{cell}</mtd></mtr>")
+            td = cls or (' class="zero"' if i in muted else "")
+            rows.append(f"<mtr{cls}><mtd{td}>{cell}</mtd></mtr>")
         return ('<mrow><mo stretchy="true">(</mo><mtable>' + "".join(rows)
                 + '</mtable><mo stretchy="true">)</mo></mrow>')
 
