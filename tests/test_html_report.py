@@ -293,3 +293,25 @@ def test_browser_check_can_fail(tmp_path):
                     "</body></html>", encoding="utf-8")
     with pytest.raises(AssertionError, match="do not stretch"):
         assert_parentheses_stretch(render(path, chromium))
+
+
+def test_huge_values_are_not_printed_and_the_page_stays_fast():
+    """A value of a generated 6-dof derivation can have 10^4+ nodes: the page says so
+    instead of printing it (SymPy's MathML printer takes ~1 ms a node)."""
+    import time
+
+    from armdyn.grade import html as grade_html
+
+    x = sp.symbols("x0:60")
+    huge = sp.Add(*[sp.Mul(*[x[(k + j) % 60] for j in range(20)]) * sp.sin(x[k]) for k in range(60)])
+    assert sum(1 for _ in sp.preorder_traversal(huge)) > grade_html.PRINT_NODE_LIMIT
+    small = x[0] * x[1]
+    steps = [StepVerdict(name="tau_1", key="tau", link="q1", status="wrong", label=r"\tau_1", source="", line=3,
+                         expected=huge, got=huge + small, difference=small)]
+    report = GradeReport("big", "newton-euler", "big.md", steps, "tau_1", [False])
+    t0 = time.perf_counter()
+    page = report_html(report)
+    assert time.perf_counter() - t0 < 10
+    assert page.count("too long to print") == 2  # yours and expected; the difference is shown
+    diff = page[page.index("difference"):]
+    assert "<msub><mi>x</mi><mn>0</mn></msub>" in diff

@@ -99,6 +99,8 @@ CSS = """
 .armdyn .st-follows-from-earlier-error mtd.hl { background:var(--hl-carry); }
 .armdyn .st-follows-from-earlier-error .side.diff { background:var(--carry-bg); }
 .armdyn mtd.zero { color:#8c959f; }
+.armdyn mtext.long { font-family:"Segoe UI","Helvetica Neue","Liberation Sans",Arial,sans-serif;
+  font-size:0.8em; color:var(--muted); }
 .armdyn details { margin-top:6px; font-size:0.92em; }
 .armdyn details summary { cursor:pointer; color:var(--muted); }
 .armdyn .legend { display:flex; flex-wrap:wrap; gap:6px 14px; font-size:0.86em; color:var(--muted);

@@ -40,8 +40,15 @@ STATUS_TEXT = {
     "unrecognised": "unrecognised",
 }
 _AXES = "xyz"
-#: expressions larger than this (nodes) are printed as they are, not tidied
-_TIDY_NODE_LIMIT = 3000
+#: a report whose values have more nodes than this in all is printed as SymPy orders
+#: it, not tidied (tidying costs ~0.3 s per component of a 6-dof arm: fine for a hand
+#: derivation, minutes for one generated from a 6-dof model)
+TIDY_BUDGET = 8000
+#: and no single expression larger than this (nodes) is tidied
+_TIDY_NODE_LIMIT = 400
+#: expressions larger than this (nodes) are not printed at all (SymPy's printer takes
+#: ~1 ms a node): the page says how large they are instead
+PRINT_NODE_LIMIT = 1000
 #: break sums wider than this (units of mathml.typeset_width): half a 1000 px page
 LINE_WIDTH = 28
 
@@ -63,6 +70,15 @@ def _coordinates(values) -> tuple[list, list, list]:
     return [sym(j) for j in joints], [sym(j + "_dot") for j in joints], [sym(j + "_ddot") for j in joints]
 
 
+def _nodes(expr, cap: int) -> int:
+    """Nodes of the expanded tree of ``expr``, counting stops at ``cap``."""
+    n = 0
+    for n, _ in enumerate(sp.preorder_traversal(sp.sympify(expr)), 1):
+        if n >= cap:
+            break
+    return n
+
+
 class _Writer:
     """MathML for one report: the student's notation, tidied scalars."""
 
@@ -76,13 +92,16 @@ class _Writer:
                 elif v is not None:
                     values.append(v)
         self.q, self.qd, self.qdd = _coordinates(values)
+        self.tidy = sum(_nodes(v, PRINT_NODE_LIMIT + 1) for v in values) <= TIDY_BUDGET
 
     def scalar(self, expr) -> str:
         from ..symbolic import dag
         from ..symbolic.report import tidy_terms
 
         expr = sp.sympify(expr)
-        if expr.free_symbols and not dag.larger_than(expr, _TIDY_NODE_LIMIT):
+        if dag.larger_than(expr, PRINT_NODE_LIMIT):
+            return f'<mtext class="long">[more than {PRINT_NODE_LIMIT} nodes: too long to print]</mtext>'
+        if self.tidy and expr.free_symbols and not dag.larger_than(expr, _TIDY_NODE_LIMIT):
             try:
                 return self.w.terms(tidy_terms(expr, self.q, self.qd, self.qdd), width=LINE_WIDTH)
             except Exception:  # noqa: BLE001 - display only: fall back to SymPy's order
