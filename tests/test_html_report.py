@@ -315,3 +315,37 @@ def test_huge_values_are_not_printed_and_the_page_stays_fast():
     assert page.count("too long to print") == 2  # yours and expected; the difference is shown
     diff = page[page.index("difference"):]
     assert "<msub><mi>x</mi><mn>0</mn></msub>" in diff
+
+
+@pytest.mark.parametrize("statuses, verdict", [
+    (["correct", "correct-by-convention"], "Every step is right"),
+    (["correct", "correct-but-unsupported"], "No step is wrong"),
+    (["unrecognised"], "No step was recognised"),
+])
+def test_summary_verdict_without_a_wrong_step(statuses, verdict):
+    x = sp.Symbol("theta1_dot")
+    steps = [StepVerdict(name=f"s{k}", key="omega" if st != "unrecognised" else "", link="", status=st,
+                         label=r"\omega_1", source=r"\omega_1 = x", line=k + 1,
+                         expected=None if st == "unrecognised" else x, got=None if st == "unrecognised" else x)
+             for k, st in enumerate(statuses)]
+    page = report_html(GradeReport("r", "newton-euler", "s.md", steps, None, []))
+    head = page[page.index('<section class="summary">'):page.index("</section>")]
+    assert verdict in head
+    assert ("verdict pass" in head) == (verdict == "Every step is right")
+
+
+def test_write_report_html_writes_whole_page_or_nothing(tmp_path, monkeypatch):
+    from armdyn.grade import html as grade_html
+
+    out = tmp_path / "r.html"
+    grade_html.write_report_html(exercise_like_report(), out)
+    assert out.read_text(encoding="utf-8") == report_html(exercise_like_report())
+
+    def boom(report):
+        raise ValueError("bad report")
+
+    monkeypatch.setattr(grade_html, "report_html", boom)
+    other = tmp_path / "s.html"
+    with pytest.raises(ValueError):
+        grade_html.write_report_html(exercise_like_report(), other)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.html"]

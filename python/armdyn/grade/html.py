@@ -29,7 +29,7 @@ from ..htmlpage import fragment, page
 from ..mathml import MathWriter, escape, latex_to_mathml, math_element
 from .verdict import STATUSES, GradeReport, StepVerdict
 
-__all__ = ["report_html", "repr_html", "STATUS_TEXT"]
+__all__ = ["report_html", "write_report_html", "repr_html", "STATUS_TEXT"]
 
 STATUS_TEXT = {
     "correct": "correct",
@@ -213,10 +213,14 @@ def _summary(report: GradeReport, anchors: dict, labels: dict) -> str:
         link = f'<a href="#step-{k}">{shown}</a>' if k is not None else shown
         verdict = (f'<div class="verdict fail">First wrong step: {link}{line}'
                    f'<span class="sub">{escape(step.message) if step is not None and step.message else ""}</span></div>')
-    elif report.passed and graded:
+    elif not graded:
+        verdict = '<div class="verdict fail">No step was recognised<span class="sub">see the equations below</span></div>'
+    elif report.passed:
         verdict = '<div class="verdict pass">Every step is right<span class="sub">(correct, or correct by a named convention)</span></div>'
     else:
-        verdict = '<div class="verdict fail">Not every step is right<span class="sub">see the steps below</span></div>'
+        n = sum(s.status == "correct-but-unsupported" for s in graded)
+        verdict = ('<div class="verdict fail">No step is wrong, but not every one follows from the ones before'
+                   f'<span class="sub">{n} correct but unsupported</span></div>')
 
     taus = []
     for i, ok in enumerate(report.tau_correct):
@@ -262,6 +266,26 @@ def _body(report: GradeReport) -> str:
 def report_html(report: GradeReport) -> str:
     """The whole report as one self-contained HTML5 page (a string)."""
     return page(f"armdyn grade: {report.submission}", _body(report))
+
+
+def write_report_html(report: GradeReport, path) -> None:
+    """Write :func:`report_html` to ``path`` (UTF-8) all at once: the page is built
+    first and moved into place, so a failure leaves no half-written file."""
+    import os
+    import tempfile
+    from pathlib import Path
+
+    page_text = report_html(report)
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as out:
+            out.write(page_text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
 
 
 def repr_html(report: GradeReport) -> str:
