@@ -49,11 +49,11 @@ CSS = """
   border:1px solid var(--rule); background:var(--paper); white-space:nowrap; }
 .armdyn .tau.right { border-color:var(--ok); }
 .armdyn .tau.notright { border-color:var(--bad); }
-.armdyn .tau.unsupported { border-color:var(--unsup); }
-.armdyn .tau.unsupported .word { color:var(--unsup); }
 .armdyn .tau .word { font-size:0.86em; font-weight:600; }
 .armdyn .tau.right .word { color:var(--ok); }
 .armdyn .tau.notright .word { color:var(--bad); }
+.armdyn .tau.unsupported { border-color:var(--unsup); }
+.armdyn .tau.unsupported .word { color:var(--unsup); }
 .armdyn .counts { grid-column:1 / -1; display:flex; flex-wrap:wrap; gap:6px 8px; }
 .armdyn .notes { grid-column:1 / -1; margin:0; padding-left:18px; color:var(--muted); font-size:0.93em; }
 
