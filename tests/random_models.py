@@ -56,6 +56,7 @@ def random_robot(
     tree: bool = False,
     kinds: str = "RRPF",
     random_gravity: bool | None = None,
+    frame_offsets: bool = False,
 ) -> Robot:
     """A random fixed-base robot with ``n_joints`` joints.
 
@@ -64,6 +65,8 @@ def random_robot(
     kinds: letters R, P, F drawn uniformly for each joint's type (at least one joint is
            made movable).
     random_gravity: gravity of norm 9.81 in a random direction (default: at random).
+    frame_offsets: give the first joint and about half the others a child frame off the joint's axis
+           (random ``frame_xyz`` and ``frame_rotation``).
     """
     types = {"R": "revolute", "P": "prismatic", "F": "fixed"}
     links = [random_link(rng, "base")]
@@ -75,6 +78,10 @@ def random_robot(
         parent = links[rng.integers(len(links))].name if tree else links[-1].name
         child = random_link(rng, f"link{k + 1}")
         rotation = np.eye(3) if rng.random() < 0.2 else random_rotation(rng)
+        offset = {}
+        if frame_offsets and (k == 0 or rng.random() < 0.6):
+            offset = {"frame_xyz": rng.uniform(-0.4, 0.4, size=3).tolist(),
+                      "frame_rotation": random_rotation(rng).tolist()}
         joints.append(
             Joint(
                 f"j{k + 1}",
@@ -84,6 +91,7 @@ def random_robot(
                 xyz=rng.uniform(-0.5, 0.5, size=3).tolist(),
                 rotation=rotation.tolist(),
                 axis=random_axis(rng).tolist(),
+                **offset,
             )
         )
         links.append(child)

@@ -4,6 +4,7 @@
     robot = armdyn.load("rp-arm")                  # a bundled model, or a .yaml/.urdf file
     eom = armdyn.derive(robot, "newton-euler")     # or "lagrange": tau, M, C, g, steps
     print(armdyn.prove_agreement(robot).text())    # Newton-Euler == Lagrange, M sym., Mdot-2C skew
+    print(armdyn.grade("my-derivation.md").text()) # a student's derivation, step by step
 
 Conventions: SI units, radians, ``M(q) qdd + C(q, qd) qd + g(q) = tau``; frames as in
 :mod:`armdyn.model`.
@@ -22,6 +23,10 @@ _NUMERIC = (
 
 
 def __getattr__(name):
+    if name == "grade":  # armdyn.grade: the package, callable as armdyn.grade(submission, ...)
+        import importlib
+
+        return importlib.import_module(".grade", __name__)
     # the numeric API lives in armdyn.numeric (over the compiled Rust core), imported on
     # first use so that symbolic work does not load the extension
     if name in _NUMERIC:
@@ -36,5 +41,5 @@ def __getattr__(name):
 __all__ = [
     *_NUMERIC,
     "inertia", "io", "ModelError", "UnboundParameterError", "Joint", "Link", "Robot",
-    "load", "bundled_robots", "derive", "check", "prove_agreement", "EquationsOfMotion",
+    "load", "bundled_robots", "derive", "check", "prove_agreement", "EquationsOfMotion", "grade",
 ]

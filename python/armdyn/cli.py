@@ -4,6 +4,7 @@
     armdyn check ROBOT [--exact | --numeric] [--samples N]
     armdyn robots
     armdyn show ROBOT [--q Q1,Q2,...] [--out arm.png]
+    armdyn grade SUBMISSION [--robot MODEL] [--json] [--html OUT.html] [--ascii] [--to-yaml]
 
 ROBOT is a bundled model's name (see ``armdyn robots``) or a model file (.yaml, .urdf).
 Bad input prints one line ``armdyn: error: ...`` and exits with status 2, no traceback.
@@ -83,6 +84,40 @@ def cmd_show(args) -> int:
     return 0
 
 
+def _write_atomically(path: str, content: str) -> None:
+    """Write ``content`` to ``path`` through a temporary file: nothing half-written."""
+    directory = os.path.dirname(os.path.abspath(path))
+    tmp = os.path.join(directory, f".{os.path.basename(path)}.{os.getpid()}.tmp")
+    try:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write(content)
+        os.replace(tmp, path)
+    except OSError as exc:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise ValueError(f"cannot write {path} ({exc.strerror})") from None
+
+
+def cmd_grade(args) -> int:
+    from .grade import grade
+    from .grade.reader import read
+
+    submission = read(args.submission)
+    if args.to_yaml:
+        print(submission.to_yaml(), end="")
+        return 0
+    report = grade(submission, robot=args.robot)
+    if args.html:
+        from .grade.html import report_html
+
+        _write_atomically(args.html, report_html(report))
+    if args.json:
+        print(report.to_json())
+    else:
+        print(report.text(ascii_only=args.ascii))
+    return 0 if report.passed else 1
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="armdyn", description="Dynamics of robot arms: derive and check equations of motion.")
     sub = p.add_subparsers(dest="command", required=True)
@@ -116,6 +151,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--q", help="joint values, comma-separated (default: zeros)")
     s.add_argument("--out", help="write a PNG picture of the arm here")
     s.set_defaults(func=cmd_show)
+
+    gr = sub.add_parser("grade", help="check a student's own derivation step by step (first wrong step)",
+                        description="Grade a derivation written in Markdown with LaTeX display math (or YAML). "
+                                    "Exit status: 0 every step correct, 1 some step wrong, 2 bad input.")
+    gr.add_argument("submission", help="the derivation: a .md file (LaTeX display math) or a .yaml file")
+    gr.add_argument("--robot", help="the model whose frames the student used (default: the front matter's robot)")
+    gr.add_argument("--json", action="store_true", help="print the verdicts as one JSON object")
+    gr.add_argument("--html", metavar="OUT.html", help="also write a self-contained HTML report")
+    gr.add_argument("--ascii", action="store_true", help="plain ASCII text (no Unicode dots and marks)")
+    gr.add_argument("--to-yaml", action="store_true", help="print the steps as read (the YAML format) and stop")
+    gr.set_defaults(func=cmd_grade)
     return p
 
 

@@ -152,6 +152,11 @@ class Joint:
     xyz:      (3, 1) placement translation in the parent link frame (m).
     rotation: (3, 3) placement rotation: placement-frame axes in the parent frame.
     axis:     (3, 1) unit axis of motion in the placement frame (ignored when fixed).
+    frame_xyz, frame_rotation:
+              (3, 1) and (3, 3): where the child link's frame sits in the moved joint
+              frame (default: on it). A frame off the joint's axis, like the exercise's
+              frame 1 at the point mass, at l1 from joint 1's axis: ``frame_xyz = (l1, 0, 0)``.
+              The child frame is ``placement * motion(q) * frame``.
     lower, upper, velocity, effort, damping, friction: optional limits and
               joint-space friction, kept on the model (None when not given).
     """
@@ -163,6 +168,8 @@ class Joint:
     xyz: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))
     rotation: sp.Matrix = field(default_factory=lambda: sp.eye(3))
     axis: sp.Matrix = field(default_factory=lambda: sp.Matrix([0, 0, 1]))
+    frame_xyz: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))
+    frame_rotation: sp.Matrix = field(default_factory=lambda: sp.eye(3))
     lower: sp.Expr | None = None
     upper: sp.Expr | None = None
     velocity: sp.Expr | None = None
@@ -181,6 +188,8 @@ class Joint:
             object.__setattr__(self, "xyz", _vec3(self.xyz, "xyz"))
             object.__setattr__(self, "rotation", _mat3(self.rotation, "rotation"))
             object.__setattr__(self, "axis", _vec3(self.axis, "axis"))
+            object.__setattr__(self, "frame_xyz", _vec3(self.frame_xyz, "frame_xyz"))
+            object.__setattr__(self, "frame_rotation", _mat3(self.frame_rotation, "frame_rotation"))
             for name in ("lower", "upper", "velocity", "effort", "damping", "friction"):
                 value = getattr(self, name)
                 if value is not None:
@@ -189,10 +198,12 @@ class Joint:
             raise err.located(element=where)
         except (sp.SympifyError, TypeError) as exc:
             raise ModelError(f"bad value ({exc})", where) from None
-        if not self.rotation.free_symbols:
-            R = np.array(self.rotation.evalf(), dtype=float)
-            if not (np.allclose(R.T @ R, np.eye(3), atol=1e-9) and np.linalg.det(R) > 0):
-                raise ModelError(f"rotation {R.tolist()} is not a proper rotation matrix", where)
+        for key in ("rotation", "frame_rotation"):
+            matrix = getattr(self, key)
+            if not matrix.free_symbols:
+                R = np.array(matrix.evalf(), dtype=float)
+                if not (np.allclose(R.T @ R, np.eye(3), atol=1e-9) and np.linalg.det(R) > 0):
+                    raise ModelError(f"{key} {R.tolist()} is not a proper rotation matrix", where)
         if self.type != "fixed":
             norm2 = sp.expand(sum(c**2 for c in self.axis))
             zero = _is_zero(norm2)
@@ -208,17 +219,59 @@ class Joint:
     def movable(self) -> bool:
         return self.type != "fixed"
 
+    @property
+    def has_frame_offset(self) -> bool:
+        """True when the child frame is not the moved joint frame itself."""
+        return self.frame_xyz != sp.zeros(3, 1) or self.frame_rotation != sp.eye(3)
+
+    def motion(self, q=0) -> tuple[sp.Matrix, sp.Matrix]:
+        """The child frame in the placement frame at coordinate ``q``: ``(R, p)``, the
+        joint's motion followed by the fixed ``frame`` offset."""
+        if self.type == "revolute":
+            Rm, pm = axis_angle_matrix(self.axis, q), sp.zeros(3, 1)
+        elif self.type == "prismatic":
+            Rm, pm = sp.eye(3), self.axis * q
+        else:
+            Rm, pm = sp.eye(3), sp.zeros(3, 1)
+        if not self.has_frame_offset:
+            return Rm, pm
+        return Rm * self.frame_rotation, pm + Rm * self.frame_xyz
+
     def transform(self, q=0) -> tuple[sp.Matrix, sp.Matrix]:
         """Child frame in the parent frame at coordinate ``q``: ``(R (3x3), p (3x1))``.
 
         ``R`` has the child frame's axes as columns, in parent coordinates; ``p`` is the
         child frame's origin in the parent frame.
         """
-        if self.type == "revolute":
-            return self.rotation * axis_angle_matrix(self.axis, q), self.xyz
+        R, p = self.motion(q)
+        return self.rotation * R, self.xyz + self.rotation * p
+
+    @property
+    def child_axis(self) -> sp.Matrix:
+        """(3, 1) the joint's axis in the child frame's axes (``axis`` unless the frame
+        offset rotates)."""
+        return self.frame_rotation.T * self.axis if self.has_frame_offset else self.axis
+
+    def joint_point(self, q=0) -> sp.Matrix:
+        """(3, 1) the placement frame's origin (a point on the joint's axis, fixed in the
+        parent) in child-frame coordinates: zero for a revolute joint whose child frame
+        sits on its axis (constant for any revolute joint), ``-q axis`` for a prismatic
+        joint without offset."""
+        slide = self.axis * q if self.type == "prismatic" else sp.zeros(3, 1)
+        return -(self.frame_rotation.T * (self.frame_xyz + slide))
+
+    def origin_motion(self, qd, qdd=0) -> tuple[sp.Matrix, sp.Matrix]:
+        """Velocity and acceleration (3, 1) of the child frame's origin relative to the
+        parent frame, in child-frame axes: ``(qd z, qdd z)`` for a prismatic joint;
+        ``qd z x r`` and ``qdd z x r + qd^2 z x (z x r)`` for a revolute joint whose
+        child origin sits at ``r`` from its axis point (zero on the axis)."""
+        z, zero = self.child_axis, sp.zeros(3, 1)
         if self.type == "prismatic":
-            return self.rotation, self.xyz + self.rotation * self.axis * q
-        return self.rotation, self.xyz
+            return qd * z, qdd * z
+        r = -self.joint_point()
+        if self.type == "fixed" or r == zero:
+            return zero, zero
+        return qd * z.cross(r), qdd * z.cross(r) + qd**2 * z.cross(z.cross(r))
 
 
 def coordinate_symbols(names: Iterable[str]) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
@@ -397,7 +450,38 @@ class Robot:
             out |= sp.sympify(link.mass).free_symbols | link.com.free_symbols | link.inertia.free_symbols
         for j in self.joints:
             out |= j.xyz.free_symbols | j.rotation.free_symbols | j.axis.free_symbols
+            out |= j.frame_xyz.free_symbols | j.frame_rotation.free_symbols
         return out
+
+    def canonical(self) -> "Robot":
+        """The same mechanism with every link frame on its joint (no ``frame`` offsets).
+
+        Where a joint has an offset ``(Rf, pf)``, its child's inertial data are moved into
+        the moved joint frame (``com' = Rf com + pf``, ``I' = Rf I Rf^T``) and the child's
+        own joints are placed from there (``xyz' = pf + Rf xyz``, ``rotation' = Rf rotation``).
+        The dynamics are unchanged (tau does not depend on where link frames sit); only the
+        link frames differ. The numeric engines use this form. ``self`` if nothing moves.
+        """
+        offsets = {j.child: (j.frame_rotation, j.frame_xyz) for j in self.joints if j.has_frame_offset}
+        if not offsets:
+            return self
+        links = []
+        for link in self.links.values():
+            if link.name in offsets:
+                Rf, pf = offsets[link.name]
+                link = Link(link.name, link.mass, Rf * link.com + pf, Rf * link.inertia * Rf.T)
+            links.append(link)
+        joints = []
+        for j in self.joints:
+            changes = {"frame_xyz": sp.zeros(3, 1), "frame_rotation": sp.eye(3)}
+            if j.parent in offsets:
+                Rf, pf = offsets[j.parent]
+                changes.update(xyz=pf + Rf * j.xyz, rotation=Rf * j.rotation)
+            joints.append(replace(j, **changes))
+        return Robot(
+            self.name, links, joints, self.gravity, self.parameters, self.meta, self.base, self.defaults,
+            strict=self.strict,
+        )
 
     @classmethod
     def from_urdf(cls, source, strict: bool = True) -> "Robot":
@@ -431,6 +515,8 @@ class Robot:
                 xyz=j.xyz.xreplace(table),
                 rotation=j.rotation.xreplace(table),
                 axis=j.axis.xreplace(table),
+                frame_xyz=j.frame_xyz.xreplace(table),
+                frame_rotation=j.frame_rotation.xreplace(table),
                 **{k: s(getattr(j, k)) for k in ("lower", "upper", "velocity", "effort", "damping", "friction")},
             )
             for j in self.joints

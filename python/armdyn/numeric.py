@@ -81,6 +81,8 @@ def compile_model(robot: Robot | NumericModel) -> NumericModel:
             f"robot '{robot.name}' has unbound parameters {names}; "
             f"bind them to numbers first: robot.bind({{{', '.join(repr(n) + ': ...' for n in names)}}})"
         )
+    source = robot
+    robot = robot.canonical()  # link frames on their joints; the dynamics are the same
     joint_index = {j.child: k for k, j in enumerate(robot.joints)}
     parents, types, rotations, translations, axes = [], [], [], [], []
     masses, coms, inertias = [], [], []
@@ -107,8 +109,21 @@ def compile_model(robot: Robot | NumericModel) -> NumericModel:
         )
     except ValueError as err:
         raise ModelError(str(err), f"robot '{robot.name}'") from None
-    robot._numeric_model = model
+    source._numeric_model = model
     return model
+
+
+def _frame_offsets(robot) -> np.ndarray | None:
+    """(nlinks, 4, 4) each link frame in its canonical (on-joint) frame, or None when
+    every link frame sits on its joint (see :meth:`armdyn.model.Robot.canonical`)."""
+    if not isinstance(robot, Robot) or not any(j.has_frame_offset for j in robot.joints):
+        return None
+    out = np.tile(np.eye(4), (len(robot.links), 1, 1))
+    for j in robot.joints:
+        k = robot.link_index(j.child)
+        out[k, :3, :3] = np.reshape(_floats(j.frame_rotation, f"joint '{j.name}'"), (3, 3))
+        out[k, :3, 3] = _floats(j.frame_xyz, f"joint '{j.name}'")
+    return out
 
 
 def _model(robot) -> NumericModel:
@@ -188,7 +203,9 @@ def forward_kinematics(robot, q, *, threads=None):
     ``list(robot.links)`` order (base first); each ``[[R, p], [0, 0, 0, 1]]`` with R the
     link's axes in base coordinates and p its origin.
     """
-    return _model(robot).forward_kinematics(q, threads)
+    poses = _model(robot).forward_kinematics(q, threads)
+    offsets = _frame_offsets(robot)
+    return poses if offsets is None else poses @ offsets
 
 
 def jacobian(robot, q, link, *, threads=None):
@@ -201,4 +218,14 @@ def jacobian(robot, q, link, *, threads=None):
     """
     if isinstance(link, Link):
         link = link.name
-    return _model(robot).jacobian(q, link, threads)
+    J = _model(robot).jacobian(q, link, threads)
+    offsets = _frame_offsets(robot)
+    if offsets is None:
+        return J
+    # the compiled model's link frame is on the joint; move the point to the link frame's
+    # origin: v' = v + w x (R pf), so J_v' = J_v - [R pf]x J_w
+    k = link if isinstance(link, (int, np.integer)) else robot.link_index(link)
+    R = _model(robot).forward_kinematics(q, threads)[..., k, :3, :3]
+    r = R @ offsets[k, :3, 3]
+    Jv, Jw = J[..., :3, :], J[..., 3:, :]
+    return np.concatenate([Jv - np.cross(r[..., None, :], Jw.swapaxes(-1, -2)).swapaxes(-1, -2), Jw], axis=-2)

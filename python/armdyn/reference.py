@@ -99,7 +99,8 @@ class _Tree:
     n: int  # number of coordinates
     parent: list[int]  # parent body index, -1 = base
     kind: list[str]  # joint type: revolute, prismatic, fixed
-    axis: list[np.ndarray]  # (3,) unit axis in the placement (= child) frame
+    axis: list[np.ndarray]  # (3,) unit axis in the child frame's axes
+    point: list[np.ndarray]  # (3,) a point on the joint's axis, child-frame coordinates
     pose: list[Callable[[float], tuple]]  # q_k -> (R (3,3), p (3,)) child in parent
     S: list[np.ndarray]  # motion subspace (6, 0 or 1) in body coordinates
     dofs: list[np.ndarray]  # coordinate indices of joint k (empty for a fixed joint)
@@ -131,21 +132,27 @@ def _tree(robot: Robot) -> _Tree:
             f"robot '{robot.name}' has unbound parameters: {names}; bind them with robot.bind({{...}})"
         )
     index = {robot.base: -1}
-    kind, axes = [j.type for j in robot.joints], []
+    kind, axes, points = [j.type for j in robot.joints], [], []
     parent, pose, S, dofs, inertia, mass, com = [], [], [], [], [], [], []
     for k, joint in enumerate(robot.joints):
         parent.append(index[joint.parent])
         index[joint.child] = k
         R, p = joint.transform(_q)  # model.py's convention, lambdified to NumPy
         pose.append(sp.lambdify(_q, (R, p), "numpy"))
-        axis = _floats(joint.axis).ravel()
+        axis = _floats(joint.child_axis).ravel()  # in the child frame's axes
         axes.append(axis)
         if joint.type == "revolute":
-            S.append(np.concatenate([axis, np.zeros(3)])[:, None])  # axis is invariant under Rot(axis, q)
+            # the axis is invariant under Rot(axis, q); a child frame off the axis (joint
+            # point jp in child coordinates, constant) moves with linear velocity jp x axis
+            jp = _floats(joint.joint_point(0)).ravel()
+            points.append(jp)
+            S.append(np.concatenate([axis, np.cross(jp, axis)])[:, None])
         elif joint.type == "prismatic":
             S.append(np.concatenate([np.zeros(3), axis])[:, None])
+            points.append(np.zeros(3))
         else:
             S.append(np.zeros((6, 0)))
+            points.append(np.zeros(3))
         i = robot.coordinate_index(joint)
         dofs.append(np.array([] if i is None else [i], dtype=int))
         link = robot.links[joint.child]
@@ -159,6 +166,7 @@ def _tree(robot: Robot) -> _Tree:
         parent=parent,
         kind=kind,
         axis=axes,
+        point=points,
         pose=pose,
         S=S,
         dofs=dofs,
@@ -418,7 +426,7 @@ def forward_kinematics(robot: Robot, q) -> np.ndarray:
 def jacobian(robot: Robot, q, link) -> np.ndarray:
     """Geometric Jacobian (6, n) of the origin of ``link``'s frame, rows ``[v; w]`` in base axes
     (Pinocchio's LOCAL_WORLD_ALIGNED) [SHV ch. 4]: for each joint j on the link's path, with
-    world axis z_j and origin o_j of its child frame,
+    world axis z_j and a point o_j on that axis,
 
         revolute:   J_v = z_j x (o_link - o_j),   J_w = z_j
         prismatic:  J_v = z_j,                    J_w = 0
@@ -440,8 +448,8 @@ def jacobian(robot: Robot, q, link) -> np.ndarray:
     J = np.zeros((6, t.n))
     while b >= 0:
         if t.dofs[b].size:
-            R, o = X[b + 1][:3, :3], X[b + 1][:3, 3]
-            z = R @ t.axis[b]  # the axis is the same in the placement and the child frame
+            R = X[b + 1][:3, :3]
+            o, z = X[b + 1][:3, 3] + R @ t.point[b], R @ t.axis[b]
             col = t.dofs[b][0]
             if t.kind[b] == "revolute":
                 J[:3, col], J[3:, col] = np.cross(z, o_link - o), z

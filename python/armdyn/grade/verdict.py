@@ -113,3 +113,23 @@ class GradeReport:
     @property
     def passed(self) -> bool:
         return all(s.status in PASSING for s in self.steps if s.status != "unrecognised")
+
+    def text(self, ascii_only: bool = False) -> str:
+        """The plain-text report (Unicode dots unless ``ascii_only``)."""
+        from .text import text
+
+        return text(self, ascii_only)
+
+    def to_dict(self) -> dict:
+        """The JSON object (stable field names), expressions as SymPy strings."""
+        from .text import to_dict
+
+        return to_dict(self)
+
+    def to_json(self) -> str:
+        from .text import to_json
+
+        return to_json(self)
+
+    def __str__(self) -> str:
+        return self.text()

@@ -30,6 +30,9 @@ General frames
                                     #   COLUMNS are the placement frame's axes in the
                                     #   parent frame (not both rpy and rotation)
         axis: [0, 0, 1]             # optional unit axis in the placement frame, default z
+        frame_xyz: [0, 0, 0]        # optional: the child link's frame in the moved joint
+        frame_rpy: [0, 0, 0]        #   frame (frame_rpy or frame_rotation as above), for
+                                    #   frames off the joint's axis; default: on it
         limits: {lower: -pi, upper: pi, velocity: 2, effort: 100}   # optional, any subset
         damping: 0.1                # optional
         friction: 0.0               # optional
@@ -43,7 +46,8 @@ General frames
 
 Semantics (as :mod:`armdyn.model`): the joint sits at ``xyz`` + ``rotation`` in the
 parent link's frame, then turns about (revolute) or slides along (prismatic) ``axis``;
-the child link's frame is the placement frame after that motion. The joint
+the child link's frame is the placement frame after that motion (then moved by
+``frame_xyz``/``frame_rpy`` when given: a frame of your own choosing, off the axis). The joint
 coordinates are named after the movable joints, in tree order.
 
 DH tables
@@ -126,7 +130,10 @@ TOP_KEYS = (
     "name", "description", "source", "notes", "convention", "base",
     "parameters", "gravity", "joints", "links", "dh",
 )  # fmt: skip
-JOINT_KEYS = ("name", "type", "parent", "child", "xyz", "rpy", "rotation", "axis", "limits", "damping", "friction")
+JOINT_KEYS = (
+    "name", "type", "parent", "child", "xyz", "rpy", "rotation", "axis",
+    "frame_xyz", "frame_rpy", "frame_rotation", "limits", "damping", "friction",
+)
 LINK_KEYS = ("name", "mass", "com", "inertia")
 JOINT_TYPES = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic", "fixed": "fixed"}
 MODEL_CONVENTIONS = ("frames", "standard-dh", "modified-dh")
@@ -192,6 +199,17 @@ def _parse_text(text: str, source: str):
 
 
 # ------------------------------------------------------------------ checks
+def _rotation(item, rpy_key, matrix_key, params, element, where):
+    """A rotation given as roll-pitch-yaw angles or as a 3x3 matrix (not both)."""
+    if rpy_key in item and matrix_key in item:
+        raise ModelError(f"give either {rpy_key} or {matrix_key}, not both", element, where)
+    if matrix_key in item:
+        rotation = parse_matrix3(item[matrix_key], params, element, where, matrix_key)
+        check_rotation(rotation, element, where, what=matrix_key)
+        return rotation
+    return rpy_matrix(*parse_vector(item.get(rpy_key, [0, 0, 0]), params, element, where, rpy_key))
+
+
 def _check_keys(data, allowed, element, where, only_mapping=False):
     """ModelError unless ``data`` is a mapping whose keys are all in ``allowed``."""
     if not isinstance(data, Mapping):
@@ -271,6 +289,7 @@ def _frames_robot(data, name, params, defaults, gravity, base, meta, source, str
         if element in lines:
             raise ModelError("duplicate joint name", element, where)
         lines[element] = where
+        extras = parse_joint_extras(item, params, element, where)
         jtype = item.get("type")
         if not isinstance(jtype, str) or jtype not in JOINT_TYPES:
             raise ModelError(
@@ -280,16 +299,12 @@ def _frames_robot(data, name, params, defaults, gravity, base, meta, source, str
             link = check_name(item.get(key), key, element, where)
             if link not in links:
                 raise ModelError(f"{key} link {quoted(link)} does not exist (not listed in links)", element, where)
-        if "rpy" in item and "rotation" in item:
-            raise ModelError("give either rpy or rotation, not both", element, where)
-        if "rotation" in item:
-            rotation = parse_matrix3(item["rotation"], params, element, where, "rotation")
-            check_rotation(rotation, element, where)
-        else:
-            rotation = rpy_matrix(*parse_vector(item.get("rpy", [0, 0, 0]), params, element, where, "rpy"))
+        rotation = _rotation(item, "rpy", "rotation", params, element, where)
         xyz = parse_vector(item.get("xyz", [0, 0, 0]), params, element, where, "xyz")
+        if "frame_xyz" in item or "frame_rpy" in item or "frame_rotation" in item:
+            extras["frame_xyz"] = parse_vector(item.get("frame_xyz", [0, 0, 0]), params, element, where, "frame_xyz")
+            extras["frame_rotation"] = _rotation(item, "frame_rpy", "frame_rotation", params, element, where)
         axis = parse_vector(item.get("axis", [0, 0, 1]), params, element, where, "axis")
-        extras = parse_joint_extras(item, params, element, where)
         try:
             joints.append(
                 Joint(jname, JOINT_TYPES[jtype], item["parent"], item["child"], xyz, rotation, axis, **extras)

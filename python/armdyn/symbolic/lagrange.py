@@ -3,7 +3,9 @@
 Energies (kinematics by a velocity recursion in link frames, no differentiation)::
 
     w_i  = R^T w_p [+ qd z  (revolute)]            angular velocity, frame i
-    v_i  = R^T (v_p + w_p x p_i) [+ qd z  (prismatic)]   frame origin velocity, frame i
+    v_i  = R^T (v_p + w_p x p_i) + V               frame origin velocity, frame i
+           (V: the origin's velocity relative to the parent, qd z for a prismatic joint,
+           qd z x r for a frame at r off a revolute axis; Joint.origin_motion)
     v_Ci = v_i + w_i x c_i                          centre-of-mass velocity, frame i
     T_i  = 1/2 m_i v_Ci . v_Ci  +  1/2 w_i^T I_i w_i   (translational + rotational)
     V_i  = - m_i gravity . p_Ci                      p_Ci: centre of mass in the base frame
@@ -47,12 +49,11 @@ def _energies(robot: Robot):
         k = robot.coordinate_index(joint)
         R, p = joint.transform(robot.joint_coordinate(joint))
         Rt = R.T
+        qd_k = robot.qd[k] if k is not None else 0
         w_i = Rt * w[joint.parent]
-        v_i = Rt * (v[joint.parent] + w[joint.parent].cross(p))
+        v_i = Rt * (v[joint.parent] + w[joint.parent].cross(p)) + joint.origin_motion(qd_k)[0]
         if joint.type == "revolute":
-            w_i = w_i + robot.qd[k] * joint.axis
-        elif joint.type == "prismatic":
-            v_i = v_i + robot.qd[k] * joint.axis
+            w_i = w_i + qd_k * joint.child_axis
         w[name], v[name] = w_i, v_i
         R0[name] = R0[joint.parent] * R
         p0[name] = p0[joint.parent] + R0[joint.parent] * p

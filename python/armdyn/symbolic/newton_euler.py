@@ -1,30 +1,40 @@
 """Equations of motion by the recursive (iterated) Newton-Euler method, symbolically.
 
 The recursion is Craig's (Introduction to Robotics, eqs. 6.45-6.53), generalised to
-joints placed anywhere (model.py's frames, non-DH included), to fixed joints and to
-branched trees. Every vector of link i is expressed in link i's own frame.
+joints placed anywhere (model.py's frames, non-DH included), to link frames off their
+joint's axis (the exercise's frame 1 at the point mass), to fixed joints and to branched
+trees. Every vector of link i is expressed in link i's own frame.
 
-Outward, for link i with parent p, child frame in parent ``(R, p_i)`` (R: axes of frame i
-in frame p), joint axis ``z`` (in frame i) and coordinate ``q``::
+Outward, for link i with parent p, child frame in parent ``(R, P)`` (R: axes of frame i
+in frame p; P(q): origin of frame i in frame p, moving relative to frame p with velocity
+``V`` and acceleration ``Vd``, both in frame i), joint axis ``z`` (in frame i) and
+coordinate ``q``::
 
     revolute:   w_i  = R^T w_p + qd z
                 wd_i = R^T wd_p + (R^T w_p) x qd z + qdd z
     prismatic:  w_i  = R^T w_p,        wd_i = R^T wd_p
-    vd_i  = R^T (wd_p x p_i + w_p x (w_p x p_i) + vd_p)
-            [+ 2 w_i x qd z + qdd z   (prismatic)]
+    vd_i  = R^T (wd_p x P + w_p x (w_p x P) + vd_p) + 2 (R^T w_p) x V + Vd
     vcd_i = wd_i x c_i + w_i x (w_i x c_i) + vd_i
     F_i = m_i vcd_i,   N_i = I_i wd_i + w_i x I_i w_i
 
-Gravity enters as the base's acceleration ``vd_0 = -gravity``. Inward, over the children
-c of link i (``R_c``, ``p_c`` the child's placement in frame i)::
+(``V = Vd = 0`` for a revolute joint whose child frame sits on its axis; for a prismatic
+joint ``V = qd z``, ``Vd = qdd z``, which is Craig's ``2 w_i x qd z + qdd z``.) Gravity enters as
+the base's acceleration ``vd_0 = -gravity``. Inward, over the children c of link i
+(``R_c``, ``P_c`` the child's placement in frame i)::
 
     f_i = F_i + sum_c R_c f_c
-    n_i = N_i + c_i x F_i + sum_c (R_c n_c + p_c x R_c f_c)
-    tau_i = z . n_i (revolute),  z . f_i (prismatic)
+    n_i = N_i + c_i x F_i + sum_c (R_c n_c + P_c x R_c f_c)      (about frame i's origin)
+    tau_i = z . (n_i - o_i x f_i) (revolute),  z . f_i (prismatic)
 
-``f_i``/``n_i`` are the force and moment that the parent exerts on link i at frame i's
-origin. ``F_i``/``N_i`` are the rates of change of momentum (Craig's sign; the exercise
-writes the d'Alembert inertial force ``-m vcd``).
+``f_i``/``n_i`` are the force and moment that the parent exerts on link i. ``o_i`` is a
+point on joint i's axis in frame i (zero when frame i sits on the axis, as in Craig's
+frames); the step ``n`` is reported about that point (the moment whose z component is
+the joint torque), ``n_i - o_i x f_i``. ``F_i``/``N_i`` are the rates of change of
+momentum (Craig's sign; the exercise writes the d'Alembert inertial force ``-m vcd``).
+
+The per-step formulas are the functions ``omega`` ... ``joint_torque`` below; the
+derivation and :mod:`armdyn.grade` (which re-applies them to a student's own values)
+share them.
 """
 
 from __future__ import annotations
@@ -34,6 +44,68 @@ import sympy as sp
 from ..model import Robot
 from .terms import EquationsOfMotion, Step
 
+
+# ------------------------------------------------------------------ step formulas
+# Vectors are (3, 1) SymPy matrices; each formula names its inputs as Craig does.
+
+def omega(R, w_p, z, qd, kind):
+    """Angular velocity of link i in frame i."""
+    return R.T * w_p + (qd * z if kind == "revolute" else sp.zeros(3, 1))
+
+
+def omega_dot(R, w_p, wd_p, z, qd, qdd, kind):
+    """Angular acceleration of link i in frame i."""
+    if kind != "revolute":
+        return R.T * wd_p
+    return R.T * wd_p + (R.T * w_p).cross(qd * z) + qdd * z
+
+
+def v_dot(R, w_p, wd_p, vd_p, P, V, Vd):
+    """Linear acceleration of frame i's origin, in frame i (the exercise's formula):
+    ``R^T (wd_p x P + w_p x (w_p x P) + vd_p) + 2 w x V + Vd`` with ``w = R^T w_p`` and the
+    origin's velocity ``V`` and acceleration ``Vd`` relative to the parent frame, in
+    frame i (:meth:`armdyn.model.Joint.origin_motion`)."""
+    return R.T * (wd_p.cross(P) + w_p.cross(w_p.cross(P)) + vd_p) + 2 * (R.T * w_p).cross(V) + Vd
+
+
+def vc_dot(w, wd, vd, c):
+    """Linear acceleration of link i's centre of mass ``c`` (frame i)."""
+    return wd.cross(c) + w.cross(w.cross(c)) + vd
+
+
+def inertial_force(m, vcd):
+    return m * vcd
+
+
+def inertial_moment(I, w, wd):
+    return I * wd + w.cross(I * w)
+
+
+def joint_force(F, children):
+    """f_i from F_i and the children's ``(R_c, f_c)``."""
+    out = F
+    for Rc, fc in children:
+        out = out + Rc * fc
+    return out
+
+
+def joint_moment(N, c, F, children):
+    """n_i about frame i's origin from N_i, F_i (at ``c``) and the children's
+    ``(R_c, P_c, n_c, f_c)``."""
+    out = N + c.cross(F)
+    for Rc, Pc, nc, fc in children:
+        out = out + Rc * nc + Pc.cross(Rc * fc)
+    return out
+
+
+def moment_about(n, f, point):
+    """The moment ``n`` (about frame i's origin) taken about ``point`` (frame i)."""
+    return n - point.cross(f)
+
+
+def joint_torque(kind, z, n_axis, f):
+    """tau_i: ``z . n`` (moment about a point on the axis) or ``z . f`` (prismatic)."""
+    return (n_axis if kind == "revolute" else f).dot(z)
 
 
 def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | None = None) -> sp.Matrix:
@@ -52,33 +124,27 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
         link = robot.links[joint.child]
         parent, i = joint.parent, robot.link_index(joint.child)
         k = robot.coordinate_index(joint)
-        R, p = joint.transform(robot.joint_coordinate(joint))
-        placement[joint.child] = (R, p)
-        Rt = R.T
-        z = joint.axis
+        qk = robot.joint_coordinate(joint)
+        qd_k, qdd_k = (qd[k], qdd[k]) if k is not None else (0, 0)
+        R, P = joint.transform(qk)
+        V, Vd = joint.origin_motion(qd_k, qdd_k)
+        placement[joint.child] = (R, P)
+        z = joint.child_axis
 
-        w_in = Rt * w[parent]
-        wd_in = Rt * wd[parent]
-        vd_c = Rt * (wd[parent].cross(p) + w[parent].cross(w[parent].cross(p)) + vd[parent])
-        if joint.type == "revolute":
-            w_i = w_in + qd[k] * z
-            wd_i = wd_in + w_in.cross(qd[k] * z) + qdd[k] * z
-        else:
-            w_i, wd_i = w_in, wd_in
-        if joint.type == "prismatic":
-            vd_c = vd_c + 2 * w_i.cross(qd[k] * z) + qdd[k] * z
-        c = link.com
-        vcd = wd_i.cross(c) + w_i.cross(w_i.cross(c)) + vd_c
-        w[joint.child], wd[joint.child], vd[joint.child] = w_i, wd_i, vd_c
-        F[joint.child] = link.mass * vcd
-        N[joint.child] = link.inertia * wd_i + w_i.cross(link.inertia * w_i)
+        w_i = omega(R, w[parent], z, qd_k, joint.type)
+        wd_i = omega_dot(R, w[parent], wd[parent], z, qd_k, qdd_k, joint.type)
+        vd_i = v_dot(R, w[parent], wd[parent], vd[parent], P, V, Vd)
+        vcd = vc_dot(w_i, wd_i, vd_i, link.com)
+        w[joint.child], wd[joint.child], vd[joint.child] = w_i, wd_i, vd_i
+        F[joint.child] = inertial_force(link.mass, vcd)
+        N[joint.child] = inertial_moment(link.inertia, w_i, wd_i)
 
         if record:
             name = joint.child
             outward += [
                 Step("outward", name, "omega", rf"{{}}^{{{i}}}\omega_{{{i}}}", w_i, "angular velocity"),
                 Step("outward", name, "omega_dot", rf"{{}}^{{{i}}}\dot\omega_{{{i}}}", wd_i, "angular acceleration"),
-                Step("outward", name, "v_dot", rf"{{}}^{{{i}}}\dot v_{{{i}}}", vd_c,
+                Step("outward", name, "v_dot", rf"{{}}^{{{i}}}\dot v_{{{i}}}", vd_i,
                      "linear acceleration of the frame origin (gravity included as base acceleration)"),
                 Step("outward", name, "vc_dot", rf"{{}}^{{{i}}}\dot v_{{C_{i}}}", vcd,
                      "linear acceleration of the centre of mass"),
@@ -92,21 +158,21 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
     for joint in reversed(robot.joints):
         name, i = joint.child, robot.link_index(joint.child)
         link = robot.links[name]
-        f_i = F[name]
-        n_i = N[name] + link.com.cross(F[name])
-        for child in robot.children(name):
-            Rc, pc = placement[child.child]
-            f_c = Rc * f[child.child]
-            f_i = f_i + f_c
-            n_i = n_i + Rc * n[child.child] + pc.cross(f_c)
+        children = [(*placement[c.child], n[c.child], f[c.child]) for c in robot.children(name)]
+        f_i = joint_force(F[name], [(Rc, fc) for Rc, _, _, fc in children])
+        n_i = joint_moment(N[name], link.com, F[name], children)
         f[name], n[name] = f_i, n_i
         k = robot.coordinate_index(joint)
+        point = joint.joint_point(robot.joint_coordinate(joint)) if joint.type == "revolute" else sp.zeros(3, 1)
+        n_axis = moment_about(n_i, f_i, point)
         if k is not None:
-            tau[k] = (n_i if joint.type == "revolute" else f_i).dot(joint.axis)
+            tau[k] = joint_torque(joint.type, joint.child_axis, n_axis, f_i)
         if record:
+            about = "" if point == sp.zeros(3, 1) else f", about joint {i}'s axis point {list(point)} (frame {i})"
             inward += [
                 Step("inward", name, "f", rf"{{}}^{{{i}}}f_{{{i}}}", f_i, "force exerted on the link by its parent"),
-                Step("inward", name, "n", rf"{{}}^{{{i}}}n_{{{i}}}", n_i, "moment exerted on the link by its parent"),
+                Step("inward", name, "n", rf"{{}}^{{{i}}}n_{{{i}}}", n_axis,
+                     "moment exerted on the link by its parent" + about),
             ]
             if k is not None:
                 kind = "torque" if joint.type == "revolute" else "force"

@@ -1,0 +1,402 @@
+"""Check a student's own derivation step by step: :func:`grade`.
+
+    report = armdyn.grade("my-derivation.md")             # front matter names the robot
+    report = armdyn.grade("steps.yaml", robot="rp-arm")
+    print(report.text()); report.to_json(); report.first_wrong
+
+The submission (Markdown with LaTeX display math, or YAML; see :mod:`.reader`) is read,
+each equation's left-hand side is mapped to a step of Newton-Euler or Lagrange
+(:mod:`.notation`), and each step gets a verdict (:mod:`.engine`, statuses in
+:mod:`.verdict`): correct, correct-by-convention, wrong, follows-from-earlier-error,
+correct-but-unsupported, or unrecognised. Bad input (no equation recognised, malformed
+front matter, an unknown symbol, a vector of the wrong length, a link that does not
+exist) raises :class:`armdyn.errors.ModelError` naming the file and line.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import types
+
+import symengine as se
+import sympy as sp
+
+from ..errors import ModelError
+from ..model import Robot
+from .engine import Sampler, Value, World, canonical, judge, to_sympy
+from .explain import component_name, describe, pretty, tidy
+from .latex import LatexError, UnknownSymbol, parse, parse_sympy_syntax
+from .methods import lagrange_method, newton_euler_method, rotation_between
+from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
+from .reader import Submission, read
+from .verdict import PASSING, STATUSES, GradeReport, StepVerdict
+
+__all__ = ["grade", "GradeReport", "StepVerdict", "STATUSES"]
+
+_NAMED = {  # step names as armdyn reports them, accepted as left-hand sides in YAML
+    "omega": "omega", "omega_dot": "omega_dot", "v_dot": "v_dot", "vc_dot": "vc_dot", "F": "F", "N": "N",
+    "f": "f", "n": "n", "tau": "tau", "dL_dqd": "dL_dqd", "dL_dq": "dL_dq", "ddt_dL_dqd": "ddt_dL_dqd",
+}
+
+
+def _named_ref(text: str) -> StepRef | None:
+    """``v_dot_1``, ``tau_2``, ``T``: armdyn's own step names."""
+    if text in ("T", "V", "L"):
+        return StepRef(text)
+    head, _, tail = text.rpartition("_")
+    if head in _NAMED and tail.isdigit():
+        return StepRef(_NAMED[head], int(tail))
+    return None
+
+
+def _load_robot(name: str, sub: Submission) -> Robot:
+    from ..io import load
+
+    candidate = os.path.join(sub.base_dir, name)
+    source = candidate if os.path.isfile(candidate) else name
+    try:
+        return load(source, strict=False)
+    except ModelError as err:
+        raise err.located(source=sub.path) from None
+
+
+class _Grader:
+    def __init__(self, sub: Submission, robot: Robot, symbols: dict | None):
+        self.sub = sub
+        self.robot = robot
+        try:
+            self.symbols = SymbolMap(robot, {**sub.symbols, **(symbols or {})})
+        except LatexError as err:
+            raise ModelError(str(err), source=sub.path) from None
+        free = set(robot.q) | set(robot.qd) | set(robot.qdd) | robot.free_symbols()
+        self.sampler = Sampler(free, robot)
+        self._worlds: dict = {}
+        self.verdicts: list[StepVerdict] = []
+        self.notes: list[str] = []
+
+    def world(self, name: str) -> World:
+        if name not in self._worlds:
+            if name == "newton-euler":
+                method, ctx = newton_euler_method(self.robot)
+                self._worlds[name] = World(method, ctx, self.sampler, numeric=True)
+            else:
+                method, ctx = lagrange_method(self.robot)
+                self._worlds[name] = World(method, ctx, self.sampler, numeric=False)
+        return self._worlds[name]
+
+    # -- reading one equation
+    def where(self, eq) -> str:
+        return f"{self.sub.path}:{eq.line}"
+
+    def value(self, eq, ref: StepRef):
+        try:
+            if eq.latex:
+                raw = eq.value
+                if isinstance(raw, list):
+                    value = sp.Matrix([parse(str(v), self.symbols) for v in raw])
+                else:
+                    value = parse(str(raw), self.symbols)
+            else:
+                names = dict(self.symbols.names)
+                names.update({k: v for k, v in self.symbols.steps.items() if not isinstance(v, sp.MatrixBase)})
+                raw = eq.value
+                items = raw if isinstance(raw, list) else [raw]
+                parsed = [se.sympify(v) if isinstance(v, (int, float)) else
+                          parse_sympy_syntax(str(v), names, symengine=True) for v in items]
+                value = se.DenseMatrix(len(parsed), 1, parsed) if isinstance(raw, list) else parsed[0]
+        except UnknownSymbol as err:
+            raise ModelError(f"{ref.name}: {err}", source=self.where(eq)) from None
+        except ModelError as err:
+            if "unknown parameter" in err.message:
+                raise ModelError(f"{ref.name}: {err.message}", source=self.where(eq)) from None
+            return None, err.message
+        except (LatexError, RecursionError, TypeError, ValueError) as err:
+            return None, f"cannot read the value ({err})"
+        return self._shape(value, ref, eq), None
+
+    def _shape(self, value, ref: StepRef, eq):
+        vector = ref.key in VECTOR_KEYS
+        if ref.key == "R":
+            want = (3, 3)
+        elif vector:
+            want = (3, 1)
+        else:
+            want = None
+        if isinstance(value, se.DenseMatrix) and (want is None or value.shape == (1, 1) or value.shape[1] != 1):
+            value = to_sympy(value)  # small: shaped by the SymPy rules below
+        elif isinstance(value, se.Basic) and not isinstance(value, se.DenseMatrix) and want is not None:
+            value = to_sympy(value)
+        if isinstance(value, se.DenseMatrix):
+            if value.shape != want:
+                raise ModelError(f"{ref.name} must be a vector of 3 components, but it has {value.shape[0]}",
+                                 source=self.where(eq))
+            return value
+        if want is None:
+            if isinstance(value, sp.MatrixBase):
+                if value.shape == (1, 1):
+                    return value[0, 0]
+                raise ModelError(f"{ref.name} is a scalar, but the value is a {value.shape[0]}x{value.shape[1]} "
+                                 "matrix", source=self.where(eq))
+            return value
+        if not isinstance(value, sp.MatrixBase):
+            if value == 0:
+                return sp.zeros(*want)
+            raise ModelError(f"{ref.name} is a {'vector' if vector else '3x3 matrix'}, but the value is a scalar",
+                             source=self.where(eq))
+        if vector and value.shape == (1, 3):
+            value = value.T
+        if value.shape != want:
+            kind = "vector of 3 components" if vector else "3x3 matrix"
+            raise ModelError(f"{ref.name} must be a {kind}, but it has shape {value.shape[0]}x{value.shape[1]}",
+                             source=self.where(eq))
+        return value
+
+    # -- grading
+    def run(self, method_hint: str | None) -> GradeReport:
+        context = method_hint if method_hint in ("newton-euler", "lagrange") else None
+        seen_methods = []
+        for eq in self.sub.equations:
+            ref = parse_lhs(eq.lhs, self.symbols.coordinate_of) if eq.latex or "\\" in eq.lhs else None
+            if ref is None:
+                ref = _named_ref(eq.lhs) or (parse_lhs(eq.lhs, self.symbols.coordinate_of) if not eq.latex else None)
+            if ref is None:
+                self.verdicts.append(StepVerdict(
+                    name="", key="", link="", status="unrecognised", label=eq.lhs, source=eq.source, line=eq.line,
+                    message="not a step of Newton-Euler or Lagrange (skipped)"))
+                continue
+            method = "lagrange" if ref.key in LAGRANGE_KEYS else (
+                context or "newton-euler" if ref.key == "tau" else "newton-euler")
+            if ref.key != "tau":
+                context = method
+            if method not in seen_methods:
+                seen_methods.append(method)
+            self._check_index(ref, eq)
+            value, problem = self.value(eq, ref)
+            if value is None:
+                self.verdicts.append(StepVerdict(
+                    name=ref.name, key=ref.key, link="", status="unrecognised", label=eq.lhs, source=eq.source,
+                    line=eq.line, message=problem))
+                continue
+            if ref.key == "R":
+                self._rotation(ref, eq, value)
+            else:
+                self._step(self.world(method), ref, eq, value, method)
+            if ref.key in ("T", "V", "L"):
+                self.symbols.steps[ref.key] = value
+        recognised = [v for v in self.verdicts if v.key]  # a step named, even if its value was unreadable
+        if not recognised:
+            raise ModelError("no step of Newton-Euler or Lagrange recognised (expected equations such as "
+                             "\\omega_1^1 = ..., F_2^2 = ..., \\tau_1 = ..., T = ...)", source=self.sub.path)
+        first_wrong = next((v.name for v in self.verdicts if v.status == "wrong"), None)
+        tau_correct = [False] * self.robot.dof
+        for v in self.verdicts:
+            if v.key == "tau":
+                tau_correct[int(v.name.split("_")[1]) - 1] = v.status in (*PASSING, "correct-but-unsupported")
+        if self.symbols.used_gravity_magnitude:
+            self.notes.append("g read as the magnitude of the model's gravity vector")
+        method_name = "+".join(seen_methods) or (method_hint or "newton-euler")
+        return GradeReport(
+            robot=self.robot.name, method=method_name, submission=self.sub.path, steps=self.verdicts,
+            first_wrong=first_wrong, tau_correct=tau_correct, symbol_latex=_symbol_latex(self.robot),
+            notes=self.notes)
+
+    def _check_index(self, ref: StepRef, eq):
+        n = len(self.robot.links) - 1
+        if ref.key in VECTOR_KEYS:
+            if not 0 <= ref.index <= n or (ref.index == 0 and ref.key not in ("omega", "omega_dot", "v_dot")):
+                raise ModelError(f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}",
+                                 source=self.where(eq))
+            if ref.frame is not None and not 0 <= ref.frame <= n:
+                raise ModelError(f"{ref.name} is written in frame {ref.frame}, which '{self.robot.name}' does not "
+                                 f"have (frames 0..{n})", source=self.where(eq))
+        elif ref.key == "R":
+            for k in (ref.index, ref.frame):
+                if not 0 <= k <= n:
+                    raise ModelError(f"{ref.name}: frame {k} does not exist (frames 0..{n})", source=self.where(eq))
+        elif ref.index is not None and not 1 <= ref.index <= self.robot.dof:
+            raise ModelError(f"{ref.name} names joint {ref.index}, but '{self.robot.name}' has joints "
+                             f"1..{self.robot.dof}", source=self.where(eq))
+
+    def _rotation(self, ref: StepRef, eq, value):
+        ctx = self.world("newton-euler").ctx
+        expected = rotation_between(ctx, ref.index, ref.frame)
+        fp = self.sampler.fingerprint
+        got_fp = fp(value)
+        from .engine import equal
+
+        status, conv, message = "correct", None, ""
+        ok = equal(got_fp, fp(expected))
+        if not ok.all():
+            if equal(got_fp, fp(expected.T)).all():
+                status = "correct-by-convention"
+                conv = (f"transposed: the columns are frame {ref.frame}'s axes in frame {ref.index} "
+                        f"(R_{ref.index}^{ref.frame} here maps frame-{ref.index} coordinates to frame {ref.frame})")
+            else:
+                status = "wrong"
+                bad = [int(i) for i in range(9) if not ok.ravel()[i]]
+                message = "; ".join(f"{component_name(i, (3, 3))}: "
+                                    + describe(value[i], expected[i], self.robot, self.sampler) for i in bad[:3])
+        self.verdicts.append(StepVerdict(
+            name=ref.name, key="R", link="", status=status, label=eq.lhs, source=eq.source, line=eq.line,
+            expected=expected, got=value, difference=None if status != "wrong" else value - expected,
+            convention=conv, message=message or ("" if status == "correct" else conv or ""),
+            frame=f"{ref.index}->{ref.frame}"))
+
+    def _step(self, world: World, ref: StepRef, eq, value, method: str):
+        key = (ref.key, ref.index)
+        if key not in world.method.refs:
+            self.verdicts.append(StepVerdict(
+                name=ref.name, key=ref.key, link="", status="unrecognised", label=eq.lhs, source=eq.source,
+                line=eq.line, message=f"{method} has no step {ref.name} for this robot"))
+            return
+        link = ""
+        own = value
+        if ref.key in VECTOR_KEYS:
+            link = list(self.robot.links)[ref.index]
+            if ref.frame is not None and ref.frame != ref.index:
+                value = own = to_sympy(value)
+                own = rotation_between(world.ctx, ref.frame, ref.index) * value  # into the link's own frame
+        got = Value(self.sampler.fingerprint(own), own)
+        candidates = lambda r: world.candidates(r)  # noqa: E731
+        j = judge(world, key, got, candidates)
+        name = ref.name
+        origins_names = sorted(j.origins, key=self._order)
+        caused_by = origins_names[0] if j.status == "follows-from-earlier-error" and origins_names else None
+        extras = [world.candidates(r)[0] for r in j.conv.extra]
+        if j.status in ("correct", "correct-by-convention"):
+            world.given[key] = [canonical(world, j.conv, got, extras, frozenset())]
+        elif j.status == "correct-but-unsupported":
+            world.given[key] = [canonical(world, j.conv, got, extras, frozenset())] + world.carried(key)
+        elif j.status == "follows-from-earlier-error":
+            world.given[key] = [canonical(world, j.conv, got, extras, j.origins)]
+        else:
+            world.given[key] = [canonical(world, j.conv, got, extras, j.origins | {name})]
+            if j.canon is not None:
+                world.given[key].append(j.canon)
+        world.invalidate()
+
+        # what is shown: expected in the student's convention, the difference against
+        # what their own earlier values give (wrong) or the expected value
+        exp_shown = j.conv.forward(world.expected[key].sym(), world.ctx,
+                                   *(world.expected[r].sym() for r in j.conv.extra))
+        if ref.key in VECTOR_KEYS and ref.frame is not None and ref.frame != ref.index:
+            exp_shown = rotation_between(world.ctx, ref.index, ref.frame) * exp_shown
+        difference, components, message = None, [], ""
+        if j.status in ("wrong", "follows-from-earlier-error", "correct-but-unsupported"):
+            value = to_sympy(value)
+            ref_value = j.reference.sym() if j.status != "correct-but-unsupported" else exp_shown
+            if j.status == "correct-but-unsupported":
+                carried = world.carried(key)
+                ref_value = carried[0].sym() if carried else exp_shown
+                ref_value = j.conv.forward(ref_value, world.ctx, *(e.sym() for e in extras))
+            if ref.key in VECTOR_KEYS and ref.frame is not None and ref.frame != ref.index:
+                ref_value = rotation_between(world.ctx, ref.index, ref.frame) * ref_value
+            got_m, ref_m = _matrix(value), _matrix(ref_value)
+            from .engine import equal
+
+            ok = equal(self.sampler.fingerprint(got_m), self.sampler.fingerprint(ref_m)).ravel()
+            components = [int(i) for i in range(len(ok)) if not ok[i]]
+            if j.status == "wrong":
+                parts = []
+                for i in components[:3]:
+                    text = describe(got_m[i], ref_m[i], self.robot, self.sampler)
+                    where = component_name(i, got_m.shape)
+                    parts.append(f"{text} in {where}" if where else text)
+                against = "" if not j.origins else " (compared with what your own earlier steps give)"
+                message = "; ".join(parts) + against
+                diff = sp.Matrix([tidy(got_m[i] - ref_m[i], self.robot) for i in range(len(got_m))])
+                difference = diff if got_m.shape != (1, 1) else diff[0]
+            elif j.status == "follows-from-earlier-error":
+                message = f"follows from the error in {caused_by}" + (f" ({j.convention})" if j.convention else "")
+                diff = _matrix(value) - _matrix(exp_shown)
+                difference = sp.Matrix([tidy(x, self.robot) for x in diff]) if diff.shape != (1, 1) \
+                    else tidy(diff[0], self.robot)
+            else:
+                # the consistent carry-through: the candidate inheriting the fewest slips
+                carried = sorted(world.carried(key), key=lambda v: len(v.origins))
+                message = "right, but not what your own earlier steps give"
+                if carried:
+                    through = j.conv.forward(carried[0].sym(), world.ctx, *(e.sym() for e in extras))
+                    d = _matrix(through) - _matrix(exp_shown)
+                    bad = [i for i in range(len(d)) if tidy(d[i], self.robot) != 0]
+                    if bad:
+                        src = sorted(carried[0].origins, key=self._order)
+                        where = component_name(bad[0], d.shape)
+                        message += (f": carried through they leave {pretty(tidy(d[bad[0]], self.robot))}"
+                                    + (f" in {where}" if where else "")
+                                    + (f" (from the error in {src[0]})" if src else "")
+                                    + " (copied, or two slips that cancel?)")
+        elif j.status == "correct-by-convention":
+            message = j.convention
+        self.verdicts.append(StepVerdict(
+            name=name, key=ref.key, link=link, status=j.status, label=eq.lhs, source=eq.source, line=eq.line,
+            expected=exp_shown, got=value, difference=difference, components=components,
+            convention=j.convention, caused_by=caused_by, message=message,
+            frame="" if ref.key not in VECTOR_KEYS else str(ref.frame if ref.frame is not None else ref.index)))
+
+    def _order(self, name: str) -> int:
+        for k, v in enumerate(self.verdicts):
+            if v.name == name:
+                return k
+        return len(self.verdicts)
+
+
+def _matrix(value) -> sp.Matrix:
+    return value if isinstance(value, sp.MatrixBase) else sp.Matrix([[value]])
+
+
+def _symbol_latex(robot: Robot) -> dict:
+    """Model symbol -> LaTeX as the field writes it (\\dot{\\theta}_1 for theta1_dot)."""
+    import re
+
+    out = {}
+    names = list(robot.q) + list(robot.qd) + list(robot.qdd) + list(robot.parameters.values())
+    for s in names:
+        m = re.fullmatch(r"([A-Za-z]+?)(\d*)(_dot|_ddot)?", s.name)
+        if not m:
+            out[s] = s.name
+            continue
+        base, digits, dots = m.groups()
+        from .latex import GREEK
+
+        tex = f"\\{base}" if base in GREEK else base
+        if dots:
+            tex = f"\\{'d' if dots == '_ddot' else ''}dot{{{tex}}}"
+        out[s] = tex + (f"_{{{digits}}}" if digits else "")
+    return out
+
+
+def grade(submission, robot: str | Robot | None = None, symbols: dict | None = None) -> GradeReport:
+    """Grade a derivation.
+
+    submission: path of a Markdown (.md) or YAML (.yaml) file, or a :class:`Submission`.
+    robot:      the model whose frames the student used (bundled name, model file or
+                Robot); default: the submission's front matter ``robot``.
+    symbols:    extra mapping of the student's symbols to model names.
+    """
+    sub = submission if isinstance(submission, Submission) else read(os.fspath(submission))
+    if isinstance(robot, Robot):
+        model = robot
+    else:
+        name = robot or sub.robot
+        if not name:
+            raise ModelError("no robot named: give --robot MODEL or 'robot:' in the front matter", source=sub.path)
+        model = _load_robot(name, sub)
+    if sub.values is not None:
+        try:
+            model = model.bind(None if sub.values == "published" else sub.values)
+        except ModelError as err:
+            raise err.located(source=sub.path) from None
+    hint = sub.method if sub.method in ("newton-euler", "lagrange") else None
+    return _Grader(sub, model, symbols).run(hint)
+
+
+class _CallableModule(types.ModuleType):
+    """``armdyn.grade(...)`` calls :func:`grade` (the package is also the function)."""
+
+    def __call__(self, *args, **kwargs):
+        return grade(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

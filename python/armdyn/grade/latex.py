@@ -1,0 +1,547 @@
+"""The LaTeX a student writes for a derivation, read into SymPy.
+
+Only what hand derivations of dynamics use is understood, and nothing is evaluated as
+code: the text is tokenised and parsed here (a recursive-descent parser with a depth
+bound), and every name goes through a ``resolve`` callback that maps the student's
+symbols to the model's (or refuses them)::
+
+    expr    := ["+" | "-"] term (("+" | "-") term)*
+    term    := factor (["*" | "\\cdot" | "\\times" | "/" | juxtaposition] factor)*
+    factor  := atom ["^" script]
+    atom    := number | symbol | "(" expr ")" | "[" expr "]" | "{" expr "}"
+             | "\\left(" expr "\\right)" | "\\frac{expr}{expr}" | "\\sqrt{expr}"
+             | function [ "^" script ] argument | matrix
+    symbol  := ["\\dot" | "\\ddot"] name ["_" script] ["^" script]   (wrappers such as
+               \\mathbf, \\boldsymbol, \\hat are looked through)
+    matrix  := "\\begin{pmatrix}" cell ("&" cell)* ("\\\\" ...)* "\\end{pmatrix}"  (also
+               bmatrix, matrix, Bmatrix, vmatrix: rows by \\\\, cells by &)
+
+Functions: \\sin \\cos \\tan \\exp \\ln \\log; ``\\sin\\theta_1`` takes the next atom,
+``\\sin^2\\theta`` is ``(\\sin\\theta)^2``. A symbol reaches ``resolve`` as a
+:class:`Name` (letter or Greek name, number of dots, subscript and superscript as text).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import sympy as sp
+
+#: nesting depth (parentheses, groups, fractions, matrices) beyond which input is refused
+MAX_DEPTH = 60
+#: largest numeric exponent accepted (10^{10^{10}} must not make SymPy compute)
+MAX_EXPONENT = 100
+#: characters in one equation beyond which it is refused
+MAX_LENGTH = 200_000
+
+GREEK = {
+    "alpha", "beta", "gamma", "delta", "epsilon", "varepsilon", "zeta", "eta", "theta",
+    "vartheta", "iota", "kappa", "lambda", "mu", "nu", "xi", "pi", "rho", "sigma", "tau",
+    "upsilon", "phi", "varphi", "chi", "psi", "omega", "Gamma", "Delta", "Theta", "Lambda",
+    "Xi", "Pi", "Sigma", "Phi", "Psi", "Omega",
+}
+UNICODE_GREEK = {
+    "α": "alpha", "β": "beta", "γ": "gamma", "δ": "delta", "ε": "epsilon", "ζ": "zeta",
+    "η": "eta", "θ": "theta", "ι": "iota", "κ": "kappa", "λ": "lambda", "μ": "mu", "ν": "nu",
+    "ξ": "xi", "π": "pi", "ρ": "rho", "σ": "sigma", "τ": "tau", "φ": "phi", "χ": "chi",
+    "ψ": "psi", "ω": "omega",
+}
+FUNCTIONS = {"sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "exp": sp.exp, "ln": sp.log, "log": sp.log,
+             "sec": sp.sec, "csc": sp.csc, "cot": sp.cot}
+#: wrappers that change a symbol's typeface, not its meaning
+WRAPPERS = {"mathbf", "boldsymbol", "bm", "mathrm", "mathit", "vec", "hat", "bar", "mathbold",
+            "pmb", "mathsf", "operatorname", "text", "mathcal", "tilde"}
+SPACES = {",", ";", ":", "!", " ", "quad", "qquad", "displaystyle", "textstyle", "left.", "right.",
+          "limits", "nolimits"}
+MATRIX_ENVS = {"pmatrix", "bmatrix", "Bmatrix", "matrix", "vmatrix", "smallmatrix", "array"}
+
+
+class LatexError(ValueError):
+    """LaTeX that could not be read (the message says what and where)."""
+
+
+class UnknownSymbol(LatexError):
+    """A symbol the resolver does not know."""
+
+
+@dataclass(frozen=True)
+class Name:
+    """A symbol as the student wrote it: ``\\ddot{\\theta}_1`` is Name("theta", 2, "1", "")."""
+
+    base: str
+    dots: int = 0
+    sub: str = ""
+    sup: str = ""
+
+    def latex(self) -> str:
+        base = f"\\{self.base}" if self.base in GREEK else self.base
+        if self.dots:
+            base = "\\" + "d" * self.dots + "ot{" + base + "}"
+        sub = f"_{{{self.sub}}}" if self.sub else ""
+        return base + sub
+
+
+_TOKEN = re.compile(
+    r"\\begin\{(?P<begin>[A-Za-z*]+)\}(?:\{[^{}]*\})?"
+    r"|\\end\{(?P<end>[A-Za-z*]+)\}"
+    r"|\\(?P<cmd>[A-Za-z]+|.)"
+    r"|(?P<num>\d+(?:\.\d*)?|\.\d+)"
+    r"|(?P<char>\S)"
+    r"|(?P<space>\s+)",
+    re.S,
+)
+
+
+def tokenize(text: str) -> list[tuple[str, str]]:
+    """Tokens ``(kind, value)``: kind is begin, end, cmd, num or char; spaces dropped."""
+    if len(text) > MAX_LENGTH:
+        raise LatexError(f"equation too long ({len(text)} characters, at most {MAX_LENGTH})")
+    out = []
+    for m in _TOKEN.finditer(text):
+        kind = m.lastgroup
+        if kind == "space":
+            continue
+        value = m.group(kind)
+        if kind == "cmd" and value in SPACES:
+            continue
+        if kind == "char" and value in UNICODE_GREEK:
+            kind, value = "cmd", UNICODE_GREEK[value]
+        out.append((kind, value))
+    return out
+
+
+class _Parser:
+    def __init__(self, tokens, resolve):
+        self.t = tokens
+        self.i = 0
+        self.resolve = resolve
+        self.depth = 0
+
+    # -- helpers
+    def peek(self, k=0):
+        j = self.i + k
+        return self.t[j] if j < len(self.t) else ("eof", "")
+
+    def take(self):
+        tok = self.peek()
+        self.i += 1
+        return tok
+
+    def expect(self, kind, value=None):
+        tok = self.take()
+        if tok[0] != kind or (value is not None and tok[1] != value):
+            want = value if value is not None else kind
+            raise LatexError(f"expected '{want}', found '{tok[1] or 'end of equation'}'")
+        return tok
+
+    def enter(self):
+        self.depth += 1
+        if self.depth > MAX_DEPTH:
+            raise LatexError(f"nesting deeper than {MAX_DEPTH} levels")
+
+    def leave(self):
+        self.depth -= 1
+
+    # -- grammar
+    def parse(self):
+        value = self.expr()
+        if self.peek()[0] != "eof":
+            raise LatexError(f"unexpected '{self.peek()[1]}'")
+        return value
+
+    def expr(self):
+        self.enter()
+        sign = 1
+        while self.peek() in (("char", "+"), ("char", "-")):
+            sign *= -1 if self.take()[1] == "-" else 1
+        value = sign * self.term()
+        while self.peek() in (("char", "+"), ("char", "-")):
+            op = self.take()[1]
+            nxt = self.term()
+            value = value + nxt if op == "+" else value - nxt
+        self.leave()
+        return value
+
+    def _starts_atom(self):
+        kind, value = self.peek()
+        if kind in ("num", "begin"):
+            return True
+        if kind == "char":
+            return value.isalpha() or value in "([{"
+        if kind == "cmd":
+            return value not in ("right", "end", "\\", "cdot", "times", "}", "&") and value != "rbrace"
+        return False
+
+    def term(self):
+        value = self.factor()
+        while True:
+            kind, tok = self.peek()
+            if (kind, tok) in (("char", "*"), ("cmd", "cdot"), ("cmd", "times"), ("cmd", "ast")):
+                self.take()
+                value = _mul(value, self.factor())
+            elif (kind, tok) == ("char", "/"):
+                self.take()
+                value = value / self.factor()
+            elif self._starts_atom():
+                value = _mul(value, self.factor())
+            else:
+                return value
+
+    def factor(self):
+        base = self.atom()
+        if self.peek() == ("char", "^"):
+            self.take()
+            exponent = self.script_value()
+            if exponent.is_Number and abs(exponent) > MAX_EXPONENT:
+                raise LatexError(f"an exponent of {exponent} (at most {MAX_EXPONENT})")
+            base = base ** exponent
+        return base
+
+    def script_value(self):
+        """The exponent after ``^``: a group or a single token."""
+        if self.peek() == ("char", "{"):
+            self.take()
+            value = self.expr()
+            self.expect("char", "}")
+            return value
+        kind, tok = self.take()
+        if kind == "num":
+            return sp.Integer(tok) if tok.isdigit() else sp.Rational(tok)
+        if kind == "char" and tok.isalpha():
+            return self.resolve(Name(tok))
+        raise LatexError(f"cannot read the exponent '{tok}'")
+
+    def group_text(self) -> str:
+        """The raw text of a ``{...}`` group or of a single token (for sub/superscripts)."""
+        if self.peek() == ("char", "{"):
+            self.take()
+            depth, parts = 1, []
+            while True:
+                kind, tok = self.take()
+                if kind == "eof":
+                    raise LatexError("unbalanced '{'")
+                if (kind, tok) == ("char", "{"):
+                    depth += 1
+                elif (kind, tok) == ("char", "}"):
+                    depth -= 1
+                    if depth == 0:
+                        return "".join(parts)
+                if kind == "cmd" and tok not in WRAPPERS:
+                    parts.append(tok)
+                elif kind in ("num", "char") and tok not in "{}":
+                    parts.append(tok)
+        kind, tok = self.take()
+        if kind in ("num", "char", "cmd"):
+            return tok[0] if kind == "num" else tok
+        raise LatexError("missing subscript or superscript")
+
+    def atom(self):
+        kind, tok = self.peek()
+        if kind == "num":
+            self.take()
+            return sp.Integer(tok) if tok.isdigit() else sp.Rational(tok)
+        if kind == "begin":
+            return self.matrix()
+        if kind == "char":
+            if tok in "([":
+                self.take()
+                value = self.expr()
+                self.expect("char", ")" if tok == "(" else "]")
+                return value
+            if tok == "{":
+                self.take()
+                if self.peek() == ("char", "}"):  # an empty group, e.g. {}^{1}
+                    self.take()
+                    return sp.Integer(1)
+                value = self.expr()
+                self.expect("char", "}")
+                return value
+            if tok.isalpha():
+                return self.symbol()
+            raise LatexError(f"unexpected '{tok}'")
+        if kind == "cmd":
+            if tok == "left":
+                self.take()
+                opener = self.take()[1]
+                if opener in ("(", "["):
+                    value = self.expr()
+                    self.expect("cmd", "right")
+                    self.take()
+                    return value
+                if opener in ("{", "lbrace"):
+                    value = self.expr()
+                    self.expect("cmd", "right")
+                    self.take()
+                    return value
+                raise LatexError(f"unsupported bracket \\left{opener}")
+            if tok in ("frac", "dfrac", "tfrac"):
+                self.take()
+                self.enter()
+                num = self._braced()
+                den = self._braced()
+                self.leave()
+                return num / den
+            if tok == "sqrt":
+                self.take()
+                return sp.sqrt(self._braced())
+            if tok in FUNCTIONS:
+                return self.function()
+            if tok in ("dot", "ddot", "dddot") or tok in GREEK or tok in WRAPPERS:
+                return self.symbol()
+            if tok == "{":  # \{ as a bracket
+                self.take()
+                value = self.expr()
+                self.expect("cmd", "}")
+                return value
+            raise LatexError(f"unsupported command \\{tok}")
+        raise LatexError("unexpected end of equation" if kind == "eof" else f"unexpected '{tok}'")
+
+    def _braced(self):
+        self.expect("char", "{")
+        value = self.expr()
+        self.expect("char", "}")
+        return value
+
+    def function(self):
+        fn = FUNCTIONS[self.take()[1]]
+        power = None
+        if self.peek() == ("char", "^"):
+            self.take()
+            power = self.script_value()
+        kind, tok = self.peek()
+        if (kind, tok) in (("char", "("), ("char", "["), ("char", "{"), ("cmd", "left")):
+            arg = self.atom()
+        else:
+            arg = self.atom()
+        value = fn(arg)
+        return value**power if power is not None else value
+
+    def symbol(self):
+        """[accents/wrappers] name [_sub] -> resolve(Name). A ``^`` after it is an
+        exponent, read by :meth:`factor`."""
+        dots, base, sub = self._accented()
+        if base[0].isdigit():  # \mathbf{0}: a number in bold
+            return sp.Rational(base)
+        if not sub and self.peek() == ("char", "_"):
+            self.take()
+            sub = self.group_text()
+        return self.resolve(Name(base, dots, sub))
+
+    def _accented(self) -> tuple[int, str, str]:
+        """(number of dots, base name, subscript written inside the braces) of an
+        accented or wrapped symbol: ``\\dot{\\theta}``, ``\\dot{\\theta_1}``, ``\\mathbf{v}``."""
+        kind, tok = self.take()
+        if kind == "cmd" and (tok in ("dot", "ddot", "dddot") or tok in WRAPPERS):
+            dots = {"dot": 1, "ddot": 2, "dddot": 3}.get(tok, 0)
+            if self.peek() != ("char", "{"):
+                inner, base, sub = self._accented()
+                return dots + inner, base, sub
+            self.take()
+            inner, base, sub = self._accented()
+            while self.peek() != ("char", "}"):
+                k2, t2 = self.peek()
+                if k2 == "eof":
+                    raise LatexError("unbalanced '{'")
+                if (k2, t2) == ("char", "_") and not sub:
+                    self.take()
+                    sub = self.group_text()
+                elif k2 in ("char", "num") and t2.isalnum() and tok in WRAPPERS:
+                    self.take()
+                    base += t2  # \mathrm{ab}: a multi-letter name
+                else:
+                    raise LatexError(f"unexpected '{t2}' inside \\{tok}{{...}}")
+            self.take()
+            return dots + inner, base, sub
+        if kind == "cmd" and tok in GREEK:
+            return 0, tok, ""
+        if kind == "char" and tok.isalpha() or kind == "num":
+            return 0, tok, ""
+        raise LatexError(f"expected a symbol, found '{tok or 'end of equation'}'")
+
+    def matrix(self):
+        env = self.take()[1]
+        if env not in MATRIX_ENVS:
+            raise LatexError(f"unsupported environment {env}")
+        self.enter()
+        rows, row = [], []
+        while True:
+            kind, tok = self.peek()
+            if kind == "end":
+                self.take()
+                break
+            if kind == "eof":
+                raise LatexError(f"\\begin{{{env}}} without \\end{{{env}}}")
+            if (kind, tok) == ("cmd", "\\"):
+                self.take()
+                continue
+            cell = self.expr()
+            row.append(cell)
+            kind, tok = self.peek()
+            if (kind, tok) == ("char", "&"):
+                self.take()
+                continue
+            if (kind, tok) == ("cmd", "\\") or kind == "end":
+                rows.append(row)
+                row = []
+                continue
+            raise LatexError(f"unexpected '{tok}' in a matrix")
+        if row:
+            rows.append(row)
+        self.leave()
+        if not rows or len({len(r) for r in rows}) != 1:
+            raise LatexError("a matrix whose rows have different lengths")
+        return sp.Matrix(rows)
+
+
+def _mul(a, b):
+    return a * b
+
+
+def parse(text: str, resolve) -> sp.Expr | sp.Matrix:
+    """Parse one LaTeX expression; ``resolve(Name) -> sympy`` maps each symbol."""
+    return _Parser(tokenize(text), resolve).parse()
+
+
+# ------------------------------------------------------------------ equations
+
+_OPEN = {"{": "}", "(": ")", "[": "]"}
+
+
+def _top_level(text: str):
+    """Yield ``(index, char)`` of characters at nesting depth 0: outside braces,
+    brackets and matrix environments."""
+    depth, env, i = 0, 0, 0
+    n = len(text)
+    while i < n:
+        if text.startswith("\\begin{", i) or text.startswith("\\end{", i):
+            env += 1 if text[i + 1] == "b" else -1
+            close = text.find("}", i)
+            i = n if close < 0 else close + 1
+            continue
+        c = text[i]
+        if c == "\\":
+            if env == 0 and depth == 0 and text.startswith("\\\\", i):
+                yield i, "\\\\"
+                i += 2
+                continue
+            i += 2 if i + 1 < n and not text[i + 1].isalpha() else 1
+            while i < n and text[i].isalpha():
+                i += 1
+            continue
+        if c in "{([":
+            depth += 1
+        elif c in "})]":
+            depth -= 1
+        elif depth == 0 and env == 0:
+            yield i, c
+        i += 1
+
+
+def split_equations(block: str) -> list[tuple[int, str]]:
+    """Split a display-math block into equations: at top-level ``\\\\`` and at top-level
+    commas followed by another ``LHS = ...``. Returns ``(offset, text)`` pairs; alignment
+    ``&`` and environment wrappers (split, aligned, align, gather) are blanked out (so
+    offsets still point into ``block``)."""
+    text = re.sub(r"\\(begin|end)\{(split|aligned|align\*?|gather\*?|equation\*?|alignedat)\}(\{\d+\})?",
+                  lambda m: " " * len(m.group(0)), block)
+    amps = _amps(text)
+    text = "".join(" " if i in amps else c for i, c in enumerate(text))
+    cuts = [i for i, c in _top_level(text) if c == "\\\\"]
+    out, start = [], 0
+    for cut in cuts + [len(text)]:
+        piece = text[start:cut]
+        commas = [i for i, c in _top_level(piece) if c == ","]
+        segments, s0 = [], 0
+        for comma in commas + [len(piece)]:
+            segments.append((start + s0, piece[s0:comma]))
+            s0 = comma + 1
+        cur_off, cur = segments[0]
+        for off, seg in segments[1:]:
+            if _has_top_equals(seg):
+                out.append((cur_off, cur))
+                cur_off, cur = off, seg
+            else:
+                cur += "," + seg
+        out.append((cur_off, cur))
+        start = cut + 2
+    result = []
+    for off, t in out:
+        stripped = t.strip().rstrip(".,;").strip()
+        if stripped:
+            result.append((off + (len(t) - len(t.lstrip())), stripped))
+    return result
+
+
+def _amps(text: str) -> set[int]:
+    return {i for i, c in _top_level(text) if c == "&"}
+
+
+def _has_top_equals(text: str) -> bool:
+    return any(c == "=" for _, c in _top_level(text))
+
+
+def sides(equation: str) -> list[str]:
+    """The sides of ``A = B = C`` split at top-level ``=`` (``\\leq`` etc. not split)."""
+    cuts = [i for i, c in _top_level(equation) if c == "="]
+    out, start = [], 0
+    for cut in cuts + [len(equation)]:
+        out.append(equation[start:cut].strip())
+        start = cut + 1
+    return out
+
+
+# ------------------------------------------------------------------ SymPy syntax
+
+#: functions a value in SymPy syntax may call
+SYMPY_FUNCTIONS = {"sin", "cos", "tan", "exp", "log", "sqrt", "Abs", "sec", "csc", "cot"}
+_BIG_POWER = re.compile(r"(\*\*|\^)\s*\(?\s*\d{4,}|\d+\s*(\*\*|\^)\s*\d+\s*(\*\*|\^)")
+_SYNTAX = re.compile(r"[A-Za-z_][A-Za-z_0-9]*|\d+(?:\.\d*)?(?:[eE][-+]?\d+)?|\.\d+(?:[eE][-+]?\d+)?|\*\*|[-+*/^(),\s]")
+
+
+def parse_sympy_syntax(text: str, names: dict, symengine: bool = False):
+    """An expression in SymPy syntax (``l1*theta1_dot**2 + g*sin(theta1)``) as SymPy.
+
+    Parsed by SymEngine's C++ parser (no Python ``eval``) after checks that keep it
+    bounded: only names, numbers, ``+ - * / ** ^ ( ) ,``; parentheses nested at most
+    :data:`MAX_DEPTH` deep; no exact power with a huge exponent; then every name must be
+    one of ``names`` (name -> SymPy symbol) or a whitelisted function. ``symengine``:
+    return the SymEngine expression (no conversion: large generated derivations)."""
+    import symengine as se
+
+    if len(text) > 50 * MAX_LENGTH:
+        raise LatexError(f"expression too long ({len(text)} characters)")
+    pos, depth = 0, 0
+    for m in _SYNTAX.finditer(text):
+        if m.start() != pos:
+            raise LatexError(f"unexpected character {text[pos]!r}")
+        pos = m.end()
+        tok = m.group(0)
+        if tok == "(":
+            depth += 1
+            if depth > MAX_DEPTH:
+                raise LatexError(f"parentheses nested deeper than {MAX_DEPTH} levels")
+        elif tok == ")":
+            depth -= 1
+            if depth < 0:
+                raise LatexError("unbalanced ')'")
+    if pos != len(text):
+        raise LatexError(f"unexpected character {text[pos]!r}")
+    if depth:
+        raise LatexError("unbalanced '('")
+    if _BIG_POWER.search(text):
+        raise LatexError("an exact power with a huge exponent")
+    try:
+        value = se.sympify(text)
+    except Exception as exc:  # noqa: BLE001 - SymEngine's parse errors have several types
+        raise LatexError(f"cannot parse {text[:60]!r} ({exc})") from None
+    for fn in value.atoms(se.FunctionSymbol) if hasattr(se, "FunctionSymbol") else ():
+        raise LatexError(f"unknown function {fn}")
+    table = {}
+    for sym in value.free_symbols:
+        name = str(sym)
+        if name not in names:
+            raise UnknownSymbol(f"unknown symbol {name}")
+        table[sym] = se.sympify(names[name])
+    value = value.xreplace(table) if table else value
+    return value if symengine else sp.sympify(value)

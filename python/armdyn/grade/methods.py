@@ -1,0 +1,258 @@
+"""The steps of each method as formulas the grader can re-apply to a student's values.
+
+A method is a set of steps ``(key, index)``; each has
+
+* an expected value (canonical form: Craig's signs, gravity as base acceleration, the
+  moment about frame i's origin, vectors in the link's own frame);
+* formulas: how the method computes it from other steps (a list of alternatives, each
+  ``(inputs, function)``); a step with no formula is a leaf (given data);
+* conventions: how a student may legitimately present it (``forward``: canonical ->
+  shown; ``inverse``: shown -> canonical), each named, the first one the usual one.
+
+Functions take the input values and a ``ctx``: the model's quantities (rotations,
+positions, axes, masses...) either symbolic or evaluated at a sample point, so the same
+formula gives the symbolic value for a report and the numbers the grader compares. The
+Newton-Euler formulas are those of :mod:`armdyn.symbolic.newton_euler`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import sympy as sp
+
+from ..model import Robot
+import importlib
+
+# the module, not the function of the same name that armdyn.symbolic exports
+ne = importlib.import_module("armdyn.symbolic.newton_euler")
+from ..symbolic.lagrange import _energies
+from ..symbolic.terms import time_derivative
+
+Ref = tuple  # (key, index)
+
+
+@dataclass
+class Convention:
+    """A way of presenting a step. ``extra``: refs whose values forward/inverse need."""
+
+    name: str  # "" for the usual presentation
+    forward: Callable
+    inverse: Callable
+    extra: tuple = ()
+
+
+def _identity(value, ctx, *extra):
+    return value
+
+
+USUAL = Convention("", _identity, _identity)
+
+
+@dataclass
+class Formula:
+    inputs: tuple
+    fn: Callable  # fn(ctx, *input_values) -> canonical value
+
+
+@dataclass
+class Method:
+    name: str
+    robot: Robot
+    refs: list  # every step, in the method's order
+    formulas: dict = field(default_factory=dict)  # ref -> [Formula]
+    conventions: dict = field(default_factory=dict)  # ref -> [Convention]
+    leaves: dict = field(default_factory=dict)  # ref -> fn(ctx) for given data (no formula)
+    labels: dict = field(default_factory=dict)  # ref -> (LaTeX label, frame text, note)
+
+    def expected(self, ctx, cache: dict | None = None) -> dict:
+        """Every step's canonical value in ``ctx`` (symbolic or at a point)."""
+        out = {} if cache is None else cache
+        for ref in self.refs:
+            if ref in self.leaves:
+                out[ref] = self.leaves[ref](ctx)
+            else:
+                formula = self.formulas[ref][0]
+                out[ref] = formula.fn(ctx, *(out[r] for r in formula.inputs))
+        return out
+
+    def conventions_of(self, ref) -> list[Convention]:
+        return self.conventions.get(ref, [USUAL])
+
+
+# ------------------------------------------------------------------ Newton-Euler
+
+def _link_context(robot: Robot):
+    """Symbolic model quantities per link index (1..n), base = 0."""
+    ctx = {"gravity": robot.gravity, "R0": {0: sp.eye(3)}, "zero": sp.zeros(3, 1)}
+    for joint in robot.joints:
+        i = robot.link_index(joint.child)
+        p = robot.link_index(joint.parent)
+        k = robot.coordinate_index(joint)
+        q = robot.joint_coordinate(joint)
+        qd, qdd = (robot.qd[k], robot.qdd[k]) if k is not None else (sp.Integer(0), sp.Integer(0))
+        R, P = joint.transform(q)
+        V, Vd = joint.origin_motion(qd, qdd)
+        link = robot.links[joint.child]
+        ctx[i] = {
+            "parent": p, "kind": joint.type, "R": R, "P": P, "V": V, "Vd": Vd, "z": joint.child_axis,
+            "qd": qd, "qdd": qdd, "m": link.mass, "c": link.com, "I": link.inertia,
+            "o": joint.joint_point(q), "children": [robot.link_index(c.child) for c in robot.children(joint.child)],
+        }
+        ctx["R0"][i] = ctx["R0"][p] * R
+    return ctx
+
+
+def evaluate_context(ctx, point: dict):
+    """``ctx`` with every symbol replaced by the numbers in ``point`` (symbol -> float)."""
+    point = {k: sp.Float(v) for k, v in point.items()}
+
+    def ev(x):
+        if isinstance(x, sp.MatrixBase):
+            return x.xreplace(point).evalf()
+        if isinstance(x, sp.Basic):
+            return x.xreplace(point).evalf()
+        return x
+
+    out = {}
+    for key, value in ctx.items():
+        if isinstance(value, dict):
+            out[key] = {k: ev(v) if not isinstance(v, (list, str, int)) else v for k, v in value.items()}
+        else:
+            out[key] = ev(value)
+    return out
+
+
+def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
+    """The Newton-Euler steps of ``robot`` and its symbolic context."""
+    ctx = _link_context(robot)
+    n = len(robot.links) - 1
+    zero = sp.zeros(3, 1)
+    m = Method("newton-euler", robot, [])
+    m.leaves[("omega", 0)] = lambda c: c["zero"]
+    m.leaves[("omega_dot", 0)] = lambda c: c["zero"]
+    m.leaves[("v_dot", 0)] = lambda c: -c["gravity"]
+    m.refs += [("omega", 0), ("omega_dot", 0), ("v_dot", 0)]
+
+    def gravity_part(c, i):  # the base acceleration -gravity in frame i
+        return c["R0"][i].T * (-c["gravity"])
+
+    for i in range(1, n + 1):
+        p = ctx[i]["parent"]
+        m.formulas[("omega", i)] = [Formula((("omega", p),), lambda c, w, i=i: ne.omega(
+            c[i]["R"], w, c[i]["z"], c[i]["qd"], c[i]["kind"]))]
+        m.formulas[("omega_dot", i)] = [Formula((("omega", p), ("omega_dot", p)), lambda c, w, wd, i=i: ne.omega_dot(
+            c[i]["R"], w, wd, c[i]["z"], c[i]["qd"], c[i]["qdd"], c[i]["kind"]))]
+        m.formulas[("v_dot", i)] = [Formula((("omega", p), ("omega_dot", p), ("v_dot", p)),
+                                            lambda c, w, wd, vd, i=i: ne.v_dot(
+            c[i]["R"], w, wd, vd, c[i]["P"], c[i]["V"], c[i]["Vd"]))]
+        m.formulas[("vc_dot", i)] = [Formula((("omega", i), ("omega_dot", i), ("v_dot", i)),
+                                             lambda c, w, wd, vd, i=i: ne.vc_dot(w, wd, vd, c[i]["c"]))]
+        m.formulas[("F", i)] = [Formula((("vc_dot", i),), lambda c, a, i=i: ne.inertial_force(c[i]["m"], a))]
+        m.formulas[("N", i)] = [Formula((("omega", i), ("omega_dot", i)),
+                                        lambda c, w, wd, i=i: ne.inertial_moment(c[i]["I"], w, wd))]
+        m.refs += [("omega", i), ("omega_dot", i), ("v_dot", i), ("vc_dot", i), ("F", i), ("N", i)]
+
+        gravity_free = Convention(
+            "gravity as a force (no base acceleration in the accelerations)",
+            lambda v, c, i=i: v - gravity_part(c, i), lambda v, c, i=i: v + gravity_part(c, i))
+        m.conventions[("v_dot", i)] = [USUAL, gravity_free]
+        m.conventions[("vc_dot", i)] = [USUAL, gravity_free]
+        dalembert = Convention("d'Alembert inertial force F = -m v̇_C", lambda v, c: -v, lambda v, c: -v)
+        m.conventions[("F", i)] = [
+            USUAL, dalembert,
+            Convention("gravity as a force (F = m v̇_C without the base acceleration)",
+                       lambda v, c, i=i: v - c[i]["m"] * gravity_part(c, i),
+                       lambda v, c, i=i: v + c[i]["m"] * gravity_part(c, i)),
+            Convention("d'Alembert inertial force, gravity as a force",
+                       lambda v, c, i=i: -(v - c[i]["m"] * gravity_part(c, i)),
+                       lambda v, c, i=i: -v + c[i]["m"] * gravity_part(c, i)),
+        ]
+        m.conventions[("N", i)] = [USUAL, Convention("d'Alembert inertial moment N = -(I ω̇ + ω × I ω)",
+                                                     lambda v, c: -v, lambda v, c: -v)]
+
+    # inward: children first
+    for i in range(n, 0, -1):
+        kids = ctx[i]["children"]
+        f_inputs = (("F", i),) + tuple(("f", k) for k in kids)
+        n_inputs = (("N", i), ("F", i)) + tuple(r for k in kids for r in (("n", k), ("f", k)))
+
+        def f_fn(c, F, *fs, i=i):
+            return ne.joint_force(F, [(c[k]["R"], fk) for k, fk in zip(c[i]["children"], fs)])
+
+        def n_fn(c, N, F, *nfs, i=i):
+            kids = c[i]["children"]
+            pairs = [(c[k]["R"], c[k]["P"], nfs[2 * j], nfs[2 * j + 1]) for j, k in enumerate(kids)]
+            return ne.joint_moment(N, c[i]["c"], F, pairs)
+
+        m.formulas[("f", i)] = [Formula(f_inputs, f_fn)]
+        m.formulas[("n", i)] = [Formula(n_inputs, n_fn)]
+        m.refs += [("f", i), ("n", i)]
+        m.conventions[("f", i)] = [
+            USUAL,
+            Convention(f"the reaction: force exerted by link {i} on link {i - 1}", lambda v, c: -v, lambda v, c: -v),
+        ]
+        about_axis = Convention(
+            f"moment about joint {i}'s axis", lambda v, c, f, i=i: ne.moment_about(v, f, c[i]["o"]),
+            lambda v, c, f, i=i: v + c[i]["o"].cross(f), (("f", i),))
+        about_origin = Convention(f"moment about frame {i}'s origin (off joint {i}'s axis)", _identity, _identity)
+        on_axis = ctx[i]["o"] == zero
+        if ctx[i]["kind"] == "revolute" and not on_axis:
+            m.conventions[("n", i)] = [Convention("", about_axis.forward, about_axis.inverse, about_axis.extra),
+                                       about_origin]
+        elif ctx[i]["kind"] == "prismatic":
+            m.conventions[("n", i)] = [USUAL, Convention(
+                f"moment about joint {i}'s placement origin (where the slide starts), not frame {i}'s origin",
+                about_axis.forward, about_axis.inverse, about_axis.extra)]
+        k = robot.coordinate_index(robot.parent_joint(robot_link(robot, i)))
+        if k is not None:
+            def tau_fn(c, nv, fv, i=i):
+                point = c[i]["o"] if c[i]["kind"] == "revolute" else c["zero"]
+                return ne.joint_torque(c[i]["kind"], c[i]["z"], ne.moment_about(nv, fv, point), fv)
+
+            m.formulas[("tau", k + 1)] = [Formula((("n", i), ("f", i)), tau_fn)]
+            m.refs.append(("tau", k + 1))
+    return m, ctx
+
+
+def robot_link(robot: Robot, index: int) -> str:
+    return list(robot.links)[index]
+
+
+def rotation_between(ctx, frm: int, to: int):
+    """The matrix mapping frame-``frm`` coordinates to frame-``to`` coordinates."""
+    return ctx["R0"][to].T * ctx["R0"][frm]
+
+
+# ------------------------------------------------------------------ Lagrange
+
+def lagrange_method(robot: Robot) -> tuple[Method, dict]:
+    """The Lagrange steps of ``robot``: T, V, L, the partial derivatives, tau."""
+    T_trans, T_rot, V_links, _ = _energies(robot)
+    T = sum(T_trans.values(), sp.Integer(0)) + sum(T_rot.values(), sp.Integer(0))
+    V = sum(V_links.values(), sp.Integer(0))
+    q, qd, qdd = robot.q, robot.qd, robot.qdd
+    ctx = {"T": T, "V": V, "q": q, "qd": qd, "qdd": qdd}
+    m = Method("lagrange", robot, [("T", None), ("V", None), ("L", None)])
+    m.leaves[("T", None)] = lambda c: c["T"]
+    m.leaves[("V", None)] = lambda c: c["V"]
+    m.formulas[("L", None)] = [Formula((("T", None), ("V", None)), lambda c, t, v: t - v)]
+    for k in range(1, robot.dof + 1):
+        j = k - 1
+        m.formulas[("dL_dqd", k)] = [Formula((("L", None),), lambda c, L, j=j: _diff(L, c, "qd", j))]
+        m.formulas[("dL_dq", k)] = [Formula((("L", None),), lambda c, L, j=j: _diff(L, c, "q", j))]
+        m.formulas[("ddt_dL_dqd", k)] = [Formula((("dL_dqd", k),), lambda c, p: _ddt(p, c))]
+        m.formulas[("tau", k)] = [Formula((("ddt_dL_dqd", k), ("dL_dq", k)), lambda c, a, b: a - b)]
+        m.refs += [("dL_dqd", k), ("dL_dq", k), ("ddt_dL_dqd", k), ("tau", k)]
+    return m, ctx
+
+
+# Lagrange formulas differentiate, so they run symbolically; at a sample point the
+# grader evaluates the symbolic result (see engine.Sampler).
+def _diff(expr, c, which, j):
+    return sp.diff(expr, c[which][j])
+
+
+def _ddt(expr, c):
+    return time_derivative(expr, c["q"], c["qd"], c["qdd"])

@@ -1,0 +1,323 @@
+"""The student's notation: which step an equation's left-hand side names, and which
+model symbol each of their symbols is.
+
+Left-hand sides understood (``i`` a link index, ``k`` a joint index, ``j`` a frame; a
+frame given neither as a superscript nor as Craig's pre-superscript is the link's own)::
+
+    Newton-Euler  \\omega_i^j  {}^{j}\\omega_{i}  \\dot{\\omega}_i^j  \\dot{v}_i^j  \\dot{v}_{C_i}^j
+                  (also \\dot{v}_{c_i}, \\dot{v}_{ci}, a_{C_i}), F_i^j, N_i^j, f_i^j, n_i^j,
+                  m_i^j (read as n_i: the exercise's name for it), \\tau_k,
+                  R_a^b / {}^{b}_{a}R (maps frame-a coordinates to frame b)
+    Lagrange      T, V, L, \\frac{\\partial L}{\\partial \\dot q_k}, \\partial L / \\partial \\dot q_k,
+                  \\frac{d}{dt}\\frac{\\partial L}{\\partial \\dot q_k}, \\frac{\\partial L}{\\partial q_k}, \\tau_k
+
+Bold, hat and roman wrappers (\\mathbf, \\boldsymbol, \\bm, \\mathrm, \\vec) are looked
+through. Symbols map to the model's by name (``\\theta_1`` -> ``theta1``,
+``\\dot{d}_2`` -> ``d2_dot``, ``l_{c1}`` -> ``lc1``), by joint index for ``\\theta_k``,
+``q_k`` and ``d_k`` when the model names its coordinates otherwise, as ``sin``/``cos``
+for ``s_1``, ``c_{12}`` (``s_{12} = sin(q1 + q2)``), or through an explicit mapping.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..model import Robot
+from .latex import GREEK, LatexError, Name, UnknownSymbol, parse
+
+VECTOR_KEYS = ("omega", "omega_dot", "v_dot", "vc_dot", "F", "N", "f", "n")
+LAGRANGE_KEYS = ("T", "V", "L", "dL_dqd", "ddt_dL_dqd", "dL_dq")
+
+
+@dataclass(frozen=True)
+class StepRef:
+    """What a left-hand side names.
+
+    key:    "omega", "omega_dot", "v_dot", "vc_dot", "F", "N", "f", "n", "tau", "R",
+            "T", "V", "L", "dL_dqd", "ddt_dL_dqd", "dL_dq"
+    index:  link index for Newton-Euler vectors (0 = base), joint index (1-based) for
+            tau and the Lagrange partials, None for T, V, L; for R the source frame
+    frame:  frame the vector is written in (None: the link's own); for R the target frame
+    alias:  the student's own name when it is not the usual one (``m`` for ``n``)
+    """
+
+    key: str
+    index: int | None = None
+    frame: int | None = None
+    alias: str = ""
+
+    @property
+    def name(self) -> str:
+        if self.key == "R":
+            return f"R_{self.index}^{self.frame}"
+        if self.index is None:
+            return self.key
+        return f"{self.key}_{self.index}"
+
+
+_WRAP = re.compile(r"\\(?:mathbf|boldsymbol|bm|mathrm|mathit|vec|pmb|mathcal|hat)\s*\{([^{}]*)\}")
+_WRAP_BARE = re.compile(r"\\(?:mathbf|boldsymbol|bm|mathrm|mathit|vec|pmb|mathcal|hat)\s*(\\[A-Za-z]+|[A-Za-z0-9])")
+
+
+def normalise(lhs: str) -> str:
+    """Drop spacing, \\left/\\right and typeface wrappers; ``\\dot x`` -> ``\\dot{x}``."""
+    s = re.sub(r"\\(left|right)(?![A-Za-z])", "", lhs)
+    s = re.sub(r"\\[,;:! ]|\\quad|\\qquad|\\displaystyle", "", s)
+    for _ in range(6):
+        t = _WRAP_BARE.sub(r"\1", _WRAP.sub(r"\1", s))
+        if t == s:
+            break
+        s = t
+    s = re.sub(r"\s+", "", s)
+    s = re.sub(r"\\(d?dot)(\\[A-Za-z]+|[A-Za-z])", r"\\\1{\2}", s)
+    return s
+
+
+def _scripts(s: str, i: int):
+    """Read ``_X`` / ``^X`` pairs from ``s[i:]``; returns (sub, sup, end)."""
+    sub = sup = None
+    while i < len(s) and s[i] in "_^":
+        mark = s[i]
+        i += 1
+        if i < len(s) and s[i] == "{":
+            depth, j = 1, i + 1
+            while j < len(s) and depth:
+                depth += {"{": 1, "}": -1}.get(s[j], 0)
+                j += 1
+            text, i = s[i + 1:j - 1], j
+        elif i < len(s) and s[i] == "\\":
+            m = re.match(r"\\[A-Za-z]+", s[i:])
+            text = m.group(0) if m else s[i:i + 2]
+            i += len(text)
+        else:
+            text, i = s[i:i + 1], i + 1
+        if mark == "_":
+            sub = text if sub is None else sub + "," + text
+        else:
+            sup = text if sup is None else sup + "," + text
+    return sub, sup, i
+
+
+def _int(text: str | None) -> int | None:
+    if text is None:
+        return None
+    t = re.sub(r"[{}\s]", "", text).rstrip("T").replace("\\top", "")
+    return int(t) if t.isdigit() else None
+
+
+_BASES = {
+    "\\omega": "omega", "F": "F", "N": "N", "f": "f", "n": "n", "m": "n", "\\tau": "tau",
+    "v": "v", "a": "a", "R": "R",
+}
+
+
+def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
+    """The step an equation's left-hand side names, or None.
+
+    ``coordinate_of(latex) -> (k, order)``: the 1-based joint index and derivative order
+    (0, 1) of a coordinate symbol written in LaTeX, or None."""
+    s = normalise(lhs)
+    if not s:
+        return None
+    lag = _lagrange(s, coordinate_of)
+    if lag is not None:
+        return lag
+    if s in ("T", "V", "L", "\\mathcal{L}", "\\mathcal{T}"):
+        return StepRef(s[-1] if len(s) == 1 else s[-2])
+
+    # pre-scripts: {}^{j}_{a} or ^{j}
+    pre_sub = pre_sup = None
+    i = 0
+    if s.startswith("{}"):
+        i = 2
+    if i < len(s) and s[i] in "_^":
+        pre_sub, pre_sup, i = _scripts(s, i)
+    dots = 0
+    m = re.match(r"\\(d?dot)\{", s[i:])
+    if m:
+        dots = 2 if m.group(1) == "ddot" else 1
+        depth, j = 1, i + len(m.group(0))
+        start = j
+        while j < len(s) and depth:
+            depth += {"{": 1, "}": -1}.get(s[j], 0)
+            j += 1
+        inner, rest = s[start:j - 1], s[j:]
+        s, i = inner + rest, 0
+        # scripts may sit inside the accent's braces: \dot{\omega_1}
+    m = re.match(r"\\omega|\\tau|[A-Za-z]", s[i:])
+    if not m:
+        return None
+    base = m.group(0)
+    sub, sup, end = _scripts(s, i + len(base))
+    if end != len(s):
+        return None
+    if pre_sup is not None and sup is None:
+        sup = pre_sup
+    if base not in _BASES:
+        return None
+    key = _BASES[base]
+    alias = "m" if base == "m" else ""
+    if key == "R":
+        if pre_sup is not None or pre_sub is not None:
+            frm, to = _int(pre_sub if pre_sub is not None else sub), _int(pre_sup)
+        else:
+            frm, to = _int(sub), _int(sup)
+        return StepRef("R", frm, to) if frm is not None and to is not None and dots == 0 else None
+    if key == "tau":
+        k = _int(sub)
+        return StepRef("tau", k) if k is not None and dots == 0 else None
+    frame = _int(sup)
+    if key in ("v", "a"):
+        want = 1 if key == "v" else 0
+        if dots != want or sub is None:
+            return None
+        body = re.sub(r"[{}\s,_]|\\mathrm", "", sub)
+        mc = re.fullmatch(r"[Cc](\d+)", body)
+        if mc:
+            return StepRef("vc_dot", int(mc.group(1)), frame)
+        return StepRef("v_dot", _int(sub), frame) if _int(sub) is not None else None
+    if key == "omega":
+        key = {0: "omega", 1: "omega_dot"}.get(dots)
+    elif dots:
+        return None
+    index = _int(sub)
+    if key is None or index is None:
+        return None
+    return StepRef(key, index, frame, alias)
+
+
+_PARTIAL = r"\\partial(?:L|\\mathcal\{L\}|\\mathcal\{?L\}?)"
+
+
+def _lagrange(s: str, coordinate_of) -> StepRef | None:
+    ddt = False
+    for prefix in (r"\frac{d}{dt}", r"\frac{\mathrm{d}}{\mathrm{d}t}", r"\dfrac{d}{dt}", "d/dt"):
+        if s.startswith(prefix):
+            s, ddt = s[len(prefix):], True
+            break
+    if ddt and s.startswith("(") and s.endswith(")"):
+        s = s[1:-1]
+    m = re.fullmatch(r"\\d?frac\{" + _PARTIAL + r"\}\{\\partial(.+)\}", s) or re.fullmatch(
+        _PARTIAL + r"/\\partial(.+)", s
+    )
+    if not m:
+        return None
+    found = coordinate_of(m.group(1))
+    if found is None:
+        return None
+    k, order = found
+    if order == 1:
+        return StepRef("ddt_dL_dqd" if ddt else "dL_dqd", k)
+    if order == 0 and not ddt:
+        return StepRef("dL_dq", k)
+    return None
+
+
+# ------------------------------------------------------------------ symbols
+
+class SymbolMap:
+    """Maps the student's symbols (:class:`~armdyn.grade.latex.Name`) to the model's.
+
+    robot:     the model the student's frames follow
+    explicit:  the student's symbol (LaTeX such as ``l_{c1}`` or a plain name such as
+               ``lc_1``) -> model name (``lc1``), from the submission's front matter
+    steps:     step name -> value, for right-hand sides that use earlier steps (``L = T - V``)
+    """
+
+    def __init__(self, robot: Robot, explicit: dict | None = None):
+        self.robot = robot
+        self.names: dict[str, sp.Symbol] = {}
+        for k, name in enumerate(robot.coordinate_names):
+            self.names[name] = robot.q[k]
+            self.names[f"{name}_dot"] = robot.qd[k]
+            self.names[f"{name}_ddot"] = robot.qdd[k]
+        self.names.update(robot.parameters)
+        self.explicit: dict[str, sp.Expr] = {}
+        self.notes: list[str] = []
+        self.steps: dict[str, object] = {}
+        self.used_gravity_magnitude = False
+        for student, model in (explicit or {}).items():
+            key = self._key_of(str(student))
+            target = self.names.get(str(model))
+            if target is None:
+                raise LatexError(f"symbols: '{student}' maps to '{model}', which the model does not have "
+                                 f"(it has {', '.join(sorted(self.names))})")
+            self.explicit[key] = target
+
+    @staticmethod
+    def _key_of(text: str) -> str:
+        """A student's symbol written in LaTeX or plainly -> the plain key ``base|dots|sub``."""
+        if "\\" in text or "_" in text or "{" in text:
+            try:
+                names = []
+                parse(text, lambda n: names.append(n) or sp.Integer(1))
+                if len(names) == 1:
+                    n = names[0]
+                    return f"{n.base}|{n.dots}|{_plain(n.sub)}"
+            except LatexError:
+                pass
+        return f"{text}|0|"
+
+    def __call__(self, name: Name):
+        sub = _plain(name.sub)
+        key = f"{name.base}|{name.dots}|{sub}"
+        if key in self.explicit:
+            return self.explicit[key]
+        if name.dots:
+            undotted = f"{name.base}|0|{sub}"
+            if undotted in self.explicit:
+                return self._derivative(self.explicit[undotted], name.dots, name)
+        plain = name.base + sub
+        if name.dots == 0 and plain in self.steps:
+            return self.steps[plain]
+        candidate = plain + {0: "", 1: "_dot", 2: "_ddot"}.get(name.dots, "?")
+        if candidate in self.names:
+            return self.names[candidate]
+        if name.base in ("theta", "q", "d", "vartheta") and sub.isdigit():
+            k = int(sub)
+            if 1 <= k <= self.robot.dof:
+                return [self.robot.q, self.robot.qd, self.robot.qdd][min(name.dots, 2)][k - 1]
+        if name.base in ("s", "c", "S", "C") and name.dots == 0 and sub.isdigit() and plain not in self.names:
+            idx = [int(ch) for ch in sub]
+            if all(1 <= k <= self.robot.dof for k in idx):
+                angle = sum((self.robot.q[k - 1] for k in idx), sp.Integer(0))
+                return (sp.sin if name.base in "sS" else sp.cos)(angle)
+        if name.base == "g" and not sub and name.dots == 0:
+            magnitude = sp.sqrt(sum(c**2 for c in self.robot.gravity))
+            if not magnitude.free_symbols:
+                self.used_gravity_magnitude = True
+                return sp.nsimplify(magnitude) if magnitude.is_Float else magnitude
+        if name.base == "pi" and not sub:
+            return sp.pi
+        raise UnknownSymbol(f"unknown symbol {name.latex()} (the model '{self.robot.name}' has "
+                            f"{', '.join(sorted(self.names))}; map it in the front matter's 'symbols')")
+
+    def _derivative(self, target, dots, name):
+        for k, q in enumerate(self.robot.q):
+            if target == q:
+                return [self.robot.q, self.robot.qd, self.robot.qdd][dots][k]
+        raise UnknownSymbol(f"unknown symbol {name.latex()}: '{target}' is not a joint coordinate")
+
+    def coordinate_of(self, latex: str):
+        """``(k, order)`` of a coordinate symbol written in LaTeX, or None."""
+        try:
+            value = parse(latex, self)
+        except LatexError:
+            return None
+        for order, vec in enumerate((self.robot.q, self.robot.qd)):
+            for k, sym in enumerate(vec):
+                if value == sym:
+                    return k + 1, order
+        return None
+
+
+def _plain(sub: str) -> str:
+    """A subscript as plain text: ``{c1}``, ``c_1``, ``c,1``, ``\\mathrm{c}1`` -> ``c1``."""
+    return re.sub(r"[{}\s,_]|\\mathrm|\\text", "", sub or "")
+
+
+def is_greek(name: str) -> bool:
+    return name in GREEK
