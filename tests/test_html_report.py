@@ -124,10 +124,14 @@ def test_grade_page_cards_badges_and_highlights():
     report = exercise_like_report()
     page = report_html(report)
     p = _parse(page)
-    cards = [(c, i) for t, c, i in p.classes if t == "li" and "step" in c.split()]
-    assert [i for _, i in cards] == [f"step-{k}" for k in range(len(report.steps))]
-    for (cls, _), step in zip(cards, report.steps):
-        assert f"st-{step.status}" in cls.split()
+    # every step has an anchor, in the student's order; each recognised one its card
+    ids = [i for _, _, i in p.classes if i.startswith("step-")]
+    assert ids == [f"step-{k}" for k in range(len(report.steps))]
+    cards = {i: c for t, c, i in p.classes if t == "li" and "step" in c.split()}
+    for k, step in enumerate(report.steps):
+        if step.status != "unrecognised":
+            assert f"st-{step.status}" in cards[f"step-{k}"].split()
+    assert sum("st-unrecognised" in c.split() for t, c, _ in p.classes if t == "li") == 1
     # one count chip per status present, with the right number
     for status in STATUSES:
         n = sum(s.status == status for s in report.steps)
@@ -349,3 +353,29 @@ def test_write_report_html_writes_whole_page_or_nothing(tmp_path, monkeypatch):
     with pytest.raises(ValueError):
         grade_html.write_report_html(exercise_like_report(), other)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.html"]
+
+
+def test_grouped_unrecognised_and_inherited_rows():
+    """Consecutive unrecognised equations share one card, each with its line and source;
+    an inherited error with no components named is highlighted where it differs from
+    the expected value; a difference taken against the student's own earlier values
+    (not the expected one) is captioned so."""
+    x, y = sp.symbols("theta1_dot l1")
+    un = [StepVerdict(name=f"u{k}", key="", link="", status="unrecognised", label=r"I_P", line=10 + k,
+                      source=f"I_P = {k} <x>", message="not a step") for k in range(3)]
+    carried = StepVerdict(name="F_1", key="F", link="link1", status="follows-from-earlier-error", label="F_1^1",
+                          source="", line=20, expected=V([x, y, 0]), got=V([x, 0, 0]), difference=V([0, -y, 0]),
+                          caused_by="u0")
+    own = StepVerdict(name="F_2", key="F", link="link2", status="wrong", label="F_2^2", source="", line=21,
+                      expected=V([x, y, 0]), got=V([2 * x, 0, 0]), difference=V([x, 0, 0]), components=[0],
+                      message="x wrong (compared with what your own earlier steps give)")
+    report = GradeReport("r", "newton-euler+lagrange", "s.md", un + [carried, own], "F_2", [])
+    page = report_html(report)
+    assert "3 equations not recognised as steps" in page and "lines 10\u201312" in page
+    assert page.count('<div class="skip"') == 3 and "I_P = 2 &lt;x&gt;" in page
+    assert "Newton\u2013Euler and Lagrange" in page
+    card = page[page.index('id="step-3"'):page.index('id="step-4"')]
+    assert card.count('<mtd class="hl">') == 3  # row 1 (y) on yours, expected and the difference
+    assert "difference: yours \u2212 expected" in card
+    card = page[page.index('id="step-4"'):]
+    assert "difference: yours \u2212 what your own earlier steps give" in card

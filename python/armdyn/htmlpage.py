@@ -81,6 +81,12 @@ CSS = """
 .armdyn .step.first { box-shadow:0 0 0 2px var(--bad-bg); }
 .armdyn .head { display:flex; flex-wrap:wrap; align-items:baseline; gap:4px 12px; }
 .armdyn .head .label { font-size:1.08em; min-width:3em; }
+.armdyn .head .title { color:var(--muted); }
+.armdyn .skip { display:grid; grid-template-columns:3.2em 1fr; gap:0 8px; margin-top:6px; }
+.armdyn .skip .ln { color:var(--muted); font-size:0.84em; text-align:right; padding-top:9px;
+  font-variant-numeric:tabular-nums; }
+.armdyn .skip pre { margin:0; }
+.armdyn .skip .why { color:var(--muted); font-size:0.88em; margin:2px 0 0 2px; }
 .armdyn .head .where { color:var(--muted); font-size:0.86em; margin-left:auto; }
 .armdyn .message { margin:6px 0 0; }
 .armdyn .message .why { color:var(--muted); }

@@ -146,6 +146,37 @@ def _components_text(components: list[int], vector: bool) -> str:
     return ", ".join(names) + (" component" if len(names) == 1 else " components")
 
 
+def _wrong_rows(step: StepVerdict) -> list[int]:
+    """Rows to highlight: the wrong components; for an inherited error (whose
+    components, compared with the student's own earlier values, are all right) the
+    rows where the value differs from the expected one."""
+    if step.status not in ("wrong", "follows-from-earlier-error"):
+        return []
+    if step.components or not isinstance(step.difference, sp.MatrixBase):
+        return list(step.components)
+    return [i for i, d in enumerate(step.difference) if sp.sympify(d) != 0]
+
+
+def _against_expected(step: StepVerdict) -> bool:
+    """True when ``difference`` is got - expected (as the verdict documents); False when
+    the grader compared with what the student's own earlier steps give instead (a wrong
+    step after an earlier slip): the caption then says so."""
+    from ..symbolic import dag
+    from ..symbolic.agreement import trig_reduce
+
+    if step.got is None or step.expected is None or step.difference is None:
+        return True
+    try:
+        gap = sp.Matrix(step.got) - sp.Matrix(step.expected) - sp.Matrix(step.difference) \
+            if isinstance(step.got, sp.MatrixBase) else sp.Matrix([step.got - step.expected - step.difference])
+        if any(dag.larger_than(e, _TIDY_NODE_LIMIT) for e in gap):
+            return "own earlier steps" not in step.message
+        q = sorted({x for e in gap for x in e.free_symbols}, key=lambda x: x.name)
+        return all(trig_reduce(e, q) == 0 for e in gap)
+    except Exception:  # noqa: BLE001 - display only
+        return "own earlier steps" not in step.message
+
+
 def _step_card(i: int, step: StepVerdict, w: _Writer, anchors: dict, first: int | None) -> str:
     cls = f"step st-{escape(step.status)}" + (" first" if i == first else "")
     where = [f"line {step.line}"] if step.line else []
@@ -155,31 +186,27 @@ def _step_card(i: int, step: StepVerdict, w: _Writer, anchors: dict, first: int 
             f'{_badge(step.status)}<span class="where">{" · ".join(where)}</span></div>')
     parts = [head]
 
-    if step.status == "unrecognised":
-        why = escape(step.message) if step.message else "not recognised as a step of the method; skipped"
-        parts.append(f'<p class="message"><span class="why">{why}</span></p>')
-        parts.append(f"<pre>{escape(step.source)}</pre>")
-        return f'<li class="{cls}" id="step-{i}">{"".join(parts)}</li>'
-
-    said = []
-    if step.message:
-        said.append(escape(step.message))
-    if step.convention:
+    message = escape(step.message)
+    said = [message] if message else []
+    if step.convention and step.convention not in step.message:
         said.append(f'<span class="why">convention:</span> {escape(step.convention)}')
     if step.caused_by:
         target = anchors.get(step.caused_by)
         name = escape(step.caused_by)
         link = f'<a href="#step-{target}">{name}</a>' if target is not None else name
-        said.append(f'<span class="why">carried from</span> {link}')
+        if message and name in message:  # the message names it: make that the link
+            said[0] = message.replace(name, link, 1)
+        else:
+            said.append(f'<span class="why">carried from</span> {link}')
+    hl = _wrong_rows(step)
     vector = isinstance(step.expected, sp.MatrixBase) or isinstance(step.got, sp.MatrixBase)
-    which = _components_text(step.components, vector)
-    if which and step.status in ("wrong", "follows-from-earlier-error"):
+    which = _components_text(hl, vector)
+    if which:
         said.append(f'<span class="why">wrong:</span> {escape(which)}')
     if said:
         parts.append('<p class="message">' + " · ".join(said) + "</p>")
 
     label = _label(step)
-    hl = step.components if step.status in ("wrong", "follows-from-earlier-error") else ()
     sides = []
     if step.got is not None:
         caption = "yours = expected" if step.status == "correct" else "yours"
@@ -187,13 +214,36 @@ def _step_card(i: int, step: StepVerdict, w: _Writer, anchors: dict, first: int 
     if step.expected is not None and (step.status != "correct" or step.got is None):
         sides.append(_side("expected", label, w.value(step.expected, hl)))
     if step.difference is not None and step.status in ("wrong", "follows-from-earlier-error"):
-        sides.append(_side("difference: yours \u2212 expected", "<mi>\u0394</mi>",
-                           w.difference(step.difference, step.components), "diff"))
+        than = "expected" if _against_expected(step) else "what your own earlier steps give"
+        sides.append(_side(f"difference: yours \u2212 {than}", "<mi>\u0394</mi>",
+                           w.difference(step.difference, hl), "diff"))
     if sides:
         parts.append('<div class="compare">' + "".join(sides) + "</div>")
     if step.source:
         parts.append(f"<details><summary>as written</summary><pre>{escape(step.source)}</pre></details>")
     return f'<li class="{cls}" id="step-{i}">{"".join(parts)}</li>'
+
+
+def _unrecognised_card(run: list[tuple[int, StepVerdict]]) -> str:
+    """Consecutive unrecognised equations in one greyed card: each one's line, left-hand
+    side and source text (escaped), and why it was skipped."""
+    lines = [s.line for _, s in run if s.line]
+    span = ""
+    if lines:
+        span = f"line {lines[0]}" if len(lines) == 1 or lines[0] == lines[-1] else f"lines {lines[0]}\u2013{lines[-1]}"
+    n = len(run)
+    title = "1 equation not recognised as a step" if n == 1 else f"{n} equations not recognised as steps"
+    head = (f'<div class="head">{_badge("unrecognised")}<span class="title">{title}: skipped</span>'
+            f'<span class="where">{span}</span></div>')
+    reasons = {s.message for _, s in run if s.message}
+    common = reasons.pop() if len(reasons) == 1 and all(s.message for _, s in run) else None
+    rows = []
+    for i, s in run:
+        why = "" if common or not s.message else f'<div class="why">{escape(s.message)}</div>'
+        rows.append(f'<div class="skip" id="step-{i}"><span class="ln">{s.line or ""}</span>'
+                    f'<div><pre>{escape(s.source or s.label)}</pre>{why}</div></div>')
+    note = f'<p class="message"><span class="why">{escape(common)}</span></p>' if common else ""
+    return f'<li class="step st-unrecognised">{head}{note}{"".join(rows)}</li>'
 
 
 def _tau_step(report: GradeReport, i: int) -> StepVerdict | None:
@@ -252,14 +302,26 @@ def _body(report: GradeReport) -> str:
         anchors.setdefault(s.name, i)
     labels = {i: _label(s) for i, s in enumerate(report.steps)}
     first = anchors.get(report.first_wrong) if report.first_wrong is not None else None
-    method = {"newton-euler": "Newton\u2013Euler", "lagrange": "Lagrange"}.get(report.method, report.method)
+    names = {"newton-euler": "Newton\u2013Euler", "lagrange": "Lagrange"}
+    method = " and ".join(names.get(m, m) for m in report.method.split("+"))
     head = ('<h1>Grade report</h1>'
             f'<p class="meta"><b>{escape(report.submission)}</b> · robot <b>{escape(report.robot)}</b> · '
             f'method <b>{escape(method)}</b> · {len(report.steps)} equations</p>')
-    cards = "".join(_step_card(i, s, w, anchors, first) for i, s in enumerate(report.steps))
+    cards, run = [], []
+    for i, s in enumerate(report.steps):
+        if s.status == "unrecognised":
+            run.append((i, s))
+            continue
+        if run:
+            cards.append(_unrecognised_card(run))
+            run = []
+        cards.append(_step_card(i, s, w, anchors, first))
+    if run:
+        cards.append(_unrecognised_card(run))
+    cards = "".join(cards)
     return (head + _summary(report, anchors, labels)
             + "<h2>Steps, in your order</h2>"
-            + '<p class="legend">Highlighted rows are the wrong components; the difference is yours \u2212 expected.</p>'
+            + '<p class="legend">Highlighted rows are the wrong components; \u0394 is yours minus the value named above it.</p>'
             + f'<ol class="steps">{cards}</ol>')
 
 
