@@ -198,3 +198,11 @@ def test_long_sums_break_into_lines_with_leading_signs():
         assert cell[0].tag == "mspace"
         first = cell[1][0]
         assert first.tag == "mo" and first.text in ("+", "\u2212") and first.get("form") == "prefix"
+
+
+def test_negative_numbers_use_a_minus_sign():
+    root = parse(to_mathml(sp.Matrix([[1, 0], [0, -1]])))
+    assert all("-" not in (e.text or "") for e in root.iter("mn"))
+    assert "\u2212" in [e.text for e in root.iter("mo")]
+    root = parse(to_mathml(sp.Float(-2.5) * sym("g")))
+    assert all("-" not in (e.text or "") for e in root.iter("mn"))

@@ -234,6 +234,21 @@ class _Printer(MathMLPresentationPrinter):
                 return self._el("msubsup", kids[0], kids[1], self._print(exp))
         return super()._print_Pow(e)
 
+    def _print_Number(self, e):
+        if e.is_negative:  # −1 with a minus sign, not <mn>-1</mn> (a hyphen)
+            return self._el("mrow", self._mo("\u2212"), self._print(-e))
+        return super()._print_Number(e)
+
+    def _print_int(self, p):
+        if p < 0:
+            return self._el("mrow", self._mo("\u2212"), self._print(-p))
+        return super()._print_int(p)
+
+    def _print_Float(self, e):
+        if e.is_negative:
+            return self._el("mrow", self._mo("\u2212"), self._print(-e))
+        return super()._print_Float(e)
+
     def _print_MatrixBase(self, m, highlight=()):
         table = self._el("mtable")
         for i in range(m.rows):
