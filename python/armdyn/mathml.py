@@ -370,7 +370,7 @@ class MathWriter:
             cells = "".join((f'<mo form="{"prefix" if i == 0 else "infix"}">{sg}</mo>' if sg else "") + b
                             for i, (sg, b) in enumerate(line))
             indent = '<mspace width="1.5em"/>' if k else ""
-            rows.append(f'<mtr><mtd style="text-align:left">{indent}<mrow>{cells}</mrow></mtd></mtr>')
+            rows.append(f'<mtr><mtd style="text-align:left; math-style:normal">{indent}<mrow>{cells}</mrow></mtd></mtr>')
         return "<mtable>" + "".join(rows) + "</mtable>"
 
     def value(self, value, highlight=(), scalar=None) -> str:
