@@ -379,3 +379,24 @@ def test_grouped_unrecognised_and_inherited_rows():
     assert "difference: yours \u2212 expected" in card
     card = page[page.index('id="step-4"'):]
     assert "difference: yours \u2212 what your own earlier steps give" in card
+
+
+def test_exercise_grade_report_renders_in_chromium(tmp_path):
+    """The real exercise (examples/grading/rp-arm-exercise.md) through the grader:
+    the page renders, its first wrong step is v̇_1 with the x row highlighted."""
+    chromium = require_chromium()
+    from armdyn.grade import grade
+
+    report = grade(ROOT / "examples" / "grading" / "rp-arm-exercise.md")
+    page = tmp_path / "grade-exercise.html"
+    page.write_text(report_html(report), encoding="utf-8")
+    shot = render(page, chromium, screenshot=SHOTS / "grade-exercise.png")
+    assert_math_rendered(shot, min_count=40)
+    assert_parentheses_stretch(shot, min_count=10)
+    k = next(i for i, s in enumerate(report.steps) if s.name == report.first_wrong)
+    text = page.read_text(encoding="utf-8")
+    assert f'<a href="#step-{k}">' in text
+    card = text[text.index(f'id="step-{k}"'):]
+    card = card[:card.index("</li>")]
+    assert card.count('<mtr class="hl">') == 3  # x row of yours, expected and the difference
+    assert card.count('<mtable><mtr class="hl">') == 3  # ... and it is the first row, x
