@@ -68,10 +68,13 @@ def pin_configuration(model, robot, q: np.ndarray):
 
     Pinocchio orders joints depth-first and represents a continuous joint by
     (cos q, sin q); ``perm[k]`` is the armdyn coordinate of Pinocchio's velocity k.
+    A mimic joint (``buildModelFromUrdf(path, mimic=True)``) has no q of its own.
     """
     qp = np.zeros(model.nq)
     perm = np.zeros(model.nv, dtype=int)
     for j in range(1, model.njoints):
+        if model.joints[j].shortname() == "JointModelMimic":
+            continue
         k = robot.coordinate_index(model.names[j])
         iq, iv = model.idx_qs[j], model.idx_vs[j]
         perm[iv] = k
@@ -158,8 +161,7 @@ def compare_with_pinocchio(
             qp, perm = pin_configuration(model, robot, q)
             tau = pin.rnea(model, data, qp, qd[perm], qdd[perm])
             assert close(engine.rnea(robot, q, qd, qdd)[perm], tau) < rtol, f"{engine.__name__}.rnea"
-            M = pin.crba(model, data, qp)
-            M = np.triu(M) + np.triu(M, 1).T
+            M = pin_mass_matrix(model, data, qp)
             assert close(engine.crba(robot, q)[np.ix_(perm, perm)], M) < rtol, f"{engine.__name__}.crba"
             if np.linalg.cond(M) > SINGULAR:
                 skipped_aba = True  # a body with no mass or inertia: qdd is not defined
@@ -167,11 +169,49 @@ def compare_with_pinocchio(
             # aba is a linear solve: compare the torque it implies (M qdd + h), whose
             # error does not grow with the condition number of M, and qdd itself
             ours = engine.aba(robot, q, qd, tau_ours := engine.rnea(robot, q, qd, qdd))[perm]
-            theirs = pin.aba(model, data, qp, qd[perm], tau_ours[perm])
+            if has_mimic(model):  # Pinocchio 4.1 has no aba with mimic joints: its M and h
+                theirs = np.linalg.solve(M, tau_ours[perm] - pin.nonLinearEffects(model, data, qp, qd[perm]))
+            else:
+                theirs = pin.aba(model, data, qp, qd[perm], tau_ours[perm])
             implied = pin.rnea(model, data, qp, qd[perm], ours)
             assert close(implied, tau_ours[perm]) < rtol, f"{engine.__name__}.aba (implied torque)"
             assert close(ours, theirs) < rtol * max(1.0, np.linalg.cond(M)), f"{engine.__name__}.aba"
     return not skipped_aba
+
+
+def pin_mass_matrix(model, data, qp) -> np.ndarray:
+    """Pinocchio's joint-space inertia matrix (full, symmetric).
+
+    With mimic joints, Pinocchio 4.1's crba disagrees with its own rnea when a joint with
+    a coordinate lies below a mimic joint (tests/test_mimic.py's arm: the fingers below
+    the mimicking wrist; ``M e_k != rnea(q, 0, e_k) - rnea(q, 0, 0)``), while its rnea
+    agrees with armdyn's three engines. So for a model with mimic joints M is read off
+    its rnea, column by column (exact: rnea is affine in the acceleration), and its
+    crba is checked against that only where no coordinate sits below a mimic joint
+    (every example-robot-data gripper)."""
+    M = pin.crba(model, data, qp)
+    M = np.triu(M) + np.triu(M, 1).T
+    if not has_mimic(model):
+        return M
+    v = np.zeros(model.nv)
+    h = pin.rnea(model, data, qp, v, v)
+    M_rnea = np.column_stack([pin.rnea(model, data, qp, v, e) - h for e in np.eye(model.nv)])
+    mimic = [model.joints[j].shortname() == "JointModelMimic" for j in range(model.njoints)]
+
+    def below_mimic(j):
+        j = model.parents[j]
+        while j > 0 and not mimic[j]:
+            j = model.parents[j]
+        return j > 0
+
+    if not any(below_mimic(j) for j in range(1, model.njoints) if not mimic[j]):
+        assert close(M, M_rnea) < RTOL, "Pinocchio's crba == its rnea's M"
+    return M_rnea
+
+
+def has_mimic(model) -> bool:
+    """Whether a Pinocchio model has mimic joints."""
+    return any(model.joints[j].shortname() == "JointModelMimic" for j in range(1, model.njoints))
 
 
 # ------------------------------------------------------------ hand-made URDFs
@@ -296,7 +336,15 @@ def test_slightly_unnormalised_axis_is_normalised():
     [
         (('type="continuous"', 'type="floating"'), "joint 'spin'", "floating joints are not supported yet"),
         (('type="continuous"', 'type="planar"'), "joint 'spin'", "planar joints are not supported yet"),
-        (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="slide"/>'), "joint 'spin'", "mimic joints"),
+        (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="slide"/>'), "joint 'spin'",
+         "a revolute joint cannot mimic the prismatic joint 'slide'"),
+        (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="elbow"/>'), "joint 'spin'",
+         "mimics joint 'elbow', which does not exist"),
+        (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="weld"/>'), "joint 'spin'", "'weld', which is fixed"),
+        (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="spin"/>'), "joint 'spin'", "loop (spin -> spin)"),
+        (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="roll" multiplier="x"/>'), "joint 'spin'",
+         "<mimic> multiplier is 'x', not a finite number"),
+        (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic/>'), "joint 'spin'", "<mimic> has no 'joint' attribute"),
         (('"0 0.6 0.8"', '"0 0.6 0.9"'), "joint 'slide'", "not a unit vector"),
         (('"0 0.6 0.8"', '"0 0 0"'), "joint 'slide'", "axis is zero"),
         (('<mass value="2"/>', '<mass value="two"/>'), "link 'l1'", "not a finite number"),
@@ -334,34 +382,101 @@ def test_iiwa14_agrees_with_pinocchio(path):
 
 
 def unsupported_joint(path: Path) -> str | None:
-    """Why Pinocchio's URDF would be out of scope: a floating/planar/mimic joint, read
-    here with a plain XML scan (independent of the reader under test)."""
+    """Why Pinocchio's URDF would be out of scope: a floating/planar joint, read here
+    with a plain XML scan (independent of the reader under test)."""
     import xml.etree.ElementTree as ET
 
     root = ET.parse(path).getroot()
     for j in root.findall("joint"):
         if j.get("type") in ("floating", "planar"):
             return f"{j.get('type')} joint '{j.get('name')}'"
-        if j.find("mimic") is not None:
-            return f"mimic joint '{j.get('name')}'"
     return None
 
 
+def xml_mimics(path: Path) -> dict[str, tuple[str, float, float]]:
+    """``{mimic joint: (leader, multiplier, offset)}`` of the non-fixed joints with a
+    ``<mimic>``, read with a plain XML scan (independent of the reader under test)."""
+    import xml.etree.ElementTree as ET
+
+    out = {}
+    for j in ET.parse(path).getroot().findall("joint"):
+        m = j.find("mimic")
+        if m is not None and j.get("type") != "fixed":
+            out[j.get("name")] = (m.get("joint"), float(m.get("multiplier", 1)), float(m.get("offset", 0)))
+    return out
+
+
+def compare_reduced_with_pinocchio(robot, path: Path, rng, states: int = 1, rtol: float = RTOL) -> bool:
+    """For a URDF whose mimic model Pinocchio cannot build: Pinocchio's model with every
+    joint free (``buildModelFromUrdf(path)``), constrained here by the principle of
+    virtual work. With the map read from the XML, ``q_full = G q + o`` (one level of
+    mimic; ``G`` (nv_full, dof)), armdyn's reduced dynamics must be
+    ``tau = G^T rnea_full(q_full, G qd, G qdd)``, ``M = G^T M_full G``, and aba's qdd
+    must reproduce its torque through Pinocchio's rnea. Returns False if aba was left out
+    because the mass matrix is singular, else True."""
+    mimics = xml_mimics(path)
+    compared_aba = True
+    model = pin.buildModelFromUrdf(str(path))
+    data = model.createData()
+    G = np.zeros((model.nv, robot.dof))
+    follow = []  # (pinocchio joint, armdyn coordinate, multiplier, offset)
+    for j in range(1, model.njoints):
+        leader, mult, off = mimics.get(model.names[j], (model.names[j], 1.0, 0.0))
+        assert leader not in mimics, f"{model.names[j]}: a chain of mimics (not handled here)"
+        k = robot.coordinate_index(leader)
+        G[model.idx_vs[j], k] = mult
+        follow.append((j, k, mult, off))
+    for engine in engines():
+        for _ in range(states):
+            q, qd, qdd = (random_coordinates(robot, rng), rng.uniform(-1, 1, robot.dof), rng.uniform(-1, 1, robot.dof))
+            qp = np.zeros(model.nq)
+            for j, k, mult, off in follow:
+                x, iq = mult * q[k] + off, model.idx_qs[j]
+                if model.joints[j].nq == 2:
+                    qp[iq : iq + 2] = np.cos(x), np.sin(x)
+                else:
+                    qp[iq] = x
+            tau = G.T @ pin.rnea(model, data, qp, G @ qd, G @ qdd)
+            tau_ours = engine.rnea(robot, q, qd, qdd)
+            assert close(tau_ours, tau) < rtol, f"{engine.__name__}.rnea"
+            M = pin.crba(model, data, qp)
+            M = G.T @ (np.triu(M) + np.triu(M, 1).T) @ G
+            assert close(engine.crba(robot, q), M) < rtol, f"{engine.__name__}.crba"
+            if np.linalg.cond(M) > SINGULAR:
+                compared_aba = False
+                continue
+            ours = engine.aba(robot, q, qd, tau_ours)
+            implied = G.T @ pin.rnea(model, data, qp, G @ qd, G @ ours)
+            assert close(implied, tau_ours) < rtol, f"{engine.__name__}.aba (implied torque)"
+    return compared_aba
+
+
 def test_example_robot_data_sweep(capsys):
-    """Every URDF of the example-robot-data wheel: those without floating, planar or
-    mimic joints load (strict; the ones whose published inertias are not physical load
-    with strict=False, which is what it is for) and agree with Pinocchio; the others get
-    the one-line "not supported yet" ModelError. ``ur3.urdf`` holds an empty <robot>
-    (its xacro expanded to nothing) and is rejected as having no link."""
+    """Every URDF of the example-robot-data wheel loads (strict; the ones whose published
+    inertias are not physical load with strict=False, which is what it is for) and
+    agrees with Pinocchio; mimic joints included:
+
+    * with Pinocchio's own mimic model (``buildModelFromUrdf(path, mimic=True)``) where
+      Pinocchio 4.1 builds it;
+    * where it refuses ("the parent joint of the mimic joint is not in the kinematic
+      tree": romeo, talos_full_v2), with Pinocchio's unconstrained model reduced by
+      virtual work (:func:`compare_reduced_with_pinocchio`);
+    * ``alex_psyonic_hands.urdf`` names mimic leaders that do not exist
+      (``index_q1`` for ``Left_index_q1``...): a one-line ModelError naming the mimic
+      joint and the missing leader (Pinocchio refuses it too).
+
+    ``ur3.urdf`` holds an empty <robot> (its xacro expanded to nothing) and is rejected
+    as having no link."""
     robots_dir = example_robot_data_dir()
-    if robots_dir is None:
-        pytest.skip("example-robot-data is not installed (pip install example-robot-data)")
+    assert robots_dir is not None, "example-robot-data is not installed (pip install example-robot-data)"
     files = sorted(robots_dir.rglob("*.urdf"))
     assert len(files) >= 60
     rng = np.random.default_rng(2024)
     counts = dict.fromkeys(
-        ["agree", "agree (non-physical, strict=False)", "rejected as unsupported", "rejected: no robot"], 0
+        ["agree", "agree (non-physical, strict=False)", "rejected as unsupported", "rejected: mimic leader missing",
+         "rejected: no robot"], 0
     )
+    with_mimic = {"Pinocchio mimic model": 0, "Pinocchio free model reduced by G": 0, "(<mimic> on fixed joints only)": 0}
     singular = []  # mass matrix singular: aba not compared
     start = time.perf_counter()
     for path in files:
@@ -379,6 +494,19 @@ def test_example_robot_data_sweep(capsys):
                 load_urdf(path)
             counts["rejected: no robot"] += 1
             continue
+        mimics = xml_mimics(path)
+        joints = {j for j in _xml_joint_names(path)}
+        missing = {m: leader for m, (leader, _, _) in mimics.items() if leader not in joints}
+        if missing:
+            with pytest.raises(ModelError) as info, warnings.catch_warnings():
+                warnings.simplefilter("ignore", UserWarning)  # its inertias are not physical either
+                load_urdf(path, strict=False)
+            mimic, leader = next((m, l) for m, l in missing.items() if info.value.element == f"joint '{m}'")
+            assert f"'{leader}', which does not exist" in info.value.message and info.value.source == str(path), name
+            with pytest.raises(Exception, match="mimic"):  # Pinocchio's view
+                pin.buildModelFromUrdf(str(path), mimic=True)
+            counts["rejected: mimic leader missing"] += 1
+            continue
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", MasslessWarning)
             try:
@@ -389,9 +517,25 @@ def test_example_robot_data_sweep(capsys):
                     robot = load_urdf(path, strict=False)
                 key = "agree (non-physical, strict=False)"
                 assert err.element and err.element.startswith("link '"), (name, str(err))
+        assert len(robot.mimic_joints) == len(mimics), name
         try:
-            if not compare_with_pinocchio(robot, pin.buildModelFromUrdf(str(path)), rng, states=1):
+            if mimics:
+                try:
+                    model = pin.buildModelFromUrdf(str(path), mimic=True)
+                except ValueError as err:
+                    assert "mimic" in str(err), (name, str(err))
+                    if not compare_reduced_with_pinocchio(robot, path, rng):
+                        singular.append(name)
+                    with_mimic["Pinocchio free model reduced by G"] += 1
+                else:
+                    assert has_mimic(model), name
+                    if not compare_with_pinocchio(robot, model, rng, states=1):
+                        singular.append(name)
+                    with_mimic["Pinocchio mimic model"] += 1
+            elif not compare_with_pinocchio(robot, pin.buildModelFromUrdf(str(path)), rng, states=1):
                 singular.append(name)
+            if not mimics and "<mimic" in path.read_text():
+                with_mimic["(<mimic> on fixed joints only)"] += 1
         except AssertionError as err:
             raise AssertionError(f"{name}: {err}") from None
         counts[key] += 1
@@ -399,6 +543,14 @@ def test_example_robot_data_sweep(capsys):
     with capsys.disabled():
         summary = ", ".join(f"{v} {k}" for k, v in counts.items())
         print(f"\nexample-robot-data: {len(files)} URDFs in {seconds:.1f} s: {summary}")
+        print(f"  with <mimic>, agreeing: {', '.join(f'{v} {k}' for k, v in with_mimic.items())}")
         print(f"  aba not compared (singular mass matrix): {singular}")
     assert sum(counts.values()) == len(files)
-    assert counts["agree"] + counts["agree (non-physical, strict=False)"] >= 50
+    assert counts["agree"] + counts["agree (non-physical, strict=False)"] >= 62
+    assert with_mimic["Pinocchio mimic model"] + with_mimic["Pinocchio free model reduced by G"] >= 8
+
+
+def _xml_joint_names(path: Path) -> list[str]:
+    import xml.etree.ElementTree as ET
+
+    return [j.get("name") for j in ET.parse(path).getroot().findall("joint")]

@@ -145,6 +145,33 @@ class Link:
 
 
 @dataclass(frozen=True)
+class Mimic:
+    """A joint that follows another one (URDF ``<mimic>``): its coordinate is
+    ``multiplier * q_leader + offset``, so its velocity and acceleration are
+    ``multiplier`` times the leader's, it adds no degree of freedom, and the torque
+    (force) along it adds ``multiplier`` times itself to the leader's.
+
+    joint:      name of the leader joint, of the same type (revolute or prismatic).
+                A chain (a mimic of a mimic) is composed; a loop is an error.
+    multiplier: dimensionless.
+    offset:     rad (revolute) or m (prismatic).
+    """
+
+    joint: str
+    multiplier: sp.Expr = sp.Integer(1)
+    offset: sp.Expr = sp.Integer(0)
+
+    def __post_init__(self):
+        try:
+            object.__setattr__(self, "multiplier", sp.sympify(self.multiplier))
+            object.__setattr__(self, "offset", sp.sympify(self.offset))
+        except (sp.SympifyError, TypeError) as exc:
+            raise ModelError(f"bad mimic value ({exc})") from None
+        if not isinstance(self.joint, str) or not self.joint:
+            raise ModelError(f"mimic: the leader joint must be a name, got {self.joint!r}")
+
+
+@dataclass(frozen=True)
 class Joint:
     """A joint between ``parent`` and ``child`` links.
 
@@ -159,6 +186,8 @@ class Joint:
               The child frame is ``placement * motion(q) * frame``.
     lower, upper, velocity, effort, damping, friction: optional limits and
               joint-space friction, kept on the model (None when not given).
+    mimic:    a :class:`Mimic` when the joint follows another joint (no coordinate of
+              its own), else None.
     """
 
     name: str
@@ -176,6 +205,7 @@ class Joint:
     effort: sp.Expr | None = None
     damping: sp.Expr | None = None
     friction: sp.Expr | None = None
+    mimic: Mimic | None = None
 
     def __post_init__(self):
         where = f"joint '{self.name}'"
@@ -198,6 +228,11 @@ class Joint:
             raise err.located(element=where)
         except (sp.SympifyError, TypeError) as exc:
             raise ModelError(f"bad value ({exc})", where) from None
+        if self.mimic is not None:
+            if not isinstance(self.mimic, Mimic):
+                raise ModelError(f"mimic must be a Mimic, got {type(self.mimic).__name__}", where)
+            if self.type == "fixed":
+                raise ModelError("a fixed joint cannot mimic another joint", where)
         for key in ("rotation", "frame_rotation"):
             matrix = getattr(self, key)
             if not matrix.free_symbols:
@@ -365,7 +400,9 @@ class Robot:
         if stray:
             raise ModelError(f"default values given for unknown parameters {sorted(stray)}", f"robot '{name}'")
 
-        self.movable_joints = [j for j in self.joints if j.movable]
+        # joints with a coordinate of their own; mimic joints move but follow a leader
+        self.movable_joints = [j for j in self.joints if j.movable and j.mimic is None]
+        self.mimic_joints = [j for j in self.joints if j.mimic is not None]
         self.dof = len(self.movable_joints)
         self.coordinate_names = [j.name for j in self.movable_joints]
         self.q, self.qd, self.qdd = coordinate_symbols(self.coordinate_names)
@@ -376,7 +413,8 @@ class Robot:
         # index of each movable joint's coordinate, None for fixed joints
         self._coord_index = {}
         for j in self.joints:
-            self._coord_index[j.name] = self.coordinate_names.index(j.name) if j.movable else None
+            self._coord_index[j.name] = self.coordinate_names.index(j.name) if j.movable and j.mimic is None else None
+        self._follows = self._resolve_mimics()
 
     def _tree_order(self, joints: list[Joint]) -> list[Joint]:
         names, child_of = set(), {}
@@ -419,9 +457,43 @@ class Robot:
             return list(joints)
         return ordered
 
+    def _resolve_mimics(self) -> dict[str, tuple[int, sp.Expr, sp.Expr]]:
+        """For every non-fixed joint, ``(k, multiplier, offset)`` with its own coordinate
+        ``multiplier * q[k] + offset``; a chain of mimics is composed down to a joint
+        with a coordinate. A missing or fixed leader, a leader of another type, and a
+        loop are ModelErrors naming the mimic joint."""
+        by_name = {j.name: j for j in self.joints}
+        follows = {j.name: (self._coord_index[j.name], sp.Integer(1), sp.Integer(0)) for j in self.movable_joints}
+        for start in self.mimic_joints:
+            chain, joint, seen = [], start, {start.name}
+            while joint.name not in follows:  # walk up to a resolved joint (memoised: O(n) overall)
+                where = f"joint '{joint.name}'"
+                leader = by_name.get(joint.mimic.joint)
+                if leader is None:
+                    raise ModelError(f"mimics joint '{joint.mimic.joint}', which does not exist", where)
+                if leader.type == "fixed":
+                    raise ModelError(f"mimics joint '{leader.name}', which is fixed", where)
+                if leader.type != joint.type:
+                    raise ModelError(
+                        f"a {joint.type} joint cannot mimic the {leader.type} joint '{leader.name}' "
+                        "(a mimic joint must be of its leader's type)",
+                        where,
+                    )
+                if leader.name in seen:
+                    loop = " -> ".join([j.name for j in chain] + [joint.name, leader.name])
+                    raise ModelError(f"mimic joints form a loop ({loop})", f"joint '{start.name}'")
+                chain.append(joint)
+                seen.add(leader.name)
+                joint = leader
+            for j in reversed(chain):  # q_j = m_j q_leader + o_j, q_leader = m q_k + o
+                k, m, o = follows[j.mimic.joint]
+                follows[j.name] = (k, j.mimic.multiplier * m, j.mimic.multiplier * o + j.mimic.offset)
+        return follows
+
     # ------------------------------------------------------------------ queries
     def coordinate_index(self, joint: str | Joint) -> int | None:
-        """Index of a joint's coordinate in ``q`` (None for a fixed joint)."""
+        """Index of a joint's coordinate in ``q`` (None for a fixed joint, and for a
+        mimic joint, which has none of its own: see :meth:`follows`)."""
         name = joint.name if isinstance(joint, Joint) else joint
         return self._coord_index[name]
 
@@ -430,9 +502,21 @@ class Robot:
         return self._link_index[link]
 
     def joint_coordinate(self, joint: Joint):
-        """The joint's coordinate symbol (0 for a fixed joint)."""
-        i = self._coord_index[joint.name]
-        return sp.Integer(0) if i is None else self.q[i]
+        """The joint's coordinate: its symbol, ``multiplier * q_leader + offset`` for a
+        mimic joint, 0 for a fixed joint."""
+        f = self._follows.get(joint.name)
+        if f is None:
+            return sp.Integer(0)
+        k, m, o = f
+        return m * self.q[k] + o
+
+    def follows(self, joint: str | Joint) -> tuple[int, sp.Expr, sp.Expr] | None:
+        """``(k, multiplier, offset)``: the joint's own coordinate is
+        ``multiplier * q[k] + offset``, its velocity and acceleration ``multiplier``
+        times ``qd[k]``, ``qdd[k]``, and its torque (force) adds ``multiplier`` times
+        itself to ``tau[k]``. ``(k, 1, 0)`` for a joint with coordinate k, the leader's
+        (chains composed) for a mimic joint, None for a fixed joint."""
+        return self._follows.get(joint.name if isinstance(joint, Joint) else joint)
 
     def parent_joint(self, link: str) -> Joint | None:
         for j in self.joints:
@@ -451,6 +535,8 @@ class Robot:
         for j in self.joints:
             out |= j.xyz.free_symbols | j.rotation.free_symbols | j.axis.free_symbols
             out |= j.frame_xyz.free_symbols | j.frame_rotation.free_symbols
+            if j.mimic is not None:
+                out |= j.mimic.multiplier.free_symbols | j.mimic.offset.free_symbols
         return out
 
     def canonical(self) -> "Robot":
@@ -518,6 +604,7 @@ class Robot:
                 frame_xyz=j.frame_xyz.xreplace(table),
                 frame_rotation=j.frame_rotation.xreplace(table),
                 **{k: s(getattr(j, k)) for k in ("lower", "upper", "velocity", "effort", "damping", "friction")},
+                mimic=None if j.mimic is None else replace(j.mimic, multiplier=s(j.mimic.multiplier), offset=s(j.mimic.offset)),
             )
             for j in self.joints
         ]

@@ -6,6 +6,8 @@ Every function takes a robot and one state or a batch of states:
   ``robot.bind({...})``; otherwise :class:`armdyn.errors.UnboundParameterError`
   names them), or a :class:`NumericModel` from :func:`compile_model`. The compiled
   model is built once per Robot and cached on it (attribute ``_numeric_model``).
+  A robot with mimic joints compiles to a :class:`armdyn.mimic.MimicModel` (same
+  methods, in the independent coordinates; see that module for how).
 * ``q``, ``qd``, ``qdd``, ``tau``: shape ``(n,)`` for one state or ``(N, n)`` for ``N``
   states (one per row), ``n = robot.dof``, joints in ``robot.coordinate_names`` order.
   Float64 C-contiguous arrays are used as they are; anything else is converted once.
@@ -24,6 +26,7 @@ import sympy as sp
 
 from . import _core
 from .errors import ModelError, UnboundParameterError
+from .mimic import MimicModel
 from .model import Link, Robot
 
 __all__ = [
@@ -67,7 +70,7 @@ def compile_model(robot: Robot | NumericModel) -> NumericModel:
     Raises UnboundParameterError if the robot still has free symbols, TypeError if
     ``robot`` is neither a Robot nor a NumericModel.
     """
-    if isinstance(robot, NumericModel):
+    if isinstance(robot, (NumericModel, MimicModel)):
         return robot
     if not isinstance(robot, Robot):
         raise TypeError(f"expected an armdyn.Robot or NumericModel, got {type(robot).__name__}")
@@ -104,11 +107,13 @@ def compile_model(robot: Robot | NumericModel) -> NumericModel:
     try:
         model = NumericModel(
             parents, types, rotations, translations, axes, masses, coms, inertias, gravity_vec,
-            list(robot.links), list(robot.coordinate_names), robot.name,
+            list(robot.links), [j.name for j in robot.joints if j.movable], robot.name,
             _floats([base.mass], where)[0], _floats(base.com, where),
         )
     except ValueError as err:
         raise ModelError(str(err), f"robot '{robot.name}'") from None
+    if robot.mimic_joints:  # every non-fixed joint is free in `model`; see armdyn.mimic
+        model = MimicModel(model, robot)
     source._numeric_model = model
     return model
 

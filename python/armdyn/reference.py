@@ -28,6 +28,12 @@ Conventions
   It is built from the child pose ``(R, p)`` given by :meth:`armdyn.model.Joint.transform`
   (the one definition of the frame convention): ``Xup = plux(R^T, p)``.
 * Gravity enters as a fictitious base acceleration ``a_0 = -[0; g]`` (RBDA ch. 5).
+* A mimic joint (``q_m = c q_l + o``, :meth:`armdyn.model.Robot.follows`) is a body whose
+  ``S`` is ``c`` times its axis, acting on its leader's coordinate ``l``: its velocity
+  and acceleration are ``S qd_l``, ``S qdd_l``, and everything it contributes to a
+  coordinate (``S^T f`` to ``tau``, entries of ``M``, Jacobian columns) is *added* to
+  ``l``'s. Forward dynamics of such a robot solves ``M qdd = tau - h`` (the constraint
+  couples bodies that ABA treats separately).
 
 References
 ----------
@@ -111,6 +117,8 @@ class _Tree:
     base_mass: float
     base_com: np.ndarray
     link_names: list[str]  # base first, then body k's name at k + 1
+    follow: list[tuple[float, float]]  # (c, o): joint k's own coordinate is c q[dofs[k]] + o
+    mimic: bool  # whether some joint is a mimic joint
 
 
 _trees: "weakref.WeakKeyDictionary[Robot, _Tree]" = weakref.WeakKeyDictionary()
@@ -133,7 +141,7 @@ def _tree(robot: Robot) -> _Tree:
         )
     index = {robot.base: -1}
     kind, axes, points = [j.type for j in robot.joints], [], []
-    parent, pose, S, dofs, inertia, mass, com = [], [], [], [], [], [], []
+    parent, pose, S, dofs, inertia, mass, com, follow = [], [], [], [], [], [], [], []
     for k, joint in enumerate(robot.joints):
         parent.append(index[joint.parent])
         index[joint.child] = k
@@ -141,20 +149,22 @@ def _tree(robot: Robot) -> _Tree:
         pose.append(sp.lambdify(_q, (R, p), "numpy"))
         axis = _floats(joint.child_axis).ravel()  # in the child frame's axes
         axes.append(axis)
+        f = robot.follows(joint)  # (coordinate, multiplier, offset), None when fixed
+        c = 1.0 if f is None else float(f[1])
+        follow.append((c, 0.0 if f is None else float(f[2])))
         if joint.type == "revolute":
             # the axis is invariant under Rot(axis, q); a child frame off the axis (joint
             # point jp in child coordinates, constant) moves with linear velocity jp x axis
             jp = _floats(joint.joint_point(0)).ravel()
             points.append(jp)
-            S.append(np.concatenate([axis, np.cross(jp, axis)])[:, None])
+            S.append(c * np.concatenate([axis, np.cross(jp, axis)])[:, None])
         elif joint.type == "prismatic":
-            S.append(np.concatenate([np.zeros(3), axis])[:, None])
+            S.append(c * np.concatenate([np.zeros(3), axis])[:, None])
             points.append(np.zeros(3))
         else:
             S.append(np.zeros((6, 0)))
             points.append(np.zeros(3))
-        i = robot.coordinate_index(joint)
-        dofs.append(np.array([] if i is None else [i], dtype=int))
+        dofs.append(np.array([] if f is None else [f[0]], dtype=int))
         link = robot.links[joint.child]
         m, c, Ic = float(link.mass), _floats(link.com).ravel(), _floats(link.inertia)
         mass.append(m)
@@ -177,6 +187,8 @@ def _tree(robot: Robot) -> _Tree:
         base_mass=float(base.mass),
         base_com=_floats(base.com).ravel(),
         link_names=list(robot.links),
+        follow=follow,
+        mimic=bool(robot.mimic_joints),
     )
     _trees[robot] = tree
     return tree
@@ -192,7 +204,8 @@ def _state(tree: _Tree, x, name: str) -> np.ndarray:
 
 
 def _joint_value(tree: _Tree, k: int, q: np.ndarray) -> float:
-    return float(q[tree.dofs[k]][0]) if tree.dofs[k].size else 0.0
+    c, o = tree.follow[k]
+    return c * float(q[tree.dofs[k]][0]) + o if tree.dofs[k].size else 0.0
 
 
 def _poses(tree: _Tree, q: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -233,7 +246,7 @@ def rnea(robot: Robot, q, qd, qdd) -> np.ndarray:
         f[i] = t.inertia[i] @ a[i] + crf(v[i]) @ t.inertia[i] @ v[i]
     tau = np.zeros(t.n)
     for i in reversed(range(nb)):
-        tau[t.dofs[i]] = t.S[i].T @ f[i]
+        tau[t.dofs[i]] += t.S[i].T @ f[i]  # += : a mimic joint adds to its leader's
         if t.parent[i] >= 0:
             f[t.parent[i]] = f[t.parent[i]] + Xup[i].T @ f[i]
     return tau
@@ -252,13 +265,13 @@ def crba(robot: Robot, q) -> np.ndarray:
     M = np.zeros((t.n, t.n))
     for i in range(nb):
         F = IC[i] @ t.S[i]
-        M[np.ix_(t.dofs[i], t.dofs[i])] = t.S[i].T @ F
+        M[np.ix_(t.dofs[i], t.dofs[i])] += t.S[i].T @ F  # += : mimic joints share a coordinate
         j = i
         while t.parent[j] >= 0:
             F = Xup[j].T @ F
             j = t.parent[j]
-            M[np.ix_(t.dofs[i], t.dofs[j])] = F.T @ t.S[j]
-            M[np.ix_(t.dofs[j], t.dofs[i])] = t.S[j].T @ F
+            M[np.ix_(t.dofs[i], t.dofs[j])] += F.T @ t.S[j]
+            M[np.ix_(t.dofs[j], t.dofs[i])] += t.S[j].T @ F
     return M
 
 
@@ -266,6 +279,8 @@ def aba(robot: Robot, q, qd, tau) -> np.ndarray:
     """Forward dynamics ``qdd`` (n,), articulated-body algorithm, RBDA Table 7.1."""
     t = _tree(robot)
     q, qd, tau = _state(t, q, "q"), _state(t, qd, "qd"), _state(t, tau, "tau")
+    if t.mimic:  # ABA's recursion cannot follow the constraint: solve M qdd = tau - h
+        return np.linalg.solve(crba(robot, q), tau - bias(robot, q, qd))
     Xup = _xup(t, q)
     nb = len(t.parent)
     v, c, IA, pA = [None] * nb, [None] * nb, [None] * nb, [None] * nb
@@ -355,7 +370,7 @@ def coriolis_matrix(robot: Robot, q, qd) -> np.ndarray:
     def jacobian_world(b):
         J = np.zeros((6, n))
         for j in path[b]:
-            J[:, t.dofs[j]] = S0[j]
+            J[:, t.dofs[j]] += S0[j]
         return J
 
     dM = np.zeros((n, n, n))  # dM[:, :, c] = dM/dq_c
@@ -369,7 +384,7 @@ def coriolis_matrix(robot: Robot, q, qd) -> np.ndarray:
             J = jacobian_world(b)
             dJ = np.zeros((6, n))
             for j in path[b][path[b].index(k):]:  # joints at or below k on b's path move
-                dJ[:, t.dofs[j]] = crm(s) @ S0[j]
+                dJ[:, t.dofs[j]] += crm(s) @ S0[j]
             dI = crf(s) @ I0[b] - I0[b] @ crm(s)
             dM[:, :, t.dofs[k][0]] += dJ.T @ I0[b] @ J + J.T @ dI @ J + J.T @ I0[b] @ dJ
     # Christoffel symbols gamma[i, j, k] = 1/2 (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i), contracted with qd
@@ -450,10 +465,11 @@ def jacobian(robot: Robot, q, link) -> np.ndarray:
         if t.dofs[b].size:
             R = X[b + 1][:3, :3]
             o, z = X[b + 1][:3, 3] + R @ t.point[b], R @ t.axis[b]
-            col = t.dofs[b][0]
+            col, c = t.dofs[b][0], t.follow[b][0]  # a mimic joint moves c times its leader's rate
             if t.kind[b] == "revolute":
-                J[:3, col], J[3:, col] = np.cross(z, o_link - o), z
+                J[:3, col] += c * np.cross(z, o_link - o)
+                J[3:, col] += c * z
             else:  # prismatic
-                J[:3, col] = z
+                J[:3, col] += c * z
         b = t.parent[b]
     return J

@@ -77,8 +77,8 @@ def frame_poses(robot: Robot, q=None) -> dict[str, np.ndarray]:
     q = _coordinates(robot, q)
     poses = {robot.base: np.eye(4)}
     for joint in robot.joints:
-        i = robot.coordinate_index(joint)
-        R, p = joint.transform(0 if i is None else q[i])
+        f = robot.follows(joint)  # (coordinate, multiplier, offset); mimic joints follow a leader
+        R, p = joint.transform(0 if f is None else float(f[1]) * q[f[0]] + float(f[2]))
         local = np.eye(4)
         local[:3, :3], local[:3, 3] = _floats(R), _floats(p).reshape(3)
         poses[joint.child] = poses[joint.parent] @ local
@@ -132,6 +132,9 @@ def table(robot: Robot) -> str:
         axis = _vec(j.axis) if j.movable else ""
         rows.append([j.name, j.type, j.parent, j.child, _vec(j.xyz), angles, axis, limits])
     lines += ["", "joints"] + _rows(["name", "type", "parent", "child", "xyz", "rpy", "axis", "limits"], rows)
+    for j in robot.mimic_joints:  # no coordinate of their own: say whom they follow
+        m, o = j.mimic.multiplier, j.mimic.offset
+        lines.append(f"mimic: {j.name} = {_num(m)} * {j.mimic.joint}" + (f" + {_num(o)}" if o != 0 else ""))
     massless = set(robot.meta.get("massless_links", ()))
     rows = []
     for link in robot.links.values():

@@ -89,9 +89,10 @@ def _link_context(robot: Robot):
     for joint in robot.joints:
         i = robot.link_index(joint.child)
         p = robot.link_index(joint.parent)
-        k = robot.coordinate_index(joint)
+        follow = robot.follows(joint)  # (k, multiplier, offset); None for a fixed joint
         q = robot.joint_coordinate(joint)
-        qd, qdd = (robot.qd[k], robot.qdd[k]) if k is not None else (sp.Integer(0), sp.Integer(0))
+        qd, qdd = (follow[1] * robot.qd[follow[0]], follow[1] * robot.qdd[follow[0]]) if follow is not None \
+            else (sp.Integer(0), sp.Integer(0))
         R, P = joint.transform(q)
         V, Vd = joint.origin_motion(qd, qdd)
         link = robot.links[joint.child]

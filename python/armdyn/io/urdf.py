@@ -7,8 +7,13 @@ What is read (the URDF 1.0 subset that describes a fixed-base arm's dynamics):
   ``<visual>``/``<collision>`` are ignored.
 * Joints ``revolute``, ``continuous`` (read as revolute, without position limits),
   ``prismatic`` and ``fixed``. Fixed joints stay fixed joints in the :class:`Robot`;
-  the engines handle them. ``floating``, ``planar`` and ``<mimic>`` joints are rejected
-  with a :class:`ModelError` saying they are not supported yet.
+  the engines handle them. ``floating`` and ``planar`` joints are rejected with a
+  :class:`ModelError` saying they are not supported yet.
+* ``<mimic joint multiplier offset>`` (defaults 1 and 0): the joint follows its leader,
+  ``q = multiplier * q_leader + offset``, and has no coordinate of its own (see
+  :class:`armdyn.model.Mimic`). The leader must exist and be of the same type; a chain
+  is composed, a loop is an error. On a fixed joint ``<mimic>`` is ignored (a fixed
+  joint does not move; ``talos_reduced.urdf`` has such joints).
 * ``<origin xyz rpy>`` (default zero, ``rpy`` is URDF's fixed-axis roll-pitch-yaw),
   ``<axis xyz>`` (default ``1 0 0``, as the URDF spec says; ignored on fixed joints).
   An axis within 1e-6 of unit length is normalised (files often write ``0.7071``);
@@ -56,7 +61,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..inertia import rotate
-from ..model import Joint, Link, Robot, rpy_matrix
+from ..model import Joint, Link, Mimic, Robot, rpy_matrix
 
 __all__ = ["load_urdf", "MasslessWarning"]
 
@@ -242,8 +247,6 @@ def _joint(elem: ET.Element, index: int) -> Joint:
         raise ModelError(f"{kind} joints are not supported yet", where)
     if kind not in JOINT_TYPES:
         raise ModelError(f"unknown joint type '{kind}' (expected one of {', '.join(JOINT_TYPES)})", where)
-    if elem.find("mimic") is not None:
-        raise ModelError("mimic joints are not supported yet", where)
     parent = _attr(_single(elem, "parent", where, required=True), "link", where)
     child = _attr(_single(elem, "child", where, required=True), "link", where)
     xyz, rotation = _origin(elem, where)
@@ -264,6 +267,7 @@ def _joint(elem: ET.Element, index: int) -> Joint:
     limits = {k: _optional(limit, k, where) for k in ("lower", "upper", "effort", "velocity")}
     if kind == "continuous":
         limits["lower"] = limits["upper"] = None  # URDF: ignored for continuous joints
+    mimic = _mimic(elem, where)
     return Joint(
         name,
         JOINT_TYPES[kind],
@@ -274,7 +278,23 @@ def _joint(elem: ET.Element, index: int) -> Joint:
         axis=axis,
         damping=_optional(dynamics, "damping", where),
         friction=_optional(dynamics, "friction", where),
+        mimic=None if kind == "fixed" else mimic,
         **limits,
+    )
+
+
+def _mimic(elem: ET.Element, where: str) -> Mimic | None:
+    """The joint's ``<mimic joint multiplier offset>``, or None."""
+    mimic = _single(elem, "mimic", where)
+    if mimic is None:
+        return None
+    leader = _attr(mimic, "joint", where)
+    multiplier = _optional(mimic, "multiplier", where)
+    offset = _optional(mimic, "offset", where)
+    return Mimic(
+        leader,
+        sp.Integer(1) if multiplier is None else _sym(multiplier),
+        sp.Integer(0) if offset is None else _sym(offset),
     )
 
 
@@ -320,7 +340,11 @@ def _warn_inert_joints(robot: Robot, source: str) -> None:
         link = robot.links[joint.child]
         own = float(link.mass) == 0 and not any(float(x) for x in link.inertia)
         inert[joint.child] = own and all(inert[j.child] for j in robot.children(joint.child))
-    idle = [j.name for j in robot.movable_joints if inert[j.child]]
+    # a coordinate is idle when every joint it moves (itself and its mimics) moves nothing
+    moves = [False] * robot.dof
+    for joint in robot.movable_joints + robot.mimic_joints:
+        moves[robot.follows(joint)[0]] |= not inert[joint.child]
+    idle = [j.name for j, moving in zip(robot.movable_joints, moves) if not moving]
     if idle:
         warnings.warn(
             f"{source}: joints {idle} move no mass or inertia (links without <inertial>?): "

@@ -11,6 +11,10 @@ Energies (kinematics by a velocity recursion in link frames, no differentiation)
     V_i  = - m_i gravity . p_Ci                      p_Ci: centre of mass in the base frame
     L = sum_i T_i - V_i
 
+A mimic joint (``q_m = c q_l + o``) moves with ``qd = c qd_l``: T and V are then
+functions of the independent coordinates only, and the equations below are the
+reduced ones (its torque carried to the leader's by the chain rule).
+
 Euler-Lagrange equations, with the time derivative taken by the chain rule::
 
     tau_k = d/dt (dL/dqd_k) - dL/dq_k
@@ -46,14 +50,14 @@ def _energies(robot: Robot):
     for joint in robot.joints:
         name, link = joint.child, robot.links[joint.child]
         i = robot.link_index(name)
-        k = robot.coordinate_index(joint)
+        follow = robot.follows(joint)  # (k, c, o): coordinate c q_k + o, rate c qd_k (mimic joints)
+        qd_j = 0 if follow is None else follow[1] * robot.qd[follow[0]]
         R, p = joint.transform(robot.joint_coordinate(joint))
         Rt = R.T
-        qd_k = robot.qd[k] if k is not None else 0
         w_i = Rt * w[joint.parent]
-        v_i = Rt * (v[joint.parent] + w[joint.parent].cross(p)) + joint.origin_motion(qd_k)[0]
+        v_i = Rt * (v[joint.parent] + w[joint.parent].cross(p)) + joint.origin_motion(qd_j)[0]
         if joint.type == "revolute":
-            w_i = w_i + qd_k * joint.child_axis
+            w_i = w_i + qd_j * joint.child_axis
         w[name], v[name] = w_i, v_i
         R0[name] = R0[joint.parent] * R
         p0[name] = p0[joint.parent] + R0[joint.parent] * p

@@ -18,9 +18,13 @@ coordinate ``q``::
     F_i = m_i vcd_i,   N_i = I_i wd_i + w_i x I_i w_i
 
 (``V = Vd = 0`` for a revolute joint whose child frame sits on its axis; for a prismatic
-joint ``V = qd z``, ``Vd = qdd z``, which is Craig's ``2 w_i x qd z + qdd z``.) Gravity enters as
-the base's acceleration ``vd_0 = -gravity``. Inward, over the children c of link i
-(``R_c``, ``P_c`` the child's placement in frame i)::
+joint ``V = qd z``, ``Vd = qdd z``, which is Craig's ``2 w_i x qd z + qdd z``.)
+A mimic joint (``q_m = c q_l + o``, :meth:`armdyn.model.Robot.follows`) moves with
+``qd = c qd_l``, ``qdd = c qdd_l``, and its ``tau`` is added ``c`` times to ``tau_l``
+(virtual work: ``delta q_m = c delta q_l``).
+
+Gravity enters as the base's acceleration ``vd_0 = -gravity``. Inward, over the children
+c of link i (``R_c``, ``P_c`` the child's placement in frame i)::
 
     f_i = F_i + sum_c R_c f_c
     n_i = N_i + c_i x F_i + sum_c (R_c n_c + P_c x R_c f_c)      (about frame i's origin)
@@ -38,6 +42,8 @@ share them.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import sympy as sp
 
@@ -123,16 +129,15 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
     for joint in robot.joints:
         link = robot.links[joint.child]
         parent, i = joint.parent, robot.link_index(joint.child)
-        k = robot.coordinate_index(joint)
-        qk = robot.joint_coordinate(joint)
-        qd_k, qdd_k = (qd[k], qdd[k]) if k is not None else (0, 0)
-        R, P = joint.transform(qk)
-        V, Vd = joint.origin_motion(qd_k, qdd_k)
+        follow = robot.follows(joint)  # (k, c, o): this joint's coordinate is c q_k + o
+        qd_j, qdd_j = (follow[1] * qd[follow[0]], follow[1] * qdd[follow[0]]) if follow is not None else (0, 0)
+        R, P = joint.transform(robot.joint_coordinate(joint))
+        V, Vd = joint.origin_motion(qd_j, qdd_j)
         placement[joint.child] = (R, P)
         z = joint.child_axis
 
-        w_i = omega(R, w[parent], z, qd_k, joint.type)
-        wd_i = omega_dot(R, w[parent], wd[parent], z, qd_k, qdd_k, joint.type)
+        w_i = omega(R, w[parent], z, qd_j, joint.type)
+        wd_i = omega_dot(R, w[parent], wd[parent], z, qd_j, qdd_j, joint.type)
         vd_i = v_dot(R, w[parent], wd[parent], vd[parent], P, V, Vd)
         vcd = vc_dot(w_i, wd_i, vd_i, link.com)
         w[joint.child], wd[joint.child], vd[joint.child] = w_i, wd_i, vd_i
@@ -155,6 +160,7 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
     f, n = {}, {}
     tau = [sp.Integer(0)] * robot.dof
     inward: list[Step] = []
+    tau_steps = []  # (position in inward, k): filled in with the final tau_k at the end
     for joint in reversed(robot.joints):
         name, i = joint.child, robot.link_index(joint.child)
         link = robot.links[name]
@@ -162,11 +168,13 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
         f_i = joint_force(F[name], [(Rc, fc) for Rc, _, _, fc in children])
         n_i = joint_moment(N[name], link.com, F[name], children)
         f[name], n[name] = f_i, n_i
-        k = robot.coordinate_index(joint)
+        follow = robot.follows(joint)
         point = joint.joint_point(robot.joint_coordinate(joint)) if joint.type == "revolute" else sp.zeros(3, 1)
         n_axis = moment_about(n_i, f_i, point)
-        if k is not None:
-            tau[k] = joint_torque(joint.type, joint.child_axis, n_axis, f_i)
+        if follow is not None:
+            k, mult, _ = follow
+            tau_j = joint_torque(joint.type, joint.child_axis, n_axis, f_i)
+            tau[k] = tau[k] + mult * tau_j  # a mimic joint's torque is carried to its leader
         if record:
             about = "" if point == sp.zeros(3, 1) else f", about joint {i}'s axis point {list(point)} (frame {i})"
             inward += [
@@ -174,9 +182,16 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
                 Step("inward", name, "n", rf"{{}}^{{{i}}}n_{{{i}}}", n_axis,
                      "moment exerted on the link by its parent" + about),
             ]
-            if k is not None:
-                kind = "torque" if joint.type == "revolute" else "force"
+            kind = "torque" if joint.type == "revolute" else "force"
+            if joint.mimic is not None:
+                tex = joint.name.replace("_", r"\_")
+                inward.append(Step("inward", name, "tau_mimic", rf"\tau_{{\mathrm{{{tex}}}}}", tau_j,
+                                   f"joint {kind} of mimic joint '{joint.name}', added {mult} times to tau{k + 1}"))
+            elif follow is not None:
+                tau_steps.append((len(inward), k))
                 inward.append(Step("inward", name, "tau", rf"\tau_{{{k + 1}}}", tau[k], f"joint {kind} of '{joint.name}'"))
+    for pos, k in tau_steps:  # with mimic joints, tau_k is complete only now
+        inward[pos] = replace(inward[pos], value=tau[k])
     if record:
         steps += outward + inward  # inward in the order computed: last link first, as in the exercise
     return sp.Matrix(tau)
