@@ -1,6 +1,6 @@
 """The ``armdyn`` command line.
 
-    armdyn derive ROBOT [--method newton-euler|lagrange|both] [--steps] [--format text|latex|markdown]
+    armdyn derive ROBOT [--method newton-euler|lagrange|both] [--steps] [--format text|latex|markdown|html]
     armdyn check ROBOT [--exact | --numeric] [--samples N]
     armdyn robots
     armdyn show ROBOT [--q Q1,Q2,...] [--out arm.png]
@@ -149,7 +149,7 @@ def build_parser() -> argparse.ArgumentParser:
     robot_arg(d)
     d.add_argument("--method", choices=["newton-euler", "lagrange", "both"], default="both")
     d.add_argument("--steps", action="store_true", help="show every intermediate step")
-    d.add_argument("--format", choices=["text", "latex", "markdown"], default="text")
+    d.add_argument("--format", choices=["text", "latex", "markdown", "html"], default="text")
     d.add_argument("--timing", action="store_true", help="print derivation times to stderr")
     d.set_defaults(func=cmd_derive)
 

@@ -646,3 +646,9 @@ class Robot:
     def __repr__(self) -> str:
         kinds = "".join({"revolute": "R", "prismatic": "P", "fixed": "F"}[j.type] for j in self.joints)
         return f"Robot({self.name!r}, dof={self.dof}, joints={kinds}, parameters={sorted(self.parameters)})"
+
+    def _repr_html_(self) -> str:
+        """Jupyter: tables of the joints and links (see symbolic/report_html.py)."""
+        from .symbolic.report_html import robot_html
+
+        return robot_html(self)

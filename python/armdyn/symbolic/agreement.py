@@ -84,6 +84,12 @@ class AgreementReport:
         head = f"checks for '{self.robot}': " + ("all passed" if self else "FAILED")
         return "\n".join([head] + ["  " + r.line() for r in self.results])
 
+    def _repr_html_(self) -> str:
+        """Jupyter: the checks as a table (see report_html.py)."""
+        from .report_html import agreement_html
+
+        return agreement_html(self)
+
 
 class _NumericSampler:
     """Random states and parameter values, and evaluation of matrices at them."""

@@ -185,7 +185,13 @@ def steps_lines(eom: EquationsOfMotion, fmt: str = "text") -> list[str]:
 
 def derivation_report(eoms: list[EquationsOfMotion], fmt: str = "text", steps: bool = False,
                       agreement=None) -> str:
-    """A whole report: the robot, for each method its (steps and) tau, then agreement."""
+    """A whole report: the robot, for each method its (steps and) tau, then agreement.
+
+    ``fmt="html"`` gives a self-contained page with MathML (see report_html.py)."""
+    if fmt == "html":
+        from .report_html import derivation_html
+
+        return derivation_html(eoms, steps=steps, agreement=agreement)
     robot = eoms[0].robot
     joints = ", ".join(f"{j.name} {j.type}" for j in robot.movable_joints)
     params = ", ".join(sorted(robot.parameters)) or "none"

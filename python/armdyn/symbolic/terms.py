@@ -146,3 +146,15 @@ class EquationsOfMotion:
 
     def __repr__(self) -> str:
         return f"EquationsOfMotion({self.robot.name!r}, method={self.method!r}, dof={self.robot.dof})"
+
+    def _repr_html_(self) -> str:
+        """Jupyter: tau as MathML (see report_html.py)."""
+        from .report_html import eom_html
+
+        return eom_html(self)
+
+    def _repr_latex_(self) -> str:
+        """Jupyter: tau as LaTeX."""
+        from .report_html import eom_latex
+
+        return eom_latex(self)
