@@ -133,3 +133,9 @@ class GradeReport:
 
     def __str__(self) -> str:
         return self.text()
+
+    def _repr_html_(self) -> str:
+        """Jupyter: the report as HTML (MathML math, no network)."""
+        from .html import repr_html
+
+        return repr_html(self)
