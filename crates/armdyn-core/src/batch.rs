@@ -93,7 +93,7 @@ pub fn set_kernels(cap: Option<Kernels>) {
 const MIN_PARALLEL_ROWS: usize = 128;
 
 /// A rayon pool with `n` threads, built once per `n` and kept.
-fn pool(n: usize) -> Arc<rayon::ThreadPool> {
+pub(crate) fn pool(n: usize) -> Arc<rayon::ThreadPool> {
     static POOLS: OnceLock<Mutex<HashMap<usize, Arc<rayon::ThreadPool>>>> = OnceLock::new();
     let mut pools = POOLS.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
     pools

@@ -8,6 +8,7 @@ pub mod aba;
 pub mod coriolis;
 pub mod crba;
 pub mod energy;
+pub mod integrate;
 pub mod jacobian;
 pub mod kinematics;
 pub mod rnea;
