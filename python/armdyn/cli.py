@@ -122,10 +122,15 @@ def cmd_simulate(args) -> int:
         if args.target is None:
             raise ValueError(f"--controller {args.controller} needs --target (joint values)")
         target = np.broadcast_to(_numbers(args.target, "--target", dof), (dof,))
-        default = {"pd": (100.0, 20.0), "pd-gravity": (100.0, 20.0), "computed-torque": (25.0, 10.0)}[args.controller]
-        kp = _numbers(args.kp, "--kp", dof) or [default[0]]
-        kd = _numbers(args.kd, "--kd", dof) or [default[1]]
-        kp, kd = np.broadcast_to(kp, (dof,)), np.broadcast_to(kd, (dof,))
+        if args.controller == "computed-torque":  # gains of the unit-inertia error dynamics
+            default = (25.0, 10.0)
+        else:  # 10 rad/s, critically damped, scaled by each joint's inertia M_ii at the target
+            from .numeric import crba
+
+            m_ii = np.diag(crba(robot, np.ascontiguousarray(target)))
+            default = (100.0 * m_ii, 20.0 * m_ii)
+        kp = np.broadcast_to(_numbers(args.kp, "--kp", dof) or default[0], (dof,))
+        kd = np.broadcast_to(_numbers(args.kd, "--kd", dof) or default[1], (dof,))
         if args.controller == "computed-torque":
             controller = ComputedTorque(kp, kd, target)
         else:
@@ -170,7 +175,10 @@ def cmd_simulate(args) -> int:
             every = max(every, -(-len(run.t) // 400))  # at most ~400 frames
             frames = np.arange(0, len(run.t), every)
             animate(robot, run.q[frames], tmp, t=run.t[frames], fps=args.fps)
+        mask = os.umask(0)
+        os.umask(mask)
         for tmp, final in done:
+            os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600 files
             os.replace(tmp, final)
         done = []
     finally:
@@ -238,8 +246,8 @@ def build_parser() -> argparse.ArgumentParser:
     m.add_argument("--controller", choices=["pd", "pd-gravity", "computed-torque"],
                    help="joint PD, PD with gravity compensation, or computed torque (default: passive)")
     m.add_argument("--target", help="controller set point, comma-separated joint values")
-    m.add_argument("--kp", help="controller gains, comma-separated (pd: 100, computed-torque: 25)")
-    m.add_argument("--kd", help="controller damping, comma-separated (pd: 20, computed-torque: 10)")
+    m.add_argument("--kp", help="controller gains, comma-separated (pd: 100 M_ii(target), computed-torque: 25)")
+    m.add_argument("--kd", help="controller damping, comma-separated (pd: 20 M_ii(target), computed-torque: 10)")
     m.add_argument("--stride", type=int, help="store every k-th step (default: about 2000 samples)")
     m.add_argument("--plot", help="write q, qd, tau and energy plots here (.png/.svg/.pdf)")
     m.add_argument("--animate", help="write an animation of the arm here (.gif)")

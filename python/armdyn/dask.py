@@ -40,23 +40,28 @@ def _arrays(dof: int, chunks, *xs):
             x = da.from_array(np.asarray(x, dtype=float), chunks=(chunks, dof) if chunks else "auto")
         if x.ndim != 2 or x.shape[1] != dof:
             raise ValueError(f"argument {k}: shape {x.shape}, expected (N, {dof})")
-        x = x.astype(float).rechunk({1: -1} if k == 0 else {0: out[0].chunks[0], 1: -1})
         if k and x.shape != out[0].shape:
             raise ValueError(f"argument {k}: shape {x.shape} does not match {out[0].shape}")
+        x = x.astype(float).rechunk({1: -1} if k == 0 else {0: out[0].chunks[0], 1: -1})
         out.append(x)
     return out
 
 
+def _c(*xs):
+    # blocks received over the network can be unaligned; the core needs aligned C arrays
+    return [np.require(x, dtype=float, requirements=["C", "A"]) for x in xs]
+
+
 def _rnea(q, qd, qdd, model, threads):
-    return model.rnea(q, qd, qdd, threads)
+    return model.rnea(*_c(q, qd, qdd), threads)
 
 
 def _aba(q, qd, tau, model, threads):
-    return model.aba(q, qd, tau, threads)
+    return model.aba(*_c(q, qd, tau), threads)
 
 
 def _crba(q, model, threads):
-    return model.crba(q, threads)
+    return model.crba(*_c(q), threads)
 
 
 def rnea(robot, q, qd, qdd, *, chunks=None, threads=1):
@@ -89,6 +94,7 @@ _FLAGS = ("limit_step", "limit_joint", "nonfinite_step")
 def _simulate(q0, qd0, model, options, samples, energies, threads):
     from .simulate import simulate as run_simulation
 
+    q0, qd0 = _c(q0, qd0)
     run = run_simulation(model, q0, qd0, energies=energies, threads=threads, **options)
     rows, dof = q0.shape
     parts = [np.stack([run.q, run.qd, run.qdd, run.tau], axis=2).reshape(rows, -1)]

@@ -76,6 +76,9 @@ def plot_trajectory(run, out=None, *, state: int = 0, title: str | None = None):
         os.close(fd)
         try:
             fig.savefig(tmp, dpi=100)
+            mask = os.umask(0)
+            os.umask(mask)
+            os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600 files
             os.replace(tmp, out)
         finally:
             plt.close(fig)

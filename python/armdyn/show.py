@@ -289,6 +289,9 @@ def animate(robot, q, out, *, t=None, fps: float = 25.0, title: str | None = Non
     try:
         images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
                        duration=max(20, round(1000 / fps)), loop=0)
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600 files
         os.replace(tmp, out)
     finally:
         if os.path.exists(tmp):

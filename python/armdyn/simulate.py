@@ -159,6 +159,11 @@ def joint_limits(robot) -> tuple[np.ndarray, np.ndarray]:
     return lower, upper
 
 
+def _c(a):
+    """C-contiguous, aligned float64 (arrays received over a network can be unaligned)."""
+    return np.require(a, dtype=float, requirements=["C", "A"])
+
+
 def _available_bytes() -> int:
     try:
         return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
@@ -182,7 +187,7 @@ def _per_joint(x, name, dof):
     a = np.broadcast_to(np.asarray(x, dtype=float), (dof,)) if np.ndim(x) == 0 else np.asarray(x, dtype=float)
     if a.shape != (dof,) or not np.all(np.isfinite(a)):
         raise ValueError(f"{name}: expected a finite scalar or ({dof},) values, got shape {a.shape}")
-    return np.ascontiguousarray(a)
+    return _c(a)
 
 
 def _per_state(x, name, rows, dof):
@@ -191,7 +196,7 @@ def _per_state(x, name, rows, dof):
     a = np.asarray(x, dtype=float)
     if a.shape not in ((dof,), (rows, dof)) or not np.all(np.isfinite(a)):
         raise ValueError(f"{name}: expected finite ({dof},) or ({rows}, {dof}) values, got shape {a.shape}")
-    return np.ascontiguousarray(np.broadcast_to(a, (rows, dof)))
+    return _c(np.broadcast_to(a, (rows, dof)))
 
 
 def _steps(duration, steps, dt) -> int:
@@ -242,12 +247,12 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
     stride = int(stride)
     q0a = _state(q0, "q0", dof)
     single = q0a.ndim == 1
-    q0a = np.ascontiguousarray(np.atleast_2d(q0a))
+    q0a = _c(np.atleast_2d(q0a))
     rows = q0a.shape[0]
     qd0a = np.zeros_like(q0a) if qd0 is None else _state(qd0, "qd0", dof)
     if qd0a.shape not in ((dof,), (rows, dof)):
         raise ValueError(f"qd0: shape {qd0a.shape} does not match q0's {q0a.shape}")
-    qd0a = np.ascontiguousarray(np.broadcast_to(qd0a, (rows, dof)))
+    qd0a = _c(np.broadcast_to(qd0a, (rows, dof)))
     lower, upper = joint_limits(robot) if limits is None else (
         _per_joint(limits[0], "limits[0] (lower)", dof), _per_joint(limits[1], "limits[1] (upper)", dof))
 
@@ -293,7 +298,7 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
                 raise ValueError(
                     f"torque: shape {tau.shape}; expected ({dof},) constant, ({steps}, {dof}) one row per step, "
                     f"or ({rows}, {steps}, {dof}) one series per state")
-            args["torque"] = np.ascontiguousarray(tau)
+            args["torque"] = _c(tau)
         out = _simulate_rust(model, q0a, qd0a, kind, args, dt, steps, stride, method, lower, upper, threads, progress)
 
     t = np.arange(samples) * (stride * dt)
@@ -332,7 +337,7 @@ def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower,
         if kind == "series":
             tau = tau[done:done + k]
         elif kind == "series-per-state":
-            tau = np.ascontiguousarray(tau[:, done:done + k])
+            tau = _c(tau[:, done:done + k])
         part = call(q, qd, k, tau)
         if out is None:
             out = {name: np.empty((rows, samples, dof)) for name in ("q", "qd", "qdd", "tau")}
@@ -375,7 +380,7 @@ def _simulate_python(model, q0, qd0, torque, dt, steps, stride, method, lower, u
         if tau.shape not in ((dof,), (rows, dof)):
             raise ValueError(f"torque callable returned shape {tau.shape} at step {k} (t = {t:.6g} s); "
                              f"expected ({dof},) or ({rows}, {dof})")
-        return np.ascontiguousarray(np.broadcast_to(tau, (rows, dof)))
+        return _c(np.broadcast_to(tau, (rows, dof)))
 
     def acc(k, t, q, qd):
         tau = tau_at(k, t, q, qd)
@@ -453,7 +458,7 @@ def simulate_adaptive(robot, q0, qd0=None, *, duration, torque=None, rtol=1e-10,
                     t_eval=t_eval)
     if not sol.success:
         raise ValueError(f"solve_ivp failed: {sol.message}")
-    q, qd = np.ascontiguousarray(sol.y[:dof].T), np.ascontiguousarray(sol.y[dof:].T)
+    q, qd = _c(sol.y[:dof].T), _c(sol.y[dof:].T)
     tau = np.array([tau_of(t, a, b) for t, a, b in zip(sol.t, q, qd)], dtype=float).reshape(len(sol.t), dof)
     qdd = model.aba(q, qd, tau, None)
     lower, upper = joint_limits(robot)

@@ -39,8 +39,15 @@ fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
 /// else converted once by `numpy.ascontiguousarray(obj, dtype=float64)`.
 fn as_f64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
-        if a.is_c_contiguous() {
+        // (aligned too: arrays received over a network, e.g. Dask results, can be
+        // C-contiguous but not 8-byte aligned, and rust-numpy then gives no slice)
+        if a.is_c_contiguous() && (a.data() as usize) % std::mem::align_of::<f64>() == 0 {
             return Ok(a.clone());
+        }
+        // an unaligned one: ascontiguousarray would return it as is, so copy it
+        if a.is_c_contiguous() {
+            let copy = a.call_method0("copy")?;
+            return Ok(copy.cast_into::<PyArrayDyn<f64>>()?);
         }
     }
     static ASCONTIGUOUS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
