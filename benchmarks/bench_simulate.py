@@ -18,10 +18,11 @@ integrator).
 * MuJoCo: ``rollout.rollout(model, [data] * threads, x0, nstep=steps, state=buf)`` into a
   preallocated state buffer (every state stored: rollout always does), in blocks of
   ``--block`` states to bound memory (a block of 1000 states x 1000 steps is ~100 MB).
-* Robotics Toolbox: ``rtb.models.DH.UR5().fdyn(T, q0, qd0=qd0, solver="RK45",
-  solver_args={"max_step": dt})``, its own UR5 (DH table and Corke's dynamic parameters,
-  not the URDF), timed per trajectory on a few trajectories (SciPy's RK45 with steps of at
-  most dt; scipy offers no fixed-step RK4 in that interface).
+* Robotics Toolbox: ``robot.fdyn(T, q0, qd0=qd0, solver="RK45", solver_args={"max_step":
+  dt})`` on a DHRobot built from armdyn's bundled ``ur5.yaml`` (RTB's own ``models.DH.UR5``
+  has a singular inertia matrix, so fdyn fails on it), checked against armdyn's aba first;
+  timed per trajectory on a few trajectories (SciPy's RK45 with steps of at most dt: scipy
+  offers no fixed-step RK4 in that interface; 6 evaluations per step against RK4's 4).
 
 Reported: median seconds over ``--repeat`` runs (runs alternate between libraries),
 simulated steps per second (states x steps / time), and ratios armdyn / other.
@@ -64,6 +65,29 @@ def urdf_path() -> str:
     return hits[0]
 
 
+def rtb_ur5():
+    """Robotics Toolbox DHRobot of armdyn's bundled UR5 (standard DH, UR's masses and
+    centres of mass, cylinder inertias; ``python/armdyn/robots/ur5.yaml``). RTB's own
+    ``models.DH.UR5`` has a singular M (links without inertia) and fdyn fails on it."""
+    import roboticstoolbox as rtb
+    import yaml
+
+    here = os.path.dirname(os.path.abspath(__file__))
+    with open(os.path.join(here, "..", "python", "armdyn", "robots", "ur5.yaml")) as f:
+        table = yaml.safe_load(f)["dh"]
+    links = []
+    for row in table:
+        alpha = {"pi/2": np.pi / 2, "-pi/2": -np.pi / 2, "0": 0.0}[str(row["alpha"])]
+        i = row["inertia"]
+        inertia = [[i.get("ixx", 0), i.get("ixy", 0), i.get("ixz", 0)],
+                   [i.get("ixy", 0), i.get("iyy", 0), i.get("iyz", 0)],
+                   [i.get("ixz", 0), i.get("iyz", 0), i.get("izz", 0)]]
+        links.append(rtb.RevoluteDH(d=float(row["d"]), a=float(row["a"]), alpha=alpha, m=float(row["mass"]),
+                                    r=[float(c) for c in row["com"]], I=np.array(inertia, dtype=float), G=0, Jm=0))
+    robot = rtb.DHRobot(links, name="ur5-armdyn", gravity=[0, 0, -9.81])
+    return robot
+
+
 def median_time(f, repeat: int) -> float:
     times = []
     for _ in range(repeat):
@@ -88,7 +112,16 @@ def main() -> None:
         args.states, args.repeat, args.rtb_trajectories = 1000, 2, 1
     n, steps, dt, threads = args.states, args.steps, args.dt, args.threads
 
-    path = urdf_path()
+    import re
+    import tempfile
+
+    # without <visual>/<collision> (meshes MuJoCo would try to open; no contacts anyway)
+    text = open(urdf_path()).read()
+    text = re.sub(r"<(visual|collision)\b.*?</\1>", "", text, flags=re.S)
+    folder = tempfile.mkdtemp()
+    path = os.path.join(folder, "ur5_robot.urdf")
+    with open(path, "w") as f:
+        f.write(text)
     ur5 = armdyn.load(path)
     dof = ur5.dof
     rng = np.random.default_rng(0)
@@ -138,14 +171,11 @@ def main() -> None:
             return buf
 
         # same model, same integrator: the final positions agree
-        out = run_mujoco()
-        last = n - ((n - 1) // block) * block  # states in the last block
         first_block = rollout.rollout(mj, datas, x0[:8], nstep=steps)[0]
         ours = run_armdyn(steps)
         err = np.abs(first_block[:, -1, qpos] - ours.q_final[:8]).max()
         print(f"# check: MuJoCo vs armdyn final q, 8 states after {steps} steps: max |diff| = {err:.2e}")
         assert err < 1e-6, err
-        del out, last
         timers["MuJoCo rollout"] = run_mujoco
 
     names = list(timers)
@@ -162,7 +192,12 @@ def main() -> None:
     except ImportError as err:
         print(f"# Robotics Toolbox: not importable ({err})")
     else:
-        robot = rtb.models.DH.UR5()
+        robot = rtb_ur5()
+        arm = armdyn.load("ur5")
+        x = rng.uniform(-1, 1, (3, dof))
+        err = np.abs(robot.accel(x[0], x[1], x[2]) - armdyn.aba(arm, x[0], x[1], x[2])).max()
+        print(f"# check: RTB accel vs armdyn aba on ur5.yaml: max |diff| = {err:.2e}")
+        assert err < 1e-9, err
         T = steps * dt
         per = []
         for i in range(args.rtb_trajectories):

@@ -152,10 +152,13 @@ def joint_limits(robot) -> tuple[np.ndarray, np.ndarray]:
             i = robot.coordinate_index(j)
             if i is None:
                 continue
-            if j.lower is not None:
-                lower[i] = float(j.lower.subs(robot.defaults) if hasattr(j.lower, "subs") else j.lower)
-            if j.upper is not None:
-                upper[i] = float(j.upper.subs(robot.defaults) if hasattr(j.upper, "subs") else j.upper)
+            for bound, out in ((j.lower, lower), (j.upper, upper)):
+                if bound is None:
+                    continue
+                try:
+                    out[i] = float(bound.subs(robot.defaults) if hasattr(bound, "subs") else bound)
+                except (TypeError, ValueError):  # a symbolic limit without a value: none
+                    pass
     return lower, upper
 
 
