@@ -58,8 +58,10 @@ __all__ = ["simulate", "simulate_adaptive", "Trajectory", "PD", "ComputedTorque"
 @dataclass(frozen=True)
 class PD:
     """Joint PD control toward ``target``: ``tau = Kp (q* - q) + Kd (qd* - qd)``, plus
-    ``g(q)`` when ``gravity_compensation`` (PD with gravity compensation drives a
-    passive-free arm to any set point: Takegaki & Arimoto 1981).
+    ``g(q)`` when ``gravity_compensation`` (PD with gravity compensation drives an arm
+    without friction to any set point: Takegaki & Arimoto 1981). Scale the gains with the
+    joint inertias (e.g. ``kp = w**2 * diag(M)``): a light wrist with a large ``kd`` is a
+    stiff system that RK4 at dt = 1e-3 cannot integrate stably.
 
     kp, kd: scalars or (dof,) diagonal gains (N m/rad, N m s/rad); target: (dof,) or
     (N, dof); target_qd: same shapes, default zero. Evaluated in Rust at every stage.
