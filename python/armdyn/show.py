@@ -30,7 +30,7 @@ import sympy as sp
 from .errors import ModelError
 from .model import Robot
 
-__all__ = ["show", "table", "frame_poses", "numeric_robot"]
+__all__ = ["show", "table", "frame_poses", "numeric_robot", "draw_on", "animate"]
 
 AXIS_COLOURS = {"revolute": "tab:orange", "prismatic": "tab:purple"}
 
@@ -166,11 +166,28 @@ def draw(robot: Robot, q=None, out=None, title: str | None = None):
     q = _coordinates(robot, q)
     poses = frame_poses(robot, q)
     origins = np.array([T[:3, 3] for T in poses.values()])
-    size = _reach(origins)
-    triad, arrow = 0.08 * size, 0.12 * size
-
     fig = plt.figure(figsize=(7, 7))
     ax = fig.add_subplot(projection="3d")
+    qtext = ", ".join(f"{v:.3g}" for v in q)
+    draw_on(ax, robot, poses, title or f"{robot.name} at q = [{qtext}]", _view(origins))
+    if out is not None:
+        fig.savefig(out, dpi=110, bbox_inches="tight")
+        plt.close(fig)
+    return fig
+
+
+def _view(origins: np.ndarray) -> tuple[np.ndarray, float]:
+    """Centre (3,) and size (m) of a view holding the points ``origins`` (k, 3)."""
+    return (origins.max(axis=0) + origins.min(axis=0)) / 2, _reach(origins)
+
+
+def draw_on(ax, robot: Robot, poses: dict[str, np.ndarray], title: str, view: tuple[np.ndarray, float]):
+    """Draw the arm with link frame ``poses`` (link name -> (4, 4), base frame) on the 3-D
+    axes ``ax``; ``view`` = (centre (3,), size in m) of the box shown (see the module
+    docstring for what is drawn). Used by :func:`draw` and for animation frames."""
+    origins = np.array([T[:3, 3] for T in poses.values()])
+    centre, size = view
+    triad, arrow = 0.08 * size, 0.12 * size
     for j in robot.joints:
         a, b = poses[j.parent][:3, 3], poses[j.child][:3, 3]
         ax.plot(*zip(a, b), color="0.45", linewidth=3, solid_capstyle="round")
@@ -195,7 +212,6 @@ def draw(robot: Robot, q=None, out=None, title: str | None = None):
             ax.scatter(*c, color="black", s=10 + 80 * m / heaviest, alpha=0.6, depthshade=False)
 
     # equal scales on the three axes, so the arm is not distorted
-    centre = (origins.max(axis=0) + origins.min(axis=0)) / 2
     half = 0.6 * size
     ax.set_xlim(centre[0] - half, centre[0] + half)
     ax.set_ylim(centre[1] - half, centre[1] + half)
@@ -204,12 +220,7 @@ def draw(robot: Robot, q=None, out=None, title: str | None = None):
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_zlabel("z (m)")
-    qtext = ", ".join(f"{v:.3g}" for v in q)
-    ax.set_title(title or f"{robot.name} at q = [{qtext}]", fontsize=10)
-    if out is not None:
-        fig.savefig(out, dpi=110, bbox_inches="tight")
-        plt.close(fig)
-    return fig
+    ax.set_title(title, fontsize=10)
 
 
 def show(robot, q=None, out=None) -> str:
@@ -225,3 +236,67 @@ def show(robot, q=None, out=None) -> str:
     if out is not None:
         draw(robot, q, out)
     return text
+
+
+# ------------------------------------------------------------------ animation
+
+
+def animate(robot, q, out, *, t=None, fps: float = 25.0, title: str | None = None, dpi: int = 80) -> int:
+    """Write a GIF of the arm moving through the joint coordinates ``q`` (frames, dof), one
+    frame per row, drawn as :func:`draw` draws it (same view box for every frame). ``t``
+    (frames,): times shown in the title (s). GIFs are written by Pillow (no video tools
+    needed), first to a temporary file next to ``out`` and then renamed, so an error never
+    leaves half a file. Returns the number of frames.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from PIL import Image
+
+    from .io import load
+    from .numeric import forward_kinematics
+
+    if not isinstance(robot, Robot):
+        robot = load(robot)
+    robot = numeric_robot(robot)
+    q = np.asarray(q, dtype=float)
+    if q.ndim != 2 or q.shape[1] != robot.dof or len(q) == 0:
+        raise ValueError(f"q: shape {q.shape}, expected (frames, {robot.dof}) with at least one frame")
+    if not np.all(np.isfinite(q)):
+        raise ValueError("q contains NaN or inf")
+    if not (np.isfinite(fps) and fps > 0):
+        raise ValueError(f"fps must be positive, got {fps}")
+    if not str(out).lower().endswith(".gif"):
+        raise ValueError(f"{out}: animations are written as GIF (give a .gif name)")
+    poses = np.asarray(forward_kinematics(robot, np.ascontiguousarray(q)))  # (frames, nlinks, 4, 4)
+    names = list(robot.links)
+    view = _view(poses[:, :, :3, 3].reshape(-1, 3))
+    fig = plt.figure(figsize=(6, 6), dpi=dpi)
+    ax = fig.add_subplot(projection="3d")
+    images = []
+    for k in range(len(q)):
+        ax.cla()
+        when = f"t = {t[k]:.2f} s" if t is not None else f"frame {k}"
+        draw_on(ax, robot, dict(zip(names, poses[k])), f"{title or robot.name}: {when}", view)
+        fig.canvas.draw()
+        rgba = np.asarray(fig.canvas.buffer_rgba())
+        images.append(Image.fromarray(rgba[..., :3].copy()).quantize(colors=64, method=Image.Quantize.MEDIANCUT))
+    plt.close(fig)
+    import os
+    import tempfile
+
+    folder = os.path.dirname(os.path.abspath(out))
+    fd, tmp = tempfile.mkstemp(suffix=".gif", dir=folder)
+    os.close(fd)
+    try:
+        images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
+                       duration=max(20, round(1000 / fps)), loop=0)
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600 files
+        os.replace(tmp, out)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+    return len(images)

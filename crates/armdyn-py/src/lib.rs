@@ -16,12 +16,13 @@ use numpy::{PyArray, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
-use pyo3::types::{PyFloat, PyString};
+use pyo3::types::{PyFloat, PyString, PyTuple};
 use std::collections::HashMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 
 mod derivatives;
+mod simulate;
 
 /// Run `f`, turning a Rust panic into a Python `RuntimeError`.
 fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
@@ -39,8 +40,15 @@ fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
 /// else converted once by `numpy.ascontiguousarray(obj, dtype=float64)`.
 fn as_f64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
-        if a.is_c_contiguous() {
+        // (aligned too: arrays received over a network, e.g. Dask results, can be
+        // C-contiguous but not 8-byte aligned, and rust-numpy then gives no slice)
+        if a.is_c_contiguous() && (a.data() as usize) % std::mem::align_of::<f64>() == 0 {
             return Ok(a.clone());
+        }
+        // an unaligned one: ascontiguousarray would return it as is, so copy it
+        if a.is_c_contiguous() {
+            let copy = a.call_method0("copy")?;
+            return Ok(copy.cast_into::<PyArrayDyn<f64>>()?);
         }
     }
     static ASCONTIGUOUS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
@@ -173,6 +181,8 @@ pub struct NumericModel {
     link_names: Vec<String>,
     link_index: HashMap<String, usize>,
     coordinate_names: Vec<String>,
+    /// The constructor's arguments, for pickling (`__reduce__`).
+    init_args: Py<PyTuple>,
 }
 
 impl NumericModel {
@@ -257,6 +267,7 @@ impl NumericModel {
     #[pyo3(signature = (parents, types, rotations, translations, axes, masses, coms, inertias, gravity, link_names, coordinate_names, name = String::new(), base_mass = 0.0, base_com = [0.0; 3]))]
     #[allow(clippy::too_many_arguments)]
     fn new(
+        py: Python<'_>,
         parents: Vec<i64>,
         types: Vec<i64>,
         rotations: Vec<[[f64; 3]; 3]>,
@@ -273,6 +284,23 @@ impl NumericModel {
         base_com: [f64; 3],
     ) -> PyResult<Self> {
         guard(|| {
+            let init_args = PyTuple::new(py, [
+                parents.clone().into_pyobject(py)?.into_any(),
+                types.clone().into_pyobject(py)?.into_any(),
+                rotations.clone().into_pyobject(py)?.into_any(),
+                translations.clone().into_pyobject(py)?.into_any(),
+                axes.clone().into_pyobject(py)?.into_any(),
+                masses.clone().into_pyobject(py)?.into_any(),
+                coms.clone().into_pyobject(py)?.into_any(),
+                inertias.clone().into_pyobject(py)?.into_any(),
+                gravity.into_pyobject(py)?.into_any(),
+                link_names.clone().into_pyobject(py)?.into_any(),
+                coordinate_names.clone().into_pyobject(py)?.into_any(),
+                name.clone().into_pyobject(py)?.into_any(),
+                base_mass.into_pyobject(py)?.into_any(),
+                base_com.into_pyobject(py)?.into_any(),
+            ])?
+            .unbind();
             let nj = parents.len();
             let lens = [types.len(), rotations.len(), translations.len(), axes.len(), masses.len(), coms.len(), inertias.len()];
             if lens.iter().any(|&l| l != nj) || link_names.len() != nj + 1 {
@@ -325,7 +353,7 @@ impl NumericModel {
             }
             let link_index = link_names.iter().enumerate().map(|(k, s)| (s.clone(), k)).collect();
             let scratch = Mutex::new(Scratch::new(&model));
-            Ok(NumericModel { model, scratch, name, link_names, link_index, coordinate_names })
+            Ok(NumericModel { model, scratch, name, link_names, link_index, coordinate_names, init_args })
         })
     }
 
@@ -363,6 +391,12 @@ impl NumericModel {
     #[getter(_numeric_model)]
     fn compiled_self(slf: Bound<'_, Self>) -> Bound<'_, Self> {
         slf
+    }
+
+    /// Pickling rebuilds the model from its constructor's arguments (so it travels to
+    /// other processes, e.g. Dask workers).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> (Bound<'py, pyo3::types::PyType>, Bound<'py, PyTuple>) {
+        (slf.get_type(), slf.get().init_args.bind(slf.py()).clone())
     }
 
     fn __repr__(&self) -> String {
@@ -610,5 +644,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simd_kernels, m)?)?;
     derivatives::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    simulate::register(m)?;
     Ok(())
 }

@@ -11,6 +11,7 @@ pub mod crba;
 pub mod energy;
 pub mod external;
 pub mod gravity_derivatives;
+pub mod integrate;
 pub mod jacobian;
 pub mod jacobian_dot;
 pub mod kinematics;

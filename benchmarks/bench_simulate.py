@@ -1,0 +1,235 @@
+"""armdyn.simulate vs MuJoCo's mujoco.rollout and Robotics Toolbox's fdyn, side by side in
+one process, on the UR5.
+
+    PYTHONPATH=python python3 benchmarks/bench_simulate.py            # N = 1e4 states x 1000 steps
+    PYTHONPATH=python python3 benchmarks/bench_simulate.py --quick    # N = 1e3
+
+The model: example-robot-data's ``ur5_robot.urdf``, loaded by armdyn (``armdyn.load``) and
+by MuJoCo (``mujoco.MjModel.from_xml_path``, which compiles URDF), no actuators, zero
+damping/friction; MuJoCo with contacts and all constraints disabled
+(``mjDSBL_CONSTRAINT``: no joint-limit forces either), ``mjINT_RK4``, ``timestep = dt``.
+Both integrate the same N random initial states (q uniform in [-pi, pi], qd in [-1, 1]),
+passive, for ``--steps`` steps of dt = 1e-3 on ``--threads`` threads; before timing, the
+final states of the first states are compared (they must agree to 1e-6: same model, same
+integrator).
+
+* armdyn: ``simulate(ur5, Q0, QD0, dt, steps, stride, threads)``, the whole batch in one
+  call; ``stride`` = steps (first and last states stored) and = 1 (every state, as MuJoCo).
+* MuJoCo: ``rollout.rollout(model, [data] * threads, x0, nstep=steps, state=buf)`` into a
+  preallocated state buffer (every state stored: rollout always does), in blocks of
+  ``--block`` states to bound memory (a block of 1000 states x 1000 steps is ~100 MB).
+* Robotics Toolbox: ``robot.fdyn(T, q0, qd0=qd0, solver="RK45", solver_args={"max_step":
+  dt})`` on a DHRobot built from armdyn's bundled ``ur5.yaml`` (RTB's own ``models.DH.UR5``
+  has a singular inertia matrix, so fdyn fails on it), checked against armdyn's aba first;
+  timed per trajectory on a few trajectories (SciPy's RK45 with steps of at most dt: scipy
+  offers no fixed-step RK4 in that interface; 6 evaluations per step against RK4's 4).
+
+Reported: median seconds over ``--repeat`` runs (runs alternate between libraries),
+simulated steps per second (states x steps / time), and ratios armdyn / other.
+Also the peak memory (tracemalloc) of armdyn with stride = steps vs stride = 1.
+
+Not a test: timings depend on the machine and its load.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import sys
+import time
+import tracemalloc
+
+import numpy as np
+
+import armdyn
+from armdyn.simulate import simulate
+
+URDF = "ur_description/urdf/ur5_robot.urdf"
+
+
+def urdf_path() -> str:
+    try:
+        import example_robot_data
+
+        return example_robot_data.getModelPath(URDF) + "/" + URDF
+    except ImportError:
+        pass
+    import glob
+
+    hits = glob.glob(os.path.join(sys.prefix, "lib", "python*", "site-packages", "cmeel.prefix", "share",
+                                  "example-robot-data", "robots", URDF))
+    if not hits:
+        sys.exit(f"cannot find example-robot-data's {URDF}: pip install example-robot-data")
+    return hits[0]
+
+
+def rtb_ur5():
+    """Robotics Toolbox DHRobot of armdyn's bundled UR5 (standard DH, UR's masses and
+    centres of mass, cylinder inertias; ``python/armdyn/robots/ur5.yaml``). RTB's own
+    ``models.DH.UR5`` has a singular M (links without inertia) and fdyn fails on it."""
+    import roboticstoolbox as rtb
+    import yaml
+
+    here = os.path.dirname(os.path.abspath(__file__))
+    with open(os.path.join(here, "..", "python", "armdyn", "robots", "ur5.yaml")) as f:
+        table = yaml.safe_load(f)["dh"]
+    links = []
+    for row in table:
+        alpha = {"pi/2": np.pi / 2, "-pi/2": -np.pi / 2, "0": 0.0}[str(row["alpha"])]
+        i = row["inertia"]
+        inertia = [[i.get("ixx", 0), i.get("ixy", 0), i.get("ixz", 0)],
+                   [i.get("ixy", 0), i.get("iyy", 0), i.get("iyz", 0)],
+                   [i.get("ixz", 0), i.get("iyz", 0), i.get("izz", 0)]]
+        links.append(rtb.RevoluteDH(d=float(row["d"]), a=float(row["a"]), alpha=alpha, m=float(row["mass"]),
+                                    r=[float(c) for c in row["com"]], I=np.array(inertia, dtype=float), G=0, Jm=0))
+    robot = rtb.DHRobot(links, name="ur5-armdyn", gravity=[0, 0, -9.81])
+    return robot
+
+
+def median_time(f, repeat: int) -> float:
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        f()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--states", type=int, default=10_000)
+    p.add_argument("--steps", type=int, default=1000)
+    p.add_argument("--dt", type=float, default=1e-3)
+    p.add_argument("--threads", type=int, default=2)
+    p.add_argument("--repeat", type=int, default=3)
+    p.add_argument("--block", type=int, default=1000, help="MuJoCo states per rollout call")
+    p.add_argument("--rtb-trajectories", type=int, default=3)
+    p.add_argument("--quick", action="store_true")
+    args = p.parse_args()
+    if args.quick:
+        args.states, args.repeat, args.rtb_trajectories = 1000, 2, 1
+    n, steps, dt, threads = args.states, args.steps, args.dt, args.threads
+
+    import re
+    import tempfile
+
+    # without <visual>/<collision> (meshes MuJoCo would try to open; no contacts anyway)
+    text = open(urdf_path()).read()
+    text = re.sub(r"<(visual|collision)\b.*?</\1>", "", text, flags=re.S)
+    folder = tempfile.mkdtemp()
+    path = os.path.join(folder, "ur5_robot.urdf")
+    with open(path, "w") as f:
+        f.write(text)
+    ur5 = armdyn.load(path)
+    dof = ur5.dof
+    rng = np.random.default_rng(0)
+    q0 = rng.uniform(-np.pi, np.pi, (n, dof))
+    qd0 = rng.uniform(-1, 1, (n, dof))
+    print(f"# UR5 from {os.path.basename(path)}, {n} states x {steps} steps, dt = {dt}, {threads} threads")
+    print(f"# {platform.processor() or platform.machine()}, {os.cpu_count()} cores, simd {armdyn.numeric._core.simd_kernels()}")
+
+    results = {}
+
+    def run_armdyn(stride):
+        return simulate(ur5, q0, qd0, dt=dt, steps=steps, stride=stride, threads=threads, energies=False)
+
+    timers = {"armdyn (stride = steps)": lambda: run_armdyn(steps), "armdyn (stride = 1)": lambda: run_armdyn(1)}
+
+    try:
+        import mujoco
+        from mujoco import rollout
+    except ImportError:
+        mujoco = None
+        print("# MuJoCo: not installed (pip install mujoco)")
+    if mujoco is not None:
+        mj = mujoco.MjModel.from_xml_path(path)
+        assert mj.nv == dof and mj.nu == 0, (mj.nv, mj.nu)
+        mj.opt.timestep = dt
+        mj.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
+        mj.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_CONTACT
+        mj.dof_damping[:] = 0
+        mj.dof_armature[:] = 0
+        mj.dof_frictionloss[:] = 0
+        datas = [mujoco.MjData(mj) for _ in range(threads)]
+        spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+        nstate = mujoco.mj_stateSize(mj, spec)
+        x0 = np.zeros((n, nstate))
+        d = datas[0]
+        for i in range(n):
+            d.qpos[:], d.qvel[:], d.time = q0[i], qd0[i], 0.0
+            mujoco.mj_getState(mj, d, x0[i], spec)
+        block = min(args.block, n)
+        buf = np.empty((block, steps, nstate))
+        qpos = slice(1, 1 + mj.nq)  # FULLPHYSICS: time, qpos, qvel, ...
+
+        def run_mujoco():
+            for b in range(0, n, block):
+                k = min(block, n - b)
+                rollout.rollout(mj, datas, x0[b:b + k], nstep=steps, state=buf[:k], persistent_pool=True)
+            return buf
+
+        # same model, same integrator: the final positions agree
+        first_block = rollout.rollout(mj, datas, x0[:8], nstep=steps)[0]
+        ours = run_armdyn(steps)
+        err = np.abs(first_block[:, -1, qpos] - ours.q_final[:8]).max()
+        print(f"# check: MuJoCo vs armdyn final q, 8 states after {steps} steps: max |diff| = {err:.2e}")
+        assert err < 1e-6, err
+        timers["MuJoCo rollout"] = run_mujoco
+
+    names = list(timers)
+    times = {k: [] for k in names}
+    for _ in range(args.repeat):
+        for k in names:
+            times[k].append(median_time(timers[k], 1))
+    for k in names:
+        results[k] = statistics.median(times[k])
+
+    rtb_per_traj = None
+    try:
+        import roboticstoolbox as rtb
+    except ImportError as err:
+        print(f"# Robotics Toolbox: not importable ({err})")
+    else:
+        robot = rtb_ur5()
+        arm = armdyn.load("ur5")
+        x = rng.uniform(-1, 1, (3, dof))
+        err = np.abs(robot.accel(x[0], x[1], x[2]) - armdyn.aba(arm, x[0], x[1], x[2])).max()
+        print(f"# check: RTB accel vs armdyn aba on ur5.yaml: max |diff| = {err:.2e}")
+        assert err < 1e-9, err
+        T = steps * dt
+        per = []
+        for i in range(args.rtb_trajectories):
+            t0 = time.perf_counter()
+            robot.fdyn(T, q0[i], qd0=qd0[i], solver="RK45", solver_args={"max_step": dt})
+            per.append(time.perf_counter() - t0)
+        rtb_per_traj = statistics.median(per)
+
+    print()
+    print(f"{'':28s} {'time (s)':>10s} {'steps/s':>12s} {'per trajectory':>15s}")
+    for k in names:
+        t = results[k]
+        print(f"{k:28s} {t:10.3f} {n * steps / t:12.3e} {t / n * 1e6:12.1f} us")
+    if rtb_per_traj is not None:
+        print(f"{'Robotics Toolbox fdyn':28s} {'':10s} {steps / rtb_per_traj:12.3e} {rtb_per_traj * 1e6:12.1f} us"
+              f"   (median of {args.rtb_trajectories} trajectories, 1 thread)")
+    print()
+    for k in names[:2]:
+        if "MuJoCo rollout" in results:
+            print(f"throughput {k} / MuJoCo rollout: {results['MuJoCo rollout'] / results[k]:.2f}x")
+        if rtb_per_traj is not None:
+            print(f"per trajectory, {k} vs RTB fdyn: {rtb_per_traj / (results[k] / n):.0f}x faster")
+
+    # memory: what is stored decides the peak
+    for stride in (steps, 10, 1):
+        tracemalloc.start()
+        simulate(ur5, q0[:1000], qd0[:1000], dt=dt, steps=steps, stride=stride, threads=threads, energies=False)
+        _, peak = tracemalloc.get_traced_memory()
+        tracemalloc.stop()
+        stored = 4 * 1000 * (steps // stride + 1) * dof * 8
+        print(f"memory, 1000 states, stride {stride:4d}: peak {peak / 2**20:8.1f} MiB, stored arrays {stored / 2**20:8.1f} MiB")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,154 @@
+"""armdyn's numeric API over Dask arrays: the same functions, for batches that do not fit
+one machine (or one process).
+
+    import dask.array as da
+    from armdyn import dask as ad
+    q = da.from_array(q_np, chunks=(100_000, -1))     # (N, dof), chunked along states
+    tau = ad.rnea(ur5, q, qd, qdd)                    # lazy (N, dof); .compute() anywhere
+    run = ad.simulate(ur5, q0, dt=1e-3, steps=1000, stride=10)   # lazy arrays of a Trajectory
+
+Every function maps the Rust core over blocks of rows with ``dask.array.map_blocks``;
+the compiled model (``armdyn.NumericModel``) pickles (it is rebuilt from its
+description), so the graph runs on any scheduler: threads, processes, or a
+``distributed`` cluster (``dask-jobqueue`` on a batch system, ``dask-kubernetes``...).
+Inputs are ``(N, dof)`` arrays (Dask, or NumPy which is wrapped with ``chunks``), chunked
+along the states only (the joint axis is made one chunk). Within a block the core uses
+``threads`` threads (default 1: Dask provides the parallelism across blocks). Results
+equal the in-process functions bit for bit (each row is computed alone, whatever the
+blocking).
+
+Conventions (DESIGN.md): SI units, radians; ``M(q) qdd + C(q, qd) qd + g(q) = tau``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .numeric import _model
+
+__all__ = ["rnea", "aba", "crba", "simulate"]
+
+
+def _arrays(dof: int, chunks, *xs):
+    """Dask arrays (N, dof) with the joint axis in one chunk and row chunks aligned to the
+    first argument's."""
+    import dask.array as da
+
+    out = []
+    for k, x in enumerate(xs):
+        if not isinstance(x, da.Array):
+            x = da.from_array(np.asarray(x, dtype=float), chunks=(chunks, dof) if chunks else "auto")
+        if x.ndim != 2 or x.shape[1] != dof:
+            raise ValueError(f"argument {k}: shape {x.shape}, expected (N, {dof})")
+        if k and x.shape != out[0].shape:
+            raise ValueError(f"argument {k}: shape {x.shape} does not match {out[0].shape}")
+        x = x.astype(float).rechunk({1: -1} if k == 0 else {0: out[0].chunks[0], 1: -1})
+        out.append(x)
+    return out
+
+
+def _c(*xs):
+    # blocks received over the network can be unaligned; the core needs aligned C arrays
+    return [np.require(x, dtype=float, requirements=["C", "A"]) for x in xs]
+
+
+def _rnea(q, qd, qdd, model, threads):
+    return model.rnea(*_c(q, qd, qdd), threads)
+
+
+def _aba(q, qd, tau, model, threads):
+    return model.aba(*_c(q, qd, tau), threads)
+
+
+def _crba(q, model, threads):
+    return model.crba(*_c(q), threads)
+
+
+def rnea(robot, q, qd, qdd, *, chunks=None, threads=1):
+    """Lazy inverse dynamics ``tau = M qdd + C qd + g``: (N, dof) Dask arrays in and out.
+    NumPy inputs are wrapped with ``chunks`` rows per block (default: Dask's "auto")."""
+    model = _model(robot)
+    q, qd, qdd = _arrays(model.dof, chunks, q, qd, qdd)
+    return q.map_blocks(_rnea, qd, qdd, model=model, threads=threads, dtype=float, meta=np.empty((0, 0)))
+
+
+def aba(robot, q, qd, tau, *, chunks=None, threads=1):
+    """Lazy forward dynamics ``qdd = M^-1 (tau - C qd - g)``: (N, dof) in and out."""
+    model = _model(robot)
+    q, qd, tau = _arrays(model.dof, chunks, q, qd, tau)
+    return q.map_blocks(_aba, qd, tau, model=model, threads=threads, dtype=float, meta=np.empty((0, 0)))
+
+
+def crba(robot, q, *, chunks=None, threads=1):
+    """Lazy joint-space inertia matrices: q (N, dof) -> M (N, dof, dof)."""
+    model = _model(robot)
+    (q,) = _arrays(model.dof, chunks, q)
+    n = model.dof
+    return q.map_blocks(_crba, model=model, threads=threads, dtype=float, meta=np.empty((0, 0, 0)), new_axis=2, chunks=(q.chunks[0], (n,), (n,)))
+
+
+_PER_ROW = ("q_final", "qd_final")
+_FLAGS = ("limit_step", "limit_joint", "nonfinite_step")
+
+
+def _simulate(q0, qd0, model, options, samples, energies, threads):
+    from .simulate import simulate as run_simulation
+
+    q0, qd0 = _c(q0, qd0)
+    run = run_simulation(model, q0, qd0, energies=energies, threads=threads, **options)
+    rows, dof = q0.shape
+    parts = [np.stack([run.q, run.qd, run.qdd, run.tau], axis=2).reshape(rows, -1)]
+    if energies:
+        parts.append(np.stack([run.kinetic, run.potential], axis=2).reshape(rows, -1))
+    parts += [run.q_final, run.qd_final] + [np.asarray(getattr(run, f), dtype=float)[:, None] for f in _FLAGS]
+    return np.concatenate(parts, axis=1)
+
+
+def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4", torque=None,
+             controller=None, stride=1, energies=True, limits=None, chunks=None, threads=1):
+    """Lazy :func:`armdyn.simulate.simulate` of the states ``q0``, ``qd0`` (N, dof), one
+    block of rows per task. Returns a :class:`armdyn.simulate.Trajectory` whose arrays are
+    Dask arrays (``t`` is NumPy): ``q``, ``qd``, ``qdd``, ``tau`` (N, S, dof); ``kinetic``,
+    ``potential`` (N, S); ``q_final``, ``qd_final`` (N, dof); ``limit_step``,
+    ``limit_joint``, ``nonfinite_step`` (N,) int64. ``torque`` may be None, (dof,) or
+    (steps, dof) (shared by all states); a controller's targets are (dof,).
+    """
+    import dask.array as da
+
+    from .simulate import PD, ComputedTorque, Trajectory, _steps, joint_limits
+
+    model = _model(robot)
+    dof = model.dof
+    steps = _steps(duration, steps, dt)
+    if torque is not None and (callable(torque) or np.ndim(torque) > 2):
+        raise ValueError("armdyn.dask.simulate: torque must be None, (dof,) or (steps, dof)")
+    if isinstance(controller, (PD, ComputedTorque)) and np.ndim(controller.target) > 1:
+        raise ValueError("armdyn.dask.simulate: the controller's target must be (dof,)")
+    if qd0 is None:
+        qd0 = da.zeros_like(q0) if isinstance(q0, da.Array) else np.zeros(np.shape(q0))
+    q0, qd0 = _arrays(dof, chunks, q0, qd0)
+    if limits is None:
+        limits = joint_limits(robot)
+    options = dict(dt=dt, steps=steps, method=method, torque=torque, controller=controller, stride=stride,
+                   limits=limits)
+    samples = steps // stride + 1
+    width = samples * dof * 4 + (2 * samples if energies else 0) + 2 * dof + len(_FLAGS)
+    packed = q0.map_blocks(_simulate, qd0, model=model, options=options, samples=samples, energies=energies,
+                           threads=threads, dtype=float, meta=np.empty((0, 0)),
+                           chunks=(q0.chunks[0], (width,)))
+    n = q0.shape[0]
+    at = samples * dof * 4
+    states = packed[:, :at].reshape(n, samples, 4, dof)
+    out = {name: states[:, :, k, :] for k, name in enumerate(("q", "qd", "qdd", "tau"))}
+    kinetic = potential = None
+    if energies:
+        e = packed[:, at:at + 2 * samples].reshape(n, samples, 2)
+        kinetic, potential = e[:, :, 0], e[:, :, 1]
+        at += 2 * samples
+    out["q_final"], out["qd_final"] = packed[:, at:at + dof], packed[:, at + dof:at + 2 * dof]
+    at += 2 * dof
+    for k, name in enumerate(_FLAGS):
+        out[name] = packed[:, at + k].astype(np.int64)
+    t = np.arange(samples) * (stride * float(dt))
+    return Trajectory(t=t, dt=float(dt), stride=stride, method=method, coordinate_names=list(model.coordinate_names),
+                      kinetic=kinetic, potential=potential, **out)

@@ -1,0 +1,87 @@
+"""Plots of a simulation (:class:`armdyn.simulate.Trajectory`) with matplotlib.
+
+``plot_trajectory(run, out="run.png")`` draws five panels against time (s):
+joint positions q (rad or m), velocities qd, torques tau (N m or N), the kinetic,
+potential and total energy (J), and the drift of the total energy
+``(E(t) - E(0)) / max(|E(0)|, max T)`` (dimensionless), whose size says how well the
+integrator conserved energy (it should stay tiny for a passive arm without friction,
+and it measures the work of the torques otherwise).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["plot_trajectory"]
+
+
+def plot_trajectory(run, out=None, *, state: int = 0, title: str | None = None):
+    """Figure of ``run`` (one state of a batch: row ``state``); saved to ``out`` (PNG, SVG,
+    PDF by extension) if given, written to a temporary file first so that an error
+    leaves nothing half-written. Returns the figure (closed when saved)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    def pick(a):
+        if a is None:
+            return None
+        a = np.asarray(a)
+        batch = run.q.ndim == 3
+        if batch and not 0 <= state < run.q.shape[0]:
+            raise ValueError(f"state {state} out of range 0..{run.q.shape[0] - 1}")
+        return a[state] if batch else a
+
+    t = run.t
+    q, qd, tau = pick(run.q), pick(run.qd), pick(run.tau)
+    kinetic, potential = pick(run.kinetic), pick(run.potential)
+    names = run.coordinate_names or [f"q{i}" for i in range(q.shape[1])]
+    panels = 5 if kinetic is not None else 3
+    fig, axes = plt.subplots(panels, 1, figsize=(8, 2.1 * panels), sharex=True)
+    for ax, values, label in zip(axes, (q, qd, tau), ("q (rad, m)", "qd (rad/s, m/s)", "tau (N m, N)")):
+        for i, name in enumerate(names):
+            ax.plot(t, values[:, i], label=name, linewidth=1.2)
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=7, ncol=min(len(names), 4), loc="upper right")
+    if kinetic is not None:
+        total = kinetic + potential
+        ax = axes[3]
+        ax.plot(t, kinetic, label="kinetic T")
+        ax.plot(t, potential, label="potential V")
+        ax.plot(t, total, label="total E = T + V", color="black", linewidth=1.5)
+        ax.set_ylabel("energy (J)")
+        ax.legend(fontsize=7, loc="upper right")
+        ax.grid(alpha=0.3)
+        scale = max(abs(total[0]), kinetic.max(), 1e-300)
+        drift = (total - total[0]) / scale
+        ax = axes[4]
+        ax.plot(t, drift, color="tab:red")
+        ax.set_ylabel("(E - E0) / scale")
+        ax.set_title(f"energy drift: max |E - E0| / scale = {np.abs(drift).max():.2e}", fontsize=9)
+        ax.grid(alpha=0.3)
+    axes[-1].set_xlabel("t (s)")
+    method = {"rk4": "RK4", "euler": "semi-implicit Euler"}.get(run.method, run.method)
+    step = f"dt = {run.dt:g} s" if np.isfinite(run.dt) else "adaptive step"
+    fig.suptitle(title or f"simulation: {method}, {step}", fontsize=11)
+    fig.tight_layout()
+    if out is not None:
+        import os
+        import tempfile
+
+        folder = os.path.dirname(os.path.abspath(out))
+        ext = os.path.splitext(str(out))[1] or ".png"
+        fd, tmp = tempfile.mkstemp(suffix=ext, dir=folder)
+        os.close(fd)
+        try:
+            fig.savefig(tmp, dpi=100)
+            mask = os.umask(0)
+            os.umask(mask)
+            os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600 files
+            os.replace(tmp, out)
+        finally:
+            plt.close(fig)
+            if os.path.exists(tmp):
+                os.remove(tmp)
+    return fig

@@ -1,0 +1,478 @@
+"""Simulation: integrate the forward dynamics of a robot from one or many initial states.
+
+    import armdyn
+    from armdyn.simulate import simulate, PD
+    ur5 = armdyn.load("ur5")
+    run = simulate(ur5, q0, duration=2.0, dt=1e-3)                  # passive, RK4
+    run = simulate(ur5, q0s, duration=2.0, dt=1e-3, stride=10)      # (N, dof) states, every 10th step kept
+    run = simulate(ur5, q0, duration=2.0, dt=1e-3, controller=PD(kp=100, kd=20, target=q_star))
+    run.q, run.qd, run.qdd, run.tau     # (S, dof), or (N, S, dof) for a batch
+    run.t, run.energy, run.energy_drift()
+
+Conventions: SI units, radians; the equation of motion is ``M(q) qdd + C(q, qd) qd + g(q)
+= tau`` with gravity the robot's vector in the base frame (DESIGN.md); forward dynamics is
+the Rust core's articulated-body algorithm (``armdyn.aba``), so whatever the model's
+``aba`` includes (joint friction, damping, rotor inertia where the model has them) is
+integrated. Joint order: ``robot.coordinate_names``.
+
+Three ways to integrate:
+
+* :func:`simulate`, fixed step, ``method="rk4"`` (classical Runge-Kutta, 4 ``aba`` per
+  step) or ``"euler"`` (semi-implicit / symplectic Euler, 1 ``aba`` per step). The loop
+  runs in Rust over all states in parallel (SIMD lanes and threads), with no Python in
+  it -- unless ``torque`` is a Python callable, the documented slow path (a NumPy loop
+  calling the callable once per stage with every state at once).
+* :func:`simulate_adaptive`: one trajectory with SciPy's ``solve_ivp`` (error control,
+  ``DOP853`` by default) over the same ``aba``.
+
+Torque: ``None`` (passive); a constant ``(dof,)``; a series ``(steps, dof)`` for every
+state or ``(N, steps, dof)`` one per state (row ``k`` acts over ``[t_k, t_k + dt)``);
+a controller run in Rust at every integrator stage (:class:`PD`,
+:class:`ComputedTorque`); or a callable ``torque(t, q, qd) -> tau`` with ``q``, ``qd``
+``(N, dof)`` and ``tau`` ``(dof,)`` or ``(N, dof)``.
+
+Joint limits (from the robot's joints, or ``limits=(lower, upper)``) are reported, never
+enforced: :attr:`Trajectory.limit_step` / :attr:`Trajectory.limit_joint` give, per state,
+the first step at which a joint is outside its range and which joint.
+
+Memory: only every ``stride``-th step is stored, so memory is proportional to what is
+kept (``N * (steps // stride + 1) * dof`` values per array); a run whose stored samples
+would not fit in the available memory (or ``max_bytes``) is refused before it starts.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from . import _core
+from .numeric import _model, kinetic_energy, potential_energy
+
+__all__ = ["simulate", "simulate_adaptive", "Trajectory", "PD", "ComputedTorque", "joint_limits"]
+
+
+@dataclass(frozen=True)
+class PD:
+    """Joint PD control toward ``target``: ``tau = Kp (q* - q) + Kd (qd* - qd)``, plus
+    ``g(q)`` when ``gravity_compensation`` (PD with gravity compensation drives an arm
+    without friction to any set point: Takegaki & Arimoto 1981). Scale the gains with the
+    joint inertias (e.g. ``kp = w**2 * diag(M)``): a light wrist with a large ``kd`` is a
+    stiff system that RK4 at dt = 1e-3 cannot integrate stably.
+
+    kp, kd: scalars or (dof,) diagonal gains (N m/rad, N m s/rad); target: (dof,) or
+    (N, dof); target_qd: same shapes, default zero. Evaluated in Rust at every stage.
+    """
+
+    kp: object
+    kd: object
+    target: object
+    target_qd: object = None
+    gravity_compensation: bool = True
+
+
+@dataclass(frozen=True)
+class ComputedTorque:
+    """Computed-torque control (inverse dynamics): ``tau = rnea(q, qd, Kp e + Kd ed)``
+    with ``e = q* - q``, ``ed = qd* - qd``; the closed loop is ``e'' + Kd e' + Kp e = 0``
+    when ``qd* = 0`` and the model is exact (Spong, Hutchinson & Vidyasagar, eq. 8.58).
+
+    kp, kd: scalars or (dof,) (1/s^2, 1/s); target, target_qd: (dof,) or (N, dof).
+    """
+
+    kp: object
+    kd: object
+    target: object
+    target_qd: object = None
+
+
+@dataclass
+class Trajectory:
+    """A simulation's stored samples.
+
+    For a single initial state (``q0`` of shape ``(dof,)``) arrays are ``(S, dof)`` and
+    ``(S,)``; for a batch they are ``(N, S, dof)`` and ``(N, S)``. ``S`` samples at times
+    ``t`` (``(S,)``, seconds). ``qdd`` and ``tau`` are the acceleration and torque at each
+    stored state. Energies (J): kinetic ``1/2 qd^T M qd``, potential ``-sum m g . p_c``,
+    and their sum ``energy``; None when ``energies=False``.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    tau: np.ndarray
+    q_final: np.ndarray
+    qd_final: np.ndarray
+    limit_step: np.ndarray
+    limit_joint: np.ndarray
+    nonfinite_step: np.ndarray
+    dt: float
+    stride: int
+    method: str
+    coordinate_names: list = field(default_factory=list)
+    kinetic: np.ndarray | None = None
+    potential: np.ndarray | None = None
+
+    @property
+    def energy(self):
+        """Total energy ``kinetic + potential`` (J), or None."""
+        return None if self.kinetic is None else self.kinetic + self.potential
+
+    def energy_drift(self):
+        """Largest ``|E(t) - E(0)| / max(|E(0)|, max_t T(t))`` per state (a float for a single
+        state): the relative drift of the total energy. The denominator guards against
+        ``E(0) = 0`` (a zero of potential energy is arbitrary)."""
+        e = self.energy
+        if e is None:
+            raise ValueError("energies were not computed (energies=False)")
+        scale = np.maximum(np.abs(e[..., :1]), self.kinetic.max(axis=-1, keepdims=True))
+        out = (np.abs(e - e[..., :1]) / scale).max(axis=-1)
+        return float(out) if out.ndim == 0 else out
+
+    def limit_crossings(self) -> list[tuple[int, int, float, str]]:
+        """``(state, step, time, joint name)`` for every state that crossed a joint limit
+        (its first crossing)."""
+        steps = np.atleast_1d(self.limit_step)
+        joints = np.atleast_1d(self.limit_joint)
+        return [(int(i), int(steps[i]), float(steps[i] * self.dt), self.coordinate_names[joints[i]])
+                for i in np.flatnonzero(steps >= 0)]
+
+
+def joint_limits(robot) -> tuple[np.ndarray, np.ndarray]:
+    """``(lower, upper)`` (dof,) of the robot's movable joints (``-inf``/``inf`` where a
+    joint has none, or when ``robot`` is a compiled model without the description)."""
+    from .model import Robot
+
+    model = _model(robot)
+    lower, upper = np.full(model.dof, -np.inf), np.full(model.dof, np.inf)
+    if isinstance(robot, Robot):
+        for j in robot.joints:
+            i = robot.coordinate_index(j)
+            if i is None:
+                continue
+            for bound, out in ((j.lower, lower), (j.upper, upper)):
+                if bound is None:
+                    continue
+                try:
+                    out[i] = float(bound.subs(robot.defaults) if hasattr(bound, "subs") else bound)
+                except (TypeError, ValueError):  # a symbolic limit without a value: none
+                    pass
+    return lower, upper
+
+
+def _c(a):
+    """C-contiguous, aligned float64 (arrays received over a network can be unaligned)."""
+    return np.require(a, dtype=float, requirements=["C", "A"])
+
+
+def _available_bytes() -> int:
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return 8 << 30
+
+
+def _state(x, name, dof):
+    try:
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: cannot be read as an array of numbers") from None
+    if a.ndim not in (1, 2) or a.shape[-1] != dof:
+        raise ValueError(f"{name}: shape {a.shape}, expected ({dof},) or (N, {dof})")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} contains NaN or inf")
+    return a
+
+
+def _per_joint(x, name, dof):
+    a = np.broadcast_to(np.asarray(x, dtype=float), (dof,)) if np.ndim(x) == 0 else np.asarray(x, dtype=float)
+    if a.shape != (dof,) or not np.all(np.isfinite(a)):
+        raise ValueError(f"{name}: expected a finite scalar or ({dof},) values, got shape {a.shape}")
+    return _c(a)
+
+
+def _per_state(x, name, rows, dof):
+    if x is None:
+        return np.zeros((rows, dof))
+    a = np.asarray(x, dtype=float)
+    if a.shape not in ((dof,), (rows, dof)) or not np.all(np.isfinite(a)):
+        raise ValueError(f"{name}: expected finite ({dof},) or ({rows}, {dof}) values, got shape {a.shape}")
+    return _c(np.broadcast_to(a, (rows, dof)))
+
+
+def _steps(duration, steps, dt) -> int:
+    if not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt) and dt > 0):
+        raise ValueError(f"dt must be a positive finite number of seconds, got {dt!r}")
+    if (duration is None) == (steps is None):
+        raise ValueError("give exactly one of duration (seconds) and steps")
+    if steps is None:
+        if not (math.isfinite(duration) and duration > 0):
+            raise ValueError(f"duration must be a positive finite number of seconds, got {duration!r}")
+        steps = round(duration / dt)
+        if abs(steps * dt - duration) > 1e-9 * max(duration, 1.0):
+            raise ValueError(f"duration {duration} is not a whole number of steps of dt = {dt}")
+    if int(steps) != steps or steps < 1:
+        raise ValueError(f"steps must be a positive integer, got {steps!r}")
+    if steps > 1 << 40:
+        raise ValueError(f"{steps} steps is more than armdyn integrates in one call")
+    return int(steps)
+
+
+def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4", torque=None,
+             controller=None, stride=1, energies=True, limits=None, threads=None, max_bytes=None,
+             progress: Callable[[int, int], None] | None = None) -> Trajectory:
+    """Integrate from ``q0``, ``qd0`` ((dof,) or (N, dof); ``qd0`` default zero) with a fixed
+    step ``dt`` (s) for ``duration`` seconds (a whole number of steps) or ``steps`` steps.
+
+    method: ``"rk4"`` or ``"euler"`` (semi-implicit). torque / controller: see the module
+    docstring (at most one of them). stride: store every ``stride``-th step (the first
+    and, when ``steps`` is a multiple of ``stride``, the last state included; the last
+    state is always in ``q_final``, ``qd_final``). energies: also compute kinetic and
+    potential energy of every stored sample. limits: ``(lower, upper)`` (dof,) or None
+    for the robot's own. threads: None = all cores. max_bytes: refuse runs whose stored
+    samples need more (default: the available memory). progress: called as
+    ``progress(steps_done, steps)`` during the run (the run is then cut into ~100
+    pieces; the result is the same bit for bit).
+
+    Bad input (shapes, NaN, a non-positive dt, a duration that is not a whole number of
+    steps, a run that would not fit in memory) raises ``ValueError`` naming it.
+    """
+    model = _model(robot)
+    dof = model.dof
+    steps = _steps(duration, steps, dt)
+    dt = float(dt)
+    if method not in ("rk4", "euler"):
+        raise ValueError(f"method must be 'rk4' or 'euler', got {method!r}")
+    if int(stride) != stride or stride < 1:
+        raise ValueError(f"stride must be a positive integer, got {stride!r}")
+    stride = int(stride)
+    q0a = _state(q0, "q0", dof)
+    single = q0a.ndim == 1
+    q0a = _c(np.atleast_2d(q0a))
+    rows = q0a.shape[0]
+    qd0a = np.zeros_like(q0a) if qd0 is None else _state(qd0, "qd0", dof)
+    if qd0a.shape not in ((dof,), (rows, dof)):
+        raise ValueError(f"qd0: shape {qd0a.shape} does not match q0's {q0a.shape}")
+    qd0a = _c(np.broadcast_to(qd0a, (rows, dof)))
+    lower, upper = joint_limits(robot) if limits is None else (
+        _per_joint(limits[0], "limits[0] (lower)", dof), _per_joint(limits[1], "limits[1] (upper)", dof))
+
+    samples = steps // stride + 1
+    need = (4 * samples * dof + (3 * samples if energies else 0)) * rows * 8
+    budget = _available_bytes() if max_bytes is None else max_bytes
+    if need > budget:
+        raise ValueError(
+            f"storing {rows} x {samples} samples of {dof} joints needs {need / 2**30:.2f} GiB, more than "
+            f"the {budget / 2**30:.2f} GiB available: store fewer samples (stride), states or steps")
+
+    if torque is not None and controller is not None:
+        raise ValueError("give torque or controller, not both")
+    empty = np.zeros(0)
+    args = dict(torque=empty, kp=empty, kd=empty, target=empty, target_qd=empty)
+    if callable(torque):
+        out = _simulate_python(model, q0a, qd0a, torque, dt, steps, stride, method, lower, upper)
+    else:
+        if controller is not None:
+            if isinstance(controller, PD):
+                kind = "pd-gravity" if controller.gravity_compensation else "pd"
+            elif isinstance(controller, ComputedTorque):
+                kind = "computed-torque"
+            else:
+                raise ValueError(f"controller must be an armdyn.simulate.PD or ComputedTorque, got {type(controller).__name__}")
+            args.update(kp=_per_joint(controller.kp, "controller.kp", dof),
+                        kd=_per_joint(controller.kd, "controller.kd", dof),
+                        target=_per_state(controller.target, "controller.target", rows, dof),
+                        target_qd=_per_state(controller.target_qd, "controller.target_qd", rows, dof))
+        elif torque is None:
+            kind = "zero"
+        else:
+            tau = np.asarray(torque, dtype=float)
+            if not np.all(np.isfinite(tau)):
+                raise ValueError("torque contains NaN or inf")
+            if tau.shape == (dof,):
+                kind, tau = "constant", np.broadcast_to(tau, (rows, dof))
+            elif tau.shape == (steps, dof):
+                kind = "series"
+            elif tau.shape == (rows, steps, dof):
+                kind = "series-per-state"
+            else:
+                raise ValueError(
+                    f"torque: shape {tau.shape}; expected ({dof},) constant, ({steps}, {dof}) one row per step, "
+                    f"or ({rows}, {steps}, {dof}) one series per state")
+            args["torque"] = _c(tau)
+        out = _simulate_rust(model, q0a, qd0a, kind, args, dt, steps, stride, method, lower, upper, threads, progress)
+
+    t = np.arange(samples) * (stride * dt)
+    run = Trajectory(t=t, dt=dt, stride=stride, method=method, coordinate_names=list(model.coordinate_names), **out)
+    if energies:
+        flat_q, flat_qd = run.q.reshape(-1, dof), run.qd.reshape(-1, dof)
+        run.kinetic = kinetic_energy(model, flat_q, flat_qd, threads=threads).reshape(rows, samples)
+        run.potential = potential_energy(model, flat_q, threads=threads).reshape(rows, samples)
+    if single:
+        for name in ("q", "qd", "qdd", "tau", "q_final", "qd_final", "kinetic", "potential"):
+            if getattr(run, name) is not None:
+                setattr(run, name, getattr(run, name)[0])
+        for name in ("limit_step", "limit_joint", "nonfinite_step"):
+            setattr(run, name, int(getattr(run, name)[0]))
+    return run
+
+
+def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower, upper, threads, progress):
+    call = lambda q, qd, k, tau: _core._simulate(  # noqa: E731
+        model, q, qd, dt, k, stride, method, kind, tau, args["kp"], args["kd"], args["target"],
+        args["target_qd"], lower, upper, threads)
+    if progress is None:
+        return call(q0, qd0, steps, args["torque"])
+    # In pieces of whole strides: each piece continues from the last one's final state,
+    # its first sample replaces the last one's final sample (same state, and the torque
+    # of the next step, as in one call).
+    rows, dof = q0.shape
+    samples = steps // stride + 1
+    piece = max(1, steps // stride // 100) * stride
+    out = None
+    q, qd, done = q0, qd0, 0
+    progress(0, steps)
+    while done < steps:
+        k = min(piece, steps - done)
+        tau = args["torque"]
+        if kind == "series":
+            tau = tau[done:done + k]
+        elif kind == "series-per-state":
+            tau = _c(tau[:, done:done + k])
+        part = call(q, qd, k, tau)
+        if out is None:
+            out = {name: np.empty((rows, samples, dof)) for name in ("q", "qd", "qdd", "tau")}
+            for name in ("limit_step", "limit_joint", "nonfinite_step"):
+                out[name] = np.full(rows, -1, dtype=np.int64)
+        first = done // stride
+        n = part["q"].shape[1]
+        for name in ("q", "qd", "qdd", "tau"):
+            out[name][:, first:first + n] = part[name]
+        for name in ("limit_step", "nonfinite_step"):
+            new = (out[name] < 0) & (part[name] >= 0)
+            if name == "limit_step":
+                out["limit_joint"][new] = part["limit_joint"][new]
+            out[name][new] = part[name][new] + done
+        q, qd, done = part["q_final"], part["qd_final"], done + k
+        progress(done, steps)
+    out["q_final"], out["qd_final"] = q, qd
+    return out
+
+
+def _simulate_python(model, q0, qd0, torque, dt, steps, stride, method, lower, upper):
+    """The slow path: a NumPy loop calling ``torque(t, q, qd)`` (q, qd (N, dof)) at every
+    stage, ``aba`` batched over the states in Rust."""
+    rows, dof = q0.shape
+    samples = steps // stride + 1
+    out = {name: np.empty((rows, samples, dof)) for name in ("q", "qd", "qdd", "tau")}
+    limit_step = np.full(rows, -1, dtype=np.int64)
+    limit_joint = np.full(rows, -1, dtype=np.int64)
+    nonfinite = np.full(rows, -1, dtype=np.int64)
+
+    def tau_at(k, t, q, qd):
+        try:
+            tau = torque(t, q.copy(), qd.copy())
+        except Exception as err:  # noqa: BLE001 - the user's error, shown with the step
+            raise ValueError(f"torque callable failed at step {k} (t = {t:.6g} s): {type(err).__name__}: {err}") from err
+        try:
+            tau = np.asarray(tau, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"torque callable returned a non-numeric value at step {k} (t = {t:.6g} s)") from None
+        if tau.shape not in ((dof,), (rows, dof)):
+            raise ValueError(f"torque callable returned shape {tau.shape} at step {k} (t = {t:.6g} s); "
+                             f"expected ({dof},) or ({rows}, {dof})")
+        return _c(np.broadcast_to(tau, (rows, dof)))
+
+    def acc(k, t, q, qd):
+        tau = tau_at(k, t, q, qd)
+        return model.aba(q, qd, tau, None), tau
+
+    def check(k, q, qd):
+        outside = (q < lower) | (q > upper)
+        new = (limit_step < 0) & outside.any(axis=1)
+        limit_step[new], limit_joint[new] = k, outside[new].argmax(axis=1)
+        bad = (nonfinite < 0) & ~np.isfinite(q + qd).all(axis=1)
+        nonfinite[bad] = k
+
+    q, qd = q0.copy(), qd0.copy()
+    check(0, q, qd)
+    h = dt
+    for k in range(steps + 1):
+        t = k * dt
+        if k < steps or k % stride == 0:
+            a1, tau1 = acc(k, t, q, qd)
+        if k % stride == 0:
+            s = k // stride
+            out["q"][:, s], out["qd"][:, s], out["qdd"][:, s], out["tau"][:, s] = q, qd, a1, tau1
+        if k == steps:
+            break
+        if method == "euler":
+            qd = qd + h * a1
+            q = q + h * qd
+        else:
+            q2, qd2 = q + h / 2 * qd, qd + h / 2 * a1
+            a2, _ = acc(k, t + h / 2, q2, qd2)
+            q3, qd3 = q + h / 2 * qd2, qd + h / 2 * a2
+            a3, _ = acc(k, t + h / 2, q3, qd3)
+            q4, qd4 = q + h * qd3, qd + h * a3
+            a4, _ = acc(k, t + h, q4, qd4)
+            q = q + h / 6 * (qd + 2 * qd2 + 2 * qd3 + qd4)
+            qd = qd + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+        check(k + 1, q, qd)
+    out.update(q_final=q, qd_final=qd, limit_step=limit_step, limit_joint=limit_joint, nonfinite_step=nonfinite)
+    return out
+
+
+def simulate_adaptive(robot, q0, qd0=None, *, duration, torque=None, rtol=1e-10, atol=1e-12,
+                      method="DOP853", t_eval=None) -> Trajectory:
+    """One trajectory with SciPy's ``solve_ivp`` (adaptive step, error control) on ``aba``.
+
+    q0, qd0: (dof,). torque: None, (dof,) constant, or a callable ``torque(t, q, qd)``
+    with q, qd (dof,) returning (dof,). t_eval: the sample times (default: 101 evenly
+    spaced over ``[0, duration]``). Returns a :class:`Trajectory` of single-state shape
+    (``dt`` is ``nan``: the steps are SciPy's).
+    """
+    from scipy.integrate import solve_ivp
+
+    model = _model(robot)
+    dof = model.dof
+    q0 = _state(q0, "q0", dof)
+    qd0 = np.zeros(dof) if qd0 is None else _state(qd0, "qd0", dof)
+    if q0.ndim != 1 or qd0.ndim != 1:
+        raise ValueError("simulate_adaptive integrates one state: q0, qd0 of shape (dof,)")
+    if not (math.isfinite(duration) and duration > 0):
+        raise ValueError(f"duration must be a positive finite number of seconds, got {duration!r}")
+    if torque is None:
+        tau_of = lambda t, q, qd: np.zeros(dof)  # noqa: E731
+    elif callable(torque):
+        tau_of = torque
+    else:
+        const = _per_joint(torque, "torque", dof)
+        tau_of = lambda t, q, qd: const  # noqa: E731
+    t_eval = np.linspace(0.0, duration, 101) if t_eval is None else np.asarray(t_eval, dtype=float)
+
+    def f(t, x):
+        q, qd = x[:dof], x[dof:]
+        return np.concatenate([qd, model.aba(q, qd, np.asarray(tau_of(t, q, qd), dtype=float), None)])
+
+    sol = solve_ivp(f, (0.0, duration), np.concatenate([q0, qd0]), method=method, rtol=rtol, atol=atol,
+                    t_eval=t_eval)
+    if not sol.success:
+        raise ValueError(f"solve_ivp failed: {sol.message}")
+    q, qd = _c(sol.y[:dof].T), _c(sol.y[dof:].T)
+    tau = np.array([tau_of(t, a, b) for t, a, b in zip(sol.t, q, qd)], dtype=float).reshape(len(sol.t), dof)
+    qdd = model.aba(q, qd, tau, None)
+    lower, upper = joint_limits(robot)
+    outside = (q < lower) | (q > upper)
+    first = int(np.flatnonzero(outside.any(axis=1))[0]) if outside.any() else -1
+    run = Trajectory(t=sol.t, q=q, qd=qd, qdd=qdd, tau=tau, q_final=q[-1], qd_final=qd[-1],
+                     limit_step=first, limit_joint=int(outside[first].argmax()) if first >= 0 else -1,
+                     nonfinite_step=-1, dt=float("nan"), stride=1, method=method,
+                     coordinate_names=list(model.coordinate_names))
+    run.kinetic = kinetic_energy(model, q, qd)
+    run.potential = potential_energy(model, q)
+    return run
