@@ -55,7 +55,15 @@ def test_formats(capsys, fmt, marker):
 def test_check_command(capsys):
     code, out, _ = run(capsys, "check", "planar-2r")
     assert code == 0
-    assert "Mdot - 2C skew-symmetric" in out and "FAIL" not in out
+    assert "M qdd + C qd + g" in out and "skew" not in out and "FAIL" not in out
+
+
+def test_check_refuses_zero_samples_and_says_how_many_were_used(capsys):
+    code, out, err = run(capsys, "check", "planar-2r", "--numeric", "--samples", "0")
+    assert code == 2 and out == "" and err.startswith("armdyn: error: ") and "samples" in err
+    assert err.count("\n") == 1
+    code, out, _ = run(capsys, "check", "planar-2r", "--numeric", "--samples", "3")
+    assert code == 0 and "numeric, 3 points" in out and "3 random points" in out
 
 
 def test_robots_lists_bundled_models(capsys):

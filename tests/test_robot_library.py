@@ -23,9 +23,8 @@ import armdyn.reference as reference
 from armdyn.errors import ModelError
 from armdyn.io import bundled_robots, load
 from armdyn.show import frame_poses
-from test_urdf import compare_with_pinocchio, example_robot_data_dir, pin_configuration
-
-pin = pytest.importorskip("pinocchio")
+from optional import example_robot_data_dir, needs_pinocchio, pin
+from test_urdf import compare_with_pinocchio, pin_configuration
 
 ROBOTS = Path(__file__).resolve().parent.parent / "python" / "armdyn" / "robots"
 MINE = ["planar-3r", "scara", "stanford", "ur5", "panda", "iiwa14"]
@@ -157,12 +156,12 @@ def test_scara_tool_position_by_hand():
 
 
 def erd_urdf(relative: str) -> Path:
-    robots_dir = example_robot_data_dir()
-    if robots_dir is None:
-        pytest.skip("example-robot-data is not installed")
-    return robots_dir / relative
+    path = example_robot_data_dir() / relative
+    assert path.is_file(), f"example-robot-data has no {relative}"
+    return path
 
 
+@needs_pinocchio
 def test_panda_agrees_with_example_robot_data():
     """example-robot-data's panda.urdf (franka_ros) is the same arm plus the Franka Hand
     (whose second finger is a mimic joint). With the hand removed (panda_hand_joint and
@@ -216,6 +215,7 @@ def _transplant_inertials(urdf: Path, robot, base_frame: str) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
+@needs_pinocchio
 def test_ur5_agrees_with_example_robot_data():
     """example-robot-data's ur5_robot.urdf (ROS-Industrial ur_description, kinetic) and
     the bundled UR5 describe the same arm with different frames and different inertial

@@ -46,6 +46,8 @@ def cmd_derive(args) -> int:
 def cmd_check(args) -> int:
     from .symbolic import prove_agreement
 
+    if args.samples < 1:  # before the (slow) derivation: zero samples would check nothing
+        raise ValueError(f"--samples must be at least 1, got {args.samples}")
     robot = _load(args.robot, args.allow_nonphysical)
     exact = True if args.exact else (False if args.numeric else None)
     report = prove_agreement(robot, exact=exact, samples=args.samples)
@@ -100,12 +102,12 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--timing", action="store_true", help="print derivation times to stderr")
     d.set_defaults(func=cmd_derive)
 
-    c = sub.add_parser("check", help="prove Newton-Euler == Lagrange, M symmetric, Mdot - 2C skew")
+    c = sub.add_parser("check", help="prove Newton-Euler == Lagrange, M symmetric, tau == M qdd + C qd + g")
     robot_arg(c)
     g = c.add_mutually_exclusive_group()
     g.add_argument("--exact", action="store_true", help="force exact symbolic checks")
     g.add_argument("--numeric", action="store_true", help="force checks at random numeric points")
-    c.add_argument("--samples", type=int, default=25, help="random points for numeric checks")
+    c.add_argument("--samples", type=int, default=25, help="random points for numeric checks (at least 1; the report says how many were used)")
     c.set_defaults(func=cmd_check)
 
     r = sub.add_parser("robots", help="list the bundled robot models")
