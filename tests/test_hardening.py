@@ -160,3 +160,126 @@ def test_concurrent_single_calls_agree():
     for t in ts:
         t.join()
     assert results == [True] * 4
+
+
+# ------------------------------------------------------------ hostile model files
+
+import signal  # noqa: E402
+from contextlib import contextmanager  # noqa: E402
+
+from armdyn.cli import main  # noqa: E402
+from armdyn.errors import ModelError  # noqa: E402
+from armdyn.io.yaml import load_yaml_string  # noqa: E402
+from armdyn.io.expressions import parse_expression  # noqa: E402
+
+PLANAR = (TESTS.parent / "python" / "armdyn" / "robots" / "planar-2r.yaml").read_text()
+
+
+@contextmanager
+def deadline(seconds: int):
+    """Turn a hang into a failure (the bound is generous: these take milliseconds)."""
+
+    def expired(*_):
+        raise TimeoutError(f"still running after {seconds} s")
+
+    old = signal.signal(signal.SIGALRM, expired)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+
+
+HOSTILE_EXPRESSIONS = {
+    "200 nested parentheses": ("(" * 200 + "l1" + ")" * 200, "nested more than 100 levels"),
+    "1000 unary minuses": ("-" * 1000 + "l1", "nested more than 100 levels"),
+    "150 nested calls": ("sin(" * 150 + "l1" + ")" * 150, "nested more than 100 levels"),
+    "10**10**10": ("10**10**10", "too large"),
+    "10^10^10": ("10^10^10", "too large"),
+    "(2**999)**999": ("(2**999)**999", "too large"),
+    "10**-(10**10)": ("10**-(10**10)", "too large"),
+    "sqrt(2)**(10**10)": ("sqrt(2)**(10**10)", "too large"),
+    "l1**(10**20)": ("l1**(10**20)", "too large"),
+    "(l1**1000)**1000": ("(l1**1000)**1000", "exponent beyond 1000"),
+    "1e999999": ("1e999999", "beyond the float64 range"),
+    "exp(exp(exp(100)))": ("exp(exp(exp(100)))", "not a finite real float64"),
+    "20000 characters": ("l1+" * 6667 + "1", "longer than 10000"),
+}
+
+
+@pytest.mark.parametrize("text, words", HOSTILE_EXPRESSIONS.values(), ids=HOSTILE_EXPRESSIONS.keys())
+def test_hostile_expressions_are_one_line_errors(text, words):
+    """Before: RecursionError (parentheses, minuses), or minutes to hours of SymPy
+    arithmetic (10**10**10, sp.Float('1e999999'), evalf of exp(exp(exp(100))))."""
+    l1 = __import__("sympy").Symbol("l1")
+    with deadline(20):
+        with pytest.raises(ModelError) as info:
+            parse_expression(text, {"l1": l1}, "link 'link1'", "arm.yaml", "mass")
+    message = str(info.value)
+    assert words in message and "\n" not in message and len(message) < 400
+    assert message.startswith("arm.yaml: link 'link1': mass:")
+
+
+@pytest.mark.parametrize("text", [v[0] for v in HOSTILE_EXPRESSIONS.values()][:6], ids=list(HOSTILE_EXPRESSIONS)[:6])
+def test_hostile_expression_in_a_file_is_one_cli_line(tmp_path, capsys, text):
+    path = tmp_path / "arm.yaml"
+    path.write_text(PLANAR.replace("com: [lc1, 0, 0]", f"com: ['{text}', 0, 0]"))
+    with deadline(30):
+        code = main(["show", str(path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.startswith(f"armdyn: error: {path}") and err.count("\n") == 1
+
+
+def test_ordinary_expressions_still_parse():
+    import sympy as sp
+
+    l1 = sp.Symbol("l1")
+    for text, want in [("2**3**2", 512), ("-l1**2", -(l1**2)), ("(((l1)))", l1), ("l1**1000", l1**1000),
+                       ("0.4318", sp.Float(0.4318)), ("1/12", sp.Rational(1, 12)), ("2**-3", sp.Rational(1, 8)),
+                       ("-" * 50 + "l1", l1), ("(" * 50 + "l1" + ")" * 50, l1), ("sqrt(2)**1000", 2**500)]:
+        assert parse_expression(text, {"l1": l1}) == want, text
+
+
+@pytest.mark.parametrize("value", [".nan", ".inf", "-.inf", "1.0e999999", "1e999999", str(10**400)])
+def test_published_defaults_must_be_finite(value):
+    text = PLANAR.replace("g: 9.81}", f"g: {value}}}")
+    with deadline(20):
+        with pytest.raises(ModelError, match="g") as info:
+            load_yaml_string(text, source="arm.yaml")
+    assert "finite" in str(info.value) or "float64" in str(info.value), str(info.value)
+
+
+@pytest.mark.parametrize("key", ["source", "description", "notes"])
+def test_source_and_description_must_be_text(tmp_path, capsys, key):
+    """Before: a list of 9**8 (43 million) aliased strings was accepted as the source,
+    and `armdyn show` printing it never finished."""
+    kept, skipping = [], False
+    for ln in PLANAR.splitlines():  # drop `key` (and a folded block under it)
+        if ln.startswith(f"{key}:"):
+            skipping = True
+            continue
+        if skipping and ln.startswith("  "):
+            continue
+        skipping = False
+        kept.append(ln)
+    doc = "\n".join(kept).replace("name: planar-2r", "name: planar-2r\n" + _inline_bomb(key))
+    path = tmp_path / "bomb.yaml"
+    path.write_text(doc)
+    with deadline(20):
+        code = main(["show", str(path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.startswith(f"armdyn: error: {path}") and "expected text" in err, err
+    assert err.count("\n") == 1 and len(err) < 500
+
+
+def _inline_bomb(key: str) -> str:
+    """``key:`` holding 9**8 strings through nested aliases, in one YAML value."""
+    inner = '&a ["lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol"]'
+    levels = [inner]
+    for k, name in enumerate("bcdefgh"):
+        prev = "abcdefgh"[k]
+        levels.append(f"&{name} [{', '.join([f'*{prev}'] * 9)}]")
+    # each level must be defined before use: a list whose first element defines the
+    # anchors, the last the bomb
+    return f"{key}: [{', '.join(levels)}]"
