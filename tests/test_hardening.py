@@ -283,3 +283,92 @@ def _inline_bomb(key: str) -> str:
     # each level must be defined before use: a list whose first element defines the
     # anchors, the last the bomb
     return f"{key}: [{', '.join(levels)}]"
+
+
+# ------------------------------------------------------------ data as published
+
+
+def test_version_matches_pyproject():
+    import tomllib
+
+    import armdyn
+
+    project = tomllib.loads((TESTS.parent / "pyproject.toml").read_text())["project"]
+    assert armdyn.__version__ == project["version"]
+
+
+def test_readme_points_only_inside_the_repository():
+    """The README is read by users of the repository, who do not have ../shared."""
+    root = TESTS.parent
+    text = (root / "README.md").read_text()
+    assert "../shared" not in text and "shared/reference" not in text
+    for target in re.findall(r"\]\(([^)#]+)\)", text):  # relative Markdown links resolve
+        if "://" not in target:
+            assert (root / target).exists(), target
+    assert "(docs/exercise.md)" in text
+
+
+def test_bundled_data_cite_what_they_are():
+    robots = TESTS.parent / "python" / "armdyn" / "robots"
+    puma = (robots / "puma560-craig.yaml").read_text()
+    assert "Fu, Gonzalez" in puma and "not Craig's own numbers" in puma
+    panda = (robots / "panda.yaml").read_text()
+    assert "-0.04762) is franka_ros's value" in panda
+    iiwa = (robots / "iiwa14.urdf").read_text()
+    assert "Drake's model values, not data published" in iiwa
+    ur5 = (robots / "ur5.yaml").read_text()
+    assert "recomputed for UR's 2.33 kg" in ur5
+
+
+# ------------------------------------------------------------ Robot is immutable
+
+
+def test_robot_cannot_change_under_its_compiled_model():
+    """Before: robot.gravity = ... (or joints.append, links[...] = ...) succeeded and
+    numeric calls kept using the stale compiled model."""
+    import copy
+
+    import sympy as sp
+
+    robot = arm()
+    q = np.array([0.1, 0.2, 0.3])
+    g0 = numeric.gravity(robot, q)
+    with pytest.raises(AttributeError, match="Robot is immutable: cannot set 'gravity'"):
+        robot.gravity = sp.Matrix([0, 0, 0])
+    with pytest.raises(AttributeError, match="immutable"):
+        robot.joints = []
+    with pytest.raises(AttributeError, match="immutable"):
+        del robot.links
+    with pytest.raises(TypeError, match="immutable"):
+        robot.joints.append(robot.joints[0])
+    with pytest.raises(TypeError, match="immutable"):
+        robot.links["l3"] = Link("l3", 100.0)
+    with pytest.raises(TypeError, match="immutable"):
+        robot.defaults["x"] = 1.0
+    with pytest.raises(TypeError):
+        robot.gravity[2] = 0  # an ImmutableMatrix
+    np.testing.assert_array_equal(numeric.gravity(robot, q), g0)
+
+    # building new robots still works: bind/subs, list + list, a with_* style copy
+    lighter = Robot("arm3b", [*robot.links.values()][:-1] + [Link("l3", 0.5, [0.1, 0, 0], np.eye(3) * 0.01)],
+                    robot.joints + [])
+    assert numeric.gravity(lighter, q)[1] != g0[1]
+    thawed = copy.copy(robot)
+    assert "_numeric_model" not in thawed.__dict__
+    thawed.gravity = sp.ImmutableMatrix([0, 0, 0])  # a with_* constructor may set fields
+    np.testing.assert_array_equal(numeric.gravity(thawed, q), np.zeros(3))
+    thawed.gravity = sp.ImmutableMatrix([0, 0, -1.0])  # ... and each set drops the cache
+    np.testing.assert_allclose(numeric.gravity(thawed, q), g0 / 9.81, rtol=1e-12)
+    np.testing.assert_array_equal(numeric.gravity(robot, q), g0)  # the original is untouched
+
+
+def test_published_defaults_in_the_api_must_be_finite():
+    import sympy as sp
+
+    m = sp.Symbol("m")
+    links = [Link("base"), Link("l1", m, [0.1, 0, 0], np.eye(3) * 0.01)]
+    joints = [Joint("j1", "revolute", "base", "l1")]
+    for bad in (float("nan"), float("inf"), "heavy", None):
+        with pytest.raises(ModelError, match="default value of parameter 'm' is not a finite number"):
+            Robot("r", links, joints, parameters=[m], defaults={"m": bad})
+    assert Robot("r", links, joints, parameters=[m], defaults={"m": 2}).bind().is_numeric

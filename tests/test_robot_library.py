@@ -254,6 +254,13 @@ def test_ur5_agrees_with_example_robot_data():
     compare_with_pinocchio(robot, transplanted, rng, states=3, rtol=1e-9, same_frames=False)
 
 
+def test_ur5_velocity_limits_are_the_ros2_descriptions():
+    """config/ur5/joint_limits.yaml of Universal_Robots_ROS2_Description: max_velocity
+    is 180 deg/s for every joint."""
+    robot = load("ur5")
+    assert [float(j.velocity) for j in robot.movable_joints] == [np.pi] * 6
+
+
 def test_ur5_inertials_match_the_ros2_description():
     """Universal Robots' ROS 2 description (config/ur5/physical_parameters.yaml) gives
     each link's centre of mass and cylinder tensor in its ROS link frames, which are
@@ -269,6 +276,14 @@ def test_ur5_inertials_match_the_ros2_description():
         "wrist_3_link": ((0.0, 0.0, -0.001159), (8.062475833333332e-05, 8.062475833333332e-05, 0.0001321171875), 0),
     }
     robot = bound("ur5")
+    # the description's forearm tensor is the cylinder r = 0.06, h = 0.39225 computed
+    # for 2.275 kg (it states 2.33 kg): ur5.yaml recomputes it for 2.33 kg
+    r, h, m = 0.06, 0.39225, 2.33
+    ixx, izz = ros["forearm_link"][1][0], ros["forearm_link"][1][2]
+    assert np.isclose(ixx, 2.275 / 12 * (3 * r * r + h * h), rtol=1e-15, atol=0)
+    assert np.isclose(izz, 2.275 / 2 * r * r, rtol=1e-15, atol=0)
+    ros["forearm_link"] = (ros["forearm_link"][0], (m / 12 * (3 * r * r + h * h),) * 2 + (m / 2 * r * r,), np.pi / 2)
+    assert float(robot.links["forearm_link"].mass) == m
     for name, (cog, diag, pitch) in ros.items():
         link = robot.links[name]
         ry = np.array([[np.cos(pitch), 0, np.sin(pitch)], [0, 1, 0], [-np.sin(pitch), 0, np.cos(pitch)]])
