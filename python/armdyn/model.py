@@ -337,7 +337,15 @@ class Robot(metaclass=_FreezeAfterInit):
         return new
 
     def __deepcopy__(self, memo):
-        return self  # immutable: a copy is the same robot
+        if self.__dict__.get("_frozen"):
+            return self  # immutable: a copy is the same robot
+        import copy
+
+        new = object.__new__(type(self))
+        memo[id(self)] = new
+        state = {k: v for k, v in self.__dict__.items() if k != "_numeric_model"}
+        new.__dict__.update(copy.deepcopy(state, memo))
+        return new
 
     def __init__(
         self,
