@@ -47,7 +47,7 @@ ROOT = Path(__file__).resolve().parents[1]
 ROBOTS = ROOT / "python" / "armdyn" / "robots"
 YAML_SEEDS = ["rp-arm", "planar-2r", "panda"]
 DH_SEEDS = ["planar-3r", "scara", "puma560", "puma560-craig", "ur5", "stanford"]
-CHUNK = 500
+CHUNK = 250
 
 HOSTILE = [
     float("nan"), float("inf"), -float("inf"), 1e308, -1e308, 5e-324, 0, -1, 1, 2**63, -(2**64), True, None,
@@ -353,9 +353,9 @@ def drive(kinds: list[str], count: int, timeout: float, minutes: float | None, j
               f"{t['expected_error']} clear errors, {t['unexpected']} unexpected exceptions, {t['timeout']} "
               f"timeouts (>{timeout} s), {t['crash']} crashed workers, {t['panic_on_stderr']} chunks with a "
               f"panic message on stderr", flush=True)
+        for f in [f for f in found if f["kind"] == kind][:30]:
+            print("finding:", json.dumps(f), flush=True)
     print(f"total {sum(t['inputs'] for t in total.values())} inputs in {time.monotonic() - start:.0f} s")
-    for f in found[:30]:
-        print("finding:", json.dumps(f))
     bad = sum(t["unexpected"] + t["timeout"] + t["crash"] + t["panic_on_stderr"] for t in total.values())
     return 1 if bad else 0
 
