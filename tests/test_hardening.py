@@ -289,12 +289,16 @@ def _inline_bomb(key: str) -> str:
 
 
 def test_version_matches_pyproject():
-    import tomllib
-
     import armdyn
 
-    project = tomllib.loads((TESTS.parent / "pyproject.toml").read_text())["project"]
-    assert armdyn.__version__ == project["version"]
+    text = (TESTS.parent / "pyproject.toml").read_text()
+    try:
+        import tomllib  # Python 3.11+
+
+        version = tomllib.loads(text)["project"]["version"]
+    except ImportError:  # 3.10: the [project] table's version line
+        version = re.search(r'^\[project\][^\[]*?^version\s*=\s*"([^"]+)"', text, re.M | re.S).group(1)
+    assert armdyn.__version__ == version
 
 
 def test_readme_points_only_inside_the_repository():
