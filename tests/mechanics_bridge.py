@@ -16,6 +16,18 @@ from armdyn.model import Robot
 def mechanics_tau(robot: Robot) -> sp.Matrix:
     """tau (n x 1) of ``robot`` by sympy.physics.mechanics' LagrangesMethod, in armdyn's
     plain symbols (q, qd, qdd)."""
+    eqs, names = mechanics_equations(robot)
+    return plain_symbols(eqs, names)
+
+
+def plain_symbols(eqs: sp.Matrix, names: dict) -> sp.Matrix:
+    """Mechanics' equations with q(t), q'(t), q''(t) replaced by armdyn's plain symbols
+    (one ``xreplace``: whole derivatives are matched before their q(t) inside)."""
+    return eqs.xreplace(names)
+
+
+def mechanics_equations(robot: Robot) -> tuple[sp.Matrix, dict]:
+    """(LagrangesMethod's equations in dynamic symbols, map dynamic -> plain symbols)."""
     n = robot.dof
     qs = me.dynamicsymbols(f"armdyn_q0:{n}")
     qds = [qi.diff(me.dynamicsymbols._t) for qi in qs]
@@ -52,5 +64,5 @@ def mechanics_tau(robot: Robot) -> sp.Matrix:
     for qi, qdi, a, b, c in zip(qs, qds, robot.q, robot.qd, robot.qdd):
         names[qdi.diff(me.dynamicsymbols._t)] = c
         names[qdi] = b
-    eqs = eqs.subs(names)
-    return eqs.subs(dict(zip(qs, robot.q)))
+        names[qi] = a
+    return eqs, names

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
+import unicodedata
 from pathlib import Path
 
 import pytest
@@ -25,7 +27,7 @@ def test_main_job_prints_both_methods_and_agreement(capsys):
     code, out, err = run(capsys, "derive", "rp-arm")
     assert code == 0 and err == ""
     assert "Newton-Euler:" in out and "Lagrange:" in out
-    assert out.count("tau1 =") == 2 and out.count("tau2 =") == 2
+    assert out.count("τ₁ =") == 2 and out.count("τ₂ =") == 2
     assert "[OK  ] tau: newton-euler == lagrange (exact)" in out
 
 
@@ -36,7 +38,22 @@ def test_steps_show_every_quantity_per_link(capsys):
         assert f"  {label} = " in out, label
     # the centripetal term the exercise drops from link 2's acceleration is there
     line = next(s for s in out.splitlines() if s.startswith("  v̇_C₂ = "))
-    assert "l1*theta1_dot**2" in line
+    assert "l₁*θ̇₁²" in line
+
+
+def test_text_report_writes_symbols_as_the_field_does(capsys):
+    """Before: ω̇₁ = [0, 0, 1*theta1_ddot] and 1*d2_ddot, Unicode labels beside ASCII
+    symbols."""
+    code, out, _ = run(capsys, "derive", "rp-arm", "--steps", "--method", "newton-euler")
+    assert code == 0
+    out, nfc = unicodedata.normalize("NFC", out), lambda t: unicodedata.normalize("NFC", t)
+    assert nfc("  ω̇₁ = [0, 0, θ̈₁]") in out and "  ω₂ = [0, -θ̇₁, 0]" in out
+    assert not re.search(r"(?<![\w.])1\*", out) and "_dot" not in out and "_ddot" not in out
+    assert nfc("m₂*d̈₂") in out and nfc("2*d₂*m₂*ḋ₂*θ̇₁") in out
+    code, ascii_out, _ = run(capsys, "derive", "rp-arm", "--steps", "--method", "newton-euler", "--ascii")
+    assert code == 0 and ascii_out.isascii()
+    assert "  omega_dot1 = [0, 0, theta1_ddot]" in ascii_out and "  tau1 = " in ascii_out
+    assert not re.search(r"(?<![\w.])1\*", ascii_out)
 
 
 def test_lagrange_steps_show_energies(capsys):
@@ -55,7 +72,15 @@ def test_formats(capsys, fmt, marker):
 def test_check_command(capsys):
     code, out, _ = run(capsys, "check", "planar-2r")
     assert code == 0
-    assert "Mdot - 2C skew-symmetric" in out and "FAIL" not in out
+    assert "M qdd + C qd + g" in out and "skew" not in out and "FAIL" not in out
+
+
+def test_check_refuses_zero_samples_and_says_how_many_were_used(capsys):
+    code, out, err = run(capsys, "check", "planar-2r", "--numeric", "--samples", "0")
+    assert code == 2 and out == "" and err.startswith("armdyn: error: ") and "samples" in err
+    assert err.count("\n") == 1
+    code, out, _ = run(capsys, "check", "planar-2r", "--numeric", "--samples", "3")
+    assert code == 0 and "numeric, 3 points" in out and "3 random points" in out
 
 
 def test_robots_lists_bundled_models(capsys):
@@ -97,14 +122,22 @@ def test_exercise_example_runs():
     assert "checks for 'rp-arm': all passed" in proc.stdout
 
 
-def test_printed_tau_is_the_exercise_result(capsys):
-    """What the user reads, parsed back, is exactly the exercise's final tau1, tau2."""
+@pytest.mark.parametrize("ascii_only", [True, False], ids=["ascii", "unicode"])
+def test_printed_tau_is_the_exercise_result(capsys, ascii_only):
+    """What the user reads, parsed back, is exactly the exercise's final tau1, tau2.
+    The Unicode report is read back by spelling its symbols in ASCII here (a table
+    written out by hand, not the report's own)."""
     import sympy as sp
 
-    _, out, _ = run(capsys, "derive", "rp-arm", "--method", "lagrange")
+    _, out, _ = run(capsys, "derive", "rp-arm", "--method", "lagrange", *(["--ascii"] if ascii_only else []))
+    spelled = {"θ̈₁": "theta1_ddot", "θ̇₁": "theta1_dot", "θ₁": "theta1", "d̈₂": "d2_ddot", "ḋ₂": "d2_dot",
+               "d₂": "d2", "m₁": "m1", "m₂": "m2", "l₁": "l1", "τ₁": "tau1", "τ₂": "tau2", "²": "**2"}
     printed = {}
-    for line in out.splitlines():
+    for line in unicodedata.normalize("NFC", out).splitlines():
+        for uni, asc in spelled.items():
+            line = line.replace(unicodedata.normalize("NFC", uni), asc)
         if line.startswith("  tau"):
+            assert line.isascii(), line
             lhs, rhs = line.split(" = ", 1)
             printed[lhs.strip()] = sp.sympify(rhs.rsplit("    (", 1)[0])
     m1, m2, l1, g, th, d, thd, dd, thdd, ddd = sp.symbols(
@@ -119,6 +152,6 @@ def test_printed_tau_is_the_exercise_result(capsys):
 def test_allow_nonphysical_loads_with_one_warning_line(capsys):
     path = HERE / "models" / "bad" / "triangle-inequality.yaml"
     code, out, err = run(capsys, "derive", str(path), "--allow-nonphysical", "--method", "newton-euler")
-    assert code == 0 and "tau1 =" in out
+    assert code == 0 and "τ₁ =" in out
     assert err.startswith("armdyn: warning: ") and err.count("\n") == 1
     assert "triangle-inequality.yaml" in err and "link 'l2'" in err and "triangle inequality" in err

@@ -6,11 +6,10 @@ import numpy as np
 import pytest
 import sympy as sp
 
-pin = pytest.importorskip("pinocchio")
-
-from armdyn import Joint, Link, Robot  # noqa: E402
-from armdyn import numeric  # noqa: E402
-from armdyn.errors import UnboundParameterError  # noqa: E402
+from armdyn import Joint, Link, Robot
+from armdyn import numeric
+from armdyn.errors import UnboundParameterError
+from optional import needs_pinocchio, pin
 
 RNG = np.random.default_rng(20240611)
 
@@ -48,14 +47,11 @@ LAYOUT = [
 
 
 def build_pair(rng=RNG):
-    """The same arm as an armdyn Robot and a Pinocchio model (+ frame ids per link)."""
+    """The same arm as an armdyn Robot and a Pinocchio model (+ frame ids per link);
+    the Robot alone (model and ids None) when Pinocchio is not installed."""
     links = [Link("base")]
     joints = []
-    pmodel = pin.Model()
-    pmodel.gravity = pin.Motion(np.array([0.4, -0.3, -9.81]), np.zeros(3))
-    # per link: (pinocchio joint id, link frame placement in that joint's frame)
-    carrier = {"base": (0, pin.SE3.Identity())}
-    frame_ids = {"base": pmodel.addFrame(pin.Frame("base", 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME))}
+    rows = []
     for k, (parent, jtype, axis) in enumerate(LAYOUT, start=1):
         name = f"l{k}"
         rot, xyz = _rotation(rng), rng.uniform(-0.4, 0.4, 3)
@@ -63,7 +59,16 @@ def build_pair(rng=RNG):
         mass, com, inertia = rng.uniform(0.5, 3.0), rng.uniform(-0.2, 0.2, 3), _inertia(rng)
         links.append(Link(name, mass, com.tolist(), inertia.tolist()))
         joints.append(Joint(f"j{k}", jtype, parent, name, xyz.tolist(), rot.tolist(), axis.tolist()))
-
+        rows.append((k, parent, jtype, name, rot, xyz, axis, mass, com, inertia))
+    robot = Robot("smoke", links, joints, gravity=[0.4, -0.3, -9.81])
+    if pin is None:
+        return robot, None, None
+    pmodel = pin.Model()
+    pmodel.gravity = pin.Motion(np.array([0.4, -0.3, -9.81]), np.zeros(3))
+    # per link: (pinocchio joint id, link frame placement in that joint's frame)
+    carrier = {"base": (0, pin.SE3.Identity())}
+    frame_ids = {"base": pmodel.addFrame(pin.Frame("base", 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME))}
+    for k, parent, jtype, name, rot, xyz, axis, mass, com, inertia in rows:
         pj, offset = carrier[parent]
         placement = offset * pin.SE3(rot, xyz)
         if jtype == "fixed":
@@ -76,12 +81,13 @@ def build_pair(rng=RNG):
         if pj != 0:
             pmodel.appendBodyToJoint(pj, pin.Inertia(mass, com, inertia), offset)
         frame_ids[name] = pmodel.addFrame(pin.Frame(name, pj, offset, pin.FrameType.OP_FRAME))
-    robot = Robot("smoke", links, joints, gravity=[0.4, -0.3, -9.81])
     return robot, pmodel, frame_ids
 
 
 @pytest.fixture(scope="module")
 def pair():
+    """(robot, Pinocchio model or None, frame ids or None): tests that use the
+    Pinocchio half are marked @needs_pinocchio."""
     return build_pair()
 
 
@@ -91,6 +97,7 @@ def close(a, b, tol=1e-12):
     assert np.max(np.abs(a - b), initial=0.0) <= tol * (1.0 + np.max(np.abs(b), initial=0.0)), (a, b)
 
 
+@needs_pinocchio
 def test_matches_pinocchio(pair):
     robot, pmodel, frame_ids = pair
     pdata = pmodel.createData()

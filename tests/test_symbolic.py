@@ -219,12 +219,42 @@ def test_mass_matrix_symmetric_positive_definite(name):
         assert np.linalg.eigvalsh(M).min() > 0
 
 
-def test_coriolis_skew_and_split_on_random_tree():
+def test_coriolis_split_on_random_tree():
     robot = random_robot(np.random.default_rng(7), n_joints=3, tree=True)
     report = check(derive(robot), exact=False, samples=6)
     names = [r.name for r in report.results]
-    assert any("skew" in n for n in names) and any("M qdd" in n for n in names)
+    assert any("M qdd + C qd + g" in n for n in names) and not any("skew" in n for n in names)
+    assert all(r.how == "numeric, 6 points" for r in report.results), report.text()
     assert report, report.text()
+
+
+def test_structure_checks_notice_wrong_velocity_terms():
+    """A Newton-Euler tau whose velocity terms are wrong (M untouched) must fail every
+    check that involves C. The old "Mdot - 2C skew-symmetric" check passed on it: C was
+    built from M alone, so it could not see the velocity terms at all."""
+    robot = armdyn.load("rp-arm")
+    ne, la = derive(robot), derive(robot, "lagrange")
+    broken = derive(robot)
+    m1, (q1, q2), (qd1, qd2) = robot.parameters["m1"], robot.q, robot.qd
+    broken.tau = ne.tau + sp.Matrix([m1 * sp.sin(q2) * qd1 * qd2, 0])  # M, g unchanged
+    for exact in (True, False):
+        report = check(broken, exact=exact, samples=5)
+        passed = {r.name for r in report.results if r.passed}
+        assert passed == {"M symmetric (newton-euler)"}, report.text()
+        # the Lagrange derivation is right, and the Newton-Euler one is the reference
+        report = check(la, broken, exact=exact, samples=5)
+        assert [r.name for r in report.results if not r.passed] == [
+            "tau: lagrange == newton-euler",
+            "tau (newton-euler) == M qdd + C qd + g, C from the Christoffel symbols of M",
+        ], report.text()
+    assert check(la, ne), check(la, ne).text()
+
+
+@pytest.mark.parametrize("samples", [0, -3, 2.5, True])
+def test_zero_samples_is_an_error(samples):
+    robot = armdyn.load("planar-2r")
+    with pytest.raises(ValueError, match="samples must be a positive integer"):
+        check(derive(robot), exact=False, samples=samples)
 
 
 def test_agreement_check_can_fail():

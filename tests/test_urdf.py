@@ -10,7 +10,6 @@ states (armdyn.reference, and armdyn.numeric once it exists) to 1e-12 relative.
 
 from __future__ import annotations
 
-import importlib.metadata
 import time
 import warnings
 from pathlib import Path
@@ -23,8 +22,7 @@ import armdyn.reference as reference
 from armdyn.errors import ModelError
 from armdyn.io.urdf import MasslessWarning, load_urdf
 from armdyn.show import frame_poses
-
-pin = pytest.importorskip("pinocchio")
+from optional import example_robot_data_dir, needs_pinocchio, pin
 
 # shared/ sits beside the repository (CI) or at /work/shared (development machines)
 IIWA = next(
@@ -35,16 +33,6 @@ IIWA = next(
 BUNDLED_IIWA = Path(__file__).resolve().parent.parent / "python" / "armdyn" / "robots" / "iiwa14.urdf"
 RTOL = 1e-12
 SINGULAR = 1e12  # condition number of M above which forward dynamics is not compared
-
-
-def example_robot_data_dir() -> Path | None:
-    """``robots/`` of the example-robot-data wheel, or None if it is not installed."""
-    try:
-        dist = importlib.metadata.distribution("example-robot-data")
-    except importlib.metadata.PackageNotFoundError:
-        return None
-    path = Path(dist.locate_file("cmeel.prefix/share/example-robot-data/robots"))
-    return path if path.is_dir() else None
 
 
 def engines():
@@ -308,6 +296,7 @@ def test_joint_moving_nothing_warns():
     assert robot.meta["massless_links"] == ["base", "tool", "l3"]
 
 
+@needs_pinocchio
 def test_features_agree_with_pinocchio():
     robot = load_urdf(FEATURES)
     model = pin.buildModelFromXML(FEATURES)
@@ -369,10 +358,13 @@ def test_bad_elements_are_one_clear_error(change, element, words):
 # ------------------------------------------------------------ iiwa 14 (Drake)
 
 
-@pytest.mark.parametrize("path", [IIWA, BUNDLED_IIWA], ids=["shared", "bundled"])
+# the exercise's copy beside the repository is compared too when it is there (it is not
+# part of the repository, so its absence is not a skip)
+@needs_pinocchio
+@pytest.mark.parametrize(
+    "path", [BUNDLED_IIWA] + ([IIWA] if IIWA.is_file() else []), ids=["bundled", "shared"][: 1 + IIWA.is_file()]
+)
 def test_iiwa14_agrees_with_pinocchio(path):
-    if not path.is_file():
-        pytest.skip(f"{path} not present")
     robot = load_urdf(path)
     assert robot.dof == 7 and robot.meta["massless_links"] == ["base", "iiwa_link_ee"]
     compare_with_pinocchio(robot, pin.buildModelFromUrdf(str(path)), np.random.default_rng(7), states=3)
@@ -451,6 +443,7 @@ def compare_reduced_with_pinocchio(robot, path: Path, rng, states: int = 1, rtol
     return compared_aba
 
 
+@needs_pinocchio
 def test_example_robot_data_sweep(capsys):
     """Every URDF of the example-robot-data wheel loads (strict; the ones whose published
     inertias are not physical load with strict=False, which is what it is for) and
@@ -468,7 +461,6 @@ def test_example_robot_data_sweep(capsys):
     ``ur3.urdf`` holds an empty <robot> (its xacro expanded to nothing) and is rejected
     as having no link."""
     robots_dir = example_robot_data_dir()
-    assert robots_dir is not None, "example-robot-data is not installed (pip install example-robot-data)"
     files = sorted(robots_dir.rglob("*.urdf"))
     assert len(files) >= 60
     rng = np.random.default_rng(2024)

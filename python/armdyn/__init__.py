@@ -3,19 +3,22 @@
     import armdyn
     robot = armdyn.load("rp-arm")                  # a bundled model, or a .yaml/.urdf file
     eom = armdyn.derive(robot, "newton-euler")     # or "lagrange": tau, M, C, g, steps
-    print(armdyn.prove_agreement(robot).text())    # Newton-Euler == Lagrange, M sym., Mdot-2C skew
+    print(armdyn.prove_agreement(robot).text())    # Newton-Euler == Lagrange, M sym., tau = M qdd + C qd + g
     print(armdyn.grade("my-derivation.md").text()) # a student's derivation, step by step
 
 Conventions: SI units, radians, ``M(q) qdd + C(q, qd) qd + g(q) = tau``; frames as in
 :mod:`armdyn.model`.
 """
 
-from . import inertia, io
-from .errors import ModelError, UnboundParameterError
-from .io import bundled_robots, load
-from .model import Joint, Link, Robot
-from .symbolic import EquationsOfMotion, check, derive, prove_agreement
-from . import codegen  # armdyn.codegen(robot, ...) and armdyn.codegen.compile(...)
+#: the package version (kept equal to pyproject.toml's; tests/test_hardening.py checks)
+__version__ = "0.1.0"
+
+from . import inertia, io  # noqa: E402
+from .errors import ModelError, UnboundParameterError  # noqa: E402
+from .io import bundled_robots, load  # noqa: E402
+from .model import Joint, Link, Robot  # noqa: E402
+from .symbolic import EquationsOfMotion, check, derive, prove_agreement  # noqa: E402
+from . import codegen  # noqa: E402  armdyn.codegen(robot, ...) and armdyn.codegen.compile(...)
 
 _NUMERIC = (
     "rnea", "crba", "aba", "gravity", "bias", "coriolis_matrix", "kinetic_energy",
@@ -41,6 +44,7 @@ def __getattr__(name):
 
 
 __all__ = [
+    "__version__",
     *_NUMERIC,
     "inertia", "io", "ModelError", "UnboundParameterError", "Joint", "Link", "Robot",
     "load", "bundled_robots", "derive", "check", "prove_agreement", "EquationsOfMotion", "grade",

@@ -31,7 +31,7 @@ def _load(source: str, allow_nonphysical: bool = False):
 
 def cmd_derive(args) -> int:
     from .symbolic import check, derive
-    from .symbolic.report import derivation_report
+    from .symbolic.report import derivation_report, unicode_supported
 
     robot = _load(args.robot, args.allow_nonphysical)
     methods = ["newton-euler", "lagrange"] if args.method == "both" else [args.method]
@@ -42,13 +42,16 @@ def cmd_derive(args) -> int:
         if args.timing:
             print(f"# {m}: derived in {time.perf_counter() - t0:.3f} s", file=sys.stderr)
     agreement = check(eoms[0], eoms[1], structure=False) if len(eoms) == 2 else None
-    print(derivation_report(eoms, args.format, steps=args.steps, agreement=agreement))
+    ascii_only = args.ascii or not unicode_supported(sys.stdout)
+    print(derivation_report(eoms, args.format, steps=args.steps, agreement=agreement, ascii=ascii_only))
     return 0 if agreement is None or agreement else 1
 
 
 def cmd_check(args) -> int:
     from .symbolic import prove_agreement
 
+    if args.samples < 1:  # before the (slow) derivation: zero samples would check nothing
+        raise ValueError(f"--samples must be at least 1, got {args.samples}")
     robot = _load(args.robot, args.allow_nonphysical)
     exact = True if args.exact else (False if args.numeric else None)
     report = prove_agreement(robot, exact=exact, samples=args.samples)
@@ -272,14 +275,17 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--steps", action="store_true", help="show every intermediate step")
     d.add_argument("--format", choices=["text", "latex", "markdown", "html"], default="text")
     d.add_argument("--timing", action="store_true", help="print derivation times to stderr")
+    d.add_argument("--ascii", action="store_true",
+                   help="text in plain ASCII (theta1_dot, tau1) instead of Unicode (θ̇₁, τ₁); "
+                        "automatic when the terminal cannot print Unicode")
     d.set_defaults(func=cmd_derive)
 
-    c = sub.add_parser("check", help="prove Newton-Euler == Lagrange, M symmetric, Mdot - 2C skew")
+    c = sub.add_parser("check", help="prove Newton-Euler == Lagrange, M symmetric, tau == M qdd + C qd + g")
     robot_arg(c)
     g = c.add_mutually_exclusive_group()
     g.add_argument("--exact", action="store_true", help="force exact symbolic checks")
     g.add_argument("--numeric", action="store_true", help="force checks at random numeric points")
-    c.add_argument("--samples", type=int, default=25, help="random points for numeric checks")
+    c.add_argument("--samples", type=int, default=25, help="random points for numeric checks (at least 1; the report says how many were used)")
     c.set_defaults(func=cmd_check)
 
     r = sub.add_parser("robots", help="list the bundled robot models")

@@ -27,6 +27,7 @@ with parameters is bound to numbers with :meth:`Robot.bind`.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 from typing import Iterable, Mapping
 
@@ -40,6 +41,8 @@ JOINT_TYPES = ("revolute", "prismatic", "fixed")
 
 
 def _vec3(value, what: str) -> sp.Matrix:
+    if isinstance(value, sp.MatrixBase) and value.shape == (3, 1):
+        return sp.Matrix(value)  # entries are SymPy objects already (readers pass these)
     try:
         m = sp.Matrix(value)
     except Exception as exc:  # noqa: BLE001 - re-raised with context
@@ -52,6 +55,8 @@ def _vec3(value, what: str) -> sp.Matrix:
 
 
 def _mat3(value, what: str) -> sp.Matrix:
+    if isinstance(value, sp.MatrixBase) and value.shape == (3, 3):
+        return sp.Matrix(value)
     try:
         m = sp.Matrix(value)
     except Exception as exc:  # noqa: BLE001
@@ -89,7 +94,12 @@ def rot_z(a) -> sp.Matrix:
 
 def rpy_matrix(roll, pitch, yaw) -> sp.Matrix:
     """URDF roll-pitch-yaw: ``Rz(yaw) * Ry(pitch) * Rx(roll)`` (fixed axes x, y, z)."""
-    return rot_z(yaw) * rot_y(pitch) * rot_x(roll)
+    # zero angles are identity factors: skipping them saves SymPy products (big URDFs)
+    factors = [rot(a) for rot, a in ((rot_z, yaw), (rot_y, pitch), (rot_x, roll)) if a != 0]
+    out = sp.eye(3)
+    for f in factors:
+        out = out * f
+    return out
 
 
 def axis_angle_matrix(axis, angle) -> sp.Matrix:
@@ -236,7 +246,7 @@ class Joint:
         for key in ("rotation", "frame_rotation"):
             matrix = getattr(self, key)
             if not matrix.free_symbols:
-                R = np.array(matrix.evalf(), dtype=float)
+                R = np.array([float(x) for x in matrix], dtype=float).reshape(3, 3)
                 if not (np.allclose(R.T @ R, np.eye(3), atol=1e-9) and np.linalg.det(R) > 0):
                     raise ModelError(f"{key} {R.tolist()} is not a proper rotation matrix", where)
         if self.type != "fixed":
@@ -320,8 +330,55 @@ def coordinate_symbols(names: Iterable[str]) -> tuple[sp.Matrix, sp.Matrix, sp.M
     return q, qd, qdd
 
 
-class Robot:
+class FrozenList(list):
+    """A list that refuses in-place changes (``+`` still gives a new plain list)."""
+
+    def _refuse(self, *args, **kwargs):
+        raise TypeError("this list belongs to a Robot, which is immutable: build a new Robot instead")
+
+    append = extend = insert = pop = remove = clear = sort = reverse = _refuse
+    __setitem__ = __delitem__ = __iadd__ = __imul__ = _refuse
+
+    def __copy__(self):
+        return list(self)
+
+
+class FrozenDict(dict):
+    """A dict that refuses in-place changes (``dict(d)``, ``{**d}`` give plain copies)."""
+
+    def _refuse(self, *args, **kwargs):
+        raise TypeError("this mapping belongs to a Robot, which is immutable: build a new Robot instead")
+
+    __setitem__ = __delitem__ = __ior__ = pop = popitem = clear = update = setdefault = _refuse
+
+    def __copy__(self):
+        return dict(self)
+
+
+class _FreezeAfterInit(type):
+    """Robot's metaclass: once ``__init__`` (whatever fields it sets) has returned, the
+    instance is frozen (see :meth:`Robot.__setattr__`). No field is listed here."""
+
+    def __call__(cls, *args, **kwargs):
+        obj = super().__call__(*args, **kwargs)
+        object.__setattr__(obj, "_frozen", True)
+        return obj
+
+
+#: what a Robot caches about itself (dropped when a thawed copy changes)
+_CACHES = ("_numeric_model", "_canonical")
+
+
+class Robot(metaclass=_FreezeAfterInit):
     """A fixed-base robot: links and joints in tree order, and gravity.
+
+    Immutable once constructed: setting a public attribute raises AttributeError and
+    its lists and dicts (``joints``, ``links``, ``parameters``, ...) refuse changes,
+    so the compiled numeric model cached on it (:func:`armdyn.numeric.compile_model`)
+    always describes it. Build a changed robot with :meth:`bind`, :meth:`subs` or
+    ``Robot(...)``. (``copy.copy(robot)`` gives a thawed copy for ``with_*`` style
+    constructors: its attributes may be set, and each set drops its cached model.)
+    ``meta`` stays an ordinary dict: it describes the model and is never compiled.
 
     Attributes
     ----------
@@ -343,6 +400,46 @@ class Robot:
     movable_joints: the non-fixed joints, in order; ``dof`` is their number.
     q, qd, qdd:     (dof, 1) symbol vectors named after the movable joints.
     """
+
+    def __setattr__(self, name, value):
+        if self.__dict__.get("_frozen") and not name.startswith("_"):
+            raise AttributeError(
+                f"Robot is immutable: cannot set '{name}' (build a new robot with bind(), subs() or Robot(...))"
+            )
+        if not name.startswith("_"):  # a thawed copy changing: its compiled model is stale
+            for cache in _CACHES:
+                self.__dict__.pop(cache, None)
+        object.__setattr__(self, name, value)
+
+    def __delattr__(self, name):
+        if self.__dict__.get("_frozen") and not name.startswith("_"):
+            raise AttributeError(f"Robot is immutable: cannot delete '{name}'")
+        for cache in _CACHES:
+            self.__dict__.pop(cache, None)
+        object.__delattr__(self, name)
+
+    def __copy__(self):
+        """A thawed shallow copy without the cached numeric model (see the class doc)."""
+        new = object.__new__(type(self))
+        state = {k: v for k, v in self.__dict__.items() if k not in ("_frozen", *_CACHES)}
+        for k, v in state.items():  # plain containers, so that a with_* constructor may edit them
+            if isinstance(v, FrozenList):
+                state[k] = list(v)
+            elif isinstance(v, FrozenDict):
+                state[k] = dict(v)
+        new.__dict__.update(state)
+        return new
+
+    def __deepcopy__(self, memo):
+        if self.__dict__.get("_frozen"):
+            return self  # immutable: a copy is the same robot
+        import copy
+
+        new = object.__new__(type(self))
+        memo[id(self)] = new
+        state = {k: v for k, v in self.__dict__.items() if k not in _CACHES}
+        new.__dict__.update(copy.deepcopy(state, memo))
+        return new
 
     def __init__(
         self,
@@ -411,10 +508,35 @@ class Robot:
             raise ModelError(f"names used both as joint and as parameter: {sorted(clash)}", f"robot '{name}'")
         self._link_index = {name: i for i, name in enumerate(self.links)}
         # index of each movable joint's coordinate, None for fixed joints
-        self._coord_index = {}
+        coordinate = {n: i for i, n in enumerate(self.coordinate_names)}
+        self._coord_index = {j.name: coordinate.get(j.name) if j.movable else None for j in self.joints}
+        self._parent_joint = {j.child: j for j in self.joints}
+        self._children: dict[str, list[Joint]] = {}
         for j in self.joints:
-            self._coord_index[j.name] = self.coordinate_names.index(j.name) if j.movable and j.mimic is None else None
+            self._children.setdefault(j.parent, []).append(j)
         self._follows = self._resolve_mimics()
+        self._check_defaults()
+        # read-only from here on (the metaclass then freezes the attributes)
+        self.joints = FrozenList(self.joints)
+        self.movable_joints = FrozenList(self.movable_joints)
+        self.mimic_joints = FrozenList(self.mimic_joints)
+        self.coordinate_names = FrozenList(self.coordinate_names)
+        self.links = FrozenDict(self.links)
+        self.parameters = FrozenDict(self.parameters)
+        self.defaults = FrozenDict(self.defaults)
+        self.gravity = sp.ImmutableMatrix(self.gravity)
+
+    def _check_defaults(self) -> None:
+        """Published values must be finite real numbers (a NaN or inf default would only
+        show up later, as NaN torques)."""
+        for key, value in self.defaults.items():
+            try:
+                finite = not isinstance(value, bool) and math.isfinite(float(value))
+            except (TypeError, ValueError, OverflowError):
+                finite = False
+            if not finite:
+                raise ModelError(f"the default value of parameter '{key}' is not a finite number: {value!r}",
+                                 f"robot '{self.name}'")
 
     def _tree_order(self, joints: list[Joint]) -> list[Joint]:
         names, child_of = set(), {}
@@ -450,10 +572,13 @@ class Robot:
             frontier = nxt
         # keep the user's order where it already is a tree order (stable for DH chains)
         if len(ordered) != len(joints):
-            stray = [j.name for j in joints if j not in ordered]
+            placed = {j.name for j in ordered}
+            stray = [j.name for j in joints if j.name not in placed]
             raise ModelError(f"joints not connected to the base '{self.base}' (a cycle?): {stray}", f"robot '{self.name}'")
+        # the given order is a tree order when every joint comes after its parent joint
+        # (the joint whose child is its parent link): one dict lookup per joint, O(n)
         position = {j.name: i for i, j in enumerate(joints)}
-        if all(position[a.name] < position[b.name] or a.child != b.parent for a in ordered for b in ordered):
+        if all(b.parent not in child_of or position[child_of[b.parent].name] < position[b.name] for b in joints):
             return list(joints)
         return ordered
 
@@ -519,13 +644,11 @@ class Robot:
         return self._follows.get(joint.name if isinstance(joint, Joint) else joint)
 
     def parent_joint(self, link: str) -> Joint | None:
-        for j in self.joints:
-            if j.child == link:
-                return j
-        return None
+        return self._parent_joint.get(link)
 
     def children(self, link: str) -> list[Joint]:
-        return [j for j in self.joints if j.parent == link]
+        """The joints whose parent is ``link``, in tree order."""
+        return list(self._children.get(link, ()))
 
     def free_symbols(self) -> set[sp.Symbol]:
         """Symbols the model's numbers depend on (the joint coordinates excluded)."""

@@ -5,15 +5,24 @@ Every function takes a robot and one state or a batch of states:
 * ``robot``: an :class:`armdyn.Robot` with no free symbols (bind them first with
   ``robot.bind({...})``; otherwise :class:`armdyn.errors.UnboundParameterError`
   names them), or a :class:`NumericModel` from :func:`compile_model`. The compiled
-  model is built once per Robot and cached on it (attribute ``_numeric_model``).
+  model is built once per Robot and cached on it (attribute ``_numeric_model``); a
+  Robot is immutable, so the cache always describes it.
   A robot with mimic joints compiles to a :class:`armdyn.mimic.MimicModel` (same
   methods, in the independent coordinates; see that module for how).
 * ``q``, ``qd``, ``qdd``, ``tau``: shape ``(n,)`` for one state or ``(N, n)`` for ``N``
   states (one per row), ``n = robot.dof``, joints in ``robot.coordinate_names`` order.
   Float64 C-contiguous arrays are used as they are; anything else is converted once.
   A wrong shape, NaN or inf raises ``ValueError`` naming the argument.
-* ``threads``: for batches, the number of threads (``None``: all cores). The GIL is
-  released while a batch is computed. Batched results equal single calls bit for bit.
+* ``threads``: for batches, the number of threads: ``None`` (all cores) or an integer
+  from 1 to 256 (anything else is a ``ValueError``). At most that many threads work
+  on the batch; counts above the number of cores run on one extra pool, grown to the
+  largest count asked for and reused. The GIL is released while a batch is computed.
+  Batched results equal single calls bit for bit.
+* Arrays must hold real numbers: complex, boolean, string or other non-real arrays
+  are refused with a ``ValueError`` (not converted).
+* ``aba`` raises ``ValueError`` when the joint-space inertia matrix is singular: a
+  movable joint whose subtree has no mass and no inertia (named in the message), or
+  a state where the result is not finite.
 
 Conventions (DESIGN.md): SI units, radians; ``M(q) qdd + C(q, qd) qd + g(q) = tau``;
 gravity is the robot's vector in the base frame; frames as in :mod:`armdyn.model`.

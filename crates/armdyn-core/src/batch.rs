@@ -22,9 +22,8 @@ use crate::data::Data;
 use crate::model::Model;
 use crate::real::{F64x4, F64x8, Real};
 use rayon::prelude::*;
-use std::collections::HashMap;
 use std::sync::atomic::{AtomicU8, Ordering};
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, Mutex};
 
 /// The SIMD kernels of the batch path.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -92,23 +91,50 @@ pub fn set_kernels(cap: Option<Kernels>) {
 /// Rows below which a batch runs on the calling thread (spawning costs more).
 const MIN_PARALLEL_ROWS: usize = 128;
 
-/// A rayon pool with `n` threads, built once per `n` and kept.
-pub(crate) fn pool(n: usize) -> Arc<rayon::ThreadPool> {
-    static POOLS: OnceLock<Mutex<HashMap<usize, Arc<rayon::ThreadPool>>>> = OnceLock::new();
-    let mut pools = POOLS.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
-    pools
-        .entry(n)
-        .or_insert_with(|| Arc::new(rayon::ThreadPoolBuilder::new().num_threads(n).build().expect("thread pool")))
-        .clone()
+/// The largest thread count a batch accepts: `threads = Some(n)` runs on
+/// `min(n, MAX_THREADS)` threads (the Python bindings refuse larger counts).
+pub const MAX_THREADS: usize = 256;
+
+/// The one extra rayon pool, for counts above the global pool's size: built when a
+/// larger count than it has is first asked for, grown (replaced) only then, so the
+/// number of threads ever started is bounded by the largest count asked for plus the
+/// global pool, whatever mix of counts is requested. `None` if the pool cannot be
+/// built (e.g. the OS refuses threads): the caller falls back to the global pool.
+fn pool_of_at_least(n: usize) -> Option<Arc<rayon::ThreadPool>> {
+    static POOL: Mutex<Option<Arc<rayon::ThreadPool>>> = Mutex::new(None);
+    let mut pool = POOL.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(p) = pool.as_ref().filter(|p| p.current_num_threads() >= n) {
+        return Some(p.clone());
+    }
+    let built = Arc::new(rayon::ThreadPoolBuilder::new().num_threads(n).build().ok()?);
+    *pool = Some(built.clone());
+    Some(built)
 }
 
-/// The number of threads `threads` means: `None` = all cores (rayon's global pool).
+/// Run `run` with `n` threads' worth of pool: rayon's global pool when it is big enough,
+/// else the shared larger pool of [`pool_of_at_least`]; the global pool if no pool can be
+/// built (never a panic). The batch drivers that split work themselves
+/// (derivatives, integration) use this.
+pub(crate) fn install<R: Send>(n: usize, run: impl FnOnce() -> R + Send) -> R {
+    let pool = if n <= rayon::current_num_threads() { None } else { pool_of_at_least(n) };
+    match pool {
+        Some(pool) => pool.install(run),
+        None => run(),
+    }
+}
+
+/// The number of threads `threads` means: `None` = all cores (rayon's global pool),
+/// `Some(n)` = `n` clamped to `1..=MAX_THREADS`.
 pub fn thread_count(threads: Option<usize>) -> usize {
-    threads.unwrap_or_else(rayon::current_num_threads).max(1)
+    threads.unwrap_or_else(rayon::current_num_threads).clamp(1, MAX_THREADS)
 }
 
 /// Run `body(workspace, first_row, out_chunk)` over chunks of `rows` rows whose outputs
 /// (`out_per_row` values each) tile `out`. Chunks start at multiples of 4 rows.
+///
+/// `threads = Some(n)`: the chunks are dealt round-robin to `n` tasks, each running
+/// its chunks in turn, so at most `n` threads work whatever pool runs them (the
+/// global pool when it is big enough, else [`pool_of_at_least`]).
 fn par_rows<W, M, B>(rows: usize, out: &mut [f64], out_per_row: usize, threads: Option<usize>, make: M, body: B)
 where
     M: Fn() -> W + Sync + Send,
@@ -122,14 +148,28 @@ where
     }
     // ~8 chunks per thread balance the load when cores are shared.
     let chunk_rows = rows.div_ceil(8 * nthreads).max(32).next_multiple_of(4);
-    let mut run = move || {
+    if threads.is_none() {
         out.par_chunks_mut(chunk_rows * out_per_row)
             .enumerate()
-            .for_each_init(&make, |w, (k, chunk)| body(w, k * chunk_rows, chunk))
+            .for_each_init(&make, |w, (k, chunk)| body(w, k * chunk_rows, chunk));
+        return;
+    }
+    let mut tasks: Vec<Vec<(usize, &mut [f64])>> = (0..nthreads).map(|_| Vec::new()).collect();
+    for (k, chunk) in out.chunks_mut(chunk_rows * out_per_row).enumerate() {
+        tasks[k % nthreads].push((k * chunk_rows, chunk));
+    }
+    let run = || {
+        tasks.into_par_iter().for_each(|task| {
+            let mut w = make();
+            for (first, chunk) in task {
+                body(&mut w, first, chunk);
+            }
+        })
     };
-    match threads {
-        None => run(),
-        Some(n) => pool(n).install(run),
+    let pool = if nthreads <= rayon::current_num_threads() { None } else { pool_of_at_least(nthreads) };
+    match pool {
+        Some(pool) => pool.install(run),
+        None => run(), // the global pool: big enough, or the fallback if no pool can be built
     }
 }
 

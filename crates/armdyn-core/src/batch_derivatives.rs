@@ -10,7 +10,7 @@
 
 use crate::algo;
 use crate::algo::{ExternalForces, ForceFrame};
-use crate::batch::{kernels, pool, thread_count, Kernels};
+use crate::batch::{install, kernels, thread_count, Kernels};
 use crate::data::Data;
 use crate::deriv_data::DerivData;
 use crate::model::Model;
@@ -58,7 +58,7 @@ fn par_rows<const R: usize, W, M, B>(
     let run = move || pieces.into_par_iter().for_each_init(&make, |w, (first, o)| body(w, first, o));
     match threads {
         None => run(),
-        Some(n) => pool(n).install(run),
+        Some(n) => install(n, run),
     }
 }
 

@@ -145,7 +145,9 @@ fn coriolis_matrix_identities() {
         algo::gravity(model, &mut Data::new(model), &c.q, &mut g);
         let hg: Vec<f64> = bias.iter().zip(&g).map(|(a, b)| a - b).collect();
         assert_close(&mat_vec(&cm, &c.qd), &hg, 1e-12, "C qd = h - g");
-        // Mdot = C + C^T (equivalently Mdot - 2C skew), Mdot by central differences along qd
+        // Mdot = C + C^T (equivalently Mdot - 2C skew), Mdot by central differences along qd.
+        // A real check: C comes from Echeandia & Wensing's recursion over body inertias and
+        // velocities (algo/coriolis.rs), not from M, for which it would hold by construction.
         let (mp, mm) = (crba(model, &step(&c.q, &c.qd, h)), crba(model, &step(&c.q, &c.qd, -h)));
         let mdot: Vec<f64> = mp.iter().zip(&mm).map(|(a, b)| (a - b) / (2.0 * h)).collect();
         let c_ct: Vec<f64> = (0..n * n).map(|k| cm[k] + cm[(k % n) * n + k / n]).collect();

@@ -38,6 +38,12 @@ fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
 
 /// `obj` as a C-contiguous float64 array: as is when it already is one (no copy),
 /// else converted once by `numpy.ascontiguousarray(obj, dtype=float64)`.
+///
+/// Only real numbers are converted: arrays of floats or integers, or object arrays
+/// whose every element is a `numbers.Real` other than `bool`. Complex, boolean,
+/// string, bytes, datetime and structured arrays are refused with a `ValueError`
+/// naming the argument (NumPy would silently drop an imaginary part, read `True` as
+/// 1.0 and parse `"1.5"`).
 fn as_f64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
         // (aligned too: arrays received over a network, e.g. Dask results, can be
@@ -52,12 +58,30 @@ fn as_f64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyArr
         }
     }
     static ASCONTIGUOUS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+    static ASARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+    static REAL: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
     let py = obj.py();
+    let unreadable = |e: PyErr| PyValueError::new_err(format!("{name}: cannot be read as a float64 array ({e})"));
+    let arr = ASARRAY.import(py, "numpy", "asarray")?.call1((obj,)).map_err(unreadable)?;
+    let dtype = arr.getattr("dtype")?;
+    let kind: String = dtype.getattr("kind")?.extract()?;
+    let refuse = |what: String| Err(PyValueError::new_err(format!("{name}: expected real numbers, got {what}")));
+    match kind.as_str() {
+        "f" | "i" | "u" => {}
+        "O" => {
+            let real = REAL.import(py, "numbers", "Real")?;
+            for x in arr.call_method0("ravel")?.try_iter()? {
+                let x = x?;
+                if x.is_instance_of::<pyo3::types::PyBool>() || !x.is_instance(real)? {
+                    return refuse(format!("an element of type {}", x.get_type().name()?));
+                }
+            }
+        }
+        _ => return refuse(format!("an array of dtype {}", dtype.str()?)),
+    }
     let conv = ASCONTIGUOUS.import(py, "numpy", "ascontiguousarray")?;
     let float64 = py.import("numpy")?.getattr("float64")?;
-    let converted = conv
-        .call1((obj, float64))
-        .map_err(|e| PyValueError::new_err(format!("{name}: cannot be read as a float64 array ({e})")))?;
+    let converted = conv.call1((arr, float64)).map_err(unreadable)?;
     Ok(converted.cast_into::<PyArrayDyn<f64>>()?)
 }
 
@@ -150,12 +174,15 @@ fn new_array<'py>(py: Python<'py>, dims: &[usize]) -> Bound<'py, PyArrayDyn<f64>
     unsafe { PyArray::<f64, _>::new(py, dims, false) }
 }
 
-/// `threads` as given from Python: None (all cores) or a positive count.
+/// `threads` as given from Python: None (all cores) or a count in `1..=MAX_THREADS`.
 fn thread_arg(threads: Option<i64>) -> PyResult<Option<usize>> {
     match threads {
         None => Ok(None),
-        Some(k) if k >= 1 => Ok(Some(k as usize)),
-        Some(k) => Err(PyValueError::new_err(format!("threads must be None or a positive integer, got {k}"))),
+        Some(k) if k >= 1 && k as u64 <= batch::MAX_THREADS as u64 => Ok(Some(k as usize)),
+        Some(k) => Err(PyValueError::new_err(format!(
+            "threads must be None or an integer from 1 to {}, got {k}",
+            batch::MAX_THREADS
+        ))),
     }
 }
 
@@ -183,6 +210,21 @@ pub struct NumericModel {
     coordinate_names: Vec<String>,
     /// The constructor's arguments, for pickling (`__reduce__`).
     init_args: Py<PyTuple>,
+    /// Movable joints whose whole subtree has no mass and no inertia: M is singular
+    /// and `aba` refuses (it would divide by zero).
+    inert_joints: Vec<String>,
+}
+
+/// Bodies (= movable joints, by coordinate index) whose subtree, themselves included,
+/// has zero spatial inertia. Parents precede children, so one backward pass suffices.
+fn inert_bodies(model: &Model) -> Vec<usize> {
+    let mut inert: Vec<bool> = model.inertia.iter().map(|i| *i == Default::default()).collect();
+    for i in (0..model.nv).rev() {
+        if let Some(p) = model.parent[i] {
+            inert[p] &= inert[i];
+        }
+    }
+    (0..model.nv).filter(|&i| inert[i]).collect()
 }
 
 impl NumericModel {
@@ -353,7 +395,8 @@ impl NumericModel {
             }
             let link_index = link_names.iter().enumerate().map(|(k, s)| (s.clone(), k)).collect();
             let scratch = Mutex::new(Scratch::new(&model));
-            Ok(NumericModel { model, scratch, name, link_names, link_index, coordinate_names, init_args })
+            let inert_joints = inert_bodies(&model).into_iter().map(|i| coordinate_names[i].clone()).collect();
+            Ok(NumericModel { model, scratch, name, link_names, link_index, coordinate_names, init_args, inert_joints })
         })
     }
 
@@ -433,14 +476,38 @@ impl NumericModel {
         tau: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        self.vector_op(
+        if !self.inert_joints.is_empty() {
+            let names: Vec<String> = self.inert_joints.iter().map(|n| format!("'{n}'")).collect();
+            return Err(PyValueError::new_err(format!(
+                "aba: the joint-space inertia matrix of '{}' is singular: joints [{}] move no mass or \
+                 inertia (links without inertia?), so their accelerations are undetermined",
+                self.name,
+                names.join(", ")
+            )));
+        }
+        let out = self.vector_op(
             py,
             [("q", q), ("qd", qd), ("tau", tau)],
             &[self.model.nv],
             threads,
             |m, s, [q, qd, tau], o| algo::aba(m, &mut s.data, q, qd, tau, o),
             batch::aba,
-        )
+        )?;
+        // finite inputs (checked) give a finite result unless M is singular at this state
+        // (e.g. a revolute joint whose subtree's mass all lies on its axis)
+        // SAFETY: `out` is ours and not yet returned.
+        let values = unsafe { slice(&out) };
+        if !all_finite(values) {
+            let k = values.iter().position(|x| !x.is_finite()).unwrap_or(0);
+            let n = self.model.nv.max(1);
+            let at = if out.ndim() == 1 { String::new() } else { format!(" (row {} of the batch)", k / n) };
+            return Err(PyValueError::new_err(format!(
+                "aba: the joint-space inertia matrix of '{}' is singular at this state{at} (e.g. a \
+                 subtree's mass all on a joint's axis): no finite acceleration",
+                self.name
+            )));
+        }
+        Ok(out)
     }
 
     /// Joint-space inertia matrix M (n, n) (or (N, n, n)).

@@ -25,6 +25,14 @@ parameter called ``E``, ``beta`` or ``lambda`` is just a Symbol of that name.
 Integers stay exact (``1/12`` is ``Rational(1, 12)``); decimals become ``sp.Float``
 (as a YAML float would).
 
+Hostile input is refused in bounded time: an expression longer than
+:data:`MAX_LENGTH` characters or nested deeper than :data:`MAX_DEPTH` (parentheses,
+function calls, unary signs and exponents each count a level) is an error, and so is
+an exact power whose result would have more than :data:`MAX_POWER_DIGITS` digits
+(``10**10**10`` would otherwise make SymPy compute a 10^10-digit integer) or whose
+exponent exceeds :data:`MAX_EXPONENT`. A decimal number must fit a float64, and a
+constant expression must evaluate to a finite float64 (``exp(exp(exp(100)))`` no).
+
 This module also converts the shaped values of a model (scalars, 3-vectors,
 3x3 matrices, inertia tensors, rotations) with the same rules; every failure is a
 :class:`~armdyn.errors.ModelError` naming the offending expression.
@@ -63,6 +71,15 @@ FUNCTIONS = {
 #: Named constants.
 CONSTANTS = {"pi": sp.pi}
 
+#: Longest expression string accepted (characters).
+MAX_LENGTH = 10_000
+#: Deepest nesting accepted (parentheses, calls, unary signs, exponents).
+MAX_DEPTH = 100
+#: Most digits an exact power (integer or rational base and exponent) may produce.
+MAX_POWER_DIGITS = 10_000
+#: Largest |numerator| of a rational exponent (``a**(10**20)`` would hang once bound).
+MAX_EXPONENT = 1000
+
 #: Names a parameter may not take (they already mean something in an expression).
 RESERVED = frozenset(FUNCTIONS) | frozenset(CONSTANTS)
 
@@ -90,6 +107,8 @@ def quoted(text) -> str:
     """``'text'`` for messages; ``repr`` when it holds newlines or control characters,
     so that an error stays one line."""
     text = str(text)
+    if len(text) > 120:  # a hostile 10k-character expression is shown by its start
+        text = f"{text[:100]}... ({len(text)} characters)"
     return f"'{text}'" if text.isprintable() else repr(text)
 
 
@@ -154,6 +173,18 @@ class _Parser:
         self.tokens = tokens
         self.i = 0
         self.parameters = parameters
+        self.depth = 0
+
+    def nested(self, parse):
+        """``parse()`` one level deeper; refused beyond MAX_DEPTH (the recursion would
+        otherwise end in RecursionError, or SymPy's own, on ~200 parentheses)."""
+        self.depth += 1
+        try:
+            if self.depth > MAX_DEPTH:
+                raise _ParseError(f"nested more than {MAX_DEPTH} levels deep")
+            return parse()
+        finally:
+            self.depth -= 1
 
     def peek(self):
         return self.tokens[self.i] if self.i < len(self.tokens) else (None, None)
@@ -189,12 +220,13 @@ class _Parser:
             _, op = self.take()
             rhs = self.unary()
             value = value * rhs if op == "*" else value / rhs
+            _check_combined_exponents(value)
         return value
 
     def unary(self):
         if self.peek()[1] in ("+", "-"):
             _, op = self.take()
-            value = self.unary()
+            value = self.nested(self.unary)
             return value if op == "+" else -value
         return self.power()
 
@@ -202,15 +234,26 @@ class _Parser:
         base = self.atom()
         if self.peek()[1] in ("**", "^"):
             self.take()
-            return base ** self.unary()
+            exponent = self.nested(self.unary)
+            _check_power_size(base, exponent)
+            value = base**exponent
+            _check_combined_exponents(value)  # SymPy folds (a**k)**m into a**(k m)
+            return value
         return base
 
     def atom(self):
         kind, tok = self.take()
         if kind == "number":
-            return sp.Float(tok) if any(c in tok for c in ".eE") else sp.Integer(tok)
+            if any(c in tok for c in ".eE"):
+                # through a float64, as a YAML float would be: sp.Float("1e999999") alone
+                # takes minutes, and such a number is no model value
+                x = float(tok)
+                if not math.isfinite(x):
+                    raise _ParseError(f"the number {_clip(tok)} is beyond the float64 range")
+                return sp.Float(x)
+            return sp.Integer(tok)
         if tok == "(":
-            value = self.expr()
+            value = self.nested(self.expr)
             self.take(")")
             return value
         if kind == "name":
@@ -221,16 +264,98 @@ class _Parser:
             if tok in FUNCTIONS:
                 func, nargs = FUNCTIONS[tok]
                 self.take("(")
-                args = [self.expr()]
+                args = [self.nested(self.expr)]
                 while self.peek()[1] == ",":
                     self.take()
-                    args.append(self.expr())
+                    args.append(self.nested(self.expr))
                 self.take(")")
                 if len(args) != nargs:
                     raise _ParseError(f"{tok}() takes {nargs} argument(s), got {len(args)}")
                 return func(*args)
             raise _UnknownName(tok)
         raise _ParseError(f"unexpected '{tok}'")
+
+
+def _clip(text: str, limit: int = 30) -> str:
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} characters)"
+
+
+#: SymPy functions -> float functions, for :func:`float_value`.
+_MATH = {
+    sp.sin: math.sin, sp.cos: math.cos, sp.tan: math.tan, sp.asin: math.asin, sp.acos: math.acos,
+    sp.atan: math.atan, sp.atan2: math.atan2, sp.sinh: math.sinh, sp.cosh: math.cosh, sp.tanh: math.tanh,
+    sp.exp: math.exp, sp.log: math.log, sp.Abs: abs,
+}
+
+
+def float_value(expr) -> float:
+    """The float64 value of a constant expression (no free symbols), computed with
+    Python floats node by node, so it takes time linear in the expression's size
+    (SymPy's ``evalf`` of ``exp(exp(exp(100)))`` does not finish). NaN if a step
+    overflows, leaves the reals or is not one of the whitelisted functions."""
+    try:
+        return _float_node(sp.sympify(expr))
+    except (OverflowError, ValueError, TypeError, ZeroDivisionError, KeyError):
+        return math.nan
+
+
+def _float_node(e) -> float:
+    if e.is_Number:
+        if e.is_Rational:
+            return int(e.p) / int(e.q)  # true division: OverflowError when out of range
+        return float(e)
+    if e is sp.pi:
+        return math.pi
+    if e is sp.E:
+        return math.e
+    args = [_float_node(a) for a in e.args]
+    if e.is_Add:
+        return math.fsum(args)
+    if e.is_Mul:
+        return math.prod(args)
+    if e.is_Pow:
+        value = args[0] ** args[1]
+        if isinstance(value, complex):
+            raise ValueError("not real")
+        return float(value)
+    return float(_MATH[e.func](*args))
+
+
+def _digits(x: sp.Rational) -> int:
+    """Decimal digits of an exact rational's numerator and denominator, roughly."""
+    return max(int(x.p).bit_length(), int(x.q).bit_length()) * 30103 // 100000 + 1
+
+
+def _check_power_size(base, exponent) -> None:
+    """Refuse ``base**exponent`` when SymPy could be made to compute an exact number of
+    more than MAX_POWER_DIGITS digits, now or once parameters are bound: an exponent
+    p/q with |p| > MAX_EXPONENT, or |b|^|p| with more than MAX_POWER_DIGITS digits
+    (about |p| log10|b|; a q-th root is no larger)."""
+    if not isinstance(exponent, sp.Rational) or exponent == 0:
+        return  # symbolic or floating exponent: nothing exact to compute
+    p = abs(int(exponent.p))
+    too_big = p > MAX_EXPONENT
+    if not too_big and not base.free_symbols and base not in (0, 1, -1):
+        if isinstance(base, sp.Rational):
+            digits = _digits(base)
+        else:
+            size = abs(float_value(base))
+            digits = abs(math.log10(size)) + 1 if math.isfinite(size) and size > 0 else math.inf
+        too_big = p * digits > MAX_POWER_DIGITS
+    if too_big:
+        raise _ParseError(
+            f"the power {_clip(str(base))}**{_clip(str(exponent))} is too large (exponents up to "
+            f"{MAX_EXPONENT}, exact results up to {MAX_POWER_DIGITS} digits)"
+        )
+
+
+def _check_combined_exponents(value) -> None:
+    """Refuse a power (alone or as a factor) whose exponent SymPy combined beyond
+    MAX_EXPONENT: ``(a**1000)**1000`` is ``a**1000000``, which binding ``a = 10``
+    would turn into a million-digit integer."""
+    for f in value.args if value.is_Mul else (value,):
+        if f.is_Pow and isinstance(f.exp, sp.Rational) and abs(int(f.exp.p)) > MAX_EXPONENT:
+            raise _ParseError(f"the power {_clip(str(f))} has an exponent beyond {MAX_EXPONENT}")
 
 
 def parse_expression(
@@ -267,6 +392,9 @@ def parse_expression(
             raise ModelError(f"{prefix}unknown parameter(s) {names} in expression '{value}'", element, source)
         result = value
     elif isinstance(value, str):
+        if len(value) > MAX_LENGTH:
+            message = f"{prefix}expression of {len(value)} characters is longer than {MAX_LENGTH}: {quoted(value)}"
+            raise ModelError(message, element, source)
         try:
             result = _Parser(_tokens(value), parameters).parse()
         except _UnknownName as exc:
@@ -281,9 +409,16 @@ def parse_expression(
             f"{prefix}expected a number or expression, got {type(value).__name__} {shown(value)}", element, source
         )
     if result.has(sp.zoo, sp.nan, sp.oo, -sp.oo):
-        raise ModelError(f"{prefix}expression {quoted(value)} is not finite ({result})", element, source)
-    if result.has(sp.I) or result.is_real is False:
-        raise ModelError(f"{prefix}expression {quoted(value)} is not real ({result})", element, source)
+        raise ModelError(f"{prefix}expression {quoted(value)} is not finite ({_clip(str(result), 60)})", element, source)
+    if result.has(sp.I):
+        raise ModelError(f"{prefix}expression {quoted(value)} is not real ({_clip(str(result), 60)})", element, source)
+    if not result.free_symbols:
+        # a constant must be a finite float64 (exp(exp(exp(100))), 1.5**(10**10): no)
+        if not math.isfinite(float_value(result)):
+            message = f"{prefix}expression {quoted(value)} is not a finite real float64 number"
+            raise ModelError(message, element, source)
+    elif result.is_real is False:
+        raise ModelError(f"{prefix}expression {quoted(value)} is not real ({_clip(str(result), 60)})", element, source)
     return result
 
 

@@ -104,6 +104,8 @@ for DH models).
 
 from __future__ import annotations
 
+import math
+
 import os
 from pathlib import Path
 from typing import Mapping
@@ -256,6 +258,13 @@ def _parameters(value, where):
             if isinstance(default, bool) or not isinstance(default, (int, float)):
                 message = f"the published value of '{name}' must be a number or null, got {shown(default)}"
                 raise ModelError(message, "parameters", where)
+            try:  # .nan, .inf, 1.0e999999 (read as inf), an int beyond float64
+                finite = math.isfinite(float(default))
+            except OverflowError:
+                finite = False
+            if not finite:
+                message = f"the published value of '{name}' is not a finite number, got {shown(default)}"
+                raise ModelError(message, "parameters", where)
             defaults[name] = default
         return params, defaults
     raise ModelError("expected a list of names or a mapping name -> value", "parameters", where)
@@ -357,6 +366,11 @@ def robot_from_dict(data, source: str = "<model>", strict: bool = True, default_
     params, defaults = _parameters(data.get("parameters"), source)
     gravity = parse_vector(data.get("gravity", [0, 0, -9.81]), params, "gravity", source)
     meta = {k: data[k] for k in ("description", "source", "notes") if k in data}
+    for key, text in meta.items():
+        # text only: a list or mapping here (say a YAML alias bomb) would be printed by
+        # `armdyn show` / `robots`, exponentially
+        if not isinstance(text, str):
+            raise ModelError(f"expected text, got {type(text).__name__} {shown(text)}", key, source)
     meta["convention"] = convention
     if source:
         meta["file"] = source  # so that warnings during construction name the file

@@ -28,6 +28,75 @@ _TEXT_NAMES = {
 }
 
 
+# ------------------------------------------------------------ text: symbols as the field writes them
+_GREEK = {
+    "alpha": "α", "beta": "β", "gamma": "γ", "delta": "δ", "epsilon": "ε", "zeta": "ζ", "eta": "η",
+    "theta": "θ", "iota": "ι", "kappa": "κ", "lambda": "λ", "mu": "μ", "nu": "ν", "xi": "ξ", "pi": "π",
+    "rho": "ρ", "sigma": "σ", "tau": "τ", "phi": "φ", "chi": "χ", "psi": "ψ", "omega": "ω",
+    "Gamma": "Γ", "Delta": "Δ", "Theta": "Θ", "Lambda": "Λ", "Xi": "Ξ", "Pi": "Π", "Sigma": "Σ",
+    "Phi": "Φ", "Psi": "Ψ", "Omega": "Ω",
+}
+_DOTS = {"": "", "_dot": "\u0307", "_ddot": "\u0308"}  # combining dot / diaeresis above
+_SUP = str.maketrans("0123456789-", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻")
+_NAME_PARTS = __import__("re").compile(r"([A-Za-z]+?)_?(\d*)")
+
+
+def unicode_name(name: str, dots: str = "") -> str | None:
+    """``theta1`` -> ``θ₁``, with ``dots`` "_dot"/"_ddot": ``θ̇₁``, ``d̈₂``; ``m2`` -> ``m₂``.
+    None for names that are not letters + optional digits (``shoulder_pan_joint``):
+    those are printed as they are."""
+    m = _NAME_PARTS.fullmatch(name)
+    if not m:
+        return None
+    base, digits = m.groups()
+    return _GREEK.get(base, base) + _DOTS[dots] + digits.translate(_SUB)
+
+
+class _UnicodeTextPrinter(sp.printing.str.StrPrinter):
+    """SymPy's str printer with θ̇₁-style symbol names and superscript integer powers."""
+
+    def __init__(self, names: dict, **settings):
+        super().__init__(settings)
+        self._names = names
+
+    def _print_Symbol(self, expr):
+        return self._names.get(expr) or expr.name
+
+    def _print_Pow(self, expr, rational=False):
+        exp = expr.exp
+        if exp.is_Integer and 2 <= exp <= 9 and expr.base.is_Symbol:
+            return self._print(expr.base) + str(exp).translate(_SUP)
+        return super()._print_Pow(expr, rational)
+
+
+def _text_names(eom: EquationsOfMotion) -> dict:
+    """Symbol -> Unicode name for the coordinates, their derivatives and parameters
+    whose names have the letters+digits form."""
+    names = {}
+    for q, qd, qdd in zip(eom.q, eom.qd, eom.qdd):
+        for sym, dots in ((q, ""), (qd, "_dot"), (qdd, "_ddot")):
+            u = unicode_name(q.name, dots)
+            if u:
+                names[sym] = u
+    for sym in list(eom.robot.parameters.values()):
+        u = unicode_name(sym.name)
+        if u:
+            names[sym] = u
+    return names
+
+
+def unicode_supported(stream=None) -> bool:
+    """Whether ``stream`` (default stdout) can print the Unicode report."""
+    import sys
+
+    encoding = getattr(stream or sys.stdout, "encoding", None) or "ascii"
+    try:
+        "θ̇₁ω̇τ₁²".encode(encoding)
+    except (UnicodeEncodeError, LookupError):
+        return False
+    return True
+
+
 def tidy_terms(expr, q, qd, qdd) -> list[tuple]:
     """``expr`` as an ordered list of ``(coefficient, monomial)``: joint-acceleration
     terms, velocity-product terms, then the rest (gravity), coefficients factored.
@@ -46,10 +115,12 @@ def tidy_terms(expr, q, qd, qdd) -> list[tuple]:
     return terms
 
 
-def _join(terms, render) -> str:
-    """Render ``(coefficient, monomial)`` terms coefficient first, signs folded."""
+def _join(terms, render, text: bool | None = None) -> str:
+    """Render ``(coefficient, monomial)`` terms coefficient first, signs folded.
+    ``text``: plain-text layout (``*`` between factors); default: ``render is str``."""
     if not terms:
         return "0"
+    text = render is str if text is None else text
     out = []
     for coef, mono in terms:
         negative = coef.could_extract_minus_sign()
@@ -57,12 +128,14 @@ def _join(terms, render) -> str:
             coef = -coef
         if mono == 1:
             body = render(coef)
+        elif coef == 1:  # a unit coefficient is not written: d2_ddot, not 1*d2_ddot
+            body = render(mono)
         elif isinstance(coef, sp.Add):  # a factored sum stays in front, in parentheses
-            body = f"({render(coef)})*{render(mono)}" if render is str else f"\\left({render(coef)}\\right) {render(mono)}"
+            body = f"({render(coef)})*{render(mono)}" if text else f"\\left({render(coef)}\\right) {render(mono)}"
         elif any((f.is_Rational and f.q != 1) or (f.is_Pow and f.exp.is_negative) for f in sp.Mul.make_args(coef)):
             body = render(coef * mono)  # a fraction reads best as SymPy writes it: l1*cos(q1)/2
         else:  # coefficient first, as by hand: l1*m2*d2_ddot
-            body = f"{render(coef)}*{render(mono)}" if render is str else f"{render(coef)} {render(mono)}"
+            body = f"{render(coef)}*{render(mono)}" if text else f"{render(coef)} {render(mono)}"
         out.append(("-" if negative else "+", body))
     text = ("-" if out[0][0] == "-" else "") + out[0][1]
     for sign, body in out[1:]:
@@ -73,10 +146,12 @@ def _join(terms, render) -> str:
 class Renderer:
     """Renders expressions of one derivation in one format."""
 
-    def __init__(self, eom: EquationsOfMotion, fmt: str = "text"):
+    def __init__(self, eom: EquationsOfMotion, fmt: str = "text", ascii: bool = False):
         if fmt not in FORMATS:
             raise ValueError(f"unknown format {fmt!r}; choose one of {', '.join(FORMATS)}")
-        self.eom, self.fmt = eom, fmt
+        self.eom, self.fmt, self.ascii = eom, fmt, ascii
+        # text: θ̇₁, d̈₂, m₂ (Unicode), or SymPy's own names with ascii (theta1_dot)
+        self._text = str if ascii else _UnicodeTextPrinter(_text_names(eom)).doprint
         names = {}
         for q, qd, qdd in zip(eom.q, eom.qd, eom.qdd):
             base = sp.latex(q)
@@ -86,15 +161,15 @@ class Renderer:
 
     def atom(self, expr) -> str:
         if self.fmt == "text":
-            return str(expr)
+            return self._text(expr)
         return sp.latex(expr, symbol_names=self._latex_names)
 
     def scalar(self, expr) -> str:
         eom = self.eom
         if dag.larger_than(expr, TIDY_NODE_LIMIT):
             return self.atom(expr)
-        render = str if self.fmt == "text" else self.atom
-        return _join(tidy_terms(expr, eom.q, eom.qd, eom.qdd), render)
+        render = self._text if self.fmt == "text" else self.atom
+        return _join(tidy_terms(expr, eom.q, eom.qd, eom.qdd), render, text=self.fmt == "text")
 
     def value(self, value) -> str:
         if isinstance(value, sp.MatrixBase):
@@ -109,15 +184,27 @@ class Renderer:
             return step.label
         robot = self.eom.robot
         i = str(robot.link_index(step.link)) if step.link in robot.links else ""
+        if self.ascii:
+            return self._ascii_label(step, i)
         if step.name in _TEXT_NAMES:
             return f"{_TEXT_NAMES[step.name]}{i.translate(_SUB)}"
         if step.link in self.eom.robot.coordinate_names:  # Lagrange equation steps are per coordinate
             k = self.eom.robot.coordinate_names.index(step.link)
-            q, qd = self.eom.q[k], self.eom.qd[k]
+            q, qd = self.atom(self.eom.q[k]), self.atom(self.eom.qd[k])
             return {"tau": f"τ{str(k + 1).translate(_SUB)}", "dL_dqd": f"∂L/∂{qd}", "dL_dq": f"∂L/∂{q}"}[step.name]
         if step.name == "tau":
             return "τ" + str(self.eom.robot.coordinate_index(self._joint_of(step.link)) + 1).translate(_SUB)
         return step.name
+
+    def _ascii_label(self, step: Step, i: str) -> str:
+        """ASCII labels for --ascii: omega_dot1, vc_dot2, tau1, dL/dtheta1_dot."""
+        robot = self.eom.robot
+        if step.link in robot.coordinate_names and step.name in ("tau", "dL_dqd", "dL_dq"):
+            k = robot.coordinate_names.index(step.link)
+            return {"tau": f"tau{k + 1}", "dL_dqd": f"dL/d{self.eom.qd[k]}", "dL_dq": f"dL/d{self.eom.q[k]}"}[step.name]
+        if step.name == "tau":
+            return f"tau{robot.coordinate_index(self._joint_of(step.link)) + 1}"
+        return f"{step.name}{i}"
 
     def _joint_of(self, link: str):
         return self.eom.robot.parent_joint(link)
@@ -134,11 +221,17 @@ def _big(eom: EquationsOfMotion) -> bool:
     return any(dag.larger_than(t, TIDY_NODE_LIMIT) for t in eom.tau)
 
 
-def tau_lines(eom: EquationsOfMotion, fmt: str = "text") -> list[str]:
-    """The joint torques/forces as equations, one per joint (CSE form for big ones)."""
-    r = Renderer(eom, fmt)
+def tau_lines(eom: EquationsOfMotion, fmt: str = "text", ascii: bool = False) -> list[str]:
+    """The joint torques/forces as equations, one per joint (CSE form for big ones).
+    ascii: plain ASCII text (tau1, theta1_dot) instead of Unicode (τ₁, θ̇₁)."""
+    r = Renderer(eom, fmt, ascii)
     lines = []
-    tau_name = (lambda k: f"tau{k + 1}") if fmt == "text" else (lambda k: rf"\tau_{{{k + 1}}}")
+    if fmt != "text":
+        tau_name = lambda k: rf"\tau_{{{k + 1}}}"  # noqa: E731
+    elif ascii:
+        tau_name = lambda k: f"tau{k + 1}"  # noqa: E731
+    else:
+        tau_name = lambda k: "τ" + str(k + 1).translate(_SUB)  # noqa: E731
     if _big(eom):
         # SymEngine's CSE: SymPy's walks the expanded tree and takes minutes on a 6-dof arm
         subexprs, reduced = se.cse(se.sympify(list(eom.tau)))
@@ -156,15 +249,16 @@ def tau_lines(eom: EquationsOfMotion, fmt: str = "text") -> list[str]:
         exprs = list(eom.tau)
         render = r.scalar
     for k, t in enumerate(exprs):
-        coord = eom.robot.coordinate_names[k]
+        coord = r.atom(eom.q[k]) if fmt == "text" else eom.robot.coordinate_names[k]
         eq = r.equation(tau_name(k), render(t))
         lines.append(f"{eq}    ({coord})" if fmt == "text" else eq)
     return lines
 
 
-def steps_lines(eom: EquationsOfMotion, fmt: str = "text") -> list[str]:
-    """Every intermediate step, grouped by stage, each in the frame its label names."""
-    r = Renderer(eom, fmt)
+def steps_lines(eom: EquationsOfMotion, fmt: str = "text", ascii: bool = False) -> list[str]:
+    """Every intermediate step, grouped by stage, each in the frame its label names
+    (ascii: see :func:`tau_lines`)."""
+    r = Renderer(eom, fmt, ascii)
     lines, stage = [], None
     titles = {
         "outward": "outward pass (each vector in its own link's frame)",
@@ -184,8 +278,9 @@ def steps_lines(eom: EquationsOfMotion, fmt: str = "text") -> list[str]:
 
 
 def derivation_report(eoms: list[EquationsOfMotion], fmt: str = "text", steps: bool = False,
-                      agreement=None) -> str:
+                      agreement=None, ascii: bool = False) -> str:
     """A whole report: the robot, for each method its (steps and) tau, then agreement.
+    ascii: text format in plain ASCII (theta1_dot, tau1) instead of Unicode (θ̇₁, τ₁).
 
     ``fmt="html"`` gives a self-contained page with MathML (see report_html.py)."""
     if fmt == "html":
@@ -207,9 +302,9 @@ def derivation_report(eoms: list[EquationsOfMotion], fmt: str = "text", steps: b
         if fmt == "latex":
             out.append(r"\begin{align*}")
         if steps:
-            out += steps_lines(eom, fmt)
+            out += steps_lines(eom, fmt, ascii)
             out.append({"text": " result:", "latex": r"\intertext{result}", "markdown": "**result**"}[fmt])
-        out += tau_lines(eom, fmt)
+        out += tau_lines(eom, fmt, ascii)
         if fmt == "latex":
             out.append(r"\end{align*}")
     if agreement is not None:

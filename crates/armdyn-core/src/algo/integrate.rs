@@ -33,7 +33,7 @@
 //! a single state, so results do not depend on the kernels, threads or grouping.
 
 use crate::algo;
-use crate::batch::{kernels, pool, thread_count, Kernels};
+use crate::batch::{install, kernels, thread_count, Kernels};
 use crate::data::Data;
 use crate::model::Model;
 use crate::real::{F64x4, F64x8, Real};
@@ -172,7 +172,7 @@ pub fn simulate(
     let run = || chunks.into_par_iter().for_each(|(first, mut chunk)| task.chunk(first, &mut chunk));
     match threads {
         None => run(),
-        Some(k) => pool(k).install(run),
+        Some(k) => install(k, run),
     }
 }
 

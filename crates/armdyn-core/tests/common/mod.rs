@@ -161,17 +161,24 @@ pub fn ur5_joints() -> Vec<JointSpec> {
     joints
 }
 
+/// Largest of `xs`, NaN if any is NaN (`f64::max` would drop a NaN silently).
+fn nan_max(xs: impl Iterator<Item = f64>) -> f64 {
+    xs.fold(0.0, |m, x| if x.is_nan() || m.is_nan() { f64::NAN } else { m.max(x) })
+}
+
 pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
     assert_eq!(a.len(), b.len());
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    nan_max(a.iter().zip(b).map(|(x, y)| (x - y).abs()))
 }
 
 pub fn max_abs(a: &[f64]) -> f64 {
-    a.iter().map(|x| x.abs()).fold(0.0, f64::max)
+    nan_max(a.iter().map(|x| x.abs()))
 }
 
-/// Assert |a - b| <= tol * (1 + max|b|).
+/// Assert |a - b| <= tol * (1 + max|b|), every entry of both finite. NaN or inf on
+/// either side fails: a comparison must never pass on a non-number.
 pub fn assert_close(a: &[f64], b: &[f64], tol: f64, what: &str) {
+    assert!(a.iter().chain(b).all(|x| x.is_finite()), "{what}: non-finite value\n  got {a:?}\n  want {b:?}");
     let err = max_abs_diff(a, b);
     let scale = 1.0 + max_abs(b);
     assert!(err <= tol * scale, "{what}: max error {err:e} (scale {scale:e})\n  got {a:?}\n  want {b:?}");
