@@ -37,6 +37,8 @@ from .errors import ModelError
 from .inertia import check_physical
 
 JOINT_TYPES = ("revolute", "prismatic", "fixed")
+#: Joint fields that add to tau (DESIGN.md: Fv, Fc, Ia, offset), in that naming.
+JOINT_DYNAMICS = ("damping", "friction", "armature", "torque_offset")
 
 
 def _vec3(value, what: str) -> sp.Matrix:
@@ -118,6 +120,23 @@ def skew(v) -> sp.Matrix:
     return sp.Matrix([[0, -z, y], [z, 0, -x], [-y, x, 0]])
 
 
+def _check_joint_dynamics(joint, where: str) -> None:
+    """Numeric friction/armature/offset values must be finite; damping, friction and
+    armature must not be negative (symbolic ones are checked once bound)."""
+    for name in JOINT_DYNAMICS:
+        value = getattr(joint, name)
+        if value is None or value.free_symbols:
+            continue
+        try:
+            x = complex(value.evalf())
+        except (TypeError, ValueError):
+            raise ModelError(f"{name} {value} is not a number", where) from None
+        if x.imag != 0 or not np.isfinite(x.real):
+            raise ModelError(f"{name} {value} is not a finite real number", where)
+        if name != "torque_offset" and x.real < 0:
+            raise ModelError(f"{name} {value} is negative (it must be >= 0)", where)
+
+
 @dataclass(frozen=True)
 class Link:
     """A rigid body.
@@ -152,8 +171,15 @@ class Joint:
     xyz:      (3, 1) placement translation in the parent link frame (m).
     rotation: (3, 3) placement rotation: placement-frame axes in the parent frame.
     axis:     (3, 1) unit axis of motion in the placement frame (ignored when fixed).
-    lower, upper, velocity, effort, damping, friction: optional limits and
-              joint-space friction, kept on the model (None when not given).
+    lower, upper, velocity, effort: optional limits, kept on the model (None when not given).
+    damping, friction, armature, torque_offset: joint-space terms added to the rigid-body
+              torque (DESIGN.md): ``tau_k += armature qdd_k + damping qd_k
+              + friction sign(qd_k) + torque_offset`` with sign(0) = 0. ``damping`` is the
+              viscous coefficient Fv (N m s/rad or N s/m), ``friction`` the Coulomb level Fc,
+              ``armature`` the rotor inertia Ia reflected to the joint (gear^2 times the
+              rotor's own inertia), ``torque_offset`` a constant torque/force. None (the
+              default) means absent, which is the same as 0. Numbers must be finite;
+              damping, friction and armature must not be negative. Ignored on a fixed joint.
     """
 
     name: str
@@ -169,6 +195,8 @@ class Joint:
     effort: sp.Expr | None = None
     damping: sp.Expr | None = None
     friction: sp.Expr | None = None
+    armature: sp.Expr | None = None
+    torque_offset: sp.Expr | None = None
 
     def __post_init__(self):
         where = f"joint '{self.name}'"
@@ -181,7 +209,7 @@ class Joint:
             object.__setattr__(self, "xyz", _vec3(self.xyz, "xyz"))
             object.__setattr__(self, "rotation", _mat3(self.rotation, "rotation"))
             object.__setattr__(self, "axis", _vec3(self.axis, "axis"))
-            for name in ("lower", "upper", "velocity", "effort", "damping", "friction"):
+            for name in ("lower", "upper", "velocity", "effort") + JOINT_DYNAMICS:
                 value = getattr(self, name)
                 if value is not None:
                     object.__setattr__(self, name, sp.sympify(value))
@@ -189,6 +217,7 @@ class Joint:
             raise err.located(element=where)
         except (sp.SympifyError, TypeError) as exc:
             raise ModelError(f"bad value ({exc})", where) from None
+        _check_joint_dynamics(self, where)
         if not self.rotation.free_symbols:
             R = np.array(self.rotation.evalf(), dtype=float)
             if not (np.allclose(R.T @ R, np.eye(3), atol=1e-9) and np.linalg.det(R) > 0):
@@ -397,6 +426,9 @@ class Robot:
             out |= sp.sympify(link.mass).free_symbols | link.com.free_symbols | link.inertia.free_symbols
         for j in self.joints:
             out |= j.xyz.free_symbols | j.rotation.free_symbols | j.axis.free_symbols
+            for name in JOINT_DYNAMICS:
+                if getattr(j, name) is not None:
+                    out |= getattr(j, name).free_symbols
         return out
 
     @classmethod
@@ -431,7 +463,7 @@ class Robot:
                 xyz=j.xyz.xreplace(table),
                 rotation=j.rotation.xreplace(table),
                 axis=j.axis.xreplace(table),
-                **{k: s(getattr(j, k)) for k in ("lower", "upper", "velocity", "effort", "damping", "friction")},
+                **{k: s(getattr(j, k)) for k in ("lower", "upper", "velocity", "effort") + JOINT_DYNAMICS},
             )
             for j in self.joints
         ]
@@ -464,6 +496,53 @@ class Robot:
         merged = {k: v for k, v in self.defaults.items() if k not in given}
         merged.update(values)
         return self.subs(merged)
+
+    def with_payload(self, mass, com=(0, 0, 0), inertia=None, link: str | None = None) -> "Robot":
+        """A new robot with a rigid load fixed to ``link`` (default: the last link in tree
+        order, the tool of a serial arm). This robot is not changed.
+
+        mass:    the payload's mass (kg), number or SymPy expression.
+        com:     (3,) its centre of mass in ``link``'s frame (m).
+        inertia: (3, 3) its inertia tensor about its own centre of mass, in ``link``'s
+                 axes (kg m^2); default zero (a point mass).
+
+        The link and the load become one body (:func:`armdyn.inertia.combine`: total
+        mass, mass-weighted centre of mass, parallel axis theorem). A payload that is not
+        physical (negative or non-finite mass, inertia not symmetric, not positive
+        semi-definite or breaking the triangle inequality) is a ModelError naming it.
+        """
+        from .inertia import Body, combine
+
+        where = "payload"
+        link = link if link is not None else list(self.links)[-1]
+        if link not in self.links:
+            raise ModelError(f"no link named {link!r} (links: {', '.join(self.links)})", where)
+        if link == self.base:
+            raise ModelError(f"the base link {link!r} does not move: a payload on it has no effect", where)
+        try:
+            mass = sp.sympify(mass)
+            com = _vec3(com, "com")
+            inertia = sp.zeros(3, 3) if inertia is None else _mat3(inertia, "inertia")
+        except ModelError as err:
+            raise err.located(element=where)
+        except (sp.SympifyError, TypeError) as exc:
+            raise ModelError(f"bad value ({exc})", where) from None
+        for name, values in (("mass", [mass]), ("com", list(com)), ("inertia", list(inertia))):
+            for v in values:
+                if not v.free_symbols and not np.isfinite(complex(v.evalf())).all():
+                    raise ModelError(f"{name} has a value that is not finite ({v})", where)
+        check_physical(mass, inertia, where, strict=True)
+        old = self.links[link]
+        body = combine([Body(old.mass, old.com, old.inertia), Body(mass, com, inertia)])
+        new = Link(old.name, sp.sympify(body.mass), sp.Matrix(body.com), sp.Matrix(body.inertia))
+        links = [new if ln.name == link else ln for ln in self.links.values()]
+        params = dict(self.parameters)
+        for s in mass.free_symbols | com.free_symbols | inertia.free_symbols:
+            params.setdefault(s.name, s)
+        return Robot(
+            self.name, links, self.joints, self.gravity, params, self.meta, self.base, self.defaults,
+            strict=self.strict,
+        )
 
     def __repr__(self) -> str:
         kinds = "".join({"revolute": "R", "prismatic": "P", "fixed": "F"}[j.type] for j in self.joints)

@@ -39,6 +39,7 @@ __all__ = [
     "potential_energy",
     "forward_kinematics",
     "jacobian",
+    "regressor",
 ]
 
 #: A robot compiled for numeric evaluation (built by :func:`compile_model`). Its
@@ -96,6 +97,14 @@ def compile_model(robot: Robot | NumericModel) -> NumericModel:
         masses.append(_floats([link.mass], where)[0])
         coms.append(_floats(link.com, where))
         inertias.append(np.reshape(_floats(link.inertia, where), (3, 3)).tolist())
+    # per movable joint [armature, viscous, coulomb, offset] (absent = 0); None when all zero
+    joint_dynamics = [
+        _floats([getattr(j, k) if getattr(j, k) is not None else 0 for k in ("armature", "damping", "friction", "torque_offset")],
+                f"joint '{j.name}'")
+        for j in robot.movable_joints
+    ]
+    if not any(any(row) for row in joint_dynamics):
+        joint_dynamics = None
     gravity_vec = _floats(robot.gravity, f"robot '{robot.name}'")
     base = robot.links[robot.base]
     where = f"link '{base.name}'"
@@ -103,7 +112,7 @@ def compile_model(robot: Robot | NumericModel) -> NumericModel:
         model = NumericModel(
             parents, types, rotations, translations, axes, masses, coms, inertias, gravity_vec,
             list(robot.links), list(robot.coordinate_names), robot.name,
-            _floats([base.mass], where)[0], _floats(base.com, where),
+            _floats([base.mass], where)[0], _floats(base.com, where), joint_dynamics,
         )
     except ValueError as err:
         raise ModelError(str(err), f"robot '{robot.name}'") from None
@@ -202,3 +211,34 @@ def jacobian(robot, q, link, *, threads=None):
     if isinstance(link, Link):
         link = link.name
     return _model(robot).jacobian(q, link, threads)
+
+
+def regressor(robot, q, qd, qdd, *, threads=None, columns: str = "model"):
+    """The joint torque regressor Y with ``rnea(q, qd, qdd) = Y @ pi`` (Rust core,
+    algo/regressor.rs). q, qd, qdd: (n,) or (N, n). Returns (n, P) or (N, n, P).
+
+    Columns, for every link but the base (in ``list(robot.links)`` order, links on
+    fixed joints included): ``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]``,
+    inertia about the link frame's origin in its axes (Pinocchio's order); then
+
+    * ``columns="model"`` (default, ``robot`` a Robot): per movable joint the columns
+      of the terms it has (``armature``, ``damping``, ``friction``, ``torque_offset`` not
+      None: ``qdd, qd, sign(qd), 1``), the order of
+      :func:`armdyn.identification.regressor`'s ``pi``;
+    * ``columns="all"``: every movable joint's four columns ``[qdd, qd, sign(qd), 1]``.
+    """
+    if columns not in ("model", "all"):
+        raise ValueError(f"columns must be 'model' or 'all', got {columns!r}")
+    model = _model(robot)
+    Y = _core.regressor(model, q, qd, qdd, threads)
+    if columns == "all":
+        return Y
+    if not isinstance(robot, Robot):
+        raise TypeError("columns='model' needs the Robot (a NumericModel does not say which terms a joint has)")
+    keep = list(range(10 * len(robot.joints)))
+    first = 10 * len(robot.joints)
+    for i, j in enumerate(robot.movable_joints):
+        for k, name in enumerate(("armature", "damping", "friction", "torque_offset")):
+            if getattr(j, name) is not None:
+                keep.append(first + 4 * i + k)
+    return Y[..., keep]

@@ -25,5 +25,5 @@ pub mod real;
 pub mod spatial;
 
 pub use data::Data;
-pub use model::{JointSpec, JointType, Model, ModelError};
+pub use model::{JointDynamics, JointSpec, JointType, Model, ModelError};
 pub use real::{F64x4, F64x8, Real};

@@ -31,8 +31,11 @@ General frames
                                     #   parent frame (not both rpy and rotation)
         axis: [0, 0, 1]             # optional unit axis in the placement frame, default z
         limits: {lower: -pi, upper: pi, velocity: 2, effort: 100}   # optional, any subset
-        damping: 0.1                # optional
-        friction: 0.0               # optional
+        damping: 0.1                # optional viscous friction Fv (tau += Fv qd)
+        friction: 0.0               # optional Coulomb friction Fc (tau += Fc sign(qd))
+        armature: 0.0               # optional rotor inertia at the joint Ia (tau += Ia qdd),
+        # or rotor_inertia: Jm with gear_ratio: G  -> Ia = G^2 Jm (not both)
+        torque_offset: 0.0          # optional constant offset (tau += offset)
     links:
       - name: link1
         mass: m1                    # optional, default 0
@@ -126,7 +129,8 @@ TOP_KEYS = (
     "name", "description", "source", "notes", "convention", "base",
     "parameters", "gravity", "joints", "links", "dh",
 )  # fmt: skip
-JOINT_KEYS = ("name", "type", "parent", "child", "xyz", "rpy", "rotation", "axis", "limits", "damping", "friction")
+JOINT_KEYS = ("name", "type", "parent", "child", "xyz", "rpy", "rotation", "axis", "limits", "damping", "friction",
+              "armature", "rotor_inertia", "gear_ratio", "torque_offset")
 LINK_KEYS = ("name", "mass", "com", "inertia")
 JOINT_TYPES = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic", "fixed": "fixed"}
 MODEL_CONVENTIONS = ("frames", "standard-dh", "modified-dh")

@@ -162,8 +162,11 @@ def check(
     # skew-symmetry of Mdot - 2C on the first derivation (C depends on M only)
     N = time_derivative(a.M, a.q, a.qd) - 2 * a.C
     report.results.append(_compare(f"Mdot - 2C skew-symmetric ({a.method})", N, -N.T, a.q, sampler, exact, tol))
-    # tau = M qdd + C qd + g: the split is consistent with what the method produced
+    # tau = M qdd + C qd + g (+ joint friction): the split is consistent with what the method produced
     recon = a.M * a.qdd + a.C * a.qd + a.g
-    report.results.append(_compare(f"tau == M qdd + C qd + g ({a.method})", a.tau, recon, a.q, sampler, exact, tol))
+    label = "tau == M qdd + C qd + g"
+    if any(x != 0 for x in a.friction):
+        recon, label = recon + a.friction, label + " + Fv qd + Fc sign(qd)"
+    report.results.append(_compare(f"{label} ({a.method})", a.tau, recon, a.q, sampler, exact, tol))
     return report
 

@@ -10,6 +10,7 @@ pub mod crba;
 pub mod energy;
 pub mod jacobian;
 pub mod kinematics;
+pub mod regressor;
 pub mod rnea;
 
 pub use aba::aba;
@@ -18,4 +19,5 @@ pub use crba::crba;
 pub use energy::{kinetic_energy, potential_energy};
 pub use jacobian::jacobian;
 pub use kinematics::forward_kinematics;
+pub use regressor::{regressor, regressor_columns};
 pub use rnea::{bias, gravity, rnea};
