@@ -59,6 +59,7 @@ import random
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
+import symengine as se
 import sympy as sp
 
 from .model import Robot
@@ -131,43 +132,76 @@ class Regressor:
         return self.Y * self.pi
 
 
+def _cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def _add(*vs):
+    return [sum(x, se.Integer(0)) for x in zip(*vs)]
+
+
+def _scale(s, a):
+    return [s * x for x in a]
+
+
+def _mul(R, a):  # R: 3x3 nested list, a: 3-list
+    return [R[i][0] * a[0] + R[i][1] * a[1] + R[i][2] * a[2] for i in range(3)]
+
+
+def _tmul(R, a):  # R^T a
+    return [R[0][i] * a[0] + R[1][i] * a[1] + R[2][i] * a[2] for i in range(3)]
+
+
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _se_vec(m):
+    return [se.sympify(x) for x in m]
+
+
+def _se_mat(m):
+    return [[se.sympify(m[i, j]) for j in range(3)] for i in range(3)]
+
+
 def _outward(robot: Robot):
-    """Craig's outward recursion (see symbolic/newton_euler.py): per link, its
-    ``w, wd, vd`` (frame origin, gravity as base acceleration) and the child's pose
-    ``(R, p)`` in the parent."""
-    zero = sp.zeros(3, 1)
-    w, wd, vd = {robot.base: zero}, {robot.base: zero}, {robot.base: -robot.gravity}
+    """Craig's outward recursion (as symbolic/newton_euler.py, in SymEngine for speed):
+    per link, its ``w, wd, vd`` (frame origin, gravity as base acceleration) and the
+    child's pose ``(R, p)`` in the parent."""
+    zero = [se.Integer(0)] * 3
+    w, wd, vd = {robot.base: zero}, {robot.base: zero}, {robot.base: _scale(-1, _se_vec(robot.gravity))}
     pose = {}
-    qd, qdd = robot.qd, robot.qdd
+    qd, qdd = _se_vec(robot.qd), _se_vec(robot.qdd)
     for joint in robot.joints:
         parent, k = joint.parent, robot.coordinate_index(joint)
         R, p = joint.transform(robot.joint_coordinate(joint))
+        R, p, z = _se_mat(R), _se_vec(p), _se_vec(joint.axis)
         pose[joint.child] = (R, p)
-        Rt, z = R.T, joint.axis
-        w_in, wd_in = Rt * w[parent], Rt * wd[parent]
-        vd_i = Rt * (wd[parent].cross(p) + w[parent].cross(w[parent].cross(p)) + vd[parent])
+        w_in, wd_in = _tmul(R, w[parent]), _tmul(R, wd[parent])
+        vd_i = _tmul(R, _add(_cross(wd[parent], p), _cross(w[parent], _cross(w[parent], p)), vd[parent]))
         if joint.type == "revolute":
-            w_i = w_in + qd[k] * z
-            wd_i = wd_in + w_in.cross(qd[k] * z) + qdd[k] * z
+            w_i = _add(w_in, _scale(qd[k], z))
+            wd_i = _add(wd_in, _cross(w_in, _scale(qd[k], z)), _scale(qdd[k], z))
         else:
             w_i, wd_i = w_in, wd_in
         if joint.type == "prismatic":
-            vd_i = vd_i + 2 * w_i.cross(qd[k] * z) + qdd[k] * z
+            vd_i = _add(vd_i, _scale(2, _cross(w_i, _scale(qd[k], z))), _scale(qdd[k], z))
         w[joint.child], wd[joint.child], vd[joint.child] = w_i, wd_i, vd_i
     return w, wd, vd, pose
 
 
-def _unit_wrenches(w, wd, vd) -> list[tuple[sp.Matrix, sp.Matrix]]:
+def _unit_wrenches(w, wd, vd):
     """For each of the 10 unit parameters, ``(f, n)``: force and moment about the frame
     origin that move a body of that parameter alone (Khalil and Dombre eq. 12.30)."""
-    zero = sp.zeros(3, 1)
+    zero = [se.Integer(0)] * 3
     out = [(vd, zero)]  # M
-    for e in (sp.eye(3)[:, i] for i in range(3)):
-        out.append((wd.cross(e) + w.cross(w.cross(e)), e.cross(vd)))  # MX, MY, MZ
+    for i in range(3):  # MX, MY, MZ
+        e = [se.Integer(int(i == j)) for j in range(3)]
+        out.append((_add(_cross(wd, e), _cross(w, _cross(w, e))), _cross(e, vd)))
     for (a, b) in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):  # XX, XY, YY, XZ, YZ, ZZ
-        E = sp.zeros(3, 3)
-        E[a, b] = E[b, a] = 1
-        out.append((zero, E * wd + w.cross(E * w)))
+        E = [[se.Integer(0)] * 3 for _ in range(3)]
+        E[a][b] = E[b][a] = se.Integer(1)
+        out.append((zero, _add(_mul(E, wd), _cross(w, _mul(E, w)))))
     return out
 
 
@@ -189,10 +223,10 @@ def regressor(robot: Robot) -> Regressor:
             for jt in chain[name]:
                 k = robot.coordinate_index(jt)
                 if k is not None:
-                    col[k] = (m if jt.type == "revolute" else f).dot(jt.axis)
+                    col[k] = sp.sympify(_dot(m if jt.type == "revolute" else f, _se_vec(jt.axis)))
                 R, p = pose[jt.child]
-                f = R * f
-                m = R * m + p.cross(f)
+                f = _mul(R, f)
+                m = _add(_mul(R, m), _cross(p, f))
             cols.append(col)
     for joint in robot.movable_joints:
         k = robot.coordinate_index(joint)
@@ -215,11 +249,11 @@ def _exact_point(symbols_sin_cos, scalars, rng: random.Random):
     rationals for everything else."""
     values = {}
     for x in symbols_sin_cos:
-        t = Fraction(rng.randint(-60, 60), rng.randint(1, 61))
+        t = Fraction(rng.randint(-20, 20), rng.randint(1, 20))
         values[sp.sin(x)] = 2 * t / (1 + t * t)
         values[sp.cos(x)] = (1 - t * t) / (1 + t * t)
     for s in scalars:
-        values[s] = Fraction(rng.randint(-97, 97), rng.randint(1, 29))
+        values[s] = Fraction(rng.randint(-30, 30), rng.randint(1, 12))
     return values
 
 
@@ -233,8 +267,8 @@ def _exact_evaluate(matrix: sp.Matrix, values: dict) -> list[list[Fraction]]:
             return values[e]
         if e.is_Rational:
             return Fraction(int(e.p), int(e.q))
-        if e.is_Float:
-            return Fraction(float(e))
+        if e.is_Float:  # the decimal as written (0.4318 -> 2159/5000): small exact numbers
+            return Fraction(repr(float(e)))
         if e.is_Add:
             return sum(args[1:], args[0])
         if e.is_Mul:
@@ -271,13 +305,20 @@ def _exact_evaluate(matrix: sp.Matrix, values: dict) -> list[list[Fraction]]:
 
 def _angles_and_scalars(Y: sp.Matrix):
     """Symbols that appear inside sin/cos (angles) and the others."""
-    angles, scalars = set(), set()
-    for e in set(Y):
-        for t in e.atoms(sp.sin, sp.cos):
-            if not t.args[0].is_Symbol:
-                raise ValueError(f"cannot evaluate {t} exactly: only sin/cos of a single symbol are handled")
-            angles.add(t.args[0])
-        scalars |= e.free_symbols
+    angles, scalars, seen = set(), set(), set()
+    stack = list(set(Y))
+    while stack:  # one visit per distinct subexpression
+        e = stack.pop()
+        if e in seen:
+            continue
+        seen.add(e)
+        if isinstance(e, (sp.sin, sp.cos)):
+            if not e.args[0].is_Symbol:
+                raise ValueError(f"cannot evaluate {e} exactly: only sin/cos of a single symbol are handled")
+            angles.add(e.args[0])
+        elif e.is_Symbol:
+            scalars.add(e)
+        stack.extend(e.args)
     return sorted(angles, key=str), sorted(scalars - angles, key=str)
 
 
@@ -323,10 +364,14 @@ def _rref(rows: list[list[Fraction]], ncols: int):
     return A[:r], pivots
 
 
-def exact_rank(Y: sp.Matrix, states: int | None = None, seed: int = 0) -> int:
-    """Rank of Y stacked over random rational states, in exact arithmetic."""
-    states = states or (Y.shape[1] // max(Y.shape[0], 1) + 4)
-    return len(_rref(stacked_exact(Y, states, seed), Y.shape[1])[1])
+def exact_rank(Y: sp.Matrix, states: int | None = None, seed: int = 0, state_symbols=()) -> int:
+    """Rank of Y stacked over random rational states, in exact arithmetic. Symbols other
+    than ``state_symbols`` (the geometry, gravity) get one random value for all states."""
+    states = states or (Y.shape[1] // max(Y.shape[0], 1) + 3)
+    angles, scalars = _angles_and_scalars(Y)
+    rng = random.Random(seed + 1)
+    fixed = {s: Fraction(rng.randint(-30, 30), rng.randint(1, 12)) for s in angles + scalars if s not in set(state_symbols)}
+    return len(_rref(stacked_exact(Y, states, seed, fixed), Y.shape[1])[1])
 
 
 # ------------------------------------------------------------------ base parameters
@@ -428,7 +473,7 @@ def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
     Y = reg.Y
     keep, exprs = _grouped(robot, reg)
     P = Y.shape[1]
-    states = P // max(robot.dof, 1) + 4
+    states = P // max(robot.dof, 1) + 3
     # exact rank tests on the kept columns at random rational points
     Yk = Y[:, keep] if keep else sp.zeros(robot.dof, 0)
     angles, scalars = _angles_and_scalars(Y)
@@ -437,7 +482,7 @@ def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
     rng = random.Random(seed + 1)
     coefficient_sets = []
     for trial in range(2 if geometry else 1):
-        fixed = {s: Fraction(rng.randint(-97, 97), rng.randint(1, 29)) for s in geometry}
+        fixed = {s: Fraction(rng.randint(-30, 30), rng.randint(1, 12)) for s in geometry}
         rows = stacked_exact(Yk, states, seed + trial, fixed)
         R, pivots = _rref(rows, len(keep))
         coefficient_sets.append((R, pivots))
@@ -461,7 +506,7 @@ def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
     names = [reg.names[keep[c]] + ("R" if g else "") for c, g in zip(pivots, grouped)]
     Yb = Y[:, [keep[c] for c in pivots]] if pivots else sp.zeros(robot.dof, 0)
     # a column that is not structurally zero can still vanish identically: test exactly
-    rows = stacked_exact(Y, states, seed + 7)
+    rows = stacked_exact(Y, 3, seed + 7)
     zero = [reg.names[c] for c in range(P) if all(row[c] == 0 for row in rows)]
     subs = dict(zip(reg.symbols, reg.pi))
     values = sp.Matrix([sp.sympify(b).xreplace(subs) for b in beta])
