@@ -539,10 +539,14 @@ class Robot:
         params = dict(self.parameters)
         for s in mass.free_symbols | com.free_symbols | inertia.free_symbols:
             params.setdefault(s.name, s)
-        return Robot(
-            self.name, links, self.joints, self.gravity, params, self.meta, self.base, self.defaults,
-            strict=self.strict,
-        )
+        import warnings
+
+        with warnings.catch_warnings():  # this robot's own links were warned about when it was built
+            warnings.simplefilter("ignore")
+            return Robot(
+                self.name, links, self.joints, self.gravity, params, self.meta, self.base, self.defaults,
+                strict=self.strict,
+            )
 
     def __repr__(self) -> str:
         kinds = "".join({"revolute": "R", "prismatic": "P", "fixed": "F"}[j.type] for j in self.joints)
