@@ -55,6 +55,7 @@ random points holds everywhere with probability 1 - O(degree / range).
 
 from __future__ import annotations
 
+import math
 import random
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
@@ -257,30 +258,45 @@ def _exact_point(symbols_sin_cos, scalars, rng: random.Random):
     return values
 
 
-def _exact_evaluate(matrix: sp.Matrix, values: dict) -> list[list[Fraction]]:
-    """Entries of ``matrix`` at exact rational ``values`` (keys: symbols, sin(x), cos(x)),
-    shared subexpressions visited once."""
+#: the Mersenne prime 2^127 - 1: ranks and dependencies are computed modulo it (exact
+#: integer arithmetic, fast), coefficients recovered by rational reconstruction and checked
+#: in exact rational arithmetic at a further random point
+PRIME = 2**127 - 1
+
+
+def _exact_evaluate(matrix: sp.Matrix, values: dict, modulus: int | None = None) -> list[list]:
+    """Entries of ``matrix`` at exact rational ``values`` (keys: symbols, sin(x), cos(x);
+    values: Fractions), shared subexpressions visited once. With ``modulus``, the
+    entries modulo that prime (ints), which is much faster."""
     memo: dict = {}
+    p = modulus
+
+    def num(x: Fraction):
+        return x if p is None else x.numerator * pow(x.denominator, -1, p) % p
 
     def node(e, args):
         if e in values:
-            return values[e]
+            return num(values[e])
         if e.is_Rational:
-            return Fraction(int(e.p), int(e.q))
+            return num(Fraction(int(e.p), int(e.q)))
         if e.is_Float:  # the decimal as written (0.4318 -> 2159/5000): small exact numbers
-            return Fraction(repr(float(e)))
+            return num(Fraction(repr(float(e))))
         if e.is_Add:
-            return sum(args[1:], args[0])
+            r = sum(args[1:], args[0])
+            return r if p is None else r % p
         if e.is_Mul:
             r = args[0]
             for a in args[1:]:
-                r = r * a
+                r = r * a if p is None else r * a % p
             return r
         if e.is_Pow and e.exp.is_Integer:
-            return args[0] ** int(e.exp)
+            return args[0] ** int(e.exp) if p is None else pow(args[0], int(e.exp), p)
         if isinstance(e, sp.sign):
-            x = args[0]
-            return Fraction((x > 0) - (x < 0))
+            if p is not None:  # the sign of the rational value, not of its residue
+                x = values[e.args[0]]
+            else:
+                x = args[0]
+            return num(Fraction((x > 0) - (x < 0)))
         if e.is_Symbol:
             raise KeyError(f"no value for symbol {e}")
         raise ValueError(f"cannot evaluate {e} exactly (only polynomials in parameters, sin/cos of symbols and sign)")
@@ -303,6 +319,19 @@ def _exact_evaluate(matrix: sp.Matrix, values: dict) -> list[list[Fraction]]:
     return [[ev(sp.sympify(matrix[i, j])) for j in range(matrix.shape[1])] for i in range(matrix.shape[0])]
 
 
+def _rational(a: int, p: int = PRIME) -> Fraction:
+    """The fraction n/d with |n|, d <= sqrt(p/2) congruent to ``a`` mod p (rational
+    reconstruction by the extended Euclidean algorithm, Wang 1981)."""
+    bound = math.isqrt(p // 2)
+    r0, r1, s0, s1 = p, a % p, 0, 1
+    while r1 > bound:
+        q = r0 // r1
+        r0, r1, s0, s1 = r1, r0 - q * r1, s1, s0 - q * s1
+    if s1 == 0 or abs(s1) > bound:
+        raise ArithmeticError("rational reconstruction failed")
+    return Fraction(r1, s1)
+
+
 def _angles_and_scalars(Y: sp.Matrix):
     """Symbols that appear inside sin/cos (angles) and the others."""
     angles, scalars, seen = set(), set(), set()
@@ -322,10 +351,11 @@ def _angles_and_scalars(Y: sp.Matrix):
     return sorted(angles, key=str), sorted(scalars - angles, key=str)
 
 
-def stacked_exact(Y: sp.Matrix, states: int, seed: int = 0, fixed: dict | None = None):
+def stacked_exact(Y: sp.Matrix, states: int, seed: int = 0, fixed: dict | None = None, modulus: int | None = None):
     """Y evaluated exactly at ``states`` random rational points, stacked: a list of rows
-    (states * dof rows of Fractions). Symbols in ``fixed`` (name -> Fraction) keep those
-    values at every point (the geometry), the others change from point to point."""
+    (states * dof rows of Fractions, or of ints modulo ``modulus``). Symbols in ``fixed``
+    (symbol -> Fraction) keep those values at every point (the geometry), the others
+    change from point to point."""
     rng = random.Random(seed)
     angles, scalars = _angles_and_scalars(Y)
     fixed = dict(fixed or {})
@@ -338,25 +368,30 @@ def stacked_exact(Y: sp.Matrix, states: int, seed: int = 0, fixed: dict | None =
                 values[sp.sin(s)], values[sp.cos(s)] = 2 * t / (1 + t * t), (1 - t * t) / (1 + t * t)
             else:
                 values[s] = v
-        rows += _exact_evaluate(Y, values)
+        rows += _exact_evaluate(Y, values, modulus)
     return rows
 
 
-def _rref(rows: list[list[Fraction]], ncols: int):
-    """Reduced row echelon form in exact rational arithmetic (Fractions): ``(R, pivots)``."""
+def _rref(rows: list[list], ncols: int, modulus: int | None = None):
+    """Reduced row echelon form, in exact rational arithmetic (Fractions) or modulo a
+    prime (ints): ``(R, pivots)``."""
+    p = modulus
     A = [list(r) for r in rows]
     pivots, r = [], 0
     for c in range(ncols):
-        p = next((i for i in range(r, len(A)) if A[i][c] != 0), None)
-        if p is None:
+        piv = next((i for i in range(r, len(A)) if A[i][c] != 0), None)
+        if piv is None:
             continue
-        A[r], A[p] = A[p], A[r]
-        inv = 1 / A[r][c]
-        A[r] = [x * inv for x in A[r]]
+        A[r], A[piv] = A[piv], A[r]
+        inv = 1 / A[r][c] if p is None else pow(A[r][c], -1, p)
+        A[r] = [x * inv for x in A[r]] if p is None else [x * inv % p for x in A[r]]
         for i in range(len(A)):
             if i != r and A[i][c] != 0:
                 f = A[i][c]
-                A[i] = [x - f * y for x, y in zip(A[i], A[r])]
+                if p is None:
+                    A[i] = [x - f * y for x, y in zip(A[i], A[r])]
+                else:
+                    A[i] = [(x - f * y) % p for x, y in zip(A[i], A[r])]
         pivots.append(c)
         r += 1
         if r == len(A):
@@ -365,13 +400,15 @@ def _rref(rows: list[list[Fraction]], ncols: int):
 
 
 def exact_rank(Y: sp.Matrix, states: int | None = None, seed: int = 0, state_symbols=()) -> int:
-    """Rank of Y stacked over random rational states, in exact arithmetic. Symbols other
+    """Rank of Y stacked over random rational states, in exact arithmetic modulo
+    :data:`PRIME` (equal to the rank over the rationals but with probability ~1e-38 per
+    pivot). Symbols other
     than ``state_symbols`` (the geometry, gravity) get one random value for all states."""
     states = states or (Y.shape[1] // max(Y.shape[0], 1) + 3)
     angles, scalars = _angles_and_scalars(Y)
     rng = random.Random(seed + 1)
     fixed = {s: Fraction(rng.randint(-30, 30), rng.randint(1, 12)) for s in angles + scalars if s not in set(state_symbols)}
-    return len(_rref(stacked_exact(Y, states, seed, fixed), Y.shape[1])[1])
+    return len(_rref(stacked_exact(Y, states, seed, fixed, PRIME), Y.shape[1], PRIME)[1])
 
 
 # ------------------------------------------------------------------ base parameters
@@ -389,6 +426,9 @@ class BaseParameters:
     unidentifiable: standard parameter names whose column of Y is identically zero.
     values:         (B, 1) ``beta`` with the robot's own parameter values substituted.
     regressor:      the standard :class:`Regressor`.
+    columns:        B indices of the base columns in the standard regressor
+                    (``Y == regressor.Y[:, columns]``; also the columns of
+                    ``armdyn.numeric.regressor(robot, ...)``).
     """
 
     Y: sp.Matrix
@@ -397,6 +437,7 @@ class BaseParameters:
     unidentifiable: list[str]
     values: sp.Matrix
     regressor: Regressor
+    columns: list[int] = field(default_factory=list)
 
 
 def _group_revolute(vec, u):
@@ -483,9 +524,16 @@ def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
     coefficient_sets = []
     for trial in range(2 if geometry else 1):
         fixed = {s: Fraction(rng.randint(-30, 30), rng.randint(1, 12)) for s in geometry}
-        rows = stacked_exact(Yk, states, seed + trial, fixed)
-        R, pivots = _rref(rows, len(keep))
+        rows = stacked_exact(Yk, states, seed + trial, fixed, PRIME)
+        R, pivots = _rref(rows, len(keep), PRIME)
+        R = [[_rational(x) for x in row] for row in R]
         coefficient_sets.append((R, pivots))
+        # the dependencies, checked in exact rational arithmetic at a fresh random state
+        check = stacked_exact(Yk, 1, seed + 100 + trial, fixed)
+        for row in check:
+            for d in range(len(keep)):
+                if d not in pivots and row[d] != sum(R[r][d] * row[c] for r, c in enumerate(pivots)):
+                    raise ArithmeticError(f"base_parameters: dependency of {reg.names[keep[d]]} not confirmed")
     R, pivots = coefficient_sets[0]
     if len(coefficient_sets) > 1 and (coefficient_sets[1][1] != pivots or coefficient_sets[1][0] != R):
         raise ValueError(
@@ -506,11 +554,11 @@ def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
     names = [reg.names[keep[c]] + ("R" if g else "") for c, g in zip(pivots, grouped)]
     Yb = Y[:, [keep[c] for c in pivots]] if pivots else sp.zeros(robot.dof, 0)
     # a column that is not structurally zero can still vanish identically: test exactly
-    rows = stacked_exact(Y, 3, seed + 7)
+    rows = stacked_exact(Y, 3, seed + 7, None, PRIME)
     zero = [reg.names[c] for c in range(P) if all(row[c] == 0 for row in rows)]
     subs = dict(zip(reg.symbols, reg.pi))
     values = sp.Matrix([sp.sympify(b).xreplace(subs) for b in beta])
-    return BaseParameters(Yb, sp.Matrix(beta), names, zero, values, reg)
+    return BaseParameters(Yb, sp.Matrix(beta), names, zero, values, reg, [keep[c] for c in pivots])
 
 
 def with_symbolic_joint_terms(robot: Robot, terms=("armature", "damping", "friction")) -> Robot:
