@@ -165,7 +165,9 @@ def numeric_rank(robot, states_count=40, seed=31) -> int:
     n = robot.dof
     Q, QD, QDD = (rng.uniform(-np.pi, np.pi, (states_count, n)) for _ in range(3))
     W = num.regressor(robot, Q, QD, QDD).reshape(states_count * n, -1)
-    W = W / np.maximum(np.linalg.norm(W, axis=0), 1e-300)  # column scaling: masses vs inertias
+    norms = np.linalg.norm(W, axis=0)
+    W = W[:, norms > 1e-9 * norms.max()]  # zero columns (round-off only) carry no rank
+    W = W / np.linalg.norm(W, axis=0)  # column scaling: masses vs inertias
     s = np.linalg.svd(W, compute_uv=False)
     return int(np.sum(s > s[0] * 1e-9))
 
