@@ -407,7 +407,7 @@ def exact_rank(Y: sp.Matrix, states: int | None = None, seed: int = 0, state_sym
     states = states or (Y.shape[1] // max(Y.shape[0], 1) + 3)
     angles, scalars = _angles_and_scalars(Y)
     rng = random.Random(seed + 1)
-    fixed = {s: Fraction(rng.randint(-30, 30), rng.randint(1, 12)) for s in angles + scalars if s not in set(state_symbols)}
+    fixed = {s: _nonzero_fraction(rng) for s in angles + scalars if s not in set(state_symbols)}
     return len(_rref(stacked_exact(Y, states, seed, fixed, PRIME), Y.shape[1], PRIME)[1])
 
 
@@ -502,14 +502,41 @@ def _grouped(robot: Robot, reg: Regressor):
     return keep, exprs
 
 
+def _nonzero_fraction(rng: random.Random) -> Fraction:
+    """A random nonzero small rational (a zero length would make the geometry special)."""
+    return Fraction(rng.choice([-1, 1]) * rng.randint(1, 30), rng.randint(1, 12))
+
+
+def rationalized(robot: Robot) -> Robot:
+    """A copy of ``robot`` whose geometry (joint placements, axes, gravity) has every
+    Float replaced by the exact decimal it prints as (0.4318 -> 2159/5000). Products of
+    lengths then stay exact (0.0825**2 in floating point is not (0.0825)^2), so the exact
+    rank tests see the true dependencies. Inertial values are left as they are."""
+    from dataclasses import replace as _replace
+
+    def exact(m):
+        return m.xreplace({f: sp.Rational(repr(float(f))) for f in m.atoms(sp.Float)})
+
+    joints = [_replace(j, xyz=exact(j.xyz), rotation=exact(j.rotation), axis=exact(j.axis)) for j in robot.joints]
+    import warnings
+
+    with warnings.catch_warnings():  # the links were checked when the robot was built
+        warnings.simplefilter("ignore")
+        return Robot(robot.name, robot.links.values(), joints, exact(robot.gravity), robot.parameters, robot.meta,
+                     robot.base, robot.defaults, strict=robot.strict)
+
+
 def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
     """The base parameters of ``robot`` (see the module docstring): exact, symbolic
     combinations of the standard parameters, for any tree of revolute, prismatic and
-    fixed joints, with symbolic geometry.
+    fixed joints, with symbolic geometry. Decimal numbers of the geometry are taken as
+    the exact decimals they are (:func:`rationalized`): ``base.regressor`` and ``base.Y``
+    are those of that copy (equal to the robot's to the last bit of its floats).
 
     Raises ValueError if two remaining columns depend on each other with a coefficient
     that changes with the geometry (not met on the bundled arms; bind the geometry).
     """
+    robot = rationalized(robot)
     reg = regressor(robot)
     Y = reg.Y
     keep, exprs = _grouped(robot, reg)
@@ -523,7 +550,7 @@ def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
     rng = random.Random(seed + 1)
     coefficient_sets = []
     for trial in range(2 if geometry else 1):
-        fixed = {s: Fraction(rng.randint(-30, 30), rng.randint(1, 12)) for s in geometry}
+        fixed = {s: _nonzero_fraction(rng) for s in geometry}
         rows = stacked_exact(Yk, states, seed + trial, fixed, PRIME)
         R, pivots = _rref(rows, len(keep), PRIME)
         R = [[_rational(x) for x in row] for row in R]
@@ -604,5 +631,5 @@ def symbolic_inertias(robot: Robot) -> Robot:
 
 __all__ = [
     "Regressor", "BaseParameters", "regressor", "base_parameters", "standard_parameters",
-    "exact_rank", "stacked_exact", "with_symbolic_joint_terms", "symbolic_inertias", "INERTIAL",
+    "exact_rank", "stacked_exact", "with_symbolic_joint_terms", "symbolic_inertias", "rationalized", "INERTIAL",
 ]
