@@ -211,7 +211,7 @@ def test_puma560_36_and_52():
 def test_planar_2r_grouping_by_hand():
     """Khalil's rules by hand for the planar elbow: joint 2 at distance l1 along x1 with a
     parallel axis gives MX1R = MX1 + l1 M2, ZZ1R = ZZ1 + l1^2 M2; the rest of link 1 and
-    M2, MZ2 (and what only turns about z) have no effect."""
+    MZ2 (and what only turns about z) have no effect; M2 acts only through the groups."""
     robot = armdyn.load("planar-2r")
     base = base_parameters(robot)
     s = {n: sp.Symbol(n) for n in ("MX1", "MY1", "ZZ1", "M2", "MX2", "MY2", "ZZ2")}
@@ -220,7 +220,7 @@ def test_planar_2r_grouping_by_hand():
                 "MX2": s["MX2"], "MY2": s["MY2"], "ZZ2": s["ZZ2"]}
     assert dict(zip(base.names, base.beta)) == expected
     assert not any(isinstance(a, sp.Float) for b in base.beta for a in sp.preorder_traversal(b))
-    assert {"M1", "XX1", "M2", "XX2"} <= set(base.unidentifiable)
+    assert {"M1", "XX1", "XX2"} <= set(base.unidentifiable) and "M2" not in base.unidentifiable
 
 
 @pytest.mark.parametrize("name", SMALL + ["scara"])
@@ -272,3 +272,20 @@ def test_base_parameters_symbolic_geometry():
         warnings.simplefilter("ignore")
         bound = robot.bind({"l1": 0.7, "g": 9.81, "m1": 1.0, "m2": 2.0})
     assert len(base.names) == numeric_rank(with_terms(bound, terms=("armature", "damping", "friction")))
+
+
+def test_scara_geometry_dependent_grouping():
+    """SCARA (standard DH, alpha2 = pi): link 3 only slides along the vertical relative to
+    link 2, its frame origin at p = (a2, 0, z) in link 2's frame, axes x3 = x2, y3 = -y2.
+    By hand, moving its first moment h3 and inertia onto link 2 (parallel axis in
+    first-moment form, I' = I + 2 (p.h) 1 - p h^T - h p^T + ...): MX2R = MX2 + MX3,
+    MY2R = MY2 - MY3 and ZZ2R = ZZ2 + ZZ3 + 2 (a2 MX3 + z MZ3) - 2 z MZ3 = ZZ2 + ZZ3 + 2 a2 MX3,
+    exact in the symbol a2 (a grouping Khalil's general rules alone do not make)."""
+    robot = armdyn.load("scara")
+    base = base_parameters(robot)
+    a2 = robot.parameters["a2"]
+    MX2, MX3, ZZ2, ZZ3 = sp.symbols("MX2 MX3 ZZ2 ZZ3")
+    by_name = dict(zip(base.names, base.beta))
+    assert sp.expand(by_name["MX2R"] - (MX2 + MX3)) == 0
+    assert sp.expand(by_name["ZZ2R"] - (ZZ2 + ZZ3 + 2 * a2 * MX3)) == 0
+    assert sp.expand(by_name["MY2R"] - (sp.Symbol("MY2") - sp.Symbol("MY3"))) == 0

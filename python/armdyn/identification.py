@@ -502,6 +502,49 @@ def _grouped(robot: Robot, reg: Regressor):
     return keep, exprs
 
 
+def _symbolic_coefficients(Yk, d, pivots, Rs, geometry, robot, seed):
+    """Column d of Yk as a combination of the pivot columns with coefficients that
+    depend on the geometry (Khalil's special rules, e.g. a prismatic joint parallel to a
+    revolute one): the columns involved are evaluated at random rational states with the
+    geometry kept symbolic, and the small linear system solved exactly (rational
+    functions of the geometry). Checked against the coefficients found at the two random
+    geometries."""
+    support = [r for r in range(len(pivots)) if any(R[r][d] != 0 for R in Rs)]
+    cols = [pivots[r] for r in support] + [d]
+    sub = Yk[:, cols]
+    rng = random.Random(seed + 55)
+    state = [s for s in _angles_and_scalars(sub)[0] + _angles_and_scalars(sub)[1] if s not in set(geometry)]
+    rows = []
+    for _ in range(len(support) // max(robot.dof, 1) + 3):
+        values = {}
+        for x in state:
+            t = _nonzero_fraction(rng)
+            if any(x in (a.args[0],) for a in sub.atoms(sp.sin, sp.cos)):
+                values[sp.sin(x)] = sp.Rational(2 * t.numerator * t.denominator, t.denominator**2 + t.numerator**2)
+                values[sp.cos(x)] = sp.Rational(t.denominator**2 - t.numerator**2, t.denominator**2 + t.numerator**2)
+            values[x] = sp.Rational(t.numerator, t.denominator)
+        signs = {sp.sign(x): sp.sign(values[x]) for x in state if x in values}
+        rows += [[sp.expand(sp.sympify(e).xreplace(signs).xreplace(values)) for e in sub.row(i)] for i in range(sub.rows)]
+    A = sp.Matrix([r[:-1] for r in rows])
+    b = sp.Matrix([r[-1] for r in rows])
+    # least squares normal equations are exact here: the system is consistent
+    k_support = (A.T * A).LUsolve(A.T * b).applyfunc(sp.factor)
+    k = [sp.Integer(0)] * len(pivots)
+    for r, value in zip(support, k_support):
+        k[r] = value
+    # the same numbers as found at the random geometries
+    for trial, R in enumerate(Rs):
+        rng_g = random.Random(seed + 1)
+        fixed = None
+        for t in range(trial + 1):
+            fixed = {s: _nonzero_fraction(rng_g) for s in geometry}
+        for r in range(len(pivots)):
+            value = sp.sympify(k[r]).xreplace({s: sp.Rational(v.numerator, v.denominator) for s, v in fixed.items()})
+            if value != sp.Rational(R[r][d].numerator, R[r][d].denominator):
+                raise ArithmeticError("base_parameters: geometry-dependent grouping not confirmed")
+    return k
+
+
 def _nonzero_fraction(rng: random.Random) -> Fraction:
     """A random nonzero small rational (a zero length would make the geometry special)."""
     return Fraction(rng.choice([-1, 1]) * rng.randint(1, 30), rng.randint(1, 12))
@@ -562,21 +605,24 @@ def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
                 if d not in pivots and row[d] != sum(R[r][d] * row[c] for r, c in enumerate(pivots)):
                     raise ArithmeticError(f"base_parameters: dependency of {reg.names[keep[d]]} not confirmed")
     R, pivots = coefficient_sets[0]
-    if len(coefficient_sets) > 1 and (coefficient_sets[1][1] != pivots or coefficient_sets[1][0] != R):
+    if len(coefficient_sets) > 1 and coefficient_sets[1][1] != pivots:
         raise ValueError(
-            "base_parameters: remaining columns depend on each other with geometry-dependent "
-            "coefficients; bind the geometric parameters to numbers (robot.bind) and retry"
+            "base_parameters: the identifiable set changes with the geometry at random values; "
+            "bind the geometric parameters to numbers (robot.bind) and retry"
         )
-    # dependent column d: Y_d = sum_r R[r][d] Y_pivot(r); its parameter joins those pivots
+    # dependent column d: Y_d = sum_r k[r] Y_pivot(r); its parameter joins those pivots
     beta = [exprs[c] for c in pivots]
     grouped = [exprs[c] != reg.symbols[keep[c]] for c in pivots]
     for d in range(len(keep)):
         if d in pivots:
             continue
-        for r, c in enumerate(pivots):
-            coef = R[r][d]
-            if coef != 0:
-                beta[r] = beta[r] + sp.Rational(coef.numerator, coef.denominator) * exprs[d]
+        k = [sp.Rational(R[r][d].numerator, R[r][d].denominator) for r in range(len(pivots))]
+        if len(coefficient_sets) > 1 and any(R[r][d] != coefficient_sets[1][0][r][d] for r in range(len(pivots))):
+            k = _symbolic_coefficients(Yk, d, pivots, [coefficient_sets[t][0] for t in range(2)], geometry,
+                                       robot, seed)
+        for r in range(len(pivots)):
+            if k[r] != 0:
+                beta[r] = beta[r] + k[r] * exprs[d]
                 grouped[r] = True
     names = [reg.names[keep[c]] + ("R" if g else "") for c, g in zip(pivots, grouped)]
     Yb = Y[:, [keep[c] for c in pivots]] if pivots else sp.zeros(robot.dof, 0)
