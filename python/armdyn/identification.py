@@ -47,9 +47,13 @@ What is left can still hold columns of Y that are zero (the first links' motion 
 restricted) or dependent on others (e.g. a rotor inertia ``IA1`` and ``ZZ1R``). Those are
 found exactly: Y is evaluated at random rational states (sin and cos given by rational
 points of the unit circle, ``((1 - t^2)/(1 + t^2), 2t/(1 + t^2))``) and reduced in exact
-rational arithmetic. A zero column is dropped; a dependent one is added to the columns it
-depends on with its exact coefficients (which must not depend on the geometry; checked at
-two random geometries). By the Schwartz-Zippel lemma a polynomial identity that holds at
+rational arithmetic (modulo the prime 2^127 - 1, coefficients recovered by rational
+reconstruction and confirmed with Fractions at a further point). A zero column is
+dropped; a dependent one is added to the columns it depends on with its exact
+coefficients. When those change with the geometry (two random geometries are tried:
+e.g. a SCARA's prismatic joint parallel to its revolute ones, ZZ2R = ZZ2 + ZZ3 + 2 a2 MX3),
+the few columns involved are evaluated with the geometry kept symbolic and the small
+system solved exactly. By the Schwartz-Zippel lemma a polynomial identity that holds at
 random points holds everywhere with probability 1 - O(degree / range).
 """
 
@@ -576,8 +580,8 @@ def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
     the exact decimals they are (:func:`rationalized`): ``base.regressor`` and ``base.Y``
     are those of that copy (equal to the robot's to the last bit of its floats).
 
-    Raises ValueError if two remaining columns depend on each other with a coefficient
-    that changes with the geometry (not met on the bundled arms; bind the geometry).
+    Raises ValueError if the set of identifiable parameters itself changes between two
+    random geometries (not met on the bundled arms; bind the geometry then).
     """
     robot = rationalized(robot)
     reg = regressor(robot)
