@@ -119,7 +119,7 @@ def symbolic_part(repeat: int):
     print(f"SymPyBotics RobotDynCode + calc_base_parms ({dyn.n_base if hasattr(dyn, 'n_base') else code.dyn.n_base}): {t_spb_base:7.3f} s  (1 run)")
     print(f"ratio armdyn/SymPyBotics: regressor {t_reg / t_spb_reg:.3f}, base parameters {t_base / t_spb_base:.3f}")
     beta = code.dyn.baseparms
-    print(f"SymPyBotics' beta[0] (numeric QR, rounded): {sp.sympify(beta[0])}")
+    print(f"SymPyBotics' beta[0]: {sp.sympify(beta[0])}")
     print(f"armdyn's    {base.names[0]} = {base.beta[0]}\n")
 
 

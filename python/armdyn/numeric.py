@@ -233,12 +233,15 @@ def regressor(robot, q, qd, qdd, *, threads=None, columns: str = "model"):
     Y = _core.regressor(model, q, qd, qdd, threads)
     if columns == "all":
         return Y
-    if not isinstance(robot, Robot):
-        raise TypeError("columns='model' needs the Robot (a NumericModel does not say which terms a joint has)")
-    keep = list(range(10 * len(robot.joints)))
-    first = 10 * len(robot.joints)
-    for i, j in enumerate(robot.movable_joints):
-        for k, name in enumerate(("armature", "damping", "friction", "torque_offset")):
-            if getattr(j, name) is not None:
-                keep.append(first + 4 * i + k)
+    keep = robot.__dict__.get("_regressor_columns") if isinstance(robot, Robot) else None
+    if keep is None:
+        if not isinstance(robot, Robot):
+            raise TypeError("columns='model' needs the Robot (a NumericModel does not say which terms a joint has)")
+        first = 10 * len(robot.joints)
+        extra = [first + 4 * i + k for i, j in enumerate(robot.movable_joints)
+                 for k, name in enumerate(("armature", "damping", "friction", "torque_offset"))
+                 if getattr(j, name) is not None]
+        # a plain slice (a view, no copy) when the model has no joint terms
+        keep = slice(0, first) if not extra else np.array(list(range(first)) + extra)
+        robot._regressor_columns = keep  # cached like the compiled model
     return Y[..., keep]
