@@ -25,6 +25,7 @@ _NUMERIC = (
     "potential_energy", "forward_kinematics", "jacobian", "NumericModel", "compile_model",
     "rnea_derivatives", "aba_derivatives", "minverse", "gravity_derivatives", "jacobian_dot",
 )
+_IDENTIFICATION = ("regressor", "base_parameters")
 
 
 def __getattr__(name):
@@ -40,12 +41,18 @@ def __getattr__(name):
         value = getattr(numeric, name)
         globals()[name] = value  # later lookups skip __getattr__ (it costs ~1 us a call)
         return value
+    if name in _IDENTIFICATION:  # symbolic regressor and base parameters (armdyn.identification)
+        from . import identification
+
+        value = getattr(identification, name)
+        globals()[name] = value
+        return value
     raise AttributeError(f"module 'armdyn' has no attribute {name!r}")
 
 
 __all__ = [
     "__version__",
-    *_NUMERIC,
+    *_NUMERIC, *_IDENTIFICATION,
     "inertia", "io", "ModelError", "UnboundParameterError", "Joint", "Link", "Robot",
     "load", "bundled_robots", "derive", "check", "prove_agreement", "EquationsOfMotion", "grade",
     "codegen",

@@ -38,6 +38,8 @@ from .errors import ModelError
 from .inertia import check_physical
 
 JOINT_TYPES = ("revolute", "prismatic", "fixed")
+#: Joint fields that add to tau (DESIGN.md: Fv, Fc, Ia, offset), in that naming.
+JOINT_DYNAMICS = ("damping", "friction", "armature", "torque_offset")
 
 
 def _vec3(value, what: str) -> sp.Matrix:
@@ -128,6 +130,23 @@ def skew(v) -> sp.Matrix:
     return sp.Matrix([[0, -z, y], [z, 0, -x], [-y, x, 0]])
 
 
+def _check_joint_dynamics(joint, where: str) -> None:
+    """Numeric friction/armature/offset values must be finite; damping, friction and
+    armature must not be negative (symbolic ones are checked once bound)."""
+    for name in JOINT_DYNAMICS:
+        value = getattr(joint, name)
+        if value is None or value.free_symbols:
+            continue
+        try:
+            x = complex(value.evalf())
+        except (TypeError, ValueError):
+            raise ModelError(f"{name} {value} is not a number", where) from None
+        if x.imag != 0 or not np.isfinite(x.real):
+            raise ModelError(f"{name} {value} is not a finite real number", where)
+        if name != "torque_offset" and x.real < 0:
+            raise ModelError(f"{name} {value} is negative (it must be >= 0)", where)
+
+
 @dataclass(frozen=True)
 class Link:
     """A rigid body.
@@ -194,8 +213,15 @@ class Joint:
               frame (default: on it). A frame off the joint's axis, like the exercise's
               frame 1 at the point mass, at l1 from joint 1's axis: ``frame_xyz = (l1, 0, 0)``.
               The child frame is ``placement * motion(q) * frame``.
-    lower, upper, velocity, effort, damping, friction: optional limits and
-              joint-space friction, kept on the model (None when not given).
+    lower, upper, velocity, effort: optional limits, kept on the model (None when not given).
+    damping, friction, armature, torque_offset: joint-space terms added to the rigid-body
+              torque (DESIGN.md): ``tau_k += armature qdd_k + damping qd_k
+              + friction sign(qd_k) + torque_offset`` with sign(0) = 0. ``damping`` is the
+              viscous coefficient Fv (N m s/rad or N s/m), ``friction`` the Coulomb level Fc,
+              ``armature`` the rotor inertia Ia reflected to the joint (gear^2 times the
+              rotor's own inertia), ``torque_offset`` a constant torque/force. None (the
+              default) means absent, which is the same as 0. Numbers must be finite;
+              damping, friction and armature must not be negative. Ignored on a fixed joint.
     mimic:    a :class:`Mimic` when the joint follows another joint (no coordinate of
               its own), else None.
     """
@@ -216,6 +242,8 @@ class Joint:
     damping: sp.Expr | None = None
     friction: sp.Expr | None = None
     mimic: Mimic | None = None
+    armature: sp.Expr | None = None
+    torque_offset: sp.Expr | None = None
 
     def __post_init__(self):
         where = f"joint '{self.name}'"
@@ -230,7 +258,7 @@ class Joint:
             object.__setattr__(self, "axis", _vec3(self.axis, "axis"))
             object.__setattr__(self, "frame_xyz", _vec3(self.frame_xyz, "frame_xyz"))
             object.__setattr__(self, "frame_rotation", _mat3(self.frame_rotation, "frame_rotation"))
-            for name in ("lower", "upper", "velocity", "effort", "damping", "friction"):
+            for name in ("lower", "upper", "velocity", "effort") + JOINT_DYNAMICS:
                 value = getattr(self, name)
                 if value is not None:
                     object.__setattr__(self, name, sp.sympify(value))
@@ -243,6 +271,7 @@ class Joint:
                 raise ModelError(f"mimic must be a Mimic, got {type(self.mimic).__name__}", where)
             if self.type == "fixed":
                 raise ModelError("a fixed joint cannot mimic another joint", where)
+        _check_joint_dynamics(self, where)
         for key in ("rotation", "frame_rotation"):
             matrix = getattr(self, key)
             if not matrix.free_symbols:
@@ -660,6 +689,9 @@ class Robot(metaclass=_FreezeAfterInit):
             out |= j.frame_xyz.free_symbols | j.frame_rotation.free_symbols
             if j.mimic is not None:
                 out |= j.mimic.multiplier.free_symbols | j.mimic.offset.free_symbols
+            for name in JOINT_DYNAMICS:
+                if getattr(j, name) is not None:
+                    out |= getattr(j, name).free_symbols
         return out
 
     def canonical(self) -> "Robot":
@@ -731,7 +763,7 @@ class Robot(metaclass=_FreezeAfterInit):
                 axis=j.axis.xreplace(table),
                 frame_xyz=j.frame_xyz.xreplace(table),
                 frame_rotation=j.frame_rotation.xreplace(table),
-                **{k: s(getattr(j, k)) for k in ("lower", "upper", "velocity", "effort", "damping", "friction")},
+                **{k: s(getattr(j, k)) for k in ("lower", "upper", "velocity", "effort") + JOINT_DYNAMICS},
                 mimic=None if j.mimic is None else replace(j.mimic, multiplier=s(j.mimic.multiplier), offset=s(j.mimic.offset)),
             )
             for j in self.joints
@@ -765,6 +797,57 @@ class Robot(metaclass=_FreezeAfterInit):
         merged = {k: v for k, v in self.defaults.items() if k not in given}
         merged.update(values)
         return self.subs(merged)
+
+    def with_payload(self, mass, com=(0, 0, 0), inertia=None, link: str | None = None) -> "Robot":
+        """A new robot with a rigid load fixed to ``link`` (default: the last link in tree
+        order, the tool of a serial arm). This robot is not changed.
+
+        mass:    the payload's mass (kg), number or SymPy expression.
+        com:     (3,) its centre of mass in ``link``'s frame (m).
+        inertia: (3, 3) its inertia tensor about its own centre of mass, in ``link``'s
+                 axes (kg m^2); default zero (a point mass).
+
+        The link and the load become one body (:func:`armdyn.inertia.combine`: total
+        mass, mass-weighted centre of mass, parallel axis theorem). A payload that is not
+        physical (negative or non-finite mass, inertia not symmetric, not positive
+        semi-definite or breaking the triangle inequality) is a ModelError naming it.
+        """
+        from .inertia import Body, combine
+
+        where = "payload"
+        link = link if link is not None else list(self.links)[-1]
+        if link not in self.links:
+            raise ModelError(f"no link named {link!r} (links: {', '.join(self.links)})", where)
+        if link == self.base:
+            raise ModelError(f"the base link {link!r} does not move: a payload on it has no effect", where)
+        try:
+            mass = sp.sympify(mass)
+            com = _vec3(com, "com")
+            inertia = sp.zeros(3, 3) if inertia is None else _mat3(inertia, "inertia")
+        except ModelError as err:
+            raise err.located(element=where)
+        except (sp.SympifyError, TypeError) as exc:
+            raise ModelError(f"bad value ({exc})", where) from None
+        for name, values in (("mass", [mass]), ("com", list(com)), ("inertia", list(inertia))):
+            for v in values:
+                if not v.free_symbols and not np.isfinite(complex(v.evalf())).all():
+                    raise ModelError(f"{name} has a value that is not finite ({v})", where)
+        check_physical(mass, inertia, where, strict=True)
+        old = self.links[link]
+        body = combine([Body(old.mass, old.com, old.inertia), Body(mass, com, inertia)])
+        new = Link(old.name, sp.sympify(body.mass), sp.Matrix(body.com), sp.Matrix(body.inertia))
+        links = [new if ln.name == link else ln for ln in self.links.values()]
+        params = dict(self.parameters)
+        for s in mass.free_symbols | com.free_symbols | inertia.free_symbols:
+            params.setdefault(s.name, s)
+        import warnings
+
+        with warnings.catch_warnings():  # this robot's own links were warned about when it was built
+            warnings.simplefilter("ignore")
+            return Robot(
+                self.name, links, self.joints, self.gravity, params, self.meta, self.base, self.defaults,
+                strict=self.strict,
+            )
 
     def __repr__(self) -> str:
         kinds = "".join({"revolute": "R", "prismatic": "P", "fixed": "F"}[j.type] for j in self.joints)

@@ -56,6 +56,7 @@ __all__ = [
     "minverse",
     "gravity_derivatives",
     "jacobian_dot",
+    "regressor",
 ]
 
 #: A robot compiled for numeric evaluation (built by :func:`compile_model`). Its
@@ -115,6 +116,16 @@ def compile_model(robot: Robot | NumericModel) -> NumericModel:
         masses.append(_floats([link.mass], where)[0])
         coms.append(_floats(link.com, where))
         inertias.append(np.reshape(_floats(link.inertia, where), (3, 3)).tolist())
+    # per movable joint [armature, viscous, coulomb, offset] (absent = 0); None when all zero
+    # one row per joint the compiled model frees (mimic joints too); a mimic joint's own
+    # friction and armature are not modelled (yet): zeros, as in the reference
+    joint_dynamics = [
+        _floats([getattr(j, k) if getattr(j, k) is not None and j.mimic is None else 0
+                 for k in ("armature", "damping", "friction", "torque_offset")], f"joint '{j.name}'")
+        for j in robot.joints if j.movable
+    ]
+    if not any(any(row) for row in joint_dynamics):
+        joint_dynamics = None
     gravity_vec = _floats(robot.gravity, f"robot '{robot.name}'")
     base = robot.links[robot.base]
     where = f"link '{base.name}'"
@@ -122,7 +133,7 @@ def compile_model(robot: Robot | NumericModel) -> NumericModel:
         model = NumericModel(
             parents, types, rotations, translations, axes, masses, coms, inertias, gravity_vec,
             list(robot.links), [j.name for j in robot.joints if j.movable], robot.name,
-            _floats([base.mass], where)[0], _floats(base.com, where),
+            _floats([base.mass], where)[0], _floats(base.com, where), joint_dynamics,
         )
     except ValueError as err:
         raise ModelError(str(err), f"robot '{robot.name}'") from None
@@ -321,3 +332,37 @@ def jacobian_dot(robot, q, qd, link, *, threads=None):
     if isinstance(link, Link):
         link = link.name
     return _core.jacobian_dot(_core_model(robot, "jacobian_dot", True), q, qd, link, threads)
+
+
+def regressor(robot, q, qd, qdd, *, threads=None, columns: str = "model"):
+    """The joint torque regressor Y with ``rnea(q, qd, qdd) = Y @ pi`` (Rust core,
+    algo/regressor.rs). q, qd, qdd: (n,) or (N, n). Returns (n, P) or (N, n, P).
+
+    Columns, for every link but the base (in ``list(robot.links)`` order, links on
+    fixed joints included): ``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]``,
+    inertia about the link frame's origin in its axes (Pinocchio's order); then
+
+    * ``columns="model"`` (default, ``robot`` a Robot): per movable joint the columns
+      of the terms it has (``armature``, ``damping``, ``friction``, ``torque_offset`` not
+      None: ``qdd, qd, sign(qd), 1``), the order of
+      :func:`armdyn.identification.regressor`'s ``pi``;
+    * ``columns="all"``: every movable joint's four columns ``[qdd, qd, sign(qd), 1]``.
+    """
+    if columns not in ("model", "all"):
+        raise ValueError(f"columns must be 'model' or 'all', got {columns!r}")
+    model = _core_model(robot, "regressor", True)  # parameters about the link frames
+    Y = _core.regressor(model, q, qd, qdd, threads)
+    if columns == "all":
+        return Y
+    keep = robot.__dict__.get("_regressor_columns") if isinstance(robot, Robot) else None
+    if keep is None:
+        if not isinstance(robot, Robot):
+            raise TypeError("columns='model' needs the Robot (a NumericModel does not say which terms a joint has)")
+        first = 10 * len(robot.joints)
+        extra = [first + 4 * i + k for i, j in enumerate(robot.movable_joints)
+                 for k, name in enumerate(("armature", "damping", "friction", "torque_offset"))
+                 if getattr(j, name) is not None]
+        # a plain slice (a view, no copy) when the model has no joint terms
+        keep = slice(0, first) if not extra else np.array(list(range(first)) + extra)
+        robot._regressor_columns = keep  # cached like the compiled model
+    return Y[..., keep]

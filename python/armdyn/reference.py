@@ -4,7 +4,8 @@ Small and readable on purpose, in the style of Featherstone's spatial_v2, for ON
 (``q, qd, qdd`` of shape ``(n,)``). It is slow; the fast engine is :mod:`armdyn.numeric`.
 Every function has the signature of its counterpart in ``armdyn.numeric``:
 
-    rnea(robot, q, qd, qdd)       -> tau (n,)       M qdd + C qd + g
+    rnea(robot, q, qd, qdd)       -> tau (n,)       M qdd + C qd + g (+ Fv qd + Fc sign(qd); Ia in M,
+                                                    the torque offset in g, as DESIGN.md)
     crba(robot, q)                -> M (n, n)
     aba(robot, q, qd, tau)        -> qdd (n,)
     gravity(robot, q)             -> g (n,)         = rnea(q, 0, 0)
@@ -125,6 +126,11 @@ class _Tree:
     link_names: list[str]  # base first, then body k's name at k + 1
     follow: list[tuple[float, float]]  # (c, o): joint k's own coordinate is c q[dofs[k]] + o
     mimic: bool  # whether some joint is a mimic joint
+    # per coordinate: rotor inertia Ia, viscous Fv, Coulomb Fc, offset (DESIGN.md), (n,) each
+    armature: np.ndarray = None
+    viscous: np.ndarray = None
+    coulomb: np.ndarray = None
+    offset: np.ndarray = None
 
 
 _trees: "weakref.WeakKeyDictionary[Robot, _Tree]" = weakref.WeakKeyDictionary()
@@ -196,6 +202,9 @@ def _tree(robot: Robot) -> _Tree:
         follow=follow,
         mimic=bool(robot.mimic_joints),
     )
+    terms = [[float(getattr(j, k)) if getattr(j, k) is not None else 0.0 for j in robot.movable_joints]
+             for k in ("armature", "damping", "friction", "torque_offset")]
+    tree.armature, tree.viscous, tree.coulomb, tree.offset = (np.array(x, dtype=float) for x in terms)
     _trees[robot] = tree
     return tree
 
@@ -255,7 +264,8 @@ def rnea(robot: Robot, q, qd, qdd) -> np.ndarray:
         tau[t.dofs[i]] += t.S[i].T @ f[i]  # += : a mimic joint adds to its leader's
         if t.parent[i] >= 0:
             f[t.parent[i]] = f[t.parent[i]] + Xup[i].T @ f[i]
-    return tau
+    # joint terms (DESIGN.md): Ia qdd + Fv qd + Fc sign(qd) + offset, np.sign(0) = 0
+    return tau + t.armature * qdd + t.viscous * qd + t.coulomb * np.sign(qd) + t.offset
 
 
 def crba(robot: Robot, q) -> np.ndarray:
@@ -278,7 +288,7 @@ def crba(robot: Robot, q) -> np.ndarray:
             j = t.parent[j]
             M[np.ix_(t.dofs[i], t.dofs[j])] += F.T @ t.S[j]
             M[np.ix_(t.dofs[j], t.dofs[i])] += t.S[j].T @ F
-    return M
+    return M + np.diag(t.armature)  # rotor inertias on the diagonal
 
 
 def aba(robot: Robot, q, qd, tau) -> np.ndarray:
@@ -298,9 +308,11 @@ def aba(robot: Robot, q, qd, tau) -> np.ndarray:
         IA[i] = t.inertia[i].copy()
         pA[i] = crf(v[i]) @ t.inertia[i] @ v[i]
     U, Dinv, u = [None] * nb, [None] * nb, [None] * nb
+    # the joint terms: Ia joins D_i = S^T I^A S + Ia; friction and offset are taken off tau
+    tau = tau - t.viscous * qd - t.coulomb * np.sign(qd) - t.offset
     for i in reversed(range(nb)):  # pass 2: articulated-body inertias and bias forces
         U[i] = IA[i] @ t.S[i]
-        Dinv[i] = np.linalg.inv(t.S[i].T @ U[i])  # 1x1, or 0x0 for a fixed joint
+        Dinv[i] = np.linalg.inv(t.S[i].T @ U[i] + np.diag(t.armature[t.dofs[i]]))  # 1x1, or 0x0 for a fixed joint
         u[i] = tau[t.dofs[i]] - t.S[i].T @ pA[i]
         lam = t.parent[i]
         if lam >= 0:
@@ -411,7 +423,7 @@ def kinetic_energy(robot: Robot, q, qd) -> float:
         v_lam = np.zeros(6) if t.parent[i] < 0 else v[t.parent[i]]
         v[i] = Xup[i] @ v_lam + t.S[i] @ qd[t.dofs[i]]
         T += 0.5 * v[i] @ t.inertia[i] @ v[i]
-    return float(T)
+    return float(T + 0.5 * t.armature @ qd**2)  # + the rotors' 1/2 Ia qd^2
 
 
 def potential_energy(robot: Robot, q) -> float:

@@ -189,7 +189,8 @@ impl<L: Real> Work<L> {
             d1: Data::new(model),
             dl: Data::new(model),
             args: [vec![L::zero(); n], vec![L::zero(); n], vec![L::zero(); n]],
-            res: vec![L::zero(); n * n],
+            // the largest per-state output: M (n x n) or the regressor (n x columns)
+            res: vec![L::zero(); n * n.max(algo::regressor_columns(model))],
         }
     }
 }
@@ -301,6 +302,13 @@ lanes_kernel!(
     /// Batched [`algo::bias`]: `args = [q, qd]` (N, nv) each, `out` = h (N, nv).
     bias, nargs = 2, out = |m| m.nv,
     |model, data, a, o| algo::bias(model, data, a[0], a[1], o)
+);
+
+lanes_kernel!(
+    /// Batched [`algo::regressor`]: `args = [q, qd, qdd]` (N, nv) each, `out` = Y
+    /// (N, nv, [`algo::regressor_columns`]).
+    regressor, nargs = 3, out = |m| m.nv * algo::regressor_columns(m),
+    |model, data, a, o| algo::regressor(model, data, a[0], a[1], a[2], o)
 );
 
 /// Row `r` of an (N, n) array.

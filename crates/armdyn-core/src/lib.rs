@@ -28,5 +28,5 @@ pub mod spatial;
 
 pub use data::Data;
 pub use deriv_data::DerivData;
-pub use model::{JointSpec, JointType, Model, ModelError};
+pub use model::{JointDynamics, JointSpec, JointType, Model, ModelError};
 pub use real::{F64x4, F64x8, Real};

@@ -37,6 +37,24 @@ pub struct JointSpec {
     pub inertia: [[f64; 3]; 3],
 }
 
+/// What a movable joint adds to the rigid-body torque (DESIGN.md):
+/// `tau_i += armature qdd_i + viscous qd_i + coulomb sign(qd_i) + offset` (sign(0) = 0).
+/// `armature` is the rotor inertia reflected to the joint (Pinocchio's `armature`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct JointDynamics {
+    pub armature: f64,
+    pub viscous: f64,
+    pub coulomb: f64,
+    pub offset: f64,
+}
+
+impl JointDynamics {
+    /// Whether every term is zero (the joint adds nothing).
+    pub fn is_zero(&self) -> bool {
+        *self == JointDynamics::default()
+    }
+}
+
 /// An invalid description: which joint (if any) and what is wrong.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ModelError {
@@ -95,6 +113,11 @@ pub struct Model {
     pub joint_body: Vec<Option<usize>>,
     /// Potential energy of the links welded to the base (constant, `-sum m g . p_c`).
     pub welded_potential: f64,
+    /// Joint friction, rotor inertia and offset of body i's joint (zero by default; set
+    /// with [`Model::set_joint_dynamics`]).
+    pub joint_dynamics: Vec<JointDynamics>,
+    /// Whether any `joint_dynamics` is nonzero (the algorithms skip the terms otherwise).
+    pub has_joint_dynamics: bool,
 }
 
 const TOL: f64 = 1e-9;
@@ -150,6 +173,8 @@ impl Model {
             links: vec![],
             joint_body: vec![],
             welded_potential: 0.0,
+            joint_dynamics: vec![],
+            has_joint_dynamics: false,
         };
         for (k, j) in joints.iter().enumerate() {
             let numbers = j.rotation.iter().flatten().chain(&j.translation).chain(&j.axis);
@@ -222,7 +247,29 @@ impl Model {
             }
         }
         m.links = links;
+        m.joint_dynamics = vec![JointDynamics::default(); m.nv];
         Ok(m)
+    }
+
+    /// Set body `body`'s joint friction, rotor inertia and offset. Every value must be
+    /// finite; armature, viscous and Coulomb coefficients must not be negative.
+    pub fn set_joint_dynamics(&mut self, body: usize, jd: JointDynamics) -> Result<(), ModelError> {
+        let err = |message: String| Err(ModelError { joint: None, message: format!("body {body}: {message}") });
+        if body >= self.nv {
+            return err(format!("no such body (the model has {})", self.nv));
+        }
+        let values = [("armature", jd.armature), ("viscous", jd.viscous), ("coulomb", jd.coulomb), ("offset", jd.offset)];
+        for (name, x) in values {
+            if !x.is_finite() {
+                return err(format!("{name} {x} is not finite"));
+            }
+            if name != "offset" && x < 0.0 {
+                return err(format!("{name} {x} is negative"));
+            }
+        }
+        self.joint_dynamics[body] = jd;
+        self.has_joint_dynamics = self.joint_dynamics.iter().any(|d| !d.is_zero());
+        Ok(())
     }
 
     /// Count a point of mass `mass` at `com` (base frame) fixed to the base, e.g. the

@@ -48,6 +48,17 @@ pub trait Real:
     fn zero() -> Self {
         Self::splat(0.0)
     }
+
+    /// Sign, lane-wise: -1, 0 or 1 (sign(0) = 0, as Coulomb friction at rest).
+    #[inline(always)]
+    fn sign0(self) -> Self {
+        let mut out = self;
+        for k in 0..Self::LANES {
+            let x = self.lane(k);
+            out.set_lane(k, if x > 0.0 { 1.0 } else if x < 0.0 { -1.0 } else { 0.0 });
+        }
+        out
+    }
 }
 
 impl Real for f64 {

@@ -11,7 +11,9 @@
 //! `RuntimeError`, never a crash.
 
 use armdyn_core::algo::coriolis::CoriolisWork;
-use armdyn_core::{algo, batch, Data, JointSpec, JointType, Model};
+use armdyn_core::{algo, batch, Data, JointDynamics, JointSpec, JointType, Model};
+
+mod regressor;
 use numpy::{PyArray, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -305,8 +307,10 @@ impl NumericModel {
     /// link, in its frame; gravity (3) in the base frame. link_names: nj + 1 names (base
     /// first); coordinate_names: the movable joints' names. base_mass and base_com (3,):
     /// the base link, which only enters the potential energy (a constant).
+    /// joint_dynamics: None, or per movable joint `[armature, viscous, coulomb, offset]`
+    /// (DESIGN.md: tau += Ia qdd + Fv qd + Fc sign(qd) + offset).
     #[new]
-    #[pyo3(signature = (parents, types, rotations, translations, axes, masses, coms, inertias, gravity, link_names, coordinate_names, name = String::new(), base_mass = 0.0, base_com = [0.0; 3]))]
+    #[pyo3(signature = (parents, types, rotations, translations, axes, masses, coms, inertias, gravity, link_names, coordinate_names, name = String::new(), base_mass = 0.0, base_com = [0.0; 3], joint_dynamics = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -324,6 +328,7 @@ impl NumericModel {
         name: String,
         base_mass: f64,
         base_com: [f64; 3],
+        joint_dynamics: Option<Vec<[f64; 4]>>,
     ) -> PyResult<Self> {
         guard(|| {
             let init_args = PyTuple::new(py, [
@@ -341,6 +346,8 @@ impl NumericModel {
                 name.clone().into_pyobject(py)?.into_any(),
                 base_mass.into_pyobject(py)?.into_any(),
                 base_com.into_pyobject(py)?.into_any(),
+                // friction and rotor inertia travel too (a pickled model on a Dask worker)
+                joint_dynamics.clone().into_pyobject(py)?.into_any(),
             ])?
             .unbind();
             let nj = parents.len();
@@ -392,6 +399,20 @@ impl NumericModel {
                     coordinate_names.len(),
                     model.nv
                 )));
+            }
+            if let Some(jd) = joint_dynamics {
+                if jd.len() != model.nv {
+                    return Err(PyValueError::new_err(format!(
+                        "joint_dynamics: {} rows for {} movable joints",
+                        jd.len(),
+                        model.nv
+                    )));
+                }
+                for (b, [armature, viscous, coulomb, offset]) in jd.into_iter().enumerate() {
+                    model
+                        .set_joint_dynamics(b, JointDynamics { armature, viscous, coulomb, offset })
+                        .map_err(|e| PyValueError::new_err(format!("joint '{}': {}", coordinate_names[b], e.message)))?;
+                }
             }
             let link_index = link_names.iter().enumerate().map(|(k, s)| (s.clone(), k)).collect();
             let scratch = Mutex::new(Scratch::new(&model));
@@ -710,6 +731,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_test_panic, m)?)?;
     m.add_function(wrap_pyfunction!(simd_kernels, m)?)?;
     derivatives::register(m)?;
+    m.add_function(wrap_pyfunction!(regressor::regressor, m)?)?;
+    m.add_function(wrap_pyfunction!(regressor::regressor_columns, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     simulate::register(m)?;
     Ok(())

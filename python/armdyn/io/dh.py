@@ -78,6 +78,7 @@ from .expressions import (
 ROW_KEYS = (
     "name", "link", "type", "a", "alpha", "d", "theta",
     "mass", "com", "inertia", "limits", "damping", "friction",
+    "armature", "rotor_inertia", "gear_ratio", "torque_offset",
 )  # fmt: skip
 
 CONVENTIONS = {

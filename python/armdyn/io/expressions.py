@@ -549,8 +549,9 @@ LIMIT_KEYS = ("lower", "upper", "velocity", "effort")
 
 def parse_joint_extras(data: Mapping, parameters, element=None, source=None) -> dict:
     """Keyword arguments for :class:`armdyn.Joint` from the optional ``limits``
-    (mapping with keys ``lower, upper, velocity, effort``), ``damping`` and ``friction``
-    entries of ``data``. Absent values are left out (the Joint keeps None)."""
+    (mapping with keys ``lower, upper, velocity, effort``), ``damping`` (Fv), ``friction``
+    (Coulomb Fc), ``armature`` (reflected rotor inertia Ia) or ``rotor_inertia`` with
+    ``gear_ratio`` (Ia = gear_ratio^2 rotor_inertia), and ``torque_offset`` entries of ``data``. Absent values are left out (the Joint keeps None)."""
     out = {}
     limits = data.get("limits")
     if limits is not None:
@@ -566,9 +567,18 @@ def parse_joint_extras(data: Mapping, parameters, element=None, source=None) -> 
         for key, value in limits.items():
             if value is not None:
                 out[key] = parse_expression(value, parameters, element, source, f"limits.{key}")
-    for key in ("damping", "friction"):
+    for key in ("damping", "friction", "armature", "torque_offset"):
         if data.get(key) is not None:
             out[key] = parse_expression(data[key], parameters, element, source, key)
+    # rotor inertia reflected through the gear: Ia = gear_ratio^2 * rotor_inertia
+    if data.get("rotor_inertia") is not None:
+        if "armature" in out:
+            raise ModelError("give either armature or rotor_inertia (with gear_ratio), not both", element, source)
+        rotor = parse_expression(data["rotor_inertia"], parameters, element, source, "rotor_inertia")
+        gear = parse_expression(data.get("gear_ratio", 1), parameters, element, source, "gear_ratio")
+        out["armature"] = gear**2 * rotor
+    elif data.get("gear_ratio") is not None:
+        raise ModelError("gear_ratio without rotor_inertia", element, source)
     return out
 
 

@@ -34,8 +34,11 @@ General frames
         frame_rpy: [0, 0, 0]        #   frame (frame_rpy or frame_rotation as above), for
                                     #   frames off the joint's axis; default: on it
         limits: {lower: -pi, upper: pi, velocity: 2, effort: 100}   # optional, any subset
-        damping: 0.1                # optional
-        friction: 0.0               # optional
+        damping: 0.1                # optional viscous friction Fv (tau += Fv qd)
+        friction: 0.0               # optional Coulomb friction Fc (tau += Fc sign(qd))
+        armature: 0.0               # optional rotor inertia at the joint Ia (tau += Ia qdd),
+        # or rotor_inertia: Jm with gear_ratio: G  -> Ia = G^2 Jm (not both)
+        torque_offset: 0.0          # optional constant offset (tau += offset)
     links:
       - name: link1
         mass: m1                    # optional, default 0
@@ -135,6 +138,7 @@ TOP_KEYS = (
 JOINT_KEYS = (
     "name", "type", "parent", "child", "xyz", "rpy", "rotation", "axis",
     "frame_xyz", "frame_rpy", "frame_rotation", "limits", "damping", "friction",
+    "armature", "rotor_inertia", "gear_ratio", "torque_offset",
 )
 LINK_KEYS = ("name", "mass", "com", "inertia")
 JOINT_TYPES = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic", "fixed": "fixed"}

@@ -200,13 +200,15 @@ def check(
             continue  # built symmetric by the method itself (Lagrange's Hessian): nothing to prove
         M = eom.M
         report.results.append(_compare(f"M symmetric ({eom.method})", M, M.T, a.q, sampler, exact, tol))
-    # tau = M qdd + C qd + g on the Newton-Euler derivation when there is one: its
-    # velocity terms come from the recursion (omega x I omega, ...), C only from M's
-    # Christoffel symbols, so they agree only if both are right. (On a Lagrange
+    # tau = M qdd + C qd + g (+ joint friction) on the Newton-Euler derivation when there
+    # is one: its velocity terms come from the recursion (omega x I omega, ...), C only
+    # from M's Christoffel symbols, so they agree only if both are right. (On a Lagrange
     # derivation alone the velocity terms are the same Christoffel sums: weaker.)
     e = next((x for x in (a, b) if x is not None and x.method == "newton-euler"), a)
     recon = e.M * e.qdd + e.C * e.qd + e.g
     name = f"tau ({e.method}) == M qdd + C qd + g, C from the Christoffel symbols of M"
+    if any(x != 0 for x in e.friction):
+        recon, name = recon + e.friction, name + ", + Fv qd + Fc sign(qd)"
     report.results.append(_compare(name, e.tau, recon, e.q, sampler, exact, tol))
     return report
 

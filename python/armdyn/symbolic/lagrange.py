@@ -34,6 +34,7 @@ import symengine as se
 import sympy as sp
 
 from ..model import Robot
+from .joint_terms import armature, friction_torques, offsets
 from .terms import EquationsOfMotion, Step
 
 
@@ -85,6 +86,12 @@ def lagrange(robot: Robot) -> EquationsOfMotion:
     q, qd, qdd, n = robot.q, robot.qd, robot.qdd, robot.dof
     T_trans, T_rot, V_links, steps = _energies(robot)
     T = sum(T_trans.values(), sp.Integer(0)) + sum(T_rot.values(), sp.Integer(0))
+    ia = armature(robot)
+    if any(x != 0 for x in ia):
+        # rotors spinning at qd_k (reflected through their gears): 1/2 Ia_k qd_k^2 each
+        T_rotor = sum((sp.Rational(1, 2) * ia[k] * qd[k] ** 2 for k in range(n)), sp.Integer(0))
+        steps.append(Step("energy", "", "T_rotor", r"T_{\mathrm{rotor}}", T_rotor, "rotor kinetic energy 1/2 Ia qd^2"))
+        T = T + T_rotor
     V = sum(V_links.values(), sp.Integer(0))
     steps += [
         Step("energy", "", "T", "T", T, "total kinetic energy"),
@@ -99,11 +106,14 @@ def lagrange(robot: Robot) -> EquationsOfMotion:
     for k in range(n):
         for j in range(k, n):
             M_[k][j] = M_[j][k] = dT_dqd[k].diff(qd_[j])
+    # friction and offset are generalised forces that do no conservative work:
+    # Rayleigh's dissipation 1/2 Fv qd^2 gives Fv qd; Coulomb Fc sign(qd); a constant offset
+    nonconservative = friction_torques(robot, qd) + offsets(robot)
     tau = []
     for k in range(n):
         ddt_p = sum((M_[k][j] * qdd_[j] + dT_dqd[k].diff(q_[j]) * qd_[j] for j in range(n)), se.Integer(0))
         dL_dq = T_.diff(q_[k]) - V_.diff(q_[k])
-        tau_k = sp.sympify(ddt_p - dL_dq)
+        tau_k = sp.sympify(ddt_p - dL_dq) + nonconservative[k]
         tau.append(tau_k)
         steps += [
             Step("equations", robot.coordinate_names[k], "dL_dqd", rf"\partial L/\partial \dot q_{{{k + 1}}}",
@@ -111,7 +121,7 @@ def lagrange(robot: Robot) -> EquationsOfMotion:
             Step("equations", robot.coordinate_names[k], "dL_dq", rf"\partial L/\partial q_{{{k + 1}}}",
                  sp.sympify(dL_dq), "dL/dq"),
             Step("equations", robot.coordinate_names[k], "tau", rf"\tau_{{{k + 1}}}", tau_k,
-                 "d/dt dL/dqd - dL/dq"),
+                 "d/dt dL/dqd - dL/dq" + (" + friction + offset" if nonconservative[k] != 0 else "")),
         ]
 
     def mass_matrix():

@@ -48,6 +48,7 @@ from dataclasses import replace
 import sympy as sp
 
 from ..model import Robot
+from .joint_terms import armature, has_joint_terms, joint_torques
 from .terms import EquationsOfMotion, Step
 
 
@@ -228,11 +229,17 @@ def mass_matrix(robot: Robot) -> sp.Matrix:
     for j in range(n):
         unit = [int(i == j) for i in range(n)]
         M[:, j] = _recursion(robot, zeros, unit, sp.zeros(3, 1))
-    return M
+    return M + sp.diag(*armature(robot))  # rotor inertias on the diagonal
 
 
 def newton_euler(robot: Robot) -> EquationsOfMotion:
     """Derive ``tau`` by iterated Newton-Euler; steps as in Craig's outward/inward passes."""
     steps: list[Step] = []
     tau = _recursion(robot, list(robot.qd), list(robot.qdd), -robot.gravity, steps)
+    if has_joint_terms(robot):
+        # DESIGN.md: tau += Ia qdd + Fv qd + Fc sign(qd) + offset, joint by joint
+        extra = joint_torques(robot, robot.qd, robot.qdd)
+        tau = tau + extra
+        steps.append(Step("inward", "", "tau_joint", r"\tau_{\mathrm{joint}}", extra,
+                          "rotor inertia, viscous and Coulomb friction, offset: Ia qdd + Fv qd + Fc sign(qd) + offset"))
     return EquationsOfMotion(robot, "newton-euler", tau, steps, _M_builder=lambda: mass_matrix(robot))

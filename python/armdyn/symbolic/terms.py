@@ -129,6 +129,15 @@ class EquationsOfMotion:
         return dag.xreplace(self.tau, zero)
 
     @cached_property
+    def friction(self) -> sp.Matrix:
+        """Joint friction (n x 1) ``Fv qd + Fc sign(qd)``: the part of tau outside
+        ``M qdd + C qd + g`` (zero without joint friction). Rotor inertia is in M, the
+        torque offset in g (see :mod:`armdyn.symbolic.joint_terms`)."""
+        from .joint_terms import friction_torques
+
+        return friction_torques(self.robot, self.qd)
+
+    @cached_property
     def C(self) -> sp.Matrix:
         """Coriolis/centrifugal matrix (n x n) from the Christoffel symbols of M."""
         return christoffel_coriolis(self.M, self.q, self.qd)

@@ -36,8 +36,15 @@ pub fn aba<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], tau: &
     for i in (0..n).rev() {
         let kind = model.kind[i];
         let u_col = kind.articulated_inertia_s(&data.ia[i]);
-        let d_inv = T::splat(1.0) / kind.s_dot(&u_col);
-        let u = tau[i] - kind.s_dot(&data.pa[i]);
+        // Joint dynamics: the rotor inertia Ia adds to D_i = S^T I^A S + Ia, and friction
+        // and offset are torques the motor does not deliver to the link:
+        // u_i = tau_i - Fv qd_i - Fc sign(qd_i) - offset - S^T p^A_i.
+        let jd = &model.joint_dynamics[i];
+        let d_inv = T::splat(1.0) / (kind.s_dot(&u_col) + T::splat(jd.armature));
+        let mut u = tau[i] - kind.s_dot(&data.pa[i]);
+        if model.has_joint_dynamics {
+            u -= T::splat(jd.viscous) * qd[i] + T::splat(jd.coulomb) * qd[i].sign0() + T::splat(jd.offset);
+        }
         data.u_col[i] = u_col;
         data.d_inv[i] = d_inv;
         data.u[i] = u;

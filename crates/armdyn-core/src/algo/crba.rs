@@ -38,4 +38,10 @@ pub fn crba<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], m: &mut [T]) {
             m[j * n + i] = h;
         }
     }
+    // rotor inertias (armature) on the diagonal
+    if model.has_joint_dynamics {
+        for i in 0..n {
+            m[i * n + i] += T::splat(model.joint_dynamics[i].armature);
+        }
+    }
 }

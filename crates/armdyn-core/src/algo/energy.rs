@@ -19,6 +19,8 @@ pub fn kinetic_energy(model: &Model, data: &mut Data<f64>, q: &[f64], qd: &[f64]
         };
         data.v[i] = v;
         t += v.dot(&model.inertia[i].mul_motion(&v));
+        // the rotor spinning at qd_i (reflected through its gear): Ia qd_i^2
+        t += model.joint_dynamics[i].armature * qd[i] * qd[i];
     }
     0.5 * t
 }

@@ -16,6 +16,7 @@ pub mod jacobian;
 pub mod jacobian_dot;
 pub mod kinematics;
 pub mod minverse;
+pub mod regressor;
 pub mod rnea;
 pub mod rnea_derivatives;
 
@@ -25,6 +26,7 @@ pub use crba::crba;
 pub use energy::{kinetic_energy, potential_energy};
 pub use jacobian::jacobian;
 pub use kinematics::forward_kinematics;
+pub use regressor::{regressor, regressor_columns};
 pub use rnea::{bias, gravity, rnea};
 pub use aba_derivatives::aba_derivatives;
 pub use external::{aba_ext, generalized_forces, rnea_ext, ExternalForces, ForceFrame};

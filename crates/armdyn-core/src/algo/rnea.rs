@@ -39,6 +39,21 @@ pub fn rnea<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd: 
             data.f[p] += fp;
         }
     }
+    if model.has_joint_dynamics {
+        add_joint_dynamics(model, qd, qdd, tau);
+    }
+}
+
+/// `tau_i += Ia_i qdd_i + Fv_i qd_i + Fc_i sign(qd_i) + offset_i` (DESIGN.md), all (nv,).
+#[inline(always)]
+pub fn add_joint_dynamics<T: Real>(model: &Model, qd: &[T], qdd: &[T], tau: &mut [T]) {
+    for i in 0..model.nv {
+        let jd = &model.joint_dynamics[i];
+        tau[i] += T::splat(jd.armature) * qdd[i]
+            + T::splat(jd.viscous) * qd[i]
+            + T::splat(jd.coulomb) * qd[i].sign0()
+            + T::splat(jd.offset);
+    }
 }
 
 /// Gravity torques `g(q) = rnea(q, 0, 0)`. `q`, `g`: (nv,).
