@@ -73,13 +73,16 @@ def to_pinocchio(robot: Robot) -> tuple[pin.Model, dict[str, int], np.ndarray]:
     for joint in depth_first(robot):
         parent_id, parent_in_joint = where[joint.parent]
         placement = parent_in_joint * pin.SE3(_floats(joint.rotation), _floats(joint.xyz).ravel())
+        # a link frame off its joint's axis (frame_xyz/frame_rotation) sits at that fixed
+        # offset in the joint's frame
+        offset = pin.SE3(_floats(joint.frame_rotation), _floats(joint.frame_xyz).ravel())
         if joint.movable:
             axis = _floats(joint.axis).ravel()
             jid = model.addJoint(parent_id, _joint_model(joint.type, axis), placement, joint.name)
-            where[joint.child] = (jid, pin.SE3.Identity())
+            where[joint.child] = (jid, offset)
             perm.append(robot.coordinate_index(joint))
         else:
-            where[joint.child] = (parent_id, placement)
+            where[joint.child] = (parent_id, placement * offset)
     frames = {}
     for name, link in robot.links.items():
         jid, placement = where[name]

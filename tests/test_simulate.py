@@ -85,7 +85,11 @@ def test_passive_energy_drift_rk4_10s(name, request):
         assert drifts[dt].shape == (4,)
     assert drifts[1e-3][0] < 1e-6, drifts  # from rest
     assert np.all(drifts[5e-4] < 1e-6), drifts
-    assert np.all(drifts[1e-3] / drifts[5e-4] > 8), drifts  # 4th order: ~16
+    # 4th order (~16x when dt halves) where the drift is truncation error, not round-off
+    # (below ~1e-8 the 10 s sum of round-off dominates and the ratio means nothing)
+    truncation = drifts[5e-4] > 1e-8
+    assert truncation.any(), drifts
+    assert np.all(drifts[1e-3][truncation] / drifts[5e-4][truncation] > 8), drifts
 
 
 @pytest.fixture(scope="module")

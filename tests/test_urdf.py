@@ -435,7 +435,11 @@ def compare_reduced_with_pinocchio(robot, path: Path, rng, states: int = 1, rtol
                     qp[iq : iq + 2] = np.cos(x), np.sin(x)
                 else:
                     qp[iq] = x
-            tau = G.T @ pin.rnea(model, data, qp, G @ qd, G @ qdd)
+            # URDF damping/friction of the independent joints enter armdyn's tau, not
+            # Pinocchio's rnea: added in closed form (as in check_against_pinocchio)
+            fr = np.array([float(j.damping or 0) * v + float(j.friction or 0) * np.sign(v)
+                           for j, v in zip(robot.movable_joints, qd)])
+            tau = G.T @ pin.rnea(model, data, qp, G @ qd, G @ qdd) + fr
             tau_ours = engine.rnea(robot, q, qd, qdd)
             assert close(tau_ours, tau) < rtol, f"{engine.__name__}.rnea"
             M = pin.crba(model, data, qp)
@@ -445,7 +449,7 @@ def compare_reduced_with_pinocchio(robot, path: Path, rng, states: int = 1, rtol
                 compared_aba = False
                 continue
             ours = engine.aba(robot, q, qd, tau_ours)
-            implied = G.T @ pin.rnea(model, data, qp, G @ qd, G @ ours)
+            implied = G.T @ pin.rnea(model, data, qp, G @ qd, G @ ours) + fr
             assert close(implied, tau_ours) < rtol, f"{engine.__name__}.aba (implied torque)"
     return compared_aba
 

@@ -213,7 +213,10 @@ def _unit_wrenches(w, wd, vd):
 def regressor(robot: Robot) -> Regressor:
     """The symbolic joint torque regressor of ``robot``: ``tau = Y pi`` (Newton-Euler
     linear in the parameters; see the module docstring). Exact: ``Y * pi`` equals
-    the Newton-Euler and Lagrange torques (tests)."""
+    the Newton-Euler and Lagrange torques (tests). Inertial parameters are about each
+    link's frame on its joint (:meth:`armdyn.model.Robot.canonical`: the same as the
+    link frame unless the model places a link frame off its joint's axis)."""
+    robot = robot.canonical()
     names, values = standard_parameters(robot)
     n = robot.dof
     w, wd, vd, pose = _outward(robot)
@@ -583,7 +586,7 @@ def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
     Raises ValueError if the set of identifiable parameters itself changes between two
     random geometries (not met on the bundled arms; bind the geometry then).
     """
-    robot = rationalized(robot)
+    robot = rationalized(robot.canonical())  # parameters about the frames on the joints
     reg = regressor(robot)
     Y = reg.Y
     keep, exprs = _grouped(robot, reg)

@@ -156,6 +156,23 @@ def _core_model(robot, what: str, link_frames: bool = False) -> NumericModel:
     return model
 
 
+def _canonical_wrenches(robot, f_ext, frame: str):
+    """Wrenches given in the link frames (``frame="local"``) moved to the compiled model's
+    on-joint frames (:meth:`armdyn.model.Robot.canonical`): with the link frame at
+    ``(Rf, pf)`` in its joint frame, ``f' = Rf f`` and ``n' = Rf n + pf x f'``. Other
+    inputs unchanged (validated by the core)."""
+    offsets = _frame_offsets(robot)
+    if f_ext is None or frame != "local" or offsets is None:
+        return f_ext
+    w = np.array(f_ext, dtype=float)  # a copy
+    if w.shape[-2:] != (len(offsets), 6):
+        return f_ext  # the core names what is wrong with the shape
+    R, p = offsets[:, :3, :3], offsets[:, :3, 3]
+    f = np.einsum("lij,...lj->...li", R, w[..., :3])
+    n = np.einsum("lij,...lj->...li", R, w[..., 3:]) + np.cross(p, f)
+    return np.ascontiguousarray(np.concatenate([f, n], axis=-1))
+
+
 def _frame_offsets(robot) -> np.ndarray | None:
     """(nlinks, 4, 4) each link frame in its canonical (on-joint) frame, or None when
     every link frame sits on its joint (see :meth:`armdyn.model.Robot.canonical`)."""
@@ -185,7 +202,8 @@ def rnea(robot, q, qd, qdd, *, f_ext=None, frame="local", threads=None):
     with external wrenches ``f_ext`` (see :func:`rnea_derivatives`), minus sum J^T w.
     """
     if f_ext is not None:
-        return _core.rnea_ext(_core_model(robot, "rnea with f_ext", frame == "local"), q, qd, qdd, f_ext, frame, threads)
+        f_ext = _canonical_wrenches(robot, f_ext, frame)
+        return _core.rnea_ext(_core_model(robot, "rnea with f_ext"), q, qd, qdd, f_ext, frame, threads)
     return _model(robot).rnea(q, qd, qdd, threads)
 
 
@@ -204,7 +222,8 @@ def aba(robot, q, qd, tau, *, f_ext=None, frame="local", threads=None):
     external wrenches ``f_ext`` (see :func:`rnea_derivatives`), M^-1 (tau + sum J^T w - C qd - g).
     """
     if f_ext is not None:
-        return _core.aba_ext(_core_model(robot, "aba with f_ext", frame == "local"), q, qd, tau, f_ext, frame, threads)
+        f_ext = _canonical_wrenches(robot, f_ext, frame)
+        return _core.aba_ext(_core_model(robot, "aba with f_ext"), q, qd, tau, f_ext, frame, threads)
     return _model(robot).aba(q, qd, tau, threads)
 
 
@@ -298,8 +317,8 @@ def rnea_derivatives(robot, q, qd, qdd, *, f_ext=None, frame="local", threads=No
     about the base frame's origin (the wrench stays fixed in space). Then
     ``tau = M qdd + C qd + g - sum_L J_L^T w_L``.
     """
-    model = _core_model(robot, "rnea_derivatives", f_ext is not None and frame == "local")
-    return _core.rnea_derivatives(model, q, qd, qdd, f_ext, frame, threads)
+    model = _core_model(robot, "rnea_derivatives")
+    return _core.rnea_derivatives(model, q, qd, qdd, _canonical_wrenches(robot, f_ext, frame), frame, threads)
 
 
 def aba_derivatives(robot, q, qd, tau, *, f_ext=None, frame="local", threads=None):
@@ -309,8 +328,8 @@ def aba_derivatives(robot, q, qd, tau, *, f_ext=None, frame="local", threads=Non
     (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
     f_ext, frame: as in :func:`rnea_derivatives`.
     """
-    model = _core_model(robot, "aba_derivatives", f_ext is not None and frame == "local")
-    return _core.aba_derivatives(model, q, qd, tau, f_ext, frame, threads)
+    model = _core_model(robot, "aba_derivatives")
+    return _core.aba_derivatives(model, q, qd, tau, _canonical_wrenches(robot, f_ext, frame), frame, threads)
 
 
 def minverse(robot, q, *, threads=None):
@@ -331,7 +350,24 @@ def jacobian_dot(robot, q, qd, link, *, threads=None):
     link: a link name, index in ``list(robot.links)``, or Link."""
     if isinstance(link, Link):
         link = link.name
-    return _core.jacobian_dot(_core_model(robot, "jacobian_dot", True), q, qd, link, threads)
+    Jd = _core.jacobian_dot(_core_model(robot, "jacobian_dot"), q, qd, link, threads)
+    offsets = _frame_offsets(robot)
+    if offsets is None:
+        return Jd
+    # the point at r = R pf from the compiled (on-joint) frame's origin: J_v' = J_v - [r]x J_w,
+    # so Jdot_v' = Jdot_v - [w x r]x J_w - [r]x Jdot_w, with w = J_w qd
+    model = _model(robot)
+    k = link if isinstance(link, (int, np.integer)) else robot.link_index(link)
+    r = model.forward_kinematics(q, threads)[..., k, :3, :3] @ offsets[k, :3, 3]
+    Jw = model.jacobian(q, link, threads)[..., 3:, :]
+    w = np.einsum("...ij,...j->...i", Jw, np.asarray(qd, dtype=float))
+    rd = np.cross(w, r)
+
+    def cross_cols(v, A):  # [v]x A, column by column
+        return np.cross(v[..., None, :], A.swapaxes(-1, -2)).swapaxes(-1, -2)
+
+    Jdv = Jd[..., :3, :] - cross_cols(rd, Jw) - cross_cols(r, Jd[..., 3:, :])
+    return np.concatenate([Jdv, Jd[..., 3:, :]], axis=-2)
 
 
 def regressor(robot, q, qd, qdd, *, threads=None, columns: str = "model"):
@@ -350,7 +386,9 @@ def regressor(robot, q, qd, qdd, *, threads=None, columns: str = "model"):
     """
     if columns not in ("model", "all"):
         raise ValueError(f"columns must be 'model' or 'all', got {columns!r}")
-    model = _core_model(robot, "regressor", True)  # parameters about the link frames
+    # parameters about each link's frame on its joint (Robot.canonical), as the symbolic
+    # armdyn.identification.regressor defines them
+    model = _core_model(robot, "regressor")
     Y = _core.regressor(model, q, qd, qdd, threads)
     if columns == "all":
         return Y

@@ -692,8 +692,9 @@ def jacobian_dot(robot: Robot, q, qd, link) -> np.ndarray:
         L[:3, :3], L[:3, 3] = R, p
         if t.dofs[k].size:
             rate = qd[t.dofs[k]][0]
-            if t.kind[k] == "revolute":
+            if t.kind[k] == "revolute":  # about the axis through the joint point (child frame)
                 dL[:3, :3] = R @ skew3(t.axis[k]) * rate
+                dL[:3, 3] = R @ np.cross(t.point[k], t.axis[k]) * rate
             else:
                 dL[:3, 3] = R @ t.axis[k] * rate
         lam = t.parent[k]
@@ -707,7 +708,8 @@ def jacobian_dot(robot: Robot, q, qd, link) -> np.ndarray:
     while j >= 0:
         if t.dofs[j].size:
             z, zd = X[j][:3, :3] @ t.axis[j], Xd[j][:3, :3] @ t.axis[j]
-            o, od = X[j][:3, 3], Xd[j][:3, 3]
+            # a point on the axis (the frame origin unless the link frame sits off it)
+            o, od = X[j][:3, 3] + X[j][:3, :3] @ t.point[j], Xd[j][:3, 3] + Xd[j][:3, :3] @ t.point[j]
             col = t.dofs[j][0]
             if t.kind[j] == "revolute":
                 Jd[:3, col] = np.cross(zd, p - o) + np.cross(z, pd - od)
