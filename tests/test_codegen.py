@@ -241,15 +241,6 @@ def test_bad_what_and_lang():
         codegen.codegen(robot, what="")
 
 
-@pytest.mark.skipif(importlib.util.find_spec("armdyn.identification") is not None,
-                    reason="armdyn.identification present: the regressor is generated")
-def test_regressor_without_identification_module_is_a_clear_error():
-    with pytest.raises(ValueError, match="not available"):
-        codegen.codegen(armdyn.load("rp-arm"), what="regressor")
-    with pytest.raises(ValueError, match="not available"):
-        codegen.codegen(armdyn.load("rp-arm"), what="tau", base=True)
-
-
 @needs_cc
 def test_compiled_function_rejects_bad_arrays(tmp_path):
     robot = _numeric(_load("planar-2r"), _values(_load("planar-2r"), np.random.default_rng(1)))
@@ -358,12 +349,3 @@ def test_base_parameter_code_equals_rust_core(tmp_path):
     _close(lib.M(q, p=p), armdyn.crba(bound, q))
     _close(lib.C(q, qd, p=p), armdyn.coriolis_matrix(bound, q, qd))
 
-
-@pytest.mark.skipif(importlib.util.find_spec("armdyn.identification") is not None,
-                    reason="armdyn.identification present: the regressor is generated")
-def test_cli_regressor_without_identification_is_one_line(tmp_path):
-    res = _cli("codegen", "rp-arm", "--what", "tau,regressor", "--out", str(tmp_path / "gen"))
-    assert res.returncode == 2
-    assert res.stderr.startswith("armdyn: error:") and "not available" in res.stderr
-    assert len(res.stderr.strip().splitlines()) == 1
-    assert not (tmp_path / "gen").exists()
