@@ -25,8 +25,9 @@ import sympy as sp
 from ..errors import ModelError
 from ..model import Robot
 from .engine import Sampler, Value, World, canonical, judge, to_sympy
-from .explain import component_name, describe, pretty, tidy
-from .latex import LatexError, UnknownSymbol, parse, parse_sympy_syntax
+from .engine import equal
+from .explain import component_name, describe, pretty, split_name, tidy
+from .latex import GREEK, LatexError, UnknownSymbol, parse, parse_sympy_syntax
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .reader import Submission, read
@@ -223,8 +224,6 @@ class _Grader:
         expected = rotation_between(ctx, ref.index, ref.frame)
         fp = self.sampler.fingerprint
         got_fp = fp(value)
-        from .engine import equal
-
         status, conv, message = "correct", None, ""
         ok = equal(got_fp, fp(expected))
         if not ok.all():
@@ -293,8 +292,6 @@ class _Grader:
             if ref.key in VECTOR_KEYS and ref.frame is not None and ref.frame != ref.index:
                 ref_value = rotation_between(world.ctx, ref.index, ref.frame) * ref_value
             got_m, ref_m = _matrix(value), _matrix(ref_value)
-            from .engine import equal
-
             ok = equal(self.sampler.fingerprint(got_m), self.sampler.fingerprint(ref_m)).ravel()
             components = [int(i) for i in range(len(ok)) if not ok[i]]
             if j.status == "wrong":
@@ -348,21 +345,16 @@ def _matrix(value) -> sp.Matrix:
 
 def _symbol_latex(robot: Robot) -> dict:
     """Model symbol -> LaTeX as the field writes it (\\dot{\\theta}_1 for theta1_dot)."""
-    import re
-
     out = {}
-    names = list(robot.q) + list(robot.qd) + list(robot.qdd) + list(robot.parameters.values())
-    for s in names:
-        m = re.fullmatch(r"([A-Za-z]+?)(\d*)(_dot|_ddot)?", s.name)
-        if not m:
+    for s in list(robot.q) + list(robot.qd) + list(robot.qdd) + list(robot.parameters.values()):
+        parts = split_name(s.name)
+        if parts is None:
             out[s] = s.name
             continue
-        base, digits, dots = m.groups()
-        from .latex import GREEK
-
+        base, digits, dots = parts
         tex = f"\\{base}" if base in GREEK else base
         if dots:
-            tex = f"\\{'d' if dots == '_ddot' else ''}dot{{{tex}}}"
+            tex = f"\\{'d' * (dots - 1)}dot{{{tex}}}"
         out[s] = tex + (f"_{{{digits}}}" if digits else "")
     return out
 

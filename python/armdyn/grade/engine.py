@@ -42,10 +42,6 @@ RTOL = 1e-8
 MAX_COMBINATIONS = 64
 
 
-def as_matrix(value) -> sp.Matrix:
-    return value if isinstance(value, sp.MatrixBase) else sp.Matrix([[value]])
-
-
 def entries(value) -> tuple[list, tuple]:
     """The entries (row-major) and shape of a SymPy or SymEngine scalar or matrix."""
     if isinstance(value, (sp.MatrixBase, se.DenseMatrix)):

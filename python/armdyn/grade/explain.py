@@ -30,16 +30,24 @@ _GREEK = {
 TIDY_LIMIT = 400
 
 
-def display_name(name: str, ascii_only: bool = False) -> str:
-    """``theta1_dot`` -> ``θ̇1``, ``d2_ddot`` -> ``d̈2``, ``l1`` -> ``l1``."""
-    if ascii_only:
-        return name
+def split_name(name: str) -> tuple[str, str, int] | None:
+    """A model symbol's name as ``(base, digits, dots)``: ``theta1_ddot`` ->
+    ``("theta", "1", 2)``; None for a name not of that form."""
     m = re.fullmatch(r"([A-Za-z]+?)(\d*)(_dot|_ddot)?", name)
     if not m:
-        return name
+        return None
     base, digits, dots = m.groups()
+    return base, digits, {"_dot": 1, "_ddot": 2, None: 0}[dots]
+
+
+def display_name(name: str, ascii_only: bool = False) -> str:
+    """``theta1_dot`` -> ``θ̇1``, ``d2_ddot`` -> ``d̈2``, ``l1`` -> ``l1``."""
+    parts = None if ascii_only else split_name(name)
+    if parts is None:
+        return name
+    base, digits, dots = parts
     base = _GREEK.get(base, base)
-    accent = {"_dot": "\u0307", "_ddot": "\u0308", None: ""}[dots]
+    accent = ("", "\u0307", "\u0308")[dots]
     return base + accent + digits
 
 

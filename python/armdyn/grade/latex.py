@@ -179,12 +179,12 @@ class _Parser:
             kind, tok = self.peek()
             if (kind, tok) in (("char", "*"), ("cmd", "cdot"), ("cmd", "times"), ("cmd", "ast")):
                 self.take()
-                value = _mul(value, self.factor())
+                value = value * self.factor()
             elif (kind, tok) == ("char", "/"):
                 self.take()
                 value = value / self.factor()
             elif self._starts_atom():
-                value = _mul(value, self.factor())
+                value = value * self.factor()
             else:
                 return value
 
@@ -309,12 +309,7 @@ class _Parser:
         if self.peek() == ("char", "^"):
             self.take()
             power = self.script_value()
-        kind, tok = self.peek()
-        if (kind, tok) in (("char", "("), ("char", "["), ("char", "{"), ("cmd", "left")):
-            arg = self.atom()
-        else:
-            arg = self.atom()
-        value = fn(arg)
+        value = fn(self.atom())  # a bracketed group, or the next symbol: \sin\theta_1
         return value**power if power is not None else value
 
     def symbol(self):
@@ -392,10 +387,6 @@ class _Parser:
         if not rows or len({len(r) for r in rows}) != 1:
             raise LatexError("a matrix whose rows have different lengths")
         return sp.Matrix(rows)
-
-
-def _mul(a, b):
-    return a * b
 
 
 def parse(text: str, resolve) -> sp.Expr | sp.Matrix:

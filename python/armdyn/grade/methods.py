@@ -206,7 +206,7 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
             m.conventions[("n", i)] = [USUAL, Convention(
                 f"moment about joint {i}'s placement origin (where the slide starts), not frame {i}'s origin",
                 about_axis.forward, about_axis.inverse, about_axis.extra)]
-        k = robot.coordinate_index(robot.parent_joint(robot_link(robot, i)))
+        k = robot.coordinate_index(robot.parent_joint(list(robot.links)[i]))
         if k is not None:
             def tau_fn(c, nv, fv, i=i):
                 point = c[i]["o"] if c[i]["kind"] == "revolute" else c["zero"]
@@ -215,10 +215,6 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
             m.formulas[("tau", k + 1)] = [Formula((("n", i), ("f", i)), tau_fn)]
             m.refs.append(("tau", k + 1))
     return m, ctx
-
-
-def robot_link(robot: Robot, index: int) -> str:
-    return list(robot.links)[index]
 
 
 def rotation_between(ctx, frm: int, to: int):

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..model import Robot
-from .latex import GREEK, LatexError, Name, UnknownSymbol, parse
+from .latex import LatexError, Name, UnknownSymbol, parse
 
 VECTOR_KEYS = ("omega", "omega_dot", "v_dot", "vc_dot", "F", "N", "f", "n")
 LAGRANGE_KEYS = ("T", "V", "L", "dL_dqd", "ddt_dL_dqd", "dL_dq")
@@ -318,6 +318,3 @@ def _plain(sub: str) -> str:
     """A subscript as plain text: ``{c1}``, ``c_1``, ``c,1``, ``\\mathrm{c}1`` -> ``c1``."""
     return re.sub(r"[{}\s,_]|\\mathrm|\\text", "", sub or "")
 
-
-def is_greek(name: str) -> bool:
-    return name in GREEK
