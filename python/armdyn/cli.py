@@ -89,20 +89,6 @@ def cmd_show(args) -> int:
     return 0
 
 
-def _write_atomically(path: str, content: str) -> None:
-    """Write ``content`` to ``path`` through a temporary file: nothing half-written."""
-    directory = os.path.dirname(os.path.abspath(path))
-    tmp = os.path.join(directory, f".{os.path.basename(path)}.{os.getpid()}.tmp")
-    try:
-        with open(tmp, "w", encoding="utf-8") as fh:
-            fh.write(content)
-        os.replace(tmp, path)
-    except OSError as exc:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise ValueError(f"cannot write {path} ({exc.strerror})") from None
-
-
 def cmd_grade(args) -> int:
     from .grade import grade
     from .grade.reader import read
@@ -113,9 +99,12 @@ def cmd_grade(args) -> int:
         return 0
     report = grade(submission, robot=args.robot)
     if args.html:
-        from .grade.html import report_html
+        from .grade.html import write_report_html  # all or nothing
 
-        _write_atomically(args.html, report_html(report))
+        try:
+            write_report_html(report, args.html)
+        except OSError as exc:
+            raise ValueError(f"cannot write {args.html} ({exc.strerror})") from None
     if args.json:
         print(report.to_json())
     else:

@@ -343,6 +343,9 @@ def write_report_html(report: GradeReport, path) -> None:
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as out:
             out.write(page_text)
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600 files; a report is for reading
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
