@@ -144,8 +144,6 @@ def _numbers(text: str | None, option: str, dof: int | None = None):
 
 
 def cmd_simulate(args) -> int:
-    import tempfile
-
     import numpy as np
 
     from .show import numeric_robot
@@ -202,36 +200,23 @@ def cmd_simulate(args) -> int:
 
     run = simulate(robot, q0, qd0, dt=args.dt, steps=steps, method=args.method, controller=controller,
                    stride=args.stride, progress=bar if show_bar else None)
-    # outputs go to temporary files first, renamed only when all are written
-    done = []
-    try:
-        if args.plot:
-            from .plots import plot_trajectory
+    # outputs are staged in temporary files, renamed only when all are written
+    from ._io_atomic import atomic_writes
 
-            fd, tmp = tempfile.mkstemp(suffix=os.path.splitext(args.plot)[1], dir=os.path.dirname(os.path.abspath(args.plot)))
-            os.close(fd)
-            done.append((tmp, args.plot))
-            plot_trajectory(run, tmp, title=f"{robot.name}: {args.method}, dt = {args.dt:g} s")
-        if args.animate:
-            from .show import animate
+    outputs = []
+    if args.plot:
+        from .plots import plot_trajectory
 
-            fd, tmp = tempfile.mkstemp(suffix=".gif", dir=os.path.dirname(os.path.abspath(args.animate)))
-            os.close(fd)
-            done.append((tmp, args.animate))
-            every = max(1, int(round(1.0 / (args.fps * run.t[1])))) if len(run.t) > 1 else 1
-            every = max(every, -(-len(run.t) // 400))  # at most ~400 frames
-            frames = np.arange(0, len(run.t), every)
-            animate(robot, run.q[frames], tmp, t=run.t[frames], fps=args.fps)
-        mask = os.umask(0)
-        os.umask(mask)
-        for tmp, final in done:
-            os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600 files
-            os.replace(tmp, final)
-        done = []
-    finally:
-        for tmp, _ in done:
-            if os.path.exists(tmp):
-                os.remove(tmp)
+        outputs.append((args.plot, lambda tmp: plot_trajectory(
+            run, tmp, title=f"{robot.name}: {args.method}, dt = {args.dt:g} s")))
+    if args.animate:
+        from .show import animate
+
+        every = max(1, int(round(1.0 / (args.fps * run.t[1])))) if len(run.t) > 1 else 1
+        every = max(every, -(-len(run.t) // 400))  # at most ~400 frames
+        frames = np.arange(0, len(run.t), every)
+        outputs.append((args.animate, lambda tmp: animate(robot, run.q[frames], tmp, t=run.t[frames], fps=args.fps)))
+    atomic_writes(outputs)
     names = robot.coordinate_names
     print(f"{robot.name}: {steps} steps of {args.dt:g} s ({args.method}), {len(run.t)} samples stored")
     print("q_final  = [" + ", ".join(f"{v:.6g}" for v in run.q_final) + "]")

@@ -67,21 +67,13 @@ def plot_trajectory(run, out=None, *, state: int = 0, title: str | None = None):
     fig.suptitle(title or f"simulation: {method}, {step}", fontsize=11)
     fig.tight_layout()
     if out is not None:
-        import os
-        import tempfile
+        from pathlib import Path
 
-        folder = os.path.dirname(os.path.abspath(out))
-        ext = os.path.splitext(str(out))[1] or ".png"
-        fd, tmp = tempfile.mkstemp(suffix=ext, dir=folder)
-        os.close(fd)
+        from ._io_atomic import atomic_write
+
+        fmt = Path(out).suffix[1:].lower() or "png"  # as before: no extension writes PNG
         try:
-            fig.savefig(tmp, dpi=100)
-            mask = os.umask(0)
-            os.umask(mask)
-            os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600 files
-            os.replace(tmp, out)
+            atomic_write(out, lambda tmp: fig.savefig(tmp, dpi=100, format=fmt))
         finally:
             plt.close(fig)
-            if os.path.exists(tmp):
-                os.remove(tmp)
     return fig

@@ -333,24 +333,9 @@ def report_html(report: GradeReport) -> str:
 def write_report_html(report: GradeReport, path) -> None:
     """Write :func:`report_html` to ``path`` (UTF-8) all at once: the page is built
     first and moved into place, so a failure leaves no half-written file."""
-    import os
-    import tempfile
-    from pathlib import Path
+    from .._io_atomic import atomic_write_text
 
-    page_text = report_html(report)
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as out:
-            out.write(page_text)
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600 files; a report is for reading
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    atomic_write_text(path, report_html(report))
 
 
 def repr_html(report: GradeReport) -> str:
