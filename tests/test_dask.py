@@ -78,3 +78,61 @@ def test_bad_input():
         ad.aba(ur5, np.zeros((4, 6)), np.zeros((3, 6)), np.zeros((4, 6)))
     with pytest.raises(ValueError, match="torque must be"):
         ad.simulate(ur5, np.zeros((4, 6)), dt=1e-3, steps=3, torque=lambda t, q, qd: 0)
+
+
+def test_derivatives_on_cluster_equal_in_process(client, ur5):
+    """rnea/aba/gravity derivatives and M^-1 chunked along states (uneven last block), run
+    in the two worker processes: equal to the in-process batch calls bit for bit."""
+    import dask
+    import dask.array as da
+    from distributed import get_task_stream
+
+    from armdyn import dask as ad
+
+    rng = np.random.default_rng(13)
+    n = 203
+    q, qd, qdd = rng.uniform(-2, 2, (3, n, ur5.dof))
+    tau = num.rnea(ur5, q, qd, qdd)
+    dq = da.from_array(q, chunks=(50, 6))  # blocks of 50, 50, 50, 50, 3 rows
+
+    lazy = ad.rnea_derivatives(ur5, dq, qd, qdd)
+    assert all(isinstance(x, da.Array) and x.shape == (n, 6, 6) and x.numblocks == (5, 1, 1) for x in lazy)
+    with get_task_stream(client) as stream:
+        got = dask.compute(*lazy)
+    # the blocks really ran on the cluster's workers (two processes)
+    ran_on = {task["worker"] for task in stream.data if "rnea_derivatives" in task["key"][0]}
+    assert ran_on and ran_on <= set(client.scheduler_info()["workers"]), stream.data
+    want = num.rnea_derivatives(ur5, q, qd, qdd)
+    for g, w, name in zip(got, want, ("dtau_dq", "dtau_dqd", "M")):
+        assert g.shape == w.shape == (n, 6, 6) and np.all(np.isfinite(g)), name
+        assert np.array_equal(g, w), name
+    # the third output is M: a second opinion from crba (a different algorithm)
+    np.testing.assert_allclose(got[2], num.crba(ur5, q), rtol=1e-12, atol=1e-12)
+
+    got = dask.compute(*ad.aba_derivatives(ur5, q, qd, tau, chunks=64))
+    want = num.aba_derivatives(ur5, q, qd, tau)
+    for g, w, name in zip(got, want, ("dqdd_dq", "dqdd_dqd", "Minv")):
+        assert g.shape == (n, 6, 6) and np.all(np.isfinite(g)), name
+        assert np.array_equal(g, w), name
+
+    Minv = ad.minverse(ur5, dq)
+    assert Minv.shape == (n, 6, 6) and Minv.chunks[0] == dq.chunks[0]
+    Minv = Minv.compute()
+    assert np.array_equal(Minv, num.minverse(ur5, q))
+    np.testing.assert_allclose(Minv @ num.crba(ur5, q), np.broadcast_to(np.eye(6), (n, 6, 6)), atol=1e-9)
+
+    dg = ad.gravity_derivatives(ur5, dq).compute()
+    assert dg.shape == (n, 6, 6) and np.all(np.isfinite(dg))
+    assert np.array_equal(dg, num.gravity_derivatives(ur5, q))
+    assert np.abs(dg).max() > 1.0  # gravity really depends on q here
+
+
+def test_derivatives_bad_input():
+    pytest.importorskip("dask.array")
+    from armdyn import dask as ad
+
+    ur5 = armdyn.load("ur5")
+    with pytest.raises(ValueError, match="expected \\(N, 6\\)"):
+        ad.minverse(ur5, np.zeros((4, 5)))
+    with pytest.raises(ValueError, match="does not match"):
+        ad.rnea_derivatives(ur5, np.zeros((4, 6)), np.zeros((3, 6)), np.zeros((4, 6)))

@@ -6,6 +6,7 @@ one machine (or one process).
     q = da.from_array(q_np, chunks=(100_000, -1))     # (N, dof), chunked along states
     tau = ad.rnea(ur5, q, qd, qdd)                    # lazy (N, dof); .compute() anywhere
     run = ad.simulate(ur5, q0, dt=1e-3, steps=1000, stride=10)   # lazy arrays of a Trajectory
+    dq, dqd, M = dask.compute(*ad.rnea_derivatives(ur5, q, qd, qdd))   # (N, dof, dof) each
 
 Every function maps the Rust core over blocks of rows with ``dask.array.map_blocks``;
 the compiled model (``armdyn.NumericModel``) pickles (it is rebuilt from its
@@ -24,9 +25,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .numeric import _model
+from .numeric import _core_model, _model
 
-__all__ = ["rnea", "aba", "crba", "simulate"]
+__all__ = ["rnea", "aba", "crba", "simulate", "rnea_derivatives", "aba_derivatives", "minverse",
+           "gravity_derivatives"]
 
 
 def _arrays(dof: int, chunks, *xs):
@@ -152,3 +154,82 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
     t = np.arange(samples) * (stride * float(dt))
     return Trajectory(t=t, dt=float(dt), stride=stride, method=method, coordinate_names=list(model.coordinate_names),
                       kinetic=kinetic, potential=potential, **out)
+
+
+# ------------------------------------------------------------------ derivatives
+# Batches of (dof, dof) matrices, row = output, column = input (DESIGN.md), chunked along
+# the states like crba: a block of rows (r, dof) maps to (r, dof, dof). The functions
+# with three results compute them in one call per block, packed as (r, 3, dof, dof), and
+# hand back three lazy views of that one graph: compute them together
+# (``dask.compute(*ad.rnea_derivatives(...))``) so each block runs once.
+
+
+def _rnea_derivatives(q, qd, qdd, model, threads):
+    from . import _core
+
+    return np.stack(_core.rnea_derivatives(model, *_c(q, qd, qdd), None, "local", threads), axis=1)
+
+
+def _aba_derivatives(q, qd, tau, model, threads):
+    from . import _core
+
+    return np.stack(_core.aba_derivatives(model, *_c(q, qd, tau), None, "local", threads), axis=1)
+
+
+def _minverse(q, model, threads):
+    from . import _core
+
+    return _core.minverse(model, *_c(q), threads)
+
+
+def _gravity_derivatives(q, model, threads):
+    from . import _core
+
+    return _core.gravity_derivatives(model, *_c(q), threads)
+
+
+def _matrices(function, model, q, *more, threads):
+    """Map ``function`` (block rows (r, dof) -> (r, dof, dof)) over the row blocks."""
+    n = model.dof
+    return q.map_blocks(function, *more, model=model, threads=threads, dtype=float, meta=np.empty((0, 0, 0)),
+                        new_axis=2, chunks=(q.chunks[0], (n,), (n,)))
+
+
+def _triple(function, model, q, *more, threads):
+    """Map ``function`` (block rows -> (r, 3, dof, dof)) and split its three results."""
+    n = model.dof
+    packed = q.map_blocks(function, *more, model=model, threads=threads, dtype=float,
+                          meta=np.empty((0, 0, 0, 0)), new_axis=[2, 3], chunks=(q.chunks[0], (3,), (n,), (n,)))
+    return packed[:, 0], packed[:, 1], packed[:, 2]
+
+
+def rnea_derivatives(robot, q, qd, qdd, *, chunks=None, threads=1):
+    """Lazy :func:`armdyn.numeric.rnea_derivatives` (without external wrenches): q, qd,
+    qdd (N, dof) -> ``(dtau_dq, dtau_dqd, M)``, three (N, dof, dof) Dask arrays,
+    ``dtau_dq[k, i, j] = d tau_i / d q_j`` at state k (compute them together, see above)."""
+    model = _core_model(robot, "rnea_derivatives")
+    q, qd, qdd = _arrays(model.dof, chunks, q, qd, qdd)
+    return _triple(_rnea_derivatives, model, q, qd, qdd, threads=threads)
+
+
+def aba_derivatives(robot, q, qd, tau, *, chunks=None, threads=1):
+    """Lazy :func:`armdyn.numeric.aba_derivatives` (without external wrenches): q, qd, tau
+    (N, dof) -> ``(dqdd_dq, dqdd_dqd, Minv)``, three (N, dof, dof) Dask arrays."""
+    model = _core_model(robot, "aba_derivatives")
+    q, qd, tau = _arrays(model.dof, chunks, q, qd, tau)
+    return _triple(_aba_derivatives, model, q, qd, tau, threads=threads)
+
+
+def minverse(robot, q, *, chunks=None, threads=1):
+    """Lazy :func:`armdyn.numeric.minverse`: q (N, dof) -> M^-1 (N, dof, dof)."""
+    model = _core_model(robot, "minverse")
+    (q,) = _arrays(model.dof, chunks, q)
+    return _matrices(_minverse, model, q, threads=threads)
+
+
+def gravity_derivatives(robot, q, *, chunks=None, threads=1):
+    """Lazy :func:`armdyn.numeric.gravity_derivatives`: q (N, dof) -> dg/dq (N, dof, dof),
+    ``[k, i, j] = d g_i / d q_j`` at state k."""
+    model = _core_model(robot, "gravity_derivatives")
+    (q,) = _arrays(model.dof, chunks, q)
+    return _matrices(_gravity_derivatives, model, q, threads=threads)
