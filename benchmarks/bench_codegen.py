@@ -166,6 +166,38 @@ def generation_times(have_identification: bool, repeat: int) -> None:
     print()
 
 
+def breakdown() -> None:
+    """Where the operations of the PUMA's tau go: per quantity (the temporaries' name
+    prefixes: w, wd, vd, U, F, N forward; Rf, f, n inward) and per link, for the
+    standard-parameter (grouped) program."""
+    import re
+    from collections import defaultdict
+
+    from armdyn.codegen.program import Program
+
+    prog = codegen.codegen(load("puma560-craig"), what="tau").programs["tau"]
+    table = defaultdict(lambda: [0, 0])
+    for sym, expr in prog.assignments:
+        m = re.match(r"([A-Za-z_]+?)(\d)", sym.name)
+        key = (m.group(1), m.group(2)) if m else (sym.name, "-")
+        c = Program([], [expr], ()).operation_counts()
+        table[key][0] += c["mul"]
+        table[key][1] += c["add"]
+    kinds = sorted({k for k, _ in table})
+    links = sorted({j for _, j in table})
+    print("## Where the operations of tau go, puma560-craig, grouped parameters (mul+add per link)\n")
+    print("| quantity | " + " | ".join(f"link {j}" for j in links) + " | total |")
+    print("|---|" + "---|" * (len(links) + 1))
+    for k in kinds:
+        cells = [table.get((k, j), [0, 0]) for j in links]
+        if sum(a + b for a, b in cells) == 0:
+            continue
+        print(f"| {k} | " + " | ".join(f"{a}+{b}" for a, b in cells) + f" | {sum(a + b for a, b in cells)} |")
+    print("\n(wi: R^T w of the parent; w: w, its products and differences; wd, vd: accelerations;"
+          " Up, a: U_parent p + vd_parent; U: skew(wd) + skew(w)^2; F, N: the link's force and moment;"
+          " Rf: a child's force rotated; f, n: inward sums)\n")
+
+
 def numeric(n_states: int, repeat: int) -> None:
     robot = load("puma560")
     with warnings.catch_warnings():
@@ -211,6 +243,7 @@ def main() -> None:
     have_identification = importlib.util.find_spec("armdyn.identification") is not None
     generation_times(have_identification, args.repeat)  # first: SymPy's caches still cold
     op_count_table(have_identification)
+    breakdown()
     if not args.skip_numeric:
         numeric(args.states, args.numeric_repeat)
 
