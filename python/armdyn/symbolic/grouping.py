@@ -1,8 +1,10 @@
 """Grouped inertial parameters: what of each link's inertia can ride on its parent.
 
 Khalil's grouping rules (W. Khalil, E. Dombre, *Modeling, Identification and Control of
-Robots*, 2002, sec. 9.3.3 / 12.5, after Gautier and Khalil 1990), stated here as one
-rigid-body fact and applied in closed form, tip to base:
+Robots*, 2002, sec. 9.3, the base inertial parameters; M. Gautier, W. Khalil, "Direct
+calculation of minimum set of inertial parameters of serial robots", IEEE Trans. Robotics
+and Automation 6(3), 1990), stated here as one rigid-body fact and applied in closed form,
+tip to base:
 
 * **revolute joint j about z_j**: the part of link j's inertia that is unchanged by a
   rotation about z_j and has no inertia about z_j itself -- mass ``M_j``, first moment
