@@ -223,7 +223,28 @@ def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
             Y = sp.Matrix(reg.Y)
             programs[w] = from_expressions(list(Y), Y.shape, reserved=reserved)
             sources[w] = "armdyn.identification.regressor, CSE"
+    _add_joint_terms(robot, programs)
     return programs, sources, definitions
+
+
+def _add_joint_terms(robot: Robot, programs: dict) -> None:
+    """Joint friction, rotor inertia and torque offsets (DESIGN.md: ``tau = M qdd + C qd +
+    g + Ia qdd + Fv qd + Fc sign(qd) + offset``; :mod:`armdyn.symbolic.joint_terms`) added
+    to the rigid-body outputs: all of them to tau, ``Ia`` to M's diagonal, the offset to
+    g (``g = tau(qd = 0, qdd = 0)``); C has none."""
+    from ..symbolic import joint_terms
+
+    if not joint_terms.has_joint_terms(robot):
+        return
+    n = robot.dof
+    extra = {"tau": list(joint_terms.joint_torques(robot, robot.qd, robot.qdd)),
+             "g": list(joint_terms.offsets(robot))}
+    ia = joint_terms.armature(robot)
+    extra["M"] = [ia[k // n] if k // n == k % n else 0 for k in range(n * n)]
+    for w, terms in extra.items():
+        if w in programs:
+            prog = programs[w]
+            programs[w] = Program(list(prog.assignments), [o + t for o, t in zip(prog.outputs, terms)], prog.shape)
 
 
 def _base_programs(robot: Robot, what) -> tuple[dict, dict, list]:
