@@ -21,7 +21,8 @@ tau, g, M and C are evaluated at Khalil's grouped parameters
 (:mod:`armdyn.symbolic.grouping`: what of a link's inertia rides on its parent moved
 there, exactly), computed once per parameter set in the header; the zeros they leave
 (``M_j = MZ_j = YY_j = 0`` behind a revolute joint) propagate, so fewer operations run
-per state.
+per state. Joint friction, rotor inertia and torque offsets, where the model has them, are
+added as DESIGN.md writes them: all to tau, ``Ia`` to M's diagonal, the offset to g.
 
 ``base=True`` (needs :mod:`armdyn.identification`): the base parameters ``beta`` are the
 inputs. When each groups standard parameters onto one whose regressor column it keeps
