@@ -9,10 +9,11 @@
    armdyn's generated code vs armdyn.derive's expressions through ``sympy.cse`` (measured
    here, in this run) and the figures of OpenSYMORO and SymPyBotics quoted in issue 8
    (theirs, not measured here).
-2. Time to derive tau, M, C, g (+ the regressor and base parameters when
-   armdyn.identification is present) and generate C for the PUMA 560, in this process:
-   the first run (SymPy's caches cold) and the median of the next ones; and the time of
-   ``armdyn.derive(robot).tau`` (Craig's Newton-Euler) alone.
+2. Time to derive tau, M, C, g, the regressor and the base parameters (tau and the
+   regressor in them) and generate C for the PUMA 560, in this process, as one table
+   with issue 8's targets (<= 3 s; SymPyBotics quoted at 3.5-9.7 s for its set) and
+   ratios: the first run (SymPy's caches cold) and the median of the next ones; tau
+   alone by the customized Newton-Euler (target <= 0.1 s); ``armdyn.derive(robot).tau``.
 3. The generated C for the PUMA's tau, numeric parameters (Corke's puma560 values),
    compiled with ``cc -O2``, one thread over 1e5 states, vs armdyn's Rust
    ``rnea(..., threads=1)`` on the same batch, alternating, 15 runs each (median and best).
@@ -37,11 +38,13 @@ import armdyn.codegen as codegen
 # SymPyBotics: C. D. Sousa's package) -- their counts on the PUMA 560, not measured here
 THEIRS = {
     ("tau", "OpenSYMORO"): (345, 296),
+    ("tau, ungrouped", "OpenSYMORO"): (345, 296),
+    ("tau, ungrouped", "SymPyBotics"): (365, 300),
     ("tau (base parameters)", "OpenSYMORO"): (301, 240),
     ("M", "OpenSYMORO"): (302, 215),
     ("tau", "SymPyBotics"): (365, 300),
 }
-TARGETS = {"tau": 0.8 * (345 + 296), "tau (base parameters)": 433, "M": 0.8 * (302 + 215)}
+TARGETS = {"tau": 0.8 * (345 + 296), "tau, ungrouped": 0.8 * (345 + 296), "tau (base parameters)": 433, "M": 0.8 * (302 + 215)}
 
 
 def cse_counts(exprs) -> tuple[int, int]:
@@ -67,8 +70,12 @@ def op_count_table(have_identification: bool) -> None:
         eom = armdyn.derive(robot)
         what = ["tau", "M", "g", "C"]
         code = codegen.codegen(robot, what=what)
-        derived = {"tau": list(eom.tau), "M": [eom.M[i, j] for i in range(6) for j in range(i, 6)], "g": list(eom.g)}
+        derived = {"tau": list(eom.tau), "tau, ungrouped": list(eom.tau), "M": [eom.M[i, j] for i in range(6) for j in range(i, 6)], "g": list(eom.g)}
         rows = [(w, code.op_counts[w]) for w in what]
+        from armdyn.symbolic.customized_ne import customized_newton_euler
+
+        # before the grouping: the customized Newton-Euler in the 60 standard parameters
+        rows.insert(1, ("tau, ungrouped", customized_newton_euler(robot)[0].operation_counts()))
         if have_identification:
             base = codegen.codegen(robot, what="tau", base=True)
             rows.insert(1, ("tau (base parameters)", base.op_counts["tau"]))
@@ -89,36 +96,106 @@ def op_count_table(have_identification: bool) -> None:
     print("\n(C: the Christoffel C matrix of M; OpenSYMORO and SymPyBotics quote no count for it.)\n")
 
 
+SYMPYBOTICS_SECONDS = (3.5, 9.7)  # quoted from issue 8: its set of quantities for the PUMA 560, not run here
+
+
+def _timed(fn, repeat):
+    """(first run, median wall time, median CPU time of this process) of ``repeat`` runs
+    after the first, in seconds. On a shared machine the CPU time (time.process_time) is
+    the less noisy of the two: the wall time also counts the waits for a core."""
+    t0 = time.perf_counter()
+    fn()
+    first = time.perf_counter() - t0
+    wall, cpu = [], []
+    for _ in range(repeat):
+        t0, c0 = time.perf_counter(), time.process_time()
+        fn()
+        wall.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
+    return first, statistics.median(wall), statistics.median(cpu)
+
+
 def generation_times(have_identification: bool, repeat: int) -> None:
+    """One table: time to derive and print C, medians of ``repeat`` runs in this process
+    (the first run, SymPy's caches cold, apart), with the targets of issue 8 and ratios."""
+    from armdyn.symbolic.customized_ne import customized_newton_euler, standard_parameters
+    from armdyn.symbolic.grouping import grouped_parameters
+
     robot = load("puma560-craig")
     what = ["tau", "M", "C", "g"] + (["regressor"] if have_identification else [])
 
-    def everything():
-        t0 = time.perf_counter()
+    def standard():
         codegen.codegen(robot, what=what, lang="c")
+
+    def base():
+        codegen.codegen(robot, what=["tau", "regressor"], lang="c", base=True)
+
+    def everything():
+        standard()
         if have_identification:
-            codegen.codegen(robot, what=["tau", "regressor"], lang="c", base=True)
-        return time.perf_counter() - t0
+            base()
 
-    first = everything()
-    rest = [everything() for _ in range(repeat)]
-    print("## Time to derive and generate C, puma560-craig, all parameters symbolic\n")
-    print(f"{', '.join(what)}{' + base parameters' if have_identification else ''} -> C: "
-          f"first run {first:.2f} s, then median {statistics.median(rest):.2f} s (of {repeat})")
-    ne = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        armdyn.derive(robot, "newton-euler")
-        ne.append(time.perf_counter() - t0)
-    print(f"armdyn.derive(robot).tau (Craig's Newton-Euler): median {statistics.median(ne):.3f} s")
-    from armdyn.symbolic.customized_ne import customized_newton_euler
+    def tau_program():  # tau alone by the customized Newton-Euler, grouped parameters
+        params, definitions = standard_parameters(robot)
+        grouped, _ = grouped_parameters(robot, params, definitions)
+        customized_newton_euler(robot, parameters=grouped)
 
-    cne = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        customized_newton_euler(robot)
-        cne.append(time.perf_counter() - t0)
-    print(f"customized Newton-Euler program for tau alone: median {statistics.median(cne):.3f} s\n")
+    rows = [(f"{', '.join(what)}{' + base parameters (tau, regressor)' if have_identification else ''} -> C",
+             _timed(everything, repeat), 3.0, "SymPyBotics 3.5-9.7 s (its set)")]
+    rows.append(("  of which " + ", ".join(what) + " -> C", _timed(standard, repeat), None, "-"))
+    if have_identification:
+        rows.append(("  of which base parameters + tau, regressor in them -> C", _timed(base, repeat), None, "-"))
+    rows += [
+        ("tau alone: customized Newton-Euler program", _timed(tau_program, repeat), 0.1, "0.16-0.18 s (issue 8, before)"),
+        ("tau alone: armdyn.codegen(what='tau') -> C", _timed(lambda: codegen.codegen(robot, what="tau"), repeat),
+         None, "-"),
+        ("armdyn.derive(robot).tau (Craig's Newton-Euler, no CSE)",
+         _timed(lambda: armdyn.derive(robot, "newton-euler"), repeat), None, "-"),
+    ]
+    print(f"## Time to derive and generate C, puma560-craig, all parameters symbolic (median of {repeat}, "
+          "first run apart)\n")
+    print("| what | median (wall) | median (CPU) | first run | target | wall / target | CPU / target | reference "
+          "| wall / SymPyBotics best |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for k, (label, (first, median, cpu), target, ref) in enumerate(rows):
+        cold = f"{first:.3f} s" if k == 0 else "-"  # only the first row's first run has cold caches
+        tgt = f"<= {target:g} s" if target else "-"
+        ratio = f"{median / target:.2f} | {cpu / target:.2f}" if target else "- | -"
+        spb = f"{median / SYMPYBOTICS_SECONDS[0]:.2f}" if ref.startswith("SymPyBotics") else "-"
+        print(f"| {label} | {median:.3f} s | {cpu:.3f} s | {cold} | {tgt} | {ratio} | {ref} | {spb} |")
+    print()
+
+
+def breakdown() -> None:
+    """Where the operations of the PUMA's tau go: per quantity (the temporaries' name
+    prefixes: w, wd, vd, U, F, N forward; Rf, f, n inward) and per link, for the
+    standard-parameter (grouped) program."""
+    import re
+    from collections import defaultdict
+
+    from armdyn.codegen.program import Program
+
+    prog = codegen.codegen(load("puma560-craig"), what="tau").programs["tau"]
+    table = defaultdict(lambda: [0, 0])
+    for sym, expr in prog.assignments:
+        m = re.match(r"([A-Za-z_]+?)(\d)", sym.name)
+        key = (m.group(1), m.group(2)) if m else (sym.name, "-")
+        c = Program([], [expr], ()).operation_counts()
+        table[key][0] += c["mul"]
+        table[key][1] += c["add"]
+    kinds = sorted({k for k, _ in table})
+    links = sorted({j for _, j in table})
+    print("## Where the operations of tau go, puma560-craig, grouped parameters (mul+add per link)\n")
+    print("| quantity | " + " | ".join(f"link {j}" for j in links) + " | total |")
+    print("|---|" + "---|" * (len(links) + 1))
+    for k in kinds:
+        cells = [table.get((k, j), [0, 0]) for j in links]
+        if sum(a + b for a, b in cells) == 0:
+            continue
+        print(f"| {k} | " + " | ".join(f"{a}+{b}" for a, b in cells) + f" | {sum(a + b for a, b in cells)} |")
+    print("\n(wi: R^T w of the parent; w: w, its products and differences; wd, vd: accelerations;"
+          " Up, a: U_parent p + vd_parent; U: skew(wd) + skew(w)^2; F, N: the link's force and moment;"
+          " Rf: a child's force rotated; f, n: inward sums)\n")
 
 
 def numeric(n_states: int, repeat: int) -> None:
@@ -166,6 +243,7 @@ def main() -> None:
     have_identification = importlib.util.find_spec("armdyn.identification") is not None
     generation_times(have_identification, args.repeat)  # first: SymPy's caches still cold
     op_count_table(have_identification)
+    breakdown()
     if not args.skip_numeric:
         numeric(args.states, args.numeric_repeat)
 

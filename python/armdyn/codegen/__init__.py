@@ -17,6 +17,13 @@ of each link, DESIGN.md's order: mass, first moment m c, inertia about the link 
 * regressor: ``armdyn.identification.regressor(robot).Y`` (dof x P) through SymPy's
   common-subexpression elimination.
 
+tau, g, M and C are evaluated at Khalil's grouped parameters
+(:mod:`armdyn.symbolic.grouping`: what of a link's inertia rides on its parent moved
+there, exactly), computed once per parameter set in the header; the zeros they leave
+(``M_j = MZ_j = YY_j = 0`` behind a revolute joint) propagate, so fewer operations run
+per state. Joint friction, rotor inertia and torque offsets, where the model has them, are
+added as DESIGN.md writes them: all to tau, ``Ia`` to M's diagonal, the offset to g.
+
 ``base=True`` (needs :mod:`armdyn.identification`): the base parameters ``beta`` are the
 inputs. When each groups standard parameters onto one whose regressor column it keeps
 (Khalil's grouping), tau, g, M and C come from the same customized algorithms evaluated
@@ -179,8 +186,13 @@ def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
     from ..symbolic.composite_mass_matrix import composite_mass_matrix
     from ..symbolic.customized_ne import customized_newton_euler, standard_parameters
     from ..symbolic.coriolis_program import christoffel_program
+    from ..symbolic.grouping import grouped_parameters
 
     params, definitions = standard_parameters(robot)
+    # Khalil's grouping (exact): what of a link's inertia rides on its parent is moved
+    # there once per parameter set, and the zeros it leaves propagate per state
+    params, grouped = grouped_parameters(robot, params, definitions)
+    definitions = definitions + grouped
     reserved = robot.free_symbols() | {s for s, _ in definitions}
     programs, sources = {}, {}
     n = robot.dof
@@ -204,13 +216,36 @@ def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
             else:
                 programs[w] = christoffel_program(robot, M_prog, builder)
                 sources[w] = "Christoffel symbols of the composite-link M, differentiated line by line"
-        elif w == "regressor":
+        if w != "regressor":
+            sources[w] += ", grouped parameters"
+        if w == "regressor":
             ident = _identification("the regressor")
             reg = ident.regressor(robot)
             Y = sp.Matrix(reg.Y)
             programs[w] = from_expressions(list(Y), Y.shape, reserved=reserved)
             sources[w] = "armdyn.identification.regressor, CSE"
+    _add_joint_terms(robot, programs)
     return programs, sources, definitions
+
+
+def _add_joint_terms(robot: Robot, programs: dict) -> None:
+    """Joint friction, rotor inertia and torque offsets (DESIGN.md: ``tau = M qdd + C qd +
+    g + Ia qdd + Fv qd + Fc sign(qd) + offset``; :mod:`armdyn.symbolic.joint_terms`) added
+    to the rigid-body outputs: all of them to tau, ``Ia`` to M's diagonal, the offset to
+    g (``g = tau(qd = 0, qdd = 0)``); C has none."""
+    from ..symbolic import joint_terms
+
+    if not joint_terms.has_joint_terms(robot):
+        return
+    n = robot.dof
+    extra = {"tau": list(joint_terms.joint_torques(robot, robot.qd, robot.qdd)),
+             "g": list(joint_terms.offsets(robot))}
+    ia = joint_terms.armature(robot)
+    extra["M"] = [ia[k // n] if k // n == k % n else 0 for k in range(n * n)]
+    for w, terms in extra.items():
+        if w in programs:
+            prog = programs[w]
+            programs[w] = Program(list(prog.assignments), [o + t for o, t in zip(prog.outputs, terms)], prog.shape)
 
 
 def _base_programs(robot: Robot, what) -> tuple[dict, dict, list]:
@@ -224,14 +259,17 @@ def _base_programs(robot: Robot, what) -> tuple[dict, dict, list]:
     n = robot.dof
     reserved = robot.free_symbols() | set(beta)
     programs, sources = {}, {}
-    custom = _customized_base_programs(robot, ident, Yb, beta, definitions, [w for w in what if w != "regressor"])
+    custom = _customized_base_programs(robot, ident, Yb, beta, definitions, [w for w in what if w != "regressor"],
+                                       bp.regressor)
     if custom is not None:
         programs, sources, extra_defs = custom
         definitions = definitions + extra_defs
-    tau = Yb * sp.Matrix(beta)
+    tau = None
     for w in what:
         if w in programs:
             continue
+        if tau is None and w != "regressor":
+            tau = Yb * sp.Matrix(beta)  # only for what the customized algorithms did not give
         if w == "tau":
             expr, shape = list(tau), (n,)
         elif w == "g":
@@ -247,7 +285,7 @@ def _base_programs(robot: Robot, what) -> tuple[dict, dict, list]:
     return programs, sources, definitions
 
 
-def _customized_base_programs(robot, ident, Yb, beta, definitions, what):
+def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=None):
     """tau, g, M, C by the customized algorithms at the base-parameter point
     (:mod:`armdyn.codegen.base`), checked against ``Yb beta`` at random points; None if
     the base parameters are not a grouping onto standard columns."""
@@ -258,7 +296,7 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what):
 
     if not what:
         return None
-    reg = ident.regressor(robot)
+    reg = reg if reg is not None else ident.regressor(robot)  # base_parameters' own: not derived twice
     found = base_inertials(robot, sp.Matrix(reg.Y), list(sp.Matrix(reg.pi)), Yb, beta)
     if found is None:
         return None
@@ -274,12 +312,16 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what):
     # the check: tau of the program == Yb beta at random points (q, qd, qdd, parameters)
     rng = np.random.default_rng(11)
     free = sorted(dag.free_symbols(Yb) | set(beta) | set(robot.q) | set(states), key=str)
-    for _ in range(2):
-        env = {s: float(rng.uniform(-1.2, 1.2)) for s in free}
+    samples = 2
+    values = {s: rng.uniform(-1.2, 1.2, samples) for s in free}
+    Ybn = dag.evaluate(Yb, values)  # (dof, n_beta, samples), numerically (no xreplace of Yb)
+    for k in range(samples):
+        env = {s: float(v[k]) for s, v in values.items()}
         env.update({s: float(e.xreplace(env)) for s, e in d})
-        want = np.array((Yb * sp.Matrix(beta)).xreplace(env), dtype=float).ravel()
+        want = Ybn[:, :, k] @ np.array([env[b] for b in beta])
         got = np.array(tau_prog.evaluate(env))
-        if not np.allclose(got, want, rtol=1e-9, atol=1e-9 * max(1.0, np.abs(want).max())):
+        if not (np.all(np.isfinite(want)) and
+                np.allclose(got, want, rtol=1e-9, atol=1e-9 * max(1.0, np.abs(want).max()))):
             return None
     for w in what:
         if w == "tau":

@@ -49,11 +49,21 @@ def base_inertials(robot: Robot, Y: sp.Matrix, pi, Yb: sp.Matrix, beta_symbols, 
     if Y.shape[1] != len(pi) or Yb.shape[1] != len(beta_symbols):
         return None
     slots = _slots(robot)
+    # match by name first; expand only what no name matches (expanding every pair
+    # against every slot took seconds on a 6-dof arm)
+    by_name, by_value = {}, {}
+    for s in slots:
+        by_name.setdefault(str(s[3]), []).append(s)
     slot_of = {}
     for k, p in enumerate(pi):
         if not p.free_symbols:
             continue  # a number: no way to tell which parameter it is
-        hits = [s for s in slots if s[3] == p or str(s[3]) == str(p) or sp.expand(p - s[4]) == 0]
+        hits = by_name.get(str(p), [])
+        if not hits:
+            if not by_value:
+                for s in slots:
+                    by_value.setdefault(sp.expand(s[4]), []).append(s)
+            hits = by_value.get(sp.expand(p), [])
         if len(hits) == 1:
             slot_of[k] = hits[0]
     # the standard column equal to each base column, at random points

@@ -129,6 +129,16 @@ def _number(expr, env):
     return float(value)
 
 
+def _key(expr, negated: bool = False):
+    """A dictionary key for ``expr`` (or ``-expr``): a sum by its terms and their
+    coefficients, so that the key of ``-expr`` costs no new SymPy sum (negating a sum
+    rebuilds it: the most expensive step of building a program)."""
+    if expr.is_Add:
+        sign = -1 if negated else 1
+        return ("+", frozenset((t, sign * c) for t, c in expr.as_coefficients_dict().items()))
+    return -expr if negated else expr
+
+
 class Builder:
     """Collects assignments: :meth:`let` names a non-trivial expression as a temporary
     and returns the symbol; numbers, symbols and their negatives are returned as they
@@ -154,15 +164,16 @@ class Builder:
             return expr
         # the same expression computed twice is one temporary (e.g. a product of two
         # velocity components met in two cross products)
-        known = self._memo.get(expr)
+        key = _key(expr)
+        known = self._memo.get(key)
         if known is not None:
             return known
-        neg = self._memo.get(-expr)
+        neg = self._memo.get(_key(expr, negated=True))
         if neg is not None:
             return -neg
         s = self.name(hint)
         self.assignments.append((s, expr))
-        self._memo[expr] = s
+        self._memo[key] = s
         return s
 
     def vector(self, v, hint: str) -> sp.Matrix:

@@ -176,7 +176,31 @@ def _euler_moment(b: Builder, J, differences, w, wd, U, tag) -> sp.Matrix:
 
 
 def _matvec(b: Builder, A, v, hint) -> sp.Matrix:
-    return b.vector(A * v, hint)
+    return b.vector(_mv(A, v), hint)
+
+
+# 3-vector arithmetic on plain sequences: SymPy's Matrix products go through its
+# DomainMatrix machinery, about ten times slower for these 3x3 products (the same sums)
+def _mv(A, v) -> list:
+    """A v (3,)."""
+    return [sp.Add(*[A[i, k] * v[k] for k in range(3)]) for i in range(3)]
+
+
+def _mtv(A, v) -> list:
+    """A^T v (3,)."""
+    return [sp.Add(*[A[k, i] * v[k] for k in range(3)]) for i in range(3)]
+
+
+def _vcross(a, c) -> list:
+    return [a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2], a[0] * c[1] - a[1] * c[0]]
+
+
+def _vadd(*vs) -> list:
+    return [sp.Add(*[v[i] for v in vs]) for i in range(3)]
+
+
+def _vscale(x, a) -> list:
+    return [x * e for e in a]
 
 
 def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, parameters=None,
@@ -213,25 +237,25 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         tag = _safe(str(robot.link_index(name)))
         k = robot.coordinate_index(joint)
         R, p = frames[name]
-        Rt = R.T
         z = joint.axis
-        w_in = _matvec(b, Rt, w[parent], f"wi{tag}")
-        wd_j = Rt * wd[parent]
+        w_in = b.vector(_mtv(R, w[parent]), f"wi{tag}")
+        wd_j = _mtv(R, wd[parent])
         if joint.type == "revolute":
-            w_j = w_in + qd[k] * z
-            wd_j = wd_j + qdd[k] * z + w_in.cross(qd[k] * z)
+            w_j = _vadd(w_in, _vscale(qd[k], z))
+            wd_j = _vadd(wd_j, _vscale(qdd[k], z), _vcross(w_in, _vscale(qd[k], z)))
         else:
             w_j = w_in
         w_j, wd_j = b.vector(w_j, f"w{tag}"), b.vector(wd_j, f"wd{tag}")
         Up_p = _matvec(b, U[parent], p, f"Up{tag}")
-        vd_j = Rt * b.vector(Up_p + vd[parent], f"a{tag}")  # named: both rows of R^T use it
+        vd_j = _mtv(R, b.vector(_vadd(Up_p, vd[parent]), f"a{tag}"))  # named: both rows of R^T use it
         if joint.type == "prismatic":
-            vd_j = vd_j + 2 * w_j.cross(qd[k] * z) + qdd[k] * z
+            vd_j = _vadd(vd_j, _vscale(2, _vcross(w_j, _vscale(qd[k], z))), _vscale(qdd[k], z))
         vd_j = b.vector(vd_j, f"vd{tag}")
         U_j = _skew2(b, w_j, wd_j, tag)
         M, MS, J = parameters[name]
-        F[name] = b.vector(M * vd_j + U_j * MS, f"F{tag}")
-        N[name] = b.vector(_euler_moment(b, J, differences[name], w_j, wd_j, U_j, tag) + MS.cross(vd_j), f"N{tag}")
+        F[name] = b.vector(_vadd(_vscale(M, vd_j), _mv(U_j, MS)), f"F{tag}")
+        N[name] = b.vector(_vadd(_euler_moment(b, J, differences[name], w_j, wd_j, U_j, tag), _vcross(MS, vd_j)),
+                           f"N{tag}")
         w[name], wd[name], vd[name], U[name] = w_j, wd_j, vd_j, U_j
 
     f, nm = {}, {}
@@ -243,8 +267,8 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         for child in robot.children(name):
             Rc, pc = frames[child.child]
             f_c = _matvec(b, Rc, f[child.child], f"Rf{_safe(str(robot.link_index(child.child)))}")
-            f_j = f_j + f_c
-            n_j = n_j + Rc * nm[child.child] + pc.cross(f_c)
+            f_j = _vadd(f_j, f_c)
+            n_j = _vadd(n_j, _mv(Rc, nm[child.child]), _vcross(pc, f_c))
         f[name], nm[name] = b.vector(f_j, f"f{tag}"), b.vector(n_j, f"n{tag}")
         k = robot.coordinate_index(joint)
         if k is not None:

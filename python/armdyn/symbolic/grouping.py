@@ -1,0 +1,121 @@
+"""Grouped inertial parameters: what of each link's inertia can ride on its parent.
+
+Khalil's grouping rules (W. Khalil, E. Dombre, *Modeling, Identification and Control of
+Robots*, 2002, sec. 9.3, the base inertial parameters; M. Gautier, W. Khalil, "Direct
+calculation of minimum set of inertial parameters of serial robots", IEEE Trans. Robotics
+and Automation 6(3), 1990), stated here as one rigid-body fact and applied in closed form,
+tip to base:
+
+* **revolute joint j about z_j**: the part of link j's inertia that is unchanged by a
+  rotation about z_j and has no inertia about z_j itself -- mass ``M_j``, first moment
+  ``(0, 0, MZ_j)`` and inertia ``diag(YY_j, YY_j, 0)`` about the origin -- has a spatial
+  inertia ``I_s`` with ``I_s S_j = 0`` (S_j the joint's motion subspace) and
+  ``X(q)^* I_s X(q) = I_s``. Its kinetic and potential energies do not depend on q_j or
+  qd_j, so it moves as if fixed to the parent: it is taken off link j (``XX_j -= YY_j``,
+  ``YY_j = MZ_j = M_j = 0``) and added to the parent through the joint's fixed placement;
+* **prismatic joint j along z_j**: the rotational part alone (``m = 0``, ``MS = 0``,
+  ``J_j``) is unchanged by a translation, so all of ``J_j`` moves to the parent.
+
+Adding a body of mass ``m``, first moment ``h`` and inertia ``J`` (about its origin) to
+the parent through the placement ``(R, p)`` of the frame it is expressed in (parallel
+axis theorem with the first moment, the same expression as the composite links of
+:mod:`armdyn.symbolic.composite_mass_matrix`)::
+
+    M'  = M + m
+    MS' = MS + R h + m p
+    J'  = J + R J R^T + m (p.p 1 - p p^T) + 2 (p.R h) 1 - p (R h)^T - (R h) p^T
+
+What reaches the fixed base is dropped (it never moves). The equations of motion are
+unchanged (the Lagrangian is the same function of q, qd), so the customized algorithms
+evaluated at the grouped parameters give the same tau, g, M and C, with the zeros
+propagated: fewer operations per state. The grouped parameters are computed once per
+parameter set (``XX2R = XX2 - YY2 + ...`` in the generated header), like the barycentric
+ones. Joints whose axis is not the child frame's +-z are left ungrouped (still exact).
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ..model import Robot
+from .customized_ne import _safe
+
+
+def _transfer(m, h, J, R, p):
+    """(m, MS, J) of a body given in a frame placed at (R, p) in its parent, expressed
+    about the parent's origin in the parent's axes (entry by entry: SymPy's Matrix
+    products are slow for these small symbolic ones)."""
+    Rh = [sp.Add(*[R[i, k] * h[k] for k in range(3)]) for i in range(3)]
+    pRh = sp.Add(*[p[i] * Rh[i] for i in range(3)])
+    pp = sp.Add(*[p[i] * p[i] for i in range(3)])
+    RJ = [[sp.Add(*[R[i, k] * J[k, l] for k in range(3)]) for l in range(3)] for i in range(3)]
+    Jp = sp.zeros(3, 3)
+    for a, b in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):
+        e = sp.Add(*[RJ[a][l] * R[b, l] for l in range(3)]) - m * p[a] * p[b] - p[a] * Rh[b] - Rh[a] * p[b]
+        if a == b:
+            e += m * pp + 2 * pRh
+        Jp[a, b] = Jp[b, a] = e
+    return m, sp.Matrix([Rh[i] + m * p[i] for i in range(3)]), Jp
+
+
+def grouped_parameters(robot: Robot, parameters: dict, definitions: list):
+    """The grouped parameters ``{link: (M, MS (3x1), J (3x3))}`` and the definitions of
+    the new symbols ``[(Symbol, expression of the model's parameters)]``.
+
+    parameters, definitions: as returned by
+    :func:`armdyn.symbolic.customized_ne.standard_parameters` (barycentric, link frames).
+    A grouped entry that is a number or a symbol stays as it is; any other is named after
+    Khalil (``XX2R``, ``MX3R``, ...). Links are keyed and framed as ``robot.canonical()``.
+    """
+    robot = robot.canonical()
+    table = dict(definitions)
+    taken = {str(s) for s in robot.free_symbols()} | {str(s) for s in (*robot.q, *robot.qd, *robot.qdd)}
+    taken |= {str(s) for s, _ in definitions}
+    work = {link: [sp.sympify(M), sp.Matrix(MS), sp.Matrix(J)] for link, (M, MS, J) in parameters.items()}
+    z = sp.Matrix([0, 0, 1])
+    for joint in reversed(robot.joints):  # tip to base: a link has received its children's parts
+        link = joint.child
+        if joint.type not in ("revolute", "prismatic") or link not in work:
+            continue
+        if not (joint.axis == z or joint.axis == -z):
+            continue
+        M, MS, J = work[link]
+        if joint.type == "revolute":
+            moved = (M, sp.Matrix([0, 0, MS[2]]), sp.diag(J[1, 1], J[1, 1], 0))
+            work[link] = [sp.Integer(0), sp.Matrix([MS[0], MS[1], 0]), J - moved[2]]
+            R, p = joint.transform(0)
+        else:
+            moved = (sp.Integer(0), sp.zeros(3, 1), J)
+            work[link] = [M, MS, sp.zeros(3, 3)]
+            R, p = joint.rotation, joint.xyz  # J alone: where the frame sits does not matter
+        if joint.parent == robot.base or joint.parent not in work:
+            continue  # the fixed base never moves
+        m, h, Jp = _transfer(*moved, R, p)
+        parent = work[joint.parent]
+        parent[0], parent[1], parent[2] = parent[0] + m, parent[1] + h, parent[2] + Jp
+
+    new_definitions = []
+
+    def named(value, original, label):
+        value = sp.expand(value)
+        if value.is_Atom or value == original:
+            return value
+        name = label + "R"
+        while name in taken:
+            name += "_"
+        taken.add(name)
+        s = sp.Symbol(name)
+        new_definitions.append((s, sp.expand(value.xreplace(table))))
+        return s
+
+    out = {}
+    for link, (M, MS, J) in work.items():
+        i = _safe(str(robot.link_index(link)))
+        M0, MS0, J0 = parameters[link]
+        Mn = named(M, M0, f"M{i}")
+        MSn = sp.Matrix([named(MS[k], MS0[k], f"M{'XYZ'[k]}{i}") for k in range(3)])
+        Jn = sp.zeros(3, 3)
+        for a, b in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):
+            Jn[a, b] = Jn[b, a] = named(J[a, b], J0[a, b], f"{'XYZ'[a]}{'XYZ'[b]}{i}")
+        out[link] = (Mn, MSn, Jn)
+    return out, new_definitions
