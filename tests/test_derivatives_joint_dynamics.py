@@ -190,3 +190,22 @@ def test_batches_with_terms_equal_single_calls(arm):
         batch = num.minverse(robot, Q, threads=threads)
         for i in range(len(Q)):
             np.testing.assert_array_equal(batch[i], num.minverse(robot, Q[i]))
+
+
+def test_against_the_reference(arm):
+    """armdyn.reference: forward-mode differentiation of RBDA's tables, the terms added to
+    the RNEA's tau and the ABA's D and u (a different algorithm), to 1e-10."""
+    from armdyn import reference as ref
+
+    name, robot = arm
+    q, qd, qdd = _state(robot, 41)
+    qd[0] = 0.0  # Coulomb at rest: both give the derivative of either side
+    for mine, theirs, what in (
+        (num.rnea_derivatives(robot, q, qd, qdd), ref.rnea_derivatives(robot, q, qd, qdd), "rnea"),
+        (num.aba_derivatives(robot, q, qd, qdd), ref.aba_derivatives(robot, q, qd, qdd), "aba"),
+    ):
+        for a, b, k in zip(mine, theirs, range(3), strict=True):
+            assert_close(a, b, 1e-10, f"{name} {what} output {k}")
+    assert_close(num.minverse(robot, q), ref.minverse(robot, q), 1e-10, f"{name} minverse")
+    np.testing.assert_allclose(ref.rnea_ext(robot, q, qd, qdd, np.zeros((len(robot.links), 6))),
+                               num.rnea(robot, q, qd, qdd), rtol=0, atol=1e-10 * max(1, np.abs(qdd).max()))

@@ -330,6 +330,12 @@ def rnea_derivatives(robot, q, qd, qdd, *, f_ext=None, frame="local", threads=No
     moves with the link; Pinocchio's LOCAL ``fext``); ``"world"``: in base axes, moment
     about the base frame's origin (the wrench stays fixed in space). Then
     ``tau = M qdd + C qd + g - sum_L J_L^T w_L``.
+
+    Joint friction, rotor inertia and offset (as in :func:`rnea`) are included: ``M`` has
+    ``diag(Ia)``, ``dtau_dqd`` has ``diag(Fv)``. Coulomb friction ``Fc sign(qd)`` is
+    piecewise constant: it adds nothing, also at ``qd_k = 0`` where rnea's term jumps
+    (``sign(0) = 0``) and has no derivative; the value given there is that of either side.
+    Robots with mimic joints: ``G^T D_full G`` (chain rule, see armdyn.mimic); no f_ext.
     """
     model = _model(robot)
     if type(model) is not NumericModel:  # mimic joints: the chain rule, see armdyn.mimic
@@ -344,7 +350,8 @@ def aba_derivatives(robot, q, qd, tau, *, f_ext=None, frame="local", threads=Non
 
     q, qd, tau: (n,) or (N, n). Returns ``(dqdd_dq, dqdd_dqd, Minv)``, each (n, n) or
     (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
-    f_ext, frame: as in :func:`rnea_derivatives`.
+    f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
+    joints as there (``Minv`` is that of ``M + diag(Ia)``).
     """
     model = _model(robot)
     if type(model) is not NumericModel:  # mimic joints: the chain rule, see armdyn.mimic
@@ -356,7 +363,9 @@ def aba_derivatives(robot, q, qd, tau, *, f_ext=None, frame="local", threads=Non
 
 def minverse(robot, q, *, threads=None):
     """The inverse of the joint-space inertia matrix, by the articulated-body recursion
-    (without forming or factorising M). q: (n,) or (N, n). Returns (n, n) or (N, n, n)."""
+    (without forming or factorising M). q: (n,) or (N, n). Returns (n, n) or (N, n, n).
+    M includes the rotor inertias, ``diag(Ia)``, as :func:`crba`. Robots with mimic joints:
+    ``(G^T M_full G)^-1`` by Cholesky (ValueError when M is not positive definite)."""
     model = _model(robot)
     if type(model) is NumericModel:
         return _core.minverse(model, q, threads)
