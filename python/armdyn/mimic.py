@@ -136,8 +136,12 @@ class MimicModel:
 
     def _call(self, method: str, named: dict[str, np.ndarray], *args):
         """``self.full.<method>(*args)``; a refusal of NaN/inf is re-worded for ``named``."""
+        return self._guarded(lambda: getattr(self.full, method)(*args), method, named)
+
+    def _guarded(self, call, method: str, named: dict[str, np.ndarray]):
+        """``call()``; a refusal of NaN/inf is re-worded for ``named`` (see :meth:`_call`)."""
         try:
-            return getattr(self.full, method)(*args)
+            return call()
         except ValueError as err:
             self._finite(named)
             if "NaN or inf" not in str(err):
@@ -247,16 +251,7 @@ class MimicModel:
 
     def _call_core(self, function: str, named: dict[str, np.ndarray], *args):
         """``armdyn._core.<function>(self.full, *args)``; NaN/inf re-worded as in :meth:`_call`."""
-        try:
-            return getattr(_core, function)(self.full, *args)
-        except ValueError as err:
-            self._finite(named)
-            if "NaN or inf" not in str(err):
-                raise
-            raise ValueError(
-                f"{function}: a mimic joint's coordinate (multiplier * q + offset) or rate overflows to inf "
-                f"at this state of '{self.name}'"
-            ) from None
+        return self._guarded(lambda: getattr(_core, function)(self.full, *args), function, named)
 
     def _inverse_mass_matrix(self, M: np.ndarray, what: str) -> np.ndarray:
         """``M^-1`` of (..., dof, dof) symmetric positive definite matrices, by Cholesky
