@@ -19,6 +19,11 @@ UR5, Panda and iiwa14.
    ``1 / t_call`` for its Python call measured here (an upper bound on its C++ call time, so
    a lower bound on its rate), and ``2 / t_call`` ("both cores") — the issue's target is
    ``>= 4 x`` that rate of its C++ call.
+3. Pinocchio's C++ per-call times (benchmarks/pinocchio_cpp: bench.cpp compiled with
+   g++ -O3 -march=native when the pip ``pin`` package's headers and ``cmeel-eigen`` are
+   there; skipped with a note otherwise, or with ``--no-cpp``), on the models its URDF
+   parser builds from the same arms, and armdyn's batch rate on the most threads asked
+   for against ``2 / t_C++`` (both cores): the issue's target is ``>= 4``.
 
 Before timing, each arm is checked: armdyn == Pinocchio to 1e-10. Ratios are armdyn time /
 Pinocchio time: below 1 means armdyn is faster. Not a test: timings depend on the machine
@@ -44,6 +49,16 @@ import arms  # noqa: E402  (also puts tests/ on sys.path for the Pinocchio bridg
 from pinocchio_derivatives import PinocchioDerivatives  # noqa: E402
 
 from armdyn import numeric as num  # noqa: E402
+
+
+def _pinocchio_cpp():
+    """benchmarks/pinocchio_cpp/run.py as a module."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("pinocchio_cpp_run", os.path.join(HERE, "pinocchio_cpp", "run.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def per_call_run(f, args, number: int):
@@ -91,6 +106,7 @@ def main(argv=None) -> int:
     parser.add_argument("--batch", type=float, default=1e5)
     parser.add_argument("--batch-repeat", type=int, default=5)
     parser.add_argument("--threads", default="1,2")
+    parser.add_argument("--no-cpp", action="store_true", help="leave out Pinocchio's C++ timing")
     args = parser.parse_args(argv)
     if args.quick:
         args.number, args.repeat, args.batch, args.batch_repeat = 2000, 5, 2e4, 3
@@ -139,6 +155,21 @@ def main(argv=None) -> int:
         rate = N / tb / 1e6
         r1 = 1 / t_pin / 1e6
         print(f"{name:7} {fn:17} {t:3d} {tb * 1e3:7.1f}ms {rate:6.2f} {r1:10.2f} {2 * r1:11.2f} {rate / (2 * r1):11.2f}")
+    if not args.no_cpp:
+        cpp = _pinocchio_cpp().run(number=args.number, repeat=args.repeat)
+        if cpp is not None:
+            t = max(threads)
+            print(f"\nPinocchio C++ per call (g++ -O3 -march=native, median of {args.repeat} x {args.number}) vs armdyn's "
+                  f"batch of N = {N} on {t} threads; target: armdyn rate >= 4 x 2 / t_C++ (both cores)")
+            print(f"{'arm':7} {'function':17} {'C++ us':>7} {'C++ 2 cores M/s':>15} {'armdyn M/s':>10} {'x':>6}")
+            for name, fn, tt, tb, _ in batch_rows:
+                if tt != t or name not in cpp:
+                    continue
+                t_cpp = cpp[name][fn]
+                rate_cpp = 2 / t_cpp / 1e6
+                print(f"{name:7} {fn:17} {t_cpp * 1e6:7.3f} {rate_cpp:15.2f} {N / tb / 1e6:10.2f} {N / tb / 1e6 / rate_cpp:6.2f}")
+            for name, r in cpp.items():
+                print(f"{name:7} {'rnea':17} {r['rnea'] * 1e6:7.3f} (for scale)")
     print(f"\nload average at the end: {os.getloadavg()[0]:.2f}")
     return 0
 

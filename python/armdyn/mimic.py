@@ -136,8 +136,12 @@ class MimicModel:
 
     def _call(self, method: str, named: dict[str, np.ndarray], *args):
         """``self.full.<method>(*args)``; a refusal of NaN/inf is re-worded for ``named``."""
+        return self._guarded(lambda: getattr(self.full, method)(*args), method, named)
+
+    def _guarded(self, call, method: str, named: dict[str, np.ndarray]):
+        """``call()``; a refusal of NaN/inf is re-worded for ``named`` (see :meth:`_call`)."""
         try:
-            return getattr(self.full, method)(*args)
+            return call()
         except ValueError as err:
             self._finite(named)
             if "NaN or inf" not in str(err):
@@ -234,3 +238,64 @@ class MimicModel:
     def jacobian(self, q, link, threads=None):
         (q,) = self._states(("q", q))
         return self._reduce(self._call("jacobian", {"q": q}, self._position(q), link, threads))
+
+    # ---------------------------------------------------------------- derivatives
+    # With q_full = G q + o (G constant), tau(q, qd, qdd) = G^T tau_full(G q + o, G qd, G qdd),
+    # so by the chain rule every derivative is the full tree's, reduced on both sides:
+    #     dtau/dx = G^T (dtau_full/dx_full) G     (x = q, qd, qdd; the last is M)
+    # and forward dynamics follows from ID(q, qd, FD(q, qd, tau)) = tau (Carpentier & Mansard,
+    # RSS 2018, IV.C): dqdd/dx = -M^-1 dID/dx at qdd = FD(q, qd, tau), dqdd/dtau = M^-1, with
+    # M = G^T M_full G inverted by Cholesky (the full tree's ABA-based M^-1 is not the
+    # constrained one). Joint friction and rotor inertia sit on the independent coordinates
+    # only (a mimic joint's own are zero in `full`), so G^T diag(Fv_full) G = diag(Fv).
+
+    def _call_core(self, function: str, named: dict[str, np.ndarray], *args):
+        """``armdyn._core.<function>(self.full, *args)``; NaN/inf re-worded as in :meth:`_call`."""
+        return self._guarded(lambda: getattr(_core, function)(self.full, *args), function, named)
+
+    def _inverse_mass_matrix(self, M: np.ndarray, what: str) -> np.ndarray:
+        """``M^-1`` of (..., dof, dof) symmetric positive definite matrices, by Cholesky
+        (``M = L L^T``, ``M^-1 = L^-T L^-1``); ValueError when M is not positive definite."""
+        try:
+            L = np.linalg.cholesky(M)
+        except np.linalg.LinAlgError:
+            raise ValueError(
+                f"{what}: the mass matrix of '{self.name}' is not positive definite at this state "
+                "(a coordinate that moves no mass or inertia?)"
+            ) from None
+        Linv = np.linalg.solve(L, np.broadcast_to(np.eye(self.dof), M.shape))
+        return np.swapaxes(Linv, -1, -2) @ Linv
+
+    def rnea_derivatives(self, q, qd, qdd, threads=None):
+        """``(dtau_dq, dtau_dqd, M)``, each (dof, dof) or (N, dof, dof): the full tree's
+        analytical derivatives reduced, ``G^T D_full G``."""
+        q, qd, qdd = self._states(("q", q), ("qd", qd), ("qdd", qdd))
+        named = {"q": q, "qd": qd, "qdd": qdd}
+        full = self._call_core("rnea_derivatives", named, self._position(q), self._rate(qd), self._rate(qdd),
+                               None, "local", threads)
+        return tuple(self._reduce_matrix(D) for D in full)
+
+    def aba_derivatives(self, q, qd, tau, threads=None):
+        """``(dqdd_dq, dqdd_dqd, Minv)``, each (dof, dof) or (N, dof, dof), at
+        ``qdd = aba(q, qd, tau)``: ``-M^-1 dID/dq``, ``-M^-1 dID/dqd``, ``M^-1``."""
+        q, qd, tau = self._states(("q", q), ("qd", qd), ("tau", tau))
+        qdd = self.aba(q, qd, tau, threads)
+        dq, dqd, M = self.rnea_derivatives(q, qd, qdd, threads)
+        Minv = self._inverse_mass_matrix(M, "aba_derivatives")
+        return -(Minv @ dq), -(Minv @ dqd), Minv
+
+    def minverse(self, q, threads=None):
+        """``(G^T M_full G)^-1``, (dof, dof) or (N, dof, dof), by Cholesky."""
+        return self._inverse_mass_matrix(self.crba(q, threads), "minverse")
+
+    def gravity_derivatives(self, q, threads=None):
+        """``dg/dq = G^T (dg_full/dq_full) G``, (dof, dof) or (N, dof, dof)."""
+        (q,) = self._states(("q", q))
+        return self._reduce_matrix(self._call_core("gravity_derivatives", {"q": q}, self._position(q), threads))
+
+    def jacobian_dot(self, q, qd, link, threads=None):
+        """``dJ/dt = Jdot_full(q_full, G qd) G`` (J = J_full G with G constant), (6, dof)
+        or (N, 6, dof), rows as :meth:`jacobian`."""
+        q, qd = self._states(("q", q), ("qd", qd))
+        Jd = self._call_core("jacobian_dot", {"q": q, "qd": qd}, self._position(q), self._rate(qd), link, threads)
+        return self._reduce(Jd)

@@ -302,6 +302,20 @@ def jacobian(robot, q, link, *, threads=None):
 # --------------------------------------------------------------------------- derivatives
 
 
+def _mimic(robot, what: str, f_ext=None, frame: str = "local") -> MimicModel | None:
+    """The compiled model if ``robot`` has mimic joints (its derivatives are the full
+    tree's reduced by the chain rule, see armdyn.mimic), else None. External wrenches are
+    not available for those robots (as for rnea/aba)."""
+    model = _model(robot)
+    if not isinstance(model, MimicModel):
+        return None
+    if f_ext is not None:
+        raise ValueError(f"{what} with f_ext is not available yet for robots with mimic joints")
+    if frame not in ("local", "world"):
+        raise ValueError(f"frame: expected 'local' or 'world', got '{frame}'")
+    return model
+
+
 def rnea_derivatives(robot, q, qd, qdd, *, f_ext=None, frame="local", threads=None):
     """Partial derivatives of inverse dynamics, analytically (Carpentier & Mansard, RSS 2018).
 
@@ -316,9 +330,19 @@ def rnea_derivatives(robot, q, qd, qdd, *, f_ext=None, frame="local", threads=No
     moves with the link; Pinocchio's LOCAL ``fext``); ``"world"``: in base axes, moment
     about the base frame's origin (the wrench stays fixed in space). Then
     ``tau = M qdd + C qd + g - sum_L J_L^T w_L``.
+
+    Joint friction, rotor inertia and offset (as in :func:`rnea`) are included: ``M`` has
+    ``diag(Ia)``, ``dtau_dqd`` has ``diag(Fv)``. Coulomb friction ``Fc sign(qd)`` is
+    piecewise constant: it adds nothing, also at ``qd_k = 0`` where rnea's term jumps
+    (``sign(0) = 0``) and has no derivative; the value given there is that of either side.
+    Robots with mimic joints: ``G^T D_full G`` (chain rule, see armdyn.mimic); no f_ext.
     """
-    model = _core_model(robot, "rnea_derivatives")
-    return _core.rnea_derivatives(model, q, qd, qdd, _canonical_wrenches(robot, f_ext, frame), frame, threads)
+    model = _model(robot)
+    if type(model) is not NumericModel:  # mimic joints: the chain rule, see armdyn.mimic
+        return _mimic(robot, "rnea_derivatives", f_ext, frame).rnea_derivatives(q, qd, qdd, threads)
+    if f_ext is not None:  # (the common call goes straight to the core: per-call time matters)
+        f_ext = _canonical_wrenches(robot, f_ext, frame)
+    return _core.rnea_derivatives(model, q, qd, qdd, f_ext, frame, threads)
 
 
 def aba_derivatives(robot, q, qd, tau, *, f_ext=None, frame="local", threads=None):
@@ -326,20 +350,34 @@ def aba_derivatives(robot, q, qd, tau, *, f_ext=None, frame="local", threads=Non
 
     q, qd, tau: (n,) or (N, n). Returns ``(dqdd_dq, dqdd_dqd, Minv)``, each (n, n) or
     (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
-    f_ext, frame: as in :func:`rnea_derivatives`.
+    f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
+    joints as there (``Minv`` is that of ``M + diag(Ia)``).
     """
-    model = _core_model(robot, "aba_derivatives")
-    return _core.aba_derivatives(model, q, qd, tau, _canonical_wrenches(robot, f_ext, frame), frame, threads)
+    model = _model(robot)
+    if type(model) is not NumericModel:  # mimic joints: the chain rule, see armdyn.mimic
+        return _mimic(robot, "aba_derivatives", f_ext, frame).aba_derivatives(q, qd, tau, threads)
+    if f_ext is not None:
+        f_ext = _canonical_wrenches(robot, f_ext, frame)
+    return _core.aba_derivatives(model, q, qd, tau, f_ext, frame, threads)
 
 
 def minverse(robot, q, *, threads=None):
     """The inverse of the joint-space inertia matrix, by the articulated-body recursion
-    (without forming or factorising M). q: (n,) or (N, n). Returns (n, n) or (N, n, n)."""
-    return _core.minverse(_core_model(robot, "minverse"), q, threads)
+    (without forming or factorising M). q: (n,) or (N, n). Returns (n, n) or (N, n, n).
+    M includes the rotor inertias, ``diag(Ia)``, as :func:`crba`. Robots with mimic joints:
+    ``(G^T M_full G)^-1`` by Cholesky (ValueError when M is not positive definite)."""
+    model = _model(robot)
+    if type(model) is NumericModel:
+        return _core.minverse(model, q, threads)
+    # mimic joints: (G^T M_full G)^-1 by Cholesky (the constraint couples branches)
+    return _mimic(robot, "minverse").minverse(q, threads)
 
 
 def gravity_derivatives(robot, q, *, threads=None):
     """``dg/dq`` of the gravity torques: (n, n) or (N, n, n), ``[i, j] = d g_i / d q_j``."""
+    mimic = _mimic(robot, "gravity_derivatives")
+    if mimic is not None:
+        return mimic.gravity_derivatives(q, threads)
     return _core.gravity_derivatives(_core_model(robot, "gravity_derivatives"), q, threads)
 
 
@@ -350,7 +388,11 @@ def jacobian_dot(robot, q, qd, link, *, threads=None):
     link: a link name, index in ``list(robot.links)``, or Link."""
     if isinstance(link, Link):
         link = link.name
-    Jd = _core.jacobian_dot(_core_model(robot, "jacobian_dot"), q, qd, link, threads)
+    mimic = _mimic(robot, "jacobian_dot")
+    if mimic is not None:
+        Jd = mimic.jacobian_dot(q, qd, link, threads)
+    else:
+        Jd = _core.jacobian_dot(_core_model(robot, "jacobian_dot"), q, qd, link, threads)
     offsets = _frame_offsets(robot)
     if offsets is None:
         return Jd

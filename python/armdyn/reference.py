@@ -565,6 +565,10 @@ def _rnea_tangent(t: _Tree, q, qd, qdd, dq, dqd, dqdd, f_ext=None, frame="local"
         if lam >= 0:
             f[lam] = f[lam] + Xup[i].T @ f[i]
             df[lam] = df[lam] + dXup[i].T @ f[i] + Xup[i].T @ df[i]
+    # joint friction, rotor inertia and offset (DESIGN.md) with their tangent (Coulomb's is 0:
+    # sign(qd) is piecewise constant)
+    tau = tau + t.armature * qdd + t.viscous * qd + t.coulomb * np.sign(qd) + t.offset
+    dtau = dtau + t.armature * dqdd + t.viscous * dqd
     return tau, dtau
 
 
@@ -591,10 +595,12 @@ def _aba_tangent(t: _Tree, q, qd, tau, dq, dqd, dtau, f_ext=None, frame="local")
     for i in reversed(range(nb)):
         S, lam = t.S[i], t.parent[i]
         U[i], dU[i] = IA[i] @ S, dIA[i] @ S
-        Dinv[i] = np.linalg.inv(S.T @ U[i])
+        # joint terms: D = S^T I^A S + Ia; friction and offset are torques not delivered
+        k = t.dofs[i]
+        Dinv[i] = np.linalg.inv(S.T @ U[i] + np.diag(t.armature[k]))
         dDinv[i] = -Dinv[i] @ (S.T @ dU[i]) @ Dinv[i]
-        u[i] = tau[t.dofs[i]] - S.T @ pA[i]
-        du[i] = dtau[t.dofs[i]] - S.T @ dpA[i]
+        u[i] = tau[k] - S.T @ pA[i] - (t.viscous[k] * qd[k] + t.coulomb[k] * np.sign(qd[k]) + t.offset[k])
+        du[i] = dtau[k] - S.T @ dpA[i] - t.viscous[k] * dqd[k]
         if lam >= 0:
             Ia = IA[i] - U[i] @ Dinv[i] @ U[i].T
             dIa = dIA[i] - dU[i] @ Dinv[i] @ U[i].T - U[i] @ dDinv[i] @ U[i].T - U[i] @ Dinv[i] @ dU[i].T

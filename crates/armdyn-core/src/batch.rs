@@ -89,7 +89,7 @@ pub fn set_kernels(cap: Option<Kernels>) {
 }
 
 /// Rows below which a batch runs on the calling thread (spawning costs more).
-const MIN_PARALLEL_ROWS: usize = 128;
+const MIN_PARALLEL_ROWS: usize = 64;
 
 /// The largest thread count a batch accepts: `threads = Some(n)` runs on
 /// `min(n, MAX_THREADS)` threads (the Python bindings refuse larger counts).
@@ -129,48 +129,66 @@ pub fn thread_count(threads: Option<usize>) -> usize {
     threads.unwrap_or_else(rayon::current_num_threads).clamp(1, MAX_THREADS)
 }
 
-/// Run `body(workspace, first_row, out_chunk)` over chunks of `rows` rows whose outputs
-/// (`out_per_row` values each) tile `out`. Chunks start at multiples of 4 rows.
+/// Run `body(workspace, first_row, out_chunks)` over chunks of `rows` rows. Output `k`
+/// has `per_row[k]` values per row (0 for an unused slot); each chunk gets the same rows
+/// of every output. Chunks start at multiples of 8 rows (whole SIMD groups of 4 or 8),
+/// one workspace per task, never per state. The one driver of every batch here and in
+/// `batch_derivatives.rs`, whatever the number of outputs `R`.
 ///
-/// `threads = Some(n)`: the chunks are dealt round-robin to `n` tasks, each running
-/// its chunks in turn, so at most `n` threads work whatever pool runs them (the
-/// global pool when it is big enough, else [`pool_of_at_least`]).
-fn par_rows<W, M, B>(rows: usize, out: &mut [f64], out_per_row: usize, threads: Option<usize>, make: M, body: B)
-where
+/// `threads = None`: the chunks go to rayon's global pool (work stealing). `Some(n)`:
+/// the chunks are dealt round-robin to `n` tasks, each running its chunks in turn, so at
+/// most `n` threads work whatever pool runs them (the global pool when it is big enough,
+/// else [`pool_of_at_least`]).
+pub(crate) fn par_rows<const R: usize, W, M, B>(
+    rows: usize,
+    outs: [&mut [f64]; R],
+    per_row: [usize; R],
+    threads: Option<usize>,
+    make: M,
+    body: B,
+) where
     M: Fn() -> W + Sync + Send,
-    B: Fn(&mut W, usize, &mut [f64]) + Sync + Send,
+    B: Fn(&mut W, usize, [&mut [f64]; R]) + Sync + Send,
 {
-    assert_eq!(out.len(), rows * out_per_row, "output size");
+    for k in 0..R {
+        assert_eq!(outs[k].len(), rows * per_row[k], "output size");
+    }
     let nthreads = thread_count(threads);
-    if nthreads == 1 || rows < MIN_PARALLEL_ROWS || out_per_row == 0 {
-        body(&mut make(), 0, out);
+    if nthreads == 1 || rows < MIN_PARALLEL_ROWS || per_row.iter().all(|&p| p == 0) {
+        body(&mut make(), 0, outs);
         return;
     }
     // ~8 chunks per thread balance the load when cores are shared.
-    let chunk_rows = rows.div_ceil(8 * nthreads).max(32).next_multiple_of(4);
+    let chunk_rows = rows.div_ceil(8 * nthreads).max(32).next_multiple_of(8);
+    let mut rest = outs;
+    let mut pieces = Vec::with_capacity(rows.div_ceil(chunk_rows));
+    let mut first = 0;
+    while first < rows {
+        let take = chunk_rows.min(rows - first);
+        let heads: [&mut [f64]; R] = std::array::from_fn(|k| {
+            let (h, t) = std::mem::take(&mut rest[k]).split_at_mut(take * per_row[k]);
+            rest[k] = t;
+            h
+        });
+        pieces.push((first, heads));
+        first += take;
+    }
     if threads.is_none() {
-        out.par_chunks_mut(chunk_rows * out_per_row)
-            .enumerate()
-            .for_each_init(&make, |w, (k, chunk)| body(w, k * chunk_rows, chunk));
+        pieces.into_par_iter().for_each_init(&make, |w, (first, o)| body(w, first, o));
         return;
     }
-    let mut tasks: Vec<Vec<(usize, &mut [f64])>> = (0..nthreads).map(|_| Vec::new()).collect();
-    for (k, chunk) in out.chunks_mut(chunk_rows * out_per_row).enumerate() {
-        tasks[k % nthreads].push((k * chunk_rows, chunk));
+    let mut tasks: Vec<Vec<_>> = (0..nthreads).map(|_| Vec::new()).collect();
+    for (k, piece) in pieces.into_iter().enumerate() {
+        tasks[k % nthreads].push(piece);
     }
-    let run = || {
+    install(nthreads, || {
         tasks.into_par_iter().for_each(|task| {
             let mut w = make();
-            for (first, chunk) in task {
-                body(&mut w, first, chunk);
+            for (first, o) in task {
+                body(&mut w, first, o);
             }
         })
-    };
-    let pool = if nthreads <= rayon::current_num_threads() { None } else { pool_of_at_least(nthreads) };
-    match pool {
-        Some(pool) => pool.install(run),
-        None => run(), // the global pool: big enough, or the fallback if no pool can be built
-    }
+    });
 }
 
 /// Workspace of a chunk: a scalar one for the leftover rows, an `L`-lane one, and the
@@ -261,16 +279,16 @@ macro_rules! lanes_kernel {
             all[..$nargs].copy_from_slice(&args);
             match kernels() {
                 #[cfg(target_arch = "x86_64")]
-                Kernels::Avx512 => par_rows(nrows, out, per_row, threads, || Work::new(model), |w, first, chunk| {
+                Kernels::Avx512 => par_rows(nrows, [out], [per_row], threads, || Work::new(model), |w, first, [chunk]| {
                     // SAFETY: the CPU supports AVX-512F (checked by `kernels`).
                     unsafe { rows_avx512(model, w, all, first, chunk) }
                 }),
                 #[cfg(target_arch = "x86_64")]
-                Kernels::Avx2 => par_rows(nrows, out, per_row, threads, || Work::new(model), |w, first, chunk| {
+                Kernels::Avx2 => par_rows(nrows, [out], [per_row], threads, || Work::new(model), |w, first, [chunk]| {
                     // SAFETY: the CPU supports AVX2 (checked by `kernels`).
                     unsafe { rows_avx2(model, w, all, first, chunk) }
                 }),
-                _ => par_rows(nrows, out, per_row, threads, || Work::<F64x4>::new(model), |w, first, chunk| {
+                _ => par_rows(nrows, [out], [per_row], threads, || Work::<F64x4>::new(model), |w, first, [chunk]| {
                     rows(model, w, all, first, chunk)
                 }),
             }
@@ -320,7 +338,7 @@ fn row(a: &[f64], n: usize, r: usize) -> &[f64] {
 pub fn coriolis_matrix(model: &Model, q: &[f64], qd: &[f64], out: &mut [f64], threads: Option<usize>) {
     let n = model.nv;
     let make = || (Data::new(model), CoriolisWork::new(model));
-    par_rows(q.len() / n.max(1), out, n * n, threads, make, |(d, cw), first, chunk| {
+    par_rows(q.len() / n.max(1), [out], [n * n], threads, make, |(d, cw), first, [chunk]| {
         for (k, o) in chunk.chunks_exact_mut(n * n).enumerate() {
             let r = first + k;
             algo::coriolis_matrix(model, d, cw, row(q, n, r), row(qd, n, r), o);
@@ -332,7 +350,7 @@ pub fn coriolis_matrix(model: &Model, q: &[f64], qd: &[f64], out: &mut [f64], th
 pub fn kinetic_energy(model: &Model, q: &[f64], qd: &[f64], out: &mut [f64], threads: Option<usize>) {
     let n = model.nv;
     assert!(q.len() == out.len() * n && qd.len() == q.len(), "argument size");
-    par_rows(out.len(), out, 1, threads, || Data::new(model), |d, first, chunk| {
+    par_rows(out.len(), [out], [1], threads, || Data::new(model), |d, first, [chunk]| {
         for (k, o) in chunk.iter_mut().enumerate() {
             *o = algo::kinetic_energy(model, d, row(q, n, first + k), row(qd, n, first + k));
         }
@@ -343,7 +361,7 @@ pub fn kinetic_energy(model: &Model, q: &[f64], qd: &[f64], out: &mut [f64], thr
 pub fn potential_energy(model: &Model, q: &[f64], out: &mut [f64], threads: Option<usize>) {
     let n = model.nv;
     assert!(q.len() == out.len() * n, "argument size");
-    par_rows(out.len(), out, 1, threads, || Data::new(model), |d, first, chunk| {
+    par_rows(out.len(), [out], [1], threads, || Data::new(model), |d, first, [chunk]| {
         for (k, o) in chunk.iter_mut().enumerate() {
             *o = algo::potential_energy(model, d, row(q, n, first + k));
         }
@@ -354,7 +372,7 @@ pub fn potential_energy(model: &Model, q: &[f64], out: &mut [f64], threads: Opti
 pub fn forward_kinematics(model: &Model, q: &[f64], out: &mut [f64], threads: Option<usize>) {
     let (n, per) = (model.nv, model.nlinks() * 16);
     assert!(q.len() * per == out.len() * n || n == 0, "argument size");
-    par_rows(out.len() / per, out, per, threads, || Data::new(model), |d, first, chunk| {
+    par_rows(out.len() / per, [out], [per], threads, || Data::new(model), |d, first, [chunk]| {
         for (k, o) in chunk.chunks_exact_mut(per).enumerate() {
             algo::forward_kinematics(model, d, row(q, n, first + k), o);
         }
@@ -365,7 +383,7 @@ pub fn forward_kinematics(model: &Model, q: &[f64], out: &mut [f64], threads: Op
 pub fn jacobian(model: &Model, q: &[f64], link: usize, out: &mut [f64], threads: Option<usize>) {
     let n = model.nv;
     let per = 6 * n;
-    par_rows(q.len() / n.max(1), out, per, threads, || Data::new(model), |d, first, chunk| {
+    par_rows(q.len() / n.max(1), [out], [per], threads, || Data::new(model), |d, first, [chunk]| {
         for (k, o) in chunk.chunks_exact_mut(per).enumerate() {
             algo::jacobian(model, d, row(q, n, first + k), link, o);
         }

@@ -10,57 +10,11 @@
 
 use crate::algo;
 use crate::algo::{ExternalForces, ForceFrame};
-use crate::batch::{install, kernels, thread_count, Kernels};
+use crate::batch::{kernels, par_rows, Kernels};
 use crate::data::Data;
 use crate::deriv_data::DerivData;
 use crate::model::Model;
 use crate::real::{F64x4, F64x8, Real};
-use rayon::prelude::*;
-
-/// Rows below which a batch runs on the calling thread.
-const MIN_PARALLEL_ROWS: usize = 64;
-
-/// Run `body(workspace, first_row, outputs)` over chunks of `rows` rows; output `k` has
-/// `per_row[k]` values per row.
-fn par_rows<const R: usize, W, M, B>(
-    rows: usize,
-    outs: [&mut [f64]; R],
-    per_row: [usize; R],
-    threads: Option<usize>,
-    make: M,
-    body: B,
-) where
-    M: Fn() -> W + Sync + Send,
-    B: Fn(&mut W, usize, [&mut [f64]; R]) + Sync + Send,
-{
-    for k in 0..R {
-        assert_eq!(outs[k].len(), rows * per_row[k], "output size");
-    }
-    let nthreads = thread_count(threads);
-    if nthreads == 1 || rows < MIN_PARALLEL_ROWS {
-        body(&mut make(), 0, outs);
-        return;
-    }
-    let chunk_rows = rows.div_ceil(8 * nthreads).max(16).next_multiple_of(8);
-    let mut rest = outs;
-    let mut pieces = Vec::with_capacity(rows.div_ceil(chunk_rows));
-    let mut first = 0;
-    while first < rows {
-        let take = chunk_rows.min(rows - first);
-        let heads: [&mut [f64]; R] = std::array::from_fn(|k| {
-            let (h, t) = std::mem::take(&mut rest[k]).split_at_mut(take * per_row[k]);
-            rest[k] = t;
-            h
-        });
-        pieces.push((first, heads));
-        first += take;
-    }
-    let run = move || pieces.into_par_iter().for_each_init(&make, |w, (first, o)| body(w, first, o));
-    match threads {
-        None => run(),
-        Some(n) => install(n, run),
-    }
-}
 
 /// One algorithm as a batch kernel, generic over the lane type.
 trait Kernel: Sync {
@@ -231,89 +185,52 @@ fn drive<K: Kernel>(
     }
 }
 
-struct RneaDerivatives;
-impl Kernel for RneaDerivatives {
-    const NARGS: usize = 3;
-    const NOUT: usize = 3;
-    fn out_len(m: &Model) -> usize {
-        m.nv * m.nv
-    }
-    #[inline(always)]
-    fn run<T: Real>(&self, m: &Model, d: &mut Data<T>, dd: &mut DerivData<T>, a: [&[T]; 3], e: Option<&ExternalForces<T>>, o: [&mut [T]; 3]) {
-        let [o0, o1, o2] = o;
-        algo::rnea_derivatives(m, d, dd, a[0], a[1], a[2], e, o0, o1, o2)
-    }
+/// Defines a [`Kernel`] `$name` with `$nargs` (N, nv) arguments and `$nout` outputs of
+/// `$out_len` values per state, running `$call` (generic over the lane type `T`).
+macro_rules! kernel {
+    ($name:ident, nargs = $nargs:literal, nout = $nout:literal, out_len = |$m:ident| $out_len:expr,
+     |$model:ident, $d:ident, $dd:ident, $a:ident, $e:pat_param, $o:pat_param| $call:expr) => {
+        struct $name;
+        impl Kernel for $name {
+            const NARGS: usize = $nargs;
+            const NOUT: usize = $nout;
+            fn out_len($m: &Model) -> usize {
+                $out_len
+            }
+            #[inline(always)]
+            fn run<T: Real>(
+                &self,
+                $model: &Model,
+                $d: &mut Data<T>,
+                $dd: &mut DerivData<T>,
+                $a: [&[T]; 3],
+                $e: Option<&ExternalForces<T>>,
+                $o: [&mut [T]; 3],
+            ) {
+                $call
+            }
+        }
+    };
 }
 
-struct AbaDerivatives;
-impl Kernel for AbaDerivatives {
-    const NARGS: usize = 3;
-    const NOUT: usize = 3;
-    fn out_len(m: &Model) -> usize {
-        m.nv * m.nv
-    }
-    #[inline(always)]
-    fn run<T: Real>(&self, m: &Model, d: &mut Data<T>, dd: &mut DerivData<T>, a: [&[T]; 3], e: Option<&ExternalForces<T>>, o: [&mut [T]; 3]) {
-        let [o0, o1, o2] = o;
-        algo::aba_derivatives(m, d, dd, a[0], a[1], a[2], e, o0, o1, o2)
-    }
-}
-
-struct Minverse;
-impl Kernel for Minverse {
-    const NARGS: usize = 1;
-    const NOUT: usize = 1;
-    fn out_len(m: &Model) -> usize {
-        m.nv * m.nv
-    }
-    #[inline(always)]
-    fn run<T: Real>(&self, m: &Model, d: &mut Data<T>, dd: &mut DerivData<T>, a: [&[T]; 3], _: Option<&ExternalForces<T>>, o: [&mut [T]; 3]) {
-        let [o0, _, _] = o;
-        algo::minverse(m, d, dd, a[0], o0)
-    }
-}
-
-struct GravityDerivatives;
-impl Kernel for GravityDerivatives {
-    const NARGS: usize = 1;
-    const NOUT: usize = 1;
-    fn out_len(m: &Model) -> usize {
-        m.nv * m.nv
-    }
-    #[inline(always)]
-    fn run<T: Real>(&self, m: &Model, d: &mut Data<T>, dd: &mut DerivData<T>, a: [&[T]; 3], _: Option<&ExternalForces<T>>, o: [&mut [T]; 3]) {
-        let [o0, _, _] = o;
-        algo::gravity_derivatives(m, d, dd, a[0], o0)
-    }
-}
-
-struct RneaExt;
-impl Kernel for RneaExt {
-    const NARGS: usize = 3;
-    const NOUT: usize = 1;
-    fn out_len(m: &Model) -> usize {
-        m.nv
-    }
-    #[inline(always)]
-    fn run<T: Real>(&self, m: &Model, d: &mut Data<T>, dd: &mut DerivData<T>, a: [&[T]; 3], e: Option<&ExternalForces<T>>, o: [&mut [T]; 3]) {
-        let [o0, _, _] = o;
-        algo::rnea_ext(m, d, dd, a[0], a[1], a[2], e.expect("external forces"), o0)
-    }
-}
-
-struct AbaExt;
-impl Kernel for AbaExt {
-    const NARGS: usize = 3;
-    const NOUT: usize = 1;
-    fn out_len(m: &Model) -> usize {
-        m.nv
-    }
-    #[inline(always)]
-    fn run<T: Real>(&self, m: &Model, d: &mut Data<T>, dd: &mut DerivData<T>, a: [&[T]; 3], e: Option<&ExternalForces<T>>, o: [&mut [T]; 3]) {
-        let [o0, _, _] = o;
-        algo::aba_ext(m, d, dd, a[0], a[1], a[2], e.expect("external forces"), o0)
-    }
-}
+kernel!(RneaDerivatives, nargs = 3, nout = 3, out_len = |m| m.nv * m.nv, |m, d, dd, a, e, [o0, o1, o2]| {
+    algo::rnea_derivatives(m, d, dd, a[0], a[1], a[2], e, o0, o1, o2)
+});
+kernel!(AbaDerivatives, nargs = 3, nout = 3, out_len = |m| m.nv * m.nv, |m, d, dd, a, e, [o0, o1, o2]| {
+    algo::aba_derivatives(m, d, dd, a[0], a[1], a[2], e, o0, o1, o2)
+});
+kernel!(Minverse, nargs = 1, nout = 1, out_len = |m| m.nv * m.nv, |m, d, dd, a, _, [o0, _, _]| {
+    algo::minverse(m, d, dd, a[0], o0)
+});
+kernel!(GravityDerivatives, nargs = 1, nout = 1, out_len = |m| m.nv * m.nv, |m, d, dd, a, _, [o0, _, _]| {
+    algo::gravity_derivatives(m, d, dd, a[0], o0)
+});
+kernel!(RneaExt, nargs = 3, nout = 1, out_len = |m| m.nv, |m, d, dd, a, e, [o0, _, _]| {
+    algo::rnea_ext(m, d, dd, a[0], a[1], a[2], e.expect("external forces"), o0)
+});
+kernel!(AbaExt, nargs = 3, nout = 1, out_len = |m| m.nv, |m, d, dd, a, e, [o0, _, _]| {
+    algo::aba_ext(m, d, dd, a[0], a[1], a[2], e.expect("external forces"), o0)
+});
 
 /// Batched [`algo::rnea_derivatives`]: `args = [q, qd, qdd]` (N, nv) each; `ext`:
 /// wrenches (N, nlinks, 6) and their frame; `outs = [dtau_dq, dtau_dqd, M]` (N, nv, nv) each.

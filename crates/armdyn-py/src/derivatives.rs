@@ -113,123 +113,93 @@ fn ext_forces(e: Ext<'_>) -> Option<ExternalForces<'_, f64>> {
     e.map(|(wrenches, frame)| ExternalForces { wrenches, frame })
 }
 
-fn tuple3<'py>(py: Python<'py>, o: [Bound<'py, PyArrayDyn<f64>>; 3]) -> PyResult<Bound<'py, PyTuple>> {
-    PyTuple::new(py, o)
+/// Defines `#[pyfunction] $name(model, q, qd, $third, f_ext=None, frame="local",
+/// threads=None)` returning the tuple of the three (n, n) (or (N, n, n)) outputs of
+/// `$algo` (one state) / `$batch` (a batch): the derivatives of rnea and aba.
+macro_rules! derivatives_of {
+    ($(#[$doc:meta])* $name:ident, $third:ident, $algo:path, $batch:path) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = (model, q, qd, $third, f_ext = None, frame = "local", threads = None))]
+        #[allow(clippy::too_many_arguments)]
+        fn $name<'py>(
+            py: Python<'py>,
+            model: &Bound<'py, NumericModel>,
+            q: &Bound<'py, PyAny>,
+            qd: &Bound<'py, PyAny>,
+            $third: &Bound<'py, PyAny>,
+            f_ext: Option<&Bound<'py, PyAny>>,
+            frame: &str,
+            threads: Option<i64>,
+        ) -> PyResult<Bound<'py, PyTuple>> {
+            let m = model.get();
+            let n = m.model.nv;
+            let o = run(
+                m,
+                py,
+                [("q", q), ("qd", qd), (stringify!($third), $third)],
+                f_ext,
+                frame,
+                &[n, n],
+                threads,
+                |md, s, [a, b, c], e, [o0, o1, o2]| {
+                    $algo(md, &mut s.data, &mut s.deriv, a, b, c, ext_forces(e).as_ref(), o0, o1, o2)
+                },
+                |md, a, e, o, t| $batch(md, a, e, o, t),
+            )?;
+            PyTuple::new(py, o)
+        }
+    };
 }
 
-/// (dtau_dq, dtau_dqd, M): the partial derivatives of rnea, each (n, n) or (N, n, n).
-#[pyfunction]
-#[pyo3(signature = (model, q, qd, qdd, f_ext = None, frame = "local", threads = None))]
-#[allow(clippy::too_many_arguments)]
-fn rnea_derivatives<'py>(
-    py: Python<'py>,
-    model: &Bound<'py, NumericModel>,
-    q: &Bound<'py, PyAny>,
-    qd: &Bound<'py, PyAny>,
-    qdd: &Bound<'py, PyAny>,
-    f_ext: Option<&Bound<'py, PyAny>>,
-    frame: &str,
-    threads: Option<i64>,
-) -> PyResult<Bound<'py, PyTuple>> {
-    let m = model.get();
-    let n = m.model.nv;
-    let o = run(
-        m,
-        py,
-        [("q", q), ("qd", qd), ("qdd", qdd)],
-        f_ext,
-        frame,
-        &[n, n],
-        threads,
-        |md, s, [q, qd, qdd], e, [o0, o1, o2]| {
-            algo::rnea_derivatives(md, &mut s.data, &mut s.deriv, q, qd, qdd, ext_forces(e).as_ref(), o0, o1, o2)
-        },
-        |md, a, e, o, t| bd::rnea_derivatives(md, a, e, o, t),
-    )?;
-    tuple3(py, o)
+derivatives_of!(
+    /// (dtau_dq, dtau_dqd, M): the partial derivatives of rnea, each (n, n) or (N, n, n).
+    rnea_derivatives, qdd, algo::rnea_derivatives, bd::rnea_derivatives
+);
+derivatives_of!(
+    /// (dqdd_dq, dqdd_dqd, Minv): the partial derivatives of aba, each (n, n) or (N, n, n).
+    aba_derivatives, tau, algo::aba_derivatives, bd::aba_derivatives
+);
+
+/// Defines `#[pyfunction] $name(model, q, threads=None)` returning the (n, n) (or
+/// (N, n, n)) output of `$algo` / `$batch`.
+macro_rules! matrix_of_q {
+    ($(#[$doc:meta])* $name:ident, $algo:path, $batch:path) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = (model, q, threads = None))]
+        fn $name<'py>(
+            py: Python<'py>,
+            model: &Bound<'py, NumericModel>,
+            q: &Bound<'py, PyAny>,
+            threads: Option<i64>,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            let m = model.get();
+            let n = m.model.nv;
+            let [o] = run(
+                m,
+                py,
+                [("q", q)],
+                None,
+                "local",
+                &[n, n],
+                threads,
+                |md, s, [q], _, [o]| $algo(md, &mut s.data, &mut s.deriv, q, o),
+                |md, [q], _, [o], t| $batch(md, q, o, t),
+            )?;
+            Ok(o)
+        }
+    };
 }
 
-/// (dqdd_dq, dqdd_dqd, Minv): the partial derivatives of aba, each (n, n) or (N, n, n).
-#[pyfunction]
-#[pyo3(signature = (model, q, qd, tau, f_ext = None, frame = "local", threads = None))]
-#[allow(clippy::too_many_arguments)]
-fn aba_derivatives<'py>(
-    py: Python<'py>,
-    model: &Bound<'py, NumericModel>,
-    q: &Bound<'py, PyAny>,
-    qd: &Bound<'py, PyAny>,
-    tau: &Bound<'py, PyAny>,
-    f_ext: Option<&Bound<'py, PyAny>>,
-    frame: &str,
-    threads: Option<i64>,
-) -> PyResult<Bound<'py, PyTuple>> {
-    let m = model.get();
-    let n = m.model.nv;
-    let o = run(
-        m,
-        py,
-        [("q", q), ("qd", qd), ("tau", tau)],
-        f_ext,
-        frame,
-        &[n, n],
-        threads,
-        |md, s, [q, qd, tau], e, [o0, o1, o2]| {
-            algo::aba_derivatives(md, &mut s.data, &mut s.deriv, q, qd, tau, ext_forces(e).as_ref(), o0, o1, o2)
-        },
-        |md, a, e, o, t| bd::aba_derivatives(md, a, e, o, t),
-    )?;
-    tuple3(py, o)
-}
-
-/// M(q)^-1, (n, n) or (N, n, n).
-#[pyfunction]
-#[pyo3(signature = (model, q, threads = None))]
-fn minverse<'py>(
-    py: Python<'py>,
-    model: &Bound<'py, NumericModel>,
-    q: &Bound<'py, PyAny>,
-    threads: Option<i64>,
-) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    let m = model.get();
-    let n = m.model.nv;
-    let [o] = run(
-        m,
-        py,
-        [("q", q)],
-        None,
-        "local",
-        &[n, n],
-        threads,
-        |md, s, [q], _, [o]| algo::minverse(md, &mut s.data, &mut s.deriv, q, o),
-        |md, [q], _, [o], t| bd::minverse(md, q, o, t),
-    )?;
-    Ok(o)
-}
-
-/// dg/dq, (n, n) or (N, n, n).
-#[pyfunction]
-#[pyo3(signature = (model, q, threads = None))]
-fn gravity_derivatives<'py>(
-    py: Python<'py>,
-    model: &Bound<'py, NumericModel>,
-    q: &Bound<'py, PyAny>,
-    threads: Option<i64>,
-) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    let m = model.get();
-    let n = m.model.nv;
-    let [o] = run(
-        m,
-        py,
-        [("q", q)],
-        None,
-        "local",
-        &[n, n],
-        threads,
-        |md, s, [q], _, [o]| algo::gravity_derivatives(md, &mut s.data, &mut s.deriv, q, o),
-        |md, [q], _, [o], t| bd::gravity_derivatives(md, q, o, t),
-    )?;
-    Ok(o)
-}
+matrix_of_q!(
+    /// M(q)^-1, (n, n) or (N, n, n).
+    minverse, algo::minverse, bd::minverse
+);
+matrix_of_q!(
+    /// dg/dq, (n, n) or (N, n, n).
+    gravity_derivatives, algo::gravity_derivatives, bd::gravity_derivatives
+);
 
 /// dJ/dt of link `link`'s Jacobian, (6, n) or (N, 6, n).
 #[pyfunction]
@@ -258,69 +228,53 @@ fn jacobian_dot<'py>(
     Ok(o)
 }
 
-/// rnea with external wrenches, (n,) or (N, n).
-#[pyfunction]
-#[pyo3(signature = (model, q, qd, qdd, f_ext, frame = "local", threads = None))]
-#[allow(clippy::too_many_arguments)]
-fn rnea_ext<'py>(
-    py: Python<'py>,
-    model: &Bound<'py, NumericModel>,
-    q: &Bound<'py, PyAny>,
-    qd: &Bound<'py, PyAny>,
-    qdd: &Bound<'py, PyAny>,
-    f_ext: &Bound<'py, PyAny>,
-    frame: &str,
-    threads: Option<i64>,
-) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    let m = model.get();
-    let [o] = run(
-        m,
-        py,
-        [("q", q), ("qd", qd), ("qdd", qdd)],
-        Some(f_ext),
-        frame,
-        &[m.model.nv],
-        threads,
-        |md, s, [q, qd, qdd], e, [o]| {
-            let e = ext_forces(e).expect("f_ext");
-            algo::rnea_ext(md, &mut s.data, &mut s.deriv, q, qd, qdd, &e, o)
-        },
-        |md, a, e, [o], t| bd::rnea_ext(md, a, e.expect("f_ext"), o, t),
-    )?;
-    Ok(o)
+/// Defines `#[pyfunction] $name(model, q, qd, $third, f_ext, frame="local",
+/// threads=None)` returning the (n,) (or (N, n)) output of `$algo` / `$batch`: rnea and
+/// aba with external wrenches.
+macro_rules! with_wrenches {
+    ($(#[$doc:meta])* $name:ident, $third:ident, $algo:path, $batch:path) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = (model, q, qd, $third, f_ext, frame = "local", threads = None))]
+        #[allow(clippy::too_many_arguments)]
+        fn $name<'py>(
+            py: Python<'py>,
+            model: &Bound<'py, NumericModel>,
+            q: &Bound<'py, PyAny>,
+            qd: &Bound<'py, PyAny>,
+            $third: &Bound<'py, PyAny>,
+            f_ext: &Bound<'py, PyAny>,
+            frame: &str,
+            threads: Option<i64>,
+        ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+            let m = model.get();
+            let [o] = run(
+                m,
+                py,
+                [("q", q), ("qd", qd), (stringify!($third), $third)],
+                Some(f_ext),
+                frame,
+                &[m.model.nv],
+                threads,
+                |md, s, [a, b, c], e, [o]| {
+                    let e = ext_forces(e).expect("f_ext");
+                    $algo(md, &mut s.data, &mut s.deriv, a, b, c, &e, o)
+                },
+                |md, a, e, [o], t| $batch(md, a, e.expect("f_ext"), o, t),
+            )?;
+            Ok(o)
+        }
+    };
 }
 
-/// aba with external wrenches, (n,) or (N, n).
-#[pyfunction]
-#[pyo3(signature = (model, q, qd, tau, f_ext, frame = "local", threads = None))]
-#[allow(clippy::too_many_arguments)]
-fn aba_ext<'py>(
-    py: Python<'py>,
-    model: &Bound<'py, NumericModel>,
-    q: &Bound<'py, PyAny>,
-    qd: &Bound<'py, PyAny>,
-    tau: &Bound<'py, PyAny>,
-    f_ext: &Bound<'py, PyAny>,
-    frame: &str,
-    threads: Option<i64>,
-) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    let m = model.get();
-    let [o] = run(
-        m,
-        py,
-        [("q", q), ("qd", qd), ("tau", tau)],
-        Some(f_ext),
-        frame,
-        &[m.model.nv],
-        threads,
-        |md, s, [q, qd, tau], e, [o]| {
-            let e = ext_forces(e).expect("f_ext");
-            algo::aba_ext(md, &mut s.data, &mut s.deriv, q, qd, tau, &e, o)
-        },
-        |md, a, e, [o], t| bd::aba_ext(md, a, e.expect("f_ext"), o, t),
-    )?;
-    Ok(o)
-}
+with_wrenches!(
+    /// rnea with external wrenches, (n,) or (N, n).
+    rnea_ext, qdd, algo::rnea_ext, bd::rnea_ext
+);
+with_wrenches!(
+    /// aba with external wrenches, (n,) or (N, n).
+    aba_ext, tau, algo::aba_ext, bd::aba_ext
+);
 
 /// Register the functions above in the `_core` module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

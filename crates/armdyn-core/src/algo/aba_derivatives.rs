@@ -9,6 +9,10 @@
 //! with the inverse-dynamics derivatives taken at `qdd = FD(q, qd, tau)`. One ABA gives
 //! `qdd` and the articulated inertias that `minverse_from_articulated` turns into M^-1;
 //! `rnea_derivatives` gives `dID/dq`, `dID/dqd`; two (nv x nv) products finish.
+//!
+//! Joint friction, rotor inertia and offset follow without a case of their own: `aba`
+//! puts `Ia` into `D_i = S^T I^A S + Ia` (so M^-1 is that of `M + diag(Ia)`), and
+//! `rnea_derivatives` adds `diag(Fv)` to `dID/dqd` (Coulomb friction: 0, see there).
 
 use crate::algo::aba;
 use crate::algo::external::{generalized_forces, ExternalForces};

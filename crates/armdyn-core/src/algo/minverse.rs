@@ -24,7 +24,8 @@ use crate::model::Model;
 use crate::real::Real;
 use crate::spatial::{ArticulatedInertia, Force, RigidInertia};
 
-/// `M(q)^-1` (nv, nv), row-major in `minv`. `q`: (nv,). Writes `data.xup`, `data.ia`,
+/// `M(q)^-1` (nv, nv), row-major in `minv`, with M including the rotor inertias
+/// (`M + diag(Ia)`, as `crba`). `q`: (nv,). Writes `data.xup`, `data.ia`,
 /// `data.u_col`, `data.d_inv`.
 #[inline(always)]
 pub fn minverse<T: Real>(model: &Model, data: &mut Data<T>, dd: &mut DerivData<T>, q: &[T], minv: &mut [T]) {
@@ -38,7 +39,8 @@ pub fn minverse<T: Real>(model: &Model, data: &mut Data<T>, dd: &mut DerivData<T
     for i in (0..n).rev() {
         let kind = model.kind[i];
         let u_col = kind.articulated_inertia_s(&data.ia[i]);
-        let d_inv = T::splat(1.0) / kind.s_dot(&u_col);
+        // the rotor inertia adds to the joint's own inertia: D_i = S^T I^A S + Ia (as in aba)
+        let d_inv = T::splat(1.0) / (kind.s_dot(&u_col) + T::splat(model.joint_dynamics[i].armature));
         data.u_col[i] = u_col;
         data.d_inv[i] = d_inv;
         if let Some(p) = model.parent[i] {

@@ -141,7 +141,8 @@ fn passes<T: Real>(
 }
 
 /// Partial derivatives of `tau = rnea(q, qd, qdd)` (with external wrenches `ext`, if
-/// any: `tau = M qdd + C qd + g - sum_L J_L^T w_L`).
+/// any: `tau = M qdd + C qd + g - sum_L J_L^T w_L`), joint friction, rotor inertia and
+/// offset included (see [`add_joint_dynamics_derivatives`]).
 ///
 /// `q`, `qd`, `qdd`: (nv,). Writes `dtau_dq`, `dtau_dqd` and `m` = `dtau/dqdd` = M(q),
 /// each (nv, nv) row-major, `[i * nv + j] = d tau_i / d x_j`. Uses `data.xup`, `data.x0`.
@@ -195,5 +196,23 @@ pub fn rnea_derivatives<T: Real>(
             dtau_dqd[i * n + j] = (dvj + dvj).dot(&fa) + bt.dot(sj.w);
             a = model.parent[j];
         }
+    }
+    if model.has_joint_dynamics {
+        add_joint_dynamics_derivatives(model, dtau_dqd, m);
+    }
+}
+
+/// The joint terms `Ia qdd + Fv qd + Fc sign(qd) + offset` of `rnea` (DESIGN.md), differentiated:
+/// `M += diag(Ia)`, `dtau/dqd += diag(Fv)`. `sign(qd)` is piecewise constant, so the Coulomb
+/// term adds nothing to `dtau/dqd` for `qd != 0`; at `qd = 0` (where it jumps and has no
+/// derivative) we report the same 0, the one-sided derivative of either side, consistent with
+/// rnea's `sign(0) = 0`. The offset is constant: nothing. `dtau/dq` is unchanged.
+#[inline(always)]
+pub fn add_joint_dynamics_derivatives<T: Real>(model: &Model, dtau_dqd: &mut [T], m: &mut [T]) {
+    let n = model.nv;
+    for i in 0..n {
+        let jd = &model.joint_dynamics[i];
+        m[i * n + i] += T::splat(jd.armature);
+        dtau_dqd[i * n + i] += T::splat(jd.viscous);
     }
 }
