@@ -142,7 +142,8 @@ fn rnea_derivatives<'py>(
         &[n, n],
         threads,
         |md, s, [q, qd, qdd], e, [o0, o1, o2]| {
-            algo::rnea_derivatives(md, &mut s.data, &mut s.deriv, q, qd, qdd, ext_forces(e).as_ref(), o0, o1, o2)
+            let (data, deriv) = s.deriv(md);
+            algo::rnea_derivatives(md, data, deriv, q, qd, qdd, ext_forces(e).as_ref(), o0, o1, o2)
         },
         |md, a, e, o, t| bd::rnea_derivatives(md, a, e, o, t),
     )?;
@@ -174,7 +175,8 @@ fn aba_derivatives<'py>(
         &[n, n],
         threads,
         |md, s, [q, qd, tau], e, [o0, o1, o2]| {
-            algo::aba_derivatives(md, &mut s.data, &mut s.deriv, q, qd, tau, ext_forces(e).as_ref(), o0, o1, o2)
+            let (data, deriv) = s.deriv(md);
+            algo::aba_derivatives(md, data, deriv, q, qd, tau, ext_forces(e).as_ref(), o0, o1, o2)
         },
         |md, a, e, o, t| bd::aba_derivatives(md, a, e, o, t),
     )?;
@@ -200,7 +202,7 @@ fn minverse<'py>(
         "local",
         &[n, n],
         threads,
-        |md, s, [q], _, [o]| algo::minverse(md, &mut s.data, &mut s.deriv, q, o),
+        |md, s, [q], _, [o]| { let (data, deriv) = s.deriv(md); algo::minverse(md, data, deriv, q, o) },
         |md, [q], _, [o], t| bd::minverse(md, q, o, t),
     )?;
     Ok(o)
@@ -225,7 +227,7 @@ fn gravity_derivatives<'py>(
         "local",
         &[n, n],
         threads,
-        |md, s, [q], _, [o]| algo::gravity_derivatives(md, &mut s.data, &mut s.deriv, q, o),
+        |md, s, [q], _, [o]| { let (data, deriv) = s.deriv(md); algo::gravity_derivatives(md, data, deriv, q, o) },
         |md, [q], _, [o], t| bd::gravity_derivatives(md, q, o, t),
     )?;
     Ok(o)
@@ -283,7 +285,8 @@ fn rnea_ext<'py>(
         threads,
         |md, s, [q, qd, qdd], e, [o]| {
             let e = ext_forces(e).expect("f_ext");
-            algo::rnea_ext(md, &mut s.data, &mut s.deriv, q, qd, qdd, &e, o)
+            let (data, deriv) = s.deriv(md);
+            algo::rnea_ext(md, data, deriv, q, qd, qdd, &e, o)
         },
         |md, a, e, [o], t| bd::rnea_ext(md, a, e.expect("f_ext"), o, t),
     )?;
@@ -315,7 +318,8 @@ fn aba_ext<'py>(
         threads,
         |md, s, [q, qd, tau], e, [o]| {
             let e = ext_forces(e).expect("f_ext");
-            algo::aba_ext(md, &mut s.data, &mut s.deriv, q, qd, tau, &e, o)
+            let (data, deriv) = s.deriv(md);
+            algo::aba_ext(md, data, deriv, q, qd, tau, &e, o)
         },
         |md, a, e, [o], t| bd::aba_ext(md, a, e.expect("f_ext"), o, t),
     )?;
