@@ -11,7 +11,10 @@ Timed, median of ``--repeat`` runs each:
   load:     ``armdyn.load(path)`` (parse, check, tree order, Robot built);
   compile:  the first ``armdyn.rnea`` call (the compiled Rust model is built then, from
             the floats the reader kept; no SymPy per joint);
-  pinocchio: ``pin.buildModelFromUrdf(path)`` + ``createData()``.
+  pinocchio: ``pin.buildModelFromUrdf(path)`` (the model only: its ``createData()``
+            runs out of memory at 10^3 joints on this 24 GB machine). Run in a thread
+            with a 1 GiB stack: its parser recurses along the tree and overflows the
+            main thread's 8 MiB stack on a 10^4-joint chain (a segmentation fault).
 The ratio is armdyn load / Pinocchio load. (armdyn's SymPy form of a joint is built
 only when a symbolic function reads it: not timed here.)
 """
@@ -23,6 +26,7 @@ import os
 import statistics
 import sys
 import tempfile
+import threading
 import time
 import warnings
 
@@ -42,6 +46,19 @@ def _time(f, repeat: int):
         out = f()
         times.append(time.perf_counter() - t0)
     return statistics.median(times), out
+
+
+def _in_big_stack(f):
+    """``f()`` run in a thread with a 1 GiB stack (Pinocchio's recursive URDF parser)."""
+    out = {}
+    old = threading.stack_size(1 << 30)
+    try:
+        t = threading.Thread(target=lambda: out.setdefault("value", f()))
+        t.start()
+        t.join()
+    finally:
+        threading.stack_size(old)
+    return out["value"]
 
 
 def main() -> None:
@@ -80,7 +97,7 @@ def main() -> None:
                 line = (f"{n:>6} joints, {kind} ({robot.dof} dof): armdyn load {t_load:7.3f} s, "
                         f"compile (first rnea) {t_compile:6.3f} s")
                 if pin is not None:
-                    t_pin, _ = _time(lambda: pin.buildModelFromUrdf(path).createData(), args.repeat)
+                    t_pin = _in_big_stack(lambda: _time(lambda: pin.buildModelFromUrdf(path), args.repeat)[0])
                     line += f" | pinocchio load {t_pin:6.3f} s | ratio armdyn/pinocchio {t_load / t_pin:5.1f}"
                 print(line, flush=True)
 
