@@ -28,7 +28,7 @@ with parameters is bound to numbers with :meth:`Robot.bind`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Iterable, Mapping
 
 import numpy as np
