@@ -222,18 +222,24 @@ def run_urdf(seed: int, rng: random.Random):
 _ROBOTS_CACHE = {}
 
 
+def _fill_robots_cache():
+    """The compiled robots the arrays are fed to (built once per worker)."""
+    if not _ROBOTS_CACHE:
+        import armdyn
+        from armdyn.io.urdf import load_urdf
+
+        _ROBOTS_CACHE["ur5"] = armdyn.load("ur5").bind()
+        _ROBOTS_CACHE["small"] = load_urdf(URDF_SMALL)
+        _ROBOTS_CACHE["iiwa14"] = armdyn.load("iiwa14")
+
+
 def run_arrays(seed: int, rng: random.Random):
     import numpy as np
 
     import armdyn
     import armdyn.numeric as numeric
 
-    if not _ROBOTS_CACHE:
-        from armdyn.io.urdf import load_urdf
-
-        _ROBOTS_CACHE["ur5"] = armdyn.load("ur5").bind()
-        _ROBOTS_CACHE["small"] = load_urdf(URDF_SMALL)
-        _ROBOTS_CACHE["iiwa14"] = armdyn.load("iiwa14")
+    _fill_robots_cache()
     robot = _ROBOTS_CACHE[rng.choice(list(_ROBOTS_CACHE))]
     n = robot.dof
     nrng = np.random.default_rng(seed)
@@ -304,6 +310,8 @@ def worker(kind: str, first: int, count: int, timeout: float) -> dict:
     import armdyn.io.yaml  # noqa: F401
     import armdyn.numeric  # noqa: F401
 
+    if kind == "arrays":  # likewise the robots it feeds (the first input built them)
+        _fill_robots_cache()
     for seed in range(first, first + count):
         rng = random.Random(seed)
         counts["inputs"] += 1
