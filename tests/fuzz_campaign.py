@@ -47,7 +47,7 @@ ROOT = Path(__file__).resolve().parents[1]
 ROBOTS = ROOT / "python" / "armdyn" / "robots"
 YAML_SEEDS = ["rp-arm", "planar-2r", "panda"]
 DH_SEEDS = ["planar-3r", "scara", "puma560", "puma560-craig", "ur5", "stanford"]
-CHUNK = 250
+CHUNK = 1000  # inputs per worker process (a fresh process per chunk: ~1.5 s of imports)
 
 HOSTILE = [
     float("nan"), float("inf"), -float("inf"), 1e308, -1e308, 5e-324, 0, -1, 1, 2**63, -(2**64), True, None,
@@ -178,15 +178,32 @@ def exercise_robot(robot, rng: random.Random):
     numeric.crba(robot, q)
 
 
+_TEXTS: dict = {}
+
+
+def _seed_text(name: str) -> str:
+    if name not in _TEXTS:
+        _TEXTS[name] = (ROBOTS / name).read_text() if name.endswith(".urdf") else (ROBOTS / f"{name}.yaml").read_text()
+    return _TEXTS[name]
+
+
+try:  # the mutator's parse/dump only; the reader under test keeps its own loader
+    from yaml import CSafeDumper as _SAFE_DUMPER
+    from yaml import CSafeLoader as _SAFE_LOADER
+except ImportError:  # PyYAML without libyaml
+    from yaml import SafeDumper as _SAFE_DUMPER
+    from yaml import SafeLoader as _SAFE_LOADER
+
+
 def run_yaml(seed: int, rng: random.Random, seeds: list[str]):
     import yaml
 
     from armdyn.io.yaml import load_yaml_string
 
-    text = (ROBOTS / f"{rng.choice(seeds)}.yaml").read_text()
-    if rng.random() < 0.7:
-        doc = mutate_doc(yaml.safe_load(text), rng)
-        text = yaml.safe_dump(doc, sort_keys=False, allow_unicode=True)
+    text = _seed_text(rng.choice(seeds))
+    if rng.random() < 0.7:  # libyaml (C) for the mutation's own parse and dump: 10x faster
+        doc = mutate_doc(yaml.load(text, Loader=_SAFE_LOADER), rng)
+        text = yaml.dump(doc, Dumper=_SAFE_DUMPER, sort_keys=False, allow_unicode=True)
     else:
         text = mutate_text(text, rng)
     robot = load_yaml_string(text, source="fuzz.yaml", strict=rng.random() < 0.5)
@@ -196,7 +213,7 @@ def run_yaml(seed: int, rng: random.Random, seeds: list[str]):
 def run_urdf(seed: int, rng: random.Random):
     from armdyn.io.urdf import load_urdf
 
-    text = URDF_SMALL if rng.random() < 0.7 else (ROBOTS / "iiwa14.urdf").read_text()
+    text = URDF_SMALL if rng.random() < 0.7 else _seed_text("iiwa14.urdf")
     text = mutate_xml(text, rng) if rng.random() < 0.7 else mutate_text(text, rng)
     robot = load_urdf(text, strict=rng.random() < 0.5)
     exercise_robot(robot, rng)
@@ -205,18 +222,24 @@ def run_urdf(seed: int, rng: random.Random):
 _ROBOTS_CACHE = {}
 
 
+def _fill_robots_cache():
+    """The compiled robots the arrays are fed to (built once per worker)."""
+    if not _ROBOTS_CACHE:
+        import armdyn
+        from armdyn.io.urdf import load_urdf
+
+        _ROBOTS_CACHE["ur5"] = armdyn.load("ur5").bind()
+        _ROBOTS_CACHE["small"] = load_urdf(URDF_SMALL)
+        _ROBOTS_CACHE["iiwa14"] = armdyn.load("iiwa14")
+
+
 def run_arrays(seed: int, rng: random.Random):
     import numpy as np
 
     import armdyn
     import armdyn.numeric as numeric
 
-    if not _ROBOTS_CACHE:
-        from armdyn.io.urdf import load_urdf
-
-        _ROBOTS_CACHE["ur5"] = armdyn.load("ur5").bind()
-        _ROBOTS_CACHE["small"] = load_urdf(URDF_SMALL)
-        _ROBOTS_CACHE["iiwa14"] = armdyn.load("iiwa14")
+    _fill_robots_cache()
     robot = _ROBOTS_CACHE[rng.choice(list(_ROBOTS_CACHE))]
     n = robot.dof
     nrng = np.random.default_rng(seed)
@@ -281,6 +304,14 @@ def worker(kind: str, first: int, count: int, timeout: float) -> dict:
         raise TimeoutError
 
     signal.signal(signal.SIGALRM, expired)
+    # imports before the first timer: under load (nice 19 behind other jobs) importing
+    # SymPy and armdyn took > 20 s and was counted as the chunk's first input timing out
+    import armdyn.io.urdf  # noqa: F401
+    import armdyn.io.yaml  # noqa: F401
+    import armdyn.numeric  # noqa: F401
+
+    if kind == "arrays":  # likewise the robots it feeds (the first input built them)
+        _fill_robots_cache()
     for seed in range(first, first + count):
         rng = random.Random(seed)
         counts["inputs"] += 1

@@ -288,20 +288,26 @@ def physical_violations(mass, inertia, rtol: float = 1e-6) -> list[str]:
     skipped (not reported).
     """
     out = []
-    mass = sp.sympify(mass)
-    if not mass.free_symbols:
-        m = complex(mass.evalf())
+    # float input (big numeric models) is checked without building SymPy objects
+    mass = np.asarray(mass, dtype=float) if isinstance(mass, (float, np.ndarray)) else sp.sympify(mass)
+    if isinstance(mass, np.ndarray) or not mass.free_symbols:
+        m = complex(mass) if isinstance(mass, np.ndarray) else complex(mass.evalf())
         if m.imag != 0 or not np.isfinite(m.real):
             out.append(f"mass {mass} is not a finite real number")
         elif m.real < 0:
             out.append(f"mass {_fmt(m.real)} is negative")
 
-    I = sp.Matrix(inertia)
-    if I.shape != (3, 3):
-        return out + [f"inertia must be 3x3, got shape {I.shape}"]
-    if I.free_symbols:
-        return out
-    I = np.array([complex(x) for x in I], dtype=complex).reshape(3, 3)
+    if isinstance(inertia, np.ndarray) and inertia.dtype == float:
+        I = inertia
+        if I.shape != (3, 3):
+            return out + [f"inertia must be 3x3, got shape {I.shape}"]
+    else:
+        I = sp.Matrix(inertia)
+        if I.shape != (3, 3):
+            return out + [f"inertia must be 3x3, got shape {I.shape}"]
+        if I.free_symbols:
+            return out
+    I = I.astype(complex) if isinstance(I, np.ndarray) else np.array([complex(x) for x in I], dtype=complex).reshape(3, 3)
     if np.any(I.imag != 0) or not np.all(np.isfinite(I.real)):
         return out + ["inertia has entries that are not finite real numbers"]
     I = I.real

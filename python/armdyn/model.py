@@ -28,7 +28,7 @@ with parameters is bound to numbers with :meth:`Robot.bind`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Iterable, Mapping
 
 import numpy as np
@@ -74,6 +74,130 @@ def _is_zero(expr) -> bool | None:
     if expr.free_symbols:
         return None
     return bool(abs(complex(expr.evalf())) < 1e-12)
+
+
+def exact_number(value: float) -> sp.Expr:
+    """A float read from a file as SymPy: whole numbers exact (0 and 1 stay exact, which
+    keeps zero tests and axis-aligned rotations exact), others as Float (all 53 bits)."""
+    value = float(value)
+    return sp.Integer(int(value)) if value.is_integer() and abs(value) < 2**53 else sp.Float(value)
+
+
+class Numbers:
+    """A numeric model field held as floats, its SymPy form built only when asked for.
+
+    Readers of big numeric models (a URDF with 10^4 joints) pass these instead of SymPy
+    matrices: building a SymPy ``Matrix``/``Float`` costs ~10 ms per joint, and the
+    numeric engines never need it (they read :meth:`Joint.floats` / :meth:`Link.floats`).
+
+    floats: array of the field's shape: ``()`` for a scalar, ``(3,)`` for a vector
+            (``(3, 1)`` as SymPy), ``(3, 3)`` for a matrix. Must be finite.
+    exact:  optional picklable zero-argument callable giving the SymPy form (e.g. a
+            rotation with exact pi/2 angles); default :func:`exact_number` per entry.
+    """
+
+    __slots__ = ("floats", "exact")
+
+    def __init__(self, floats, exact=None):
+        f = np.array(floats, dtype=float)
+        if not np.isfinite(f).all():
+            raise ModelError(f"value {f.tolist()} is not finite")
+        f.setflags(write=False)
+        self.floats = f
+        self.exact = exact
+
+    def sympy(self):
+        if self.exact is not None:
+            return self.exact()
+        f = self.floats
+        if f.ndim == 0:
+            return exact_number(f)
+        rows, cols = (f.shape[0], 1) if f.ndim == 1 else f.shape
+        return sp.Matrix(rows, cols, [exact_number(x) for x in f.ravel()])
+
+    def __reduce__(self):
+        return (Numbers, (self.floats, self.exact))
+
+
+_DEFAULT = object()  # a lazy field not given: __post_init__ puts its default in
+
+
+class _LazyField:
+    """Data descriptor for a numeric field of Link/Joint: the instance keeps what it was
+    given (SymPy, or :class:`Numbers`) under the field's name and reading the attribute
+    always gives SymPy, built from Numbers on first read and cached (``_sym_<name>``)."""
+
+    def __init__(self, optional: bool = False):
+        self.optional = optional  # an optional field's default is None
+
+    def __set_name__(self, owner, name):
+        self.name = name
+
+    def __get__(self, obj, owner=None):
+        if obj is None:
+            return None if self.optional else _DEFAULT  # the dataclass default
+        d = obj.__dict__
+        raw = d[self.name]
+        if not isinstance(raw, Numbers):
+            return raw
+        key = "_sym_" + self.name
+        if key not in d:
+            d[key] = raw.sympy()
+        return d[key]
+
+    def __set__(self, obj, value):
+        obj.__dict__[self.name] = value
+
+
+def _field_floats(obj, name: str):
+    """Float array of a Link/Joint field (shape () / (3,) / (3, 3)), None when it has
+    free symbols; cached on the instance."""
+    d = obj.__dict__
+    raw = d[name]
+    if isinstance(raw, Numbers):
+        return raw.floats
+    if raw is None:
+        return None
+    key = "_floats_" + name
+    if key not in d:
+        if raw.free_symbols:
+            d[key] = None
+        else:
+            try:
+                if isinstance(raw, sp.MatrixBase):  # (3, 1) -> (3,), (3, 3) stays
+                    f = np.array([float(x) for x in raw], dtype=float).reshape(raw.shape)
+                    f = f.reshape(-1) if raw.shape[1] == 1 else f
+                else:
+                    f = np.array(float(raw), dtype=float)
+                f.setflags(write=False)
+            except (TypeError, ValueError):
+                f = None  # complex or not a number: the SymPy-side checks report it
+            d[key] = f
+    return d[key]
+
+
+def _lazy_init(obj, name: str, convert, default: "Numbers", shape: tuple) -> None:
+    """Normalise a lazy field in ``__post_init__``: the default when not given, a
+    :class:`Numbers` of the right shape kept as it is, anything else converted to SymPy."""
+    raw = obj.__dict__.get(name, _DEFAULT)
+    if raw is _DEFAULT:
+        raw = default
+    elif raw is None and default is None:  # an optional field left out
+        pass
+    elif isinstance(raw, Numbers):
+        if raw.floats.shape != shape:
+            raise ModelError(f"{name} must have shape {shape}, got {raw.floats.shape}")
+    else:
+        raw = convert(raw)
+    obj.__dict__[name] = raw
+
+
+_I3 = np.eye(3)
+_ZERO3 = Numbers(np.zeros(3))
+_EYE3 = Numbers(np.eye(3))
+_ZERO33 = Numbers(np.zeros((3, 3)))
+_Z_AXIS = Numbers(np.array([0.0, 0.0, 1.0]))
+_ZERO = Numbers(0.0)
 
 
 def rot_x(a) -> sp.Matrix:
@@ -134,6 +258,11 @@ def _check_joint_dynamics(joint, where: str) -> None:
     """Numeric friction/armature/offset values must be finite; damping, friction and
     armature must not be negative (symbolic ones are checked once bound)."""
     for name in JOINT_DYNAMICS:
+        raw = joint.__dict__[name]
+        if isinstance(raw, Numbers):  # finite already; only the sign to check
+            if name != "torque_offset" and raw.floats < 0:
+                raise ModelError(f"{name} {float(raw.floats)} is negative (it must be >= 0)", where)
+            continue
         value = getattr(joint, name)
         if value is None or value.free_symbols:
             continue
@@ -157,20 +286,25 @@ class Link:
     """
 
     name: str
-    mass: sp.Expr = sp.Integer(0)
-    com: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))
-    inertia: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 3))
+    mass: sp.Expr = _LazyField()
+    com: sp.Matrix = _LazyField()
+    inertia: sp.Matrix = _LazyField()
 
     def __post_init__(self):
         where = f"link '{self.name}'"
         try:
-            object.__setattr__(self, "mass", sp.sympify(self.mass))
-            object.__setattr__(self, "com", _vec3(self.com, "com"))
-            object.__setattr__(self, "inertia", _mat3(self.inertia, "inertia"))
+            _lazy_init(self, "mass", sp.sympify, _ZERO, ())
+            _lazy_init(self, "com", lambda v: _vec3(v, "com"), _ZERO3, (3,))
+            _lazy_init(self, "inertia", lambda v: _mat3(v, "inertia"), _ZERO33, (3, 3))
         except ModelError as err:
             raise err.located(element=where)
         except (sp.SympifyError, TypeError) as exc:
             raise ModelError(f"bad value ({exc})", where) from None
+
+    def floats(self, name: str):
+        """``mass``, ``com`` or ``inertia`` as a float array of shape ``()``, ``(3,)``
+        or ``(3, 3)`` without building SymPy objects; None when it has free symbols."""
+        return _field_floats(self, name)
 
 
 @dataclass(frozen=True)
@@ -230,20 +364,20 @@ class Joint:
     type: str
     parent: str
     child: str
-    xyz: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))
-    rotation: sp.Matrix = field(default_factory=lambda: sp.eye(3))
-    axis: sp.Matrix = field(default_factory=lambda: sp.Matrix([0, 0, 1]))
-    frame_xyz: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))
-    frame_rotation: sp.Matrix = field(default_factory=lambda: sp.eye(3))
-    lower: sp.Expr | None = None
-    upper: sp.Expr | None = None
-    velocity: sp.Expr | None = None
-    effort: sp.Expr | None = None
-    damping: sp.Expr | None = None
-    friction: sp.Expr | None = None
+    xyz: sp.Matrix = _LazyField()
+    rotation: sp.Matrix = _LazyField()
+    axis: sp.Matrix = _LazyField()
+    frame_xyz: sp.Matrix = _LazyField()
+    frame_rotation: sp.Matrix = _LazyField()
+    lower: sp.Expr | None = _LazyField(optional=True)
+    upper: sp.Expr | None = _LazyField(optional=True)
+    velocity: sp.Expr | None = _LazyField(optional=True)
+    effort: sp.Expr | None = _LazyField(optional=True)
+    damping: sp.Expr | None = _LazyField(optional=True)
+    friction: sp.Expr | None = _LazyField(optional=True)
     mimic: Mimic | None = None
-    armature: sp.Expr | None = None
-    torque_offset: sp.Expr | None = None
+    armature: sp.Expr | None = _LazyField(optional=True)
+    torque_offset: sp.Expr | None = _LazyField(optional=True)
 
     def __post_init__(self):
         where = f"joint '{self.name}'"
@@ -253,15 +387,13 @@ class Joint:
                 where,
             )
         try:
-            object.__setattr__(self, "xyz", _vec3(self.xyz, "xyz"))
-            object.__setattr__(self, "rotation", _mat3(self.rotation, "rotation"))
-            object.__setattr__(self, "axis", _vec3(self.axis, "axis"))
-            object.__setattr__(self, "frame_xyz", _vec3(self.frame_xyz, "frame_xyz"))
-            object.__setattr__(self, "frame_rotation", _mat3(self.frame_rotation, "frame_rotation"))
+            _lazy_init(self, "xyz", lambda v: _vec3(v, "xyz"), _ZERO3, (3,))
+            _lazy_init(self, "rotation", lambda v: _mat3(v, "rotation"), _EYE3, (3, 3))
+            _lazy_init(self, "axis", lambda v: _vec3(v, "axis"), _Z_AXIS, (3,))
+            _lazy_init(self, "frame_xyz", lambda v: _vec3(v, "frame_xyz"), _ZERO3, (3,))
+            _lazy_init(self, "frame_rotation", lambda v: _mat3(v, "frame_rotation"), _EYE3, (3, 3))
             for name in ("lower", "upper", "velocity", "effort") + JOINT_DYNAMICS:
-                value = getattr(self, name)
-                if value is not None:
-                    object.__setattr__(self, name, sp.sympify(value))
+                _lazy_init(self, name, sp.sympify, None, ())
         except ModelError as err:
             raise err.located(element=where)
         except (sp.SympifyError, TypeError) as exc:
@@ -273,12 +405,23 @@ class Joint:
                 raise ModelError("a fixed joint cannot mimic another joint", where)
         _check_joint_dynamics(self, where)
         for key in ("rotation", "frame_rotation"):
-            matrix = getattr(self, key)
-            if not matrix.free_symbols:
-                R = np.array([float(x) for x in matrix], dtype=float).reshape(3, 3)
-                if not (np.allclose(R.T @ R, np.eye(3), atol=1e-9) and np.linalg.det(R) > 0):
+            if self.__dict__[key] is _EYE3:  # the default: a rotation, no check needed
+                continue
+            R = self.floats(key)
+            if R is not None:
+                # R^T R = I (np.allclose's tolerances: atol 1e-9, rtol 1e-5) and det R > 0
+                (a, b, c), (d, e, f), (g, h, i) = R.tolist()
+                det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+                if not (np.all(np.abs(R.T @ R - _I3) <= 1e-9 + 1e-5 * _I3) and det > 0):
                     raise ModelError(f"{key} {R.tolist()} is not a proper rotation matrix", where)
-        if self.type != "fixed":
+        axis = self.__dict__["axis"]
+        if self.type != "fixed" and isinstance(axis, Numbers):  # numbers: checked without SymPy
+            norm = float(np.linalg.norm(axis.floats))
+            if norm == 0:
+                raise ModelError("axis is zero", where)
+            if abs(norm - 1) > 1e-12:
+                raise ModelError(f"axis {axis.floats.tolist()} is not a unit vector (norm {norm:.6g})", where)
+        elif self.type != "fixed":
             norm2 = sp.expand(sum(c**2 for c in self.axis))
             zero = _is_zero(norm2)
             if zero:
@@ -293,9 +436,18 @@ class Joint:
     def movable(self) -> bool:
         return self.type != "fixed"
 
+    def floats(self, name: str):
+        """``xyz``, ``axis``, ``frame_xyz`` (shape ``(3,)``), ``rotation`` or
+        ``frame_rotation`` (``(3, 3)``) as a float array without building SymPy
+        objects; None when it has free symbols."""
+        return _field_floats(self, name)
+
     @property
     def has_frame_offset(self) -> bool:
         """True when the child frame is not the moved joint frame itself."""
+        fx, fr = self.__dict__["frame_xyz"], self.__dict__["frame_rotation"]
+        if isinstance(fx, Numbers) and isinstance(fr, Numbers):  # no SymPy for numbers
+            return bool(np.any(fx.floats != 0) or np.any(fr.floats != np.eye(3)))
         return self.frame_xyz != sp.zeros(3, 1) or self.frame_rotation != sp.eye(3)
 
     def motion(self, q=0) -> tuple[sp.Matrix, sp.Matrix]:
@@ -499,7 +651,9 @@ class Robot(metaclass=_FreezeAfterInit):
             # an error is located by the loader (which knows the line); a warning cannot be
             # located later, so it names the model file itself
             source = None if strict else self.meta.get("file")
-            check_physical(link.mass, link.inertia, f"link '{link.name}'", source, strict=strict)
+            m, inertia = link.floats("mass"), link.floats("inertia")  # floats: no SymPy per link
+            check_physical(link.mass if m is None else m, link.inertia if inertia is None else inertia,
+                           f"link '{link.name}'", source, strict=strict)
             self.links[link.name] = link
 
         children = {j.child for j in joints}
@@ -681,17 +835,20 @@ class Robot(metaclass=_FreezeAfterInit):
 
     def free_symbols(self) -> set[sp.Symbol]:
         """Symbols the model's numbers depend on (the joint coordinates excluded)."""
+        def free(obj, name):  # Numbers have none (and are not built into SymPy here)
+            raw = obj.__dict__[name]
+            return set() if raw is None or isinstance(raw, Numbers) else sp.sympify(raw).free_symbols
+
         out: set = set(self.gravity.free_symbols)
         for link in self.links.values():
-            out |= sp.sympify(link.mass).free_symbols | link.com.free_symbols | link.inertia.free_symbols
+            out |= free(link, "mass") | free(link, "com") | free(link, "inertia")
         for j in self.joints:
-            out |= j.xyz.free_symbols | j.rotation.free_symbols | j.axis.free_symbols
-            out |= j.frame_xyz.free_symbols | j.frame_rotation.free_symbols
+            for name in ("xyz", "rotation", "axis", "frame_xyz", "frame_rotation"):
+                out |= free(j, name)
             if j.mimic is not None:
                 out |= j.mimic.multiplier.free_symbols | j.mimic.offset.free_symbols
             for name in JOINT_DYNAMICS:
-                if getattr(j, name) is not None:
-                    out |= getattr(j, name).free_symbols
+                out |= free(j, name)
         return out
 
     def canonical(self) -> "Robot":
@@ -747,6 +904,8 @@ class Robot(metaclass=_FreezeAfterInit):
         for key, val in values.items():
             sym = self.parameters.get(key, sp.Symbol(key)) if isinstance(key, str) else key
             table[sym] = sp.sympify(val)
+        if not table and self.__dict__.get("_frozen"):  # nothing to substitute: the same
+            return self  # immutable robot (a big numeric URDF is not rebuilt in SymPy)
 
         def s(x):
             return None if x is None else sp.sympify(x).xreplace(table)

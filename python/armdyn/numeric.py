@@ -72,11 +72,27 @@ def _floats(values, where: str) -> list[float]:
     """SymPy numbers (exact or float) to Python floats."""
     out = []
     for v in values:
+        if isinstance(v, (int, float, sp.Integer, sp.Float)):  # the common case, no evalf
+            out.append(float(v))
+            continue
         try:
             out.append(float(sp.N(v)))
         except (TypeError, ValueError):
             raise ModelError(f"value {v} is not a real number", where) from None
     return out
+
+
+def _field(obj, name: str, where: str) -> list:
+    """A Link/Joint field as floats (nested lists): read from the floats it was built
+    from when it has them (no SymPy per joint for big URDFs), else from SymPy."""
+    f = obj.floats(name)
+    if f is not None:
+        return f.tolist()
+    value = getattr(obj, name)
+    if isinstance(value, sp.MatrixBase):
+        flat = _floats(value, where)
+        return flat if value.shape[1] == 1 else np.reshape(flat, value.shape).tolist()
+    return _floats([value], where)[0]
 
 
 def compile_model(robot: Robot | NumericModel) -> NumericModel:
@@ -108,20 +124,20 @@ def compile_model(robot: Robot | NumericModel) -> NumericModel:
         where = f"joint '{j.name}'"
         parents.append(joint_index.get(j.parent, -1))
         types.append(_TYPE_CODES[j.type])
-        rotations.append(np.reshape(_floats(j.rotation, where), (3, 3)).tolist())
-        translations.append(_floats(j.xyz, where))
-        axes.append(_floats(j.axis, where) if j.movable else [0.0, 0.0, 1.0])
+        rotations.append(_field(j, "rotation", where))
+        translations.append(_field(j, "xyz", where))
+        axes.append(_field(j, "axis", where) if j.movable else [0.0, 0.0, 1.0])
         link = robot.links[j.child]
         where = f"link '{link.name}'"
-        masses.append(_floats([link.mass], where)[0])
-        coms.append(_floats(link.com, where))
-        inertias.append(np.reshape(_floats(link.inertia, where), (3, 3)).tolist())
+        masses.append(_field(link, "mass", where))
+        coms.append(_field(link, "com", where))
+        inertias.append(_field(link, "inertia", where))
     # per movable joint [armature, viscous, coulomb, offset] (absent = 0); None when all zero
     # one row per joint the compiled model frees (mimic joints too); a mimic joint's own
     # friction and armature are not modelled (yet): zeros, as in the reference
     joint_dynamics = [
-        _floats([getattr(j, k) if getattr(j, k) is not None and j.mimic is None else 0
-                 for k in ("armature", "damping", "friction", "torque_offset")], f"joint '{j.name}'")
+        [0.0 if j.mimic is not None or j.floats(k) is None else float(j.floats(k))
+         for k in ("armature", "damping", "friction", "torque_offset")]
         for j in robot.joints if j.movable
     ]
     if not any(any(row) for row in joint_dynamics):
@@ -133,7 +149,7 @@ def compile_model(robot: Robot | NumericModel) -> NumericModel:
         model = NumericModel(
             parents, types, rotations, translations, axes, masses, coms, inertias, gravity_vec,
             list(robot.links), [j.name for j in robot.joints if j.movable], robot.name,
-            _floats([base.mass], where)[0], _floats(base.com, where), joint_dynamics,
+            _field(base, "mass", where), _field(base, "com", where), joint_dynamics,
         )
     except ValueError as err:
         raise ModelError(str(err), f"robot '{robot.name}'") from None

@@ -143,7 +143,8 @@ macro_rules! derivatives_of {
                 &[n, n],
                 threads,
                 |md, s, [a, b, c], e, [o0, o1, o2]| {
-                    $algo(md, &mut s.data, &mut s.deriv, a, b, c, ext_forces(e).as_ref(), o0, o1, o2)
+                    let (data, deriv) = s.deriv(md);
+                    $algo(md, data, deriv, a, b, c, ext_forces(e).as_ref(), o0, o1, o2)
                 },
                 |md, a, e, o, t| $batch(md, a, e, o, t),
             )?;
@@ -184,7 +185,10 @@ macro_rules! matrix_of_q {
                 "local",
                 &[n, n],
                 threads,
-                |md, s, [q], _, [o]| $algo(md, &mut s.data, &mut s.deriv, q, o),
+                |md, s, [q], _, [o]| {
+                    let (data, deriv) = s.deriv(md);
+                    $algo(md, data, deriv, q, o)
+                },
                 |md, [q], _, [o], t| $batch(md, q, o, t),
             )?;
             Ok(o)
@@ -258,7 +262,8 @@ macro_rules! with_wrenches {
                 threads,
                 |md, s, [a, b, c], e, [o]| {
                     let e = ext_forces(e).expect("f_ext");
-                    $algo(md, &mut s.data, &mut s.deriv, a, b, c, &e, o)
+                    let (data, deriv) = s.deriv(md);
+                    $algo(md, data, deriv, a, b, c, &e, o)
                 },
                 |md, a, e, [o], t| $batch(md, a, e.expect("f_ext"), o, t),
             )?;

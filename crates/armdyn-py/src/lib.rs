@@ -192,12 +192,20 @@ fn thread_arg(threads: Option<i64>) -> PyResult<Option<usize>> {
 struct Scratch {
     data: Data<f64>,
     coriolis: CoriolisWork,
-    deriv: armdyn_core::DerivData<f64>,
+    /// Built on the first derivative call: it holds nv x nv blocks and subtree lists
+    /// (O(nv^2) memory), which a 10^4-joint model must not pay for rnea alone.
+    deriv_work: Option<armdyn_core::DerivData<f64>>,
 }
 
 impl Scratch {
     fn new(model: &Model) -> Self {
-        Scratch { data: Data::new(model), coriolis: CoriolisWork::new(model), deriv: armdyn_core::DerivData::new(model) }
+        Scratch { data: Data::new(model), coriolis: CoriolisWork::new(model), deriv_work: None }
+    }
+
+    /// The derivative workspace and `data`, the workspace built on first use.
+    fn deriv(&mut self, model: &Model) -> (&mut Data<f64>, &mut armdyn_core::DerivData<f64>) {
+        let deriv = self.deriv_work.get_or_insert_with(|| armdyn_core::DerivData::new(model));
+        (&mut self.data, deriv)
     }
 }
 

@@ -54,6 +54,7 @@ import os
 import re
 import warnings
 import xml.etree.ElementTree as ET
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -61,7 +62,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..inertia import rotate
-from ..model import Joint, Link, Mimic, Robot, rpy_matrix
+from ..model import Joint, Link, Mimic, Numbers, Robot, rpy_matrix
 
 __all__ = ["load_urdf", "MasslessWarning"]
 
@@ -193,14 +194,47 @@ def _angle(value: float) -> sp.Expr:
     return _sym(value)
 
 
+def _rpy_floats(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """URDF roll-pitch-yaw in floats: ``Rz(yaw) Ry(pitch) Rx(roll)`` (3, 3)."""
+    cr, sr, cp, sp_, cy, sy = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch), math.cos(yaw), math.sin(yaw)
+    return np.array([
+        [cy * cp, cy * sp_ * sr - sy * cr, cy * sp_ * cr + sy * sr],
+        [sy * cp, sy * sp_ * sr + cy * cr, sy * sp_ * cr - cy * sr],
+        [-sp_, cp * sr, cp * cr],
+    ])
+
+
+def _rpy_exact(rpy: tuple) -> sp.Matrix:
+    """The SymPy form of an rpy rotation (pi/2 multiples exact, see :func:`_angle`);
+    built only when a symbolic function reads the joint."""
+    return rpy_matrix(*(_angle(a) for a in rpy))
+
+
+def _inertia_exact(entries: tuple, rpy: tuple) -> sp.Matrix:
+    """The SymPy form of an inertia tensor given in a rotated inertial frame."""
+    ixx, ixy, ixz, iyy, iyz, izz = (_sym(v) for v in entries)
+    tensor = sp.Matrix([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+    return rotate(tensor, _rpy_exact(rpy))
+
+
 def _optional(elem: ET.Element | None, name: str, where: str) -> float | None:
     if elem is None or elem.get(name) is None:
         return None
     return _number(elem.get(name), f"<{elem.tag}> {name}", where)
 
 
-def _origin(parent: ET.Element, where: str) -> tuple[sp.Matrix, sp.Matrix]:
-    """``(xyz (3, 1), R (3, 3))`` of an optional ``<origin>`` child (default identity)."""
+def _optional_numbers(elem: ET.Element | None, name: str, where: str) -> Numbers | None:
+    """An optional joint value as :class:`Numbers` (SymPy only when asked for: a Float,
+    as these were always read)."""
+    value = _optional(elem, name, where)
+    return None if value is None else Numbers(value, partial(sp.Float, value))
+
+
+def _origin(parent: ET.Element, where: str) -> tuple[Numbers, Numbers, tuple]:
+    """``(xyz (3,), R (3, 3), rpy)`` of an optional ``<origin>`` child (default identity).
+
+    xyz and R are :class:`Numbers`: floats now, SymPy (whole numbers and pi/2 angles
+    exact) only when a symbolic function asks, so big URDFs load without SymPy."""
     origin = _single(parent, "origin", where)
     xyz, rpy = [0.0] * 3, [0.0] * 3
     if origin is not None:
@@ -208,8 +242,12 @@ def _origin(parent: ET.Element, where: str) -> tuple[sp.Matrix, sp.Matrix]:
             xyz = _numbers(origin.get("xyz"), 3, "<origin> xyz", where)
         if origin.get("rpy") is not None:
             rpy = _numbers(origin.get("rpy"), 3, "<origin> rpy", where)
-    rotation = sp.eye(3) if not any(rpy) else rpy_matrix(*(_angle(a) for a in rpy))
-    return sp.Matrix([_sym(v) for v in xyz]), rotation
+    rpy = tuple(rpy)
+    if not any(rpy):
+        rotation = Numbers(np.eye(3))
+    else:
+        rotation = Numbers(_rpy_floats(*rpy), partial(_rpy_exact, rpy))
+    return Numbers(xyz), rotation, rpy
 
 
 def _link(elem: ET.Element, index: int) -> tuple[Link, bool]:
@@ -223,20 +261,24 @@ def _link(elem: ET.Element, index: int) -> tuple[Link, bool]:
     mass = _number(_attr(mass_elem, "value", where), "<mass> value", where)
     tensor = _single(inertial, "inertia", where, required=True)
     i = {
-        k: _sym(_number(_attr(tensor, k, where), f"<inertia> {k}", where))
+        k: _number(_attr(tensor, k, where), f"<inertia> {k}", where)
         for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
     }
-    inertia = sp.Matrix(
+    tensor = np.array(
         [
             [i["ixx"], i["ixy"], i["ixz"]],
             [i["ixy"], i["iyy"], i["iyz"]],
             [i["ixz"], i["iyz"], i["izz"]],
         ]
     )
-    com, rotation = _origin(inertial, where)
-    if rotation != sp.eye(3):
-        inertia = rotate(inertia, rotation)
-    return Link(name, _sym(mass), com, inertia), True
+    com, rotation, rpy = _origin(inertial, where)
+    if any(rpy):  # given in the inertial frame: I_link = R I R^T
+        R = rotation.floats
+        entries = tuple(i[k] for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"))
+        inertia = Numbers(R @ tensor @ R.T, partial(_inertia_exact, entries, rpy))
+    else:
+        inertia = Numbers(tensor)
+    return Link(name, Numbers(mass), com, inertia), True
 
 
 def _joint(elem: ET.Element, index: int) -> Joint:
@@ -249,9 +291,9 @@ def _joint(elem: ET.Element, index: int) -> Joint:
         raise ModelError(f"unknown joint type '{kind}' (expected one of {', '.join(JOINT_TYPES)})", where)
     parent = _attr(_single(elem, "parent", where, required=True), "link", where)
     child = _attr(_single(elem, "child", where, required=True), "link", where)
-    xyz, rotation = _origin(elem, where)
+    xyz, rotation, _ = _origin(elem, where)
 
-    axis = sp.Matrix([1, 0, 0])
+    axis = Numbers([1.0, 0.0, 0.0])
     axis_elem = _single(elem, "axis", where)
     if kind != "fixed" and axis_elem is not None:
         values = _numbers(_attr(axis_elem, "xyz", where), 3, "<axis> xyz", where)
@@ -260,11 +302,11 @@ def _joint(elem: ET.Element, index: int) -> Joint:
             raise ModelError("axis is zero", where)
         if abs(norm - 1) > AXIS_TOLERANCE:
             raise ModelError(f"axis {values} is not a unit vector (norm {norm:.6g})", where)
-        axis = sp.Matrix([_sym(v / norm) for v in values])
+        axis = Numbers([v / norm for v in values])
 
     limit = _single(elem, "limit", where)
     dynamics = _single(elem, "dynamics", where)
-    limits = {k: _optional(limit, k, where) for k in ("lower", "upper", "effort", "velocity")}
+    limits = {k: _optional_numbers(limit, k, where) for k in ("lower", "upper", "effort", "velocity")}
     if kind == "continuous":
         limits["lower"] = limits["upper"] = None  # URDF: ignored for continuous joints
     mimic = _mimic(elem, where)
@@ -276,8 +318,8 @@ def _joint(elem: ET.Element, index: int) -> Joint:
         xyz=xyz,
         rotation=rotation,
         axis=axis,
-        damping=_optional(dynamics, "damping", where),
-        friction=_optional(dynamics, "friction", where),
+        damping=_optional_numbers(dynamics, "damping", where),
+        friction=_optional_numbers(dynamics, "friction", where),
         mimic=None if kind == "fixed" else mimic,
         **limits,
     )
@@ -338,7 +380,7 @@ def _warn_inert_joints(robot: Robot, source: str) -> None:
     inert: dict[str, bool] = {}
     for joint in reversed(robot.joints):  # children before parents
         link = robot.links[joint.child]
-        own = float(link.mass) == 0 and not any(float(x) for x in link.inertia)
+        own = float(link.floats("mass")) == 0 and not np.any(link.floats("inertia"))
         inert[joint.child] = own and all(inert[j.child] for j in robot.children(joint.child))
     # a coordinate is idle when every joint it moves (itself and its mimics) moves nothing
     moves = [False] * robot.dof
