@@ -366,6 +366,29 @@ def test_robot_cannot_change_under_its_compiled_model():
     np.testing.assert_array_equal(numeric.gravity(robot, q), g0)  # the original is untouched
 
 
+def test_robot_pickles_and_stays_frozen():
+    """Before: pickle.loads refilled the frozen lists/dicts item by item and raised
+    TypeError, so a Robot could not be sent to a process pool or cached to disk."""
+    import pickle
+
+    import armdyn
+
+    for name in ("ur5", "panda"):
+        robot = armdyn.load(name)
+        q = np.linspace(-0.6, 0.7, robot.dof)
+        expect = numeric.rnea(robot, q, 0.5 * q, -q)
+        copy = pickle.loads(pickle.dumps(robot))
+        assert type(copy.joints).__name__ == "FrozenList" and type(copy.links).__name__ == "FrozenDict"
+        np.testing.assert_array_equal(numeric.rnea(copy, q, 0.5 * q, -q), expect)
+        with pytest.raises(TypeError, match="immutable"):
+            copy.joints.append(copy.joints[0])
+        with pytest.raises(AttributeError, match="immutable"):
+            copy.gravity = None
+    # symbolic: the pickled rp-arm derives the same equations, term for term
+    rp = armdyn.load("rp-arm")
+    assert armdyn.derive(pickle.loads(pickle.dumps(rp))).tau == armdyn.derive(rp).tau
+
+
 def test_published_defaults_in_the_api_must_be_finite():
     import sympy as sp
 

@@ -523,6 +523,10 @@ class FrozenList(list):
     def __copy__(self):
         return list(self)
 
+    def __reduce__(self):
+        # pickle's default for a list subclass refills it with extend(), which is refused
+        return (FrozenList, (list(self),))
+
 
 class FrozenDict(dict):
     """A dict that refuses in-place changes (``dict(d)``, ``{**d}`` give plain copies)."""
@@ -534,6 +538,10 @@ class FrozenDict(dict):
 
     def __copy__(self):
         return dict(self)
+
+    def __reduce__(self):
+        # pickle's default for a dict subclass refills it item by item, which is refused
+        return (FrozenDict, (dict(self),))
 
 
 class _FreezeAfterInit(type):
