@@ -68,6 +68,7 @@ import symengine as se
 import sympy as sp
 
 from .model import Robot
+from .symbolic import dag
 from .symbolic.joint_terms import _value
 
 #: standard inertial parameter names per link, DESIGN.md's (Pinocchio's) order
@@ -308,22 +309,10 @@ def _exact_evaluate(matrix: sp.Matrix, values: dict, modulus: int | None = None)
             raise KeyError(f"no value for symbol {e}")
         raise ValueError(f"cannot evaluate {e} exactly (only polynomials in parameters, sin/cos of symbols and sign)")
 
-    def ev(root):
-        stack = [(root, False)]
-        while stack:
-            e, ready = stack.pop()
-            if e in memo:
-                continue
-            if e in values or not e.args or e.is_Number:
-                memo[e] = node(e, [])
-            elif ready:
-                memo[e] = node(e, [memo[a] for a in e.args])
-            else:
-                stack.append((e, True))
-                stack.extend((a, False) for a in e.args if a not in memo)
-        return memo[root]
+    def ev(entry):
+        return dag.fold(sp.sympify(entry), node, memo, leaf=values.__contains__)
 
-    return [[ev(sp.sympify(matrix[i, j])) for j in range(matrix.shape[1])] for i in range(matrix.shape[0])]
+    return [[ev(matrix[i, j]) for j in range(matrix.shape[1])] for i in range(matrix.shape[0])]
 
 
 def _rational(a: int, p: int = PRIME) -> Fraction:

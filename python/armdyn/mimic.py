@@ -207,13 +207,7 @@ class MimicModel:
         qf = self._position(q)
         M = self._reduce_matrix(self._call("crba", named, qf, threads))
         rhs = tau - self._reduce(self._call("bias", named, qf, self._rate(qd), threads))
-        try:
-            L = np.linalg.cholesky(M)
-        except np.linalg.LinAlgError:
-            raise ValueError(
-                f"aba: the mass matrix of '{self.name}' is not positive definite at this state "
-                "(a coordinate that moves no mass or inertia?)"
-            ) from None
+        L = self._cholesky(M, "aba")
         y = np.linalg.solve(L, rhs[..., None])
         return np.linalg.solve(np.swapaxes(L, -1, -2), y)[..., 0]
 
@@ -253,16 +247,21 @@ class MimicModel:
         """``armdyn._core.<function>(self.full, *args)``; NaN/inf re-worded as in :meth:`_call`."""
         return self._guarded(lambda: getattr(_core, function)(self.full, *args), function, named)
 
-    def _inverse_mass_matrix(self, M: np.ndarray, what: str) -> np.ndarray:
-        """``M^-1`` of (..., dof, dof) symmetric positive definite matrices, by Cholesky
-        (``M = L L^T``, ``M^-1 = L^-T L^-1``); ValueError when M is not positive definite."""
+    def _cholesky(self, M: np.ndarray, what: str) -> np.ndarray:
+        """L with ``M = L L^T`` for (..., dof, dof) mass matrices; ValueError naming
+        ``what`` when M is not positive definite."""
         try:
-            L = np.linalg.cholesky(M)
+            return np.linalg.cholesky(M)
         except np.linalg.LinAlgError:
             raise ValueError(
                 f"{what}: the mass matrix of '{self.name}' is not positive definite at this state "
                 "(a coordinate that moves no mass or inertia?)"
             ) from None
+
+    def _inverse_mass_matrix(self, M: np.ndarray, what: str) -> np.ndarray:
+        """``M^-1`` of (..., dof, dof) symmetric positive definite matrices, by Cholesky
+        (``M = L L^T``, ``M^-1 = L^-T L^-1``); ValueError when M is not positive definite."""
+        L = self._cholesky(M, what)
         Linv = np.linalg.solve(L, np.broadcast_to(np.eye(self.dof), M.shape))
         return np.swapaxes(Linv, -1, -2) @ Linv
 

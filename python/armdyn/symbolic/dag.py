@@ -48,24 +48,36 @@ def xreplace(expr, mapping: dict):
     return _xreplace(expr, mapping, {})
 
 
-def _xreplace(expr, mapping, memo):
-    # iterative post-order walk: deep expressions must not hit the recursion limit
-    stack = [(sp.sympify(expr), False)]
+def fold(root, node, memo: dict, leaf=None):
+    """Evaluate the expression DAG under ``root`` bottom-up: ``node(e, results of e.args)``
+    once per distinct subexpression (results kept in ``memo``, which callers may share
+    between roots). ``e`` is a leaf, ``node(e, [])``, when it has no args, is a Number or
+    ``leaf(e)`` is true. An iterative post-order walk: deep expressions must not hit the
+    recursion limit."""
+    stack = [(root, False)]
     while stack:
         e, ready = stack.pop()
         if e in memo:
             continue
-        if e in mapping:
-            memo[e] = mapping[e]
-        elif not e.args:
-            memo[e] = e
+        if not e.args or e.is_Number or (leaf is not None and leaf(e)):
+            memo[e] = node(e, [])
         elif ready:
-            args = [memo[a] for a in e.args]
-            memo[e] = e if all(a is b for a, b in zip(args, e.args)) else e.func(*args)
+            memo[e] = node(e, [memo[a] for a in e.args])
         else:
             stack.append((e, True))
             stack.extend((a, False) for a in e.args if a not in memo)
-    return memo[sp.sympify(expr)]
+    return memo[root]
+
+
+def _xreplace(expr, mapping, memo):
+    def node(e, args):
+        if e in mapping:
+            return mapping[e]
+        if not args or all(a is b for a, b in zip(args, e.args)):
+            return e
+        return e.func(*args)
+
+    return fold(sp.sympify(expr), node, memo, leaf=mapping.__contains__)
 
 
 _NUMPY_FUNCS = {sp.sin: np.sin, sp.cos: np.cos, sp.tan: np.tan, sp.exp: np.exp, sp.log: np.log, sp.Abs: np.abs}
@@ -97,22 +109,9 @@ def evaluate(matrix: sp.Matrix, values: dict) -> np.ndarray:
         f = sp.lambdify(list(e.free_symbols), e, modules="numpy")  # anything rarer
         return f(*(values[s] for s in e.free_symbols))
 
-    def ev(root):
-        stack = [(root, False)]
-        while stack:
-            e, ready = stack.pop()
-            if e in memo:
-                continue
-            if ready or not e.args or e.is_Number:
-                memo[e] = node(e, [memo[a] for a in e.args] if e.args and not e.is_Number else [])
-            else:
-                stack.append((e, True))
-                stack.extend((a, False) for a in e.args if a not in memo)
-        return memo[root]
-
     rows, cols = matrix.shape
     out = np.empty((rows, cols, samples))
     for i in range(rows):
         for j in range(cols):
-            out[i, j] = ev(sp.sympify(matrix[i, j]))
+            out[i, j] = fold(sp.sympify(matrix[i, j]), node, memo)
     return out
