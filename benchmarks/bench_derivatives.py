@@ -37,8 +37,6 @@ import os
 import platform
 import statistics
 import sys
-import time
-import timeit
 
 import numpy as np
 import pinocchio as pin
@@ -46,6 +44,7 @@ import pinocchio as pin
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import arms  # noqa: E402  (also puts tests/ on sys.path for the Pinocchio bridge)
+from bench_numeric import batch_run, paired_medians, per_call_run  # noqa: E402  (the same timers as bench_numeric)
 from pinocchio_derivatives import PinocchioDerivatives  # noqa: E402
 
 from armdyn import numeric as num  # noqa: E402
@@ -59,30 +58,6 @@ def _pinocchio_cpp():
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
-
-
-def per_call_run(f, args, number: int):
-    names = [f"a{i}" for i in range(len(args))]
-    timer = timeit.Timer(f"f({', '.join(names)})", globals={"f": f, **dict(zip(names, args))})
-    return lambda: timer.timeit(number) / number
-
-
-def batch_run(f):
-    def run():
-        t0 = time.perf_counter()
-        f()
-        return time.perf_counter() - t0
-
-    return run
-
-
-def paired_medians(run_mine, run_theirs, repeat: int):
-    run_mine(), run_theirs()
-    mine, theirs = [], []
-    for _ in range(repeat):
-        mine.append(run_mine())
-        theirs.append(run_theirs())
-    return statistics.median(mine), statistics.median(theirs)
 
 
 def check(robot, P, rng):
