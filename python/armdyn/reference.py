@@ -649,10 +649,7 @@ def rnea_derivatives(robot: Robot, q, qd, qdd, f_ext=None, frame: str = "local")
     differentiation of RBDA Table 5.1 (one tangent pass per coordinate)."""
     t = _tree(robot)
     q, qd, qdd = _state(t, q, "q"), _state(t, qd, "qd"), _state(t, qdd, "qdd")
-    E, Z = np.eye(t.n), np.zeros(t.n)
-    cols = [[_rnea_tangent(t, q, qd, qdd, *(E[c] if k == w else Z for k in range(3)), f_ext, frame)[1]
-             for c in range(t.n)] for w in range(3)]
-    return tuple(np.array(c).reshape(t.n, t.n).T for c in cols)
+    return _forward_mode(t, _rnea_tangent, q, qd, qdd, f_ext, frame)
 
 
 def aba_derivatives(robot: Robot, q, qd, tau, f_ext=None, frame: str = "local"):
@@ -660,8 +657,15 @@ def aba_derivatives(robot: Robot, q, qd, tau, f_ext=None, frame: str = "local"):
     forward-mode differentiation of RBDA Table 7.1 (one tangent pass per coordinate)."""
     t = _tree(robot)
     q, qd, tau = _state(t, q, "q"), _state(t, qd, "qd"), _state(t, tau, "tau")
+    return _forward_mode(t, _aba_tangent, q, qd, tau, f_ext, frame)
+
+
+def _forward_mode(t, tangent, q, qd, x, f_ext, frame):
+    """The three (n, n) Jacobians of ``tangent``'s output with respect to q, qd and x
+    (qdd or tau), ``[i, j] = d out_i / d arg_j``: one tangent pass per coordinate, seeded
+    with a unit vector in one argument and zeros in the other two."""
     E, Z = np.eye(t.n), np.zeros(t.n)
-    cols = [[_aba_tangent(t, q, qd, tau, *(E[c] if k == w else Z for k in range(3)), f_ext, frame)[1]
+    cols = [[tangent(t, q, qd, x, *(E[c] if k == w else Z for k in range(3)), f_ext, frame)[1]
              for c in range(t.n)] for w in range(3)]
     return tuple(np.array(c).reshape(t.n, t.n).T for c in cols)
 
