@@ -111,6 +111,93 @@ def test_customized_algorithms_equal_derive_exactly(name):
         assert _is_zero(C[k] - eom.C[k // n, k % n], robot), f"C[{k // n}, {k % n}]"
 
 
+# a shoulder, then two joints about axes through one point (alpha -90, +90: the PUMA's
+# wrist in small), every inertial parameter symbolic; gravity along -y so that no
+# component of the base acceleration is zero
+WRIST_3R = """
+name: wrist-3r
+description: "3R arm, joints 2 and 3 sharing an origin, all inertia symbolic"
+convention: modified-dh
+parameters: {
+  L1: 0.3, g: 9.81,
+  m1: null, cx1: null, cy1: null, cz1: null, Ixx1: null, Iyy1: null, Izz1: null, Ixy1: null, Ixz1: null, Iyz1: null,
+  m2: null, cx2: null, cy2: null, cz2: null, Ixx2: null, Iyy2: null, Izz2: null, Ixy2: null, Ixz2: null, Iyz2: null,
+  m3: null, cx3: null, cy3: null, cz3: null, Ixx3: null, Iyy3: null, Izz3: null, Ixy3: null, Ixz3: null, Iyz3: null,
+}
+gravity: [0, -g, 0]
+dh:
+  - {name: q1, type: revolute, link: link1, a: 0, alpha: 0, d: 0, theta: 0, mass: m1, com: [cx1, cy1, cz1],
+     inertia: {ixx: Ixx1, iyy: Iyy1, izz: Izz1, ixy: Ixy1, ixz: Ixz1, iyz: Iyz1}}
+  - {name: q2, type: revolute, link: link2, a: L1, alpha: -pi/2, d: 0, theta: 0, mass: m2, com: [cx2, cy2, cz2],
+     inertia: {ixx: Ixx2, iyy: Iyy2, izz: Izz2, ixy: Ixy2, ixz: Ixz2, iyz: Iyz2}}
+  - {name: q3, type: revolute, link: link3, a: 0, alpha: pi/2, d: 0, theta: 0, mass: m3, com: [cx3, cy3, cz3],
+     inertia: {ixx: Ixx3, iyy: Iyy3, izz: Izz3, ixy: Ixy3, ixz: Ixz3, iyz: Iyz3}}
+"""
+
+
+@pytest.fixture
+def wrist_3r(tmp_path):
+    path = tmp_path / "wrist-3r.yaml"
+    path.write_text(WRIST_3R)
+    return _load(str(path))
+
+
+@pytest.mark.parametrize("grouped", [False, True])
+def test_customized_tau_equals_derive_exactly_on_a_shared_origin_wrist(wrist_3r, grouped):
+    """Exact symbolic equality with armdyn.derive (Craig's Newton-Euler) on a spatial 3R
+    arm whose joints 2, 3 share an origin (alpha = -90, +90 deg), in the standard and in
+    the grouped parameters: the frames where every program transformation applies (the
+    norm invariant of the child's angular velocity read off the parent's U, zeros of the
+    grouping, p = 0 between links)."""
+    from armdyn.symbolic.grouping import grouped_parameters
+
+    robot = wrist_3r
+    eom = derive(robot, "newton-euler")
+    params, defs = standard_parameters(robot)
+    if grouped:
+        params, extra = grouped_parameters(robot, params, defs)
+        defs = defs + extra
+    tau_prog, tdefs = customized_newton_euler(robot, parameters=params)
+    tau = _substituted(_substituted(tau_prog.inlined(), tdefs), defs)
+    for k in range(robot.dof):
+        assert _is_zero(tau[k] - eom.tau[k], robot), f"tau[{k}]"
+
+
+def test_child_angular_velocity_norm_is_read_off_the_parent(wrist_3r):
+    """The invariant ``wx^2 + wy^2`` of a child whose z axis is a parent axis is taken from
+    the parent's U (no ``wy^2`` product is formed) on every moving link after the first of
+    the wrist arm and of the PUMA 560; and it is the right value: on the wrist arm, the
+    parent's U entry it reads equals ``-(wx^2 + wy^2)`` of the child's angular velocity
+    ``R^T w_parent + qd z`` formed here directly (exact, with sin^2 + cos^2 = 1)."""
+    from armdyn.codegen.program import Builder
+    from armdyn.symbolic import customized_ne as cne
+
+    for robot in (wrist_3r, _load("puma560-craig")):
+        prog, _ = customized_newton_euler(robot)
+        names = {str(s) for s, _ in prog.assignments}
+        for k in range(2, robot.dof + 1):
+            assert f"w{k}yy" not in names, (robot.name, k)
+    robot = wrist_3r.canonical()
+    b = Builder()
+    frames = cne.joint_frames(robot, b)
+    U = {robot.base: sp.zeros(3, 3)}
+    w = {robot.base: sp.zeros(3, 1)}
+    used = 0
+    for joint in robot.joints:
+        R, _ = frames[joint.child]
+        k = robot.coordinate_index(joint)
+        S = cne._parent_invariant(joint, R, U[joint.parent])
+        wj = R.T * w[joint.parent] + robot.qd[k] * joint.axis
+        if S is not None:
+            used += 1
+            values = dict(b.assignments)  # c2 = cos(q2), ... of the frames
+            assert _is_zero((S + wj[0] ** 2 + wj[1] ** 2).xreplace(values), robot), joint.child
+        sq = {"U11": -wj[1] ** 2 - wj[2] ** 2, "U22": -wj[0] ** 2 - wj[2] ** 2, "U33": -wj[0] ** 2 - wj[1] ** 2}
+        U[joint.child] = sp.diag(sq["U11"], sq["U22"], sq["U33"])
+        w[joint.child] = wj
+    assert used == robot.dof
+
+
 @pytest.mark.parametrize("name", ["puma560-craig", "puma560", "stanford", "ur5"])
 def test_customized_algorithms_equal_derive_at_random_points(name):
     """All parameters symbolic (as loaded); tau and M at random values of q, qd, qdd and

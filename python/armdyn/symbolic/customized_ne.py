@@ -138,20 +138,67 @@ def joint_frames(robot: Robot, b: Builder) -> dict:
     return frames
 
 
-def _skew2(b: Builder, w, wd, tag) -> sp.Matrix:
-    """U = skew(wd) + skew(w) skew(w) (3x3), Khalil eq. 9.79, with the products named."""
+def _squares(b: Builder, w, tag, S=None) -> dict:
+    """The products of w's components that U and the Euler moment use (named once):
+    ``xy, xz, yz``, the diagonal of ``skew(w)^2`` (``U11 = -wy^2 - wz^2``, ``U22``,
+    ``U33``) and the differences ``d0 = wy^2 - wz^2, d1 = wz^2 - wx^2, d2 = wx^2 - wy^2``.
+
+    S: ``-(wx^2 + wy^2)`` when it is already known from the parent (see
+    :func:`_parent_invariant`): a rotation about the joint axis z leaves ``wx^2 + wy^2``
+    unchanged, so ``wy^2`` is not needed (one multiplication less per link)::
+
+        U22 = -wx^2 - wz^2,  d1 = wz^2 - wx^2,  U33 = S,  U11 = S - d1,  d0 = U22 - S,
+        d2 = U11 - U22
+    """
     w1, w2, w3 = w
-    sq = [b.let(w1 * w1, f"w{tag}xx"), b.let(w2 * w2, f"w{tag}yy"), b.let(w3 * w3, f"w{tag}zz")]
-    xy, xz, yz = b.let(w1 * w2, f"w{tag}xy"), b.let(w1 * w3, f"w{tag}xz"), b.let(w2 * w3, f"w{tag}yz")
+    xx, zz = b.let(w1 * w1, f"w{tag}xx"), b.let(w3 * w3, f"w{tag}zz")
+    out = {"xy": b.let(w1 * w2, f"w{tag}xy"), "xz": b.let(w1 * w3, f"w{tag}xz"), "yz": b.let(w2 * w3, f"w{tag}yz")}
+    if S is None:
+        yy = b.let(w2 * w2, f"w{tag}yy")
+        out.update(U11=b.let(-yy - zz, f"U{tag}_11"), U22=b.let(-xx - zz, f"U{tag}_22"),
+                   U33=b.let(-xx - yy, f"U{tag}_33"), d0=b.let(yy - zz, f"w{tag}_yy_zz"),
+                   d1=b.let(zz - xx, f"w{tag}_zz_xx"), d2=b.let(xx - yy, f"w{tag}_xx_yy"))
+    else:
+        U22, d1 = b.let(-xx - zz, f"U{tag}_22"), b.let(zz - xx, f"w{tag}_zz_xx")
+        U11 = b.let(S - d1, f"U{tag}_11")
+        out.update(U11=U11, U22=U22, U33=S, d0=b.let(U22 - S, f"w{tag}_yy_zz"), d1=d1,
+                   d2=b.let(U11 - U22, f"w{tag}_xx_yy"))
+    return out
+
+
+def _parent_invariant(joint, R, U_parent):
+    """``-(wx^2 + wy^2)`` of the child's angular velocity, read off the parent's U, or
+    None. When the joint moves about (or along) the child's z axis and that axis is a
+    parent axis ``+-e_k`` (``R e_z = +-e_k``, as in every DH frame), the child's x and y
+    components are the parent's other two components rotated about it, so
+    ``wx^2 + wy^2 = sum_{i != k} wp_i^2 = -U_parent[k, k]`` (the norm is unchanged by a
+    rotation; the parent's U diagonal holds these sums)."""
+    if joint.type == "revolute" and not (joint.axis == sp.Matrix([0, 0, 1]) or joint.axis == sp.Matrix([0, 0, -1])):
+        return None
+    if joint.type not in ("revolute", "prismatic"):
+        return None
+    col = [R[i, 2] for i in range(3)]
+    if not all(e.is_Number for e in col):
+        return None
+    hits = [i for i, e in enumerate(col) if e != 0]
+    if len(hits) != 1 or abs(col[hits[0]]) != 1:
+        return None
+    return U_parent[hits[0], hits[0]]
+
+
+def _skew2(b: Builder, w, wd, tag, sq: dict) -> sp.Matrix:
+    """U = skew(wd) + skew(w) skew(w) (3x3), Khalil eq. 9.79, from the named products
+    ``sq`` of :func:`_squares`."""
+    xy, xz, yz = sq["xy"], sq["xz"], sq["yz"]
     U = sp.Matrix([
-        [-sq[1] - sq[2], xy - wd[2], xz + wd[1]],
-        [xy + wd[2], -sq[0] - sq[2], yz - wd[0]],
-        [xz - wd[1], yz + wd[0], -sq[0] - sq[1]],
+        [sq["U11"], xy - wd[2], xz + wd[1]],
+        [xy + wd[2], sq["U22"], yz - wd[0]],
+        [xz - wd[1], yz + wd[0], sq["U33"]],
     ])
     return sp.Matrix(3, 3, lambda r, s: b.let(U[r, s], f"U{tag}_{r + 1}{s + 1}"))
 
 
-def _euler_moment(b: Builder, J, differences, w, wd, U, tag) -> sp.Matrix:
+def _euler_moment(b: Builder, J, differences, w, wd, U, sq) -> sp.Matrix:
     """J wd + w x (J w) (3x1) for a symmetric J, as linear in J's six entries, with the
     coefficients taken from U (whose off-diagonal entries are wd_k +- w_i w_j) and the
     squares of w::
@@ -164,10 +211,8 @@ def _euler_moment(b: Builder, J, differences, w, wd, U, tag) -> sp.Matrix:
     are (ZZ - YY, XX - ZZ, YY - XX), parameters of their own (:func:`moment_differences`)."""
     XX, XY, XZ, YY, YZ, ZZ = J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2]
     ZZ_YY, XX_ZZ, YY_XX = differences
-    wx, wy, wz = w
-    sq = [b.let(wx * wx, f"w{tag}xx"), b.let(wy * wy, f"w{tag}yy"), b.let(wz * wz, f"w{tag}zz")]
-    wxy, wxz, wyz = b.let(wx * wy, f"w{tag}xy"), b.let(wx * wz, f"w{tag}xz"), b.let(wy * wz, f"w{tag}yz")
-    d = [b.let(sq[1] - sq[2], f"w{tag}_yy_zz"), b.let(sq[2] - sq[0], f"w{tag}_zz_xx"), b.let(sq[0] - sq[1], f"w{tag}_xx_yy")]
+    wxy, wxz, wyz = sq["xy"], sq["xz"], sq["yz"]
+    d = [sq["d0"], sq["d1"], sq["d2"]]
     return sp.Matrix([
         XX * wd[0] - XY * U[2, 0] + XZ * U[1, 0] + YZ * d[0] + ZZ_YY * wyz,
         XY * U[2, 1] + YY * wd[1] - YZ * U[0, 1] + XZ * d[1] + XX_ZZ * wxz,
@@ -251,10 +296,11 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         if joint.type == "prismatic":
             vd_j = _vadd(vd_j, _vscale(2, _vcross(w_j, _vscale(qd[k], z))), _vscale(qdd[k], z))
         vd_j = b.vector(vd_j, f"vd{tag}")
-        U_j = _skew2(b, w_j, wd_j, tag)
+        sq = _squares(b, w_j, tag, _parent_invariant(joint, R, U[parent]))
+        U_j = _skew2(b, w_j, wd_j, tag, sq)
         M, MS, J = parameters[name]
         F[name] = b.vector(_vadd(_vscale(M, vd_j), _mv(U_j, MS)), f"F{tag}")
-        N[name] = b.vector(_vadd(_euler_moment(b, J, differences[name], w_j, wd_j, U_j, tag), _vcross(MS, vd_j)),
+        N[name] = b.vector(_vadd(_euler_moment(b, J, differences[name], w_j, wd_j, U_j, sq), _vcross(MS, vd_j)),
                            f"N{tag}")
         w[name], wd[name], vd[name], U[name] = w_j, wd_j, vd_j, U_j
 
