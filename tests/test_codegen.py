@@ -198,6 +198,68 @@ def test_child_angular_velocity_norm_is_read_off_the_parent(wrist_3r):
     assert used == robot.dof
 
 
+def _is_zero_in(expr, angles) -> bool:
+    """expr == 0 identically: expanded (trig sums too), sin^2 + cos^2 = 1 for each angle."""
+    expr = sp.expand(sp.expand_trig(expr))
+    for q in angles:
+        s, c = sp.Dummy("s"), sp.Dummy("c")
+        expr = sp.expand(expr.xreplace({sp.sin(q): s, sp.cos(q): c}))
+        expr = sp.rem(expr, s**2 + c**2 - 1, s) if expr.has(s) else expr
+        expr = sp.expand(expr).xreplace({s: sp.sin(q), c: sp.cos(q)})
+    return sp.expand(expr) == 0
+
+
+def test_turned_leaf_frame_gives_the_same_tau_exactly_for_any_angle(wrist_3r):
+    """The leaf link's frame turned about its joint axis by a free angle th (joint angle
+    q3 + th, first moment and inertia turned with it, grouped parameters): tau equals
+    armdyn.derive's exactly, for every th. And the angle turn_leaf_frames picks puts the
+    first moment on x: its MY' is zero and its MX' is |(MX, MY)| (exact)."""
+    from armdyn.symbolic.grouping import grouped_parameters
+    from armdyn.symbolic.leaf_frames import _turned, turn_leaf_frames
+
+    robot = wrist_3r
+    eom = derive(robot, "newton-euler")
+    params, defs = standard_parameters(robot)
+    params, extra = grouped_parameters(robot, params, defs)
+    defs = defs + extra
+    th = sp.Symbol("th")
+    turned = dict(params)
+    turned["link3"] = _turned(*params["link3"], sp.cos(th), sp.sin(th))
+    tau_prog, tdefs = customized_newton_euler(robot, parameters=turned, turns={"link3": th})
+    assert any(str(s) == "q3t" for s, _ in tau_prog.assignments)
+    tau = _substituted(_substituted(tau_prog.inlined(), tdefs), defs)
+    for k in range(robot.dof):
+        assert _is_zero_in(tau[k] - eom.tau[k], list(robot.q) + [th]), f"tau[{k}]"
+    # the chosen angle
+    chosen, new, turns = turn_leaf_frames(robot, params, defs)
+    assert set(turns) == {"link3"}
+    M, MS, J = params["link3"]
+    assert chosen["link3"][1][1] == 0
+    r = sp.sqrt(MS[0] ** 2 + MS[1] ** 2)
+    _, MSt, _ = _turned(M, MS, J, MS[0] / r, MS[1] / r)
+    assert sp.simplify(MSt[1]) == 0 and sp.simplify(MSt[0] - r) == 0
+    assert sp.simplify(dict(new)[chosen["link3"][1][0]] - r) == 0
+
+
+@needs_cc
+def test_turned_leaf_frame_with_zero_first_moment_is_finite_and_right(tmp_path):
+    """A leaf whose first moment is zero (MX = MY = 0, the symmetric end link of most
+    arms) at run time: the turning angle is 0 (no division by |(MX, MY)| = 0), the
+    parameter vector is finite and tau, g equal the Rust core."""
+    robot = _load("puma560-craig")
+    rng = np.random.default_rng(5)
+    values = _values(robot, rng)
+    values.update(cx6=0.0, cy6=0.0)
+    lib = codegen.compile(robot, what="tau,g", directory=tmp_path)
+    assert any(str(s).startswith("th6") for s in lib.code.parameters)
+    p = lib.code.parameter_values(values)
+    assert np.all(np.isfinite(p)) and p.size > 0
+    bound = _numeric(robot, values)
+    q, qd, qdd = _states(rng, robot.dof, samples=11)  # one block of 8 lanes and 3 single states
+    _close(lib.tau(q, qd, qdd, p=p), armdyn.rnea(bound, q, qd, qdd))
+    _close(lib.g(q, p=p), armdyn.gravity(bound, q))
+
+
 @pytest.mark.parametrize("name", ["puma560-craig", "puma560", "stanford", "ur5"])
 def test_customized_algorithms_equal_derive_at_random_points(name):
     """All parameters symbolic (as loaded); tau and M at random values of q, qd, qdd and
@@ -464,5 +526,6 @@ def test_compiled_c_with_joint_friction_and_rotor_inertia_equals_rust_core(name,
     _close(lib.C(q, qd, p=p), armdyn.coriolis_matrix(bound, q, qd))
     py = codegen.codegen(robot, what="tau", lang="python")
     ns = _exec(py.source)
+    p = py.parameter_values(values)  # this code's own parameter vector (tau alone needs fewer)
     for k in range(len(q)):
         _close(ns[py.functions["tau"]](q[k], qd[k], qdd[k], p), armdyn.rnea(bound, q[k], qd[k], qdd[k]))

@@ -21,7 +21,10 @@ tau, g, M and C are evaluated at Khalil's grouped parameters
 (:mod:`armdyn.symbolic.grouping`: what of a link's inertia rides on its parent moved
 there, exactly), computed once per parameter set in the header; the zeros they leave
 (``M_j = MZ_j = YY_j = 0`` behind a revolute joint) propagate, so fewer operations run
-per state. Joint friction, rotor inertia and torque offsets, where the model has them, are
+per state. For tau and g each leaf link's frame is also turned about its joint axis so
+that its first moment lies on x (:mod:`armdyn.symbolic.leaf_frames`; the angle ``th`` and
+the turned parameters are computed once per parameter set, the joint angle becomes
+``q + th``). Joint friction, rotor inertia and torque offsets, where the model has them, are
 added as DESIGN.md writes them: all to tau, ``Ia`` to M's diagonal, the offset to g.
 
 ``base=True`` (needs :mod:`armdyn.identification`): the base parameters ``beta`` are the
@@ -176,10 +179,19 @@ def _parse_what(what) -> list[str]:
     return list(dict.fromkeys(what))
 
 
-def _in_model_parameters(extra, definitions) -> list:
-    """New definitions with the barycentric symbols in them replaced by theirs."""
+def _in_model_parameters(extra, definitions, chained: bool = False) -> list:
+    """New definitions with the barycentric symbols in them replaced by theirs
+    (``chained``: also the symbols of earlier entries of ``extra``)."""
     table = dict(definitions)
-    return [(s, sp.expand(e.xreplace(table))) for s, e in extra if s not in table]
+    out = []
+    for s, e in extra:
+        if s in table:
+            continue
+        value = sp.expand(e.xreplace(table))
+        out.append((s, value))
+        if chained:
+            table[s] = value
+    return out
 
 
 def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
@@ -193,17 +205,21 @@ def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
     # there once per parameter set, and the zeros it leaves propagate per state
     params, grouped = grouped_parameters(robot, params, definitions)
     definitions = definitions + grouped
+    # tau and g: each leaf link's frame turned about its joint axis to put its first
+    # moment on x (exact; per parameter set); M and C keep the link frames
+    ne_params, turned, turns = _turned_leaves(robot, params, definitions)
+    definitions = definitions + turned
     reserved = robot.free_symbols() | {s for s, _ in definitions}
     programs, sources = {}, {}
     n = robot.dof
     M_prog = None
     for w in what:
         if w == "tau":
-            programs[w], extra = customized_newton_euler(robot, parameters=params)
+            programs[w], extra = customized_newton_euler(robot, parameters=ne_params, turns=turns)
             definitions += _in_model_parameters(extra, definitions)
             sources[w] = "customized Newton-Euler"
         elif w == "g":
-            programs[w], extra = customized_newton_euler(robot, [0] * n, [0] * n, parameters=params)
+            programs[w], extra = customized_newton_euler(robot, [0] * n, [0] * n, parameters=ne_params, turns=turns)
             definitions += _in_model_parameters(extra, definitions)
             sources[w] = "customized Newton-Euler at qd = qdd = 0"
         elif w in ("M", "C"):
@@ -226,6 +242,15 @@ def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
             sources[w] = "armdyn.identification.regressor, CSE"
     _add_joint_terms(robot, programs)
     return programs, sources, definitions
+
+
+def _turned_leaves(robot: Robot, params: dict, definitions: list, taken=()):
+    """:func:`armdyn.symbolic.leaf_frames.turn_leaf_frames`, with the new definitions in
+    the model's parameters (``definitions``' symbols replaced by theirs)."""
+    from ..symbolic.leaf_frames import turn_leaf_frames
+
+    turned, new, turns = turn_leaf_frames(robot, params, definitions, taken)
+    return turned, _in_model_parameters(new, definitions), turns
 
 
 def _add_joint_terms(robot: Robot, programs: dict) -> None:
@@ -306,7 +331,12 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
     programs, sources, defs = {}, {}, []
     M_prog = builder = None
     reserved = robot.free_symbols() | set(beta) | set(robot.q) | set(robot.qd) | set(robot.qdd)
-    tau_prog, d = customized_newton_euler(robot, parameters=params)
+    # tau and g with the leaf links' frames turned (first moment on x), in the betas
+    from ..symbolic.leaf_frames import turn_leaf_frames
+
+    ne_params, leaf_defs, turns = turn_leaf_frames(robot, params, [], taken=beta)
+    tau_prog, d = customized_newton_euler(robot, parameters=ne_params, turns=turns)
+    d = leaf_defs + d  # in the betas; later ones may use earlier ones
     defs += d
     tau_prog.outputs = [o + extra[i] for i, o in enumerate(tau_prog.outputs)]
     # the check: tau of the program == Yb beta at random points (q, qd, qdd, parameters)
@@ -317,7 +347,8 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
     Ybn = dag.evaluate(Yb, values)  # (dof, n_beta, samples), numerically (no xreplace of Yb)
     for k in range(samples):
         env = {s: float(v[k]) for s, v in values.items()}
-        env.update({s: float(e.xreplace(env)) for s, e in d})
+        for s, e in d:
+            env[s] = float(e.xreplace(env))
         want = Ybn[:, :, k] @ np.array([env[b] for b in beta])
         got = np.array(tau_prog.evaluate(env))
         if not (np.all(np.isfinite(want)) and
@@ -327,7 +358,7 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
         if w == "tau":
             programs[w] = tau_prog
         elif w == "g":
-            programs[w], _ = customized_newton_euler(robot, [0] * n, [0] * n, parameters=params)
+            programs[w], _ = customized_newton_euler(robot, [0] * n, [0] * n, parameters=ne_params, turns=turns)
             g_extra = extra.xreplace({s: 0 for s in states})
             programs[w].outputs = [o + g_extra[i] for i, o in enumerate(programs[w].outputs)]
         elif w in ("M", "C") and M_prog is None:
@@ -342,7 +373,7 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
         sources[w] = {"tau": "customized Newton-Euler", "g": "customized Newton-Euler at qd = qdd = 0",
                       "M": "composite links", "C": "Christoffel symbols of the composite-link M"}[w] + \
             ", at the base parameters"
-    return programs, sources, _in_model_parameters(defs, definitions)
+    return programs, sources, _in_model_parameters(defs, definitions, chained=True)
 
 
 def codegen(robot: Robot | str, what=("tau", "M", "C", "g"), lang: str = "c", base: bool = False) -> GeneratedCode:

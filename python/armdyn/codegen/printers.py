@@ -253,6 +253,20 @@ def _c_batch(code, what, prog, fn, args, size) -> list[str]:
                 nm = names.name(s)
                 out.append(f"        double {nm}[{L}];")
                 out.append(f"        for (int l = 0; l < {L}; ++l) {nm}[l] = {a}[(k + l) * {dof} + {j}];")
+    # an angle that is a temporary of the inputs and parameters (a turned leaf frame's
+    # q + th): computed before the range check; any other goes to libm line by line
+    known = {s for a in INPUTS[what] for s in arrays[a]} | set(code.parameters)
+    assigned = dict(prog.assignments)
+    done = set()
+    for x in list(trig):
+        if x in assigned:
+            if assigned[x].free_symbols <= known:
+                nm = names.name(x)
+                out.append(f"        double {nm}[{L}];")
+                out.append(f"        for (int l = 0; l < {L}; ++l) {nm}[l] = {printer(assigned[x])};")
+                done.add(x)
+            else:
+                del trig[x]
     for x in trig:
         out.append(f"        for (int l = 0; l < {L}; ++l) wide |= !(fabs({names.name(x)}[l]) <= 1e8);")
     out.append("        if (wide) {")
@@ -260,7 +274,7 @@ def _c_batch(code, what, prog, fn, args, size) -> list[str]:
     out.append(f"            for (size_t l = 0; l < {L}; ++l) {fn}({call}, p, out + (k + l) * {size});")
     out.append("            continue;")
     out.append("        }")
-    done, body, declared = set(), [], []
+    body, declared = [], []
     for s, e in prog.assignments:
         if s in done:
             continue

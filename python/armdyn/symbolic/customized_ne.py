@@ -120,15 +120,23 @@ def moment_differences(robot: Robot, parameters: dict, definitions: list) -> tup
     return out, new
 
 
-def joint_frames(robot: Robot, b: Builder) -> dict:
+def joint_frames(robot: Robot, b: Builder, turns: dict | None = None) -> dict:
     """``{child link: (R, p)}`` of every joint, with ``cos q``, ``sin q`` named once
-    (``c1, s1``; 1-based like the joints) and non-trivial entries of ``R`` named."""
+    (``c1, s1``; 1-based like the joints) and non-trivial entries of ``R`` named.
+
+    turns: ``{link: th}`` links whose frame is turned by the constant ``th`` about their
+    (revolute, +z) joint axis (:mod:`armdyn.symbolic.leaf_frames`): their joint angle is
+    ``q + th`` (named ``q6t``, one addition), and ``c6, s6`` are its cosine and sine."""
     frames = {}
+    turns = turns or {}
     for joint in robot.joints:
         k = robot.coordinate_index(joint)
-        R, p = joint.transform(robot.joint_coordinate(joint))
+        coordinate = robot.joint_coordinate(joint)
+        if joint.child in turns:
+            coordinate = b.let(coordinate + turns[joint.child], f"q{k + 1}t")
+        R, p = joint.transform(coordinate)
         if joint.type == "revolute":
-            q = robot.q[k]
+            q = coordinate
             trig = {sp.cos(q): b.let(sp.cos(q), f"c{k + 1}"), sp.sin(q): b.let(sp.sin(q), f"s{k + 1}")}
             R = R.xreplace(trig)
         tag = _safe(str(robot.link_index(joint.child)))
@@ -249,7 +257,7 @@ def _vscale(x, a) -> list:
 
 
 def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, parameters=None,
-                            builder: Builder | None = None) -> tuple[Program, list]:
+                            builder: Builder | None = None, turns: dict | None = None) -> tuple[Program, list]:
     """tau (n,) of ``robot`` as a :class:`Program` of the joint coordinates, velocities
     ``qd`` and accelerations ``qdd`` (default: the robot's symbols; pass zeros for the
     gravity torques) and the barycentric parameters.
@@ -258,6 +266,8 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     Returns ``(program, definitions)``: the definitions of the new parameter symbols, as
     :func:`standard_parameters` (those only when ``parameters`` is None) and
     :func:`moment_differences` (always).
+    turns: ``{link: th}`` leaf links whose frame (and ``parameters``) are turned about
+    their joint axis (:func:`armdyn.symbolic.leaf_frames.turn_leaf_frames`).
     """
     robot = robot.canonical()  # link frames on their joints (frames off the axis: same dynamics)
     n = robot.dof
@@ -270,7 +280,7 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     definitions = definitions + extra
     b = builder or Builder(reserved=robot.free_symbols() | set(robot.q) | set(robot.qd) | set(robot.qdd)
                            | {s for s, _ in definitions})
-    frames = joint_frames(robot, b)
+    frames = joint_frames(robot, b, turns)
     zero = sp.zeros(3, 1)
     base_acc = -robot.gravity if gravity else zero
     w, wd = {robot.base: zero}, {robot.base: zero}

@@ -1,0 +1,103 @@
+"""Turning a leaf link's frame about its joint axis so that its first moment lies on x.
+
+A link with no children (the last link of a chain, each tip of a tree) is free to have
+its frame turned about its joint axis by any constant angle ``th``: the joint axis, the
+joint torque ``tau = z . n`` and every other link are unchanged, the joint coordinate
+enters as ``q + th`` (Khalil and Dombre, *Modeling, Identification and Control of
+Robots*, 2002, sec. 3.2: the x axis of the terminal frame is arbitrary). Choosing
+
+    th = atan2(MY, MX)      (0 when MX = MY = 0)
+
+puts the link's first moment on x: ``MS' = (sqrt(MX^2 + MY^2), 0, MZ)``, so every
+product with ``MY`` disappears from the link's force ``U MS`` and moment ``MS x vd``
+(and the ``x`` component of the acceleration with it). The inertia about the origin
+turns with the frame (``J' = Rz(th)^T J Rz(th)``; its ``YY'`` is no longer zero after
+Khalil's grouping, one product more). The angle, the turned first moment and inertia are
+computed once per parameter set, like the grouped parameters; per state the joint angle
+costs one addition, ``q + th``, whose sine and cosine replace those of ``q``.
+
+Only revolute joints about the child frame's +z (armdyn's canonical frames) are turned.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ..model import Robot
+from .customized_ne import _safe
+
+
+def _turned(M, MS, J, c, s):
+    """(M, MS', J') of a body seen from its frame turned by the angle with cosine ``c``
+    and sine ``s`` about z: ``MS' = Rz^T MS``, ``J' = Rz^T J Rz``."""
+    XX, XY, XZ, YY, YZ, ZZ = J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2]
+    Jp = sp.Matrix([
+        [c * c * XX + 2 * c * s * XY + s * s * YY, c * s * (YY - XX) + (c * c - s * s) * XY, c * XZ + s * YZ],
+        [0, s * s * XX - 2 * c * s * XY + c * c * YY, -s * XZ + c * YZ],
+        [0, 0, ZZ],
+    ])
+    for a, b in ((1, 0), (2, 0), (2, 1)):
+        Jp[a, b] = Jp[b, a]
+    return M, sp.Matrix([c * MS[0] + s * MS[1], -s * MS[0] + c * MS[1], MS[2]]), Jp
+
+
+def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()):
+    """``(parameters, new_definitions, turns)``: ``parameters`` ``{link: (M, MS, J)}`` with
+    every leaf link's turned (first moment on x), the definitions
+    ``[(Symbol, expression)]`` of the new per-parameter-set symbols (``th6``, ``MX6L``,
+    ``XX6L``, ... ; in the symbols of ``parameters`` and ``definitions``' right-hand
+    sides), and ``turns`` ``{link: th}`` for :func:`customized_newton_euler`.
+
+    A leaf whose ``MY`` is already zero, or whose joint is not revolute about +z, is
+    left as it is.
+    """
+    robot = robot.canonical()
+    used = {str(s) for s in robot.free_symbols()} | {str(s) for s in (*robot.q, *robot.qd, *robot.qdd)}
+    used |= {str(s) for s, _ in definitions} | {str(s) for s in taken}
+    parents = {j.parent for j in robot.joints}
+    out, new, turns = dict(parameters), [], {}
+
+    def symbol(name):
+        while name in used:
+            name += "_"
+        used.add(name)
+        return sp.Symbol(name)
+
+    z = sp.Matrix([0, 0, 1])
+    for joint in robot.joints:
+        link = joint.child
+        if joint.type != "revolute" or joint.axis != z or link in parents or link not in parameters:
+            continue
+        M, MS, J = parameters[link]
+        if sp.sympify(MS[1]) == 0:
+            continue
+        tag = _safe(str(robot.link_index(link)))
+        MX, MY = MS[0], MS[1]
+        norm2 = MX**2 + MY**2
+        nonzero = sp.Ne(norm2, 0)
+        r = sp.sqrt(norm2)
+        # MX = MY = 0: nothing to turn (th = 0, J' = J)
+        th = sp.Piecewise((sp.atan2(MY, MX), nonzero), (0, True))
+        if not th.free_symbols:  # a model bound to numbers: a number (atan2 may leave pi in it)
+            th = sp.Float(sp.N(th, 20), 20)
+        else:
+            sym = symbol(f"th{tag}")
+            new.append((sym, th))
+            th = sym
+        _, MSt, Jt = _turned(M, MS, J, MX / r, MY / r)
+
+        def named(value, label, unturned=None):
+            if value.is_Atom:
+                return value
+            sym = symbol(label)
+            new.append((sym, value if unturned is None else sp.Piecewise((sp.factor(value), nonzero), (unturned, True))))
+            return sym
+
+        MSn = sp.Matrix([named(r, f"MX{tag}L"), 0, MS[2]])  # c MX + s MY = |(MX, MY)|; -s MX + c MY = 0
+        Jn = sp.zeros(3, 3)
+        for a, b in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):
+            Jn[a, b] = Jn[b, a] = (named(Jt[a, b], f"{'XYZ'[a]}{'XYZ'[b]}{tag}L", J[a, b])
+                                   if Jt[a, b] != J[a, b] else J[a, b])
+        out[link] = (M, MSn, Jn)
+        turns[link] = th
+    return out, new, turns
