@@ -195,7 +195,7 @@ def breakdown() -> None:
         print(f"| {k} | " + " | ".join(f"{a}+{b}" for a, b in cells) + f" | {sum(a + b for a, b in cells)} |")
     print("\n(wi: R^T w of the parent; w: w, its products and differences; wd, vd: accelerations;"
           " Up, a: U_parent p + vd_parent; U: skew(wd) + skew(w)^2; F, N: the link's force and moment;"
-          " Rf: a child's force rotated; f, n: inward sums)\n")
+          " Rf: a child's force rotated; f, n: inward sums; q: q + th of a leaf link's turned frame)\n")
 
 
 def numeric(n_states: int, repeat: int) -> None:

@@ -169,6 +169,22 @@ def test_puma_base_parameter_tau_takes_fewer_operations_than_opensymoro(name):
     assert counts["total"] < 301 + 240, counts
 
 
+def test_puma_tau_program_has_no_sum_with_a_common_factor():
+    """No line of the PUMA's base-parameter tau is a sum with two terms sharing a factor
+    (``a x + a y``, which ``a (x + y)`` would do with one product less): the claim
+    benchmarks/README.md makes about the program, checked on the program."""
+    prog = codegen.codegen(_load("puma560-craig"), what="tau", base=True).programs["tau"]
+    sums = [e for _, e in prog.assignments if e.is_Add] + [sp.sympify(e) for e in prog.outputs if sp.sympify(e).is_Add]
+    assert len(sums) > 50
+    for e in sums:
+        seen = {}
+        for term in e.args:
+            for f in set(sp.Mul.make_args(term)):
+                if f.is_Symbol:
+                    assert f not in seen, f"{f} in both {seen.get(f)} and {term} of {e}"
+                    seen[f] = term
+
+
 def test_grouping_moves_the_axisymmetric_part_of_a_revolute_link():
     """Closed form on one revolute joint: what Khalil's rules say for the PUMA's joint 3
     (alpha = 0, p = (a2, 0, d3)): M3, MZ3, YY3 leave link 3 and MX2R = MX2 + a2 M3 ...

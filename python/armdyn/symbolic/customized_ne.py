@@ -12,7 +12,12 @@ as :mod:`armdyn.symbolic.newton_euler`, but
   mass ``M``, first moment ``MS = M c`` and inertia ``J`` about the link frame's origin
   (DESIGN.md's standard parameters), so that no parallel-axis term is computed per state;
 * ``U_j = skew(wd_j) + skew(w_j)^2`` is formed once per link and used both for the link's
-  own force and its children's accelerations (Khalil eq. 9.79).
+  own force and its children's accelerations (Khalil eq. 9.79);
+* a rotation about the joint axis keeps ``wx^2 + wy^2``: when the axis is a parent axis
+  ``e_k`` (every DH frame), ``U_j[2, 2] = -(wx^2 + wy^2)`` is the parent's ``U[k, k]``
+  and ``wy^2`` is never formed (:func:`_squares`);
+* optionally (``turns``, :mod:`armdyn.symbolic.leaf_frames`) a leaf link's frame turned
+  about its joint axis by a per-parameter-set angle.
 
 All vectors of link j are in link j's frame. Outward, with ``(R, p)`` link j's frame in
 its parent's and ``z`` the joint axis (Khalil eqs. 9.77-9.82)::
