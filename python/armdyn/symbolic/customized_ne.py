@@ -161,7 +161,10 @@ def _squares(b: Builder, w, tag, S=None) -> dict:
     unchanged, so ``wy^2`` is not needed (one multiplication less per link)::
 
         U22 = -wx^2 - wz^2,  d1 = wz^2 - wx^2,  U33 = S,  U11 = S - d1,  d0 = U22 - S,
-        d2 = U11 - U22
+        d2 = -d0 - d1
+
+    (``d2`` from the other two differences, not from ``U11``: a link that needs no
+    ``U11`` does not pay for it; never more operations than without ``S``, given ``S``.)
     """
     w1, w2, w3 = w
     xx, zz = b.let(w1 * w1, f"w{tag}xx"), b.let(w3 * w3, f"w{tag}zz")
@@ -174,8 +177,9 @@ def _squares(b: Builder, w, tag, S=None) -> dict:
     else:
         U22, d1 = b.let(-xx - zz, f"U{tag}_22"), b.let(zz - xx, f"w{tag}_zz_xx")
         U11 = b.let(S - d1, f"U{tag}_11")
-        out.update(U11=U11, U22=U22, U33=S, d0=b.let(U22 - S, f"w{tag}_yy_zz"), d1=d1,
-                   d2=b.let(U11 - U22, f"w{tag}_xx_yy"))
+        out_d0 = b.let(U22 - S, f"w{tag}_yy_zz")
+        out.update(U11=U11, U22=U22, U33=S, d0=out_d0, d1=d1,
+                   d2=b.let(-out_d0 - d1, f"w{tag}_xx_yy"))
     return out
 
 

@@ -48,8 +48,10 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
     ``XX6L``, ... ; in the symbols of ``parameters`` and ``definitions``' right-hand
     sides), and ``turns`` ``{link: th}`` for :func:`customized_newton_euler`.
 
-    A leaf whose ``MY`` is already zero, or whose joint is not revolute about +z, is
-    left as it is.
+    A leaf whose ``MX`` or ``MY`` is zero, or whose joint is not revolute about +z, is
+    left as it is. Otherwise the turn always pays: it removes the 6 products and 6 sums of
+    ``MY`` (and ``vd_x``, 3 operations) and adds at most ``q + th``, ``YY'`` and ``XY'``
+    terms (3 products, 3 sums, 1 addition).
     """
     robot = robot.canonical()
     used = {str(s) for s in robot.free_symbols()} | {str(s) for s in (*robot.q, *robot.qd, *robot.qdd)}
@@ -69,8 +71,8 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
         if joint.type != "revolute" or joint.axis != z or link in parents or link not in parameters:
             continue
         M, MS, J = parameters[link]
-        if sp.sympify(MS[1]) == 0:
-            continue
+        if sp.sympify(MS[0]) == 0 or sp.sympify(MS[1]) == 0:
+            continue  # already on an axis: turning would only swap x and y
         tag = _safe(str(robot.link_index(link)))
         MX, MY = MS[0], MS[1]
         norm2 = MX**2 + MY**2
