@@ -49,9 +49,10 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
     sides), and ``turns`` ``{link: th}`` for :func:`customized_newton_euler`.
 
     A leaf whose ``MX`` or ``MY`` is zero, or whose joint is not revolute about +z, is
-    left as it is. Otherwise the turn always pays: it removes the 6 products and 6 sums of
-    ``MY`` (and ``vd_x``, 3 operations) and adds at most ``q + th``, ``YY'`` and ``XY'``
-    terms (3 products, 3 sums, 1 addition).
+    left as it is. Otherwise the turn pays: it removes the 5 products of ``MY`` with their
+    5 sums (3 in ``U MS``, 2 in ``MS x vd``) and ``vd_x`` (2 products, 1 sum), and adds at
+    most ``q + th`` (1 addition), the ``YY'`` term (1 product, 1 sum) and, where ``XY``
+    was zero, the ``XY'`` terms (3 products, 3 sums).
     """
     robot = robot.canonical()
     used = {str(s) for s in robot.free_symbols()} | {str(s) for s in (*robot.q, *robot.qd, *robot.qdd)}
