@@ -179,7 +179,7 @@ def _aba_derivatives(q, qd, tau, model, threads):
 def _minverse(q, model, threads):
     from . import _core
 
-    return _core.minverse(model, *_c(q), threads)
+    return _core.minverse_model(model, *_c(q), threads)
 
 
 def _gravity_derivatives(q, model, threads):

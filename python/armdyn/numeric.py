@@ -377,14 +377,17 @@ def aba_derivatives(robot, q, qd, tau, *, f_ext=None, frame="local", threads=Non
     return _core.aba_derivatives(model, q, qd, tau, f_ext, frame, threads)
 
 
-def minverse(robot, q, *, threads=None):
-    """The inverse of the joint-space inertia matrix, by the articulated-body recursion
-    (without forming or factorising M). q: (n,) or (N, n). Returns (n, n) or (N, n, n).
-    M includes the rotor inertias, ``diag(Ia)``, as :func:`crba`. Robots with mimic joints:
-    ``(G^T M_full G)^-1`` by Cholesky (ValueError when M is not positive definite)."""
+# minverse(robot, q, *, threads=None): the Rust entry itself (docstring there, in
+# crates/armdyn-py/src/derivatives.rs): no Python frame per call, as issue 9 times it
+minverse = _core.minverse
+
+
+def _minverse_python(robot, q, threads):
+    """:func:`minverse` for what the Rust entry hands back: a robot not compiled yet (this
+    compiles and caches it) and robots with mimic joints."""
     model = _model(robot)
     if type(model) is NumericModel:
-        return _core.minverse(model, q, threads)
+        return _core.minverse_model(model, q, threads)
     # mimic joints: (G^T M_full G)^-1 by Cholesky (the constraint couples branches)
     return _mimic(robot, "minverse").minverse(q, threads)
 

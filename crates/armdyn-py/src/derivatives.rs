@@ -9,6 +9,7 @@ use armdyn_core::{batch_derivatives as bd, Model};
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
 use pyo3::types::PyTuple;
 
 fn parse_frame(frame: &str) -> PyResult<ForceFrame> {
@@ -79,11 +80,20 @@ fn run<'py, const K: usize, const R: usize>(
         let frame = parse_frame(frame)?;
         let (shape, arrays) = states(m.model.nv, args)?;
         let ext_arr = f_ext.map(|f| check_f_ext(m, f, shape)).transpose()?;
-        let dims: Vec<usize> = match shape {
-            Shape::Single => out_shape.to_vec(),
-            Shape::Batch(rows) => std::iter::once(rows).chain(out_shape.iter().copied()).collect(),
+        // the output shape, with a leading N for a batch (a stack buffer: no allocation per call)
+        let mut buf = [0usize; 4];
+        let dims: &[usize] = match shape {
+            Shape::Single => {
+                buf[..out_shape.len()].copy_from_slice(out_shape);
+                &buf[..out_shape.len()]
+            }
+            Shape::Batch(rows) => {
+                buf[0] = rows;
+                buf[1..=out_shape.len()].copy_from_slice(out_shape);
+                &buf[..=out_shape.len()]
+            }
         };
-        let outs: [Bound<'py, PyArrayDyn<f64>>; R] = std::array::from_fn(|_| new_array(py, &dims));
+        let outs: [Bound<'py, PyArrayDyn<f64>>; R] = std::array::from_fn(|_| new_array(py, dims));
         // SAFETY: the outputs are fresh and not visible to Python until returned.
         let os: [&mut [f64]; R] = {
             let mut it = outs.iter().map(|o| unsafe { o.as_slice_mut().expect("fresh array") });
@@ -197,9 +207,46 @@ macro_rules! matrix_of_q {
 }
 
 matrix_of_q!(
-    /// M(q)^-1, (n, n) or (N, n, n).
-    minverse, algo::minverse, bd::minverse
+    /// M(q)^-1 of a NumericModel, (n, n) or (N, n, n) (for armdyn.dask).
+    minverse_model, algo::minverse, bd::minverse
 );
+
+/// The compiled model behind `obj`: `obj` itself when it is a NumericModel, else the
+/// NumericModel that `armdyn.numeric.compile_model` cached on a Robot as `_numeric_model`.
+/// None when there is none yet, or when it is a mimic model (Python's path).
+fn compiled<'py>(obj: &Bound<'py, PyAny>) -> Option<Bound<'py, NumericModel>> {
+    if let Ok(m) = obj.cast::<NumericModel>() {
+        return Some(m.clone());
+    }
+    let cached = obj.getattr(pyo3::intern!(obj.py(), "_numeric_model")).ok()?;
+    cached.cast_into::<NumericModel>().ok()
+}
+
+/// The inverse of the joint-space inertia matrix, by the articulated-body recursion
+/// (without forming or factorising M; Carpentier 2018). q: (n,) or (N, n). Returns (n, n)
+/// or (N, n, n). M includes the rotor inertias, ``diag(Ia)``, as :func:`crba`. Robots
+/// with mimic joints: ``(G^T M_full G)^-1`` by Cholesky (ValueError when M is not
+/// positive definite).
+///
+/// (armdyn.numeric.minverse itself: called straight from Python, no Python frame in
+/// between, as its per-call time is one of issue 9's targets; a robot not compiled yet,
+/// or with mimic joints, goes through armdyn.numeric._minverse_python.)
+#[pyfunction]
+#[pyo3(signature = (robot, q, *, threads = None))]
+fn minverse<'py>(
+    py: Python<'py>,
+    robot: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    match compiled(robot) {
+        Some(model) => Ok(minverse_model(py, &model, q, threads)?.into_any()),
+        None => {
+            static PYTHON_PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+            PYTHON_PATH.import(py, "armdyn.numeric", "_minverse_python")?.call1((robot, q, threads))
+        }
+    }
+}
 matrix_of_q!(
     /// dg/dq, (n, n) or (N, n, n).
     gravity_derivatives, algo::gravity_derivatives, bd::gravity_derivatives
@@ -286,6 +333,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rnea_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(aba_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(minverse, m)?)?;
+    m.add_function(wrap_pyfunction!(minverse_model, m)?)?;
     m.add_function(wrap_pyfunction!(gravity_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(jacobian_dot, m)?)?;
     m.add_function(wrap_pyfunction!(rnea_ext, m)?)?;
