@@ -164,12 +164,12 @@ macro_rules! derivatives_of {
 }
 
 derivatives_of!(
-    /// (dtau_dq, dtau_dqd, M): the partial derivatives of rnea, each (n, n) or (N, n, n).
-    rnea_derivatives, qdd, algo::rnea_derivatives, bd::rnea_derivatives
+    /// (dtau_dq, dtau_dqd, M) of a NumericModel: the partial derivatives of rnea, each (n, n) or (N, n, n).
+    rnea_derivatives_model, qdd, algo::rnea_derivatives, bd::rnea_derivatives
 );
 derivatives_of!(
-    /// (dqdd_dq, dqdd_dqd, Minv): the partial derivatives of aba, each (n, n) or (N, n, n).
-    aba_derivatives, tau, algo::aba_derivatives, bd::aba_derivatives
+    /// (dqdd_dq, dqdd_dqd, Minv) of a NumericModel: the partial derivatives of aba, each (n, n) or (N, n, n).
+    aba_derivatives_model, tau, algo::aba_derivatives, bd::aba_derivatives
 );
 
 /// Defines `#[pyfunction] $name(model, q, threads=None)` returning the (n, n) (or
@@ -222,15 +222,95 @@ fn compiled<'py>(obj: &Bound<'py, PyAny>) -> Option<Bound<'py, NumericModel>> {
     cached.cast_into::<NumericModel>().ok()
 }
 
+/// `armdyn.numeric.<name>(*args)`, looked up once: the Python path of the entries below
+/// (a robot not compiled yet, mimic joints, external wrenches).
+fn python_path<'py, A: pyo3::call::PyCallArgs<'py>>(
+    py: Python<'py>,
+    cell: &'static PyOnceLock<Py<PyAny>>,
+    name: &str,
+    args: A,
+) -> PyResult<Bound<'py, PyAny>> {
+    cell.import(py, "armdyn.numeric", name)?.call1(args)
+}
+
+// The entries armdyn.numeric exports as they are (issue 9 times their per-call cost: no
+// Python frame in between). The common call, a compiled plain model and no f_ext, runs
+// here; anything else goes through armdyn.numeric's `_<name>_python`.
+
+/// Partial derivatives of inverse dynamics, analytically (Carpentier & Mansard, RSS 2018).
+///
+/// q, qd, qdd: (n,) or (N, n). Returns ``(dtau_dq, dtau_dqd, M)``, each (n, n) or
+/// (N, n, n), row = output, column = input: ``dtau_dq[i, j] = d tau_i / d q_j``;
+/// ``M = d tau / d qdd``.
+///
+/// f_ext: external wrenches, one per link: shape (nlinks, 6) (or (N, nlinks, 6) for a
+/// batch), rows in ``list(robot.links)`` order (base first; the base's row does not act
+/// on the joints), each ``[fx, fy, fz, nx, ny, nz]`` (force, then moment). ``frame``
+/// says where: ``"local"``: in the link's frame, moment about its origin (the wrench
+/// moves with the link; Pinocchio's LOCAL ``fext``); ``"world"``: in base axes, moment
+/// about the base frame's origin (the wrench stays fixed in space). Then
+/// ``tau = M qdd + C qd + g - sum_L J_L^T w_L``.
+///
+/// Joint friction, rotor inertia and offset (as in :func:`rnea`) are included: ``M`` has
+/// ``diag(Ia)``, ``dtau_dqd`` has ``diag(Fv)``. Coulomb friction ``Fc sign(qd)`` is
+/// piecewise constant: it adds nothing, also at ``qd_k = 0`` where rnea's term jumps
+/// (``sign(0) = 0``) and has no derivative; the value given there is that of either side.
+/// Robots with mimic joints: ``G^T D_full G`` (chain rule, see armdyn.mimic); no f_ext.
+#[pyfunction]
+#[pyo3(signature = (robot, q, qd, qdd, *, f_ext = None, frame = "local", threads = None))]
+#[allow(clippy::too_many_arguments)]
+fn rnea_derivatives<'py>(
+    py: Python<'py>,
+    robot: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    qd: &Bound<'py, PyAny>,
+    qdd: &Bound<'py, PyAny>,
+    f_ext: Option<&Bound<'py, PyAny>>,
+    frame: &str,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    match (compiled(robot), f_ext) {
+        (Some(model), None) => Ok(rnea_derivatives_model(py, &model, q, qd, qdd, None, frame, threads)?.into_any()),
+        _ => {
+            static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+            python_path(py, &PATH, "_rnea_derivatives_python", (robot, q, qd, qdd, f_ext, frame, threads))
+        }
+    }
+}
+
+/// Partial derivatives of forward dynamics (Carpentier & Mansard, RSS 2018, IV.C).
+///
+/// q, qd, tau: (n,) or (N, n). Returns ``(dqdd_dq, dqdd_dqd, Minv)``, each (n, n) or
+/// (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
+/// f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
+/// joints as there (``Minv`` is that of ``M + diag(Ia)``).
+#[pyfunction]
+#[pyo3(signature = (robot, q, qd, tau, *, f_ext = None, frame = "local", threads = None))]
+#[allow(clippy::too_many_arguments)]
+fn aba_derivatives<'py>(
+    py: Python<'py>,
+    robot: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    qd: &Bound<'py, PyAny>,
+    tau: &Bound<'py, PyAny>,
+    f_ext: Option<&Bound<'py, PyAny>>,
+    frame: &str,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    match (compiled(robot), f_ext) {
+        (Some(model), None) => Ok(aba_derivatives_model(py, &model, q, qd, tau, None, frame, threads)?.into_any()),
+        _ => {
+            static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+            python_path(py, &PATH, "_aba_derivatives_python", (robot, q, qd, tau, f_ext, frame, threads))
+        }
+    }
+}
+
 /// The inverse of the joint-space inertia matrix, by the articulated-body recursion
 /// (without forming or factorising M; Carpentier 2018). q: (n,) or (N, n). Returns (n, n)
 /// or (N, n, n). M includes the rotor inertias, ``diag(Ia)``, as :func:`crba`. Robots
 /// with mimic joints: ``(G^T M_full G)^-1`` by Cholesky (ValueError when M is not
 /// positive definite).
-///
-/// (armdyn.numeric.minverse itself: called straight from Python, no Python frame in
-/// between, as its per-call time is one of issue 9's targets; a robot not compiled yet,
-/// or with mimic joints, goes through armdyn.numeric._minverse_python.)
 #[pyfunction]
 #[pyo3(signature = (robot, q, *, threads = None))]
 fn minverse<'py>(
@@ -242,11 +322,12 @@ fn minverse<'py>(
     match compiled(robot) {
         Some(model) => Ok(minverse_model(py, &model, q, threads)?.into_any()),
         None => {
-            static PYTHON_PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
-            PYTHON_PATH.import(py, "armdyn.numeric", "_minverse_python")?.call1((robot, q, threads))
+            static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+            python_path(py, &PATH, "_minverse_python", (robot, q, threads))
         }
     }
 }
+
 matrix_of_q!(
     /// dg/dq, (n, n) or (N, n, n).
     gravity_derivatives, algo::gravity_derivatives, bd::gravity_derivatives
@@ -332,6 +413,8 @@ with_wrenches!(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rnea_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(aba_derivatives, m)?)?;
+    m.add_function(wrap_pyfunction!(rnea_derivatives_model, m)?)?;
+    m.add_function(wrap_pyfunction!(aba_derivatives_model, m)?)?;
     m.add_function(wrap_pyfunction!(minverse, m)?)?;
     m.add_function(wrap_pyfunction!(minverse_model, m)?)?;
     m.add_function(wrap_pyfunction!(gravity_derivatives, m)?)?;
