@@ -237,74 +237,67 @@ fn python_path<'py, A: pyo3::call::PyCallArgs<'py>>(
 // Python frame in between). The common call, a compiled plain model and no f_ext, runs
 // here; anything else goes through armdyn.numeric's `_<name>_python`.
 
-/// Partial derivatives of inverse dynamics, analytically (Carpentier & Mansard, RSS 2018).
-///
-/// q, qd, qdd: (n,) or (N, n). Returns ``(dtau_dq, dtau_dqd, M)``, each (n, n) or
-/// (N, n, n), row = output, column = input: ``dtau_dq[i, j] = d tau_i / d q_j``;
-/// ``M = d tau / d qdd``.
-///
-/// f_ext: external wrenches, one per link: shape (nlinks, 6) (or (N, nlinks, 6) for a
-/// batch), rows in ``list(robot.links)`` order (base first; the base's row does not act
-/// on the joints), each ``[fx, fy, fz, nx, ny, nz]`` (force, then moment). ``frame``
-/// says where: ``"local"``: in the link's frame, moment about its origin (the wrench
-/// moves with the link; Pinocchio's LOCAL ``fext``); ``"world"``: in base axes, moment
-/// about the base frame's origin (the wrench stays fixed in space). Then
-/// ``tau = M qdd + C qd + g - sum_L J_L^T w_L``.
-///
-/// Joint friction, rotor inertia and offset (as in :func:`rnea`) are included: ``M`` has
-/// ``diag(Ia)``, ``dtau_dqd`` has ``diag(Fv)``. Coulomb friction ``Fc sign(qd)`` is
-/// piecewise constant: it adds nothing, also at ``qd_k = 0`` where rnea's term jumps
-/// (``sign(0) = 0``) and has no derivative; the value given there is that of either side.
-/// Robots with mimic joints: ``G^T D_full G`` (chain rule, see armdyn.mimic); no f_ext.
-#[pyfunction]
-#[pyo3(signature = (robot, q, qd, qdd, *, f_ext = None, frame = "local", threads = None))]
-#[allow(clippy::too_many_arguments)]
-fn rnea_derivatives<'py>(
-    py: Python<'py>,
-    robot: &Bound<'py, PyAny>,
-    q: &Bound<'py, PyAny>,
-    qd: &Bound<'py, PyAny>,
-    qdd: &Bound<'py, PyAny>,
-    f_ext: Option<&Bound<'py, PyAny>>,
-    frame: &str,
-    threads: Option<i64>,
-) -> PyResult<Bound<'py, PyAny>> {
-    match (compiled(robot), f_ext) {
-        (Some(model), None) => Ok(rnea_derivatives_model(py, &model, q, qd, qdd, None, frame, threads)?.into_any()),
-        _ => {
-            static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
-            python_path(py, &PATH, "_rnea_derivatives_python", (robot, q, qd, qdd, f_ext, frame, threads))
+/// Defines the entry `#[pyfunction] $name(robot, q, qd, $third, *, f_ext=None,
+/// frame="local", threads=None)`: `$model_fn` on the robot's compiled model when there is
+/// one and no f_ext, else armdyn.numeric's `$python` (see above).
+macro_rules! derivatives_entry {
+    ($(#[$doc:meta])* $name:ident, $third:ident, $model_fn:ident, $python:literal) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = (robot, q, qd, $third, *, f_ext = None, frame = "local", threads = None))]
+        #[allow(clippy::too_many_arguments)]
+        fn $name<'py>(
+            py: Python<'py>,
+            robot: &Bound<'py, PyAny>,
+            q: &Bound<'py, PyAny>,
+            qd: &Bound<'py, PyAny>,
+            $third: &Bound<'py, PyAny>,
+            f_ext: Option<&Bound<'py, PyAny>>,
+            frame: &str,
+            threads: Option<i64>,
+        ) -> PyResult<Bound<'py, PyAny>> {
+            match (compiled(robot), f_ext) {
+                (Some(model), None) => Ok($model_fn(py, &model, q, qd, $third, None, frame, threads)?.into_any()),
+                _ => {
+                    static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+                    python_path(py, &PATH, $python, (robot, q, qd, $third, f_ext, frame, threads))
+                }
+            }
         }
-    }
+    };
 }
 
-/// Partial derivatives of forward dynamics (Carpentier & Mansard, RSS 2018, IV.C).
-///
-/// q, qd, tau: (n,) or (N, n). Returns ``(dqdd_dq, dqdd_dqd, Minv)``, each (n, n) or
-/// (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
-/// f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
-/// joints as there (``Minv`` is that of ``M + diag(Ia)``).
-#[pyfunction]
-#[pyo3(signature = (robot, q, qd, tau, *, f_ext = None, frame = "local", threads = None))]
-#[allow(clippy::too_many_arguments)]
-fn aba_derivatives<'py>(
-    py: Python<'py>,
-    robot: &Bound<'py, PyAny>,
-    q: &Bound<'py, PyAny>,
-    qd: &Bound<'py, PyAny>,
-    tau: &Bound<'py, PyAny>,
-    f_ext: Option<&Bound<'py, PyAny>>,
-    frame: &str,
-    threads: Option<i64>,
-) -> PyResult<Bound<'py, PyAny>> {
-    match (compiled(robot), f_ext) {
-        (Some(model), None) => Ok(aba_derivatives_model(py, &model, q, qd, tau, None, frame, threads)?.into_any()),
-        _ => {
-            static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
-            python_path(py, &PATH, "_aba_derivatives_python", (robot, q, qd, tau, f_ext, frame, threads))
-        }
-    }
-}
+derivatives_entry!(
+    /// Partial derivatives of inverse dynamics, analytically (Carpentier & Mansard, RSS 2018).
+    ///
+    /// q, qd, qdd: (n,) or (N, n). Returns ``(dtau_dq, dtau_dqd, M)``, each (n, n) or
+    /// (N, n, n), row = output, column = input: ``dtau_dq[i, j] = d tau_i / d q_j``;
+    /// ``M = d tau / d qdd``.
+    ///
+    /// f_ext: external wrenches, one per link: shape (nlinks, 6) (or (N, nlinks, 6) for a
+    /// batch), rows in ``list(robot.links)`` order (base first; the base's row does not act
+    /// on the joints), each ``[fx, fy, fz, nx, ny, nz]`` (force, then moment). ``frame``
+    /// says where: ``"local"``: in the link's frame, moment about its origin (the wrench
+    /// moves with the link; Pinocchio's LOCAL ``fext``); ``"world"``: in base axes, moment
+    /// about the base frame's origin (the wrench stays fixed in space). Then
+    /// ``tau = M qdd + C qd + g - sum_L J_L^T w_L``.
+    ///
+    /// Joint friction, rotor inertia and offset (as in :func:`rnea`) are included: ``M`` has
+    /// ``diag(Ia)``, ``dtau_dqd`` has ``diag(Fv)``. Coulomb friction ``Fc sign(qd)`` is
+    /// piecewise constant: it adds nothing, also at ``qd_k = 0`` where rnea's term jumps
+    /// (``sign(0) = 0``) and has no derivative; the value given there is that of either side.
+    /// Robots with mimic joints: ``G^T D_full G`` (chain rule, see armdyn.mimic); no f_ext.
+    rnea_derivatives, qdd, rnea_derivatives_model, "_rnea_derivatives_python"
+);
+derivatives_entry!(
+    /// Partial derivatives of forward dynamics (Carpentier & Mansard, RSS 2018, IV.C).
+    ///
+    /// q, qd, tau: (n,) or (N, n). Returns ``(dqdd_dq, dqdd_dqd, Minv)``, each (n, n) or
+    /// (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
+    /// f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
+    /// joints as there (``Minv`` is that of ``M + diag(Ia)``).
+    aba_derivatives, tau, aba_derivatives_model, "_aba_derivatives_python"
+);
 
 /// The inverse of the joint-space inertia matrix, by the articulated-body recursion
 /// (without forming or factorising M; Carpentier 2018). q: (n,) or (N, n). Returns (n, n)
