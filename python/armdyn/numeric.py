@@ -332,59 +332,42 @@ def _mimic(robot, what: str, f_ext=None, frame: str = "local") -> MimicModel | N
     return model
 
 
-def rnea_derivatives(robot, q, qd, qdd, *, f_ext=None, frame="local", threads=None):
-    """Partial derivatives of inverse dynamics, analytically (Carpentier & Mansard, RSS 2018).
+# rnea_derivatives, aba_derivatives and minverse are the Rust entries themselves
+# (docstrings there, crates/armdyn-py/src/derivatives.rs): no Python frame per call, as
+# issue 9 times them per call. They run the common call (a compiled plain model, no
+# f_ext) and hand the rest to the `_<name>_python` functions below.
+rnea_derivatives = _core.rnea_derivatives
+aba_derivatives = _core.aba_derivatives
+minverse = _core.minverse
 
-    q, qd, qdd: (n,) or (N, n). Returns ``(dtau_dq, dtau_dqd, M)``, each (n, n) or
-    (N, n, n), row = output, column = input: ``dtau_dq[i, j] = d tau_i / d q_j``;
-    ``M = d tau / d qdd``.
 
-    f_ext: external wrenches, one per link: shape (nlinks, 6) (or (N, nlinks, 6) for a
-    batch), rows in ``list(robot.links)`` order (base first; the base's row does not act
-    on the joints), each ``[fx, fy, fz, nx, ny, nz]`` (force, then moment). ``frame``
-    says where: ``"local"``: in the link's frame, moment about its origin (the wrench
-    moves with the link; Pinocchio's LOCAL ``fext``); ``"world"``: in base axes, moment
-    about the base frame's origin (the wrench stays fixed in space). Then
-    ``tau = M qdd + C qd + g - sum_L J_L^T w_L``.
-
-    Joint friction, rotor inertia and offset (as in :func:`rnea`) are included: ``M`` has
-    ``diag(Ia)``, ``dtau_dqd`` has ``diag(Fv)``. Coulomb friction ``Fc sign(qd)`` is
-    piecewise constant: it adds nothing, also at ``qd_k = 0`` where rnea's term jumps
-    (``sign(0) = 0``) and has no derivative; the value given there is that of either side.
-    Robots with mimic joints: ``G^T D_full G`` (chain rule, see armdyn.mimic); no f_ext.
-    """
+def _rnea_derivatives_python(robot, q, qd, qdd, f_ext, frame, threads):
+    """:func:`rnea_derivatives` for a robot not compiled yet (this compiles and caches
+    it), mimic joints, and external wrenches."""
     model = _model(robot)
     if type(model) is not NumericModel:  # mimic joints: the chain rule, see armdyn.mimic
         return _mimic(robot, "rnea_derivatives", f_ext, frame).rnea_derivatives(q, qd, qdd, threads)
-    if f_ext is not None:  # (the common call goes straight to the core: per-call time matters)
+    if f_ext is not None:
         f_ext = _canonical_wrenches(robot, f_ext, frame)
-    return _core.rnea_derivatives(model, q, qd, qdd, f_ext, frame, threads)
+    return _core.rnea_derivatives_model(model, q, qd, qdd, f_ext, frame, threads)
 
 
-def aba_derivatives(robot, q, qd, tau, *, f_ext=None, frame="local", threads=None):
-    """Partial derivatives of forward dynamics (Carpentier & Mansard, RSS 2018, IV.C).
-
-    q, qd, tau: (n,) or (N, n). Returns ``(dqdd_dq, dqdd_dqd, Minv)``, each (n, n) or
-    (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
-    f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
-    joints as there (``Minv`` is that of ``M + diag(Ia)``).
-    """
+def _aba_derivatives_python(robot, q, qd, tau, f_ext, frame, threads):
+    """:func:`aba_derivatives` for what the Rust entry hands back (as above)."""
     model = _model(robot)
     if type(model) is not NumericModel:  # mimic joints: the chain rule, see armdyn.mimic
         return _mimic(robot, "aba_derivatives", f_ext, frame).aba_derivatives(q, qd, tau, threads)
     if f_ext is not None:
         f_ext = _canonical_wrenches(robot, f_ext, frame)
-    return _core.aba_derivatives(model, q, qd, tau, f_ext, frame, threads)
+    return _core.aba_derivatives_model(model, q, qd, tau, f_ext, frame, threads)
 
 
-def minverse(robot, q, *, threads=None):
-    """The inverse of the joint-space inertia matrix, by the articulated-body recursion
-    (without forming or factorising M). q: (n,) or (N, n). Returns (n, n) or (N, n, n).
-    M includes the rotor inertias, ``diag(Ia)``, as :func:`crba`. Robots with mimic joints:
-    ``(G^T M_full G)^-1`` by Cholesky (ValueError when M is not positive definite)."""
+def _minverse_python(robot, q, threads):
+    """:func:`minverse` for what the Rust entry hands back (a robot not compiled yet, mimic
+    joints)."""
     model = _model(robot)
     if type(model) is NumericModel:
-        return _core.minverse(model, q, threads)
+        return _core.minverse_model(model, q, threads)
     # mimic joints: (G^T M_full G)^-1 by Cholesky (the constraint couples branches)
     return _mimic(robot, "minverse").minverse(q, threads)
 

@@ -9,6 +9,7 @@ use armdyn_core::{batch_derivatives as bd, Model};
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
 use pyo3::types::PyTuple;
 
 fn parse_frame(frame: &str) -> PyResult<ForceFrame> {
@@ -79,11 +80,20 @@ fn run<'py, const K: usize, const R: usize>(
         let frame = parse_frame(frame)?;
         let (shape, arrays) = states(m.model.nv, args)?;
         let ext_arr = f_ext.map(|f| check_f_ext(m, f, shape)).transpose()?;
-        let dims: Vec<usize> = match shape {
-            Shape::Single => out_shape.to_vec(),
-            Shape::Batch(rows) => std::iter::once(rows).chain(out_shape.iter().copied()).collect(),
+        // the output shape, with a leading N for a batch (a stack buffer: no allocation per call)
+        let mut buf = [0usize; 4];
+        let dims: &[usize] = match shape {
+            Shape::Single => {
+                buf[..out_shape.len()].copy_from_slice(out_shape);
+                &buf[..out_shape.len()]
+            }
+            Shape::Batch(rows) => {
+                buf[0] = rows;
+                buf[1..=out_shape.len()].copy_from_slice(out_shape);
+                &buf[..=out_shape.len()]
+            }
         };
-        let outs: [Bound<'py, PyArrayDyn<f64>>; R] = std::array::from_fn(|_| new_array(py, &dims));
+        let outs: [Bound<'py, PyArrayDyn<f64>>; R] = std::array::from_fn(|_| new_array(py, dims));
         // SAFETY: the outputs are fresh and not visible to Python until returned.
         let os: [&mut [f64]; R] = {
             let mut it = outs.iter().map(|o| unsafe { o.as_slice_mut().expect("fresh array") });
@@ -154,12 +164,12 @@ macro_rules! derivatives_of {
 }
 
 derivatives_of!(
-    /// (dtau_dq, dtau_dqd, M): the partial derivatives of rnea, each (n, n) or (N, n, n).
-    rnea_derivatives, qdd, algo::rnea_derivatives, bd::rnea_derivatives
+    /// (dtau_dq, dtau_dqd, M) of a NumericModel: the partial derivatives of rnea, each (n, n) or (N, n, n).
+    rnea_derivatives_model, qdd, algo::rnea_derivatives, bd::rnea_derivatives
 );
 derivatives_of!(
-    /// (dqdd_dq, dqdd_dqd, Minv): the partial derivatives of aba, each (n, n) or (N, n, n).
-    aba_derivatives, tau, algo::aba_derivatives, bd::aba_derivatives
+    /// (dqdd_dq, dqdd_dqd, Minv) of a NumericModel: the partial derivatives of aba, each (n, n) or (N, n, n).
+    aba_derivatives_model, tau, algo::aba_derivatives, bd::aba_derivatives
 );
 
 /// Defines `#[pyfunction] $name(model, q, threads=None)` returning the (n, n) (or
@@ -197,9 +207,120 @@ macro_rules! matrix_of_q {
 }
 
 matrix_of_q!(
-    /// M(q)^-1, (n, n) or (N, n, n).
-    minverse, algo::minverse, bd::minverse
+    /// M(q)^-1 of a NumericModel, (n, n) or (N, n, n) (for armdyn.dask).
+    minverse_model, algo::minverse, bd::minverse
 );
+
+/// The compiled model behind `obj`: `obj` itself when it is a NumericModel, else the
+/// NumericModel that `armdyn.numeric.compile_model` cached on a Robot as `_numeric_model`.
+/// None when there is none yet, or when it is a mimic model (Python's path).
+fn compiled<'py>(obj: &Bound<'py, PyAny>) -> Option<Bound<'py, NumericModel>> {
+    if let Ok(m) = obj.cast::<NumericModel>() {
+        return Some(m.clone());
+    }
+    let cached = obj.getattr(pyo3::intern!(obj.py(), "_numeric_model")).ok()?;
+    cached.cast_into::<NumericModel>().ok()
+}
+
+/// `armdyn.numeric.<name>(*args)`, looked up once: the Python path of the entries below
+/// (a robot not compiled yet, mimic joints, external wrenches).
+fn python_path<'py, A: pyo3::call::PyCallArgs<'py>>(
+    py: Python<'py>,
+    cell: &'static PyOnceLock<Py<PyAny>>,
+    name: &str,
+    args: A,
+) -> PyResult<Bound<'py, PyAny>> {
+    cell.import(py, "armdyn.numeric", name)?.call1(args)
+}
+
+// The entries armdyn.numeric exports as they are (issue 9 times their per-call cost: no
+// Python frame in between). The common call, a compiled plain model and no f_ext, runs
+// here; anything else goes through armdyn.numeric's `_<name>_python`.
+
+/// Defines the entry `#[pyfunction] $name(robot, q, qd, $third, *, f_ext=None,
+/// frame="local", threads=None)`: `$model_fn` on the robot's compiled model when there is
+/// one and no f_ext, else armdyn.numeric's `$python` (see above).
+macro_rules! derivatives_entry {
+    ($(#[$doc:meta])* $name:ident, $third:ident, $model_fn:ident, $python:literal) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = (robot, q, qd, $third, *, f_ext = None, frame = "local", threads = None))]
+        #[allow(clippy::too_many_arguments)]
+        fn $name<'py>(
+            py: Python<'py>,
+            robot: &Bound<'py, PyAny>,
+            q: &Bound<'py, PyAny>,
+            qd: &Bound<'py, PyAny>,
+            $third: &Bound<'py, PyAny>,
+            f_ext: Option<&Bound<'py, PyAny>>,
+            frame: &str,
+            threads: Option<i64>,
+        ) -> PyResult<Bound<'py, PyAny>> {
+            match (compiled(robot), f_ext) {
+                (Some(model), None) => Ok($model_fn(py, &model, q, qd, $third, None, frame, threads)?.into_any()),
+                _ => {
+                    static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+                    python_path(py, &PATH, $python, (robot, q, qd, $third, f_ext, frame, threads))
+                }
+            }
+        }
+    };
+}
+
+derivatives_entry!(
+    /// Partial derivatives of inverse dynamics, analytically (Carpentier & Mansard, RSS 2018).
+    ///
+    /// q, qd, qdd: (n,) or (N, n). Returns ``(dtau_dq, dtau_dqd, M)``, each (n, n) or
+    /// (N, n, n), row = output, column = input: ``dtau_dq[i, j] = d tau_i / d q_j``;
+    /// ``M = d tau / d qdd``.
+    ///
+    /// f_ext: external wrenches, one per link: shape (nlinks, 6) (or (N, nlinks, 6) for a
+    /// batch), rows in ``list(robot.links)`` order (base first; the base's row does not act
+    /// on the joints), each ``[fx, fy, fz, nx, ny, nz]`` (force, then moment). ``frame``
+    /// says where: ``"local"``: in the link's frame, moment about its origin (the wrench
+    /// moves with the link; Pinocchio's LOCAL ``fext``); ``"world"``: in base axes, moment
+    /// about the base frame's origin (the wrench stays fixed in space). Then
+    /// ``tau = M qdd + C qd + g - sum_L J_L^T w_L``.
+    ///
+    /// Joint friction, rotor inertia and offset (as in :func:`rnea`) are included: ``M`` has
+    /// ``diag(Ia)``, ``dtau_dqd`` has ``diag(Fv)``. Coulomb friction ``Fc sign(qd)`` is
+    /// piecewise constant: it adds nothing, also at ``qd_k = 0`` where rnea's term jumps
+    /// (``sign(0) = 0``) and has no derivative; the value given there is that of either side.
+    /// Robots with mimic joints: ``G^T D_full G`` (chain rule, see armdyn.mimic); no f_ext.
+    rnea_derivatives, qdd, rnea_derivatives_model, "_rnea_derivatives_python"
+);
+derivatives_entry!(
+    /// Partial derivatives of forward dynamics (Carpentier & Mansard, RSS 2018, IV.C).
+    ///
+    /// q, qd, tau: (n,) or (N, n). Returns ``(dqdd_dq, dqdd_dqd, Minv)``, each (n, n) or
+    /// (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
+    /// f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
+    /// joints as there (``Minv`` is that of ``M + diag(Ia)``).
+    aba_derivatives, tau, aba_derivatives_model, "_aba_derivatives_python"
+);
+
+/// The inverse of the joint-space inertia matrix, by the articulated-body recursion
+/// (without forming or factorising M; Carpentier 2018). q: (n,) or (N, n). Returns (n, n)
+/// or (N, n, n). M includes the rotor inertias, ``diag(Ia)``, as :func:`crba`. Robots
+/// with mimic joints: ``(G^T M_full G)^-1`` by Cholesky (ValueError when M is not
+/// positive definite).
+#[pyfunction]
+#[pyo3(signature = (robot, q, *, threads = None))]
+fn minverse<'py>(
+    py: Python<'py>,
+    robot: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    match compiled(robot) {
+        Some(model) => Ok(minverse_model(py, &model, q, threads)?.into_any()),
+        None => {
+            static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+            python_path(py, &PATH, "_minverse_python", (robot, q, threads))
+        }
+    }
+}
+
 matrix_of_q!(
     /// dg/dq, (n, n) or (N, n, n).
     gravity_derivatives, algo::gravity_derivatives, bd::gravity_derivatives
@@ -285,7 +406,10 @@ with_wrenches!(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rnea_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(aba_derivatives, m)?)?;
+    m.add_function(wrap_pyfunction!(rnea_derivatives_model, m)?)?;
+    m.add_function(wrap_pyfunction!(aba_derivatives_model, m)?)?;
     m.add_function(wrap_pyfunction!(minverse, m)?)?;
+    m.add_function(wrap_pyfunction!(minverse_model, m)?)?;
     m.add_function(wrap_pyfunction!(gravity_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(jacobian_dot, m)?)?;
     m.add_function(wrap_pyfunction!(rnea_ext, m)?)?;

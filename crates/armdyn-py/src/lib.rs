@@ -111,13 +111,12 @@ fn states<'py, const K: usize>(
     n: usize,
     args: [(&str, &Bound<'py, PyAny>); K],
 ) -> PyResult<(Shape, [Bound<'py, PyArrayDyn<f64>>; K])> {
-    let arrays: [Bound<'py, PyArrayDyn<f64>>; K] = {
-        let mut v = Vec::with_capacity(K);
-        for (name, obj) in args {
-            v.push(as_f64(obj, name)?);
-        }
-        v.try_into().map_err(|_| PyRuntimeError::new_err("argument count"))?
-    };
+    // (no Vec: a single-state call is timed per call, and an allocation shows)
+    let mut converted = args.map(|(name, obj)| as_f64(obj, name));
+    if let Some(k) = converted.iter().position(|r| r.is_err()) {
+        return Err(std::mem::replace(&mut converted[k], Err(PyRuntimeError::new_err(""))).err().expect("an error"));
+    }
+    let arrays: [Bound<'py, PyArrayDyn<f64>>; K] = converted.map(|r| r.expect("checked above"));
     let mut shape = None;
     for ((name, _), a) in args.iter().zip(&arrays) {
         let s = match a.shape() {
