@@ -54,8 +54,8 @@ pub fn aba_derivatives<T: Real>(
     assert!(dqdd_dq.len() == n * n && dqdd_dqd.len() == n * n && minv.len() == n * n, "output size");
     velocity_pass(model, data, dd, q, qd, ext);
     let mut qdd = std::mem::take(&mut dd.qdd);
-    aba_world(model, data, dd, qd, tau, &mut qdd);
-    acceleration_pass(model, dd, qd, &qdd);
+    aba_world(model, data, dd, qd, tau, ext.is_some(), &mut qdd);
+    acceleration_pass(model, dd, qd, &qdd, ext.is_some());
     subtree_sums(model, dd, ext);
     minverse_sweeps(model, data, dd, minv);
     // dID/dq and dID/dqd at qdd
@@ -81,17 +81,20 @@ pub fn aba_derivatives<T: Real>(
 
 /// The articulated-body algorithm (RBDA Table 7.1) in base coordinates, after
 /// [`velocity_pass`]: body i's inertia `dd.ic[i]`, momentum `(dd.bn, dd.bp)[i]`, axis
-/// `J_i = dd.s[i]`, external force `dd.fx[i]`, and the velocity-product acceleration
+/// `J_i = dd.s[i]`, external force `dd.fx[i]` (if `has_ext`), and the velocity-product acceleration
 /// `c_i = (v_i x J_i) qd_i = dV_i qd_i`. Writes `qdd` (nv,) and, in base coordinates,
 /// `data.ia`, `data.pa`, `data.c`, `data.u_col`, `data.d_inv`, `data.u`, `data.a`.
 /// Joint dynamics as in `aba`: `D_i = J^T I^A J + Ia`, `u_i = tau_i - Fv qd_i -
 /// Fc sign(qd_i) - offset - J^T p^A_i`.
 #[inline(always)]
-fn aba_world<T: Real>(model: &Model, data: &mut Data<T>, dd: &DerivData<T>, qd: &[T], tau: &[T], qdd: &mut [T]) {
+fn aba_world<T: Real>(model: &Model, data: &mut Data<T>, dd: &DerivData<T>, qd: &[T], tau: &[T], has_ext: bool, qdd: &mut [T]) {
     let n = model.nv;
     for i in 0..n {
         data.ia[i] = ArticulatedInertia::from_rigid(&dd.ic[i]);
-        data.pa[i] = dd.v[i].cross_force(&Force::new(dd.bn[i], dd.bp[i])) - dd.fx[i];
+        data.pa[i] = dd.v[i].cross_force(&Force::new(dd.bn[i], dd.bp[i]));
+        if has_ext {
+            data.pa[i] -= dd.fx[i];
+        }
         data.c[i] = dd.dvdq[i].scale(qd[i]);
     }
     for i in (0..n).rev() {

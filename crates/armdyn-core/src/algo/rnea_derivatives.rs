@@ -120,10 +120,11 @@ pub(crate) fn velocity_pass<T: Real>(
 }
 
 /// The forward pass's acceleration part, after [`velocity_pass`]: `dd.a`, `dd.dadq` and
-/// the net forces `dd.f` of the bodies (from their own `dd.ic`, `dd.bn`, `dd.bp`).
+/// the net forces `dd.f` of the bodies (from their own `dd.ic`, `dd.bn`, `dd.bp`, and
+/// `dd.fx` if `has_ext`).
 /// `a_i = a_lambda + J_i qdd_i + (v_i x J_i) qd_i`, where `v_i x J_i = v_lambda x J_i = dV_i`.
 #[inline(always)]
-pub(crate) fn acceleration_pass<T: Real>(model: &Model, dd: &mut DerivData<T>, qd: &[T], qdd: &[T]) {
+pub(crate) fn acceleration_pass<T: Real>(model: &Model, dd: &mut DerivData<T>, qd: &[T], qdd: &[T], has_ext: bool) {
     let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
     for i in 0..model.nv {
         let (s, dvdq) = (dd.s[i], dd.dvdq[i]);
@@ -134,7 +135,10 @@ pub(crate) fn acceleration_pass<T: Real>(model: &Model, dd: &mut DerivData<T>, q
         let a = ap + s.scale(qdd[i]) + dvdq.scale(qd[i]);
         dd.dadq[i] = ap.cross_motion(&s) + vp.cross_motion(&dvdq);
         let h = Force::new(dd.bn[i], dd.bp[i]);
-        dd.f[i] = dd.ic[i].mul_motion(&a) + dd.v[i].cross_force(&h) - dd.fx[i];
+        dd.f[i] = dd.ic[i].mul_motion(&a) + dd.v[i].cross_force(&h);
+        if has_ext {
+            dd.f[i] -= dd.fx[i];
+        }
         dd.a[i] = a;
     }
 }
@@ -143,19 +147,23 @@ pub(crate) fn acceleration_pass<T: Real>(model: &Model, dd: &mut DerivData<T>, q
 /// (`dd.fx` only for forces fixed in space).
 #[inline(always)]
 pub(crate) fn subtree_sums<T: Real>(model: &Model, dd: &mut DerivData<T>, ext: Option<&ExternalForces<T>>) {
-    if !matches!(ext, Some(e) if e.frame == ForceFrame::World) {
+    let world_ext = matches!(ext, Some(e) if e.frame == ForceFrame::World);
+    if !world_ext {
         // forces given in link frames move with their links like the inertial forces
         dd.fx.iter_mut().for_each(|f| *f = Force::zero());
     }
     for i in (0..model.nv).rev() {
         if let Some(p) = model.parent[i] {
-            let (ic, bs, bn, bp, f, fx) = (dd.ic[i], dd.bs[i], dd.bn[i], dd.bp[i], dd.f[i], dd.fx[i]);
+            let (ic, bs, bn, bp, f) = (dd.ic[i], dd.bs[i], dd.bn[i], dd.bp[i], dd.f[i]);
             dd.ic[p] += ic;
             dd.bs[p] = dd.bs[p] + bs;
             dd.bn[p] += bn;
             dd.bp[p] += bp;
             dd.f[p] += f;
-            dd.fx[p] += fx;
+            if world_ext {
+                let fx = dd.fx[i];
+                dd.fx[p] += fx;
+            }
         }
     }
 }
@@ -184,7 +192,7 @@ pub fn rnea_derivatives<T: Real>(
     assert!(q.len() == n && qd.len() == n && qdd.len() == n, "state length");
     assert!(dtau_dq.len() == n * n && dtau_dqd.len() == n * n && m.len() == n * n, "output size");
     velocity_pass(model, data, dd, q, qd, ext);
-    acceleration_pass(model, dd, qd, qdd);
+    acceleration_pass(model, dd, qd, qdd, ext.is_some());
     subtree_sums(model, dd, ext);
     derivative_terms(model, dd, ext, dtau_dq, dtau_dqd, Some(m));
 }
@@ -212,7 +220,9 @@ pub(crate) fn derivative_terms<T: Real>(
         let ic = dd.ic[i];
         let (dvdq, dadq) = (dd.dvdq[i], dd.dadq[i]);
         let fa = ic.mul_motion(&s);
-        let fq = s.cross_force(&(dd.f[i] + dd.fx[i])) + ic.mul_motion(&dadq) + b_apply(dd, i, &dvdq);
+        // dd.fx is zero unless the forces are fixed in space
+        let ft = if world_ext { dd.f[i] + dd.fx[i] } else { dd.f[i] };
+        let fq = s.cross_force(&ft) + ic.mul_motion(&dadq) + b_apply(dd, i, &dvdq);
         let fv = ic.mul_motion(&(dvdq + dvdq)) + b_apply(dd, i, &s);
         let bt = b_tr_apply(dd, i, &s);
         // row i: the columns of i and its ancestors j (the motion of j moves body i's subtree)
