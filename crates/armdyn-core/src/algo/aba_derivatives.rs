@@ -32,7 +32,7 @@ use crate::spatial::{ArticulatedInertia, Force, Motion, V3};
 ///
 /// One set of kinematics serves everything (as in Pinocchio's `computeABADerivatives`):
 /// the velocity pass of `rnea_derivatives` (base-frame axes, velocities, inertias), the
-/// ABA in base coordinates on them ([`aba_world`]), whose articulated inertias give M^-1
+/// ABA in base coordinates on them (`aba_world`), whose articulated inertias give M^-1
 /// ([`minverse_sweeps`]), then the acceleration and backward passes of
 /// `rnea_derivatives` at `qdd` and its (body, ancestor) terms without M.
 #[allow(clippy::too_many_arguments)]
