@@ -138,9 +138,39 @@ fn table(name: &str, model: &Model) {
     }
 }
 
+/// Batch rate on one thread (SIMD lanes, no Python): N = 20 000 states, median of 7 runs.
+fn batch_table(name: &str, model: &Model) {
+    use armdyn_core::batch_derivatives as bd;
+    let (n, rows) = (model.nv, 20_000);
+    let mut rng = common::Rng::new(2);
+    let (q, qd, x) = (rng.vec(rows * n, -3.0, 3.0), rng.vec(rows * n, -1.0, 1.0), rng.vec(rows * n, -1.0, 1.0));
+    let (mut a, mut b, mut c) = (vec![0.0; rows * n * n], vec![0.0; rows * n * n], vec![0.0; rows * n * n]);
+    let mut time = |f: &mut dyn FnMut(&mut [f64], &mut [f64], &mut [f64])| {
+        let mut runs: Vec<f64> = (0..7)
+            .map(|_| {
+                let t0 = std::time::Instant::now();
+                f(&mut a, &mut b, &mut c);
+                t0.elapsed().as_secs_f64()
+            })
+            .collect();
+        runs.sort_by(f64::total_cmp);
+        rows as f64 / runs[3] / 1e6
+    };
+    println!("{name}: batch of {rows} states, 1 thread, M states/s (median of 7)");
+    let r = time(&mut |a, b, c| bd::rnea_derivatives(model, [&q, &qd, &x], None, [a, b, c], Some(1)));
+    println!("  rnea_derivatives     {r:6.2}");
+    let r = time(&mut |a, b, c| bd::aba_derivatives(model, [&q, &qd, &x], None, [a, b, c], Some(1)));
+    println!("  aba_derivatives      {r:6.2}");
+    let r = time(&mut |a, _, _| bd::minverse(model, &q, a, Some(1)));
+    println!("  minverse             {r:6.2}");
+    let r = time(&mut |a, _, _| bd::gravity_derivatives(model, &q, a, Some(1)));
+    println!("  gravity_derivatives  {r:6.2}");
+}
+
 fn main() {
     let ur5 = Model::new(&common::ur5_joints(), [0.0, 0.0, -9.81]).unwrap();
     table("UR5", &ur5);
+    batch_table("UR5", &ur5);
     let mut rng = common::Rng::new(4);
     let chain = common::random_model(&mut rng, 7, false);
     table("random 7-joint chain", &chain);

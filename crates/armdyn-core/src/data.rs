@@ -23,7 +23,9 @@ pub struct Data<T> {
     /// CRBA: composite rigid-body inertia of the subtree at i, body frame.
     pub ic: Vec<RigidInertia<T>>,
     /// ABA: articulated inertia `I^A_i`, bias force `p^A_i`, `U_i = I^A_i S_i`,
-    /// `1 / D_i = 1 / (S_i^T U_i)`, `u_i = tau_i - S_i^T p^A_i`.
+    /// `1 / D_i = 1 / (S_i^T U_i)`, `u_i = tau_i - S_i^T p^A_i`. Body frame after `aba`;
+    /// base frame (with `J_i` for `S_i`) after `minverse` and `aba_derivatives` (which
+    /// also leaves `c`, `a` in base coordinates).
     pub ia: Vec<ArticulatedInertia<T>>,
     pub pa: Vec<Force<T>>,
     pub u_col: Vec<Force<T>>,

@@ -32,6 +32,18 @@ impl JointKind {
         }
     }
 
+    /// `^A X_B S`: the axis expressed in frame A, for `x = ^B X_A` (B the body frame):
+    /// `w = E^T S_w`, `v = E^T S_v + r x w` (as `Xform::inv_apply_motion`), with
+    /// `E^T e_z` = row 2 of `E` picked instead of multiplied out.
+    #[inline(always)]
+    pub fn s_in<T: Real>(self, x: &Xform<T>) -> Motion<T> {
+        let ez = x.e.rows[2];
+        match self {
+            JointKind::RevoluteZ => Motion::new(ez, x.r.cross(ez)),
+            JointKind::PrismaticZ => Motion::new(V3::zero(), ez),
+        }
+    }
+
     /// `S^T f`: the component of a force along the joint's motion.
     #[inline(always)]
     pub fn s_dot<T: Real>(self, f: &Force<T>) -> T {

@@ -6,28 +6,35 @@
 //! dFD/dq = -M^-1 dID/dq,   dFD/dqd = -M^-1 dID/dqd,   dFD/dtau = M^-1,
 //! ```
 //!
-//! with the inverse-dynamics derivatives taken at `qdd = FD(q, qd, tau)`. One ABA gives
-//! `qdd` and the articulated inertias that `minverse_from_articulated` turns into M^-1;
-//! `rnea_derivatives` gives `dID/dq`, `dID/dqd`; two (nv x nv) products finish.
+//! with the inverse-dynamics derivatives taken at `qdd = FD(q, qd, tau)`. One ABA (in
+//! base coordinates) gives `qdd` and the articulated inertias that `minverse_sweeps`
+//! turns into M^-1; the passes of `rnea_derivatives` give `dID/dq`, `dID/dqd`; two
+//! (nv x nv) products finish.
 //!
 //! Joint friction, rotor inertia and offset follow without a case of their own: `aba`
 //! puts `Ia` into `D_i = S^T I^A S + Ia` (so M^-1 is that of `M + diag(Ia)`), and
 //! `rnea_derivatives` adds `diag(Fv)` to `dID/dqd` (Coulomb friction: 0, see there).
 
-use crate::algo::aba;
-use crate::algo::external::{generalized_forces, ExternalForces};
-use crate::algo::minverse::minverse_from_articulated;
-use crate::algo::rnea_derivatives::rnea_derivatives;
+use crate::algo::external::ExternalForces;
+use crate::algo::minverse::minverse_sweeps;
+use crate::algo::rnea_derivatives::{acceleration_pass, derivative_terms, subtree_sums, velocity_pass};
 use crate::data::Data;
 use crate::deriv_data::DerivData;
 use crate::model::Model;
 use crate::real::Real;
+use crate::spatial::{ArticulatedInertia, Force, Motion, V3};
 
 /// Partial derivatives of `qdd = aba(q, qd, tau)` (with external wrenches `ext`, if any:
 /// `M qdd + C qd + g = tau + sum_L J_L^T w_L`).
 ///
 /// `q`, `qd`, `tau`: (nv,). Writes `dqdd_dq`, `dqdd_dqd` and `minv` = `dqdd/dtau` =
 /// M(q)^-1, each (nv, nv) row-major, `[i * nv + j] = d qdd_i / d x_j`; and `qdd` (nv,).
+///
+/// One set of kinematics serves everything (as in Pinocchio's `computeABADerivatives`):
+/// the velocity pass of `rnea_derivatives` (base-frame axes, velocities, inertias), the
+/// ABA in base coordinates on them (`aba_world`), whose articulated inertias give M^-1
+/// ([`minverse_sweeps`]), then the acceleration and backward passes of
+/// `rnea_derivatives` at `qdd` and its (body, ancestor) terms without M.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn aba_derivatives<T: Real>(
@@ -45,21 +52,15 @@ pub fn aba_derivatives<T: Real>(
     let n = model.nv;
     assert!(q.len() == n && qd.len() == n && tau.len() == n, "state length");
     assert!(dqdd_dq.len() == n * n && dqdd_dqd.len() == n * n && minv.len() == n * n, "output size");
-    let mut total = std::mem::take(&mut dd.tau);
-    match ext {
-        Some(e) => {
-            generalized_forces(model, data, dd, q, e, &mut total);
-            total.iter_mut().zip(tau).for_each(|(t, u)| *t += *u);
-        }
-        None => total.copy_from_slice(tau),
-    }
+    velocity_pass(model, data, dd, q, qd, ext);
     let mut qdd = std::mem::take(&mut dd.qdd);
-    aba(model, data, q, qd, &total, &mut qdd);
-    dd.tau = total;
-    minverse_from_articulated(model, data, dd, minv);
-    // dID/dq and dID/dqd at qdd; dqdd_dq serves as scratch for the unused M.
+    aba_world(model, data, dd, qd, tau, ext.is_some(), &mut qdd);
+    acceleration_pass(model, dd, qd, &qdd, ext.is_some());
+    subtree_sums(model, dd, ext);
+    minverse_sweeps(model, data, dd, minv);
+    // dID/dq and dID/dqd at qdd
     let (mut dq, mut dqd) = (std::mem::take(&mut dd.dq), std::mem::take(&mut dd.dqd));
-    rnea_derivatives(model, data, dd, q, qd, &qdd, ext, &mut dq, &mut dqd, dqdd_dq);
+    derivative_terms(model, dd, ext, &mut dq, &mut dqd, None);
     // dqdd/dx = -Minv dID/dx
     for i in 0..n {
         for j in 0..n {
@@ -76,4 +77,54 @@ pub fn aba_derivatives<T: Real>(
     dd.dq = dq;
     dd.dqd = dqd;
     dd.qdd = qdd;
+}
+
+/// The articulated-body algorithm (RBDA Table 7.1) in base coordinates, after
+/// [`velocity_pass`]: body i's inertia `dd.ic[i]`, momentum `(dd.bn, dd.bp)[i]`, axis
+/// `J_i = dd.s[i]`, external force `dd.fx[i]` (if `has_ext`), and the velocity-product acceleration
+/// `c_i = (v_i x J_i) qd_i = dV_i qd_i`. Writes `qdd` (nv,) and, in base coordinates,
+/// `data.ia`, `data.pa`, `data.c`, `data.u_col`, `data.d_inv`, `data.u`, `data.a`.
+/// Joint dynamics as in `aba`: `D_i = J^T I^A J + Ia`, `u_i = tau_i - Fv qd_i -
+/// Fc sign(qd_i) - offset - J^T p^A_i`.
+#[inline(always)]
+fn aba_world<T: Real>(model: &Model, data: &mut Data<T>, dd: &DerivData<T>, qd: &[T], tau: &[T], has_ext: bool, qdd: &mut [T]) {
+    let n = model.nv;
+    for i in 0..n {
+        data.ia[i] = ArticulatedInertia::from_rigid(&dd.ic[i]);
+        data.pa[i] = dd.v[i].cross_force(&Force::new(dd.bn[i], dd.bp[i]));
+        if has_ext {
+            data.pa[i] -= dd.fx[i];
+        }
+        data.c[i] = dd.dvdq[i].scale(qd[i]);
+    }
+    for i in (0..n).rev() {
+        let s = dd.s[i];
+        let u_col = data.ia[i].mul_motion(&s);
+        let jd = &model.joint_dynamics[i];
+        let d_inv = T::splat(1.0) / (s.dot(&u_col) + T::splat(jd.armature));
+        let mut u = tau[i] - s.dot(&data.pa[i]);
+        if model.has_joint_dynamics {
+            u -= T::splat(jd.viscous) * qd[i] + T::splat(jd.coulomb) * qd[i].sign0() + T::splat(jd.offset);
+        }
+        data.u_col[i] = u_col;
+        data.d_inv[i] = d_inv;
+        data.u[i] = u;
+        if let Some(p) = model.parent[i] {
+            let ia = data.ia[i].sub_outer(&u_col, d_inv);
+            let pa = data.pa[i] + ia.mul_motion(&data.c[i]) + u_col.scale(u * d_inv);
+            data.ia[p] += ia;
+            data.pa[p] += pa;
+        }
+    }
+    let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
+    for i in 0..n {
+        let ap = match model.parent[i] {
+            Some(p) => data.a[p],
+            None => a0,
+        };
+        let a = ap + data.c[i];
+        let qddi = (data.u[i] - a.dot(&data.u_col[i])) * data.d_inv[i];
+        qdd[i] = qddi;
+        data.a[i] = a + dd.s[i].scale(qddi);
+    }
 }

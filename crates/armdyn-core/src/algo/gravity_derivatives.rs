@@ -25,7 +25,7 @@ pub fn gravity_derivatives<T: Real>(model: &Model, data: &mut Data<T>, dd: &mut 
     let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
     for i in 0..n {
         let x0 = data.x0[i];
-        let s = x0.inv_apply_motion(&model.kind[i].s());
+        let s = model.kind[i].s_in(&x0);
         dd.s[i] = s;
         dd.dadq[i] = a0.cross_motion(&s);
         dd.ic[i] = RigidInertia::splat(&model.inertia[i]).tr_transform(&x0);

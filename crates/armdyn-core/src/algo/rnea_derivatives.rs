@@ -79,63 +79,91 @@ fn b_sym<T: Real>(i: &RigidInertia<T>, v: &Motion<T>) -> Sym3<T> {
     (s - Sym3::sym_outer(v.v, i.h)).add_diag(vh + vh)
 }
 
-/// The forward and backward passes shared by `rnea_derivatives` and `aba_derivatives`:
-/// fills `dd.s`, `dd.v`, `dd.a`, `dd.dvdq`, `dd.dadq` and the subtree sums `dd.ic`,
-/// `dd.bs`, `dd.bn`, `dd.bp`, `dd.f`, `dd.fx`.
+/// The forward pass's velocity part (independent of `qdd`), shared by
+/// `rnea_derivatives` and `aba_derivatives`: writes `data.xup`, `data.x0`, `dd.fx`
+/// (the external forces in base coordinates, whatever their frame) and per body the
+/// base-frame `dd.s` (`J_i`), `dd.v`, `dd.dvdq`, `dd.ic` (body i's own inertia),
+/// `dd.bn`, `dd.bp` (its momentum `I_i v_i`) and `dd.bs`.
 #[inline(always)]
-fn passes<T: Real>(
+pub(crate) fn velocity_pass<T: Real>(
     model: &Model,
     data: &mut Data<T>,
     dd: &mut DerivData<T>,
     q: &[T],
     qd: &[T],
-    qdd: &[T],
     ext: Option<&ExternalForces<T>>,
 ) {
-    let n = model.nv;
     update_xup(model, data, q);
     update_x0(model, data);
     match ext {
         Some(e) => world_forces(model, data, e, &mut dd.fx),
         None => dd.fx.iter_mut().for_each(|f| *f = Force::zero()),
     }
-    let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
-    for i in 0..n {
+    for i in 0..model.nv {
         let x0 = data.x0[i];
-        let s = x0.inv_apply_motion(&model.kind[i].s());
-        let (vp, ap) = match model.parent[i] {
-            Some(p) => (dd.v[p], dd.a[p]),
-            None => (Motion::zero(), a0),
+        let s = model.kind[i].s_in(&x0);
+        let vp = match model.parent[i] {
+            Some(p) => dd.v[p],
+            None => Motion::zero(),
         };
         let v = vp + s.scale(qd[i]);
-        let a = ap + s.scale(qdd[i]) + v.cross_motion(&s).scale(qd[i]);
-        let dvdq = vp.cross_motion(&s);
-        dd.dadq[i] = ap.cross_motion(&s) + vp.cross_motion(&dvdq);
-        dd.dvdq[i] = dvdq;
         let inertia = RigidInertia::splat(&model.inertia[i]).tr_transform(&x0);
         let h = inertia.mul_motion(&v);
-        dd.f[i] = inertia.mul_motion(&a) + v.cross_force(&h) - dd.fx[i];
         dd.bs[i] = b_sym(&inertia, &v);
         dd.bn[i] = h.n;
         dd.bp[i] = h.f;
         dd.ic[i] = inertia;
+        dd.dvdq[i] = vp.cross_motion(&s);
         dd.s[i] = s;
         dd.v[i] = v;
+    }
+}
+
+/// The forward pass's acceleration part, after [`velocity_pass`]: `dd.a`, `dd.dadq` and
+/// the net forces `dd.f` of the bodies (from their own `dd.ic`, `dd.bn`, `dd.bp`, and
+/// `dd.fx` if `has_ext`).
+/// `a_i = a_lambda + J_i qdd_i + (v_i x J_i) qd_i`, where `v_i x J_i = v_lambda x J_i = dV_i`.
+#[inline(always)]
+pub(crate) fn acceleration_pass<T: Real>(model: &Model, dd: &mut DerivData<T>, qd: &[T], qdd: &[T], has_ext: bool) {
+    let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
+    for i in 0..model.nv {
+        let (s, dvdq) = (dd.s[i], dd.dvdq[i]);
+        let (vp, ap) = match model.parent[i] {
+            Some(p) => (dd.v[p], dd.a[p]),
+            None => (Motion::zero(), a0),
+        };
+        let a = ap + s.scale(qdd[i]) + dvdq.scale(qd[i]);
+        dd.dadq[i] = ap.cross_motion(&s) + vp.cross_motion(&dvdq);
+        let h = Force::new(dd.bn[i], dd.bp[i]);
+        dd.f[i] = dd.ic[i].mul_motion(&a) + dd.v[i].cross_force(&h);
+        if has_ext {
+            dd.f[i] -= dd.fx[i];
+        }
         dd.a[i] = a;
     }
-    if !matches!(ext, Some(e) if e.frame == ForceFrame::World) {
+}
+
+/// The backward pass: the subtree sums `dd.ic`, `dd.bs`, `dd.bn`, `dd.bp`, `dd.f`, `dd.fx`
+/// (`dd.fx` only for forces fixed in space).
+#[inline(always)]
+pub(crate) fn subtree_sums<T: Real>(model: &Model, dd: &mut DerivData<T>, ext: Option<&ExternalForces<T>>) {
+    let world_ext = matches!(ext, Some(e) if e.frame == ForceFrame::World);
+    if !world_ext {
         // forces given in link frames move with their links like the inertial forces
         dd.fx.iter_mut().for_each(|f| *f = Force::zero());
     }
-    for i in (0..n).rev() {
+    for i in (0..model.nv).rev() {
         if let Some(p) = model.parent[i] {
-            let (ic, bs, bn, bp, f, fx) = (dd.ic[i], dd.bs[i], dd.bn[i], dd.bp[i], dd.f[i], dd.fx[i]);
+            let (ic, bs, bn, bp, f) = (dd.ic[i], dd.bs[i], dd.bn[i], dd.bp[i], dd.f[i]);
             dd.ic[p] += ic;
             dd.bs[p] = dd.bs[p] + bs;
             dd.bn[p] += bn;
             dd.bp[p] += bp;
             dd.f[p] += f;
-            dd.fx[p] += fx;
+            if world_ext {
+                let fx = dd.fx[i];
+                dd.fx[p] += fx;
+            }
         }
     }
 }
@@ -163,29 +191,54 @@ pub fn rnea_derivatives<T: Real>(
     let n = model.nv;
     assert!(q.len() == n && qd.len() == n && qdd.len() == n, "state length");
     assert!(dtau_dq.len() == n * n && dtau_dqd.len() == n * n && m.len() == n * n, "output size");
-    passes(model, data, dd, q, qd, qdd, ext);
+    velocity_pass(model, data, dd, q, qd, ext);
+    acceleration_pass(model, dd, qd, qdd, ext.is_some());
+    subtree_sums(model, dd, ext);
+    derivative_terms(model, dd, ext, dtau_dq, dtau_dqd, Some(m));
+}
+
+/// The (body, ancestor) terms of the module docs from the passes' results, into
+/// `dtau_dq`, `dtau_dqd` and (if given) `m`, then the joint dynamics' terms.
+#[inline(always)]
+pub(crate) fn derivative_terms<T: Real>(
+    model: &Model,
+    dd: &DerivData<T>,
+    ext: Option<&ExternalForces<T>>,
+    dtau_dq: &mut [T],
+    dtau_dqd: &mut [T],
+    mut m: Option<&mut [T]>,
+) {
+    let n = model.nv;
     let world_ext = matches!(ext, Some(e) if e.frame == ForceFrame::World);
     dtau_dq.fill(T::zero());
     dtau_dqd.fill(T::zero());
-    m.fill(T::zero());
+    if let Some(m) = m.as_deref_mut() {
+        m.fill(T::zero());
+    }
     for i in 0..n {
         let s = dd.s[i];
         let ic = dd.ic[i];
         let (dvdq, dadq) = (dd.dvdq[i], dd.dadq[i]);
         let fa = ic.mul_motion(&s);
-        let fq = s.cross_force(&(dd.f[i] + dd.fx[i])) + ic.mul_motion(&dadq) + b_apply(dd, i, &dvdq);
+        // dd.fx is zero unless the forces are fixed in space
+        let ft = if world_ext { dd.f[i] + dd.fx[i] } else { dd.f[i] };
+        let fq = s.cross_force(&ft) + ic.mul_motion(&dadq) + b_apply(dd, i, &dvdq);
         let fv = ic.mul_motion(&(dvdq + dvdq)) + b_apply(dd, i, &s);
         let bt = b_tr_apply(dd, i, &s);
         // row i: the columns of i and its ancestors j (the motion of j moves body i's subtree)
-        m[i * n + i] = s.dot(&fa);
+        if let Some(m) = m.as_deref_mut() {
+            m[i * n + i] = s.dot(&fa);
+        }
         dtau_dq[i * n + i] = s.dot(&fq);
         dtau_dqd[i * n + i] = s.dot(&fv);
         let mut a = model.parent[i];
         while let Some(j) = a {
             let (sj, dvj, daj) = (dd.s[j], dd.dvdq[j], dd.dadq[j]);
-            let mji = sj.dot(&fa);
-            m[j * n + i] = mji;
-            m[i * n + j] = mji;
+            if let Some(m) = m.as_deref_mut() {
+                let mji = sj.dot(&fa);
+                m[j * n + i] = mji;
+                m[i * n + j] = mji;
+            }
             dtau_dq[j * n + i] = sj.dot(&fq);
             dtau_dqd[j * n + i] = sj.dot(&fv);
             dtau_dq[i * n + j] = daj.dot(&fa) + bt.dot(dvj.w);
@@ -208,11 +261,13 @@ pub fn rnea_derivatives<T: Real>(
 /// derivative) we report the same 0, the one-sided derivative of either side, consistent with
 /// rnea's `sign(0) = 0`. The offset is constant: nothing. `dtau/dq` is unchanged.
 #[inline(always)]
-pub fn add_joint_dynamics_derivatives<T: Real>(model: &Model, dtau_dqd: &mut [T], m: &mut [T]) {
+pub fn add_joint_dynamics_derivatives<T: Real>(model: &Model, dtau_dqd: &mut [T], mut m: Option<&mut [T]>) {
     let n = model.nv;
     for i in 0..n {
         let jd = &model.joint_dynamics[i];
-        m[i * n + i] += T::splat(jd.armature);
+        if let Some(m) = m.as_deref_mut() {
+            m[i * n + i] += T::splat(jd.armature);
+        }
         dtau_dqd[i * n + i] += T::splat(jd.viscous);
     }
 }
