@@ -14,7 +14,9 @@ UR5, Panda and iiwa14.
    its result matrices as new NumPy arrays; armdyn allocates (n, n) outputs per call; neither
    symmetrises its M or Minv (armdyn's are full, Pinocchio fills the upper triangle).
 2. Batch throughput: ``armdyn.rnea_derivatives(robot, Q, QD, QDD, threads=t)`` on (N, n)
-   arrays (outputs (N, n, n) allocated per call), t = 1 and 2, in million states per second,
+   arrays, t = 1 and 2, in million states per second, with outputs (N, n, n) allocated by
+   each call ("fresh") and written into the caller's arrays (``out=``, allocated once: what
+   a loop over batches does, and what Pinocchio's per-call time does with its ``Data``),
    compared with the rate of Pinocchio's per-call time (Pinocchio has no batched derivatives):
    ``1 / t_call`` for its Python call measured here (an upper bound on its C++ call time, so
    a lower bound on its rate), and ``2 / t_call`` ("both cores") — the issue's target is
@@ -116,33 +118,46 @@ def main(argv=None) -> int:
         TAU = num.rnea(robot, Q, V, A)
         for fn, f, X in (("rnea_derivatives", num.rnea_derivatives, A), ("aba_derivatives", num.aba_derivatives, TAU),
                          ("minverse", None, None)):
+            n = robot.dof
+            out = np.empty((N, n, n)) if f is None else tuple(np.empty((N, n, n)) for _ in range(3))
             for t in threads:
-                call = (lambda: num.minverse(robot, Q, threads=t)) if f is None else (lambda: f(robot, Q, V, X, threads=t))
-                times = [batch_run(call)() for _ in range(args.batch_repeat + 1)][1:]
-                batch_rows.append((name, fn, t, statistics.median(times), pin_call[fn]))
+                times = {}
+                for kind, o in (("fresh", None), ("out", out)):  # fresh outputs, and the caller's out=
+                    if f is None:
+                        call = lambda: num.minverse(robot, Q, threads=t, out=o)  # noqa: E731
+                    else:
+                        call = lambda: f(robot, Q, V, X, threads=t, out=o)  # noqa: E731
+                    times[kind] = statistics.median([batch_run(call)() for _ in range(args.batch_repeat + 1)][1:])
+                batch_rows.append((name, fn, t, times["fresh"], times["out"], pin_call[fn]))
 
     print(f"{'arm':7} {'function':17} {'armdyn':>9} {'Pinocchio':>10} {'ratio':>6}")
     for name, fn, t_mine, t_pin in rows:
         print(f"{name:7} {fn:17} {t_mine * 1e6:7.2f}us {t_pin * 1e6:8.2f}us {t_mine / t_pin:6.2f}")
-    print(f"\nbatch of N = {N}: armdyn M states/s vs the rate of Pinocchio's per-call time (Python call: 1 core, 2 cores)")
-    print(f"{'arm':7} {'function':17} {'thr':>3} {'armdyn':>9} {'M/s':>6} {'pin 1 core':>10} {'pin 2 cores':>11} {'x (2 cores)':>11}")
-    for name, fn, t, tb, t_pin in batch_rows:
-        rate = N / tb / 1e6
+    print(f"\nbatch of N = {N}: armdyn M states/s (fresh outputs; out=: into the caller's arrays) vs the rate of "
+          "Pinocchio's per-call time (Python call: 1 core, 2 cores)")
+    print(f"{'arm':7} {'function':17} {'thr':>3} {'armdyn':>9} {'M/s':>6} {'out= M/s':>8} {'pin 1 core':>10} "
+          f"{'pin 2 cores':>11} {'x (2 cores)':>11} {'x out=':>6}")
+    for name, fn, t, tb, tb_out, t_pin in batch_rows:
+        rate, rate_out = N / tb / 1e6, N / tb_out / 1e6
         r1 = 1 / t_pin / 1e6
-        print(f"{name:7} {fn:17} {t:3d} {tb * 1e3:7.1f}ms {rate:6.2f} {r1:10.2f} {2 * r1:11.2f} {rate / (2 * r1):11.2f}")
+        print(f"{name:7} {fn:17} {t:3d} {tb * 1e3:7.1f}ms {rate:6.2f} {rate_out:8.2f} {r1:10.2f} {2 * r1:11.2f} "
+              f"{rate / (2 * r1):11.2f} {rate_out / (2 * r1):6.2f}")
     if not args.no_cpp:
         cpp = _pinocchio_cpp().run(number=args.number, repeat=args.repeat)
         if cpp is not None:
             t = max(threads)
             print(f"\nPinocchio C++ per call (g++ -O3 -march=native, median of {args.repeat} x {args.number}) vs armdyn's "
                   f"batch of N = {N} on {t} threads; target: armdyn rate >= 4 x 2 / t_C++ (both cores)")
-            print(f"{'arm':7} {'function':17} {'C++ us':>7} {'C++ 2 cores M/s':>15} {'armdyn M/s':>10} {'x':>6}")
-            for name, fn, tt, tb, _ in batch_rows:
+            print(f"{'arm':7} {'function':17} {'C++ us':>7} {'C++ 2 cores M/s':>15} {'armdyn M/s':>10} {'x':>6} "
+                  f"{'out= M/s':>8} {'x out=':>6}")
+            for name, fn, tt, tb, tb_out, _ in batch_rows:
                 if tt != t or name not in cpp:
                     continue
                 t_cpp = cpp[name][fn]
                 rate_cpp = 2 / t_cpp / 1e6
-                print(f"{name:7} {fn:17} {t_cpp * 1e6:7.3f} {rate_cpp:15.2f} {N / tb / 1e6:10.2f} {N / tb / 1e6 / rate_cpp:6.2f}")
+                rate, rate_out = N / tb / 1e6, N / tb_out / 1e6
+                print(f"{name:7} {fn:17} {t_cpp * 1e6:7.3f} {rate_cpp:15.2f} {rate:10.2f} {rate / rate_cpp:6.2f} "
+                      f"{rate_out:8.2f} {rate_out / rate_cpp:6.2f}")
             for name, r in cpp.items():
                 print(f"{name:7} {'rnea':17} {r['rnea'] * 1e6:7.3f} (for scale)")
     print(f"\nload average at the end: {os.getloadavg()[0]:.2f}")

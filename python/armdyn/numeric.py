@@ -341,35 +341,58 @@ aba_derivatives = _core.aba_derivatives
 minverse = _core.minverse
 
 
-def _rnea_derivatives_python(robot, q, qd, qdd, f_ext, frame, threads):
+def _into(out, result):
+    """``result`` (an array or a tuple of arrays) copied into the caller's ``out`` (same
+    structure, float64, same shapes, writeable), for the paths that compute apart from
+    the Rust entries' own ``out=`` (mimic joints); returns ``out``. None: ``result``."""
+    if out is None:
+        return result
+    many = isinstance(result, tuple)
+    outs = tuple(out) if many and isinstance(out, (tuple, list)) else (out,)
+    results = result if many else (result,)
+    if len(outs) != len(results):
+        raise ValueError(f"out: expected {len(results)} arrays, got {len(outs)}")
+    for k, (o, r) in enumerate(zip(outs, results)):
+        name = f"out[{k}]" if many else "out"
+        if not isinstance(o, np.ndarray) or o.dtype != np.float64:
+            raise ValueError(f"{name}: expected a float64 numpy array, got {type(o).__name__}")
+        if o.shape != r.shape:
+            raise ValueError(f"{name}: expected shape {list(r.shape)}, got {list(o.shape)}")
+        if not o.flags.writeable:
+            raise ValueError(f"{name}: is read-only")
+        o[...] = r
+    return outs if many else out
+
+
+def _rnea_derivatives_python(robot, q, qd, qdd, f_ext, frame, threads, out):
     """:func:`rnea_derivatives` for a robot not compiled yet (this compiles and caches
     it), mimic joints, and external wrenches."""
     model = _model(robot)
     if type(model) is not NumericModel:  # mimic joints: the chain rule, see armdyn.mimic
-        return _mimic(robot, "rnea_derivatives", f_ext, frame).rnea_derivatives(q, qd, qdd, threads)
+        return _into(out, _mimic(robot, "rnea_derivatives", f_ext, frame).rnea_derivatives(q, qd, qdd, threads))
     if f_ext is not None:
         f_ext = _canonical_wrenches(robot, f_ext, frame)
-    return _core.rnea_derivatives_model(model, q, qd, qdd, f_ext, frame, threads)
+    return _core.rnea_derivatives_model(model, q, qd, qdd, f_ext, frame, threads, out)
 
 
-def _aba_derivatives_python(robot, q, qd, tau, f_ext, frame, threads):
+def _aba_derivatives_python(robot, q, qd, tau, f_ext, frame, threads, out):
     """:func:`aba_derivatives` for what the Rust entry hands back (as above)."""
     model = _model(robot)
     if type(model) is not NumericModel:  # mimic joints: the chain rule, see armdyn.mimic
-        return _mimic(robot, "aba_derivatives", f_ext, frame).aba_derivatives(q, qd, tau, threads)
+        return _into(out, _mimic(robot, "aba_derivatives", f_ext, frame).aba_derivatives(q, qd, tau, threads))
     if f_ext is not None:
         f_ext = _canonical_wrenches(robot, f_ext, frame)
-    return _core.aba_derivatives_model(model, q, qd, tau, f_ext, frame, threads)
+    return _core.aba_derivatives_model(model, q, qd, tau, f_ext, frame, threads, out)
 
 
-def _minverse_python(robot, q, threads):
+def _minverse_python(robot, q, threads, out):
     """:func:`minverse` for what the Rust entry hands back (a robot not compiled yet, mimic
     joints)."""
     model = _model(robot)
     if type(model) is NumericModel:
-        return _core.minverse_model(model, q, threads)
+        return _core.minverse_model(model, q, threads, out)
     # mimic joints: (G^T M_full G)^-1 by Cholesky (the constraint couples branches)
-    return _mimic(robot, "minverse").minverse(q, threads)
+    return _into(out, _mimic(robot, "minverse").minverse(q, threads))
 
 
 def gravity_derivatives(robot, q, *, threads=None):
