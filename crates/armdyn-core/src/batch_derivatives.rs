@@ -62,6 +62,47 @@ impl<L: Real> Work<L> {
     }
 }
 
+/// Transposes `L::LANES` rows of `len` values (`rows`, row-major: one state per row)
+/// into `len` lane vectors (`lanes[j]` holds value `j` of every state).
+///
+/// Each state's row is read contiguously; the lane loop has a constant trip count
+/// (`L::LANES`), so it unrolls and every `set_lane` has a constant lane index.
+#[inline(always)]
+fn rows_to_lanes<L: Real>(rows: &[f64], lanes: &mut [L], len: usize) {
+    for l in 0..L::LANES {
+        let row = &rows[l * len..(l + 1) * len];
+        for (v, &x) in lanes[..len].iter_mut().zip(row) {
+            v.set_lane(l, x);
+        }
+    }
+}
+
+/// The inverse of [`rows_to_lanes`]: `len` lane vectors (`lanes`) into `L::LANES`
+/// rows of `len` values (`rows`, row-major, one state per row).
+///
+/// Blocks of `L::LANES` values are square `LANES x LANES` transposes with constant
+/// indices (both loops unroll): whole-vector loads and contiguous stores of each
+/// state's row segment, instead of `LANES` stores strided by a whole output per value.
+#[inline(always)]
+fn lanes_to_rows<L: Real>(lanes: &[L], rows: &mut [f64], len: usize) {
+    let w = L::LANES;
+    let full = len / w * w;
+    for jb in (0..full).step_by(w) {
+        let block = &lanes[jb..jb + w];
+        for l in 0..w {
+            let row = &mut rows[l * len + jb..l * len + jb + w];
+            for jj in 0..w {
+                row[jj] = L::lane_of(&block[jj], l);
+            }
+        }
+    }
+    for j in full..len {
+        for l in 0..w {
+            rows[l * len + j] = L::lane_of(&lanes[j], l);
+        }
+    }
+}
+
 /// The rows `first..first + rows` of the batch, `L::LANES` at a time, then one by one.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
@@ -80,30 +121,19 @@ fn rows<L: Real, K: Kernel>(
     let rows = if per == 0 { 0 } else { outs[0].len() / per };
     let mut r = 0;
     while r + L::LANES <= rows {
+        let group = first + r..first + r + L::LANES;
         for (slot, arg) in w.args.iter_mut().zip(args).take(K::NARGS) {
-            for j in 0..n {
-                for l in 0..L::LANES {
-                    slot[j].set_lane(l, arg[(first + r + l) * n + j]);
-                }
-            }
+            rows_to_lanes(&arg[group.start * n..group.end * n], slot, n);
         }
         if let Some((e, _)) = ext {
-            for j in 0..ne {
-                for l in 0..L::LANES {
-                    w.ext[j].set_lane(l, e[(first + r + l) * ne + j]);
-                }
-            }
+            rows_to_lanes(&e[group.start * ne..group.end * ne], &mut w.ext, ne);
         }
         let e = ext.map(|(_, frame)| ExternalForces { wrenches: &w.ext[..], frame });
         let [a0, a1, a2] = &w.args;
         let [r0, r1, r2] = &mut w.res;
         k.run(model, &mut w.dl, &mut w.ddl, [a0, a1, a2], e.as_ref(), [r0, r1, r2]);
         for (o, res) in outs.iter_mut().zip(&w.res).take(K::NOUT) {
-            for j in 0..per {
-                for l in 0..L::LANES {
-                    o[(r + l) * per + j] = res[j].lane(l);
-                }
-            }
+            lanes_to_rows(res, &mut o[r * per..(r + L::LANES) * per], per);
         }
         r += L::LANES;
     }

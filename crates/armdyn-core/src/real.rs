@@ -43,6 +43,13 @@ pub trait Real:
     fn lane(self, k: usize) -> f64;
     /// Set lane `k`.
     fn set_lane(&mut self, k: usize, x: f64);
+    /// Lane `k` of `*v`, read in place. Same value as `v.lane(k)`; the SIMD types
+    /// override it so that a variable `k` is one scalar load from `v`'s memory instead
+    /// of a copy of the whole vector to the stack first (the batch transposition).
+    #[inline(always)]
+    fn lane_of(v: &Self, k: usize) -> f64 {
+        v.lane(k)
+    }
 
     #[inline(always)]
     fn zero() -> Self {
@@ -156,6 +163,10 @@ macro_rules! lanes_type {
             #[inline(always)]
             fn set_lane(&mut self, k: usize, x: f64) {
                 self.0[k] = x
+            }
+            #[inline(always)]
+            fn lane_of(v: &Self, k: usize) -> f64 {
+                v.0[k]
             }
         }
     };
