@@ -1,6 +1,7 @@
 //! The immutable model: built once from a robot description, then shared (read-only)
 //! by any number of threads, each with its own [`crate::Data`] workspace.
 
+use crate::real::Real;
 use crate::joint::JointKind;
 use crate::spatial::{Motion, RigidInertia, Sym3, Xform, M3, V3};
 use std::fmt;
@@ -52,6 +53,12 @@ impl JointDynamics {
     /// Whether every term is zero (the joint adds nothing).
     pub fn is_zero(&self) -> bool {
         *self == JointDynamics::default()
+    }
+    /// `viscous qd + coulomb sign(qd) + offset`: the torque the motor spends on the joint
+    /// itself at rate `qd` (what the ABA subtracts from `tau` before it reaches the link).
+    #[inline(always)]
+    pub fn passive_torque<T: Real>(&self, qd: T) -> T {
+        T::splat(self.viscous) * qd + T::splat(self.coulomb) * qd.sign0() + T::splat(self.offset)
     }
 }
 

@@ -3,7 +3,7 @@
 //! `python/armdyn/numeric.py`, which documents them). Same rules as the methods in
 //! `lib.rs`: one state `(n,)` or a batch `(N, n)`, ValueError naming the argument.
 
-use crate::{as_f64, guard, new_array, slice, states, thread_arg, NumericModel, Scratch, Shape};
+use crate::{as_f64, guard, is_c_contiguous_aligned, new_array, slice, states, thread_arg, NumericModel, Scratch, Shape};
 use armdyn_core::algo::{self, ExternalForces, ForceFrame};
 use armdyn_core::{batch_derivatives as bd, Model};
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
@@ -97,7 +97,7 @@ fn outputs_given<'py, const R: usize>(
         if a.shape() != dims {
             return Err(PyValueError::new_err(format!("{}: expected shape {dims:?}, got {:?}", name(k), a.shape())));
         }
-        if !a.is_c_contiguous() || (a.data() as usize) % std::mem::align_of::<f64>() != 0 {
+        if !is_c_contiguous_aligned(a) {
             return Err(PyValueError::new_err(format!("{}: must be C-contiguous and aligned", name(k))));
         }
         if a.try_readwrite().is_err() {

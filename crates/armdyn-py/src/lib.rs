@@ -38,6 +38,12 @@ fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
     })
 }
 
+/// Whether the array's data can be used as a `&[f64]` in place: C-contiguous and 8-byte
+/// aligned (arrays received over a network can be C-contiguous but unaligned).
+fn is_c_contiguous_aligned(a: &Bound<'_, PyArrayDyn<f64>>) -> bool {
+    a.is_c_contiguous() && (a.data() as usize) % std::mem::align_of::<f64>() == 0
+}
+
 /// `obj` as a C-contiguous float64 array: as is when it already is one (no copy),
 /// else converted once by `numpy.ascontiguousarray(obj, dtype=float64)`.
 ///
@@ -50,7 +56,7 @@ fn as_f64<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyArr
     if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
         // (aligned too: arrays received over a network, e.g. Dask results, can be
         // C-contiguous but not 8-byte aligned, and rust-numpy then gives no slice)
-        if a.is_c_contiguous() && (a.data() as usize) % std::mem::align_of::<f64>() == 0 {
+        if is_c_contiguous_aligned(&a) {
             return Ok(a.clone());
         }
         // an unaligned one: ascontiguousarray would return it as is, so copy it

@@ -43,7 +43,7 @@ pub fn aba<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], tau: &
         let d_inv = T::splat(1.0) / (kind.s_dot(&u_col) + T::splat(jd.armature));
         let mut u = tau[i] - kind.s_dot(&data.pa[i]);
         if model.has_joint_dynamics {
-            u -= T::splat(jd.viscous) * qd[i] + T::splat(jd.coulomb) * qd[i].sign0() + T::splat(jd.offset);
+            u -= jd.passive_torque(qd[i]);
         }
         data.u_col[i] = u_col;
         data.d_inv[i] = d_inv;

@@ -104,7 +104,7 @@ fn aba_world<T: Real>(model: &Model, data: &mut Data<T>, dd: &DerivData<T>, qd: 
         let d_inv = T::splat(1.0) / (s.dot(&u_col) + T::splat(jd.armature));
         let mut u = tau[i] - s.dot(&data.pa[i]);
         if model.has_joint_dynamics {
-            u -= T::splat(jd.viscous) * qd[i] + T::splat(jd.coulomb) * qd[i].sign0() + T::splat(jd.offset);
+            u -= jd.passive_torque(qd[i]);
         }
         data.u_col[i] = u_col;
         data.d_inv[i] = d_inv;
