@@ -81,7 +81,8 @@ pub fn aba_derivatives<T: Real>(
 
 /// The articulated-body algorithm (RBDA Table 7.1) in base coordinates, after
 /// [`velocity_pass`]: body i's inertia `dd.ic[i]`, momentum `(dd.bn, dd.bp)[i]`, axis
-/// `J_i = dd.s[i]`, velocity-product force `v_i x* I_i v_i` in `dd.f[i]`, external force `dd.fx[i]` (if `has_ext`), and the velocity-product acceleration
+/// `J_i = dd.s[i]`, velocity-product force `v_i x* I_i v_i` (`dd.f[i]`), external force
+/// `dd.fx[i]` (if `has_ext`), and the velocity-product acceleration
 /// `c_i = (v_i x J_i) qd_i = dV_i qd_i`. Writes `qdd` (nv,) and, in base coordinates,
 /// `data.ia`, `data.pa`, `data.c`, `data.u_col`, `data.d_inv`, `data.u`, `data.a`.
 /// Joint dynamics as in `aba`: `D_i = J^T I^A J + Ia`, `u_i = tau_i - Fv qd_i -

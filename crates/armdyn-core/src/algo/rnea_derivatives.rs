@@ -75,13 +75,12 @@ fn b_sym<T: Real>(i: &RigidInertia<T>, v: &Motion<T>) -> Sym3<T> {
 }
 
 /// The forward pass's velocity part (independent of `qdd`), shared by
-/// `rnea_derivatives` and `aba_derivatives`: writes `data.xup`, `data.x0`, `dd.fx`
-/// (the external forces in base coordinates, whatever their frame; only if `ext` is
-/// given) and per body the
-/// base-frame `dd.s` (`J_i`), `dd.v`, `dd.dvdq`, `dd.ic` (body i's own inertia),
-/// `dd.bn`, `dd.bp` (its momentum `I_i v_i`), `dd.bs`, and in `dd.f` the velocity-product
-/// force `v_i x* I_i v_i` (the acceleration pass adds `I_i a_i`; the base-frame ABA
-/// starts its bias forces from it).
+/// `rnea_derivatives` and `aba_derivatives`: writes `data.xup`, `data.x0`, `dd.fx` (the
+/// external forces in base coordinates, whatever their frame; only if `ext` is given)
+/// and per body the base-frame `dd.s` (`J_i`), `dd.v`, `dd.dvdq`, `dd.ic` (body i's own
+/// inertia), `dd.bn`, `dd.bp` (its momentum `I_i v_i`), `dd.bs`, and in `dd.f` the
+/// velocity-product force `v_i x* I_i v_i` (the acceleration pass adds `I_i a_i`; the
+/// base-frame ABA starts its bias forces from it).
 ///
 /// A root body's parent does not move (`v_lambda = 0`): `v_i = J_i qd_i`, `dV_i = 0`.
 #[inline(always)]
