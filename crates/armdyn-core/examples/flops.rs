@@ -6,6 +6,11 @@
 //! structure, hence the counts, of the benchmark UR5) and a random 7-joint chain.
 //!
 //! Counted: `+ - * /` and negation (one each; no FMA is ever used), `sin_cos` apart.
+//!
+//! `cargo run --release --example flops -- loop KERNEL SECONDS` instead runs one batch
+//! kernel (`rnea_derivatives`, `aba_derivatives`, `minverse`, `gravity_derivatives`;
+//! UR5, N = 20 000, one thread) over and over for about SECONDS seconds and prints its
+//! rate: a target for `perf record` / `perf stat`.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -167,7 +172,44 @@ fn batch_table(name: &str, model: &Model) {
     println!("  gravity_derivatives  {r:6.2}");
 }
 
+/// The `loop KERNEL SECONDS` mode (see the module docs).
+fn batch_loop(kernel: &str, seconds: f64) {
+    use armdyn_core::batch_derivatives as bd;
+    let model = Model::new(&common::ur5_joints(), [0.0, 0.0, -9.81]).unwrap();
+    let (n, rows) = (model.nv, 20_000);
+    let mut rng = common::Rng::new(2);
+    let (q, qd, x) = (rng.vec(rows * n, -3.0, 3.0), rng.vec(rows * n, -1.0, 1.0), rng.vec(rows * n, -1.0, 1.0));
+    let (mut a, mut b, mut c) = (vec![0.0; rows * n * n], vec![0.0; rows * n * n], vec![0.0; rows * n * n]);
+    let mut run: Box<dyn FnMut()> = match kernel {
+        "rnea_derivatives" => Box::new(|| bd::rnea_derivatives(&model, [&q, &qd, &x], None, [&mut a, &mut b, &mut c], Some(1))),
+        "aba_derivatives" => Box::new(|| bd::aba_derivatives(&model, [&q, &qd, &x], None, [&mut a, &mut b, &mut c], Some(1))),
+        "minverse" => Box::new(|| bd::minverse(&model, &q, &mut a, Some(1))),
+        "gravity_derivatives" => Box::new(|| bd::gravity_derivatives(&model, &q, &mut a, Some(1))),
+        _ => {
+            eprintln!("flops: unknown kernel {kernel:?}");
+            std::process::exit(2);
+        }
+    };
+    let t0 = std::time::Instant::now();
+    let mut calls = 0;
+    while t0.elapsed().as_secs_f64() < seconds {
+        run();
+        calls += 1;
+    }
+    let rate = (calls * rows) as f64 / t0.elapsed().as_secs_f64() / 1e6;
+    println!("UR5 {kernel}: {calls} batches of {rows}, 1 thread, {rate:.2} M states/s");
+}
+
 fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if args.len() == 4 && args[1] == "loop" {
+        let seconds = args[3].parse().unwrap_or_else(|_| {
+            eprintln!("flops: SECONDS must be a number, got {:?}", args[3]);
+            std::process::exit(2)
+        });
+        batch_loop(&args[2], seconds);
+        return;
+    }
     let ur5 = Model::new(&common::ur5_joints(), [0.0, 0.0, -9.81]).unwrap();
     table("UR5", &ur5);
     batch_table("UR5", &ur5);

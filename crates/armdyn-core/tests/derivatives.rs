@@ -139,3 +139,50 @@ fn batches_equal_single_calls_bitwise_with_every_kernel() {
     }
     armdyn_core::batch::set_kernels(None);
 }
+
+/// Every output entry is written on every call (chains skip the zero fill, trees keep
+/// it): outputs start as NaN, the workspace has just served another state, and the
+/// result must equal, bit for bit, a call on a fresh workspace into zeroed outputs; and
+/// for two joints in different branches (neither supports the other) the torque of one
+/// does not depend on the other's q or qd (a zero entry, exactly), nor its M entry
+/// (rnea_derivatives; M^-1 couples the branches, so aba_derivatives' entries are not 0).
+#[test]
+fn every_entry_written_and_unrelated_pairs_zero() {
+    let mut rng = Rng::new(23);
+    let (mut chains, mut trees) = (0, 0);
+    for (model, q, qd, x, _) in cases() {
+        let n = model.nv;
+        let is_chain = (0..n).all(|i| model.parent[i] == i.checked_sub(1));
+        if is_chain { chains += 1 } else { trees += 1 }
+        let (q0, qd0, x0) = (rng.vec(n, -3.0, 3.0), rng.vec(n, -2.0, 2.0), rng.vec(n, -2.0, 2.0));
+        for aba in [false, true] {
+            let run = |d: &mut Data<f64>, dd: &mut DerivData<f64>, s: [&[f64]; 3], init: f64| {
+                let mut o = [vec![init; n * n], vec![init; n * n], vec![init; n * n]];
+                let [a, b, c] = &mut o;
+                if aba {
+                    algo::aba_derivatives(&model, d, dd, s[0], s[1], s[2], None, a, b, c);
+                } else {
+                    algo::rnea_derivatives(&model, d, dd, s[0], s[1], s[2], None, a, b, c);
+                }
+                o
+            };
+            let (mut d, mut dd) = (Data::new(&model), DerivData::new(&model));
+            run(&mut d, &mut dd, [&q0, &qd0, &x0], f64::NAN);
+            let reused = run(&mut d, &mut dd, [&q, &qd, &x], f64::NAN);
+            let fresh = run(&mut Data::new(&model), &mut DerivData::new(&model), [&q, &qd, &x], 0.0);
+            for (k, (r, f)) in reused.iter().zip(&fresh).enumerate() {
+                assert!(r.iter().all(|v| v.is_finite()), "aba {aba}, output {k}: an entry not written");
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(r), bits(f), "aba {aba}, output {k}: reused workspace differs");
+                for i in 0..n {
+                    for j in 0..n {
+                        if !aba && !model.supports(i, j) && !model.supports(j, i) {
+                            assert_eq!(r[i * n + j], 0.0, "aba {aba}, output {k}, ({i}, {j}) unrelated");
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(chains > 0 && trees > 0, "chains {chains}, trees {trees}");
+}

@@ -22,7 +22,7 @@ use crate::data::Data;
 use crate::deriv_data::DerivData;
 use crate::model::Model;
 use crate::real::Real;
-use crate::spatial::{ArticulatedInertia, Force, Motion, V3};
+use crate::spatial::{ArticulatedInertia, Motion, V3};
 
 /// Partial derivatives of `qdd = aba(q, qd, tau)` (with external wrenches `ext`, if any:
 /// `M qdd + C qd + g = tau + sum_L J_L^T w_L`).
@@ -81,7 +81,8 @@ pub fn aba_derivatives<T: Real>(
 
 /// The articulated-body algorithm (RBDA Table 7.1) in base coordinates, after
 /// [`velocity_pass`]: body i's inertia `dd.ic[i]`, momentum `(dd.bn, dd.bp)[i]`, axis
-/// `J_i = dd.s[i]`, external force `dd.fx[i]` (if `has_ext`), and the velocity-product acceleration
+/// `J_i = dd.s[i]`, velocity-product force `v_i x* I_i v_i` (`dd.f[i]`), external force
+/// `dd.fx[i]` (if `has_ext`), and the velocity-product acceleration
 /// `c_i = (v_i x J_i) qd_i = dV_i qd_i`. Writes `qdd` (nv,) and, in base coordinates,
 /// `data.ia`, `data.pa`, `data.c`, `data.u_col`, `data.d_inv`, `data.u`, `data.a`.
 /// Joint dynamics as in `aba`: `D_i = J^T I^A J + Ia`, `u_i = tau_i - Fv qd_i -
@@ -91,7 +92,8 @@ fn aba_world<T: Real>(model: &Model, data: &mut Data<T>, dd: &DerivData<T>, qd: 
     let n = model.nv;
     for i in 0..n {
         data.ia[i] = ArticulatedInertia::from_rigid(&dd.ic[i]);
-        data.pa[i] = dd.v[i].cross_force(&Force::new(dd.bn[i], dd.bp[i]));
+        // v_i x* I_i v_i, from the velocity pass
+        data.pa[i] = dd.f[i];
         if has_ext {
             data.pa[i] -= dd.fx[i];
         }

@@ -44,46 +44,45 @@ use crate::model::Model;
 use crate::real::Real;
 use crate::spatial::{Force, Motion, RigidInertia, Sym3, V3};
 
-/// `B^c_i m` for the subtree sums of body i (only `m`'s angular part matters).
+/// `B^c_i m = [S w - N x w; w x 2P]` for the subtree sums of body i (only `m`'s angular
+/// part `w` matters), given `p2 = 2P`.
 #[inline(always)]
-fn b_apply<T: Real>(dd: &DerivData<T>, i: usize, m: &Motion<T>) -> Force<T> {
+fn b_apply<T: Real>(dd: &DerivData<T>, i: usize, p2: V3<T>, m: &Motion<T>) -> Force<T> {
     let w = m.w;
-    let p2 = dd.bp[i] + dd.bp[i];
     Force::new(dd.bs[i].mul_v(w) - dd.bn[i].cross(w), w.cross(p2))
-}
-
-/// The angular part of `B^c_i^T m = [(S + N^x) m_w + 2 P x m_v; 0]`.
-#[inline(always)]
-fn b_tr_apply<T: Real>(dd: &DerivData<T>, i: usize, m: &Motion<T>) -> V3<T> {
-    let p2 = dd.bp[i] + dd.bp[i];
-    dd.bs[i].mul_v(m.w) + dd.bn[i].cross(m.w) + p2.cross(m.v)
 }
 
 /// The symmetric block `S = w^x Ibar - Ibar w^x - (v^x h^x + h^x v^x)` of `B` for a
 /// body of base-frame inertia `i` moving with base-frame velocity `v`:
-/// `w^x Ibar + (w^x Ibar)^T - (v h^T + h v^T) + 2 (v . h) 1`.
+/// `K + K^T - (v h^T + h v^T) + 2 (v . h) 1` with `K = w^x Ibar`. On the diagonal the
+/// outer products and `v . h` partly cancel: `S_xx = 2 K_xx + 2 (v_y h_y + v_z h_z)`, and
+/// so on.
 #[inline(always)]
 fn b_sym<T: Real>(i: &RigidInertia<T>, v: &Motion<T>) -> Sym3<T> {
-    let w = v.w;
+    let (w, vv, h) = (v.w, v.v, i.h);
     // columns of w^x Ibar
     let (k0, k1, k2) = (w.cross(i.ibar.col(0)), w.cross(i.ibar.col(1)), w.cross(i.ibar.col(2)));
-    let s = Sym3 {
-        xx: k0.x + k0.x,
-        yy: k1.y + k1.y,
-        zz: k2.z + k2.z,
-        xy: k1.x + k0.y,
-        xz: k2.x + k0.z,
-        yz: k2.y + k1.z,
-    };
-    let vh = v.v.dot(i.h);
-    (s - Sym3::sym_outer(v.v, i.h)).add_diag(vh + vh)
+    let (px, py, pz) = (vv.x * h.x, vv.y * h.y, vv.z * h.z);
+    let (dx, dy, dz) = (k0.x + py + pz, k1.y + px + pz, k2.z + px + py);
+    Sym3 {
+        xx: dx + dx,
+        yy: dy + dy,
+        zz: dz + dz,
+        xy: k1.x + k0.y - (vv.x * h.y + h.x * vv.y),
+        xz: k2.x + k0.z - (vv.x * h.z + h.x * vv.z),
+        yz: k2.y + k1.z - (vv.y * h.z + h.y * vv.z),
+    }
 }
 
 /// The forward pass's velocity part (independent of `qdd`), shared by
-/// `rnea_derivatives` and `aba_derivatives`: writes `data.xup`, `data.x0`, `dd.fx`
-/// (the external forces in base coordinates, whatever their frame) and per body the
-/// base-frame `dd.s` (`J_i`), `dd.v`, `dd.dvdq`, `dd.ic` (body i's own inertia),
-/// `dd.bn`, `dd.bp` (its momentum `I_i v_i`) and `dd.bs`.
+/// `rnea_derivatives` and `aba_derivatives`: writes `data.xup`, `data.x0`, `dd.fx` (the
+/// external forces in base coordinates, whatever their frame; only if `ext` is given)
+/// and per body the base-frame `dd.s` (`J_i`), `dd.v`, `dd.dvdq`, `dd.ic` (body i's own
+/// inertia), `dd.bn`, `dd.bp` (its momentum `I_i v_i`), `dd.bs`, and in `dd.f` the
+/// velocity-product force `v_i x* I_i v_i` (the acceleration pass adds `I_i a_i`; the
+/// base-frame ABA starts its bias forces from it).
+///
+/// A root body's parent does not move (`v_lambda = 0`): `v_i = J_i qd_i`, `dV_i = 0`.
 #[inline(always)]
 pub(crate) fn velocity_pass<T: Real>(
     model: &Model,
@@ -95,47 +94,56 @@ pub(crate) fn velocity_pass<T: Real>(
 ) {
     update_xup(model, data, q);
     update_x0(model, data);
-    match ext {
-        Some(e) => world_forces(model, data, e, &mut dd.fx),
-        None => dd.fx.iter_mut().for_each(|f| *f = Force::zero()),
+    // without external forces nothing reads dd.fx
+    if let Some(e) = ext {
+        world_forces(model, data, e, &mut dd.fx);
     }
     for i in 0..model.nv {
         let x0 = data.x0[i];
         let s = model.kind[i].s_in(&x0);
-        let vp = match model.parent[i] {
-            Some(p) => dd.v[p],
-            None => Motion::zero(),
+        let (v, dvdq) = match model.parent[i] {
+            Some(p) => {
+                let vp = dd.v[p];
+                (vp + s.scale(qd[i]), vp.cross_motion(&s))
+            }
+            None => (s.scale(qd[i]), Motion::zero()),
         };
-        let v = vp + s.scale(qd[i]);
         let inertia = RigidInertia::splat(&model.inertia[i]).tr_transform(&x0);
         let h = inertia.mul_motion(&v);
         dd.bs[i] = b_sym(&inertia, &v);
         dd.bn[i] = h.n;
         dd.bp[i] = h.f;
+        dd.f[i] = v.cross_force(&h);
         dd.ic[i] = inertia;
-        dd.dvdq[i] = vp.cross_motion(&s);
+        dd.dvdq[i] = dvdq;
         dd.s[i] = s;
         dd.v[i] = v;
     }
 }
 
 /// The forward pass's acceleration part, after [`velocity_pass`]: `dd.a`, `dd.dadq` and
-/// the net forces `dd.f` of the bodies (from their own `dd.ic`, `dd.bn`, `dd.bp`, and
-/// `dd.fx` if `has_ext`).
+/// the net forces `dd.f` of the bodies (`I_i a_i` added to the velocity pass's
+/// `v_i x* I_i v_i`, less `dd.fx` if `has_ext`).
 /// `a_i = a_lambda + J_i qdd_i + (v_i x J_i) qd_i`, where `v_i x J_i = v_lambda x J_i = dV_i`.
+///
+/// At a root `v_lambda = 0` and `dV_i = 0`, so `a_i = a_0 + J_i qdd_i` and
+/// `dA_i = a_0 x J_i`, which for `a_0 = [0; -g]` is `[0; -g x J_i^w]`.
 #[inline(always)]
 pub(crate) fn acceleration_pass<T: Real>(model: &Model, dd: &mut DerivData<T>, qd: &[T], qdd: &[T], has_ext: bool) {
     let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
+    let a0_linear = model.a0.w == V3::zero();
     for i in 0..model.nv {
-        let (s, dvdq) = (dd.s[i], dd.dvdq[i]);
-        let (vp, ap) = match model.parent[i] {
-            Some(p) => (dd.v[p], dd.a[p]),
-            None => (Motion::zero(), a0),
+        let s = dd.s[i];
+        let (a, dadq) = match model.parent[i] {
+            Some(p) => {
+                let (vp, ap, dvdq) = (dd.v[p], dd.a[p], dd.dvdq[i]);
+                (ap + s.scale(qdd[i]) + dvdq.scale(qd[i]), ap.cross_motion(&s) + vp.cross_motion(&dvdq))
+            }
+            None if a0_linear => (a0 + s.scale(qdd[i]), Motion::new(V3::zero(), a0.v.cross(s.w))),
+            None => (a0 + s.scale(qdd[i]), a0.cross_motion(&s)),
         };
-        let a = ap + s.scale(qdd[i]) + dvdq.scale(qd[i]);
-        dd.dadq[i] = ap.cross_motion(&s) + vp.cross_motion(&dvdq);
-        let h = Force::new(dd.bn[i], dd.bp[i]);
-        dd.f[i] = dd.ic[i].mul_motion(&a) + dd.v[i].cross_force(&h);
+        dd.dadq[i] = dadq;
+        dd.f[i] = dd.ic[i].mul_motion(&a) + dd.f[i];
         if has_ext {
             dd.f[i] -= dd.fx[i];
         }
@@ -144,11 +152,12 @@ pub(crate) fn acceleration_pass<T: Real>(model: &Model, dd: &mut DerivData<T>, q
 }
 
 /// The backward pass: the subtree sums `dd.ic`, `dd.bs`, `dd.bn`, `dd.bp`, `dd.f`, `dd.fx`
-/// (`dd.fx` only for forces fixed in space).
+/// (`dd.fx` only for forces fixed in space; zeroed for forces in link frames, untouched
+/// without external forces).
 #[inline(always)]
 pub(crate) fn subtree_sums<T: Real>(model: &Model, dd: &mut DerivData<T>, ext: Option<&ExternalForces<T>>) {
     let world_ext = matches!(ext, Some(e) if e.frame == ForceFrame::World);
-    if !world_ext {
+    if matches!(ext, Some(e) if e.frame != ForceFrame::World) {
         // forces given in link frames move with their links like the inertial forces
         dd.fx.iter_mut().for_each(|f| *f = Force::zero());
     }
@@ -199,6 +208,11 @@ pub fn rnea_derivatives<T: Real>(
 
 /// The (body, ancestor) terms of the module docs from the passes' results, into
 /// `dtau_dq`, `dtau_dqd` and (if given) `m`, then the joint dynamics' terms.
+///
+/// Per body i, with `w` the angular part of `J_i` and `2P = 2 P^c_i`:
+/// `I^c_i J_i`, `B^c_i J_i = [S w - N x w; w x 2P]` and the angular part of `B^c_i^T J_i`,
+/// `S w + N x w + 2P x J_i^v` (sharing `S w` and `N x w`); per ancestor j, five spatial
+/// dot products. A root j has `dV_j = 0`, which drops its `B dV` and `I (2 dV)` terms.
 #[inline(always)]
 pub(crate) fn derivative_terms<T: Real>(
     model: &Model,
@@ -210,21 +224,34 @@ pub(crate) fn derivative_terms<T: Real>(
 ) {
     let n = model.nv;
     let world_ext = matches!(ext, Some(e) if e.frame == ForceFrame::World);
-    dtau_dq.fill(T::zero());
-    dtau_dqd.fill(T::zero());
-    if let Some(m) = m.as_deref_mut() {
-        m.fill(T::zero());
+    // On a chain every (row, column) pair is a body and itself or one of its ancestors,
+    // so the loop below writes every entry; elsewhere the unrelated pairs stay 0.
+    if !is_chain(model) {
+        dtau_dq.fill(T::zero());
+        dtau_dqd.fill(T::zero());
+        if let Some(m) = m.as_deref_mut() {
+            m.fill(T::zero());
+        }
     }
     for i in 0..n {
         let s = dd.s[i];
         let ic = dd.ic[i];
-        let (dvdq, dadq) = (dd.dvdq[i], dd.dadq[i]);
         let fa = ic.mul_motion(&s);
+        let fa2 = fa + fa;
         // dd.fx is zero unless the forces are fixed in space
         let ft = if world_ext { dd.f[i] + dd.fx[i] } else { dd.f[i] };
-        let fq = s.cross_force(&ft) + ic.mul_motion(&dadq) + b_apply(dd, i, &dvdq);
-        let fv = ic.mul_motion(&(dvdq + dvdq)) + b_apply(dd, i, &s);
-        let bt = b_tr_apply(dd, i, &s);
+        let p2 = dd.bp[i] + dd.bp[i];
+        let (sw, nw) = (dd.bs[i].mul_v(s.w), dd.bn[i].cross(s.w));
+        let bj = Force::new(sw - nw, s.w.cross(p2));
+        let bt = sw + nw + p2.cross(s.v);
+        let (fq, fv) = match model.parent[i] {
+            Some(_) => {
+                let dvdq = dd.dvdq[i];
+                let fq = s.cross_force(&ft) + ic.mul_motion(&dd.dadq[i]) + b_apply(dd, i, p2, &dvdq);
+                (fq, ic.mul_motion(&(dvdq + dvdq)) + bj)
+            }
+            None => (s.cross_force(&ft) + ic.mul_motion(&dd.dadq[i]), bj),
+        };
         // row i: the columns of i and its ancestors j (the motion of j moves body i's subtree)
         if let Some(m) = m.as_deref_mut() {
             m[i * n + i] = s.dot(&fa);
@@ -233,7 +260,7 @@ pub(crate) fn derivative_terms<T: Real>(
         dtau_dqd[i * n + i] = s.dot(&fv);
         let mut a = model.parent[i];
         while let Some(j) = a {
-            let (sj, dvj, daj) = (dd.s[j], dd.dvdq[j], dd.dadq[j]);
+            let (sj, daj) = (dd.s[j], dd.dadq[j]);
             if let Some(m) = m.as_deref_mut() {
                 let mji = sj.dot(&fa);
                 m[j * n + i] = mji;
@@ -241,18 +268,30 @@ pub(crate) fn derivative_terms<T: Real>(
             }
             dtau_dq[j * n + i] = sj.dot(&fq);
             dtau_dqd[j * n + i] = sj.dot(&fv);
-            dtau_dq[i * n + j] = daj.dot(&fa) + bt.dot(dvj.w);
+            a = model.parent[j];
+            if a.is_some() {
+                let dvj = dd.dvdq[j];
+                dtau_dq[i * n + j] = daj.dot(&fa) + bt.dot(dvj.w);
+                dtau_dqd[i * n + j] = dvj.dot(&fa2) + bt.dot(sj.w);
+            } else {
+                dtau_dq[i * n + j] = daj.dot(&fa);
+                dtau_dqd[i * n + j] = bt.dot(sj.w);
+            }
             if world_ext {
                 // forces fixed in space do not turn with joint j: J_i^T (J_j x* FX_i)
                 dtau_dq[i * n + j] += s.dot(&sj.cross_force(&dd.fx[i]));
             }
-            dtau_dqd[i * n + j] = (dvj + dvj).dot(&fa) + bt.dot(sj.w);
-            a = model.parent[j];
         }
     }
     if model.has_joint_dynamics {
         add_joint_dynamics_derivatives(model, dtau_dqd, m);
     }
+}
+
+/// Whether body i's parent is body i - 1 for every i (a serial chain in tree order).
+#[inline(always)]
+fn is_chain(model: &Model) -> bool {
+    model.parent.iter().enumerate().all(|(i, &p)| p == i.checked_sub(1))
 }
 
 /// The joint terms `Ia qdd + Fv qd + Fc sign(qd) + offset` of `rnea` (DESIGN.md), differentiated:
