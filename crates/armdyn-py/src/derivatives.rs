@@ -203,56 +203,6 @@ fn ext_forces(e: Ext<'_>) -> Option<ExternalForces<'_, f64>> {
     e.map(|(wrenches, frame)| ExternalForces { wrenches, frame })
 }
 
-/// Defines `fn $name(py, model, q, qd, $third, f_ext, frame, threads, out)` returning
-/// the tuple of the three (n, n) (or (N, n, n)) outputs of `$algo` (one state) /
-/// `$batch` (a batch) on a compiled model, `f_ext` in its canonical link order: the
-/// derivatives of rnea and aba behind the entries below.
-macro_rules! derivatives_of {
-    ($(#[$doc:meta])* $name:ident, $third:ident, $algo:path, $batch:path) => {
-        $(#[$doc])*
-        #[allow(clippy::too_many_arguments)]
-        fn $name<'py>(
-            py: Python<'py>,
-            model: &Bound<'py, NumericModel>,
-            q: &Bound<'py, PyAny>,
-            qd: &Bound<'py, PyAny>,
-            $third: &Bound<'py, PyAny>,
-            f_ext: Option<&Bound<'py, PyAny>>,
-            frame: &str,
-            threads: Option<i64>,
-            out: Option<&Bound<'py, PyAny>>,
-        ) -> PyResult<Bound<'py, PyTuple>> {
-            let m = model.get();
-            let n = m.model.nv;
-            let o = run(
-                m,
-                py,
-                [("q", q), ("qd", qd), (stringify!($third), $third)],
-                f_ext,
-                frame,
-                &[n, n],
-                threads,
-                out,
-                |md, s, [a, b, c], e, [o0, o1, o2]| {
-                    let (data, deriv) = s.deriv(md);
-                    $algo(md, data, deriv, a, b, c, ext_forces(e).as_ref(), o0, o1, o2)
-                },
-                |md, a, e, o, t| $batch(md, a, e, o, t),
-            )?;
-            PyTuple::new(py, o)
-        }
-    };
-}
-
-derivatives_of!(
-    /// (dtau_dq, dtau_dqd, M) of a NumericModel: the partial derivatives of rnea, each (n, n) or (N, n, n).
-    rnea_derivatives_on, qdd, algo::rnea_derivatives, bd::rnea_derivatives
-);
-derivatives_of!(
-    /// (dqdd_dq, dqdd_dqd, Minv) of a NumericModel: the partial derivatives of aba, each (n, n) or (N, n, n).
-    aba_derivatives_on, tau, algo::aba_derivatives, bd::aba_derivatives
-);
-
 /// Defines `fn $name(py, model, q, threads, out)` returning the (n, n) (or (N, n, n))
 /// output of `$algo` / `$batch` on a compiled model; the attributes given first (e.g.
 /// `#[pyfunction]`) are passed on.
@@ -326,10 +276,11 @@ fn python_path<'py, A: pyo3::call::PyCallArgs<'py>>(
 // robot, reorders f_ext and calls the same entry again with the NumericModel.
 
 /// Defines the entry `#[pyfunction] $name(robot, q, qd, $third, *, f_ext=None,
-/// frame="local", threads=None, out=None)`: `$model_fn` on the compiled model (see
-/// [`compiled`]), else armdyn.numeric's `$python`.
+/// frame="local", threads=None, out=None)` returning the tuple of the three (n, n) (or
+/// (N, n, n)) outputs of `$algo` (one state) / `$batch` (a batch) on the compiled model
+/// (see [`compiled`]), else of armdyn.numeric's `$python`.
 macro_rules! derivatives_entry {
-    ($(#[$doc:meta])* $name:ident, $third:ident, $model_fn:ident, $python:literal) => {
+    ($(#[$doc:meta])* $name:ident, $third:ident, $algo:path, $batch:path, $python:literal) => {
         $(#[$doc])*
         #[pyfunction]
         #[pyo3(signature = (robot, q, qd, $third, *, f_ext = None, frame = "local", threads = None, out = None))]
@@ -345,13 +296,28 @@ macro_rules! derivatives_entry {
             threads: Option<i64>,
             out: Option<&Bound<'py, PyAny>>,
         ) -> PyResult<Bound<'py, PyAny>> {
-            match compiled(robot, f_ext) {
-                Some(model) => Ok($model_fn(py, &model, q, qd, $third, f_ext, frame, threads, out)?.into_any()),
-                None => {
-                    static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
-                    python_path(py, &PATH, $python, (robot, q, qd, $third, f_ext, frame, threads, out))
-                }
-            }
+            let Some(model) = compiled(robot, f_ext) else {
+                static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+                return python_path(py, &PATH, $python, (robot, q, qd, $third, f_ext, frame, threads, out));
+            };
+            let m = model.get();
+            let n = m.model.nv;
+            let o = run(
+                m,
+                py,
+                [("q", q), ("qd", qd), (stringify!($third), $third)],
+                f_ext,
+                frame,
+                &[n, n],
+                threads,
+                out,
+                |md, s, [a, b, c], e, [o0, o1, o2]| {
+                    let (data, deriv) = s.deriv(md);
+                    $algo(md, data, deriv, a, b, c, ext_forces(e).as_ref(), o0, o1, o2)
+                },
+                |md, a, e, o, t| $batch(md, a, e, o, t),
+            )?;
+            Ok(PyTuple::new(py, o)?.into_any())
         }
     };
 }
@@ -382,7 +348,7 @@ derivatives_entry!(
     /// C-contiguous, the results' shapes, sharing no memory with the inputs): a loop over
     /// batches then allocates nothing, and a large batch is spared the first-touch page
     /// faults of fresh arrays.
-    rnea_derivatives, qdd, rnea_derivatives_on, "_rnea_derivatives_python"
+    rnea_derivatives, qdd, algo::rnea_derivatives, bd::rnea_derivatives, "_rnea_derivatives_python"
 );
 derivatives_entry!(
     /// Partial derivatives of forward dynamics (Carpentier & Mansard, RSS 2018, IV.C).
@@ -391,7 +357,7 @@ derivatives_entry!(
     /// (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
     /// f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
     /// joints as there (``Minv`` is that of ``M + diag(Ia)``). out: as there.
-    aba_derivatives, tau, aba_derivatives_on, "_aba_derivatives_python"
+    aba_derivatives, tau, algo::aba_derivatives, bd::aba_derivatives, "_aba_derivatives_python"
 );
 
 /// The inverse of the joint-space inertia matrix, by the articulated-body recursion
