@@ -167,19 +167,19 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
 def _rnea_derivatives(q, qd, qdd, model, threads):
     from . import _core
 
-    return np.stack(_core.rnea_derivatives_model(model, *_c(q, qd, qdd), None, "local", threads), axis=1)
+    return np.stack(_core.rnea_derivatives(model, *_c(q, qd, qdd), threads=threads), axis=1)
 
 
 def _aba_derivatives(q, qd, tau, model, threads):
     from . import _core
 
-    return np.stack(_core.aba_derivatives_model(model, *_c(q, qd, tau), None, "local", threads), axis=1)
+    return np.stack(_core.aba_derivatives(model, *_c(q, qd, tau), threads=threads), axis=1)
 
 
 def _minverse(q, model, threads):
     from . import _core
 
-    return _core.minverse_model(model, *_c(q), threads)
+    return _core.minverse(model, *_c(q), threads=threads)
 
 
 def _gravity_derivatives(q, model, threads):

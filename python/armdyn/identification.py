@@ -69,6 +69,7 @@ import sympy as sp
 
 from .model import Robot
 from .symbolic import dag
+from .symbolic.grouping import moved_to_parent
 from .symbolic.joint_terms import _value
 
 #: standard inertial parameter names per link, DESIGN.md's (Pinocchio's) order
@@ -453,16 +454,6 @@ def _group_revolute(vec, u):
     return {0, 1 + k, [4, 6, 9][l]}, (m, h, I), left
 
 
-def _move_to_parent(m, h, I, R, p):
-    """A body (mass m, first moment h, inertia I about the origin, in the child frame)
-    described in the parent frame, where the child frame has axes R and origin p:
-    ``h' = R h + m p``, ``I' = R I R^T + 2 (p.Rh) 1 - p (Rh)^T - (Rh) p^T + m (p.p 1 - p p^T)``."""
-    Rh = R * h
-    hp = Rh + m * p
-    Ip = R * I * R.T + 2 * p.dot(Rh) * sp.eye(3) - p * Rh.T - Rh * p.T + m * (p.dot(p) * sp.eye(3) - p * p.T)
-    return m, hp, Ip
-
-
 def _grouped(robot: Robot, reg: Regressor):
     """Khalil's general grouping rules from the leaves to the root. Returns the list of
     candidate (kept) standard-parameter indices and, for each, its grouped expression in
@@ -483,7 +474,7 @@ def _grouped(robot: Robot, reg: Regressor):
         vec[joint.child] = left
         dropped |= {10 * i + g for g in gone}
         if joint.parent != robot.base:
-            mp, hp, Ip = _move_to_parent(m, h, I, R, p)
+            mp, hp, Ip = moved_to_parent(m, h, I, R, p)
             add = _vector(mp, hp, Ip)
             vec[joint.parent] = [sp.expand(a + b) for a, b in zip(vec[joint.parent], add)]
     keep, exprs = [], []

@@ -243,9 +243,9 @@ class MimicModel:
     # constrained one). Joint friction and rotor inertia sit on the independent coordinates
     # only (a mimic joint's own are zero in `full`), so G^T diag(Fv_full) G = diag(Fv).
 
-    def _call_core(self, function: str, named: dict[str, np.ndarray], *args):
-        """``armdyn._core.<function>(self.full, *args)``; NaN/inf re-worded as in :meth:`_call`."""
-        return self._guarded(lambda: getattr(_core, function)(self.full, *args), function.removesuffix("_model"), named)
+    def _call_core(self, function: str, named: dict[str, np.ndarray], *args, **kwargs):
+        """``armdyn._core.<function>(self.full, *args, **kwargs)``; NaN/inf re-worded as in :meth:`_call`."""
+        return self._guarded(lambda: getattr(_core, function)(self.full, *args, **kwargs), function, named)
 
     def _cholesky(self, M: np.ndarray, what: str) -> np.ndarray:
         """L with ``M = L L^T`` for (..., dof, dof) mass matrices; ValueError naming
@@ -270,8 +270,8 @@ class MimicModel:
         analytical derivatives reduced, ``G^T D_full G``."""
         q, qd, qdd = self._states(("q", q), ("qd", qd), ("qdd", qdd))
         named = {"q": q, "qd": qd, "qdd": qdd}
-        full = self._call_core("rnea_derivatives_model", named, self._position(q), self._rate(qd), self._rate(qdd),
-                               None, "local", threads)
+        full = self._call_core("rnea_derivatives", named, self._position(q), self._rate(qd), self._rate(qdd),
+                               threads=threads)
         return tuple(self._reduce_matrix(D) for D in full)
 
     def aba_derivatives(self, q, qd, tau, threads=None):

@@ -372,7 +372,7 @@ def _rnea_derivatives_python(robot, q, qd, qdd, f_ext, frame, threads, out):
         return _into(out, _mimic(robot, "rnea_derivatives", f_ext, frame).rnea_derivatives(q, qd, qdd, threads))
     if f_ext is not None:
         f_ext = _canonical_wrenches(robot, f_ext, frame)
-    return _core.rnea_derivatives_model(model, q, qd, qdd, f_ext, frame, threads, out)
+    return _core.rnea_derivatives(model, q, qd, qdd, f_ext=f_ext, frame=frame, threads=threads, out=out)
 
 
 def _aba_derivatives_python(robot, q, qd, tau, f_ext, frame, threads, out):
@@ -382,7 +382,7 @@ def _aba_derivatives_python(robot, q, qd, tau, f_ext, frame, threads, out):
         return _into(out, _mimic(robot, "aba_derivatives", f_ext, frame).aba_derivatives(q, qd, tau, threads))
     if f_ext is not None:
         f_ext = _canonical_wrenches(robot, f_ext, frame)
-    return _core.aba_derivatives_model(model, q, qd, tau, f_ext, frame, threads, out)
+    return _core.aba_derivatives(model, q, qd, tau, f_ext=f_ext, frame=frame, threads=threads, out=out)
 
 
 def _minverse_python(robot, q, threads, out):
@@ -390,7 +390,7 @@ def _minverse_python(robot, q, threads, out):
     joints)."""
     model = _model(robot)
     if type(model) is NumericModel:
-        return _core.minverse_model(model, q, threads, out)
+        return _core.minverse(model, q, threads=threads, out=out)
     # mimic joints: (G^T M_full G)^-1 by Cholesky (the constraint couples branches)
     return _into(out, _mimic(robot, "minverse").minverse(q, threads))
 

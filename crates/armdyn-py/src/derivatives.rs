@@ -203,64 +203,12 @@ fn ext_forces(e: Ext<'_>) -> Option<ExternalForces<'_, f64>> {
     e.map(|(wrenches, frame)| ExternalForces { wrenches, frame })
 }
 
-/// Defines `#[pyfunction] $name(model, q, qd, $third, f_ext=None, frame="local",
-/// threads=None)` returning the tuple of the three (n, n) (or (N, n, n)) outputs of
-/// `$algo` (one state) / `$batch` (a batch): the derivatives of rnea and aba.
-macro_rules! derivatives_of {
-    ($(#[$doc:meta])* $name:ident, $third:ident, $algo:path, $batch:path) => {
-        $(#[$doc])*
-        #[pyfunction]
-        #[pyo3(signature = (model, q, qd, $third, f_ext = None, frame = "local", threads = None, out = None))]
-        #[allow(clippy::too_many_arguments)]
-        fn $name<'py>(
-            py: Python<'py>,
-            model: &Bound<'py, NumericModel>,
-            q: &Bound<'py, PyAny>,
-            qd: &Bound<'py, PyAny>,
-            $third: &Bound<'py, PyAny>,
-            f_ext: Option<&Bound<'py, PyAny>>,
-            frame: &str,
-            threads: Option<i64>,
-            out: Option<&Bound<'py, PyAny>>,
-        ) -> PyResult<Bound<'py, PyTuple>> {
-            let m = model.get();
-            let n = m.model.nv;
-            let o = run(
-                m,
-                py,
-                [("q", q), ("qd", qd), (stringify!($third), $third)],
-                f_ext,
-                frame,
-                &[n, n],
-                threads,
-                out,
-                |md, s, [a, b, c], e, [o0, o1, o2]| {
-                    let (data, deriv) = s.deriv(md);
-                    $algo(md, data, deriv, a, b, c, ext_forces(e).as_ref(), o0, o1, o2)
-                },
-                |md, a, e, o, t| $batch(md, a, e, o, t),
-            )?;
-            PyTuple::new(py, o)
-        }
-    };
-}
-
-derivatives_of!(
-    /// (dtau_dq, dtau_dqd, M) of a NumericModel: the partial derivatives of rnea, each (n, n) or (N, n, n).
-    rnea_derivatives_model, qdd, algo::rnea_derivatives, bd::rnea_derivatives
-);
-derivatives_of!(
-    /// (dqdd_dq, dqdd_dqd, Minv) of a NumericModel: the partial derivatives of aba, each (n, n) or (N, n, n).
-    aba_derivatives_model, tau, algo::aba_derivatives, bd::aba_derivatives
-);
-
-/// Defines `#[pyfunction] $name(model, q, threads=None)` returning the (n, n) (or
-/// (N, n, n)) output of `$algo` / `$batch`.
+/// Defines `fn $name(py, model, q, threads, out)` returning the (n, n) (or (N, n, n))
+/// output of `$algo` / `$batch` on a compiled model; the attributes given first (e.g.
+/// `#[pyfunction]`) are passed on.
 macro_rules! matrix_of_q {
-    ($(#[$doc:meta])* $name:ident, $algo:path, $batch:path) => {
-        $(#[$doc])*
-        #[pyfunction]
-        #[pyo3(signature = (model, q, threads = None, out = None))]
+    ($(#[$attr:meta])* $name:ident, $algo:path, $batch:path) => {
+        $(#[$attr])*
         fn $name<'py>(
             py: Python<'py>,
             model: &Bound<'py, NumericModel>,
@@ -291,16 +239,21 @@ macro_rules! matrix_of_q {
 }
 
 matrix_of_q!(
-    /// M(q)^-1 of a NumericModel, (n, n) or (N, n, n) (for armdyn.dask).
-    minverse_model, algo::minverse, bd::minverse
+    /// M(q)^-1 of a NumericModel, (n, n) or (N, n, n): the entry `minverse` below.
+    minverse_on, algo::minverse, bd::minverse
 );
 
-/// The compiled model behind `obj`: `obj` itself when it is a NumericModel, else the
-/// NumericModel that `armdyn.numeric.compile_model` cached on a Robot as `_numeric_model`.
-/// None when there is none yet, or when it is a mimic model (Python's path).
-fn compiled<'py>(obj: &Bound<'py, PyAny>) -> Option<Bound<'py, NumericModel>> {
+/// The compiled model to run on: `obj` itself when it is a NumericModel (its `f_ext`, if
+/// any, already in canonical link order), else, without `f_ext`, the NumericModel that
+/// `armdyn.numeric.compile_model` cached on a Robot as `_numeric_model`. None sends the
+/// call to Python: a robot not compiled yet, mimic joints (no plain NumericModel), or a
+/// Robot's `f_ext` (given in `list(robot.links)` order, reordered there).
+fn compiled<'py>(obj: &Bound<'py, PyAny>, f_ext: Option<&Bound<'py, PyAny>>) -> Option<Bound<'py, NumericModel>> {
     if let Ok(m) = obj.cast::<NumericModel>() {
         return Some(m.clone());
+    }
+    if f_ext.is_some() {
+        return None;
     }
     let cached = obj.getattr(pyo3::intern!(obj.py(), "_numeric_model")).ok()?;
     cached.cast_into::<NumericModel>().ok()
@@ -319,13 +272,15 @@ fn python_path<'py, A: pyo3::call::PyCallArgs<'py>>(
 
 // The entries armdyn.numeric exports as they are (issue 9 times their per-call cost: no
 // Python frame in between). The common call, a compiled plain model and no f_ext, runs
-// here; anything else goes through armdyn.numeric's `_<name>_python`.
+// here; anything else goes through armdyn.numeric's `_<name>_python`, which compiles the
+// robot, reorders f_ext and calls the same entry again with the NumericModel.
 
 /// Defines the entry `#[pyfunction] $name(robot, q, qd, $third, *, f_ext=None,
-/// frame="local", threads=None)`: `$model_fn` on the robot's compiled model when there is
-/// one and no f_ext, else armdyn.numeric's `$python` (see above).
+/// frame="local", threads=None, out=None)` returning the tuple of the three (n, n) (or
+/// (N, n, n)) outputs of `$algo` (one state) / `$batch` (a batch) on the compiled model
+/// (see [`compiled`]), else of armdyn.numeric's `$python`.
 macro_rules! derivatives_entry {
-    ($(#[$doc:meta])* $name:ident, $third:ident, $model_fn:ident, $python:literal) => {
+    ($(#[$doc:meta])* $name:ident, $third:ident, $algo:path, $batch:path, $python:literal) => {
         $(#[$doc])*
         #[pyfunction]
         #[pyo3(signature = (robot, q, qd, $third, *, f_ext = None, frame = "local", threads = None, out = None))]
@@ -341,13 +296,28 @@ macro_rules! derivatives_entry {
             threads: Option<i64>,
             out: Option<&Bound<'py, PyAny>>,
         ) -> PyResult<Bound<'py, PyAny>> {
-            match (compiled(robot), f_ext) {
-                (Some(model), None) => Ok($model_fn(py, &model, q, qd, $third, None, frame, threads, out)?.into_any()),
-                _ => {
-                    static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
-                    python_path(py, &PATH, $python, (robot, q, qd, $third, f_ext, frame, threads, out))
-                }
-            }
+            let Some(model) = compiled(robot, f_ext) else {
+                static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+                return python_path(py, &PATH, $python, (robot, q, qd, $third, f_ext, frame, threads, out));
+            };
+            let m = model.get();
+            let n = m.model.nv;
+            let o = run(
+                m,
+                py,
+                [("q", q), ("qd", qd), (stringify!($third), $third)],
+                f_ext,
+                frame,
+                &[n, n],
+                threads,
+                out,
+                |md, s, [a, b, c], e, [o0, o1, o2]| {
+                    let (data, deriv) = s.deriv(md);
+                    $algo(md, data, deriv, a, b, c, ext_forces(e).as_ref(), o0, o1, o2)
+                },
+                |md, a, e, o, t| $batch(md, a, e, o, t),
+            )?;
+            Ok(PyTuple::new(py, o)?.into_any())
         }
     };
 }
@@ -355,7 +325,8 @@ macro_rules! derivatives_entry {
 derivatives_entry!(
     /// Partial derivatives of inverse dynamics, analytically (Carpentier & Mansard, RSS 2018).
     ///
-    /// q, qd, qdd: (n,) or (N, n). Returns ``(dtau_dq, dtau_dqd, M)``, each (n, n) or
+    /// robot: a Robot (or its compiled ``armdyn.numeric.compile_model``, whose f_ext rows
+    /// follow the model's own link order). q, qd, qdd: (n,) or (N, n). Returns ``(dtau_dq, dtau_dqd, M)``, each (n, n) or
     /// (N, n, n), row = output, column = input: ``dtau_dq[i, j] = d tau_i / d q_j``;
     /// ``M = d tau / d qdd``.
     ///
@@ -377,7 +348,7 @@ derivatives_entry!(
     /// C-contiguous, the results' shapes, sharing no memory with the inputs): a loop over
     /// batches then allocates nothing, and a large batch is spared the first-touch page
     /// faults of fresh arrays.
-    rnea_derivatives, qdd, rnea_derivatives_model, "_rnea_derivatives_python"
+    rnea_derivatives, qdd, algo::rnea_derivatives, bd::rnea_derivatives, "_rnea_derivatives_python"
 );
 derivatives_entry!(
     /// Partial derivatives of forward dynamics (Carpentier & Mansard, RSS 2018, IV.C).
@@ -386,7 +357,7 @@ derivatives_entry!(
     /// (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
     /// f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
     /// joints as there (``Minv`` is that of ``M + diag(Ia)``). out: as there.
-    aba_derivatives, tau, aba_derivatives_model, "_aba_derivatives_python"
+    aba_derivatives, tau, algo::aba_derivatives, bd::aba_derivatives, "_aba_derivatives_python"
 );
 
 /// The inverse of the joint-space inertia matrix, by the articulated-body recursion
@@ -404,8 +375,8 @@ fn minverse<'py>(
     threads: Option<i64>,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    match compiled(robot) {
-        Some(model) => Ok(minverse_model(py, &model, q, threads, out)?.into_any()),
+    match compiled(robot, None) {
+        Some(model) => Ok(minverse_on(py, &model, q, threads, out)?.into_any()),
         None => {
             static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
             python_path(py, &PATH, "_minverse_python", (robot, q, threads, out))
@@ -415,6 +386,8 @@ fn minverse<'py>(
 
 matrix_of_q!(
     /// dg/dq, (n, n) or (N, n, n).
+    #[pyfunction]
+    #[pyo3(signature = (model, q, threads = None, out = None))]
     gravity_derivatives, algo::gravity_derivatives, bd::gravity_derivatives
 );
 
@@ -500,10 +473,7 @@ with_wrenches!(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rnea_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(aba_derivatives, m)?)?;
-    m.add_function(wrap_pyfunction!(rnea_derivatives_model, m)?)?;
-    m.add_function(wrap_pyfunction!(aba_derivatives_model, m)?)?;
     m.add_function(wrap_pyfunction!(minverse, m)?)?;
-    m.add_function(wrap_pyfunction!(minverse_model, m)?)?;
     m.add_function(wrap_pyfunction!(gravity_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(jacobian_dot, m)?)?;
     m.add_function(wrap_pyfunction!(rnea_ext, m)?)?;

@@ -41,10 +41,12 @@ from ..model import Robot
 from .customized_ne import _safe
 
 
-def _transfer(m, h, J, R, p):
-    """(m, MS, J) of a body given in a frame placed at (R, p) in its parent, expressed
-    about the parent's origin in the parent's axes (entry by entry: SymPy's Matrix
-    products are slow for these small symbolic ones)."""
+def moved_to_parent(m, h, J, R, p):
+    """(m, MS, J) of a body (mass m, first moment h (3,), inertia J (3, 3) about its
+    origin, in its own frame) given in a frame placed at (R, p) in its parent, expressed
+    about the parent's origin in the parent's axes (the module docstring's formula; entry
+    by entry: SymPy's Matrix products are slow for these small symbolic ones). Also
+    Khalil's general grouping in :mod:`armdyn.identification`."""
     Rh = [sp.Add(*[R[i, k] * h[k] for k in range(3)]) for i in range(3)]
     pRh = sp.Add(*[p[i] * Rh[i] for i in range(3)])
     pp = sp.Add(*[p[i] * p[i] for i in range(3)])
@@ -90,7 +92,7 @@ def grouped_parameters(robot: Robot, parameters: dict, definitions: list):
             R, p = joint.rotation, joint.xyz  # J alone: where the frame sits does not matter
         if joint.parent == robot.base or joint.parent not in work:
             continue  # the fixed base never moves
-        m, h, Jp = _transfer(*moved, R, p)
+        m, h, Jp = moved_to_parent(*moved, R, p)
         parent = work[joint.parent]
         parent[0], parent[1], parent[2] = parent[0] + m, parent[1] + h, parent[2] + Jp
 
