@@ -33,9 +33,15 @@ pub struct DerivData<T> {
     /// Subtree sum of the external forces that stay fixed in space (`ForceFrame::World`).
     pub fx: Vec<Force<T>>,
     /// Minverse: `F_i` (nv x nv forces, row i = body, column = unit torque) and the
-    /// accelerations `P_i` (nv x nv motions).
+    /// accelerations `P_i` (nv x nv motions). `minverse_sweeps` runs one column at a
+    /// time: it keeps `F` in a local and uses `pm[..nv]` (`P_i` of the current column,
+    /// per body); `fm` is no longer read.
     pub fm: Vec<Force<T>>,
     pub pm: Vec<Motion<T>>,
+    /// Minverse: per body, the centre of mass `c` (body frame) and the rotational inertia
+    /// `I_c` about it (body axes), from `model.inertia` (constants of the model).
+    pub com: Vec<V3<f64>>,
+    pub i_com: Vec<Sym3<f64>>,
     /// Bodies of the subtree of i (i first, ascending): `sub[sub_start[i]..sub_start[i + 1]]`.
     pub sub: Vec<usize>,
     pub sub_start: Vec<usize>,
@@ -70,6 +76,8 @@ impl<T: Real> DerivData<T> {
             fx: vec![Force::zero(); n],
             fm: vec![Force::zero(); n * n],
             pm: vec![Motion::zero(); n * n],
+            com: model.inertia.iter().map(|i| i.com()).collect(),
+            i_com: model.inertia.iter().map(|i| i.rotational_inertia_about_com()).collect(),
             sub,
             sub_start,
             qdd: vec![T::zero(); n],

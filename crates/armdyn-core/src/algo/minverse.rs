@@ -18,18 +18,25 @@
 //! forward (i = 1..n):   Minv[i, c] -= U_i^T P_lambda[:, c] / D_i,  P_i[:, c] = P_lambda[:, c] + J_i Minv[i, c]
 //! ```
 //!
-//! `F_lambda[:, c] =` rather than `+=`: column c of `F_lambda` receives from the one
-//! child whose subtree holds c, so nothing needs zeroing between calls. The forward pass
-//! only fills the columns `c >= i` (the upper triangle: with parents before children,
-//! `P_lambda[:, c]` is ready for them; the rest follows by symmetry), and leaves keep
-//! no `P`.
+//! The sweeps run one column at a time (every column is independent: unit torque c):
+//! the backward recursion for column c only touches c and its ancestors (`F_i[:, c]`
+//! is zero elsewhere), so `F[:, c]` is carried up the ancestor path in a local, and
+//! the forward recursion for column c needs `P_i[:, c]` only for the bodies before
+//! c, kept in an nv-long buffer. That replaces two nv x nv blocks of 6-vectors (on a
+//! 7-dof arm with 8 states per SIMD vector, 2 x 49 x 6 x 64 bytes = 38 KB: more than
+//! the 32 KB L1 data cache) by nv 6-vectors. Only the upper triangle `i <= c` is computed; each entry is written
+//! to both triangles as it is found, and `Minv[i, c]` is zeroed first only for the
+//! bodies i that are not ancestors of c (none in a chain). Leaves keep no `P`.
+//!
+//! Body inertias reach the base frame by one parallel-axis shift from the centre of
+//! mass ([`RigidInertia::from_com_transformed`]).
 
 use crate::algo::kinematics::{update_x0, update_xup};
 use crate::data::Data;
 use crate::deriv_data::DerivData;
 use crate::model::Model;
 use crate::real::Real;
-use crate::spatial::{ArticulatedInertia, RigidInertia};
+use crate::spatial::{ArticulatedInertia, RigidInertia, Sym3, V3};
 
 /// `M(q)^-1` (nv, nv), row-major in `minv`, with M including the rotor inertias
 /// (`M + diag(Ia)`, as `crba`). `q`: (nv,). Writes `data.xup`, `data.x0`, `dd.s` (the
@@ -44,7 +51,8 @@ pub fn minverse<T: Real>(model: &Model, data: &mut Data<T>, dd: &mut DerivData<T
     for i in 0..n {
         let x0 = data.x0[i];
         dd.s[i] = model.kind[i].s_in(&x0);
-        let inertia = RigidInertia::splat(&model.inertia[i]).tr_transform(&x0);
+        let m = T::splat(model.inertia[i].m);
+        let inertia = RigidInertia::from_com_transformed(m, V3::splat(dd.com[i]), &Sym3::splat(dd.i_com[i]), &x0);
         data.ia[i] = ArticulatedInertia::from_rigid(&inertia);
     }
     articulated_inertias_world(model, data, dd);
@@ -72,53 +80,57 @@ pub fn articulated_inertias_world<T: Real>(model: &Model, data: &mut Data<T>, dd
 
 /// The two passes over unit torques (module docs), given the base-frame `dd.s` (`J_i`),
 /// `data.u_col` (`U_i`) and `data.d_inv` (`1 / D_i`) of [`articulated_inertias_world`]
-/// (or of a base-frame ABA).
+/// (or of a base-frame ABA). Writes all of `minv` (nv, nv), row-major; uses `dd.pm[..nv]`.
 #[inline(always)]
 pub fn minverse_sweeps<T: Real>(model: &Model, data: &Data<T>, dd: &mut DerivData<T>, minv: &mut [T]) {
     let n = model.nv;
-    // entries (i, c > i) with c outside i's subtree start from 0 in the forward pass
-    minv.fill(T::zero());
-    for i in (0..n).rev() {
-        let (s, u, d_inv) = (dd.s[i], data.u_col[i], data.d_inv[i]);
-        let (start, end) = (dd.sub_start[i], dd.sub_start[i + 1]);
-        minv[i * n + i] = d_inv;
-        for k in start + 1..end {
-            let c = dd.sub[k];
-            minv[i * n + c] = -(s.dot(&dd.fm[i * n + c]) * d_inv);
-        }
-        if let Some(p) = model.parent[i] {
-            // F_i[:, i] = 0: a unit torque at i leaves i's children unloaded
-            dd.fm[p * n + i] = u.scale(d_inv);
-            for k in start + 1..end {
-                let c = dd.sub[k];
-                dd.fm[p * n + c] = dd.fm[i * n + c] + u.scale(minv[i * n + c]);
+    let chain = (0..n).all(|i| model.parent[i] == i.checked_sub(1));
+    let (s, u, d_inv) = (&dd.s[..n], &data.u_col[..n], &data.d_inv[..n]);
+    // P_i[:, c] of the current column c, per body
+    let p_col = &mut dd.pm[..n];
+    for c in 0..n {
+        // Backward, up the ancestors of c: Minv[c, c] = 1/D_c and F_lambda(c)[:, c] =
+        // U_c / D_c (F_c[:, c] = 0: a unit torque at c leaves c's children unloaded), then
+        // Minv[i, c] = -J_i^T F_i[:, c] / D_i, F_lambda(i)[:, c] = F_i[:, c] + U_i Minv[i, c].
+        if !chain {
+            for i in 0..c {
+                minv[i * n + c] = T::zero();
             }
         }
-    }
-    for i in 0..n {
-        let (s, u, d_inv) = (dd.s[i], data.u_col[i], data.d_inv[i]);
-        let leaf = dd.sub_start[i + 1] - dd.sub_start[i] == 1;
-        match model.parent[i] {
-            Some(p) => {
-                for c in i..n {
-                    let a = dd.pm[p * n + c];
-                    let m = minv[i * n + c] - a.dot(&u) * d_inv;
-                    minv[i * n + c] = m;
-                    if !leaf {
-                        dd.pm[i * n + c] = a + s.scale(m);
+        minv[c * n + c] = d_inv[c];
+        let mut f = u[c].scale(d_inv[c]);
+        let mut up = model.parent[c];
+        while let Some(i) = up {
+            let m = -(s[i].dot(&f) * d_inv[i]);
+            minv[i * n + c] = m;
+            up = model.parent[i];
+            if up.is_some() {
+                f = f + u[i].scale(m);
+            }
+        }
+        // Forward, bodies 0..=c: Minv[i, c] -= U_i^T P_lambda(i)[:, c] / D_i,
+        // P_i[:, c] = P_lambda(i)[:, c] + J_i Minv[i, c] (needed by bodies i < j <= c only).
+        for i in 0..=c {
+            let keep_p = i < c && dd.sub_start[i + 1] - dd.sub_start[i] > 1;
+            let m = match model.parent[i] {
+                Some(p) => {
+                    let a = p_col[p];
+                    let m = minv[i * n + c] - a.dot(&u[i]) * d_inv[i];
+                    if keep_p {
+                        p_col[i] = a + s[i].scale(m);
                     }
+                    m
                 }
-            }
-            None => {
-                for c in i..n {
-                    dd.pm[i * n + c] = s.scale(minv[i * n + c]);
+                None => {
+                    let m = minv[i * n + c];
+                    if keep_p {
+                        p_col[i] = s[i].scale(m);
+                    }
+                    m
                 }
-            }
-        }
-    }
-    for i in 0..n {
-        for c in i + 1..n {
-            minv[c * n + i] = minv[i * n + c];
+            };
+            minv[i * n + c] = m;
+            minv[c * n + i] = m;
         }
     }
 }

@@ -62,6 +62,44 @@ impl<T: Real> RigidInertia<T> {
         let diag = (r.dot(h1) + r.dot(h1)) + m * r.dot(r);
         RigidInertia { m, h: h1 + r.scale(m), ibar: ibar.add_diag(diag) }
     }
+
+    /// The rotational inertia about the centre of mass `c = com()`, in this frame's
+    /// axes: `I_c = ibar - m (|c|^2 1 - c c^T)` (the parallel-axis theorem, RBDA eq. 2.63
+    /// read backwards; `ibar` itself for a massless body).
+    pub fn rotational_inertia_about_com(&self) -> Sym3<T>
+    where
+        T: PartialEq,
+    {
+        let c = self.com();
+        let h = c.scale(self.m);
+        (self.ibar + Sym3::outer_scaled(c, self.m)).add_diag(-h.dot(c))
+    }
+
+    /// A body's inertia about frame A's origin in A's axes, from its mass `m`, centre of
+    /// mass `c` and rotational inertia `i_c` about the centre of mass, both given in a
+    /// frame B (`c` in B coordinates, `i_c` in B's axes), with `x = ^B X_A` (`E`, `r`).
+    ///
+    /// The same inertia as `from_mass_com(m, c, i_c).tr_transform(x)`, with one
+    /// parallel-axis shift (RBDA eq. 2.63) at A's origin instead of a rotation of `h`
+    /// and `ibar` followed by a shift: `c_A = r + E^T c`, `h = m c_A`,
+    /// `ibar = E^T i_c E + m (|c_A|^2 1 - c_A c_A^T) = E^T i_c E + (h.c_A) 1 - h c_A^T`
+    /// (116 flops against 156).
+    #[inline(always)]
+    pub fn from_com_transformed(m: T, c: V3<T>, i_c: &Sym3<T>, x: &Xform<T>) -> Self {
+        let c_a = x.r + x.e.tr_mul_v(c);
+        let h = c_a.scale(m);
+        let rotated = i_c.rotate_tr(&x.e);
+        // h c_A^T, upper triangle (symmetric: h is parallel to c_A)
+        let hc = Sym3 {
+            xx: h.x * c_a.x,
+            yy: h.y * c_a.y,
+            zz: h.z * c_a.z,
+            xy: h.x * c_a.y,
+            xz: h.x * c_a.z,
+            yz: h.y * c_a.z,
+        };
+        RigidInertia { m, h, ibar: (rotated - hc).add_diag(h.dot(c_a)) }
+    }
 }
 
 impl<T: Real> Add for RigidInertia<T> {
