@@ -40,6 +40,12 @@ fn inertia_from_the_centre_of_mass_equals_featherstones_transform() {
         let expected = body.tr_transform(&x);
         let got = RigidInertia::from_com_transformed(m, body.com(), &body.rotational_inertia_about_com(), &x);
         assert_close(&flat(&got), &flat(&expected), 1e-13, &format!("trial {trial}"));
+        // diagonal i_c: the cheaper rotation
+        let d = v3([rng.uniform(0.01, 0.2), rng.uniform(0.01, 0.2), rng.uniform(0.01, 0.2)]);
+        let diag = Sym3 { xx: d.x, yy: d.y, zz: d.z, xy: 0.0, xz: 0.0, yz: 0.0 };
+        let expected_diag = RigidInertia::from_mass_com(m, c, diag).tr_transform(&x);
+        let got_diag = RigidInertia::from_com_transformed_diagonal(m, c, d, &x);
+        assert_close(&flat(&got_diag), &flat(&expected_diag), 1e-13, &format!("diagonal, trial {trial}"));
         // the centre-of-mass data read back off the origin-based inertia
         assert_close(&flat(&RigidInertia::from_mass_com(m, body.com(), body.rotational_inertia_about_com())), &flat(&body), 1e-14, "round trip");
     }
@@ -144,4 +150,25 @@ fn minverse_batches_equal_single_calls_bitwise_on_every_kernel() {
         }
     }
     batch::set_kernels(None);
+}
+
+#[test]
+fn diagonal_inertias_are_recognised_after_the_round_trip_through_the_model() {
+    // ur5_joints gives diagonal tensors about the centre of mass; the model stores them
+    // about the body origin, and DerivData reads them back (off-diagonal residue ~eps)
+    let ur5 = Model::new(&ur5_joints(), [0.0, 0.0, -9.81]).unwrap();
+    let dd = DerivData::<f64>::new(&ur5);
+    assert_eq!(dd.i_com_diagonal, vec![true; 6]);
+    for (i, body) in ur5.inertia.iter().enumerate() {
+        let spec = ur5_joints()[i].inertia;
+        let i_c = dd.i_com[i];
+        assert_close(&[i_c.xx, i_c.yy, i_c.zz], &[spec[0][0], spec[1][1], spec[2][2]], 1e-12, "diagonal");
+        assert_close(&[dd.com[i].x, dd.com[i].y, dd.com[i].z], &ur5_joints()[i].com, 1e-14, "com");
+        assert!(body.m > 0.0);
+    }
+    // random rotated tensors are not diagonal
+    let mut rng = Rng::new(25);
+    let model = random_model(&mut rng, 6, false);
+    let dd = DerivData::<f64>::new(&model);
+    assert!(dd.i_com_diagonal.iter().all(|&d| !d), "{:?}", dd.i_com_diagonal);
 }

@@ -18,18 +18,19 @@
 //! forward (i = 1..n):   Minv[i, c] -= U_i^T P_lambda[:, c] / D_i,  P_i[:, c] = P_lambda[:, c] + J_i Minv[i, c]
 //! ```
 //!
-//! The sweeps run one column at a time (every column is independent: unit torque c):
-//! the backward recursion for column c only touches c and its ancestors (`F_i[:, c]`
-//! is zero elsewhere), so `F[:, c]` is carried up the ancestor path in a local, and
-//! the forward recursion for column c needs `P_i[:, c]` only for the bodies before
-//! c, kept in an nv-long buffer. That replaces two nv x nv blocks of 6-vectors (on a
-//! 7-dof arm with 8 states per SIMD vector, 2 x 49 x 6 x 64 bytes = 38 KB: more than
-//! the 32 KB L1 data cache) by nv 6-vectors. Only the upper triangle `i <= c` is computed; each entry is written
-//! to both triangles as it is found, and `Minv[i, c]` is zeroed first only for the
-//! bodies i that are not ancestors of c (none in a chain). Leaves keep no `P`.
+//! Storage: column c of `F` is non-zero at one body at a time in the backward pass
+//! (the ancestor of c being visited, which hands it on to its parent), so `F` needs nv
+//! 6-vectors, not nv x nv; on a chain the same holds for `P` in the forward pass (each
+//! body overwrites its parent's `P` in place). That replaces two nv x nv blocks of
+//! 6-vectors (on a 7-dof arm with 8 states per SIMD vector, 2 x 49 x 6 x 64 bytes =
+//! 38 KB: more than the 32 KB L1 data cache) by 2 nv. Only the upper triangle `c >= i`
+//! is computed, each entry written to both triangles as it is found; on a chain every
+//! entry `(i, c > i)` is in i's subtree, so nothing needs zeroing first. Leaves keep no `P`.
 //!
 //! Body inertias reach the base frame by one parallel-axis shift from the centre of
-//! mass ([`RigidInertia::from_com_transformed`]).
+//! mass ([`RigidInertia::from_com_transformed`]), with a cheaper rotation when the
+//! inertia about the centre of mass is diagonal in the body's axes, as in most robot
+//! descriptions (UR5, iiwa14; not the Panda's identified inertias).
 
 use crate::algo::kinematics::{update_x0, update_xup};
 use crate::data::Data;
@@ -52,7 +53,12 @@ pub fn minverse<T: Real>(model: &Model, data: &mut Data<T>, dd: &mut DerivData<T
         let x0 = data.x0[i];
         dd.s[i] = model.kind[i].s_in(&x0);
         let m = T::splat(model.inertia[i].m);
-        let inertia = RigidInertia::from_com_transformed(m, V3::splat(dd.com[i]), &Sym3::splat(dd.i_com[i]), &x0);
+        let (c, i_c) = (V3::splat(dd.com[i]), Sym3::splat(dd.i_com[i]));
+        let inertia = if dd.i_com_diagonal[i] {
+            RigidInertia::from_com_transformed_diagonal(m, c, V3::new(i_c.xx, i_c.yy, i_c.zz), &x0)
+        } else {
+            RigidInertia::from_com_transformed(m, c, &i_c, &x0)
+        };
         data.ia[i] = ArticulatedInertia::from_rigid(&inertia);
     }
     articulated_inertias_world(model, data, dd);
@@ -80,51 +86,62 @@ pub fn articulated_inertias_world<T: Real>(model: &Model, data: &mut Data<T>, dd
 
 /// The two passes over unit torques (module docs), given the base-frame `dd.s` (`J_i`),
 /// `data.u_col` (`U_i`) and `data.d_inv` (`1 / D_i`) of [`articulated_inertias_world`]
-/// (or of a base-frame ABA). Writes all of `minv` (nv, nv), row-major; uses `dd.pm[..nv]`.
+/// (or of a base-frame ABA). Writes all of `minv` (nv, nv), row-major; uses `dd.fm[..nv]`
+/// and `dd.pm` (its first nv entries on a chain).
 #[inline(always)]
 pub fn minverse_sweeps<T: Real>(model: &Model, data: &Data<T>, dd: &mut DerivData<T>, minv: &mut [T]) {
     let n = model.nv;
     let chain = (0..n).all(|i| model.parent[i] == i.checked_sub(1));
+    if !chain {
+        // entries (i, c > i) with c outside i's subtree start from 0 in the forward pass
+        minv.fill(T::zero());
+    }
     let (s, u, d_inv) = (&dd.s[..n], &data.u_col[..n], &data.d_inv[..n]);
-    // P_i[:, c] of the current column c, per body
-    let p_col = &mut dd.pm[..n];
-    for c in 0..n {
-        // Backward, up the ancestors of c: Minv[c, c] = 1/D_c and F_lambda(c)[:, c] =
-        // U_c / D_c (F_c[:, c] = 0: a unit torque at c leaves c's children unloaded), then
-        // Minv[i, c] = -J_i^T F_i[:, c] / D_i, F_lambda(i)[:, c] = F_i[:, c] + U_i Minv[i, c].
-        if !chain {
-            for i in 0..c {
-                minv[i * n + c] = T::zero();
+    // Backward. F_i[:, c] sits in f_col[c]: column c is loaded at one body at a time (the
+    // ancestor of c being visited), which hands it on to its parent.
+    let f_col = &mut dd.fm[..n];
+    for i in (0..n).rev() {
+        let (si, ui, di) = (s[i], u[i], d_inv[i]);
+        let below = &dd.sub[dd.sub_start[i] + 1..dd.sub_start[i + 1]];
+        minv[i * n + i] = di;
+        for &c in below {
+            minv[i * n + c] = -(si.dot(&f_col[c]) * di);
+        }
+        if model.parent[i].is_some() {
+            // F_i[:, i] = 0: a unit torque at i leaves i's children unloaded
+            f_col[i] = ui.scale(di);
+            for &c in below {
+                f_col[c] = f_col[c] + ui.scale(minv[i * n + c]);
             }
         }
-        minv[c * n + c] = d_inv[c];
-        let mut f = u[c].scale(d_inv[c]);
-        let mut up = model.parent[c];
-        while let Some(i) = up {
-            let m = -(s[i].dot(&f) * d_inv[i]);
-            minv[i * n + c] = m;
-            up = model.parent[i];
-            if up.is_some() {
-                f = f + u[i].scale(m);
-            }
-        }
-        // Forward, bodies 0..=c: Minv[i, c] -= U_i^T P_lambda(i)[:, c] / D_i,
-        // P_i[:, c] = P_lambda(i)[:, c] + J_i Minv[i, c] (needed by bodies i < j <= c only).
-        for i in 0..=c {
-            let keep_p = i < c && dd.sub_start[i + 1] - dd.sub_start[i] > 1;
+    }
+    // Forward, upper triangle (c >= i), both triangles written. P_i[:, c] sits in
+    // p[i * stride + c]: on a chain (stride 0) each body overwrites its parent's P in
+    // place, column by column; in a tree siblings need their parent's, so each body has
+    // its own row. P_i[:, i] is never read (children only read columns c > i), nor a leaf's.
+    let stride = if chain { 0 } else { n };
+    let p = &mut dd.pm[..];
+    for i in 0..n {
+        let (si, ui, di) = (s[i], u[i], d_inv[i]);
+        let keep_p = dd.sub_start[i + 1] - dd.sub_start[i] > 1;
+        minv[i * n + i] = match model.parent[i] {
+            Some(l) => minv[i * n + i] - p[l * stride + i].dot(&ui) * di,
+            None => minv[i * n + i],
+        };
+        for c in i + 1..n {
             let m = match model.parent[i] {
-                Some(p) => {
-                    let a = p_col[p];
-                    let m = minv[i * n + c] - a.dot(&u[i]) * d_inv[i];
+                Some(l) => {
+                    let a = p[l * stride + c];
+                    let m = minv[i * n + c] - a.dot(&ui) * di;
                     if keep_p {
-                        p_col[i] = a + s[i].scale(m);
+                        p[i * stride + c] = a + si.scale(m);
                     }
                     m
                 }
                 None => {
                     let m = minv[i * n + c];
                     if keep_p {
-                        p_col[i] = s[i].scale(m);
+                        p[i * stride + c] = si.scale(m);
                     }
                     m
                 }

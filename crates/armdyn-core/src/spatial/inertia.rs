@@ -100,6 +100,34 @@ impl<T: Real> RigidInertia<T> {
         };
         RigidInertia { m, h, ibar: (rotated - hc).add_diag(h.dot(c_a)) }
     }
+
+    /// [`Self::from_com_transformed`] for `i_c = diag(d)`: `E^T diag(d) E` has entries
+    /// `sum_l d_l E[l][j] E[l][k]` (39 flops instead of the 75 of a general `E^T i_c E`;
+    /// 80 in all).
+    #[inline(always)]
+    pub fn from_com_transformed_diagonal(m: T, c: V3<T>, d: V3<T>, x: &Xform<T>) -> Self {
+        let c_a = x.r + x.e.tr_mul_v(c);
+        let h = c_a.scale(m);
+        let [e0, e1, e2] = x.e.rows;
+        let (a0, a1, a2) = (e0.scale(d.x), e1.scale(d.y), e2.scale(d.z));
+        let hc = Sym3 {
+            xx: h.x * c_a.x,
+            yy: h.y * c_a.y,
+            zz: h.z * c_a.z,
+            xy: h.x * c_a.y,
+            xz: h.x * c_a.z,
+            yz: h.y * c_a.z,
+        };
+        let rotated = Sym3 {
+            xx: a0.x * e0.x + a1.x * e1.x + a2.x * e2.x,
+            yy: a0.y * e0.y + a1.y * e1.y + a2.y * e2.y,
+            zz: a0.z * e0.z + a1.z * e1.z + a2.z * e2.z,
+            xy: a0.x * e0.y + a1.x * e1.y + a2.x * e2.y,
+            xz: a0.x * e0.z + a1.x * e1.z + a2.x * e2.z,
+            yz: a0.y * e0.z + a1.y * e1.z + a2.y * e2.z,
+        };
+        RigidInertia { m, h, ibar: (rotated - hc).add_diag(h.dot(c_a)) }
+    }
 }
 
 impl<T: Real> Add for RigidInertia<T> {
