@@ -4,7 +4,8 @@
 //! output, SIMD lanes; median of 15 runs), for before/after comparisons of
 //! `algo/minverse.rs`. `cargo run --release -p armdyn-core --example minverse_rate`
 //! (`examples/flops.rs` counts the flops). An argument `batch ARM` (ARM: ur5 or
-//! iiwa14) runs only that arm's batch loop, 100 x 20 000 states, for `perf stat`.
+//! iiwa14) runs only that arm's batch loop, 100 x 20 000 states, for `perf record`
+//! (`batch ARM ROWS`: 2e6 / ROWS batches of ROWS states).
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -92,13 +93,15 @@ fn report(name: &str, model: &Model) {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if args.len() == 3 && args[1] == "batch" {
+    if args.len() >= 3 && args[1] == "batch" {
         let joints = if args[2] == "ur5" { common::ur5_joints() } else { iiwa14_joints() };
         let model = Model::new(&joints, [0.0, 0.0, -9.81]).unwrap();
-        let (n, rows) = (model.nv, 20_000);
+        // optional third argument: rows per batch (2e6 states in all)
+        let rows: usize = args.get(3).map_or(20_000, |r| r.parse().expect("rows"));
+        let n = model.nv;
         let q = common::Rng::new(3).vec(rows * n, -3.0, 3.0);
         let mut out = vec![0.0; rows * n * n];
-        for _ in 0..100 {
+        for _ in 0..2_000_000 / rows {
             batch_derivatives::minverse(&model, &q, &mut out, Some(1));
         }
         assert!(out.iter().all(|x| x.is_finite()), "non-finite M^-1 entry");
