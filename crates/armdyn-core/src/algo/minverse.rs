@@ -23,7 +23,8 @@
 //! 6-vectors, not nv x nv; on a chain the same holds for `P` in the forward pass (each
 //! body overwrites its parent's `P` in place). That replaces two nv x nv blocks of
 //! 6-vectors (on a 7-dof arm with 8 states per SIMD vector, 2 x 49 x 6 x 64 bytes =
-//! 38 KB: more than the 32 KB L1 data cache) by 2 nv. Only the upper triangle `c >= i`
+//! 38 KB: more than the 32 KB L1 data cache) by 2 nv (a tree keeps `P`'s block: siblings
+//! both read their parent's). Only the upper triangle `c >= i`
 //! is computed, each entry written to both triangles as it is found; on a chain every
 //! entry `(i, c > i)` is in i's subtree, so nothing needs zeroing first. Leaves keep no `P`.
 //!
