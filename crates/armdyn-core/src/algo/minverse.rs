@@ -112,7 +112,7 @@ pub fn minverse_sweeps<T: Real>(model: &Model, data: &Data<T>, dd: &mut DerivDat
             // F_i[:, i] = 0: a unit torque at i leaves i's children unloaded
             f_col[i] = ui.scale(di);
             for &c in below {
-                f_col[c] = f_col[c] + ui.scale(minv[i * n + c]);
+                f_col[c] += ui.scale(minv[i * n + c]);
             }
         }
     }
