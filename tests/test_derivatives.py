@@ -232,7 +232,12 @@ def test_identities(name, robot):
         sc = _scales(robot, q, qd, (dqdd_dq, dqdd_dqd), "aba")
         assert_rel(dqdd_dq, -Minv @ dtau_dq, what=f"{name} dqdd/dq = -Minv dtau/dq", scale=sc[0])
         assert_rel(dqdd_dqd, -Minv @ dtau_dqd, what=f"{name} dqdd/dqd = -Minv dtau/dqd", scale=sc[1])
-        assert_rel(Minv2, Minv, 1e-13, what=f"{name} aba_derivatives Minv = minverse")
+        # Two roundings of the same inverse (minverse moves body inertias to the base frame
+        # from the centre of mass, aba_derivatives from the body origin), so they agree to
+        # ~eps cond(M), as each does with the exact inverse of M and Pinocchio's does:
+        # iiwa14 cond(M) ~ 3e3, up to 5e-13 apart; stanford ~ 1e6, up to 7e-12.
+        tol = max(1e-13, 1e-15 * np.linalg.cond(M))
+        assert_rel(Minv2, Minv, tol, what=f"{name} aba_derivatives Minv = minverse")
         # dg/dq = dtau/dq at qd = qdd = 0; M = dtau/dqdd is the CRBA's
         z = np.zeros(n)
         assert_rel(num.gravity_derivatives(robot, q), num.rnea_derivatives(robot, q, z, z)[0], 1e-12,

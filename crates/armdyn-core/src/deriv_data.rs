@@ -33,9 +33,16 @@ pub struct DerivData<T> {
     /// Subtree sum of the external forces that stay fixed in space (`ForceFrame::World`).
     pub fx: Vec<Force<T>>,
     /// Minverse: `F_i` (nv x nv forces, row i = body, column = unit torque) and the
-    /// accelerations `P_i` (nv x nv motions).
+    /// accelerations `P_i` (nv x nv motions). `minverse_sweeps` keeps `F` per column in
+    /// `fm[..nv]` and, on a chain, `P` per column in `pm[..nv]` (see `minverse.rs`).
     pub fm: Vec<Force<T>>,
     pub pm: Vec<Motion<T>>,
+    /// Minverse: per body, the centre of mass `c` (body frame) and the rotational inertia
+    /// `I_c` about it (body axes), from `model.inertia` (constants of the model).
+    pub com: Vec<V3<f64>>,
+    pub i_com: Vec<Sym3<f64>>,
+    /// Whether `i_com[i]` is diagonal (its off-diagonal entries are then exactly 0).
+    pub i_com_diagonal: Vec<bool>,
     /// Bodies of the subtree of i (i first, ascending): `sub[sub_start[i]..sub_start[i + 1]]`.
     pub sub: Vec<usize>,
     pub sub_start: Vec<usize>,
@@ -70,6 +77,12 @@ impl<T: Real> DerivData<T> {
             fx: vec![Force::zero(); n],
             fm: vec![Force::zero(); n * n],
             pm: vec![Motion::zero(); n * n],
+            com: model.inertia.iter().map(|i| i.com()).collect(),
+            i_com: model.inertia.iter().map(|i| diagonal_if_rounding(i.rotational_inertia_about_com(), i)).collect(),
+            i_com_diagonal: model.inertia.iter().map(|i| {
+                let s = diagonal_if_rounding(i.rotational_inertia_about_com(), i);
+                s.xy == 0.0 && s.xz == 0.0 && s.yz == 0.0
+            }).collect(),
             sub,
             sub_start,
             qdd: vec![T::zero(); n],
@@ -84,4 +97,21 @@ impl<T: Real> DerivData<T> {
     pub fn subtree(&self, i: usize) -> &[usize] {
         &self.sub[self.sub_start[i]..self.sub_start[i + 1]]
     }
+}
+
+/// `i_c` (the rotational inertia about the centre of mass read back off `body`, see
+/// `RigidInertia::rotational_inertia_about_com`) with off-diagonal entries that are
+/// rounding residue set to 0: a tensor given diagonal comes back with off-diagonal
+/// entries of the order of `eps m |c|^2` (the parallel-axis term they went through),
+/// and the diagonal case has a cheaper base-frame rotation (`minverse`).
+fn diagonal_if_rounding(mut i_c: Sym3<f64>, body: &RigidInertia<f64>) -> Sym3<f64> {
+    let c = body.com();
+    let scale = body.m * c.dot(c) + i_c.xx.abs() + i_c.yy.abs() + i_c.zz.abs();
+    let tol = 16.0 * f64::EPSILON * scale;
+    if i_c.xy.abs() <= tol && i_c.xz.abs() <= tol && i_c.yz.abs() <= tol {
+        i_c.xy = 0.0;
+        i_c.xz = 0.0;
+        i_c.yz = 0.0;
+    }
+    i_c
 }

@@ -18,18 +18,27 @@
 //! forward (i = 1..n):   Minv[i, c] -= U_i^T P_lambda[:, c] / D_i,  P_i[:, c] = P_lambda[:, c] + J_i Minv[i, c]
 //! ```
 //!
-//! `F_lambda[:, c] =` rather than `+=`: column c of `F_lambda` receives from the one
-//! child whose subtree holds c, so nothing needs zeroing between calls. The forward pass
-//! only fills the columns `c >= i` (the upper triangle: with parents before children,
-//! `P_lambda[:, c]` is ready for them; the rest follows by symmetry), and leaves keep
-//! no `P`.
+//! Storage: column c of `F` is non-zero at one body at a time in the backward pass
+//! (the ancestor of c being visited, which hands it on to its parent), so `F` needs nv
+//! 6-vectors, not nv x nv; on a chain the same holds for `P` in the forward pass (each
+//! body overwrites its parent's `P` in place). That replaces two nv x nv blocks of
+//! 6-vectors (on a 7-dof arm with 8 states per SIMD vector, 2 x 49 x 6 x 64 bytes =
+//! 38 KB: more than the 32 KB L1 data cache) by 2 nv (a tree keeps `P`'s block: siblings
+//! both read their parent's). Only the upper triangle `c >= i`
+//! is computed, each entry written to both triangles as it is found; on a chain every
+//! entry `(i, c > i)` is in i's subtree, so nothing needs zeroing first. Leaves keep no `P`.
+//!
+//! Body inertias reach the base frame by one parallel-axis shift from the centre of
+//! mass ([`RigidInertia::from_com_transformed`]), with a cheaper rotation when the
+//! inertia about the centre of mass is diagonal in the body's axes, as in most robot
+//! descriptions (UR5, iiwa14; not the Panda's identified inertias).
 
 use crate::algo::kinematics::{update_x0, update_xup};
 use crate::data::Data;
 use crate::deriv_data::DerivData;
 use crate::model::Model;
 use crate::real::Real;
-use crate::spatial::{ArticulatedInertia, RigidInertia};
+use crate::spatial::{ArticulatedInertia, RigidInertia, Sym3, V3};
 
 /// `M(q)^-1` (nv, nv), row-major in `minv`, with M including the rotor inertias
 /// (`M + diag(Ia)`, as `crba`). `q`: (nv,). Writes `data.xup`, `data.x0`, `dd.s` (the
@@ -44,7 +53,13 @@ pub fn minverse<T: Real>(model: &Model, data: &mut Data<T>, dd: &mut DerivData<T
     for i in 0..n {
         let x0 = data.x0[i];
         dd.s[i] = model.kind[i].s_in(&x0);
-        let inertia = RigidInertia::splat(&model.inertia[i]).tr_transform(&x0);
+        let m = T::splat(model.inertia[i].m);
+        let (c, i_c) = (V3::splat(dd.com[i]), Sym3::splat(dd.i_com[i]));
+        let inertia = if dd.i_com_diagonal[i] {
+            RigidInertia::from_com_transformed_diagonal(m, c, V3::new(i_c.xx, i_c.yy, i_c.zz), &x0)
+        } else {
+            RigidInertia::from_com_transformed(m, c, &i_c, &x0)
+        };
         data.ia[i] = ArticulatedInertia::from_rigid(&inertia);
     }
     articulated_inertias_world(model, data, dd);
@@ -72,53 +87,68 @@ pub fn articulated_inertias_world<T: Real>(model: &Model, data: &mut Data<T>, dd
 
 /// The two passes over unit torques (module docs), given the base-frame `dd.s` (`J_i`),
 /// `data.u_col` (`U_i`) and `data.d_inv` (`1 / D_i`) of [`articulated_inertias_world`]
-/// (or of a base-frame ABA).
+/// (or of a base-frame ABA). Writes all of `minv` (nv, nv), row-major; uses `dd.fm[..nv]`
+/// and `dd.pm` (its first nv entries on a chain).
 #[inline(always)]
 pub fn minverse_sweeps<T: Real>(model: &Model, data: &Data<T>, dd: &mut DerivData<T>, minv: &mut [T]) {
     let n = model.nv;
-    // entries (i, c > i) with c outside i's subtree start from 0 in the forward pass
-    minv.fill(T::zero());
+    let chain = (0..n).all(|i| model.parent[i] == i.checked_sub(1));
+    if !chain {
+        // entries (i, c > i) with c outside i's subtree start from 0 in the forward pass
+        minv.fill(T::zero());
+    }
+    let (s, u, d_inv) = (&dd.s[..n], &data.u_col[..n], &data.d_inv[..n]);
+    // Backward. F_i[:, c] sits in f_col[c]: column c is loaded at one body at a time (the
+    // ancestor of c being visited), which hands it on to its parent.
+    let f_col = &mut dd.fm[..n];
     for i in (0..n).rev() {
-        let (s, u, d_inv) = (dd.s[i], data.u_col[i], data.d_inv[i]);
-        let (start, end) = (dd.sub_start[i], dd.sub_start[i + 1]);
-        minv[i * n + i] = d_inv;
-        for k in start + 1..end {
-            let c = dd.sub[k];
-            minv[i * n + c] = -(s.dot(&dd.fm[i * n + c]) * d_inv);
+        let (si, ui, di) = (s[i], u[i], d_inv[i]);
+        let below = &dd.sub[dd.sub_start[i] + 1..dd.sub_start[i + 1]];
+        minv[i * n + i] = di;
+        for &c in below {
+            minv[i * n + c] = -(si.dot(&f_col[c]) * di);
         }
-        if let Some(p) = model.parent[i] {
+        if model.parent[i].is_some() {
             // F_i[:, i] = 0: a unit torque at i leaves i's children unloaded
-            dd.fm[p * n + i] = u.scale(d_inv);
-            for k in start + 1..end {
-                let c = dd.sub[k];
-                dd.fm[p * n + c] = dd.fm[i * n + c] + u.scale(minv[i * n + c]);
+            f_col[i] = ui.scale(di);
+            for &c in below {
+                f_col[c] += ui.scale(minv[i * n + c]);
             }
         }
     }
+    // Forward, upper triangle (c >= i), both triangles written. P_i[:, c] sits in
+    // p[i * stride + c]: on a chain (stride 0) each body overwrites its parent's P in
+    // place, column by column; in a tree siblings need their parent's, so each body has
+    // its own row. P_i[:, i] is never read (children only read columns c > i), nor a leaf's.
+    let stride = if chain { 0 } else { n };
+    let p = &mut dd.pm[..];
     for i in 0..n {
-        let (s, u, d_inv) = (dd.s[i], data.u_col[i], data.d_inv[i]);
-        let leaf = dd.sub_start[i + 1] - dd.sub_start[i] == 1;
-        match model.parent[i] {
-            Some(p) => {
-                for c in i..n {
-                    let a = dd.pm[p * n + c];
-                    let m = minv[i * n + c] - a.dot(&u) * d_inv;
-                    minv[i * n + c] = m;
-                    if !leaf {
-                        dd.pm[i * n + c] = a + s.scale(m);
-                    }
-                }
-            }
-            None => {
-                for c in i..n {
-                    dd.pm[i * n + c] = s.scale(minv[i * n + c]);
-                }
-            }
-        }
-    }
-    for i in 0..n {
+        let (si, ui, di) = (s[i], u[i], d_inv[i]);
+        let keep_p = dd.sub_start[i + 1] - dd.sub_start[i] > 1;
+        minv[i * n + i] = match model.parent[i] {
+            Some(l) => minv[i * n + i] - p[l * stride + i].dot(&ui) * di,
+            None => minv[i * n + i],
+        };
         for c in i + 1..n {
-            minv[c * n + i] = minv[i * n + c];
+            let m = match model.parent[i] {
+                Some(l) => {
+                    let a = p[l * stride + c];
+                    let m = minv[i * n + c] - a.dot(&ui) * di;
+                    if keep_p {
+                        p[i * stride + c] = a + si.scale(m);
+                    }
+                    m
+                }
+                None => {
+                    let m = minv[i * n + c];
+                    if keep_p {
+                        p[i * stride + c] = si.scale(m);
+                    }
+                    m
+                }
+            };
+            minv[i * n + c] = m;
+            minv[c * n + i] = m;
         }
     }
 }
