@@ -83,15 +83,7 @@ fn minverse_inverts_crba_and_gravity_derivatives_match_differences() {
         let (mut minv, mut m) = (vec![0.0; n * n], vec![0.0; n * n]);
         algo::minverse(&model, &mut d, &mut dd, &q, &mut minv);
         algo::crba(&model, &mut d, &q, &mut m);
-        let mut prod = vec![0.0; n * n];
-        let mut eye = vec![0.0; n * n];
-        for i in 0..n {
-            eye[i * n + i] = 1.0;
-            for j in 0..n {
-                prod[i * n + j] = (0..n).map(|k| m[i * n + k] * minv[k * n + j]).sum();
-            }
-        }
-        assert_close(&prod, &eye, 1e-10, "M Minv = I");
+        assert_inverse(&m, &minv, n, 1e-10, "M Minv = I");
         let mut dg = vec![0.0; n * n];
         algo::gravity_derivatives(&model, &mut d, &mut dd, &q, &mut dg);
         let g = |y: &[f64]| {

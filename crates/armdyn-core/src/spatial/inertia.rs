@@ -86,9 +86,15 @@ impl<T: Real> RigidInertia<T> {
     /// (116 flops against 156).
     #[inline(always)]
     pub fn from_com_transformed(m: T, c: V3<T>, i_c: &Sym3<T>, x: &Xform<T>) -> Self {
-        let c_a = x.r + x.e.tr_mul_v(c);
+        Self::shifted_from_com(m, x.r + x.e.tr_mul_v(c), i_c.rotate_tr(&x.e))
+    }
+
+    /// The parallel-axis shift of the two constructors around it: mass `m` at `c_a`
+    /// (A coordinates) with rotational inertia `rotated` about the centre of mass (A's
+    /// axes): `h = m c_A`, `ibar = rotated + (h.c_A) 1 - h c_A^T`.
+    #[inline(always)]
+    fn shifted_from_com(m: T, c_a: V3<T>, rotated: Sym3<T>) -> Self {
         let h = c_a.scale(m);
-        let rotated = i_c.rotate_tr(&x.e);
         // h c_A^T, upper triangle (symmetric: h is parallel to c_A)
         let hc = Sym3 {
             xx: h.x * c_a.x,
@@ -106,18 +112,8 @@ impl<T: Real> RigidInertia<T> {
     /// 80 in all).
     #[inline(always)]
     pub fn from_com_transformed_diagonal(m: T, c: V3<T>, d: V3<T>, x: &Xform<T>) -> Self {
-        let c_a = x.r + x.e.tr_mul_v(c);
-        let h = c_a.scale(m);
         let [e0, e1, e2] = x.e.rows;
         let (a0, a1, a2) = (e0.scale(d.x), e1.scale(d.y), e2.scale(d.z));
-        let hc = Sym3 {
-            xx: h.x * c_a.x,
-            yy: h.y * c_a.y,
-            zz: h.z * c_a.z,
-            xy: h.x * c_a.y,
-            xz: h.x * c_a.z,
-            yz: h.y * c_a.z,
-        };
         let rotated = Sym3 {
             xx: a0.x * e0.x + a1.x * e1.x + a2.x * e2.x,
             yy: a0.y * e0.y + a1.y * e1.y + a2.y * e2.y,
@@ -126,7 +122,7 @@ impl<T: Real> RigidInertia<T> {
             xz: a0.x * e0.z + a1.x * e1.z + a2.x * e2.z,
             yz: a0.y * e0.z + a1.y * e1.z + a2.y * e2.z,
         };
-        RigidInertia { m, h, ibar: (rotated - hc).add_diag(h.dot(c_a)) }
+        Self::shifted_from_com(m, x.r + x.e.tr_mul_v(c), rotated)
     }
 }
 

@@ -183,3 +183,16 @@ pub fn assert_close(a: &[f64], b: &[f64], tol: f64, what: &str) {
     let scale = 1.0 + max_abs(b);
     assert!(err <= tol * scale, "{what}: max error {err:e} (scale {scale:e})\n  got {a:?}\n  want {b:?}");
 }
+
+/// `M Minv = I` (n x n, row-major) to `tol` in the max norm.
+pub fn assert_inverse(m: &[f64], minv: &[f64], n: usize, tol: f64, what: &str) {
+    let mut prod = vec![0.0; n * n];
+    let mut eye = vec![0.0; n * n];
+    for i in 0..n {
+        eye[i * n + i] = 1.0;
+        for j in 0..n {
+            prod[i * n + j] = (0..n).map(|k| m[i * n + k] * minv[k * n + j]).sum();
+        }
+    }
+    assert_close(&prod, &eye, tol, what);
+}
