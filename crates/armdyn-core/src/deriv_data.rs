@@ -63,6 +63,8 @@ impl<T: Real> DerivData<T> {
             sub.extend((i..n).filter(|&c| model.supports(i, c)));
         }
         sub_start.push(sub.len());
+        let i_com: Vec<Sym3<f64>> =
+            model.inertia.iter().map(|i| diagonal_if_rounding(i.rotational_inertia_about_com(), i)).collect();
         DerivData {
             s: vec![Motion::zero(); n],
             v: vec![Motion::zero(); n],
@@ -78,11 +80,8 @@ impl<T: Real> DerivData<T> {
             fm: vec![Force::zero(); n * n],
             pm: vec![Motion::zero(); n * n],
             com: model.inertia.iter().map(|i| i.com()).collect(),
-            i_com: model.inertia.iter().map(|i| diagonal_if_rounding(i.rotational_inertia_about_com(), i)).collect(),
-            i_com_diagonal: model.inertia.iter().map(|i| {
-                let s = diagonal_if_rounding(i.rotational_inertia_about_com(), i);
-                s.xy == 0.0 && s.xz == 0.0 && s.yz == 0.0
-            }).collect(),
+            i_com_diagonal: i_com.iter().map(|s| s.xy == 0.0 && s.xz == 0.0 && s.yz == 0.0).collect(),
+            i_com,
             sub,
             sub_start,
             qdd: vec![T::zero(); n],
