@@ -84,25 +84,20 @@ fn rows_to_lanes<L: Real>(rows: &[f64], lanes: &mut [L], len: usize) {
 /// indices (both loops unroll): whole-vector loads and contiguous stores of each
 /// state's row segment, instead of `LANES` stores strided by a whole output per value.
 ///
-/// With 8 lanes on an AVX-512 CPU the blocks go through [`lanes_to_rows_avx512`]
+/// With 8 lanes on an AVX-512 CPU the blocks go through [`blocks_to_rows_avx512`]
 /// (the same values, moved by shuffles).
 #[inline(always)]
 fn lanes_to_rows<L: Real>(lanes: &[L], rows: &mut [f64], len: usize) {
-    #[cfg(target_arch = "x86_64")]
-    if std::any::TypeId::of::<L>() == std::any::TypeId::of::<F64x8>() && std::arch::is_x86_feature_detected!("avx512f") {
-        // SAFETY: L is F64x8 (same type, so the cast is the identity); the CPU has AVX-512F.
-        let lanes = unsafe { std::slice::from_raw_parts(lanes.as_ptr() as *const F64x8, lanes.len()) };
-        unsafe { lanes_to_rows_avx512(lanes, rows, len) };
-        return;
-    }
     let w = L::LANES;
     let full = len / w * w;
-    for jb in (0..full).step_by(w) {
-        let block = &lanes[jb..jb + w];
-        for l in 0..w {
-            let row = &mut rows[l * len + jb..l * len + jb + w];
-            for jj in 0..w {
-                row[jj] = L::lane_of(&block[jj], l);
+    if !blocks_shuffled(lanes, rows, len) {
+        for jb in (0..full).step_by(w) {
+            let block = &lanes[jb..jb + w];
+            for l in 0..w {
+                let row = &mut rows[l * len + jb..l * len + jb + w];
+                for jj in 0..w {
+                    row[jj] = L::lane_of(&block[jj], l);
+                }
             }
         }
     }
@@ -113,7 +108,23 @@ fn lanes_to_rows<L: Real>(lanes: &[L], rows: &mut [f64], len: usize) {
     }
 }
 
-/// [`lanes_to_rows`] for 8 lanes with AVX-512 shuffles. Each 8 x 8 block is 8 vector
+/// The full blocks of [`lanes_to_rows`] by [`blocks_to_rows_avx512`] when `L` is
+/// [`F64x8`] and the CPU has AVX-512F; false (nothing written) otherwise.
+#[inline(always)]
+fn blocks_shuffled<L: Real>(lanes: &[L], rows: &mut [f64], len: usize) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if std::any::TypeId::of::<L>() == std::any::TypeId::of::<F64x8>() && std::arch::is_x86_feature_detected!("avx512f") {
+        // SAFETY: L is F64x8 (same type, so the cast is the identity); the CPU has AVX-512F.
+        let lanes = unsafe { std::slice::from_raw_parts(lanes.as_ptr() as *const F64x8, lanes.len()) };
+        unsafe { blocks_to_rows_avx512(lanes, rows, len) };
+        return true;
+    }
+    let _ = (lanes, rows, len);
+    false
+}
+
+/// The full 8 x 8 blocks of [`lanes_to_rows`] (values `0..len / 8 * 8`; the caller writes
+/// the rest) for 8 lanes with AVX-512 shuffles. Each 8 x 8 block is 8 vector
 /// loads, the three-stage register transpose (`unpacklo/hi` of value pairs, then
 /// `permutex2var` across 128-bit and then 256-bit halves: 24 shuffles) and 8 row stores.
 /// What LLVM makes of the generic loop here is one `vgatherdpd` per row segment, which
@@ -121,7 +132,7 @@ fn lanes_to_rows<L: Real>(lanes: &[L], rows: &mut [f64], len: usize) {
 /// the iiwa14 (AMD Zen 4, where gathers are slow).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn lanes_to_rows_avx512(lanes: &[F64x8], rows: &mut [f64], len: usize) {
+unsafe fn blocks_to_rows_avx512(lanes: &[F64x8], rows: &mut [f64], len: usize) {
     use std::arch::x86_64::*;
     assert!(lanes.len() >= len && rows.len() >= 8 * len, "lanes_to_rows sizes");
     let full = len / 8 * 8;
@@ -159,11 +170,6 @@ unsafe fn lanes_to_rows_avx512(lanes: &[F64x8], rows: &mut [f64], len: usize) {
                 _mm512_storeu_pd(rows.as_mut_ptr().add(k * len + jb), row_k);
                 _mm512_storeu_pd(rows.as_mut_ptr().add((k + 4) * len + jb), row_k4);
             }
-        }
-    }
-    for j in full..len {
-        for l in 0..8 {
-            rows[l * len + j] = lanes[j].0[l];
         }
     }
 }
