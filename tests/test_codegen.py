@@ -241,6 +241,54 @@ def test_turned_leaf_frame_gives_the_same_tau_exactly_for_any_angle(wrist_3r):
     assert sp.simplify(dict(new)[chosen["link3"][1][0]] - r) == 0
 
 
+def _evaluated(assignments, env):
+    """The program's temporaries at one numeric point (``env``: every input, floats)."""
+    env = dict(env)
+    for s, e in assignments:
+        env[s] = float(sp.sympify(e).xreplace(env))
+    return env
+
+
+def _model_point(robot, rng, definitions=()):
+    """Random joint state and model parameters, with ``definitions`` evaluated."""
+    values = _values(robot, rng)
+    env = {sp.Symbol(k): v for k, v in values.items()}
+    for group in (robot.q, robot.qd, robot.qdd):
+        env.update({s: float(rng.uniform(-1.5, 1.5)) for s in group})
+    return _evaluated(definitions, env)
+
+
+def test_U_column_read_off_the_parent_is_the_textbook_value():
+    """U13, U23 of every link of the PUMA 560 after the first are read off the parent's U
+    (no ``qd wi x z`` term is formed):
+    at random points they equal ``w_x w_z + wd_y`` and ``w_y w_z - wd_x`` of the
+    textbook recursion ``w = R^T w_p + qd z``, ``wd = R^T wd_p + qdd z + R^T w_p x qd z``
+    done here in NumPy from the joint frames."""
+    robot = _load("puma560-craig")
+    prog, defs = customized_newton_euler(robot)
+    canon = robot.canonical()
+    e3 = np.array([0.0, 0.0, 1.0])
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        env = _evaluated(prog.assignments, _model_point(robot, rng, defs))
+        w, wd = {canon.base: np.zeros(3)}, {canon.base: np.zeros(3)}
+        for joint in canon.joints:
+            k = canon.coordinate_index(joint)
+            R, _ = joint.transform(canon.q[k])
+            R = np.array(R.xreplace(env), dtype=float)
+            wi = R.T @ w[joint.parent]
+            w[joint.child] = wi + env[canon.qd[k]] * e3
+            wd[joint.child] = R.T @ wd[joint.parent] + env[canon.qdd[k]] * e3 + np.cross(wi, env[canon.qd[k]] * e3)
+            i = canon.link_index(joint.child)
+            if i < 2:
+                continue
+            wx, wy, wz = w[joint.child]
+            want = (wx * wz + wd[joint.child][1], wy * wz - wd[joint.child][0])
+            got = (env[sp.Symbol(f"U{i}_13")], env[sp.Symbol(f"U{i}_23")])
+            assert np.all(np.isfinite(got))
+            np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+
+
 @needs_cc
 def test_turned_leaf_frame_with_zero_first_moment_is_finite_and_right(tmp_path):
     """A leaf whose first moment is zero (MX = MY = 0, the symmetric end link of most

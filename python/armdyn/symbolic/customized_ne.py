@@ -203,16 +203,47 @@ def _parent_invariant(joint, R, U_parent):
     return U_parent[hits[0], hits[0]]
 
 
-def _skew2(b: Builder, w, wd, tag, sq: dict) -> sp.Matrix:
+def _skew2(b: Builder, w, wd, tag, sq: dict, column=None) -> sp.Matrix:
     """U = skew(wd) + skew(w) skew(w) (3x3), Khalil eq. 9.79, from the named products
-    ``sq`` of :func:`_squares`."""
+    ``sq`` of :func:`_squares`; ``column``: ``(U13, U23)`` when already known
+    (:func:`_column_from_parent`)."""
     xy, xz, yz = sq["xy"], sq["xz"], sq["yz"]
+    U13, U23 = column if column is not None else (xz + wd[1], yz - wd[0])
     U = sp.Matrix([
-        [sq["U11"], xy - wd[2], xz + wd[1]],
-        [xy + wd[2], sq["U22"], yz - wd[0]],
+        [sq["U11"], xy - wd[2], U13],
+        [xy + wd[2], sq["U22"], U23],
         [xz - wd[1], yz + wd[0], sq["U33"]],
     ])
     return sp.Matrix(3, 3, lambda r, s: b.let(U[r, s], f"U{tag}_{r + 1}{s + 1}"))
+
+
+def _column_from_parent(joint, R, U_parent):
+    """``(U13, U23)`` of a revolute child, from its parent's U, or None.
+
+    With ``wi = R^T w_p`` and the joint rate ``qd`` about z, the child's
+    ``U = skew(wd) + skew(w)^2`` is the parent's seen in the child frame plus terms of
+    the joint's own motion::
+
+        U = R^T U_p R + qdd skew(z) + 2 qd z wi^T - (2 qd wi_z + qd^2) (1 - z z^T)
+
+    (expand ``skew(wi + qd z)^2`` and ``skew(R^T wd_p + qdd z + qd wi x z)``; the
+    ``qd wi z^T`` parts of the two cancel). Its last column above the diagonal has no
+    such term: ``(U13, U23)`` are the first two entries of ``R^T U_p R z = +-R^T U_p[:, k]``
+    when ``R z = +-e_k``, a rotation of two entries of the parent's column k (4 products,
+    2 sums) instead of ``R^T wd_p`` and ``qd (wi_y, -wi_x)`` (6 products, 4 sums); the
+    child's ``wd_x = w_y w_z - U23`` and ``wd_y = U13 - w_x w_z`` then follow with one
+    sum each."""
+    if joint.type != "revolute" or joint.axis != sp.Matrix([0, 0, 1]):
+        return None
+    col = [R[i, 2] for i in range(3)]
+    if not all(e.is_Number for e in col):
+        return None
+    hits = [i for i, e in enumerate(col) if e != 0]
+    if len(hits) != 1 or abs(col[hits[0]]) != 1:
+        return None
+    k, sign = hits[0], col[hits[0]]
+    v = _mtv(R, [sign * U_parent[i, k] for i in range(3)])
+    return v[0], v[1]
 
 
 def _euler_moment(b: Builder, J, differences, w, wd, U, sq) -> sp.Matrix:
@@ -302,21 +333,28 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         k = robot.coordinate_index(joint)
         R, p = frames[name]
         z = joint.axis
-        w_in = b.vector(_mtv(R, w[parent]), f"wi{tag}")
+        w_in = _mtv(R, w[parent])
+        column = _column_from_parent(joint, R, U[parent])
+        w_in = b.vector(w_in, f"wi{tag}")
         wd_j = _mtv(R, wd[parent])
         if joint.type == "revolute":
-            w_j = _vadd(w_in, _vscale(qd[k], z))
-            wd_j = _vadd(wd_j, _vscale(qdd[k], z), _vcross(w_in, _vscale(qd[k], z)))
+            w_j = b.vector(_vadd(w_in, _vscale(qd[k], z)), f"w{tag}")
+            sq = _squares(b, w_j, tag, _parent_invariant(joint, R, U[parent]))
+            if column is not None:
+                column = b.let(column[0], f"U{tag}_13"), b.let(column[1], f"U{tag}_23")
+                wd_j = [sq["yz"] - column[1], column[0] - sq["xz"], wd_j[2] + qdd[k]]
+            else:
+                wd_j = _vadd(wd_j, _vscale(qdd[k], z), _vcross(w_in, _vscale(qd[k], z)))
         else:
-            w_j = w_in
-        w_j, wd_j = b.vector(w_j, f"w{tag}"), b.vector(wd_j, f"wd{tag}")
+            w_j = b.vector(w_in, f"w{tag}")
+            sq = _squares(b, w_j, tag, _parent_invariant(joint, R, U[parent]))
+        wd_j = b.vector(wd_j, f"wd{tag}")
         Up_p = _matvec(b, U[parent], p, f"Up{tag}")
         vd_j = _mtv(R, b.vector(_vadd(Up_p, vd[parent]), f"a{tag}"))  # named: both rows of R^T use it
         if joint.type == "prismatic":
             vd_j = _vadd(vd_j, _vscale(2, _vcross(w_j, _vscale(qd[k], z))), _vscale(qdd[k], z))
         vd_j = b.vector(vd_j, f"vd{tag}")
-        sq = _squares(b, w_j, tag, _parent_invariant(joint, R, U[parent]))
-        U_j = _skew2(b, w_j, wd_j, tag, sq)
+        U_j = _skew2(b, w_j, wd_j, tag, sq, column)
         M, MS, J = parameters[name]
         F[name] = b.vector(_vadd(_vscale(M, vd_j), _mv(U_j, MS)), f"F{tag}")
         N[name] = b.vector(_vadd(_euler_moment(b, J, differences[name], w_j, wd_j, U_j, sq), _vcross(MS, vd_j)),
