@@ -289,6 +289,31 @@ def test_U_column_read_off_the_parent_is_the_textbook_value():
             np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
 
 
+def test_turned_leaf_inertia_rides_on_its_parent(wrist_3r):
+    """After the leaf's frame is turned, its YY' (nonzero again) is grouped onto the parent
+    like Khalil's YY: the leaf's YY is 0 and the parent's XX, ZZ take it; tau of the
+    customized Newton-Euler with these parameters equals armdyn.derive's at random
+    points (the turned parameters are Piecewise in the model's)."""
+    from armdyn.symbolic.grouping import grouped_parameters
+    from armdyn.symbolic.leaf_frames import turn_leaf_frames
+
+    robot = wrist_3r
+    params, defs = standard_parameters(robot)
+    params, extra = grouped_parameters(robot, params, defs)
+    defs = defs + extra
+    turned, new, turns = turn_leaf_frames(robot, params, defs)
+    assert set(turns) == {"link3"} and turned["link3"][2][1, 1] == 0
+    assert turned["link2"][2][0, 0] != params["link2"][2][0, 0]
+    tau_prog, tdefs = customized_newton_euler(robot, parameters=turned, turns=turns)
+    eom = derive(robot, "newton-euler")
+    rng = np.random.default_rng(8)
+    for _ in range(3):
+        env = _model_point(robot, rng, defs + new + tdefs)
+        got = np.array(tau_prog.evaluate(env), dtype=float)
+        want = np.array([float(e.xreplace(env)) for e in eom.tau], dtype=float)
+        _close(got, want)
+
+
 @needs_cc
 def test_turned_leaf_frame_with_zero_first_moment_is_finite_and_right(tmp_path):
     """A leaf whose first moment is zero (MX = MY = 0, the symmetric end link of most

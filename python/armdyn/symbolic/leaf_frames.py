@@ -97,6 +97,18 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
             return sym
 
         MSn = sp.Matrix([named(r, f"MX{tag}L"), 0, MS[2]])  # c MX + s MY = |(MX, MY)|; -s MX + c MY = 0
+        moved = _yy_moved(robot, joint, out, Jt[1, 1], J[1, 1])
+        if moved is not None:  # Khalil's grouping again: YY' rides on the parent
+            Jt, J = Jt - Jt[1, 1] * sp.diag(1, 1, 0), J - J[1, 1] * sp.diag(1, 1, 0)
+            if joint.parent != robot.base:
+                Mp, MSp, Jp = out[joint.parent]
+                Jp = sp.Matrix(Jp)
+                ptag = _safe(str(robot.link_index(joint.parent)))
+                for a, b in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):
+                    if moved[0][a, b] != 0:
+                        Jp[a, b] = Jp[b, a] = named(Jp[a, b] + moved[0][a, b], f"{'XYZ'[a]}{'XYZ'[b]}{ptag}L",
+                                                    Jp[a, b] + moved[1][a, b])
+                out[joint.parent] = (Mp, MSp, Jp)
         Jn = sp.zeros(3, 3)
         for a, b in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):
             Jn[a, b] = Jn[b, a] = (named(Jt[a, b], f"{'XYZ'[a]}{'XYZ'[b]}{tag}L", J[a, b])
@@ -104,3 +116,25 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
         out[link] = (M, MSn, Jn)
         turns[link] = th
     return out, new, turns
+
+
+def _yy_moved(robot: Robot, joint, parameters: dict, YYt, YY):
+    """``(D YYt, D YY)`` with ``D = R diag(1, 1, 0) R^T`` (3x3, the parent's axes; ``R``
+    the joint's fixed rotation): the turned leaf's ``diag(YY', YY', 0)``, which a rotation
+    about the joint axis leaves unchanged and which has no inertia about it, moved onto
+    the parent (Khalil's grouping, as :mod:`armdyn.symbolic.grouping` did before the turn:
+    the turn made ``YY' != 0`` again); ``YY`` is its value when the turn angle is 0. None
+    when ``YY'`` is zero or when moving it would make a zero entry of the parent's
+    inertia nonzero (more products than it saves). Onto the fixed base it simply goes: it
+    never moves."""
+    if sp.sympify(YYt) == 0:
+        return None
+    R, _ = joint.transform(sp.Integer(0))
+    D = R * sp.diag(1, 1, 0) * R.T
+    if not all(sp.sympify(e).is_Number for e in D):
+        return None
+    if joint.parent != robot.base:
+        Jp = parameters[joint.parent][2]
+        if any(D[a, b] != 0 and sp.sympify(Jp[a, b]) == 0 for a in range(3) for b in range(3)):
+            return None
+    return D * YYt, D * YY
