@@ -260,12 +260,14 @@ def _model_point(robot, rng, definitions=()):
 
 def test_U_column_read_off_the_parent_is_the_textbook_value():
     """U13, U23 of every link of the PUMA 560 after the first are read off the parent's U
-    (no ``qd wi x z`` term is formed):
+    (no ``qd wi x z`` term is formed; links 3 by the compound angle q2 + q3 from link 1):
     at random points they equal ``w_x w_z + wd_y`` and ``w_y w_z - wd_x`` of the
     textbook recursion ``w = R^T w_p + qd z``, ``wd = R^T wd_p + qdd z + R^T w_p x qd z``
     done here in NumPy from the joint frames."""
     robot = _load("puma560-craig")
     prog, defs = customized_newton_euler(robot)
+    names = {str(s) for s, _ in prog.assignments}
+    assert "q23" in names and not {"n2x", "n2y"} & names  # the run 2-3 and its root torque
     canon = robot.canonical()
     e3 = np.array([0.0, 0.0, 1.0])
     rng = np.random.default_rng(3)
@@ -287,6 +289,36 @@ def test_U_column_read_off_the_parent_is_the_textbook_value():
             got = (env[sp.Symbol(f"U{i}_13")], env[sp.Symbol(f"U{i}_23")])
             assert np.all(np.isfinite(got))
             np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+
+
+# a shoulder, then two parallel joints (alpha 0) with both offsets of the PUMA 560's
+# (a2 along x, d3 along the common axis), every inertial parameter symbolic
+RUN_3R = WRIST_3R.replace("name: wrist-3r", "name: run-3r").replace(
+    "a: 0, alpha: pi/2, d: 0", "a: L2, alpha: 0, d: D3").replace("L1: 0.3,", "L1: 0.3, L2: null, D3: null,")
+
+
+@pytest.mark.parametrize("grouped", [False, True])
+def test_parallel_run_by_its_compound_angle_equals_derive_exactly(tmp_path, grouped):
+    """Joints 2 and 3 parallel: link 3's angular velocity and U column come from link 1
+    by the angle q2 + q3 (named once), and link 1's torque takes link 3's moment by that
+    rotation (link 2's moment is never formed in full); tau equals armdyn.derive's
+    exactly, with the standard and with the grouped parameters."""
+    from armdyn.symbolic.grouping import grouped_parameters
+
+    path = tmp_path / "run-3r.yaml"
+    path.write_text(RUN_3R)
+    robot = _load(str(path))
+    eom = derive(robot, "newton-euler")
+    params, defs = standard_parameters(robot)
+    if grouped:
+        params, extra = grouped_parameters(robot, params, defs)
+        defs = defs + extra
+    tau_prog, tdefs = customized_newton_euler(robot, parameters=params)
+    names = {str(s) for s, _ in tau_prog.assignments}
+    assert "q23" in names and not {"n2x", "n2y"} & names
+    tau = _substituted(_substituted(tau_prog.inlined(), tdefs), defs)
+    for k in range(robot.dof):
+        assert _is_zero(tau[k] - eom.tau[k], robot), f"tau[{k}]"
 
 
 def test_turned_leaf_inertia_rides_on_its_parent(wrist_3r):

@@ -45,6 +45,7 @@ import sympy as sp
 
 from ..codegen.program import Builder, Program
 from ..model import Robot
+from .parallel_joints import cheaper, parallel_runs, root_moment
 
 #: per link, in DESIGN.md's (Pinocchio's) order of the standard parameters
 STANDARD_NAMES = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")
@@ -321,6 +322,7 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     b = builder or Builder(reserved=robot.free_symbols() | set(robot.q) | set(robot.qd) | set(robot.qdd)
                            | {s for s, _ in definitions})
     frames = joint_frames(robot, b, turns)
+    runs, rotations = parallel_runs(robot, turns), {}
     zero = sp.zeros(3, 1)
     base_acc = -robot.gravity if gravity else zero
     w, wd = {robot.base: zero}, {robot.base: zero}
@@ -335,6 +337,13 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         z = joint.axis
         w_in = _mtv(R, w[parent])
         column = _column_from_parent(joint, R, U[parent])
+        run = runs.get(name)
+        if run is not None:  # a run of parallel joints: from its anchor, by the compound angle
+            Ra = run.rotation(b)
+            w_run, column_run = _mtv(Ra, w[run.anchor])[:2], _column_from_parent(joint, Ra, U[run.anchor])
+            if cheaper([*w_run, *(column_run or ())], [*w_in[:2], *(column or ())]):
+                w_in, column = [*w_run, w_in[2]], column_run
+                rotations[name] = Ra
         w_in = b.vector(w_in, f"wi{tag}")
         wd_j = _mtv(R, wd[parent])
         if joint.type == "revolute":
@@ -376,4 +385,10 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         k = robot.coordinate_index(joint)
         if k is not None:
             tau[k] = (nm[name] if joint.type == "revolute" else f[name]).dot(joint.axis)
+    for joint in robot.joints:  # base-fixed links behind runs: their torque only
+        k = robot.coordinate_index(joint)
+        if (joint.parent == robot.base and joint.type == "revolute" and k is not None
+                and any(r.anchor == joint.child for l, r in runs.items() if l in rotations)):
+            moment = root_moment(b, robot, joint.child, frames, rotations, N, f, nm)
+            tau[k] = sp.Add(*[moment[i] * joint.axis[i] for i in range(3)])
     return b.program(tau, (n,)), definitions

@@ -1,0 +1,147 @@
+"""Runs of parallel revolute joints: the compound angle ``q2 + q3`` (Khalil and Dombre,
+*Modeling, Identification and Control of Robots*, 2002, sec. 9.5, as SYMORO's ``S23,
+C23``).
+
+A revolute joint about its child frame's z whose child frame is its parent's turned only
+about that same axis (modified DH ``alpha = 0``: ``R = Rz(q)``), behind another revolute
+joint about z, continues a *run* of parallel joints: from the link before the run (the
+*anchor*) to the joint's child, the rotation is ``R0 Rz(q2 + q3 + ...)`` with ``R0`` the
+first joint's constant rotation. Per state this costs one addition (the angle) and its
+sine and cosine; it pays when the anchor's vectors are sparse (the first link of an arm
+turns about the base's fixed axis: ``w1 = (0, 0, qd1)``):
+
+* outward, the x, y components of the child's angular velocity and its U's last column
+  (:func:`armdyn.symbolic.customized_ne._column_from_parent`) come from the anchor's in one
+  rotation each (two products instead of four products and two sums on the PUMA 560);
+* inward, a link fixed to the base needs only its torque ``z . n``: the moments of the
+  run are brought to it directly, ``R2 (N2 + (a2, 0, 0) x R3 f3) + R0 Rz(q2 + q3) (n3 +
+  d3 z x f3)`` (the offset ``d3`` along the common axis turns with link 3), so the
+  middle links' moments ``n2_x, n2_y`` are never formed (:func:`root_moment`).
+
+Where a run's anchor is not sparse the compound form costs as much as the link-by-link
+one plus the angle's addition, so the caller keeps the cheaper (:func:`cheaper`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..codegen.program import Builder
+from ..model import Robot
+
+E3 = sp.Matrix([0, 0, 1])
+
+
+@dataclass
+class Run:
+    """The rotation from a run's anchor link to one of its links: ``R0 Rz(angle)``.
+
+    anchor: the link before the run (its first joint's parent); R0 (3x3): the first
+    joint's constant rotation (anchor axes); angle: the sum of the run's joint angles up
+    to this link; tags: their joint numbers (``"23"``), for the temporaries' names."""
+
+    anchor: str
+    R0: sp.Matrix
+    angle: sp.Expr
+    tags: str
+
+    def rotation(self, b: Builder) -> sp.Matrix:
+        """(3x3) the link's frame in the anchor's, with the compound angle's cosine and
+        sine named once (``c23, s23``)."""
+        angle = b.let(self.angle, f"q{self.tags}")
+        c, s = b.let(sp.cos(angle), f"c{self.tags}"), b.let(sp.sin(angle), f"s{self.tags}")
+        return self.R0 * sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def _about_z(robot: Robot, joint) -> bool:
+    k = robot.coordinate_index(joint)
+    return (joint.type == "revolute" and joint.axis == E3 and k is not None
+            and robot.joint_coordinate(joint) == robot.q[k])
+
+
+def parallel_runs(robot: Robot, turns: dict | None = None) -> dict:
+    """``{link: Run}`` for every link that continues a run of parallel revolute joints
+    (second joint of the run and after). ``robot``: canonical frames; ``turns``: the
+    leaf links turned about their joint axis (:mod:`armdyn.symbolic.leaf_frames`), whose
+    angle is ``q + th``."""
+    turns = turns or {}
+    joint_of = {j.child: j for j in robot.joints}
+    start, runs = {}, {}
+    for joint in robot.joints:
+        if not _about_z(robot, joint):
+            continue
+        angle = robot.joint_coordinate(joint) + turns.get(joint.child, 0)
+        tag = str(robot.coordinate_index(joint) + 1)
+        parent = joint_of.get(joint.parent)
+        pure = joint.rotation == sp.eye(3)
+        if pure and parent is not None and joint.parent in start:
+            first = start[joint.parent]
+            runs[joint.child] = start[joint.child] = Run(first.anchor, first.R0, first.angle + angle, first.tags + tag)
+        else:
+            start[joint.child] = Run(joint.parent, sp.Matrix(joint.rotation), angle, tag)
+    return runs
+
+
+def cheaper(compound: list, separate: list) -> bool:
+    """True when the compound expressions cost fewer operations than the link-by-link
+    ones, counting the compound angle's addition."""
+    def cost(exprs):
+        return sum(sp.count_ops(e) for e in exprs if e is not None)
+    return cost(compound) + 1 < cost(separate)
+
+
+def root_moment(b: Builder, robot: Robot, link: str, frames: dict, rotations: dict, N: dict, f: dict, n: dict):
+    """(3,) the moment about a base-fixed link's origin, in its axes, with the runs of
+    parallel joints behind it brought over by their compound rotations: only its
+    component on the joint axis is a torque anyone needs (the base does not move), so
+    the middle links' moments are not rotated one by one.
+
+    A run link y behind x (``R_y = Rz(q_y)``, offset ``p_y``) adds to ``R_ax n_x``::
+
+        R_ax (p_y' x R_y f_y) + R_ay (n_y + p_yz z x f_y)      (p_y' = (p_yx, p_yy, 0))
+
+    the first with x's own moment (one rotation), the second with y's by the compound
+    rotation; the offset along the common axis turns with y (``p_z z x R_y f = R_y (p_z z
+    x f)``).
+
+    b: the builder of the program (rotated forces it already named are reused); frames:
+    ``{link: (R, p)}`` of the joints; rotations: ``{link: R_anchor_link}`` of the links
+    whose outward quantities used the compound form; N, f, n: each link's Euler moment,
+    total force and total moment (its axes)."""
+
+    def cross(a, c):
+        return [a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2], a[0] * c[1] - a[1] * c[0]]
+
+    def mv(A, v):
+        return [sp.Add(*[A[i, k] * v[k] for k in range(3)]) for i in range(3)]
+
+    def add(*vs):
+        return [sp.Add(*[v[i] for v in vs]) for i in range(3)]
+
+    def rotated_force(y):
+        R, _ = frames[y]
+        return b.vector(mv(R, f[y]), f"Rf{robot.link_index(y)}")
+
+    def brought(x, Rax, extra=(0, 0, 0)):
+        """R_ax (n_x + extra) with x's children in a run expanded."""
+        kids = [j.child for j in robot.children(x)]
+        if not any(y in rotations for y in kids):
+            return mv(Rax, add(n[x], extra))
+        own, out = add(N[x], extra), []
+        for y in kids:
+            R, p = frames[y]
+            if y in rotations:
+                own = add(own, cross([p[0], p[1], 0], rotated_force(y)))
+                out.append(brought(y, rotations[y], [-p[2] * f[y][1], p[2] * f[y][0], 0]))
+            else:
+                own = add(own, mv(R, n[y]), cross(p, rotated_force(y)))
+        return add(mv(Rax, own), *out)
+
+    total = list(N[link])
+    for joint in robot.children(link):
+        c = joint.child
+        R, p = frames[c]
+        total = add(total, brought(c, R), cross(p, rotated_force(c)))
+    return total
