@@ -16,6 +16,12 @@ as :mod:`armdyn.symbolic.newton_euler`, but
 * a rotation about the joint axis keeps ``wx^2 + wy^2``: when the axis is a parent axis
   ``e_k`` (every DH frame), ``U_j[2, 2] = -(wx^2 + wy^2)`` is the parent's ``U[k, k]``
   and ``wy^2`` is never formed (:func:`_squares`);
+* the last column of a child's U above the diagonal is its parent's U column turned by
+  the joint (the joint's own motion adds nothing there, :func:`_column_from_parent`); the
+  child's ``wd_x = w_y w_z - U23`` and ``wd_y = U13 - w_x w_z`` follow with one sum each;
+* runs of parallel joints (``q2 + q3``) take their angular quantities from the link before
+  the run, and a base-fixed link's torque their moments, by the compound angle
+  (:mod:`armdyn.symbolic.parallel_joints`);
 * optionally (``turns``, :mod:`armdyn.symbolic.leaf_frames`) a leaf link's frame turned
   about its joint axis by a per-parameter-set angle.
 

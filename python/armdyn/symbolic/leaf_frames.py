@@ -11,8 +11,9 @@ Robots*, 2002, sec. 3.2: the x axis of the terminal frame is arbitrary). Choosin
 puts the link's first moment on x: ``MS' = (sqrt(MX^2 + MY^2), 0, MZ)``, so every
 product with ``MY`` disappears from the link's force ``U MS`` and moment ``MS x vd``
 (and the ``x`` component of the acceleration with it). The inertia about the origin
-turns with the frame (``J' = Rz(th)^T J Rz(th)``; its ``YY'`` is no longer zero after
-Khalil's grouping, one product more). The angle, the turned first moment and inertia are
+turns with the frame (``J' = Rz(th)^T J Rz(th)``); its ``YY'``, zero after Khalil's
+grouping before the turn, is not zero any more, so ``diag(YY', YY', 0)`` is grouped onto
+the parent again (:func:`_yy_moved`). The angle, the turned first moment and inertia are
 computed once per parameter set, like the grouped parameters; per state the joint angle
 costs one addition, ``q + th``, whose sine and cosine replace those of ``q``.
 
@@ -51,8 +52,10 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
     A leaf whose ``MX`` or ``MY`` is zero, or whose joint is not revolute about +z, is
     left as it is. Otherwise the turn pays: it removes the 5 products of ``MY`` with their
     5 sums (3 in ``U MS``, 2 in ``MS x vd``) and ``vd_x`` (2 products, 1 sum), and adds at
-    most ``q + th`` (1 addition), the ``YY'`` term (1 product, 1 sum) and, where ``XY``
-    was zero, the ``XY'`` terms (3 products, 3 sums).
+    most ``q + th`` (1 addition), the ``YY'`` term (1 product, 1 sum) where it cannot be
+    grouped onto the parent and, where ``XY`` was zero, the ``XY'`` terms (3 products,
+    3 sums). The parent's inertia entries that take ``YY'`` become per-parameter-set
+    symbols too (``XX5L = XX5R + YY6'``).
     """
     robot = robot.canonical()
     used = {str(s) for s in robot.free_symbols()} | {str(s) for s in (*robot.q, *robot.qd, *robot.qdd)}
