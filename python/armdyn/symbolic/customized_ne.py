@@ -51,7 +51,7 @@ import sympy as sp
 
 from ..codegen.program import Builder, Program
 from ..model import Robot
-from .parallel_joints import cheaper, parallel_runs, root_moment
+from .parallel_joints import cheaper, parallel_runs, root_torque
 
 #: per link, in DESIGN.md's (Pinocchio's) order of the standard parameters
 STANDARD_NAMES = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")
@@ -249,8 +249,7 @@ def _column_from_parent(joint, R, U_parent):
     if len(hits) != 1 or abs(col[hits[0]]) != 1:
         return None
     k, sign = hits[0], col[hits[0]]
-    v = _mtv(R, [sign * U_parent[i, k] for i in range(3)])
-    return v[0], v[1]
+    return tuple(sp.Add(*[R[m, i] * sign * U_parent[m, k] for m in range(3)]) for i in range(2))
 
 
 def _euler_moment(b: Builder, J, differences, w, wd, U, sq) -> sp.Matrix:
@@ -395,6 +394,5 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         k = robot.coordinate_index(joint)
         if (joint.parent == robot.base and joint.type == "revolute" and k is not None
                 and any(r.anchor == joint.child for l, r in runs.items() if l in rotations)):
-            moment = root_moment(b, robot, joint.child, frames, rotations, N, f, nm)
-            tau[k] = sp.Add(*[moment[i] * joint.axis[i] for i in range(3)])
+            tau[k] = root_torque(b, robot, joint, frames, rotations, N, f, nm)
     return b.program(tau, (n,)), definitions

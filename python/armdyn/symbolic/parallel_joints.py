@@ -16,7 +16,7 @@ turns about the base's fixed axis: ``w1 = (0, 0, qd1)``):
 * inward, a link fixed to the base needs only its torque ``z . n``: the moments of the
   run are brought to it directly, ``R2 (N2 + (a2, 0, 0) x R3 f3) + R0 Rz(q2 + q3) (n3 +
   d3 z x f3)`` (the offset ``d3`` along the common axis turns with link 3), so the
-  middle links' moments ``n2_x, n2_y`` are never formed (:func:`root_moment`).
+  middle links' moments ``n2_x, n2_y`` are never formed (:func:`root_torque`).
 
 Where a run's anchor is not sparse the compound form costs as much as the link-by-link
 one plus the angle's addition, so the caller keeps the cheaper (:func:`cheaper`).
@@ -52,7 +52,9 @@ class Run:
         sine named once (``c23, s23``)."""
         angle = b.let(self.angle, f"q{self.tags}")
         c, s = b.let(sp.cos(angle), f"c{self.tags}"), b.let(sp.sin(angle), f"s{self.tags}")
-        return self.R0 * sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+        R0 = self.R0  # numbers: the entries by hand (SymPy's Matrix product is slow here)
+        return sp.Matrix(3, 3, lambda i, k: R0[i, 0] * c + R0[i, 1] * s if k == 0 else
+                         -R0[i, 0] * s + R0[i, 1] * c if k == 1 else R0[i, 2])
 
 
 def _about_z(robot: Robot, joint) -> bool:
@@ -92,11 +94,11 @@ def cheaper(compound: list, separate: list) -> bool:
     return cost(compound) + 1 < cost(separate)
 
 
-def root_moment(b: Builder, robot: Robot, link: str, frames: dict, rotations: dict, N: dict, f: dict, n: dict):
-    """(3,) the moment about a base-fixed link's origin, in its axes, with the runs of
-    parallel joints behind it brought over by their compound rotations: only its
-    component on the joint axis is a torque anyone needs (the base does not move), so
-    the middle links' moments are not rotated one by one.
+def root_torque(b: Builder, robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: dict, n: dict):
+    """The torque ``z . n`` of a base-fixed link (its joint ``joint``), with the runs of
+    parallel joints behind it brought over by their compound rotations: of the moment of
+    a link the base carries, only its component on the joint axis is needed (the base does
+    not move), so the middle links' moments are not rotated one by one.
 
     A run link y behind x (``R_y = Rz(q_y)``, offset ``p_y``) adds to ``R_ax n_x``::
 
@@ -104,7 +106,7 @@ def root_moment(b: Builder, robot: Robot, link: str, frames: dict, rotations: di
 
     the first with x's own moment (one rotation), the second with y's by the compound
     rotation; the offset along the common axis turns with y (``p_z z x R_y f = R_y (p_z z
-    x f)``).
+    x f)``). Each rotated vector is only ever dotted with the axis: ``z . R v = (R^T z) . v``.
 
     b: the builder of the program (rotated forces it already named are reused); frames:
     ``{link: (R, p)}`` of the joints; rotations: ``{link: R_anchor_link}`` of the links
@@ -114,21 +116,22 @@ def root_moment(b: Builder, robot: Robot, link: str, frames: dict, rotations: di
     def cross(a, c):
         return [a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2], a[0] * c[1] - a[1] * c[0]]
 
-    def mv(A, v):
-        return [sp.Add(*[A[i, k] * v[k] for k in range(3)]) for i in range(3)]
+    def dot(a, c):
+        return sp.Add(*[a[i] * c[i] for i in range(3) if a[i] != 0])
 
     def add(*vs):
         return [sp.Add(*[v[i] for v in vs]) for i in range(3)]
 
     def rotated_force(y):
         R, _ = frames[y]
-        return b.vector(mv(R, f[y]), f"Rf{robot.link_index(y)}")
+        return b.vector([sp.Add(*[R[i, k] * f[y][k] for k in range(3)]) for i in range(3)], f"Rf{robot.link_index(y)}")
 
     def brought(x, Rax, extra=(0, 0, 0)):
-        """R_ax (n_x + extra) with x's children in a run expanded."""
+        """z . R_ax (n_x + extra) with x's children in a run expanded."""
+        u = [sp.Add(*[Rax[k, i] * axis[k] for k in range(3)]) for i in range(3)]  # R_ax^T z
         kids = [j.child for j in robot.children(x)]
         if not any(y in rotations for y in kids):
-            return mv(Rax, add(n[x], extra))
+            return dot(u, add(n[x], extra))
         own, out = add(N[x], extra), []
         for y in kids:
             R, p = frames[y]
@@ -136,12 +139,17 @@ def root_moment(b: Builder, robot: Robot, link: str, frames: dict, rotations: di
                 own = add(own, cross([p[0], p[1], 0], rotated_force(y)))
                 out.append(brought(y, rotations[y], [-p[2] * f[y][1], p[2] * f[y][0], 0]))
             else:
-                own = add(own, mv(R, n[y]), cross(p, rotated_force(y)))
-        return add(mv(Rax, own), *out)
+                Rn = [sp.Add(*[R[i, k] * n[y][k] for k in range(3)]) for i in range(3)]
+                own = add(own, Rn, cross(p, rotated_force(y)))
+        return sp.Add(dot(u, own), *out)
 
-    total = list(N[link])
-    for joint in robot.children(link):
-        c = joint.child
+    axis = list(joint.axis)
+    link = joint.child
+    total = [dot(axis, N[link])]
+    for child in robot.children(link):
+        c = child.child
         R, p = frames[c]
-        total = add(total, brought(c, R), cross(p, rotated_force(c)))
-    return total
+        total.append(brought(c, R))
+        if any(e != 0 for e in p):
+            total.append(dot(axis, cross(p, rotated_force(c))))
+    return sp.Add(*total)
