@@ -175,11 +175,16 @@ def breakdown() -> None:
 
     from armdyn.codegen.program import Program
 
-    prog = codegen.codegen(load("puma560-craig"), what="tau").programs["tau"]
+    robot = load("puma560-craig")
+    prog = codegen.codegen(robot, what="tau").programs["tau"]
     table = defaultdict(lambda: [0, 0])
+    lines = []
     for sym, expr in prog.assignments:
         m = re.match(r"([A-Za-z_]+?)(\d)", sym.name)
-        key = (m.group(1), m.group(2)) if m else (sym.name, "-")
+        lines.append(((m.group(1), m.group(2)) if m else (sym.name, "-"), expr))
+    # an output that is not a temporary is formed in place (a base-fixed link's torque)
+    lines += [(("tau", str(k + 1)), e) for k, e in enumerate(prog.outputs) if not sp.sympify(e).is_Atom]
+    for key, expr in lines:
         c = Program([], [expr], ()).operation_counts()
         table[key][0] += c["mul"]
         table[key][1] += c["add"]
@@ -195,7 +200,8 @@ def breakdown() -> None:
         print(f"| {k} | " + " | ".join(f"{a}+{b}" for a, b in cells) + f" | {sum(a + b for a, b in cells)} |")
     print("\n(wi: R^T w of the parent; w: w, its products and differences; wd, vd: accelerations;"
           " Up, a: U_parent p + vd_parent; U: skew(wd) + skew(w)^2; F, N: the link's force and moment;"
-          " Rf: a child's force rotated; f, n: inward sums; q: q + th of a leaf link's turned frame)\n")
+          " Rf: a child's force rotated; f, n: inward sums; q: q + th of a leaf link's turned frame, q2 + q3 of"
+          " the parallel joints; tau: joint 1's torque, formed from the moments of links 1-3 directly)\n")
 
 
 def numeric(n_states: int, repeat: int) -> None:

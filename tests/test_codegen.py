@@ -321,6 +321,44 @@ def test_parallel_run_by_its_compound_angle_equals_derive_exactly(tmp_path, grou
         assert _is_zero(tau[k] - eom.tau[k], robot), f"tau[{k}]"
 
 
+def test_runs_of_parallel_joints_on_a_tree_agree_with_the_rust_core():
+    """A tree made to exercise the runs: joint 1 about the base's z, two branches from
+    link 1 (one turned by alpha -90 then three parallel joints, its last one followed by a
+    prismatic joint and a leaf; one parallel to joint 1 with a fixed joint and a second
+    child of the run's middle link), random physical inertias. The customized
+    Newton-Euler with its compound angles evaluated at random states equals the Rust
+    core's rnea (a different algorithm: spatial vectors, no runs)."""
+    from armdyn.model import Joint, Robot
+    from random_models import random_link
+
+    rng = np.random.default_rng(21)
+    rx = [[1, 0, 0], [0, 0, 1], [0, -1, 0]]  # alpha = -90 deg
+    eye = np.eye(3).tolist()
+    spec = [  # name, type, parent, child, xyz, rotation, axis
+        ("j1", "revolute", "base", "l1", [0, 0, 0.3], eye, [0, 0, 1]),
+        ("j2", "revolute", "l1", "l2", [0.1, 0, 0], rx, [0, 0, 1]),
+        ("j3", "revolute", "l2", "l3", [0.4, 0, 0.15], eye, [0, 0, 1]),
+        ("j4", "revolute", "l3", "l4", [0.35, 0.05, -0.1], eye, [0, 0, 1]),
+        ("j5", "prismatic", "l4", "l5", [0.1, 0, 0], rx, [0, 0, 1]),
+        ("j6", "revolute", "l1", "l6", [0, 0.2, 0.1], eye, [0, 0, 1]),
+        ("j7", "fixed", "l6", "l7", [0.1, 0, 0], rx, [0, 0, 1]),
+        ("j8", "revolute", "l3", "l8", [0, 0.1, 0.2], eye, [0, 0, 1]),
+    ]
+    links = [random_link(rng, "base")] + [random_link(rng, f"l{k}") for k in range(1, 9)]
+    joints = [Joint(n, t, p, c, xyz=x, rotation=r, axis=a) for n, t, p, c, x, r, a in spec]
+    robot = Robot("runs-tree", links, joints, gravity=(0.0, -3.0, -9.0))
+    prog, defs = customized_newton_euler(robot)
+    names = {str(s) for s, _ in prog.assignments}
+    assert {"q23", "q234"} <= names  # j3, j4 continue the run of j2 (anchor l1)
+    values = {s: float(e) for s, e in defs}
+    for _ in range(4):
+        q, qd, qdd = (rng.uniform(-1.5, 1.5, robot.dof) for _ in range(3))
+        env = dict(values)
+        for group, v in ((robot.q, q), (robot.qd, qd), (robot.qdd, qdd)):
+            env.update({s: float(x) for s, x in zip(group, v)})
+        _close(np.array(prog.evaluate(env), dtype=float), armdyn.rnea(robot, q, qd, qdd))
+
+
 def test_turned_leaf_inertia_rides_on_its_parent(wrist_3r):
     """After the leaf's frame is turned, its YY' (nonzero again) is grouped onto the parent
     like Khalil's YY: the leaf's YY is 0 and the parent's XX, ZZ take it; tau of the

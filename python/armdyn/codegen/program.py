@@ -21,6 +21,13 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 
+def is_value(expr, value: float) -> bool:
+    """``expr`` is the number ``value``, exact or float (SymPy 1.14: ``Float(0.0) != 0``, so
+    frames read from URDF, whose entries are Floats, need this test)."""
+    expr = sp.sympify(expr)
+    return bool(expr.is_Number) and float(expr) == float(value)
+
+
 def is_atom(expr) -> bool:
     """A value that needs no temporary: a number, a symbol, or minus a symbol."""
     if expr.is_Atom:

@@ -49,7 +49,7 @@ import re
 
 import sympy as sp
 
-from ..codegen.program import Builder, Program
+from ..codegen.program import Builder, Program, is_value
 from ..model import Robot
 from .parallel_joints import cheaper, parallel_runs, root_torque
 
@@ -190,24 +190,29 @@ def _squares(b: Builder, w, tag, S=None) -> dict:
     return out
 
 
+def _axis_in_parent(joint, R):
+    """``(k, sign)`` when the joint moves about or along its child's z axis and that axis
+    is the parent's ``sign e_k`` (``R e_z = sign e_k``, as in every DH frame), else None."""
+    axis = joint.axis
+    if joint.type not in ("revolute", "prismatic") or not (
+            is_value(axis[0], 0) and is_value(axis[1], 0) and is_value(abs(axis[2]), 1)):
+        return None
+    col = [R[i, 2] for i in range(3)]
+    hits = [i for i, e in enumerate(col) if not is_value(e, 0)]
+    if len(hits) != 1 or not is_value(abs(col[hits[0]]), 1):
+        return None
+    return hits[0], 1 if float(col[hits[0]]) > 0 else -1
+
+
 def _parent_invariant(joint, R, U_parent):
     """``-(wx^2 + wy^2)`` of the child's angular velocity, read off the parent's U, or
     None. When the joint moves about (or along) the child's z axis and that axis is a
-    parent axis ``+-e_k`` (``R e_z = +-e_k``, as in every DH frame), the child's x and y
-    components are the parent's other two components rotated about it, so
+    parent axis ``+-e_k`` (:func:`_axis_in_parent`), the child's x and y components are
+    the parent's other two components rotated about it, so
     ``wx^2 + wy^2 = sum_{i != k} wp_i^2 = -U_parent[k, k]`` (the norm is unchanged by a
     rotation; the parent's U diagonal holds these sums)."""
-    if joint.type == "revolute" and not (joint.axis == sp.Matrix([0, 0, 1]) or joint.axis == sp.Matrix([0, 0, -1])):
-        return None
-    if joint.type not in ("revolute", "prismatic"):
-        return None
-    col = [R[i, 2] for i in range(3)]
-    if not all(e.is_Number for e in col):
-        return None
-    hits = [i for i, e in enumerate(col) if e != 0]
-    if len(hits) != 1 or abs(col[hits[0]]) != 1:
-        return None
-    return U_parent[hits[0], hits[0]]
+    found = _axis_in_parent(joint, R)
+    return None if found is None else U_parent[found[0], found[0]]
 
 
 def _skew2(b: Builder, w, wd, tag, sq: dict, column=None) -> sp.Matrix:
@@ -240,15 +245,10 @@ def _column_from_parent(joint, R, U_parent):
     2 sums) instead of ``R^T wd_p`` and ``qd (wi_y, -wi_x)`` (6 products, 4 sums); the
     child's ``wd_x = w_y w_z - U23`` and ``wd_y = U13 - w_x w_z`` then follow with one
     sum each."""
-    if joint.type != "revolute" or joint.axis != sp.Matrix([0, 0, 1]):
+    found = _axis_in_parent(joint, R)
+    if found is None or joint.type != "revolute" or not is_value(joint.axis[2], 1):
         return None
-    col = [R[i, 2] for i in range(3)]
-    if not all(e.is_Number for e in col):
-        return None
-    hits = [i for i, e in enumerate(col) if e != 0]
-    if len(hits) != 1 or abs(col[hits[0]]) != 1:
-        return None
-    k, sign = hits[0], col[hits[0]]
+    k, sign = found
     return tuple(sp.Add(*[R[m, i] * sign * U_parent[m, k] for m in range(3)]) for i in range(2))
 
 
@@ -327,7 +327,9 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     b = builder or Builder(reserved=robot.free_symbols() | set(robot.q) | set(robot.qd) | set(robot.qdd)
                            | {s for s, _ in definitions})
     frames = joint_frames(robot, b, turns)
-    runs, rotations = parallel_runs(robot, turns), {}
+    # each joint's angle as joint_frames named it (a turned leaf's q + th is one temporary)
+    angles = {j.child: b.let(robot.joint_coordinate(j) + (turns or {}).get(j.child, 0)) for j in robot.joints}
+    runs, rotations = parallel_runs(robot, angles), {}
     zero = sp.zeros(3, 1)
     base_acc = -robot.gravity if gravity else zero
     w, wd = {robot.base: zero}, {robot.base: zero}

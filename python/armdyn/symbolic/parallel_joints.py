@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..codegen.program import Builder
+from ..codegen.program import Builder, is_value
 from ..model import Robot
 
 E3 = sp.Matrix([0, 0, 1])
@@ -59,25 +59,24 @@ class Run:
 
 def _about_z(robot: Robot, joint) -> bool:
     k = robot.coordinate_index(joint)
-    return (joint.type == "revolute" and joint.axis == E3 and k is not None
-            and robot.joint_coordinate(joint) == robot.q[k])
+    return (joint.type == "revolute" and all(is_value(joint.axis[i], E3[i]) for i in range(3))
+            and k is not None and robot.joint_coordinate(joint) == robot.q[k])
 
 
-def parallel_runs(robot: Robot, turns: dict | None = None) -> dict:
+def parallel_runs(robot: Robot, angles: dict) -> dict:
     """``{link: Run}`` for every link that continues a run of parallel revolute joints
-    (second joint of the run and after). ``robot``: canonical frames; ``turns``: the
-    leaf links turned about their joint axis (:mod:`armdyn.symbolic.leaf_frames`), whose
-    angle is ``q + th``."""
-    turns = turns or {}
+    (second joint of the run and after). ``robot``: canonical frames; ``angles``:
+    ``{link: its joint angle}`` as the program names it (``q6t = q6 + th6`` for a leaf
+    turned about its joint axis, :mod:`armdyn.symbolic.leaf_frames`)."""
     joint_of = {j.child: j for j in robot.joints}
     start, runs = {}, {}
     for joint in robot.joints:
         if not _about_z(robot, joint):
             continue
-        angle = robot.joint_coordinate(joint) + turns.get(joint.child, 0)
+        angle = angles[joint.child]
         tag = str(robot.coordinate_index(joint) + 1)
         parent = joint_of.get(joint.parent)
-        pure = joint.rotation == sp.eye(3)
+        pure = all(is_value(joint.rotation[i, k], i == k) for i in range(3) for k in range(3))
         if pure and parent is not None and joint.parent in start:
             first = start[joint.parent]
             runs[joint.child] = start[joint.child] = Run(first.anchor, first.R0, first.angle + angle, first.tags + tag)
@@ -117,7 +116,7 @@ def root_torque(b: Builder, robot: Robot, joint, frames: dict, rotations: dict, 
         return [a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2], a[0] * c[1] - a[1] * c[0]]
 
     def dot(a, c):
-        return sp.Add(*[a[i] * c[i] for i in range(3) if a[i] != 0])
+        return sp.Add(*[a[i] * c[i] for i in range(3) if not is_value(a[i], 0)])
 
     def add(*vs):
         return [sp.Add(*[v[i] for v in vs]) for i in range(3)]
@@ -150,6 +149,6 @@ def root_torque(b: Builder, robot: Robot, joint, frames: dict, rotations: dict, 
         c = child.child
         R, p = frames[c]
         total.append(brought(c, R))
-        if any(e != 0 for e in p):
+        if not all(is_value(e, 0) for e in p):
             total.append(dot(axis, cross(p, rotated_force(c))))
     return sp.Add(*total)
