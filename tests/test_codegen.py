@@ -149,9 +149,14 @@ def test_customized_tau_equals_derive_exactly_on_a_shared_origin_wrist(wrist_3r,
     the grouped parameters: the frames where every program transformation applies (the
     norm invariant of the child's angular velocity read off the parent's U, zeros of the
     grouping, p = 0 between links)."""
+    _customized_tau_equals_derive(wrist_3r, grouped)
+
+
+def _customized_tau_equals_derive(robot, grouped: bool):
+    """Asserts that the customized Newton-Euler's tau, with the standard or the grouped
+    parameters, equals armdyn.derive's exactly; returns the program."""
     from armdyn.symbolic.grouping import grouped_parameters
 
-    robot = wrist_3r
     eom = derive(robot, "newton-euler")
     params, defs = standard_parameters(robot)
     if grouped:
@@ -161,6 +166,7 @@ def test_customized_tau_equals_derive_exactly_on_a_shared_origin_wrist(wrist_3r,
     tau = _substituted(_substituted(tau_prog.inlined(), tdefs), defs)
     for k in range(robot.dof):
         assert _is_zero(tau[k] - eom.tau[k], robot), f"tau[{k}]"
+    return tau_prog
 
 
 def test_child_angular_velocity_norm_is_read_off_the_parent(wrist_3r):
@@ -303,22 +309,11 @@ def test_parallel_run_by_its_compound_angle_equals_derive_exactly(tmp_path, grou
     by the angle q2 + q3 (named once), and link 1's torque takes link 3's moment by that
     rotation (link 2's moment is never formed in full); tau equals armdyn.derive's
     exactly, with the standard and with the grouped parameters."""
-    from armdyn.symbolic.grouping import grouped_parameters
-
     path = tmp_path / "run-3r.yaml"
     path.write_text(RUN_3R)
-    robot = _load(str(path))
-    eom = derive(robot, "newton-euler")
-    params, defs = standard_parameters(robot)
-    if grouped:
-        params, extra = grouped_parameters(robot, params, defs)
-        defs = defs + extra
-    tau_prog, tdefs = customized_newton_euler(robot, parameters=params)
+    tau_prog = _customized_tau_equals_derive(_load(str(path)), grouped)
     names = {str(s) for s, _ in tau_prog.assignments}
     assert "q23" in names and not {"n2x", "n2y"} & names
-    tau = _substituted(_substituted(tau_prog.inlined(), tdefs), defs)
-    for k in range(robot.dof):
-        assert _is_zero(tau[k] - eom.tau[k], robot), f"tau[{k}]"
 
 
 def test_runs_of_parallel_joints_on_a_tree_agree_with_the_rust_core():
