@@ -51,7 +51,7 @@ import sympy as sp
 
 from ..codegen.program import Builder, Program, is_value
 from ..model import Robot
-from .parallel_joints import cheaper, parallel_runs, root_torque
+from .parallel_joints import about_z, cheaper, parallel_runs, root_torque, turned_about_z
 
 #: per link, in DESIGN.md's (Pinocchio's) order of the standard parameters
 STANDARD_NAMES = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")
@@ -103,13 +103,14 @@ def standard_parameters(robot: Robot):
     return out, definitions
 
 
-def moment_differences(robot: Robot, parameters: dict, definitions: list) -> tuple[dict, list]:
+def moment_differences(robot: Robot, parameters: dict, definitions: list, free=None) -> tuple[dict, list]:
     """``{link: (ZZ - YY, XX - ZZ, YY - XX)}`` of the inertias about the link origins,
     each a number, a symbol, or a new parameter ``ZZmYY2, XXmZZ2, YYmXX2`` whose
     definition (in the model's parameters) is returned: like the barycentric parameters,
     they are computed once per parameter set, not per state (Khalil's grouped
     parameters have the same form, e.g. ``XXR = XX - YY``)."""
-    taken = {str(s) for s in robot.free_symbols()} | {str(s) for s, _ in definitions} | {str(s) for s in robot.q}
+    free = robot.free_symbols() if free is None else free
+    taken = {str(s) for s in free} | {str(s) for s, _ in definitions} | {str(s) for s in robot.q}
     table = dict(definitions)
     out, new = {}, []
     for link, (_, _, J) in parameters.items():
@@ -146,11 +147,16 @@ def joint_frames(robot: Robot, b: Builder, turns: dict | None = None) -> dict:
         coordinate = robot.joint_coordinate(joint)
         if joint.child in turns:
             coordinate = b.let(coordinate + turns[joint.child], f"q{k + 1}t")
-        R, p = joint.transform(coordinate)
-        if joint.type == "revolute":
-            q = coordinate
-            trig = {sp.cos(q): b.let(sp.cos(q), f"c{k + 1}"), sp.sin(q): b.let(sp.sin(q), f"s{k + 1}")}
-            R = R.xreplace(trig)
+        if joint.type == "revolute" and about_z(joint) and not joint.has_frame_offset:
+            # the placement rotation times Rz(q), entry by hand (SymPy's Matrix product is slow)
+            c, s = b.let(sp.cos(coordinate), f"c{k + 1}"), b.let(sp.sin(coordinate), f"s{k + 1}")
+            R, p = turned_about_z(joint.rotation, c, s), joint.xyz
+        else:
+            R, p = joint.transform(coordinate)
+            if joint.type == "revolute":
+                q = coordinate
+                trig = {sp.cos(q): b.let(sp.cos(q), f"c{k + 1}"), sp.sin(q): b.let(sp.sin(q), f"s{k + 1}")}
+                R = R.xreplace(trig)
         tag = _safe(str(robot.link_index(joint.child)))
         R = sp.Matrix(3, 3, lambda r, s: b.let(R[r, s], f"R{tag}_{r + 1}{s + 1}"))
         p = sp.Matrix([b.let(p[r], f"p{tag}_{'xyz'[r]}") for r in range(3)])
@@ -322,10 +328,10 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     definitions = []
     if parameters is None:
         parameters, definitions = standard_parameters(robot)
-    differences, extra = moment_differences(robot, parameters, definitions)
+    free = robot.free_symbols()
+    differences, extra = moment_differences(robot, parameters, definitions, free)
     definitions = definitions + extra
-    b = builder or Builder(reserved=robot.free_symbols() | set(robot.q) | set(robot.qd) | set(robot.qdd)
-                           | {s for s, _ in definitions})
+    b = builder or Builder(reserved=free | set(robot.q) | set(robot.qd) | set(robot.qdd) | {s for s, _ in definitions})
     frames = joint_frames(robot, b, turns)
     # each joint's angle as joint_frames named it (a turned leaf's q + th is one temporary)
     angles = {j.child: b.let(robot.joint_coordinate(j) + (turns or {}).get(j.child, 0)) for j in robot.joints}

@@ -51,16 +51,26 @@ class Run:
         """(3x3) the link's frame in the anchor's, with the compound angle's cosine and
         sine named once (``c23, s23``)."""
         angle = b.let(self.angle, f"q{self.tags}")
-        c, s = b.let(sp.cos(angle), f"c{self.tags}"), b.let(sp.sin(angle), f"s{self.tags}")
-        R0 = self.R0  # numbers: the entries by hand (SymPy's Matrix product is slow here)
-        return sp.Matrix(3, 3, lambda i, k: R0[i, 0] * c + R0[i, 1] * s if k == 0 else
-                         -R0[i, 0] * s + R0[i, 1] * c if k == 1 else R0[i, 2])
+        return turned_about_z(self.R0, b.let(sp.cos(angle), f"c{self.tags}"), b.let(sp.sin(angle), f"s{self.tags}"))
 
 
-def _about_z(robot: Robot, joint) -> bool:
+def turned_about_z(R0, c, s) -> sp.Matrix:
+    """``R0 Rz`` (3x3) for the rotation about z with cosine ``c`` and sine ``s``, entry
+    by entry (SymPy's Matrix product is slow for these)."""
+    return sp.Matrix(3, 3, lambda i, k: R0[i, 0] * c + R0[i, 1] * s if k == 0 else
+                     -R0[i, 0] * s + R0[i, 1] * c if k == 1 else R0[i, 2])
+
+
+def about_z(joint) -> bool:
+    """The joint's axis is its frame's +z."""
+    return all(is_value(joint.axis[i], E3[i]) for i in range(3))
+
+
+def _own_revolute_about_z(robot: Robot, joint) -> bool:
+    """A revolute joint about +z with a coordinate of its own (not a mimic)."""
     k = robot.coordinate_index(joint)
-    return (joint.type == "revolute" and all(is_value(joint.axis[i], E3[i]) for i in range(3))
-            and k is not None and robot.joint_coordinate(joint) == robot.q[k])
+    return (joint.type == "revolute" and about_z(joint) and k is not None
+            and robot.joint_coordinate(joint) == robot.q[k])
 
 
 def parallel_runs(robot: Robot, angles: dict) -> dict:
@@ -71,7 +81,7 @@ def parallel_runs(robot: Robot, angles: dict) -> dict:
     joint_of = {j.child: j for j in robot.joints}
     start, runs = {}, {}
     for joint in robot.joints:
-        if not _about_z(robot, joint):
+        if not _own_revolute_about_z(robot, joint):
             continue
         angle = angles[joint.child]
         tag = str(robot.coordinate_index(joint) + 1)
