@@ -12,9 +12,11 @@ opinions:
 from __future__ import annotations
 
 import warnings
+from collections import Counter
 
 import numpy as np
 import pytest
+
 import sympy as sp
 
 import armdyn
@@ -170,11 +172,20 @@ def test_puma_base_parameter_tau_takes_fewer_operations_than_opensymoro(name):
 
 
 def test_puma_tau_program_has_no_sum_with_a_common_factor():
-    """No line of the PUMA's base-parameter tau is a sum with two terms sharing a factor
-    (``a x + a y``, which ``a (x + y)`` would do with one product less): the claim
-    benchmarks/README.md makes about the program, checked on the program."""
+    """No sum anywhere in the PUMA's base-parameter tau has two terms sharing a factor
+    (``a x + a y``, which ``a (x + y)`` would do with one product less), also once each
+    temporary used only once is put back where it is used (so that a sum split over two
+    lines is seen whole): the claim benchmarks/README.md makes about the program,
+    checked on the program."""
     prog = codegen.codegen(_load("puma560-craig"), what="tau", base=True).programs["tau"]
-    sums = [e for _, e in prog.assignments if e.is_Add] + [sp.sympify(e) for e in prog.outputs if sp.sympify(e).is_Add]
+    lines = [e for _, e in prog.assignments] + [sp.sympify(e) for e in prog.outputs]
+    uses = Counter(s for e in lines for s in e.free_symbols)
+    once = {s: e for s, e in prog.assignments if uses[s] == 1}
+
+    def inlined(e):
+        return e.xreplace({s: inlined(once[s]) for s in e.free_symbols if s in once})
+
+    sums = [sub for e in lines for sub in sp.preorder_traversal(inlined(e)) if isinstance(sub, sp.Add)]
     assert len(sums) > 50
     for e in sums:
         seen = {}
