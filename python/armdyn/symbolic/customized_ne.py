@@ -51,7 +51,8 @@ import sympy as sp
 
 from ..codegen.program import Builder, Program, is_value
 from ..model import Robot
-from .parallel_joints import about_z, cheaper, parallel_runs, root_torque, turned_about_z
+from .parallel_joints import about_z, cheaper, parallel_runs, root_torque
+from .vectors import cross, mtv, mv, turned_about_z, vadd, vscale
 
 #: per link, in DESIGN.md's (Pinocchio's) order of the standard parameters
 STANDARD_NAMES = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")
@@ -252,7 +253,7 @@ def _column_from_parent(joint, R, U_parent):
     child's ``wd_x = w_y w_z - U23`` and ``wd_y = U13 - w_x w_z`` then follow with one
     sum each."""
     found = _axis_in_parent(joint, R)
-    if found is None or joint.type != "revolute" or not is_value(joint.axis[2], 1):
+    if found is None or joint.type != "revolute" or not about_z(joint):
         return None
     k, sign = found
     return tuple(sp.Add(*[R[m, i] * sign * U_parent[m, k] for m in range(3)]) for i in range(2))
@@ -281,31 +282,7 @@ def _euler_moment(b: Builder, J, differences, w, wd, U, sq) -> sp.Matrix:
 
 
 def _matvec(b: Builder, A, v, hint) -> sp.Matrix:
-    return b.vector(_mv(A, v), hint)
-
-
-# 3-vector arithmetic on plain sequences: SymPy's Matrix products go through its
-# DomainMatrix machinery, about ten times slower for these 3x3 products (the same sums)
-def _mv(A, v) -> list:
-    """A v (3,)."""
-    return [sp.Add(*[A[i, k] * v[k] for k in range(3)]) for i in range(3)]
-
-
-def _mtv(A, v) -> list:
-    """A^T v (3,)."""
-    return [sp.Add(*[A[k, i] * v[k] for k in range(3)]) for i in range(3)]
-
-
-def _vcross(a, c) -> list:
-    return [a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2], a[0] * c[1] - a[1] * c[0]]
-
-
-def _vadd(*vs) -> list:
-    return [sp.Add(*[v[i] for v in vs]) for i in range(3)]
-
-
-def _vscale(x, a) -> list:
-    return [x * e for e in a]
+    return b.vector(mv(A, v), hint)
 
 
 def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, parameters=None,
@@ -348,42 +325,42 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         k = robot.coordinate_index(joint)
         R, p = frames[name]
         z = joint.axis
-        w_in = _mtv(R, w[parent])
+        w_in = mtv(R, w[parent])
         column = _column_from_parent(joint, R, U[parent])
         run = runs.get(name)
         if run is not None:  # a run of parallel joints: from its anchor, by the compound angle
             Ra = run.rotation(b)
-            w_run, column_run = _mtv(Ra, w[run.anchor])[:2], _column_from_parent(joint, Ra, U[run.anchor])
+            w_run, column_run = mtv(Ra, w[run.anchor])[:2], _column_from_parent(joint, Ra, U[run.anchor])
             if cheaper([*w_run, *(column_run or ())], [*w_in[:2], *(column or ())]):
                 w_in, column = [*w_run, w_in[2]], column_run
                 rotations[name] = Ra
         w_in = b.vector(w_in, f"wi{tag}")
-        wd_j = _mtv(R, wd[parent])
+        wd_j = mtv(R, wd[parent])
         if joint.type == "revolute":
-            w_j = b.vector(_vadd(w_in, _vscale(qd[k], z)), f"w{tag}")
+            w_j = b.vector(vadd(w_in, vscale(qd[k], z)), f"w{tag}")
             sq = _squares(b, w_j, tag, _parent_invariant(joint, R, U[parent]))
             if column is not None:
                 column = b.let(column[0], f"U{tag}_13"), b.let(column[1], f"U{tag}_23")
                 wd_j = [sq["yz"] - column[1], column[0] - sq["xz"], wd_j[2] + qdd[k]]
             else:
-                wd_j = _vadd(wd_j, _vscale(qdd[k], z), _vcross(w_in, _vscale(qd[k], z)))
+                wd_j = vadd(wd_j, vscale(qdd[k], z), cross(w_in, vscale(qd[k], z)))
         else:
             w_j = b.vector(w_in, f"w{tag}")
             sq = _squares(b, w_j, tag, _parent_invariant(joint, R, U[parent]))
         wd_j = b.vector(wd_j, f"wd{tag}")
         Up_p = _matvec(b, U[parent], p, f"Up{tag}")
-        vd_j = _mtv(R, b.vector(_vadd(Up_p, vd[parent]), f"a{tag}"))  # named: both rows of R^T use it
+        vd_j = mtv(R, b.vector(vadd(Up_p, vd[parent]), f"a{tag}"))  # named: both rows of R^T use it
         if joint.type == "prismatic":
-            vd_j = _vadd(vd_j, _vscale(2, _vcross(w_j, _vscale(qd[k], z))), _vscale(qdd[k], z))
+            vd_j = vadd(vd_j, vscale(2, cross(w_j, vscale(qd[k], z))), vscale(qdd[k], z))
         vd_j = b.vector(vd_j, f"vd{tag}")
         U_j = _skew2(b, w_j, wd_j, tag, sq, column)
         M, MS, J = parameters[name]
-        F[name] = b.vector(_vadd(_vscale(M, vd_j), _mv(U_j, MS)), f"F{tag}")
-        N[name] = b.vector(_vadd(_euler_moment(b, J, differences[name], w_j, wd_j, U_j, sq), _vcross(MS, vd_j)),
+        F[name] = b.vector(vadd(vscale(M, vd_j), mv(U_j, MS)), f"F{tag}")
+        N[name] = b.vector(vadd(_euler_moment(b, J, differences[name], w_j, wd_j, U_j, sq), cross(MS, vd_j)),
                            f"N{tag}")
         w[name], wd[name], vd[name], U[name] = w_j, wd_j, vd_j, U_j
 
-    f, nm = {}, {}
+    f, nm, Rf = {}, {}, {}
     tau = [sp.Integer(0)] * n
     for joint in reversed(robot.joints):
         name = joint.child
@@ -391,9 +368,9 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         f_j, n_j = F[name], N[name]
         for child in robot.children(name):
             Rc, pc = frames[child.child]
-            f_c = _matvec(b, Rc, f[child.child], f"Rf{_safe(str(robot.link_index(child.child)))}")
-            f_j = _vadd(f_j, f_c)
-            n_j = _vadd(n_j, _mv(Rc, nm[child.child]), _vcross(pc, f_c))
+            f_c = Rf[child.child] = _matvec(b, Rc, f[child.child], f"Rf{_safe(str(robot.link_index(child.child)))}")
+            f_j = vadd(f_j, f_c)
+            n_j = vadd(n_j, mv(Rc, nm[child.child]), cross(pc, f_c))
         f[name], nm[name] = b.vector(f_j, f"f{tag}"), b.vector(n_j, f"n{tag}")
         k = robot.coordinate_index(joint)
         if k is not None:
@@ -401,6 +378,6 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     for joint in robot.joints:  # base-fixed links behind runs: their torque only
         k = robot.coordinate_index(joint)
         if (joint.parent == robot.base and joint.type == "revolute" and k is not None
-                and any(r.anchor == joint.child for l, r in runs.items() if l in rotations)):
-            tau[k] = root_torque(b, robot, joint, frames, rotations, N, f, nm)
+                and any(runs[link].anchor == joint.child for link in rotations)):
+            tau[k] = root_torque(robot, joint, frames, rotations, N, f, nm, Rf)
     return b.program(tau, (n,)), definitions

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ..codegen.program import is_value
 from ..model import Robot
 from .customized_ne import _safe
 
@@ -108,7 +109,7 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
                 Jp = sp.Matrix(Jp)
                 ptag = _safe(str(robot.link_index(joint.parent)))
                 for a, b in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):
-                    if moved[0][a, b] != 0:
+                    if not is_value(moved[0][a, b], 0):
                         Jp[a, b] = Jp[b, a] = named(Jp[a, b] + moved[0][a, b], f"{'XYZ'[a]}{'XYZ'[b]}{ptag}L",
                                                     Jp[a, b] + moved[1][a, b])
                 out[joint.parent] = (Mp, MSp, Jp)
@@ -130,7 +131,7 @@ def _yy_moved(robot: Robot, joint, parameters: dict, YYt, YY):
     when ``YY'`` is zero or when moving it would make a zero entry of the parent's
     inertia nonzero (more products than it saves). Onto the fixed base it simply goes: it
     never moves."""
-    if sp.sympify(YYt) == 0:
+    if is_value(YYt, 0):
         return None
     R, _ = joint.transform(sp.Integer(0))
     D = R * sp.diag(1, 1, 0) * R.T
@@ -138,6 +139,6 @@ def _yy_moved(robot: Robot, joint, parameters: dict, YYt, YY):
         return None
     if joint.parent != robot.base:
         Jp = parameters[joint.parent][2]
-        if any(D[a, b] != 0 and sp.sympify(Jp[a, b]) == 0 for a in range(3) for b in range(3)):
+        if any(not is_value(D[a, b], 0) and is_value(Jp[a, b], 0) for a in range(3) for b in range(3)):
             return None
     return D * YYt, D * YY

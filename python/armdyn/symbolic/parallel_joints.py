@@ -30,6 +30,7 @@ import sympy as sp
 
 from ..codegen.program import Builder, is_value
 from ..model import Robot
+from .vectors import cross, mv, turned_about_z, vadd
 
 E3 = sp.Matrix([0, 0, 1])
 
@@ -52,13 +53,6 @@ class Run:
         sine named once (``c23, s23``)."""
         angle = b.let(self.angle, f"q{self.tags}")
         return turned_about_z(self.R0, b.let(sp.cos(angle), f"c{self.tags}"), b.let(sp.sin(angle), f"s{self.tags}"))
-
-
-def turned_about_z(R0, c, s) -> sp.Matrix:
-    """``R0 Rz`` (3x3) for the rotation about z with cosine ``c`` and sine ``s``, entry
-    by entry (SymPy's Matrix product is slow for these)."""
-    return sp.Matrix(3, 3, lambda i, k: R0[i, 0] * c + R0[i, 1] * s if k == 0 else
-                     -R0[i, 0] * s + R0[i, 1] * c if k == 1 else R0[i, 2])
 
 
 def about_z(joint) -> bool:
@@ -103,7 +97,7 @@ def cheaper(compound: list, separate: list) -> bool:
     return cost(compound) + 1 < cost(separate)
 
 
-def root_torque(b: Builder, robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: dict, n: dict):
+def root_torque(robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: dict, n: dict, Rf: dict):
     """The torque ``z . n`` of a base-fixed link (its joint ``joint``), with the runs of
     parallel joints behind it brought over by their compound rotations: of the moment of
     a link the base carries, only its component on the joint axis is needed (the base does
@@ -117,39 +111,28 @@ def root_torque(b: Builder, robot: Robot, joint, frames: dict, rotations: dict, 
     rotation; the offset along the common axis turns with y (``p_z z x R_y f = R_y (p_z z
     x f)``). Each rotated vector is only ever dotted with the axis: ``z . R v = (R^T z) . v``.
 
-    b: the builder of the program (rotated forces it already named are reused); frames:
-    ``{link: (R, p)}`` of the joints; rotations: ``{link: R_anchor_link}`` of the links
-    whose outward quantities used the compound form; N, f, n: each link's Euler moment,
-    total force and total moment (its axes)."""
-
-    def cross(a, c):
-        return [a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2], a[0] * c[1] - a[1] * c[0]]
+    frames: ``{link: (R, p)}`` of the joints; rotations: ``{link: R_anchor_link}`` of the
+    links whose outward quantities used the compound form; N, f, n: each link's Euler
+    moment, total force and total moment (its axes); Rf: ``{link: R f}``, its force in its
+    parent's axes, as the program named it."""
 
     def dot(a, c):
         return sp.Add(*[a[i] * c[i] for i in range(3) if not is_value(a[i], 0)])
-
-    def add(*vs):
-        return [sp.Add(*[v[i] for v in vs]) for i in range(3)]
-
-    def rotated_force(y):
-        R, _ = frames[y]
-        return b.vector([sp.Add(*[R[i, k] * f[y][k] for k in range(3)]) for i in range(3)], f"Rf{robot.link_index(y)}")
 
     def brought(x, Rax, extra=(0, 0, 0)):
         """z . R_ax (n_x + extra) with x's children in a run expanded."""
         u = [sp.Add(*[Rax[k, i] * axis[k] for k in range(3)]) for i in range(3)]  # R_ax^T z
         kids = [j.child for j in robot.children(x)]
         if not any(y in rotations for y in kids):
-            return dot(u, add(n[x], extra))
-        own, out = add(N[x], extra), []
+            return dot(u, vadd(n[x], extra))
+        own, out = vadd(N[x], extra), []
         for y in kids:
             R, p = frames[y]
             if y in rotations:
-                own = add(own, cross([p[0], p[1], 0], rotated_force(y)))
+                own = vadd(own, cross([p[0], p[1], 0], Rf[y]))
                 out.append(brought(y, rotations[y], [-p[2] * f[y][1], p[2] * f[y][0], 0]))
             else:
-                Rn = [sp.Add(*[R[i, k] * n[y][k] for k in range(3)]) for i in range(3)]
-                own = add(own, Rn, cross(p, rotated_force(y)))
+                own = vadd(own, mv(R, n[y]), cross(p, Rf[y]))
         return sp.Add(dot(u, own), *out)
 
     axis = list(joint.axis)
@@ -160,5 +143,5 @@ def root_torque(b: Builder, robot: Robot, joint, frames: dict, rotations: dict, 
         R, p = frames[c]
         total.append(brought(c, R))
         if not all(is_value(e, 0) for e in p):
-            total.append(dot(axis, cross(p, rotated_force(c))))
+            total.append(dot(axis, cross(p, Rf[c])))
     return sp.Add(*total)
