@@ -2,6 +2,7 @@
 
     PYTHONPATH=python python3 benchmarks/bench_codegen.py            # everything (~1 min)
     PYTHONPATH=python python3 benchmarks/bench_codegen.py --skip-numeric
+    PYTHONPATH=python python3 benchmarks/bench_codegen.py --processes 6   # tau alone, 6 fresh processes
 
 1. Operation counts on the PUMA 560 with every parameter symbolic (60 inertial ones,
    kinematics and g too), counted as ``sympy.count_ops(visual=True)`` counts them
@@ -204,6 +205,54 @@ def breakdown() -> None:
           " the parallel joints; tau: joint 1's torque, formed from the moments of links 1-3 directly)\n")
 
 
+# tau alone by the customized Newton-Euler in a fresh process: the first build, then the
+# median of 9 more (CPU time, seconds), printed as "first median"
+_TAU_IN_A_PROCESS = """
+import statistics, time, warnings
+import armdyn
+from armdyn.symbolic.customized_ne import customized_newton_euler, standard_parameters
+from armdyn.symbolic.grouping import grouped_parameters
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    robot = armdyn.load("puma560-craig", strict=False)
+def tau_program():
+    params, definitions = standard_parameters(robot)
+    grouped, _ = grouped_parameters(robot, params, definitions)
+    customized_newton_euler(robot, parameters=grouped)
+times = []
+for _ in range(10):
+    t0 = time.process_time()
+    tau_program()
+    times.append(time.process_time() - t0)
+print(times[0], statistics.median(times[1:]))
+"""
+
+
+def tau_in_processes(n: int) -> None:
+    """tau alone (the time table's row) in ``n`` fresh processes, ``PYTHONHASHSEED`` 0 to
+    n-1: the repeated builds' median depends on which expressions stay in SymPy's cache
+    (1000 entries unless ``SYMPY_CACHE_SIZE`` says otherwise), which depends on the hash
+    seed; the first build is what a user's one call costs."""
+    import os
+    import subprocess
+    import sys
+
+    print(f"## tau alone by the customized Newton-Euler in {n} fresh processes, puma560-craig "
+          f"(CPU s; SYMPY_CACHE_SIZE={os.environ.get('SYMPY_CACHE_SIZE', 'default')})\n")
+    print("| PYTHONHASHSEED | first build | median of the next 9 | target |")
+    print("|---|---|---|---|")
+    firsts, medians = [], []
+    for seed in range(n):
+        env = dict(os.environ, PYTHONHASHSEED=str(seed))
+        out = subprocess.run([sys.executable, "-c", _TAU_IN_A_PROCESS], env=env, check=True,
+                             capture_output=True, text=True).stdout.split()
+        first, median = float(out[0]), float(out[1])
+        firsts.append(first)
+        medians.append(median)
+        print(f"| {seed} | {first:.3f} | {median:.3f} | <= 0.1 |")
+    print(f"| all | {min(firsts):.3f}-{max(firsts):.3f} | {min(medians):.3f}-{max(medians):.3f} | <= 0.1 |\n")
+
+
 def numeric(n_states: int, repeat: int) -> None:
     robot = load("puma560")
     with warnings.catch_warnings():
@@ -245,7 +294,12 @@ def main() -> None:
     ap.add_argument("--states", type=int, default=100_000)
     ap.add_argument("--skip-numeric", action="store_true")
     ap.add_argument("--numeric-repeat", type=int, default=15)
+    ap.add_argument("--processes", type=int, default=0,
+                    help="only time tau alone in this many fresh processes (PYTHONHASHSEED 0, 1, ...)")
     args = ap.parse_args()
+    if args.processes:
+        tau_in_processes(args.processes)
+        return
     have_identification = importlib.util.find_spec("armdyn.identification") is not None
     generation_times(have_identification, args.repeat)  # first: SymPy's caches still cold
     op_count_table(have_identification)
