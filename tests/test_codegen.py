@@ -63,7 +63,9 @@ def _numeric(robot, values):
         return robot.bind(values)
 
 
-def _states(rng, n, samples=7):
+def _states(rng, n, samples=11):
+    """Random states; 11 by default: one block of 8 lanes through the C batch code (the
+    sin/cos kernel, the addition formula) and 3 through its single-state function."""
     return tuple(rng.uniform(-np.pi, np.pi, (samples, n)) for _ in range(3))
 
 
@@ -393,7 +395,7 @@ def test_turned_leaf_frame_with_zero_first_moment_is_finite_and_right(tmp_path):
     p = lib.code.parameter_values(values)
     assert np.all(np.isfinite(p)) and p.size > 0
     bound = _numeric(robot, values)
-    q, qd, qdd = _states(rng, robot.dof, samples=11)  # one block of 8 lanes and 3 single states
+    q, qd, qdd = _states(rng, robot.dof)
     _close(lib.tau(q, qd, qdd, p=p), armdyn.rnea(bound, q, qd, qdd))
     _close(lib.g(q, p=p), armdyn.gravity(bound, q))
 

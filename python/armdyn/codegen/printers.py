@@ -17,6 +17,9 @@ from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
+from .program import Program
+from .sincos_coefficients import COS, SIN
+
 INPUTS = {"tau": ("q", "qd", "qdd"), "M": ("q",), "C": ("q", "qd"), "g": ("q",), "regressor": ("q", "qd", "qdd")}
 
 _C_RESERVED = set(
@@ -164,7 +167,12 @@ _SIMD_CLONES = """\
 /* The batch entry points work on blocks of lanes that the compiler vectorises. With GCC
  * or Clang on x86-64 Linux they are also compiled for AVX2 (4 doubles a vector instead
  * of SSE2's 2), the version picked at load time by the CPU; plain C99 elsewhere. No FMA:
- * results are the same to the last bit either way. */
+ * results are the same to the last bit either way. Their sines and cosines come from the
+ * polynomial kernel below, and those of a compound angle (q23 = q2 + q3) from its parts'
+ * by the addition formula (s23 = s2 c3 + c2 s3, c23 = c2 c3 - s2 s3) instead of a kernel
+ * call; the operation counts above are the program's, as the single-state functions run
+ * it with libm's sin and cos. Batch and single-state results agree to a few ulp, not to
+ * the bit. */
 #if defined(__GNUC__) && defined(__x86_64__) && defined(__linux__) && !defined(ARMDYN_NO_CLONES)
 #define ARMDYN_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
 #else
@@ -172,25 +180,30 @@ _SIMD_CLONES = """\
 #endif
 """
 
-_SINCOS_KERNEL = """\
+def _horner(coefficients) -> str:
+    """``c0 + z * (c1 + z * (... + z * cn))`` one coefficient a line, printed with ``repr``
+    (exact)."""
+    *inner, last = coefficients
+    return ("\n        + z * (".join(repr(c) for c in inner) + f"\n        + z * {last!r}" + ")" * (len(inner) - 1))
+
+
+_SINCOS_KERNEL = f"""\
 /* (sin x, cos x) to about 1 ulp for |x| <= 1e8, branch-free so that loops over lanes
  * vectorise: x = j pi/2 + r (three-part Cody-Waite split of pi/2, exact for |j| < 2^29),
- * Taylor polynomials of degree 17 / 16 on |r| <= pi/4, picked and signed by j mod 4
- * (the same kernel as armdyn's Rust core, crates/armdyn-core/src/real.rs). */
+ * minimax polynomials of degree 13 / 14 on |r| <= pi/4 (their coefficients computed by
+ * python/armdyn/codegen/sincos_coefficients.py), picked and signed by j mod 4. armdyn's
+ * Rust core (crates/armdyn-core/src/real.rs) reduces x the same way but uses Taylor
+ * polynomials of degree 17 / 16: the two agree to about 1 ulp, not to the bit. */
 static inline void armdyn_sincos_kernel(double x, double *s, double *c)
-{
+{{
     const double t = x * 0.6366197723675814 + 6755399441055744.0;
     uint64_t quadrant;
     memcpy(&quadrant, &t, 8);
     const double j = t - 6755399441055744.0;
     const double r = ((x - j * 1.570796251296997) - j * 7.549789415861596e-08) - j * 5.390302858158119e-15;
     const double z = r * r;
-    const double ps = r + r * z * (-0.16666666666666666 + z * (0.008333333333333333 + z * (-0.0001984126984126984
-        + z * (2.7557319223985893e-06 + z * (-2.505210838544172e-08 + z * (1.6059043836821613e-10
-        + z * (-7.647163731819816e-13 + z * 2.8114572543455206e-15)))))));
-    const double pc = (1.0 - 0.5 * z) + z * z * (0.041666666666666664 + z * (-0.001388888888888889
-        + z * (2.48015873015873e-05 + z * (-2.755731922398589e-07 + z * (2.08767569878681e-09
-        + z * (-1.1470745597729725e-11 + z * 4.779477332387385e-14))))));
+    const double ps = r + r * z * ({_horner(SIN)});
+    const double pc = (1.0 - 0.5 * z) + z * z * ({_horner(COS)});
     const int swap = (int)(quadrant & 1);
     const double sv = swap ? pc : ps, cv = swap ? ps : pc;
     uint64_t sb, cb;
@@ -200,7 +213,7 @@ static inline void armdyn_sincos_kernel(double x, double *s, double *c)
     cb ^= ((quadrant + 1) & 2) << 62;
     memcpy(s, &sb, 8);
     memcpy(c, &cb, 8);
-}
+}}
 """
 
 LANES = 8
@@ -222,18 +235,77 @@ class _LaneNames:
         return sp.sympify(expr).xreplace(self.map)
 
 
-def _c_batch(code, what, prog, fn, args, size) -> list[str]:
-    """The batch entry point: blocks of LANES states, every temporary an array over the
-    lanes and the lines in one loop over them (which the compiler turns into SIMD), sin and
-    cos by the polynomial kernel; the last n mod LANES states, and any block with a
-    |q| > 1e8, by the single-state function (libm's sin and cos)."""
-    names = code.names
-    lanes = _LaneNames(names, code.parameters)
-    printer = FastPrinter("c", lanes)
-    trig = {}
+def _as_sum(angle, known: dict):
+    """``(g1, a, g2, b)`` with ``angle = g1 a + g2 b`` (signs g = +-1) for two keys a, b
+    of ``known``, else None. Angles are expressions in the inputs and parameters, which
+    SymPy keeps in one canonical form for sums of terms (``(q2 + q3 + q4) - (q2 + q3)``
+    is ``q4``)."""
+    for a in known:
+        for g1 in (1, -1):
+            rest = angle - g1 * a
+            for g2 in (1, -1):
+                if g2 * rest in known:
+                    return g1, a, g2, g2 * rest
+    return None
+
+
+def _batch_sincos(prog, known):
+    """How the batch computes the sines and cosines of the program's angles (symbols).
+
+    An angle that is the sum or difference of two angles whose sine and cosine are both
+    computed before it (``q23 = q2 + q3``; ``q234 = q2 + q3 + q4`` from q23 and q4) gets
+    them by the addition formula, ``s23 = s2 c3 + c2 s3``, ``c23 = c2 c3 - s2 s3`` (4 mul
+    and 2 add against ~40 flops of the kernel; a few ulp). Else an angle whose sine and
+    cosine are both needed, an input or a temporary of the inputs and the parameters
+    (``known``), goes to the polynomial kernel. Any other (one of sin, cos needed; an
+    angle of other temporaries) stays a line of the program (libm).
+
+    Returns (kernel, formulas): ``[(angle, sin symbol, cos symbol)]`` and ``[(sin or
+    cos symbol, expression in the kernel's and earlier formulas' symbols)]``, the
+    formulas in an order that computes every symbol before its use."""
+    assigned = dict(prog.assignments)
+    order = {s: k for k, (s, _) in enumerate(prog.assignments)}
+    trig: dict = {}
     for s, e in prog.assignments:
         if isinstance(e, (sp.sin, sp.cos)) and e.args[0].is_Symbol:
             trig.setdefault(e.args[0], {})[type(e).__name__] = s
+
+    def value(e):
+        """e with the temporaries in it replaced by their expressions."""
+        inner = e.free_symbols & assigned.keys()
+        return e.xreplace({t: value(assigned[t]) for t in inner}) if inner else e
+
+    kernel, formulas = [], []
+    pairs: dict = {}  # an angle's value -> (its sin, its cos), both computed
+    for x in sorted(trig, key=lambda a: order.get(a, -1)):  # the inputs, then as assigned
+        need, angle = trig[x], value(x)
+        split = _as_sum(angle, pairs)
+        if split:
+            g1, a, g2, b = split
+            (s1, c1), (s2, c2) = pairs[a], pairs[b]
+            by_formula = {"sin": g1 * s1 * c2 + g2 * c1 * s2, "cos": c1 * c2 - g1 * g2 * s1 * s2}
+            formulas += [(need[f], by_formula[f]) for f in ("sin", "cos") if f in need]
+        elif len(need) == 2 and (x not in assigned or assigned[x].free_symbols <= known):
+            kernel.append((x, need["sin"], need["cos"]))
+        else:
+            continue
+        if len(need) == 2:
+            pairs[angle] = (need["sin"], need["cos"])
+    return kernel, formulas
+
+
+def _c_batch(code, what, prog, fn, args, size) -> list[str]:
+    """The batch entry point: blocks of LANES states, every temporary an array over the
+    lanes and the lines in one loop over them (which the compiler turns into SIMD), sin and
+    cos by the polynomial kernel, or from those of two other angles by the addition formula
+    (:func:`_batch_sincos`); the last n mod LANES states, and any block with a kernel angle
+    |x| > 1e8, by the single-state function (libm's sin and cos)."""
+    names = code.names
+    lanes = _LaneNames(names, code.parameters)
+    printer = FastPrinter("c", lanes)
+    arrays = {"q": code.q, "qd": code.qd, "qdd": code.qdd}
+    known = {s for a in INPUTS[what] for s in arrays[a]} | set(code.parameters)
+    kernel, formulas = _batch_sincos(prog, known)
     L = LANES
     dof = code.dof
     out = [f"/* {what} over n states: inputs row-major (n, {dof}), out row-major (n, {size}) */",
@@ -242,8 +314,7 @@ def _c_batch(code, what, prog, fn, args, size) -> list[str]:
     out = [ln for ln in out if ln is not None]
     out.append("    size_t k = 0;")
     out.append(f"    for (; k + {L} <= n; k += {L}) {{")
-    out.append(f"        int wide = 0;  /* some |q| beyond the kernel's range: libm, state by state */")
-    arrays = {"q": code.q, "qd": code.qd, "qdd": code.qdd}
+    out.append(f"        int wide = 0;  /* some angle beyond the kernel's range: libm, state by state */")
     used = set()
     for e in [e for _, e in prog.assignments] + list(prog.outputs):
         used |= sp.sympify(e).free_symbols
@@ -253,41 +324,30 @@ def _c_batch(code, what, prog, fn, args, size) -> list[str]:
                 nm = names.name(s)
                 out.append(f"        double {nm}[{L}];")
                 out.append(f"        for (int l = 0; l < {L}; ++l) {nm}[l] = {a}[(k + l) * {dof} + {j}];")
-    # an angle that is a temporary of the inputs and parameters (a turned leaf frame's
-    # q + th): computed before the range check; any other goes to libm line by line
-    known = {s for a in INPUTS[what] for s in arrays[a]} | set(code.parameters)
+    # a kernel angle that is a temporary of the inputs and parameters (a turned leaf
+    # frame's q + th): computed before the range check
     assigned = dict(prog.assignments)
-    done = set()
-    for x in list(trig):
-        if x in assigned:
-            if assigned[x].free_symbols <= known:
-                nm = names.name(x)
-                out.append(f"        double {nm}[{L}];")
-                out.append(f"        for (int l = 0; l < {L}; ++l) {nm}[l] = {printer(assigned[x])};")
-                done.add(x)
-            else:
-                del trig[x]
-    for x in trig:
-        out.append(f"        for (int l = 0; l < {L}; ++l) wide |= !(fabs({names.name(x)}[l]) <= 1e8);")
+    early = [x for x, _, _ in kernel if x in assigned]
+    for x in early:
+        out.append(f"        double {names.name(x)}[{L}];")
+        out.append(f"        for (int l = 0; l < {L}; ++l) {lanes.name(x)} = {printer(assigned[x])};")
+    for x, _, _ in kernel:
+        out.append(f"        for (int l = 0; l < {L}; ++l) wide |= !(fabs({lanes.name(x)}) <= 1e8);")
     out.append("        if (wide) {")
     call = ", ".join(f"{a} + (k + l) * {dof}" for a in INPUTS[what])
     out.append(f"            for (size_t l = 0; l < {L}; ++l) {fn}({call}, p, out + (k + l) * {size});")
     out.append("            continue;")
     out.append("        }")
-    body, declared = [], []
-    for s, e in prog.assignments:
-        if s in done:
-            continue
-        if isinstance(e, (sp.sin, sp.cos)) and e.args[0] in trig and len(trig[e.args[0]]) == 2:
-            pair = trig[e.args[0]]
-            sn, cn = names.name(pair["sin"]), names.name(pair["cos"])
-            declared += [sn, cn]
-            body.append(f"armdyn_sincos_kernel({names.name(e.args[0])}[l], &{sn}[l], &{cn}[l]);")
-            done |= {pair["sin"], pair["cos"]}
-            continue
-        declared.append(names.name(s))
-        body.append(f"{names.name(s)}[l] = {printer(e)};")
+    # the program's other lines, less those that only the replaced sin and cos lines used
+    # (a compound angle whose sine and cosine come from the addition formula)
+    handled = {s for _, sn, cn in kernel for s in (sn, cn)} | {s for s, _ in formulas} | set(early)
+    rest = Program([(s, e) for s, e in prog.assignments if s not in handled], prog.outputs, prog.shape).pruned()
+    lines = formulas + rest.assignments
+    body = [f"armdyn_sincos_kernel({lanes.name(x)}, &{names.name(sn)}[l], &{names.name(cn)}[l]);"
+            for x, sn, cn in kernel]
+    body += [f"{lanes.name(s)} = {printer(e)};" for s, e in lines]
     body += [f"out[(k + l) * {size} + {j}] = {printer(e)};" for j, e in enumerate(prog.outputs)]
+    declared = [names.name(s) for _, sn, cn in kernel for s in (sn, cn)] + [names.name(s) for s, _ in lines]
     for i in range(0, len(declared), 8):
         out.append("        double " + ", ".join(f"{d}[{L}]" for d in declared[i:i + 8]) + ";")
     # one loop over the lanes holding every line: the compiler vectorises it as a whole
