@@ -183,8 +183,9 @@ class Builder:
         self._memo[key] = s
         return s
 
-    def vector(self, v, hint: str) -> sp.Matrix:
-        return sp.Matrix([self.let(v[k], f"{hint}{'xyz'[k]}") for k in range(3)])
+    def vector(self, v, hint: str) -> list:
+        """The 3-vector ``v`` with each component named (``{hint}x``, ``{hint}y``, ``{hint}z``)."""
+        return [self.let(v[k], f"{hint}{'xyz'[k]}") for k in range(3)]
 
     def program(self, outputs, shape) -> Program:
         return Program(list(self.assignments), list(outputs), tuple(shape)).pruned()
