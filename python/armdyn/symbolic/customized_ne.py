@@ -49,7 +49,7 @@ import re
 
 import sympy as sp
 
-from ..codegen.program import Builder, Program, is_value
+from ..codegen.program import Builder, Program, is_value, names
 from ..model import Robot
 from .parallel_joints import about_z, cheaper, parallel_runs, root_torque
 from .vectors import (UPPER, ZERO, cross, dot, expanded, minus, mtv, mv, plus, rows, times, turned_about_z, vadd,
@@ -74,7 +74,7 @@ def standard_parameters(robot: Robot):
     ``MX2, XX2, ...`` (Khalil's names, the number is the link's frame index).
     """
     robot = robot.canonical()  # link frames on their joints (frames off the axis: same dynamics)
-    taken = {str(s) for s in robot.free_symbols()} | {str(s) for s in (*robot.q, *robot.qd, *robot.qdd)}
+    taken = names(robot.free_symbols()) | names((*robot.q, *robot.qd, *robot.qdd))
     definitions = []
     out = {}
 
@@ -113,7 +113,7 @@ def moment_differences(robot: Robot, parameters: dict, definitions: list, free=N
     they are computed once per parameter set, not per state (Khalil's grouped
     parameters have the same form, e.g. ``XXR = XX - YY``)."""
     free = robot.free_symbols() if free is None else free
-    taken = {str(s) for s in free} | {str(s) for s, _ in definitions} | {str(s) for s in robot.q}
+    taken = names(free) | names(s for s, _ in definitions) | names(robot.q)
     table = dict(definitions)
     out, new = {}, []
     for link, (_, _, J) in parameters.items():

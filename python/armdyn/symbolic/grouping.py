@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ..codegen.program import names
 from ..model import Robot
 from .customized_ne import _safe
 from .vectors import UPPER, ZERO, dot, expanded, minus, mv, plus, rows, times
@@ -74,16 +75,15 @@ def grouped_parameters(robot: Robot, parameters: dict, definitions: list):
     """
     robot = robot.canonical()
     table = dict(definitions)
-    taken = {str(s) for s in robot.free_symbols()} | {str(s) for s in (*robot.q, *robot.qd, *robot.qdd)}
-    taken |= {str(s) for s, _ in definitions}
+    taken = names(robot.free_symbols()) | names((*robot.q, *robot.qd, *robot.qdd)) | names(s for s, _ in definitions)
     # (M, MS (3,), J (3x3 rows)) of each link, as lists: SymPy's Matrix arithmetic is slow
     work = {link: [sp.sympify(M), list(MS), rows(J)] for link, (M, MS, J) in parameters.items()}
-    z = sp.Matrix([0, 0, 1])
+    z_axes = (sp.Matrix([0, 0, 1]), sp.Matrix([0, 0, -1]))
     for joint in reversed(robot.joints):  # tip to base: a link has received its children's parts
         link = joint.child
         if joint.type not in ("revolute", "prismatic") or link not in work:
             continue
-        if not (joint.axis == z or joint.axis == -z):
+        if joint.axis not in z_axes:
             continue
         M, MS, J = work[link]
         if joint.type == "revolute":

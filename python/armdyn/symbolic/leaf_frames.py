@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..codegen.program import is_value
+from ..codegen.program import is_value, names
 from ..model import Robot
 from .customized_ne import _safe
 from .vectors import UPPER
@@ -60,8 +60,8 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
     symbols too (``XX5L = XX5R + YY6'``).
     """
     robot = robot.canonical()
-    used = {str(s) for s in robot.free_symbols()} | {str(s) for s in (*robot.q, *robot.qd, *robot.qdd)}
-    used |= {str(s) for s, _ in definitions} | {str(s) for s in taken}
+    used = names(robot.free_symbols()) | names((*robot.q, *robot.qd, *robot.qdd))
+    used |= names(s for s, _ in definitions) | names(taken)
     parents = {j.parent for j in robot.joints}
     out, new, turns = dict(parameters), [], {}
 
