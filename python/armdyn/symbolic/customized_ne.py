@@ -52,8 +52,8 @@ import sympy as sp
 from ..codegen.program import Builder, Program, is_value, names
 from ..model import Robot
 from .parallel_joints import about_z, cheaper, parallel_runs, root_torque
-from .vectors import (UPPER, ZERO, cross, dot, expanded, minus, mtv, mv, plus, rows, times, turned_about_z, vadd,
-                      vscale)
+from .vectors import (UPPER, ZERO, cross, dot, expanded, expanded_times, minus, mtv, mv, plus, rows, times,
+                      turned_about_z, vadd, vscale)
 
 #: per link, in DESIGN.md's (Pinocchio's) order of the standard parameters
 STANDARD_NAMES = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")
@@ -100,7 +100,7 @@ def standard_parameters(robot: Robot):
         MS = [named(times(m, c[k]), "M" + "XYZ"[k], i) for k in range(3)]
         J = [[None] * 3 for _ in range(3)]
         for a, b in UPPER:
-            J_ab = plus(Ic[a][b], times(m, minus(cc if a == b else ZERO, times(c[a], c[b]))))
+            J_ab = plus(Ic[a][b], expanded_times(m, minus(cc if a == b else ZERO, times(c[a], c[b]))))
             J[a][b] = J[b][a] = named(J_ab, "XYZ"[a] + "XYZ"[b], i)
         out[link_name] = (M, sp.Matrix(MS), sp.Matrix(J))
     return out, definitions

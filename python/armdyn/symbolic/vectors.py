@@ -59,14 +59,25 @@ def expanded(e):
     return e if all(_is_monomial(t) for t in sp.Add.make_args(e)) else sp.expand(e)
 
 
-def _is_monomial(t) -> bool:
-    """t is a number, a symbol, a positive integer power of a symbol, or a product of
-    those."""
+def expanded_times(a, b):
+    """a b, expanded (``sp.expand(a*b)``) when a and b are sums of monomials with rational
+    coefficients: the sum of the products of their terms, the one expanded form of the
+    product, without expand's passes over the tree (with float coefficients, the order in
+    which expand adds up like terms could round differently: then ``a*b``)."""
+    A, B = sp.Add.make_args(a), sp.Add.make_args(b)
+    if len(A) * len(B) == 1 or not all(_is_monomial(t, rational=True) for t in (*A, *B)):
+        return times(a, b)
+    return plus(*[times(s, t) for s in A for t in B])
+
+
+def _is_monomial(t, rational: bool = False) -> bool:
+    """t is a number (a rational one if ``rational``), a symbol, a positive integer power
+    of a symbol, or a product of those."""
     if t.is_Mul:
-        return all(not f.is_Mul and _is_monomial(f) for f in t.args)
+        return all(not f.is_Mul and _is_monomial(f, rational) for f in t.args)
     if t.is_Pow:
         return t.base.is_Symbol and t.exp.is_Integer and t.exp > 0
-    return t.is_Number or t.is_Symbol
+    return t.is_Symbol or (t.is_Rational if rational else t.is_Number)
 
 
 def rows(A) -> list:
