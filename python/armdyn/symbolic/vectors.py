@@ -4,15 +4,15 @@ algorithms' straight-line programs.
 A vector is a sequence of three expressions, a 3x3 matrix a sequence of three rows
 (``A[i][k]``); every function returns lists. SymPy's Matrix goes through its
 DomainMatrix machinery, about ten times slower for these small products than the same
-sums written out, and even creating or indexing one costs more than the arithmetic.
+sums written out, and creating one costs tens of microseconds.
 
 Products and sums skip the integer zeros and ones before SymPy sees them
 (:func:`times`, :func:`plus`): SymPy would give the same result (``0*x = 0``,
 ``1*x = x``, ``x + 0 = x``) but only after building, hashing and caching the trivial
 expression, and the frames of DH arms are mostly zeros and ones (more than half of the
 products a customized program writes down are by one of them). The results are the
-same SymPy objects as SymPy's own arithmetic gives; so is :func:`expanded`'s, which
-skips SymPy's expand on what is already expanded.
+same SymPy objects as SymPy's own arithmetic gives; so are those of :func:`expanded`
+and :func:`expanded_times`, which skip SymPy's expand where its result is known.
 """
 
 from __future__ import annotations
