@@ -188,20 +188,20 @@ def test_child_angular_velocity_norm_is_read_off_the_parent(wrist_3r):
     robot = wrist_3r.canonical()
     b = Builder()
     frames = cne.joint_frames(robot, b)
-    U = {robot.base: sp.zeros(3, 3)}
+    U = {robot.base: sp.zeros(3, 3).tolist()}  # the program's 3x3 matrices are lists of rows
     w = {robot.base: sp.zeros(3, 1)}
     used = 0
     for joint in robot.joints:
         R, _ = frames[joint.child]
         k = robot.coordinate_index(joint)
         S = cne._parent_invariant(joint, R, U[joint.parent])
-        wj = R.T * w[joint.parent] + robot.qd[k] * joint.axis
+        wj = sp.Matrix(R).T * w[joint.parent] + robot.qd[k] * joint.axis
         if S is not None:
             used += 1
             values = dict(b.assignments)  # c2 = cos(q2), ... of the frames
             assert _is_zero((S + wj[0] ** 2 + wj[1] ** 2).xreplace(values), robot), joint.child
         sq = {"U11": -wj[1] ** 2 - wj[2] ** 2, "U22": -wj[0] ** 2 - wj[2] ** 2, "U33": -wj[0] ** 2 - wj[1] ** 2}
-        U[joint.child] = sp.diag(sq["U11"], sq["U22"], sq["U33"])
+        U[joint.child] = sp.diag(sq["U11"], sq["U22"], sq["U33"]).tolist()
         w[joint.child] = wj
     assert used == robot.dof
 

@@ -71,6 +71,7 @@ from .model import Robot
 from .symbolic import dag
 from .symbolic.grouping import moved_to_parent
 from .symbolic.joint_terms import _value
+from .symbolic.vectors import rows
 
 #: standard inertial parameter names per link, DESIGN.md's (Pinocchio's) order
 INERTIAL = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")
@@ -474,8 +475,8 @@ def _grouped(robot: Robot, reg: Regressor):
         vec[joint.child] = left
         dropped |= {10 * i + g for g in gone}
         if joint.parent != robot.base:
-            mp, hp, Ip = moved_to_parent(m, h, I, R, p)
-            add = _vector(mp, hp, Ip)
+            mp, hp, Ip = moved_to_parent(m, list(h), rows(I), rows(R), list(p))
+            add = _vector(mp, hp, sp.Matrix(Ip))
             vec[joint.parent] = [sp.expand(a + b) for a, b in zip(vec[joint.parent], add)]
     keep, exprs = [], []
     for i, joint in enumerate(robot.joints):

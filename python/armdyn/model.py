@@ -454,7 +454,9 @@ class Joint:
         """The child frame in the placement frame at coordinate ``q``: ``(R, p)``, the
         joint's motion followed by the fixed ``frame`` offset."""
         if self.type == "revolute":
-            Rm, pm = axis_angle_matrix(self.axis, q), sp.zeros(3, 1)
+            # at exactly 0 (the grouping's placements), Rodrigues' rotation is the identity
+            at_zero = q is sp.S.Zero or (type(q) is int and q == 0)
+            Rm, pm = sp.eye(3) if at_zero else axis_angle_matrix(self.axis, q), sp.zeros(3, 1)
         elif self.type == "prismatic":
             Rm, pm = sp.eye(3), self.axis * q
         else:
@@ -824,6 +826,8 @@ class Robot(metaclass=_FreezeAfterInit):
         if f is None:
             return sp.Integer(0)
         k, m, o = f
+        if m is sp.S.One and o is sp.S.Zero:  # a joint's own coordinate: no SymPy arithmetic
+            return self.q[k]
         return m * self.q[k] + o
 
     def follows(self, joint: str | Joint) -> tuple[int, sp.Expr, sp.Expr] | None:
@@ -844,8 +848,8 @@ class Robot(metaclass=_FreezeAfterInit):
     def free_symbols(self) -> set[sp.Symbol]:
         """Symbols the model's numbers depend on (the joint coordinates excluded)."""
         def free(obj, name):  # Numbers have none (and are not built into SymPy here)
-            raw = obj.__dict__[name]
-            return set() if raw is None or isinstance(raw, Numbers) else sp.sympify(raw).free_symbols
+            raw = obj.__dict__[name]  # None, Numbers or SymPy (sympify would copy a Matrix to ask it)
+            return set() if raw is None or isinstance(raw, Numbers) else raw.free_symbols
 
         out: set = set(self.gravity.free_symbols)
         for link in self.links.values():

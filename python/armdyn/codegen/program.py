@@ -136,13 +136,20 @@ def _number(expr, env):
     return float(value)
 
 
-def _key(expr, negated: bool = False):
+def names(symbols) -> set:
+    """The names of ``symbols`` as printed (``str(s)``; a plain Symbol's read off
+    directly: SymPy's printer costs microseconds a call, and the builders ask for
+    hundreds)."""
+    return {s.name if type(s) is sp.Symbol else str(s) for s in symbols}
+
+
+def _key(expr, terms, negated: bool = False):
     """A dictionary key for ``expr`` (or ``-expr``): a sum by its terms and their
-    coefficients, so that the key of ``-expr`` costs no new SymPy sum (negating a sum
+    coefficients (``terms``: ``expr.as_coefficients_dict().items()``, None when ``expr``
+    is not a sum), so that the key of ``-expr`` costs no new SymPy sum (negating a sum
     rebuilds it: the most expensive step of building a program)."""
-    if expr.is_Add:
-        sign = -1 if negated else 1
-        return ("+", frozenset((t, sign * c) for t, c in expr.as_coefficients_dict().items()))
+    if terms is not None:
+        return ("+", frozenset(((t, -c) for t, c in terms) if negated else terms))
     return -expr if negated else expr
 
 
@@ -153,7 +160,7 @@ class Builder:
 
     def __init__(self, reserved=()):
         self.assignments: list = []
-        self._used = {str(s) for s in reserved}
+        self._used = names(reserved)
         self._memo: dict = {}
 
     def name(self, hint: str) -> sp.Symbol:
@@ -171,11 +178,12 @@ class Builder:
             return expr
         # the same expression computed twice is one temporary (e.g. a product of two
         # velocity components met in two cross products)
-        key = _key(expr)
+        terms = expr.as_coefficients_dict().items() if expr.is_Add else None
+        key = _key(expr, terms)
         known = self._memo.get(key)
         if known is not None:
             return known
-        neg = self._memo.get(_key(expr, negated=True))
+        neg = self._memo.get(_key(expr, terms, negated=True))
         if neg is not None:
             return -neg
         s = self.name(hint)
@@ -183,8 +191,9 @@ class Builder:
         self._memo[key] = s
         return s
 
-    def vector(self, v, hint: str) -> sp.Matrix:
-        return sp.Matrix([self.let(v[k], f"{hint}{'xyz'[k]}") for k in range(3)])
+    def vector(self, v, hint: str) -> list:
+        """The 3-vector ``v`` with each component named (``{hint}x``, ``{hint}y``, ``{hint}z``)."""
+        return [self.let(v[k], f"{hint}{'xyz'[k]}") for k in range(3)]
 
     def program(self, outputs, shape) -> Program:
         return Program(list(self.assignments), list(outputs), tuple(shape)).pruned()
@@ -193,7 +202,7 @@ class Builder:
 def from_expressions(exprs, shape, hint: str = "x", reserved=()) -> Program:
     """A program for arbitrary SymPy expressions by SymPy's common subexpression
     elimination (temporaries ``x0, x1, ...``)."""
-    used = {str(s) for s in reserved}
+    used = names(reserved)
     symbols = (sp.Symbol(f"{hint}{k}") for k in range(10**9) if f"{hint}{k}" not in used)
     replacements, reduced = sp.cse(list(exprs), symbols=symbols, order="none")
     return Program(list(replacements), list(reduced), tuple(shape)).pruned()

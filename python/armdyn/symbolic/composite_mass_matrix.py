@@ -32,16 +32,16 @@ import sympy as sp
 from ..codegen.program import Builder, Program
 from ..model import Robot
 from .customized_ne import _safe, joint_frames, standard_parameters
+from .vectors import UPPER, ZERO, cross, dot, minus, mv, plus, rows, times, vadd, vscale
 
-_UPPER = ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2))
 
-
-def _rotate_symmetric(b: Builder, R, J, hint) -> sp.Matrix:
-    """R J R^T for a symmetric J, computing the upper triangle only."""
-    A = sp.Matrix(3, 3, lambda r, s: b.let((R[r, :] * J[:, s])[0], f"{hint}A{r + 1}{s + 1}"))
-    out = sp.zeros(3, 3)
-    for r, s in _UPPER:
-        out[r, s] = out[s, r] = (A[r, :] * R[s, :].T)[0]
+def _rotate_symmetric(b: Builder, R, J, hint) -> list:
+    """R J R^T (3x3 rows) for a symmetric J (rows), computing the upper triangle only."""
+    A = [[b.let(plus(*[times(R[r][k], J[k][s]) for k in range(3)]), f"{hint}A{r + 1}{s + 1}") for s in range(3)]
+         for r in range(3)]
+    out = [[None] * 3 for _ in range(3)]
+    for r, s in UPPER:
+        out[r][s] = out[s][r] = dot(A[r], R[s])
     return out
 
 
@@ -61,21 +61,29 @@ def composite_mass_matrix(robot: Robot, parameters=None, builder: Builder | None
         name = joint.child
         tag = _safe(str(robot.link_index(name)))
         m, ms, J = parameters[name]
+        ms, J = list(ms), rows(J)
         for child in robot.children(name):
             c = child.child
             R, p = frames[c]
-            MSr = b.vector(R * MSc[c], f"MSr{_safe(str(robot.link_index(c)))}")
-            pMS = (p.T * MSr)[0]
-            pp = (p.T * p)[0]
+            MSr = b.vector(mv(R, MSc[c]), f"MSr{_safe(str(robot.link_index(c)))}")
+            pMS, pp = dot(p, MSr), dot(p, p)
             Jr = _rotate_symmetric(b, R, Jc[c], f"Jr{_safe(str(robot.link_index(c)))}")
-            J = J + Jr + Mc[c] * (pp * sp.eye(3) - p * p.T) + 2 * pMS * sp.eye(3) - p * MSr.T - MSr * p.T
-            ms = ms + MSr + Mc[c] * p
-            m = m + Mc[c]
+            # J + Jr + Mc (pp 1 - p p^T) + 2 pMS 1 - p MSr^T - MSr p^T, summed in this order
+            # (floats may round differently in another)
+            Jnew = [[None] * 3 for _ in range(3)]
+            for r, s in UPPER:
+                diagonal = r == s
+                e = plus(plus(J[r][s], Jr[r][s]), times(Mc[c], minus(pp if diagonal else ZERO, times(p[r], p[s]))))
+                e = plus(e, times(2, pMS) if diagonal else ZERO)
+                Jnew[r][s] = Jnew[s][r] = minus(minus(e, times(p[r], MSr[s])), times(MSr[r], p[s]))
+            J = Jnew
+            ms = [plus(plus(ms[i], MSr[i]), times(Mc[c], p[i])) for i in range(3)]
+            m = plus(m, Mc[c])
         Mc[name] = b.let(m, f"Mc{tag}")
         MSc[name] = b.vector(ms, f"MSc{tag}")
-        Jn = sp.zeros(3, 3)
-        for r, s in _UPPER:
-            Jn[r, s] = Jn[s, r] = b.let(J[r, s], f"Jc{tag}_{'xyz'[r]}{'xyz'[s]}")
+        Jn = [[None] * 3 for _ in range(3)]
+        for r, s in UPPER:
+            Jn[r][s] = Jn[s][r] = b.let(J[r][s], f"Jc{tag}_{'xyz'[r]}{'xyz'[s]}")
         Jc[name] = Jn
 
     M = [[sp.Integer(0)] * n for _ in range(n)]
@@ -83,12 +91,12 @@ def composite_mass_matrix(robot: Robot, parameters=None, builder: Builder | None
         j = robot.coordinate_index(joint)
         if j is None:
             continue
-        name, z = joint.child, joint.axis
+        name, z = joint.child, list(joint.axis)
         if joint.type == "revolute":
-            nv, fv = Jc[name] * z, z.cross(MSc[name])
+            nv, fv = mv(Jc[name], z), cross(z, MSc[name])
         else:
-            nv, fv = MSc[name].cross(z), Mc[name] * z
-        M[j][j] = b.let((nv if joint.type == "revolute" else fv).dot(z), f"M{j + 1}{j + 1}")
+            nv, fv = cross(MSc[name], z), vscale(Mc[name], z)
+        M[j][j] = b.let(dot(nv if joint.type == "revolute" else fv, z), f"M{j + 1}{j + 1}")
         link = name
         while True:
             up = robot.parent_joint(link)
@@ -97,11 +105,11 @@ def composite_mass_matrix(robot: Robot, parameters=None, builder: Builder | None
                 break
             R, p = frames[link]
             hint = f"{j + 1}_{_safe(str(robot.link_index(parent)))}"
-            fv = b.vector(R * fv, f"f{hint}")
-            nv = b.vector(R * nv + p.cross(fv), f"n{hint}")
+            fv = b.vector(mv(R, fv), f"f{hint}")
+            nv = b.vector(vadd(mv(R, nv), cross(p, fv)), f"n{hint}")
             pj = robot.parent_joint(parent)
             i = robot.coordinate_index(pj)
             if i is not None:
-                M[i][j] = M[j][i] = b.let((nv if pj.type == "revolute" else fv).dot(pj.axis), f"M{i + 1}{j + 1}")
+                M[i][j] = M[j][i] = b.let(dot(nv if pj.type == "revolute" else fv, list(pj.axis)), f"M{i + 1}{j + 1}")
             link = parent
     return b.program([M[r][c] for r in range(n) for c in range(n)], (n, n)), definitions

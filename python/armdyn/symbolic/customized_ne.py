@@ -49,10 +49,11 @@ import re
 
 import sympy as sp
 
-from ..codegen.program import Builder, Program, is_value
+from ..codegen.program import Builder, Program, is_value, names
 from ..model import Robot
 from .parallel_joints import about_z, cheaper, parallel_runs, root_torque
-from .vectors import cross, mtv, mv, turned_about_z, vadd, vscale
+from .vectors import (UPPER, ZERO, cross, dot, expanded, expanded_times, minus, mtv, mv, plus, rows, times,
+                      turned_about_z, vadd, vscale)
 
 #: per link, in DESIGN.md's (Pinocchio's) order of the standard parameters
 STANDARD_NAMES = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")
@@ -73,12 +74,12 @@ def standard_parameters(robot: Robot):
     ``MX2, XX2, ...`` (Khalil's names, the number is the link's frame index).
     """
     robot = robot.canonical()  # link frames on their joints (frames off the axis: same dynamics)
-    taken = {str(s) for s in robot.free_symbols()} | {str(s) for s in (*robot.q, *robot.qd, *robot.qdd)}
+    taken = names(robot.free_symbols()) | names((*robot.q, *robot.qd, *robot.qdd))
     definitions = []
     out = {}
 
     def named(value, kind, index):
-        value = sp.expand(value) if value.free_symbols else value
+        value = expanded(value) if value.free_symbols else value
         if value.is_Atom:
             return value
         name = f"{kind}{index}"
@@ -93,14 +94,15 @@ def standard_parameters(robot: Robot):
         if link_name == robot.base:
             continue
         i = robot.link_index(link_name)
-        m, c, Ic = sp.sympify(link.mass), link.com, link.inertia
-        J = Ic + m * ((c.T * c)[0] * sp.eye(3) - c * c.T)
+        m, c, Ic = sp.sympify(link.mass), list(link.com), rows(link.inertia)
+        cc = dot(c, c)
         M = named(m, "M", i)
-        MS = sp.Matrix([named(m * c[k], "M" + "XYZ"[k], i) for k in range(3)])
-        Jn = sp.zeros(3, 3)
-        for a, b in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):
-            Jn[a, b] = Jn[b, a] = named(J[a, b], "XYZ"[a] + "XYZ"[b], i)
-        out[link_name] = (M, MS, Jn)
+        MS = [named(times(m, c[k]), "M" + "XYZ"[k], i) for k in range(3)]
+        J = [[None] * 3 for _ in range(3)]
+        for a, b in UPPER:
+            J_ab = plus(Ic[a][b], expanded_times(m, minus(cc if a == b else ZERO, times(c[a], c[b]))))
+            J[a][b] = J[b][a] = named(J_ab, "XYZ"[a] + "XYZ"[b], i)
+        out[link_name] = (M, sp.Matrix(MS), sp.Matrix(J))
     return out, definitions
 
 
@@ -111,7 +113,7 @@ def moment_differences(robot: Robot, parameters: dict, definitions: list, free=N
     they are computed once per parameter set, not per state (Khalil's grouped
     parameters have the same form, e.g. ``XXR = XX - YY``)."""
     free = robot.free_symbols() if free is None else free
-    taken = {str(s) for s in free} | {str(s) for s, _ in definitions} | {str(s) for s in robot.q}
+    taken = names(free) | names(s for s, _ in definitions) | names(robot.q)
     table = dict(definitions)
     out, new = {}, []
     for link, (_, _, J) in parameters.items():
@@ -128,15 +130,16 @@ def moment_differences(robot: Robot, parameters: dict, definitions: list, free=N
                 name += "_"
             taken.add(name)
             sym = sp.Symbol(name)
-            new.append((sym, sp.expand(value.xreplace(table))))
+            new.append((sym, expanded(value.xreplace(table))))
             diffs.append(sym)
         out[link] = tuple(diffs)
     return out, new
 
 
 def joint_frames(robot: Robot, b: Builder, turns: dict | None = None) -> dict:
-    """``{child link: (R, p)}`` of every joint, with ``cos q``, ``sin q`` named once
-    (``c1, s1``; 1-based like the joints) and non-trivial entries of ``R`` named.
+    """``{child link: (R (3x3 rows), p (3,))}`` of every joint (the child frame in its
+    parent's), with ``cos q``, ``sin q`` named once (``c1, s1``; 1-based like the joints)
+    and non-trivial entries of ``R`` and ``p`` named.
 
     turns: ``{link: th}`` links whose frame is turned by the constant ``th`` about their
     (revolute, +z) joint axis (:mod:`armdyn.symbolic.leaf_frames`): their joint angle is
@@ -151,16 +154,17 @@ def joint_frames(robot: Robot, b: Builder, turns: dict | None = None) -> dict:
         if joint.type == "revolute" and about_z(joint) and not joint.has_frame_offset:
             # the placement rotation times Rz(q), entry by hand (SymPy's Matrix product is slow)
             c, s = b.let(sp.cos(coordinate), f"c{k + 1}"), b.let(sp.sin(coordinate), f"s{k + 1}")
-            R, p = turned_about_z(joint.rotation, c, s), joint.xyz
+            R, p = turned_about_z(rows(joint.rotation), c, s), joint.xyz
         else:
             R, p = joint.transform(coordinate)
             if joint.type == "revolute":
                 q = coordinate
                 trig = {sp.cos(q): b.let(sp.cos(q), f"c{k + 1}"), sp.sin(q): b.let(sp.sin(q), f"s{k + 1}")}
                 R = R.xreplace(trig)
+            R = R.tolist()
         tag = _safe(str(robot.link_index(joint.child)))
-        R = sp.Matrix(3, 3, lambda r, s: b.let(R[r, s], f"R{tag}_{r + 1}{s + 1}"))
-        p = sp.Matrix([b.let(p[r], f"p{tag}_{'xyz'[r]}") for r in range(3)])
+        R = [[b.let(R[r][s], f"R{tag}_{r + 1}{s + 1}") for s in range(3)] for r in range(3)]
+        p = [b.let(p[r], f"p{tag}_{'xyz'[r]}") for r in range(3)]
         frames[joint.child] = (R, p)
     return frames
 
@@ -204,7 +208,7 @@ def _axis_in_parent(joint, R):
     if joint.type not in ("revolute", "prismatic") or not (
             is_value(axis[0], 0) and is_value(axis[1], 0) and is_value(abs(axis[2]), 1)):
         return None
-    col = [R[i, 2] for i in range(3)]
+    col = [R[i][2] for i in range(3)]
     hits = [i for i, e in enumerate(col) if not is_value(e, 0)]
     if len(hits) != 1 or not is_value(abs(col[hits[0]]), 1):
         return None
@@ -219,21 +223,21 @@ def _parent_invariant(joint, R, U_parent):
     ``wx^2 + wy^2 = sum_{i != k} wp_i^2 = -U_parent[k, k]`` (the norm is unchanged by a
     rotation; the parent's U diagonal holds these sums)."""
     found = _axis_in_parent(joint, R)
-    return None if found is None else U_parent[found[0], found[0]]
+    return None if found is None else U_parent[found[0]][found[0]]
 
 
-def _skew2(b: Builder, w, wd, tag, sq: dict, column=None) -> sp.Matrix:
-    """U = skew(wd) + skew(w) skew(w) (3x3), Khalil eq. 9.79, from the named products
-    ``sq`` of :func:`_squares`; ``column``: ``(U13, U23)`` when already known
+def _skew2(b: Builder, w, wd, tag, sq: dict, column=None) -> list:
+    """U = skew(wd) + skew(w) skew(w) (3x3 rows), Khalil eq. 9.79, from the named
+    products ``sq`` of :func:`_squares`; ``column``: ``(U13, U23)`` when already known
     (:func:`_column_from_parent`)."""
     xy, xz, yz = sq["xy"], sq["xz"], sq["yz"]
-    U13, U23 = column if column is not None else (xz + wd[1], yz - wd[0])
-    U = sp.Matrix([
-        [sq["U11"], xy - wd[2], U13],
-        [xy + wd[2], sq["U22"], U23],
-        [xz - wd[1], yz + wd[0], sq["U33"]],
-    ])
-    return sp.Matrix(3, 3, lambda r, s: b.let(U[r, s], f"U{tag}_{r + 1}{s + 1}"))
+    U13, U23 = column if column is not None else (plus(xz, wd[1]), minus(yz, wd[0]))
+    U = [
+        [sq["U11"], minus(xy, wd[2]), U13],
+        [plus(xy, wd[2]), sq["U22"], U23],
+        [minus(xz, wd[1]), plus(yz, wd[0]), sq["U33"]],
+    ]
+    return [[b.let(U[r][s], f"U{tag}_{r + 1}{s + 1}") for s in range(3)] for r in range(3)]
 
 
 def _column_from_parent(joint, R, U_parent):
@@ -256,13 +260,14 @@ def _column_from_parent(joint, R, U_parent):
     if found is None or joint.type != "revolute" or not about_z(joint):
         return None
     k, sign = found
-    return tuple(sp.Add(*[R[m, i] * sign * U_parent[m, k] for m in range(3)]) for i in range(2))
+    return tuple(plus(*[times(R[m][i] if sign > 0 else -R[m][i], U_parent[m][k]) for m in range(3)])
+                 for i in range(2))
 
 
-def _euler_moment(b: Builder, J, differences, w, wd, U, sq) -> sp.Matrix:
-    """J wd + w x (J w) (3x1) for a symmetric J, as linear in J's six entries, with the
-    coefficients taken from U (whose off-diagonal entries are wd_k +- w_i w_j) and the
-    squares of w::
+def _euler_moment(J, differences, wd, U, sq) -> list:
+    """J wd + w x (J w) (3,) for a symmetric J (3x3 rows), as linear in J's six entries,
+    with the coefficients taken from U (whose off-diagonal entries are wd_k +- w_i w_j)
+    and the squares of w::
 
         x: XX wdx + XY (wdy - wx wz) + XZ (wdz + wx wy) + YZ (wy^2 - wz^2) + (ZZ - YY) wy wz
         y: XY (wdx + wy wz) + YY wdy + YZ (wdz - wx wy) + XZ (wz^2 - wx^2) + (XX - ZZ) wx wz
@@ -270,19 +275,15 @@ def _euler_moment(b: Builder, J, differences, w, wd, U, sq) -> sp.Matrix:
 
     (15 products instead of the 24 of J wd, J w and the cross product). ``differences``
     are (ZZ - YY, XX - ZZ, YY - XX), parameters of their own (:func:`moment_differences`)."""
-    XX, XY, XZ, YY, YZ, ZZ = J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2]
+    (XX, XY, XZ), (_, YY, YZ), (_, _, ZZ) = J
     ZZ_YY, XX_ZZ, YY_XX = differences
     wxy, wxz, wyz = sq["xy"], sq["xz"], sq["yz"]
     d = [sq["d0"], sq["d1"], sq["d2"]]
-    return sp.Matrix([
-        XX * wd[0] - XY * U[2, 0] + XZ * U[1, 0] + YZ * d[0] + ZZ_YY * wyz,
-        XY * U[2, 1] + YY * wd[1] - YZ * U[0, 1] + XZ * d[1] + XX_ZZ * wxz,
-        -XZ * U[1, 2] + YZ * U[0, 2] + ZZ * wd[2] + XY * d[2] + YY_XX * wxy,
-    ])
-
-
-def _matvec(b: Builder, A, v, hint) -> sp.Matrix:
-    return b.vector(mv(A, v), hint)
+    return [
+        plus(times(XX, wd[0]), -times(XY, U[2][0]), times(XZ, U[1][0]), times(YZ, d[0]), times(ZZ_YY, wyz)),
+        plus(times(XY, U[2][1]), times(YY, wd[1]), -times(YZ, U[0][1]), times(XZ, d[1]), times(XX_ZZ, wxz)),
+        plus(-times(XZ, U[1][2]), times(YZ, U[0][2]), times(ZZ, wd[2]), times(XY, d[2]), times(YY_XX, wxy)),
+    ]
 
 
 def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, parameters=None,
@@ -313,18 +314,18 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     # each joint's angle as joint_frames named it (a turned leaf's q + th is one temporary)
     angles = {j.child: b.let(robot.joint_coordinate(j) + (turns or {}).get(j.child, 0)) for j in robot.joints}
     runs, rotations = parallel_runs(robot, angles), {}
-    zero = sp.zeros(3, 1)
-    base_acc = -robot.gravity if gravity else zero
+    zero = [ZERO] * 3
+    base_acc = list(-robot.gravity) if gravity else zero
     w, wd = {robot.base: zero}, {robot.base: zero}
     vd = {robot.base: b.vector(base_acc, "g")}
-    U = {robot.base: sp.zeros(3, 3)}
+    U = {robot.base: [zero] * 3}
     F, N = {}, {}
     for joint in robot.joints:
         name, parent = joint.child, joint.parent
         tag = _safe(str(robot.link_index(name)))
         k = robot.coordinate_index(joint)
         R, p = frames[name]
-        z = joint.axis
+        z = list(joint.axis)
         w_in = mtv(R, w[parent])
         column = _column_from_parent(joint, R, U[parent])
         run = runs.get(name)
@@ -341,23 +342,23 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
             sq = _squares(b, w_j, tag, _parent_invariant(joint, R, U[parent]))
             if column is not None:
                 column = b.let(column[0], f"U{tag}_13"), b.let(column[1], f"U{tag}_23")
-                wd_j = [sq["yz"] - column[1], column[0] - sq["xz"], wd_j[2] + qdd[k]]
+                wd_j = [minus(sq["yz"], column[1]), minus(column[0], sq["xz"]), plus(wd_j[2], qdd[k])]
             else:
                 wd_j = vadd(wd_j, vscale(qdd[k], z), cross(w_in, vscale(qd[k], z)))
         else:
             w_j = b.vector(w_in, f"w{tag}")
             sq = _squares(b, w_j, tag, _parent_invariant(joint, R, U[parent]))
         wd_j = b.vector(wd_j, f"wd{tag}")
-        Up_p = _matvec(b, U[parent], p, f"Up{tag}")
+        Up_p = b.vector(mv(U[parent], p), f"Up{tag}")
         vd_j = mtv(R, b.vector(vadd(Up_p, vd[parent]), f"a{tag}"))  # named: both rows of R^T use it
         if joint.type == "prismatic":
             vd_j = vadd(vd_j, vscale(2, cross(w_j, vscale(qd[k], z))), vscale(qdd[k], z))
         vd_j = b.vector(vd_j, f"vd{tag}")
         U_j = _skew2(b, w_j, wd_j, tag, sq, column)
         M, MS, J = parameters[name]
+        MS, J = list(MS), rows(J)
         F[name] = b.vector(vadd(vscale(M, vd_j), mv(U_j, MS)), f"F{tag}")
-        N[name] = b.vector(vadd(_euler_moment(b, J, differences[name], w_j, wd_j, U_j, sq), cross(MS, vd_j)),
-                           f"N{tag}")
+        N[name] = b.vector(vadd(_euler_moment(J, differences[name], wd_j, U_j, sq), cross(MS, vd_j)), f"N{tag}")
         w[name], wd[name], vd[name], U[name] = w_j, wd_j, vd_j, U_j
 
     f, nm, Rf = {}, {}, {}
@@ -368,13 +369,13 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         f_j, n_j = F[name], N[name]
         for child in robot.children(name):
             Rc, pc = frames[child.child]
-            f_c = Rf[child.child] = _matvec(b, Rc, f[child.child], f"Rf{_safe(str(robot.link_index(child.child)))}")
+            f_c = Rf[child.child] = b.vector(mv(Rc, f[child.child]), f"Rf{_safe(str(robot.link_index(child.child)))}")
             f_j = vadd(f_j, f_c)
             n_j = vadd(n_j, mv(Rc, nm[child.child]), cross(pc, f_c))
         f[name], nm[name] = b.vector(f_j, f"f{tag}"), b.vector(n_j, f"n{tag}")
         k = robot.coordinate_index(joint)
         if k is not None:
-            tau[k] = (nm[name] if joint.type == "revolute" else f[name]).dot(joint.axis)
+            tau[k] = dot(nm[name] if joint.type == "revolute" else f[name], list(joint.axis))
     for joint in robot.joints:  # base-fixed links behind runs: their torque only
         k = robot.coordinate_index(joint)
         if (joint.parent == robot.base and joint.type == "revolute" and k is not None

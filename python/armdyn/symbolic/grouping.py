@@ -37,27 +37,31 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ..codegen.program import names
 from ..model import Robot
 from .customized_ne import _safe
+from .vectors import UPPER, ZERO, dot, expanded, minus, mv, plus, rows, times
 
 
 def moved_to_parent(m, h, J, R, p):
-    """(m, MS, J) of a body (mass m, first moment h (3,), inertia J (3, 3) about its
-    origin, in its own frame) given in a frame placed at (R, p) in its parent, expressed
-    about the parent's origin in the parent's axes (the module docstring's formula; entry
-    by entry: SymPy's Matrix products are slow for these small symbolic ones). Also
-    Khalil's general grouping in :mod:`armdyn.identification`."""
-    Rh = [sp.Add(*[R[i, k] * h[k] for k in range(3)]) for i in range(3)]
-    pRh = sp.Add(*[p[i] * Rh[i] for i in range(3)])
-    pp = sp.Add(*[p[i] * p[i] for i in range(3)])
-    RJ = [[sp.Add(*[R[i, k] * J[k, l] for k in range(3)]) for l in range(3)] for i in range(3)]
-    Jp = sp.zeros(3, 3)
-    for a, b in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):
-        e = sp.Add(*[RJ[a][l] * R[b, l] for l in range(3)]) - m * p[a] * p[b] - p[a] * Rh[b] - Rh[a] * p[b]
+    """(m, MS (3,), J (3x3 rows)) of a body (mass m, first moment h (3,), inertia J
+    (3x3 rows) about its origin, in its own frame) given in a frame placed at
+    (R (3x3 rows), p (3,)) in its parent, expressed about the parent's origin in the
+    parent's axes (the module docstring's formula, entry by entry). Also Khalil's general
+    grouping in :mod:`armdyn.identification`."""
+    Rh, pp = mv(R, h), dot(p, p)
+    pRh = dot(p, Rh)
+    RJ = [[plus(*[times(R[i][k], J[k][l]) for k in range(3)]) for l in range(3)] for i in range(3)]
+    Jp = [[None] * 3 for _ in range(3)]
+    for a, b in UPPER:
+        # the sums in the order of the formula: with float coefficients a different
+        # grouping of the same terms could round differently
+        e = plus(*[times(RJ[a][l], R[b][l]) for l in range(3)])
+        e = minus(minus(minus(e, times(times(m, p[a]), p[b])), times(p[a], Rh[b])), times(Rh[a], p[b]))
         if a == b:
-            e += m * pp + 2 * pRh
-        Jp[a, b] = Jp[b, a] = e
-    return m, sp.Matrix([Rh[i] + m * p[i] for i in range(3)]), Jp
+            e = plus(e, plus(times(m, pp), times(2, pRh)))
+        Jp[a][b] = Jp[b][a] = e
+    return m, [plus(Rh[i], times(m, p[i])) for i in range(3)], Jp
 
 
 def grouped_parameters(robot: Robot, parameters: dict, definitions: list):
@@ -71,35 +75,37 @@ def grouped_parameters(robot: Robot, parameters: dict, definitions: list):
     """
     robot = robot.canonical()
     table = dict(definitions)
-    taken = {str(s) for s in robot.free_symbols()} | {str(s) for s in (*robot.q, *robot.qd, *robot.qdd)}
-    taken |= {str(s) for s, _ in definitions}
-    work = {link: [sp.sympify(M), sp.Matrix(MS), sp.Matrix(J)] for link, (M, MS, J) in parameters.items()}
-    z = sp.Matrix([0, 0, 1])
+    taken = names(robot.free_symbols()) | names((*robot.q, *robot.qd, *robot.qdd)) | names(s for s, _ in definitions)
+    # (M, MS (3,), J (3x3 rows)) of each link, as lists: SymPy's Matrix arithmetic is slow
+    work = {link: [sp.sympify(M), list(MS), rows(J)] for link, (M, MS, J) in parameters.items()}
+    z_axes = (sp.Matrix([0, 0, 1]), sp.Matrix([0, 0, -1]))
     for joint in reversed(robot.joints):  # tip to base: a link has received its children's parts
         link = joint.child
         if joint.type not in ("revolute", "prismatic") or link not in work:
             continue
-        if not (joint.axis == z or joint.axis == -z):
+        if joint.axis not in z_axes:
             continue
         M, MS, J = work[link]
         if joint.type == "revolute":
-            moved = (M, sp.Matrix([0, 0, MS[2]]), sp.diag(J[1, 1], J[1, 1], 0))
-            work[link] = [sp.Integer(0), sp.Matrix([MS[0], MS[1], 0]), J - moved[2]]
+            D = [[J[1][1], ZERO, ZERO], [ZERO, J[1][1], ZERO], [ZERO, ZERO, ZERO]]  # diag(YY, YY, 0)
+            moved = (M, [ZERO, ZERO, MS[2]], D)
+            work[link] = [ZERO, [MS[0], MS[1], ZERO], [[minus(J[a][b], D[a][b]) for b in range(3)] for a in range(3)]]
             R, p = joint.transform(0)
         else:
-            moved = (sp.Integer(0), sp.zeros(3, 1), J)
-            work[link] = [M, MS, sp.zeros(3, 3)]
+            moved = (ZERO, [ZERO] * 3, J)
+            work[link] = [M, MS, [[ZERO] * 3 for _ in range(3)]]
             R, p = joint.rotation, joint.xyz  # J alone: where the frame sits does not matter
         if joint.parent == robot.base or joint.parent not in work:
             continue  # the fixed base never moves
-        m, h, Jp = moved_to_parent(*moved, R, p)
-        parent = work[joint.parent]
-        parent[0], parent[1], parent[2] = parent[0] + m, parent[1] + h, parent[2] + Jp
+        m, h, Jp = moved_to_parent(*moved, rows(R), list(p))
+        M_p, MS_p, J_p = work[joint.parent]
+        work[joint.parent] = [plus(M_p, m), [plus(MS_p[i], h[i]) for i in range(3)],
+                              [[plus(J_p[a][b], Jp[a][b]) for b in range(3)] for a in range(3)]]
 
     new_definitions = []
 
     def named(value, original, label):
-        value = sp.expand(value)
+        value = expanded(value)
         if value.is_Atom or value == original:
             return value
         name = label + "R"
@@ -107,7 +113,7 @@ def grouped_parameters(robot: Robot, parameters: dict, definitions: list):
             name += "_"
         taken.add(name)
         s = sp.Symbol(name)
-        new_definitions.append((s, sp.expand(value.xreplace(table))))
+        new_definitions.append((s, expanded(value.xreplace(table))))
         return s
 
     out = {}
@@ -115,9 +121,9 @@ def grouped_parameters(robot: Robot, parameters: dict, definitions: list):
         i = _safe(str(robot.link_index(link)))
         M0, MS0, J0 = parameters[link]
         Mn = named(M, M0, f"M{i}")
-        MSn = sp.Matrix([named(MS[k], MS0[k], f"M{'XYZ'[k]}{i}") for k in range(3)])
-        Jn = sp.zeros(3, 3)
-        for a, b in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):
-            Jn[a, b] = Jn[b, a] = named(J[a, b], J0[a, b], f"{'XYZ'[a]}{'XYZ'[b]}{i}")
-        out[link] = (Mn, MSn, Jn)
+        MSn = [named(MS[k], MS0[k], f"M{'XYZ'[k]}{i}") for k in range(3)]
+        Jn = [[None] * 3 for _ in range(3)]
+        for a, b in UPPER:
+            Jn[a][b] = Jn[b][a] = named(J[a][b], J0[a, b], f"{'XYZ'[a]}{'XYZ'[b]}{i}")
+        out[link] = (Mn, sp.Matrix(MSn), sp.Matrix(Jn))
     return out, new_definitions

@@ -24,9 +24,10 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..codegen.program import is_value
+from ..codegen.program import is_value, names
 from ..model import Robot
 from .customized_ne import _safe
+from .vectors import UPPER
 
 
 def _turned(M, MS, J, c, s):
@@ -59,8 +60,8 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
     symbols too (``XX5L = XX5R + YY6'``).
     """
     robot = robot.canonical()
-    used = {str(s) for s in robot.free_symbols()} | {str(s) for s in (*robot.q, *robot.qd, *robot.qdd)}
-    used |= {str(s) for s, _ in definitions} | {str(s) for s in taken}
+    used = names(robot.free_symbols()) | names((*robot.q, *robot.qd, *robot.qdd))
+    used |= names(s for s, _ in definitions) | names(taken)
     parents = {j.parent for j in robot.joints}
     out, new, turns = dict(parameters), [], {}
 
@@ -108,13 +109,13 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
                 Mp, MSp, Jp = out[joint.parent]
                 Jp = sp.Matrix(Jp)
                 ptag = _safe(str(robot.link_index(joint.parent)))
-                for a, b in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):
+                for a, b in UPPER:
                     if not is_value(moved[0][a, b], 0):
                         Jp[a, b] = Jp[b, a] = named(Jp[a, b] + moved[0][a, b], f"{'XYZ'[a]}{'XYZ'[b]}{ptag}L",
                                                     Jp[a, b] + moved[1][a, b])
                 out[joint.parent] = (Mp, MSp, Jp)
         Jn = sp.zeros(3, 3)
-        for a, b in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):
+        for a, b in UPPER:
             Jn[a, b] = Jn[b, a] = (named(Jt[a, b], f"{'XYZ'[a]}{'XYZ'[b]}{tag}L", J[a, b])
                                    if Jt[a, b] != J[a, b] else J[a, b])
         out[link] = (M, MSn, Jn)

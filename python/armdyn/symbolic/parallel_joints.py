@@ -30,7 +30,7 @@ import sympy as sp
 
 from ..codegen.program import Builder, is_value
 from ..model import Robot
-from .vectors import cross, mv, turned_about_z, vadd
+from .vectors import ZERO, cross, mtv, mv, rows, turned_about_z, vadd
 
 E3 = sp.Matrix([0, 0, 1])
 
@@ -39,17 +39,17 @@ E3 = sp.Matrix([0, 0, 1])
 class Run:
     """The rotation from a run's anchor link to one of its links: ``R0 Rz(angle)``.
 
-    anchor: the link before the run (its first joint's parent); R0 (3x3): the first
+    anchor: the link before the run (its first joint's parent); R0 (3x3 rows): the first
     joint's constant rotation (anchor axes); angle: the sum of the run's joint angles up
     to this link; tags: their joint numbers (``"23"``), for the temporaries' names."""
 
     anchor: str
-    R0: sp.Matrix
+    R0: list
     angle: sp.Expr
     tags: str
 
-    def rotation(self, b: Builder) -> sp.Matrix:
-        """(3x3) the link's frame in the anchor's, with the compound angle's cosine and
+    def rotation(self, b: Builder) -> list:
+        """(3x3 rows) the link's frame in the anchor's, with the compound angle's cosine and
         sine named once (``c23, s23``)."""
         angle = b.let(self.angle, f"q{self.tags}")
         return turned_about_z(self.R0, b.let(sp.cos(angle), f"c{self.tags}"), b.let(sp.sin(angle), f"s{self.tags}"))
@@ -85,7 +85,7 @@ def parallel_runs(robot: Robot, angles: dict) -> dict:
             first = start[joint.parent]
             runs[joint.child] = start[joint.child] = Run(first.anchor, first.R0, first.angle + angle, first.tags + tag)
         else:
-            start[joint.child] = Run(joint.parent, sp.Matrix(joint.rotation), angle, tag)
+            start[joint.child] = Run(joint.parent, rows(joint.rotation), angle, tag)
     return runs
 
 
@@ -111,17 +111,18 @@ def root_torque(robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: 
     rotation; the offset along the common axis turns with y (``p_z z x R_y f = R_y (p_z z
     x f)``). Each rotated vector is only ever dotted with the axis: ``z . R v = (R^T z) . v``.
 
-    frames: ``{link: (R, p)}`` of the joints; rotations: ``{link: R_anchor_link}`` of the
-    links whose outward quantities used the compound form; N, f, n: each link's Euler
-    moment, total force and total moment (its axes); Rf: ``{link: R f}``, its force in its
-    parent's axes, as the program named it."""
+    frames: ``{link: (R, p)}`` of the joints (3x3 rows, (3,));
+    rotations: ``{link: R_anchor_link}`` (3x3 rows) of the links whose outward quantities
+    used the compound form; N, f, n: each link's Euler moment, total force and total
+    moment (its axes); Rf: ``{link: R f}``, its force in its parent's axes, as the program
+    named it."""
 
     def dot(a, c):
         return sp.Add(*[a[i] * c[i] for i in range(3) if not is_value(a[i], 0)])
 
-    def brought(x, Rax, extra=(0, 0, 0)):
+    def brought(x, Rax, extra=(ZERO, ZERO, ZERO)):
         """z . R_ax (n_x + extra) with x's children in a run expanded."""
-        u = [sp.Add(*[Rax[k, i] * axis[k] for k in range(3)]) for i in range(3)]  # R_ax^T z
+        u = mtv(Rax, axis)  # R_ax^T z
         kids = [j.child for j in robot.children(x)]
         if not any(y in rotations for y in kids):
             return dot(u, vadd(n[x], extra))
@@ -129,8 +130,8 @@ def root_torque(robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: 
         for y in kids:
             R, p = frames[y]
             if y in rotations:
-                own = vadd(own, cross([p[0], p[1], 0], Rf[y]))
-                out.append(brought(y, rotations[y], [-p[2] * f[y][1], p[2] * f[y][0], 0]))
+                own = vadd(own, cross([p[0], p[1], ZERO], Rf[y]))
+                out.append(brought(y, rotations[y], [-p[2] * f[y][1], p[2] * f[y][0], ZERO]))
             else:
                 own = vadd(own, mv(R, n[y]), cross(p, Rf[y]))
         return sp.Add(dot(u, own), *out)
