@@ -122,12 +122,18 @@ def _header_lines(code, comment: str) -> list[str]:
     return [comment + (" " + ln if ln else "") for ln in lines]
 
 
+def _used_symbols(prog) -> set:
+    """The symbols the program's lines and outputs read (inputs, parameters, temporaries)."""
+    used = set()
+    for e in [e for _, e in prog.assignments] + list(prog.outputs):
+        used |= sp.sympify(e).free_symbols
+    return used
+
+
 def _unpack(code, what, names: Names, fmt) -> list[str]:
     out = []
     arrays = {"q": code.q, "qd": code.qd, "qdd": code.qdd}
-    used = set()
-    for e in [e for _, e in code.programs[what].assignments] + list(code.programs[what].outputs):
-        used |= sp.sympify(e).free_symbols
+    used = _used_symbols(code.programs[what])
     for arg in INPUTS[what]:
         for k, s in enumerate(arrays[arg]):
             if s in used:
@@ -315,9 +321,7 @@ def _c_batch(code, what, prog, fn, args, size) -> list[str]:
     out.append("    size_t k = 0;")
     out.append(f"    for (; k + {L} <= n; k += {L}) {{")
     out.append(f"        int wide = 0;  /* some angle beyond the kernel's range: libm, state by state */")
-    used = set()
-    for e in [e for _, e in prog.assignments] + list(prog.outputs):
-        used |= sp.sympify(e).free_symbols
+    used = _used_symbols(prog)
     for a in INPUTS[what]:
         for j, s in enumerate(arrays[a]):
             if s in used:

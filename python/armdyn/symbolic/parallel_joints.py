@@ -30,7 +30,7 @@ import sympy as sp
 
 from ..codegen.program import Builder, is_value
 from ..model import Robot
-from .vectors import ZERO, cross, mtv, mv, rows, turned_about_z, vadd
+from .vectors import ZERO, cross, dot, mtv, mv, rows, turned_about_z, vadd
 
 E3 = sp.Matrix([0, 0, 1])
 
@@ -116,9 +116,6 @@ def root_torque(robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: 
     used the compound form; N, f, n: each link's Euler moment, total force and total
     moment (its axes); Rf: ``{link: R f}``, its force in its parent's axes, as the program
     named it."""
-
-    def dot(a, c):
-        return sp.Add(*[a[i] * c[i] for i in range(3) if not is_value(a[i], 0)])
 
     def brought(x, Rax, extra=(ZERO, ZERO, ZERO)):
         """z . R_ax (n_x + extra) with x's children in a run expanded."""
