@@ -201,7 +201,9 @@ def breakdown() -> None:
             continue
         print(f"| {k} | " + " | ".join(f"{a}+{b}" for a, b in cells) + f" | {sum(a + b for a, b in cells)} |")
     print("\n(wi: R^T w of the parent; w: w, its products and differences; wd, vd: accelerations;"
-          " Up, a: U_parent p + vd_parent; U: skew(wd) + skew(w)^2; F, N: the link's force and moment;"
+          " Up, a: U_parent p + vd_parent (link 2: a point's acceleration in the basis (u, v, z));"
+          " A, B, C, D, J: link 2's inertia seen along joint 1's axis u (its Euler moment's two"
+          " projections); p: link 3's origin along u and v; U: skew(wd) + skew(w)^2; F, N: the link's force and moment;"
           " Rf: a child's force rotated; f, n: inward sums; q: q + th of a leaf link's turned frame, q2 + q3 of"
           " the parallel joints; tau: joint 1's torque, formed from the moments of links 1-3 directly)\n")
 

@@ -267,8 +267,10 @@ def _model_point(robot, rng, definitions=()):
 
 
 def test_U_column_read_off_the_parent_is_the_textbook_value():
-    """U13, U23 of every link of the PUMA 560 after the first are read off the parent's U
-    (no ``qd wi x z`` term is formed; links 3 by the compound angle q2 + q3 from link 1):
+    """U13, U23 of every link of the PUMA 560 after the second are read off the parent's U
+    (no ``qd wi x z`` term is formed; links 3 by the compound angle q2 + q3 from link 1;
+    link 2's U is not needed, its moment and link 3's acceleration go by the closed forms
+    of armdyn.symbolic.second_link):
     at random points they equal ``w_x w_z + wd_y`` and ``w_y w_z - wd_x`` of the
     textbook recursion ``w = R^T w_p + qd z``, ``wd = R^T wd_p + qdd z + R^T w_p x qd z``
     done here in NumPy from the joint frames."""
@@ -279,6 +281,7 @@ def test_U_column_read_off_the_parent_is_the_textbook_value():
     canon = robot.canonical()
     e3 = np.array([0.0, 0.0, 1.0])
     rng = np.random.default_rng(3)
+    checked = set()
     for _ in range(3):
         env = _evaluated(prog.assignments, _model_point(robot, rng, defs))
         w, wd = {canon.base: np.zeros(3)}, {canon.base: np.zeros(3)}
@@ -290,13 +293,15 @@ def test_U_column_read_off_the_parent_is_the_textbook_value():
             w[joint.child] = wi + env[canon.qd[k]] * e3
             wd[joint.child] = R.T @ wd[joint.parent] + env[canon.qdd[k]] * e3 + np.cross(wi, env[canon.qd[k]] * e3)
             i = canon.link_index(joint.child)
-            if i < 2:
+            if i < 3:
                 continue
+            checked.add(i)
             wx, wy, wz = w[joint.child]
             want = (wx * wz + wd[joint.child][1], wy * wz - wd[joint.child][0])
             got = (env[sp.Symbol(f"U{i}_13")], env[sp.Symbol(f"U{i}_23")])
             assert np.all(np.isfinite(got))
             np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+    assert checked == {3, 4, 5, 6}
 
 
 # a shoulder, then two parallel joints (alpha 0) with both offsets of the PUMA 560's

@@ -22,6 +22,9 @@ as :mod:`armdyn.symbolic.newton_euler`, but
 * runs of parallel joints (``q2 + q3``) take their angular quantities from the link before
   the run, and a base-fixed link's torque their moments, by the compound angle
   (:mod:`armdyn.symbolic.parallel_joints`);
+* the second link of an arm on a base-fixed first joint (perpendicular axes) gives only
+  two projections of its Euler moment, in closed form, and a child continuing a run its
+  acceleration without the link's U (:mod:`armdyn.symbolic.second_link`);
 * optionally (``turns``, :mod:`armdyn.symbolic.leaf_frames`) a leaf link's frame turned
   about its joint axis by a per-parameter-set angle.
 
@@ -51,7 +54,8 @@ import sympy as sp
 
 from ..codegen.program import Builder, Program, is_value, names
 from ..model import Robot
-from .parallel_joints import about_z, cheaper, parallel_runs, root_torque
+from .parallel_joints import about_z, cheaper, own_revolute_about_z, parallel_runs, root_torque
+from .second_link import euler_projections, gravity_moment, in_frame, point_acceleration, second_link
 from .vectors import (UPPER, ZERO, cross, dot, expanded, expanded_times, minus, mtv, mv, plus, rows, times,
                       turned_about_z, vadd, vscale)
 
@@ -320,6 +324,8 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     vd = {robot.base: b.vector(base_acc, "g")}
     U = {robot.base: [zero] * 3}
     F, N = {}, {}
+    joint_of = {j.child: j for j in robot.joints}
+    seconds, raw, along_root = {}, {}, {}  # second links; each link's (Euler, MS x vd); root torques' extra
     for joint in robot.joints:
         name, parent = joint.child, joint.parent
         tag = _safe(str(robot.link_index(name)))
@@ -349,8 +355,16 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
             w_j = b.vector(w_in, f"w{tag}")
             sq = _squares(b, w_j, tag, _parent_invariant(joint, R, U[parent]))
         wd_j = b.vector(wd_j, f"wd{tag}")
-        Up_p = b.vector(mv(U[parent], p), f"Up{tag}")
-        vd_j = mtv(R, b.vector(vadd(Up_p, vd[parent]), f"a{tag}"))  # named: both rows of R^T use it
+        through = seconds.get(parent)
+        if run is not None and through is not None and through.gz is not None and run.anchor == through.root:
+            # a run from the root through the second link: the origin's acceleration in the
+            # basis (u, v, e3) of the parent, turned here by the compound angle
+            u_run = mtv(Ra, [ZERO, ZERO, sp.S.One])
+            vd_j = in_frame(point_acceleration(b, through, p, _safe(str(robot.link_index(parent)))),
+                            u_run, [u_run[1], -u_run[0], ZERO])
+        else:
+            Up_p = b.vector(mv(U[parent], p), f"Up{tag}")
+            vd_j = mtv(R, b.vector(vadd(Up_p, vd[parent]), f"a{tag}"))  # named: both rows of R^T use it
         if joint.type == "prismatic":
             vd_j = vadd(vd_j, vscale(2, cross(w_j, vscale(qd[k], z))), vscale(qdd[k], z))
         vd_j = b.vector(vd_j, f"vd{tag}")
@@ -358,7 +372,24 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         M, MS, J = parameters[name]
         MS, J = list(MS), rows(J)
         F[name] = b.vector(vadd(vscale(M, vd_j), mv(U_j, MS)), f"F{tag}")
-        N[name] = b.vector(vadd(_euler_moment(J, differences[name], wd_j, U_j, sq), cross(MS, vd_j)), f"N{tag}")
+        root = joint_of.get(parent)
+        second = None
+        if (root is not None and root.parent == robot.base and own_revolute_about_z(robot, root)
+                and own_revolute_about_z(robot, joint)):
+            origin = vadd(mv(U[parent], p), vd[parent])  # L's origin's acceleration, root axes
+            second = second_link(b, joint, R, root, w[parent], wd[parent], origin, qd[k], qdd[k], tag)
+        if second is None:
+            raw[name] = (_euler_moment(J, differences[name], wd_j, U_j, sq), cross(MS, vd_j))
+            N[name] = b.vector(vadd(*raw[name]), f"N{tag}")
+        else:
+            seconds[name] = second
+            root_tag = _safe(str(robot.link_index(parent)))
+            N[name], root_J33 = _second_link_moment(b, second, J, MS, vd_j, tag, root_tag, raw, N, parameters,
+                                                    definitions)
+            along_u, along_z = euler_projections(b, J, second, tag, root_J33)
+            N[name] = b.vector(vadd(N[name], [ZERO, ZERO, along_z]), f"N{tag}")
+            kr = robot.coordinate_index(root)
+            along_root[kr] = plus(along_root.get(kr, ZERO), along_u)
         w[name], wd[name], vd[name], U[name] = w_j, wd_j, vd_j, U_j
 
     f, nm, Rf = {}, {}, {}
@@ -380,5 +411,31 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         k = robot.coordinate_index(joint)
         if (joint.parent == robot.base and joint.type == "revolute" and k is not None
                 and any(runs[link].anchor == joint.child for link in rotations)):
-            tau[k] = root_torque(robot, joint, frames, rotations, N, f, nm, Rf)
+            tau[k] = root_torque(robot, joint, frames, rotations, N, f, nm, Rf, b)
+    for k, extra_u in along_root.items():  # second links' Euler moments on the root axis
+        tau[k] = plus(tau[k], extra_u)
     return b.program(tau, (n,)), definitions
+
+
+def _second_link_moment(b: Builder, s, J, MS, vd_j, tag, root_tag, raw: dict, N: dict, parameters: dict,
+                        definitions: list):
+    """A second link's moment without its Euler part (only its projections are used,
+    :func:`armdyn.symbolic.second_link.euler_projections`): ``MS x vd`` (3,), as
+    ``(g MS) x u`` when gravity is all of the root's acceleration (new parameters appended
+    to ``definitions``); and the root's inertia about its axis, ``J33_R``, taken out of the
+    root's moment ``N`` (its Euler moment on its axis is ``J33_R a'``, added inside the
+    second link's ``A`` instead), or 0 when another second link took it already or the
+    root's moment is not that."""
+    if s.gz is not None:
+        ms, new = gravity_moment(b, MS, s, tag)
+        definitions += new
+    else:
+        ms = cross(MS, vd_j)
+    root_J33 = ZERO
+    if s.root in raw:
+        euler, root_ms = raw.pop(s.root)
+        J33 = rows(parameters[s.root][2])[2][2]
+        if euler[2] == times(J33, s.ad):
+            root_J33 = J33
+            N[s.root] = b.vector(vadd([euler[0], euler[1], ZERO], root_ms), f"N{root_tag}")
+    return ms, root_J33

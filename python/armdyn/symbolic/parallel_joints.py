@@ -60,7 +60,7 @@ def about_z(joint) -> bool:
     return all(is_value(joint.axis[i], E3[i]) for i in range(3))
 
 
-def _own_revolute_about_z(robot: Robot, joint) -> bool:
+def own_revolute_about_z(robot: Robot, joint) -> bool:
     """A revolute joint about +z with a coordinate of its own (not a mimic)."""
     k = robot.coordinate_index(joint)
     return (joint.type == "revolute" and about_z(joint) and k is not None
@@ -75,7 +75,7 @@ def parallel_runs(robot: Robot, angles: dict) -> dict:
     joint_of = {j.child: j for j in robot.joints}
     start, runs = {}, {}
     for joint in robot.joints:
-        if not _own_revolute_about_z(robot, joint):
+        if not own_revolute_about_z(robot, joint):
             continue
         angle = angles[joint.child]
         tag = str(robot.coordinate_index(joint) + 1)
@@ -97,7 +97,8 @@ def cheaper(compound: list, separate: list) -> bool:
     return cost(compound) + 1 < cost(separate)
 
 
-def root_torque(robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: dict, n: dict, Rf: dict):
+def root_torque(robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: dict, n: dict, Rf: dict,
+                b: Builder | None = None):
     """The torque ``z . n`` of a base-fixed link (its joint ``joint``), with the runs of
     parallel joints behind it brought over by their compound rotations: of the moment of
     a link the base carries, only its component on the joint axis is needed (the base does
@@ -115,7 +116,7 @@ def root_torque(robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: 
     rotations: ``{link: R_anchor_link}`` (3x3 rows) of the links whose outward quantities
     used the compound form; N, f, n: each link's Euler moment, total force and total
     moment (its axes); Rf: ``{link: R f}``, its force in its parent's axes, as the program
-    named it."""
+    named it; b: the program's builder (None: the offsets' lever arms are not named)."""
 
     def brought(x, Rax, extra=(ZERO, ZERO, ZERO)):
         """z . R_ax (n_x + extra) with x's children in a run expanded."""
@@ -127,7 +128,13 @@ def root_torque(robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: 
         for y in kids:
             R, p = frames[y]
             if y in rotations:
-                own = vadd(own, cross([p[0], p[1], ZERO], Rf[y]))
+                # z . R_ax (p' x R_y f_y) = (u x p') . R_y f_y, u x p' named: it is a
+                # multiple of a sine or cosine of x's angle that x's offsets may use too
+                arm = [b.let(e, f"p{y}_arm") for e in cross(u, [p[0], p[1], ZERO])] if b else None
+                if arm is None:
+                    own = vadd(own, cross([p[0], p[1], ZERO], Rf[y]))
+                else:
+                    out.append(dot(arm, Rf[y]))
                 out.append(brought(y, rotations[y], [-p[2] * f[y][1], p[2] * f[y][0], ZERO]))
             else:
                 own = vadd(own, mv(R, n[y]), cross(p, Rf[y]))

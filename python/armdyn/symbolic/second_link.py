@@ -1,0 +1,161 @@
+"""Closed forms for the second link of an arm whose first joint turns about the base's
+fixed axis (the PUMA 560's link 2, and most arms' shoulder link).
+
+The first joint ``R`` (base-fixed, revolute about its frame's z) gives its link
+``w_R = (0, 0, a)``, ``wd_R = (0, 0, a')``. The second link ``L`` turns about its own z,
+perpendicular to R's axis. With ``u = R_L^T z_R`` (R's axis in L's frame, a unit vector
+in L's xy plane that turns with ``q_L``; ``u = (-s2, -c2, 0)`` on the PUMA) and
+``v = u x e3``, L's angular velocity and acceleration are two joint rates on two axes::
+
+    w = a u + b e3,    wd = a' u + b' e3 + a b v                  (a = qd_R, b = qd_L)
+
+**Two projections of the moment.** Of L's moment only ``e3 . n_L`` (L's torque) and
+``u . n_L`` (R's torque: ``z_R . R_L n_L``; the base carries the rest) are ever used. For
+L's Euler moment ``E = J wd + w x (J w)`` (J about L's origin, L's axes), with
+``A = u^T J u``, ``B = u^T J e3``, ``C = u^T J v``, ``D = e3^T J v``::
+
+    u . E  = a' A + b' B + 2 a b C + b^2 D
+    e3 . E = a' B + b' J33 - a^2 C
+
+(``u . (w x J w) = J w . (u x w) = b J w . v`` and ``e3 x w = -a v``). ``A`` and ``C`` are
+J's xy block seen along u; with Khalil's grouping (``YY = 0``) they take 9 operations, B
+and D 6, where forming E's x and y components and the coefficients only they use takes
+about 25 (:func:`euler_projections`).
+
+**Gravity on the first moment.** When the root's acceleration is ``(0, 0, gz)`` in its
+frame (gravity along the base axis), L's origin accelerates by ``gz u``, and L's
+``MS x vd = (gz MS) x u``: ``gz MS`` is a parameter, computed once per parameter set
+(:func:`gravity_moment`).
+
+**A point of L.** A point ``p`` fixed in L (L's axes, from its origin) accelerates, in
+the basis ``(u, v, e3)``, by (``p_u = u . p``, ``p_v = v . p``)::
+
+    U_L p = (b' p_v - b^2 p_u) u + (a' p_z - b' p_u - (a^2 + b^2) p_v) v
+            + (2 a b p_u - a' p_v - a^2 p_z) e3
+
+(from ``U_L p = wd x p + w (w . p) - |w|^2 p`` and ``u x v = -e3``, ``e3 x u = -v``,
+``v x e3 = -u``). A child that continues a run of parallel joints from R sees u and v
+turned by the compound angle, so its acceleration needs neither L's U nor a rotation
+by ``q_L`` (:func:`point_acceleration`).
+
+All vectors are lists of 3 SymPy expressions; named temporaries go through the
+customized program's :class:`~armdyn.codegen.program.Builder`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..codegen.program import Builder, is_value
+from .vectors import ZERO, cross, dot, minus, mtv, plus, times
+
+
+@dataclass
+class SecondLink:
+    """L's motion as two rates on two axes (module docstring).
+
+    root: R's link; u, v (3,): R's axis and ``u x e3`` in L's frame (``u[2] = v[2] = 0``);
+    a, ad: R's joint rate and acceleration; b, bd: L's; aa, bb, ab2: ``a^2``, ``b^2``,
+    ``2 a b`` (named); gz: the root's acceleration along its axis (``g``) when that is
+    all of it, else None."""
+
+    root: str
+    u: list
+    v: list
+    a: sp.Expr
+    ad: sp.Expr
+    b: sp.Expr
+    bd: sp.Expr
+    aa: sp.Expr
+    bb: sp.Expr
+    ab2: sp.Expr
+    gz: sp.Expr | None
+
+
+def second_link(builder: Builder, joint, R, root_joint, w_root, wd_root, origin, qd, qdd, tag) -> SecondLink | None:
+    """The closed-form description of ``joint``'s child, or None when it is not a second
+    link: ``joint`` revolute about its frame's +z (frame ``R`` in the parent's, 3x3 rows),
+    its parent ``root_joint``'s child, fixed to the base by a revolute joint about +z
+    (``w_root = (0, 0, a)``, ``wd_root = (0, 0, a')``), the two axes perpendicular.
+    ``qd``, ``qdd``: L's joint rate and acceleration; ``origin``: the acceleration of L's
+    origin in the root's axes (3,), gravity included (``gz`` when it lies on the root's
+    axis: L's origin on that axis, gravity along it)."""
+    if root_joint is None or joint.type != "revolute" or root_joint.type != "revolute":
+        return None
+    if not all(is_value(x, 0) for x in (*w_root[:2], *wd_root[:2])):
+        return None
+    u = mtv(R, [ZERO, ZERO, sp.S.One])
+    if not is_value(u[2], 0):
+        return None
+    u = [u[0], u[1], ZERO]
+    a, ad = w_root[2], wd_root[2]
+    gz = origin[2] if is_value(origin[0], 0) and is_value(origin[1], 0) else None
+    return SecondLink(root_joint.child, u, [u[1], -u[0], ZERO], a, ad, qd, qdd,
+                      builder.let(times(a, a), f"w{tag}aa"), builder.let(times(qd, qd), f"w{tag}bb"),
+                      builder.let(times(2, times(a, qd)), f"w{tag}ab2"), gz)
+
+
+def euler_projections(b: Builder, J, s: SecondLink, tag: str, root_J33=ZERO) -> tuple:
+    """``(u . E, e3 . E)`` of L's Euler moment ``E = J wd + w x (J w)`` (module
+    docstring), J (3x3 rows) about L's origin in L's axes.
+
+    root_J33: the root link's inertia about its axis; its own Euler moment on that axis,
+    ``J33_R a'``, is added to the first projection inside ``A`` (one product less)."""
+    (J00, J01, J02), (_, J11, J12), (_, _, J22) = J
+    u1, u2 = s.u[0], s.u[1]
+    t = b.let(times(J01, u2), f"J{tag}_xy_u")
+    Ju1 = b.let(plus(times(J00, u1), t), f"J{tag}_u_x")  # (J u)_x
+    Ju2 = b.let(plus(times(J01, u1), times(J11, u2)), f"J{tag}_u_y")
+    # u^T J u = u1 (J u)_x + u2 (J u)_y; with YY = 0 (J11), u2 (J u)_y = u1 (J01 u2) = u1 t
+    if is_value(J11, 0):
+        A = plus(root_J33, times(u1, plus(Ju1, t)))
+    else:
+        A = plus(root_J33, times(u1, Ju1), times(u2, Ju2))
+    A = b.let(A, f"A{tag}")
+    C = b.let(minus(times(u2, Ju1), times(u1, Ju2)), f"C{tag}")  # v . J u, v = (u2, -u1, 0)
+    B = b.let(plus(times(J02, u1), times(J12, u2)), f"B{tag}")   # (J e3) . u
+    D = b.let(minus(times(J02, u2), times(J12, u1)), f"D{tag}")  # (J e3) . v
+    along_u = plus(times(s.ad, A), times(s.bd, B), times(s.ab2, C), times(s.bb, D))
+    along_z = plus(times(s.ad, B), times(s.bd, J22), -times(s.aa, C))
+    return along_u, along_z
+
+
+def gravity_moment(b: Builder, MS, s: SecondLink, tag: str) -> tuple[list, list]:
+    """L's ``MS x vd`` when its origin accelerates by ``gz u`` (``s.gz`` not None):
+    ``(gz MS) x u`` (3,), with ``gz MS`` new parameters where it is not a number (named
+    ``gMX2`` after the first moment's symbol; the builder keeps the names unique), and
+    their definitions ``[(Symbol, gz MS_k)]``."""
+    gMS, new = [], []
+    for k, m in enumerate(MS):
+        value = times(s.gz, m)
+        if value.is_Number:
+            gMS.append(value)
+            continue
+        sym = b.name(f"g{m}" if m.is_Symbol else f"gM{'XYZ'[k]}{tag}")
+        new.append((sym, value))
+        gMS.append(sym)
+    return cross(gMS, s.u), new
+
+
+def point_acceleration(b: Builder, s: SecondLink, p, tag: str) -> tuple:
+    """``(A_u, A_v, A_z)``: the acceleration of the point ``p`` (3,) of L (L's axes, from
+    its origin), gravity included, in the basis ``(u, v, e3)`` (module docstring); needs
+    ``s.gz`` (L's origin then accelerates by ``gz u``)."""
+    pu = b.let(dot(s.u, p), f"p{tag}_u")
+    pv = b.let(dot(s.v, p), f"p{tag}_v")
+    pz = p[2]
+    A_u = plus(times(s.bd, pv), -times(s.bb, pu), s.gz)
+    A_v = plus(times(s.ad, pz), -times(s.bd, pu), -times(b.let(plus(s.aa, s.bb), f"w{tag}_norm2"), pv))
+    A_z = plus(times(s.ab2, pu), -times(s.ad, pv), -times(s.aa, pz))
+    # named: each is used twice, turned into the child's x and y
+    return b.let(A_u, f"a{tag}_u"), b.let(A_v, f"a{tag}_v"), A_z
+
+
+def in_frame(A, u, v) -> list:
+    """``A_u u + A_v v + A_z e3`` (3,) for components ``A`` in the basis ``(u, v, e3)``
+    given in some frame (u, v with no z part)."""
+    return [plus(times(A[0], u[0]), times(A[1], v[0])), plus(times(A[0], u[1]), times(A[1], v[1])), A[2]]
+
+
