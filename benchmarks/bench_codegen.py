@@ -4,6 +4,7 @@
     PYTHONPATH=python python3 benchmarks/bench_codegen.py --skip-numeric
     PYTHONPATH=python python3 benchmarks/bench_codegen.py --processes 6   # tau alone, 6 fresh processes
     PYTHONPATH=python python3 benchmarks/bench_codegen.py --numeric-only --numeric-repeat 31
+    PYTHONPATH=python python3 benchmarks/bench_codegen.py --arms          # op counts, every bundled arm
 
 1. Operation counts on the PUMA 560 with every parameter symbolic (60 inertial ones,
    kinematics and g too), counted as ``sympy.count_ops(visual=True)`` counts them
@@ -202,8 +203,9 @@ def breakdown() -> None:
         print(f"| {k} | " + " | ".join(f"{a}+{b}" for a, b in cells) + f" | {sum(a + b for a, b in cells)} |")
     print("\n(wi: R^T w of the parent; w: w, its products and differences; wd, vd: accelerations;"
           " Up, a: U_parent p + vd_parent (link 2: a point's acceleration in the basis (u, v, z));"
-          " A, B, C, D, J: link 2's inertia seen along joint 1's axis u (its Euler moment's two"
-          " projections); p: link 3's origin along u and v; U: skew(wd) + skew(w)^2; F, N: the link's force and moment;"
+          " A, C, J: link 2's inertia seen along joint 1's axis u (its Euler moment's two"
+          " projections); W: link 2's own rates on u and v; p: link 3's origin along u and v;"
+          " U: skew(wd) + skew(w)^2; F, N: the link's force and moment;"
           " Rf: a child's force rotated; f, n: inward sums; q: q + th of a leaf link's turned frame, q2 + q3 of"
           " the parallel joints; tau: joint 1's torque, formed from the moments of links 1-3 directly)\n")
 
@@ -304,6 +306,24 @@ def numeric(n_states: int, repeat: int) -> None:
           f"median of the rounds' ratios {rounds:.2f}  (max rel. difference {err:.1e})")
 
 
+def every_arm() -> None:
+    """Operation counts of every bundled arm's generated tau and g (grouped parameters,
+    leaves turned) and of tau in the base parameters (up to 6 dof: the 7-dof arms' base
+    parameters take minutes)."""
+    from armdyn.io import bundled_robots
+
+    print("## Operation counts of every bundled arm (mul + add)\n")
+    print("| arm | dof | tau | g | tau, base parameters |")
+    print("|---|---|---|---|---|")
+    for entry in bundled_robots():
+        robot = load(entry["name"])
+        counts = codegen.codegen(robot, what="tau,g").op_counts
+        base = "-"
+        if robot.dof <= 6 and importlib.util.find_spec("armdyn.identification") is not None:
+            base = codegen.codegen(robot, what="tau", base=True).op_counts["tau"]["total"]
+        print(f"| {entry['name']} | {robot.dof} | {counts['tau']['total']} | {counts['g']['total']} | {base} |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=5)
@@ -313,7 +333,11 @@ def main() -> None:
     ap.add_argument("--numeric-repeat", type=int, default=15)
     ap.add_argument("--processes", type=int, default=0,
                     help="only time tau alone in this many fresh processes (PYTHONHASHSEED 0, 1, ...)")
+    ap.add_argument("--arms", action="store_true", help="only the operation counts of every bundled arm")
     args = ap.parse_args()
+    if args.arms:
+        every_arm()
+        return
     if args.processes:
         tau_in_processes(args.processes)
         return

@@ -38,8 +38,9 @@ def _textbook(rng, R0):
 def _second(u, rates, gz=None):
     a, ad, b, bd = (sp.Float(x) for x in rates)
     u = [sp.Float(u[0]), sp.Float(u[1]), sp.S.Zero]
-    return SecondLink("root", u, [u[1], -u[0], sp.S.Zero], a, ad, b, bd, a * a, b * b, 2 * a * b,
-                      None if gz is None else sp.Float(gz))
+    v = [u[1], -u[0], sp.S.Zero]
+    W = [bd * u[i] + b * b * v[i] for i in range(2)]
+    return SecondLink("root", u, v, a, ad, b, bd, a * a, b * b, 2 * a * b, W, None if gz is None else sp.Float(gz))
 
 
 @pytest.mark.parametrize("grouped", [False, True])
@@ -61,6 +62,10 @@ def test_euler_projections_equal_the_moment_projected(grouped):
         along_u, along_z = euler_projections(Builder(), Js, _second(u, rates), "2", sp.Float(J33_root))
         np.testing.assert_allclose(float(along_u), u @ E + J33_root * rates[1], rtol=1e-12, atol=1e-12)
         np.testing.assert_allclose(float(along_z), E[2], rtol=1e-12, atol=1e-12)
+        # with gravity gz along the root's axis folded in: + ((gz MS) x u)_z
+        gMS = rng.uniform(-1, 1, 3)
+        _, along_zg = euler_projections(Builder(), Js, _second(u, rates), "2", gravity=[sp.Float(x) for x in gMS[:2]])
+        np.testing.assert_allclose(float(along_zg), E[2] + np.cross(gMS, u)[2], rtol=1e-12, atol=1e-12)
 
 
 def test_point_acceleration_equals_the_textbook_one():

@@ -384,10 +384,14 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         else:
             seconds[name] = second
             root_tag = _safe(str(robot.link_index(parent)))
-            N[name], root_J33 = _second_link_moment(b, second, J, MS, vd_j, tag, root_tag, raw, N, parameters,
-                                                    definitions)
-            along_u, along_z = euler_projections(b, J, second, tag, root_J33)
-            N[name] = b.vector(vadd(N[name], [ZERO, ZERO, along_z]), f"N{tag}")
+            ms, gMS, root_J33 = _second_link_moment(b, second, MS, vd_j, tag, root_tag, raw, N, parameters,
+                                                   definitions)
+            # a child continuing a run from the root shares W (second_link.point_acceleration)
+            shared = gMS is not None and any(
+                runs.get(c.child) is not None and runs[c.child].anchor == root.child for c in robot.children(name))
+            along_u, along_z = euler_projections(b, J, second, tag, root_J33, gMS[:2] if shared else None)
+            # with gravity folded in, along_z holds the first moment's z part too
+            N[name] = b.vector([ms[0], ms[1], along_z if shared else plus(ms[2], along_z)], f"N{tag}")
             kr = robot.coordinate_index(root)
             along_root[kr] = plus(along_root.get(kr, ZERO), along_u)
         w[name], wd[name], vd[name], U[name] = w_j, wd_j, vd_j, U_j
@@ -417,18 +421,21 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     return b.program(tau, (n,)), definitions
 
 
-def _second_link_moment(b: Builder, s, J, MS, vd_j, tag, root_tag, raw: dict, N: dict, parameters: dict,
+def _second_link_moment(b: Builder, s, MS, vd_j, tag, root_tag, raw: dict, N: dict, parameters: dict,
                         definitions: list):
     """A second link's moment without its Euler part (only its projections are used,
-    :func:`armdyn.symbolic.second_link.euler_projections`): ``MS x vd`` (3,), as
-    ``(g MS) x u`` when gravity is all of the root's acceleration (new parameters appended
-    to ``definitions``); and the root's inertia about its axis, ``J33_R``, taken out of the
-    root's moment ``N`` (its Euler moment on its axis is ``J33_R a'``, added inside the
-    second link's ``A`` instead), or 0 when another second link took it already or the
-    root's moment is not that."""
+    :func:`armdyn.symbolic.second_link.euler_projections`): ``(MS x vd (3,), gMS, J33_R)``.
+
+    ``MS x vd`` is ``(g MS) x u`` when gravity is all of the root's acceleration; ``gMS``
+    (3,) is then ``g MS`` (new parameters appended to ``definitions``), else None. J33_R:
+    the root's inertia about its axis, taken out of the root's moment ``N`` (its Euler
+    moment on its axis is ``J33_R a'``, added inside the second link's ``A`` instead), or
+    0 when another second link took it already or the root's moment is not that."""
+    gMS = None
     if s.gz is not None:
-        ms, new = gravity_moment(b, MS, s, tag)
+        gMS, new = gravity_moment(b, MS, s, tag)
         definitions += new
+        ms = cross(gMS, s.u)
     else:
         ms = cross(MS, vd_j)
     root_J33 = ZERO
@@ -438,4 +445,4 @@ def _second_link_moment(b: Builder, s, J, MS, vd_j, tag, root_tag, raw: dict, N:
         if euler[2] == times(J33, s.ad):
             root_J33 = J33
             N[s.root] = b.vector(vadd([euler[0], euler[1], ZERO], root_ms), f"N{root_tag}")
-    return ms, root_J33
+    return ms, gMS, root_J33

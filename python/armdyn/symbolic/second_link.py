@@ -20,7 +20,9 @@ L's Euler moment ``E = J wd + w x (J w)`` (J about L's origin, L's axes), with
 (``u . (w x J w) = J w . (u x w) = b J w . v`` and ``e3 x w = -a v``). ``A`` and ``C`` are
 J's xy block seen along u; with Khalil's grouping (``YY = 0``) they take 9 operations, B
 and D 6, where forming E's x and y components and the coefficients only they use takes
-about 25 (:func:`euler_projections`).
+about 25 (:func:`euler_projections`). L's own rates enter together as
+``W = b' u + b^2 v``: ``b' B + b^2 D = (J e3) . W``, and a point's acceleration below
+uses W too.
 
 **Gravity on the first moment.** When the root's acceleration is ``(0, 0, gz)`` in its
 frame (gravity along the base axis), L's origin accelerates by ``gz u``, and L's
@@ -32,6 +34,7 @@ the basis ``(u, v, e3)``, by (``p_u = u . p``, ``p_v = v . p``)::
 
     U_L p = (b' p_v - b^2 p_u) u + (a' p_z - b' p_u - (a^2 + b^2) p_v) v
             + (2 a b p_u - a' p_v - a^2 p_z) e3
+          = (p . (W_y, -W_x)) u + (a' p_z - p . W - a^2 p_v) v + (2 a b p_u - a' p_v - a^2 p_z) e3
 
 (from ``U_L p = wd x p + w (w . p) - |w|^2 p`` and ``u x v = -e3``, ``e3 x u = -v``,
 ``v x e3 = -u``). A child that continues a run of parallel joints from R sees u and v
@@ -49,7 +52,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..codegen.program import Builder, is_value
-from .vectors import ZERO, cross, dot, minus, mtv, plus, times
+from .vectors import ZERO, dot, minus, mtv, plus, times
 
 
 @dataclass
@@ -58,8 +61,10 @@ class SecondLink:
 
     root: R's link; u, v (3,): R's axis and ``u x e3`` in L's frame (``u[2] = v[2] = 0``);
     a, ad: R's joint rate and acceleration; b, bd: L's; aa, bb, ab2: ``a^2``, ``b^2``,
-    ``2 a b`` (named); gz: the root's acceleration along its axis (``g``) when that is
-    all of it, else None."""
+    ``2 a b`` (named); W (2,): ``b' u + b^2 v`` in L's xy plane (named; L's own rates on
+    the two in-plane axes, used by the moment's projection on u and by a point's
+    acceleration); gz: the root's acceleration along its axis (``g``) when that is all of
+    it, else None."""
 
     root: str
     u: list
@@ -71,6 +76,7 @@ class SecondLink:
     aa: sp.Expr
     bb: sp.Expr
     ab2: sp.Expr
+    W: list
     gz: sp.Expr | None
 
 
@@ -92,17 +98,25 @@ def second_link(builder: Builder, joint, R, root_joint, w_root, wd_root, origin,
     u = [u[0], u[1], ZERO]
     a, ad = w_root[2], wd_root[2]
     gz = origin[2] if is_value(origin[0], 0) and is_value(origin[1], 0) else None
-    return SecondLink(root_joint.child, u, [u[1], -u[0], ZERO], a, ad, qd, qdd,
-                      builder.let(times(a, a), f"w{tag}aa"), builder.let(times(qd, qd), f"w{tag}bb"),
-                      builder.let(times(2, times(a, qd)), f"w{tag}ab2"), gz)
+    v = [u[1], -u[0], ZERO]
+    bb = builder.let(times(qd, qd), f"w{tag}bb")
+    W = [builder.let(plus(times(qdd, u[i]), times(bb, v[i])), f"W{tag}{'xy'[i]}") for i in range(2)]
+    return SecondLink(root_joint.child, u, v, a, ad, qd, qdd, builder.let(times(a, a), f"w{tag}aa"), bb,
+                      builder.let(times(2, times(a, qd)), f"w{tag}ab2"), W, gz)
 
 
-def euler_projections(b: Builder, J, s: SecondLink, tag: str, root_J33=ZERO) -> tuple:
+def euler_projections(b: Builder, J, s: SecondLink, tag: str, root_J33=ZERO, gravity=None) -> tuple:
     """``(u . E, e3 . E)`` of L's Euler moment ``E = J wd + w x (J w)`` (module
     docstring), J (3x3 rows) about L's origin in L's axes.
 
     root_J33: the root link's inertia about its axis; its own Euler moment on that axis,
-    ``J33_R a'``, is added to the first projection inside ``A`` (one product less)."""
+    ``J33_R a'``, is added to the first projection inside ``A`` (one product less).
+    gravity: None, or ``(gz MX, gz MY)`` (:func:`gravity_moment`) when a child's
+    acceleration uses ``W`` too (:func:`point_acceleration`): then the terms of L's own
+    rates are taken together, ``b' B + b^2 D = (J e3) . W``, and L's ``((gz MS) x u)_z``
+    joins the second projection with ``a' B``, ``u1 (a' J13 - gz MY) + u2 (a' J23 + gz
+    MX)``, so that neither B nor D is formed (one operation less than with them; without
+    a child sharing W, three more)."""
     (J00, J01, J02), (_, J11, J12), (_, _, J22) = J
     u1, u2 = s.u[0], s.u[1]
     t = b.let(times(J01, u2), f"J{tag}_xy_u")
@@ -115,18 +129,23 @@ def euler_projections(b: Builder, J, s: SecondLink, tag: str, root_J33=ZERO) -> 
         A = plus(root_J33, times(u1, Ju1), times(u2, Ju2))
     A = b.let(A, f"A{tag}")
     C = b.let(minus(times(u2, Ju1), times(u1, Ju2)), f"C{tag}")  # v . J u, v = (u2, -u1, 0)
-    B = b.let(plus(times(J02, u1), times(J12, u2)), f"B{tag}")   # (J e3) . u
-    D = b.let(minus(times(J02, u2), times(J12, u1)), f"D{tag}")  # (J e3) . v
-    along_u = plus(times(s.ad, A), times(s.bd, B), times(s.ab2, C), times(s.bb, D))
-    along_z = plus(times(s.ad, B), times(s.bd, J22), -times(s.aa, C))
+    if gravity is None:
+        B = b.let(plus(times(J02, u1), times(J12, u2)), f"B{tag}")   # (J e3) . u
+        D = b.let(minus(times(J02, u2), times(J12, u1)), f"D{tag}")  # (J e3) . v
+        along_u = plus(times(s.ad, A), times(s.bd, B), times(s.ab2, C), times(s.bb, D))
+        along_z = plus(times(s.ad, B), times(s.bd, J22), -times(s.aa, C))
+    else:
+        along_u = plus(times(s.ad, A), times(s.ab2, C), times(J02, s.W[0]), times(J12, s.W[1]))
+        along_z = plus(times(u1, minus(times(s.ad, J02), gravity[1])), times(u2, plus(times(s.ad, J12), gravity[0])),
+                       times(s.bd, J22), -times(s.aa, C))
     return along_u, along_z
 
 
 def gravity_moment(b: Builder, MS, s: SecondLink, tag: str) -> tuple[list, list]:
-    """L's ``MS x vd`` when its origin accelerates by ``gz u`` (``s.gz`` not None):
-    ``(gz MS) x u`` (3,), with ``gz MS`` new parameters where it is not a number (named
-    ``gMX2`` after the first moment's symbol; the builder keeps the names unique), and
-    their definitions ``[(Symbol, gz MS_k)]``."""
+    """``gz MS`` (3,) for L's ``MS x vd = (gz MS) x u`` when its origin accelerates by
+    ``gz u`` (``s.gz`` not None): new parameters where it is not a number (named ``gMX2``
+    after the first moment's symbol; the builder keeps the names unique), and their
+    definitions ``[(Symbol, gz MS_k)]``."""
     gMS, new = [], []
     for k, m in enumerate(MS):
         value = times(s.gz, m)
@@ -136,7 +155,7 @@ def gravity_moment(b: Builder, MS, s: SecondLink, tag: str) -> tuple[list, list]
         sym = b.name(f"g{m}" if m.is_Symbol else f"gM{'XYZ'[k]}{tag}")
         new.append((sym, value))
         gMS.append(sym)
-    return cross(gMS, s.u), new
+    return gMS, new
 
 
 def point_acceleration(b: Builder, s: SecondLink, p, tag: str) -> tuple:
@@ -146,8 +165,9 @@ def point_acceleration(b: Builder, s: SecondLink, p, tag: str) -> tuple:
     pu = b.let(dot(s.u, p), f"p{tag}_u")
     pv = b.let(dot(s.v, p), f"p{tag}_v")
     pz = p[2]
-    A_u = plus(times(s.bd, pv), -times(s.bb, pu), s.gz)
-    A_v = plus(times(s.ad, pz), -times(s.bd, pu), -times(b.let(plus(s.aa, s.bb), f"w{tag}_norm2"), pv))
+    # L's own rates: b' p_v - b^2 p_u = p . (W_y, -W_x), b' p_u + b^2 p_v = p . W
+    A_u = plus(times(p[0], s.W[1]), -times(p[1], s.W[0]), s.gz)
+    A_v = plus(times(s.ad, pz), -times(p[0], s.W[0]), -times(p[1], s.W[1]), -times(s.aa, pv))
     A_z = plus(times(s.ab2, pu), -times(s.ad, pv), -times(s.aa, pz))
     # named: each is used twice, turned into the child's x and y
     return b.let(A_u, f"a{tag}_u"), b.let(A_v, f"a{tag}_v"), A_z
