@@ -221,7 +221,7 @@ def test_turned_leaf_frame_gives_the_same_tau_exactly_for_any_angle(wrist_3r):
     """The leaf link's frame turned about its joint axis by a free angle th (joint angle
     q3 + th, first moment and inertia turned with it, grouped parameters): tau equals
     armdyn.derive's exactly, for every th. And the angle turn_leaf_frames picks puts the
-    first moment on x: its MY' is zero and its MX' is |(MX, MY)| (exact)."""
+    first moment on y: its MX' is zero and its MY' is |(MX, MY)| (exact)."""
     from armdyn.symbolic.grouping import grouped_parameters
     from armdyn.symbolic.leaf_frames import _turned, turn_leaf_frames
 
@@ -242,11 +242,12 @@ def test_turned_leaf_frame_gives_the_same_tau_exactly_for_any_angle(wrist_3r):
     chosen, new, turns = turn_leaf_frames(robot, params, defs)
     assert set(turns) == {"link3"}
     M, MS, J = params["link3"]
-    assert chosen["link3"][1][1] == 0
+    assert chosen["link3"][1][0] == 0
     r = sp.sqrt(MS[0] ** 2 + MS[1] ** 2)
-    _, MSt, _ = _turned(M, MS, J, MS[0] / r, MS[1] / r)
-    assert sp.simplify(MSt[1]) == 0 and sp.simplify(MSt[0] - r) == 0
-    assert sp.simplify(dict(new)[chosen["link3"][1][0]] - r) == 0
+    th = dict(new)[turns["link3"]].args[0][0]  # the angle where |(MX, MY)| != 0
+    _, MSt, _ = _turned(M, MS, J, sp.cos(th), sp.sin(th))
+    assert sp.simplify(MSt[0]) == 0 and sp.simplify(MSt[1] - r) == 0
+    assert sp.simplify(dict(new)[chosen["link3"][1][1]] - r) == 0
 
 
 def _evaluated(assignments, env):

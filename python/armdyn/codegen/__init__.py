@@ -22,7 +22,7 @@ tau, g, M and C are evaluated at Khalil's grouped parameters
 there, exactly), computed once per parameter set in the header; the zeros they leave
 (``M_j = MZ_j = YY_j = 0`` behind a revolute joint) propagate, so fewer operations run
 per state. For tau and g each leaf link's frame is also turned about its joint axis so
-that its first moment lies on x (:mod:`armdyn.symbolic.leaf_frames`; the angle ``th`` and
+that its first moment lies on y (:mod:`armdyn.symbolic.leaf_frames`; the angle ``th`` and
 the turned parameters are computed once per parameter set, the joint angle becomes
 ``q + th``). Joint friction, rotor inertia and torque offsets, where the model has them, are
 added as DESIGN.md writes them: all to tau, ``Ia`` to M's diagonal, the offset to g.
@@ -206,7 +206,7 @@ def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
     params, grouped = grouped_parameters(robot, params, definitions)
     definitions = definitions + grouped
     # tau and g: each leaf link's frame turned about its joint axis to put its first
-    # moment on x (exact; per parameter set); M and C keep the link frames
+    # moment on y (exact; per parameter set); M and C keep the link frames
     ne_params, turned, turns = _turned_leaves(robot, params, definitions)
     definitions = definitions + turned
     reserved = robot.free_symbols() | {s for s, _ in definitions}
@@ -331,7 +331,7 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
     programs, sources, defs = {}, {}, []
     M_prog = builder = None
     reserved = robot.free_symbols() | set(beta) | set(robot.q) | set(robot.qd) | set(robot.qdd)
-    # tau and g with the leaf links' frames turned (first moment on x), in the betas
+    # tau and g with the leaf links' frames turned (first moment on y), in the betas
     from ..symbolic.leaf_frames import turn_leaf_frames
 
     ne_params, leaf_defs, turns = turn_leaf_frames(robot, params, [], taken=beta)

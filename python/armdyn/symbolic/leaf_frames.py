@@ -1,4 +1,4 @@
-"""Turning a leaf link's frame about its joint axis so that its first moment lies on x.
+"""Turning a leaf link's frame about its joint axis so that its first moment lies on y.
 
 A link with no children (the last link of a chain, each tip of a tree) is free to have
 its frame turned about its joint axis by any constant angle ``th``: the joint axis, the
@@ -6,11 +6,14 @@ joint torque ``tau = z . n`` and every other link are unchanged, the joint coord
 enters as ``q + th`` (Khalil and Dombre, *Modeling, Identification and Control of
 Robots*, 2002, sec. 3.2: the x axis of the terminal frame is arbitrary). Choosing
 
-    th = atan2(MY, MX)      (0 when MX = MY = 0)
+    th = atan2(-MX, MY)     (0 when MX = MY = 0)
 
-puts the link's first moment on x: ``MS' = (sqrt(MX^2 + MY^2), 0, MZ)``, so every
-product with ``MY`` disappears from the link's force ``U MS`` and moment ``MS x vd``
-(and the ``x`` component of the acceleration with it). The inertia about the origin
+puts the link's first moment on y: ``MS' = (0, sqrt(MX^2 + MY^2), MZ)``, so every
+product with ``MX`` disappears from the link's force ``U MS`` and moment ``MS x vd``
+(and the ``y`` component of the acceleration with it). On y rather than x: the force
+then takes U's second column, whose diagonal entry ``U22`` the Euler moment's
+coefficients need anyway (:func:`armdyn.symbolic.customized_ne._squares`), where ``U11``
+would be formed for the force alone (one sum more). The inertia about the origin
 turns with the frame (``J' = Rz(th)^T J Rz(th)``); its ``YY'``, zero after Khalil's
 grouping before the turn, is not zero any more, so ``diag(YY', YY', 0)`` is grouped onto
 the parent again (:func:`_yy_moved`). The angle, the turned first moment and inertia are
@@ -46,14 +49,15 @@ def _turned(M, MS, J, c, s):
 
 def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()):
     """``(parameters, new_definitions, turns)``: ``parameters`` ``{link: (M, MS, J)}`` with
-    every leaf link's turned (first moment on x), the definitions
-    ``[(Symbol, expression)]`` of the new per-parameter-set symbols (``th6``, ``MX6L``,
+    every leaf link's turned (first moment on y), the definitions
+    ``[(Symbol, expression)]`` of the new per-parameter-set symbols (``th6``, ``MY6L``,
     ``XX6L``, ... ; in the symbols of ``parameters`` and ``definitions``' right-hand
     sides), and ``turns`` ``{link: th}`` for :func:`customized_newton_euler`.
 
     A leaf whose ``MX`` or ``MY`` is zero, or whose joint is not revolute about +z, is
-    left as it is. Otherwise the turn pays: it removes the 5 products of ``MY`` with their
-    5 sums (3 in ``U MS``, 2 in ``MS x vd``) and ``vd_x`` (2 products, 1 sum), and adds at
+    left as it is. Otherwise the turn pays: it removes the 5 products of ``MX`` with their
+    5 sums (3 in ``U MS``, 2 in ``MS x vd``), ``vd_y`` (2 products, 1 sum) and ``U11``
+    (1 sum), and adds at
     most ``q + th`` (1 addition), the ``YY'`` term (1 product, 1 sum) where it cannot be
     grouped onto the parent and, where ``XY`` was zero, the ``XY'`` terms (3 products,
     3 sums). The parent's inertia entries that take ``YY'`` become per-parameter-set
@@ -85,14 +89,14 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
         nonzero = sp.Ne(norm2, 0)
         r = sp.sqrt(norm2)
         # MX = MY = 0: nothing to turn (th = 0, J' = J)
-        th = sp.Piecewise((sp.atan2(MY, MX), nonzero), (0, True))
+        th = sp.Piecewise((sp.atan2(-MX, MY), nonzero), (0, True))
         if not th.free_symbols:  # a model bound to numbers: a number (atan2 may leave pi in it)
             th = sp.Float(sp.N(th, 20), 20)
         else:
             sym = symbol(f"th{tag}")
             new.append((sym, th))
             th = sym
-        _, MSt, Jt = _turned(M, MS, J, MX / r, MY / r)
+        _, MSt, Jt = _turned(M, MS, J, MY / r, -MX / r)
 
         def named(value, label, unturned=None):
             if value.is_Atom:
@@ -101,7 +105,7 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
             new.append((sym, value if unturned is None else sp.Piecewise((sp.factor(value), nonzero), (unturned, True))))
             return sym
 
-        MSn = sp.Matrix([named(r, f"MX{tag}L"), 0, MS[2]])  # c MX + s MY = |(MX, MY)|; -s MX + c MY = 0
+        MSn = sp.Matrix([0, named(r, f"MY{tag}L"), MS[2]])  # c MX + s MY = 0; -s MX + c MY = |(MX, MY)|
         moved = _yy_moved(robot, joint, out, Jt[1, 1], J[1, 1])
         if moved is not None:  # Khalil's grouping again: YY' rides on the parent
             Jt, J = Jt - Jt[1, 1] * sp.diag(1, 1, 0), J - J[1, 1] * sp.diag(1, 1, 0)
