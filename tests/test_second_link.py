@@ -11,8 +11,8 @@ import sympy as sp
 import armdyn
 from armdyn.codegen.program import Builder
 from armdyn.model import Joint, Robot
-from armdyn.symbolic.customized_ne import customized_newton_euler
-from armdyn.symbolic.second_link import SecondLink, euler_projections, in_frame, point_acceleration
+from armdyn.symbolic.customized_ne import _customized_newton_euler, customized_newton_euler
+from armdyn.symbolic.second_link import SecondLink, euler_projections, in_frame, lower_column, point_acceleration
 from random_models import random_link
 
 RX = [[1, 0, 0], [0, 0, 1], [0, -1, 0]]  # alpha = -90 deg: the next axis perpendicular
@@ -59,13 +59,28 @@ def test_euler_projections_equal_the_moment_projected(grouped):
         E = J @ wd + np.cross(w, J @ w)
         J33_root = rng.uniform(0.5, 1.5)
         Js = [[sp.S.Zero if x == 0 else sp.Float(x) for x in row] for row in J]
-        along_u, along_z = euler_projections(Builder(), Js, _second(u, rates), "2", sp.Float(J33_root))
-        np.testing.assert_allclose(float(along_u), u @ E + J33_root * rates[1], rtol=1e-12, atol=1e-12)
+        A, rest, along_z = euler_projections(Builder(), Js, _second(u, rates), "2", sp.Float(J33_root))
+        along_u = float(A) * rates[1] + float(rest)  # u . E = a' A + rest
+        np.testing.assert_allclose(along_u, u @ E + J33_root * rates[1], rtol=1e-12, atol=1e-12)
         np.testing.assert_allclose(float(along_z), E[2], rtol=1e-12, atol=1e-12)
-        # with gravity gz along the root's axis folded in: + ((gz MS) x u)_z
+        # with gravity gz along the root's axis folded in: + ((gz MS) x u)_z; the u part the same
         gMS = rng.uniform(-1, 1, 3)
-        _, along_zg = euler_projections(Builder(), Js, _second(u, rates), "2", gravity=[sp.Float(x) for x in gMS[:2]])
+        A, rest, along_zg = euler_projections(Builder(), Js, _second(u, rates), "2",
+                                              gravity=[sp.Float(x) for x in gMS[:2]])
+        np.testing.assert_allclose(float(A) * rates[1] + float(rest), u @ E, rtol=1e-12, atol=1e-12)
         np.testing.assert_allclose(float(along_zg), E[2] + np.cross(gMS, u)[2], rtol=1e-12, atol=1e-12)
+
+
+def test_lower_column_equals_the_textbook_U():
+    """U31 = w_x w_z - wd_y and U32 = w_y w_z + wd_x of the textbook recursion equal the
+    closed forms from the last column, -U13 + 2 a b u1 and -U23 + 2 a b u2."""
+    rng = np.random.default_rng(6)
+    for _ in range(20):
+        u, w, wd, rates = _textbook(rng, RX)
+        column = [sp.Float(w[0] * w[2] + wd[1]), sp.Float(w[1] * w[2] - wd[0])]  # U13, U23
+        got = [float(x) for x in lower_column(_second(u, rates), column)]
+        want = [w[0] * w[2] - wd[1], w[1] * w[2] + wd[0]]
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
 
 
 def test_point_acceleration_equals_the_textbook_one():
@@ -106,14 +121,22 @@ def _arm(origin, gravity, run: bool):
     ([0.1, 0.05, 0], (0, 0, -9.81), True),  # origin off the axis: L's origin accelerates otherwise
     ([0, 0, 0], (1.5, -3.0, -9.0), True),  # gravity off the root axis
 ])
-def test_customized_tau_with_a_second_link_equals_rust_rnea(origin, gravity, run):
+@pytest.mark.parametrize("close_runs", [False, True])
+def test_customized_tau_with_a_second_link_equals_rust_rnea(origin, gravity, run, close_runs):
     """tau of the customized Newton-Euler (standard parameters) == the Rust rnea at random
     states, on arms where the second link's closed forms apply in full, in part, or not
-    (its origin off the root's axis, gravity tilted)."""
+    (its origin off the root's axis, gravity tilted); with and without the closed forms
+    of the run's link 3 (customized_newton_euler keeps the shorter of the two programs,
+    so both are built here)."""
     robot = _arm(origin, gravity, run)
-    prog, defs = customized_newton_euler(robot)
+    prog, defs, closed = _customized_newton_euler(robot, None, None, True, None, None, None, close_runs)
     names = {str(s) for s, _ in prog.assignments}
     assert "A2" in names  # the closed form is on
+    assert closed == ("C3" in names) == (close_runs and run)  # and on link 3 where asked
+    if closed:  # the public function keeps the shorter program
+        generic, _, _ = _customized_newton_euler(robot, None, None, True, None, None, None, False)
+        kept, _ = customized_newton_euler(robot)
+        assert kept.operation_counts()["total"] == min(p.operation_counts()["total"] for p in (prog, generic))
     values = {s: float(e) for s, e in defs}
     rng = np.random.default_rng(5)
     for _ in range(5):

@@ -55,7 +55,8 @@ import sympy as sp
 from ..codegen.program import Builder, Program, is_value, names
 from ..model import Robot
 from .parallel_joints import about_z, cheaper, own_revolute_about_z, parallel_runs, root_torque
-from .second_link import euler_projections, gravity_moment, in_frame, point_acceleration, second_link
+from .second_link import (euler_projections, gravity_moment, in_frame, lower_column, point_acceleration, run_link,
+                          second_link)
 from .vectors import (UPPER, ZERO, cross, dot, expanded, expanded_times, minus, mtv, mv, plus, rows, times,
                       turned_about_z, vadd, vscale)
 
@@ -230,16 +231,18 @@ def _parent_invariant(joint, R, U_parent):
     return None if found is None else U_parent[found[0]][found[0]]
 
 
-def _skew2(b: Builder, w, wd, tag, sq: dict, column=None) -> list:
+def _skew2(b: Builder, w, wd, tag, sq: dict, column=None, lower=None) -> list:
     """U = skew(wd) + skew(w) skew(w) (3x3 rows), Khalil eq. 9.79, from the named
     products ``sq`` of :func:`_squares`; ``column``: ``(U13, U23)`` when already known
-    (:func:`_column_from_parent`)."""
+    (:func:`_column_from_parent`); ``lower``: ``(U31, U32)`` where known otherwise
+    (:func:`armdyn.symbolic.second_link.lower_column`; None entries: the generic ones)."""
     xy, xz, yz = sq["xy"], sq["xz"], sq["yz"]
     U13, U23 = column if column is not None else (plus(xz, wd[1]), minus(yz, wd[0]))
+    U31, U32 = lower if lower is not None else (None, None)
     U = [
         [sq["U11"], minus(xy, wd[2]), U13],
         [plus(xy, wd[2]), sq["U22"], U23],
-        [minus(xz, wd[1]), plus(yz, wd[0]), sq["U33"]],
+        [minus(xz, wd[1]) if U31 is None else U31, plus(yz, wd[0]) if U32 is None else U32, sq["U33"]],
     ]
     return [[b.let(U[r][s], f"U{tag}_{r + 1}{s + 1}") for s in range(3)] for r in range(3)]
 
@@ -302,7 +305,25 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     :func:`moment_differences` (always).
     turns: ``{link: th}`` leaf links whose frame (and ``parameters``) are turned about
     their joint axis (:func:`armdyn.symbolic.leaf_frames.turn_leaf_frames`).
+
+    The closed forms of the links further along a run from the second link
+    (:func:`armdyn.symbolic.second_link.run_link`) take one operation less on the PUMA 560
+    and two more on the bundled UR5 (its inertia tensors numeric and diagonal): with a
+    fresh builder the program is built with and without them and the shorter kept.
     """
+    args = (robot, qd, qdd, gravity, parameters, builder, turns)
+    program, definitions, closed = _customized_newton_euler(*args, close_runs=builder is None)
+    if closed:
+        generic, generic_definitions, _ = _customized_newton_euler(*args, close_runs=False)
+        if generic.operation_counts()["total"] <= program.operation_counts()["total"]:
+            return generic, generic_definitions
+    return program, definitions
+
+
+def _customized_newton_euler(robot: Robot, qd, qdd, gravity, parameters, builder: Builder | None, turns: dict | None,
+                             close_runs: bool) -> tuple[Program, list, bool]:
+    """:func:`customized_newton_euler`, with or without the closed forms of run links
+    (``close_runs``); also whether it used any."""
     robot = robot.canonical()  # link frames on their joints (frames off the axis: same dynamics)
     n = robot.dof
     qd = list(robot.qd) if qd is None else [sp.sympify(x) for x in qd]
@@ -325,7 +346,8 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     U = {robot.base: [zero] * 3}
     F, N = {}, {}
     joint_of = {j.child: j for j in robot.joints}
-    seconds, raw, along_root = {}, {}, {}  # second links; each link's (Euler, MS x vd); root torques' extra
+    # second links; each link's (Euler, MS x vd); per root: the A and the rest of its links' u . E
+    seconds, raw, along_root = {}, {}, {}
     for joint in robot.joints:
         name, parent = joint.child, joint.parent
         tag = _safe(str(robot.link_index(name)))
@@ -368,32 +390,46 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         if joint.type == "prismatic":
             vd_j = vadd(vd_j, vscale(2, cross(w_j, vscale(qd[k], z))), vscale(qdd[k], z))
         vd_j = b.vector(vd_j, f"vd{tag}")
-        U_j = _skew2(b, w_j, wd_j, tag, sq, column)
         M, MS, J = parameters[name]
         MS, J = list(MS), rows(J)
-        F[name] = b.vector(vadd(vscale(M, vd_j), mv(U_j, MS)), f"F{tag}")
         root = joint_of.get(parent)
-        second = None
+        second = closed = None
         if (root is not None and root.parent == robot.base and own_revolute_about_z(robot, root)
                 and own_revolute_about_z(robot, joint)):
             origin = vadd(mv(U[parent], p), vd[parent])  # L's origin's acceleration, root axes
             second = second_link(b, joint, R, root, w[parent], wd[parent], origin, qd[k], qdd[k], tag)
-        if second is None:
+        elif close_runs and name in rotations and column is not None and own_revolute_about_z(robot, joint):
+            # further along a run from a base-fixed root, by its compound rotation: its
+            # moment's x, y components only ever reach the root's torque (root_torque)
+            root = joint_of[run.anchor]
+            if root.parent == robot.base and own_revolute_about_z(robot, root):
+                closed = run_link(b, root, w[run.anchor], wd[run.anchor], Ra, w_j, wd_j, tag)
+        lower = None
+        if closed is not None:  # U31 without w_x w_z and wd_y, U32 without w_y w_z and wd_x
+            needed, closed_lower = _children_need_wd(robot, name, frames), lower_column(closed, column)
+            # U31 needs wd_y generically, U32 wd_x: the closed form where no child reads them
+            lower = (None if 1 in needed else closed_lower[0], None if 0 in needed else closed_lower[1])
+        U_j = _skew2(b, w_j, wd_j, tag, sq, column, lower)
+        F[name] = b.vector(vadd(vscale(M, vd_j), mv(U_j, MS)), f"F{tag}")
+        if second is None and closed is None:
             raw[name] = (_euler_moment(J, differences[name], wd_j, U_j, sq), cross(MS, vd_j))
             N[name] = b.vector(vadd(*raw[name]), f"N{tag}")
         else:
-            seconds[name] = second
-            root_tag = _safe(str(robot.link_index(parent)))
-            ms, gMS, root_J33 = _second_link_moment(b, second, MS, vd_j, tag, root_tag, raw, N, parameters,
-                                                   definitions)
-            # a child continuing a run from the root shares W (second_link.point_acceleration)
-            shared = gMS is not None and any(
-                runs.get(c.child) is not None and runs[c.child].anchor == root.child for c in robot.children(name))
-            along_u, along_z = euler_projections(b, J, second, tag, root_J33, gMS[:2] if shared else None)
+            ms, gMS, root_J33, shared = cross(MS, vd_j), None, ZERO, False
+            if second is not None:
+                seconds[name] = second
+                root_tag = _safe(str(robot.link_index(parent)))
+                ms, gMS, root_J33 = _second_link_moment(b, second, MS, vd_j, tag, root_tag, raw, N, parameters,
+                                                       definitions)
+                # a child continuing a run from the root shares W (second_link.point_acceleration)
+                shared = gMS is not None and any(
+                    runs.get(c.child) is not None and runs[c.child].anchor == root.child for c in robot.children(name))
+            A, rest, along_z = euler_projections(b, J, second or closed, tag, root_J33, gMS[:2] if shared else None)
             # with gravity folded in, along_z holds the first moment's z part too
             N[name] = b.vector([ms[0], ms[1], along_z if shared else plus(ms[2], along_z)], f"N{tag}")
             kr = robot.coordinate_index(root)
-            along_root[kr] = plus(along_root.get(kr, ZERO), along_u)
+            As, rests, ad, first = along_root.get(kr, ([], [], (second or closed).ad, tag))
+            along_root[kr] = (As + [A], rests + [rest], ad, first)
         w[name], wd[name], vd[name], U[name] = w_j, wd_j, vd_j, U_j
 
     f, nm, Rf = {}, {}, {}
@@ -416,9 +452,20 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
         if (joint.parent == robot.base and joint.type == "revolute" and k is not None
                 and any(runs[link].anchor == joint.child for link in rotations)):
             tau[k] = root_torque(robot, joint, frames, rotations, N, f, nm, Rf, b)
-    for k, extra_u in along_root.items():  # second links' Euler moments on the root axis
-        tau[k] = plus(tau[k], extra_u)
-    return b.program(tau, (n,)), definitions
+    for k, (As, rests, ad, first) in along_root.items():  # the run's Euler moments on the root axis
+        tau[k] = plus(tau[k], times(ad, b.let(plus(*As), f"A{first}")), *rests)
+    return b.program(tau, (n,)), definitions, any(len(As) > 1 for As, _, _, _ in along_root.values())
+
+
+def _children_need_wd(robot: Robot, name, frames) -> set:
+    """The components of link ``name``'s angular acceleration its children read: ``k``
+    for a revolute child about the link's ``+-e_k`` (only its ``wd_z`` takes it), all
+    three for any other child."""
+    out = set()
+    for child in robot.children(name):
+        found = _axis_in_parent(child, frames[child.child][0])
+        out |= {found[0]} if found is not None and child.type == "revolute" else {0, 1, 2}
+    return out
 
 
 def _second_link_moment(b: Builder, s, MS, vd_j, tag, root_tag, raw: dict, N: dict, parameters: dict,

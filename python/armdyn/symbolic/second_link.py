@@ -41,6 +41,13 @@ the basis ``(u, v, e3)``, by (``p_u = u . p``, ``p_v = v . p``)::
 turned by the compound angle, so its acceleration needs neither L's U nor a rotation
 by ``q_L`` (:func:`point_acceleration`).
 
+**Further along the run.** A link that continues a run of parallel joints from L (the
+PUMA's link 3) turns the same way, ``w = a u + b e3`` with its own ``u`` (R's axis turned
+by the compound angle) and ``b`` the run's summed rates, and its moment's x and y
+components reach only R's torque, by that compound rotation: the same two projections
+apply (:func:`run_link`), the ``A`` of every such link summed before one product with
+``a'``; its U's lower row then also comes from its last column (:func:`lower_column`).
+
 All vectors are lists of 3 SymPy expressions; named temporaries go through the
 customized program's :class:`~armdyn.codegen.program.Builder`.
 """
@@ -63,8 +70,8 @@ class SecondLink:
     a, ad: R's joint rate and acceleration; b, bd: L's; aa, bb, ab2: ``a^2``, ``b^2``,
     ``2 a b`` (named); W (2,): ``b' u + b^2 v`` in L's xy plane (named; L's own rates on
     the two in-plane axes, used by the moment's projection on u and by a point's
-    acceleration); gz: the root's acceleration along its axis (``g``) when that is all of
-    it, else None."""
+    acceleration; unused for a link further along the run, :func:`run_link`); gz: the
+    root's acceleration along its axis (``g``) when that is all of it, else None."""
 
     root: str
     u: list
@@ -90,27 +97,56 @@ def second_link(builder: Builder, joint, R, root_joint, w_root, wd_root, origin,
     axis: L's origin on that axis, gravity along it)."""
     if root_joint is None or joint.type != "revolute" or root_joint.type != "revolute":
         return None
+    gz = origin[2] if is_value(origin[0], 0) and is_value(origin[1], 0) else None
+    return _two_rates(builder, root_joint, R, w_root, wd_root, qd, qdd, tag, gz)
+
+
+def run_link(builder: Builder, root_joint, w_root, wd_root, Ra, w, wd, tag) -> SecondLink | None:
+    """The same description for a link further along a run of parallel joints that starts
+    at the second link (the PUMA's link 3: ``w3 = qd1 u3 + (qd2 + qd3) e3``), or None.
+    ``Ra`` (3x3 rows): the link's frame in the root's (the run's compound rotation), so
+    ``u = Ra^T z_R``; ``w``, ``wd`` (3,): the link's own, whose z components are its ``b``,
+    ``b'``. No gravity term (its origin is not on the root's axis)."""
+    return _two_rates(builder, root_joint, Ra, w_root, wd_root, w[2], wd[2], tag, None)
+
+
+def _two_rates(builder: Builder, root_joint, R, w_root, wd_root, b, bd, tag, gz) -> SecondLink | None:
+    """A link turning as ``w = a u + b e3`` on a base-fixed root (``w_root = (0, 0, a)``):
+    its :class:`SecondLink`, with ``u = R^T z_R`` (``R``: its frame in the root's), or
+    None when u has a z part (its axis not perpendicular to the root's) or the root moves
+    otherwise. ``W`` is named here; unused (a link further along the run), it is dead code
+    the program drops."""
     if not all(is_value(x, 0) for x in (*w_root[:2], *wd_root[:2])):
         return None
     u = mtv(R, [ZERO, ZERO, sp.S.One])
     if not is_value(u[2], 0):
         return None
-    u = [u[0], u[1], ZERO]
-    a, ad = w_root[2], wd_root[2]
-    gz = origin[2] if is_value(origin[0], 0) and is_value(origin[1], 0) else None
+    u, a, ad = [u[0], u[1], ZERO], w_root[2], wd_root[2]
     v = [u[1], -u[0], ZERO]
-    bb = builder.let(times(qd, qd), f"w{tag}bb")
-    W = [builder.let(plus(times(qdd, u[i]), times(bb, v[i])), f"W{tag}{'xy'[i]}") for i in range(2)]
-    return SecondLink(root_joint.child, u, v, a, ad, qd, qdd, builder.let(times(a, a), f"w{tag}aa"), bb,
-                      builder.let(times(2, times(a, qd)), f"w{tag}ab2"), W, gz)
+    bb = builder.let(times(b, b), f"w{tag}bb")
+    W = [builder.let(plus(times(bd, u[i]), times(bb, v[i])), f"W{tag}{'xy'[i]}") for i in range(2)]
+    return SecondLink(root_joint.child, u, v, a, ad, b, bd, builder.let(times(a, a), f"w{tag}aa"), bb,
+                      builder.let(times(2, times(a, b)), f"w{tag}ab2"), W, gz)
+
+
+def lower_column(s: SecondLink, column) -> tuple:
+    """``(U31, U32)`` of the link's ``U = skew(wd) + skew(w)^2`` from its last column
+    ``(U13, U23)``: ``U31 = -U13 + 2 a b u1``, ``U32 = -U23 + 2 a b u2`` (``U13 = a' u2``,
+    ``U23 = -a' u1``, and ``w x (w x .)`` adds ``a b (u_i e3 + e3 u_i)``). Where the Euler
+    moment's x and y components are not formed, ``w_y w_z`` and ``wd_x`` (or ``w_x w_z``
+    and ``wd_y``) are needed for nothing else than the generic ``U32 = w_y w_z + wd_x``:
+    one operation less, if no child needs ``wd_x``."""
+    return minus(times(s.ab2, s.u[0]), column[0]), minus(times(s.ab2, s.u[1]), column[1])
 
 
 def euler_projections(b: Builder, J, s: SecondLink, tag: str, root_J33=ZERO, gravity=None) -> tuple:
-    """``(u . E, e3 . E)`` of L's Euler moment ``E = J wd + w x (J w)`` (module
-    docstring), J (3x3 rows) about L's origin in L's axes.
+    """``(A, rest, e3 . E)`` of L's Euler moment ``E = J wd + w x (J w)`` (module
+    docstring), J (3x3 rows) about L's origin in L's axes: ``u . E = a' A + rest``, A
+    unnamed, so that the caller adds the A of every link on the same root before one
+    product with ``a'``.
 
     root_J33: the root link's inertia about its axis; its own Euler moment on that axis,
-    ``J33_R a'``, is added to the first projection inside ``A`` (one product less).
+    ``J33_R a'``, is added inside ``A`` (one product less).
     gravity: None, or ``(gz MX, gz MY)`` (:func:`gravity_moment`) when a child's
     acceleration uses ``W`` too (:func:`point_acceleration`): then the terms of L's own
     rates are taken together, ``b' B + b^2 D = (J e3) . W``, and L's ``((gz MS) x u)_z``
@@ -127,18 +163,17 @@ def euler_projections(b: Builder, J, s: SecondLink, tag: str, root_J33=ZERO, gra
         A = plus(root_J33, times(u1, plus(Ju1, t)))
     else:
         A = plus(root_J33, times(u1, Ju1), times(u2, Ju2))
-    A = b.let(A, f"A{tag}")
     C = b.let(minus(times(u2, Ju1), times(u1, Ju2)), f"C{tag}")  # v . J u, v = (u2, -u1, 0)
     if gravity is None:
         B = b.let(plus(times(J02, u1), times(J12, u2)), f"B{tag}")   # (J e3) . u
         D = b.let(minus(times(J02, u2), times(J12, u1)), f"D{tag}")  # (J e3) . v
-        along_u = plus(times(s.ad, A), times(s.bd, B), times(s.ab2, C), times(s.bb, D))
+        rest = plus(times(s.bd, B), times(s.ab2, C), times(s.bb, D))
         along_z = plus(times(s.ad, B), times(s.bd, J22), -times(s.aa, C))
     else:
-        along_u = plus(times(s.ad, A), times(s.ab2, C), times(J02, s.W[0]), times(J12, s.W[1]))
+        rest = plus(times(s.ab2, C), times(J02, s.W[0]), times(J12, s.W[1]))
         along_z = plus(times(u1, minus(times(s.ad, J02), gravity[1])), times(u2, plus(times(s.ad, J12), gravity[0])),
                        times(s.bd, J22), -times(s.aa, C))
-    return along_u, along_z
+    return A, rest, along_z
 
 
 def gravity_moment(b: Builder, MS, s: SecondLink, tag: str) -> tuple[list, list]:
