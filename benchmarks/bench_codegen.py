@@ -203,8 +203,8 @@ def breakdown() -> None:
         print(f"| {k} | " + " | ".join(f"{a}+{b}" for a, b in cells) + f" | {sum(a + b for a, b in cells)} |")
     print("\n(wi: R^T w of the parent; w: w, its products and differences; wd, vd: accelerations;"
           " Up, a: U_parent p + vd_parent (link 2: a point's acceleration in the basis (u, v, z));"
-          " A, C, J: link 2's inertia seen along joint 1's axis u (its Euler moment's two"
-          " projections); W: link 2's own rates on u and v; p: link 3's origin along u and v;"
+          " A, B, C, D, J: links 2 and 3's inertia seen along joint 1's axis u (their Euler moments'"
+          " two projections; A of both summed in link 2's row); W: link 2's own rates on u and v; p: link 3's origin along u and v;"
           " U: skew(wd) + skew(w)^2; F, N: the link's force and moment;"
           " Rf: a child's force rotated; f, n: inward sums; q: q + th of a leaf link's turned frame, q2 + q3 of"
           " the parallel joints; tau: joint 1's torque, formed from the moments of links 1-3 directly)\n")
