@@ -24,7 +24,8 @@ as :mod:`armdyn.symbolic.newton_euler`, but
   (:mod:`armdyn.symbolic.parallel_joints`);
 * the second link of an arm on a base-fixed first joint (perpendicular axes) gives only
   two projections of its Euler moment, in closed form, and a child continuing a run its
-  acceleration without the link's U (:mod:`armdyn.symbolic.second_link`);
+  acceleration without the link's U; the links further along that run give the same two
+  projections, where that makes the program shorter (:mod:`armdyn.symbolic.second_link`);
 * optionally (``turns``, :mod:`armdyn.symbolic.leaf_frames`) a leaf link's frame turned
   about its joint axis by a per-parameter-set angle.
 
