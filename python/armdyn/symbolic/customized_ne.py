@@ -56,8 +56,8 @@ import sympy as sp
 from ..codegen.program import Builder, Program, is_value, names
 from ..model import Robot
 from .parallel_joints import about_z, cheaper, own_revolute_about_z, parallel_runs, root_torque
-from .second_link import (euler_projections, gravity_moment, in_frame, lower_column, point_acceleration, run_link,
-                          second_link)
+from .second_link import (euler_projections, gravity_moment, in_frame, lower_column, point_acceleration, root_axes,
+                          run_link, second_link)
 from .vectors import (UPPER, ZERO, cross, dot, expanded, expanded_times, minus, mtv, mv, plus, rows, times,
                       turned_about_z, vadd, vscale)
 
@@ -382,9 +382,7 @@ def _customized_newton_euler(robot: Robot, qd, qdd, gravity, parameters, builder
         if run is not None and through is not None and through.gz is not None and run.anchor == through.root:
             # a run from the root through the second link: the origin's acceleration in the
             # basis (u, v, e3) of the parent, turned here by the compound angle
-            u_run = mtv(Ra, [ZERO, ZERO, sp.S.One])
-            vd_j = in_frame(point_acceleration(b, through, p, _safe(str(robot.link_index(parent)))),
-                            u_run, [u_run[1], -u_run[0], ZERO])
+            vd_j = in_frame(point_acceleration(b, through, p, _safe(str(robot.link_index(parent)))), *root_axes(Ra))
         else:
             Up_p = b.vector(mv(U[parent], p), f"Up{tag}")
             vd_j = mtv(R, b.vector(vadd(Up_p, vd[parent]), f"a{tag}"))  # named: both rows of R^T use it

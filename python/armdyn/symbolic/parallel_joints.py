@@ -98,7 +98,7 @@ def cheaper(compound: list, separate: list) -> bool:
 
 
 def root_torque(robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: dict, n: dict, Rf: dict,
-                b: Builder | None = None):
+                b: Builder):
     """The torque ``z . n`` of a base-fixed link (its joint ``joint``), with the runs of
     parallel joints behind it brought over by their compound rotations: of the moment of
     a link the base carries, only its component on the joint axis is needed (the base does
@@ -116,7 +116,7 @@ def root_torque(robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: 
     rotations: ``{link: R_anchor_link}`` (3x3 rows) of the links whose outward quantities
     used the compound form; N, f, n: each link's Euler moment, total force and total
     moment (its axes); Rf: ``{link: R f}``, its force in its parent's axes, as the program
-    named it; b: the program's builder (None: the offsets' lever arms are not named)."""
+    named it; b: the program's builder (it names the offsets' lever arms)."""
 
     def brought(x, Rax, extra=(ZERO, ZERO, ZERO)):
         """z . R_ax (n_x + extra) with x's children in a run expanded."""
@@ -130,11 +130,8 @@ def root_torque(robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: 
             if y in rotations:
                 # z . R_ax (p' x R_y f_y) = (u x p') . R_y f_y, u x p' named: it is a
                 # multiple of a sine or cosine of x's angle that x's offsets may use too
-                arm = [b.let(e, f"p{y}_arm") for e in cross(u, [p[0], p[1], ZERO])] if b else None
-                if arm is None:
-                    own = vadd(own, cross([p[0], p[1], ZERO], Rf[y]))
-                else:
-                    out.append(dot(arm, Rf[y]))
+                arm = [b.let(e, f"p{y}_arm") for e in cross(u, [p[0], p[1], ZERO])]
+                out.append(dot(arm, Rf[y]))
                 out.append(brought(y, rotations[y], [-p[2] * f[y][1], p[2] * f[y][0], ZERO]))
             else:
                 own = vadd(own, mv(R, n[y]), cross(p, Rf[y]))

@@ -70,8 +70,8 @@ class SecondLink:
     a, ad: R's joint rate and acceleration; b, bd: L's; aa, bb, ab2: ``a^2``, ``b^2``,
     ``2 a b`` (named); W (2,): ``b' u + b^2 v`` in L's xy plane (named; L's own rates on
     the two in-plane axes, used by the moment's projection on u and by a point's
-    acceleration; unused for a link further along the run, :func:`run_link`); gz: the
-    root's acceleration along its axis (``g``) when that is all of it, else None."""
+    acceleration, both only with ``gz``; None without it); gz: the root's acceleration
+    along its axis (``g``) when that is all of it, else None."""
 
     root: str
     u: list
@@ -83,7 +83,7 @@ class SecondLink:
     aa: sp.Expr
     bb: sp.Expr
     ab2: sp.Expr
-    W: list
+    W: list | None
     gz: sp.Expr | None
 
 
@@ -110,21 +110,28 @@ def run_link(builder: Builder, root_joint, w_root, wd_root, Ra, w, wd, tag) -> S
     return _two_rates(builder, root_joint, Ra, w_root, wd_root, w[2], wd[2], tag, None)
 
 
+def root_axes(R) -> tuple | None:
+    """``(u, v)`` (3,) each: the root's axis ``u = R^T z_R`` in the frame ``R`` (3x3 rows,
+    that frame in the root's) and ``v = u x e3``; None when u has a z part (the frame's z
+    axis not perpendicular to the root's)."""
+    u = mtv(R, [ZERO, ZERO, sp.S.One])
+    if not is_value(u[2], 0):
+        return None
+    return [u[0], u[1], ZERO], [u[1], -u[0], ZERO]
+
+
 def _two_rates(builder: Builder, root_joint, R, w_root, wd_root, b, bd, tag, gz) -> SecondLink | None:
     """A link turning as ``w = a u + b e3`` on a base-fixed root (``w_root = (0, 0, a)``):
     its :class:`SecondLink`, with ``u = R^T z_R`` (``R``: its frame in the root's), or
     None when u has a z part (its axis not perpendicular to the root's) or the root moves
-    otherwise. ``W`` is named here; unused (a link further along the run), it is dead code
-    the program drops."""
-    if not all(is_value(x, 0) for x in (*w_root[:2], *wd_root[:2])):
+    otherwise."""
+    axes = root_axes(R)
+    if axes is None or not all(is_value(x, 0) for x in (*w_root[:2], *wd_root[:2])):
         return None
-    u = mtv(R, [ZERO, ZERO, sp.S.One])
-    if not is_value(u[2], 0):
-        return None
-    u, a, ad = [u[0], u[1], ZERO], w_root[2], wd_root[2]
-    v = [u[1], -u[0], ZERO]
+    (u, v), a, ad = axes, w_root[2], wd_root[2]
     bb = builder.let(times(b, b), f"w{tag}bb")
-    W = [builder.let(plus(times(bd, u[i]), times(bb, v[i])), f"W{tag}{'xy'[i]}") for i in range(2)]
+    W = None if gz is None else [builder.let(plus(times(bd, u[i]), times(bb, v[i])), f"W{tag}{'xy'[i]}")
+                                 for i in range(2)]
     return SecondLink(root_joint.child, u, v, a, ad, b, bd, builder.let(times(a, a), f"w{tag}aa"), bb,
                       builder.let(times(2, times(a, b)), f"w{tag}ab2"), W, gz)
 
