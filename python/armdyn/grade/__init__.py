@@ -29,8 +29,8 @@ from .engine import equal
 from .explain import component_name, describe, pretty, split_name, tidy
 from .latex import GREEK, LatexError, UnknownSymbol, parse, parse_sympy_syntax
 from .methods import lagrange_method, newton_euler_method, rotation_between
-from .proofs import grade_proofs
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
+from .proofs import grade_proofs
 from .reader import Submission, read
 from .verdict import PASSING, STATUSES, GradeReport, StepVerdict
 

@@ -36,7 +36,7 @@ from .checker import LinkVerdict, ProofChecker
 from .matrices import Mat
 from .regions import proof_regions
 
-__all__ = ["grade_proofs", "check_text"]
+__all__ = ["check_text", "grade_proofs"]
 
 #: display lines of proofs in one submission beyond which grading stops with an error
 MAX_PROOF_LINES = 400

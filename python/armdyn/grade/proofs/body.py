@@ -88,7 +88,8 @@ class Instance:
 
     def point(self, name: str) -> Mat:
         if name not in self.points:
-            self.points[name] = Mat.col([0, 0, 0]) if self.small and (name == "O" or name.startswith("ref:")) else self._draw_vector()
+            at_origin = self.small and (name == "O" or name.startswith("ref:"))  # simpler by hand
+            self.points[name] = Mat.col([0, 0, 0]) if at_origin else self._draw_vector()
         return self.points[name]
 
     def vector(self, name: str) -> Mat:

@@ -30,7 +30,7 @@ from fractions import Fraction
 from ..latex import LatexError, sides
 from .body import random_instance
 from .counterexample import find, sentence
-from .evaluate import (MAX_DEGREE, NeedElement, NotRational, ProofState, Scope, UnknownName, _VECTORS, degree,
+from .evaluate import (_VECTORS, MAX_DEGREE, NeedElement, NotRational, ProofState, Scope, UnknownName, degree,
                        evaluate, key)
 from .expr import Add, Integral, Num, ProofSyntaxError, Sym, parse_side, walk
 from .matrices import ShapeError, SizeError
@@ -40,8 +40,9 @@ from .regions import Display
 #: has probability at most (MAX_DEGREE / 2^31)^K < 1e-20 (docs/grading.md)
 K = 3
 _ORDINALS = {"first": 0, "second": 1, "third": 2, "fourth": 3, "fifth": 4}
-_JOIN = re.compile(r"\b(first|second|third|fourth|fifth|last)\s+(integral|term|summand)\b", re.I)
-_VANISH = re.compile(r"\b(first|second|third|fourth|fifth|last)\s+(integral|term|summand)\s+(vanishes|is zero)", re.I)
+_JOIN = re.compile(r"\b(first|second|third|fourth|fifth|last)\s+(integral|term|summand)\b", re.IGNORECASE)
+_VANISH = re.compile(r"\b(first|second|third|fourth|fifth|last)\s+(integral|term|summand)\s+(vanishes|is zero)",
+                     re.IGNORECASE)
 _FROM_TO = re.compile(r"from\s+\$?\s*(?:\\mathbf\{)?([A-Z])\}?\s*\$?\s+to\s+\$?\s*(?:\\mathbf\{)?([A-Z])\b")
 
 
@@ -370,7 +371,7 @@ def _same(a, b) -> bool:
 
 
 def _states_center_fact(left, right) -> bool:
-    """``\int r_C dm = 0`` as written (either order)."""
+    """``\\int r_C dm = 0`` as written (either order)."""
     pair = (left, right)
     zero = any(isinstance(t, Num) and t.value == 0 for t in pair)
     integral = any(isinstance(t, Integral) and isinstance(t.body, Sym) and t.body.base == "r" for t in pair)

@@ -15,7 +15,7 @@ Name rules (the typeface and the scripts decide; ``r_i``, ``I_{l_i}`` as in the 
   point): the position of a mass element, so only meaningful inside an integral or in a
   line that holds for every element (then checked for every element); ``r_{ix}``,
   ``r_{iy}``, ``r_{iz}``: its components.
-* ``d``, ``\\omega``, ``\\omega_i``, ``a``, ``b``, ``u``, ``v``, ``w``: constant vectors (``d`` is
+* ``d``, ``p``, ``\\omega``, ``\\omega_i``, ``a``, ``b``, ``u``, ``v``, ``w``: constant vectors (``d`` is
   bound by a definition such as ``r_P = r_C + d``); ``\\omega^c``: ``R^c \\omega`` (the angular
   velocity the proof last named); ``R``, ``R^c``, ``R_c``: rotations.
 * ``M``: the body's mass; ``E_{rot}``: ``1/2 sum_k m_k |\\omega x r_k|^2``.
@@ -32,7 +32,7 @@ from .body import Instance
 from .expr import Add, Cross, Div, Dot, Integral, Matrix, Mul, Norm, Num, Pow, Skew, Sym, Transpose, walk
 from .matrices import Mat, ShapeError
 
-_VECTORS = {"d", "omega", "a", "b", "u", "v", "w"}
+_VECTORS = {"d", "p", "omega", "a", "b", "u", "v", "w"}
 #: a line whose (conservative) polynomial degree exceeds this is not evaluated
 MAX_DEGREE = 400
 

@@ -32,7 +32,7 @@ def _check(x: Fraction) -> Fraction:
 class Mat:
     """A rows x cols matrix of Fractions, stored row-major in ``v``."""
 
-    __slots__ = ("r", "c", "v")
+    __slots__ = ("c", "r", "v")
 
     def __init__(self, r: int, c: int, v):
         self.r, self.c, self.v = r, c, tuple(v)

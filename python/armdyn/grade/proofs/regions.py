@@ -15,10 +15,10 @@ from dataclasses import dataclass
 
 from ..latex import split_equations
 
-_MATH = re.compile(r"\$\$(.+?)\$\$|\\\[(.+?)\\\]", re.S)
-_START = re.compile(r"\b(prove|proof|show that)\b", re.I)
-_KEEP_HEADING = re.compile(r"^\W*(solution|proof|answer|demonstration)\b", re.I)
-_INSTRUCTION = re.compile(r"^\W*(check|formulate|derive|compute|calculate|find|determine|solve|write)\b", re.I)
+_MATH = re.compile(r"\$\$(.+?)\$\$|\\\[(.+?)\\\]", re.DOTALL)
+_START = re.compile(r"\b(prove|proof|show that)\b", re.IGNORECASE)
+_KEEP_HEADING = re.compile(r"^\W*(solution|proof|answer|demonstration)\b", re.IGNORECASE)
+_INSTRUCTION = re.compile(r"^\W*(check|formulate|derive|compute|calculate|find|determine|solve|write)\b", re.IGNORECASE)
 _EXERCISE_NUMBER = re.compile(r"^\W*\d+([-.]\d+)+\W*$")
 
 
@@ -34,7 +34,7 @@ class Display:
 
 def _body_start(text: str) -> int:
     if text.startswith("---"):
-        end = re.search(r"^---\s*$", text[3:], re.M)
+        end = re.search(r"^---\s*$", text[3:], re.MULTILINE)
         if end is not None:
             return 3 + end.end()
     return 0
@@ -51,9 +51,7 @@ def _update(in_proof: bool, prose: str) -> tuple[bool, bool]:
         body = line.lstrip("#").strip()
         if _START.search(body) and not _KEEP_HEADING.match(body):
             in_proof, started = True, True
-        elif heading and not _KEEP_HEADING.match(body):
-            in_proof = False
-        elif _EXERCISE_NUMBER.match(body) or _INSTRUCTION.match(body):
+        elif heading and not _KEEP_HEADING.match(body) or _EXERCISE_NUMBER.match(body) or _INSTRUCTION.match(body):
             in_proof = False
     return in_proof, started
 
@@ -63,6 +61,7 @@ def proof_regions(text: str, step_lines: set[int]) -> list[list[Display]]:
     regions: list[list[Display]] = []
     in_proof = False
     pos = _body_start(text)
+    counted, line_at = 0, 1  # line numbers counted incrementally: linear in the text's length
     for m in _MATH.finditer(text, pos):
         prose = text[pos:m.start()]
         pos = m.end()
@@ -73,7 +72,9 @@ def proof_regions(text: str, step_lines: set[int]) -> list[list[Display]]:
         block, block_start = m.group(group), m.start(group)
         first = True
         for offset, eq in split_equations(block):
-            line = text.count("\n", 0, block_start + offset) + 1
+            line_at += text.count("\n", counted, block_start + offset)
+            counted = block_start + offset
+            line = line_at
             if line in step_lines:
                 in_proof = False  # a dynamics step: the proof is over
             if in_proof:
