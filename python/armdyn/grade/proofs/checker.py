@@ -79,20 +79,21 @@ class ProofChecker:
         self.overrides: dict = {}  # name key -> (tree, line): the student's wrong definitions
         self.seen: set = set()     # constant vectors named so far
         self.sums: list = []       # (line, tree) of sums met, for "the second integral"
+        self.notes: set = set()    # how the names of the current link were read
         self.instances = [random_instance(seed) for seed in range(K)]
         self.uncentered = random_instance(1000, centered=False)
 
     # -- evaluation
     def _pairs(self, left, right, inst, env):
         """[(element or None, left value, right value)] on one instance."""
-        sc = Scope(inst, env, self.state)
+        sc = Scope(inst, env, self.state, notes=self.notes)
         try:
             return [(None, evaluate(left, sc), evaluate(right, sc))]
         except NeedElement:
             pass
         out = []
         for k in range(len(inst)):
-            sc = Scope(inst, env, self.state, elem=k)
+            sc = Scope(inst, env, self.state, elem=k, notes=self.notes)
             out.append((k, evaluate(left, sc), evaluate(right, sc)))
         return out
 
@@ -121,23 +122,6 @@ class ProofChecker:
         except RecursionError:
             raise _Failure("unrecognised", "nested too deeply") from None
 
-    def _notes(self, left, right) -> set:
-        sc = Scope(self.instances[0], self.defs, self.state)
-        try:
-            self._pairs(left, right, sc.inst, self.defs)
-        except Exception:  # noqa: BLE001 - notes only; the verdict reports real errors
-            return set()
-        notes = set()
-        for inst in self.instances[:1]:
-            s = Scope(inst, self.defs, self.state)
-            try:
-                evaluate(left, s)
-                evaluate(right, s)
-            except Exception:  # noqa: BLE001
-                pass
-            notes |= s.notes
-        return notes
-
     # -- one link
     def link(self, left, right, line: int, label: str, source: str, prefix: str = "") -> LinkVerdict:
         if time.perf_counter() > self.deadline:
@@ -152,9 +136,10 @@ class ProofChecker:
         self.state.scan([left, right])
         if max(degree(left), degree(right)) > MAX_DEGREE:
             raise _Failure("unrecognised", f"too many factors to evaluate (degree over {MAX_DEGREE})")
-        notes = self._notes(left, right)
-        said = "; ".join(sorted(notes))
-        if self._guarded(lambda: self._agree(left, right, self.defs, self.instances)):
+        self.notes = set()  # how names were read (filled while evaluating)
+        agree = self._guarded(lambda: self._agree(left, right, self.defs, self.instances))
+        said = "; ".join(sorted(self.notes))
+        if agree:
             msg = prefix
             try:
                 if not self._agree(left, right, self.defs, [self.uncentered]):
@@ -278,6 +263,12 @@ class ProofChecker:
             for t in (a, b):
                 self.seen |= {key(n) for n in walk(t) if isinstance(n, Sym) and n.base in _VECTORS}
             v = self.link(a, b, d.line, label, source)
+            if v.status == "correct" and len(raw) == 2 and isinstance(a, Sym) and a.base == "I" and a.sub \
+                    and not a.transposed:
+                what = f"the inertia tensor about {a.sub}" if len(a.sub) == 1 and a.sub.isupper() else \
+                    f"the inertia tensor {a.latex()}"
+                what += f", in frame {a.frame} (R^{a.frame} I R^{a.frame}T)" if a.frame else ""
+                v.message = _join(f"agrees with {what}", v.message)
             if v.status == "wrong" and len(raw) == 2 and isinstance(a, Sym) and not a.transposed:
                 self.overrides[key(a)] = (b, d.line)  # later lines may rely on the student's version
             out.append(v)
