@@ -109,10 +109,12 @@ def test_json_has_one_entry_per_link_and_the_counterexample():
     from armdyn.grade.text import to_json
 
     data = json.loads(to_json(grade(EXERCISE)))
-    proofs = [s for s in data["steps"] if s["name"] == "proof"]
+    proofs = [s for s in data["steps"] if (s["name"] or "").startswith("proof_")]
     assert len(proofs) == 13 + 4 + 3  # 7-3: 13 links; energy: 4 single links + a chain of 3
     wrong = [s for s in proofs if s["status"] == "wrong"]
-    assert len(wrong) == 1 and wrong[0]["line"] == 153
+    assert len(wrong) == 1 and wrong[0]["line"] == 153 and wrong[0]["name"] == "proof_153.2"
+    follows = next(s for s in proofs if s["name"] == "proof_153.3")
+    assert follows["status"] == "follows-from-earlier-error" and follows["caused_by"] == "proof_153.2"
     assert set(wrong[0]["counterexample"]) >= {"masses", "points", "vectors", "rotations", "left", "right"}
     assert all("counterexample" not in s for s in proofs if s["status"] != "wrong")
 
@@ -123,6 +125,7 @@ def test_parallel_axis_example_verdict():
     r = grade(PARALLEL)
     assert proof_status(r) == {16: ["correct"], 20: ["correct"], 24: ["correct"], 28: ["wrong"],
                                32: ["correct", "correct"], 36: ["correct"]}
+    assert r.first_wrong == "proof_28" and not r.passed
     wrong = next(v for v in r.steps if v.status == "wrong")
     ce = wrong.counterexample
     masses, points = body(ce)
@@ -259,3 +262,5 @@ def test_html_escapes_proof_text(tmp_path):
     path.write_text(HEAD + "$$E_{rot} = <img src=x onerror=alert(1)>$$\n\n$$\\tau_2 = 0$$\n")
     html = report_html(grade(path))
     assert "<img src=x" not in html
+    shown = report_html(grade(ENERGY))  # the counterexample is on the page
+    assert "left side, on the counterexample" in shown and "for the mass element at" in shown

@@ -50,8 +50,21 @@ def _sympy(value):
     return sp.Matrix(value.r, value.c, [sp.Rational(x.numerator, x.denominator) for x in value.v])
 
 
+def _name(links: list[LinkVerdict]) -> None:
+    """``proof_<line>``, or ``proof_<line>.<k>`` for the k-th link of a line with several."""
+    per_line: dict = {}
+    for v in links:
+        per_line.setdefault(v.line, []).append(v)
+    for line, group in per_line.items():
+        for k, v in enumerate(group, start=1):
+            v.name = f"proof_{line}" if len(group) == 1 else f"proof_{line}.{k}"
+    for v in links:
+        if v.cause is not None:
+            v.caused_by = v.cause.name
+
+
 def _verdict(v: LinkVerdict) -> StepVerdict:
-    return StepVerdict(name="proof", key="proof", link="", status=v.status, label=v.label, source=v.source,
+    return StepVerdict(name=v.name, key="proof", link="", status=v.status, label=v.label, source=v.source,
                        line=v.line, expected=_sympy(v.right), got=_sympy(v.left), message=v.message,
                        caused_by=v.caused_by, counterexample=v.counterexample)
 
@@ -63,7 +76,7 @@ def check_text(text: str, path: str = "<string>", step_lines: set | None = None)
     if total > MAX_PROOF_LINES:
         line = regions[-1][-1].line
         raise ModelError(f"{total} proof lines (at most {MAX_PROOF_LINES} are checked)", source=f"{path}:{line}")
-    out: list[StepVerdict] = []
+    links: list[LinkVerdict] = []
     checker = None
     for region in regions:
         checker = ProofChecker() if checker is None else _fresh(checker)
@@ -72,9 +85,10 @@ def check_text(text: str, path: str = "<string>", step_lines: set | None = None)
             if d.prose:
                 extra = checker.vanishing(d)
                 if extra is not None:
-                    out.append(_verdict(extra))
-            out.extend(_verdict(v) for v in checker.display(d, following))
-    return out
+                    links.append(extra)
+            links.extend(checker.display(d, following))
+    _name(links)
+    return [_verdict(v) for v in links]
 
 
 def _fresh(previous: ProofChecker) -> ProofChecker:

@@ -59,6 +59,8 @@ class LinkVerdict:
     right: object = None
     counterexample: dict | None = None
     caused_by: str | None = None
+    cause: LinkVerdict | None = None  # the wrong link this one follows from (named later)
+    name: str = "proof"
 
 
 class _Failure(Exception):
@@ -80,6 +82,7 @@ class ProofChecker:
         self.seen: set = set()     # constant vectors named so far
         self.sums: list = []       # (line, tree) of sums met, for "the second integral"
         self.notes: set = set()    # how the names of the current link were read
+        self.named: set = set()    # inertia tensors whose definition was met
         self.instances = [random_instance(seed) for seed in range(K)]
         self.uncentered = random_instance(1000, centered=False)
 
@@ -152,10 +155,10 @@ class ProofChecker:
             return LinkVerdict(line, label, source, "correct", _join(msg, said))
         env = {**self.defs, **self.overrides}
         if self.overrides and self._guarded(lambda: self._agree(left, right, env, self.instances)):
-            first = min(v[1] for v in self.overrides.values())
+            first = min(self.overrides.values(), key=lambda v: v[1])
             return LinkVerdict(line, label, source, "follows-from-earlier-error",
-                               _join(prefix, f"right with your own definition at line {first}, which is wrong"),
-                               caused_by=f"proof (line {first})")
+                               _join(prefix, f"right with your own definition at line {first[1]}, which is wrong"),
+                               cause=first[2])
         example = self._guarded(lambda: find(lambda inst: self._pairs(left, right, inst, self.defs),
                                              self.instances[0], self._defined_values))
         msg = _join(prefix, "the two sides differ")
@@ -241,7 +244,7 @@ class ProofChecker:
             return [self._continuation(d, trees[0], source)]
         out = []
         for j in range(len(raw) - 1):
-            label = f"{_short(raw[j])} = {_short(raw[j + 1])}"
+            label = f"{raw[j]} = {raw[j + 1]}"
             a, b = trees[j], trees[j + 1]
             bad = a if isinstance(a, Exception) else b if isinstance(b, Exception) else None
             if bad is not None:
@@ -264,13 +267,17 @@ class ProofChecker:
                 self.seen |= {key(n) for n in walk(t) if isinstance(n, Sym) and n.base in _VECTORS}
             v = self.link(a, b, d.line, label, source)
             if v.status == "correct" and len(raw) == 2 and isinstance(a, Sym) and a.base == "I" and a.sub \
-                    and not a.transposed:
-                what = f"the inertia tensor about {a.sub}" if len(a.sub) == 1 and a.sub.isupper() else \
-                    f"the inertia tensor {a.latex()}"
-                what += f", in frame {a.frame} (R^{a.frame} I R^{a.frame}T)" if a.frame else ""
+                    and not a.transposed and key(a) not in self.named:  # a definition: say what it agrees with
+                self.named.add(key(a))
+                if a.frame:
+                    what = f"the frame change of the inertia tensor into frame {a.frame}: R^{a.frame} I R^{a.frame}T"
+                elif len(a.sub) == 1 and a.sub.isupper():
+                    what = f"the inertia tensor about {a.sub}"
+                else:
+                    what = f"the inertia tensor {a.latex()}"
                 v.message = _join(f"agrees with {what}", v.message)
             if v.status == "wrong" and len(raw) == 2 and isinstance(a, Sym) and not a.transposed:
-                self.overrides[key(a)] = (b, d.line)  # later lines may rely on the student's version
+                self.overrides[key(a)] = (b, d.line, v)  # later lines may rely on the student's version
             out.append(v)
         if len(raw) > 2:
             self._chain_ends(trees, raw, out)
@@ -294,7 +301,7 @@ class ProofChecker:
             if j > first and j - 1 in failing:
                 out[j].status = "follows-from-earlier-error"
                 out[j].counterexample = out[j].left = out[j].right = None
-                out[j].caused_by = f"proof (line {out[first].line}, link {first + 1})"
+                out[j].cause = out[first]
                 out[j].message = _join(note, "this link compares that wrong expression with the next one")
 
     def _continuation(self, d: Display, tree, source) -> LinkVerdict:
@@ -312,7 +319,8 @@ class ProofChecker:
         line, (sign, term) = summand
         left = term if sign > 0 else Add(((-1, term),))
         prefix = f"the {word} {noun} of line {line} equals this"
-        return self.link(left, tree, d.line, f"({word} {noun} of line {line}) = {label}", source, prefix)
+        return self.link(left, tree, d.line, f"\\text{{({word} {noun} of line {line})}} = {d.text}", source,
+                         prefix)
 
     def _summand(self, word: str, exclude=None):
         for line, s in reversed(self.sums):
@@ -334,7 +342,7 @@ class ProofChecker:
         if summand is None:
             return None
         line, (sign, term) = summand
-        return self.link(term, Num(Fraction(0)), d.line, f"({word} {noun} of line {line}) = 0",
+        return self.link(term, Num(Fraction(0)), d.line, f"\\text{{({word} {noun} of line {line})}} = 0",
                          f"the {word} {noun} vanishes", f"the {word} {noun} of line {line} vanishes")
 
     def _direction_remark(self, prose: str) -> str:
