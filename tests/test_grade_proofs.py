@@ -219,6 +219,30 @@ def test_one_line_mutations_are_caught(make, old, new, kind):
     assert line not in before and block_line not in before  # the line was right before the mutation
 
 
+def test_definitions_facts_and_unknown_names():
+    text = "\n\n".join([
+        "Prove it.",
+        r"$$\int_{\mathcal{B}} dm = M$$",
+        r"$$\mathbf{I}_C = \int_{\mathcal{B}} \left( \|\mathbf{r}_C\|^2 \mathbf{I} + "
+        r"\mathbf{r}_C \mathbf{r}_C^T \right) dm$$",
+        r"$$\mathbf{I}_C - 2 \int_{\mathcal{B}} \mathbf{r}_C \mathbf{r}_C^T dm = "
+        r"\int_{\mathcal{B}} \left( \|\mathbf{r}_C\|^2 \mathbf{I} - \mathbf{r}_C \mathbf{r}_C^T \right) dm$$",
+        r"$$J = \int_{\mathcal{B}} \mathbf{r}_C \mathbf{r}_C^T dm$$",
+        r"$$\mathbf{I}_C = \int_{\mathcal{B}} \|\mathbf{r}_C\|^2 dm \, \mathbf{I} - J$$",
+        r"$$\mathbf{I}_C = \sum_k m_k \mathbf{r}_k$$",
+        r"$$\mathbf{r}_C \cdot \mathbf{r}_C = \|\mathbf{r}_C\|$$",
+        r"$$\mathbf{r}_P = \mathbf{r}_C + \mathbf{d}$$",
+        r"$$\mathbf{r}_C = \mathbf{r} + \mathbf{a} + \mathbf{r}_P$$",
+    ])
+    got = [(v.line, v.status) for v in check_text(text)]
+    assert got == [(3, "correct"), (5, "wrong"), (7, "follows-from-earlier-error"), (9, "correct"),
+                   (11, "correct"), (13, "unrecognised"), (15, "unrecognised"), (17, "correct"), (19, "wrong")]
+    v = {v.line: v for v in check_text(text)}
+    assert "not the inertia tensor about C" in v[5].message and v[7].caused_by == "proof_5"
+    assert "defines J" in v[9].message and "\\sum" in v[13].message and "squared" in v[15].message
+    assert "not constant over the body" in v[19].message  # a = r_C - r - r_P varies with the element
+
+
 # ---------------------------------------------------------------- hostile input
 
 HEAD = "---\nrobot: rp-arm\n---\nProve it.\n\n"

@@ -278,6 +278,8 @@ class ProofChecker:
                 v.message = _join(f"agrees with {what}", v.message)
             if v.status == "wrong" and len(raw) == 2 and isinstance(a, Sym) and not a.transposed:
                 self.overrides[key(a)] = (b, d.line, v)  # later lines may rely on the student's version
+                if a.base == "I" and len(a.sub) == 1 and a.sub.isupper() and not a.frame:
+                    v.message = _join(f"not the inertia tensor about {a.sub}", v.message)
             out.append(v)
         if len(raw) > 2:
             self._chain_ends(trees, raw, out)

@@ -412,7 +412,7 @@ class _Parser:
         self.integrals += 1
         if self.integrals > MAX_INTEGRALS:
             raise ProofSyntaxError(f"integrals nested deeper than {MAX_INTEGRALS}")
-        body = self.expr()
+        body = Num(Fraction(1)) if self.differential() is not None else self.expr()  # \int dm = M
         kind = self.differential()
         if kind is None:
             raise ProofSyntaxError("an integral without dm (or \\rho dV)")
