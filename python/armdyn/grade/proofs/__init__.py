@@ -16,10 +16,11 @@ How equality is decided. Both sides are evaluated on ``K = 3`` random bodies of 
 masses: integer masses in [1, 2^31], integer coordinates, constant vectors and Cayley
 rotation parameters in [-2^31, 2^31]; the mass center is computed exactly; rotations are
 exactly orthogonal. The difference of the two sides, denominators cleared, is a polynomial
-of degree at most ``D`` (bounded structurally, lines with ``D > 400`` are not evaluated)
-in these integers. If it is not identically zero, by the Schwartz-Zippel lemma a random
-draw makes it vanish with probability at most ``D / 2^31 < 2e-7``; three independent
-draws all vanish with probability below ``1e-20``. Equal sides are always found equal
+in these integers of degree ``D <= deg(left) + deg(right)``, each counted from its tree
+(:func:`.evaluate.degree`; a side above 400 is not evaluated, so ``D <= 800``). If it is not
+identically zero, by the Schwartz-Zippel lemma a random draw makes it vanish with
+probability at most ``D / 2^31 < 4e-7``; three independent draws all vanish with
+probability below ``1e-19``. Equal sides are always found equal
 (exact arithmetic: no tolerance, no false failure). Nothing in the student's text is
 executed (no eval, no sympify).
 """

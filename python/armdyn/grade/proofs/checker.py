@@ -36,8 +36,8 @@ from .expr import Add, Integral, Num, ProofSyntaxError, Sym, parse_side, walk
 from .matrices import ShapeError, SizeError
 from .regions import Display
 
-#: random instances per link: with the degree cap and 2^32 values per draw, a false pass
-#: has probability at most (MAX_DEGREE / 2^31)^K < 1e-20 (docs/grading.md)
+#: random instances per link: with the degree cap and at least 2^31 values per draw, a false
+#: pass has probability at most (2 MAX_DEGREE / 2^31)^K < 1e-19 (docs/grading.md)
 K = 3
 _ORDINALS = {"first": 0, "second": 1, "third": 2, "fourth": 3, "fifth": 4}
 _JOIN = re.compile(r"\b(first|second|third|fourth|fifth|last)\s+(integral|term|summand)\b", re.IGNORECASE)
@@ -235,11 +235,8 @@ class ProofChecker:
             except ProofSyntaxError as err:
                 trees.append(err)
         for t in trees:
-            if not isinstance(t, Exception):
-                for n in walk(t):
-                    if isinstance(n, Add) and len(n.terms) > 1:
-                        self.sums.append((d.line, n))
-                        break
+            if isinstance(t, Add) and len(t.terms) > 1:
+                self.sums.append((d.line, t))  # a sum whose "second integral" the prose may name
         if len(raw) == 1:
             return [self._continuation(d, trees[0], source)]
         out = []
@@ -315,7 +312,7 @@ class ProofChecker:
             return LinkVerdict(d.line, label, source, "unrecognised",
                                "an expression without '=' and no sentence saying what it equals")
         word, noun = m.group(1).lower(), m.group(2).lower()
-        summand = self._summand(word, exclude=tree)
+        summand = self._summand(word, noun, exclude=tree)
         if summand is None:
             return LinkVerdict(d.line, label, source, "unrecognised", f"no earlier sum has a {word} {noun}")
         line, (sign, term) = summand
@@ -324,13 +321,15 @@ class ProofChecker:
         return self.link(left, tree, d.line, f"\\text{{({word} {noun} of line {line})}} = {d.text}", source,
                          prefix)
 
-    def _summand(self, word: str, exclude=None):
+    def _summand(self, word: str, noun: str, exclude=None):
+        """The latest sum's ``word`` (first, second... last) summand: (line, (sign, tree))."""
         for line, s in reversed(self.sums):
-            if s is exclude or any(s is n for n in walk(exclude)):
+            if exclude is not None and any(s is n for n in walk(exclude)):
+                continue
+            if noun == "integral" and not all(isinstance(t, Integral) for _, t in s.terms):
                 continue
             index = len(s.terms) - 1 if word == "last" else _ORDINALS[word]
-            if index < len(s.terms) and all(isinstance(t, Integral) for _, t in s.terms) or \
-                    index < len(s.terms) and word != "last" and len(s.terms) > 2:
+            if index < len(s.terms):
                 return line, s.terms[index]
         return None
 
@@ -340,7 +339,7 @@ class ProofChecker:
         if m is None:
             return None
         word, noun = m.group(1).lower(), m.group(2).lower()
-        summand = self._summand(word)
+        summand = self._summand(word, noun)
         if summand is None:
             return None
         line, (sign, term) = summand
