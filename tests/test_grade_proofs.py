@@ -75,6 +75,8 @@ def test_exercise_parallel_axis_proof_is_right_line_by_line(exercise):
     assert "from P to C" in by_line[35].message  # the prose says "from C to P"
     assert "second integral of line 61" in by_line[69].message
     assert "uses \\int r_C dm = 0" in by_line[77].message
+    for line in (29, 41, 45, 49, 53, 57, 61, 65, 69):  # pure algebra: no fact needed
+        assert "r_C dm = 0" not in by_line[line].message, line
 
 
 def test_exercise_energy_chain_middle_link_is_wrong_with_a_counterexample(exercise):
@@ -152,6 +154,20 @@ def test_rotational_energy_example_verdict():
     left, right = np.cross(omega, ri), np.cross(ri, omega)  # S(a) b = a x b
     assert np.allclose(left, arr(ce["left"])) and np.allclose(right, arr(ce["right"]))
     assert not np.allclose(left, right)
+
+
+def test_cli_json_and_exit_status(capsys, tmp_path):
+    from armdyn.cli import main
+
+    assert main(["grade", str(PARALLEL), "--json"]) == 1
+    data = json.loads(capsys.readouterr().out)
+    wrong = [s for s in data["steps"] if s["status"] == "wrong"]
+    assert [s["name"] for s in wrong] == ["proof_28"] and data["first_wrong"] == "proof_28"
+    assert wrong[0]["got"] != wrong[0]["expected"] and wrong[0]["counterexample"]["element"] is not None
+    fixed = tmp_path / "fixed.md"
+    fixed.write_text(fixed_parallel())
+    assert main(["grade", str(fixed)]) == 0  # the slip repaired: every link right
+    assert "WRONG" not in capsys.readouterr().out
 
 
 # ---------------------------------------------------------------- mutations
