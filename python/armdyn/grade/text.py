@@ -76,8 +76,9 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
             what = f"{v.status.upper() if v.status == 'wrong' else v.status}: {v.message}"
         lines.append(f"  {mark} line {v.line:>4}  {_pad(step_title(v, ascii_only), width)}  {what}")
         if details and v.status == "wrong":
-            lines.append(f"{'':>{16 + width}}yours:    {_value(v.got, ascii_only)}")
-            lines.append(f"{'':>{16 + width}}expected: {_value(v.expected, ascii_only)}")
+            mine, other = ("left:    ", "right:   ") if v.key == "proof" else ("yours:   ", "expected:")  # proof: sides
+            lines.append(f"{'':>{16 + width}}{mine} {_value(v.got, ascii_only)}")
+            lines.append(f"{'':>{16 + width}}{other} {_value(v.expected, ascii_only)}")
     if skipped:
         shown = ", ".join(map(str, skipped[:12])) + (", ..." if len(skipped) > 12 else "")
         lines.append(f"  {'·' if not ascii_only else '--'} {len(skipped)} equation(s) not recognised as steps, skipped "

@@ -156,8 +156,9 @@ def _builtin(s: Sym, sc: Scope) -> Mat:
             if state.point is None:
                 raise UnknownName(f"{s.latex()}: an inertia tensor about which point? (no r_X in the proof yet)")
             point = state.point
+            frame = f", in frame {s.frame}" if s.frame else ""
             sc.notes.add(f"{s.latex()} read as the inertia tensor about the reference point of r_{state.point_sub}"
-                         if state.point_sub else f"{s.latex()} read as the inertia tensor about O")
+                         + frame if state.point_sub else f"{s.latex()} read as the inertia tensor about O" + frame)
         else:
             if state.inertia is None:
                 raise UnknownName(f"{s.latex()}: the frame-{s.frame} version of which inertia tensor?")
@@ -177,7 +178,7 @@ def _builtin(s: Sym, sc: Scope) -> Mat:
         sub = s.sub
         if s.base == "omega" and not sub and s.frame and state.omega is not None:
             sub = state.omega
-            sc.notes.add(f"{s.latex()} read as R^{s.frame} \\omega_{sub}")
+            sc.notes.add(f"{Sym(s.base, False, '', s.frame).latex()} read as R^{s.frame} omega_{sub}")
         base_key = key(Sym(s.base, s.bold, sub))
         if base_key in sc.env:
             value = evaluate(sc.env[base_key][0], sc.at(sc.elem if sc.elem is not None else 0, sc.in_integral))
@@ -195,7 +196,7 @@ def _builtin(s: Sym, sc: Scope) -> Mat:
         for k, m in enumerate(inst.masses):
             v = omega.cross(inst.element(k, point))
             total += m * v.dot(v)
-        sc.notes.add("E_rot read as the kinetic energy of rotation 1/2 \\int |\\omega x r|^2 dm"
+        sc.notes.add("E_rot read as the kinetic energy of rotation 1/2 \\int |omega x r|^2 dm"
                      + (f" (r = r_{state.point_sub})" if state.point_sub else ""))
         return Mat.scalar(total / 2)
     raise UnknownName(f"unknown name {s.latex()} (not a rigid-body quantity this checker knows)")

@@ -56,12 +56,10 @@ class Sym:
     transposed: bool = False
 
     def latex(self) -> str:
-        base = self.base if len(self.base) == 1 else f"\\{self.base}"
-        if self.bold:
-            base = f"\\mathbf{{{base}}}"
-        sub = f"_{{{self.sub}}}" if self.sub else ""
+        """The name as plain text for messages: ``d``, ``omega_i``, ``I_{l_i}^c``, ``r_C^T``."""
+        sub = "" if not self.sub else f"_{self.sub}" if len(self.sub) == 1 else f"_{{{self.sub}}}"
         sup = self.frame + ("T" if self.transposed else "")
-        return base + sub + (f"^{{{sup}}}" if sup else "")
+        return self.base + sub + ("" if not sup else f"^{sup}" if len(sup) == 1 else f"^{{{sup}}}")
 
 
 @dataclass(frozen=True)
