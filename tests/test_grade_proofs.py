@@ -259,6 +259,22 @@ def test_definitions_facts_and_unknown_names():
     assert "not constant over the body" in v[19].message  # a = r_C - r - r_P varies with the element
 
 
+def test_other_notations_and_a_bare_proof_heading():
+    text = "\n\n".join([
+        "Proof.",
+        r"$$[\mathbf{r}]_\times \boldsymbol{\omega} = -\boldsymbol{\omega} \times \mathbf{r} = "
+        r"\mathbf{r} \times \boldsymbol{\omega}$$",
+        r"$$\left\| \mathbf{r} \right\|^2 = \mathbf{r}^\top \mathbf{r} = \mathbf{r} \cdot \mathbf{r}$$",
+        r"$$S^T(\mathbf{r}) S(\mathbf{r}) = \|\mathbf{r}\|^2 \mathbf{1} - \mathbf{r}\mathbf{r}^T$$",
+        r"$$\int_{\mathcal{B}} \int_{\mathcal{B}} \mathbf{r}^T \mathbf{r} \, dm \, dm = "
+        r"M \int_{\mathcal{B}} \mathbf{r}^T \mathbf{r} \, dm$$",
+        r"$$S(\mathbf{r}) S(\mathbf{r}) = \|\mathbf{r}\|^2 \mathbf{1} - \mathbf{r}\mathbf{r}^T$$",
+    ])
+    got = [(v.line, v.status) for v in check_text(text)]
+    assert got == [(3, "correct"), (3, "correct"), (5, "correct"), (5, "correct"), (7, "correct"), (9, "correct"),
+                   (11, "wrong")]  # S(r) S(r) = -S^T(r) S(r)
+
+
 # ---------------------------------------------------------------- hostile input
 
 HEAD = "---\nrobot: rp-arm\n---\nProve it.\n\n"

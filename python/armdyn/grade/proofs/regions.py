@@ -49,8 +49,9 @@ def _update(in_proof: bool, prose: str) -> tuple[bool, bool]:
             continue
         heading = line.startswith("#")
         body = line.lstrip("#").strip()
-        if _START.search(body) and not _KEEP_HEADING.match(body):
-            in_proof, started = True, True
+        if _START.search(body):
+            started = started or not in_proof  # "Proof" inside a proof continues it
+            in_proof = True
         elif heading and not _KEEP_HEADING.match(body) or _EXERCISE_NUMBER.match(body) or _INSTRUCTION.match(body):
             in_proof = False
     return in_proof, started
