@@ -275,6 +275,20 @@ def test_other_notations_and_a_bare_proof_heading():
                    (11, "wrong")]  # S(r) S(r) = -S^T(r) S(r)
 
 
+def test_a_chain_that_names_its_first_expression():
+    text = ("Proof.\n\n$$K = \\frac{1}{2} \\int_{\\mathcal{B}} (\\omega \\times \\mathbf{r})^T "
+            "(\\omega \\times \\mathbf{r}) dm"
+            " = \\frac{1}{2} \\omega^T \\mathbf{I}_O \\omega = \\omega^T \\mathbf{I}_O \\omega$$\n")
+    v = check_text(text)
+    assert [x.status for x in v] == ["correct", "correct", "wrong"] and "defines K" in v[0].message
+    ce = v[2].counterexample  # NumPy: w^T I_O w on the counterexample is twice the left side
+    masses, points = body(ce)
+    omega = arr(ce["vectors"]["omega"])
+    inertia = inertia_about(masses, points, arr(ce["named_points"]["O"]))
+    assert frac(ce["left"]) == pytest.approx(0.5 * omega @ inertia @ omega)
+    assert frac(ce["right"]) == pytest.approx(omega @ inertia @ omega) != frac(ce["left"])
+
+
 # ---------------------------------------------------------------- hostile input
 
 HEAD = "---\nrobot: rp-arm\n---\nProve it.\n\n"

@@ -247,7 +247,7 @@ class ProofChecker:
             if bad is not None:
                 out.append(LinkVerdict(d.line, label, source, "unrecognised", f"cannot read: {bad}"))
                 continue
-            if len(raw) == 2 and self._is_new_name(a):
+            if j == 0 and self._is_new_name(a):  # K = ... (= ...): names the first expression
                 self.defs[key(a)] = (b, d.line)
                 out.append(LinkVerdict(d.line, label, source, "correct",
                                        f"defines {a.latex()} (a definition: nothing to check)"))
