@@ -12,11 +12,12 @@ Used by tests/test_html_report.py; a new test of a report is a few lines::
         assert_math_rendered(shot, min_count=10)
 
 How: the page is copied with a small measuring script appended (the report itself has
-no script) and loaded from a file with ``--dump-dom``; the script writes, as JSON, the
+no script, and its Content-Security-Policy, which would block the script, is taken out
+of the copy) and loaded from a file with ``--dump-dom``; the script writes, as JSON, the
 bounding box of every ``<math>`` element, the number of ``<merror>`` elements, any
 math whose text still looks like LaTeX source (a backslash: a conversion that did not
 happen), and the box and background of each highlighted table cell (``mtd.hl``).
-A second run of the original page takes a screenshot of the full page height.
+A second run of the original page (policy and all) takes a screenshot of the full page height.
 Chromium runs headless, with a fresh profile, no first-run, sync, component updates
 or background networking; the pages load nothing from the network.
 
@@ -116,6 +117,15 @@ class Rendered:
     screenshot: Path | None = None
 
 
+_CSP_META = re.compile(r'<meta http-equiv="Content-Security-Policy"[^>]*>\n?', re.IGNORECASE)
+
+
+def without_csp(source: str) -> str:
+    """The page without its Content-Security-Policy ``<meta>`` (so that a test's own
+    script may run in it)."""
+    return _CSP_META.sub("", source)
+
+
 def find_chromium() -> str | None:
     """Path of a Chromium binary (``ARMDYN_CHROMIUM`` first), or None."""
     env = os.environ.get("ARMDYN_CHROMIUM")
@@ -151,7 +161,7 @@ def render(page: str | Path, chromium: str, screenshot: str | Path | None = None
     math (see :class:`Rendered`) and, when ``screenshot`` is given, save a PNG of the
     whole page there."""
     page = Path(page).resolve()
-    source = page.read_text(encoding="utf-8")
+    source = without_csp(page.read_text(encoding="utf-8"))
     with tempfile.TemporaryDirectory(prefix="armdyn-page-") as tmp:
         probe = Path(tmp) / page.name
         at = source.rfind("</body>")
