@@ -141,7 +141,7 @@ def test_sanitizer_keeps_mathml_and_drops_the_rest():
            '<mi onmouseover="x()">a</mi><script>alert(1)</script><svg onload="x()"><text>t</text></svg>'
            '<mtext>&lt;img src=x onerror=alert(1)&gt;</mtext><annotation-xml encoding="text/html">'
            '<img src="x"/></annotation-xml><mstyle mathcolor="url(javascript:x)" displaystyle="true">'
-           '<mi>b</mi></mstyle><mi class="hl evil">c</mi><mspace width="calc(1em)"/><math><mi>d</mi></math></mrow>')
+           '<mi>b</mi></mstyle><mi class="hl evil">c</mi><mspace width="calc(1em)" height="99999em"/><math><mi>d</mi></math></mrow>')
     with pytest.raises(ValueError):  # xlink: undeclared prefix: not well-formed
         clean_mathml(bad)
     bad = bad.replace(' xlink:href="x"', "")
@@ -149,7 +149,7 @@ def test_sanitizer_keeps_mathml_and_drops_the_rest():
     assert out.markup == ('<mrow><mi>a</mi><mtext>&lt;img src=x onerror=alert(1)&gt;</mtext>'
                           '<mstyle displaystyle="true"><mi>b</mi></mstyle><mi>c</mi><mspace></mspace></mrow>')
     assert out.dropped == 4  # script, svg, annotation-xml, the nested math
-    assert out.stripped == 8  # href, style, onclick, id, onmouseover, mathcolor, class, width
+    assert out.stripped == 9  # href, style, onclick, id, onmouseover, mathcolor, class, width, height
 
 
 def test_sanitizer_output_passes_an_independent_html_check():
