@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import html
 import json
+import os
 import re
 import subprocess
 import sys
@@ -78,8 +79,6 @@ def _groups() -> list[dict]:
 
 
 def _cli(*args, cwd: Path) -> subprocess.CompletedProcess:
-    import os
-
     env = {**os.environ, "PYTHONPATH": str(ROOT / "python")}
     return subprocess.run([sys.executable, "-m", "armdyn", *args], cwd=cwd, env=env, capture_output=True,
                           text=True, timeout=300, check=False)
