@@ -5,6 +5,7 @@
     armdyn robots
     armdyn show ROBOT [--q Q1,Q2,...] [--out arm.png]
     armdyn grade SUBMISSION [--robot MODEL] [--json] [--html OUT.html] [--ascii] [--to-yaml]
+    armdyn serve [--host H] [--port P] [--db URL] [--workers N] [--exercises DIR] [--instructor-token T]
     armdyn codegen ROBOT [--what tau,M,C,g,regressor] [--base] [--lang c|python|numpy] [--bind] [--out DIR]
     armdyn simulate ROBOT --duration T --dt DT [--q0 ...] [--controller pd --target ...] [--plot run.png] [--animate run.gif]
 
@@ -110,6 +111,12 @@ def cmd_grade(args) -> int:
     else:
         print(report.text(ascii_only=args.ascii))
     return 0 if report.passed else 1
+
+
+def cmd_serve(args) -> int:
+    from .serve.server import run
+
+    return run(args)
 
 
 def cmd_codegen(args) -> int:
@@ -281,6 +288,19 @@ def build_parser() -> argparse.ArgumentParser:
     gr.add_argument("--ascii", action="store_true", help="plain ASCII text (no Unicode dots and marks)")
     gr.add_argument("--to-yaml", action="store_true", help="print the steps as read (the YAML format) and stop")
     gr.set_defaults(func=cmd_grade)
+    sv = sub.add_parser("serve", help="web app: students submit derivations, instructors see the class",
+                        description="Serve the grading web app (docs/serve.md). Needs: pip install 'armdyn[serve]'.")
+    sv.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1)")
+    sv.add_argument("--port", type=int, default=8000)
+    sv.add_argument("--db", help="sqlite:///PATH (default sqlite:///armdyn-serve.db) or postgresql://USER@HOST/DB")
+    sv.add_argument("--workers", type=int, default=2, help="grading processes (default 2)")
+    sv.add_argument("--exercises", metavar="DIR", help="variants made by `armdyn exercise make` (DIR/<id>/model.yaml)")
+    sv.add_argument("--instructor-token", help="the instructor's login token (or env ARMDYN_INSTRUCTOR_TOKEN)")
+    sv.add_argument("--timeout", type=float, default=60.0, help="seconds one grading may take (default 60)")
+    sv.add_argument("--memory-mb", type=int, default=2048, help="address-space limit of a worker (default 2048)")
+    sv.add_argument("--forwarded-allow-ips", default="127.0.0.1",
+                    help="proxies whose X-Forwarded-* headers are trusted (default 127.0.0.1)")
+    sv.set_defaults(func=cmd_serve)
     cg = sub.add_parser("codegen", help="generate C, Python or NumPy code for tau, M, C, g, the regressor")
     robot_arg(cg)
     cg.add_argument("--what", default="tau,M,C,g", help="comma-separated: tau,M,C,g,regressor (default tau,M,C,g)")
@@ -328,7 +348,7 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # e.g. `armdyn robots | head`
         sys.stderr.close()
         return 0
-    except Exception as err:  # noqa: BLE001 - a bug: one line unless debugging
+    except Exception as err:
         if os.environ.get("ARMDYN_DEBUG"):
             raise
         print(f"armdyn: internal error: {type(err).__name__}: {err} (set ARMDYN_DEBUG=1 for a traceback)",
