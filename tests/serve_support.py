@@ -34,7 +34,6 @@ PG_ENV = "ARMDYN_TEST_POSTGRES_URL"
 
 def _drop_postgres_tables(url: str) -> None:
     import sqlalchemy as sa
-
     from armdyn.serve.storage import _engine
 
     engine = _engine(url)

@@ -19,20 +19,18 @@ pytest.importorskip("starlette")
 pytest.importorskip("sqlalchemy")
 pytest.importorskip("httpx")
 
-from serve_support import EXERCISE, RIGHT, db_url  # noqa: E402,F401
-
-from armdyn.grade import grade  # noqa: E402
-from armdyn.grade.reader import read_markdown  # noqa: E402
+from armdyn.grade import grade
+from armdyn.grade.reader import read_markdown
+from serve_support import EXERCISE, RIGHT, db_url  # noqa: F401
 
 TOKEN = "instructor-secret-for-tests"
 MD = {"content-type": "text/markdown"}
 
 
 def client_for(url: str, **kw):
-    from starlette.testclient import TestClient
-
     from armdyn.serve.app import Settings, build_app
     from armdyn.serve.exercises import catalogue
+    from starlette.testclient import TestClient
 
     settings = Settings(db=url, exercises=catalogue(), workers=1, instructor_token=TOKEN, **kw)
     return TestClient(build_app(settings))

@@ -14,10 +14,9 @@ import pytest
 pytest.importorskip("sqlalchemy")
 pytest.importorskip("alembic")
 
-from serve_support import db_url  # noqa: E402,F401 - the parametrized fixture
-
-from armdyn.serve.migrations import MIGRATIONS, current_version  # noqa: E402
-from armdyn.serve.storage import DONE, FAILED, QUEUED, RUNNING, Repository  # noqa: E402
+from armdyn.serve.migrations import MIGRATIONS, current_version
+from armdyn.serve.storage import DONE, FAILED, QUEUED, RUNNING, Repository
+from serve_support import db_url  # noqa: F401 - the parametrized fixture
 
 RESULT = {"graded_as": "rp-arm", "passed": False, "first_wrong": "v_dot_1", "error": None,
           "report_json": '{"first_wrong": "v_dot_1"}', "report_html": "<p>page</p>", "report_fragment": "<p>f</p>"}
