@@ -200,7 +200,7 @@ def _api_view(row: dict, full: dict | None = None) -> dict:
 
 async def _text_body(request: Request) -> str:
     kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
-    if kind not in ("text/markdown", "text/plain", "text/x-markdown"):
+    if kind not in ("text/markdown", "text/x-markdown"):  # not text/plain: a cross-site form cannot send these
         raise _BadRequest("send the derivation as the body with Content-Type: text/markdown")
     try:
         return (await request.body()).decode("utf-8")
