@@ -194,7 +194,7 @@ def _api_view(row: dict, full: dict | None = None) -> dict:
     if full is not None and full.get("report_json"):
         out.update(json.loads(full["report_json"]))
     out.update({k: row[k] for k in ("id", "status", "attempts", "exercise", "graded_as", "passed", "first_wrong",
-                                    "error", "cached", "created_at", "finished_at")})
+                                    "error", "cached", "created_at", "started_at", "finished_at")})
     return out
 
 

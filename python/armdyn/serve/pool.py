@@ -106,7 +106,6 @@ class Pool:
         self._stopping = threading.Event()
         self._threads: list[threading.Thread] = []
         self._procs: dict[int, WorkerProcess | None] = {}
-        self._running: dict[int, str] = {}
         self._ready = threading.Event()
         self._started = 0
         self._lock = threading.Lock()
@@ -148,7 +147,8 @@ class Pool:
         with self._lock:
             procs = [p for p in self._procs.values() if p is not None]
         for p in procs:
-            p.kill()  # a thread still waiting on it sees WorkerDied and releases its submission
+            if p.alive():
+                p.proc.kill()  # its thread, still waiting, sees WorkerDied and releases the submission
         for t in self._threads:
             t.join(5.0)
         with self._preview_lock:
@@ -183,7 +183,6 @@ class Pool:
                 self._wake.wait(0.5)
                 self._wake.clear()
                 continue
-            self._running[i] = job.id
             ids = [job.id]
             try:
                 reply = proc.request({"kind": "grade", "exercise": job.exercise, "markdown": job.markdown},
@@ -206,8 +205,6 @@ class Pool:
                     ids = self.repo.finish(job.id, reply)
                 else:
                     self.repo.give_up(job.id, str(reply.get("reason", "grading failed")), retry=False)
-            finally:
-                self._running.pop(i, None)
             if ids:
                 self.on_done(ids)
         if proc is not None:
