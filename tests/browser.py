@@ -186,6 +186,17 @@ def render(page: str | Path, chromium: str, screenshot: str | Path | None = None
     return out
 
 
+def dump_dom(page: str | Path, chromium: str, timeout: float = 90.0, budget_ms: int = 3000) -> str:
+    """The DOM of the HTML file ``page`` as Chromium serializes it after loading it as
+    it is (no script added, its own policy in force) and letting ``budget_ms`` of
+    virtual time pass (timers, image errors, load events run)."""
+    done = _run(chromium, [f"--virtual-time-budget={budget_ms}", "--dump-dom", Path(page).resolve().as_uri()],
+                timeout)
+    if "<html" not in done.stdout:
+        raise AssertionError(f"Chromium dumped no document (exit {done.returncode}); stderr:\n{done.stderr[-2000:]}")
+    return done.stdout
+
+
 def assert_math_rendered(r: Rendered, min_count: int = 1) -> None:
     """Every ``<math>`` element has a non-zero box, none is an ``<merror>``, none shows
     LaTeX source; and there are at least ``min_count`` of them."""

@@ -22,7 +22,8 @@ An element not in the list is dropped with everything inside it (counted in
 :attr:`Sanitized.dropped`, so a caller can fall back to showing the source as text);
 so is anything nested deeper than :data:`MAX_DEPTH`. Comments, processing
 instructions and CDATA markers do not survive parsing; a document type declaration
-(entity expansion) is not well-formed inside the wrapper and is rejected. The output
+(entity expansion) is not well-formed inside the wrapper and is rejected; characters
+XML cannot carry (C0 controls, lone surrogates) become U+FFFD. The output
 is well-formed XML and parses as the same tree in an HTML5 page.
 """
 
@@ -46,6 +47,8 @@ ELEMENTS = frozenset({
 CLASSES = frozenset({"hl", "zero", "long", "left"})
 #: deeper subtrees are dropped (a browser's parser gives up nesting at a few hundred)
 MAX_DEPTH = 200
+# characters XML 1.0 cannot carry (a NUL in a name): replaced by U+FFFD before parsing
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
 
 _NUMBER = r"[+-]?(?:\d{1,6}(?:\.\d{0,6})?|\.\d{1,6})"
 _LENGTH = (rf"{_NUMBER}(?:em|ex|px|pt|pc|in|cm|mm|%|mu)?"
@@ -156,7 +159,7 @@ def clean_mathml(markup: str) -> Sanitized:
     see the module's docstring. Raises ValueError when it is not well-formed XML
     (numeric character references only: no HTML named entities)."""
     try:
-        root = ET.fromstring(f"<armdyn-fragment>{markup}</armdyn-fragment>")
+        root = ET.fromstring(f"<armdyn-fragment>{_NOT_XML.sub(chr(0xFFFD), markup)}</armdyn-fragment>")
     except ET.ParseError as exc:
         raise ValueError(f"MathML is not well-formed: {exc}") from None
     w = _Writer()
