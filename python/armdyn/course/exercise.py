@@ -7,7 +7,8 @@ model and the worked solution.
 Each ``out/<id>/`` holds ``problem.md``, ``problem.html`` (with a drawing),
 ``model.yaml`` and ``solution.md`` (front matter ``robot: model.yaml``, ``student``,
 ``variant``; grading it gives every step correct). The same seed and roster give
-byte-identical files. A roster is a CSV file with a header naming an ``id`` (or
+byte-identical files. ``out/rubric.yaml`` is the default rubric with every step of
+the solution required (for ``armdyn grade DIR --rubric``). A roster is a CSV file with a header naming an ``id`` (or
 ``student``) column; other columns are ignored. Ids are folder names: letters, digits,
 ``.``, ``_``, ``-`` (not first), at most 64 characters.
 """
@@ -110,11 +111,19 @@ def variant_files(kind: str, ident: str, seed: int, convention: str | None = Non
              "$N_i = I_i \\dot\\omega_i + \\omega_i \\times I_i \\omega_i$; gravity as an upward acceleration of "
              "the base). `armdyn grade solution.md` grades every step correct.")
     return {
+        "steps.txt": "".join(f"    - {s.name}\n" for s in steps),
         "model.yaml": model_text,
         "problem.md": statement_markdown(blocks),
         "problem.html": statement_html(blocks, drawing_uri(v, robot)),
         "solution.md": solution_markdown(robot, steps, front, f"Solution of exercise {ident}", intro),
     }
+
+
+def _writer(text: str):
+    def write(tmp):
+        with open(tmp, "w", encoding="utf-8", newline="\n") as fh:
+            fh.write(text)
+    return write
 
 
 def make_exercise(kind: str, out, seed: int = 0, count: int | None = None, roster=None,
@@ -137,19 +146,25 @@ def make_exercise(kind: str, out, seed: int = 0, count: int | None = None, roste
             raise ModelError(f"--count must be in 1..100000, got {count}")
         ids = [f"v{k:03d}" for k in range(1, count + 1)]
     out = os.fspath(out)
+    required: list[str] = []
     for ident in ids:
         files = variant_files(kind, ident, seed, convention)
         folder = os.path.join(out, ident)
         os.makedirs(folder, exist_ok=True)
 
-        def writer(text):
-            def write(tmp):
-                with open(tmp, "w", encoding="utf-8", newline="\n") as fh:
-                    fh.write(text)
-            return write
-
-        atomic_writes([(os.path.join(folder, name), writer(text)) for name, text in sorted(files.items())])
+        steps_list = files.pop("steps.txt")
+        atomic_writes([(os.path.join(folder, name), _writer(text)) for name, text in sorted(files.items())])
+        for name in re.findall(r"^    - (\S+)$", steps_list, re.M):
+            if name not in required:
+                required.append(name)
         result.written.append(ident)
         if progress is not None:
             progress(ident)
+    if required:
+        rubric = (f"# armdyn exercise make {kind}: the default rubric, with every step of the worked\n"
+                  "# solution required (a step not handed in scores 0 of its points). See docs/course.md.\n"
+                  "points:\n  tau: 2\ndefault: 1\ncredit:\n  correct: 1\n  correct-by-convention: 1\n"
+                  "  follows-from-earlier-error: 0.5\n  correct-but-unsupported: 0.5\n  wrong: 0\n"
+                  "required:\n" + "".join(f"  - {n}\n" for n in required))
+        atomic_writes([(os.path.join(out, "rubric.yaml"), _writer(rubric))])
     return result

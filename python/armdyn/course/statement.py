@@ -188,9 +188,7 @@ def drawing_uri(variant: Variant, robot) -> str:
 
     from ..show import _view, draw_on, frame_poses
 
-    values = {s: _NOMINAL_LENGTHS.get(s.name, 1.0) for s in robot.free_symbols()}
-    values.update({sp.Symbol(k): v for k, v in variant.lengths})
-    bound = robot.bind({s.name: v for s, v in values.items()})
+    bound = robot.bind({s.name: _NOMINAL_LENGTHS.get(s.name, 1.0) for s in robot.free_symbols()})
     q = np.array([0.5 if j.type == "revolute" else 0.4 for j in robot.movable_joints])
     poses = frame_poses(bound, q)
     origins = np.array([T[:3, 3] for T in poses.values()])
