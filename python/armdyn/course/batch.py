@@ -94,28 +94,34 @@ def _dask_task(task: dict, timeout: float, memory_mb: int | None) -> dict:
 
 
 # ------------------------------------------------------------------ finding submissions
-def _front_matter(path: str) -> dict:
-    """The submission's front matter (Markdown) or top-level mapping (YAML), or {} when
-    it cannot be read (the grader then says why)."""
+def _front_matter(path: str) -> tuple[dict, str | None]:
+    """The submission's front matter (Markdown) or top-level mapping (YAML), and why the
+    file cannot be graded at all (too large, not UTF-8: ``path:line: what``) or None.
+    A front matter that does not parse gives {} (the grader then says why)."""
     try:
         if os.path.getsize(path) > MAX_BYTES:
-            return {}
-        with open(path, encoding="utf-8") as fh:
-            text = fh.read()
-    except (OSError, UnicodeDecodeError):
-        return {}
+            return {}, f"{path}: larger than {MAX_BYTES} bytes"
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except OSError as exc:
+        return {}, f"{path}: cannot read it ({exc.strerror})"
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        return {}, f"{path}:{line}: not UTF-8 text (byte {exc.start + 1})"
     if path.lower().endswith(".md"):
         if not text.startswith("---"):
-            return {}
-        end = re.search(r"^---\s*$", text[3:], re.MULTILINE)
+            return {}, None
+        end = re.search(r"^---\s*$", text[3:], re.M)
         if end is None:
-            return {}
+            return {}, None
         text = text[3:3 + end.start()]
     try:
         data = yaml.safe_load(text)
     except (yaml.YAMLError, RecursionError, ValueError):
-        return {}
-    return data if isinstance(data, dict) else {}
+        return {}, None
+    return (data if isinstance(data, dict) else {}), None
 
 
 def _name(value) -> str | None:
@@ -143,10 +149,13 @@ def discover(folder, variants=None, want_html: bool = False) -> tuple[list[Task]
     tasks, refused, owner = [], [], {}
     for f in files:
         path = os.path.join(folder, f)
-        meta = _front_matter(path)
+        meta, unreadable = _front_matter(path)
         stem = os.path.splitext(f)[0]
         student = _name(meta.get("student")) or stem
         variant = _name(meta.get("variant"))
+        if unreadable:
+            refused.append((student, variant, f"error: {unreadable}"))
+            continue
         robot = None
         if variants is not None:
             if variant is None:
@@ -244,10 +253,10 @@ def grade_class(folder, gradebook, rubric: Rubric | None = None, html_dir=None, 
         r = results[t.path]
         items.append((t.student, t.variant, r.get("report"), r.get("error")))
         if "report" not in r:
-            not_graded.append(f"{t.path}: {r.get('error')}")
+            not_graded.append(_why(t.path, r.get("error") or "crashed: no result"))
     for student, variant, error in refused:
         items.append((student, variant, None, error))
-        not_graded.append(error.split(": ", 1)[1] + f" ({error.split(':', 1)[0]})")
+        not_graded.append(_why(None, error))
     book = Gradebook.from_results(items, rubric=rubric)
 
     outputs = [(gradebook, book.to_csv()), (os.path.splitext(gradebook)[0] + ".json", book.to_json()),
@@ -260,6 +269,14 @@ def grade_class(folder, gradebook, rubric: Rubric | None = None, html_dir=None, 
             outputs.append((os.path.join(html_dir, safe_file_name(t.student) + ".html"), page))
     atomic_writes([(p, _text_writer(text)) for p, text in outputs])
     return BatchResult(gradebook=book, not_graded=not_graded, cached=cached, seconds=time.perf_counter() - t0)
+
+
+def _why(path: str | None, error: str) -> str:
+    """``status: what`` as one line for stderr: ``file[:line]: what (status)``."""
+    status, _, rest = error.partition(": ")
+    if path and path not in rest:
+        rest = f"{path}: {rest}"
+    return f"{rest} ({status})"
 
 
 def _text_writer(text: str):

@@ -13,6 +13,7 @@ with status ``timeout``, ``memory`` or ``crashed``.
 
 from __future__ import annotations
 
+import faulthandler
 import json
 import os
 import resource
@@ -29,6 +30,7 @@ def _child(fn, arg, memory_bytes: int | None, w: int) -> None:
     code = 0
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+        faulthandler.disable()  # a crash is reported by the parent, in one line
         if memory_bytes:
             resource.setrlimit(resource.RLIMIT_AS, (memory_bytes, memory_bytes))
         try:

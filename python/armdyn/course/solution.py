@@ -165,10 +165,13 @@ def _latex_names(robot: Robot) -> dict:
     return names
 
 
-def render_value(value, names: dict) -> str:
-    """LaTeX of a step's value (a pmatrix column for vectors)."""
+def render_value(value, names: dict, q=()) -> str:
+    """LaTeX of a step's value (a pmatrix column for vectors); small expressions
+    expanded with sin^2 + cos^2 = 1 applied in the coordinates ``q``."""
     def one(x):
-        return sp.latex(sp.expand(x) if sp.count_ops(x) < 400 else x, symbol_names=names)
+        if sp.count_ops(x) < 400:
+            x = sp.expand(trig_reduce(x, q, keep_trig=True)) if len(q) else sp.expand(x)
+        return sp.latex(x, symbol_names=names)
 
     if isinstance(value, sp.MatrixBase):
         return r"\begin{pmatrix}" + r" \\ ".join(one(v) for v in value) + r"\end{pmatrix}"
@@ -195,5 +198,5 @@ def solution_markdown(robot: Robot, steps: list[SolutionStep], front: dict, titl
         if s.stage != stage:
             stage = s.stage
             lines += [f"**{stage}**", ""]
-        lines += [f"$${s.label} = {render_value(s.value, names)}$$", ""]
+        lines += [f"$${s.label} = {render_value(s.value, names, robot.q)}$$", ""]
     return "\n".join(lines).rstrip() + "\n"
