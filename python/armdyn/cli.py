@@ -5,6 +5,8 @@
     armdyn robots
     armdyn show ROBOT [--q Q1,Q2,...] [--out arm.png]
     armdyn grade SUBMISSION [--robot MODEL] [--json] [--html OUT.html] [--ascii] [--to-yaml]
+    armdyn grade DIR --gradebook grades.csv [--rubric R.yaml] [--html-dir DIR] [--variants DIR] [--jobs N]
+    armdyn exercise make KIND (--count N | --roster roster.csv) --seed S --out DIR
     armdyn serve [--host H] [--port P] [--db URL] [--workers N] [--exercises DIR] [--instructor-token T]
     armdyn codegen ROBOT [--what tau,M,C,g,regressor] [--base] [--lang c|python|numpy] [--bind] [--out DIR]
     armdyn simulate ROBOT --duration T --dt DT [--q0 ...] [--controller pd --target ...] [--plot run.png] [--animate run.gif]
@@ -91,6 +93,10 @@ def cmd_show(args) -> int:
 
 
 def cmd_grade(args) -> int:
+    if os.path.isdir(args.submission):  # a folder: the whole class (armdyn.course)
+        from .course.cli import cmd_grade_class
+
+        return cmd_grade_class(args)
     from .grade import grade
     from .grade.reader import read
 
@@ -281,13 +287,18 @@ def build_parser() -> argparse.ArgumentParser:
     gr = sub.add_parser("grade", help="check a student's own derivation step by step (first wrong step)",
                         description="Grade a derivation written in Markdown with LaTeX display math (or YAML). "
                                     "Exit status: 0 every step correct, 1 some step wrong, 2 bad input.")
-    gr.add_argument("submission", help="the derivation: a .md file (LaTeX display math) or a .yaml file")
+    gr.add_argument("submission", help="the derivation: a .md file (LaTeX display math) or a .yaml file; "
+                    "or a folder of them: the whole class (see --gradebook)")
     gr.add_argument("--robot", help="the model whose frames the student used (default: the front matter's robot)")
     gr.add_argument("--json", action="store_true", help="print the verdicts as one JSON object")
     gr.add_argument("--html", metavar="OUT.html", help="also write a self-contained HTML report")
     gr.add_argument("--ascii", action="store_true", help="plain ASCII text (no Unicode dots and marks)")
     gr.add_argument("--to-yaml", action="store_true", help="print the steps as read (the YAML format) and stop")
     gr.set_defaults(func=cmd_grade)
+    from .course.cli import add_batch_arguments, add_exercise_parser
+
+    add_batch_arguments(gr)
+    add_exercise_parser(sub)
     sv = sub.add_parser("serve", help="web app: students submit derivations, instructors see the class",
                         description="Serve the grading web app (docs/serve.md). Needs: pip install 'armdyn[serve]'.")
     sv.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1)")

@@ -84,7 +84,8 @@ class Rubric:
 
     @classmethod
     def from_text(cls, text: str, source: str = "<rubric>") -> Rubric:
-        from ..io.yaml import _parse_text  # the model loader's YAML: lines kept, duplicates refused
+        # the model loader's YAML reader: lines kept, duplicate keys refused
+        from ..io.yaml import _parse_text
 
         try:
             data = _parse_text(text, source)
@@ -166,6 +167,6 @@ def _line_of(text: str, source: str, key: str, fallback: str) -> str:
     """``file:line`` of the first line that starts (after indentation) with ``key:``."""
     for k, line in enumerate(text.splitlines(), 1):
         stripped = line.lstrip().lstrip("-").lstrip()
-        if stripped.startswith(f"{key}:") or stripped.startswith(f"'{key}':") or stripped.startswith(f'"{key}":'):
+        if stripped.startswith((f"{key}:", f"'{key}':", f'"{key}":')):
             return f"{source}:{k}"
     return fallback
