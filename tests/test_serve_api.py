@@ -32,7 +32,8 @@ def client_for(url: str, **kw):
     from armdyn.serve.exercises import catalogue
     from starlette.testclient import TestClient
 
-    settings = Settings(db=url, exercises=catalogue(), workers=1, instructor_token=TOKEN, **kw)
+    kw.setdefault("exercises", catalogue())
+    settings = Settings(db=url, workers=1, instructor_token=TOKEN, **kw)
     return TestClient(build_app(settings))
 
 
@@ -174,3 +175,23 @@ def test_forms_need_csrf_and_instructor_token(tmp_path):
         row = dict(zip(head, lines[1].split(",")))
         assert row["student"] == "Ada" and row["first_wrong"] == "v_dot_1"
         assert c.get("/instructor/summary").status_code == 200
+
+
+def test_variants_by_id_from_exercise_make(tmp_path):
+    from armdyn.cli import main
+    from armdyn.serve.exercises import catalogue
+
+    out = tmp_path / "variants"
+    assert main(["exercise", "make", "rp", "--count", "2", "--seed", "7", "--out", str(out)]) == 0
+    exercises = catalogue(str(out))
+    assert {"v001", "v002", "rp-arm"} <= set(exercises)
+    solution = (out / "v001" / "solution.md").read_bytes()
+    with client_for(f"sqlite:///{tmp_path / 'db.sqlite'}", exercises=exercises) as c:
+        wait_ready(c)
+        assert "variant v001" in c.get("/").text
+        own = c.post("/api/grade", content=solution, headers=MD).json()  # front matter: variant v001
+        assert own["graded_as"] == "v001" and own["passed"] is True, own
+        other = c.post("/api/grade?variant=v002", content=solution, headers=MD).json()
+        assert other["graded_as"] == "v002" and other["passed"] is False and other["first_wrong"]
+        # a variant is an id, not a path
+        assert c.post(f"/api/grade?variant={out / 'v001'}", content=solution, headers=MD).status_code == 400

@@ -60,6 +60,20 @@ class Grader:
             self._robots[name] = load(self.exercises[name], strict=False)
         return self._robots[name]
 
+    def named(self, markdown: str, robot: str | None) -> str | None:
+        """The exercise a submission's front matter names: its ``variant:`` when that is
+        a served variant (``armdyn exercise make`` writes ``robot: model.yaml`` beside
+        it), else its ``robot:``."""
+        from ..grade.reader import _safe_yaml
+
+        if markdown.startswith("---"):
+            end = markdown.find("\n---", 3)
+            meta = _safe_yaml(markdown[3:end], SUBMISSION) if end > 0 else None
+            variant = meta.get("variant") if isinstance(meta, dict) else None
+            if isinstance(variant, str) and variant in self.exercises:
+                return variant
+        return robot
+
     def grade(self, markdown: str, exercise: str | None) -> dict:
         from ..errors import ModelError
         from ..grade import grade
@@ -68,7 +82,7 @@ class Grader:
 
         try:
             sub = read_markdown(SUBMISSION, markdown)
-            name = exercise or sub.robot
+            name = exercise or self.named(markdown, sub.robot)
             report = grade(sub, robot=self.robot(name))
         except (ModelError, ValueError, RecursionError) as err:
             return {"ok": True, "graded_as": exercise, "passed": False, "first_wrong": None,
@@ -89,7 +103,8 @@ class Grader:
         except (ModelError, ValueError) as err:
             return {"ok": True, "html": f'<p class="error">{escape(str(err))}</p>'}
         try:
-            coordinate_of = SymbolMap(self.robot(exercise or sub.robot), sub.symbols).coordinate_of
+            coordinate_of = SymbolMap(self.robot(exercise or self.named(markdown, sub.robot)),
+                                      sub.symbols).coordinate_of
         except Exception:  # noqa: BLE001 - no model: show the equations without step names
             coordinate_of = None
         items = []
