@@ -53,11 +53,12 @@ def post(base: str, text: str) -> tuple[int, dict, float]:
     t0 = time.perf_counter()
     with urllib.request.urlopen(req, timeout=300) as r:
         status, body = r.status, json.loads(r.read())
+    poll = f"{base}/api/submissions/{body['id']}?t={body['token']}"
     for _ in range(3600):  # bounded: at most an hour of polling
         if body["status"] in ("done", "failed"):
             break
         time.sleep(0.5)
-        with urllib.request.urlopen(f"{base}/api/submissions/{body['id']}?t={body['token']}", timeout=60) as r:
+        with urllib.request.urlopen(poll, timeout=60) as r:
             status, body = r.status, json.loads(r.read())
     return status, body, time.perf_counter() - t0
 

@@ -48,3 +48,19 @@ def test_memory_limit_caps_the_address_space():
     out = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True, text=True, timeout=120,
                          env={"PYTHONPATH": str(ROOT / "python"), "PATH": "/usr/bin:/bin"})
     assert out.stdout.strip() == "capped", out.stdout + out.stderr
+
+
+def test_worker_report_is_grade_html():
+    """The worker builds the report's body once; the page and the fragment must still be
+    exactly what ``armdyn grade --html`` (report_html) and Jupyter (repr_html) show."""
+    from armdyn.grade import grade
+    from armdyn.grade.html import report_html, repr_html
+    from armdyn.grade.reader import read_markdown
+    from armdyn.serve.worker import SUBMISSION, Grader
+
+    text = EXERCISE.read_text(encoding="utf-8")
+    got = Grader({"rp-arm": "rp-arm"}).grade(text, None)
+    report = grade(read_markdown(SUBMISSION, text))
+    assert got["report_html"] == report_html(report)
+    assert got["report_fragment"] == repr_html(report)
+    assert got["first_wrong"] == "v_dot_1" and got["graded_as"] == "rp-arm"

@@ -77,8 +77,9 @@ class Grader:
     def grade(self, markdown: str, exercise: str | None) -> dict:
         from ..errors import ModelError
         from ..grade import grade
-        from ..grade.html import report_html, repr_html
+        from ..grade.html import _body  # built once, wrapped twice (saves ~0.4 s CPU)
         from ..grade.reader import read_markdown
+        from ..htmlpage import fragment, page
 
         try:
             sub = read_markdown(SUBMISSION, markdown)
@@ -88,9 +89,11 @@ class Grader:
             return {"ok": True, "graded_as": exercise, "passed": False, "first_wrong": None,
                     "error": " ".join(str(err).split())[:2000], "report_json": None, "report_html": None,
                     "report_fragment": None}
+        body = _body(report)
         return {"ok": True, "graded_as": name, "passed": bool(report.passed), "first_wrong": report.first_wrong,
-                "error": None, "report_json": report.to_json(), "report_html": report_html(report),
-                "report_fragment": repr_html(report)}
+                "error": None, "report_json": report.to_json(),
+                "report_html": page(f"armdyn grade: {report.submission}", body),  # = grade.html.report_html
+                "report_fragment": fragment(body)}                                  # = grade.html.repr_html
 
     def preview(self, markdown: str, exercise: str | None) -> dict:
         from ..errors import ModelError
