@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import base64
 import json
+import os
 import re
+import signal
 import subprocess
 import tempfile
 import time
@@ -31,7 +33,8 @@ class Browser:
         self._profile = tempfile.TemporaryDirectory(prefix="armdyn-cdp-")
         self.proc = subprocess.Popen([chromium, *FLAGS, f"--user-data-dir={self._profile.name}",
                                       "--remote-debugging-port=0", "--window-size=1280,900", "about:blank"],
-                                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                                     start_new_session=True)  # Debian's binary is a wrapper script: kill the group
         url, deadline, seen = None, time.monotonic() + 60, []
         while time.monotonic() < deadline and url is None:
             line = self.proc.stderr.readline()
@@ -92,8 +95,10 @@ class Browser:
             if getattr(self, "ws", None) is not None:
                 self.ws.close()
         finally:
-            if self.proc.poll() is None:
-                self.proc.kill()
+            try:
+                os.killpg(self.proc.pid, signal.SIGKILL)  # the wrapper, the browser and its helpers
+            except ProcessLookupError:
+                pass
             self.proc.wait()
             self._profile.cleanup()
 
