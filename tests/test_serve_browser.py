@@ -90,8 +90,8 @@ def test_student_submits_and_sees_first_wrong_step(server, browser, tmp_path):
     assert n >= 10 and "v_dot_1" in steps and "tau_1" in steps, steps
     shot = os.environ.get("ARMDYN_SERVE_SCREENSHOT")
     if shot:
-        page.eval("document.getElementById('preview').scrollTop = 1400; "
-                  "document.getElementById('markdown').scrollTop = 1500")
+        page.eval("var t = document.getElementById('markdown'); document.getElementById('preview').scrollTop = 1400;"
+                  "t.scrollTop = t.scrollHeight * t.value.indexOf('\\\\begin{split}') / t.value.length - 60")
         page.screenshot(shot, full=False)
     page.eval("document.getElementById('grade-button').click()")
     page.wait_for("location.pathname.startsWith('/submissions/') && document.readyState === 'complete'", 90,
