@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import html
 import json
+import os
 import re
 import subprocess
 import sys
@@ -78,8 +79,6 @@ def _groups() -> list[dict]:
 
 
 def _cli(*args, cwd: Path) -> subprocess.CompletedProcess:
-    import os
-
     env = {**os.environ, "PYTHONPATH": str(ROOT / "python")}
     return subprocess.run([sys.executable, "-m", "armdyn", *args], cwd=cwd, env=env, capture_output=True,
                           text=True, timeout=300, check=False)
@@ -141,7 +140,7 @@ def test_sanitizer_keeps_mathml_and_drops_the_rest():
            '<mi onmouseover="x()">a</mi><script>alert(1)</script><svg onload="x()"><text>t</text></svg>'
            '<mtext>&lt;img src=x onerror=alert(1)&gt;</mtext><annotation-xml encoding="text/html">'
            '<img src="x"/></annotation-xml><mstyle mathcolor="url(javascript:x)" displaystyle="true">'
-           '<mi>b</mi></mstyle><mi class="hl evil">c</mi><mspace width="calc(1em)"/><math><mi>d</mi></math></mrow>')
+           '<mi>b</mi></mstyle><mi class="hl evil">c</mi><mspace width="calc(1em)" height="99999em"/><math><mi>d</mi></math></mrow>')
     with pytest.raises(ValueError):  # xlink: undeclared prefix: not well-formed
         clean_mathml(bad)
     bad = bad.replace(' xlink:href="x"', "")
@@ -149,7 +148,7 @@ def test_sanitizer_keeps_mathml_and_drops_the_rest():
     assert out.markup == ('<mrow><mi>a</mi><mtext>&lt;img src=x onerror=alert(1)&gt;</mtext>'
                           '<mstyle displaystyle="true"><mi>b</mi></mstyle><mi>c</mi><mspace></mspace></mrow>')
     assert out.dropped == 4  # script, svg, annotation-xml, the nested math
-    assert out.stripped == 8  # href, style, onclick, id, onmouseover, mathcolor, class, width
+    assert out.stripped == 9  # href, style, onclick, id, onmouseover, mathcolor, class, width, height
 
 
 def test_sanitizer_output_passes_an_independent_html_check():

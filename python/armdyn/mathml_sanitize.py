@@ -50,7 +50,8 @@ MAX_DEPTH = 200
 # characters XML 1.0 cannot carry (a NUL in a name): replaced by U+FFFD before parsing
 _NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
 
-_NUMBER = r"[+-]?(?:\d{1,6}(?:\.\d{0,6})?|\.\d{1,6})"
+# at most 9999 units: a label cannot push the page kilometres wide
+_NUMBER = r"[+-]?(?:\d{1,4}(?:\.\d{0,6})?|\.\d{1,6})"
 _LENGTH = (rf"{_NUMBER}(?:em|ex|px|pt|pc|in|cm|mm|%|mu)?"
            r"|(?:negative)?(?:very){0,2}(?:thin|thick)mathspace|(?:negative)?mediummathspace|infinity")
 _BOOL = r"true|false"
