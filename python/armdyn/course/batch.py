@@ -349,7 +349,7 @@ def _warm_up(tasks: list[Task]) -> None:
     import collections
     import tempfile
 
-    from ..grade import grade
+    from ..grade import grade, text  # noqa: F401 - text: to_json's module, loaded once here
     from ..grade.html import report_html
     from ..io import load
     from .solution import solution_markdown, solution_steps
@@ -364,7 +364,9 @@ def _warm_up(tasks: list[Task]) -> None:
                 path = os.path.join(tmp, "solution.md")
                 with open(path, "w", encoding="utf-8") as fh:
                     fh.write(text)
-                report_html(grade(path, robot=robot))
+                report = grade(path, robot=robot)
+                report.to_json()
+                report_html(report)
         except Exception:  # noqa: BLE001, S112 - a warm-up that fails only costs time
             continue
 
