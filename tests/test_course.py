@@ -19,7 +19,7 @@ import sympy as sp
 import armdyn
 from armdyn.course import Gradebook, Rubric, summary_html
 from armdyn.course.errorkinds import classify
-from armdyn.course.exercise import make_exercise, read_roster, variant_files
+from armdyn.course.exercise import make_exercise, read_roster
 from armdyn.course.kinds import KINDS
 from armdyn.course.solution import inject_slip, solution_markdown, solution_steps
 from armdyn.course.variants import CONVENTIONS, draw_variant

@@ -349,7 +349,7 @@ def _warm_up(tasks: list[Task]) -> None:
     import collections
     import tempfile
 
-    from ..grade import grade, text  # noqa: F401 - text: to_json's module, loaded once here
+    from ..grade import grade, text  # text: to_json's module, loaded here once
     from ..grade.html import report_html
     from ..io import load
     from .solution import solution_markdown, solution_steps

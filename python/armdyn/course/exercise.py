@@ -97,8 +97,8 @@ def proof_files(kind: str, ident: str, seed: int) -> dict[str, str]:
 
     title, blocks = proof_blocks(kind, rng_for(seed, ident))
     statement = [("h1", f"Exercise {ident}: prove {title}"), ("p", blocks[0]), ("h2", "Handing in"),
-                 ("p", "One Markdown file: your proof in prose with every equation as display math `$$ ... $$`; "
-                       "armdyn checks every `=` of every equation. Start with this front matter:"),
+                 ("p", ("One Markdown file: your proof in prose with every equation as display math `$$ ... $$`; "
+                       "armdyn checks every `=` of every equation. Start with this front matter:")),
                  ("code", f"---\nstudent: {ident}\nvariant: {ident}\nrobot: model.yaml\n---")]
     front = {"robot": "model.yaml", "student": ident, "variant": ident}
     text, _ = proof_markdown(blocks, front, f"Solution of exercise {ident}: {title}")
@@ -172,7 +172,7 @@ def make_exercise(kind: str, out, seed: int = 0, count: int | None = None, roste
 
         steps_list = files.pop("steps.txt")
         atomic_writes([(os.path.join(folder, name), _writer(text)) for name, text in sorted(files.items())])
-        for name in re.findall(r"^    - (\S+)$", steps_list, re.M):
+        for name in re.findall(r"^    - (\S+)$", steps_list, re.MULTILINE):
             if name not in required:
                 required.append(name)
         result.written.append(ident)

@@ -52,8 +52,8 @@ def _parallel_axis(rng) -> tuple[str, list]:
     IA, IC = rf"\mathbf{{I}}_{point}", r"\mathbf{I}_C"
     integral = r"\int_{\mathcal{B}}"
     blocks = [
-        f"Prove that the inertia tensor of a rigid body about a point {point} is the one about its mass center "
-        f"C plus that of the whole mass M placed at C.",
+        (f"Prove that the inertia tensor of a rigid body about a point {point} is the one about its mass center "
+        f"C plus that of the whole mass M placed at C."),
         "## Proof",
         f"By definition, with ${rA}$ the position of the mass element $dm$ relative to {point},",
         ProofLine(rf"{IA} = {integral} \left( {rA}^T {rA} {one} - {rA} {rA}^T \right) dm",
@@ -72,9 +72,9 @@ def _parallel_axis(rng) -> tuple[str, list]:
         ProofLine(rf"{IA} = {integral} \left( ({rC} + {d})^T ({rC} + {d}) {one} - ({rC} + {d})({rC} + {d})^T \right) dm"
                   rf" = {IC} + {integral} \left( 2 {d}^T {rC} {one} - {rC} {d}^T - {d} {rC}^T \right) dm"
                   rf" + M \left( {d}^T {d} {one} - {d} {d}^T \right)",
-                  (rf"{IA} = {integral} \left( ({rC} + {d})^T ({rC} + {d}) {one} - ({rC} + {d})({rC} + {d})^T \right)"
+                  ((rf"{IA} = {integral} \left( ({rC} + {d})^T ({rC} + {d}) {one} - ({rC} + {d})({rC} + {d})^T \right)"
                    rf" dm = {IC} + {integral} \left( 2 {d}^T {rC} {one} - {rC} {d}^T - {d} {rC}^T \right) dm"
-                   rf" + M \left( {d}^T {d} {one} + {d} {d}^T \right)",),
+                   rf" + M \left( {d}^T {d} {one} + {d} {d}^T \right)"),),
                   ("wrong sign",)),
         "The middle integral is linear in the position relative to C, so it vanishes:",
         ProofLine(rf"{IA} = {IC} + M \left( {d}^T {d} {one} - {d} {d}^T \right)",
@@ -94,14 +94,14 @@ def _rotational_energy(rng) -> tuple[str, list]:
     else:
         integral, measure = r"\int_{\mathcal{B}}", "dm"
     blocks = [
-        r"Prove that the kinetic energy of rotation of link i is $E_{rot} = \frac{1}{2}\omega^{cT} I^c \omega^c$ "
-        "in any frame c.",
+        (r"Prove that the kinetic energy of rotation of link i is $E_{rot} = \frac{1}{2}\omega^{cT} I^c \omega^c$ "
+        "in any frame c."),
         "## Proof",
         r"Each mass element moves with the velocity $\omega_i \times r_i$, so",
         ProofLine(rf"E_{{rot}} = \frac{{1}}{{2}} {integral} (\omega_i \times r_i)^T (\omega_i \times r_i) {measure}"
                   rf" = \frac{{1}}{{2}} {integral} r_i^T S^T(\omega_i) S(\omega_i) r_i {measure}",
-                  (rf"E_{{rot}} = {integral} (\omega_i \times r_i)^T (\omega_i \times r_i) {measure}"
-                   rf" = {integral} r_i^T S^T(\omega_i) S(\omega_i) r_i {measure}",),
+                  ((rf"E_{{rot}} = {integral} (\omega_i \times r_i)^T (\omega_i \times r_i) {measure}"
+                   rf" = {integral} r_i^T S^T(\omega_i) S(\omega_i) r_i {measure}"),),
                   ("factor missing",)),
         "The skew matrix swaps its argument with the vector it multiplies, changing sign:",
         ProofLine(r"S(\omega_i) r_i = -S(r_i) \omega_i", (r"S(\omega_i) r_i = S(r_i) \omega_i",), ("wrong sign",)),

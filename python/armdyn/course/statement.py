@@ -36,7 +36,7 @@ def statement_blocks(variant: Variant, model: dict) -> list[tuple]:
     spec = variant.spec
     dof = len(spec.rows)
     rows = variant.rows()
-    coords = [("\\theta_{%d}" % i) if r.kind == "revolute" else ("d_{%d}" % i) for i, r in enumerate(rows, 1)]
+    coords = [f"\\theta_{{{i}}}" if r.kind == "revolute" else f"d_{{{i}}}" for i, r in enumerate(rows, 1)]
     out = [("h1", f"Exercise {variant.ident}: the dynamics of {spec.title.split(':')[0]}")]
     out.append(("p", f"The arm is {spec.title}. Its joint coordinates are "
                 + ", ".join(f"${c}$" for c in coords) + "."))
