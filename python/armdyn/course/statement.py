@@ -199,6 +199,8 @@ def drawing_uri(variant: Variant, robot) -> str:
             draw_on(ax, bound, poses, f"{variant.ident}: frames at a sample pose", _view(origins))
             if variant.spec.planar and variant.gravity != (0, 0, -1):
                 ax.view_init(elev=90, azim=-90)  # the arm's plane is x0-y0: seen from above
+                ax.set_zticks([])
+                ax.set_zlabel("")
             buf = io.BytesIO()
             fig.savefig(buf, format="svg", bbox_inches="tight", metadata={"Date": None, "Creator": None})
         finally:
