@@ -234,3 +234,16 @@ def test_same_batch_on_a_dask_cluster(small_class, tmp_path, capsys):
         cluster.close()
     assert code == 0
     assert book.read_text() == local
+
+
+def test_hostile_student_names_stay_inside_the_report_folder(tmp_path):
+    from armdyn.course.batch import discover, safe_file_name
+
+    assert safe_file_name("../../etc/passwd") == "_.._etc_passwd"
+    assert safe_file_name("..") == "_" and safe_file_name("") == "_"
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    (subs / "a.md").write_text("---\nstudent: ../../x\nvariant: {a: 1}\n---\n$$T = 0$$\n")
+    tasks, refused = discover(subs)
+    assert [t.student for t in tasks] == ["../../x"] and tasks[0].variant is None and refused == []
+    assert "/" not in safe_file_name(tasks[0].student)
