@@ -19,7 +19,7 @@ import sympy as sp
 import armdyn
 from armdyn.course import Gradebook, Rubric, summary_html
 from armdyn.course.errorkinds import classify
-from armdyn.course.exercise import make_exercise, read_roster, variant_files
+from armdyn.course.exercise import make_exercise, read_roster
 from armdyn.course.kinds import KINDS
 from armdyn.course.solution import inject_slip, solution_markdown, solution_steps
 from armdyn.course.variants import CONVENTIONS, draw_variant
@@ -276,3 +276,34 @@ def test_summary_page_is_self_contained_and_escaped():
     assert "mallory" not in page  # anonymised
     assert re.search(r'<img class="chart" [^>]*src="data:image/svg\+xml;base64,', page)
     assert summary_html(gb) == page  # byte-reproducible
+
+
+# ------------------------------------------------------------------ proofs
+@pytest.mark.parametrize("kind", ["parallel-axis", "rotational-energy"])
+def test_proof_solutions_grade_correct_and_slips_are_found(tmp_path, kind):
+    from armdyn.course.proofkinds import PROOF_MODEL, proof_blocks, proof_markdown, slippable_lines
+
+    (tmp_path / "model.yaml").write_text(PROOF_MODEL)
+    for seed in range(3):  # three notations
+        title, blocks = proof_blocks(kind, np.random.default_rng(seed))
+        text, where = proof_markdown(blocks, {"robot": "model.yaml"}, title)
+        (tmp_path / "proof.md").write_text(text)
+        report = armdyn.grade(str(tmp_path / "proof.md"))
+        links = [s for s in report.steps if s.name.startswith("proof_")]
+        assert len(links) >= len(where) and all(s.status == "correct" for s in links), \
+            [(s.name, s.status, s.message) for s in links]
+        for k in slippable_lines(blocks):
+            for j in range(len(blocks[k].slips)):
+                text, where = proof_markdown(blocks, {"robot": "model.yaml"}, title, slip=(k, j))
+                (tmp_path / "slip.md").write_text(text)
+                report = armdyn.grade(str(tmp_path / "slip.md"))
+                assert report.first_wrong is not None
+                assert report.first_wrong.split(".")[0] == f"proof_{where[k]}", (k, j, report.first_wrong)
+
+
+def test_make_a_proof_exercise(tmp_path):
+    make_exercise("rotational-energy", tmp_path, seed=3, count=2)
+    for v in ("v001", "v002"):
+        report = armdyn.grade(str(tmp_path / v / "solution.md"))
+        assert report.first_wrong is None and report.passed
+        assert sum(1 for s in report.steps if s.name.startswith("proof_")) >= 7

@@ -104,10 +104,10 @@ def test_class_of_60_against_the_injected_truth(course, tmp_path, capsys):
     firsts = collections.Counter(s.name for _, s, _, _ in truth.values() if s)
     kinds = collections.Counter(KIND_OF_SLIP[s.how] for _, s, _, _ in truth.values() if s)
     page = (tmp_path / "out" / "summary.html").read_text()
-    shown = dict((k, int(n)) for k, n in re.findall(r'<tr><td><code>([^<]+)</code></td><td class="num">(\d+)</td>',
-                                                    page))
+    shown = {k: int(n) for k, n in re.findall(r'<tr><td><code>([^<]+)</code></td><td class="num">(\d+)</td>',
+                                                    page)}
     assert shown == dict(firsts)
-    shown_kinds = dict((k, int(n)) for k, n in re.findall(r'<tr><td>([a-z ]+)</td><td class="num">(\d+)</td>', page))
+    shown_kinds = {k: int(n) for k, n in re.findall(r'<tr><td>([a-z ]+)</td><td class="num">(\d+)</td>', page)}
     assert shown_kinds == dict(kinds)
     assert f"<b>{sum(1 for *_x, in truth.values())}</b> submissions" in page
     assert len(list((tmp_path / "reports").glob("*.html"))) == 60
@@ -179,7 +179,7 @@ def test_cache_regrades_only_what_changed(small_class, tmp_path, capsys):
     assert code == 0 and "(3 unchanged" in capsys.readouterr().out
     assert {p: p.read_bytes() for p in book.parent.glob("*.*") if p.is_file()} == outputs  # same bytes
     text = (subs / "s2.md").read_text()
-    (subs / "s2.md").write_text(re.sub(r"^(\$\$\\tau_\{1\} = .*)\$\$$", r"\1 + 2 m_{1}$$", text, count=1, flags=re.M))
+    (subs / "s2.md").write_text(re.sub(r"^(\$\$\\tau_\{1\} = .*)\$\$$", r"\1 + 2 m_{1}$$", text, count=1, flags=re.MULTILINE))
     code, _ = _run(root, subs, tmp_path)
     assert code == 0 and "(2 unchanged" in capsys.readouterr().out
     rows = {r["student"]: r for r in json.loads(book.with_suffix(".json").read_text())["rows"]}
@@ -234,3 +234,16 @@ def test_same_batch_on_a_dask_cluster(small_class, tmp_path, capsys):
         cluster.close()
     assert code == 0
     assert book.read_text() == local
+
+
+def test_hostile_student_names_stay_inside_the_report_folder(tmp_path):
+    from armdyn.course.batch import discover, safe_file_name
+
+    assert safe_file_name("../../etc/passwd") == "_.._etc_passwd"
+    assert safe_file_name("..") == "_" and safe_file_name("") == "_"
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    (subs / "a.md").write_text("---\nstudent: ../../x\nvariant: {a: 1}\n---\n$$T = 0$$\n")
+    tasks, refused = discover(subs)
+    assert [t.student for t in tasks] == ["../../x"] and tasks[0].variant is None and refused == []
+    assert "/" not in safe_file_name(tasks[0].student)

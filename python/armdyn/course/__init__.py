@@ -24,7 +24,7 @@ Names are imported on first use, so that ``armdyn --help`` stays fast.
 
 from __future__ import annotations
 
-__all__ = ["Gradebook", "Rubric", "summary_html", "make_exercise", "grade_class"]
+__all__ = ["Gradebook", "Rubric", "grade_class", "make_exercise", "summary_html"]
 
 _WHERE = {"Gradebook": "gradebook", "Rubric": "rubric", "summary_html": "summary", "make_exercise": "exercise",
           "grade_class": "batch"}

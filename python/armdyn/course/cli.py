@@ -59,7 +59,8 @@ def cmd_grade_class(args) -> int:
 
 
 def add_exercise_parser(sub) -> None:
-    from .kinds import KINDS, PROOF_KINDS
+    from .kinds import KINDS
+    from .proofkinds import PROOF_KINDS
     from .variants import CONVENTIONS
 
     e = sub.add_parser("exercise", help="make a variant of an exercise per student")

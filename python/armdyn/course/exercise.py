@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 import yaml
 
 from ..errors import ModelError
-from .kinds import KINDS, PROOF_KINDS
+from .kinds import KINDS
+from .proofkinds import PROOF_KINDS
 from .variants import draw_variant
 
 ID_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9._-]{0,63}")
@@ -88,8 +89,27 @@ def read_roster(path) -> tuple[list[str], list[str]]:
     return ids, problems
 
 
+def proof_files(kind: str, ident: str, seed: int) -> dict[str, str]:
+    """The four files of one variant of a proof exercise: name -> text."""
+    from .proofkinds import PROOF_MODEL, proof_blocks, proof_markdown
+    from .statement import statement_html, statement_markdown
+    from .variants import rng_for
+
+    title, blocks = proof_blocks(kind, rng_for(seed, ident))
+    statement = [("h1", f"Exercise {ident}: prove {title}"), ("p", blocks[0]), ("h2", "Handing in"),
+                 ("p", ("One Markdown file: your proof in prose with every equation as display math `$$ ... $$`; "
+                       "armdyn checks every `=` of every equation. Start with this front matter:")),
+                 ("code", f"---\nstudent: {ident}\nvariant: {ident}\nrobot: model.yaml\n---")]
+    front = {"robot": "model.yaml", "student": ident, "variant": ident}
+    text, _ = proof_markdown(blocks, front, f"Solution of exercise {ident}: {title}")
+    return {"steps.txt": "", "model.yaml": PROOF_MODEL, "problem.md": statement_markdown(statement),
+            "problem.html": statement_html(statement, None), "solution.md": text}
+
+
 def variant_files(kind: str, ident: str, seed: int, convention: str | None = None) -> dict[str, str]:
     """The four files of one variant: name -> text."""
+    if kind in PROOF_KINDS:
+        return proof_files(kind, ident, seed)
     from ..io.yaml import load_yaml_string
     from .solution import solution_markdown, solution_steps
     from .statement import (
@@ -132,10 +152,8 @@ def make_exercise(kind: str, out, seed: int = 0, count: int | None = None, roste
     written all or nothing. ``progress(ident)`` is called after each one."""
     from .._io_atomic import atomic_writes
 
-    if kind in PROOF_KINDS:
-        raise ModelError(f"exercise kind {kind!r} needs proof grading, which this armdyn does not have yet")
-    if kind not in KINDS:
-        raise ModelError(f"unknown exercise kind {kind!r} (known: {', '.join(KINDS)})")
+    if kind not in KINDS and kind not in PROOF_KINDS:
+        raise ModelError(f"unknown exercise kind {kind!r} (known: {', '.join([*KINDS, *PROOF_KINDS])})")
     if (count is None) == (roster is None):
         raise ModelError("give either a count of variants or a roster")
     result = MakeResult()
@@ -154,7 +172,7 @@ def make_exercise(kind: str, out, seed: int = 0, count: int | None = None, roste
 
         steps_list = files.pop("steps.txt")
         atomic_writes([(os.path.join(folder, name), _writer(text)) for name, text in sorted(files.items())])
-        for name in re.findall(r"^    - (\S+)$", steps_list, re.M):
+        for name in re.findall(r"^    - (\S+)$", steps_list, re.MULTILINE):
             if name not in required:
                 required.append(name)
         result.written.append(ident)

@@ -122,13 +122,17 @@ def _cell(value) -> str:
 
 def part_of_steps(steps: list[dict], method: str | None) -> list[str]:
     """The part of each step: its ``part`` field, else ``newton-euler`` / ``lagrange``
-    from its key (a tau belongs to the method of the steps before it)."""
+    from its key (a tau belongs to the method of the steps before it), ``proof`` for the
+    links of a proof (``proof_<line>``)."""
     context = "lagrange" if method == "lagrange" else "newton-euler"
     out = []
     for s in steps:
         key = s.get("key") or _key_of(s.get("name") or "")
         if s.get("part"):
             out.append(s["part"])
+            continue
+        if key == "proof":
+            out.append("proof")  # a link of a rigid-body proof (grade.proofs)
             continue
         if key in LAGRANGE_KEYS:
             context = "lagrange"
@@ -144,6 +148,8 @@ def _key_of(name: str) -> str:
         return name
     if name.startswith("R_"):
         return "R"
+    if name.startswith("proof_"):
+        return "proof"
     head, _, tail = name.rpartition("_")
     return head if tail.isdigit() else name
 

@@ -106,5 +106,3 @@ def _kinds() -> dict[str, Kind]:
 
 
 KINDS = _kinds()
-#: proof exercises (graded once the grader reads proofs)
-PROOF_KINDS = ("parallel-axis", "rotational-energy")

@@ -6,8 +6,8 @@ A rubric is a small YAML file (every key optional; this is :meth:`Rubric.default
       tau: 2                     #   a name wins over its key; steps not listed: `default`
     default: 1
     parts:                       # optional: scale each part's steps to this many points
-      newton-euler: 10           #   (parts: newton-euler, lagrange, and the proofs
-      lagrange: 5                #    parallel-axis, rotational-energy)
+      newton-euler: 10           #   (parts: newton-euler, lagrange, proof)
+      lagrange: 5
     required: [tau_1, tau_2]     # optional: steps every submission must write; one that
                                  #   is missing scores 0 of its points (steps not written
                                  #   and not required are simply not counted)
@@ -20,7 +20,8 @@ A rubric is a small YAML file (every key optional; this is :meth:`Rubric.default
 
 A step's part is the ``part`` field of the grade JSON when it has one, else read from its
 key: Lagrange's steps (T, V, L, the derivatives of L, and a tau after them) are part
-``lagrange``, the others ``newton-euler``. Unrecognised equations score nothing and are
+``lagrange``, the links of a proof (``proof_<line>``) ``proof``, the others
+``newton-euler``. Unrecognised equations score nothing and are
 not counted. Points are rounded to 2 decimals.
 """
 

@@ -36,7 +36,7 @@ def statement_blocks(variant: Variant, model: dict) -> list[tuple]:
     spec = variant.spec
     dof = len(spec.rows)
     rows = variant.rows()
-    coords = [("\\theta_{%d}" % i) if r.kind == "revolute" else ("d_{%d}" % i) for i, r in enumerate(rows, 1)]
+    coords = [f"\\theta_{{{i}}}" if r.kind == "revolute" else f"d_{{{i}}}" for i, r in enumerate(rows, 1)]
     out = [("h1", f"Exercise {variant.ident}: the dynamics of {spec.title.split(':')[0]}")]
     out.append(("p", f"The arm is {spec.title}. Its joint coordinates are "
                 + ", ".join(f"${c}$" for c in coords) + "."))
@@ -199,6 +199,8 @@ def drawing_uri(variant: Variant, robot) -> str:
             draw_on(ax, bound, poses, f"{variant.ident}: frames at a sample pose", _view(origins))
             if variant.spec.planar and variant.gravity != (0, 0, -1):
                 ax.view_init(elev=90, azim=-90)  # the arm's plane is x0-y0: seen from above
+                ax.set_zticks([])
+                ax.set_zlabel("")
             buf = io.BytesIO()
             fig.savefig(buf, format="svg", bbox_inches="tight", metadata={"Date": None, "Creator": None})
         finally:

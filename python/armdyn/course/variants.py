@@ -143,8 +143,14 @@ class Variant:
         for i, (r, (m, com, inertia)) in enumerate(zip(rows, inert), 1):
             nxt = rows[i] if i < n else None
             # standard row i: a_i, alpha_i of the common normal to the next axis (Craig's row i+1);
-            # the last row: none (DH frame n = frame n)
-            a, alpha = (nxt.a, nxt.alpha) if nxt is not None else (sp.Integer(0), sp.Integer(0))
+            # the last row: the tool frame at the end of a last link along x (as Spong draws a
+            # planar arm), else none
+            if nxt is not None:
+                a, alpha = nxt.a, nxt.alpha
+            else:
+                end = sp.Matrix(r.rod[1])
+                a = end[0] if end[1] == 0 and end[2] == 0 else sp.Integer(0)
+                alpha = sp.Integer(0)
             Rx = sp.rot_axis1(-alpha)  # rot_axis1(t) is the passive rotation: Rx(alpha) = rot_axis1(-alpha)
             com_dh = Rx.T * (com - sp.Matrix([a, 0, 0]))
             table.append({"name": self.joint_name(i, r), "type": r.kind, "a": _text(a), "alpha": _text(alpha),

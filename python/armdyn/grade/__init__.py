@@ -30,6 +30,7 @@ from .explain import component_name, describe, pretty, split_name, tidy
 from .latex import GREEK, LatexError, UnknownSymbol, parse, parse_sympy_syntax
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
+from .proofs import grade_proofs
 from .reader import Submission, read
 from .verdict import PASSING, STATUSES, GradeReport, StepVerdict
 
@@ -185,6 +186,7 @@ class _Grader:
                 self._step(self.world(method), ref, eq, value, method)
             if ref.key in ("T", "V", "L"):
                 self.symbols.steps[ref.key] = value
+        self.verdicts = grade_proofs(self.sub, self.verdicts)  # rigid-body proofs: every link checked
         recognised = [v for v in self.verdicts if v.key]  # a step named, even if its value was unreadable
         if not recognised:
             raise ModelError("no step of Newton-Euler or Lagrange recognised (expected equations such as "

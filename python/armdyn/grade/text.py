@@ -70,6 +70,8 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
                 what += f" ({v.convention})"
         elif v.status == "correct-by-convention":
             what = f"correct ({v.convention})"
+        elif v.status == "correct" and v.key == "proof" and v.message:
+            what = f"correct: {v.message}"
         elif v.status in ("wrong", "correct-but-unsupported", "unrecognised"):
             what = f"{v.status.upper() if v.status == 'wrong' else v.status}: {v.message}"
         lines.append(f"  {mark} line {v.line:>4}  {_pad(step_title(v, ascii_only), width)}  {what}")
@@ -136,6 +138,7 @@ def to_dict(report: GradeReport) -> dict:
             "label": v.label,
             "message": v.message,
             "components": v.components,
+            **({"counterexample": v.counterexample} if v.counterexample else {}),
         })
     return {
         "robot": report.robot,

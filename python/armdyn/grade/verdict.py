@@ -61,6 +61,8 @@ class StepVerdict:
     caused_by:   name of the earlier step an inherited error comes from, or None
     message:     one readable sentence, e.g. "missing term −l1·θ̇1² in the x component"
     frame:       the frame the value is expressed in, e.g. "1" (text), "" for scalars
+    counterexample: for a wrong proof link, the small body on which its sides differ
+                 (masses, points, vectors, rotations, both sides' values), else None
     """
 
     name: str
@@ -78,6 +80,7 @@ class StepVerdict:
     caused_by: str | None = None
     message: str = ""
     frame: str = ""
+    counterexample: dict | None = None
 
     @property
     def passed(self) -> bool:
