@@ -5,6 +5,9 @@
     armdyn robots
     armdyn show ROBOT [--q Q1,Q2,...] [--out arm.png]
     armdyn grade SUBMISSION [--robot MODEL] [--json] [--html OUT.html] [--ascii] [--to-yaml]
+    armdyn grade DIR --gradebook grades.csv [--rubric R.yaml] [--html-dir DIR] [--variants DIR] [--jobs N]
+    armdyn exercise make KIND (--count N | --roster roster.csv) --seed S --out DIR
+    armdyn serve [--host H] [--port P] [--db URL] [--workers N] [--exercises DIR] [--instructor-token T]
     armdyn codegen ROBOT [--what tau,M,C,g,regressor] [--base] [--lang c|python|numpy] [--bind] [--out DIR]
     armdyn simulate ROBOT --duration T --dt DT [--q0 ...] [--controller pd --target ...] [--plot run.png] [--animate run.gif]
 
@@ -90,6 +93,10 @@ def cmd_show(args) -> int:
 
 
 def cmd_grade(args) -> int:
+    if os.path.isdir(args.submission):  # a folder: the whole class (armdyn.course)
+        from .course.cli import cmd_grade_class
+
+        return cmd_grade_class(args)
     from .grade import grade
     from .grade.reader import read
 
@@ -110,6 +117,12 @@ def cmd_grade(args) -> int:
     else:
         print(report.text(ascii_only=args.ascii))
     return 0 if report.passed else 1
+
+
+def cmd_serve(args) -> int:
+    from .serve.server import run
+
+    return run(args)
 
 
 def cmd_codegen(args) -> int:
@@ -274,13 +287,31 @@ def build_parser() -> argparse.ArgumentParser:
     gr = sub.add_parser("grade", help="check a student's own derivation step by step (first wrong step)",
                         description="Grade a derivation written in Markdown with LaTeX display math (or YAML). "
                                     "Exit status: 0 every step correct, 1 some step wrong, 2 bad input.")
-    gr.add_argument("submission", help="the derivation: a .md file (LaTeX display math) or a .yaml file")
+    gr.add_argument("submission", help="the derivation: a .md file (LaTeX display math) or a .yaml file; "
+                    "or a folder of them: the whole class (see --gradebook)")
     gr.add_argument("--robot", help="the model whose frames the student used (default: the front matter's robot)")
     gr.add_argument("--json", action="store_true", help="print the verdicts as one JSON object")
     gr.add_argument("--html", metavar="OUT.html", help="also write a self-contained HTML report")
     gr.add_argument("--ascii", action="store_true", help="plain ASCII text (no Unicode dots and marks)")
     gr.add_argument("--to-yaml", action="store_true", help="print the steps as read (the YAML format) and stop")
     gr.set_defaults(func=cmd_grade)
+    from .course.cli import add_batch_arguments, add_exercise_parser
+
+    add_batch_arguments(gr)
+    add_exercise_parser(sub)
+    sv = sub.add_parser("serve", help="web app: students submit derivations, instructors see the class",
+                        description="Serve the grading web app (docs/serve.md). Needs: pip install 'armdyn[serve]'.")
+    sv.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1)")
+    sv.add_argument("--port", type=int, default=8000)
+    sv.add_argument("--db", help="sqlite:///PATH (default sqlite:///armdyn-serve.db) or postgresql://USER@HOST/DB")
+    sv.add_argument("--workers", type=int, default=2, help="grading processes (default 2)")
+    sv.add_argument("--exercises", metavar="DIR", help="variants made by `armdyn exercise make` (DIR/<id>/model.yaml)")
+    sv.add_argument("--instructor-token", help="the instructor's login token (or env ARMDYN_INSTRUCTOR_TOKEN)")
+    sv.add_argument("--timeout", type=float, default=60.0, help="seconds one grading may take (default 60)")
+    sv.add_argument("--memory-mb", type=int, default=2048, help="address-space limit of a worker (default 2048)")
+    sv.add_argument("--forwarded-allow-ips", default="127.0.0.1",
+                    help="proxies whose X-Forwarded-* headers are trusted (default 127.0.0.1)")
+    sv.set_defaults(func=cmd_serve)
     cg = sub.add_parser("codegen", help="generate C, Python or NumPy code for tau, M, C, g, the regressor")
     robot_arg(cg)
     cg.add_argument("--what", default="tau,M,C,g", help="comma-separated: tau,M,C,g,regressor (default tau,M,C,g)")
@@ -328,7 +359,7 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # e.g. `armdyn robots | head`
         sys.stderr.close()
         return 0
-    except Exception as err:  # noqa: BLE001 - a bug: one line unless debugging
+    except Exception as err:
         if os.environ.get("ARMDYN_DEBUG"):
             raise
         print(f"armdyn: internal error: {type(err).__name__}: {err} (set ARMDYN_DEBUG=1 for a traceback)",

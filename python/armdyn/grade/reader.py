@@ -109,6 +109,7 @@ def _front(meta, path: str, sub: Submission) -> None:
     if not isinstance(meta, dict):
         raise ModelError("the front matter must be a mapping (robot: ..., method: ...)", source=path)
     allowed = {"robot", "method", "symbols", "values", "convention", "title", "author", "steps", "notes"}
+    allowed |= {"student", "variant"}  # a course's bookkeeping (armdyn.course), not graded
     unknown = sorted(str(k) for k in meta if k not in allowed)
     if unknown:
         raise ModelError(f"unknown key(s) {', '.join(unknown)} (expected {', '.join(sorted(allowed))})",

@@ -10,6 +10,8 @@ derivations themselves never call ``simplify``.
 
 from __future__ import annotations
 
+import functools
+
 import symengine as se
 import sympy as sp
 
@@ -100,7 +102,13 @@ def unicode_supported(stream=None) -> bool:
 def tidy_terms(expr, q, qd, qdd) -> list[tuple]:
     """``expr`` as an ordered list of ``(coefficient, monomial)``: joint-acceleration
     terms, velocity-product terms, then the rest (gravity), coefficients factored.
-    Empty list for zero."""
+    Empty list for zero. Memoised: reports show the same values again and again (a
+    class graded against one model), and factoring is the slow part of a report."""
+    return list(_tidy_terms(sp.sympify(expr), tuple(q), tuple(qd), tuple(qdd)))
+
+
+@functools.lru_cache(maxsize=4096)
+def _tidy_terms(expr, q, qd, qdd) -> tuple:
     e = trig_reduce(expr, q, keep_trig=True)
     if e == 0:
         return []
@@ -112,7 +120,7 @@ def tidy_terms(expr, q, qd, qdd) -> list[tuple]:
         trig = [f(qi) for qi in q for f in (sp.sin, sp.cos)]
         for mono, coef in sp.collect(sp.expand(rest), trig, evaluate=False).items():
             terms.append((sp.factor(coef), mono))
-    return terms
+    return tuple(terms)
 
 
 def _join(terms, render, text: bool | None = None) -> str:

@@ -1,0 +1,400 @@
+"""Grade a whole class: ``armdyn grade DIR --gradebook grades.csv``.
+
+    result = grade_class("submissions/", "grades.csv", variants="exercise/", rubric=Rubric.default(),
+                         html_dir="reports/", jobs=2)
+    result.gradebook.rows; result.not_graded      # lines "file: why", one per submission not graded
+
+Every ``*.md``, ``*.yaml``, ``*.yml`` file directly in the folder is a submission. Its
+student is the front matter's ``student:`` (else the file's stem); its variant the front
+matter's ``variant:``, else the student's id, else the stem, when ``variants/<that>/``
+exists. With ``variants`` (the folder ``armdyn exercise make`` wrote) each submission is
+graded against ``variants/<variant>/model.yaml``; a submission whose variant is not
+there is not graded (status ``no-variant``). Without it, the front matter's ``robot:``
+is used as ``armdyn grade FILE`` would. A second file for the same student is not graded
+(``duplicate``).
+
+Each submission is graded in its own forked child (:mod:`.isolate`) with a time and
+memory limit; one that times out, runs out of memory or crashes is reported as such
+and loses no one else's result. Results are cached in ``.armdyn-cache/`` beside the
+gradebook, keyed by a hash of the submission's bytes, the model's bytes, the rubric,
+armdyn's version and the grader's source: a re-run grades only what changed.
+
+Outputs (each written all or nothing): the gradebook CSV, the same as JSON beside it
+(``grades.json``), ``summary.html`` beside it, and with ``html_dir`` one report per
+student (``<student>.html``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import re
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+from ..errors import ModelError
+from .gradebook import Gradebook
+from .rubric import Rubric
+
+SUFFIXES = (".md", ".yaml", ".yml")
+#: files larger than this are not read for their front matter (the grader refuses them too)
+MAX_BYTES = 5_000_000
+CACHE_DIR = ".armdyn-cache"
+
+
+@dataclass
+class Task:
+    """One submission to grade (JSON-able: it crosses to the child and to Dask workers)."""
+
+    path: str
+    student: str
+    variant: str | None
+    robot: str | None
+    want_html: bool
+
+
+@dataclass
+class BatchResult:
+    """The gradebook, one line per submission not graded (``file: status: why``),
+    how many were taken from the cache, and the seconds it took."""
+
+    gradebook: Gradebook
+    not_graded: list[str] = field(default_factory=list)
+    cached: int = 0
+    seconds: float = 0.0
+
+
+# ------------------------------------------------------------------ one submission
+def grade_task(task: dict) -> dict:
+    """Grade one submission (runs in the child): ``{"report": grade JSON, "html": page}``
+    or ``{"error": "error: file:line: what"}`` for a submission the grader refuses."""
+    from ..grade import grade
+
+    try:
+        report = grade(task["path"], robot=task["robot"])
+    except (ModelError, ValueError, OSError) as exc:
+        return {"error": "error: " + " ".join(str(exc).split())}
+    out = {"report": json.loads(report.to_json())}
+    if task["want_html"]:
+        from ..grade.html import report_html
+
+        out["html"] = report_html(report)
+    return out
+
+
+def _dask_task(task: dict, timeout: float, memory_mb: int | None) -> dict:
+    from .isolate import run_isolated
+
+    return run_isolated(grade_task, task, timeout, memory_mb)
+
+
+# ------------------------------------------------------------------ finding submissions
+def _front_matter(path: str) -> tuple[dict, str | None]:
+    """The submission's front matter (Markdown) or top-level mapping (YAML), and why the
+    file cannot be graded at all (too large, not UTF-8: ``path:line: what``) or None.
+    A front matter that does not parse gives {} (the grader then says why)."""
+    try:
+        if os.path.getsize(path) > MAX_BYTES:
+            return {}, f"{path}: larger than {MAX_BYTES} bytes"
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except OSError as exc:
+        return {}, f"{path}: cannot read it ({exc.strerror})"
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        return {}, f"{path}:{line}: not UTF-8 text (byte {exc.start + 1})"
+    if path.lower().endswith(".md"):
+        if not text.startswith("---"):
+            return {}, None
+        end = re.search(r"^---\s*$", text[3:], re.MULTILINE)
+        if end is None:
+            return {}, None
+        text = text[3:3 + end.start()]
+    try:
+        data = yaml.safe_load(text)
+    except (yaml.YAMLError, RecursionError, ValueError):
+        return {}, None
+    return (data if isinstance(data, dict) else {}), None
+
+
+def _name(value) -> str | None:
+    if value is None or isinstance(value, (dict, list)):
+        return None
+    text = " ".join(str(value).split())
+    return text[:200] or None
+
+
+def safe_file_name(student: str) -> str:
+    """A file name for a student's report: unsafe characters become ``_``."""
+    name = re.sub(r"[^A-Za-z0-9._-]", "_", student)[:100].lstrip(".")
+    return name or "_"
+
+
+def discover(folder, variants=None, want_html: bool = False) -> tuple[list[Task], list[tuple]]:
+    """The submissions of ``folder`` as tasks, and the rows of those that cannot be graded:
+    ``(student, variant, error)``."""
+    folder = os.fspath(folder)
+    if not os.path.isdir(folder):
+        raise ModelError("not a folder of submissions", source=folder)
+    files = sorted(f for f in os.listdir(folder)
+                   if f.lower().endswith(SUFFIXES) and not f.startswith(".")
+                   and os.path.isfile(os.path.join(folder, f)))
+    tasks, refused, owner = [], [], {}
+    for f in files:
+        path = os.path.join(folder, f)
+        meta, unreadable = _front_matter(path)
+        stem = os.path.splitext(f)[0]
+        student = _name(meta.get("student")) or stem
+        variant = _name(meta.get("variant"))
+        if unreadable:
+            refused.append((student, variant, f"error: {unreadable}"))
+            continue
+        robot = None
+        if variants is not None:
+            if variant is None:
+                variant = next((c for c in (student, stem) if os.path.isdir(os.path.join(variants, c))), None)
+            model = os.path.join(variants, variant, "model.yaml") if variant else None
+            if variant is None or "/" in variant or variant.startswith(".") or not os.path.isfile(model):
+                what = f"no variant {variant!r} in {variants}" if variant else \
+                    f"no variant for student {student!r} (no variant: in the front matter, no folder {student!r})"
+                refused.append((student, variant, f"no-variant: {path}: {what}"))
+                continue
+            robot = model
+        if student in owner:
+            why = f"duplicate: {path}: student {student!r} also handed in {owner[student]} (graded that one)"
+            refused.append((student, variant, why))
+            continue
+        owner[student] = path
+        tasks.append(Task(path=path, student=student, variant=variant, robot=robot, want_html=want_html))
+    return tasks, refused
+
+
+# ------------------------------------------------------------------ cache
+def _grader_fingerprint() -> str:
+    """armdyn's version and a hash of the grader's source (a changed grader re-grades)."""
+    from .. import __version__
+
+    h = hashlib.sha256(__version__.encode())
+    root = Path(__file__).resolve().parent.parent / "grade"
+    for p in sorted(root.rglob("*.py")):
+        h.update(p.name.encode())
+        h.update(p.read_bytes())
+    return h.hexdigest()
+
+
+def _file_bytes(path: str | None) -> bytes:
+    if not path:
+        return b""
+    try:
+        with open(path, "rb") as fh:
+            return fh.read(MAX_BYTES + 1)
+    except OSError:
+        return b""
+
+
+def cache_key(task: Task, rubric: Rubric, grader: str) -> str:
+    h = hashlib.sha256()
+    for part in (_file_bytes(task.path), _file_bytes(task.robot), (task.robot or "").encode(),
+                 rubric.fingerprint().encode(), grader.encode(), b"html" if task.want_html else b""):
+        h.update(hashlib.sha256(part).digest())
+    return h.hexdigest()
+
+
+# ------------------------------------------------------------------ the class
+def grade_class(folder, gradebook, rubric: Rubric | None = None, html_dir=None, jobs: int | None = None,
+                variants=None, timeout: float = 60.0, memory_mb: int | None = 1024, use_cache: bool = True,
+                dask: str | None = None, progress: bool | None = None) -> BatchResult:
+    """Grade every submission in ``folder`` and write the gradebook (see the module docstring)."""
+    from .._io_atomic import atomic_writes
+    from .summary import summary_html
+
+    t0 = time.perf_counter()
+    rubric = rubric or Rubric.default()
+    gradebook = os.fspath(gradebook)
+    if variants is not None and not os.path.isdir(variants):
+        raise ModelError("not a folder of variants (the output of armdyn exercise make)", source=os.fspath(variants))
+    tasks, refused = discover(folder, variants, want_html=html_dir is not None)
+    out_dir = os.path.dirname(os.path.abspath(gradebook))
+    cache_dir = os.path.join(out_dir, CACHE_DIR)
+    grader = _grader_fingerprint()
+    keys = {t.path: cache_key(t, rubric, grader) for t in tasks}
+    results: dict[str, dict] = {}
+    todo = []
+    for t in tasks:
+        hit = _cache_get(cache_dir, keys[t.path]) if use_cache else None
+        if hit is not None:
+            results[t.path] = hit
+        else:
+            todo.append(t)
+    cached = len(results)
+    jobs = jobs or os.cpu_count() or 1
+    bar = _bar(len(todo), progress)
+    try:
+        for path, result in _run(todo, jobs, timeout, memory_mb, dask):
+            results[path] = result
+            deterministic = "report" in result or str(result.get("error", "")).startswith("error:")
+            if use_cache and deterministic:
+                _cache_put(cache_dir, keys[path], result)
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+
+    items, not_graded = [], []
+    for t in tasks:
+        r = results[t.path]
+        items.append((t.student, t.variant, r.get("report"), r.get("error")))
+        if "report" not in r:
+            not_graded.append(_why(t.path, r.get("error") or "crashed: no result"))
+    for student, variant, error in refused:
+        items.append((student, variant, None, error))
+        not_graded.append(_why(None, error))
+    book = Gradebook.from_results(items, rubric=rubric)
+
+    outputs = [(gradebook, book.to_csv()), (os.path.splitext(gradebook)[0] + ".json", book.to_json()),
+               (os.path.join(out_dir, "summary.html"), summary_html(book))]
+    if html_dir is not None:
+        os.makedirs(html_dir, exist_ok=True)
+        for t in tasks:
+            r = results[t.path]
+            page = r.get("html") or _not_graded_page(t.student, r.get("error") or "not graded")
+            outputs.append((os.path.join(html_dir, safe_file_name(t.student) + ".html"), page))
+    atomic_writes([(p, _text_writer(text)) for p, text in outputs])
+    return BatchResult(gradebook=book, not_graded=not_graded, cached=cached, seconds=time.perf_counter() - t0)
+
+
+def _why(path: str | None, error: str) -> str:
+    """``status: what`` as one line for stderr: ``file[:line]: what (status)``."""
+    status, _, rest = error.partition(": ")
+    if path and path not in rest:
+        rest = f"{path}: {rest}"
+    return f"{rest} ({status})"
+
+
+def _text_writer(text: str):
+    def write(tmp):
+        with open(tmp, "w", encoding="utf-8", newline="\n") as fh:
+            fh.write(text)
+    return write
+
+
+def _not_graded_page(student: str, error: str) -> str:
+    from ..mathml import escape
+    from .page import course_page
+
+    return course_page(f"{student}: not graded", f"<h1>{escape(student)}: not graded</h1>\n"
+                                                  f"<p>{escape(error)}</p>")
+
+
+def _run(tasks: list[Task], jobs: int, timeout: float, memory_mb, dask: str | None):
+    """Yield ``(path, result)`` per task, locally (forked children) or on a Dask cluster."""
+    if not tasks:
+        return
+    if dask:
+        try:
+            from distributed import Client, as_completed
+        except ImportError:
+            raise ModelError("--dask needs the 'distributed' package (pip install armdyn[dask])") from None
+        with Client(dask) as client:
+            futures = {client.submit(_dask_task, t.__dict__, timeout, memory_mb, pure=False): t.path for t in tasks}
+            for fut in as_completed(futures):
+                try:
+                    result = fut.result()
+                except Exception as exc:  # noqa: BLE001 - a lost worker loses one result, not the batch
+                    result = {"error": f"crashed: {type(exc).__name__}: {exc}"}
+                yield futures[fut], result
+        return
+    # import the grader once here: every forked child starts with it loaded
+    import armdyn.grade
+    import armdyn.grade.html  # noqa: F401
+
+    from .isolate import ChildPool
+
+    _warm_up(tasks)  # also imports the grader here: every forked child starts with it loaded
+    pool = ChildPool(grade_task, jobs, timeout, memory_mb)
+    yield from pool.run((t.path, t.__dict__) for t in tasks)
+
+
+#: a model shared by at least this many submissions is warmed up in the parent first
+WARM_SHARED = 3
+#: at most this many models are warmed up
+WARM_MODELS = 4
+
+
+def _model_of(task: Task) -> str | None:
+    """The model a task is graded against (file or bundled name), as the grader finds it."""
+    if task.robot:
+        return task.robot
+    name = _name(_front_matter(task.path)[0].get("robot"))
+    if not name:
+        return None
+    beside = os.path.join(os.path.dirname(os.path.abspath(task.path)), name)
+    return beside if os.path.isfile(beside) else name
+
+
+def _warm_up(tasks: list[Task]) -> None:
+    """Import the grader, then grade armdyn's own solution of each model that many
+    submissions share, in the parent, before the children fork: they start with the
+    derivation's and the report's caches warm (the expected values they show are the
+    same for the whole class). Trusted input (armdyn's own derivation); a failure here
+    only costs the speed-up."""
+    import collections
+    import tempfile
+
+    from ..grade import grade, text  # text: to_json's module, loaded here once
+    from ..grade.html import report_html
+    from ..io import load
+    from .solution import solution_markdown, solution_steps
+
+    counts = collections.Counter(m for m in map(_model_of, tasks) if m)
+    shared = [m for m, n in counts.most_common(WARM_MODELS) if n >= WARM_SHARED]
+    for model in shared:
+        try:
+            robot = load(model, strict=False)
+            text = solution_markdown(robot, solution_steps(robot), {"method": "both"}, "warm-up")
+            with tempfile.TemporaryDirectory() as tmp:
+                path = os.path.join(tmp, "solution.md")
+                with open(path, "w", encoding="utf-8") as fh:
+                    fh.write(text)
+                report = grade(path, robot=robot)
+                report.to_json()
+                report_html(report)
+        except Exception:  # noqa: BLE001, S112 - a warm-up that fails only costs time
+            continue
+
+
+def _bar(total: int, progress: bool | None):
+    if progress is False or total == 0 or (progress is None and not sys.stderr.isatty()):
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return None
+    return tqdm(total=total, unit="submission", file=sys.stderr)
+
+
+def _cache_get(folder: str, key: str) -> dict | None:
+    try:
+        with open(os.path.join(folder, key + ".json"), encoding="utf-8") as fh:
+            data = json.load(fh)
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) and ("report" in data or "error" in data) else None
+
+
+def _cache_put(folder: str, key: str, result: dict) -> None:
+    from .._io_atomic import atomic_write_text
+
+    try:
+        os.makedirs(folder, exist_ok=True)
+        atomic_write_text(os.path.join(folder, key + ".json"), json.dumps(result, sort_keys=True))
+    except OSError:
+        pass  # a cache that cannot be written only costs time

@@ -1,0 +1,173 @@
+"""A rubric: how many points each step of a graded derivation is worth.
+
+A rubric is a small YAML file (every key optional; this is :meth:`Rubric.default`)::
+
+    points:                      # points of a step, by step name (tau_1) or step key (tau);
+      tau: 2                     #   a name wins over its key; steps not listed: `default`
+    default: 1
+    parts:                       # optional: scale each part's steps to this many points
+      newton-euler: 10           #   (parts: newton-euler, lagrange, proof)
+      lagrange: 5
+    required: [tau_1, tau_2]     # optional: steps every submission must write; one that
+                                 #   is missing scores 0 of its points (steps not written
+                                 #   and not required are simply not counted)
+    credit:                      # fraction of a step's points, by verdict status
+      correct: 1
+      correct-by-convention: 1
+      follows-from-earlier-error: 0.5
+      correct-but-unsupported: 0.5
+      wrong: 0
+
+A step's part is the ``part`` field of the grade JSON when it has one, else read from its
+key: Lagrange's steps (T, V, L, the derivatives of L, and a tau after them) are part
+``lagrange``, the links of a proof (``proof_<line>``) ``proof``, the others
+``newton-euler``. Unrecognised equations score nothing and are
+not counted. Points are rounded to 2 decimals.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+
+from ..errors import ModelError
+
+#: credit (fraction of a step's points) per verdict status, by default
+DEFAULT_CREDIT = {
+    "correct": 1.0,
+    "correct-by-convention": 1.0,
+    "follows-from-earlier-error": 0.5,
+    "correct-but-unsupported": 0.5,
+    "wrong": 0.0,
+    "unrecognised": 0.0,
+}
+_KEYS = ("points", "default", "parts", "required", "credit")
+#: the largest rubric file read (bytes): a rubric is a few lines
+MAX_BYTES = 1 << 20
+
+
+@dataclass
+class Rubric:
+    """Points per step (``points`` by name or key, else ``default_points``: the file's
+    ``default``), optional part totals (``parts``), required steps and the credit per
+    status (fractions in [0, 1])."""
+
+    points: dict[str, float] = field(default_factory=lambda: {"tau": 2.0})
+    default_points: float = 1.0
+    parts: dict[str, float] = field(default_factory=dict)
+    required: list[str] = field(default_factory=list)
+    credit: dict[str, float] = field(default_factory=lambda: dict(DEFAULT_CREDIT))
+    source: str = "<default rubric>"
+
+    @classmethod
+    def default(cls) -> Rubric:
+        """Every step 1 point, each tau 2; wrong 0, inherited or unsupported half."""
+        return cls()
+
+    @classmethod
+    def load(cls, path) -> Rubric:
+        """Read a rubric file; a bad one raises :class:`ModelError` naming ``file:line``."""
+        path = os.fspath(path)
+        try:
+            with open(path, "rb") as fh:
+                raw = fh.read(MAX_BYTES + 1)
+        except OSError as exc:
+            raise ModelError(f"cannot read the rubric ({exc.strerror})", source=path) from None
+        if len(raw) > MAX_BYTES:
+            raise ModelError(f"rubric larger than {MAX_BYTES} bytes", source=path)
+        try:
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            line = raw[: exc.start].count(b"\n") + 1
+            raise ModelError("not UTF-8 text", source=f"{path}:{line}") from None
+        return cls.from_text(text, path)
+
+    @classmethod
+    def from_text(cls, text: str, source: str = "<rubric>") -> Rubric:
+        # the model loader's YAML reader: lines kept, duplicate keys refused
+        from ..io.yaml import _parse_text
+
+        try:
+            data = _parse_text(text, source)
+        except RecursionError:
+            raise ModelError("rubric nested too deeply", source=source) from None
+        if data is None:
+            data = {}
+        if not isinstance(data, dict):
+            raise ModelError("a rubric is a mapping (points:, default:, parts:, required:, credit:)",
+                             source=f"{source}:1")
+        top = f"{source}:{getattr(data, 'line', 1) or 1}"
+        unknown = [k for k in data if k not in _KEYS]
+        if unknown:
+            raise ModelError(f"unknown key {unknown[0]!r} (known: {', '.join(_KEYS)})", source=_line_of(text, source,
+                                                                                                   unknown[0], top))
+        rubric = cls(source=source)
+        rubric.default_points = _number(data.get("default", 1.0), "default", _line_of(text, source, "default", top))
+        rubric.points = dict(rubric.points)
+        for key in ("points", "parts", "credit"):
+            if key not in data:
+                continue
+            where = _line_of(text, source, key, top)
+            value = data[key]
+            if not isinstance(value, dict):
+                raise ModelError(f"{key} must be a mapping of name: number", source=where)
+            at = f"{source}:{getattr(value, 'line', None)}" if getattr(value, "line", None) else where
+            table = {str(k): _number(v, f"{key}.{k}", _line_of(text, source, str(k), at)) for k, v in value.items()}
+            if key == "credit":
+                bad = [k for k in table if k not in DEFAULT_CREDIT]
+                if bad:
+                    raise ModelError(f"credit: unknown status {bad[0]!r} (known: {', '.join(DEFAULT_CREDIT)})",
+                                     source=_line_of(text, source, bad[0], at))
+                over = [k for k, v in table.items() if v > 1]
+                if over:
+                    raise ModelError(f"credit.{over[0]} must be a fraction in [0, 1], got {table[over[0]]}",
+                                     source=_line_of(text, source, over[0], at))
+                rubric.credit = {**DEFAULT_CREDIT, **table}
+            elif key == "points":
+                rubric.points = table
+            else:
+                rubric.parts = table
+        if "required" in data:
+            req = data["required"]
+            if not isinstance(req, list) or not all(isinstance(x, str) for x in req):
+                raise ModelError("required must be a list of step names (tau_1, v_dot_2, ...)",
+                                 source=_line_of(text, source, "required", top))
+            rubric.required = list(req)
+        return rubric
+
+    # -- scoring
+    def step_points(self, name: str, key: str) -> float:
+        """The points of one step: by its name, else its key, else ``default``."""
+        if name in self.points:
+            return self.points[name]
+        return self.points.get(key, self.default_points)
+
+    def to_dict(self) -> dict:
+        return {"points": dict(sorted(self.points.items())), "default": self.default_points,
+                "parts": dict(sorted(self.parts.items())), "required": list(self.required),
+                "credit": dict(sorted(self.credit.items()))}
+
+    def fingerprint(self) -> str:
+        """A stable text of the rubric's content (for the batch cache key)."""
+        import json
+
+        return json.dumps(self.to_dict(), sort_keys=True)
+
+
+def _number(value, what: str, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ModelError(f"{what} must be a number, got {value!r}", source=where)
+    value = float(value)
+    if not math.isfinite(value) or value < 0 or value > 1e6:
+        raise ModelError(f"{what} must be a number in [0, 1e6], got {value}", source=where)
+    return value
+
+
+def _line_of(text: str, source: str, key: str, fallback: str) -> str:
+    """``file:line`` of the first line that starts (after indentation) with ``key:``."""
+    for k, line in enumerate(text.splitlines(), 1):
+        stripped = line.lstrip().lstrip("-").lstrip()
+        if stripped.startswith((f"{key}:", f"'{key}':", f'"{key}":')):
+            return f"{source}:{k}"
+    return fallback

@@ -1,0 +1,66 @@
+// armdyn serve: the student's page. Plain JS, loaded from this server only (the CSP
+// allows no inline script). The preview HTML comes from the server, already
+// sanitized (MathML whitelist, text escaped); it is parsed into an inert template
+// before it is shown.
+"use strict";
+
+(function () {
+  function $(id) { return document.getElementById(id); }
+
+  // -- live preview: debounced, one request in flight, the newest text wins
+  var text = $("markdown"), box = $("preview"), state = $("preview-state"), exercise = $("exercise");
+  if (text && box) {
+    var timer = null, inflight = false, again = false;
+    var show = function (html) {
+      var t = document.createElement("template");
+      t.innerHTML = html;
+      box.replaceChildren(t.content);
+    };
+    var run = function () {
+      if (inflight) { again = true; return; }
+      inflight = true; again = false;
+      state.textContent = "…";
+      var url = "/api/preview" + (exercise && exercise.value ? "?exercise=" + encodeURIComponent(exercise.value) : "");
+      fetch(url, {method: "POST", headers: {"Content-Type": "text/markdown"}, body: text.value})
+        .then(function (r) { return r.json().then(function (j) { return [r.ok, j]; }); })
+        .then(function (res) {
+          if (res[0]) { show(res[1].html); state.textContent = ""; }
+          else { state.textContent = "(" + (res[1].error || "preview unavailable") + ")"; }
+        })
+        .catch(function () { state.textContent = "(offline)"; })
+        .finally(function () { inflight = false; if (again) { schedule(); } });
+    };
+    var schedule = function () { clearTimeout(timer); timer = setTimeout(run, 400); };
+    text.addEventListener("input", schedule);
+    if (exercise) { exercise.addEventListener("change", schedule); }
+    if (text.value) { schedule(); }
+
+    // -- upload: read the file into the text area (and preview it)
+    var upload = $("upload");
+    if (upload) {
+      upload.addEventListener("change", function () {
+        var f = upload.files && upload.files[0];
+        if (!f) { return; }
+        f.text().then(function (t) { text.value = t; upload.value = ""; schedule(); });
+      });
+    }
+    var form = $("grade-form"), button = $("grade-button");
+    if (form && button) {
+      form.addEventListener("submit", function () { button.disabled = true; button.textContent = "Grading…"; });
+    }
+  }
+
+  // -- a submission still being graded: poll, reload when it is done
+  var sub = $("submission");
+  if (sub && (sub.dataset.status === "queued" || sub.dataset.status === "running")) {
+    var url = "/api/submissions/" + encodeURIComponent(sub.dataset.id)
+      + (sub.dataset.token ? "?t=" + encodeURIComponent(sub.dataset.token) : "");
+    var poll = function () {
+      fetch(url, {credentials: "same-origin"}).then(function (r) { return r.json(); }).then(function (j) {
+        if (j.status === "done" || j.status === "failed") { window.location.reload(); }
+        else { setTimeout(poll, 1000); }
+      }).catch(function () { setTimeout(poll, 3000); });
+    };
+    setTimeout(poll, 1000);
+  }
+})();
