@@ -76,7 +76,8 @@ def test_three_frame_conventions_give_the_same_torques(kind):
 
     taus = []
     for convention in CONVENTIONS:
-        v = draw_variant(kind, "x", seed=5, convention=convention, masses="rod", symbolic=True)
+        masses = "point" if kind == "rrr" else "rod"  # rrr's rods: a minute of derivation
+        v = draw_variant(kind, "x", seed=5, convention=convention, masses=masses, symbolic=True)
         import yaml
 
         robot = load_yaml_string(yaml.safe_dump(v.model_dict()), "m.yaml")

@@ -14,6 +14,7 @@ derivative, ∂L/∂q and τ. The LaTeX of each value is armdyn's report rendere
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, replace
 
 import sympy as sp
@@ -101,7 +102,13 @@ def solution_steps(robot: Robot) -> list[SolutionStep]:
 def _terms(expr, q) -> list:
     """The terms of ``expr`` as the grader's explanations see them (sin^2 -> 1 - cos^2,
     expanded), so that a slip made on one of them is described as that term."""
-    return list(sp.Add.make_args(sp.expand(trig_reduce(expr, q, keep_trig=True))))
+    return list(_reduced_terms(sp.sympify(expr), tuple(q)))
+
+
+@functools.lru_cache(maxsize=8192)
+def _reduced_terms(expr, q: tuple) -> tuple:
+    # memoised: a mock class injects many slips into the same solution
+    return sp.Add.make_args(sp.expand(trig_reduce(expr, q, keep_trig=True)))
 
 
 def _candidates(step: SolutionStep, q, how: str) -> list[tuple]:
