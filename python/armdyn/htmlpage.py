@@ -148,15 +148,16 @@ CSS = """
 """
 
 
-def page(title: str, body: str) -> str:
-    """A complete, self-contained HTML5 document around ``body`` (already HTML)."""
+def page(title: str, body: str, extra_css: str = "") -> str:
+    """A complete, self-contained HTML5 document around ``body`` (already HTML), with
+    ``extra_css`` after armdyn's stylesheet."""
     return (
         "<!DOCTYPE html>\n"
         '<html lang="en">\n<head>\n<meta charset="utf-8">\n'
         f'<meta http-equiv="Content-Security-Policy" content="{CSP}">\n'
         '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
         f"<title>{escape(title)}</title>\n"
-        f"<style>{CSS}\nbody {{ margin:0; background:#ffffff; }}\n</style>\n"
+        f"<style>{CSS}{extra_css}\nbody {{ margin:0; background:#ffffff; }}\n</style>\n"
         "</head>\n<body>\n"
         f'<main class="armdyn">\n{body}\n</main>\n'
         "</body>\n</html>\n"

@@ -26,6 +26,7 @@ import yaml
 from ..errors import ModelError
 from .kinds import KINDS
 from .proofkinds import PROOF_KINDS
+from .textfile import read_text
 from .variants import draw_variant
 
 ID_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9._-]{0,63}")
@@ -45,19 +46,7 @@ def read_roster(path) -> tuple[list[str], list[str]]:
     """The ids of a roster CSV and one line per refused row (``file:line: ...``):
     a duplicate id, an empty or unsafe one. A roster without an id column is a
     :class:`ModelError`."""
-    path = os.fspath(path)
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read(MAX_ROSTER_BYTES + 1)
-    except OSError as exc:
-        raise ModelError(f"cannot read the roster ({exc.strerror})", source=path) from None
-    if len(raw) > MAX_ROSTER_BYTES:
-        raise ModelError(f"roster larger than {MAX_ROSTER_BYTES} bytes", source=path)
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise ModelError("not UTF-8 text", source=f"{path}:{line}") from None
+    path, text = read_text(path, "roster", MAX_ROSTER_BYTES, encoding="utf-8-sig")
     reader = csv.reader(io.StringIO(text))
     try:
         header = next(reader)

@@ -3,11 +3,7 @@ that allows nothing but inline styles and ``data:`` images (no script, no networ
 
 from __future__ import annotations
 
-from ..htmlpage import CSS
-from ..mathml import escape
-
-#: the page's policy: it loads nothing, runs nothing
-CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'; base-uri 'none'; form-action 'none'"
+from ..htmlpage import page
 
 _EXTRA_CSS = """
 .armdyn table.grid { border-collapse:collapse; margin:8px 0 16px; }
@@ -19,15 +15,6 @@ _EXTRA_CSS = """
 
 
 def course_page(title: str, body: str) -> str:
-    """A complete HTML5 document around ``body`` (already HTML), with the CSP meta."""
-    return (
-        "<!DOCTYPE html>\n"
-        '<html lang="en">\n<head>\n<meta charset="utf-8">\n'
-        f'<meta http-equiv="Content-Security-Policy" content="{CSP}">\n'
-        '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
-        f"<title>{escape(title)}</title>\n"
-        f"<style>{CSS}{_EXTRA_CSS}\nbody {{ margin:0; background:#ffffff; }}\n</style>\n"
-        "</head>\n<body>\n"
-        f'<main class="armdyn">\n{body}\n</main>\n'
-        "</body>\n</html>\n"
-    )
+    """A complete HTML5 document around ``body`` (already HTML): armdyn's page with the
+    course tables' styles."""
+    return page(title, body, extra_css=_EXTRA_CSS)

@@ -28,10 +28,10 @@ not counted. Points are rounded to 2 decimals.
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass, field
 
 from ..errors import ModelError
+from .textfile import read_text
 
 #: credit (fraction of a step's points) per verdict status, by default
 DEFAULT_CREDIT = {
@@ -68,19 +68,7 @@ class Rubric:
     @classmethod
     def load(cls, path) -> Rubric:
         """Read a rubric file; a bad one raises :class:`ModelError` naming ``file:line``."""
-        path = os.fspath(path)
-        try:
-            with open(path, "rb") as fh:
-                raw = fh.read(MAX_BYTES + 1)
-        except OSError as exc:
-            raise ModelError(f"cannot read the rubric ({exc.strerror})", source=path) from None
-        if len(raw) > MAX_BYTES:
-            raise ModelError(f"rubric larger than {MAX_BYTES} bytes", source=path)
-        try:
-            text = raw.decode("utf-8")
-        except UnicodeDecodeError as exc:
-            line = raw[: exc.start].count(b"\n") + 1
-            raise ModelError("not UTF-8 text", source=f"{path}:{line}") from None
+        path, text = read_text(path, "rubric", MAX_BYTES)
         return cls.from_text(text, path)
 
     @classmethod
