@@ -34,6 +34,8 @@ MAX_DEPTH = 60
 MAX_EXPONENT = 100
 #: characters in one equation beyond which it is refused
 MAX_LENGTH = 200_000
+#: digits of a number written or of a numeric power (9^{99^{99}}) beyond which it is refused
+MAX_DIGITS = 400
 
 GREEK = {
     "alpha", "beta", "gamma", "delta", "epsilon", "varepsilon", "zeta", "eta", "theta",
@@ -54,11 +56,19 @@ WRAPPERS = {"mathbf", "boldsymbol", "bm", "mathrm", "mathit", "vec", "hat", "bar
             "pmb", "mathsf", "operatorname", "text", "mathcal", "tilde"}
 SPACES = {",", ";", ":", "!", " ", "quad", "qquad", "displaystyle", "textstyle", "left.", "right.",
           "limits", "nolimits"}
+#: sizing commands before a delimiter (\big( ... \big)): they change its size, not the math
+SIZES = {"big", "Big", "bigg", "Bigg", "bigl", "bigr", "Bigl", "Bigr", "biggl", "biggr", "Biggl", "Biggr",
+         "bigm", "Bigm"}
 MATRIX_ENVS = {"pmatrix", "bmatrix", "Bmatrix", "matrix", "vmatrix", "smallmatrix", "array"}
 
 
 class LatexError(ValueError):
-    """LaTeX that could not be read (the message says what and where)."""
+    """LaTeX that could not be read (the message says what; ``pos``, when known, is the
+    0-based character offset in the parsed text where reading stopped)."""
+
+    def __init__(self, message: str, pos: int | None = None):
+        super().__init__(message)
+        self.pos = pos
 
 
 class UnknownSymbol(LatexError):
@@ -93,8 +103,9 @@ _TOKEN = re.compile(
 )
 
 
-def tokenize(text: str) -> list[tuple[str, str]]:
-    """Tokens ``(kind, value)``: kind is begin, end, cmd, num or char; spaces dropped."""
+def tokenize(text: str, positions: list | None = None) -> list[tuple[str, str]]:
+    """Tokens ``(kind, value)``: kind is begin, end, cmd, num or char; spaces and sizing
+    commands dropped. ``positions``, if given, receives each token's offset in ``text``."""
     if len(text) > MAX_LENGTH:
         raise LatexError(f"equation too long ({len(text)} characters, at most {MAX_LENGTH})")
     out = []
@@ -103,20 +114,31 @@ def tokenize(text: str) -> list[tuple[str, str]]:
         if kind == "space":
             continue
         value = m.group(kind)
-        if kind == "cmd" and value in SPACES:
+        if kind == "cmd" and (value in SPACES or value in SIZES):
             continue
+        if kind == "num" and len(value) > MAX_DIGITS:
+            raise LatexError(f"a number with {len(value)} digits (at most {MAX_DIGITS})", m.start())
         if kind == "char" and value in UNICODE_GREEK:
             kind, value = "cmd", UNICODE_GREEK[value]
         out.append((kind, value))
+        if positions is not None:
+            positions.append(m.start())
     return out
 
 
 class _Parser:
-    def __init__(self, tokens, resolve):
+    def __init__(self, tokens, resolve, positions=None):
         self.t = tokens
         self.i = 0
         self.resolve = resolve
         self.depth = 0
+        self.positions = positions or []
+
+    def at(self, k: int) -> int | None:
+        """The text offset of token ``k`` (the end of the text past the last one)."""
+        if not self.positions:
+            return None
+        return self.positions[min(max(k, 0), len(self.positions) - 1)]
 
     # -- helpers
     def peek(self, k=0):
@@ -132,22 +154,28 @@ class _Parser:
         tok = self.take()
         if tok[0] != kind or (value is not None and tok[1] != value):
             want = value if value is not None else kind
-            raise LatexError(f"expected '{want}', found '{tok[1] or 'end of equation'}'")
+            found = "\\" + tok[1] if tok[0] == "cmd" else tok[1]
+            raise LatexError(f"expected '{want}', found '{found or 'end of equation'}'", self.at(self.i - 1))
         return tok
 
     def enter(self):
         self.depth += 1
         if self.depth > MAX_DEPTH:
-            raise LatexError(f"nesting deeper than {MAX_DEPTH} levels")
+            raise LatexError(f"nesting deeper than {MAX_DEPTH} levels", self.at(self.i))
 
     def leave(self):
         self.depth -= 1
 
     # -- grammar
     def parse(self):
-        value = self.expr()
+        try:
+            value = self.expr()
+        except LatexError as err:
+            if err.pos is None:
+                err.pos = self.at(self.i)
+            raise
         if self.peek()[0] != "eof":
-            raise LatexError(f"unexpected '{self.peek()[1]}'")
+            raise LatexError(f"unexpected '{self.peek()[1]}'", self.at(self.i))
         return value
 
     def expr(self):
@@ -189,14 +217,29 @@ class _Parser:
                 return value
 
     def factor(self):
+        self.enter()  # a^b^c...: each exponent nests one level
         base = self.atom()
         if self.peek() == ("char", "^"):
+            at = self.at(self.i)
             self.take()
+            if isinstance(base, sp.MatrixBase) and self._transpose_mark():
+                self.leave()
+                return base.T
             exponent = self.script_value()
-            if exponent.is_Number and abs(exponent) > MAX_EXPONENT:
-                raise LatexError(f"an exponent of {exponent} (at most {MAX_EXPONENT})")
-            base = base ** exponent
+            base = _power(base, exponent, at)
+        self.leave()
         return base
+
+    def _transpose_mark(self) -> bool:
+        """After ``^`` on a matrix: ``T``, ``\\top``, ``{T}``, ``{\\mathrm{T}}`` (consumed)."""
+        marks = ([("char", "T")], [("cmd", "top")], [("char", "{"), ("char", "T"), ("char", "}")],
+                 [("char", "{"), ("cmd", "top"), ("char", "}")],
+                 [("char", "{"), ("cmd", "mathrm"), ("char", "{"), ("char", "T"), ("char", "}"), ("char", "}")])
+        for mark in marks:
+            if all(self.peek(k) == tok for k, tok in enumerate(mark)):
+                self.i += len(mark)
+                return True
+        return False
 
     def script_value(self):
         """The exponent after ``^``: a group or a single token."""
@@ -247,6 +290,13 @@ class _Parser:
             if tok in "([":
                 self.take()
                 value = self.expr()
+                if tok == "(" and self.peek() == ("char", ","):  # (a, b, c): a row, usually ^T after it
+                    row = [value]
+                    while self.peek() == ("char", ","):
+                        self.take()
+                        row.append(self.expr())
+                    self.expect("char", ")")
+                    return sp.Matrix([row])
                 self.expect("char", ")" if tok == "(" else "]")
                 return value
             if tok == "{":
@@ -305,12 +355,15 @@ class _Parser:
 
     def function(self):
         fn = FUNCTIONS[self.take()[1]]
+        self.enter()  # \sin\sin\sin...: each nests one level
         power = None
+        at = self.at(self.i)
         if self.peek() == ("char", "^"):
             self.take()
             power = self.script_value()
         value = fn(self.atom())  # a bracketed group, or the next symbol: \sin\theta_1
-        return value**power if power is not None else value
+        self.leave()
+        return _power(value, power, at) if power is not None else value
 
     def symbol(self):
         """[accents/wrappers] name [_sub] -> resolve(Name). A ``^`` after it is an
@@ -328,9 +381,11 @@ class _Parser:
         accented or wrapped symbol: ``\\dot{\\theta}``, ``\\dot{\\theta_1}``, ``\\mathbf{v}``."""
         kind, tok = self.take()
         if kind == "cmd" and (tok in ("dot", "ddot", "dddot") or tok in WRAPPERS):
+            self.enter()  # \dot{\dot{...}}: each accent nests one level (left unbalanced on error)
             dots = {"dot": 1, "ddot": 2, "dddot": 3}.get(tok, 0)
             if self.peek() != ("char", "{"):
                 inner, base, sub = self._accented()
+                self.leave()
                 return dots + inner, base, sub
             self.take()
             inner, base, sub = self._accented()
@@ -347,6 +402,7 @@ class _Parser:
                 else:
                     raise LatexError(f"unexpected '{t2}' inside \\{tok}{{...}}")
             self.take()
+            self.leave()
             return dots + inner, base, sub
         if kind == "cmd" and tok in GREEK:
             return 0, tok, ""
@@ -389,9 +445,39 @@ class _Parser:
         return sp.Matrix(rows)
 
 
+def _power(base, exponent, at):
+    """``base ** exponent``, refused before SymPy computes it when it would be huge:
+    a numeric exponent beyond :data:`MAX_EXPONENT`, a power of a power whose combined
+    exponent is (x^{99})^{99}, or a number of more than :data:`MAX_DIGITS` digits."""
+    import math
+
+    if isinstance(base, sp.MatrixBase) or isinstance(exponent, sp.MatrixBase):
+        raise LatexError("a power of a matrix (only ^T, a transpose, is read)", at)
+    if exponent.is_Number:
+        if abs(exponent) > MAX_EXPONENT:
+            raise LatexError(f"an exponent of {_short_number(exponent)} (at most {MAX_EXPONENT})", at)
+        inner = base.exp if base.is_Pow and base.exp.is_Number else 1
+        if abs(inner * exponent) > MAX_EXPONENT:
+            raise LatexError(f"a power of a power with exponent {_short_number(inner * exponent)} "
+                             f"(at most {MAX_EXPONENT})", at)
+        if base.is_Number and base != 0:
+            digits = float(abs(exponent)) * abs(math.log10(abs(float(base))) if abs(base) < 1e300 else 300) \
+                if abs(base) != 1 else 0.0
+            if not base.is_Float and (base.is_Integer or base.is_Rational) and digits > MAX_DIGITS:
+                raise LatexError(f"a number of about {int(digits)} digits (at most {MAX_DIGITS})", at)
+    return base ** exponent
+
+
+def _short_number(x) -> str:
+    text = str(x)
+    return text if len(text) <= 20 else f"{text[:8]}...({len(text)} digits)"
+
+
 def parse(text: str, resolve) -> sp.Expr | sp.Matrix:
-    """Parse one LaTeX expression; ``resolve(Name) -> sympy`` maps each symbol."""
-    return _Parser(tokenize(text), resolve).parse()
+    """Parse one LaTeX expression; ``resolve(Name) -> sympy`` maps each symbol. A
+    :class:`LatexError` carries ``pos``, the offset in ``text`` where reading stopped."""
+    positions: list[int] = []
+    return _Parser(tokenize(text, positions), resolve, positions).parse()
 
 
 # ------------------------------------------------------------------ equations
@@ -470,6 +556,11 @@ def _amps(text: str) -> set[int]:
 
 def _has_top_equals(text: str) -> bool:
     return any(c == "=" for _, c in _top_level(text))
+
+
+def side_offsets(equation: str) -> list[int]:
+    """Offsets where each side of ``A = B = C`` starts (0, then one past each top-level ``=``)."""
+    return [0] + [i + 1 for i, c in _top_level(equation) if c == "="]
 
 
 def sides(equation: str) -> list[str]:

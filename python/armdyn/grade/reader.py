@@ -23,6 +23,7 @@ YAML::
 
 from __future__ import annotations
 
+import bisect
 import os
 import re
 from dataclasses import dataclass, field
@@ -33,19 +34,30 @@ from ..errors import ModelError
 
 #: a submission larger than this is refused (a derivation is a few kB)
 MAX_BYTES = 5_000_000
+#: equations beyond this number are refused (the whole exercise has about fifty)
+MAX_EQUATIONS = 2000
 
 
 @dataclass
 class Equation:
     """One equation as written: ``lhs`` (LaTeX or a step name), ``value`` (the last
     right-hand side: LaTeX, SymPy syntax, or a list of components), ``line`` (1-based),
-    ``source`` (the whole equation as written) and ``latex`` (is ``value`` LaTeX?)."""
+    ``source`` (the whole equation as written) and ``latex`` (is ``value`` LaTeX?);
+    ``column`` (1-based) and ``offset`` (0-based, in the file) of where ``value`` starts;
+    ``problem``: why the equation cannot be read at all (an unbalanced brace), or "";
+    ``part``: the assignment's part it belongs to (``"7-4"``, None: unnumbered or none)
+    and ``task``: that task's title (see :mod:`.parts`)."""
 
     lhs: str
     value: object
     line: int
     source: str
     latex: bool = True
+    column: int = 0
+    offset: int = -1
+    problem: str = ""
+    part: str | None = None
+    task: str = ""
 
 
 @dataclass
@@ -57,6 +69,11 @@ class Submission:
     values: object = None  # "published" or {parameter: number}: numbers the student used
     equations: list[Equation] = field(default_factory=list)
     base_dir: str = "."
+    lines: "LineIndex | None" = None  # line/column of offsets in the Markdown text
+
+    def locate(self, offset: int) -> tuple[int, int]:
+        """1-based (line, column) of a 0-based offset in the submission's text."""
+        return self.lines.locate(offset) if self.lines is not None else (0, 0)
 
     def to_yaml(self) -> str:
         """The submission as the YAML format states it (what the Markdown reader read)."""
@@ -65,7 +82,8 @@ class Submission:
             data["symbols"] = dict(self.symbols)
         if self.values is not None:
             data["values"] = self.values
-        data["steps"] = [{"line": e.line, "step": e.lhs, "value": e.value} for e in self.equations]
+        data["steps"] = [{"line": e.line, "step": e.lhs, "value": e.value,
+                          **({"part": e.part} if e.part else {})} for e in self.equations]
         return yaml.safe_dump(data, sort_keys=False, allow_unicode=True, width=100)
 
 
@@ -134,15 +152,77 @@ def _front(meta, path: str, sub: Submission) -> None:
     sub.values = values
 
 
-_MATH = re.compile(r"\$\$(.+?)\$\$|\\\[(.+?)\\\]", re.S)
+_OPENER = re.compile(r"\$\$|\\\[")
+
+
+def math_blocks(text: str, start: int = 0):
+    """``(block_start, block_end, body_start, body)`` of each ``$$ ... $$`` / ``\\[ ... \\]``
+    block from ``start`` on. Linear: each closer is looked for once with ``str.find``,
+    and an opener that is never closed ends the search for that kind."""
+    closed = {"$$": True, "\\[": True}
+    pos = start
+    while True:
+        m = _OPENER.search(text, pos)
+        if m is None:
+            return
+        opener = m.group(0)
+        closer = "$$" if opener == "$$" else "\\]"
+        end = text.find(closer, m.end()) if closed[opener] else -1
+        if end < 0:
+            closed[opener] = False
+            if not any(closed.values()):
+                return
+            pos = m.end()
+            continue
+        if end > m.end():
+            yield m.start(), end + 2, m.end(), text[m.end():end]
+        pos = end + 2
+
+
+class LineIndex:
+    """Line and column of any offset in a text, from one pass over its newlines
+    (a bisection per lookup: reading stays linear in the file's size)."""
+
+    def __init__(self, text: str):
+        self.newlines = [m.start() for m in re.finditer("\n", text)]
+
+    def locate(self, offset: int) -> tuple[int, int]:
+        k = bisect.bisect_left(self.newlines, offset)
+        line_start = self.newlines[k - 1] + 1 if k else 0
+        return k + 1, offset - line_start + 1
+
+    def line(self, offset: int) -> int:
+        return bisect.bisect_left(self.newlines, offset) + 1
+
+
+def unbalanced_brace(text: str) -> tuple[int, str] | None:
+    """``(offset, what)`` of the first brace that does not pair up in ``text``
+    (``\\{``, ``\\}`` and ``\\\\`` are not braces), or None."""
+    stack = []
+    i, n = 0, len(text)
+    while i < n:
+        c = text[i]
+        if c == "\\":
+            i += 2
+            continue
+        if c == "{":
+            stack.append(i)
+        elif c == "}":
+            if not stack:
+                return i, "close"
+            stack.pop()
+        i += 1
+    return (stack[-1], "open") if stack else None
 
 
 def read_markdown(path: str, text: str | None = None) -> Submission:
     """Read a Markdown derivation (see the module docstring)."""
-    from .latex import sides, split_equations
+    from .latex import side_offsets, split_equations
+    from .parts import find_parts, part_of
 
     text = _read_text(path) if text is None else text
-    sub = Submission(path, base_dir=os.path.dirname(os.path.abspath(path)))
+    index = LineIndex(text)
+    sub = Submission(path, base_dir=os.path.dirname(os.path.abspath(path)), lines=index)
     body_start = 0
     if text.startswith("---"):
         end = re.search(r"^---\s*$", text[3:], re.M)
@@ -150,15 +230,39 @@ def read_markdown(path: str, text: str | None = None) -> Submission:
             raise ModelError("front matter opened with '---' is never closed", source=f"{path}:1")
         _front(_safe_yaml(text[3:3 + end.start()], path), path, sub)
         body_start = 3 + end.end()
-    for m in _MATH.finditer(text, body_start):
-        group = 1 if m.group(1) is not None else 2
-        block, block_start = m.group(group), m.start(group)
+    hidden = set(range(1, index.line(body_start) + 1))  # front matter and display math: no headings there
+    for outer_start, outer_end, block_start, block in math_blocks(text, body_start):
+        hidden.update(range(index.line(outer_start), index.line(outer_end) + 1))
         for offset, eq in split_equations(block):
-            parts = sides(eq)
-            if len(parts) < 2:
+            start = block_start + offset
+            brace = unbalanced_brace(eq)
+            if brace is not None:
+                at, what = brace
+                b_line, b_col = index.locate(start + at)
+                problem = (f"the '{{' opened at line {b_line}, column {b_col} is never closed" if what == "open"
+                           else f"the '}}' at line {b_line}, column {b_col} closes no '{{'")
+                lhs = eq.split("=", 1)[0].strip() if "=" in eq else eq[:40]
+                line, col = index.locate(start)
+                sub.equations.append(Equation(lhs, eq, line, " ".join(eq.split()), column=col, offset=start,
+                                              problem=f"unbalanced brace: {problem}"))
                 continue
-            line = text.count("\n", 0, block_start + offset) + 1
-            sub.equations.append(Equation(parts[0], parts[-1], line, " ".join(eq.split())))
+            cuts = side_offsets(eq)
+            if len(cuts) < 2:
+                continue
+            lhs = eq[:cuts[1] - 1].strip()
+            value = eq[cuts[-1]:]
+            lead = len(value) - len(value.lstrip())
+            line, col = index.locate(start + cuts[-1] + lead)
+            sub.equations.append(Equation(lhs, value.strip(), index.line(start), " ".join(eq.split()),
+                                          column=col, offset=start + cuts[-1] + lead))
+            if len(sub.equations) > MAX_EQUATIONS:
+                raise ModelError(f"more than {MAX_EQUATIONS} equations (a derivation has a few dozen)",
+                                 source=f"{path}:{index.line(start)}")
+    parts = find_parts(text.split("\n"), hidden)
+    for eq in sub.equations:
+        part = part_of(parts, eq.line)
+        if part is not None:
+            eq.part, eq.task = part.number, part.title
     return sub
 
 
@@ -174,15 +278,17 @@ def read_yaml(path: str, text: str | None = None) -> Submission:
     steps = data["steps"]
     items = []
     if isinstance(steps, dict):
-        items = [(str(k), v, None) for k, v in steps.items()]
+        items = [(str(k), v, None, None) for k, v in steps.items()]
     elif isinstance(steps, list):
         for entry in steps:
             if not (isinstance(entry, dict) and "step" in entry and "value" in entry):
                 raise ModelError("each entry of 'steps' needs 'step' and 'value'", source=path)
-            items.append((str(entry["step"]), entry["value"], entry.get("line")))
+            items.append((str(entry["step"]), entry["value"], entry.get("line"), entry.get("part")))
     else:
         raise ModelError("'steps' must be a mapping (step: value) or a list", source=path)
-    for n, (name, value, line) in enumerate(items):
+    if len(items) > MAX_EQUATIONS:
+        raise ModelError(f"more than {MAX_EQUATIONS} steps (a derivation has a few dozen)", source=path)
+    for n, (name, value, line, part) in enumerate(items):
         if isinstance(value, (list, tuple)):
             if any(isinstance(v, (list, dict)) for v in value):
                 value = [list(v) if isinstance(v, (list, tuple)) else v for v in value]
@@ -191,7 +297,8 @@ def read_yaml(path: str, text: str | None = None) -> Submission:
             raise ModelError(f"step '{name}': the value must be an expression or a list of them", source=where)
         is_latex = any("\\" in str(v) for v in (value if isinstance(value, list) else [value]))
         line = line if isinstance(line, int) else (lines[n] if n < len(lines) else 0)
-        sub.equations.append(Equation(name, value, line, f"{name}: {value}", latex=is_latex))
+        sub.equations.append(Equation(name, value, line, f"{name}: {value}", latex=is_latex,
+                                      part=str(part) if part is not None else None))
     return sub
 
 

@@ -24,12 +24,16 @@ _KEY_TEXT = {
     "omega": "ω", "omega_dot": "ω̇", "v_dot": "v̇", "vc_dot": "v̇_C", "F": "F", "N": "N", "f": "f", "n": "n",
     "tau": "τ", "dL_dqd": "∂L/∂q̇", "dL_dq": "∂L/∂q", "ddt_dL_dqd": "d/dt ∂L/∂q̇",
 }
+#: the message of an equation that names no step (listed by line, not one by one)
+NOT_A_STEP = "not a step of Newton-Euler or Lagrange (skipped)"
 
 
 def step_title(v: StepVerdict, ascii_only: bool = False) -> str:
     """``v̇_1`` (Unicode) or the step's name (ASCII)."""
+    if v.key == "law":
+        return "Lagrange eq." if not ascii_only else "lagrange_equation"
     if ascii_only or v.key not in _KEY_TEXT:
-        return v.name
+        return v.name or "?"
     index = v.name.rsplit("_", 1)[-1]
     return f"{_KEY_TEXT[v.key]}_{index}"
 
@@ -58,10 +62,16 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
     lines = [f"armdyn grade {report.submission}: robot '{report.robot}', {report.method}", ""]
     skipped = []
     width = max((_width(step_title(v, ascii_only)) for v in report.steps if v.status != "unrecognised"), default=6)
+    group = object()
     for v in report.steps:
-        if v.status == "unrecognised" and not v.key:
+        if v.status == "unrecognised" and not v.key and v.message == NOT_A_STEP:
             skipped.append(v.line)
             continue
+        if (v.part, v.task) != group:
+            group = (v.part, v.task)
+            if v.part or v.task:
+                lines.append(f"part {v.part}" + (f": {v.task}" if v.task else "") if v.part
+                             else f"(task without a number) {v.task}")
         mark = _MARK[v.status][1 if ascii_only else 0]
         what = v.status
         if v.status == "follows-from-earlier-error":
@@ -136,6 +146,9 @@ def to_dict(report: GradeReport) -> dict:
             "label": v.label,
             "message": v.message,
             "components": v.components,
+            "part": v.part,
+            "task": v.task or None,
+            "column": v.column or None,
         })
     return {
         "robot": report.robot,
