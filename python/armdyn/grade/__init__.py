@@ -183,14 +183,13 @@ class _Grader:
 
     def _equation(self, eq, seen_methods: list, context: str | None) -> None:
         """Grade one equation: append its verdict."""
-        ref = None if eq.problem else (
-            parse_lhs(eq.lhs, self.symbols.coordinate_of) if eq.latex or "\\" in eq.lhs else None)
-        if ref is None and not eq.problem:
+        ref = parse_lhs(eq.lhs, self.symbols.coordinate_of) if eq.latex or "\\" in eq.lhs else None
+        if ref is None:
             ref = _named_ref(eq.lhs) or (parse_lhs(eq.lhs, self.symbols.coordinate_of) if not eq.latex else None)
-        if ref is None and eq.problem:
+        if eq.problem:  # cannot be split into sides: shown with where and why, named if its start names a step
             self.verdicts.append(StepVerdict(
-                name="", key="", link="", status="unrecognised", label=eq.lhs, source=eq.source, line=eq.line,
-                message=self._unreadable(eq, eq.problem)))
+                name=ref.name if ref else "", key=ref.key if ref else "", link="", status="unrecognised",
+                label=eq.lhs, source=eq.source, line=eq.line, message=self._unreadable(eq, eq.problem)))
             return
         if ref is None:
             law = lagrange_law(eq.lhs, str(eq.value)) if eq.latex else None
@@ -234,6 +233,9 @@ class _Grader:
 
     def _report(self, seen_methods: list, method_hint: str | None) -> GradeReport:
         recognised = [v for v in self.verdicts if v.key]  # a step named, even if its value was unreadable
+        unread = [v for v in self.verdicts if v.status == "unrecognised" and "cannot read" in v.message]
+        if not recognised and unread:  # nothing graded: the reason is the unreadable equation
+            raise ModelError(unread[0].message.split(": ", 1)[1], source=unread[0].message.split(": ", 1)[0])
         if not recognised:
             raise ModelError("no step of Newton-Euler or Lagrange recognised (expected equations such as "
                              "\\omega_1^1 = ..., F_2^2 = ..., \\tau_1 = ..., T = ...)", source=self.sub.path)
@@ -248,7 +250,7 @@ class _Grader:
         return GradeReport(
             robot=self.robot.name, method=method_name, submission=self.sub.path, steps=self.verdicts,
             first_wrong=first_wrong, tau_correct=tau_correct, symbol_latex=_symbol_latex(self.robot),
-            notes=self.notes)
+            notes=self.notes, shorthand=dict(self.symbols.shorthand))
 
     def _check_index(self, ref: StepRef, eq):
         n = len(self.robot.links) - 1
@@ -290,7 +292,7 @@ class _Grader:
                 status = "wrong"
                 bad = [int(i) for i in range(9) if not ok.ravel()[i]]
                 message = "; ".join(f"{component_name(i, (3, 3))}: "
-                                    + describe(value[i], expected[i], self.robot, self.sampler) for i in bad[:3])
+                                    + describe(value[i], expected[i], self.robot, self.sampler, shorthand=self.symbols.shorthand) for i in bad[:3])
         self.verdicts.append(StepVerdict(
             name=ref.name, key="R", link="", status=status, label=eq.lhs, source=eq.source, line=eq.line,
             expected=expected, got=value, difference=None if status != "wrong" else value - expected,
@@ -314,7 +316,7 @@ class _Grader:
         fp = self.sampler.fingerprint
         ok = equal(fp(value), fp(expected)).ravel()
         bad = [int(i) for i in range(3) if not ok[i]]
-        message = "; ".join(f"{describe(value[i], expected[i], self.robot, self.sampler)} in "
+        message = "; ".join(f"{describe(value[i], expected[i], self.robot, self.sampler, shorthand=self.symbols.shorthand)} in "
                             f"{component_name(i, (3, 1))}" for i in bad)
         if bad:
             message += f" ({what}, in frame {frame})"
@@ -396,7 +398,7 @@ class _Grader:
             if j.status == "wrong":
                 parts = []
                 for i in components[:3]:
-                    text = describe(got_m[i], ref_m[i], self.robot, self.sampler)
+                    text = describe(got_m[i], ref_m[i], self.robot, self.sampler, shorthand=self.symbols.shorthand)
                     where = component_name(i, got_m.shape)
                     parts.append(f"{text} in {where}" if where else text)
                 against = "" if not j.origins else " (compared with what your own earlier steps give)"
@@ -419,7 +421,7 @@ class _Grader:
                     if bad:
                         src = sorted(carried[0].origins, key=self._order)
                         where = component_name(bad[0], d.shape)
-                        message += (f": carried through they leave {pretty(tidy(d[bad[0]], self.robot))}"
+                        message += (f": carried through they leave {pretty(tidy(d[bad[0]], self.robot), shorthand=self.symbols.shorthand)}"
                                     + (f" in {where}" if where else "")
                                     + (f" (from the error in {src[0]})" if src else "")
                                     + " (copied, or two slips that cancel?)")

@@ -252,6 +252,8 @@ class SymbolMap:
         self.explicit: dict[str, sp.Expr] = {}
         self.notes: list[str] = []
         self.steps: dict[str, object] = {}
+        #: sin/cos of the angles the student wrote as shorthand -> a symbol printing as theirs (s₁₂)
+        self.shorthand: dict = {}
         self.used_gravity_magnitude = False
         for student, model in (explicit or {}).items():
             key = self._key_of(str(student))
@@ -298,7 +300,11 @@ class SymbolMap:
             idx = [int(ch) for ch in sub]
             if all(1 <= k <= self.robot.dof for k in idx):
                 angle = sum((self.robot.q[k - 1] for k in idx), sp.Integer(0))
-                return (sp.sin if name.base in "sS" else sp.cos)(angle)
+                value = (sp.sin if name.base in "sS" else sp.cos)(angle)
+                from ..symbolic.report import unicode_name
+
+                self.shorthand[value] = sp.Symbol(unicode_name(name.base + sub) or name.base + sub)
+                return value
         if name.base == "g" and not sub and name.dots == 0:
             magnitude = sp.sqrt(sum(c**2 for c in self.robot.gravity))
             if not magnitude.free_symbols:

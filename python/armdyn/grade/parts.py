@@ -25,9 +25,9 @@ from dataclasses import dataclass
 #: a task's number alone on a line, optionally as a heading or with a word before it
 _NUMBER = re.compile(
     r"^\s*(?:#{1,6}\s*)?(?:\*\*|__)?\s*(?:(?:exercise|problem|question|task|part|aufgabe)\s*)?"
-    r"(\d+(?:[-.]\d+)*[a-z]?)\s*[.:)]?\s*(?:\*\*|__)?\s*$", re.I)
+    r"(\d+(?:[-.]\d+)*[a-z]?)\s*[.:)]?\s*(?:\*\*|__)?\s*$", re.IGNORECASE)
 _SOLUTION = re.compile(r"^\s*(?:#{1,6}\s*)?(?:\*\*|__)?\s*(?:solution|answer|proof)\s*[.:]?\s*(?:\*\*|__)?\s*[.:]?\s*$",
-                       re.I)
+                       re.IGNORECASE)
 #: characters of a task's statement kept as its title
 TITLE_LENGTH = 80
 

@@ -69,7 +69,7 @@ class Submission:
     values: object = None  # "published" or {parameter: number}: numbers the student used
     equations: list[Equation] = field(default_factory=list)
     base_dir: str = "."
-    lines: "LineIndex | None" = None  # line/column of offsets in the Markdown text
+    lines: LineIndex | None = None  # line/column of offsets in the Markdown text
 
     def locate(self, offset: int) -> tuple[int, int]:
         """1-based (line, column) of a 0-based offset in the submission's text."""

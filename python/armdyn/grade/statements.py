@@ -68,7 +68,7 @@ def lagrange_law(lhs: str, rhs: str) -> tuple[bool, str] | None:
     terms = [(sign, _kind(t)) for sign, t in _signed_terms(left)]
     if any(k is None for _, k in terms) or len(terms) != 2:
         return False, f"not the Lagrange equation {LAW}"
-    kinds = dict((k, sign) for sign, k in terms)
+    kinds = {k: sign for sign, k in terms}
     torque = bool(_RHS_TORQUE.match(right))
     if "dqd" in kinds and "ddt" not in kinds:
         return False, f"d/dt missing before ∂L/∂q̇: the Lagrange equation is {LAW}"

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+import re
 import unicodedata
 
 import symengine as se
@@ -38,14 +39,17 @@ def step_title(v: StepVerdict, ascii_only: bool = False) -> str:
     return f"{_KEY_TEXT[v.key]}_{index}"
 
 
-def _value(value, ascii_only: bool) -> str:
+def _value(value, ascii_only: bool, shorthand: dict | None = None) -> str:
     if value is None:
         return ""
+    if isinstance(value, str):
+        return value
     if isinstance(value, sp.MatrixBase):
         if value.shape[1] == 1:
-            return "[" + ", ".join(pretty(x, ascii_only) for x in value) + "]"
-        return "[" + "; ".join(", ".join(pretty(x, ascii_only) for x in value.row(i)) for i in range(value.rows)) + "]"
-    return pretty(value, ascii_only)
+            return "[" + ", ".join(pretty(x, ascii_only, shorthand) for x in value) + "]"
+        return "[" + "; ".join(", ".join(pretty(x, ascii_only, shorthand) for x in value.row(i))
+                               for i in range(value.rows)) + "]"
+    return pretty(value, ascii_only, shorthand)
 
 
 def _width(s: str) -> int:
@@ -84,8 +88,9 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
             what = f"{v.status.upper() if v.status == 'wrong' else v.status}: {v.message}"
         lines.append(f"  {mark} line {v.line:>4}  {_pad(step_title(v, ascii_only), width)}  {what}")
         if details and v.status == "wrong":
-            lines.append(f"{'':>{16 + width}}yours:    {_value(v.got, ascii_only)}")
-            lines.append(f"{'':>{16 + width}}expected: {_value(v.expected, ascii_only)}")
+            if v.got is not None:
+                lines.append(f"{'':>{16 + width}}yours:    {_value(v.got, ascii_only, report.shorthand)}")
+            lines.append(f"{'':>{16 + width}}expected: {_value(v.expected, ascii_only, report.shorthand)}")
     if skipped:
         shown = ", ".join(map(str, skipped[:12])) + (", ..." if len(skipped) > 12 else "")
         lines.append(f"  {'·' if not ascii_only else '--'} {len(skipped)} equation(s) not recognised as steps, skipped "
@@ -165,4 +170,19 @@ def to_json(report: GradeReport) -> str:
     return json.dumps(to_dict(report), indent=2, ensure_ascii=False)
 
 
-__all__ = ["text", "to_dict", "to_json", "step_title", "display_name"]
+def error_json(err, path: str) -> str:
+    """A submission that cannot be graded, as JSON: ``{"error", "file", "line", "column"}``
+    (line and column null where not known). ``err``: a ModelError whose ``source`` is
+    ``file``, ``file:line`` or ``file:line:column``."""
+    source = getattr(err, "source", None) or path
+    line = column = None
+    m = re.fullmatch(r"(.*?):(\d+)(?::(\d+))?", source)
+    if m:
+        source, line, column = m.group(1), int(m.group(2)), int(m.group(3)) if m.group(3) else None
+    message = getattr(err, "message", None) or str(err)
+    if getattr(err, "element", None):
+        message = f"{err.element}: {message}"
+    return json.dumps({"error": message, "file": source, "line": line, "column": column}, ensure_ascii=False)
+
+
+__all__ = ["text", "to_dict", "to_json", "error_json", "step_title", "display_name"]

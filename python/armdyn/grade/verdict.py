@@ -107,6 +107,8 @@ class GradeReport:
                    False where the student gave no tau_i
     symbol_latex:  SymPy symbol -> the student's LaTeX for it, for printing
     notes:         general remarks (mapping used, steps the method has that the student skipped)
+    shorthand:     sin/cos terms the student wrote as shorthand -> symbols printing as theirs
+                   (``sin(q1 + q2)`` -> ``s₁₂``), for showing values in their notation
     """
 
     robot: str
@@ -117,6 +119,7 @@ class GradeReport:
     tau_correct: list[bool]
     symbol_latex: dict = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    shorthand: dict = field(default_factory=dict)
 
     @property
     def passed(self) -> bool:
