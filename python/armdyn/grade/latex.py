@@ -485,63 +485,76 @@ def parse(text: str, resolve) -> sp.Expr | sp.Matrix:
 _OPEN = {"{": "}", "(": ")", "[": "]"}
 
 
+_MARKS = re.compile(r"\\(?:begin|end)\{[^}]*\}?|\\\\|\\[A-Za-z]+|\\.?|[{}()\[\]&,=]", re.S)
+
+
 def _top_level(text: str):
-    """Yield ``(index, char)`` of characters at nesting depth 0: outside braces,
-    brackets and matrix environments."""
-    depth, env, i = 0, 0, 0
-    n = len(text)
-    while i < n:
-        if text.startswith("\\begin{", i) or text.startswith("\\end{", i):
-            env += 1 if text[i + 1] == "b" else -1
-            close = text.find("}", i)
-            i = n if close < 0 else close + 1
-            continue
-        c = text[i]
+    """Yield ``(index, mark)`` of the marks ``&``, ``,``, ``=`` and ``\\\\`` at nesting depth 0:
+    outside braces, brackets and matrix environments. One regular-expression pass over
+    the text (only the characters that matter are looked at in Python)."""
+    depth, env = 0, 0
+    for m in _MARKS.finditer(text):
+        tok = m.group(0)
+        c = tok[0]
         if c == "\\":
-            if env == 0 and depth == 0 and text.startswith("\\\\", i):
-                yield i, "\\\\"
-                i += 2
-                continue
-            i += 2 if i + 1 < n and not text[i + 1].isalpha() else 1
-            while i < n and text[i].isalpha():
-                i += 1
+            if tok.startswith("\\begin{"):
+                env += 1
+            elif tok.startswith("\\end{"):
+                env -= 1
+            elif tok == "\\\\" and env == 0 and depth == 0:
+                yield m.start(), tok
             continue
         if c in "{([":
             depth += 1
         elif c in "})]":
             depth -= 1
         elif depth == 0 and env == 0:
-            yield i, c
-        i += 1
+            yield m.start(), c
 
 
-def split_equations(block: str) -> list[tuple[int, str]]:
+def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str]]:
     """Split a display-math block into equations: at top-level ``\\\\`` and at top-level
     commas followed by another ``LHS = ...``. Returns ``(offset, text)`` pairs; alignment
     ``&`` and environment wrappers (split, aligned, align, gather) are blanked out (so
-    offsets still point into ``block``)."""
+    offsets still point into ``block``). Linear in the block's length; ``limit``: stop
+    after that many equations (the caller refuses more)."""
     text = re.sub(r"\\(begin|end)\{(split|aligned|align\*?|gather\*?|equation\*?|alignedat)\}(\{\d+\})?",
                   lambda m: " " * len(m.group(0)), block)
-    amps = _amps(text)
-    text = "".join(" " if i in amps else c for i, c in enumerate(text))
-    cuts = [i for i, c in _top_level(text) if c == "\\\\"]
-    out, start = [], 0
-    for cut in cuts + [len(text)]:
-        piece = text[start:cut]
-        commas = [i for i, c in _top_level(piece) if c == ","]
-        segments, s0 = [], 0
-        for comma in commas + [len(piece)]:
-            segments.append((start + s0, piece[s0:comma]))
-            s0 = comma + 1
-        cur_off, cur = segments[0]
-        for off, seg in segments[1:]:
-            if _has_top_equals(seg):
-                out.append((cur_off, cur))
-                cur_off, cur = off, seg
-            else:
-                cur += "," + seg
-        out.append((cur_off, cur))
+    marks = [(i, c) for i, c in _top_level(text) if c in ("&", ",", "=", "\\\\")]  # one pass, depth 0
+    if any(c == "&" for _, c in marks):
+        chars = list(text)
+        for i, c in marks:
+            if c == "&":
+                chars[i] = " "
+        text = "".join(chars)
+    out: list[tuple[int, str]] = []
+    start = 0
+    pieces = [i for i, c in marks if c == "\\\\"] + [len(text)]
+    k = 0  # index into marks
+    for cut in pieces:
+        # segments of this piece at top-level commas, each flagged: has a top-level '='?
+        segments, s0, has_eq = [], start, False
+        while k < len(marks) and marks[k][0] < cut:
+            i, c = marks[k]
+            if c == ",":
+                segments.append((s0, i, has_eq))
+                s0, has_eq = i + 1, False
+            elif c == "=":
+                has_eq = True
+            k += 1
+        segments.append((s0, cut, has_eq))
+        cur_start, cur_end = segments[0][0], segments[0][1]
+        for seg_start, seg_end, seg_eq in segments[1:]:
+            if seg_eq:
+                out.append((cur_start, text[cur_start:cur_end]))
+                cur_start = seg_start
+            cur_end = seg_end
+            if limit is not None and len(out) > limit:
+                break
+        out.append((cur_start, text[cur_start:cur_end]))
         start = cut + 2
+        if limit is not None and len(out) > limit:
+            break
     result = []
     for off, t in out:
         stripped = t.strip().rstrip(".,;").strip()

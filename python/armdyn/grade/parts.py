@@ -42,25 +42,38 @@ class Part:
     line: int
 
 
-def find_parts(lines: list[str], math_lines: set[int]) -> list[Part]:
-    """The tasks in order of their first line. ``lines``: the file's lines (0-based
-    list); ``math_lines``: 1-based numbers of lines inside display math (ignored)."""
+#: lines that may be a number or Solution line (found by one scan of the whole text)
+_CANDIDATE = re.compile(r"^[ \t]*(?:#|\*\*|__|\d|exercise|problem|question|task|part|aufgabe|solution|answer|proof)"
+                        r"[^\n]{0,80}$", re.MULTILINE | re.IGNORECASE)
+#: parts beyond this number are not looked for (an assignment has a handful)
+MAX_PARTS = 500
+
+
+def find_parts(text: str, line_of, lines: list[str], math_lines: set[int]) -> list[Part]:
+    """The tasks in order of their first line (titles not yet filled in: see
+    :func:`with_title`). ``text``: the file; ``line_of(offset)``: its 1-based line;
+    ``lines``: its lines (0-based list); ``math_lines``: 1-based numbers of lines inside
+    display math or the front matter (ignored). One regular-expression scan finds the
+    candidate lines; only those are looked at in Python."""
     parts: list[Part] = []
     numbered_since_answer = False  # a number line came after the last Solution line
     answered = False  # a Solution line has been seen in the current task
-    for k, raw in enumerate(lines, start=1):
+    for cand in _CANDIDATE.finditer(text):
+        k = line_of(cand.start())
+        raw = cand.group(0)
         if k in math_lines:
             continue
-        m = _NUMBER.match(raw)
-        if m and not _SOLUTION.match(raw):
-            parts.append(Part(m.group(1), _title(lines, k, math_lines, skip_self=True), k))
+        solution = _SOLUTION.match(raw)
+        m = None if solution else _NUMBER.match(raw)
+        if m:
+            parts.append(Part(m.group(1), "", k))
             numbered_since_answer, answered = True, False
-            continue
-        if _SOLUTION.match(raw):
+        elif solution:
             if answered and not numbered_since_answer or not parts:
-                start = _statement_start(lines, k, math_lines)
-                parts.append(Part(None, _title(lines, start, math_lines), start))
+                parts.append(Part(None, "", _statement_start(lines, k, math_lines)))
             answered, numbered_since_answer = True, False
+        if len(parts) >= MAX_PARTS:
+            break
     return parts
 
 
@@ -74,6 +87,12 @@ def _statement_start(lines: list[str], k: int, math_lines: set[int]) -> int:
     return max(j, 1)
 
 
+def with_title(part: Part, lines: list[str], math_lines: set[int]) -> Part:
+    """``part`` with its title: the first prose line of its statement (looked up only
+    for the parts that hold equations: a file may have many number lines)."""
+    return Part(part.number, _title(lines, part.line, math_lines, skip_self=part.number is not None), part.line)
+
+
 def _title(lines: list[str], k: int, math_lines: set[int], skip_self: bool = False) -> str:
     """The first prose line from line ``k`` on (markdown marks removed), shortened."""
     for j in range(k + (1 if skip_self else 0), min(len(lines), k + 12) + 1):
@@ -85,8 +104,9 @@ def _title(lines: list[str], k: int, math_lines: set[int], skip_self: bool = Fal
     return ""
 
 
-def part_of(parts: list[Part], line: int) -> Part | None:
-    """The task line ``line`` (1-based) belongs to, or None before the first one."""
-    starts = [p.line for p in parts]
+def part_of(parts: list[Part], line: int, starts: list[int] | None = None) -> Part | None:
+    """The task line ``line`` (1-based) belongs to, or None before the first one.
+    ``starts``: the parts' first lines, if the caller has them (many lookups)."""
+    starts = [p.line for p in parts] if starts is None else starts
     k = bisect.bisect_right(starts, line) - 1
     return parts[k] if k >= 0 else None

@@ -34,8 +34,9 @@ from ..errors import ModelError
 
 #: a submission larger than this is refused (a derivation is a few kB)
 MAX_BYTES = 5_000_000
-#: equations beyond this number are refused (the whole exercise has about fifty)
-MAX_EQUATIONS = 2000
+#: equations beyond this number are refused (the whole exercise has about fifty; grading
+#: takes up to ~10 ms an equation, so this bounds a file's work to a few seconds)
+MAX_EQUATIONS = 500
 
 
 @dataclass
@@ -195,30 +196,28 @@ class LineIndex:
         return bisect.bisect_left(self.newlines, offset) + 1
 
 
+_BRACES = re.compile(r"\\.|[{}]", re.S)
+
+
 def unbalanced_brace(text: str) -> tuple[int, str] | None:
     """``(offset, what)`` of the first brace that does not pair up in ``text``
-    (``\\{``, ``\\}`` and ``\\\\`` are not braces), or None."""
+    (``\\{``, ``\\}`` and ``\\\\`` are not braces), or None. ``what``: "open" or "close"."""
     stack = []
-    i, n = 0, len(text)
-    while i < n:
-        c = text[i]
-        if c == "\\":
-            i += 2
-            continue
+    for m in _BRACES.finditer(text):
+        c = m.group(0)
         if c == "{":
-            stack.append(i)
+            stack.append(m.start())
         elif c == "}":
             if not stack:
-                return i, "close"
+                return m.start(), "close"
             stack.pop()
-        i += 1
     return (stack[-1], "open") if stack else None
 
 
 def read_markdown(path: str, text: str | None = None) -> Submission:
     """Read a Markdown derivation (see the module docstring)."""
-    from .latex import side_offsets, split_equations
-    from .parts import find_parts, part_of
+    from .latex import MAX_LENGTH, side_offsets, split_equations
+    from .parts import find_parts, part_of, with_title
 
     text = _read_text(path) if text is None else text
     index = LineIndex(text)
@@ -233,9 +232,21 @@ def read_markdown(path: str, text: str | None = None) -> Submission:
     hidden = set(range(1, index.line(body_start) + 1))  # front matter and display math: no headings there
     for outer_start, outer_end, block_start, block in math_blocks(text, body_start):
         hidden.update(range(index.line(outer_start), index.line(outer_end) + 1))
-        for offset, eq in split_equations(block):
+        if len(block) > MAX_LENGTH:  # not split: one unreadable equation, refused in bounded time
+            line, col = index.locate(block_start)
+            sub.equations.append(Equation(block[:40].strip(), block[:200], line, block[:200].strip(), column=col,
+                                          offset=block_start, problem=f"display math too long ({len(block)} "
+                                          f"characters, at most {MAX_LENGTH})"))
+            continue
+        for offset, eq in split_equations(block, limit=MAX_EQUATIONS):
             start = block_start + offset
-            brace = unbalanced_brace(eq)
+            brace = unbalanced_brace(eq) if len(eq) <= MAX_LENGTH else None
+            if len(eq) > MAX_LENGTH:
+                line, col = index.locate(start)
+                sub.equations.append(Equation(eq[:40], eq[:200], line, eq[:200], column=col, offset=start,
+                                              problem=f"equation too long ({len(eq)} characters, at most "
+                                                      f"{MAX_LENGTH})"))
+                continue
             if brace is not None:
                 at, what = brace
                 b_line, b_col = index.locate(start + at)
@@ -258,11 +269,15 @@ def read_markdown(path: str, text: str | None = None) -> Submission:
             if len(sub.equations) > MAX_EQUATIONS:
                 raise ModelError(f"more than {MAX_EQUATIONS} equations (a derivation has a few dozen)",
                                  source=f"{path}:{index.line(start)}")
-    parts = find_parts(text.split("\n"), hidden)
+    lines = text.split("\n")
+    parts = find_parts(text, index.line, lines, hidden)
+    starts, titled = [p.line for p in parts], {}
     for eq in sub.equations:
-        part = part_of(parts, eq.line)
+        part = part_of(parts, eq.line, starts)
         if part is not None:
-            eq.part, eq.task = part.number, part.title
+            if part.line not in titled:
+                titled[part.line] = with_title(part, lines, hidden)
+            eq.part, eq.task = part.number, titled[part.line].title
     return sub
 
 
