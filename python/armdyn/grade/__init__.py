@@ -26,7 +26,7 @@ from ..errors import ModelError
 from ..model import Robot
 from .engine import Sampler, Value, World, canonical, judge, to_sympy
 from .engine import equal
-from .explain import component_name, describe, pretty, split_name, tidy
+from .explain import component_name, contract, describe, pretty, split_name, tidy
 from .latex import GREEK, LatexError, UnknownSymbol, parse, parse_sympy_syntax
 from .diagnose import unreadable
 from .methods import lagrange_method, newton_euler_method, rotation_between
@@ -405,6 +405,7 @@ class _Grader:
                 message = "; ".join(parts) + against
                 diff = sp.Matrix([tidy(got_m[i] - ref_m[i], self.robot) for i in range(len(got_m))])
                 difference = diff if got_m.shape != (1, 1) else diff[0]
+                exp_shown = contract(exp_shown, self.symbols.shorthand)  # in the student's s₁₂, c₁₂
             elif j.status == "follows-from-earlier-error":
                 message = f"follows from the error in {caused_by}" + (f" ({j.convention})" if j.convention else "")
                 diff = _matrix(value) - _matrix(exp_shown)

@@ -124,9 +124,31 @@ def tidy(expr, robot: Robot):
     return plain
 
 
-def simplified(expr, robot: Robot) -> bool:
-    """Could :func:`tidy` simplify ``expr`` (not too large)?"""
-    return sp.count_ops(sp.sympify(expr)) <= TIDY_LIMIT
+#: entries larger than this (nodes) are not rewritten into angle sums for display
+CONTRACT_LIMIT = 150
+
+
+def contract(value, shorthand: dict | None):
+    """``value`` (expression or matrix) with products of sines and cosines gathered back
+    into the angle sums the student abbreviated (``sin q1 cos q2 + cos q1 sin q2`` ->
+    ``sin(q1 + q2)``, shown as their ``s₁₂``), so that an expected value reads in their
+    notation. Only when they used such a shorthand, and only for small entries."""
+    if not shorthand or not any(isinstance(k.args[0], sp.Add) for k in shorthand):
+        return value
+
+    def one(x):
+        x = sp.sympify(x)
+        if sp.count_ops(x) > CONTRACT_LIMIT:
+            return x
+        try:
+            return sp.trigsimp(sp.expand(x))
+        except Exception:  # noqa: BLE001 - display only: keep the value as it is
+            return x
+
+    if isinstance(value, sp.MatrixBase):
+        return value.applyfunc(one)
+    return one(value)
+
 
 
 def _terms(expr) -> list:

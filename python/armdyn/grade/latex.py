@@ -127,18 +127,19 @@ def tokenize(text: str, positions: list | None = None) -> list[tuple[str, str]]:
 
 
 class _Parser:
-    def __init__(self, tokens, resolve, positions=None):
+    def __init__(self, tokens, resolve, positions=None, length: int | None = None):
         self.t = tokens
         self.i = 0
         self.resolve = resolve
         self.depth = 0
         self.positions = positions or []
+        self.length = length
 
     def at(self, k: int) -> int | None:
         """The text offset of token ``k`` (the end of the text past the last one)."""
-        if not self.positions:
-            return None
-        return self.positions[min(max(k, 0), len(self.positions) - 1)]
+        if k >= len(self.positions):
+            return self.length
+        return self.positions[max(k, 0)] if self.positions else None
 
     # -- helpers
     def peek(self, k=0):
@@ -477,7 +478,7 @@ def parse(text: str, resolve) -> sp.Expr | sp.Matrix:
     """Parse one LaTeX expression; ``resolve(Name) -> sympy`` maps each symbol. A
     :class:`LatexError` carries ``pos``, the offset in ``text`` where reading stopped."""
     positions: list[int] = []
-    return _Parser(tokenize(text, positions), resolve, positions).parse()
+    return _Parser(tokenize(text, positions), resolve, positions, len(text)).parse()
 
 
 # ------------------------------------------------------------------ equations
