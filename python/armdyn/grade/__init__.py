@@ -200,8 +200,7 @@ class _Grader:
                     seen_methods.append("lagrange")
                 self.verdicts.append(StepVerdict(
                     name="lagrange_equation", key="law", link="", status="correct" if law[0] else "wrong",
-                    label=eq.lhs, source=eq.source, line=eq.line, message=law[1],
-                    expected="d/dt dL/dqd_i - dL/dq_i = tau_i"))
+                    label=eq.lhs, source=eq.source, line=eq.line, message=law[1]))
                 return
             self.verdicts.append(StepVerdict(
                 name="", key="", link="", status="unrecognised", label=eq.lhs, source=eq.source, line=eq.line,
@@ -209,11 +208,13 @@ class _Grader:
             return
         n_links = len(self.robot.links) - 1
         if ref.key in ("f", "n") and ref.index == n_links + 1:
+            if "newton-euler" not in seen_methods:
+                seen_methods.append("newton-euler")
             self._free_end(ref, eq)
             return
         method = "lagrange" if ref.key in LAGRANGE_KEYS else (
             context or "newton-euler" if ref.key == "tau" else "newton-euler")
-        if method not in seen_methods and ref.key not in ("R", "P", "Pc"):
+        if method not in seen_methods:
             seen_methods.append(method)
         self._check_index(ref, eq)
         value, problem = self.value(eq, ref)
@@ -312,7 +313,7 @@ class _Grader:
             vector = ctx[ref.index]["c"]
             what = f"link {ref.index}'s mass centre from frame {ref.index}'s origin"
         frame = home if ref.frame is None else ref.frame
-        expected = sp.Matrix(rotation_between(ctx, home, frame) * vector)
+        expected = sp.Matrix(rotation_between(ctx, home, frame) * vector).applyfunc(lambda x: tidy(x, self.robot))
         fp = self.sampler.fingerprint
         ok = equal(fp(value), fp(expected)).ravel()
         bad = [int(i) for i in range(3) if not ok[i]]

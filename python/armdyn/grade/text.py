@@ -90,7 +90,8 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
         if details and v.status == "wrong":
             if v.got is not None:
                 lines.append(f"{'':>{16 + width}}yours:    {_value(v.got, ascii_only, report.shorthand)}")
-            lines.append(f"{'':>{16 + width}}expected: {_value(v.expected, ascii_only, report.shorthand)}")
+            if v.expected is not None:
+                lines.append(f"{'':>{16 + width}}expected: {_value(v.expected, ascii_only, report.shorthand)}")
     if skipped:
         shown = ", ".join(map(str, skipped[:12])) + (", ..." if len(skipped) > 12 else "")
         lines.append(f"  {'·' if not ascii_only else '--'} {len(skipped)} equation(s) not recognised as steps, skipped "
