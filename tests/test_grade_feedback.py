@@ -307,3 +307,15 @@ def test_a_file_just_under_the_size_limit_ends_in_bounded_time(tmp_path, shape):
     assert "error" in data or data["steps"]
     if "error" in data:
         assert data["file"] == str(path) and data["line"]
+
+
+def test_hostile_yaml_values_in_sympy_syntax_are_refused_naming_the_line(tmp_path):
+    digits = "1" + "0" * 5000
+    path = tmp_path / "tower.yaml"
+    path.write_text(f'robot: rp-arm\nsteps:\n  tau_2: "(((9**99)**99)**99)**99"\n  tau_1: "{digits}"\n'
+                    f'  T: "{"+".join(["m1"] * 3000)}+((9**99)**99)**99"\n')
+    done = _grade_subprocess(path)
+    assert done.returncode == 1, done.stderr
+    for line, words in ((3, "digits"), (4, "5001 digits"), (5, "digits")):
+        assert any(f"{path}:{line}: cannot read the value" in t and words in t for t in done.stdout.split("\n")), line
+    assert "Exceeds the limit" not in done.stdout + done.stderr

@@ -595,6 +595,77 @@ _BIG_POWER = re.compile(r"(\*\*|\^)\s*\(?\s*\d{4,}|\d+\s*(\*\*|\^)\s*\d+\s*(\*\*
 _SYNTAX = re.compile(r"[A-Za-z_][A-Za-z_0-9]*|\d+(?:\.\d*)?(?:[eE][-+]?\d+)?|\.\d+(?:[eE][-+]?\d+)?|\*\*|[-+*/^(),\s]")
 
 
+def _check_numbers(text: str) -> None:
+    """Refuse, before SymEngine computes it, a number of more than :data:`MAX_DIGITS`
+    digits, written or produced by powers of powers (``((9**99)**99)**99``). The size
+    (log10 of a bound of the magnitude) of every purely numeric part is estimated by one
+    operator-precedence pass over the tokens, iterative (a sum of 10^5 terms is fine),
+    evaluating nothing. ``text`` has passed the checks of :func:`parse_sympy_syntax`."""
+    import math
+
+    for m in re.finditer(r"\d+", text):
+        if len(m.group(0)) > MAX_DIGITS:
+            raise LatexError(f"a number with {len(m.group(0))} digits (at most {MAX_DIGITS})")
+    tokens = [t for t in _SYNTAX.findall(text) if not t.isspace()]
+    prec = {"+": 1, "-": 1, "*": 2, "/": 2, "**": 3, "^": 3}
+    values: list = []  # sizes: float, or None for a part with a symbol in it
+    ops: list = []  # operators, "(" and "f(" (a function call)
+
+    def reduce_one():
+        op = ops.pop()
+        if len(values) < 2:
+            raise IndexError
+        b, a = values.pop(), values.pop()
+        if op in ("**", "^"):
+            if b is not None and b > 6:
+                raise LatexError(f"an exact power with an exponent of about 10^{int(b)}")
+            size = None if a is None or b is None else abs(a) * 10**b
+            if size is not None and size > MAX_DIGITS:
+                raise LatexError(f"a number of about {int(size)} digits (at most {MAX_DIGITS})")
+        elif a is None or b is None:
+            size = None
+        else:
+            size = a + b if op in ("*", "/") else max(a, b) + 1
+        values.append(size)
+
+    try:
+        previous = None
+        for k, tok in enumerate(tokens):
+            unary = tok in ("+", "-") and (previous is None or previous in prec or previous in ("(", ","))
+            if unary:
+                pass  # a sign does not change a magnitude
+            elif tok in prec:
+                right = tok in ("**", "^")
+                while ops and ops[-1] in prec and (prec[ops[-1]] > prec[tok] or
+                                                   prec[ops[-1]] == prec[tok] and not right):
+                    reduce_one()
+                ops.append(tok)
+            elif tok == "(":
+                ops.append("f(" if previous is not None and (previous[0].isalpha() or previous[0] == "_") else "(")
+            elif tok in (")", ","):
+                while ops and ops[-1] not in ("(", "f("):
+                    reduce_one()
+                if tok == ",":
+                    values.pop()  # an argument of a function: checked, not a magnitude
+                else:
+                    opener = ops.pop()
+                    if opener == "f(":
+                        values.pop()
+                        values.append(None)
+            elif tok[0].isdigit() or tok[0] == ".":
+                number = float(tok) if len(tok) < 300 else float("inf")
+                values.append(math.log10(number) if 0 < number < float("inf") else 0.0)
+            elif k + 1 < len(tokens) and tokens[k + 1] == "(":
+                pass  # a function's name: its call is marked at the "("
+            else:
+                values.append(None)  # a symbol
+            previous = tok
+        while ops:
+            reduce_one()
+    except (IndexError, OverflowError):  # not LatexError (a ValueError): that is the answer
+        return  # malformed: SymEngine's parser reports it
+
+
 def parse_sympy_syntax(text: str, names: dict, symengine: bool = False):
     """An expression in SymPy syntax (``l1*theta1_dot**2 + g*sin(theta1)``) as SymPy.
 
@@ -627,6 +698,7 @@ def parse_sympy_syntax(text: str, names: dict, symengine: bool = False):
         raise LatexError("unbalanced '('")
     if _BIG_POWER.search(text):
         raise LatexError("an exact power with a huge exponent")
+    _check_numbers(text)
     try:
         value = se.sympify(text)
     except Exception as exc:  # noqa: BLE001 - SymEngine's parse errors have several types

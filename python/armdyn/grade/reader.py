@@ -120,6 +120,8 @@ def _safe_yaml(text: str, where: str):
         line = f":{mark.line + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
         raise ModelError(f"malformed YAML ({problem})", source=where + line) from None
+    except ValueError as exc:  # an integer beyond Python's conversion limit (thousands of digits)
+        raise ModelError(f"a value YAML cannot read ({str(exc).split(';')[0]})", source=where) from None
 
 
 def _front(meta, path: str, sub: Submission) -> None:
