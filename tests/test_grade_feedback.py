@@ -57,11 +57,14 @@ def test_position_vectors_and_rotations_are_kinematics_steps(tmp_path):
     # point masses at the frame origins: P_{C_i}^i = 0; R_1^0 = Rz(θ1), R_0^1 its transpose
     path = write(tmp_path, "kin.md", r"""
 $$\mathbf{P}_1^0 = \begin{pmatrix} l_1 \cos\theta_1 \\ l_1 \sin\theta_1 \\ 0 \end{pmatrix}$$
-$$\mathbf{P}_1^1 = (l_1,\ 0,\ 0)^T, \mathbf{P}_{C_1}^1 = \mathbf{0}, \mathbf{P}_2^1 = \begin{pmatrix} 0 \\ d_2 \\ 0 \end{pmatrix}$$
+$$\mathbf{P}_1^1 = (l_1,\ 0,\ 0)^T, \mathbf{P}_{C_1}^1 = \mathbf{0},
+\mathbf{P}_2^1 = \begin{pmatrix} 0 \\ d_2 \\ 0 \end{pmatrix}$$
 $$\mathbf{P}_{C_2}^2 = \mathbf{0}$$
 $$\mathbf{P}_2^1 = \begin{pmatrix} 0 \\ 0 \\ d_2 \end{pmatrix}$$
-$$R_1^0 = \begin{pmatrix} \cos\theta_1 & -\sin\theta_1 & 0 \\ \sin\theta_1 & \cos\theta_1 & 0 \\ 0 & 0 & 1 \end{pmatrix}$$
-$$R_0^1 = \begin{pmatrix} \cos\theta_1 & -\sin\theta_1 & 0 \\ \sin\theta_1 & \cos\theta_1 & 0 \\ 0 & 0 & 1 \end{pmatrix}$$
+$$R_1^0 = \begin{pmatrix} \cos\theta_1 & -\sin\theta_1 & 0 \\ \sin\theta_1 & \cos\theta_1 & 0 \\
+0 & 0 & 1 \end{pmatrix}$$
+$$R_0^1 = \begin{pmatrix} \cos\theta_1 & -\sin\theta_1 & 0 \\ \sin\theta_1 & \cos\theta_1 & 0 \\
+0 & 0 & 1 \end{pmatrix}$$
 """)
     r = grade(path)
     status = [(v.name, v.status) for v in r.steps]

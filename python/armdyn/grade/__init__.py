@@ -293,7 +293,7 @@ class _Grader:
                 status = "wrong"
                 bad = [int(i) for i in range(9) if not ok.ravel()[i]]
                 message = "; ".join(f"{component_name(i, (3, 3))}: "
-                                    + describe(value[i], expected[i], self.robot, self.sampler, shorthand=self.symbols.shorthand) for i in bad[:3])
+                                    + self._describe(value[i], expected[i]) for i in bad[:3])
         self.verdicts.append(StepVerdict(
             name=ref.name, key="R", link="", status=status, label=eq.lhs, source=eq.source, line=eq.line,
             expected=expected, got=value, difference=None if status != "wrong" else value - expected,
@@ -317,7 +317,7 @@ class _Grader:
         fp = self.sampler.fingerprint
         ok = equal(fp(value), fp(expected)).ravel()
         bad = [int(i) for i in range(3) if not ok[i]]
-        message = "; ".join(f"{describe(value[i], expected[i], self.robot, self.sampler, shorthand=self.symbols.shorthand)} in "
+        message = "; ".join(f"{self._describe(value[i], expected[i])} in "
                             f"{component_name(i, (3, 1))}" for i in bad)
         if bad:
             message += f" ({what}, in frame {frame})"
@@ -399,7 +399,7 @@ class _Grader:
             if j.status == "wrong":
                 parts = []
                 for i in components[:3]:
-                    text = describe(got_m[i], ref_m[i], self.robot, self.sampler, shorthand=self.symbols.shorthand)
+                    text = self._describe(got_m[i], ref_m[i])
                     where = component_name(i, got_m.shape)
                     parts.append(f"{text} in {where}" if where else text)
                 against = "" if not j.origins else " (compared with what your own earlier steps give)"
@@ -423,7 +423,8 @@ class _Grader:
                     if bad:
                         src = sorted(carried[0].origins, key=self._order)
                         where = component_name(bad[0], d.shape)
-                        message += (f": carried through they leave {pretty(tidy(d[bad[0]], self.robot), shorthand=self.symbols.shorthand)}"
+                        left = pretty(tidy(d[bad[0]], self.robot), shorthand=self.symbols.shorthand)
+                        message += (f": carried through they leave {left}"
                                     + (f" in {where}" if where else "")
                                     + (f" (from the error in {src[0]})" if src else "")
                                     + " (copied, or two slips that cancel?)")
@@ -434,6 +435,10 @@ class _Grader:
             expected=exp_shown, got=value, difference=difference, components=components,
             convention=j.convention, caused_by=caused_by, message=message,
             frame="" if ref.key not in VECTOR_KEYS else str(ref.frame if ref.frame is not None else ref.index)))
+
+    def _describe(self, got, ref) -> str:
+        """What differs, in the student's shorthand."""
+        return describe(got, ref, self.robot, self.sampler, shorthand=self.symbols.shorthand)
 
     def _order(self, name: str) -> int:
         for k, v in enumerate(self.verdicts):
