@@ -7,7 +7,11 @@ Markdown reader's output is exactly what a YAML submission states directly
 
 Markdown: an optional front matter between ``---`` lines at the top (YAML: ``robot``,
 ``method``, ``symbols``), then any text; every ``$$ ... $$`` or ``\\[ ... \\]`` block is
-split into equations (at ``\\\\`` and at commas before another ``LHS = ...``).
+split into equations (at ``\\\\`` and at commas before another ``LHS = ...``), each with
+its line, the column where its value starts, and the part of the assignment it is in
+(:mod:`.parts`). Reading is linear in the file's size and bounded: at most
+:data:`MAX_BYTES` bytes and :data:`MAX_EQUATIONS` equations; an equation with an
+unbalanced brace is kept with ``problem`` naming the brace's line and column.
 
 YAML::
 
@@ -162,19 +166,17 @@ def math_blocks(text: str, start: int = 0):
     """``(block_start, block_end, body_start, body)`` of each ``$$ ... $$`` / ``\\[ ... \\]``
     block from ``start`` on. Linear: each closer is looked for once with ``str.find``,
     and an opener that is never closed ends the search for that kind."""
-    closed = {"$$": True, "\\[": True}
+    openers = {"$$": "$$", "\\[": "\\]"}  # opener -> closer, for the kinds still possible
     pos = start
-    while True:
-        m = _OPENER.search(text, pos)
+    while openers:
+        pattern = _OPENER if len(openers) == 2 else re.compile(re.escape(next(iter(openers))))
+        m = pattern.search(text, pos)
         if m is None:
             return
         opener = m.group(0)
-        closer = "$$" if opener == "$$" else "\\]"
-        end = text.find(closer, m.end()) if closed[opener] else -1
-        if end < 0:
-            closed[opener] = False
-            if not any(closed.values()):
-                return
+        end = text.find(openers[opener], m.end())
+        if end < 0:  # never closed: no block of this kind from here on
+            del openers[opener]
             pos = m.end()
             continue
         if end > m.end():
