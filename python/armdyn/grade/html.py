@@ -182,6 +182,8 @@ def _step_card(i: int, step: StepVerdict, w: _Writer, anchors: dict, first: int 
     where = [f"line {step.line}"] if step.line else []
     if step.frame:
         where.append(f"in frame {escape(step.frame)}")
+    if step.part or step.task:  # the assignment's part (or the unnumbered task's title)
+        where.append(f"part {escape(step.part)}" if step.part else escape(step.task[:40]))
     head = (f'<div class="head"><span class="label">{math_element(_label(step))}</span>'
             f'{_badge(step.status)}<span class="where">{" · ".join(where)}</span></div>')
     parts = [head]
