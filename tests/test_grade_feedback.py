@@ -322,3 +322,11 @@ def test_hostile_yaml_values_in_sympy_syntax_are_refused_naming_the_line(tmp_pat
     for line, words in ((3, "digits"), (4, "5001 digits"), (5, "digits")):
         assert any(f"{path}:{line}: cannot read the value" in t and words in t for t in done.stdout.split("\n")), line
     assert "Exceeds the limit" not in done.stdout + done.stderr
+
+
+def test_deeply_nested_yaml_value_is_a_clear_error(tmp_path):
+    path = tmp_path / "deep.yaml"
+    path.write_text("robot: rp-arm\nsteps:\n  tau_1: '0'\n  tau_2: " + "[" * 5000 + "]" * 5000 + "\n")
+    done = _grade_subprocess(path)
+    assert done.returncode == 2 and done.stderr.count("\n") == 1
+    assert done.stderr.startswith(f"armdyn: error: {path}:4: step 'tau_2'") and "internal error" not in done.stderr

@@ -309,7 +309,13 @@ def read_yaml(path: str, text: str | None = None) -> Submission:
         raise ModelError(f"more than {MAX_EQUATIONS} steps (a derivation has a few dozen)", source=path)
     for n, (name, value, line, part) in enumerate(items):
         if isinstance(value, (list, tuple)):
-            if any(isinstance(v, (list, dict)) for v in value):
+            # components, or rows of components: nothing nested deeper (and no deep repr later)
+            if any(isinstance(v, dict) or isinstance(v, (list, tuple)) and any(
+                    isinstance(x, (list, tuple, dict)) for x in v) for v in value):
+                where = f"{path}:{lines[n]}" if n < len(lines) else path
+                raise ModelError(f"step '{name}': a value is an expression, a list of them or a list of rows",
+                                 source=where)
+            if any(isinstance(v, list) for v in value):
                 value = [list(v) if isinstance(v, (list, tuple)) else v for v in value]
         elif not isinstance(value, (str, int, float)) or isinstance(value, bool):
             where = f"{path}:{lines[n]}" if n < len(lines) else path
