@@ -2,11 +2,16 @@
 
     python3 benchmarks/bench_grade.py [--runs 5]
 
-1. the exercise (examples/grading/rp-arm-exercise.md): target under 2 s;
+1. the exercise (examples/grading/rp-arm-exercise.md, all four parts): target under 3 s;
 2. a 6-dof derivation: PUMA 560 (published numbers), every Newton-Euler step written out
    from armdyn's own derivation into YAML, then one term added to one step (vc_dot_3):
    target under 10 s. The file is written to a temporary directory (about 2.6 MB: the
    steps are unexpanded expression trees).
+
+3. proofs (grade/proofs): one proof line, the exercise's energy chain
+   ``E_rot = 1/2 w^T I w = 1/2 w^T R I R^T w = 1/2 w^cT I^c w^c`` (three links, one wrong, so
+   its counterexample search included), checked in process: target median under 0.2 s;
+   and all the exercise's proof lines (7-3 and the energy proof) in process.
 
 No other tool grades derivations, so there is no side-by-side ratio; for scale the table
 also times `armdyn derive rp-arm` (the main job) the same way. Medians of --runs runs.
@@ -57,6 +62,36 @@ def timed(argv: list[str], runs: int) -> tuple[float, list[float], str]:
     return statistics.median(times[1:]), times[1:], out
 
 
+def proof_line_times(runs: int) -> list[tuple[str, float, list[float], float]]:
+    """In-process medians: one proof line (the energy chain, after the lines before it),
+    and all the exercise's proof lines."""
+    sys.path.insert(0, str(ROOT / "python"))
+    from armdyn.grade.proofs import check_text
+    from armdyn.grade.proofs.checker import ProofChecker
+    from armdyn.grade.proofs.regions import proof_regions
+
+    exercise = (ROOT / "examples" / "grading" / "rp-arm-exercise.md").read_text()
+    energy = proof_regions(exercise, set())[1]
+    one = []
+    for _ in range(max(runs, 20) + 1):
+        checker = ProofChecker()
+        for d in energy[:-1]:  # the lines before the chain name r_i, I_{l_i}, R^c
+            checker.display(d, "")
+        t0 = time.perf_counter()
+        verdicts = checker.display(energy[-1], "")
+        one.append(time.perf_counter() - t0)
+        if [v.status for v in verdicts] != ["correct", "wrong", "follows-from-earlier-error"]:
+            raise SystemExit(f"unexpected verdicts on the energy chain: {verdicts}")
+    whole = []
+    for _ in range(runs + 1):
+        t0 = time.perf_counter()
+        check_text(exercise)
+        whole.append(time.perf_counter() - t0)
+    return [("check one proof line (the energy chain: 3 links, 1 wrong + its counterexample)",
+             statistics.median(one[1:]), one[1:], 0.2),
+            ("check all the exercise's proof lines (20 links)", statistics.median(whole[1:]), whole[1:], None)]
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=5)
@@ -67,7 +102,8 @@ def main() -> None:
         puma_submission(puma)
         cases = [
             ("armdyn derive rp-arm (for scale)", py + ["derive", "rp-arm"], None),
-            ("grade the exercise (rp-arm, 46 equations)", py + ["grade", "examples/grading/rp-arm-exercise.md"], 2.0),
+            ("grade the exercise (rp-arm, 46 equations, proofs checked)",
+             py + ["grade", "examples/grading/rp-arm-exercise.md"], 3.0),
             (f"grade PUMA 560, 54 steps, one altered ({puma.stat().st_size / 1e6:.1f} MB)",
              py + ["grade", str(puma)], 10.0),
         ]
@@ -78,6 +114,10 @@ def main() -> None:
             print(f"| {label} | {med:.2f} ({spread}) | {args.runs} | {'' if target is None else f'< {target:g} s'} |")
             if "grade" in argv and "first wrong step" not in out:
                 raise SystemExit(f"unexpected output of {' '.join(argv)}:\n{out}")
+        for label, med, times, target in proof_line_times(args.runs):
+            spread = f"{min(times):.3f}-{max(times):.3f}"
+            print(f"| {label}, in process | {med:.3f} ({spread}) | {len(times)} | "
+                  f"{'' if target is None else f'< {target:g} s'} |")
 
 
 if __name__ == "__main__":

@@ -12,11 +12,12 @@ Used by tests/test_html_report.py; a new test of a report is a few lines::
         assert_math_rendered(shot, min_count=10)
 
 How: the page is copied with a small measuring script appended (the report itself has
-no script) and loaded from a file with ``--dump-dom``; the script writes, as JSON, the
+no script, and its Content-Security-Policy, which would block the script, is taken out
+of the copy) and loaded from a file with ``--dump-dom``; the script writes, as JSON, the
 bounding box of every ``<math>`` element, the number of ``<merror>`` elements, any
 math whose text still looks like LaTeX source (a backslash: a conversion that did not
 happen), and the box and background of each highlighted table cell (``mtd.hl``).
-A second run of the original page takes a screenshot of the full page height.
+A second run of the original page (policy and all) takes a screenshot of the full page height.
 Chromium runs headless, with a fresh profile, no first-run, sync, component updates
 or background networking; the pages load nothing from the network.
 
@@ -116,6 +117,15 @@ class Rendered:
     screenshot: Path | None = None
 
 
+_CSP_META = re.compile(r'<meta http-equiv="Content-Security-Policy"[^>]*>\n?', re.IGNORECASE)
+
+
+def without_csp(source: str) -> str:
+    """The page without its Content-Security-Policy ``<meta>`` (so that a test's own
+    script may run in it)."""
+    return _CSP_META.sub("", source)
+
+
 def find_chromium() -> str | None:
     """Path of a Chromium binary (``ARMDYN_CHROMIUM`` first), or None."""
     env = os.environ.get("ARMDYN_CHROMIUM")
@@ -151,7 +161,7 @@ def render(page: str | Path, chromium: str, screenshot: str | Path | None = None
     math (see :class:`Rendered`) and, when ``screenshot`` is given, save a PNG of the
     whole page there."""
     page = Path(page).resolve()
-    source = page.read_text(encoding="utf-8")
+    source = without_csp(page.read_text(encoding="utf-8"))
     with tempfile.TemporaryDirectory(prefix="armdyn-page-") as tmp:
         probe = Path(tmp) / page.name
         at = source.rfind("</body>")
@@ -174,6 +184,17 @@ def render(page: str | Path, chromium: str, screenshot: str | Path | None = None
             raise AssertionError(f"Chromium wrote no screenshot (exit {done.returncode}); stderr:\n{done.stderr[-2000:]}")
         out.screenshot = shot
     return out
+
+
+def dump_dom(page: str | Path, chromium: str, timeout: float = 90.0, budget_ms: int = 3000) -> str:
+    """The DOM of the HTML file ``page`` as Chromium serializes it after loading it as
+    it is (no script added, its own policy in force) and letting ``budget_ms`` of
+    virtual time pass (timers, image errors, load events run)."""
+    done = _run(chromium, [f"--virtual-time-budget={budget_ms}", "--dump-dom", Path(page).resolve().as_uri()],
+                timeout)
+    if "<html" not in done.stdout:
+        raise AssertionError(f"Chromium dumped no document (exit {done.returncode}); stderr:\n{done.stderr[-2000:]}")
+    return done.stdout
 
 
 def assert_math_rendered(r: Rendered, min_count: int = 1) -> None:

@@ -14,7 +14,14 @@ Kinds of input (each from a fixed seed, so a finding can be replayed):
   hostile numbers, elements dropped or duplicated, names swapped) or as text;
 * ``arrays``: random arrays (shapes, dtypes, NaN/inf/huge values, non-contiguous, object
   and complex arrays, odd ``threads``/``link`` values) into every numeric function of a
-  few compiled robots.
+  few compiled robots;
+* ``html``:   payloads into HTML (run it with ``--kinds html``): random strings of script
+  and markup fragments (tests/html_payloads.py) as a student's LaTeX label, as raw
+  MathML for the sanitizer, as symbol names in the MathML printer and as a model's
+  robot/link/joint names in ``Robot._repr_html_`` and a page; the output must pass an
+  HTML tokenizer's check independent of the sanitizer (no foreign element, no on*
+  attribute, no link or style attribute, no ``javascript:``), parse as XML with only
+  whitelisted MathML, and the sanitizer must be idempotent on it.
 
 A model that loads is bound to its defaults and, when numeric, compiled and evaluated
 once. Each input must end in a result or an expected error (``ModelError``,
@@ -291,6 +298,98 @@ def run_arrays(seed: int, rng: random.Random):
             raise AssertionError(f"{name} returned NaN for finite inputs")
 
 
+# ------------------------------------------------------------------ kind "html": payloads into HTML
+
+
+def _html_text(rng: random.Random) -> str:
+    """A random string of payload fragments, whole payloads and random characters."""
+    from html_payloads import FRAGMENTS, PAYLOADS
+
+    parts = []
+    for _ in range(rng.randint(1, 8)):
+        r = rng.random()
+        if r < 0.6:
+            parts.append(rng.choice(FRAGMENTS))
+        elif r < 0.75:
+            parts.append(rng.choice(PAYLOADS)[1])
+        elif r < 0.9:
+            parts.append("".join(chr(rng.choice([rng.randrange(32, 127), rng.randrange(0, 0x3000)]))
+                                 for _ in range(rng.randint(1, 6))))
+        else:
+            parts.append(rng.choice(["Q", "theta1", "l_1", "\\omega", "x"]))
+    return "".join(parts)
+
+
+def _check_math(markup: str) -> None:
+    """A ``<math>`` element armdyn wrote: safe by the independent check, well-formed,
+    whitelisted, and a fixed point of the sanitizer."""
+    from html_payloads import html_findings
+
+    from armdyn.mathml_sanitize import ATTRIBUTES, ELEMENTS, sanitize_mathml
+
+    found = html_findings(markup)
+    if found:
+        raise AssertionError(f"live markup {found[:3]} in {markup[:200]!r}")
+    root = ET.fromstring(markup)
+    for el in root.iter():
+        if el.tag.split("}")[-1] not in ELEMENTS:
+            raise AssertionError(f"element {el.tag} in {markup[:200]!r}")
+        for name, value in el.attrib.items():
+            if name not in ATTRIBUTES or not ATTRIBUTES[name].fullmatch(value):
+                raise AssertionError(f"attribute {name}={value!r} in {markup[:200]!r}")
+    inner = markup[markup.index(">") + 1: markup.rindex("</math>")]
+    if sanitize_mathml(inner) != inner:
+        raise AssertionError(f"the sanitizer is not idempotent on {inner[:200]!r}")
+
+
+def run_html(seed: int, rng: random.Random):
+    text = _html_text(rng)
+    r = rng.random()
+    try:  # only a model may be refused (ModelError): any other error here is a finding
+        _html_case(text, r, rng)
+    except (ValueError, TypeError) as err:
+        if type(err).__name__ == "ModelError":
+            raise
+        raise AssertionError(f"{type(err).__name__}: {err}") from None
+
+
+def _html_case(text: str, r: float, rng: random.Random):
+    import sympy as sp
+    from html_payloads import html_findings
+
+    from armdyn.htmlpage import page
+    from armdyn.mathml import MathWriter, escape, latex_to_mathml, math_element
+
+    if r < 0.4:  # a student's LaTeX label (grade report, derive step label)
+        inner = latex_to_mathml(text)
+        _check_math(math_element(inner if inner is not None else f"<mtext>{escape(text)}</mtext>"))
+    elif r < 0.7:  # raw markup: the sanitizer alone
+        _check_math(math_element(text))
+    elif r < 0.95:  # names in the printer, and a student's notation for a symbol
+        a, b = sp.Symbol(text), sp.Symbol("theta1_dot")
+        w = MathWriter({b: _html_text(rng)} if rng.random() < 0.5 else None)
+        _check_math(math_element(w.expr(rng.choice([a, a**2 * b, sp.sin(a) + b / a, sp.Matrix([a, b])]))))
+    else:  # a model's names in Robot._repr_html_ and a page's title
+        from armdyn.io.yaml import load_yaml_string
+
+        names = {"name: rp-arm": None, "name: link1": "link1", "name: theta1": None}
+        model = _seed_text("rp-arm")
+        for old, ref in names.items():
+            new = json.dumps(_html_text(rng))
+            model = model.replace(old, f"name: {new}")
+            if ref:
+                model = model.replace(f"child: {ref}", f"child: {new}").replace(f"parent: {ref}", f"parent: {new}")
+        robot = load_yaml_string(model, source="fuzz.yaml")
+        for markup in (robot._repr_html_(), page(robot.name, f"<p>{escape(robot.name)}</p>")):
+            found = html_findings(markup)
+            if found:
+                raise AssertionError(f"live markup {found[:3]} for names {robot.name!r}, {list(robot.links)}")
+
+
+#: kinds that are one function (seed, rng) each
+RUNNERS = {"html": run_html}
+
+
 # ------------------------------------------------------------------ worker / driver
 
 
@@ -323,6 +422,8 @@ def worker(kind: str, first: int, count: int, timeout: float) -> dict:
                 run_yaml(seed, rng, DH_SEEDS)
             elif kind == "urdf":
                 run_urdf(seed, rng)
+            elif kind in RUNNERS:
+                RUNNERS[kind](seed, rng)
             else:
                 run_arrays(seed, rng)
             counts["loaded_or_ok"] += 1

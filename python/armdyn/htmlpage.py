@@ -4,6 +4,12 @@ Reports are self-contained: inline CSS, math as MathML (rendered natively by bro
 no script, no web font, no network. Every rule is scoped under ``.armdyn`` so that a
 fragment can sit inside a Jupyter notebook without restyling it.
 
+A page carries a Content-Security-Policy (:data:`CSP`) that lets it load and run
+nothing but its own inline stylesheet and ``data:`` images: a second line of defence
+behind the escaping and the MathML whitelist (:mod:`armdyn.mathml_sanitize`), should
+student or model text ever get through as markup. A Jupyter fragment cannot carry one
+(the notebook's page sets its own policy); it relies on the escaping alone.
+
 Colours of the statuses (text on a pale background, readable in print):
 correct green, correct-by-convention blue, wrong red, follows-from-earlier-error amber,
 correct-but-unsupported violet, unrecognised grey.
@@ -12,6 +18,10 @@ correct-but-unsupported violet, unrecognised grey.
 from __future__ import annotations
 
 from .mathml import escape
+
+#: every page: no script, no fetch, no frame, no form, no base URL; inline CSS only
+CSP = ("default-src 'none'; style-src 'unsafe-inline'; img-src data:; "
+       "base-uri 'none'; form-action 'none'")
 
 CSS = """
 .armdyn { --ink:#1f2328; --muted:#59636e; --rule:#d1d9e0; --paper:#ffffff; --tint:#f6f8fa;
@@ -105,6 +115,7 @@ CSS = """
 .armdyn .st-follows-from-earlier-error mtd.hl { background:var(--hl-carry); }
 .armdyn .st-follows-from-earlier-error .side.diff { background:var(--carry-bg); }
 .armdyn mtd.zero { color:#8c959f; }
+.armdyn mtd.left { text-align:left; math-style:normal; }
 .armdyn mtext.long { font-family:"Segoe UI","Helvetica Neue","Liberation Sans",Arial,sans-serif;
   font-size:0.8em; color:var(--muted); }
 .armdyn details { margin-top:6px; font-size:0.92em; }
@@ -142,6 +153,7 @@ def page(title: str, body: str) -> str:
     return (
         "<!DOCTYPE html>\n"
         '<html lang="en">\n<head>\n<meta charset="utf-8">\n'
+        f'<meta http-equiv="Content-Security-Policy" content="{CSP}">\n'
         '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
         f"<title>{escape(title)}</title>\n"
         f"<style>{CSS}\nbody {{ margin:0; background:#ffffff; }}\n</style>\n"

@@ -19,7 +19,9 @@ expression layout; this module teaches it the field's notation:
   snippets are converted with the ``latex2mathml`` package.
 
 The output is well-formed XML (numeric character references only, text escaped), so
-it can be embedded in HTML5 or parsed by ``xml.etree``.
+it can be embedded in HTML5 or parsed by ``xml.etree``. Neither the student's LaTeX nor
+a model's names are trusted: :func:`latex_to_mathml` and :func:`math_element` pass
+every fragment through the whitelist of :mod:`armdyn.mathml_sanitize`.
 """
 
 from __future__ import annotations
@@ -33,6 +35,8 @@ import sympy as sp
 from sympy.printing.conventions import split_super_sub
 from sympy.printing.mathml import MathMLPresentationPrinter
 from sympy.printing.pretty.pretty_symbology import greek_unicode
+
+from .mathml_sanitize import clean_mathml, sanitize_mathml
 
 __all__ = ["MathWriter", "to_mathml", "latex_to_mathml", "math_element", "escape"]
 
@@ -67,15 +71,21 @@ def _numeric_entities(markup: str) -> str:
 
 
 def math_element(inner: str, display: bool = False) -> str:
-    """Wrap MathML content in a ``<math>`` element (block when ``display``)."""
+    """Wrap MathML content in a ``<math>`` element (block when ``display``), after the
+    whitelist sanitizer (:func:`armdyn.mathml_sanitize.sanitize_mathml`): the content
+    may carry a model's names or a student's LaTeX."""
     mode = "block" if display else "inline"
-    return f'<math xmlns="{MATHML_NS}" display="{mode}">{inner}</math>'
+    return f'<math xmlns="{MATHML_NS}" display="{mode}">{sanitize_mathml(inner)}</math>'
 
 
 @lru_cache(maxsize=1024)
 def latex_to_mathml(latex: str) -> str | None:
     """The content (without ``<math>``) of a LaTeX snippet as MathML, or None when it
-    cannot be converted (``latex2mathml`` missing, or LaTeX it does not parse)."""
+    cannot be converted (``latex2mathml`` missing, or LaTeX it does not parse) or when
+    the whitelist sanitizer had to drop an element of the conversion (``\\text{<b>}``
+    comes out of latex2mathml as a live ``<b>``): the caller then shows the LaTeX
+    source as escaped text. Disallowed attributes (``\\href``, ``\\style``) are
+    dropped and the rest kept."""
     try:
         from latex2mathml.converter import convert
     except ImportError:
@@ -102,8 +112,11 @@ def latex_to_mathml(latex: str) -> str | None:
             mover.setAttribute("accent", "true")
     root = doc.documentElement
     inner = "".join(k.toxml() for k in root.childNodes)
-    inner = inner.encode("ascii", "xmlcharrefreplace").decode()
-    return _numeric_entities(inner)
+    try:
+        clean = clean_mathml(_numeric_entities(inner))
+    except ValueError:
+        return None
+    return None if clean.dropped else clean.markup
 
 
 class _Printer(MathMLPresentationPrinter):
@@ -370,7 +383,7 @@ class MathWriter:
             cells = "".join((f'<mo form="{"prefix" if i == 0 else "infix"}">{sg}</mo>' if sg else "") + b
                             for i, (sg, b) in enumerate(line))
             indent = '<mspace width="1.5em"/>' if k else ""
-            rows.append(f'<mtr><mtd style="text-align:left; math-style:normal">{indent}<mrow>{cells}</mrow></mtd></mtr>')
+            rows.append(f'<mtr><mtd class="left">{indent}<mrow>{cells}</mrow></mtd></mtr>')
         return "<mtable>" + "".join(rows) + "</mtable>"
 
     def value(self, value, highlight=(), scalar=None) -> str:

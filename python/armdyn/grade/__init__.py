@@ -31,6 +31,7 @@ from .latex import GREEK, LatexError, UnknownSymbol, parse, parse_sympy_syntax
 from .diagnose import unreadable
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
+from .proofs import grade_proofs
 from .reader import Submission, read
 from .statements import FREE_END, lagrange_law
 from .verdict import PASSING, STATUSES, GradeReport, StepVerdict
@@ -179,6 +180,10 @@ class _Grader:
                 context = "lagrange" if self.verdicts[-1].key in LAGRANGE_KEYS else "newton-euler"
             for v in self.verdicts[done:]:
                 v.part, v.task, v.column = eq.part, eq.task, eq.column
+        self.verdicts = grade_proofs(self.sub, self.verdicts)  # rigid-body proofs: every link checked
+        for v in self.verdicts:  # proof links (also bare expressions) carry the part they are in
+            if v.part is None and not v.task:
+                v.part, v.task = self.sub.part_at(v.line)
         return self._report(seen_methods, method_hint)
 
     def _equation(self, eq, seen_methods: list, context: str | None) -> None:

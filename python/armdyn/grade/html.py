@@ -210,11 +210,13 @@ def _step_card(i: int, step: StepVerdict, w: _Writer, anchors: dict, first: int 
 
     label = _label(step)
     sides = []
+    proof = step.key == "proof"  # a wrong proof link: its two sides' values on the counterexample
     if step.got is not None:
         caption = "yours = expected" if step.status == "correct" else "yours"
-        sides.append(_side(caption, label, w.value(step.got, hl)))
+        sides.append(_side("left side, on the counterexample" if proof else caption, label, w.value(step.got, hl)))
     if step.expected is not None and (step.status != "correct" or step.got is None):
-        sides.append(_side("expected", label, w.value(step.expected, hl)))
+        sides.append(_side("right side, on the counterexample" if proof else "expected", label,
+                           w.value(step.expected, hl)))
     if step.difference is not None and step.status in ("wrong", "follows-from-earlier-error"):
         than = "expected" if _against_expected(step) else "what your own earlier steps give"
         sides.append(_side(f"difference: yours \u2212 {than}", "<mi>\u0394</mi>",

@@ -88,8 +88,8 @@ def _statement_start(lines: list[str], k: int, math_lines: set[int]) -> int:
 
 
 def with_title(part: Part, lines: list[str], math_lines: set[int]) -> Part:
-    """``part`` with its title: the first prose line of its statement (looked up only
-    for the parts that hold equations: a file may have many number lines)."""
+    """``part`` with its title: the first prose line of its statement (a dozen lines
+    looked at, at most :data:`MAX_PARTS` parts)."""
     return Part(part.number, _title(lines, part.line, math_lines, skip_self=part.number is not None), part.line)
 
 

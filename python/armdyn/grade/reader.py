@@ -76,6 +76,15 @@ class Submission:
     base_dir: str = "."
     lines: LineIndex | None = None  # line/column of offsets in the Markdown text
 
+    parts: list = field(default_factory=list)  # the assignment's parts (.parts.Part), Markdown only
+
+    def part_at(self, line: int) -> tuple[str | None, str]:
+        """(part number or None, task title or "") of a 1-based line (see :mod:`.parts`)."""
+        from .parts import part_of
+
+        part = part_of(self.parts, line)
+        return (part.number, part.title) if part is not None else (None, "")
+
     def locate(self, offset: int) -> tuple[int, int]:
         """1-based (line, column) of a 0-based offset in the submission's text."""
         return self.lines.locate(offset) if self.lines is not None else (0, 0)
@@ -191,6 +200,15 @@ class LineIndex:
     def __init__(self, text: str):
         self.newlines = [m.start() for m in re.finditer("\n", text)]
 
+    parts: list = field(default_factory=list)  # the assignment's parts (.parts.Part), Markdown only
+
+    def part_at(self, line: int) -> tuple[str | None, str]:
+        """(part number or None, task title or "") of a 1-based line (see :mod:`.parts`)."""
+        from .parts import part_of
+
+        part = part_of(self.parts, line)
+        return (part.number, part.title) if part is not None else (None, "")
+
     def locate(self, offset: int) -> tuple[int, int]:
         k = bisect.bisect_left(self.newlines, offset)
         line_start = self.newlines[k - 1] + 1 if k else 0
@@ -221,7 +239,7 @@ def unbalanced_brace(text: str) -> tuple[int, str] | None:
 def read_markdown(path: str, text: str | None = None) -> Submission:
     """Read a Markdown derivation (see the module docstring)."""
     from .latex import MAX_LENGTH, side_offsets, split_equations
-    from .parts import find_parts, part_of, with_title
+    from .parts import find_parts, with_title
 
     text = _read_text(path) if text is None else text
     index = LineIndex(text)
@@ -274,14 +292,9 @@ def read_markdown(path: str, text: str | None = None) -> Submission:
                 raise ModelError(f"more than {MAX_EQUATIONS} equations (a derivation has a few dozen)",
                                  source=f"{path}:{index.line(start)}")
     lines = text.split("\n")
-    parts = find_parts(text, index.line, lines, hidden)
-    starts, titled = [p.line for p in parts], {}
+    sub.parts = [with_title(p, lines, hidden) for p in find_parts(text, index.line, lines, hidden)]
     for eq in sub.equations:
-        part = part_of(parts, eq.line, starts)
-        if part is not None:
-            if part.line not in titled:
-                titled[part.line] = with_title(part, lines, hidden)
-            eq.part, eq.task = part.number, titled[part.line].title
+        eq.part, eq.task = sub.part_at(eq.line)
     return sub
 
 

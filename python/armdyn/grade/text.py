@@ -84,14 +84,17 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
                 what += f" ({v.convention})"
         elif v.status == "correct-by-convention":
             what = f"correct ({v.convention})"
+        elif v.status == "correct" and v.key == "proof" and v.message:
+            what = f"correct: {v.message}"
         elif v.status in ("wrong", "correct-but-unsupported", "unrecognised"):
             what = f"{v.status.upper() if v.status == 'wrong' else v.status}: {v.message}"
         lines.append(f"  {mark} line {v.line:>4}  {_pad(step_title(v, ascii_only), width)}  {what}")
         if details and v.status == "wrong":
+            mine, other = ("left:    ", "right:   ") if v.key == "proof" else ("yours:   ", "expected:")  # proof: sides
             if v.got is not None:
-                lines.append(f"{'':>{16 + width}}yours:    {_value(v.got, ascii_only, report.shorthand)}")
+                lines.append(f"{'':>{16 + width}}{mine} {_value(v.got, ascii_only, report.shorthand)}")
             if v.expected is not None:
-                lines.append(f"{'':>{16 + width}}expected: {_value(v.expected, ascii_only, report.shorthand)}")
+                lines.append(f"{'':>{16 + width}}{other} {_value(v.expected, ascii_only, report.shorthand)}")
     if skipped:
         shown = ", ".join(map(str, skipped[:12])) + (", ..." if len(skipped) > 12 else "")
         lines.append(f"  {'·' if not ascii_only else '--'} {len(skipped)} equation(s) not recognised as steps, skipped "
@@ -155,6 +158,7 @@ def to_dict(report: GradeReport) -> dict:
             "part": v.part,
             "task": v.task or None,
             "column": v.column or None,
+            **({"counterexample": v.counterexample} if v.counterexample else {}),
         })
     return {
         "robot": report.robot,

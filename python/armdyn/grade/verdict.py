@@ -66,6 +66,8 @@ class StepVerdict:
                  has no number or there are no parts (see :mod:`armdyn.grade.parts`)
     task:        that task's title (the first line of its statement), "" if none
     column:      1-based column where the value starts (0: not known, e.g. YAML)
+    counterexample: for a wrong proof link, the small body on which its sides differ
+                 (masses, points, vectors, rotations, both sides' values), else None
     """
 
     name: str
@@ -86,6 +88,7 @@ class StepVerdict:
     part: str | None = None
     task: str = ""
     column: int = 0
+    counterexample: dict | None = None
 
     @property
     def passed(self) -> bool:

@@ -1,0 +1,504 @@
+"""Read one side of a proof line (LaTeX) into a typed expression tree; nothing is executed.
+
+A small recursive-descent parser over :func:`armdyn.grade.latex.tokenize`'s tokens. Its
+own tree rather than SymPy because the algebra of a rigid-body proof is not commutative
+(``d r_C^T`` is not ``r_C d^T``, ``R I R^T`` is not ``I``), mixes scalars, vectors and 3x3
+matrices, and holds integrals over the body; the tree is evaluated exactly on point-mass
+bodies (:mod:`.evaluate`), which decides equality without any symbolic simplifier::
+
+    expr    := ["+" | "-"] term (("+" | "-") term)*
+    term    := factor (["\\cdot" | "*" | "\\times" | "/" | juxtaposition] factor)*
+    factor  := atom ["^" script]           (script: an integer power, T / \\top / \\mathrm{T})
+    atom    := number | name [scripts] | "(" expr ")" | "[" expr "]" ["_\\times"] | "{" expr "}"
+             | "\\|" expr "\\|" | "\\frac{expr}{expr}" | "S" ["^T"] "(" expr ")"
+             | "\\int" ["_" script] expr ("dm" | "\\rho dV") | matrix environment
+
+Names keep their typeface (bold ``\\mathbf{I}`` is the identity, plain ``I_{l_i}`` an inertia
+tensor), subscript and superscript as text (:class:`Sym`); what a name means is decided
+when it is evaluated. Limits (bounded time on hostile input): :data:`MAX_TOKENS`,
+:data:`MAX_DEPTH`, :data:`MAX_INTEGRALS` nested integrals, integer exponents of at most
+:data:`MAX_POWER`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+from ..latex import LatexError, tokenize
+
+MAX_TOKENS = 4000
+MAX_DEPTH = 40
+MAX_INTEGRALS = 3
+MAX_POWER = 8
+
+_BOLD = {"mathbf", "boldsymbol", "bm", "pmb", "mathbold"}
+_WRAPPERS = {"mathrm", "mathit", "vec", "hat", "bar", "mathsf", "operatorname", "text", "mathcal", "tilde",
+             "textrm", "mathbb"} | _BOLD
+_MATRIX_ENVS = {"pmatrix", "bmatrix", "Bmatrix", "matrix", "smallmatrix", "array"}
+_STOP_CHARS = {"+", "-", ")", "]", "}", "=", "&", ",", ".", ";", "eof"}
+
+
+class ProofSyntaxError(LatexError):
+    """A proof line that could not be read (the message says what)."""
+
+
+@dataclass(frozen=True)
+class Sym:
+    """A name as written: base (``r``, ``omega``, ``I``, ``R``, ``1``...), bold typeface,
+    subscript text (``C``, ``l_i``, ``ix``), frame label from the superscript (``c``) and
+    whether the superscript transposes (``^T``, ``^{c\\mathrm{T}}``)."""
+
+    base: str
+    bold: bool = False
+    sub: str = ""
+    frame: str = ""
+    transposed: bool = False
+
+    def latex(self) -> str:
+        """The name as plain text for messages: ``d``, ``omega_i``, ``I_{l_i}^c``, ``r_C^T``."""
+        sub = "" if not self.sub else f"_{self.sub}" if len(self.sub) == 1 else f"_{{{self.sub}}}"
+        sup = self.frame + ("T" if self.transposed else "")
+        return self.base + sub + ("" if not sup else f"^{sup}" if len(sup) == 1 else f"^{{{sup}}}")
+
+
+@dataclass(frozen=True)
+class Num:
+    value: Fraction
+
+
+@dataclass(frozen=True)
+class Add:
+    terms: tuple  # ((sign +1/-1, node), ...)
+
+
+@dataclass(frozen=True)
+class Mul:
+    factors: tuple  # left to right (matrix products keep their order)
+
+
+@dataclass(frozen=True)
+class Dot:
+    a: object
+    b: object
+
+
+@dataclass(frozen=True)
+class Cross:
+    a: object
+    b: object
+
+
+@dataclass(frozen=True)
+class Div:
+    a: object
+    b: object
+
+
+@dataclass(frozen=True)
+class Pow:
+    base: object
+    n: int
+
+
+@dataclass(frozen=True)
+class Norm:
+    arg: object
+
+
+@dataclass(frozen=True)
+class Transpose:
+    arg: object
+
+
+@dataclass(frozen=True)
+class Skew:
+    arg: object
+    transposed: bool = False
+
+
+@dataclass(frozen=True)
+class Integral:
+    body: object
+    domain: str = ""
+
+
+@dataclass(frozen=True)
+class Matrix:
+    rows: tuple  # ((node, ...), ...)
+
+
+def _script_text(tokens) -> str:
+    """A script's tokens as plain text: wrappers and braces dropped (``c\\mathrm{T}`` -> ``cT``)."""
+    out = []
+    for kind, value in tokens:
+        if kind == "cmd" and (value in _WRAPPERS or value in ("left", "right")):
+            continue
+        if kind == "cmd" and value == "top":
+            out.append("T")
+        elif kind == "cmd" and value == "times":
+            out.append("×")
+        elif value in ("{", "}"):
+            continue
+        elif kind == "cmd":
+            out.append(value)
+        else:
+            out.append(value)
+    return "".join(out)
+
+
+class _Parser:
+    def __init__(self, tokens):
+        if len(tokens) > MAX_TOKENS:
+            raise ProofSyntaxError(f"a proof line of {len(tokens)} tokens (at most {MAX_TOKENS})")
+        self.t = tokens
+        self.i = 0
+        self.depth = 0
+        self.integrals = 0
+        self.norms = 0
+
+    def peek(self, k=0):
+        j = self.i + k
+        return self.t[j] if j < len(self.t) else ("eof", "eof")
+
+    def take(self):
+        tok = self.peek()
+        self.i += 1
+        return tok
+
+    def expect(self, value):
+        tok = self.take()
+        if tok[1] != value:
+            raise ProofSyntaxError(f"expected '{value}', found '{tok[1]}'")
+
+    def enter(self):
+        self.depth += 1
+        if self.depth > MAX_DEPTH:
+            raise ProofSyntaxError(f"nested deeper than {MAX_DEPTH} levels")
+
+    # -- grammar
+    def parse(self):
+        node = self.expr()
+        if self.peek()[0] != "eof":
+            raise ProofSyntaxError(f"unexpected '{self.peek()[1]}'")
+        return node
+
+    def expr(self):
+        self.enter()
+        terms = []
+        sign = 1
+        if self.peek()[1] in ("+", "-"):
+            sign = -1 if self.take()[1] == "-" else 1
+        terms.append((sign, self.term()))
+        while self.peek()[1] in ("+", "-"):
+            sign = -1 if self.take()[1] == "-" else 1
+            terms.append((sign, self.term()))
+        self.depth -= 1
+        if len(terms) == 1 and terms[0][0] == 1:
+            return terms[0][1]
+        return Add(tuple(terms))
+
+    def differential(self) -> str | None:
+        """``dm`` / ``dV`` / ``\\mathrm{d}m`` ahead (only inside an integral)."""
+        if not self.integrals:
+            return None
+        k, v = self.peek()
+        if (k, v) == ("char", "d") and self.peek(1)[1] in ("m", "V"):
+            return self.peek(1)[1]
+        if k == "cmd" and v in ("mathrm", "text", "operatorname") and self.peek(1)[1] == "{" \
+                and self.peek(2)[1] == "d" and self.peek(3)[1] == "}" and self.peek(4)[1] in ("m", "V"):
+            return self.peek(4)[1]
+        return None
+
+    def take_differential(self):
+        if self.peek()[1] == "d":
+            self.i += 2
+        else:
+            self.i += 5
+
+    def at_term_end(self) -> bool:
+        k, v = self.peek()
+        if k == "eof" or (k == "char" and v in _STOP_CHARS) or (k == "cmd" and v in ("right", "\\")):
+            return True
+        if k == "end":
+            return True
+        if self.norms and ((k == "cmd" and v in ("|", "rVert", "Vert")) or (k == "char" and v == "|")):
+            return True
+        return self.differential() is not None
+
+    def term(self):
+        self.enter()
+        node = self.factor()
+        factors = [node]
+        while not self.at_term_end():
+            k, v = self.peek()
+            if k == "cmd" and v == "cdot":
+                self.take()
+                factors = [Dot(_mul(factors), self.factor())]
+            elif k == "cmd" and v == "times":
+                self.take()
+                factors = [Cross(_mul(factors), self.factor())]
+            elif (k, v) == ("char", "*"):
+                self.take()
+                factors.append(self.factor())
+            elif (k, v) == ("char", "/"):
+                self.take()
+                factors = [Div(_mul(factors), self.factor())]
+            else:
+                factors.append(self.factor())
+        self.depth -= 1
+        return _mul(factors)
+
+    def script_tokens(self):
+        """The tokens of one script: a single token or a braced group."""
+        tok = self.take()
+        if tok[1] != "{":
+            if tok[0] == "cmd" and tok[1] in _WRAPPERS and self.peek()[1] == "{":
+                return [tok] + self.script_tokens()
+            return [tok]
+        out, depth = [], 1
+        while True:
+            t = self.take()
+            if t[0] == "eof":
+                raise ProofSyntaxError("a script's '{' is never closed")
+            if t[1] == "{":
+                depth += 1
+            elif t[1] == "}":
+                depth -= 1
+                if depth == 0:
+                    return out
+            out.append(t)
+
+    def power(self, node):
+        """``^`` after an atom: an integer power or a transpose."""
+        while self.peek()[1] == "^":
+            self.take()
+            toks = self.script_tokens()
+            text = _script_text(toks)
+            if text == "T":
+                node = Transpose(node)
+                continue
+            try:
+                n = int(text)
+            except ValueError:
+                raise ProofSyntaxError(f"cannot read the exponent '{text}' (an integer or T)") from None
+            if abs(n) > MAX_POWER:
+                raise ProofSyntaxError(f"exponent {text[:20]} is too large (at most {MAX_POWER})")
+            node = Pow(node, n)
+        return node
+
+    def factor(self):
+        self.enter()
+        node = self.power(self.atom())
+        self.depth -= 1
+        return node
+
+    def group(self, close):
+        node = self.expr()
+        self.expect(close)
+        return node
+
+    def atom(self):
+        k, v = self.take()
+        if k == "num":
+            return Num(Fraction(v))
+        if k == "char" and v in ("(", "["):
+            node = self.group(")" if v == "(" else "]")
+            if v == "[" and self.peek()[1] == "_" and self.peek(1)[1] == "times":
+                self.i += 2
+                return Skew(node)
+            return node
+        if k == "char" and v == "{":
+            return self.group("}")
+        if k == "cmd" and v == "left":
+            d = self.take()
+            if d[1] in ("|", "Vert", "lVert"):
+                return self.norm_rest()
+            node = self.expr()
+            self.expect("right")
+            self.take()
+            return node
+        if (k == "cmd" and v in ("|", "Vert", "lVert")) or (k == "char" and v == "|"):
+            return self.norm_rest()
+        if k == "cmd" and v in ("frac", "dfrac", "tfrac"):
+            self.expect("{")
+            a = self.group("}")
+            self.expect("{")
+            b = self.group("}")
+            return Div(a, b)
+        if k == "cmd" and v == "int":
+            return self.integral()
+        if k == "begin":
+            return self.matrix(v)
+        if k == "cmd" and v in _WRAPPERS:
+            bold = v in _BOLD
+            if self.peek()[1] != "{":
+                return self.name(self.take(), bold)
+            self.take()
+            inner = self.take()
+            if inner[0] == "num" and inner[1] != "1" and self.peek()[1] == "}":
+                self.take()
+                return Num(Fraction(inner[1]))  # \mathbf{0}: the zero vector (compares with any shape)
+            if self.peek()[1] == "}":
+                self.take()
+                return self.name(inner, bold)
+            self.i -= 1  # \mathbf{r_C}: scripts inside the braces
+            node = self.name(self.take(), bold)
+            self.expect("}")
+            return self.scripts_after(node)
+        if k in ("char", "cmd") and (v.isalpha() or v == "1"):
+            return self.name((k, v), False)
+        raise ProofSyntaxError(f"unexpected '{v}'")
+
+    def norm_rest(self):
+        self.norms += 1
+        node = self.expr()
+        self.norms -= 1
+        if self.peek()[1] == "right":
+            self.take()
+        tok = self.take()
+        if tok[1] not in ("|", "Vert", "rVert"):
+            raise ProofSyntaxError("a norm \\| is never closed")
+        return Norm(node)
+
+    def name(self, tok, bold):
+        kind, value = tok
+        if kind not in ("char", "cmd", "num") or not (value.isalpha() or value == "1"):
+            raise ProofSyntaxError(f"unexpected '{value}'")
+        if kind == "cmd" and value in ("dot", "ddot"):
+            raise ProofSyntaxError("time derivatives are not part of a rigid-body proof here")
+        node = Sym(value, bold)
+        return self.scripts_after(node)
+
+    def scripts_after(self, node: Sym):
+        sub, sup = node.sub, ""
+        while self.peek()[1] in ("_", "^"):
+            mark = self.peek()[1]
+            save = self.i
+            self.take()
+            toks = self.script_tokens()
+            text = _script_text(toks)
+            if mark == "_":
+                sub += text
+            else:
+                if text.lstrip("-").isdigit():
+                    self.i = save  # a power: handled by factor()
+                    break
+                sup += text
+        transposed = sup.endswith("T")
+        frame = sup[:-1] if transposed else sup
+        node = Sym(node.base, node.bold, sub, frame, transposed)
+        if node.base == "S" and self.peek()[1] in ("(", "left"):
+            if self.peek()[1] == "left":
+                self.take()
+            self.expect("(")
+            arg = self.expr()
+            if self.peek()[1] == "right":
+                self.take()
+            self.expect(")")
+            return Skew(arg, node.transposed)
+        return node
+
+    def integral(self):
+        domain = ""
+        while self.peek()[1] in ("_", "^"):
+            mark = self.take()[1]
+            text = _script_text(self.script_tokens())
+            if mark == "^":
+                raise ProofSyntaxError("an integral with bounds: only integrals over the body are understood")
+            domain = text
+        self.integrals += 1
+        if self.integrals > MAX_INTEGRALS:
+            raise ProofSyntaxError(f"integrals nested deeper than {MAX_INTEGRALS}")
+        body = Num(Fraction(1)) if self.differential() is not None else self.expr()  # \int dm = M
+        kind = self.differential()
+        if kind is None:
+            raise ProofSyntaxError("an integral without dm (or \\rho dV)")
+        self.take_differential()
+        self.integrals -= 1
+        if kind == "V":
+            body = _strip_density(body)
+        return Integral(body, domain)
+
+    def matrix(self, env):
+        if env not in _MATRIX_ENVS:
+            raise ProofSyntaxError(f"environment '{env}' is not a matrix")
+        self.enter()
+        rows, row = [], []
+        while True:
+            if self.peek()[0] == "end":
+                self.take()
+                break
+            if self.peek()[0] == "eof":
+                raise ProofSyntaxError(f"\\begin{{{env}}} is never closed")
+            row.append(self.expr())
+            k, v = self.peek()
+            if v == "&":
+                self.take()
+            elif k == "cmd" and v == "\\":
+                self.take()
+                rows.append(tuple(row))
+                row = []
+            elif k != "end":
+                raise ProofSyntaxError(f"unexpected '{v}' in a matrix")
+        if row:
+            rows.append(tuple(row))
+        if not rows or len({len(r) for r in rows}) != 1:
+            raise ProofSyntaxError("a matrix whose rows have different lengths")
+        self.depth -= 1
+        return Matrix(tuple(rows))
+
+
+def _mul(factors):
+    return factors[0] if len(factors) == 1 else Mul(tuple(factors))
+
+
+def _is_rho(node) -> bool:
+    return isinstance(node, Sym) and node.base == "rho" and not node.sub and not node.frame
+
+
+def _strip_density(body):
+    """``f \\rho dV`` is ``f dm``: take the density factor out of the integrand."""
+    if _is_rho(body):
+        return Num(Fraction(1))
+    if isinstance(body, Mul) and any(_is_rho(f) for f in body.factors):
+        rest = list(body.factors)
+        rest.remove(next(f for f in rest if _is_rho(f)))
+        return _mul(rest)
+    raise ProofSyntaxError("an integral over dV without the density \\rho: only mass integrals (\\rho dV = dm)")
+
+
+def parse_side(text: str):
+    """One side of a proof line -> expression tree (raises :class:`ProofSyntaxError`)."""
+    try:
+        tokens = tokenize(text)
+    except LatexError as err:
+        raise ProofSyntaxError(str(err)) from None
+    try:
+        return _Parser(tokens).parse()
+    except RecursionError:
+        raise ProofSyntaxError("nested too deeply") from None
+    except ValueError as err:  # Fraction of a malformed number
+        raise ProofSyntaxError(str(err)) from None
+
+
+def walk(node):
+    """Every node of a tree, depth first."""
+    stack = [node]
+    while stack:
+        n = stack.pop()
+        yield n
+        if isinstance(n, Add):
+            stack.extend(t for _, t in n.terms)
+        elif isinstance(n, Mul):
+            stack.extend(n.factors)
+        elif isinstance(n, (Dot, Cross, Div)):
+            stack.extend((n.a, n.b))
+        elif isinstance(n, (Pow,)):
+            stack.append(n.base)
+        elif isinstance(n, (Norm, Transpose, Skew)):
+            stack.append(n.arg)
+        elif isinstance(n, Integral):
+            stack.append(n.body)
+        elif isinstance(n, Matrix):
+            stack.extend(c for row in n.rows for c in row)
