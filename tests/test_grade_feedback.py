@@ -317,10 +317,11 @@ def test_hostile_yaml_values_in_sympy_syntax_are_refused_naming_the_line(tmp_pat
     digits = "1" + "0" * 5000
     path = tmp_path / "tower.yaml"
     path.write_text(f'robot: rp-arm\nsteps:\n  tau_2: "(((9**99)**99)**99)**99"\n  tau_1: "{digits}"\n'
-                    f'  T: "{"+".join(["m1"] * 3000)}+((9**99)**99)**99"\n')
+                    f'  T: "{"+".join(["m1"] * 3000)}+((9**99)**99)**99"\n'
+                    '  V: "((m1*9**99)**99)**99"\n')  # a symbol's numeric coefficient grows too
     done = _grade_subprocess(path)
     assert done.returncode == 1, done.stderr
-    for line, words in ((3, "digits"), (4, "5001 digits"), (5, "digits")):
+    for line, words in ((3, "digits"), (4, "5001 digits"), (5, "digits"), (6, "digits")):
         assert any(f"{path}:{line}: cannot read the value" in t and words in t for t in done.stdout.split("\n")), line
     assert "Exceeds the limit" not in done.stdout + done.stderr
 

@@ -608,7 +608,7 @@ def _check_numbers(text: str) -> None:
             raise LatexError(f"a number with {len(m.group(0))} digits (at most {MAX_DIGITS})")
     tokens = [t for t in _SYNTAX.findall(text) if not t.isspace()]
     prec = {"+": 1, "-": 1, "*": 2, "/": 2, "**": 3, "^": 3}
-    values: list = []  # sizes: float, or None for a part with a symbol in it
+    values: list = []  # log10 of a bound of the magnitude of each part's numbers (a symbol: 0)
     ops: list = []  # operators, "(" and "f(" (a function call)
 
     def reduce_one():
@@ -617,15 +617,15 @@ def _check_numbers(text: str) -> None:
             raise IndexError
         b, a = values.pop(), values.pop()
         if op in ("**", "^"):
-            if b is not None and b > 6:
+            if b > 6:
                 raise LatexError(f"an exact power with an exponent of about 10^{int(b)}")
-            size = None if a is None or b is None else abs(a) * 10**b
-            if size is not None and size > MAX_DIGITS:
+            size = a * 10**b  # (c x)^e holds c^e: SymEngine distributes an integer power
+            if size > MAX_DIGITS:
                 raise LatexError(f"a number of about {int(size)} digits (at most {MAX_DIGITS})")
-        elif a is None or b is None:
-            size = None
-        else:
-            size = a + b if op in ("*", "/") else max(a, b) + 1
+        elif op in ("*", "/"):
+            size = a + b
+        else:  # |u + v| <= |u| + |v|: a sum of n terms grows by log10(n), not by n
+            size = max(a, b) + math.log10(1 + 10 ** (min(a, b) - max(a, b)))
         values.append(size)
 
     try:
@@ -651,14 +651,14 @@ def _check_numbers(text: str) -> None:
                     opener = ops.pop()
                     if opener == "f(":
                         values.pop()
-                        values.append(None)
+                        values.append(0.0)  # sin, cos, exp...: left symbolic, no big integer
             elif tok[0].isdigit() or tok[0] == ".":
                 number = float(tok) if len(tok) < 300 else float("inf")
-                values.append(math.log10(number) if 0 < number < float("inf") else 0.0)
+                values.append(max(0.0, math.log10(number)) if 0 < number < float("inf") else 0.0)
             elif k + 1 < len(tokens) and tokens[k + 1] == "(":
                 pass  # a function's name: its call is marked at the "("
             else:
-                values.append(None)  # a symbol
+                values.append(0.0)  # a symbol: magnitude 1 (only its numeric coefficient grows)
             previous = tok
         while ops:
             reduce_one()
