@@ -321,7 +321,8 @@ def test_ten_thousand_proof_lines_are_refused_naming_the_file(tmp_path):
         check_text(path.read_text(), str(path))
     assert time.perf_counter() - t0 < 5
     assert f"{path}:10005" in str(err.value)
-    with pytest.raises(ModelError, match="proof lines"):  # the same through armdyn grade (its reader first)
+    # through armdyn grade its reader refuses first (at most 500 equations in a file)
+    with pytest.raises(ModelError, match="proof lines|more than 500 equations"):
         grade(path)
 
 

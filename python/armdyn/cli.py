@@ -100,11 +100,19 @@ def cmd_grade(args) -> int:
     from .grade import grade
     from .grade.reader import read
 
-    submission = read(args.submission)
-    if args.to_yaml:
-        print(submission.to_yaml(), end="")
-        return 0
-    report = grade(submission, robot=args.robot)
+    try:
+        submission = read(args.submission)
+        if args.to_yaml:
+            print(submission.to_yaml(), end="")
+            return 0
+        report = grade(submission, robot=args.robot)
+    except ModelError as err:
+        if not args.json:
+            raise
+        from .grade.text import error_json
+
+        print(error_json(err, args.submission))  # scripts read one JSON object either way
+        return 2
     if args.html:
         from .grade.html import write_report_html  # all or nothing
 

@@ -26,12 +26,14 @@ from ..errors import ModelError
 from ..model import Robot
 from .engine import Sampler, Value, World, canonical, judge, to_sympy
 from .engine import equal
-from .explain import component_name, describe, pretty, split_name, tidy
+from .explain import component_name, contract, describe, pretty, split_name, tidy
 from .latex import GREEK, LatexError, UnknownSymbol, parse, parse_sympy_syntax
+from .diagnose import unreadable
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
 from .reader import Submission, read
+from .statements import FREE_END, lagrange_law
 from .verdict import PASSING, STATUSES, GradeReport, StepVerdict
 
 __all__ = ["grade", "GradeReport", "StepVerdict", "STATUSES"]
@@ -91,7 +93,16 @@ class _Grader:
     def where(self, eq) -> str:
         return f"{self.sub.path}:{eq.line}"
 
+    def _unreadable(self, eq, problem: str, pos: int | None = None) -> str:
+        """The message for an equation that cannot be read: file:line:column, a hint."""
+        line, column = eq.line, eq.column
+        if pos is not None and eq.offset >= 0 and isinstance(eq.value, str):
+            line, column = self.sub.locate(eq.offset + pos)
+        return unreadable(self.sub.path, line, column, problem)
+
     def value(self, eq, ref: StepRef):
+        if eq.problem:
+            return None, self._unreadable(eq, eq.problem)
         try:
             if eq.latex:
                 raw = eq.value
@@ -113,12 +124,16 @@ class _Grader:
             if "unknown parameter" in err.message:
                 raise ModelError(f"{ref.name}: {err.message}", source=self.where(eq)) from None
             return None, err.message
-        except (LatexError, RecursionError, TypeError, ValueError) as err:
-            return None, f"cannot read the value ({err})"
+        except LatexError as err:
+            return None, self._unreadable(eq, str(err), err.pos)
+        except RecursionError:
+            return None, self._unreadable(eq, "nested too deeply to read")
+        except (TypeError, ValueError) as err:
+            return None, self._unreadable(eq, str(err).split("\n")[0][:200])
         return self._shape(value, ref, eq), None
 
     def _shape(self, value, ref: StepRef, eq):
-        vector = ref.key in VECTOR_KEYS
+        vector = ref.key in VECTOR_KEYS or ref.key in ("P", "Pc")
         if ref.key == "R":
             want = (3, 3)
         elif vector:
@@ -159,35 +174,74 @@ class _Grader:
         context = method_hint if method_hint in ("newton-euler", "lagrange") else None
         seen_methods = []
         for eq in self.sub.equations:
-            ref = parse_lhs(eq.lhs, self.symbols.coordinate_of) if eq.latex or "\\" in eq.lhs else None
-            if ref is None:
-                ref = _named_ref(eq.lhs) or (parse_lhs(eq.lhs, self.symbols.coordinate_of) if not eq.latex else None)
-            if ref is None:
-                self.verdicts.append(StepVerdict(
-                    name="", key="", link="", status="unrecognised", label=eq.lhs, source=eq.source, line=eq.line,
-                    message="not a step of Newton-Euler or Lagrange (skipped)"))
-                continue
-            method = "lagrange" if ref.key in LAGRANGE_KEYS else (
-                context or "newton-euler" if ref.key == "tau" else "newton-euler")
-            if ref.key != "tau":
-                context = method
-            if method not in seen_methods:
-                seen_methods.append(method)
-            self._check_index(ref, eq)
-            value, problem = self.value(eq, ref)
-            if value is None:
-                self.verdicts.append(StepVerdict(
-                    name=ref.name, key=ref.key, link="", status="unrecognised", label=eq.lhs, source=eq.source,
-                    line=eq.line, message=problem))
-                continue
-            if ref.key == "R":
-                self._rotation(ref, eq, value)
-            else:
-                self._step(self.world(method), ref, eq, value, method)
-            if ref.key in ("T", "V", "L"):
-                self.symbols.steps[ref.key] = value
+            done = len(self.verdicts)
+            self._equation(eq, seen_methods, context)
+            if self.verdicts[done:] and self.verdicts[-1].key not in ("", "R", "P", "Pc", "law", "tau"):
+                context = "lagrange" if self.verdicts[-1].key in LAGRANGE_KEYS else "newton-euler"
+            for v in self.verdicts[done:]:
+                v.part, v.task, v.column = eq.part, eq.task, eq.column
         self.verdicts = grade_proofs(self.sub, self.verdicts)  # rigid-body proofs: every link checked
+        for v in self.verdicts:  # proof links (also bare expressions) carry the part they are in
+            if v.part is None and not v.task:
+                v.part, v.task = self.sub.part_at(v.line)
+        return self._report(seen_methods, method_hint)
+
+    def _equation(self, eq, seen_methods: list, context: str | None) -> None:
+        """Grade one equation: append its verdict."""
+        ref = parse_lhs(eq.lhs, self.symbols.coordinate_of) if eq.latex or "\\" in eq.lhs else None
+        if ref is None:
+            ref = _named_ref(eq.lhs) or (parse_lhs(eq.lhs, self.symbols.coordinate_of) if not eq.latex else None)
+        if eq.problem:  # cannot be split into sides: shown with where and why, named if its start names a step
+            self.verdicts.append(StepVerdict(
+                name=ref.name if ref else "", key=ref.key if ref else "", link="", status="unrecognised",
+                label=eq.lhs, source=eq.source, line=eq.line, message=self._unreadable(eq, eq.problem)))
+            return
+        if ref is None:
+            law = lagrange_law(eq.lhs, str(eq.value)) if eq.latex else None
+            if law is None and eq.latex:
+                law = lagrange_law(str(eq.value), eq.lhs)
+            if law is not None:
+                if "lagrange" not in seen_methods:
+                    seen_methods.append("lagrange")
+                self.verdicts.append(StepVerdict(
+                    name="lagrange_equation", key="law", link="", status="correct" if law[0] else "wrong",
+                    label=eq.lhs, source=eq.source, line=eq.line, message=law[1]))
+                return
+            self.verdicts.append(StepVerdict(
+                name="", key="", link="", status="unrecognised", label=eq.lhs, source=eq.source, line=eq.line,
+                message="not a step of Newton-Euler or Lagrange (skipped)"))
+            return
+        n_links = len(self.robot.links) - 1
+        if ref.key in ("f", "n") and ref.index == n_links + 1:
+            if "newton-euler" not in seen_methods:
+                seen_methods.append("newton-euler")
+            self._free_end(ref, eq)
+            return
+        method = "lagrange" if ref.key in LAGRANGE_KEYS else (
+            context or "newton-euler" if ref.key == "tau" else "newton-euler")
+        if method not in seen_methods:
+            seen_methods.append(method)
+        self._check_index(ref, eq)
+        value, problem = self.value(eq, ref)
+        if value is None:
+            self.verdicts.append(StepVerdict(
+                name=ref.name, key=ref.key, link="", status="unrecognised", label=eq.lhs, source=eq.source,
+                line=eq.line, message=problem))
+            return
+        if ref.key == "R":
+            self._rotation(ref, eq, value)
+        elif ref.key in ("P", "Pc"):
+            self._position(ref, eq, value)
+        else:
+            self._step(self.world(method), ref, eq, value, method)
+        if ref.key in ("T", "V", "L"):
+            self.symbols.steps[ref.key] = value
+
+    def _report(self, seen_methods: list, method_hint: str | None) -> GradeReport:
         recognised = [v for v in self.verdicts if v.key]  # a step named, even if its value was unreadable
+        unread = [v for v in self.verdicts if v.status == "unrecognised" and "cannot read" in v.message]
+        if not recognised and unread:  # nothing graded: the reason is the unreadable equation
+            raise ModelError(unread[0].message.split(": ", 1)[1], source=unread[0].message.split(": ", 1)[0])
         if not recognised:
             raise ModelError("no step of Newton-Euler or Lagrange recognised (expected equations such as "
                              "\\omega_1^1 = ..., F_2^2 = ..., \\tau_1 = ..., T = ...)", source=self.sub.path)
@@ -202,7 +256,7 @@ class _Grader:
         return GradeReport(
             robot=self.robot.name, method=method_name, submission=self.sub.path, steps=self.verdicts,
             first_wrong=first_wrong, tau_correct=tau_correct, symbol_latex=_symbol_latex(self.robot),
-            notes=self.notes)
+            notes=self.notes, shorthand=dict(self.symbols.shorthand))
 
     def _check_index(self, ref: StepRef, eq):
         n = len(self.robot.links) - 1
@@ -213,6 +267,13 @@ class _Grader:
             if ref.frame is not None and not 0 <= ref.frame <= n:
                 raise ModelError(f"{ref.name} is written in frame {ref.frame}, which '{self.robot.name}' does not "
                                  f"have (frames 0..{n})", source=self.where(eq))
+        elif ref.key in ("P", "Pc"):
+            if not 1 <= ref.index <= n:
+                raise ModelError(f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}",
+                                 source=self.where(eq))
+            if ref.frame is not None and not 0 <= ref.frame <= n:
+                raise ModelError(f"{ref.name}: frame {ref.frame} does not exist (frames 0..{n})",
+                                 source=self.where(eq))
         elif ref.key == "R":
             for k in (ref.index, ref.frame):
                 if not 0 <= k <= n:
@@ -237,12 +298,56 @@ class _Grader:
                 status = "wrong"
                 bad = [int(i) for i in range(9) if not ok.ravel()[i]]
                 message = "; ".join(f"{component_name(i, (3, 3))}: "
-                                    + describe(value[i], expected[i], self.robot, self.sampler) for i in bad[:3])
+                                    + self._describe(value[i], expected[i]) for i in bad[:3])
         self.verdicts.append(StepVerdict(
             name=ref.name, key="R", link="", status=status, label=eq.lhs, source=eq.source, line=eq.line,
             expected=expected, got=value, difference=None if status != "wrong" else value - expected,
             convention=conv, message=message or ("" if status == "correct" else conv or ""),
             frame=f"{ref.index}->{ref.frame}"))
+
+    def _position(self, ref: StepRef, eq, value):
+        """A kinematics step: P_i^j, frame i's origin seen from frame i-1's, or P_{C_i}^j,
+        link i's mass centre seen from frame i's origin, both written in frame j."""
+        ctx = self.world("newton-euler").ctx
+        if ref.key == "P":
+            home = ctx[ref.index]["parent"]
+            vector = ctx[ref.index]["P"]
+            what = f"frame {ref.index}'s origin from frame {home}'s"
+        else:
+            home = ref.index
+            vector = ctx[ref.index]["c"]
+            what = f"link {ref.index}'s mass centre from frame {ref.index}'s origin"
+        frame = home if ref.frame is None else ref.frame
+        expected = sp.Matrix(rotation_between(ctx, home, frame) * vector).applyfunc(lambda x: tidy(x, self.robot))
+        fp = self.sampler.fingerprint
+        ok = equal(fp(value), fp(expected)).ravel()
+        bad = [int(i) for i in range(3) if not ok[i]]
+        message = "; ".join(f"{self._describe(value[i], expected[i])} in "
+                            f"{component_name(i, (3, 1))}" for i in bad)
+        if bad:
+            message += f" ({what}, in frame {frame})"
+        self.verdicts.append(StepVerdict(
+            name=ref.name, key=ref.key, link=list(self.robot.links)[ref.index], status="wrong" if bad else "correct",
+            label=eq.lhs, source=eq.source, line=eq.line, expected=expected, got=value,
+            difference=sp.Matrix([tidy(value[i] - expected[i], self.robot) for i in range(3)]) if bad else None,
+            components=bad, message=message, frame=str(frame)))
+
+    def _free_end(self, ref: StepRef, eq):
+        """``f_{n+1} = 0``, ``n_{n+1} = 0``: the load at the free end, zero."""
+        value, problem = self.value(eq, StepRef(ref.key, ref.index, ref.frame))
+        name = f"{ref.key}_{ref.index}"
+        if value is None:
+            self.verdicts.append(StepVerdict(
+                name=name, key="free_end", link="", status="unrecognised", label=eq.lhs, source=eq.source,
+                line=eq.line, message=problem))
+            return
+        zero = sp.zeros(3, 1)
+        ok = equal(self.sampler.fingerprint(value), self.sampler.fingerprint(zero)).ravel()
+        bad = [int(i) for i in range(3) if not ok[i]]
+        self.verdicts.append(StepVerdict(
+            name=name, key="free_end", link="", status="wrong" if bad else "correct", label=eq.lhs,
+            source=eq.source, line=eq.line, expected=zero, got=value, difference=value if bad else None,
+            components=bad, message=FREE_END if bad else "the free end: no load beyond the last link"))
 
     def _step(self, world: World, ref: StepRef, eq, value, method: str):
         key = (ref.key, ref.index)
@@ -299,13 +404,14 @@ class _Grader:
             if j.status == "wrong":
                 parts = []
                 for i in components[:3]:
-                    text = describe(got_m[i], ref_m[i], self.robot, self.sampler)
+                    text = self._describe(got_m[i], ref_m[i])
                     where = component_name(i, got_m.shape)
                     parts.append(f"{text} in {where}" if where else text)
                 against = "" if not j.origins else " (compared with what your own earlier steps give)"
                 message = "; ".join(parts) + against
                 diff = sp.Matrix([tidy(got_m[i] - ref_m[i], self.robot) for i in range(len(got_m))])
                 difference = diff if got_m.shape != (1, 1) else diff[0]
+                exp_shown = contract(exp_shown, self.symbols.shorthand)  # in the student's s₁₂, c₁₂
             elif j.status == "follows-from-earlier-error":
                 message = f"follows from the error in {caused_by}" + (f" ({j.convention})" if j.convention else "")
                 diff = _matrix(value) - _matrix(exp_shown)
@@ -322,7 +428,8 @@ class _Grader:
                     if bad:
                         src = sorted(carried[0].origins, key=self._order)
                         where = component_name(bad[0], d.shape)
-                        message += (f": carried through they leave {pretty(tidy(d[bad[0]], self.robot))}"
+                        left = pretty(tidy(d[bad[0]], self.robot), shorthand=self.symbols.shorthand)
+                        message += (f": carried through they leave {left}"
                                     + (f" in {where}" if where else "")
                                     + (f" (from the error in {src[0]})" if src else "")
                                     + " (copied, or two slips that cancel?)")
@@ -333,6 +440,10 @@ class _Grader:
             expected=exp_shown, got=value, difference=difference, components=components,
             convention=j.convention, caused_by=caused_by, message=message,
             frame="" if ref.key not in VECTOR_KEYS else str(ref.frame if ref.frame is not None else ref.index)))
+
+    def _describe(self, got, ref) -> str:
+        """What differs, in the student's shorthand."""
+        return describe(got, ref, self.robot, self.sampler, shorthand=self.symbols.shorthand)
 
     def _order(self, name: str) -> int:
         for k, v in enumerate(self.verdicts):

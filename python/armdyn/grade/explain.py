@@ -20,6 +20,7 @@ import sympy as sp
 
 from ..model import Robot
 from ..symbolic.agreement import trig_reduce
+from ..symbolic.report import _UnicodeTextPrinter, unicode_name
 
 COMPONENTS = "xyz"
 _GREEK = {
@@ -28,6 +29,11 @@ _GREEK = {
 }
 #: expressions larger than this (in nodes) are not tidied for messages
 TIDY_LIMIT = 400
+#: angle sums expanded (sin(q1 + q2) -> sin q1 cos q2 + ...) only up to this many nodes after
+#: expansion: beyond it the difference is shown as it is, with a note (bounded time)
+EXPAND_LIMIT = 2000
+#: the note added when a difference was too large to simplify
+NOT_SIMPLIFIED = "difference not simplified (too large)"
 
 
 def split_name(name: str) -> tuple[str, str, int] | None:
@@ -41,61 +47,117 @@ def split_name(name: str) -> tuple[str, str, int] | None:
 
 
 def display_name(name: str, ascii_only: bool = False) -> str:
-    """``theta1_dot`` -> ``θ̇1``, ``d2_ddot`` -> ``d̈2``, ``l1`` -> ``l1``."""
-    parts = None if ascii_only else split_name(name)
-    if parts is None:
+    """``theta1_dot`` -> ``θ̇₁``, ``d2_ddot`` -> ``d̈₂``, ``l1`` -> ``l₁``: the names
+    ``armdyn derive`` prints (:func:`armdyn.symbolic.report.unicode_name`)."""
+    if ascii_only:
         return name
-    base, digits, dots = parts
-    base = _GREEK.get(base, base)
-    accent = ("", "\u0307", "\u0308")[dots]
-    return base + accent + digits
+    m = re.fullmatch(r"(.+?)(_dot|_ddot)?", name)
+    return unicode_name(m.group(1), m.group(2) or "") or name
 
 
 _LATIN = {v: k for k, v in _GREEK.items()}
 
 
+_SUBSCRIPT = str.maketrans("₀₁₂₃₄₅₆₇₈₉", "0123456789")
+_SUPERSCRIPT = {c: str(k) for k, c in enumerate("⁰¹²³⁴⁵⁶⁷⁸⁹")}
+
+
 def to_ascii(text: str) -> str:
-    """A message printed with :func:`pretty` back in plain ASCII (``θ̇1`` -> ``theta1_dot``)."""
+    """A message printed with :func:`pretty` back in plain ASCII (``θ̇₁`` -> ``theta1_dot``)."""
     def name(m):
         base, accent, digits = m.groups()
         dots = {"\u0307": "_dot", "\u0308": "_ddot"}.get(accent or "", "")
-        return _LATIN.get(base, base) + digits + dots
+        return _LATIN.get(base, base) + digits.translate(_SUBSCRIPT) + dots
 
-    text = re.sub("([A-Za-z\u0370-\u03ff])([\u0307\u0308])?(\\d*)", name, text)
-    for a, b in (("·", "*"), ("−", "-"), ("²", "**2"), ("³", "**3"), ("→", "->"), ("×", "x")):
+    text = re.sub("([A-Za-z\u0370-\u03ff])([\u0307\u0308])?([\\d₀-₉]*)", name, text)
+    text = re.sub("[⁰¹²³⁴⁵⁶⁷⁸⁹]+", lambda m: "**" + "".join(_SUPERSCRIPT[c] for c in m.group(0)), text)
+    for a, b in (("·", "*"), ("−", "-"), ("→", "->"), ("×", "x"), ("…", "...")):
         text = text.replace(a, b)
     return text.encode("ascii", "replace").decode()
 
 
-def pretty(expr, ascii_only: bool = False) -> str:
-    """One line, ``−l1·θ̇1²`` style."""
+def pretty(expr, ascii_only: bool = False, shorthand: dict | None = None) -> str:
+    """One line, ``−l₁·θ̇₁²`` style: derive's symbol names, ``·`` and ``−``.
+    ``shorthand``: sin/cos terms -> the student's own symbols (``sin(q1 + q2)`` -> ``s₁₂``)."""
     expr = sp.sympify(expr)
-    table = {s: sp.Symbol(display_name(s.name, ascii_only)) for s in expr.free_symbols}
-    text = sp.sstr(expr.xreplace(table), order="none")
+    if shorthand:
+        expr = expr.xreplace(shorthand)
     if ascii_only:
-        return text
+        return to_ascii(sp.sstr(expr, order="none")) if shorthand else sp.sstr(expr, order="none")
+    names = {s: display_name(s.name) for s in expr.free_symbols}
+    text = _UnicodeTextPrinter(names, order="none").doprint(expr)
     text = re.sub(r"\*\*2\b", "²", text)
     text = re.sub(r"\*\*3\b", "³", text)
     return text.replace("*", "·").replace("-", "−")
 
 
+def reduce(expr, robot: Robot):
+    """``expr`` with angle sums expanded (sin(q1 + q2) -> sin q1 cos q2 + cos q1 sin q2),
+    sin² + cos² = 1 applied and everything expanded: terms that cancel are gone. None
+    when it is too large to do in bounded time (:data:`TIDY_LIMIT`, :data:`EXPAND_LIMIT`)."""
+    expr = sp.sympify(expr)
+    if sp.count_ops(expr) > TIDY_LIMIT:
+        return None
+    try:
+        expanded = sp.expand_trig(expr)
+        if sp.count_ops(expanded) > EXPAND_LIMIT:
+            return None
+        return sp.expand(trig_reduce(expanded, robot.q, keep_trig=True))
+    except Exception:  # noqa: BLE001 - display only: the caller falls back to the plain form
+        return None
+
+
 def tidy(expr, robot: Robot):
-    """sin² + cos² reduced and expanded, for small expressions only."""
+    """A difference as shown: simplified (:func:`reduce`) when that has fewer terms than
+    the plain reduction (a sign slip in ``l1 θ̇1² c2`` is ``2 l1 θ̇1² c2``, not four terms
+    of which three cancel), else sin² + cos² reduced and expanded; as it is when large."""
     expr = sp.sympify(expr)
     if sp.count_ops(expr) > TIDY_LIMIT:
         return expr
     try:
-        return sp.expand(trig_reduce(expr, robot.q, keep_trig=True))
+        plain = sp.expand(trig_reduce(expr, robot.q, keep_trig=True))
     except Exception:  # noqa: BLE001 - display only: fall back to the plain form
-        return sp.expand(expr)
+        plain = sp.expand(expr)
+    full = reduce(expr, robot)
+    if full is not None and (full == 0 or len(_terms(full)) < len(_terms(plain))):
+        return full
+    return plain
+
+
+#: entries larger than this (nodes) are not rewritten into angle sums for display
+CONTRACT_LIMIT = 150
+
+
+def contract(value, shorthand: dict | None):
+    """``value`` (expression or matrix) with products of sines and cosines gathered back
+    into the angle sums the student abbreviated (``sin q1 cos q2 + cos q1 sin q2`` ->
+    ``sin(q1 + q2)``, shown as their ``s₁₂``), so that an expected value reads in their
+    notation. Only when they used such a shorthand, and only for small entries."""
+    if not shorthand or not any(isinstance(k.args[0], sp.Add) for k in shorthand):
+        return value
+
+    def one(x):
+        x = sp.sympify(x)
+        if sp.count_ops(x) > CONTRACT_LIMIT:
+            return x
+        try:
+            return sp.trigsimp(sp.expand(x))
+        except Exception:  # noqa: BLE001 - display only: keep the value as it is
+            return x
+
+    if isinstance(value, sp.MatrixBase):
+        return value.applyfunc(one)
+    return one(value)
+
 
 
 def _terms(expr) -> list:
     return list(sp.Add.make_args(sp.expand(expr)))
 
 
-def describe(got, ref, robot: Robot, sampler, ascii_only: bool = False) -> str:
-    """A sentence for ``got`` (student) versus ``ref`` (what it should be), scalars."""
+def describe(got, ref, robot: Robot, sampler, ascii_only: bool = False, shorthand: dict | None = None) -> str:
+    """A sentence for ``got`` (student) versus ``ref`` (what it should be), scalars;
+    expressions in the student's ``shorthand`` where they used one."""
     got, ref = sp.sympify(got), sp.sympify(ref)
     fp = sampler.fingerprint
     g = fp(got)
@@ -115,6 +177,8 @@ def describe(got, ref, robot: Robot, sampler, ascii_only: bool = False) -> str:
                     return (f"{display_name(wrote.name, ascii_only)} written where "
                             f"{display_name(right.name, ascii_only)} belongs")
     d = tidy(got - ref, robot)
+    if sp.count_ops(got - ref) > TIDY_LIMIT:
+        return f"differs by {_short(d, ascii_only, shorthand)} ({NOT_SIMPLIFIED})"
     # a factor missing (got = X where ref has s X) or extra
     for s in sorted((ref.free_symbols | got.free_symbols) - set(robot.q) - set(robot.qd) - set(robot.qdd), key=str):
         if not d.has(s):
@@ -123,28 +187,34 @@ def describe(got, ref, robot: Robot, sampler, ascii_only: bool = False) -> str:
             X = sp.factor(sp.cancel(d / (1 - s)))
             ref_terms = len(_terms(ref))
             if len(_terms(sp.expand(ref - s * X))) < ref_terms:
-                return f"a factor {display_name(s.name, ascii_only)} missing on {_short(X, ascii_only)}"
-            return f"an extra factor {display_name(s.name, ascii_only)} on {_short(-X, ascii_only)}"
-    ref_terms = {t for t in _terms(tidy(ref, robot))}
-    got_terms = {t for t in _terms(tidy(got, robot))}
+                return (f"a factor {display_name(s.name, ascii_only)} missing on "
+                        f"{_short(X, ascii_only, shorthand)}")
+            return f"an extra factor {display_name(s.name, ascii_only)} on {_short(-X, ascii_only, shorthand)}"
+    # compare term by term in one form: angle sums expanded when the difference was
+    full = reduce(got - ref, robot)
+    same_form = full is not None and d == full
+    form = (lambda e: reduce(e, robot) if reduce(e, robot) is not None else tidy(e, robot)) if same_form \
+        else (lambda e: tidy(e, robot))
+    ref_terms = set(_terms(form(ref)))
+    got_terms = set(_terms(form(got)))
     d_terms = _terms(d)
     word = "term" if len(d_terms) == 1 else "terms"
     if d_terms and all(-t in ref_terms for t in d_terms):
-        return f"missing {word} {_short(-d, ascii_only)}"
+        return f"missing {word} {_short(-d, ascii_only, shorthand)}"
     if d_terms and all(t in got_terms for t in d_terms):
-        return f"extra {word} {_short(d, ascii_only)}"
+        return f"extra {word} {_short(d, ascii_only, shorthand)}"
     half = [-t / 2 for t in d_terms]
     if d_terms and all(t in ref_terms for t in half):
-        return f"wrong sign on the {word} {_short(sp.Add(*half), ascii_only)}"
-    return f"differs by {_short(d, ascii_only)}"
+        return f"wrong sign on the {word} {_short(sp.Add(*half), ascii_only, shorthand)}"
+    return f"differs by {_short(d, ascii_only, shorthand)}"
 
 
-def _short(expr, ascii_only: bool) -> str:
+def _short(expr, ascii_only: bool, shorthand: dict | None = None) -> str:
     """The expression, factored when that is shorter: −lc2·(q̇1 + q̇2)²."""
     # full factorisation only for a few terms (it is the slow part of a report)
     factored = sp.factor(expr) if len(sp.Add.make_args(expr)) <= 4 else sp.factor_terms(expr)
     best = factored if sp.count_ops(factored) < sp.count_ops(expr) else expr
-    return pretty(best, ascii_only)
+    return pretty(best, ascii_only, shorthand)
 
 
 def component_name(index: int, shape) -> str:

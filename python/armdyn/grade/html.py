@@ -182,6 +182,8 @@ def _step_card(i: int, step: StepVerdict, w: _Writer, anchors: dict, first: int 
     where = [f"line {step.line}"] if step.line else []
     if step.frame:
         where.append(f"in frame {escape(step.frame)}")
+    if step.part or step.task:  # the assignment's part (or the unnumbered task's title)
+        where.append(f"part {escape(step.part)}" if step.part else escape(step.task[:40]))
     head = (f'<div class="head"><span class="label">{math_element(_label(step))}</span>'
             f'{_badge(step.status)}<span class="where">{" · ".join(where)}</span></div>')
     parts = [head]
@@ -269,10 +271,14 @@ def _summary(report: GradeReport, anchors: dict, labels: dict) -> str:
         verdict = '<div class="verdict fail">No step was recognised<span class="sub">see the equations below</span></div>'
     elif report.passed:
         verdict = '<div class="verdict pass">Every step is right<span class="sub">(correct, or correct by a named convention)</span></div>'
-    else:
+    elif any(s.status == "correct-but-unsupported" for s in graded):
         n = sum(s.status == "correct-but-unsupported" for s in graded)
         verdict = ('<div class="verdict fail">No step is wrong, but not every one follows from the ones before'
                    f'<span class="sub">{n} correct but unsupported</span></div>')
+    else:  # every step read is right, but some equations were not read: not checked, not a pass
+        n = len(report.steps) - len(graded)
+        verdict = ('<div class="verdict fail">Every step read is right, but not every equation was read'
+                   f'<span class="sub">{n} not recognised or not readable: see below</span></div>')
 
     taus = []
     for i, ok in enumerate(report.tau_correct):

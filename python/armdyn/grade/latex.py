@@ -34,6 +34,8 @@ MAX_DEPTH = 60
 MAX_EXPONENT = 100
 #: characters in one equation beyond which it is refused
 MAX_LENGTH = 200_000
+#: digits of a number written or of a numeric power (9^{99^{99}}) beyond which it is refused
+MAX_DIGITS = 400
 
 GREEK = {
     "alpha", "beta", "gamma", "delta", "epsilon", "varepsilon", "zeta", "eta", "theta",
@@ -54,11 +56,19 @@ WRAPPERS = {"mathbf", "boldsymbol", "bm", "mathrm", "mathit", "vec", "hat", "bar
             "pmb", "mathsf", "operatorname", "text", "mathcal", "tilde"}
 SPACES = {",", ";", ":", "!", " ", "quad", "qquad", "displaystyle", "textstyle", "left.", "right.",
           "limits", "nolimits"}
+#: sizing commands before a delimiter (\big( ... \big)): they change its size, not the math
+SIZES = {"big", "Big", "bigg", "Bigg", "bigl", "bigr", "Bigl", "Bigr", "biggl", "biggr", "Biggl", "Biggr",
+         "bigm", "Bigm"}
 MATRIX_ENVS = {"pmatrix", "bmatrix", "Bmatrix", "matrix", "vmatrix", "smallmatrix", "array"}
 
 
 class LatexError(ValueError):
-    """LaTeX that could not be read (the message says what and where)."""
+    """LaTeX that could not be read (the message says what; ``pos``, when known, is the
+    0-based character offset in the parsed text where reading stopped)."""
+
+    def __init__(self, message: str, pos: int | None = None):
+        super().__init__(message)
+        self.pos = pos
 
 
 class UnknownSymbol(LatexError):
@@ -93,8 +103,9 @@ _TOKEN = re.compile(
 )
 
 
-def tokenize(text: str) -> list[tuple[str, str]]:
-    """Tokens ``(kind, value)``: kind is begin, end, cmd, num or char; spaces dropped."""
+def tokenize(text: str, positions: list | None = None) -> list[tuple[str, str]]:
+    """Tokens ``(kind, value)``: kind is begin, end, cmd, num or char; spaces and sizing
+    commands dropped. ``positions``, if given, receives each token's offset in ``text``."""
     if len(text) > MAX_LENGTH:
         raise LatexError(f"equation too long ({len(text)} characters, at most {MAX_LENGTH})")
     out = []
@@ -103,20 +114,32 @@ def tokenize(text: str) -> list[tuple[str, str]]:
         if kind == "space":
             continue
         value = m.group(kind)
-        if kind == "cmd" and value in SPACES:
+        if kind == "cmd" and (value in SPACES or value in SIZES):
             continue
+        if kind == "num" and len(value) > MAX_DIGITS:
+            raise LatexError(f"a number with {len(value)} digits (at most {MAX_DIGITS})", m.start())
         if kind == "char" and value in UNICODE_GREEK:
             kind, value = "cmd", UNICODE_GREEK[value]
         out.append((kind, value))
+        if positions is not None:
+            positions.append(m.start())
     return out
 
 
 class _Parser:
-    def __init__(self, tokens, resolve):
+    def __init__(self, tokens, resolve, positions=None, length: int | None = None):
         self.t = tokens
         self.i = 0
         self.resolve = resolve
         self.depth = 0
+        self.positions = positions or []
+        self.length = length
+
+    def at(self, k: int) -> int | None:
+        """The text offset of token ``k`` (the end of the text past the last one)."""
+        if k >= len(self.positions):
+            return self.length
+        return self.positions[max(k, 0)] if self.positions else None
 
     # -- helpers
     def peek(self, k=0):
@@ -132,22 +155,28 @@ class _Parser:
         tok = self.take()
         if tok[0] != kind or (value is not None and tok[1] != value):
             want = value if value is not None else kind
-            raise LatexError(f"expected '{want}', found '{tok[1] or 'end of equation'}'")
+            found = "\\" + tok[1] if tok[0] == "cmd" else tok[1]
+            raise LatexError(f"expected '{want}', found '{found or 'end of equation'}'", self.at(self.i - 1))
         return tok
 
     def enter(self):
         self.depth += 1
         if self.depth > MAX_DEPTH:
-            raise LatexError(f"nesting deeper than {MAX_DEPTH} levels")
+            raise LatexError(f"nesting deeper than {MAX_DEPTH} levels", self.at(self.i))
 
     def leave(self):
         self.depth -= 1
 
     # -- grammar
     def parse(self):
-        value = self.expr()
+        try:
+            value = self.expr()
+        except LatexError as err:
+            if err.pos is None:
+                err.pos = self.at(self.i)
+            raise
         if self.peek()[0] != "eof":
-            raise LatexError(f"unexpected '{self.peek()[1]}'")
+            raise LatexError(f"unexpected '{self.peek()[1]}'", self.at(self.i))
         return value
 
     def expr(self):
@@ -189,14 +218,29 @@ class _Parser:
                 return value
 
     def factor(self):
+        self.enter()  # a^b^c...: each exponent nests one level
         base = self.atom()
         if self.peek() == ("char", "^"):
+            at = self.at(self.i)
             self.take()
+            if isinstance(base, sp.MatrixBase) and self._transpose_mark():
+                self.leave()
+                return base.T
             exponent = self.script_value()
-            if exponent.is_Number and abs(exponent) > MAX_EXPONENT:
-                raise LatexError(f"an exponent of {exponent} (at most {MAX_EXPONENT})")
-            base = base ** exponent
+            base = _power(base, exponent, at)
+        self.leave()
         return base
+
+    def _transpose_mark(self) -> bool:
+        """After ``^`` on a matrix: ``T``, ``\\top``, ``{T}``, ``{\\mathrm{T}}`` (consumed)."""
+        marks = ([("char", "T")], [("cmd", "top")], [("char", "{"), ("char", "T"), ("char", "}")],
+                 [("char", "{"), ("cmd", "top"), ("char", "}")],
+                 [("char", "{"), ("cmd", "mathrm"), ("char", "{"), ("char", "T"), ("char", "}"), ("char", "}")])
+        for mark in marks:
+            if all(self.peek(k) == tok for k, tok in enumerate(mark)):
+                self.i += len(mark)
+                return True
+        return False
 
     def script_value(self):
         """The exponent after ``^``: a group or a single token."""
@@ -247,6 +291,13 @@ class _Parser:
             if tok in "([":
                 self.take()
                 value = self.expr()
+                if tok == "(" and self.peek() == ("char", ","):  # (a, b, c): a row, usually ^T after it
+                    row = [value]
+                    while self.peek() == ("char", ","):
+                        self.take()
+                        row.append(self.expr())
+                    self.expect("char", ")")
+                    return sp.Matrix([row])
                 self.expect("char", ")" if tok == "(" else "]")
                 return value
             if tok == "{":
@@ -305,12 +356,15 @@ class _Parser:
 
     def function(self):
         fn = FUNCTIONS[self.take()[1]]
+        self.enter()  # \sin\sin\sin...: each nests one level
         power = None
+        at = self.at(self.i)
         if self.peek() == ("char", "^"):
             self.take()
             power = self.script_value()
         value = fn(self.atom())  # a bracketed group, or the next symbol: \sin\theta_1
-        return value**power if power is not None else value
+        self.leave()
+        return _power(value, power, at) if power is not None else value
 
     def symbol(self):
         """[accents/wrappers] name [_sub] -> resolve(Name). A ``^`` after it is an
@@ -328,9 +382,11 @@ class _Parser:
         accented or wrapped symbol: ``\\dot{\\theta}``, ``\\dot{\\theta_1}``, ``\\mathbf{v}``."""
         kind, tok = self.take()
         if kind == "cmd" and (tok in ("dot", "ddot", "dddot") or tok in WRAPPERS):
+            self.enter()  # \dot{\dot{...}}: each accent nests one level (left unbalanced on error)
             dots = {"dot": 1, "ddot": 2, "dddot": 3}.get(tok, 0)
             if self.peek() != ("char", "{"):
                 inner, base, sub = self._accented()
+                self.leave()
                 return dots + inner, base, sub
             self.take()
             inner, base, sub = self._accented()
@@ -347,6 +403,7 @@ class _Parser:
                 else:
                     raise LatexError(f"unexpected '{t2}' inside \\{tok}{{...}}")
             self.take()
+            self.leave()
             return dots + inner, base, sub
         if kind == "cmd" and tok in GREEK:
             return 0, tok, ""
@@ -389,9 +446,39 @@ class _Parser:
         return sp.Matrix(rows)
 
 
+def _power(base, exponent, at):
+    """``base ** exponent``, refused before SymPy computes it when it would be huge:
+    a numeric exponent beyond :data:`MAX_EXPONENT`, a power of a power whose combined
+    exponent is (x^{99})^{99}, or a number of more than :data:`MAX_DIGITS` digits."""
+    import math
+
+    if isinstance(base, sp.MatrixBase) or isinstance(exponent, sp.MatrixBase):
+        raise LatexError("a power of a matrix (only ^T, a transpose, is read)", at)
+    if exponent.is_Number:
+        if abs(exponent) > MAX_EXPONENT:
+            raise LatexError(f"an exponent of {_short_number(exponent)} (at most {MAX_EXPONENT})", at)
+        inner = base.exp if base.is_Pow and base.exp.is_Number else 1
+        if abs(inner * exponent) > MAX_EXPONENT:
+            raise LatexError(f"a power of a power with exponent {_short_number(inner * exponent)} "
+                             f"(at most {MAX_EXPONENT})", at)
+        if base.is_Number and base != 0:
+            digits = float(abs(exponent)) * abs(math.log10(abs(float(base))) if abs(base) < 1e300 else 300) \
+                if abs(base) != 1 else 0.0
+            if not base.is_Float and (base.is_Integer or base.is_Rational) and digits > MAX_DIGITS:
+                raise LatexError(f"a number of about {int(digits)} digits (at most {MAX_DIGITS})", at)
+    return base ** exponent
+
+
+def _short_number(x) -> str:
+    text = str(x)
+    return text if len(text) <= 20 else f"{text[:8]}...({len(text)} digits)"
+
+
 def parse(text: str, resolve) -> sp.Expr | sp.Matrix:
-    """Parse one LaTeX expression; ``resolve(Name) -> sympy`` maps each symbol."""
-    return _Parser(tokenize(text), resolve).parse()
+    """Parse one LaTeX expression; ``resolve(Name) -> sympy`` maps each symbol. A
+    :class:`LatexError` carries ``pos``, the offset in ``text`` where reading stopped."""
+    positions: list[int] = []
+    return _Parser(tokenize(text, positions), resolve, positions, len(text)).parse()
 
 
 # ------------------------------------------------------------------ equations
@@ -399,63 +486,76 @@ def parse(text: str, resolve) -> sp.Expr | sp.Matrix:
 _OPEN = {"{": "}", "(": ")", "[": "]"}
 
 
+_MARKS = re.compile(r"\\(?:begin|end)\{[^}]*\}?|\\\\|\\[A-Za-z]+|\\.?|[{}()\[\]&,=]", re.S)
+
+
 def _top_level(text: str):
-    """Yield ``(index, char)`` of characters at nesting depth 0: outside braces,
-    brackets and matrix environments."""
-    depth, env, i = 0, 0, 0
-    n = len(text)
-    while i < n:
-        if text.startswith("\\begin{", i) or text.startswith("\\end{", i):
-            env += 1 if text[i + 1] == "b" else -1
-            close = text.find("}", i)
-            i = n if close < 0 else close + 1
-            continue
-        c = text[i]
+    """Yield ``(index, mark)`` of the marks ``&``, ``,``, ``=`` and ``\\\\`` at nesting depth 0:
+    outside braces, brackets and matrix environments. One regular-expression pass over
+    the text (only the characters that matter are looked at in Python)."""
+    depth, env = 0, 0
+    for m in _MARKS.finditer(text):
+        tok = m.group(0)
+        c = tok[0]
         if c == "\\":
-            if env == 0 and depth == 0 and text.startswith("\\\\", i):
-                yield i, "\\\\"
-                i += 2
-                continue
-            i += 2 if i + 1 < n and not text[i + 1].isalpha() else 1
-            while i < n and text[i].isalpha():
-                i += 1
+            if tok.startswith("\\begin{"):
+                env += 1
+            elif tok.startswith("\\end{"):
+                env -= 1
+            elif tok == "\\\\" and env == 0 and depth == 0:
+                yield m.start(), tok
             continue
         if c in "{([":
             depth += 1
         elif c in "})]":
             depth -= 1
         elif depth == 0 and env == 0:
-            yield i, c
-        i += 1
+            yield m.start(), c
 
 
-def split_equations(block: str) -> list[tuple[int, str]]:
+def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str]]:
     """Split a display-math block into equations: at top-level ``\\\\`` and at top-level
     commas followed by another ``LHS = ...``. Returns ``(offset, text)`` pairs; alignment
     ``&`` and environment wrappers (split, aligned, align, gather) are blanked out (so
-    offsets still point into ``block``)."""
+    offsets still point into ``block``). Linear in the block's length; ``limit``: stop
+    after that many equations (the caller refuses more)."""
     text = re.sub(r"\\(begin|end)\{(split|aligned|align\*?|gather\*?|equation\*?|alignedat)\}(\{\d+\})?",
                   lambda m: " " * len(m.group(0)), block)
-    amps = _amps(text)
-    text = "".join(" " if i in amps else c for i, c in enumerate(text))
-    cuts = [i for i, c in _top_level(text) if c == "\\\\"]
-    out, start = [], 0
-    for cut in cuts + [len(text)]:
-        piece = text[start:cut]
-        commas = [i for i, c in _top_level(piece) if c == ","]
-        segments, s0 = [], 0
-        for comma in commas + [len(piece)]:
-            segments.append((start + s0, piece[s0:comma]))
-            s0 = comma + 1
-        cur_off, cur = segments[0]
-        for off, seg in segments[1:]:
-            if _has_top_equals(seg):
-                out.append((cur_off, cur))
-                cur_off, cur = off, seg
-            else:
-                cur += "," + seg
-        out.append((cur_off, cur))
+    marks = [(i, c) for i, c in _top_level(text) if c in ("&", ",", "=", "\\\\")]  # one pass, depth 0
+    if any(c == "&" for _, c in marks):
+        chars = list(text)
+        for i, c in marks:
+            if c == "&":
+                chars[i] = " "
+        text = "".join(chars)
+    out: list[tuple[int, str]] = []
+    start = 0
+    pieces = [i for i, c in marks if c == "\\\\"] + [len(text)]
+    k = 0  # index into marks
+    for cut in pieces:
+        # segments of this piece at top-level commas, each flagged: has a top-level '='?
+        segments, s0, has_eq = [], start, False
+        while k < len(marks) and marks[k][0] < cut:
+            i, c = marks[k]
+            if c == ",":
+                segments.append((s0, i, has_eq))
+                s0, has_eq = i + 1, False
+            elif c == "=":
+                has_eq = True
+            k += 1
+        segments.append((s0, cut, has_eq))
+        cur_start, cur_end = segments[0][0], segments[0][1]
+        for seg_start, seg_end, seg_eq in segments[1:]:
+            if seg_eq:
+                out.append((cur_start, text[cur_start:cur_end]))
+                cur_start = seg_start
+            cur_end = seg_end
+            if limit is not None and len(out) > limit:
+                break
+        out.append((cur_start, text[cur_start:cur_end]))
         start = cut + 2
+        if limit is not None and len(out) > limit:
+            break
     result = []
     for off, t in out:
         stripped = t.strip().rstrip(".,;").strip()
@@ -470,6 +570,11 @@ def _amps(text: str) -> set[int]:
 
 def _has_top_equals(text: str) -> bool:
     return any(c == "=" for _, c in _top_level(text))
+
+
+def side_offsets(equation: str) -> list[int]:
+    """Offsets where each side of ``A = B = C`` starts (0, then one past each top-level ``=``)."""
+    return [0] + [i + 1 for i, c in _top_level(equation) if c == "="]
 
 
 def sides(equation: str) -> list[str]:
@@ -488,6 +593,77 @@ def sides(equation: str) -> list[str]:
 SYMPY_FUNCTIONS = {"sin", "cos", "tan", "exp", "log", "sqrt", "Abs", "sec", "csc", "cot"}
 _BIG_POWER = re.compile(r"(\*\*|\^)\s*\(?\s*\d{4,}|\d+\s*(\*\*|\^)\s*\d+\s*(\*\*|\^)")
 _SYNTAX = re.compile(r"[A-Za-z_][A-Za-z_0-9]*|\d+(?:\.\d*)?(?:[eE][-+]?\d+)?|\.\d+(?:[eE][-+]?\d+)?|\*\*|[-+*/^(),\s]")
+
+
+def _check_numbers(text: str) -> None:
+    """Refuse, before SymEngine computes it, a number of more than :data:`MAX_DIGITS`
+    digits, written or produced by powers of powers (``((9**99)**99)**99``). The size
+    (log10 of a bound of the magnitude) of every purely numeric part is estimated by one
+    operator-precedence pass over the tokens, iterative (a sum of 10^5 terms is fine),
+    evaluating nothing. ``text`` has passed the checks of :func:`parse_sympy_syntax`."""
+    import math
+
+    for m in re.finditer(r"\d+", text):
+        if len(m.group(0)) > MAX_DIGITS:
+            raise LatexError(f"a number with {len(m.group(0))} digits (at most {MAX_DIGITS})")
+    tokens = [t for t in _SYNTAX.findall(text) if not t.isspace()]
+    prec = {"+": 1, "-": 1, "*": 2, "/": 2, "**": 3, "^": 3}
+    values: list = []  # log10 of a bound of the magnitude of each part's numbers (a symbol: 0)
+    ops: list = []  # operators, "(" and "f(" (a function call)
+
+    def reduce_one():
+        op = ops.pop()
+        if len(values) < 2:
+            raise IndexError
+        b, a = values.pop(), values.pop()
+        if op in ("**", "^"):
+            if b > 6:
+                raise LatexError(f"an exact power with an exponent of about 10^{int(b)}")
+            size = a * 10**b  # (c x)^e holds c^e: SymEngine distributes an integer power
+            if size > MAX_DIGITS:
+                raise LatexError(f"a number of about {int(size)} digits (at most {MAX_DIGITS})")
+        elif op in ("*", "/"):
+            size = a + b
+        else:  # |u + v| <= |u| + |v|: a sum of n terms grows by log10(n), not by n
+            size = max(a, b) + math.log10(1 + 10 ** (min(a, b) - max(a, b)))
+        values.append(size)
+
+    try:
+        previous = None
+        for k, tok in enumerate(tokens):
+            unary = tok in ("+", "-") and (previous is None or previous in prec or previous in ("(", ","))
+            if unary:
+                pass  # a sign does not change a magnitude
+            elif tok in prec:
+                right = tok in ("**", "^")
+                while ops and ops[-1] in prec and (prec[ops[-1]] > prec[tok] or
+                                                   prec[ops[-1]] == prec[tok] and not right):
+                    reduce_one()
+                ops.append(tok)
+            elif tok == "(":
+                ops.append("f(" if previous is not None and (previous[0].isalpha() or previous[0] == "_") else "(")
+            elif tok in (")", ","):
+                while ops and ops[-1] not in ("(", "f("):
+                    reduce_one()
+                if tok == ",":
+                    values.pop()  # an argument of a function: checked, not a magnitude
+                else:
+                    opener = ops.pop()
+                    if opener == "f(":
+                        values.pop()
+                        values.append(0.0)  # sin, cos, exp...: left symbolic, no big integer
+            elif tok[0].isdigit() or tok[0] == ".":
+                number = float(tok) if len(tok) < 300 else float("inf")
+                values.append(max(0.0, math.log10(number)) if 0 < number < float("inf") else 0.0)
+            elif k + 1 < len(tokens) and tokens[k + 1] == "(":
+                pass  # a function's name: its call is marked at the "("
+            else:
+                values.append(0.0)  # a symbol: magnitude 1 (only its numeric coefficient grows)
+            previous = tok
+        while ops:
+            reduce_one()
+    except (IndexError, OverflowError):  # not LatexError (a ValueError): that is the answer
+        return  # malformed: SymEngine's parser reports it
 
 
 def parse_sympy_syntax(text: str, names: dict, symengine: bool = False):
@@ -522,6 +698,7 @@ def parse_sympy_syntax(text: str, names: dict, symengine: bool = False):
         raise LatexError("unbalanced '('")
     if _BIG_POWER.search(text):
         raise LatexError("an exact power with a huge exponent")
+    _check_numbers(text)
     try:
         value = se.sympify(text)
     except Exception as exc:  # noqa: BLE001 - SymEngine's parse errors have several types

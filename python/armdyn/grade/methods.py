@@ -206,6 +206,10 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
             m.conventions[("n", i)] = [USUAL, Convention(
                 f"moment about joint {i}'s placement origin (where the slide starts), not frame {i}'s origin",
                 about_axis.forward, about_axis.inverse, about_axis.extra)]
+        # the reaction, as for f: the moment exerted by link i on link i-1, in each of the above
+        m.conventions[("n", i)] = [*m.conventions_of(("n", i)), *(
+            _reaction(c, f"the reaction: moment exerted by link {i} on link {i - 1}")
+            for c in m.conventions_of(("n", i)))]
         k = robot.coordinate_index(robot.parent_joint(list(robot.links)[i]))
         if k is not None:
             def tau_fn(c, nv, fv, i=i):
@@ -215,6 +219,13 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
             m.formulas[("tau", k + 1)] = [Formula((("n", i), ("f", i)), tau_fn)]
             m.refs.append(("tau", k + 1))
     return m, ctx
+
+
+def _reaction(conv: Convention, name: str) -> Convention:
+    """``conv`` with the sign of the reaction (action = -reaction), named."""
+    full = f"{name} ({conv.name})" if conv.name else name
+    return Convention(full, lambda v, c, *x: -conv.forward(v, c, *x), lambda v, c, *x: conv.inverse(-v, c, *x),
+                      conv.extra)
 
 
 def rotation_between(ctx, frm: int, to: int):

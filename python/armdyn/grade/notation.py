@@ -7,7 +7,9 @@ frame given neither as a superscript nor as Craig's pre-superscript is the link'
     Newton-Euler  \\omega_i^j  {}^{j}\\omega_{i}  \\dot{\\omega}_i^j  \\dot{v}_i^j  \\dot{v}_{C_i}^j
                   (also \\dot{v}_{c_i}, \\dot{v}_{ci}, a_{C_i}), F_i^j, N_i^j, f_i^j, n_i^j,
                   m_i^j (read as n_i: the exercise's name for it), \\tau_k,
-                  R_a^b / {}^{b}_{a}R (maps frame-a coordinates to frame b)
+                  R_a^b / {}^{b}_{a}R (maps frame-a coordinates to frame b),
+                  P_i^j (frame i's origin from frame i-1's, in frame j; j = i-1 if not
+                  given), P_{C_i}^j (link i's mass centre from frame i's origin, in frame j)
     Lagrange      T, V, L, \\frac{\\partial L}{\\partial \\dot q_k}, \\partial L / \\partial \\dot q_k,
                   \\frac{d}{dt}\\frac{\\partial L}{\\partial \\dot q_k}, \\frac{\\partial L}{\\partial q_k}, \\tau_k
 
@@ -37,7 +39,8 @@ class StepRef:
     """What a left-hand side names.
 
     key:    "omega", "omega_dot", "v_dot", "vc_dot", "F", "N", "f", "n", "tau", "R",
-            "T", "V", "L", "dL_dqd", "ddt_dL_dqd", "dL_dq"
+            "P" (frame i's origin from frame i-1's), "Pc" (link i's mass centre from frame
+            i's origin), "T", "V", "L", "dL_dqd", "ddt_dL_dqd", "dL_dq"
     index:  link index for Newton-Euler vectors (0 = base), joint index (1-based) for
             tau and the Lagrange partials, None for T, V, L; for R the source frame
     frame:  frame the vector is written in (None: the link's own); for R the target frame
@@ -53,6 +56,9 @@ class StepRef:
     def name(self) -> str:
         if self.key == "R":
             return f"R_{self.index}^{self.frame}"
+        if self.key in ("P", "Pc"):
+            return f"P_{'C' if self.key == 'Pc' else ''}{self.index}" + (
+                f"^{self.frame}" if self.frame is not None else "")
         if self.index is None:
             return self.key
         return f"{self.key}_{self.index}"
@@ -110,7 +116,7 @@ def _int(text: str | None) -> int | None:
 
 _BASES = {
     "\\omega": "omega", "F": "F", "N": "N", "f": "f", "n": "n", "m": "n", "\\tau": "tau",
-    "v": "v", "a": "a", "R": "R",
+    "v": "v", "a": "a", "R": "R", "P": "P",
 }
 
 
@@ -170,6 +176,14 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
         k = _int(sub)
         return StepRef("tau", k) if k is not None and dots == 0 else None
     frame = _int(sup)
+    if key == "P":  # P_i^j: frame i's origin from frame i-1's; P_{C_i}^j: link i's mass centre from frame i's
+        if dots or sub is None:
+            return None
+        body = re.sub(r"[{}\s,_]|\\mathrm", "", sub)
+        mc = re.fullmatch(r"[Cc](\d+)", body)
+        if mc:
+            return StepRef("Pc", int(mc.group(1)), frame)
+        return StepRef("P", _int(sub), frame) if _int(sub) is not None else None
     if key in ("v", "a"):
         want = 1 if key == "v" else 0
         if dots != want or sub is None:
@@ -238,6 +252,8 @@ class SymbolMap:
         self.explicit: dict[str, sp.Expr] = {}
         self.notes: list[str] = []
         self.steps: dict[str, object] = {}
+        #: sin/cos of the angles the student wrote as shorthand -> a symbol printing as theirs (s₁₂)
+        self.shorthand: dict = {}
         self.used_gravity_magnitude = False
         for student, model in (explicit or {}).items():
             key = self._key_of(str(student))
@@ -284,7 +300,11 @@ class SymbolMap:
             idx = [int(ch) for ch in sub]
             if all(1 <= k <= self.robot.dof for k in idx):
                 angle = sum((self.robot.q[k - 1] for k in idx), sp.Integer(0))
-                return (sp.sin if name.base in "sS" else sp.cos)(angle)
+                value = (sp.sin if name.base in "sS" else sp.cos)(angle)
+                from ..symbolic.report import unicode_name
+
+                self.shorthand[value] = sp.Symbol(unicode_name(name.base + sub) or name.base + sub)
+                return value
         if name.base == "g" and not sub and name.dots == 0:
             magnitude = sp.sqrt(sum(c**2 for c in self.robot.gravity))
             if not magnitude.free_symbols:

@@ -7,7 +7,11 @@ Markdown reader's output is exactly what a YAML submission states directly
 
 Markdown: an optional front matter between ``---`` lines at the top (YAML: ``robot``,
 ``method``, ``symbols``), then any text; every ``$$ ... $$`` or ``\\[ ... \\]`` block is
-split into equations (at ``\\\\`` and at commas before another ``LHS = ...``).
+split into equations (at ``\\\\`` and at commas before another ``LHS = ...``), each with
+its line, the column where its value starts, and the part of the assignment it is in
+(:mod:`.parts`). Reading is linear in the file's size and bounded: at most
+:data:`MAX_BYTES` bytes and :data:`MAX_EQUATIONS` equations; an equation with an
+unbalanced brace is kept with ``problem`` naming the brace's line and column.
 
 YAML::
 
@@ -23,6 +27,7 @@ YAML::
 
 from __future__ import annotations
 
+import bisect
 import os
 import re
 from dataclasses import dataclass, field
@@ -33,19 +38,31 @@ from ..errors import ModelError
 
 #: a submission larger than this is refused (a derivation is a few kB)
 MAX_BYTES = 5_000_000
+#: equations beyond this number are refused (the whole exercise has about fifty; grading
+#: takes up to ~10 ms an equation, so this bounds a file's work to a few seconds)
+MAX_EQUATIONS = 500
 
 
 @dataclass
 class Equation:
     """One equation as written: ``lhs`` (LaTeX or a step name), ``value`` (the last
     right-hand side: LaTeX, SymPy syntax, or a list of components), ``line`` (1-based),
-    ``source`` (the whole equation as written) and ``latex`` (is ``value`` LaTeX?)."""
+    ``source`` (the whole equation as written) and ``latex`` (is ``value`` LaTeX?);
+    ``column`` (1-based) and ``offset`` (0-based, in the file) of where ``value`` starts;
+    ``problem``: why the equation cannot be read at all (an unbalanced brace), or "";
+    ``part``: the assignment's part it belongs to (``"7-4"``, None: unnumbered or none)
+    and ``task``: that task's title (see :mod:`.parts`)."""
 
     lhs: str
     value: object
     line: int
     source: str
     latex: bool = True
+    column: int = 0
+    offset: int = -1
+    problem: str = ""
+    part: str | None = None
+    task: str = ""
 
 
 @dataclass
@@ -57,6 +74,20 @@ class Submission:
     values: object = None  # "published" or {parameter: number}: numbers the student used
     equations: list[Equation] = field(default_factory=list)
     base_dir: str = "."
+    lines: LineIndex | None = None  # line/column of offsets in the Markdown text
+
+    parts: list = field(default_factory=list)  # the assignment's parts (.parts.Part), Markdown only
+
+    def part_at(self, line: int) -> tuple[str | None, str]:
+        """(part number or None, task title or "") of a 1-based line (see :mod:`.parts`)."""
+        from .parts import part_of
+
+        part = part_of(self.parts, line)
+        return (part.number, part.title) if part is not None else (None, "")
+
+    def locate(self, offset: int) -> tuple[int, int]:
+        """1-based (line, column) of a 0-based offset in the submission's text."""
+        return self.lines.locate(offset) if self.lines is not None else (0, 0)
 
     def to_yaml(self) -> str:
         """The submission as the YAML format states it (what the Markdown reader read)."""
@@ -65,7 +96,8 @@ class Submission:
             data["symbols"] = dict(self.symbols)
         if self.values is not None:
             data["values"] = self.values
-        data["steps"] = [{"line": e.line, "step": e.lhs, "value": e.value} for e in self.equations]
+        data["steps"] = [{"line": e.line, "step": e.lhs, "value": e.value,
+                          **({"part": e.part} if e.part else {})} for e in self.equations]
         return yaml.safe_dump(data, sort_keys=False, allow_unicode=True, width=100)
 
 
@@ -101,6 +133,8 @@ def _safe_yaml(text: str, where: str):
         line = f":{mark.line + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
         raise ModelError(f"malformed YAML ({problem})", source=where + line) from None
+    except ValueError as exc:  # an integer beyond Python's conversion limit (thousands of digits)
+        raise ModelError(f"a value YAML cannot read ({str(exc).split(';')[0]})", source=where) from None
 
 
 def _front(meta, path: str, sub: Submission) -> None:
@@ -135,15 +169,82 @@ def _front(meta, path: str, sub: Submission) -> None:
     sub.values = values
 
 
-_MATH = re.compile(r"\$\$(.+?)\$\$|\\\[(.+?)\\\]", re.S)
+_OPENER = re.compile(r"\$\$|\\\[")
+
+
+def math_blocks(text: str, start: int = 0):
+    """``(block_start, block_end, body_start, body)`` of each ``$$ ... $$`` / ``\\[ ... \\]``
+    block from ``start`` on. Linear: each closer is looked for once with ``str.find``,
+    and an opener that is never closed ends the search for that kind."""
+    openers = {"$$": "$$", "\\[": "\\]"}  # opener -> closer, for the kinds still possible
+    pos = start
+    while openers:
+        pattern = _OPENER if len(openers) == 2 else re.compile(re.escape(next(iter(openers))))
+        m = pattern.search(text, pos)
+        if m is None:
+            return
+        opener = m.group(0)
+        end = text.find(openers[opener], m.end())
+        if end < 0:  # never closed: no block of this kind from here on
+            del openers[opener]
+            pos = m.end()
+            continue
+        if end > m.end():
+            yield m.start(), end + 2, m.end(), text[m.end():end]
+        pos = end + 2
+
+
+class LineIndex:
+    """Line and column of any offset in a text, from one pass over its newlines
+    (a bisection per lookup: reading stays linear in the file's size)."""
+
+    def __init__(self, text: str):
+        self.newlines = [m.start() for m in re.finditer("\n", text)]
+
+    parts: list = field(default_factory=list)  # the assignment's parts (.parts.Part), Markdown only
+
+    def part_at(self, line: int) -> tuple[str | None, str]:
+        """(part number or None, task title or "") of a 1-based line (see :mod:`.parts`)."""
+        from .parts import part_of
+
+        part = part_of(self.parts, line)
+        return (part.number, part.title) if part is not None else (None, "")
+
+    def locate(self, offset: int) -> tuple[int, int]:
+        k = bisect.bisect_left(self.newlines, offset)
+        line_start = self.newlines[k - 1] + 1 if k else 0
+        return k + 1, offset - line_start + 1
+
+    def line(self, offset: int) -> int:
+        return bisect.bisect_left(self.newlines, offset) + 1
+
+
+_BRACES = re.compile(r"\\.|[{}]", re.S)
+
+
+def unbalanced_brace(text: str) -> tuple[int, str] | None:
+    """``(offset, what)`` of the first brace that does not pair up in ``text``
+    (``\\{``, ``\\}`` and ``\\\\`` are not braces), or None. ``what``: "open" or "close"."""
+    stack = []
+    for m in _BRACES.finditer(text):
+        c = m.group(0)
+        if c == "{":
+            stack.append(m.start())
+        elif c == "}":
+            if not stack:
+                return m.start(), "close"
+            stack.pop()
+    return (stack[-1], "open") if stack else None
 
 
 def read_markdown(path: str, text: str | None = None) -> Submission:
     """Read a Markdown derivation (see the module docstring)."""
-    from .latex import sides, split_equations
+    from .latex import MAX_LENGTH, side_offsets, split_equations
+    from .parts import find_parts, with_title
 
     text = _read_text(path) if text is None else text
-    sub = Submission(path, base_dir=os.path.dirname(os.path.abspath(path)))
+    index = LineIndex(text)
+    sub = Submission(path, base_dir=os.path.dirname(os.path.abspath(path)), lines=index)
     body_start = 0
     if text.startswith("---"):
         end = re.search(r"^---\s*$", text[3:], re.M)
@@ -151,15 +252,50 @@ def read_markdown(path: str, text: str | None = None) -> Submission:
             raise ModelError("front matter opened with '---' is never closed", source=f"{path}:1")
         _front(_safe_yaml(text[3:3 + end.start()], path), path, sub)
         body_start = 3 + end.end()
-    for m in _MATH.finditer(text, body_start):
-        group = 1 if m.group(1) is not None else 2
-        block, block_start = m.group(group), m.start(group)
-        for offset, eq in split_equations(block):
-            parts = sides(eq)
-            if len(parts) < 2:
+    hidden = set(range(1, index.line(body_start) + 1))  # front matter and display math: no headings there
+    for outer_start, outer_end, block_start, block in math_blocks(text, body_start):
+        hidden.update(range(index.line(outer_start), index.line(outer_end) + 1))
+        if len(block) > MAX_LENGTH:  # not split: one unreadable equation, refused in bounded time
+            line, col = index.locate(block_start)
+            sub.equations.append(Equation(block[:40].strip(), block[:200], line, block[:200].strip(), column=col,
+                                          offset=block_start, problem=f"display math too long ({len(block)} "
+                                          f"characters, at most {MAX_LENGTH})"))
+            continue
+        for offset, eq in split_equations(block, limit=MAX_EQUATIONS):
+            start = block_start + offset
+            brace = unbalanced_brace(eq) if len(eq) <= MAX_LENGTH else None
+            if len(eq) > MAX_LENGTH:
+                line, col = index.locate(start)
+                sub.equations.append(Equation(eq[:40], eq[:200], line, eq[:200], column=col, offset=start,
+                                              problem=f"equation too long ({len(eq)} characters, at most "
+                                                      f"{MAX_LENGTH})"))
                 continue
-            line = text.count("\n", 0, block_start + offset) + 1
-            sub.equations.append(Equation(parts[0], parts[-1], line, " ".join(eq.split())))
+            if brace is not None:
+                at, what = brace
+                b_line, b_col = index.locate(start + at)
+                problem = (f"the '{{' opened at line {b_line}, column {b_col} is never closed" if what == "open"
+                           else f"the '}}' at line {b_line}, column {b_col} closes no '{{'")
+                lhs = eq.split("=", 1)[0].strip() if "=" in eq else eq[:40]
+                line, col = index.locate(start)
+                sub.equations.append(Equation(lhs, eq, line, " ".join(eq.split()), column=col, offset=start,
+                                              problem=f"unbalanced brace: {problem}"))
+                continue
+            cuts = side_offsets(eq)
+            if len(cuts) < 2:
+                continue
+            lhs = eq[:cuts[1] - 1].strip()
+            value = eq[cuts[-1]:]
+            lead = len(value) - len(value.lstrip())
+            line, col = index.locate(start + cuts[-1] + lead)
+            sub.equations.append(Equation(lhs, value.strip(), index.line(start), " ".join(eq.split()),
+                                          column=col, offset=start + cuts[-1] + lead))
+            if len(sub.equations) > MAX_EQUATIONS:
+                raise ModelError(f"more than {MAX_EQUATIONS} equations (a derivation has a few dozen)",
+                                 source=f"{path}:{index.line(start)}")
+    lines = text.split("\n")
+    sub.parts = [with_title(p, lines, hidden) for p in find_parts(text, index.line, lines, hidden)]
+    for eq in sub.equations:
+        eq.part, eq.task = sub.part_at(eq.line)
     return sub
 
 
@@ -175,24 +311,33 @@ def read_yaml(path: str, text: str | None = None) -> Submission:
     steps = data["steps"]
     items = []
     if isinstance(steps, dict):
-        items = [(str(k), v, None) for k, v in steps.items()]
+        items = [(str(k), v, None, None) for k, v in steps.items()]
     elif isinstance(steps, list):
         for entry in steps:
             if not (isinstance(entry, dict) and "step" in entry and "value" in entry):
                 raise ModelError("each entry of 'steps' needs 'step' and 'value'", source=path)
-            items.append((str(entry["step"]), entry["value"], entry.get("line")))
+            items.append((str(entry["step"]), entry["value"], entry.get("line"), entry.get("part")))
     else:
         raise ModelError("'steps' must be a mapping (step: value) or a list", source=path)
-    for n, (name, value, line) in enumerate(items):
+    if len(items) > MAX_EQUATIONS:
+        raise ModelError(f"more than {MAX_EQUATIONS} steps (a derivation has a few dozen)", source=path)
+    for n, (name, value, line, part) in enumerate(items):
         if isinstance(value, (list, tuple)):
-            if any(isinstance(v, (list, dict)) for v in value):
+            # components, or rows of components: nothing nested deeper (and no deep repr later)
+            if any(isinstance(v, dict) or isinstance(v, (list, tuple)) and any(
+                    isinstance(x, (list, tuple, dict)) for x in v) for v in value):
+                where = f"{path}:{lines[n]}" if n < len(lines) else path
+                raise ModelError(f"step '{name}': a value is an expression, a list of them or a list of rows",
+                                 source=where)
+            if any(isinstance(v, list) for v in value):
                 value = [list(v) if isinstance(v, (list, tuple)) else v for v in value]
         elif not isinstance(value, (str, int, float)) or isinstance(value, bool):
             where = f"{path}:{lines[n]}" if n < len(lines) else path
             raise ModelError(f"step '{name}': the value must be an expression or a list of them", source=where)
         is_latex = any("\\" in str(v) for v in (value if isinstance(value, list) else [value]))
         line = line if isinstance(line, int) else (lines[n] if n < len(lines) else 0)
-        sub.equations.append(Equation(name, value, line, f"{name}: {value}", latex=is_latex))
+        sub.equations.append(Equation(name, value, line, f"{name}: {value}", latex=is_latex,
+                                      part=str(part) if part is not None else None))
     return sub
 
 

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+import re
 import unicodedata
 
 import symengine as se
@@ -24,24 +25,31 @@ _KEY_TEXT = {
     "omega": "ω", "omega_dot": "ω̇", "v_dot": "v̇", "vc_dot": "v̇_C", "F": "F", "N": "N", "f": "f", "n": "n",
     "tau": "τ", "dL_dqd": "∂L/∂q̇", "dL_dq": "∂L/∂q", "ddt_dL_dqd": "d/dt ∂L/∂q̇",
 }
+#: the message of an equation that names no step (listed by line, not one by one)
+NOT_A_STEP = "not a step of Newton-Euler or Lagrange (skipped)"
 
 
 def step_title(v: StepVerdict, ascii_only: bool = False) -> str:
     """``v̇_1`` (Unicode) or the step's name (ASCII)."""
+    if v.key == "law":
+        return "Lagrange eq." if not ascii_only else "lagrange_equation"
     if ascii_only or v.key not in _KEY_TEXT:
-        return v.name
+        return v.name or "?"
     index = v.name.rsplit("_", 1)[-1]
     return f"{_KEY_TEXT[v.key]}_{index}"
 
 
-def _value(value, ascii_only: bool) -> str:
+def _value(value, ascii_only: bool, shorthand: dict | None = None) -> str:
     if value is None:
         return ""
+    if isinstance(value, str):
+        return value
     if isinstance(value, sp.MatrixBase):
         if value.shape[1] == 1:
-            return "[" + ", ".join(pretty(x, ascii_only) for x in value) + "]"
-        return "[" + "; ".join(", ".join(pretty(x, ascii_only) for x in value.row(i)) for i in range(value.rows)) + "]"
-    return pretty(value, ascii_only)
+            return "[" + ", ".join(pretty(x, ascii_only, shorthand) for x in value) + "]"
+        return "[" + "; ".join(", ".join(pretty(x, ascii_only, shorthand) for x in value.row(i))
+                               for i in range(value.rows)) + "]"
+    return pretty(value, ascii_only, shorthand)
 
 
 def _width(s: str) -> int:
@@ -58,10 +66,16 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
     lines = [f"armdyn grade {report.submission}: robot '{report.robot}', {report.method}", ""]
     skipped = []
     width = max((_width(step_title(v, ascii_only)) for v in report.steps if v.status != "unrecognised"), default=6)
+    group = object()
     for v in report.steps:
-        if v.status == "unrecognised" and not v.key:
+        if v.status == "unrecognised" and not v.key and v.message == NOT_A_STEP:
             skipped.append(v.line)
             continue
+        if (v.part, v.task) != group:
+            group = (v.part, v.task)
+            if v.part or v.task:
+                lines.append(f"part {v.part}" + (f": {v.task}" if v.task else "") if v.part
+                             else f"(task without a number) {v.task}")
         mark = _MARK[v.status][1 if ascii_only else 0]
         what = v.status
         if v.status == "follows-from-earlier-error":
@@ -77,8 +91,10 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
         lines.append(f"  {mark} line {v.line:>4}  {_pad(step_title(v, ascii_only), width)}  {what}")
         if details and v.status == "wrong":
             mine, other = ("left:    ", "right:   ") if v.key == "proof" else ("yours:   ", "expected:")  # proof: sides
-            lines.append(f"{'':>{16 + width}}{mine} {_value(v.got, ascii_only)}")
-            lines.append(f"{'':>{16 + width}}{other} {_value(v.expected, ascii_only)}")
+            if v.got is not None:
+                lines.append(f"{'':>{16 + width}}{mine} {_value(v.got, ascii_only, report.shorthand)}")
+            if v.expected is not None:
+                lines.append(f"{'':>{16 + width}}{other} {_value(v.expected, ascii_only, report.shorthand)}")
     if skipped:
         shown = ", ".join(map(str, skipped[:12])) + (", ..." if len(skipped) > 12 else "")
         lines.append(f"  {'·' if not ascii_only else '--'} {len(skipped)} equation(s) not recognised as steps, skipped "
@@ -139,6 +155,9 @@ def to_dict(report: GradeReport) -> dict:
             "label": v.label,
             "message": v.message,
             "components": v.components,
+            "part": v.part,
+            "task": v.task or None,
+            "column": v.column or None,
             **({"counterexample": v.counterexample} if v.counterexample else {}),
         })
     return {
@@ -156,4 +175,19 @@ def to_json(report: GradeReport) -> str:
     return json.dumps(to_dict(report), indent=2, ensure_ascii=False)
 
 
-__all__ = ["text", "to_dict", "to_json", "step_title", "display_name"]
+def error_json(err, path: str) -> str:
+    """A submission that cannot be graded, as JSON: ``{"error", "file", "line", "column"}``
+    (line and column null where not known). ``err``: a ModelError whose ``source`` is
+    ``file``, ``file:line`` or ``file:line:column``."""
+    source = getattr(err, "source", None) or path
+    line = column = None
+    m = re.fullmatch(r"(.*?):(\d+)(?::(\d+))?", source)
+    if m:
+        source, line, column = m.group(1), int(m.group(2)), int(m.group(3)) if m.group(3) else None
+    message = getattr(err, "message", None) or str(err)
+    if getattr(err, "element", None):
+        message = f"{err.element}: {message}"
+    return json.dumps({"error": message, "file": source, "line": line, "column": column}, ensure_ascii=False)
+
+
+__all__ = ["text", "to_dict", "to_json", "error_json", "step_title", "display_name"]

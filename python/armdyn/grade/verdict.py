@@ -17,7 +17,8 @@ Statuses (``StepVerdict.status``):
 * ``follows-from-earlier-error``: wrong, but exactly what the method gives from the
   student's own earlier values (``caused_by`` names the earliest wrong step it inherits).
 * ``correct-but-unsupported``: right, but not what the student's own earlier steps give.
-* ``unrecognised``: the LHS could not be mapped to a step (shown, skipped).
+* ``unrecognised``: the LHS could not be mapped to a step, or the value could not be
+  read (the message says where, line and column, and why); it counts against passing.
 
 Values are SymPy: a (3, 1) ``Matrix`` for vectors, an expression for scalars, in the
 robot model's symbols (``theta1``, ``theta1_dot``, ``l1``...); ``symbol_latex`` maps those
@@ -37,7 +38,7 @@ STATUSES = (
     "unrecognised",
 )
 
-#: statuses that count as right for the exit status (0 when all steps are one of these)
+#: statuses that count as right for the exit status (0 when every equation is one of these)
 PASSING = ("correct", "correct-by-convention")
 
 
@@ -61,6 +62,10 @@ class StepVerdict:
     caused_by:   name of the earlier step an inherited error comes from, or None
     message:     one readable sentence, e.g. "missing term −l1·θ̇1² in the x component"
     frame:       the frame the value is expressed in, e.g. "1" (text), "" for scalars
+    part:        the assignment's part the equation is in (``"7-4"``), None when the task
+                 has no number or there are no parts (see :mod:`armdyn.grade.parts`)
+    task:        that task's title (the first line of its statement), "" if none
+    column:      1-based column where the value starts (0: not known, e.g. YAML)
     counterexample: for a wrong proof link, the small body on which its sides differ
                  (masses, points, vectors, rotations, both sides' values), else None
     """
@@ -80,6 +85,9 @@ class StepVerdict:
     caused_by: str | None = None
     message: str = ""
     frame: str = ""
+    part: str | None = None
+    task: str = ""
+    column: int = 0
     counterexample: dict | None = None
 
     @property
@@ -102,6 +110,8 @@ class GradeReport:
                    False where the student gave no tau_i
     symbol_latex:  SymPy symbol -> the student's LaTeX for it, for printing
     notes:         general remarks (mapping used, steps the method has that the student skipped)
+    shorthand:     sin/cos terms the student wrote as shorthand -> symbols printing as theirs
+                   (``sin(q1 + q2)`` -> ``s₁₂``), for showing values in their notation
     """
 
     robot: str
@@ -112,10 +122,12 @@ class GradeReport:
     tau_correct: list[bool]
     symbol_latex: dict = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    shorthand: dict = field(default_factory=dict)
 
     @property
     def passed(self) -> bool:
-        return all(s.status in PASSING for s in self.steps if s.status != "unrecognised")
+        """Every equation read and right (an unread one is not a pass: it was not checked)."""
+        return all(s.status in PASSING for s in self.steps)
 
     def text(self, ascii_only: bool = False) -> str:
         """The plain-text report (Unicode dots unless ``ascii_only``)."""

@@ -14,8 +14,7 @@ import re
 from dataclasses import dataclass
 
 from ..latex import split_equations
-
-_MATH = re.compile(r"\$\$(.+?)\$\$|\\\[(.+?)\\\]", re.DOTALL)
+from ..reader import math_blocks
 _START = re.compile(r"\b(prove|proof|show that)\b", re.IGNORECASE)
 _KEEP_HEADING = re.compile(r"^\W*(solution|proof|answer|demonstration)\b", re.IGNORECASE)
 _INSTRUCTION = re.compile(r"^\W*(check|formulate|derive|compute|calculate|find|determine|solve|write)\b", re.IGNORECASE)
@@ -63,14 +62,12 @@ def proof_regions(text: str, step_lines: set[int]) -> list[list[Display]]:
     in_proof = False
     pos = _body_start(text)
     counted, line_at = 0, 1  # line numbers counted incrementally: linear in the text's length
-    for m in _MATH.finditer(text, pos):
-        prose = text[pos:m.start()]
-        pos = m.end()
+    for outer_start, outer_end, block_start, block in math_blocks(text, pos):  # linear, as the reader's
+        prose = text[pos:outer_start]
+        pos = outer_end
         in_proof, started = _update(in_proof, prose)
         if started or (in_proof and not regions):
             regions.append([])
-        group = 1 if m.group(1) is not None else 2
-        block, block_start = m.group(group), m.start(group)
         first = True
         for offset, eq in split_equations(block):
             line_at += text.count("\n", counted, block_start + offset)
