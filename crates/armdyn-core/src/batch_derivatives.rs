@@ -67,8 +67,9 @@ impl<L: Real> Work<L> {
 ///
 /// Each state's row is read contiguously; the lane loop has a constant trip count
 /// (`L::LANES`), so it unrolls and every `set_lane` has a constant lane index.
+#[doc(hidden)] // public for tests/transposition.rs
 #[inline(always)]
-fn rows_to_lanes<L: Real>(rows: &[f64], lanes: &mut [L], len: usize) {
+pub fn rows_to_lanes<L: Real>(rows: &[f64], lanes: &mut [L], len: usize) {
     for l in 0..L::LANES {
         let row = &rows[l * len..(l + 1) * len];
         for (v, &x) in lanes[..len].iter_mut().zip(row) {
@@ -86,8 +87,9 @@ fn rows_to_lanes<L: Real>(rows: &[f64], lanes: &mut [L], len: usize) {
 ///
 /// With 8 lanes on an AVX-512 CPU the blocks go through [`blocks_to_rows_avx512`]
 /// (the same values, moved by shuffles).
+#[doc(hidden)] // public for tests/transposition.rs
 #[inline(always)]
-fn lanes_to_rows<L: Real>(lanes: &[L], rows: &mut [f64], len: usize) {
+pub fn lanes_to_rows<L: Real>(lanes: &[L], rows: &mut [f64], len: usize) {
     let w = L::LANES;
     let full = len / w * w;
     if !blocks_shuffled(lanes, rows, len) {
@@ -376,45 +378,4 @@ pub fn jacobian_dot(model: &Model, q: &[f64], qd: &[f64], link: usize, out: &mut
             algo::jacobian_dot(model, d, &q[r * n..(r + 1) * n], &qd[r * n..(r + 1) * n], link, o);
         }
     });
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `rows_to_lanes` against the definition (value `j` of state `l` in lane `l` of
-    /// vector `j`), and `lanes_to_rows` back to the original rows, for lengths below,
-    /// at and above a multiple of the lane count (the block transpose and its tail).
-    fn round_trip<L: Real>() {
-        for len in [1, 5, 8, 13, 36, 49] {
-            let rows: Vec<f64> = (0..L::LANES * len).map(|i| i as f64 * 0.5 - 3.0).collect();
-            let mut lanes = vec![L::zero(); len];
-            rows_to_lanes(&rows, &mut lanes, len);
-            for l in 0..L::LANES {
-                for j in 0..len {
-                    assert_eq!(lanes[j].lane(l), rows[l * len + j], "len {len}, lane {l}, value {j}");
-                    assert_eq!(L::lane_of(&lanes[j], l), lanes[j].lane(l));
-                }
-            }
-            // NaN start: an entry left unwritten fails the comparison
-            let mut back = vec![f64::NAN; L::LANES * len];
-            lanes_to_rows(&lanes, &mut back, len);
-            assert_eq!(back, rows, "len {len}");
-        }
-    }
-
-    #[test]
-    fn transposition_f64x8() {
-        round_trip::<F64x8>()
-    }
-
-    #[test]
-    fn transposition_f64x4() {
-        round_trip::<F64x4>()
-    }
-
-    #[test]
-    fn transposition_f64() {
-        round_trip::<f64>()
-    }
 }
