@@ -55,6 +55,7 @@ from ..model import Robot
 from ..symbolic import dag
 from .program import Builder, Program, from_expressions
 from .printers import INPUTS, Names, print_c, print_python
+from .safe_names import identifier_base
 
 QUANTITIES = ("tau", "M", "C", "g", "regressor")
 LANGUAGES = ("c", "python", "numpy")
@@ -129,10 +130,8 @@ class GeneratedCode:
 
 
 def _identifier(name: str) -> str:
-    import re
-
-    s = re.sub(r"\W", "_", name)
-    return s if s and not s[0].isdigit() else "robot_" + s
+    """The robot's name as an ASCII identifier: the functions' prefix and the file's stem."""
+    return identifier_base(name, fallback="robot")
 
 
 def write_files(codes, directory) -> list[str]:
@@ -409,12 +408,14 @@ def codegen(robot: Robot | str, what=("tau", "M", "C", "g"), lang: str = "c", ba
     defs = [(s, e) for s, e in definitions if s in free]
 
     temps = [s for prog in programs.values() for s, _ in prog.assignments]
-    names = Names(list(dict.fromkeys([*robot.q, *robot.qd, *robot.qdd, *order, *temps])))
     prefix = _identifier(robot.name)
+    functions = {w: f"{prefix}_{w}" for w in programs}
+    taken = [*functions.values(), *(f + "_batch" for f in functions.values())]
+    names = Names(list(dict.fromkeys([*robot.q, *robot.qd, *robot.qdd, *order, *temps])), taken=taken)
     code = GeneratedCode(
         robot.name, lang, robot.dof, list(robot.coordinate_names), robot.q, robot.qd, robot.qdd, programs, sources,
         order, defs, base,
-        functions={w: f"{prefix}_{w}" for w in programs},
+        functions=functions,
         op_counts={w: p.operation_counts() for w, p in programs.items()},
         names=names,
     )
