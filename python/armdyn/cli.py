@@ -98,7 +98,7 @@ def cmd_grade(args) -> int:
         print(submission.to_yaml(), end="")
         return 0
     report = grade(submission, robot=args.robot)
-    if args.html:
+    if args.html is not None:  # "" is an error of the writer, not "no report"
         from .grade.html import write_report_html  # all or nothing
 
         try:
@@ -146,11 +146,13 @@ def _numbers(text: str | None, option: str, dof: int | None = None):
 def cmd_simulate(args) -> int:
     import numpy as np
 
+    from ._io_atomic import destination
     from .show import numeric_robot
     from .simulate import PD, ComputedTorque, simulate
 
     for path, ext in ((args.plot, (".png", ".svg", ".pdf")), (args.animate, (".gif",))):
         if path is not None:
+            destination(path)  # refused before the run: not a regular file, read-only, ""
             if not path.lower().endswith(ext):
                 raise ValueError(f"{path}: expected a file name ending in {' or '.join(ext)}")
             folder = os.path.dirname(os.path.abspath(path))

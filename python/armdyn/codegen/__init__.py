@@ -135,26 +135,27 @@ def _identifier(name: str) -> str:
 
 
 def write_files(codes, directory) -> list[str]:
-    """Write each code's source into ``directory`` atomically: every file is written to
-    a temporary name first, then all are renamed, so a failure leaves nothing half-written."""
+    """Write each code's source into ``directory`` (created if missing) all or nothing,
+    through :func:`armdyn._io_atomic.atomic_writes` (files get the umask's permissions; an
+    existing destination that is not a writable regular file is refused)."""
     import os
-    import tempfile
+    from pathlib import Path
 
-    os.makedirs(directory, exist_ok=True)
-    staged = []
+    from .._io_atomic import OutputPathError, atomic_writes
+
+    shown = os.fspath(directory)
+    if not shown:
+        raise OutputPathError("output directory is empty")
+    if os.path.lexists(shown) and not os.path.isdir(shown):
+        raise OutputPathError(f"{shown}: exists and is not a directory (--out takes a directory)")
     try:
-        for code in codes:
-            fd, tmp = tempfile.mkstemp(prefix=".armdyn-", dir=directory)
-            with os.fdopen(fd, "w") as fh:
-                fh.write(code.source)
-            staged.append((tmp, os.path.join(directory, code.filename)))
-    except BaseException:
-        for tmp, _ in staged:
-            os.unlink(tmp)
-        raise
-    for tmp, final in staged:
-        os.replace(tmp, final)
-    return [final for _, final in staged]
+        os.makedirs(shown, exist_ok=True)
+    except OSError as exc:
+        raise OutputPathError(f"{shown}: cannot create the directory ({exc.strerror})") from None
+    paths = [os.path.join(shown, code.filename) for code in codes]
+    atomic_writes([(path, lambda tmp, c=code: Path(tmp).write_text(c.source, encoding="utf-8"))
+                   for path, code in zip(paths, codes)])
+    return paths
 
 
 def _identification(what: str):
