@@ -117,10 +117,7 @@ def _read(path_or_xml) -> tuple[bytes, str]:
 
 
 def _parse(text: bytes) -> ET.Element:
-    # Entity declarations are the one XML feature that can make a small file huge
-    # ("billion laughs"); URDF never needs them.
-    if b"<!ENTITY" in text:
-        raise ModelError("XML entity declarations are not allowed in URDF", "<!ENTITY>")
+    _refuse_dtd(text)
     try:
         root = ET.fromstring(text)
     except ET.ParseError as err:
@@ -130,6 +127,38 @@ def _parse(text: bytes) -> ET.Element:
     if root.tag != "robot":
         raise ModelError(f"the root element is <{root.tag}>, expected <robot>", f"<{root.tag}>")
     return root
+
+
+class _DTD(Exception):
+    pass
+
+
+def _refuse_dtd(text: bytes) -> None:
+    """ModelError if the document has a DTD (``<!DOCTYPE ...>``, with or without entity
+    or ``<!ATTLIST>`` declarations), in whatever encoding it is written.
+
+    Entity declarations are the one XML feature that can make a small file huge ("billion
+    laughs"); they and ATTLIST defaults also change what the file says (a robot name, a
+    mass) invisibly; URDF needs none of it. Looking for the bytes ``<!ENTITY`` misses a
+    UTF-16 file, so expat itself (which decodes any encoding it accepts) reads the
+    document up to its DTD and stops there, before anything is declared or expanded."""
+    import xml.parsers.expat
+
+    def refuse(*_args):
+        raise _DTD
+
+    parser = xml.parsers.expat.ParserCreate()
+    parser.StartDoctypeDeclHandler = refuse
+    parser.EntityDeclHandler = refuse  # a DTD cannot be skipped, but be explicit
+    parser.AttlistDeclHandler = refuse
+    try:
+        parser.Parse(text, True)
+    except _DTD:
+        where = f"<!DOCTYPE> on line {parser.CurrentLineNumber}"
+        raise ModelError("a DTD is not allowed in URDF (entity declarations are not allowed, nor ATTLIST "
+                         "defaults)", where) from None
+    except xml.parsers.expat.ExpatError:
+        return  # malformed: ElementTree reports it with its own wording
 
 
 # ------------------------------------------------------------------ elements
