@@ -189,6 +189,9 @@ def cmd_simulate(args) -> int:
     steps = round(args.duration / args.dt) if np.isfinite(args.duration) and args.duration > 0 else 0
     if steps < 1:
         raise ValueError(f"--duration must be at least one step of --dt, got {args.duration}")
+    if abs(steps * args.dt - args.duration) > 1e-9 * max(args.duration, 1.0):  # as simulate() checks it
+        raise ValueError(f"--duration {args.duration:g} is not a whole number of steps of --dt {args.dt:g} "
+                         f"({args.duration / args.dt:.6g} steps)")
     if args.stride is None:  # keep ~2000 samples
         args.stride = max(1, steps // 2000)
     show_bar = not args.quiet and steps * dof >= 600_000
