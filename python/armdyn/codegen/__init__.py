@@ -130,8 +130,14 @@ class GeneratedCode:
 
 
 def _identifier(name: str) -> str:
-    """The robot's name as an ASCII identifier: the functions' prefix and the file's stem."""
-    return identifier_base(name, fallback="robot")
+    """The robot's name as an ASCII identifier: the functions' prefix and the file's stem
+    (a long name cut, with a digest of the whole: a file name has at most 255 bytes)."""
+    base = identifier_base(name, fallback="robot")
+    if len(base) > 48:
+        import hashlib
+
+        base = f"{base[:39]}_{hashlib.sha1(name.encode('utf-8', 'surrogatepass')).hexdigest()[:8]}"
+    return base
 
 
 def write_files(codes, directory) -> list[str]:
