@@ -432,3 +432,13 @@ def test_urdf_in_utf16_without_dtd_loads_as_utf8():
     q = np.array([0.4])
     assert a.name == b.name == "r\u00e9"
     np.testing.assert_array_equal(armdyn.gravity(a, q), armdyn.gravity(b, q))
+
+
+def test_urdf_names_are_one_line_like_yaml():
+    """A character reference put a line break into a URDF name (YAML refused it)."""
+    body = (f'<link name="base"/><link name="l1">{INERTIAL}</link><joint name="j&#10;1" type="continuous">'
+            '<parent link="base"/><child link="l1"/><axis xyz="0 0 1"/></joint>')
+    with pytest.raises(ModelError, match=r"joint #1: name: expected a name \(a one-line string\), got 'j\\n1'"):
+        load_urdf(f'<robot name="r">{body}</robot>'.encode())
+    with pytest.raises(ModelError, match="<robot>: name: expected a name"):
+        load_urdf(f'<robot name="a&#13;b">{body.replace("&#10;", "")}</robot>'.encode())

@@ -63,6 +63,7 @@ import sympy as sp
 from ..errors import ModelError
 from ..inertia import rotate
 from ..model import Joint, Link, Mimic, Numbers, Robot, rpy_matrix
+from .expressions import check_name
 
 __all__ = ["load_urdf", "MasslessWarning"]
 
@@ -279,9 +280,15 @@ def _origin(parent: ET.Element, where: str) -> tuple[Numbers, Numbers, tuple]:
     return Numbers(xyz), rotation, rpy
 
 
+def _name(elem: ET.Element, where: str) -> str:
+    """The element's ``name``: a non-empty one-line printable string, as in YAML models
+    (a character reference such as ``&#10;`` would otherwise put a line break in it)."""
+    return check_name(_attr(elem, "name", where), "name", where)
+
+
 def _link(elem: ET.Element, index: int) -> tuple[Link, bool]:
     """The link and whether it had an ``<inertial>``."""
-    name = _attr(elem, "name", f"link #{index + 1}")
+    name = _name(elem, f"link #{index + 1}")
     where = f"link '{_clip(name)}'"
     inertial = _single(elem, "inertial", where)
     if inertial is None:
@@ -311,7 +318,7 @@ def _link(elem: ET.Element, index: int) -> tuple[Link, bool]:
 
 
 def _joint(elem: ET.Element, index: int) -> Joint:
-    name = _attr(elem, "name", f"joint #{index + 1}")
+    name = _name(elem, f"joint #{index + 1}")
     where = f"joint '{_clip(name)}'"
     kind = _attr(elem, "type", where)
     if kind in UNSUPPORTED_TYPES:
@@ -375,7 +382,7 @@ def _mimic(elem: ET.Element, where: str) -> Mimic | None:
 def _build(root: ET.Element, text: bytes, source: str, strict: bool) -> Robot:
     if root.find("link") is None:
         raise ModelError("the robot has no <link>", "<robot>")
-    name = _attr(root, "name", None)
+    name = _name(root, "<robot>")
     links, massless = [], []
     for i, elem in enumerate(root.findall("link")):
         link, has_inertial = _link(elem, i)
