@@ -253,7 +253,7 @@ def test_published_defaults_must_be_finite(value):
 @pytest.mark.parametrize("key", ["source", "description", "notes"])
 def test_source_and_description_must_be_text(tmp_path, capsys, key):
     """Before: a list of 9**8 (43 million) aliased strings was accepted as the source,
-    and `armdyn show` printing it never finished."""
+    and `armdyn show` printing it never finished. Now any alias is refused first."""
     kept, skipping = [], False
     for ln in PLANAR.splitlines():  # drop `key` (and a folded block under it)
         if ln.startswith(f"{key}:"):
@@ -269,7 +269,7 @@ def test_source_and_description_must_be_text(tmp_path, capsys, key):
     with deadline(20):
         code = main(["show", str(path)])
     err = capsys.readouterr().err
-    assert code == 2 and err.startswith(f"armdyn: error: {path}") and "expected text" in err, err
+    assert code == 2 and err.startswith(f"armdyn: error: {path}:") and "aliases" in err, err
     assert err.count("\n") == 1 and len(err) < 500
 
 

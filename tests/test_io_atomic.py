@@ -8,7 +8,7 @@ import stat
 
 import pytest
 
-from armdyn._io_atomic import atomic_write, atomic_write_text, atomic_writes
+from armdyn._io_atomic import OutputPathError, atomic_write, atomic_write_text, atomic_writes
 
 
 def _mode(path):
@@ -74,7 +74,7 @@ def test_several_outputs_all_or_nothing(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.gif", "run.png"]
 
 
-def test_missing_folder_is_an_os_error(tmp_path):
-    with pytest.raises(FileNotFoundError):
+def test_missing_folder_is_refused_naming_it(tmp_path):
+    with pytest.raises(OutputPathError, match="nope.* does not exist"):
         atomic_write_text(tmp_path / "nope" / "r.html", "x")
     assert list(tmp_path.iterdir()) == []

@@ -113,7 +113,7 @@ def cmd_grade(args) -> int:
 
         print(error_json(err, args.submission))  # scripts read one JSON object either way
         return 2
-    if args.html:
+    if args.html is not None:  # "" is an error of the writer, not "no report"
         from .grade.html import write_report_html  # all or nothing
 
         try:
@@ -167,11 +167,13 @@ def _numbers(text: str | None, option: str, dof: int | None = None):
 def cmd_simulate(args) -> int:
     import numpy as np
 
+    from ._io_atomic import destination
     from .show import numeric_robot
     from .simulate import PD, ComputedTorque, simulate
 
     for path, ext in ((args.plot, (".png", ".svg", ".pdf")), (args.animate, (".gif",))):
         if path is not None:
+            destination(path)  # refused before the run: not a regular file, read-only, ""
             if not path.lower().endswith(ext):
                 raise ValueError(f"{path}: expected a file name ending in {' or '.join(ext)}")
             folder = os.path.dirname(os.path.abspath(path))
@@ -208,6 +210,9 @@ def cmd_simulate(args) -> int:
     steps = round(args.duration / args.dt) if np.isfinite(args.duration) and args.duration > 0 else 0
     if steps < 1:
         raise ValueError(f"--duration must be at least one step of --dt, got {args.duration}")
+    if abs(steps * args.dt - args.duration) > 1e-9 * max(args.duration, 1.0):  # as simulate() checks it
+        raise ValueError(f"--duration {args.duration:g} is not a whole number of steps of --dt {args.dt:g} "
+                         f"({args.duration / args.dt:.6g} steps)")
     if args.stride is None:  # keep ~2000 samples
         args.stride = max(1, steps // 2000)
     show_bar = not args.quiet and steps * dof >= 600_000

@@ -30,6 +30,9 @@ gravity is the robot's vector in the base frame; frames as in :mod:`armdyn.model
 
 from __future__ import annotations
 
+import functools
+import math
+
 import numpy as np
 import sympy as sp
 
@@ -217,10 +220,15 @@ def rnea(robot, q, qd, qdd, *, f_ext=None, frame="local", threads=None):
     q, qd, qdd: (n,) or (N, n). Returns tau = M(q) qdd + C(q, qd) qd + g(q), same shape;
     with external wrenches ``f_ext`` (see :func:`rnea_derivatives`), minus sum J^T w.
     """
+    threads = _threads(threads)
     if f_ext is not None:
         f_ext = _canonical_wrenches(robot, f_ext, frame)
-        return _core.rnea_ext(_core_model(robot, "rnea with f_ext"), q, qd, qdd, f_ext, frame, threads)
-    return _model(robot).rnea(q, qd, qdd, threads)
+        return _finite(_core.rnea_ext(_core_model(robot, "rnea with f_ext"), q, qd, qdd, f_ext, frame, threads),
+                       "rnea", q=q, qd=qd, qdd=qdd)
+    tau = _model(robot).rnea(q, qd, qdd, threads)
+    if tau.ndim == 1 and tau.size <= 64 and math.isfinite(sum(tau.tolist())) or _all_finite(tau):  # inlined: hot
+        return tau
+    raise _overflow("rnea", {"q": q, "qd": qd, "qdd": qdd})
 
 
 def crba(robot, q, *, threads=None):
@@ -228,7 +236,8 @@ def crba(robot, q, *, threads=None):
 
     q: (n,) or (N, n). Returns the full symmetric M: (n, n) or (N, n, n).
     """
-    return _model(robot).crba(q, threads)
+    threads = _threads(threads)
+    return _finite(_model(robot).crba(q, threads), "crba", q=q)
 
 
 def aba(robot, q, qd, tau, *, f_ext=None, frame="local", threads=None):
@@ -237,15 +246,24 @@ def aba(robot, q, qd, tau, *, f_ext=None, frame="local", threads=None):
     q, qd, tau: (n,) or (N, n). Returns qdd = M^-1 (tau - C qd - g), same shape; with
     external wrenches ``f_ext`` (see :func:`rnea_derivatives`), M^-1 (tau + sum J^T w - C qd - g).
     """
+    threads = _threads(threads)
     if f_ext is not None:
         f_ext = _canonical_wrenches(robot, f_ext, frame)
         return _core.aba_ext(_core_model(robot, "aba with f_ext"), q, qd, tau, f_ext, frame, threads)
-    return _model(robot).aba(q, qd, tau, threads)
+    try:
+        return _model(robot).aba(q, qd, tau, threads)
+    except ValueError as err:
+        # the core calls any non-finite result "singular at this state"; an overflow (M
+        # well conditioned, tau or qd too large) is told apart by factoring M at that q
+        if "singular at this state" in str(err) and _well_conditioned(crba(robot, q, threads=threads)):
+            raise _overflow("aba", {"qd": qd, "tau": tau}) from None
+        raise
 
 
 def gravity(robot, q, *, threads=None):
     """Gravity torques g(q) = rnea(q, 0, 0). q: (n,) or (N, n); same shape out."""
-    return _model(robot).gravity_torques(q, threads)
+    threads = _threads(threads)
+    return _finite(_model(robot).gravity_torques(q, threads), "gravity", q=q)
 
 
 def bias(robot, q, qd, *, threads=None):
@@ -253,7 +271,8 @@ def bias(robot, q, qd, *, threads=None):
 
     q, qd: (n,) or (N, n); same shape out.
     """
-    return _model(robot).bias(q, qd, threads)
+    threads = _threads(threads)
+    return _finite(_model(robot).bias(q, qd, threads), "bias", q=q, qd=qd)
 
 
 def coriolis_matrix(robot, q, qd, *, threads=None):
@@ -262,12 +281,14 @@ def coriolis_matrix(robot, q, qd, *, threads=None):
     C qd = h - g, and Mdot - 2C is skew-symmetric. q, qd: (n,) or (N, n).
     Returns (n, n) or (N, n, n).
     """
-    return _model(robot).coriolis_matrix(q, qd, threads)
+    threads = _threads(threads)
+    return _finite(_model(robot).coriolis_matrix(q, qd, threads), "coriolis_matrix", q=q, qd=qd)
 
 
 def kinetic_energy(robot, q, qd, *, threads=None):
     """Kinetic energy T = 1/2 qd^T M(q) qd. q, qd: (n,) -> float, or (N, n) -> (N,)."""
-    return _model(robot).kinetic_energy(q, qd, threads)
+    threads = _threads(threads)
+    return _finite(_model(robot).kinetic_energy(q, qd, threads), "kinetic_energy", q=q, qd=qd)
 
 
 def potential_energy(robot, q, *, threads=None):
@@ -277,7 +298,8 @@ def potential_energy(robot, q, *, threads=None):
 
     q: (n,) -> float, or (N, n) -> (N,).
     """
-    return _model(robot).potential_energy(q, threads)
+    threads = _threads(threads)
+    return _finite(_model(robot).potential_energy(q, threads), "potential_energy", q=q)
 
 
 def forward_kinematics(robot, q, *, threads=None):
@@ -468,3 +490,77 @@ def regressor(robot, q, qd, qdd, *, threads=None, columns: str = "model"):
         keep = slice(0, first) if not extra else np.array(list(range(first)) + extra)
         robot._regressor_columns = keep  # cached like the compiled model
     return Y[..., keep]
+
+
+# ------------------------------------------------------------------ argument checks
+MAX_THREADS = 256
+
+
+def _threads(threads):
+    """Checked ``threads``: ``threads`` if it is None or an integer from 1 to MAX_THREADS, else ValueError naming
+    it (True is an int to Python; 2**64 would be PyO3's OverflowError, naming nothing)."""
+    if threads is None or type(threads) is int and 1 <= threads <= MAX_THREADS:
+        return threads
+    if isinstance(threads, (bool, np.bool_)) or not isinstance(threads, (int, np.integer)) \
+            or not 1 <= threads <= MAX_THREADS:
+        shown = repr(threads) if len(repr(threads)) <= 40 else f"{type(threads).__name__} {repr(threads)[:30]}..."
+        raise ValueError(f"threads: expected None or an integer from 1 to {MAX_THREADS}, got {shown}")
+    return int(threads)
+
+
+def _overflow(what: str, arrays: dict) -> ValueError:
+    sizes = []
+    for name, a in arrays.items():
+        try:
+            sizes.append(f"max |{name}| = {float(np.max(np.abs(np.asarray(a, dtype=float)))):.3g}")
+        except (TypeError, ValueError):
+            pass
+    return ValueError(f"{what}: the result overflows float64 (not finite) for finite inputs ({', '.join(sizes)}); "
+                      "the state or torque is too large for this arm")
+
+
+def _well_conditioned(M) -> bool:
+    """Every (n, n) matrix of ``M`` finite, positive definite, condition number < 1e12."""
+    M = np.asarray(M, dtype=float)
+    try:
+        np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        return False
+    return bool(np.isfinite(M).all() and np.linalg.cond(M.reshape((-1,) + M.shape[-2:])).max() < 1e12)
+
+
+def _all_finite(result) -> bool:
+    """No NaN or inf in ``result`` (a float or an array). Small arrays by the sum of their
+    entries as Python floats (NaN and inf propagate; a sum that overflows is checked
+    again entry by entry), about 4 times quicker than ``np.isfinite`` on a 6-vector."""
+    if type(result) is float:
+        return math.isfinite(result)
+    if result.ndim == 1 and result.size <= 64 and math.isfinite(sum(result.tolist())):
+        return True
+    return bool(np.isfinite(result).all())
+
+
+def _checked(fn, finite: bool = False):
+    """``fn`` with ``threads`` checked first (for the functions whose bodies do not)."""
+
+    @functools.wraps(fn)
+    def call(robot, *args, threads=None, **kwargs):
+        if threads is not None:
+            threads = _threads(threads)
+        return fn(robot, *args, threads=threads, **kwargs)
+
+    return call
+
+
+def _finite(result, what: str, **arrays):
+    """``result``, or the ValueError of :func:`_overflow` if it holds NaN or inf: the core
+    checks that the inputs are finite, so that is an overflow (qd = 1e300 squared in the
+    velocity products), which the core would return silently."""
+    if not _all_finite(result):
+        raise _overflow(what, arrays)
+    return result
+
+
+for _name in ("forward_kinematics", "jacobian", "gravity_derivatives", "jacobian_dot", "regressor"):
+    globals()[_name] = _checked(globals()[_name])
+del _name

@@ -190,8 +190,10 @@ def _state(x, name, dof):
 
 def _per_joint(x, name, dof):
     a = np.broadcast_to(np.asarray(x, dtype=float), (dof,)) if np.ndim(x) == 0 else np.asarray(x, dtype=float)
-    if a.shape != (dof,) or not np.all(np.isfinite(a)):
+    if a.shape != (dof,):
         raise ValueError(f"{name}: expected a finite scalar or ({dof},) values, got shape {a.shape}")
+    if not np.all(np.isfinite(a)):  # the shape is right: say what is wrong instead
+        raise ValueError(f"{name} contains NaN or inf")
     return _c(a)
 
 
@@ -205,17 +207,21 @@ def _per_state(x, name, rows, dof):
 
 
 def _steps(duration, steps, dt) -> int:
-    if not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt) and dt > 0):
+    # bool is an int to Python: dt=True would be a step of 1 s
+    if isinstance(dt, (bool, np.bool_)) or not (isinstance(dt, (int, float, np.integer, np.floating))
+                                                 and math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt must be a positive finite number of seconds, got {dt!r}")
     if (duration is None) == (steps is None):
         raise ValueError("give exactly one of duration (seconds) and steps")
     if steps is None:
-        if not (math.isfinite(duration) and duration > 0):
+        if isinstance(duration, (bool, np.bool_)) or not (isinstance(duration, (int, float, np.integer, np.floating))
+                                                           and math.isfinite(duration) and duration > 0):
             raise ValueError(f"duration must be a positive finite number of seconds, got {duration!r}")
         steps = round(duration / dt)
         if abs(steps * dt - duration) > 1e-9 * max(duration, 1.0):
             raise ValueError(f"duration {duration} is not a whole number of steps of dt = {dt}")
-    if int(steps) != steps or steps < 1:
+    if isinstance(steps, (bool, np.bool_)) or not isinstance(steps, (int, float, np.integer, np.floating)) \
+            or int(steps) != steps or steps < 1:
         raise ValueError(f"steps must be a positive integer, got {steps!r}")
     if steps > 1 << 40:
         raise ValueError(f"{steps} steps is more than armdyn integrates in one call")
@@ -378,6 +384,9 @@ def _simulate_python(model, q0, qd0, torque, dt, steps, stride, method, lower, u
             tau = torque(t, q.copy(), qd.copy())
         except Exception as err:  # noqa: BLE001 - the user's error, shown with the step
             raise ValueError(f"torque callable failed at step {k} (t = {t:.6g} s): {type(err).__name__}: {err}") from err
+        if np.iscomplexobj(tau):  # float() would drop the imaginary part with only a warning
+            raise ValueError(f"torque callable returned complex values at step {k} (t = {t:.6g} s); "
+                             "torques are real")
         try:
             tau = np.asarray(tau, dtype=float)
         except (TypeError, ValueError):

@@ -55,6 +55,7 @@ from ..model import Robot
 from ..symbolic import dag
 from .program import Builder, Program, from_expressions
 from .printers import INPUTS, Names, print_c, print_python
+from .safe_names import identifier_base
 
 QUANTITIES = ("tau", "M", "C", "g", "regressor")
 LANGUAGES = ("c", "python", "numpy")
@@ -129,33 +130,38 @@ class GeneratedCode:
 
 
 def _identifier(name: str) -> str:
-    import re
+    """The robot's name as an ASCII identifier: the functions' prefix and the file's stem
+    (a long name cut, with a digest of the whole: a file name has at most 255 bytes)."""
+    base = identifier_base(name, fallback="robot")
+    if len(base) > 48:
+        import hashlib
 
-    s = re.sub(r"\W", "_", name)
-    return s if s and not s[0].isdigit() else "robot_" + s
+        base = f"{base[:39]}_{hashlib.sha1(name.encode('utf-8', 'surrogatepass')).hexdigest()[:8]}"
+    return base
 
 
 def write_files(codes, directory) -> list[str]:
-    """Write each code's source into ``directory`` atomically: every file is written to
-    a temporary name first, then all are renamed, so a failure leaves nothing half-written."""
+    """Write each code's source into ``directory`` (created if missing) all or nothing,
+    through :func:`armdyn._io_atomic.atomic_writes` (files get the umask's permissions; an
+    existing destination that is not a writable regular file is refused)."""
     import os
-    import tempfile
+    from pathlib import Path
 
-    os.makedirs(directory, exist_ok=True)
-    staged = []
+    from .._io_atomic import OutputPathError, atomic_writes
+
+    shown = os.fspath(directory)
+    if not shown:
+        raise OutputPathError("output directory is empty")
+    if os.path.lexists(shown) and not os.path.isdir(shown):
+        raise OutputPathError(f"{shown}: exists and is not a directory (--out takes a directory)")
     try:
-        for code in codes:
-            fd, tmp = tempfile.mkstemp(prefix=".armdyn-", dir=directory)
-            with os.fdopen(fd, "w") as fh:
-                fh.write(code.source)
-            staged.append((tmp, os.path.join(directory, code.filename)))
-    except BaseException:
-        for tmp, _ in staged:
-            os.unlink(tmp)
-        raise
-    for tmp, final in staged:
-        os.replace(tmp, final)
-    return [final for _, final in staged]
+        os.makedirs(shown, exist_ok=True)
+    except OSError as exc:
+        raise OutputPathError(f"{shown}: cannot create the directory ({exc.strerror})") from None
+    paths = [os.path.join(shown, code.filename) for code in codes]
+    atomic_writes([(path, lambda tmp, c=code: Path(tmp).write_text(c.source, encoding="utf-8"))
+                   for path, code in zip(paths, codes)])
+    return paths
 
 
 def _identification(what: str):
@@ -409,12 +415,14 @@ def codegen(robot: Robot | str, what=("tau", "M", "C", "g"), lang: str = "c", ba
     defs = [(s, e) for s, e in definitions if s in free]
 
     temps = [s for prog in programs.values() for s, _ in prog.assignments]
-    names = Names(list(dict.fromkeys([*robot.q, *robot.qd, *robot.qdd, *order, *temps])))
     prefix = _identifier(robot.name)
+    functions = {w: f"{prefix}_{w}" for w in programs}
+    taken = [*functions.values(), *(f + "_batch" for f in functions.values())]
+    names = Names(list(dict.fromkeys([*robot.q, *robot.qd, *robot.qdd, *order, *temps])), taken=taken)
     code = GeneratedCode(
         robot.name, lang, robot.dof, list(robot.coordinate_names), robot.q, robot.qd, robot.qdd, programs, sources,
         order, defs, base,
-        functions={w: f"{prefix}_{w}" for w in programs},
+        functions=functions,
         op_counts={w: p.operation_counts() for w, p in programs.items()},
         names=names,
     )

@@ -10,7 +10,6 @@ the model has none). Outputs are row-major: a vector (dof,), a matrix (rows, col
 from __future__ import annotations
 
 import keyword
-import re
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
@@ -18,6 +17,7 @@ from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
 from .program import Program
+from .safe_names import comment_text, identifier_base
 from .sincos_coefficients import COS, SIN
 
 INPUTS = {"tau": ("q", "qd", "qdd"), "M": ("q",), "C": ("q", "qd"), "g": ("q",), "regressor": ("q", "qd", "qdd")}
@@ -25,20 +25,24 @@ INPUTS = {"tau": ("q", "qd", "qdd"), "M": ("q",), "C": ("q", "qd"), "g": ("q",),
 _C_RESERVED = set(
     "auto break case char const continue default do double else enum extern float for goto if inline int long "
     "register restrict return short signed sizeof static struct switch typedef union unsigned void volatile while "
-    "_Bool _Complex _Imaginary sin cos tan pow sqrt exp log fabs M_PI out p q qd qdd n k math numpy np".split()
+    "_Bool _Complex _Imaginary sin cos tan pow sqrt exp log fabs M_PI out p q qd qdd n k math numpy np "
+    # what else the generated code names: headers' functions, types and macros, the batch
+    # loops' locals (a variable of that name would not compile or would shadow them)
+    "bool true false asm typeof memcpy size_t uint64_t int64_t errno NULL INFINITY NAN HUGE_VAL EOF "
+    "l j r t z ps pc swap sv cv sb cb quadrant wide flat armdyn_sincos_kernel ARMDYN_SIMD_CLONES".split()
 )
 
 
 class Names:
-    """Identifier for every symbol: its name made safe for C and Python, unique."""
+    """Identifier for every symbol: its name made an ASCII identifier
+    (:func:`~armdyn.codegen.safe_names.identifier_base`), unique, none a keyword or a
+    name the generated code uses itself (``taken``: e.g. its function names)."""
 
-    def __init__(self, symbols):
+    def __init__(self, symbols, taken=()):
         self.map: dict = {}
-        used = set(_C_RESERVED) | set(keyword.kwlist)
+        used = set(_C_RESERVED) | set(keyword.kwlist) | set(taken)
         for s in symbols:
-            base = re.sub(r"\W", "_", s.name)
-            if not base or base[0].isdigit():
-                base = "v_" + base
+            base = identifier_base(s.name)
             name, k = base, 1
             while name in used:
                 k += 1
@@ -51,6 +55,10 @@ class Names:
 
     def name(self, s) -> str:
         return self.map[s].name
+
+    def renamed(self, symbols) -> list[tuple[str, str]]:
+        """``[(name, identifier)]`` of those of ``symbols`` whose identifier differs."""
+        return [(s.name, self.map[s].name) for s in symbols if s in self.map and self.map[s].name != s.name]
 
 
 class FastPrinter:
@@ -119,7 +127,12 @@ def _header_lines(code, comment: str) -> list[str]:
             lines.append(f"  p[{k}] = {s.name}" + (f" = {sp.sstr(d)}" if d is not None else ""))
     else:
         lines.append("Parameters: none (numeric model); p may be NULL/None.")
-    return [comment + (" " + ln if ln else "") for ln in lines]
+    renamed = code.names.renamed([*code.q, *code.qd, *code.qdd, *code.parameters]) if code.names else []
+    if renamed:
+        lines.append("Identifiers of the names that are not one (name -> identifier):")
+        lines += [f"  {name} -> {ident}" for name, ident in renamed]
+    # every name from the model is untrusted text: printable ASCII, nothing that ends the comment
+    return [comment + (" " + comment_text(ln) if ln else "") for ln in lines]
 
 
 def _used_symbols(prog) -> set:
@@ -154,7 +167,7 @@ def print_c(code) -> str:
         fn = code.functions[what]
         args = ", ".join(f"const double *{a}" for a in INPUTS[what])
         size = code.output_size(what)
-        lines.append(f"/* {what}: {code.describe(what)} */")
+        lines.append(f"/* {what}: {comment_text(code.describe(what))} */")
         lines.append(f"void {fn}({args}, const double *p, double *out)")
         lines.append("{")
         lines.append("    (void)p;")
@@ -381,7 +394,7 @@ def print_python(code, numpy: bool = False) -> str:
         args = ", ".join(INPUTS[what])
         lines.append("")
         lines.append(f"def {fn}({args}, p=None):")
-        lines.append(f'    """{what}: {code.describe(what)}"""')
+        lines.append(f'    """{what}: {comment_text(code.describe(what))}"""')
         if numpy:
             lines += [f"    {a} = numpy.asarray({a}, dtype=float)" for a in INPUTS[what]]
             if code.parameters:

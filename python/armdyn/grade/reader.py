@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import yaml
 
 from ..errors import ModelError
+from ..io.yaml_screen import screen
 
 #: a submission larger than this is refused (a derivation is a few kB)
 MAX_BYTES = 5_000_000
@@ -122,11 +123,11 @@ _LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when present:
 
 
 def _safe_yaml(text: str, where: str):
-    """YAML with no aliases (an alias bomb cannot expand) and no Python tags."""
+    """YAML with no aliases (an alias bomb cannot expand), no deep nesting, no huge
+    integers (:func:`armdyn.io.yaml_screen.screen`, shared with model files) and no
+    Python tags."""
+    screen(text, where, "a submission")
     try:
-        for event in yaml.parse(text, Loader=_LOADER):
-            if isinstance(event, yaml.AliasEvent):
-                raise ModelError("YAML aliases (*name) are not allowed in a submission", source=where)
         return yaml.load(text, Loader=_LOADER)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)

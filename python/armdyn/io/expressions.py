@@ -77,6 +77,8 @@ MAX_LENGTH = 10_000
 MAX_DEPTH = 100
 #: Most digits an exact power (integer or rational base and exponent) may produce.
 MAX_POWER_DIGITS = 10_000
+#: Most digits of an integer literal (a float64 is at most about 1.8e308).
+MAX_INT_DIGITS = 400
 #: Largest |numerator| of a rational exponent (``a**(10**20)`` would hang once bound).
 MAX_EXPONENT = 1000
 
@@ -182,7 +184,12 @@ class _Parser:
         try:
             if self.depth > MAX_DEPTH:
                 raise _ParseError(f"nested more than {MAX_DEPTH} levels deep")
-            return parse()
+            value = parse()
+            # SymPy's floats have unbounded exponents: sin(exp(1e300)) or sinh(sinh(sinh(1e3)))
+            # would reach the interpreter's int-to-float limits (or worse) one level up
+            if getattr(value, "is_Float", False) and not math.isfinite(float_value(value)):
+                raise _ParseError(f"the value {_clip(str(value))} is beyond the float64 range")
+            return value
         finally:
             self.depth -= 1
 
@@ -251,6 +258,9 @@ class _Parser:
                 if not math.isfinite(x):
                     raise _ParseError(f"the number {_clip(tok)} is beyond the float64 range")
                 return sp.Float(x)
+            if len(tok) > MAX_INT_DIGITS:  # Python itself refuses int() of > 4300 digits
+                raise _ParseError(f"an integer of {len(tok)} digits is beyond the float64 range "
+                                  f"(at most {MAX_INT_DIGITS} digits)")
             return sp.Integer(tok)
         if tok == "(":
             value = self.nested(self.expr)
@@ -331,8 +341,20 @@ def _check_power_size(base, exponent) -> None:
     more than MAX_POWER_DIGITS digits, now or once parameters are bound: an exponent
     p/q with |p| > MAX_EXPONENT, or |b|^|p| with more than MAX_POWER_DIGITS digits
     (about |p| log10|b|; a q-th root is no larger)."""
+    if exponent.is_Float:
+        # a float power is computed in floating point, but SymPy's floats have unbounded
+        # exponents: 2.0**999.0**999.0**999.0 overflows, sin() of it kills the process
+        e = abs(float(exponent))
+        too_big = not e <= MAX_EXPONENT
+        if not too_big and not base.free_symbols and base not in (0, 1, -1):
+            size = abs(float_value(base))
+            too_big = not (math.isfinite(size) and size > 0 and e * abs(math.log10(size)) <= 308)
+        if too_big:
+            raise _ParseError(f"the power {_clip(str(base))}**{_clip(str(exponent))} is too large (exponents up "
+                              f"to {MAX_EXPONENT}, results within float64's range)")
+        return
     if not isinstance(exponent, sp.Rational) or exponent == 0:
-        return  # symbolic or floating exponent: nothing exact to compute
+        return  # symbolic exponent: nothing exact to compute
     p = abs(int(exponent.p))
     too_big = p > MAX_EXPONENT
     if not too_big and not base.free_symbols and base not in (0, 1, -1):
@@ -354,7 +376,8 @@ def _check_combined_exponents(value) -> None:
     MAX_EXPONENT: ``(a**1000)**1000`` is ``a**1000000``, which binding ``a = 10``
     would turn into a million-digit integer."""
     for f in value.args if value.is_Mul else (value,):
-        if f.is_Pow and isinstance(f.exp, sp.Rational) and abs(int(f.exp.p)) > MAX_EXPONENT:
+        if f.is_Pow and isinstance(f.exp, sp.Rational) and abs(int(f.exp.p)) > MAX_EXPONENT or \
+                f.is_Pow and f.exp.is_Float and not abs(float(f.exp)) <= MAX_EXPONENT:
             raise _ParseError(f"the power {_clip(str(f))} has an exponent beyond {MAX_EXPONENT}")
 
 

@@ -63,6 +63,7 @@ import sympy as sp
 from ..errors import ModelError
 from ..inertia import rotate
 from ..model import Joint, Link, Mimic, Numbers, Robot, rpy_matrix
+from .expressions import check_name
 
 __all__ = ["load_urdf", "MasslessWarning"]
 
@@ -117,10 +118,7 @@ def _read(path_or_xml) -> tuple[bytes, str]:
 
 
 def _parse(text: bytes) -> ET.Element:
-    # Entity declarations are the one XML feature that can make a small file huge
-    # ("billion laughs"); URDF never needs them.
-    if b"<!ENTITY" in text:
-        raise ModelError("XML entity declarations are not allowed in URDF", "<!ENTITY>")
+    _refuse_dtd(text)
     try:
         root = ET.fromstring(text)
     except ET.ParseError as err:
@@ -130,6 +128,38 @@ def _parse(text: bytes) -> ET.Element:
     if root.tag != "robot":
         raise ModelError(f"the root element is <{root.tag}>, expected <robot>", f"<{root.tag}>")
     return root
+
+
+class _DTD(Exception):
+    pass
+
+
+def _refuse_dtd(text: bytes) -> None:
+    """ModelError if the document has a DTD (``<!DOCTYPE ...>``, with or without entity
+    or ``<!ATTLIST>`` declarations), in whatever encoding it is written.
+
+    Entity declarations are the one XML feature that can make a small file huge ("billion
+    laughs"); they and ATTLIST defaults also change what the file says (a robot name, a
+    mass) invisibly; URDF needs none of it. Looking for the bytes ``<!ENTITY`` misses a
+    UTF-16 file, so expat itself (which decodes any encoding it accepts) reads the
+    document up to its DTD and stops there, before anything is declared or expanded."""
+    import xml.parsers.expat
+
+    def refuse(*_args):
+        raise _DTD
+
+    parser = xml.parsers.expat.ParserCreate()
+    parser.StartDoctypeDeclHandler = refuse
+    parser.EntityDeclHandler = refuse  # a DTD cannot be skipped, but be explicit
+    parser.AttlistDeclHandler = refuse
+    try:
+        parser.Parse(text, True)
+    except _DTD:
+        where = f"<!DOCTYPE> on line {parser.CurrentLineNumber}"
+        raise ModelError("a DTD is not allowed in URDF (entity declarations are not allowed, nor ATTLIST "
+                         "defaults)", where) from None
+    except xml.parsers.expat.ExpatError:
+        return  # malformed: ElementTree reports it with its own wording
 
 
 # ------------------------------------------------------------------ elements
@@ -250,9 +280,15 @@ def _origin(parent: ET.Element, where: str) -> tuple[Numbers, Numbers, tuple]:
     return Numbers(xyz), rotation, rpy
 
 
+def _name(elem: ET.Element, where: str) -> str:
+    """The element's ``name``: a non-empty one-line printable string, as in YAML models
+    (a character reference such as ``&#10;`` would otherwise put a line break in it)."""
+    return check_name(_attr(elem, "name", where), "name", where)
+
+
 def _link(elem: ET.Element, index: int) -> tuple[Link, bool]:
     """The link and whether it had an ``<inertial>``."""
-    name = _attr(elem, "name", f"link #{index + 1}")
+    name = _name(elem, f"link #{index + 1}")
     where = f"link '{_clip(name)}'"
     inertial = _single(elem, "inertial", where)
     if inertial is None:
@@ -282,7 +318,7 @@ def _link(elem: ET.Element, index: int) -> tuple[Link, bool]:
 
 
 def _joint(elem: ET.Element, index: int) -> Joint:
-    name = _attr(elem, "name", f"joint #{index + 1}")
+    name = _name(elem, f"joint #{index + 1}")
     where = f"joint '{_clip(name)}'"
     kind = _attr(elem, "type", where)
     if kind in UNSUPPORTED_TYPES:
@@ -346,7 +382,7 @@ def _mimic(elem: ET.Element, where: str) -> Mimic | None:
 def _build(root: ET.Element, text: bytes, source: str, strict: bool) -> Robot:
     if root.find("link") is None:
         raise ModelError("the robot has no <link>", "<robot>")
-    name = _attr(root, "name", None)
+    name = _name(root, "<robot>")
     links, massless = [], []
     for i, elem in enumerate(root.findall("link")):
         link, has_inertial = _link(elem, i)

@@ -118,6 +118,7 @@ import yaml
 from ..errors import ModelError
 from ..model import Joint, Link, Robot, rpy_matrix
 from .dh import from_dh
+from .yaml_screen import screen
 from .expressions import (
     check_name,
     check_rotation,
@@ -189,6 +190,7 @@ def _at(source: str, node) -> str:
 
 
 def _parse_text(text: str, source: str):
+    screen(text, source)  # aliases, deep nesting, huge integers: refused before anything is built
     try:
         return yaml.load(text, Loader=_LineLoader)  # noqa: S506 - a SafeLoader subclass
     except yaml.MarkedYAMLError as exc:
