@@ -106,7 +106,7 @@ def test_free_parameters_are_named():
 
 def test_non_physical_defaults_need_the_relaxed_check():
     with pytest.raises(ModelError, match="triangle inequality"):
-        show(load("stanford"))
+        show(load("stanford", strict=True))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         assert "link5" in show(load("stanford", strict=False))

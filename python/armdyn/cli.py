@@ -23,17 +23,19 @@ import warnings
 from .errors import ModelError
 
 
-def _load(source: str, allow_nonphysical: bool = False):
+def _load(source: str, allow_nonphysical: bool = False, strict: bool = False):
+    """A model file (strict unless --allow-nonphysical) or a bundled model (as published,
+    one warning if it is not physical, unless --strict)."""
     from .io import load
 
-    return load(source, strict=not allow_nonphysical)
+    return load(source, strict=True if strict else (False if allow_nonphysical else None))
 
 
 def cmd_derive(args) -> int:
     from .symbolic import check, derive
     from .symbolic.report import derivation_report, unicode_supported
 
-    robot = _load(args.robot, args.allow_nonphysical)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict)
     methods = ["newton-euler", "lagrange"] if args.method == "both" else [args.method]
     eoms = []
     for m in methods:
@@ -52,7 +54,7 @@ def cmd_check(args) -> int:
 
     if args.samples < 1:  # before the (slow) derivation: zero samples would check nothing
         raise ValueError(f"--samples must be at least 1, got {args.samples}")
-    robot = _load(args.robot, args.allow_nonphysical)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict)
     exact = True if args.exact else (False if args.numeric else None)
     report = prove_agreement(robot, exact=exact, samples=args.samples)
     print(report.text())
@@ -78,7 +80,7 @@ def cmd_robots(args) -> int:
 def cmd_show(args) -> int:
     from .show import show
 
-    robot = _load(args.robot, args.allow_nonphysical)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict)
     q = None
     if args.q is not None:
         try:
@@ -115,7 +117,7 @@ def cmd_grade(args) -> int:
 def cmd_codegen(args) -> int:
     from .codegen import codegen, write_files
 
-    robot = _load(args.robot, args.allow_nonphysical)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict)
     if args.bind:
         robot = robot.bind()
     code = codegen(robot, what=args.what, lang=args.lang, base=args.base)
@@ -158,7 +160,7 @@ def cmd_simulate(args) -> int:
                 raise ValueError(f"{path}: folder {folder} does not exist")
     if not (np.isfinite(args.fps) and args.fps > 0):
         raise ValueError(f"--fps must be positive, got {args.fps}")
-    robot = numeric_robot(_load(args.robot, args.allow_nonphysical))
+    robot = numeric_robot(_load(args.robot, args.allow_nonphysical, args.strict))
     dof = robot.dof
     q0 = np.broadcast_to(_numbers(args.q0, "--q0", dof) or [0.0], (dof,))
     qd0 = np.broadcast_to(_numbers(args.qd0, "--qd0", dof) or [0.0], (dof,))
@@ -241,7 +243,10 @@ def build_parser() -> argparse.ArgumentParser:
     def robot_arg(sp_):
         sp_.add_argument("robot", help="bundled model name (armdyn robots) or a .yaml/.urdf file")
         sp_.add_argument("--allow-nonphysical", action="store_true",
-                         help="load models whose inertias break physical validity, with a warning")
+                         help="load model files whose inertias break physical validity, with a warning")
+        sp_.add_argument("--strict", action="store_true",
+                         help="refuse non-physical inertias in bundled models too (they load as published, "
+                              "with one warning, by default)")
 
     d = sub.add_parser("derive", help="derive the equations of motion symbolically")
     robot_arg(d)

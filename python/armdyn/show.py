@@ -121,6 +121,9 @@ def table(robot: Robot) -> str:
     lines = [f"{robot.name}: {robot.dof} dof, base '{robot.base}', gravity {_vec(robot.gravity)}"]
     if robot.meta.get("source"):
         lines.append(f"source: {robot.meta['source']}")
+    if robot.joint_dynamics:  # a rigid-body library (Pinocchio) leaves these out
+        lines.append(f"joint dynamics: {', '.join(robot.joint_dynamics)} (in rnea/aba; "
+                     "robot.without_joint_dynamics() drops them)")
     rows = []
     for j in robot.joints:
         angles = "(" + ", ".join(_num(a) for a in rpy(j.rotation)) + ")" if not j.rotation.free_symbols else "symbolic"
