@@ -2,7 +2,8 @@
 
 ``load(source)`` takes a bundled model's name (``armdyn.load("rp-arm")``; the files
 live in ``armdyn/robots/``) or a file path (``.yaml``/``.yml``: :mod:`armdyn.io.yaml`;
-``.urdf``: :mod:`armdyn.io.urdf`). ``bundled_robots()`` lists the bundled models.
+``.urdf``: :mod:`armdyn.io.urdf`; ``.xacro``: :mod:`armdyn.io.xacro`, needs the ``xacro``
+package). ``bundled_robots()`` lists the bundled models.
 
 Physical validity: a model file is checked strictly by default (a link whose inertia is
 not physical is a :class:`ModelError`). A bundled model is a published one, kept as
@@ -23,7 +24,7 @@ from ..model import Robot
 #: Directory of the bundled models.
 ROBOTS_DIR = Path(__file__).resolve().parent.parent / "robots"
 
-_SUFFIXES = (".yaml", ".yml", ".urdf")
+_SUFFIXES = (".yaml", ".yml", ".urdf", ".xacro")
 
 
 def _bundled_files() -> dict[str, Path]:
@@ -48,7 +49,11 @@ def _load_file(path: Path, strict: bool, source: str) -> Robot:
         except ImportError:
             raise ModelError("URDF support not available", None, source) from None
         return load_urdf(path, strict=strict)
-    raise ModelError(f"unknown model file type '{suffix}' (expected .yaml, .yml or .urdf)", None, source)
+    if suffix == ".xacro":
+        from .xacro import load_xacro
+
+        return load_xacro(path, strict=strict)
+    raise ModelError(f"unknown model file type '{suffix}' (expected .yaml, .yml, .urdf or .xacro)", None, source)
 
 
 def _published(path: Path) -> Robot:
