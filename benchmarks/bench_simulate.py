@@ -24,6 +24,10 @@ integrator).
   timed per trajectory on a few trajectories (SciPy's RK45 with steps of at most dt: scipy
   offers no fixed-step RK4 in that interface; 6 evaluations per step against RK4's 4).
 
+``--core-before PATH``: also time another build of the extension (``_core*.so``, e.g.
+the one before a change to the integrator) in the same process, alternating with this
+one, on the same compiled model description: "armdyn before (...)" rows and the ratio.
+
 Reported: median seconds over ``--repeat`` runs (runs alternate between libraries),
 simulated steps per second (states x steps / time), and ratios armdyn / other.
 Also the peak memory (tracemalloc) of armdyn with stride = steps vs stride = 1.
@@ -88,6 +92,30 @@ def rtb_ur5():
     return robot
 
 
+def load_core(path: str):
+    """Another build of the extension module, imported under a name of its own (its
+    init function is ``PyInit__core``, so the module's last name part must be ``_core``)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("armdyn_core_before._core", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def compiled_with(core, robot):
+    """``robot`` compiled by the extension module ``core`` (armdyn.numeric's compile_model
+    with that module's NumericModel)."""
+    import armdyn.numeric as numeric
+
+    saved = numeric.NumericModel, numeric._core
+    numeric.NumericModel, numeric._core = core.NumericModel, core
+    try:
+        return numeric.compile_model(armdyn.load(robot.meta["file"]) if robot.meta.get("file") else robot)
+    finally:
+        numeric.NumericModel, numeric._core = saved
+
+
 def median_time(f, repeat: int) -> float:
     times = []
     for _ in range(repeat):
@@ -107,6 +135,7 @@ def main() -> None:
     p.add_argument("--block", type=int, default=1000, help="MuJoCo states per rollout call")
     p.add_argument("--rtb-trajectories", type=int, default=3)
     p.add_argument("--quick", action="store_true")
+    p.add_argument("--core-before", help="another build of armdyn's _core*.so to time alongside")
     args = p.parse_args()
     if args.quick:
         args.states, args.repeat, args.rtb_trajectories = 1000, 2, 1
@@ -136,6 +165,32 @@ def main() -> None:
         return simulate(ur5, q0, qd0, dt=dt, steps=steps, stride=stride, threads=threads, energies=False)
 
     timers = {"armdyn (stride = steps)": lambda: run_armdyn(steps), "armdyn (stride = 1)": lambda: run_armdyn(1)}
+    if args.core_before:
+        import armdyn.simulate as sim_module
+
+        before_core = load_core(args.core_before)
+        now_core = sim_module._core
+        before_model = compiled_with(before_core, ur5)
+        now_model = armdyn.numeric.compile_model(ur5)
+        lower, upper = armdyn.simulate.joint_limits(ur5)
+
+        def run_with(core, model, stride):
+            sim_module._core = core
+            try:
+                return simulate(model, q0, qd0, dt=dt, steps=steps, stride=stride, threads=threads, energies=False,
+                                limits=(lower, upper))
+            finally:
+                sim_module._core = now_core
+
+        a, b = run_with(before_core, before_model, steps), run_with(now_core, now_model, steps)
+        assert np.array_equal(a.q_final, b.q_final), "the two builds integrate differently"
+        print(f"# check: {args.core_before} and this build: final states bit for bit equal")
+        timers = {
+            "armdyn (stride = steps)": lambda: run_with(now_core, now_model, steps),
+            "armdyn before (stride = steps)": lambda: run_with(before_core, before_model, steps),
+            "armdyn (stride = 1)": lambda: run_with(now_core, now_model, 1),
+            "armdyn before (stride = 1)": lambda: run_with(before_core, before_model, 1),
+        }
 
     try:
         import mujoco
@@ -215,11 +270,14 @@ def main() -> None:
         print(f"{'Robotics Toolbox fdyn':28s} {'':10s} {steps / rtb_per_traj:12.3e} {rtb_per_traj * 1e6:12.1f} us"
               f"   (median of {args.rtb_trajectories} trajectories, 1 thread)")
     print()
-    for k in names[:2]:
+    for k in [k for k in names if k.startswith("armdyn")]:
         if "MuJoCo rollout" in results:
             print(f"throughput {k} / MuJoCo rollout: {results['MuJoCo rollout'] / results[k]:.2f}x")
         if rtb_per_traj is not None:
             print(f"per trajectory, {k} vs RTB fdyn: {rtb_per_traj / (results[k] / n):.0f}x faster")
+    for k in [k for k in names if k.startswith("armdyn before")]:
+        now = k.replace("armdyn before", "armdyn")
+        print(f"time {now} / {k}: {results[now] / results[k]:.3f}")
 
     # memory: what is stored decides the peak
     for stride in (steps, 10, 1):

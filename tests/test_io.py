@@ -10,6 +10,7 @@ in the bad file itself.
 from __future__ import annotations
 
 import re
+import warnings
 from pathlib import Path
 
 import pytest
@@ -213,11 +214,18 @@ def test_puma560_published_inertias_are_flagged_as_the_file_says():
     """The file notes that links 1 and 3 break the triangle inequality as published:
     link 1 (0, 0.35, 0), link 3 (0.066, 0.086, 0.0125) -> 0.066 + 0.0125 < 0.086."""
     with pytest.raises(ModelError, match="link 'link1'.*triangle"):
-        load("puma560").bind()
+        load("puma560", strict=True).bind()
     with pytest.warns(UserWarning) as record:
         load("puma560", strict=False).bind()
     flagged = sorted(re.search(r"link '(\w+)'", str(w.message))[1] for w in record)
     assert flagged == ["link1", "link3"]
+    # by default the published model loads and binds with ONE warning naming its source
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        load("puma560").bind({"m2": 17.4}).bind()
+    assert len(record) == 1
+    message = str(record[0].message)
+    assert "Corke" in message and re.findall(r"link '(\w+)'", message) == ["link1", "link3"]
 
 
 # ------------------------------------------------------------------ YAML format

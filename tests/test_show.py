@@ -12,6 +12,7 @@ import warnings
 from pathlib import Path
 
 import matplotlib.image
+import matplotlib.text
 import numpy as np
 import pytest
 import sympy as sp
@@ -90,7 +91,27 @@ def test_picture_contains_every_frame_origin(tmp_path):
         p = T[:3, 3]
         assert np.all(p >= limits[:, 0]) and np.all(p <= limits[:, 1])
     spans = limits[:, 1] - limits[:, 0]
-    assert np.allclose(spans, spans[0])  # equal scales: the arm is not distorted
+    # equal scales: each side of the drawn box is proportional to its axis range
+    ratio = spans / np.asarray(ax.get_box_aspect())
+    assert np.allclose(ratio, ratio[0])
+
+
+@pytest.mark.parametrize("name, q", [("ur5", [0, -1.2, 1.4, -1.8, -1.57, 0]), ("panda", None), ("iiwa14", None)])
+def test_joint_names_do_not_overlap(name, q):
+    """Every movable joint is named once; the names' rendered boxes overlap neither each
+    other nor the figure's edge."""
+    fig = draw(load(name), q)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    ax = fig.axes[0]
+    robot = load(name)
+    names = [t for t in ax.texts if t.get_text() in {j.name for j in robot.movable_joints}]
+    assert sorted(t.get_text() for t in names) == sorted(j.name for j in robot.movable_joints)
+    boxes = [matplotlib.text.Text.get_window_extent(t, renderer) for t in names]  # the text, not its leader line
+    for i, a in enumerate(boxes):
+        assert a.x0 >= 0 and a.y0 >= 0 and a.x1 <= fig.bbox.width and a.y1 <= fig.bbox.height, names[i].get_text()
+        for b in boxes[i + 1:]:
+            assert not a.overlaps(b), (names[i].get_text(), a, b)
 
 
 def test_symbolic_robot_is_bound_to_its_defaults():
@@ -106,7 +127,7 @@ def test_free_parameters_are_named():
 
 def test_non_physical_defaults_need_the_relaxed_check():
     with pytest.raises(ModelError, match="triangle inequality"):
-        show(load("stanford"))
+        show(load("stanford", strict=True))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         assert "link5" in show(load("stanford", strict=False))

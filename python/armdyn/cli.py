@@ -13,6 +13,8 @@
 
 ROBOT is a bundled model's name (see ``armdyn robots``) or a model file (.yaml, .urdf).
 Bad input prints one line ``armdyn: error: ...`` and exits with status 2, no traceback.
+Ctrl-C prints ``armdyn: interrupted`` and exits with status 130, writing nothing.
+``simulate`` exits with status 4 when the state became NaN/inf (see armdyn.simulate_cli).
 """
 
 from __future__ import annotations
@@ -26,17 +28,19 @@ import warnings
 from .errors import ModelError
 
 
-def _load(source: str, allow_nonphysical: bool = False):
+def _load(source: str, allow_nonphysical: bool = False, strict: bool = False):
+    """A model file (strict unless --allow-nonphysical) or a bundled model (as published,
+    one warning if it is not physical, unless --strict)."""
     from .io import load
 
-    return load(source, strict=not allow_nonphysical)
+    return load(source, strict=True if strict else (False if allow_nonphysical else None))
 
 
 def cmd_derive(args) -> int:
     from .symbolic import check, derive
     from .symbolic.report import derivation_report, unicode_supported
 
-    robot = _load(args.robot, args.allow_nonphysical)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict)
     methods = ["newton-euler", "lagrange"] if args.method == "both" else [args.method]
     eoms = []
     for m in methods:
@@ -55,7 +59,7 @@ def cmd_check(args) -> int:
 
     if args.samples < 1:  # before the (slow) derivation: zero samples would check nothing
         raise ValueError(f"--samples must be at least 1, got {args.samples}")
-    robot = _load(args.robot, args.allow_nonphysical)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict)
     exact = True if args.exact else (False if args.numeric else None)
     report = prove_agreement(robot, exact=exact, samples=args.samples)
     print(report.text())
@@ -81,7 +85,7 @@ def cmd_robots(args) -> int:
 def cmd_show(args) -> int:
     from .show import show
 
-    robot = _load(args.robot, args.allow_nonphysical)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict)
     q = None
     if args.q is not None:
         try:
@@ -89,6 +93,8 @@ def cmd_show(args) -> int:
         except ValueError:
             raise ValueError(f"--q must be comma-separated numbers, got {args.q!r}") from None
     print(show(robot, q=q, out=args.out))
+    if args.out is not None:
+        print(f"wrote {args.out}")
     return 0
 
 
@@ -136,7 +142,7 @@ def cmd_serve(args) -> int:
 def cmd_codegen(args) -> int:
     from .codegen import codegen, write_files
 
-    robot = _load(args.robot, args.allow_nonphysical)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict)
     if args.bind:
         robot = robot.bind()
     code = codegen(robot, what=args.what, lang=args.lang, base=args.base)
@@ -152,24 +158,11 @@ def cmd_codegen(args) -> int:
     return 0
 
 
-def _numbers(text: str | None, option: str, dof: int | None = None):
-    if text is None:
-        return None
-    try:
-        values = [float(x) for x in text.split(",")]
-    except ValueError:
-        raise ValueError(f"{option} must be comma-separated numbers, got {text!r}") from None
-    if dof is not None and len(values) not in (1, dof):
-        raise ValueError(f"{option} needs 1 or {dof} values (one per joint), got {len(values)}")
-    return values
-
-
 def cmd_simulate(args) -> int:
     import numpy as np
 
     from ._io_atomic import destination
-    from .show import numeric_robot
-    from .simulate import PD, ComputedTorque, simulate
+    from .simulate_cli import run
 
     for path, ext in ((args.plot, (".png", ".svg", ".pdf")), (args.animate, (".gif",))):
         if path is not None:
@@ -181,93 +174,23 @@ def cmd_simulate(args) -> int:
                 raise ValueError(f"{path}: folder {folder} does not exist")
     if not (np.isfinite(args.fps) and args.fps > 0):
         raise ValueError(f"--fps must be positive, got {args.fps}")
-    robot = numeric_robot(_load(args.robot, args.allow_nonphysical))
-    dof = robot.dof
-    q0 = np.broadcast_to(_numbers(args.q0, "--q0", dof) or [0.0], (dof,))
-    qd0 = np.broadcast_to(_numbers(args.qd0, "--qd0", dof) or [0.0], (dof,))
-    controller = None
-    if args.controller is not None:
-        if args.target is None:
-            raise ValueError(f"--controller {args.controller} needs --target (joint values)")
-        target = np.broadcast_to(_numbers(args.target, "--target", dof), (dof,))
-        if args.controller == "computed-torque":  # gains of the unit-inertia error dynamics
-            default = (25.0, 10.0)
-        else:  # 10 rad/s, critically damped, scaled by each joint's inertia M_ii at the target
-            from .numeric import crba
-
-            m_ii = np.diag(crba(robot, np.ascontiguousarray(target)))
-            default = (100.0 * m_ii, 20.0 * m_ii)
-        kp = np.broadcast_to(_numbers(args.kp, "--kp", dof) or default[0], (dof,))
-        kd = np.broadcast_to(_numbers(args.kd, "--kd", dof) or default[1], (dof,))
-        if args.controller == "computed-torque":
-            controller = ComputedTorque(kp, kd, target)
-        else:
-            controller = PD(kp, kd, target, gravity_compensation=args.controller == "pd-gravity")
-    elif args.target is not None:
-        raise ValueError("--target needs --controller")
-    if not (np.isfinite(args.dt) and args.dt > 0):
-        raise ValueError(f"--dt must be a positive number of seconds, got {args.dt}")
-    steps = round(args.duration / args.dt) if np.isfinite(args.duration) and args.duration > 0 else 0
-    if steps < 1:
-        raise ValueError(f"--duration must be at least one step of --dt, got {args.duration}")
-    if abs(steps * args.dt - args.duration) > 1e-9 * max(args.duration, 1.0):  # as simulate() checks it
-        raise ValueError(f"--duration {args.duration:g} is not a whole number of steps of --dt {args.dt:g} "
-                         f"({args.duration / args.dt:.6g} steps)")
-    if args.stride is None:  # keep ~2000 samples
-        args.stride = max(1, steps // 2000)
-    show_bar = not args.quiet and steps * dof >= 600_000
-
-    def bar(done, total):
-        filled = int(30 * done / total)
-        sys.stderr.write(f"\rsimulating [{'#' * filled}{'.' * (30 - filled)}] {100 * done // total:3d}%")
-        if done == total:
-            sys.stderr.write("\n")
-        sys.stderr.flush()
-
-    run = simulate(robot, q0, qd0, dt=args.dt, steps=steps, method=args.method, controller=controller,
-                   stride=args.stride, progress=bar if show_bar else None)
-    # outputs are staged in temporary files, renamed only when all are written
-    from ._io_atomic import atomic_writes
-
-    outputs = []
-    if args.plot:
-        from .plots import plot_trajectory
-
-        outputs.append((args.plot, lambda tmp: plot_trajectory(
-            run, tmp, title=f"{robot.name}: {args.method}, dt = {args.dt:g} s")))
-    if args.animate:
-        from .show import animate
-
-        every = max(1, int(round(1.0 / (args.fps * run.t[1])))) if len(run.t) > 1 else 1
-        every = max(every, -(-len(run.t) // 400))  # at most ~400 frames
-        frames = np.arange(0, len(run.t), every)
-        outputs.append((args.animate, lambda tmp: animate(robot, run.q[frames], tmp, t=run.t[frames], fps=args.fps)))
-    atomic_writes(outputs)
-    names = robot.coordinate_names
-    print(f"{robot.name}: {steps} steps of {args.dt:g} s ({args.method}), {len(run.t)} samples stored")
-    print("q_final  = [" + ", ".join(f"{v:.6g}" for v in run.q_final) + "]")
-    print("qd_final = [" + ", ".join(f"{v:.6g}" for v in run.qd_final) + "]")
-    print(f"energy: E(0) = {run.energy[0]:.6g} J, E(end) = {run.energy[-1]:.6g} J, "
-          f"relative drift {run.energy_drift():.3e}")
-    if run.limit_step >= 0:
-        print(f"joint limit: '{names[run.limit_joint]}' left its range at step {run.limit_step} "
-              f"(t = {run.limit_step * args.dt:.4g} s); not clamped")
-    if run.nonfinite_step >= 0:
-        print(f"warning: the state became NaN/inf at step {run.nonfinite_step}")
-    for path in (args.plot, args.animate):
-        if path:
-            print(f"wrote {path}")
-    return 0
+    return run(args, _load(args.robot, args.allow_nonphysical, args.strict))
 
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="armdyn", description="Dynamics of robot arms: derive and check equations of motion.")
+    from . import __version__
+
+    p.add_argument("--version", action="version", version=f"armdyn {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 
     def robot_arg(sp_):
         sp_.add_argument("robot", help="bundled model name (armdyn robots) or a .yaml/.urdf file")
         sp_.add_argument("--allow-nonphysical", action="store_true",
-                         help="load models whose inertias break physical validity, with a warning")
+                         help="load model files whose inertias break physical validity, with a warning")
+        sp_.add_argument("--strict", action="store_true",
+                         help="refuse non-physical inertias in bundled models too (they load as published, "
+                              "with one warning, by default)")
 
     d = sub.add_parser("derive", help="derive the equations of motion symbolically")
     robot_arg(d)
@@ -333,7 +256,10 @@ def build_parser() -> argparse.ArgumentParser:
     cg.add_argument("--bind", action="store_true", help="bind the model's published parameter values first")
     cg.add_argument("--out", help="directory to write the source file into (default: print it)")
     cg.set_defaults(func=cmd_codegen)
-    m = sub.add_parser("simulate", help="integrate the forward dynamics; plot and animate the run")
+    m = sub.add_parser("simulate", help="integrate the forward dynamics; plot and animate the run",
+                       description="Integrate the forward dynamics; plot and animate the run. Exit status: 0 done, "
+                                   "2 bad input, 4 the state became NaN/inf (the run stopped there; what was "
+                                   "computed is reported and written), 130 interrupted (nothing written).")
     robot_arg(m)
     m.add_argument("--duration", type=float, required=True, help="seconds")
     m.add_argument("--dt", type=float, required=True, help="fixed step (s)")
@@ -348,7 +274,9 @@ def build_parser() -> argparse.ArgumentParser:
     m.add_argument("--stride", type=int, help="store every k-th step (default: about 2000 samples)")
     m.add_argument("--plot", help="write q, qd, tau and energy plots here (.png/.svg/.pdf)")
     m.add_argument("--animate", help="write an animation of the arm here (.gif)")
-    m.add_argument("--fps", type=float, default=20.0, help="animation frames per second of simulated time")
+    m.add_argument("--fps", type=float, default=20.0,
+                   help="animation frame rate (the GIF plays in real time; at most 300 frames, longer runs get "
+                        "longer frames)")
     m.add_argument("--quiet", action="store_true", help="no progress bar")
     m.set_defaults(func=cmd_simulate)
     return p
@@ -367,7 +295,8 @@ def main(argv: list[str] | None = None) -> int:
     except (ModelError, ValueError, FileNotFoundError) as err:
         print(f"armdyn: error: {err}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # Ctrl-C: outputs are staged in temporary files, so nothing is half-written
+        print("armdyn: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:  # e.g. `armdyn robots | head`
         sys.stderr.close()

@@ -90,7 +90,7 @@ def crba(robot, q, *, chunks=None, threads=1):
 
 
 _PER_ROW = ("q_final", "qd_final")
-_FLAGS = ("limit_step", "limit_joint", "nonfinite_step")
+_FLAGS = ("limit_step", "limit_joint", "nonfinite_step", "nonfinite_joint")
 
 
 def _simulate(q0, qd0, model, options, samples, energies, threads):
@@ -99,7 +99,7 @@ def _simulate(q0, qd0, model, options, samples, energies, threads):
     q0, qd0 = _c(q0, qd0)
     run = run_simulation(model, q0, qd0, energies=energies, threads=threads, **options)
     rows, dof = q0.shape
-    parts = [np.stack([run.q, run.qd, run.qdd, run.tau], axis=2).reshape(rows, -1)]
+    parts = [np.stack([run.q, run.qd, run.qdd, run.tau], axis=2).reshape(rows, -1), run.work]
     if energies:
         parts.append(np.stack([run.kinetic, run.potential], axis=2).reshape(rows, -1))
     parts += [run.q_final, run.qd_final] + [np.asarray(getattr(run, f), dtype=float)[:, None] for f in _FLAGS]
@@ -111,8 +111,8 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
     """Lazy :func:`armdyn.simulate.simulate` of the states ``q0``, ``qd0`` (N, dof), one
     block of rows per task. Returns a :class:`armdyn.simulate.Trajectory` whose arrays are
     Dask arrays (``t`` is NumPy): ``q``, ``qd``, ``qdd``, ``tau`` (N, S, dof); ``kinetic``,
-    ``potential`` (N, S); ``q_final``, ``qd_final`` (N, dof); ``limit_step``,
-    ``limit_joint``, ``nonfinite_step`` (N,) int64. ``torque`` may be None, (dof,) or
+    ``potential``, ``work`` (N, S); ``q_final``, ``qd_final`` (N, dof); ``limit_step``,
+    ``limit_joint``, ``nonfinite_step``, ``nonfinite_joint`` (N,) int64. ``torque`` may be None, (dof,) or
     (steps, dof) (shared by all states); a controller's targets are (dof,).
     """
     import dask.array as da
@@ -134,7 +134,7 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
     options = dict(dt=dt, steps=steps, method=method, torque=torque, controller=controller, stride=stride,
                    limits=limits)
     samples = steps // stride + 1
-    width = samples * dof * 4 + (2 * samples if energies else 0) + 2 * dof + len(_FLAGS)
+    width = samples * dof * 4 + samples + (2 * samples if energies else 0) + 2 * dof + len(_FLAGS)
     packed = q0.map_blocks(_simulate, qd0, model=model, options=options, samples=samples, energies=energies,
                            threads=threads, dtype=float, meta=np.empty((0, 0)),
                            chunks=(q0.chunks[0], (width,)))
@@ -142,6 +142,8 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
     at = samples * dof * 4
     states = packed[:, :at].reshape(n, samples, 4, dof)
     out = {name: states[:, :, k, :] for k, name in enumerate(("q", "qd", "qdd", "tau"))}
+    out["work"] = packed[:, at:at + samples]
+    at += samples
     kinetic = potential = None
     if energies:
         e = packed[:, at:at + 2 * samples].reshape(n, samples, 2)

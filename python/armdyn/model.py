@@ -35,7 +35,7 @@ import numpy as np
 import sympy as sp
 
 from .errors import ModelError
-from .inertia import check_physical
+from .inertia import check_physical, physical_violations
 
 JOINT_TYPES = ("revolute", "prismatic", "fixed")
 #: Joint fields that add to tau (DESIGN.md: Fv, Fc, Ia, offset), in that naming.
@@ -654,6 +654,9 @@ class Robot(metaclass=_FreezeAfterInit):
             raise err.located(element=f"robot '{name}'")
 
         self.strict = strict
+        # (link, problems) a bundled model is published with, reported once by armdyn.load:
+        # not warned about again in every bound copy
+        accepted = self.meta.get("nonphysical_accepted", ())
         self.links: dict[str, Link] = {}
         for link in links:
             if link.name in self.links:
@@ -662,8 +665,9 @@ class Robot(metaclass=_FreezeAfterInit):
             # located later, so it names the model file itself
             source = None if strict else self.meta.get("file")
             m, inertia = link.floats("mass"), link.floats("inertia")  # floats: no SymPy per link
-            check_physical(link.mass if m is None else m, link.inertia if inertia is None else inertia,
-                           f"link '{link.name}'", source, strict=strict)
+            m, inertia = link.mass if m is None else m, link.inertia if inertia is None else inertia
+            if not (accepted and not strict and (link.name, "; ".join(physical_violations(m, inertia))) in accepted):
+                check_physical(m, inertia, f"link '{link.name}'", source, strict=strict)
             self.links[link.name] = link
 
         children = {j.child for j in joints}
@@ -1020,9 +1024,38 @@ class Robot(metaclass=_FreezeAfterInit):
                 strict=self.strict,
             )
 
+    @property
+    def joint_dynamics(self) -> tuple[str, ...]:
+        """The joint-space terms (of ``damping``, ``friction``, ``armature``,
+        ``torque_offset``) that some movable joint carries with a value other than 0:
+        ``rnea``/``aba`` include them, a rigid-body library such as Pinocchio does not."""
+        present = []
+        for name in JOINT_DYNAMICS:
+            for j in self.movable_joints:
+                value = getattr(j, name)
+                if value is not None and (value.free_symbols or float(value) != 0.0):
+                    present.append(name)
+                    break
+        return tuple(present)
+
+    def without_joint_dynamics(self) -> "Robot":
+        """A copy with no joint damping, friction, armature or torque offset: the rigid-body
+        dynamics alone, as Pinocchio's ``rnea``/``aba`` compute them (Robotics Toolbox's
+        ``nofriction()``, with armature and offset dropped too). This robot is not changed."""
+        if not self.joint_dynamics:
+            return self
+        joints = [replace(j, **dict.fromkeys(JOINT_DYNAMICS)) for j in self.joints]
+        import warnings
+
+        with warnings.catch_warnings():  # this robot's own links were warned about when it was built
+            warnings.simplefilter("ignore")
+            return Robot(self.name, self.links.values(), joints, self.gravity, self.parameters, self.meta, self.base,
+                         self.defaults, strict=self.strict)
+
     def __repr__(self) -> str:
         kinds = "".join({"revolute": "R", "prismatic": "P", "fixed": "F"}[j.type] for j in self.joints)
-        return f"Robot({self.name!r}, dof={self.dof}, joints={kinds}, parameters={sorted(self.parameters)})"
+        extra = f", joint_dynamics={list(self.joint_dynamics)}" if self.joint_dynamics else ""
+        return f"Robot({self.name!r}, dof={self.dof}, joints={kinds}, parameters={sorted(self.parameters)}{extra})"
 
     def _repr_html_(self) -> str:
         """Jupyter: tables of the joints and links (see symbolic/report_html.py)."""

@@ -314,14 +314,43 @@ def forward_kinematics(robot, q, *, threads=None):
     return poses if offsets is None else poses @ offsets
 
 
-def jacobian(robot, q, link, *, threads=None):
-    """Geometric Jacobian of a link frame's origin.
+#: the reference frames of :func:`jacobian`, named as Pinocchio names them
+REFERENCE_FRAMES = ("local_world_aligned", "local", "world")
+
+
+def jacobian(robot, q, link, *, reference_frame: str = "local_world_aligned", threads=None):
+    """Geometric Jacobian of a link frame.
 
     q: (n,) or (N, n); link: a link name, index in ``list(robot.links)``, or Link.
-    Returns J (6, n) or (N, 6, n) with ``[v; w] = J qd``: rows [v_x v_y v_z w_x w_y w_z],
-    v the velocity of the link frame's origin and w the link's angular velocity, both in
-    base-frame axes (Spong's [J_v; J_w]; Pinocchio's LOCAL_WORLD_ALIGNED).
+    Returns J (6, n) or (N, 6, n) with ``[v; w] = J qd``, rows [v_x v_y v_z w_x w_y w_z],
+    w the link's angular velocity. ``reference_frame`` (Pinocchio's names, any case):
+
+    * ``"local_world_aligned"`` (default): v the velocity of the link frame's origin p,
+      v and w in base-frame axes (Spong's [J_v; J_w]);
+    * ``"local"``: the same v and w in the link frame's own axes (``R^T v``, ``R^T w``);
+    * ``"world"``: the spatial velocity in the base frame: v the velocity of the body
+      point passing through the base origin, ``v_p - w x p``; w in base axes.
     """
+    frame = str(getattr(reference_frame, "name", reference_frame)).lower()
+    if frame not in REFERENCE_FRAMES:
+        raise ValueError(f"reference_frame must be one of {', '.join(REFERENCE_FRAMES)}, got {reference_frame!r}")
+    J = _aligned_jacobian(robot, q, link, threads)
+    if frame == "local_world_aligned":
+        return J
+    name = link.name if isinstance(link, Link) else link
+    k = name if isinstance(name, (int, np.integer)) else list(_model(robot).link_names).index(name)
+    pose = forward_kinematics(robot, q, threads=threads)[..., k, :, :]
+    R, p = pose[..., :3, :3], pose[..., :3, 3]
+    Jv, Jw = J[..., :3, :], J[..., 3:, :]
+    if frame == "local":
+        Rt = R.swapaxes(-1, -2)
+        return np.concatenate([Rt @ Jv, Rt @ Jw], axis=-2)
+    # world: v_O = v_p + w x (0 - p) = v_p + p x w, column by column
+    return np.concatenate([Jv + np.cross(p[..., None, :], Jw.swapaxes(-1, -2)).swapaxes(-1, -2), Jw], axis=-2)
+
+
+def _aligned_jacobian(robot, q, link, threads):
+    """:func:`jacobian` in LOCAL_WORLD_ALIGNED."""
     if isinstance(link, Link):
         link = link.name
     J = _model(robot).jacobian(q, link, threads)

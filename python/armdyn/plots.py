@@ -2,10 +2,11 @@
 
 ``plot_trajectory(run, out="run.png")`` draws five panels against time (s):
 joint positions q (rad or m), velocities qd, torques tau (N m or N), the kinetic,
-potential and total energy (J), and the drift of the total energy
-``(E(t) - E(0)) / max(|E(0)|, max T)`` (dimensionless), whose size says how well the
-integrator conserved energy (it should stay tiny for a passive arm without friction,
-and it measures the work of the torques otherwise).
+potential and total energy (J), and the integration error in energy: for a passive run
+the drift of the total energy ``(E(t) - E(0)) / max(|E(0)|, max T)``, with torques
+applied the work-energy balance ``(E(t) - E(0) - W(t)) / scale`` (``W`` the work of
+the torques, :attr:`armdyn.simulate.Trajectory.work`); either should stay tiny for an
+arm without joint friction.
 """
 
 from __future__ import annotations
@@ -54,12 +55,19 @@ def plot_trajectory(run, out=None, *, state: int = 0, title: str | None = None):
         ax.set_ylabel("energy (J)")
         ax.legend(fontsize=7, loc="upper right")
         ax.grid(alpha=0.3)
-        scale = max(abs(total[0]), kinetic.max(), 1e-300)
-        drift = (total - total[0]) / scale
+        work = pick(run.work) if run.work is not None else np.zeros_like(t)
+        passive = not np.any(np.nan_to_num(tau))
+        scale = max(abs(total[0]), np.nanmax(kinetic), np.nanmax(np.abs(work)), 1e-300)
+        error = (total - total[0] - (0 if passive else work)) / scale
         ax = axes[4]
-        ax.plot(t, drift, color="tab:red")
-        ax.set_ylabel("(E - E0) / scale")
-        ax.set_title(f"energy drift: max |E - E0| / scale = {np.abs(drift).max():.2e}", fontsize=9)
+        ax.plot(t, error, color="tab:red")
+        if passive:
+            ax.set_ylabel("(E - E0) / scale")
+            ax.set_title(f"energy drift: max |E - E0| / scale = {np.nanmax(np.abs(error)):.2e}", fontsize=9)
+        else:
+            ax.set_ylabel("(E - E0 - W) / scale")
+            ax.set_title(f"energy balance (W: work of tau): max |E - E0 - W| / scale = "
+                         f"{np.nanmax(np.abs(error)):.2e}", fontsize=9)
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel("t (s)")
     method = {"rk4": "RK4", "euler": "semi-implicit Euler"}.get(run.method, run.method)

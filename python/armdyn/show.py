@@ -10,7 +10,8 @@ The picture, in the base frame (metres, z up as the model has it):
   frame origin to its child frame origin (so the "links" are drawn between frame
   origins, which for DH models need not follow the physical links);
 * each movable joint's axis is an arrow at the child frame origin (orange: revolute,
-  purple: prismatic), with the joint's name;
+  purple: prismatic), with the joint's name joined to the arrow's tip by a thin line
+  (names are placed away from the arm and from each other, so that they never overlap);
 * each link frame is a small triad (x red, y green, z blue);
 * each centre of mass is a black dot whose area grows with the mass; the base is a
   black square.
@@ -121,6 +122,9 @@ def table(robot: Robot) -> str:
     lines = [f"{robot.name}: {robot.dof} dof, base '{robot.base}', gravity {_vec(robot.gravity)}"]
     if robot.meta.get("source"):
         lines.append(f"source: {robot.meta['source']}")
+    if robot.joint_dynamics:  # a rigid-body library (Pinocchio) leaves these out
+        lines.append(f"joint dynamics: {', '.join(robot.joint_dynamics)} (in rnea/aba; "
+                     "robot.without_joint_dynamics() drops them)")
     rows = []
     for j in robot.joints:
         angles = "(" + ", ".join(_num(a) for a in rpy(j.rotation)) + ")" if not j.rotation.free_symbols else "symbolic"
@@ -167,12 +171,19 @@ def draw(robot: Robot, q=None, out=None, title: str | None = None):
     poses = frame_poses(robot, q)
     origins = np.array([T[:3, 3] for T in poses.values()])
     fig = plt.figure(figsize=(7, 7))
-    ax = fig.add_subplot(projection="3d")
+    ax = fig.add_axes((0, 0, 1, 0.95), projection="3d")
     qtext = ", ".join(f"{v:.3g}" for v in q)
     draw_on(ax, robot, poses, title or f"{robot.name} at q = [{qtext}]", _view(origins))
     if out is not None:
-        fig.savefig(out, dpi=110, bbox_inches="tight")
-        plt.close(fig)
+        from pathlib import Path
+
+        from ._io_atomic import atomic_write
+
+        fmt = Path(out).suffix[1:].lower() or "png"
+        try:  # staged in a temporary file: an error (or Ctrl-C) leaves nothing half-written
+            atomic_write(out, lambda tmp: fig.savefig(tmp, dpi=110, bbox_inches="tight", format=fmt))
+        finally:
+            plt.close(fig)
     return fig
 
 
@@ -181,28 +192,105 @@ def _view(origins: np.ndarray) -> tuple[np.ndarray, float]:
     return (origins.max(axis=0) + origins.min(axis=0)) / 2, _reach(origins)
 
 
+def _view_box(origins: np.ndarray, size: float) -> np.ndarray:
+    """Half extents (3,) of the box shown around the points ``origins`` (k, 3): each
+    axis as long as the points' span there plus a margin for the arrows and frames, at
+    least a third of ``size`` (a flat arm keeps some depth). The three axes share one
+    scale (``set_box_aspect``), so the box is not a cube: the arm fills the picture."""
+    span = np.ptp(origins, axis=0) if len(origins) > 1 else np.zeros(3)
+    return np.maximum(0.5 * span + 0.15 * size, size / 3)
+
+
+def _place_labels(ax, labels: list[tuple[str, np.ndarray, str]], avoid: np.ndarray, fontsize: float = 7):
+    """Write each ``(text, point (3,), colour)`` of ``labels`` near its point, joined to it
+    by a thin line, where it overlaps no other label and covers none of the points
+    ``avoid`` (k, 3) (the arm): greedy, in projected screen coordinates, trying
+    directions away from the arm's middle first, at growing distances."""
+    from mpl_toolkits.mplot3d import proj3d
+
+    if not labels:
+        return
+    M = ax.get_proj()
+    to_screen = ax.transData.transform
+    px_per_pt = ax.figure.dpi / 72
+
+    def screen(p):
+        x, y, _ = proj3d.proj_transform(p[0], p[1], p[2], M)
+        return np.array([x, y]), to_screen((x, y))
+
+    arm = np.array([screen(p)[1] for p in avoid]) if len(avoid) else np.zeros((0, 2))
+    middle = arm.mean(axis=0) if len(arm) else np.zeros(2)
+    taken: list[tuple[float, float, float, float]] = []  # screen boxes (x0, y0, x1, y1)
+    w_char, h_text = 0.62 * fontsize * px_per_pt, 1.3 * fontsize * px_per_pt
+
+    width, height = ax.figure.bbox.width, ax.figure.bbox.height
+
+    def clash(box):
+        x0, y0, x1, y1 = box
+        if x0 < 2 or y0 < 2 or x1 > width - 2 or y1 > height - 2:  # inside the picture
+            return True
+        if any(x0 < b[2] and b[0] < x1 and y0 < b[3] and b[1] < y1 for b in taken):
+            return True
+        return bool(len(arm)) and bool(np.any((arm[:, 0] > x0 - 4) & (arm[:, 0] < x1 + 4)
+                                              & (arm[:, 1] > y0 - 4) & (arm[:, 1] < y1 + 4)))
+
+    for text, point, colour in labels:
+        xy, at = screen(point)
+        away = at - middle
+        base = math.atan2(away[1], away[0]) if np.hypot(*away) > 1e-6 else math.pi / 2
+        w, h = w_char * len(text), h_text
+        best = None
+        for dist in (14, 26, 40, 56, 75, 100):
+            for turn in (0, 30, -30, 60, -60, 90, -90, 120, -120, 150, -150, 180):
+                a = base + math.radians(turn)
+                dx, dy = dist * px_per_pt * math.cos(a), dist * px_per_pt * math.sin(a)
+                # anchor the text's near side at the offset point
+                x0 = at[0] + dx - (w if math.cos(a) < -0.3 else (w / 2 if abs(math.cos(a)) <= 0.3 else 0))
+                y0 = at[1] + dy - (h if math.sin(a) < -0.3 else (h / 2 if abs(math.sin(a)) <= 0.3 else 0))
+                box = (x0, y0, x0 + w, y0 + h)
+                if not clash(box):
+                    best = (box, dx, dy)
+                    break
+            if best:
+                break
+        if best is None:  # crowded: the farthest candidate straight out
+            dx, dy = 100 * px_per_pt * math.cos(base), 100 * px_per_pt * math.sin(base)
+            best = ((at[0] + dx, at[1] + dy, at[0] + dx + w, at[1] + dy + h), dx, dy)
+        box, dx, dy = best
+        taken.append(box)
+        ax.annotate(text, xy=xy, xytext=(box[0] - at[0], box[1] - at[1]), textcoords="offset pixels",
+                    fontsize=fontsize, color=colour, ha="left", va="bottom",
+                    arrowprops=dict(arrowstyle="-", color=colour, linewidth=0.6, shrinkA=0, shrinkB=1))
+
+
 def draw_on(ax, robot: Robot, poses: dict[str, np.ndarray], title: str, view: tuple[np.ndarray, float]):
     """Draw the arm with link frame ``poses`` (link name -> (4, 4), base frame) on the 3-D
-    axes ``ax``; ``view`` = (centre (3,), size in m) of the box shown (see the module
+    axes ``ax``; ``view`` = (centre (3,), size in m[, half extents (3,)]) of the box shown (see the module
     docstring for what is drawn). Used by :func:`draw` and for animation frames."""
     origins = np.array([T[:3, 3] for T in poses.values()])
-    centre, size = view
+    centre, size = view[0], view[1]
+    half = view[2] if len(view) > 2 else _view_box(origins, size)
     triad, arrow = 0.08 * size, 0.12 * size
+    drawn = [origins]  # points the joint names must not cover
     for j in robot.joints:
         a, b = poses[j.parent][:3, 3], poses[j.child][:3, 3]
         ax.plot(*zip(a, b), color="0.45", linewidth=3, solid_capstyle="round")
+        drawn.append(a + np.linspace(0, 1, 12)[:, None] * (b - a))
     ax.scatter(*origins.T, color="0.2", s=12, depthshade=False)
     ax.scatter(*poses[robot.base][:3, 3], marker="s", color="black", s=60, depthshade=False)
 
     for T in poses.values():
         for k, colour in enumerate(("red", "green", "blue")):
             ax.quiver(*T[:3, 3], *(triad * T[:3, k]), color=colour, linewidth=1)
+            drawn.append(T[:3, 3] + np.linspace(0.5, 1, 2)[:, None] * triad * T[:3, k])
 
+    labels = []
     for j in robot.movable_joints:
         T = poses[j.child]
         axis = T[:3, :3] @ _floats(j.axis).reshape(3)
         ax.quiver(*T[:3, 3], *(arrow * axis), color=AXIS_COLOURS[j.type], linewidth=2.5, arrow_length_ratio=0.3)
-        ax.text(*(T[:3, 3] + 1.15 * arrow * axis), j.name, fontsize=7, color=AXIS_COLOURS[j.type])
+        labels.append((j.name, T[:3, 3] + arrow * axis, AXIS_COLOURS[j.type]))
+        drawn.append(T[:3, 3] + np.linspace(0.3, 1, 3)[:, None] * arrow * axis)
 
     masses = {n: float(ln.mass) for n, ln in robot.links.items() if n != robot.base}
     heaviest = max(masses.values(), default=0.0)
@@ -211,16 +299,16 @@ def draw_on(ax, robot: Robot, poses: dict[str, np.ndarray], title: str, view: tu
             c = poses[name][:3, :3] @ _floats(robot.links[name].com).reshape(3) + poses[name][:3, 3]
             ax.scatter(*c, color="black", s=10 + 80 * m / heaviest, alpha=0.6, depthshade=False)
 
-    # equal scales on the three axes, so the arm is not distorted
-    half = 0.6 * size
-    ax.set_xlim(centre[0] - half, centre[0] + half)
-    ax.set_ylim(centre[1] - half, centre[1] + half)
-    ax.set_zlim(centre[2] - half, centre[2] + half)
-    ax.set_box_aspect((1, 1, 1))
+    # equal scales on the three axes (box sides proportional to the ranges): not distorted
+    ax.set_xlim(centre[0] - half[0], centre[0] + half[0])
+    ax.set_ylim(centre[1] - half[1], centre[1] + half[1])
+    ax.set_zlim(centre[2] - half[2], centre[2] + half[2])
+    ax.set_box_aspect(tuple(half), zoom=1.15)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_zlabel("z (m)")
     ax.set_title(title, fontsize=10)
+    _place_labels(ax, labels, np.vstack(drawn))
 
 
 def show(robot, q=None, out=None) -> str:
@@ -241,12 +329,17 @@ def show(robot, q=None, out=None) -> str:
 # ------------------------------------------------------------------ animation
 
 
-def animate(robot, q, out, *, t=None, fps: float = 25.0, title: str | None = None, dpi: int = 80) -> int:
+def animate(robot, q, out, *, t=None, fps: float = 25.0, title: str | None = None, dpi: int = 80,
+            frame_ms: int | None = None, progress=None) -> int:
     """Write a GIF of the arm moving through the joint coordinates ``q`` (frames, dof), one
     frame per row, drawn as :func:`draw` draws it (same view box for every frame). ``t``
     (frames,): times shown in the title (s). GIFs are written by Pillow (no video tools
     needed), first to a temporary file next to ``out`` and then renamed, so an error never
-    leaves half a file. Returns the number of frames.
+    leaves half a file. Each frame lasts ``frame_ms`` ms (default ``1000 / fps``; GIF
+    delays are whole centiseconds, at least 20 ms); for real-time playback give the
+    simulated time between frames (see :func:`armdyn.simulate_cli.gif_frames`).
+    ``progress(done, frames)`` is called after each frame drawn. Returns the number of
+    frames.
     """
     import matplotlib
 
@@ -271,9 +364,11 @@ def animate(robot, q, out, *, t=None, fps: float = 25.0, title: str | None = Non
         raise ValueError(f"{out}: animations are written as GIF (give a .gif name)")
     poses = np.asarray(forward_kinematics(robot, np.ascontiguousarray(q)))  # (frames, nlinks, 4, 4)
     names = list(robot.links)
-    view = _view(poses[:, :, :3, 3].reshape(-1, 3))
+    points = poses[:, :, :3, 3].reshape(-1, 3)
+    centre, size = _view(points)
+    view = (centre, size, _view_box(points, size))  # one box for every frame: the arm moves in it
     fig = plt.figure(figsize=(6, 6), dpi=dpi)
-    ax = fig.add_subplot(projection="3d")
+    ax = fig.add_axes((0.0, 0.03, 0.94, 0.91), projection="3d")  # room for the tick labels
     images = []
     for k in range(len(q)):
         ax.cla()
@@ -282,9 +377,12 @@ def animate(robot, q, out, *, t=None, fps: float = 25.0, title: str | None = Non
         fig.canvas.draw()
         rgba = np.asarray(fig.canvas.buffer_rgba())
         images.append(Image.fromarray(rgba[..., :3].copy()).quantize(colors=64, method=Image.Quantize.MEDIANCUT))
+        if progress is not None:
+            progress(k + 1, len(q))
     plt.close(fig)
+    duration = max(20, round(1000 / fps)) if frame_ms is None else max(20, int(frame_ms))
     from ._io_atomic import atomic_write
 
     atomic_write(out, lambda tmp: images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
-                                                 duration=max(20, round(1000 / fps)), loop=0))
+                                                 duration=duration, loop=0))
     return len(images)

@@ -35,6 +35,15 @@ Joint limits (from the robot's joints, or ``limits=(lower, upper)``) are reporte
 enforced: :attr:`Trajectory.limit_step` / :attr:`Trajectory.limit_joint` give, per state,
 the first step at which a joint is outside its range and which joint.
 
+Divergence: a state whose ``q`` or ``qd`` becomes NaN or inf stops there;
+:attr:`Trajectory.nonfinite_step` / :attr:`Trajectory.nonfinite_joint` say when and in
+which joint. A single state's arrays then end with the last finite sample before that
+step (nothing after it was computed); in a batch the samples from that step on are NaN.
+Energies are computed for the finite samples only.
+
+Interrupting: Ctrl-C (SIGINT) during a run in Rust raises ``KeyboardInterrupt`` within
+about 0.1 s; nothing is returned.
+
 Memory: only every ``stride``-th step is stored, so memory is proportional to what is
 kept (``N * (steps // stride + 1) * dof`` values per array); a run whose stored samples
 would not fit in the available memory (or ``max_bytes``) is refused before it starts.
@@ -96,8 +105,12 @@ class Trajectory:
     For a single initial state (``q0`` of shape ``(dof,)``) arrays are ``(S, dof)`` and
     ``(S,)``; for a batch they are ``(N, S, dof)`` and ``(N, S)``. ``S`` samples at times
     ``t`` (``(S,)``, seconds). ``qdd`` and ``tau`` are the acceleration and torque at each
-    stored state. Energies (J): kinetic ``1/2 qd^T M qd``, potential ``-sum m g . p_c``,
-    and their sum ``energy``; None when ``energies=False``.
+    stored state; ``work`` (J) the work done by the torque since t = 0,
+    ``W(t) = integral of tau . qd dt``, integrated with the state by the same method
+    (RK4: to the same order), not from the stored samples. Joint damping/friction of the
+    model are not in ``tau``: their dissipation shows in :meth:`energy_balance`.
+    Energies (J): kinetic ``1/2 qd^T M qd``, potential ``-sum m g . p_c``, and their sum
+    ``energy``; None when ``energies=False``.
     """
 
     t: np.ndarray
@@ -116,6 +129,9 @@ class Trajectory:
     coordinate_names: list = field(default_factory=list)
     kinetic: np.ndarray | None = None
     potential: np.ndarray | None = None
+    #: joint index whose q or qd was first not finite (-1: never); see nonfinite_step
+    nonfinite_joint: np.ndarray | int = -1
+    work: np.ndarray | None = None
 
     @property
     def energy(self):
@@ -129,9 +145,31 @@ class Trajectory:
         e = self.energy
         if e is None:
             raise ValueError("energies were not computed (energies=False)")
-        scale = np.maximum(np.abs(e[..., :1]), self.kinetic.max(axis=-1, keepdims=True))
-        out = (np.abs(e - e[..., :1]) / scale).max(axis=-1)
+        scale = np.maximum(np.abs(e[..., :1]), np.nanmax(self.kinetic, axis=-1, keepdims=True))
+        out = np.nanmax(np.abs(e - e[..., :1]) / scale, axis=-1)  # NaN: samples after a divergence
         return float(out) if out.ndim == 0 else out
+
+    def energy_balance(self):
+        """Largest ``|E(t) - E(0) - W(t)| / max(|E(0)|, max_t T(t), max_t |W(t)|)`` per state
+        (a float for one state): how far the run is from the work-energy theorem
+        ``E(t) - E(0) = W(t)`` (:attr:`work`). For a passive run ``W = 0`` and this is
+        :meth:`energy_drift`; with torques applied the drift measures the torques' work,
+        the balance the integration (and the trapezoid rule's) error."""
+        e = self.energy
+        if e is None:
+            raise ValueError("energies were not computed (energies=False)")
+        if self.work is None:
+            raise ValueError("this trajectory has no record of the torques' work")
+        w = self.work
+        scale = np.maximum(np.maximum(np.abs(e[..., :1]), np.nanmax(self.kinetic, axis=-1, keepdims=True)),
+                           np.nanmax(np.abs(w), axis=-1, keepdims=True))
+        out = np.nanmax(np.abs(e - e[..., :1] - w) / scale, axis=-1)
+        return float(out) if out.ndim == 0 else out
+
+    @property
+    def passive(self) -> bool:
+        """True when no torque acted (every stored ``tau`` is zero)."""
+        return not np.any(np.nan_to_num(self.tau))
 
     def limit_crossings(self) -> list[tuple[int, int, float, str]]:
         """``(state, step, time, joint name)`` for every state that crossed a joint limit
@@ -314,15 +352,29 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
 
     t = np.arange(samples) * (stride * dt)
     run = Trajectory(t=t, dt=dt, stride=stride, method=method, coordinate_names=list(model.coordinate_names), **out)
+    # a diverged state stopped at its nonfinite_step: its later samples were never written
+    diverged = run.nonfinite_step >= 0
+    kept = np.ones((rows, samples), dtype=bool)
+    if diverged.any():
+        kept[diverged] = run.t[None, :] < (run.nonfinite_step[diverged, None] * dt - 0.5 * dt)
+        for name in ("q", "qd", "qdd", "tau"):
+            getattr(run, name)[~kept] = np.nan
+        run.work[~kept] = np.nan
     if energies:
-        flat_q, flat_qd = run.q.reshape(-1, dof), run.qd.reshape(-1, dof)
-        run.kinetic = kinetic_energy(model, flat_q, flat_qd, threads=threads).reshape(rows, samples)
-        run.potential = potential_energy(model, flat_q, threads=threads).reshape(rows, samples)
+        run.kinetic, run.potential = np.full((rows, samples), np.nan), np.full((rows, samples), np.nan)
+        flat_q, flat_qd = run.q[kept], run.qd[kept]
+        if len(flat_q):
+            run.kinetic[kept] = kinetic_energy(model, _c(flat_q), _c(flat_qd), threads=threads)
+            run.potential[kept] = potential_energy(model, _c(flat_q), threads=threads)
     if single:
-        for name in ("q", "qd", "qdd", "tau", "q_final", "qd_final", "kinetic", "potential"):
+        last = int(kept[0].sum())  # a single diverged state: only what was computed
+        run.t = run.t[:last]
+        for name in ("q", "qd", "qdd", "tau", "work", "kinetic", "potential"):
             if getattr(run, name) is not None:
-                setattr(run, name, getattr(run, name)[0])
-        for name in ("limit_step", "limit_joint", "nonfinite_step"):
+                setattr(run, name, getattr(run, name)[0][:last])
+        for name in ("q_final", "qd_final"):
+            setattr(run, name, getattr(run, name)[0])
+        for name in ("limit_step", "limit_joint", "nonfinite_step", "nonfinite_joint"):
             setattr(run, name, int(getattr(run, name)[0]))
     return run
 
@@ -352,20 +404,29 @@ def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower,
         part = call(q, qd, k, tau)
         if out is None:
             out = {name: np.empty((rows, samples, dof)) for name in ("q", "qd", "qdd", "tau")}
-            for name in ("limit_step", "limit_joint", "nonfinite_step"):
+            out["work"] = np.empty((rows, samples))
+            for name in ("limit_step", "limit_joint", "nonfinite_step", "nonfinite_joint"):
                 out[name] = np.full(rows, -1, dtype=np.int64)
+            work_before = np.zeros(rows)
         first = done // stride
         n = part["q"].shape[1]
         for name in ("q", "qd", "qdd", "tau"):
             out[name][:, first:first + n] = part[name]
+        # each piece's work starts at 0 from its first state, the previous piece's last sample
+        out["work"][:, first:first + n] = part["work"] + work_before[:, None]
+        work_before = out["work"][:, first + n - 1]
         for name in ("limit_step", "nonfinite_step"):
             new = (out[name] < 0) & (part[name] >= 0)
-            if name == "limit_step":
-                out["limit_joint"][new] = part["limit_joint"][new]
+            joint = "limit_joint" if name == "limit_step" else "nonfinite_joint"
+            out[joint][new] = part[joint][new]
             out[name][new] = part[name][new] + done
         q, qd, done = part["q_final"], part["qd_final"], done + k
         progress(done, steps)
+        if (out["nonfinite_step"] >= 0).all():  # every state diverged: nothing left to integrate
+            break
     out["q_final"], out["qd_final"] = q, qd
+    if done < steps:
+        progress(steps, steps)
     return out
 
 
@@ -375,9 +436,12 @@ def _simulate_python(model, q0, qd0, torque, dt, steps, stride, method, lower, u
     rows, dof = q0.shape
     samples = steps // stride + 1
     out = {name: np.empty((rows, samples, dof)) for name in ("q", "qd", "qdd", "tau")}
+    out["work"] = np.empty((rows, samples))
+    work = np.zeros(rows)  # of the torque, integrated by the same method as the state
     limit_step = np.full(rows, -1, dtype=np.int64)
     limit_joint = np.full(rows, -1, dtype=np.int64)
     nonfinite = np.full(rows, -1, dtype=np.int64)
+    nonfinite_joint = np.full(rows, -1, dtype=np.int64)
 
     def tau_at(k, t, q, qd):
         try:
@@ -397,42 +461,66 @@ def _simulate_python(model, q0, qd0, torque, dt, steps, stride, method, lower, u
         return _c(np.broadcast_to(tau, (rows, dof)))
 
     def acc(k, t, q, qd):
+        live = nonfinite < 0
+        if not live.all():  # diverged states stopped: finite stand-ins, their samples are dropped
+            q, qd = np.where(live[:, None], q, 0.0), np.where(live[:, None], qd, 0.0)
         tau = tau_at(k, t, q, qd)
-        return model.aba(q, qd, tau, None), tau
+        try:
+            return model.aba(_c(q), _c(qd), tau, None), tau
+        except ValueError:
+            pass
+        # no finite acceleration for some state (velocities so large that the dynamics
+        # overflow: a diverging run): that state stops here, the others go on
+        a = np.full_like(q, np.nan)
+        for i in np.flatnonzero(live):
+            try:
+                a[i] = model.aba(q[i], qd[i], tau[i], None)
+            except ValueError:
+                nonfinite[i], nonfinite_joint[i] = k, int(np.argmax(np.abs(qd[i])))
+        return a, tau
 
     def check(k, q, qd):
         outside = (q < lower) | (q > upper)
         new = (limit_step < 0) & outside.any(axis=1)
         limit_step[new], limit_joint[new] = k, outside[new].argmax(axis=1)
-        bad = (nonfinite < 0) & ~np.isfinite(q + qd).all(axis=1)
-        nonfinite[bad] = k
+        finite = np.isfinite(q + qd)
+        bad = (nonfinite < 0) & ~finite.all(axis=1)
+        nonfinite[bad], nonfinite_joint[bad] = k, (~finite[bad]).argmax(axis=1)
 
     q, qd = q0.copy(), qd0.copy()
     check(0, q, qd)
     h = dt
-    for k in range(steps + 1):
-        t = k * dt
-        if k < steps or k % stride == 0:
-            a1, tau1 = acc(k, t, q, qd)
-        if k % stride == 0:
-            s = k // stride
-            out["q"][:, s], out["qd"][:, s], out["qdd"][:, s], out["tau"][:, s] = q, qd, a1, tau1
-        if k == steps:
-            break
-        if method == "euler":
-            qd = qd + h * a1
-            q = q + h * qd
-        else:
-            q2, qd2 = q + h / 2 * qd, qd + h / 2 * a1
-            a2, _ = acc(k, t + h / 2, q2, qd2)
-            q3, qd3 = q + h / 2 * qd2, qd + h / 2 * a2
-            a3, _ = acc(k, t + h / 2, q3, qd3)
-            q4, qd4 = q + h * qd3, qd + h * a3
-            a4, _ = acc(k, t + h, q4, qd4)
-            q = q + h / 6 * (qd + 2 * qd2 + 2 * qd3 + qd4)
-            qd = qd + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
-        check(k + 1, q, qd)
-    out.update(q_final=q, qd_final=qd, limit_step=limit_step, limit_joint=limit_joint, nonfinite_step=nonfinite)
+    with np.errstate(over="ignore", invalid="ignore"):  # a diverging state is reported, not warned about
+        for k in range(steps + 1):
+            t = k * dt
+            if k < steps or k % stride == 0:
+                a1, tau1 = acc(k, t, q, qd)
+            if k % stride == 0:
+                s = k // stride
+                out["q"][:, s], out["qd"][:, s], out["qdd"][:, s], out["tau"][:, s] = q, qd, a1, tau1
+                out["work"][:, s] = work
+            if k == steps:
+                break
+            if method == "euler":
+                work = work + h * (tau1 * qd).sum(axis=1)
+                qd = qd + h * a1
+                q = q + h * qd
+            else:
+                q2, qd2 = q + h / 2 * qd, qd + h / 2 * a1
+                a2, tau2 = acc(k, t + h / 2, q2, qd2)
+                q3, qd3 = q + h / 2 * qd2, qd + h / 2 * a2
+                a3, tau3 = acc(k, t + h / 2, q3, qd3)
+                q4, qd4 = q + h * qd3, qd + h * a3
+                a4, tau4 = acc(k, t + h, q4, qd4)
+                work = work + h / 6 * ((tau1 * qd).sum(axis=1) + 2 * (tau2 * qd2).sum(axis=1)
+                                       + 2 * (tau3 * qd3).sum(axis=1) + (tau4 * qd4).sum(axis=1))
+                q = q + h / 6 * (qd + 2 * qd2 + 2 * qd3 + qd4)
+                qd = qd + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+            check(k + 1, q, qd)
+            if (nonfinite >= 0).all():
+                break
+    out.update(q_final=q, qd_final=qd, limit_step=limit_step, limit_joint=limit_joint, nonfinite_step=nonfinite,
+               nonfinite_joint=nonfinite_joint)
     return out
 
 
@@ -464,15 +552,16 @@ def simulate_adaptive(robot, q0, qd0=None, *, duration, torque=None, rtol=1e-10,
         tau_of = lambda t, q, qd: const  # noqa: E731
     t_eval = np.linspace(0.0, duration, 101) if t_eval is None else np.asarray(t_eval, dtype=float)
 
-    def f(t, x):
-        q, qd = x[:dof], x[dof:]
-        return np.concatenate([qd, model.aba(q, qd, np.asarray(tau_of(t, q, qd), dtype=float), None)])
+    def f(t, x):  # x = (q, qd, W): the torque's work integrated with the state
+        q, qd = x[:dof], x[dof:2 * dof]
+        tau = np.asarray(tau_of(t, q, qd), dtype=float)
+        return np.concatenate([qd, model.aba(q, qd, tau, None), [tau @ qd]])
 
-    sol = solve_ivp(f, (0.0, duration), np.concatenate([q0, qd0]), method=method, rtol=rtol, atol=atol,
+    sol = solve_ivp(f, (0.0, duration), np.concatenate([q0, qd0, [0.0]]), method=method, rtol=rtol, atol=atol,
                     t_eval=t_eval)
     if not sol.success:
         raise ValueError(f"solve_ivp failed: {sol.message}")
-    q, qd = _c(sol.y[:dof].T), _c(sol.y[dof:].T)
+    q, qd = _c(sol.y[:dof].T), _c(sol.y[dof:2 * dof].T)
     tau = np.array([tau_of(t, a, b) for t, a, b in zip(sol.t, q, qd)], dtype=float).reshape(len(sol.t), dof)
     qdd = model.aba(q, qd, tau, None)
     lower, upper = joint_limits(robot)
@@ -481,7 +570,7 @@ def simulate_adaptive(robot, q0, qd0=None, *, duration, torque=None, rtol=1e-10,
     run = Trajectory(t=sol.t, q=q, qd=qd, qdd=qdd, tau=tau, q_final=q[-1], qd_final=qd[-1],
                      limit_step=first, limit_joint=int(outside[first].argmax()) if first >= 0 else -1,
                      nonfinite_step=-1, dt=float("nan"), stride=1, method=method,
-                     coordinate_names=list(model.coordinate_names))
+                     coordinate_names=list(model.coordinate_names), work=sol.y[2 * dof].copy())
     run.kinetic = kinetic_energy(model, q, qd)
     run.potential = potential_energy(model, q)
     return run

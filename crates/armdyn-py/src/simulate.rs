@@ -3,13 +3,69 @@
 //! Low level: `python/armdyn/simulate.py` validates and broadcasts the arguments, and
 //! documents them; here every array must already have its exact shape (checked again,
 //! a mismatch is a `ValueError`). The GIL is released while integrating.
+//!
+//! Ctrl-C: a long run integrates on a worker thread while this (the Python) thread waits
+//! in slices of [`SIGNAL_POLL`] with the GIL released, re-acquiring it between slices only
+//! to run Python's signal handlers (`Python::check_signals`). On a `KeyboardInterrupt`
+//! (or any exception a handler raises) the worker's stop flag is set, the worker ends
+//! within [`integrate::STOP_POLL`] steps, and the exception is returned with no result.
 
 use super::{guard, thread_arg, NumericModel};
 use armdyn_core::algo::integrate::{self, Input, Method, Outputs, Settings};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Condvar, Mutex};
+use std::time::Duration;
 use numpy::{PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+
+/// How often a waiting run looks at Python's signals.
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
+
+/// Runs with fewer `rows * steps * nv` than this (a few milliseconds at most) integrate on
+/// the calling thread: a worker thread is not worth its start-up there.
+const INLINE_WORK: usize = 100_000;
+
+/// Set when the worker ends, also by a panic (the guard's drop), so the wait always ends.
+struct Done<'a>(&'a (Mutex<bool>, Condvar));
+
+impl Drop for Done<'_> {
+    fn drop(&mut self) {
+        *self.0 .0.lock().unwrap_or_else(|e| e.into_inner()) = true;
+        self.0 .1.notify_all();
+    }
+}
+
+/// Run `work(stop)` on a worker thread, polling Python's signal handlers meanwhile;
+/// an exception from a handler sets `stop`, waits for the worker and is returned.
+fn interruptible<F: FnOnce(&AtomicBool) + Send>(py: Python<'_>, work: F) -> PyResult<()> {
+    let stop = AtomicBool::new(false);
+    let done = (Mutex::new(false), Condvar::new());
+    // true once the worker has ended (waits at most `timeout`)
+    let wait = |timeout: Duration| {
+        let guard = done.0.lock().unwrap_or_else(|e| e.into_inner());
+        let (guard, _) = done.1.wait_timeout_while(guard, timeout, |d| !*d).unwrap_or_else(|e| e.into_inner());
+        *guard
+    };
+    std::thread::scope(|scope| {
+        let (stop, done) = (&stop, &done);
+        scope.spawn(move || {
+            let _done = Done(done);
+            work(stop);
+        });
+        loop {
+            if py.detach(|| wait(SIGNAL_POLL)) {
+                return Ok(()); // finished (a panic is re-raised by the scope)
+            }
+            if let Err(err) = py.check_signals() {
+                stop.store(true, Ordering::Relaxed);
+                while !py.detach(|| wait(Duration::from_secs(3600))) {}
+                return Err(err);
+            }
+        }
+    })
+}
 
 /// The data of a C-contiguous read-only array, with its shape checked.
 fn data<'a>(a: &'a PyReadonlyArrayDyn<'_, f64>, name: &str, shape: &[usize]) -> PyResult<&'a [f64]> {
@@ -24,8 +80,10 @@ fn data<'a>(a: &'a PyReadonlyArrayDyn<'_, f64>, name: &str, shape: &[usize]) -> 
 /// torque_kind: "zero", "constant" (torque (N, nv)), "series" (torque (steps, nv)),
 /// "series-per-state" (torque (N, steps, nv)), "pd", "pd-gravity", "computed-torque"
 /// (kp, kd (nv,), target, target_qd (N, nv)). lower, upper: (nv,). Returns a dict of
-/// q, qd, qdd, tau (N, S, nv), q_final, qd_final (N, nv), limit_step, limit_joint,
-/// nonfinite_step (N,) int64.
+/// q, qd, qdd, tau (N, S, nv), work (N, S) (of the torque since the start), q_final, qd_final (N, nv), limit_step, limit_joint,
+/// nonfinite_step, nonfinite_joint (N,) int64 (a state's samples after its
+/// nonfinite_step are not written). Ctrl-C during a long run raises KeyboardInterrupt
+/// within about 0.1 s (see the module docstring).
 #[pyfunction]
 #[pyo3(signature = (model, q0, qd0, dt, steps, stride, method, torque_kind, torque, kp, kd, target, target_qd, lower, upper, threads = None))]
 #[allow(clippy::too_many_arguments)]
@@ -92,12 +150,14 @@ fn _simulate<'py>(
         let i = |dims: &[usize]| PyArrayDyn::<i64>::zeros(py, dims, false);
         let (q, qd, qdd, tau) = (f(&[rows, s, n]), f(&[rows, s, n]), f(&[rows, s, n]), f(&[rows, s, n]));
         let (q_final, qd_final) = (f(&[rows, n]), f(&[rows, n]));
-        let (limit_step, limit_joint, nonfinite_step) = (i(&[rows]), i(&[rows]), i(&[rows]));
+        let work = f(&[rows, s]);
+        let (limit_step, limit_joint, nonfinite_step, nonfinite_joint) = (i(&[rows]), i(&[rows]), i(&[rows]), i(&[rows]));
         {
             // SAFETY: fresh arrays, not visible to Python until returned.
             let out = unsafe {
                 Outputs {
                     q: q.as_slice_mut().expect("fresh"),
+                    work: work.as_slice_mut().expect("fresh"),
                     qd: qd.as_slice_mut().expect("fresh"),
                     qdd: qdd.as_slice_mut().expect("fresh"),
                     tau: tau.as_slice_mut().expect("fresh"),
@@ -106,20 +166,30 @@ fn _simulate<'py>(
                     limit_step: limit_step.as_slice_mut().expect("fresh"),
                     limit_joint: limit_joint.as_slice_mut().expect("fresh"),
                     nonfinite_step: nonfinite_step.as_slice_mut().expect("fresh"),
+                    nonfinite_joint: nonfinite_joint.as_slice_mut().expect("fresh"),
                 }
             };
-            py.detach(|| integrate::simulate(m, q0, qd0, input, settings, lower, upper, out, threads));
+            let run = |stop: &AtomicBool| {
+                integrate::simulate_until(m, q0, qd0, input, settings, lower, upper, out, threads, stop);
+            };
+            if rows.saturating_mul(steps).saturating_mul(n.max(1)) < INLINE_WORK {
+                py.detach(|| run(&AtomicBool::new(false)));
+            } else {
+                interruptible(py, run)?;
+            }
         }
         let d = PyDict::new(py);
         d.set_item("q", q)?;
         d.set_item("qd", qd)?;
         d.set_item("qdd", qdd)?;
         d.set_item("tau", tau)?;
+        d.set_item("work", work)?;
         d.set_item("q_final", q_final)?;
         d.set_item("qd_final", qd_final)?;
         d.set_item("limit_step", limit_step)?;
         d.set_item("limit_joint", limit_joint)?;
         d.set_item("nonfinite_step", nonfinite_step)?;
+        d.set_item("nonfinite_joint", nonfinite_joint)?;
         Ok(d)
     })
 }

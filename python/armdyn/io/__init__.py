@@ -2,12 +2,20 @@
 
 ``load(source)`` takes a bundled model's name (``armdyn.load("rp-arm")``; the files
 live in ``armdyn/robots/``) or a file path (``.yaml``/``.yml``: :mod:`armdyn.io.yaml`;
-``.urdf``: :mod:`armdyn.io.urdf`). ``bundled_robots()`` lists the bundled models.
+``.urdf``: :mod:`armdyn.io.urdf`; ``.xacro``: :mod:`armdyn.io.xacro`, needs the ``xacro``
+package). ``bundled_robots()`` lists the bundled models.
+
+Physical validity: a model file is checked strictly by default (a link whose inertia is
+not physical is a :class:`ModelError`). A bundled model is a published one, kept as
+published: it loads by default even where its published inertias are not physical
+(PUMA 560 and Stanford arm values break the triangle inequality), with one warning
+naming its source and each such link; ``load(name, strict=True)`` refuses it.
 """
 
 from __future__ import annotations
 
 import os
+import warnings
 from pathlib import Path
 
 from ..errors import ModelError
@@ -16,7 +24,7 @@ from ..model import Robot
 #: Directory of the bundled models.
 ROBOTS_DIR = Path(__file__).resolve().parent.parent / "robots"
 
-_SUFFIXES = (".yaml", ".yml", ".urdf")
+_SUFFIXES = (".yaml", ".yml", ".urdf", ".xacro")
 
 
 def _bundled_files() -> dict[str, Path]:
@@ -41,10 +49,43 @@ def _load_file(path: Path, strict: bool, source: str) -> Robot:
         except ImportError:
             raise ModelError("URDF support not available", None, source) from None
         return load_urdf(path, strict=strict)
-    raise ModelError(f"unknown model file type '{suffix}' (expected .yaml, .yml or .urdf)", None, source)
+    if suffix == ".xacro":
+        from .xacro import load_xacro
+
+        return load_xacro(path, strict=strict)
+    raise ModelError(f"unknown model file type '{suffix}' (expected .yaml, .yml, .urdf or .xacro)", None, source)
 
 
-def load(source, strict: bool = True) -> Robot:
+def _published(path: Path) -> Robot:
+    """A bundled model as published: links whose published (default) values are not
+    physical are accepted, with one warning for the whole model (not one per link, nor
+    again for every bound copy)."""
+    from ..inertia import physical_violations
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = _load_file(path, False, path.name)
+        bound = robot.bind() if robot.defaults else robot
+    accepted = []
+    for link in bound.links.values():
+        mass, inertia = link.floats("mass"), link.floats("inertia")
+        problems = physical_violations(link.mass if mass is None else mass,
+                                       link.inertia if inertia is None else inertia)
+        if problems:
+            accepted.append((link.name, "; ".join(problems)))
+    if not accepted:
+        return robot
+    source = " ".join(str(robot.meta.get("source", "")).split())
+    source = source if len(source) <= 90 else source[:87] + "..."
+    what = "; ".join(f"link '{name}': {problem}" for name, problem in accepted)
+    warnings.warn(f"{path.stem} as published{f' ({source})' if source else ''} is not physical: {what} "
+                  f"(loaded anyway; strict=True / --strict refuses it)", UserWarning, stacklevel=3)
+    meta = dict(robot.meta, nonphysical_accepted=tuple(accepted))
+    return Robot(robot.name, robot.links.values(), robot.joints, robot.gravity, robot.parameters, meta,
+                 robot.base, robot.defaults, strict=False)
+
+
+def load(source, strict: bool | None = None) -> Robot:
     """A :class:`~armdyn.Robot` from a bundled model's name or a model file.
 
     source: a bundled name (see :func:`bundled_robots`, e.g. ``"rp-arm"``, ``"puma560"``)
@@ -52,7 +93,9 @@ def load(source, strict: bool = True) -> Robot:
             with a path separator or one of those suffixes is always taken as a path; a
             bare bundled name wins over a file of that name in the working directory.
     strict: check each link's physical validity (mass >= 0, inertia PSD, triangle
-            inequality); see :class:`armdyn.Robot`.
+            inequality); see :class:`armdyn.Robot`. None (default): strict for files;
+            a bundled model loads as published with one warning if it is not physical.
+            False: warn (per link) instead of raising; True: raise, bundled models too.
 
     Raises ModelError (one line naming the file) for an unknown name, a missing file
     or a bad model.
@@ -62,7 +105,10 @@ def load(source, strict: bool = True) -> Robot:
     looks_like_path = path.suffix.lower() in _SUFFIXES or os.sep in text or "/" in text
     bundled = _bundled_files()
     if not looks_like_path and text in bundled:
+        if strict is None:
+            return _published(bundled[text])
         return _load_file(bundled[text], strict, bundled[text].name)
+    strict = True if strict is None else strict
     if looks_like_path or path.is_file():
         if not path.is_file():
             raise ModelError("no such file", None, text)

@@ -22,11 +22,19 @@
 //! *Robot Modeling and Control*, eq. 8.58 with `qdd* = 0`).
 //!
 //! Every `stride`-th step (`0, stride, 2 stride, ...` up to `steps`) is stored: `q`,
-//! `qd`, the `qdd` and `tau` at that state. The last state is always returned
+//! `qd`, the `qdd` and `tau` at that state, and the work done by the torque since the
+//! start, `W = integral of tau . qd dt`, integrated alongside the state by the same
+//! method (its stages' powers `tau . qd` with the RK4 weights; Euler: `h tau . qd` at
+//! the step's start), so that `E(t) - E(0) - W(t)` measures the integration error of a
+//! run with torques applied as the energy drift does for a passive one. The last state is always returned
 //! separately (`q_final`, `qd_final`), so that a long run can continue in pieces
 //! bit-for-bit. Joint limits are reported (first step and joint at which a state is
 //! outside `[lower, upper]`), never enforced; the first step at which a state is not
-//! finite is reported as well.
+//! finite, and the joint, is reported as well, and that state's integration stops there
+//! (the samples after it are left as they were: NaN is all a diverged run would give).
+//!
+//! [`simulate_until`] takes a stop flag, read every [`STOP_POLL`] steps, so that a caller
+//! (e.g. a Ctrl-C handler) can end a long run early without slowing the step loop.
 //!
 //! States run in SIMD lanes (4 or 8 per group, the kernels of [`crate::batch`]), the
 //! groups spread over threads by rayon; every lane performs exactly the operations of
@@ -38,6 +46,11 @@ use crate::data::Data;
 use crate::model::Model;
 use crate::real::{F64x4, F64x8, Real};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Steps between two reads of the stop flag of [`simulate_until`] (a power of two: the
+/// test is a mask; a relaxed atomic load per 256 steps costs nothing measurable).
+pub const STOP_POLL: usize = 256;
 
 /// The integration method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,6 +98,8 @@ impl Settings {
 pub struct Outputs<'a> {
     /// `(N, S, nv)` each.
     pub q: &'a mut [f64],
+    /// `(N, S)`: work done by the torque from the start to each stored sample.
+    pub work: &'a mut [f64],
     pub qd: &'a mut [f64],
     pub qdd: &'a mut [f64],
     pub tau: &'a mut [f64],
@@ -95,8 +110,11 @@ pub struct Outputs<'a> {
     /// which joint (the lowest index at that step).
     pub limit_step: &'a mut [i64],
     pub limit_joint: &'a mut [i64],
-    /// `(N,)`: first step at which `q` or `qd` is not finite (`-1`: never).
+    /// `(N,)`: first step at which `q` or `qd` is not finite (`-1`: never), and the
+    /// lowest joint index whose `q` or `qd` is not finite at that step. The state's
+    /// integration stops at that step: later samples are not written.
     pub nonfinite_step: &'a mut [i64],
+    pub nonfinite_joint: &'a mut [i64],
 }
 
 /// Integrate `N` initial states `q0`, `qd0` (N, nv) for `settings.steps` steps.
@@ -113,6 +131,24 @@ pub fn simulate(
     out: Outputs,
     threads: Option<usize>,
 ) {
+    simulate_until(model, q0, qd0, input, settings, lower, upper, out, threads, &AtomicBool::new(false));
+}
+
+/// [`simulate`], ending early once `stop` is set (read every [`STOP_POLL`] steps of each
+/// state). Returns false if it was stopped: the outputs are then incomplete.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_until(
+    model: &Model,
+    q0: &[f64],
+    qd0: &[f64],
+    input: Input,
+    settings: Settings,
+    lower: &[f64],
+    upper: &[f64],
+    out: Outputs,
+    threads: Option<usize>,
+    stop: &AtomicBool,
+) -> bool {
     let n = model.nv;
     assert!(settings.stride >= 1 && settings.dt.is_finite(), "settings");
     assert!(lower.len() == n && upper.len() == n, "limits length");
@@ -122,8 +158,10 @@ pub fn simulate(
     for o in [&out.q, &out.qd, &out.qdd, &out.tau] {
         assert_eq!(o.len(), rows * s * n, "output size");
     }
+    assert_eq!(out.work.len(), rows * s, "work size");
     assert!(out.q_final.len() == rows * n && out.qd_final.len() == rows * n, "final state size");
     assert!(out.limit_step.len() == rows && out.limit_joint.len() == rows && out.nonfinite_step.len() == rows);
+    assert!(out.nonfinite_joint.len() == rows);
     match input {
         Input::Zero => {}
         Input::Constant(t) => assert_eq!(t.len(), rows * n, "constant torque size"),
@@ -136,13 +174,16 @@ pub fn simulate(
             assert!(target.len() == rows * n && target_qd.len() == rows * n, "target size");
         }
     }
-    let task = Task { model, q0, qd0, input, settings, lower, upper };
+    let task = Task { model, q0, qd0, input, settings, lower, upper, stop };
 
     // Chunks of rows (multiples of 8 so that lane groups never straddle chunks).
     let nthreads = thread_count(threads);
     let chunk_rows = if nthreads == 1 || rows < 16 { rows.max(1) } else { rows.div_ceil(4 * nthreads).next_multiple_of(8) };
     let mut chunks = Vec::new();
-    let Outputs { mut q, mut qd, mut qdd, mut tau, mut q_final, mut qd_final, mut limit_step, mut limit_joint, mut nonfinite_step } = out;
+    let Outputs {
+        mut q, mut work, mut qd, mut qdd, mut tau, mut q_final, mut qd_final, mut limit_step, mut limit_joint,
+        mut nonfinite_step, mut nonfinite_joint,
+    } = out;
     let mut first = 0;
     while first < rows {
         let r = chunk_rows.min(rows - first);
@@ -157,6 +198,7 @@ pub fn simulate(
             first,
             Outputs {
                 q: take!(q, s * n),
+                work: take!(work, s),
                 qd: take!(qd, s * n),
                 qdd: take!(qdd, s * n),
                 tau: take!(tau, s * n),
@@ -165,6 +207,7 @@ pub fn simulate(
                 limit_step: take!(limit_step, 1),
                 limit_joint: take!(limit_joint, 1),
                 nonfinite_step: take!(nonfinite_step, 1),
+                nonfinite_joint: take!(nonfinite_joint, 1),
             },
         ));
         first += r;
@@ -174,6 +217,7 @@ pub fn simulate(
         None => run(),
         Some(k) => install(k, run),
     }
+    !stop.load(Ordering::Relaxed)
 }
 
 /// The shared read-only inputs of one call.
@@ -185,6 +229,7 @@ struct Task<'a> {
     settings: Settings,
     lower: &'a [f64],
     upper: &'a [f64],
+    stop: &'a AtomicBool,
 }
 
 /// Per-group workspace: lane vectors of length nv.
@@ -201,6 +246,9 @@ struct Work<T> {
     /// RK4 weighted sums of the stage derivatives (of q and of qd).
     sum_q: Vec<T>,
     sum_qd: Vec<T>,
+    /// Work done so far, and the RK4 weighted sum of the stage powers.
+    work: T,
+    sum_work: T,
     /// Per-state constants: constant torque or controller targets; scratch.
     c0: Vec<T>,
     c1: Vec<T>,
@@ -220,6 +268,8 @@ impl<T: Real> Work<T> {
             qdd: z(),
             sum_q: z(),
             sum_qd: z(),
+            work: T::zero(),
+            sum_work: T::zero(),
             c0: z(),
             c1: z(),
             tmp: z(),
@@ -334,6 +384,7 @@ impl Task<'_> {
         let n = self.model.nv;
         let per = self.settings.samples() * n;
         for l in 0..T::LANES {
+            out.work[(r + l) * self.settings.samples() + s] = w.work.lane(l);
             let at = (r + l) * per + s * n;
             for j in 0..n {
                 out.q[at + j] = w.q[j].lane(l);
@@ -344,9 +395,11 @@ impl Task<'_> {
         }
     }
 
-    /// Record limit crossings and non-finite states of `w.q`, `w.qd` at step `k`.
+    /// Record limit crossings and non-finite states of `w.q`, `w.qd` at step `k`; true
+    /// when every lane is non-finite (nothing left to integrate).
     #[inline(always)]
-    fn check<T: Real>(&self, w: &Work<T>, out: &mut Outputs, r: usize, k: usize) {
+    fn check<T: Real>(&self, w: &Work<T>, out: &mut Outputs, r: usize, k: usize) -> bool {
+        let mut diverged = 0;
         for l in 0..T::LANES {
             let row = r + l;
             if out.limit_step[row] < 0 {
@@ -359,10 +412,15 @@ impl Task<'_> {
                     }
                 }
             }
-            if out.nonfinite_step[row] < 0 && !(0..self.model.nv).all(|j| (w.q[j].lane(l) + w.qd[j].lane(l)).is_finite()) {
-                out.nonfinite_step[row] = k as i64;
+            if out.nonfinite_step[row] < 0 {
+                if let Some(j) = (0..self.model.nv).find(|&j| !(w.q[j].lane(l) + w.qd[j].lane(l)).is_finite()) {
+                    out.nonfinite_step[row] = k as i64;
+                    out.nonfinite_joint[row] = j as i64;
+                }
             }
+            diverged += (out.nonfinite_step[row] >= 0) as usize;
         }
+        diverged == T::LANES
     }
 
     /// Integrate the lanes of chunk rows `r..r + LANES` (global rows `first + r..`).
@@ -385,8 +443,10 @@ impl Task<'_> {
             out.limit_step[r + l] = -1;
             out.limit_joint[r + l] = -1;
             out.nonfinite_step[r + l] = -1;
+            out.nonfinite_joint[r + l] = -1;
         }
         self.check(w, out, r, 0);
+        w.work = T::zero();
         let (h, h2, h6) = (T::splat(dt), T::splat(0.5 * dt), T::splat(dt / 6.0));
         let two = T::splat(2.0);
         let stages = match method {
@@ -400,6 +460,11 @@ impl Task<'_> {
         w.qds.copy_from_slice(&w.qd);
         loop {
             self.stage(w, row, k);
+            // power of the torque at the stage state
+            let mut power = T::zero();
+            for j in 0..n {
+                power += w.tau[j] * w.qds[j];
+            }
             if st == 0 {
                 // stage 1 is at the step's start: the stored sample
                 if k % stride == 0 {
@@ -411,6 +476,7 @@ impl Task<'_> {
             }
             match (method, st) {
                 (Method::SemiImplicitEuler, _) => {
+                    w.work += h * power;
                     for j in 0..n {
                         w.qd[j] += h * w.qdd[j];
                         w.q[j] += h * w.qd[j];
@@ -418,6 +484,7 @@ impl Task<'_> {
                 }
                 // k1 = (qd, qdd1); stage 2 at x + h/2 k1.
                 (Method::Rk4, 0) => {
+                    w.sum_work = power;
                     for j in 0..n {
                         w.sum_q[j] = w.qd[j];
                         w.sum_qd[j] = w.qdd[j];
@@ -428,6 +495,7 @@ impl Task<'_> {
                 // k2 = (qds, qdd2) (k3 likewise); stage 3 at x + h/2 k2, stage 4 at x + h k3.
                 (Method::Rk4, 1 | 2) => {
                     let c = if st == 1 { h2 } else { h };
+                    w.sum_work += two * power;
                     for j in 0..n {
                         let kq = w.qds[j];
                         w.sum_q[j] += two * kq;
@@ -438,6 +506,7 @@ impl Task<'_> {
                 }
                 // x += h/6 (k1 + 2 k2 + 2 k3 + k4)
                 (Method::Rk4, _) => {
+                    w.work += h6 * (w.sum_work + power);
                     for j in 0..n {
                         w.q[j] += h6 * (w.sum_q[j] + w.qds[j]);
                         w.qd[j] += h6 * (w.sum_qd[j] + w.qdd[j]);
@@ -448,8 +517,10 @@ impl Task<'_> {
             if st == stages {
                 st = 0;
                 k += 1;
-                self.check(w, out, r, k);
-                if k == steps && steps % stride != 0 {
+                if self.check(w, out, r, k) || (k == steps && steps % stride != 0) {
+                    break;
+                }
+                if k % STOP_POLL == 0 && self.stop.load(Ordering::Relaxed) {
                     break;
                 }
                 w.qs.copy_from_slice(&w.q);

@@ -1,0 +1,40 @@
+"""``.xacro`` files: expanded to URDF by the ``xacro`` package (PyPI, no ROS needed;
+``pip install armdyn[xacro]``), then read as URDF (:mod:`armdyn.io.urdf`).
+
+Without the package, loading a ``.xacro`` file is a :class:`ModelError` naming it.
+Line numbers in URDF errors refer to the expanded document, not the ``.xacro`` source.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import ModelError
+from ..model import Robot
+
+__all__ = ["load_xacro"]
+
+
+def load_xacro(path, strict: bool = True, mappings: dict[str, str] | None = None) -> Robot:
+    """The robot of the ``.xacro`` file ``path``, its macros expanded with ``mappings``
+    (xacro arguments, name -> value). ``strict``: as for URDF."""
+    source = str(path)
+    try:
+        import xacro
+    except ImportError:
+        raise ModelError("reading .xacro files needs the 'xacro' package: pip install xacro "
+                         "(or expand it first: xacro FILE > FILE.urdf)", None, source) from None
+    from .urdf import _build, _parse
+
+    if not Path(path).is_file():
+        raise ModelError("no such file", None, source)
+    try:
+        doc = xacro.process_file(source, mappings=dict(mappings or {}))
+    except Exception as err:  # noqa: BLE001 - xacro raises its own and XML errors; one line naming the file
+        message = " ".join(str(err).split()) or type(err).__name__
+        raise ModelError(f"xacro could not expand it: {message}", None, source) from None
+    text = doc.toxml(encoding="utf-8")
+    try:
+        return _build(_parse(text), text, source, strict)
+    except ModelError as err:
+        raise err.located(source=source) from None
