@@ -75,7 +75,7 @@ def op_count_table(have_identification: bool) -> None:
         code = codegen.codegen(robot, what=what)
         derived = {"tau": list(eom.tau), "tau, ungrouped": list(eom.tau), "M": [eom.M[i, j] for i in range(6) for j in range(i, 6)], "g": list(eom.g)}
         rows = [(w, code.op_counts[w]) for w in what]
-        from armdyn.symbolic.customized_ne import customized_newton_euler
+        from armdyn.programs.customized_ne import customized_newton_euler
 
         # before the grouping: the customized Newton-Euler in the 60 standard parameters
         rows.insert(1, ("tau, ungrouped", customized_newton_euler(robot)[0].operation_counts()))
@@ -121,8 +121,8 @@ def _timed(fn, repeat):
 def generation_times(have_identification: bool, repeat: int) -> None:
     """One table: time to derive and print C, medians of ``repeat`` runs in this process
     (the first run, SymPy's caches cold, apart), with the targets of issue 8 and ratios."""
-    from armdyn.symbolic.customized_ne import customized_newton_euler, standard_parameters
-    from armdyn.symbolic.grouping import grouped_parameters
+    from armdyn.programs.customized_ne import customized_newton_euler, standard_parameters
+    from armdyn.programs.grouping import grouped_parameters
 
     robot = load("puma560-craig")
     what = ["tau", "M", "C", "g"] + (["regressor"] if have_identification else [])
@@ -176,7 +176,7 @@ def breakdown() -> None:
     import re
     from collections import defaultdict
 
-    from armdyn.codegen.program import Program
+    from armdyn.programs.program import Program
 
     robot = load("puma560-craig")
     prog = codegen.codegen(robot, what="tau").programs["tau"]
@@ -222,8 +222,8 @@ x, y = sympy.symbols("x y")
 t0 = time.process_time()
 x + y
 first_sum = time.process_time() - t0
-from armdyn.symbolic.customized_ne import customized_newton_euler, standard_parameters
-from armdyn.symbolic.grouping import grouped_parameters
+from armdyn.programs.customized_ne import customized_newton_euler, standard_parameters
+from armdyn.programs.grouping import grouped_parameters
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")
     robot = armdyn.load("puma560-craig", strict=False)

@@ -25,11 +25,11 @@ import sympy as sp
 import armdyn
 import armdyn.codegen as codegen
 from armdyn.codegen.compile import CompilerError, build_shared_library
-from armdyn.codegen.program import Builder, _fast_count
+from armdyn.programs.composite_mass_matrix import composite_mass_matrix
+from armdyn.programs.coriolis_program import christoffel_program
+from armdyn.programs.customized_ne import customized_newton_euler, standard_parameters
+from armdyn.programs.program import Builder, _fast_count
 from armdyn.symbolic import dag, derive
-from armdyn.symbolic.composite_mass_matrix import composite_mass_matrix
-from armdyn.symbolic.coriolis_program import christoffel_program
-from armdyn.symbolic.customized_ne import customized_newton_euler, standard_parameters
 
 BUNDLED = [r["name"] for r in armdyn.bundled_robots()]
 HAVE_CC = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc")
@@ -157,7 +157,7 @@ def test_customized_tau_equals_derive_exactly_on_a_shared_origin_wrist(wrist_3r,
 def _customized_tau_equals_derive(robot, grouped: bool):
     """Asserts that the customized Newton-Euler's tau, with the standard or the grouped
     parameters, equals armdyn.derive's exactly; returns the program."""
-    from armdyn.symbolic.grouping import grouped_parameters
+    from armdyn.programs.grouping import grouped_parameters
 
     eom = derive(robot, "newton-euler")
     params, defs = standard_parameters(robot)
@@ -177,8 +177,8 @@ def test_child_angular_velocity_norm_is_read_off_the_parent(wrist_3r):
     the wrist arm and of the PUMA 560; and it is the right value: on the wrist arm, the
     parent's U entry it reads equals ``-(wx^2 + wy^2)`` of the child's angular velocity
     ``R^T w_parent + qd z`` formed here directly (exact, with sin^2 + cos^2 = 1)."""
-    from armdyn.codegen.program import Builder
-    from armdyn.symbolic import customized_ne as cne
+    from armdyn.programs import customized_ne as cne
+    from armdyn.programs.program import Builder
 
     for robot in (wrist_3r, _load("puma560-craig")):
         prog, _ = customized_newton_euler(robot)
@@ -222,8 +222,8 @@ def test_turned_leaf_frame_gives_the_same_tau_exactly_for_any_angle(wrist_3r):
     q3 + th, first moment and inertia turned with it, grouped parameters): tau equals
     armdyn.derive's exactly, for every th. And the angle turn_leaf_frames picks puts the
     first moment on y: its MX' is zero and its MY' is |(MX, MY)| (exact)."""
-    from armdyn.symbolic.grouping import grouped_parameters
-    from armdyn.symbolic.leaf_frames import _turned, turn_leaf_frames
+    from armdyn.programs.grouping import grouped_parameters
+    from armdyn.programs.leaf_frames import _turned, turn_leaf_frames
 
     robot = wrist_3r
     eom = derive(robot, "newton-euler")
@@ -271,7 +271,7 @@ def test_U_column_read_off_the_parent_is_the_textbook_value():
     """U13, U23 of every link of the PUMA 560 after the second are read off the parent's U
     (no ``qd wi x z`` term is formed; links 3 by the compound angle q2 + q3 from link 1;
     link 2's U is not needed, its moment and link 3's acceleration go by the closed forms
-    of armdyn.symbolic.second_link):
+    of armdyn.programs.two_rate_link):
     at random points they equal ``w_x w_z + wd_y`` and ``w_y w_z - wd_x`` of the
     textbook recursion ``w = R^T w_p + qd z``, ``wd = R^T wd_p + qdd z + R^T w_p x qd z``
     done here in NumPy from the joint frames."""
@@ -367,8 +367,8 @@ def test_turned_leaf_inertia_rides_on_its_parent(wrist_3r):
     like Khalil's YY: the leaf's YY is 0 and the parent's XX, ZZ take it; tau of the
     customized Newton-Euler with these parameters equals armdyn.derive's at random
     points (the turned parameters are Piecewise in the model's)."""
-    from armdyn.symbolic.grouping import grouped_parameters
-    from armdyn.symbolic.leaf_frames import turn_leaf_frames
+    from armdyn.programs.grouping import grouped_parameters
+    from armdyn.programs.leaf_frames import turn_leaf_frames
 
     robot = wrist_3r
     params, defs = standard_parameters(robot)

@@ -1,4 +1,4 @@
-"""The second link's closed forms (armdyn.symbolic.second_link) against the textbook
+"""The second link's closed forms (armdyn.programs.two_rate_link) against the textbook
 recursion done in NumPy, and the customized Newton-Euler that uses them against the Rust
 core's rnea (spatial vectors, no closed forms) on arms made to switch them on and off."""
 
@@ -9,10 +9,10 @@ import pytest
 import sympy as sp
 
 import armdyn
-from armdyn.codegen.program import Builder
 from armdyn.model import Joint, Robot
-from armdyn.symbolic.customized_ne import _customized_newton_euler, customized_newton_euler
-from armdyn.symbolic.second_link import SecondLink, euler_projections, in_frame, lower_column, point_acceleration
+from armdyn.programs.customized_ne import _customized_newton_euler, customized_newton_euler
+from armdyn.programs.program import Builder
+from armdyn.programs.two_rate_link import SecondLink, euler_projections, in_frame, lower_column, point_acceleration
 from random_models import random_link
 
 RX = [[1, 0, 0], [0, 0, 1], [0, -1, 0]]  # alpha = -90 deg: the next axis perpendicular

@@ -53,7 +53,7 @@ import sympy as sp
 
 from ..model import Robot
 from ..symbolic import dag
-from .program import Builder, Program, from_expressions
+from ..programs.program import Builder, Program, from_expressions
 from .printers import INPUTS, Names, print_c, print_python
 
 QUANTITIES = ("tau", "M", "C", "g", "regressor")
@@ -195,10 +195,10 @@ def _in_model_parameters(extra, definitions, chained: bool = False) -> list:
 
 
 def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
-    from ..symbolic.composite_mass_matrix import composite_mass_matrix
-    from ..symbolic.customized_ne import customized_newton_euler, standard_parameters
-    from ..symbolic.coriolis_program import christoffel_program
-    from ..symbolic.grouping import grouped_parameters
+    from ..programs.composite_mass_matrix import composite_mass_matrix
+    from ..programs.customized_ne import customized_newton_euler, standard_parameters
+    from ..programs.coriolis_program import christoffel_program
+    from ..programs.grouping import grouped_parameters
 
     params, definitions = standard_parameters(robot)
     # Khalil's grouping (exact): what of a link's inertia rides on its parent is moved
@@ -247,7 +247,7 @@ def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
 def _turned_leaves(robot: Robot, params: dict, definitions: list, taken=()):
     """:func:`armdyn.symbolic.leaf_frames.turn_leaf_frames`, with the new definitions in
     the model's parameters (``definitions``' symbols replaced by theirs)."""
-    from ..symbolic.leaf_frames import turn_leaf_frames
+    from ..programs.leaf_frames import turn_leaf_frames
 
     turned, new, turns = turn_leaf_frames(robot, params, definitions, taken)
     return turned, _in_model_parameters(new, definitions), turns
@@ -314,10 +314,10 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
     """tau, g, M, C by the customized algorithms at the base-parameter point
     (:mod:`armdyn.codegen.base`), checked against ``Yb beta`` at random points; None if
     the base parameters are not a grouping onto standard columns."""
-    from ..symbolic.composite_mass_matrix import composite_mass_matrix
-    from ..symbolic.coriolis_program import christoffel_program
-    from ..symbolic.customized_ne import customized_newton_euler
-    from .base import base_inertials
+    from ..programs.composite_mass_matrix import composite_mass_matrix
+    from ..programs.coriolis_program import christoffel_program
+    from ..programs.customized_ne import customized_newton_euler
+    from ..programs.base_parameters import base_inertials
 
     if not what:
         return None
@@ -332,7 +332,7 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
     M_prog = builder = None
     reserved = robot.free_symbols() | set(beta) | set(robot.q) | set(robot.qd) | set(robot.qdd)
     # tau and g with the leaf links' frames turned (first moment on y), in the betas
-    from ..symbolic.leaf_frames import turn_leaf_frames
+    from ..programs.leaf_frames import turn_leaf_frames
 
     ne_params, leaf_defs, turns = turn_leaf_frames(robot, params, [], taken=beta)
     tau_prog, d = customized_newton_euler(robot, parameters=ne_params, turns=turns)

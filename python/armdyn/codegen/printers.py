@@ -17,7 +17,7 @@ from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
-from .program import Program
+from ..programs.program import Program
 from .sincos_coefficients import COS, SIN
 
 INPUTS = {"tau": ("q", "qd", "qdd"), "M": ("q",), "C": ("q", "qd"), "g": ("q",), "regressor": ("q", "qd", "qdd")}

@@ -49,7 +49,7 @@ apply (:func:`run_link`), the ``A`` of every such link summed before one product
 ``a'``; its U's lower row then also comes from its last column (:func:`lower_column`).
 
 All vectors are lists of 3 SymPy expressions; named temporaries go through the
-customized program's :class:`~armdyn.codegen.program.Builder`.
+customized program's :class:`~armdyn.programs.program.Builder`.
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..codegen.program import Builder, is_value
+from .program import Builder, is_value
 from .vectors import ZERO, dot, minus, mtv, plus, times
 
 

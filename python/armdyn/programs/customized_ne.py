@@ -21,12 +21,12 @@ as :mod:`armdyn.symbolic.newton_euler`, but
   child's ``wd_x = w_y w_z - U23`` and ``wd_y = U13 - w_x w_z`` follow with one sum each;
 * runs of parallel joints (``q2 + q3``) take their angular quantities from the link before
   the run, and a base-fixed link's torque their moments, by the compound angle
-  (:mod:`armdyn.symbolic.parallel_joints`);
+  (:mod:`armdyn.programs.parallel_joints`);
 * the second link of an arm on a base-fixed first joint (perpendicular axes) gives only
   two projections of its Euler moment, in closed form, and a child continuing a run its
   acceleration without the link's U; the links further along that run give the same two
-  projections, where that makes the program shorter (:mod:`armdyn.symbolic.second_link`);
-* optionally (``turns``, :mod:`armdyn.symbolic.leaf_frames`) a leaf link's frame turned
+  projections, where that makes the program shorter (:mod:`armdyn.programs.two_rate_link`);
+* optionally (``turns``, :mod:`armdyn.programs.leaf_frames`) a leaf link's frame turned
   about its joint axis by a per-parameter-set angle.
 
 All vectors of link j are in link j's frame. Outward, with ``(R, p)`` link j's frame in
@@ -53,11 +53,11 @@ import re
 
 import sympy as sp
 
-from ..codegen.program import Builder, Program, is_value, names
 from ..model import Robot
 from .parallel_joints import about_z, cheaper, own_revolute_about_z, parallel_runs, root_torque
-from .second_link import (euler_projections, gravity_moment, in_frame, lower_column, point_acceleration, root_axes,
-                          run_link, second_link)
+from .program import Builder, Program, is_value, names
+from .two_rate_link import (euler_projections, gravity_moment, in_frame, lower_column, point_acceleration, root_axes,
+                            run_link, second_link)
 from .vectors import (UPPER, ZERO, cross, dot, expanded, expanded_times, minus, mtv, mv, plus, rows, times,
                       turned_about_z, vadd, vscale)
 
@@ -148,7 +148,7 @@ def joint_frames(robot: Robot, b: Builder, turns: dict | None = None) -> dict:
     and non-trivial entries of ``R`` and ``p`` named.
 
     turns: ``{link: th}`` links whose frame is turned by the constant ``th`` about their
-    (revolute, +z) joint axis (:mod:`armdyn.symbolic.leaf_frames`): their joint angle is
+    (revolute, +z) joint axis (:mod:`armdyn.programs.leaf_frames`): their joint angle is
     ``q + th`` (named ``q6t``, one addition), and ``c6, s6`` are its cosine and sine."""
     frames = {}
     turns = turns or {}
@@ -236,7 +236,7 @@ def _skew2(b: Builder, w, wd, tag, sq: dict, column=None, lower=None) -> list:
     """U = skew(wd) + skew(w) skew(w) (3x3 rows), Khalil eq. 9.79, from the named
     products ``sq`` of :func:`_squares`; ``column``: ``(U13, U23)`` when already known
     (:func:`_column_from_parent`); ``lower``: ``(U31, U32)`` where known otherwise
-    (:func:`armdyn.symbolic.second_link.lower_column`; None entries: the generic ones)."""
+    (:func:`armdyn.programs.two_rate_link.lower_column`; None entries: the generic ones)."""
     xy, xz, yz = sq["xy"], sq["xz"], sq["yz"]
     U13, U23 = column if column is not None else (plus(xz, wd[1]), minus(yz, wd[0]))
     U31, U32 = lower if lower is not None else (None, None)
@@ -305,10 +305,10 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     :func:`standard_parameters` (those only when ``parameters`` is None) and
     :func:`moment_differences` (always).
     turns: ``{link: th}`` leaf links whose frame (and ``parameters``) are turned about
-    their joint axis (:func:`armdyn.symbolic.leaf_frames.turn_leaf_frames`).
+    their joint axis (:func:`armdyn.programs.leaf_frames.turn_leaf_frames`).
 
     The closed forms of the links further along a run from the second link
-    (:func:`armdyn.symbolic.second_link.run_link`) take one operation less on the PUMA 560
+    (:func:`armdyn.programs.two_rate_link.run_link`) take one operation less on the PUMA 560
     and two more on the bundled UR5 (its inertia tensors numeric and diagonal): with a
     fresh builder the program is built with and without them and the shorter kept.
     """
@@ -470,7 +470,7 @@ def _children_need_wd(robot: Robot, name, frames) -> set:
 def _second_link_moment(b: Builder, s, MS, vd_j, tag, root_tag, raw: dict, N: dict, parameters: dict,
                         definitions: list):
     """A second link's moment without its Euler part (only its projections are used,
-    :func:`armdyn.symbolic.second_link.euler_projections`): ``(MS x vd (3,), gMS, J33_R)``.
+    :func:`armdyn.programs.two_rate_link.euler_projections`): ``(MS x vd (3,), gMS, J33_R)``.
 
     ``MS x vd`` is ``(g MS) x u`` when gravity is all of the root's acceleration; ``gMS``
     (3,) is then ``g MS`` (new parameters appended to ``definitions``), else None. J33_R:

@@ -11,7 +11,7 @@ sine and cosine; it pays when the anchor's vectors are sparse (the first link of
 turns about the base's fixed axis: ``w1 = (0, 0, qd1)``):
 
 * outward, the x, y components of the child's angular velocity and its U's last column
-  (:func:`armdyn.symbolic.customized_ne._column_from_parent`) come from the anchor's in one
+  (:func:`armdyn.programs.customized_ne._column_from_parent`) come from the anchor's in one
   rotation each (two products instead of four products and two sums on the PUMA 560);
 * inward, a link fixed to the base needs only its torque ``z . n``: the moments of the
   run are brought to it directly, ``R2 (N2 + (a2, 0, 0) x R3 f3) + R0 Rz(q2 + q3) (n3 +
@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..codegen.program import Builder, is_value
 from ..model import Robot
+from .program import Builder, is_value
 from .vectors import ZERO, cross, dot, mtv, mv, rows, turned_about_z, vadd
 
 E3 = sp.Matrix([0, 0, 1])
@@ -71,7 +71,7 @@ def parallel_runs(robot: Robot, angles: dict) -> dict:
     """``{link: Run}`` for every link that continues a run of parallel revolute joints
     (second joint of the run and after). ``robot``: canonical frames; ``angles``:
     ``{link: its joint angle}`` as the program names it (``q6t = q6 + th6`` for a leaf
-    turned about its joint axis, :mod:`armdyn.symbolic.leaf_frames`)."""
+    turned about its joint axis, :mod:`armdyn.programs.leaf_frames`)."""
     joint_of = {j.child: j for j in robot.joints}
     start, runs = {}, {}
     for joint in robot.joints:
