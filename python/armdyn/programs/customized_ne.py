@@ -50,14 +50,16 @@ Dead code (quantities no torque needs, e.g. the first link's force) is removed a
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass, field
 
 import sympy as sp
 
 from ..model import Robot
-from .parallel_joints import about_z, cheaper, own_revolute_about_z, parallel_runs, root_torque
-from .program import Builder, Program, is_value, names
-from .two_rate_link import (euler_projections, gravity_moment, in_frame, lower_column, point_acceleration, root_axes,
-                            run_link, second_link)
+from .link_terms import children_need_wd, column_from_parent, euler_moment, parent_invariant, skew2, squares
+from .parallel_joints import Run, about_z, compound_angular, own_revolute_about_z, parallel_runs, root_torque
+from .program import Builder, Program, names
+from .two_rate_link import (TwoRateLink, euler_projections, in_frame, lower_column, point_acceleration, root_axes,
+                            run_link, second_link, second_link_moment)
 from .vectors import (UPPER, ZERO, cross, dot, expanded, expanded_times, minus, mtv, mv, plus, rows, times,
                       turned_about_z, vadd, vscale)
 
@@ -175,127 +177,96 @@ def joint_frames(robot: Robot, b: Builder, turns: dict | None = None) -> dict:
     return frames
 
 
-def _squares(b: Builder, w, tag, S=None) -> dict:
-    """The products of w's components that U and the Euler moment use (named once):
-    ``xy, xz, yz``, the diagonal of ``skew(w)^2`` (``U11 = -wy^2 - wz^2``, ``U22``,
-    ``U33``) and the differences ``d0 = wy^2 - wz^2, d1 = wz^2 - wx^2, d2 = wx^2 - wy^2``.
 
-    S: ``-(wx^2 + wy^2)`` when it is already known from the parent (see
-    :func:`_parent_invariant`): a rotation about the joint axis z leaves ``wx^2 + wy^2``
-    unchanged, so ``wy^2`` is not needed (one multiplication less per link)::
 
-        U22 = -wx^2 - wz^2,  d1 = wz^2 - wx^2,  U33 = S,  U11 = S - d1,  d0 = U22 - S,
-        d2 = -d0 - d1
+@dataclass(frozen=True)
+class Forms:
+    """The special forms :func:`customized_newton_euler` may use, each where it applies
+    (all of them by default). Switching one off leaves the plain recursion there: to
+    measure what a form saves, or to test it against the program without it.
 
-    (``d2`` from the other two differences, not from ``U11``: a link that needs no
-    ``U11`` does not pay for it; never more operations than without ``S``, given ``S``.)
+    parallel_runs: a link continuing a run of parallel joints takes its angular velocity
+        and U column from the run's anchor by the compound angle where that is cheaper,
+        and a base-fixed link's torque the run's moments by the compound rotation
+        (:mod:`~armdyn.programs.parallel_joints`);
+    two_rate_links: the second link of an arm on a base-fixed first joint gives only two
+        projections of its Euler moment, in closed form, and a child continuing a run
+        from the root its acceleration without the link's U
+        (:mod:`~armdyn.programs.two_rate_link`);
+    run_links: the links further along such a run give the same two projections:
+        ``"shorter"`` (the program is built with and without them and the shorter kept:
+        they save one operation on the PUMA 560 and cost two on the bundled UR5, whose
+        inertia tensors are numeric and diagonal; with a caller's builder, never),
+        ``"always"`` or ``"never"``.
     """
-    w1, w2, w3 = w
-    xx, zz = b.let(w1 * w1, f"w{tag}xx"), b.let(w3 * w3, f"w{tag}zz")
-    out = {"xy": b.let(w1 * w2, f"w{tag}xy"), "xz": b.let(w1 * w3, f"w{tag}xz"), "yz": b.let(w2 * w3, f"w{tag}yz")}
-    if S is None:
-        yy = b.let(w2 * w2, f"w{tag}yy")
-        out.update(U11=b.let(-yy - zz, f"U{tag}_11"), U22=b.let(-xx - zz, f"U{tag}_22"),
-                   U33=b.let(-xx - yy, f"U{tag}_33"), d0=b.let(yy - zz, f"w{tag}_yy_zz"),
-                   d1=b.let(zz - xx, f"w{tag}_zz_xx"), d2=b.let(xx - yy, f"w{tag}_xx_yy"))
-    else:
-        U22, d1 = b.let(-xx - zz, f"U{tag}_22"), b.let(zz - xx, f"w{tag}_zz_xx")
-        U11 = b.let(S - d1, f"U{tag}_11")
-        out_d0 = b.let(U22 - S, f"w{tag}_yy_zz")
-        out.update(U11=U11, U22=U22, U33=S, d0=out_d0, d1=d1,
-                   d2=b.let(-out_d0 - d1, f"w{tag}_xx_yy"))
-    return out
+
+    parallel_runs: bool = True
+    two_rate_links: bool = True
+    run_links: str = "shorter"
+
+    def __post_init__(self):
+        if self.run_links not in ("shorter", "always", "never"):
+            raise ValueError(f"Forms: run_links must be 'shorter', 'always' or 'never', not {self.run_links!r}")
 
 
-def _axis_in_parent(joint, R):
-    """``(k, sign)`` when the joint moves about or along its child's z axis and that axis
-    is the parent's ``sign e_k`` (``R e_z = sign e_k``, as in every DH frame), else None."""
-    axis = joint.axis
-    if joint.type not in ("revolute", "prismatic") or not (
-            is_value(axis[0], 0) and is_value(axis[1], 0) and is_value(abs(axis[2]), 1)):
-        return None
-    col = [R[i][2] for i in range(3)]
-    hits = [i for i, e in enumerate(col) if not is_value(e, 0)]
-    if len(hits) != 1 or not is_value(abs(col[hits[0]]), 1):
-        return None
-    return hits[0], 1 if float(col[hits[0]]) > 0 else -1
+@dataclass
+class LinkState:
+    """One link's quantities in the recursion, filled in pass by pass, all in the link's
+    own frame (3-vectors as lists, 3x3 matrices as lists of rows).
+
+    joint, tag (the link's index as the temporaries' names show it), k (its coordinate's
+    index, None for a fixed joint), R, p: its frame in the parent's.
+    Outward: w, wd (angular velocity and acceleration), sq (the named products of w,
+    :func:`~armdyn.programs.link_terms.squares`), column ((U13, U23) when read off the
+    parent, else None), vd (the origin's acceleration, gravity included), U, F (force),
+    N (moment about the origin); euler_and_ms: ``(J wd + w x J w, MS x vd)`` when N is
+    their plain sum (a root link's, until a second link takes its J33 part), else None.
+    Forms: run (the run of parallel joints it continues, or None), Ra (its compound
+    rotation from the run's anchor), compound (its angular quantities came by Ra);
+    two_rate (its moment's closed form, or None), root (that form's base-fixed joint),
+    second (the form is the second link's, not a run link's).
+    Inward: f, n (total force and moment), Rf (its force in the parent's axes)."""
+
+    joint: object = None
+    tag: str = ""
+    k: int | None = None
+    R: list | None = None
+    p: list | None = None
+    w: list | None = None
+    wd: list | None = None
+    sq: dict | None = None
+    column: tuple | None = None
+    vd: list | None = None
+    U: list | None = None
+    F: list | None = None
+    N: list | None = None
+    euler_and_ms: tuple | None = None
+    run: Run | None = None
+    Ra: list | None = None
+    compound: bool = False
+    two_rate: TwoRateLink | None = None
+    root: object = None
+    second: bool = False
+    f: list | None = None
+    n: list | None = None
+    Rf: list | None = None
 
 
-def _parent_invariant(joint, R, U_parent):
-    """``-(wx^2 + wy^2)`` of the child's angular velocity, read off the parent's U, or
-    None. When the joint moves about (or along) the child's z axis and that axis is a
-    parent axis ``+-e_k`` (:func:`_axis_in_parent`), the child's x and y components are
-    the parent's other two components rotated about it, so
-    ``wx^2 + wy^2 = sum_{i != k} wp_i^2 = -U_parent[k, k]`` (the norm is unchanged by a
-    rotation; the parent's U diagonal holds these sums)."""
-    found = _axis_in_parent(joint, R)
-    return None if found is None else U_parent[found[0]][found[0]]
+@dataclass
+class RootSum:
+    """The projections on a base-fixed root's axis of the Euler moments of the two-rate
+    links on it: ``a' (A_1 + A_2 + ...) + rest_1 + rest_2 + ...`` (one product with
+    ``a'``), named ``A<first>`` after the first such link."""
 
-
-def _skew2(b: Builder, w, wd, tag, sq: dict, column=None, lower=None) -> list:
-    """U = skew(wd) + skew(w) skew(w) (3x3 rows), Khalil eq. 9.79, from the named
-    products ``sq`` of :func:`_squares`; ``column``: ``(U13, U23)`` when already known
-    (:func:`_column_from_parent`); ``lower``: ``(U31, U32)`` where known otherwise
-    (:func:`armdyn.programs.two_rate_link.lower_column`; None entries: the generic ones)."""
-    xy, xz, yz = sq["xy"], sq["xz"], sq["yz"]
-    U13, U23 = column if column is not None else (plus(xz, wd[1]), minus(yz, wd[0]))
-    U31, U32 = lower if lower is not None else (None, None)
-    U = [
-        [sq["U11"], minus(xy, wd[2]), U13],
-        [plus(xy, wd[2]), sq["U22"], U23],
-        [minus(xz, wd[1]) if U31 is None else U31, plus(yz, wd[0]) if U32 is None else U32, sq["U33"]],
-    ]
-    return [[b.let(U[r][s], f"U{tag}_{r + 1}{s + 1}") for s in range(3)] for r in range(3)]
-
-
-def _column_from_parent(joint, R, U_parent):
-    """``(U13, U23)`` of a revolute child, from its parent's U, or None.
-
-    With ``wi = R^T w_p`` and the joint rate ``qd`` about z, the child's
-    ``U = skew(wd) + skew(w)^2`` is the parent's seen in the child frame plus terms of
-    the joint's own motion::
-
-        U = R^T U_p R + qdd skew(z) + 2 qd z wi^T - (2 qd wi_z + qd^2) (1 - z z^T)
-
-    (expand ``skew(wi + qd z)^2`` and ``skew(R^T wd_p + qdd z + qd wi x z)``; the
-    ``qd wi z^T`` parts of the two cancel). Its last column above the diagonal has no
-    such term: ``(U13, U23)`` are the first two entries of ``R^T U_p R z = +-R^T U_p[:, k]``
-    when ``R z = +-e_k``, a rotation of two entries of the parent's column k (4 products,
-    2 sums) instead of ``R^T wd_p`` and ``qd (wi_y, -wi_x)`` (6 products, 4 sums); the
-    child's ``wd_x = w_y w_z - U23`` and ``wd_y = U13 - w_x w_z`` then follow with one
-    sum each."""
-    found = _axis_in_parent(joint, R)
-    if found is None or joint.type != "revolute" or not about_z(joint):
-        return None
-    k, sign = found
-    return tuple(plus(*[times(R[m][i] if sign > 0 else -R[m][i], U_parent[m][k]) for m in range(3)])
-                 for i in range(2))
-
-
-def _euler_moment(J, differences, wd, U, sq) -> list:
-    """J wd + w x (J w) (3,) for a symmetric J (3x3 rows), as linear in J's six entries,
-    with the coefficients taken from U (whose off-diagonal entries are wd_k +- w_i w_j)
-    and the squares of w::
-
-        x: XX wdx + XY (wdy - wx wz) + XZ (wdz + wx wy) + YZ (wy^2 - wz^2) + (ZZ - YY) wy wz
-        y: XY (wdx + wy wz) + YY wdy + YZ (wdz - wx wy) + XZ (wz^2 - wx^2) + (XX - ZZ) wx wz
-        z: XZ (wdx - wy wz) + YZ (wdy + wx wz) + ZZ wdz + XY (wx^2 - wy^2) + (YY - XX) wx wy
-
-    (15 products instead of the 24 of J wd, J w and the cross product). ``differences``
-    are (ZZ - YY, XX - ZZ, YY - XX), parameters of their own (:func:`moment_differences`)."""
-    (XX, XY, XZ), (_, YY, YZ), (_, _, ZZ) = J
-    ZZ_YY, XX_ZZ, YY_XX = differences
-    wxy, wxz, wyz = sq["xy"], sq["xz"], sq["yz"]
-    d = [sq["d0"], sq["d1"], sq["d2"]]
-    return [
-        plus(times(XX, wd[0]), -times(XY, U[2][0]), times(XZ, U[1][0]), times(YZ, d[0]), times(ZZ_YY, wyz)),
-        plus(times(XY, U[2][1]), times(YY, wd[1]), -times(YZ, U[0][1]), times(XZ, d[1]), times(XX_ZZ, wxz)),
-        plus(-times(XZ, U[1][2]), times(YZ, U[0][2]), times(ZZ, wd[2]), times(XY, d[2]), times(YY_XX, wxy)),
-    ]
+    ad: sp.Expr
+    first: str
+    A: list = field(default_factory=list)
+    rests: list = field(default_factory=list)
 
 
 def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, parameters=None,
-                            builder: Builder | None = None, turns: dict | None = None) -> tuple[Program, list]:
+                            builder: Builder | None = None, turns: dict | None = None,
+                            forms: Forms | None = None) -> tuple[Program, list]:
     """tau (n,) of ``robot`` as a :class:`Program` of the joint coordinates, velocities
     ``qd`` and accelerations ``qdd`` (default: the robot's symbols; pass zeros for the
     gravity torques) and the barycentric parameters.
@@ -306,27 +277,25 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     :func:`moment_differences` (always).
     turns: ``{link: th}`` leaf links whose frame (and ``parameters``) are turned about
     their joint axis (:func:`armdyn.programs.leaf_frames.turn_leaf_frames`).
-
-    The closed forms of the links further along a run from the second link
-    (:func:`armdyn.programs.two_rate_link.run_link`) take one operation less on the PUMA 560
-    and two more on the bundled UR5 (its inertia tensors numeric and diagonal): with a
-    fresh builder the program is built with and without them and the shorter kept.
+    forms: the special forms to use (:class:`Forms`; default all).
     """
-    args = (robot, qd, qdd, gravity, parameters, builder, turns)
-    program, definitions, closed = _customized_newton_euler(*args, close_runs=builder is None)
-    if closed:
-        generic, generic_definitions, _ = _customized_newton_euler(*args, close_runs=False)
+    forms = forms or Forms()
+    run_links = forms.run_links == "always" or (forms.run_links == "shorter" and builder is None)
+    args = (robot, qd, qdd, gravity, parameters, builder, turns, forms)
+    program, definitions, joined = _program(*args, run_links=run_links)
+    if joined and forms.run_links == "shorter":
+        # the run links' closed forms' saving depends on the inertias: keep the shorter
+        generic, generic_definitions, _ = _program(*args, run_links=False)
         if generic.operation_counts()["total"] <= program.operation_counts()["total"]:
             return generic, generic_definitions
     return program, definitions
 
 
-def _customized_newton_euler(robot: Robot, qd, qdd, gravity, parameters, builder: Builder | None, turns: dict | None,
-                             close_runs: bool) -> tuple[Program, list, bool]:
-    """:func:`customized_newton_euler`, with or without the closed forms of run links
-    (``close_runs``); also whether it used any."""
+def _program(robot: Robot, qd, qdd, gravity, parameters, builder: Builder | None, turns: dict | None, forms: Forms,
+             run_links: bool) -> tuple[Program, list, bool]:
+    """The program, its definitions, and whether a run link's projections joined another
+    link's on a root (then the program without run links may be the shorter)."""
     robot = robot.canonical()  # link frames on their joints (frames off the axis: same dynamics)
-    n = robot.dof
     qd = list(robot.qd) if qd is None else [sp.sympify(x) for x in qd]
     qdd = list(robot.qdd) if qdd is None else [sp.sympify(x) for x in qdd]
     definitions = []
@@ -336,159 +305,169 @@ def _customized_newton_euler(robot: Robot, qd, qdd, gravity, parameters, builder
     differences, extra = moment_differences(robot, parameters, definitions, free)
     definitions = definitions + extra
     b = builder or Builder(reserved=free | set(robot.q) | set(robot.qd) | set(robot.qdd) | {s for s, _ in definitions})
-    frames = joint_frames(robot, b, turns)
-    # each joint's angle as joint_frames named it (a turned leaf's q + th is one temporary)
-    angles = {j.child: b.let(robot.joint_coordinate(j) + (turns or {}).get(j.child, 0)) for j in robot.joints}
-    runs, rotations = parallel_runs(robot, angles), {}
-    zero = [ZERO] * 3
-    base_acc = list(-robot.gravity) if gravity else zero
-    w, wd = {robot.base: zero}, {robot.base: zero}
-    vd = {robot.base: b.vector(base_acc, "g")}
-    U = {robot.base: [zero] * 3}
-    F, N = {}, {}
-    joint_of = {j.child: j for j in robot.joints}
-    # second links; each link's (Euler, MS x vd); per root: the A and the rest of its links' u . E
-    seconds, raw, along_root = {}, {}, {}
+    recursion = _Recursion(robot, b, qd, qdd, gravity, parameters, differences, definitions, turns, forms, run_links)
     for joint in robot.joints:
-        name, parent = joint.child, joint.parent
-        tag = _safe(str(robot.link_index(name)))
-        k = robot.coordinate_index(joint)
-        R, p = frames[name]
-        z = list(joint.axis)
-        w_in = mtv(R, w[parent])
-        column = _column_from_parent(joint, R, U[parent])
-        run = runs.get(name)
-        if run is not None:  # a run of parallel joints: from its anchor, by the compound angle
-            Ra = run.rotation(b)
-            w_run, column_run = mtv(Ra, w[run.anchor])[:2], _column_from_parent(joint, Ra, U[run.anchor])
-            if cheaper([*w_run, *(column_run or ())], [*w_in[:2], *(column or ())]):
-                w_in, column = [*w_run, w_in[2]], column_run
-                rotations[name] = Ra
+        recursion.outward(joint)
+    tau = recursion.inward()
+    joined = any(len(total.A) > 1 for total in recursion.along_root.values())
+    return b.program(tau, (robot.dof,)), definitions, joined
+
+
+class _Recursion:
+    """The customized recursion over one robot (canonical frames): per link, outward
+    (:meth:`outward`: angular velocity and acceleration, origin acceleration, the form of
+    the moment, force and moment), then inward (:meth:`inward`: forces, moments,
+    torques). Each form is asked where it applies; the plain recursion does the rest."""
+
+    def __init__(self, robot: Robot, b: Builder, qd, qdd, gravity, parameters, differences, definitions, turns, forms,
+                 run_links):
+        self.robot, self.b, self.qd, self.qdd = robot, b, qd, qdd
+        self.parameters, self.differences, self.definitions = parameters, differences, definitions
+        self.forms, self.run_links = forms, run_links
+        self.frames = joint_frames(robot, b, turns)
+        # each joint's angle as joint_frames named it (a turned leaf's q + th is one temporary)
+        angles = {j.child: b.let(robot.joint_coordinate(j) + (turns or {}).get(j.child, 0)) for j in robot.joints}
+        self.runs = parallel_runs(robot, angles) if forms.parallel_runs else {}
+        zero = [ZERO] * 3
+        base_acc = list(-robot.gravity) if gravity else zero
+        self.links = {robot.base: LinkState(w=zero, wd=zero, vd=b.vector(base_acc, "g"), U=[zero] * 3)}
+        self.joint_of = {j.child: j for j in robot.joints}
+        self.along_root: dict = {}  # root coordinate index -> RootSum
+
+    def outward(self, joint) -> None:
+        robot = self.robot
+        name = joint.child
+        s = LinkState(joint, _safe(str(robot.link_index(name))), robot.coordinate_index(joint), *self.frames[name])
+        s.run = self.runs.get(name)
+        self._angular(s)
+        self._origin_acceleration(s)
+        self._two_rate_form(s)
+        self._wrench(s)
+        self.links[name] = s
+
+    def _angular(self, s: LinkState) -> None:
+        """w, wd, the products of w and U's column read off the parent, of a link; for
+        one continuing a run, by the compound angle where that is cheaper."""
+        b, joint, R, tag = self.b, s.joint, s.R, s.tag
+        parent = self.links[joint.parent]
+        w_in = mtv(R, parent.w)
+        column = column_from_parent(joint, R, parent.U)
+        if s.run is not None:
+            anchor = self.links[s.run.anchor]
+            s.Ra = s.run.rotation(b)
+            column_run = column_from_parent(joint, s.Ra, anchor.U)
+            w_in, column, s.compound = compound_angular(s.Ra, anchor.w, column_run, w_in, column)
         w_in = b.vector(w_in, f"wi{tag}")
-        wd_j = mtv(R, wd[parent])
+        wd = mtv(R, parent.wd)
+        z, k = list(joint.axis), s.k
         if joint.type == "revolute":
-            w_j = b.vector(vadd(w_in, vscale(qd[k], z)), f"w{tag}")
-            sq = _squares(b, w_j, tag, _parent_invariant(joint, R, U[parent]))
+            s.w = b.vector(vadd(w_in, vscale(self.qd[k], z)), f"w{tag}")
+            s.sq = squares(b, s.w, tag, parent_invariant(joint, R, parent.U))
             if column is not None:
                 column = b.let(column[0], f"U{tag}_13"), b.let(column[1], f"U{tag}_23")
-                wd_j = [minus(sq["yz"], column[1]), minus(column[0], sq["xz"]), plus(wd_j[2], qdd[k])]
+                wd = [minus(s.sq["yz"], column[1]), minus(column[0], s.sq["xz"]), plus(wd[2], self.qdd[k])]
             else:
-                wd_j = vadd(wd_j, vscale(qdd[k], z), cross(w_in, vscale(qd[k], z)))
+                wd = vadd(wd, vscale(self.qdd[k], z), cross(w_in, vscale(self.qd[k], z)))
         else:
-            w_j = b.vector(w_in, f"w{tag}")
-            sq = _squares(b, w_j, tag, _parent_invariant(joint, R, U[parent]))
-        wd_j = b.vector(wd_j, f"wd{tag}")
-        through = seconds.get(parent)
-        if run is not None and through is not None and through.gz is not None and run.anchor == through.root:
-            # a run from the root through the second link: the origin's acceleration in the
-            # basis (u, v, e3) of the parent, turned here by the compound angle
-            vd_j = in_frame(point_acceleration(b, through, p, _safe(str(robot.link_index(parent)))), *root_axes(Ra))
+            s.w = b.vector(w_in, f"w{tag}")
+            s.sq = squares(b, s.w, tag, parent_invariant(joint, R, parent.U))
+        s.column = column
+        s.wd = b.vector(wd, f"wd{tag}")
+
+    def _origin_acceleration(self, s: LinkState) -> None:
+        """vd of a link: through its parent's U, or, for a link continuing a run from the
+        root through a second link, in that link's basis (u, v, e3) turned by the
+        compound angle (:func:`~armdyn.programs.two_rate_link.point_acceleration`)."""
+        b, joint, tag = self.b, s.joint, s.tag
+        parent = self.links[joint.parent]
+        through = parent.two_rate
+        if s.run is not None and through is not None and through.gz is not None and s.run.anchor == through.root:
+            vd = in_frame(point_acceleration(b, through, s.p, parent.tag), *root_axes(s.Ra))
         else:
-            Up_p = b.vector(mv(U[parent], p), f"Up{tag}")
-            vd_j = mtv(R, b.vector(vadd(Up_p, vd[parent]), f"a{tag}"))  # named: both rows of R^T use it
+            Up_p = b.vector(mv(parent.U, s.p), f"Up{tag}")
+            vd = mtv(s.R, b.vector(vadd(Up_p, parent.vd), f"a{tag}"))  # named: both rows of R^T use it
         if joint.type == "prismatic":
-            vd_j = vadd(vd_j, vscale(2, cross(w_j, vscale(qd[k], z))), vscale(qdd[k], z))
-        vd_j = b.vector(vd_j, f"vd{tag}")
-        M, MS, J = parameters[name]
-        MS, J = list(MS), rows(J)
-        root = joint_of.get(parent)
-        second = closed = None
+            z, k = list(joint.axis), s.k
+            vd = vadd(vd, vscale(2, cross(s.w, vscale(self.qd[k], z))), vscale(self.qdd[k], z))
+        s.vd = b.vector(vd, f"vd{tag}")
+
+    def _two_rate_form(self, s: LinkState) -> None:
+        """The closed form of the link's moment, where it applies: a second link
+        (:func:`~armdyn.programs.two_rate_link.second_link`), or a link further along a run
+        from a base-fixed root, by its compound rotation (its moment's x, y components
+        only ever reach the root's torque, :func:`~armdyn.programs.parallel_joints.root_torque`)."""
+        robot, joint = self.robot, s.joint
+        parent = self.links[joint.parent]
+        root = self.joint_of.get(joint.parent)
         if (root is not None and root.parent == robot.base and own_revolute_about_z(robot, root)
                 and own_revolute_about_z(robot, joint)):
-            origin = vadd(mv(U[parent], p), vd[parent])  # L's origin's acceleration, root axes
-            second = second_link(b, joint, R, root, w[parent], wd[parent], origin, qd[k], qdd[k], tag)
-        elif close_runs and name in rotations and column is not None and own_revolute_about_z(robot, joint):
-            # further along a run from a base-fixed root, by its compound rotation: its
-            # moment's x, y components only ever reach the root's torque (root_torque)
-            root = joint_of[run.anchor]
+            if self.forms.two_rate_links:
+                origin = vadd(mv(parent.U, s.p), parent.vd)  # L's origin's acceleration, root axes
+                s.two_rate = second_link(self.b, joint, s.R, root, parent.w, parent.wd, origin, self.qd[s.k],
+                                         self.qdd[s.k], s.tag)
+                s.root, s.second = root, True
+        elif self.run_links and s.compound and s.column is not None and own_revolute_about_z(robot, joint):
+            root = self.joint_of[s.run.anchor]
             if root.parent == robot.base and own_revolute_about_z(robot, root):
-                closed = run_link(b, root, w[run.anchor], wd[run.anchor], Ra, w_j, wd_j, tag)
+                anchor = self.links[s.run.anchor]
+                s.two_rate = run_link(self.b, root, anchor.w, anchor.wd, s.Ra, s.w, s.wd, s.tag)
+                s.root = root
+
+    def _wrench(self, s: LinkState) -> None:
+        """U, the force F and the moment N of a link (Khalil eqs. 9.79-9.82), the moment
+        by its closed form where :meth:`_two_rate_form` found one."""
+        b, name, tag = self.b, s.joint.child, s.tag
+        M, MS, J = self.parameters[name]
+        MS, J = list(MS), rows(J)
         lower = None
-        if closed is not None:  # U31 without w_x w_z and wd_y, U32 without w_y w_z and wd_x
-            needed, closed_lower = _children_need_wd(robot, name, frames), lower_column(closed, column)
+        if s.two_rate is not None and not s.second:  # U31, U32 of a run link without w_x w_z, w_y w_z
+            needed, closed_lower = children_need_wd(self.robot, name, self.frames), lower_column(s.two_rate, s.column)
             # U31 needs wd_y generically, U32 wd_x: the closed form where no child reads them
             lower = (None if 1 in needed else closed_lower[0], None if 0 in needed else closed_lower[1])
-        U_j = _skew2(b, w_j, wd_j, tag, sq, column, lower)
-        F[name] = b.vector(vadd(vscale(M, vd_j), mv(U_j, MS)), f"F{tag}")
-        if second is None and closed is None:
-            raw[name] = (_euler_moment(J, differences[name], wd_j, U_j, sq), cross(MS, vd_j))
-            N[name] = b.vector(vadd(*raw[name]), f"N{tag}")
-        else:
-            ms, gMS, root_J33, shared = cross(MS, vd_j), None, ZERO, False
-            if second is not None:
-                seconds[name] = second
-                root_tag = _safe(str(robot.link_index(parent)))
-                ms, gMS, root_J33 = _second_link_moment(b, second, MS, vd_j, tag, root_tag, raw, N, parameters,
-                                                       definitions)
-                # a child continuing a run from the root shares W (second_link.point_acceleration)
-                shared = gMS is not None and any(
-                    runs.get(c.child) is not None and runs[c.child].anchor == root.child for c in robot.children(name))
-            A, rest, along_z = euler_projections(b, J, second or closed, tag, root_J33, gMS[:2] if shared else None)
-            # with gravity folded in, along_z holds the first moment's z part too
-            N[name] = b.vector([ms[0], ms[1], along_z if shared else plus(ms[2], along_z)], f"N{tag}")
-            kr = robot.coordinate_index(root)
-            As, rests, ad, first = along_root.get(kr, ([], [], (second or closed).ad, tag))
-            along_root[kr] = (As + [A], rests + [rest], ad, first)
-        w[name], wd[name], vd[name], U[name] = w_j, wd_j, vd_j, U_j
+        s.U = skew2(b, s.w, s.wd, tag, s.sq, s.column, lower)
+        s.F = b.vector(vadd(vscale(M, s.vd), mv(s.U, MS)), f"F{tag}")
+        if s.two_rate is None:
+            s.euler_and_ms = (euler_moment(J, self.differences[name], s.wd, s.U, s.sq), cross(MS, s.vd))
+            s.N = b.vector(vadd(*s.euler_and_ms), f"N{tag}")
+            return
+        t = s.two_rate
+        ms, gMS, root_J33, shared = cross(MS, s.vd), None, ZERO, False
+        if s.second:
+            root = self.links[t.root]
+            ms, gMS, root_J33, new = second_link_moment(b, t, MS, s.vd, tag, root, self.parameters[t.root][2])
+            self.definitions += new
+            # a child continuing a run from the root shares W (two_rate_link.point_acceleration)
+            shared = gMS is not None and any(self.runs.get(c.child) is not None and self.runs[c.child].anchor == t.root
+                                             for c in self.robot.children(name))
+        A, rest, along_z = euler_projections(b, J, t, tag, root_J33, gMS[:2] if shared else None)
+        # with gravity folded in, along_z holds the first moment's z part too
+        s.N = b.vector([ms[0], ms[1], along_z if shared else plus(ms[2], along_z)], f"N{tag}")
+        total = self.along_root.setdefault(self.robot.coordinate_index(s.root), RootSum(t.ad, tag))
+        total.A.append(A)
+        total.rests.append(rest)
 
-    f, nm, Rf = {}, {}, {}
-    tau = [sp.Integer(0)] * n
-    for joint in reversed(robot.joints):
-        name = joint.child
-        tag = _safe(str(robot.link_index(name)))
-        f_j, n_j = F[name], N[name]
-        for child in robot.children(name):
-            Rc, pc = frames[child.child]
-            f_c = Rf[child.child] = b.vector(mv(Rc, f[child.child]), f"Rf{_safe(str(robot.link_index(child.child)))}")
-            f_j = vadd(f_j, f_c)
-            n_j = vadd(n_j, mv(Rc, nm[child.child]), cross(pc, f_c))
-        f[name], nm[name] = b.vector(f_j, f"f{tag}"), b.vector(n_j, f"n{tag}")
-        k = robot.coordinate_index(joint)
-        if k is not None:
-            tau[k] = dot(nm[name] if joint.type == "revolute" else f[name], list(joint.axis))
-    for joint in robot.joints:  # base-fixed links behind runs: their torque only
-        k = robot.coordinate_index(joint)
-        if (joint.parent == robot.base and joint.type == "revolute" and k is not None
-                and any(runs[link].anchor == joint.child for link in rotations)):
-            tau[k] = root_torque(robot, joint, frames, rotations, N, f, nm, Rf, b)
-    for k, (As, rests, ad, first) in along_root.items():  # the run's Euler moments on the root axis
-        tau[k] = plus(tau[k], times(ad, b.let(plus(*As), f"A{first}")), *rests)
-    return b.program(tau, (n,)), definitions, any(len(As) > 1 for As, _, _, _ in along_root.values())
-
-
-def _children_need_wd(robot: Robot, name, frames) -> set:
-    """The components of link ``name``'s angular acceleration its children read: ``k``
-    for a revolute child about the link's ``+-e_k`` (only its ``wd_z`` takes it), all
-    three for any other child."""
-    out = set()
-    for child in robot.children(name):
-        found = _axis_in_parent(child, frames[child.child][0])
-        out |= {found[0]} if found is not None and child.type == "revolute" else {0, 1, 2}
-    return out
-
-
-def _second_link_moment(b: Builder, s, MS, vd_j, tag, root_tag, raw: dict, N: dict, parameters: dict,
-                        definitions: list):
-    """A second link's moment without its Euler part (only its projections are used,
-    :func:`armdyn.programs.two_rate_link.euler_projections`): ``(MS x vd (3,), gMS, J33_R)``.
-
-    ``MS x vd`` is ``(g MS) x u`` when gravity is all of the root's acceleration; ``gMS``
-    (3,) is then ``g MS`` (new parameters appended to ``definitions``), else None. J33_R:
-    the root's inertia about its axis, taken out of the root's moment ``N`` (its Euler
-    moment on its axis is ``J33_R a'``, added inside the second link's ``A`` instead), or
-    0 when another second link took it already or the root's moment is not that."""
-    gMS = None
-    if s.gz is not None:
-        gMS, new = gravity_moment(b, MS, s, tag)
-        definitions += new
-        ms = cross(gMS, s.u)
-    else:
-        ms = cross(MS, vd_j)
-    root_J33 = ZERO
-    if s.root in raw:
-        euler, root_ms = raw.pop(s.root)
-        J33 = rows(parameters[s.root][2])[2][2]
-        if euler[2] == times(J33, s.ad):
-            root_J33 = J33
-            N[s.root] = b.vector(vadd([euler[0], euler[1], ZERO], root_ms), f"N{root_tag}")
-    return ms, gMS, root_J33
+    def inward(self) -> list:
+        """tau (n,): forces and moments tip to base (Khalil eqs. 9.83-9.85), a base-fixed
+        link's torque through the runs behind it, the two-rate links' projections added
+        to their roots' torques."""
+        robot, b, links = self.robot, self.b, self.links
+        tau = [sp.Integer(0)] * robot.dof
+        for joint in reversed(robot.joints):
+            s = links[joint.child]
+            f, n = s.F, s.N
+            for child in robot.children(joint.child):
+                c = links[child.child]
+                c.Rf = b.vector(mv(c.R, c.f), f"Rf{c.tag}")
+                f = vadd(f, c.Rf)
+                n = vadd(n, mv(c.R, c.n), cross(c.p, c.Rf))
+            s.f, s.n = b.vector(f, f"f{s.tag}"), b.vector(n, f"n{s.tag}")
+            if s.k is not None:
+                tau[s.k] = dot(s.n if joint.type == "revolute" else s.f, list(joint.axis))
+        for joint in robot.joints:  # base-fixed links behind runs: their torque only
+            k = robot.coordinate_index(joint)
+            if (joint.parent == robot.base and joint.type == "revolute" and k is not None
+                    and any(s.compound and s.run.anchor == joint.child for s in links.values())):
+                tau[k] = root_torque(robot, joint, links, b)
+        for k, total in self.along_root.items():  # the two-rate links' Euler moments on the root axis
+            tau[k] = plus(tau[k], times(total.ad, b.let(plus(*total.A), f"A{total.first}")), *total.rests)
+        return tau
