@@ -15,10 +15,11 @@ as :mod:`armdyn.symbolic.newton_euler`, but
   own force and its children's accelerations (Khalil eq. 9.79);
 * a rotation about the joint axis keeps ``wx^2 + wy^2``: when the axis is a parent axis
   ``e_k`` (every DH frame), ``U_j[2, 2] = -(wx^2 + wy^2)`` is the parent's ``U[k, k]``
-  and ``wy^2`` is never formed (:func:`_squares`);
+  and ``wy^2`` is never formed (:func:`~armdyn.programs.link_terms.squares`);
 * the last column of a child's U above the diagonal is its parent's U column turned by
-  the joint (the joint's own motion adds nothing there, :func:`_column_from_parent`); the
-  child's ``wd_x = w_y w_z - U23`` and ``wd_y = U13 - w_x w_z`` follow with one sum each;
+  the joint (the joint's own motion adds nothing there,
+  :func:`~armdyn.programs.link_terms.column_from_parent`); the child's
+  ``wd_x = w_y w_z - U23`` and ``wd_y = U13 - w_x w_z`` follow with one sum each;
 * runs of parallel joints (``q2 + q3``) take their angular quantities from the link before
   the run, and a base-fixed link's torque their moments, by the compound angle
   (:mod:`armdyn.programs.parallel_joints`);
@@ -28,6 +29,9 @@ as :mod:`armdyn.symbolic.newton_euler`, but
   projections, where that makes the program shorter (:mod:`armdyn.programs.two_rate_link`);
 * optionally (``turns``, :mod:`armdyn.programs.leaf_frames`) a leaf link's frame turned
   about its joint axis by a per-parameter-set angle.
+
+The recursion runs per link over one state object (:class:`LinkState`); each special form
+is asked where it applies, and :class:`Forms` switches them off one by one.
 
 All vectors of link j are in link j's frame. Outward, with ``(R, p)`` link j's frame in
 its parent's and ``z`` the joint axis (Khalil eqs. 9.77-9.82)::

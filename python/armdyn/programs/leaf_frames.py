@@ -12,7 +12,7 @@ puts the link's first moment on y: ``MS' = (0, sqrt(MX^2 + MY^2), MZ)``, so ever
 product with ``MX`` disappears from the link's force ``U MS`` and moment ``MS x vd``
 (and the ``y`` component of the acceleration with it). On y rather than x: the force
 then takes U's second column, whose diagonal entry ``U22`` the Euler moment's
-coefficients need anyway (:func:`armdyn.programs.customized_ne._squares`), where ``U11``
+coefficients need anyway (:func:`armdyn.programs.link_terms.squares`), where ``U11``
 would be formed for the force alone (one sum more). The inertia about the origin
 turns with the frame (``J' = Rz(th)^T J Rz(th)``); its ``YY'``, zero after Khalil's
 grouping before the turn, is not zero any more, so ``diag(YY', YY', 0)`` is grouped onto

@@ -11,7 +11,7 @@ sine and cosine; it pays when the anchor's vectors are sparse (the first link of
 turns about the base's fixed axis: ``w1 = (0, 0, qd1)``):
 
 * outward, the x, y components of the child's angular velocity and its U's last column
-  (:func:`armdyn.programs.customized_ne._column_from_parent`) come from the anchor's in one
+  (:func:`armdyn.programs.link_terms.column_from_parent`) come from the anchor's in one
   rotation each (two products instead of four products and two sums on the PUMA 560);
 * inward, a link fixed to the base needs only its torque ``z . n``: the moments of the
   run are brought to it directly, ``R2 (N2 + (a2, 0, 0) x R3 f3) + R0 Rz(q2 + q3) (n3 +
