@@ -12,8 +12,15 @@ import armdyn
 import armdyn.codegen as codegen
 from armdyn.programs.customized_ne import customized_newton_euler, standard_parameters
 from armdyn.symbolic import derive
-from test_codegen import (_close, _load, _model_point, _numeric, _states, _substituted, _values,  # noqa: F401
-                          needs_cc, wrist_3r)
+from test_codegen import WRIST_3R, _close, _load, _model_point, _numeric, _states, _substituted, _values, needs_cc
+
+
+def _wrist_3r(tmp_path):
+    """The wrist arm of test_codegen (joints 2, 3 sharing an origin), every parameter symbolic."""
+    path = tmp_path / "wrist-3r.yaml"
+    path.write_text(WRIST_3R)
+    return _load(str(path))
+
 
 
 def _is_zero_in(expr, angles) -> bool:
@@ -27,7 +34,7 @@ def _is_zero_in(expr, angles) -> bool:
     return sp.expand(expr) == 0
 
 
-def test_turned_leaf_frame_gives_the_same_tau_exactly_for_any_angle(wrist_3r):
+def test_turned_leaf_frame_gives_the_same_tau_exactly_for_any_angle(tmp_path):
     """The leaf link's frame turned about its joint axis by a free angle th (joint angle
     q3 + th, first moment and inertia turned with it, grouped parameters): tau equals
     armdyn.derive's exactly, for every th. And the angle turn_leaf_frames picks puts the
@@ -35,7 +42,7 @@ def test_turned_leaf_frame_gives_the_same_tau_exactly_for_any_angle(wrist_3r):
     from armdyn.programs.grouping import grouped_parameters
     from armdyn.programs.leaf_frames import _turned, turn_leaf_frames
 
-    robot = wrist_3r
+    robot = _wrist_3r(tmp_path)
     eom = derive(robot, "newton-euler")
     params, defs = standard_parameters(robot)
     params, extra = grouped_parameters(robot, params, defs)
@@ -59,7 +66,7 @@ def test_turned_leaf_frame_gives_the_same_tau_exactly_for_any_angle(wrist_3r):
     assert sp.simplify(dict(new)[chosen["link3"][1][1]] - r) == 0
 
 
-def test_turned_leaf_inertia_rides_on_its_parent(wrist_3r):
+def test_turned_leaf_inertia_rides_on_its_parent(tmp_path):
     """After the leaf's frame is turned, its YY' (nonzero again) is grouped onto the parent
     like Khalil's YY: the leaf's YY is 0 and the parent's XX, ZZ take it; tau of the
     customized Newton-Euler with these parameters equals armdyn.derive's at random
@@ -67,7 +74,7 @@ def test_turned_leaf_inertia_rides_on_its_parent(wrist_3r):
     from armdyn.programs.grouping import grouped_parameters
     from armdyn.programs.leaf_frames import turn_leaf_frames
 
-    robot = wrist_3r
+    robot = _wrist_3r(tmp_path)
     params, defs = standard_parameters(robot)
     params, extra = grouped_parameters(robot, params, defs)
     defs = defs + extra

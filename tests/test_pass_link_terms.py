@@ -11,15 +11,23 @@ import sympy as sp
 from armdyn.programs.customized_ne import joint_frames
 from armdyn.programs.link_terms import column_from_parent, parent_invariant, squares
 from armdyn.programs.program import Builder, Program
-from test_codegen import _is_zero, _load, wrist_3r  # noqa: F401  (wrist_3r: a fixture)
+from test_codegen import WRIST_3R, _is_zero, _load
 
 
-def test_child_angular_velocity_norm_is_read_off_the_parent(wrist_3r):
+def _wrist_3r(tmp_path):
+    """The wrist arm of test_codegen (joints 2, 3 sharing an origin), every parameter symbolic."""
+    path = tmp_path / "wrist-3r.yaml"
+    path.write_text(WRIST_3R)
+    return _load(str(path))
+
+
+
+def test_child_angular_velocity_norm_is_read_off_the_parent(tmp_path):
     """On the wrist arm (joints 2, 3 sharing an origin, alpha -90 and +90 deg), the
     parent's U entry that parent_invariant reads for every moving link equals
     ``-(wx^2 + wy^2)`` of the child's angular velocity ``R^T w_parent + qd z`` formed here
     directly (exact, with sin^2 + cos^2 = 1)."""
-    robot = wrist_3r.canonical()
+    robot = _wrist_3r(tmp_path).canonical()
     b = Builder()
     frames = joint_frames(robot, b)
     U = {robot.base: sp.zeros(3, 3).tolist()}  # the program's 3x3 matrices are lists of rows
