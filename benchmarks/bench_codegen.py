@@ -5,6 +5,7 @@
     PYTHONPATH=python python3 benchmarks/bench_codegen.py --processes 6   # tau alone, 6 fresh processes
     PYTHONPATH=python python3 benchmarks/bench_codegen.py --numeric-only --numeric-repeat 31
     PYTHONPATH=python python3 benchmarks/bench_codegen.py --arms          # op counts, every bundled arm
+    PYTHONPATH=python python3 benchmarks/bench_codegen.py --ledger        # write benchmarks/op_counts.json
 
 1. Operation counts on the PUMA 560 with every parameter symbolic (60 inertial ones,
    kinematics and g too), counted as ``sympy.count_ops(visual=True)`` counts them
@@ -26,6 +27,8 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import json
+import os
 import statistics
 import time
 import warnings
@@ -75,7 +78,7 @@ def op_count_table(have_identification: bool) -> None:
         code = codegen.codegen(robot, what=what)
         derived = {"tau": list(eom.tau), "tau, ungrouped": list(eom.tau), "M": [eom.M[i, j] for i in range(6) for j in range(i, 6)], "g": list(eom.g)}
         rows = [(w, code.op_counts[w]) for w in what]
-        from armdyn.symbolic.customized_ne import customized_newton_euler
+        from armdyn.programs.customized_ne import customized_newton_euler
 
         # before the grouping: the customized Newton-Euler in the 60 standard parameters
         rows.insert(1, ("tau, ungrouped", customized_newton_euler(robot)[0].operation_counts()))
@@ -121,8 +124,8 @@ def _timed(fn, repeat):
 def generation_times(have_identification: bool, repeat: int) -> None:
     """One table: time to derive and print C, medians of ``repeat`` runs in this process
     (the first run, SymPy's caches cold, apart), with the targets of issue 8 and ratios."""
-    from armdyn.symbolic.customized_ne import customized_newton_euler, standard_parameters
-    from armdyn.symbolic.grouping import grouped_parameters
+    from armdyn.programs.customized_ne import customized_newton_euler, standard_parameters
+    from armdyn.programs.grouping import grouped_parameters
 
     robot = load("puma560-craig")
     what = ["tau", "M", "C", "g"] + (["regressor"] if have_identification else [])
@@ -176,7 +179,7 @@ def breakdown() -> None:
     import re
     from collections import defaultdict
 
-    from armdyn.codegen.program import Program
+    from armdyn.programs.program import Program
 
     robot = load("puma560-craig")
     prog = codegen.codegen(robot, what="tau").programs["tau"]
@@ -222,8 +225,8 @@ x, y = sympy.symbols("x y")
 t0 = time.process_time()
 x + y
 first_sum = time.process_time() - t0
-from armdyn.symbolic.customized_ne import customized_newton_euler, standard_parameters
-from armdyn.symbolic.grouping import grouped_parameters
+from armdyn.programs.customized_ne import customized_newton_euler, standard_parameters
+from armdyn.programs.grouping import grouped_parameters
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")
     robot = armdyn.load("puma560-craig", strict=False)
@@ -324,6 +327,49 @@ def every_arm() -> None:
         print(f"| {entry['name']} | {robot.dof} | {counts['tau']['total']} | {counts['g']['total']} | {base} |")
 
 
+LEDGER = os.path.join(os.path.dirname(os.path.abspath(__file__)), "op_counts.json")
+#: what the ledger counts, per arm and parameter set
+LEDGER_QUANTITIES = ("tau", "g", "M", "C")
+
+
+def write_ledger(path: str = LEDGER) -> None:
+    """The operation-count ledger: ``codegen(...).op_counts`` of tau, g, M and C of every
+    bundled arm, in the standard (grouped) and in the base parameters, as JSON
+    ``{"arms": {arm: {"dof": n, "standard": {quantity: counts}, "base": {...}}}}``.
+    tests/test_op_ledger.py recomputes it and fails when a count differs. The 7-dof arms'
+    base parameters take minutes (the identification's base-parameter search)."""
+    from armdyn.io import bundled_robots
+
+    arms = {}
+    for entry in bundled_robots():
+        robot = load(entry["name"])
+        row = {"dof": robot.dof}
+        for key, base in (("standard", False), ("base", True)):
+            t = time.perf_counter()
+            row[key] = codegen.codegen(robot, what=LEDGER_QUANTITIES, base=base).op_counts
+            print(f"{entry['name']:14s} {key:8s} {time.perf_counter() - t:6.1f} s", flush=True)
+        arms[entry["name"]] = row
+    tmp = path + ".tmp"
+    with open(tmp, "w") as fh:
+        fh.write(ledger_text(arms))
+    os.replace(tmp, path)
+    print(f"wrote {path}")
+
+
+def ledger_text(arms: dict) -> str:
+    """The ledger as JSON text, one line per arm, parameter set and quantity (a change in
+    the counts is a one-line diff)."""
+    import re
+
+    ledger = {"about": "operation counts per state of armdyn's generated code (mul + add = total; "
+                       "sympy.count_ops(visual=True) kinds), written by "
+                       "PYTHONPATH=python python3 benchmarks/bench_codegen.py --ledger",
+              "arms": arms}
+    text = json.dumps(ledger, indent=1, sort_keys=True)
+    # the innermost objects (the counts) on one line each
+    return re.sub(r"\{\n\s+([^{}]*?)\n\s*\}", lambda m: "{" + " ".join(m.group(1).split()) + "}", text) + "\n"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=5)
@@ -334,7 +380,12 @@ def main() -> None:
     ap.add_argument("--processes", type=int, default=0,
                     help="only time tau alone in this many fresh processes (PYTHONHASHSEED 0, 1, ...)")
     ap.add_argument("--arms", action="store_true", help="only the operation counts of every bundled arm")
+    ap.add_argument("--ledger", action="store_true",
+                    help=f"only write the operation-count ledger ({os.path.relpath(LEDGER)}) of every bundled arm")
     args = ap.parse_args()
+    if args.ledger:
+        write_ledger()
+        return
     if args.arms:
         every_arm()
         return

@@ -11,7 +11,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import os
 import shutil
 import subprocess
@@ -25,11 +24,11 @@ import sympy as sp
 import armdyn
 import armdyn.codegen as codegen
 from armdyn.codegen.compile import CompilerError, build_shared_library
-from armdyn.codegen.program import Builder, _fast_count
+from armdyn.programs.composite_mass_matrix import composite_mass_matrix
+from armdyn.programs.coriolis_program import christoffel_program
+from armdyn.programs.customized_ne import customized_newton_euler, standard_parameters
+from armdyn.programs.program import Builder, _fast_count
 from armdyn.symbolic import dag, derive
-from armdyn.symbolic.composite_mass_matrix import composite_mass_matrix
-from armdyn.symbolic.coriolis_program import christoffel_program
-from armdyn.symbolic.customized_ne import customized_newton_euler, standard_parameters
 
 BUNDLED = [r["name"] for r in armdyn.bundled_robots()]
 HAVE_CC = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc")
@@ -157,7 +156,7 @@ def test_customized_tau_equals_derive_exactly_on_a_shared_origin_wrist(wrist_3r,
 def _customized_tau_equals_derive(robot, grouped: bool):
     """Asserts that the customized Newton-Euler's tau, with the standard or the grouped
     parameters, equals armdyn.derive's exactly; returns the program."""
-    from armdyn.symbolic.grouping import grouped_parameters
+    from armdyn.programs.grouping import grouped_parameters
 
     eom = derive(robot, "newton-euler")
     params, defs = standard_parameters(robot)
@@ -169,85 +168,6 @@ def _customized_tau_equals_derive(robot, grouped: bool):
     for k in range(robot.dof):
         assert _is_zero(tau[k] - eom.tau[k], robot), f"tau[{k}]"
     return tau_prog
-
-
-def test_child_angular_velocity_norm_is_read_off_the_parent(wrist_3r):
-    """The invariant ``wx^2 + wy^2`` of a child whose z axis is a parent axis is taken from
-    the parent's U (no ``wy^2`` product is formed) on every moving link after the first of
-    the wrist arm and of the PUMA 560; and it is the right value: on the wrist arm, the
-    parent's U entry it reads equals ``-(wx^2 + wy^2)`` of the child's angular velocity
-    ``R^T w_parent + qd z`` formed here directly (exact, with sin^2 + cos^2 = 1)."""
-    from armdyn.codegen.program import Builder
-    from armdyn.symbolic import customized_ne as cne
-
-    for robot in (wrist_3r, _load("puma560-craig")):
-        prog, _ = customized_newton_euler(robot)
-        names = {str(s) for s, _ in prog.assignments}
-        for k in range(2, robot.dof + 1):
-            assert f"w{k}yy" not in names, (robot.name, k)
-    robot = wrist_3r.canonical()
-    b = Builder()
-    frames = cne.joint_frames(robot, b)
-    U = {robot.base: sp.zeros(3, 3).tolist()}  # the program's 3x3 matrices are lists of rows
-    w = {robot.base: sp.zeros(3, 1)}
-    used = 0
-    for joint in robot.joints:
-        R, _ = frames[joint.child]
-        k = robot.coordinate_index(joint)
-        S = cne._parent_invariant(joint, R, U[joint.parent])
-        wj = sp.Matrix(R).T * w[joint.parent] + robot.qd[k] * joint.axis
-        if S is not None:
-            used += 1
-            values = dict(b.assignments)  # c2 = cos(q2), ... of the frames
-            assert _is_zero((S + wj[0] ** 2 + wj[1] ** 2).xreplace(values), robot), joint.child
-        sq = {"U11": -wj[1] ** 2 - wj[2] ** 2, "U22": -wj[0] ** 2 - wj[2] ** 2, "U33": -wj[0] ** 2 - wj[1] ** 2}
-        U[joint.child] = sp.diag(sq["U11"], sq["U22"], sq["U33"]).tolist()
-        w[joint.child] = wj
-    assert used == robot.dof
-
-
-def _is_zero_in(expr, angles) -> bool:
-    """expr == 0 identically: expanded (trig sums too), sin^2 + cos^2 = 1 for each angle."""
-    expr = sp.expand(sp.expand_trig(expr))
-    for q in angles:
-        s, c = sp.Dummy("s"), sp.Dummy("c")
-        expr = sp.expand(expr.xreplace({sp.sin(q): s, sp.cos(q): c}))
-        expr = sp.rem(expr, s**2 + c**2 - 1, s) if expr.has(s) else expr
-        expr = sp.expand(expr).xreplace({s: sp.sin(q), c: sp.cos(q)})
-    return sp.expand(expr) == 0
-
-
-def test_turned_leaf_frame_gives_the_same_tau_exactly_for_any_angle(wrist_3r):
-    """The leaf link's frame turned about its joint axis by a free angle th (joint angle
-    q3 + th, first moment and inertia turned with it, grouped parameters): tau equals
-    armdyn.derive's exactly, for every th. And the angle turn_leaf_frames picks puts the
-    first moment on y: its MX' is zero and its MY' is |(MX, MY)| (exact)."""
-    from armdyn.symbolic.grouping import grouped_parameters
-    from armdyn.symbolic.leaf_frames import _turned, turn_leaf_frames
-
-    robot = wrist_3r
-    eom = derive(robot, "newton-euler")
-    params, defs = standard_parameters(robot)
-    params, extra = grouped_parameters(robot, params, defs)
-    defs = defs + extra
-    th = sp.Symbol("th")
-    turned = dict(params)
-    turned["link3"] = _turned(*params["link3"], sp.cos(th), sp.sin(th))
-    tau_prog, tdefs = customized_newton_euler(robot, parameters=turned, turns={"link3": th})
-    assert any(str(s) == "q3t" for s, _ in tau_prog.assignments)
-    tau = _substituted(_substituted(tau_prog.inlined(), tdefs), defs)
-    for k in range(robot.dof):
-        assert _is_zero_in(tau[k] - eom.tau[k], list(robot.q) + [th]), f"tau[{k}]"
-    # the chosen angle
-    chosen, new, turns = turn_leaf_frames(robot, params, defs)
-    assert set(turns) == {"link3"}
-    M, MS, J = params["link3"]
-    assert chosen["link3"][1][0] == 0
-    r = sp.sqrt(MS[0] ** 2 + MS[1] ** 2)
-    th = dict(new)[turns["link3"]].args[0][0]  # the angle where |(MX, MY)| != 0
-    _, MSt, _ = _turned(M, MS, J, sp.cos(th), sp.sin(th))
-    assert sp.simplify(MSt[0]) == 0 and sp.simplify(MSt[1] - r) == 0
-    assert sp.simplify(dict(new)[chosen["link3"][1][1]] - r) == 0
 
 
 def _evaluated(assignments, env):
@@ -265,145 +185,6 @@ def _model_point(robot, rng, definitions=()):
     for group in (robot.q, robot.qd, robot.qdd):
         env.update({s: float(rng.uniform(-1.5, 1.5)) for s in group})
     return _evaluated(definitions, env)
-
-
-def test_U_column_read_off_the_parent_is_the_textbook_value():
-    """U13, U23 of every link of the PUMA 560 after the second are read off the parent's U
-    (no ``qd wi x z`` term is formed; links 3 by the compound angle q2 + q3 from link 1;
-    link 2's U is not needed, its moment and link 3's acceleration go by the closed forms
-    of armdyn.symbolic.second_link):
-    at random points they equal ``w_x w_z + wd_y`` and ``w_y w_z - wd_x`` of the
-    textbook recursion ``w = R^T w_p + qd z``, ``wd = R^T wd_p + qdd z + R^T w_p x qd z``
-    done here in NumPy from the joint frames."""
-    robot = _load("puma560-craig")
-    prog, defs = customized_newton_euler(robot)
-    names = {str(s) for s, _ in prog.assignments}
-    assert "q23" in names and not {"n2x", "n2y"} & names  # the run 2-3 and its root torque
-    canon = robot.canonical()
-    e3 = np.array([0.0, 0.0, 1.0])
-    rng = np.random.default_rng(3)
-    checked = set()
-    for _ in range(3):
-        env = _evaluated(prog.assignments, _model_point(robot, rng, defs))
-        w, wd = {canon.base: np.zeros(3)}, {canon.base: np.zeros(3)}
-        for joint in canon.joints:
-            k = canon.coordinate_index(joint)
-            R, _ = joint.transform(canon.q[k])
-            R = np.array(R.xreplace(env), dtype=float)
-            wi = R.T @ w[joint.parent]
-            w[joint.child] = wi + env[canon.qd[k]] * e3
-            wd[joint.child] = R.T @ wd[joint.parent] + env[canon.qdd[k]] * e3 + np.cross(wi, env[canon.qd[k]] * e3)
-            i = canon.link_index(joint.child)
-            if i < 3:
-                continue
-            checked.add(i)
-            wx, wy, wz = w[joint.child]
-            want = (wx * wz + wd[joint.child][1], wy * wz - wd[joint.child][0])
-            got = (env[sp.Symbol(f"U{i}_13")], env[sp.Symbol(f"U{i}_23")])
-            assert np.all(np.isfinite(got))
-            np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
-    assert checked == {3, 4, 5, 6}
-
-
-# a shoulder, then two parallel joints (alpha 0) with both offsets of the PUMA 560's
-# (a2 along x, d3 along the common axis), every inertial parameter symbolic
-RUN_3R = WRIST_3R.replace("name: wrist-3r", "name: run-3r").replace(
-    "a: 0, alpha: pi/2, d: 0", "a: L2, alpha: 0, d: D3").replace("L1: 0.3,", "L1: 0.3, L2: null, D3: null,")
-
-
-@pytest.mark.parametrize("grouped", [False, True])
-def test_parallel_run_by_its_compound_angle_equals_derive_exactly(tmp_path, grouped):
-    """Joints 2 and 3 parallel: link 3's angular velocity and U column come from link 1
-    by the angle q2 + q3 (named once), and link 1's torque takes link 3's moment by that
-    rotation (link 2's moment is never formed in full); tau equals armdyn.derive's
-    exactly, with the standard and with the grouped parameters."""
-    path = tmp_path / "run-3r.yaml"
-    path.write_text(RUN_3R)
-    tau_prog = _customized_tau_equals_derive(_load(str(path)), grouped)
-    names = {str(s) for s, _ in tau_prog.assignments}
-    assert "q23" in names and not {"n2x", "n2y"} & names
-
-
-def test_runs_of_parallel_joints_on_a_tree_agree_with_the_rust_core():
-    """A tree made to exercise the runs: joint 1 about the base's z, two branches from
-    link 1 (one turned by alpha -90 then three parallel joints, its last one followed by a
-    prismatic joint and a leaf; one parallel to joint 1 with a fixed joint and a second
-    child of the run's middle link), random physical inertias. The customized
-    Newton-Euler with its compound angles evaluated at random states equals the Rust
-    core's rnea (a different algorithm: spatial vectors, no runs)."""
-    from armdyn.model import Joint, Robot
-    from random_models import random_link
-
-    rng = np.random.default_rng(21)
-    rx = [[1, 0, 0], [0, 0, 1], [0, -1, 0]]  # alpha = -90 deg
-    eye = np.eye(3).tolist()
-    spec = [  # name, type, parent, child, xyz, rotation, axis
-        ("j1", "revolute", "base", "l1", [0, 0, 0.3], eye, [0, 0, 1]),
-        ("j2", "revolute", "l1", "l2", [0.1, 0, 0], rx, [0, 0, 1]),
-        ("j3", "revolute", "l2", "l3", [0.4, 0, 0.15], eye, [0, 0, 1]),
-        ("j4", "revolute", "l3", "l4", [0.35, 0.05, -0.1], eye, [0, 0, 1]),
-        ("j5", "prismatic", "l4", "l5", [0.1, 0, 0], rx, [0, 0, 1]),
-        ("j6", "revolute", "l1", "l6", [0, 0.2, 0.1], eye, [0, 0, 1]),
-        ("j7", "fixed", "l6", "l7", [0.1, 0, 0], rx, [0, 0, 1]),
-        ("j8", "revolute", "l3", "l8", [0, 0.1, 0.2], eye, [0, 0, 1]),
-    ]
-    links = [random_link(rng, "base")] + [random_link(rng, f"l{k}") for k in range(1, 9)]
-    joints = [Joint(n, t, p, c, xyz=x, rotation=r, axis=a) for n, t, p, c, x, r, a in spec]
-    robot = Robot("runs-tree", links, joints, gravity=(0.0, -3.0, -9.0))
-    prog, defs = customized_newton_euler(robot)
-    names = {str(s) for s, _ in prog.assignments}
-    assert {"q23", "q234"} <= names  # j3, j4 continue the run of j2 (anchor l1)
-    values = {s: float(e) for s, e in defs}
-    for _ in range(4):
-        q, qd, qdd = (rng.uniform(-1.5, 1.5, robot.dof) for _ in range(3))
-        env = dict(values)
-        for group, v in ((robot.q, q), (robot.qd, qd), (robot.qdd, qdd)):
-            env.update({s: float(x) for s, x in zip(group, v)})
-        _close(np.array(prog.evaluate(env), dtype=float), armdyn.rnea(robot, q, qd, qdd))
-
-
-def test_turned_leaf_inertia_rides_on_its_parent(wrist_3r):
-    """After the leaf's frame is turned, its YY' (nonzero again) is grouped onto the parent
-    like Khalil's YY: the leaf's YY is 0 and the parent's XX, ZZ take it; tau of the
-    customized Newton-Euler with these parameters equals armdyn.derive's at random
-    points (the turned parameters are Piecewise in the model's)."""
-    from armdyn.symbolic.grouping import grouped_parameters
-    from armdyn.symbolic.leaf_frames import turn_leaf_frames
-
-    robot = wrist_3r
-    params, defs = standard_parameters(robot)
-    params, extra = grouped_parameters(robot, params, defs)
-    defs = defs + extra
-    turned, new, turns = turn_leaf_frames(robot, params, defs)
-    assert set(turns) == {"link3"} and turned["link3"][2][1, 1] == 0
-    assert turned["link2"][2][0, 0] != params["link2"][2][0, 0]
-    tau_prog, tdefs = customized_newton_euler(robot, parameters=turned, turns=turns)
-    eom = derive(robot, "newton-euler")
-    rng = np.random.default_rng(8)
-    for _ in range(3):
-        env = _model_point(robot, rng, defs + new + tdefs)
-        got = np.array(tau_prog.evaluate(env), dtype=float)
-        want = np.array([float(e.xreplace(env)) for e in eom.tau], dtype=float)
-        _close(got, want)
-
-
-@needs_cc
-def test_turned_leaf_frame_with_zero_first_moment_is_finite_and_right(tmp_path):
-    """A leaf whose first moment is zero (MX = MY = 0, the symmetric end link of most
-    arms) at run time: the turning angle is 0 (no division by |(MX, MY)| = 0), the
-    parameter vector is finite and tau, g equal the Rust core."""
-    robot = _load("puma560-craig")
-    rng = np.random.default_rng(5)
-    values = _values(robot, rng)
-    values.update(cx6=0.0, cy6=0.0)
-    lib = codegen.compile(robot, what="tau,g", directory=tmp_path)
-    assert any(str(s).startswith("th6") for s in lib.code.parameters)
-    p = lib.code.parameter_values(values)
-    assert np.all(np.isfinite(p)) and p.size > 0
-    bound = _numeric(robot, values)
-    q, qd, qdd = _states(rng, robot.dof)
-    _close(lib.tau(q, qd, qdd, p=p), armdyn.rnea(bound, q, qd, qdd))
-    _close(lib.g(q, p=p), armdyn.gravity(bound, q))
 
 
 @pytest.mark.parametrize("name", ["puma560-craig", "puma560", "stanford", "ur5"])
@@ -646,7 +427,6 @@ def test_base_parameter_code_equals_rust_core(tmp_path):
     _close(lib.g(q, p=p), armdyn.gravity(bound, q))
     _close(lib.M(q, p=p), armdyn.crba(bound, q))
     _close(lib.C(q, qd, p=p), armdyn.coriolis_matrix(bound, q, qd))
-
 
 
 @needs_cc

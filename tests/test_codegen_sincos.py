@@ -24,7 +24,7 @@ import armdyn
 import armdyn.codegen as codegen
 from armdyn.codegen import printers, sincos_coefficients
 from armdyn.codegen.compile import build_shared_library
-from armdyn.codegen.program import Program
+from armdyn.programs.program import Program
 
 HAVE_CC = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc")
 needs_cc = pytest.mark.skipif(not HAVE_CC, reason="no C compiler")

@@ -1,4 +1,4 @@
-"""Khalil's grouping of the inertial parameters (armdyn.symbolic.grouping) and the
+"""Khalil's grouping of the inertial parameters (armdyn.programs.grouping) and the
 customized programs evaluated at the grouped parameters, against independent second
 opinions:
 
@@ -21,9 +21,9 @@ import sympy as sp
 
 import armdyn
 import armdyn.codegen as codegen
-from armdyn.symbolic.composite_mass_matrix import composite_mass_matrix
-from armdyn.symbolic.customized_ne import customized_newton_euler, standard_parameters
-from armdyn.symbolic.grouping import grouped_parameters
+from armdyn.programs.composite_mass_matrix import composite_mass_matrix
+from armdyn.programs.customized_ne import customized_newton_euler, standard_parameters
+from armdyn.programs.grouping import grouped_parameters
 
 BUNDLED = [r["name"] for r in armdyn.bundled_robots()]
 

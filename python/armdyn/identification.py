@@ -68,10 +68,10 @@ import symengine as se
 import sympy as sp
 
 from .model import Robot
+from .programs.grouping import moved_to_parent
+from .programs.vectors import rows
 from .symbolic import dag
-from .symbolic.grouping import moved_to_parent
 from .symbolic.joint_terms import _value
-from .symbolic.vectors import rows
 
 #: standard inertial parameter names per link, DESIGN.md's (Pinocchio's) order
 INERTIAL = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")

@@ -9,20 +9,20 @@
 Where each quantity comes from (all with the barycentric / standard inertial parameters
 of each link, DESIGN.md's order: mass, first moment m c, inertia about the link origin):
 
-* tau: customized Newton-Euler (:mod:`armdyn.symbolic.customized_ne`);
+* tau: customized Newton-Euler (:mod:`armdyn.programs.customized_ne`);
 * g:   the same recursion with ``qd = qdd = 0``;
-* M:   composite links (:mod:`armdyn.symbolic.composite_mass_matrix`);
+* M:   composite links (:mod:`armdyn.programs.composite_mass_matrix`);
 * C:   the Christoffel symbols of that M, its program differentiated line by line
-  (:mod:`armdyn.symbolic.coriolis_program`);
+  (:mod:`armdyn.programs.coriolis_program`);
 * regressor: ``armdyn.identification.regressor(robot).Y`` (dof x P) through SymPy's
   common-subexpression elimination.
 
 tau, g, M and C are evaluated at Khalil's grouped parameters
-(:mod:`armdyn.symbolic.grouping`: what of a link's inertia rides on its parent moved
+(:mod:`armdyn.programs.grouping`: what of a link's inertia rides on its parent moved
 there, exactly), computed once per parameter set in the header; the zeros they leave
 (``M_j = MZ_j = YY_j = 0`` behind a revolute joint) propagate, so fewer operations run
 per state. For tau and g each leaf link's frame is also turned about its joint axis so
-that its first moment lies on y (:mod:`armdyn.symbolic.leaf_frames`; the angle ``th`` and
+that its first moment lies on y (:mod:`armdyn.programs.leaf_frames`; the angle ``th`` and
 the turned parameters are computed once per parameter set, the joint angle becomes
 ``q + th``). Joint friction, rotor inertia and torque offsets, where the model has them, are
 added as DESIGN.md writes them: all to tau, ``Ia`` to M's diagonal, the offset to g.
@@ -30,7 +30,7 @@ added as DESIGN.md writes them: all to tau, ``Ia`` to M's diagonal, the offset t
 ``base=True`` (needs :mod:`armdyn.identification`): the base parameters ``beta`` are the
 inputs. When each groups standard parameters onto one whose regressor column it keeps
 (Khalil's grouping), tau, g, M and C come from the same customized algorithms evaluated
-at that point (:mod:`armdyn.codegen.base`); otherwise from ``Y_base beta`` through CSE.
+at that point (:mod:`armdyn.programs.base_parameters`); otherwise from ``Y_base beta`` through CSE.
 The regressor becomes the base regressor.
 
 A model whose parameters are bound to numbers gives code with the numbers folded in (the
@@ -53,7 +53,7 @@ import sympy as sp
 
 from ..model import Robot
 from ..symbolic import dag
-from .program import Builder, Program, from_expressions
+from ..programs.program import Builder, Program, from_expressions
 from .printers import INPUTS, Names, print_c, print_python
 from .safe_names import identifier_base
 
@@ -72,7 +72,7 @@ class GeneratedCode:
     op_counts:   quantity -> {'mul', 'add', 'sin_cos', 'other', 'total'} per state.
     parameters:  Symbols of the parameter vector ``p``, in order (empty for numbers).
     definitions: [(Symbol, expression of the model's parameters)] of the barycentric ones.
-    programs:    quantity -> :class:`~armdyn.codegen.program.Program`.
+    programs:    quantity -> :class:`~armdyn.programs.program.Program`.
     """
 
     robot_name: str
@@ -201,10 +201,10 @@ def _in_model_parameters(extra, definitions, chained: bool = False) -> list:
 
 
 def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
-    from ..symbolic.composite_mass_matrix import composite_mass_matrix
-    from ..symbolic.customized_ne import customized_newton_euler, standard_parameters
-    from ..symbolic.coriolis_program import christoffel_program
-    from ..symbolic.grouping import grouped_parameters
+    from ..programs.composite_mass_matrix import composite_mass_matrix
+    from ..programs.customized_ne import customized_newton_euler, standard_parameters
+    from ..programs.coriolis_program import christoffel_program
+    from ..programs.grouping import grouped_parameters
 
     params, definitions = standard_parameters(robot)
     # Khalil's grouping (exact): what of a link's inertia rides on its parent is moved
@@ -251,9 +251,9 @@ def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
 
 
 def _turned_leaves(robot: Robot, params: dict, definitions: list, taken=()):
-    """:func:`armdyn.symbolic.leaf_frames.turn_leaf_frames`, with the new definitions in
+    """:func:`armdyn.programs.leaf_frames.turn_leaf_frames`, with the new definitions in
     the model's parameters (``definitions``' symbols replaced by theirs)."""
-    from ..symbolic.leaf_frames import turn_leaf_frames
+    from ..programs.leaf_frames import turn_leaf_frames
 
     turned, new, turns = turn_leaf_frames(robot, params, definitions, taken)
     return turned, _in_model_parameters(new, definitions), turns
@@ -318,12 +318,12 @@ def _base_programs(robot: Robot, what) -> tuple[dict, dict, list]:
 
 def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=None):
     """tau, g, M, C by the customized algorithms at the base-parameter point
-    (:mod:`armdyn.codegen.base`), checked against ``Yb beta`` at random points; None if
+    (:mod:`armdyn.programs.base_parameters`), checked against ``Yb beta`` at random points; None if
     the base parameters are not a grouping onto standard columns."""
-    from ..symbolic.composite_mass_matrix import composite_mass_matrix
-    from ..symbolic.coriolis_program import christoffel_program
-    from ..symbolic.customized_ne import customized_newton_euler
-    from .base import base_inertials
+    from ..programs.composite_mass_matrix import composite_mass_matrix
+    from ..programs.coriolis_program import christoffel_program
+    from ..programs.customized_ne import customized_newton_euler
+    from ..programs.base_parameters import base_inertials
 
     if not what:
         return None
@@ -338,7 +338,7 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
     M_prog = builder = None
     reserved = robot.free_symbols() | set(beta) | set(robot.q) | set(robot.qd) | set(robot.qdd)
     # tau and g with the leaf links' frames turned (first moment on y), in the betas
-    from ..symbolic.leaf_frames import turn_leaf_frames
+    from ..programs.leaf_frames import turn_leaf_frames
 
     ne_params, leaf_defs, turns = turn_leaf_frames(robot, params, [], taken=beta)
     tau_prog, d = customized_newton_euler(robot, parameters=ne_params, turns=turns)

@@ -1,4 +1,4 @@
-"""Printers: a set of :class:`~armdyn.codegen.program.Program` as C99, Python or NumPy source.
+"""Printers: a set of :class:`~armdyn.programs.program.Program` as C99, Python or NumPy source.
 
 Every function evaluates one quantity at one state (C, Python) or at a batch (NumPy,
 and C's ``_batch`` entry point). Inputs per quantity (``INPUTS``): tau and the regressor
@@ -16,7 +16,7 @@ from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
-from .program import Program
+from ..programs.program import Program
 from .safe_names import comment_text, identifier_base
 from .sincos_coefficients import COS, SIN
 

@@ -2,7 +2,7 @@
 
 The composite rigid-body method (Walker and Orin 1982, method 3; Featherstone's CRBA,
 *Rigid Body Dynamics Algorithms* sec. 6.2) in the barycentric parameters of
-:func:`armdyn.symbolic.customized_ne.standard_parameters` (Khalil and Dombre 2002,
+:func:`armdyn.programs.customized_ne.standard_parameters` (Khalil and Dombre 2002,
 sec. 9.4.2): composite link j (link j and everything beyond it) has mass ``Mc_j``,
 first moment ``MSc_j`` and inertia ``Jc_j`` about link j's origin, in link j's frame.
 Inward, for each child c of j with frame ``(R, p)`` in j::
@@ -22,16 +22,16 @@ the wrench at link j's origin, in link j's frame::
 and ``M[i, j]`` is that wrench carried to each ancestor i (``f <- R f``,
 ``n <- R n + p x R f``) projected on joint i's axis: ``z_i . n`` (revolute) or
 ``z_i . f`` (prismatic). Only the upper triangle is computed; zeros and ones propagate
-and dead code is removed as in :mod:`armdyn.symbolic.customized_ne`.
+and dead code is removed as in :mod:`armdyn.programs.customized_ne`.
 """
 
 from __future__ import annotations
 
 import sympy as sp
 
-from ..codegen.program import Builder, Program
 from ..model import Robot
 from .customized_ne import _safe, joint_frames, standard_parameters
+from .program import Builder, Program
 from .vectors import UPPER, ZERO, cross, dot, minus, mv, plus, rows, times, vadd, vscale
 
 
@@ -48,7 +48,7 @@ def _rotate_symmetric(b: Builder, R, J, hint) -> list:
 def composite_mass_matrix(robot: Robot, parameters=None, builder: Builder | None = None) -> tuple[Program, list]:
     """M (n x n, row-major outputs) as a :class:`Program` of q and the barycentric
     parameters. Returns ``(program, definitions)`` as
-    :func:`~armdyn.symbolic.customized_ne.customized_newton_euler`."""
+    :func:`~armdyn.programs.customized_ne.customized_newton_euler`."""
     robot = robot.canonical()  # link frames on their joints (frames off the axis: same dynamics)
     n = robot.dof
     definitions = []

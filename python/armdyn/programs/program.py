@@ -2,8 +2,8 @@
 
 A :class:`Program` is a list of assignments ``t = expr`` (each ``expr`` built from
 inputs, parameters and earlier temporaries) and a list of outputs. The customized
-symbolic algorithms (:mod:`armdyn.symbolic.customized_ne`,
-:mod:`armdyn.symbolic.composite_mass_matrix`) build one directly with a
+symbolic algorithms (:mod:`armdyn.programs.customized_ne`,
+:mod:`armdyn.programs.composite_mass_matrix`) build one directly with a
 :class:`Builder`, naming each intermediate quantity as Khalil's customized
 Newton-Euler does; any other SymPy expression becomes one through common
 subexpression elimination (:func:`from_expressions`).

@@ -1,6 +1,6 @@
 """The Coriolis matrix C(q, qd) from the Christoffel symbols of M, as a straight-line program.
 
-M comes as a program (:mod:`armdyn.symbolic.composite_mass_matrix`); its partial
+M comes as a program (:mod:`armdyn.programs.composite_mass_matrix`); its partial
 derivatives are that program differentiated line by line (forward mode: for each
 temporary ``t = e(a, b, ...)``, ``dt/dq_i = sum_a (de/da) (da/dq_i)``, with
 ``d cos q_k / dq_k = -sin q_k``), so nothing is expanded and zero derivatives vanish.
@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..codegen.program import Builder, Program
 from ..model import Robot
+from .program import Builder, Program
 
 
 def _partial(e, a):

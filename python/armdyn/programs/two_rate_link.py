@@ -49,7 +49,7 @@ apply (:func:`run_link`), the ``A`` of every such link summed before one product
 ``a'``; its U's lower row then also comes from its last column (:func:`lower_column`).
 
 All vectors are lists of 3 SymPy expressions; named temporaries go through the
-customized program's :class:`~armdyn.codegen.program.Builder`.
+customized program's :class:`~armdyn.programs.program.Builder`.
 """
 
 from __future__ import annotations
@@ -58,12 +58,12 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..codegen.program import Builder, is_value
-from .vectors import ZERO, dot, minus, mtv, plus, times
+from .program import Builder, is_value
+from .vectors import ZERO, cross, dot, minus, mtv, plus, rows, times, vadd
 
 
 @dataclass
-class SecondLink:
+class TwoRateLink:
     """L's motion as two rates on two axes (module docstring).
 
     root: R's link; u, v (3,): R's axis and ``u x e3`` in L's frame (``u[2] = v[2] = 0``);
@@ -87,7 +87,7 @@ class SecondLink:
     gz: sp.Expr | None
 
 
-def second_link(builder: Builder, joint, R, root_joint, w_root, wd_root, origin, qd, qdd, tag) -> SecondLink | None:
+def second_link(builder: Builder, joint, R, root_joint, w_root, wd_root, origin, qd, qdd, tag) -> TwoRateLink | None:
     """The closed-form description of ``joint``'s child, or None when it is not a second
     link: ``joint`` revolute about its frame's +z (frame ``R`` in the parent's, 3x3 rows),
     its parent ``root_joint``'s child, fixed to the base by a revolute joint about +z
@@ -101,7 +101,7 @@ def second_link(builder: Builder, joint, R, root_joint, w_root, wd_root, origin,
     return _two_rates(builder, root_joint, R, w_root, wd_root, qd, qdd, tag, gz)
 
 
-def run_link(builder: Builder, root_joint, w_root, wd_root, Ra, w, wd, tag) -> SecondLink | None:
+def run_link(builder: Builder, root_joint, w_root, wd_root, Ra, w, wd, tag) -> TwoRateLink | None:
     """The same description for a link further along a run of parallel joints that starts
     at the second link (the PUMA's link 3: ``w3 = qd1 u3 + (qd2 + qd3) e3``), or None.
     ``Ra`` (3x3 rows): the link's frame in the root's (the run's compound rotation), so
@@ -120,9 +120,9 @@ def root_axes(R) -> tuple | None:
     return [u[0], u[1], ZERO], [u[1], -u[0], ZERO]
 
 
-def _two_rates(builder: Builder, root_joint, R, w_root, wd_root, b, bd, tag, gz) -> SecondLink | None:
+def _two_rates(builder: Builder, root_joint, R, w_root, wd_root, b, bd, tag, gz) -> TwoRateLink | None:
     """A link turning as ``w = a u + b e3`` on a base-fixed root (``w_root = (0, 0, a)``):
-    its :class:`SecondLink`, with ``u = R^T z_R`` (``R``: its frame in the root's), or
+    its :class:`TwoRateLink`, with ``u = R^T z_R`` (``R``: its frame in the root's), or
     None when u has a z part (its axis not perpendicular to the root's) or the root moves
     otherwise."""
     axes = root_axes(R)
@@ -132,11 +132,11 @@ def _two_rates(builder: Builder, root_joint, R, w_root, wd_root, b, bd, tag, gz)
     bb = builder.let(times(b, b), f"w{tag}bb")
     W = None if gz is None else [builder.let(plus(times(bd, u[i]), times(bb, v[i])), f"W{tag}{'xy'[i]}")
                                  for i in range(2)]
-    return SecondLink(root_joint.child, u, v, a, ad, b, bd, builder.let(times(a, a), f"w{tag}aa"), bb,
+    return TwoRateLink(root_joint.child, u, v, a, ad, b, bd, builder.let(times(a, a), f"w{tag}aa"), bb,
                       builder.let(times(2, times(a, b)), f"w{tag}ab2"), W, gz)
 
 
-def lower_column(s: SecondLink, column) -> tuple:
+def lower_column(s: TwoRateLink, column) -> tuple:
     """``(U31, U32)`` of the link's ``U = skew(wd) + skew(w)^2`` from its last column
     ``(U13, U23)``: ``U31 = -U13 + 2 a b u1``, ``U32 = -U23 + 2 a b u2`` (``U13 = a' u2``,
     ``U23 = -a' u1``, and ``w x (w x .)`` adds ``a b (u_i e3 + e3 u_i)``). Where the Euler
@@ -146,7 +146,7 @@ def lower_column(s: SecondLink, column) -> tuple:
     return minus(times(s.ab2, s.u[0]), column[0]), minus(times(s.ab2, s.u[1]), column[1])
 
 
-def euler_projections(b: Builder, J, s: SecondLink, tag: str, root_J33=ZERO, gravity=None) -> tuple:
+def euler_projections(b: Builder, J, s: TwoRateLink, tag: str, root_J33=ZERO, gravity=None) -> tuple:
     """``(A, rest, e3 . E)`` of L's Euler moment ``E = J wd + w x (J w)`` (module
     docstring), J (3x3 rows) about L's origin in L's axes: ``u . E = a' A + rest``, A
     unnamed, so that the caller adds the A of every link on the same root before one
@@ -183,7 +183,7 @@ def euler_projections(b: Builder, J, s: SecondLink, tag: str, root_J33=ZERO, gra
     return A, rest, along_z
 
 
-def gravity_moment(b: Builder, MS, s: SecondLink, tag: str) -> tuple[list, list]:
+def gravity_moment(b: Builder, MS, s: TwoRateLink, tag: str) -> tuple[list, list]:
     """``gz MS`` (3,) for L's ``MS x vd = (gz MS) x u`` when its origin accelerates by
     ``gz u`` (``s.gz`` not None): new parameters where it is not a number (named ``gMX2``
     after the first moment's symbol; the builder keeps the names unique), and their
@@ -200,7 +200,7 @@ def gravity_moment(b: Builder, MS, s: SecondLink, tag: str) -> tuple[list, list]
     return gMS, new
 
 
-def point_acceleration(b: Builder, s: SecondLink, p, tag: str) -> tuple:
+def point_acceleration(b: Builder, s: TwoRateLink, p, tag: str) -> tuple:
     """``(A_u, A_v, A_z)``: the acceleration of the point ``p`` (3,) of L (L's axes, from
     its origin), gravity included, in the basis ``(u, v, e3)`` (module docstring); needs
     ``s.gz`` (L's origin then accelerates by ``gz u``)."""
@@ -221,3 +221,28 @@ def in_frame(A, u, v) -> list:
     return [plus(times(A[0], u[0]), times(A[1], v[0])), plus(times(A[0], u[1]), times(A[1], v[1])), A[2]]
 
 
+def second_link_moment(b: Builder, s: TwoRateLink, MS, vd, tag: str, root, root_J) -> tuple:
+    """A second link's moment without its Euler part (only its projections are used,
+    :func:`euler_projections`): ``(MS x vd (3,), gMS, J33_R, definitions)``.
+
+    ``MS x vd`` is ``(g MS) x u`` when gravity is all of the root's acceleration; ``gMS``
+    (3,) is then ``g MS`` (new parameters, whose definitions are returned), else None.
+    J33_R: the root's inertia about its axis (``root_J``: the root's J, 3x3), taken out
+    of the root's moment (``root``: the root link's state, whose ``euler_and_ms`` and
+    ``N`` this rewrites; its Euler moment on its axis is ``J33_R a'``, added inside the
+    second link's ``A`` instead), or 0 when another second link took it already or the
+    root's moment is not that."""
+    gMS, new = None, []
+    if s.gz is not None:
+        gMS, new = gravity_moment(b, MS, s, tag)
+        ms = cross(gMS, s.u)
+    else:
+        ms = cross(MS, vd)
+    root_J33 = ZERO
+    if root.euler_and_ms is not None:
+        (euler, root_ms), root.euler_and_ms = root.euler_and_ms, None
+        J33 = rows(root_J)[2][2]
+        if euler[2] == times(J33, s.ad):
+            root_J33 = J33
+            root.N = b.vector(vadd([euler[0], euler[1], ZERO], root_ms), f"N{root.tag}")
+    return ms, gMS, root_J33, new

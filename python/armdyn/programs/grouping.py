@@ -19,7 +19,7 @@ tip to base:
 Adding a body of mass ``m``, first moment ``h`` and inertia ``J`` (about its origin) to
 the parent through the placement ``(R, p)`` of the frame it is expressed in (parallel
 axis theorem with the first moment, the same expression as the composite links of
-:mod:`armdyn.symbolic.composite_mass_matrix`)::
+:mod:`armdyn.programs.composite_mass_matrix`)::
 
     M'  = M + m
     MS' = MS + R h + m p
@@ -37,9 +37,9 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..codegen.program import names
 from ..model import Robot
 from .customized_ne import _safe
+from .program import names
 from .vectors import UPPER, ZERO, dot, expanded, minus, mv, plus, rows, times
 
 
@@ -69,7 +69,7 @@ def grouped_parameters(robot: Robot, parameters: dict, definitions: list):
     the new symbols ``[(Symbol, expression of the model's parameters)]``.
 
     parameters, definitions: as returned by
-    :func:`armdyn.symbolic.customized_ne.standard_parameters` (barycentric, link frames).
+    :func:`armdyn.programs.customized_ne.standard_parameters` (barycentric, link frames).
     A grouped entry that is a number or a symbol stays as it is; any other is named after
     Khalil (``XX2R``, ``MX3R``, ...). Links are keyed and framed as ``robot.canonical()``.
     """

@@ -11,7 +11,7 @@ sine and cosine; it pays when the anchor's vectors are sparse (the first link of
 turns about the base's fixed axis: ``w1 = (0, 0, qd1)``):
 
 * outward, the x, y components of the child's angular velocity and its U's last column
-  (:func:`armdyn.symbolic.customized_ne._column_from_parent`) come from the anchor's in one
+  (:func:`armdyn.programs.link_terms.column_from_parent`) come from the anchor's in one
   rotation each (two products instead of four products and two sums on the PUMA 560);
 * inward, a link fixed to the base needs only its torque ``z . n``: the moments of the
   run are brought to it directly, ``R2 (N2 + (a2, 0, 0) x R3 f3) + R0 Rz(q2 + q3) (n3 +
@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..codegen.program import Builder, is_value
 from ..model import Robot
+from .program import Builder, is_value
 from .vectors import ZERO, cross, dot, mtv, mv, rows, turned_about_z, vadd
 
 E3 = sp.Matrix([0, 0, 1])
@@ -71,7 +71,7 @@ def parallel_runs(robot: Robot, angles: dict) -> dict:
     """``{link: Run}`` for every link that continues a run of parallel revolute joints
     (second joint of the run and after). ``robot``: canonical frames; ``angles``:
     ``{link: its joint angle}`` as the program names it (``q6t = q6 + th6`` for a leaf
-    turned about its joint axis, :mod:`armdyn.symbolic.leaf_frames`)."""
+    turned about its joint axis, :mod:`armdyn.programs.leaf_frames`)."""
     joint_of = {j.child: j for j in robot.joints}
     start, runs = {}, {}
     for joint in robot.joints:
@@ -97,8 +97,20 @@ def cheaper(compound: list, separate: list) -> bool:
     return cost(compound) + 1 < cost(separate)
 
 
-def root_torque(robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: dict, n: dict, Rf: dict,
-                b: Builder):
+def compound_angular(Ra, anchor_w, column_run, w_in, column) -> tuple:
+    """``(w_in, column, compound)`` of a link continuing a run: the x, y components of
+    ``R^T w_parent`` (``w_in`` (3,)) and U's column ``(U13, U23)`` read off the parent
+    (``column``, or None) replaced by the anchor's turned by the compound rotation
+    ``Ra`` (``anchor_w`` (3,); ``column_run``: that column read off the anchor's U, or
+    None) where that is cheaper (:func:`cheaper`; it saves four products and two sums
+    on the PUMA 560's link 3), and whether it was."""
+    w_run = mtv(Ra, anchor_w)[:2]
+    if cheaper([*w_run, *(column_run or ())], [*w_in[:2], *(column or ())]):
+        return [*w_run, w_in[2]], column_run, True
+    return w_in, column, False
+
+
+def root_torque(robot: Robot, joint, links: dict, b: Builder):
     """The torque ``z . n`` of a base-fixed link (its joint ``joint``), with the runs of
     parallel joints behind it brought over by their compound rotations: of the moment of
     a link the base carries, only its component on the joint axis is needed (the base does
@@ -112,38 +124,40 @@ def root_torque(robot: Robot, joint, frames: dict, rotations: dict, N: dict, f: 
     rotation; the offset along the common axis turns with y (``p_z z x R_y f = R_y (p_z z
     x f)``). Each rotated vector is only ever dotted with the axis: ``z . R v = (R^T z) . v``.
 
-    frames: ``{link: (R, p)}`` of the joints (3x3 rows, (3,));
-    rotations: ``{link: R_anchor_link}`` (3x3 rows) of the links whose outward quantities
-    used the compound form; N, f, n: each link's Euler moment, total force and total
-    moment (its axes); Rf: ``{link: R f}``, its force in its parent's axes, as the program
-    named it; b: the program's builder (it names the offsets' lever arms)."""
+    links: ``{link: state}`` after the inward pass
+    (:class:`~armdyn.programs.customized_ne.LinkState`): each link's joint frame ``R``,
+    ``p`` (3x3 rows, (3,)), Euler moment ``N``, total force ``f`` and moment ``n`` (its
+    axes), ``Rf`` (its force in its parent's axes, as the program named it), and, where
+    its outward quantities used the compound form (``compound``), ``Ra`` (3x3 rows, its
+    frame in the run's anchor's); b: the program's builder (it names the offsets' lever
+    arms)."""
 
     def brought(x, Rax, extra=(ZERO, ZERO, ZERO)):
         """z . R_ax (n_x + extra) with x's children in a run expanded."""
         u = mtv(Rax, axis)  # R_ax^T z
         kids = [j.child for j in robot.children(x)]
-        if not any(y in rotations for y in kids):
-            return dot(u, vadd(n[x], extra))
-        own, out = vadd(N[x], extra), []
+        if not any(links[y].compound for y in kids):
+            return dot(u, vadd(links[x].n, extra))
+        own, out = vadd(links[x].N, extra), []
         for y in kids:
-            R, p = frames[y]
-            if y in rotations:
+            ly = links[y]
+            R, p = ly.R, ly.p
+            if ly.compound:
                 # z . R_ax (p' x R_y f_y) = (u x p') . R_y f_y, u x p' named: it is a
                 # multiple of a sine or cosine of x's angle that x's offsets may use too
                 arm = [b.let(e, f"p{y}_arm") for e in cross(u, [p[0], p[1], ZERO])]
-                out.append(dot(arm, Rf[y]))
-                out.append(brought(y, rotations[y], [-p[2] * f[y][1], p[2] * f[y][0], ZERO]))
+                out.append(dot(arm, ly.Rf))
+                out.append(brought(y, ly.Ra, [-p[2] * ly.f[1], p[2] * ly.f[0], ZERO]))
             else:
-                own = vadd(own, mv(R, n[y]), cross(p, Rf[y]))
+                own = vadd(own, mv(R, ly.n), cross(p, ly.Rf))
         return sp.Add(dot(u, own), *out)
 
     axis = list(joint.axis)
     link = joint.child
-    total = [dot(axis, N[link])]
+    total = [dot(axis, links[link].N)]
     for child in robot.children(link):
-        c = child.child
-        R, p = frames[c]
-        total.append(brought(c, R))
-        if not all(is_value(e, 0) for e in p):
-            total.append(dot(axis, cross(p, Rf[c])))
+        c = links[child.child]
+        total.append(brought(child.child, c.R))
+        if not all(is_value(e, 0) for e in c.p):
+            total.append(dot(axis, cross(c.p, c.Rf)))
     return sp.Add(*total)

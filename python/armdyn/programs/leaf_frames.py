@@ -12,7 +12,7 @@ puts the link's first moment on y: ``MS' = (0, sqrt(MX^2 + MY^2), MZ)``, so ever
 product with ``MX`` disappears from the link's force ``U MS`` and moment ``MS x vd``
 (and the ``y`` component of the acceleration with it). On y rather than x: the force
 then takes U's second column, whose diagonal entry ``U22`` the Euler moment's
-coefficients need anyway (:func:`armdyn.symbolic.customized_ne._squares`), where ``U11``
+coefficients need anyway (:func:`armdyn.programs.link_terms.squares`), where ``U11``
 would be formed for the force alone (one sum more). The inertia about the origin
 turns with the frame (``J' = Rz(th)^T J Rz(th)``); its ``YY'``, zero after Khalil's
 grouping before the turn, is not zero any more, so ``diag(YY', YY', 0)`` is grouped onto
@@ -27,9 +27,9 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..codegen.program import is_value, names
 from ..model import Robot
 from .customized_ne import _safe
+from .program import is_value, names
 from .vectors import UPPER
 
 
@@ -131,7 +131,7 @@ def _yy_moved(robot: Robot, joint, parameters: dict, YYt, YY):
     """``(D YYt, D YY)`` with ``D = R diag(1, 1, 0) R^T`` (3x3, the parent's axes; ``R``
     the joint's fixed rotation): the turned leaf's ``diag(YY', YY', 0)``, which a rotation
     about the joint axis leaves unchanged and which has no inertia about it, moved onto
-    the parent (Khalil's grouping, as :mod:`armdyn.symbolic.grouping` did before the turn:
+    the parent (Khalil's grouping, as :mod:`armdyn.programs.grouping` did before the turn:
     the turn made ``YY' != 0`` again); ``YY`` is its value when the turn angle is 0. None
     when ``YY'`` is zero or when moving it would make a zero entry of the parent's
     inertia nonzero (more products than it saves). Onto the fixed base it simply goes: it

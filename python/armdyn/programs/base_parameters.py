@@ -24,7 +24,7 @@ import sympy as sp
 
 from ..model import Robot
 from ..symbolic import dag
-from ..symbolic.customized_ne import standard_parameters
+from .customized_ne import standard_parameters
 
 
 def _slots(robot: Robot):

@@ -1,6 +1,7 @@
-"""The second link's closed forms (armdyn.symbolic.second_link) against the textbook
-recursion done in NumPy, and the customized Newton-Euler that uses them against the Rust
-core's rnea (spatial vectors, no closed forms) on arms made to switch them on and off."""
+"""The two-rate links' closed forms (armdyn.programs.two_rate_link: the second link of an
+arm and the links further along its run) against the textbook recursion done in NumPy, and
+the customized Newton-Euler that uses them against the Rust core's rnea (spatial vectors,
+no closed forms) on arms made to switch them on and off."""
 
 from __future__ import annotations
 
@@ -9,10 +10,10 @@ import pytest
 import sympy as sp
 
 import armdyn
-from armdyn.codegen.program import Builder
 from armdyn.model import Joint, Robot
-from armdyn.symbolic.customized_ne import _customized_newton_euler, customized_newton_euler
-from armdyn.symbolic.second_link import SecondLink, euler_projections, in_frame, lower_column, point_acceleration
+from armdyn.programs.customized_ne import Forms, customized_newton_euler
+from armdyn.programs.program import Builder
+from armdyn.programs.two_rate_link import TwoRateLink, euler_projections, in_frame, lower_column, point_acceleration
 from random_models import random_link
 
 RX = [[1, 0, 0], [0, 0, 1], [0, -1, 0]]  # alpha = -90 deg: the next axis perpendicular
@@ -40,7 +41,7 @@ def _second(u, rates, gz=None):
     u = [sp.Float(u[0]), sp.Float(u[1]), sp.S.Zero]
     v = [u[1], -u[0], sp.S.Zero]
     W = [bd * u[i] + b * b * v[i] for i in range(2)]
-    return SecondLink("root", u, v, a, ad, b, bd, a * a, b * b, 2 * a * b, W, None if gz is None else sp.Float(gz))
+    return TwoRateLink("root", u, v, a, ad, b, bd, a * a, b * b, 2 * a * b, W, None if gz is None else sp.Float(gz))
 
 
 @pytest.mark.parametrize("grouped", [False, True])
@@ -121,22 +122,19 @@ def _arm(origin, gravity, run: bool):
     ([0.1, 0.05, 0], (0, 0, -9.81), True),  # origin off the axis: L's origin accelerates otherwise
     ([0, 0, 0], (1.5, -3.0, -9.0), True),  # gravity off the root axis
 ])
-@pytest.mark.parametrize("close_runs", [False, True])
-def test_customized_tau_with_a_second_link_equals_rust_rnea(origin, gravity, run, close_runs):
+@pytest.mark.parametrize("forms", [Forms(run_links="never"), Forms(run_links="always"), Forms(two_rate_links=False),
+                                   Forms(two_rate_links=False, run_links="never")], ids=repr)
+def test_customized_tau_with_two_rate_links_equals_rust_rnea(origin, gravity, run, forms):
     """tau of the customized Newton-Euler (standard parameters) == the Rust rnea at random
     states, on arms where the second link's closed forms apply in full, in part, or not
-    (its origin off the root's axis, gravity tilted); with and without the closed forms
-    of the run's link 3 (customized_newton_euler keeps the shorter of the two programs,
-    so both are built here)."""
+    (its origin off the root's axis, gravity tilted), with and without the closed forms of
+    the second link and of the run's link 3. On the PUMA-like arm the second link's form
+    saves operations (on the others it may not: origin off the root's axis, no run)."""
     robot = _arm(origin, gravity, run)
-    prog, defs, closed = _customized_newton_euler(robot, None, None, True, None, None, None, close_runs)
-    names = {str(s) for s, _ in prog.assignments}
-    assert "A2" in names  # the closed form is on
-    assert closed == ("C3" in names) == (close_runs and run)  # and on link 3 where asked
-    if closed:  # the public function keeps the shorter program
-        generic, _, _ = _customized_newton_euler(robot, None, None, True, None, None, None, False)
-        kept, _ = customized_newton_euler(robot)
-        assert kept.operation_counts()["total"] == min(p.operation_counts()["total"] for p in (prog, generic))
+    prog, defs = customized_newton_euler(robot, forms=forms)
+    if forms.two_rate_links and origin == [0, 0, 0] and run:
+        plain, _ = customized_newton_euler(robot, forms=Forms(two_rate_links=False, run_links=forms.run_links))
+        assert prog.operation_counts()["total"] < plain.operation_counts()["total"]
     values = {s: float(e) for s, e in defs}
     rng = np.random.default_rng(5)
     for _ in range(5):
@@ -147,3 +145,18 @@ def test_customized_tau_with_a_second_link_equals_rust_rnea(origin, gravity, run
         got, want = np.array(prog.evaluate(env), dtype=float), armdyn.rnea(robot, q, qd, qdd)
         assert np.all(np.isfinite(got))
         np.testing.assert_allclose(got, want, rtol=1e-11, atol=1e-11 * max(1.0, np.abs(want).max()))
+
+
+@pytest.mark.parametrize("run", [True, False])
+def test_default_keeps_the_shorter_of_with_and_without_run_links(run):
+    """The default (run_links "shorter") gives the program of the two, with and without the
+    run links' closed forms, that has fewer operations."""
+    robot = _arm([0, 0, 0], (0, 0, -9.81), run)
+    totals = [customized_newton_euler(robot, forms=Forms(run_links=r))[0].operation_counts()["total"]
+              for r in ("always", "never")]
+    assert customized_newton_euler(robot)[0].operation_counts()["total"] == min(totals)
+
+
+def test_forms_rejects_an_unknown_run_links_choice():
+    with pytest.raises(ValueError, match="run_links"):
+        Forms(run_links="sometimes")
