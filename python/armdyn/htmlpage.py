@@ -124,10 +124,13 @@ CSS = """
   margin:8px 0 14px; }
 
 /* derivation pages and small tables */
-.armdyn .eq { display:flex; align-items:center; justify-content:space-between; gap:6px 24px;
-  overflow-x:auto; padding:5px 0; }
-.armdyn .eq math { margin:2px 0; }
-.armdyn .eq .note { flex:0 0 auto; max-width:45%; color:var(--muted); font-size:0.84em; text-align:right; }
+/* an equation and its caption share a row while both fit, else the caption wraps under
+   it; a formula wider than the page (MathML Core does not break lines) scrolls alone */
+.armdyn .eq { display:flex; flex-wrap:wrap; align-items:center; justify-content:space-between; gap:6px 24px;
+  padding:5px 0; }
+.armdyn .eq > math { margin:2px 0; max-width:100%; overflow-x:auto; overflow-y:hidden; }
+.armdyn .eq .note { flex:1 1 16em; color:var(--muted); font-size:0.84em; text-align:right; }
+.armdyn .note math { font-size:1.1em; }
 .armdyn .group { border:1px solid var(--rule); border-radius:8px; padding:6px 16px 10px; margin:0 0 10px;
   break-inside:avoid; }
 .armdyn .group > h3 { margin-top:6px; }
