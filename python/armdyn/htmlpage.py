@@ -97,6 +97,8 @@ CSS = """
   font-variant-numeric:tabular-nums; }
 .armdyn .skip pre { margin:0; }
 .armdyn .skip .why { color:var(--muted); font-size:0.88em; margin:2px 0 0 2px; }
+.armdyn .skip .written { max-width:100%; overflow-x:auto; padding:4px 0; }
+.armdyn .skip details { margin-top:2px; }
 .armdyn .head .where { color:var(--muted); font-size:0.86em; margin-left:auto; }
 .armdyn .message { margin:6px 0 0; }
 .armdyn .message .why { color:var(--muted); }
@@ -108,7 +110,7 @@ CSS = """
 .armdyn .side math { margin:4px 0 2px; }
 /* display-style math laid out from the left: a wide formula scrolls instead of being
    cut on both sides, as centred block math would be */
-.armdyn .side math[display=block], .armdyn .eq math[display=block] { display:inline math; math-style:normal; }
+.armdyn .side math[display=block], .armdyn .eq math[display=block], .armdyn .skip .written math[display=block] { display:inline math; math-style:normal; }
 .armdyn .side.diff { background:var(--bad-bg); }
 .armdyn mtd { padding:2px 6px; }
 .armdyn mtd.hl { background:var(--hl); border-radius:4px; }
