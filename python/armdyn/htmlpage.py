@@ -110,7 +110,8 @@ CSS = """
 .armdyn .side math { margin:4px 0 2px; }
 /* display-style math laid out from the left: a wide formula scrolls instead of being
    cut on both sides, as centred block math would be */
-.armdyn .side math[display=block], .armdyn .eq math[display=block], .armdyn .skip .written math[display=block] { display:inline math; math-style:normal; }
+.armdyn .side math[display=block], .armdyn .eq math[display=block], .armdyn .skip .written math[display=block] {
+  display:inline math; math-style:normal; }
 .armdyn .side.diff { background:var(--bad-bg); }
 .armdyn mtd { padding:2px 6px; }
 .armdyn mtd.hl { background:var(--hl); border-radius:4px; }

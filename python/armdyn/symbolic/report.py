@@ -245,10 +245,10 @@ def _join(terms, render, text: bool | None = None, times: str | None = None) -> 
         else:  # coefficient first, as by hand: l₁ m₂ d̈₂
             body = f"{render(coef)}{star}{render(mono)}" if text else f"{render(coef)} {render(mono)}"
         out.append(("-" if negative else "+", body))
-    text = ("-" if out[0][0] == "-" else "") + out[0][1]
+    joined = ("-" if out[0][0] == "-" else "") + out[0][1]
     for sign, body in out[1:]:
-        text += f" {sign} {body}"
-    return text
+        joined += f" {sign} {body}"
+    return joined
 
 
 class Renderer:
@@ -297,7 +297,7 @@ class Renderer:
             q, qd = self.atom(self.eom.q[k]), self.atom(self.eom.qd[k])
             return {"tau": f"τ{str(k + 1).translate(_SUB)}", "dL_dqd": f"∂L/∂{qd}", "dL_dq": f"∂L/∂{q}"}[step.name]
         if step.name == "tau":
-            return "τ" + str(self.eom.robot.coordinate_index(self._joint_of(step.link)) + 1).translate(_SUB)
+            return "τ" + str(self._tau_index(step.link) + 1).translate(_SUB)
         return step.name
 
     def _ascii_label(self, step: Step, i: str) -> str:
@@ -307,11 +307,17 @@ class Renderer:
             k = robot.coordinate_names.index(step.link)
             return {"tau": f"tau{k + 1}", "dL_dqd": f"dL/d{self.eom.qd[k]}", "dL_dq": f"dL/d{self.eom.q[k]}"}[step.name]
         if step.name == "tau":
-            return f"tau{robot.coordinate_index(self._joint_of(step.link)) + 1}"
+            return f"tau{self._tau_index(step.link) + 1}"
         return f"{step.name}{i}"
 
     def _joint_of(self, link: str):
         return self.eom.robot.parent_joint(link)
+
+    def _tau_index(self, link: str) -> int:
+        """0-based coordinate of the joint moving ``link`` (a tau step's joint has one)."""
+        k = self.eom.robot.coordinate_index(self._joint_of(link))
+        assert k is not None
+        return k
 
     def equation(self, lhs: str, rhs: str) -> str:
         if self.fmt == "text":
