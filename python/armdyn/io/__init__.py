@@ -44,7 +44,7 @@ def _load_file(path: Path, strict: bool, source: str) -> Robot:
     raise ModelError(f"unknown model file type '{suffix}' (expected .yaml, .yml or .urdf)", None, source)
 
 
-def load(source, strict: bool = True) -> Robot:
+def load(source: str | os.PathLike[str], strict: bool = True) -> Robot:
     """A :class:`~armdyn.Robot` from a bundled model's name or a model file.
 
     source: a bundled name (see :func:`bundled_robots`, e.g. ``"rp-arm"``, ``"puma560"``)
@@ -77,7 +77,7 @@ def bundled_robots() -> list[dict]:
     file does not load, with ``dof`` None)."""
     out = []
     for name, path in _bundled_files().items():
-        entry = {"name": name, "path": os.fspath(path)}
+        entry: dict[str, object] = {"name": name, "path": os.fspath(path)}
         try:
             robot = _load_file(path, strict=False, source=path.name)
         except ModelError as err:
