@@ -132,6 +132,9 @@ def test_latex_symbol_names_as_written_by_hand(rp):
                 "m2": "m_{2}", "g": "g"}
     assert names == expected
     assert latex_symbol_names(robot) is latex_symbol_names(robot)  # built once per robot
+    planar = armdyn.load("planar-2r")  # the field's l_{c1}: distance to the centre of mass
+    names = {str(k): v for k, v in latex_symbol_names(planar).items()}
+    assert names["lc1"] == "l_{c1}" and names["q1_dot"] == r"\dot{q}_{1}" and names["I2"] == "I_{2}"
 
 
 @pytest.mark.parametrize("where", ["report", "repr_latex", "sympy"])

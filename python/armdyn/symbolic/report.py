@@ -110,12 +110,15 @@ def _text_names(eom: EquationsOfMotion) -> dict:
 
 def latex_name(name: str, dots: str = "") -> str | None:
     """``theta1`` -> ``\\theta_{1}``, with ``dots`` "_dot"/"_ddot": ``\\dot{\\theta}_{1}``,
-    ``\\ddot{d}_{2}`` (the accent on the letter, the index outside); ``l1`` -> ``l_{1}``.
+    ``\\ddot{d}_{2}`` (the accent on the letter, the index outside); ``l1`` -> ``l_{1}``,
+    ``lc1`` -> ``l_{c1}``.
     None for names that are not letters + optional digits."""
     m = _NAME_PARTS.fullmatch(name)
     if not m:
         return None
     base, digits = m.groups()
+    if len(base) == 2 and base not in _GREEK and not dots:
+        return f"{base[0]}_{{{base[1]}{digits}}}"  # lc1 -> l_{c1}, as the field writes it
     letter = f"\\{base}" if base in _GREEK else base
     if len(base) > 1 and base not in _GREEK:
         letter = rf"\mathit{{{base}}}"  # a multi-letter name is one symbol, not a product
