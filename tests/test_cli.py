@@ -38,7 +38,7 @@ def test_steps_show_every_quantity_per_link(capsys):
         assert f"  {label} = " in out, label
     # the centripetal term the exercise drops from link 2's acceleration is there
     line = next(s for s in out.splitlines() if s.startswith("  v̇_C₂ = "))
-    assert "l₁*θ̇₁²" in line
+    assert "l₁ θ̇₁²" in line
 
 
 def test_text_report_writes_symbols_as_the_field_does(capsys):
@@ -49,7 +49,8 @@ def test_text_report_writes_symbols_as_the_field_does(capsys):
     out, nfc = unicodedata.normalize("NFC", out), lambda t: unicodedata.normalize("NFC", t)
     assert nfc("  ω̇₁ = [0, 0, θ̈₁]") in out and "  ω₂ = [0, -θ̇₁, 0]" in out
     assert not re.search(r"(?<![\w.])1\*", out) and "_dot" not in out and "_ddot" not in out
-    assert nfc("m₂*d̈₂") in out and nfc("2*d₂*m₂*ḋ₂*θ̇₁") in out
+    # factors side by side, as written by hand: no "*" anywhere in the Unicode report
+    assert nfc("m₂ d̈₂") in out and nfc("2 d₂ m₂ ḋ₂ θ̇₁") in out and "*" not in out
     code, ascii_out, _ = run(capsys, "derive", "rp-arm", "--steps", "--method", "newton-euler", "--ascii")
     assert code == 0 and ascii_out.isascii()
     assert "  omega_dot1 = [0, 0, theta1_ddot]" in ascii_out and "  tau1 = " in ascii_out
@@ -63,7 +64,7 @@ def test_lagrange_steps_show_energies(capsys):
         assert label in out, label
 
 
-@pytest.mark.parametrize("fmt,marker", [("latex", r"\ddot{\theta_{1}}"), ("markdown", "$$\\tau_{1} =")])
+@pytest.mark.parametrize("fmt,marker", [("latex", r"\ddot{\theta}_{1}"), ("markdown", "$$\\tau_{1} =")])
 def test_formats(capsys, fmt, marker):
     code, out, _ = run(capsys, "derive", "rp-arm", "--format", fmt, "--steps")
     assert code == 0 and marker in out
@@ -128,7 +129,9 @@ def test_printed_tau_is_the_exercise_result(capsys, ascii_only):
     The Unicode report is read back by spelling its symbols in ASCII here (a table
     written out by hand, not the report's own)."""
     import sympy as sp
+    from sympy.parsing.sympy_parser import implicit_multiplication, parse_expr, standard_transformations
 
+    implicit = standard_transformations + (implicit_multiplication,)
     _, out, _ = run(capsys, "derive", "rp-arm", "--method", "lagrange", *(["--ascii"] if ascii_only else []))
     spelled = {"θ̈₁": "theta1_ddot", "θ̇₁": "theta1_dot", "θ₁": "theta1", "d̈₂": "d2_ddot", "ḋ₂": "d2_dot",
                "d₂": "d2", "m₁": "m1", "m₂": "m2", "l₁": "l1", "τ₁": "tau1", "τ₂": "tau2", "²": "**2"}
@@ -139,7 +142,8 @@ def test_printed_tau_is_the_exercise_result(capsys, ascii_only):
         if line.startswith("  tau"):
             assert line.isascii(), line
             lhs, rhs = line.split(" = ", 1)
-            printed[lhs.strip()] = sp.sympify(rhs.rsplit("    (", 1)[0])
+            # the Unicode report writes factors side by side: read juxtaposition as a product
+            printed[lhs.strip()] = parse_expr(rhs.rsplit("    (", 1)[0], transformations=implicit)
     m1, m2, l1, g, th, d, thd, dd, thdd, ddd = sp.symbols(
         "m1 m2 l1 g theta1 d2 theta1_dot d2_dot theta1_ddot d2_ddot")
     tau1 = ((m1 + m2) * l1**2 * thdd + m2 * l1 * ddd + 2 * m2 * d * thd * dd + m2 * thdd * d**2

@@ -20,6 +20,17 @@ from .model import Joint, Link, Robot  # noqa: E402
 from .symbolic import EquationsOfMotion, check, derive, prove_agreement  # noqa: E402
 from . import codegen  # noqa: E402  armdyn.codegen(robot, ...) and armdyn.codegen.compile(...)
 
+from typing import TYPE_CHECKING  # noqa: E402
+
+if TYPE_CHECKING:  # what __getattr__ below imports on first use, for type checkers (py.typed)
+    # armdyn.grade is the package made callable: typed as its grade() function
+    from .grade import grade  # noqa: F401
+    from .identification import base_parameters, regressor  # noqa: F401
+    from .numeric import NumericModel, aba, aba_derivatives, bias, compile_model, coriolis_matrix  # noqa: F401
+    from .numeric import crba, forward_kinematics, gravity, gravity_derivatives, jacobian  # noqa: F401
+    from .numeric import jacobian_dot, kinetic_energy, minverse, potential_energy, rnea  # noqa: F401
+    from .numeric import rnea_derivatives  # noqa: F401
+
 _NUMERIC = (
     "rnea", "crba", "aba", "gravity", "bias", "coriolis_matrix", "kinetic_energy",
     "potential_energy", "forward_kinematics", "jacobian", "NumericModel", "compile_model",

@@ -97,6 +97,8 @@ CSS = """
   font-variant-numeric:tabular-nums; }
 .armdyn .skip pre { margin:0; }
 .armdyn .skip .why { color:var(--muted); font-size:0.88em; margin:2px 0 0 2px; }
+.armdyn .skip .written { max-width:100%; overflow-x:auto; padding:4px 0; }
+.armdyn .skip details { margin-top:2px; }
 .armdyn .head .where { color:var(--muted); font-size:0.86em; margin-left:auto; }
 .armdyn .message { margin:6px 0 0; }
 .armdyn .message .why { color:var(--muted); }
@@ -108,7 +110,8 @@ CSS = """
 .armdyn .side math { margin:4px 0 2px; }
 /* display-style math laid out from the left: a wide formula scrolls instead of being
    cut on both sides, as centred block math would be */
-.armdyn .side math[display=block], .armdyn .eq math[display=block] { display:inline math; math-style:normal; }
+.armdyn .side math[display=block], .armdyn .eq math[display=block], .armdyn .skip .written math[display=block] {
+  display:inline math; math-style:normal; }
 .armdyn .side.diff { background:var(--bad-bg); }
 .armdyn mtd { padding:2px 6px; }
 .armdyn mtd.hl { background:var(--hl); border-radius:4px; }
@@ -124,10 +127,13 @@ CSS = """
   margin:8px 0 14px; }
 
 /* derivation pages and small tables */
-.armdyn .eq { display:flex; align-items:center; justify-content:space-between; gap:6px 24px;
-  overflow-x:auto; padding:5px 0; }
-.armdyn .eq math { margin:2px 0; }
-.armdyn .eq .note { flex:0 0 auto; max-width:45%; color:var(--muted); font-size:0.84em; text-align:right; }
+/* an equation and its caption share a row while both fit, else the caption wraps under
+   it; a formula wider than the page (MathML Core does not break lines) scrolls alone */
+.armdyn .eq { display:flex; flex-wrap:wrap; align-items:center; justify-content:space-between; gap:6px 24px;
+  padding:5px 0; }
+.armdyn .eq > math { margin:2px 0; max-width:100%; overflow-x:auto; overflow-y:hidden; }
+.armdyn .eq .note { flex:1 1 16em; color:var(--muted); font-size:0.84em; text-align:right; }
+.armdyn .note math { font-size:1.1em; }
 .armdyn .group { border:1px solid var(--rule); border-radius:8px; padding:6px 16px 10px; margin:0 0 10px;
   break-inside:avoid; }
 .armdyn .group > h3 { margin-top:6px; }

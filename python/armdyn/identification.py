@@ -224,7 +224,7 @@ def regressor(robot: Robot) -> Regressor:
     n = robot.dof
     w, wd, vd, pose = _outward(robot)
     cols = []
-    chain = {}  # link -> its joints from itself to the base
+    chain: dict[str, list] = {}  # link -> its joints from itself to the base
     for joint in robot.joints:
         chain[joint.child] = [joint] + chain.get(joint.parent, [])
     for joint in robot.joints:
@@ -241,6 +241,7 @@ def regressor(robot: Robot) -> Regressor:
             cols.append(col)
     for joint in robot.movable_joints:
         k = robot.coordinate_index(joint)
+        assert k is not None  # a movable joint has a coordinate
         coefficient = {"armature": robot.qdd[k], "damping": robot.qd[k], "friction": sp.sign(robot.qd[k]),
                        "torque_offset": sp.Integer(1)}
         for attr, _ in JOINT_TERMS:

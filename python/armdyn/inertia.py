@@ -162,7 +162,7 @@ def _axisymmetric(axial, transverse, axis: str, sym: bool):
         raise ValueError(f"axis must be 'x', 'y' or 'z', got {axis!r}")
     moments = [transverse] * 3
     moments[_AXES[axis]] = axial
-    return _diag(*moments, sym)
+    return _diag(moments[0], moments[1], moments[2], sym)
 
 
 def point_mass(m):
@@ -197,7 +197,8 @@ def sphere(m, r, hollow: bool = False):
     """Solid sphere ``2/5 m r^2`` or, with ``hollow``, thin spherical shell ``2/3 m r^2``."""
     sym = _any_symbolic(m, r)
     k = _frac(2, 3, sym) if hollow else _frac(2, 5, sym)
-    return _diag(*[k * m * r**2] * 3, sym)
+    moment = k * m * r**2
+    return _diag(moment, moment, moment, sym)
 
 
 # ------------------------------------------------------------------------ bodies

@@ -38,7 +38,7 @@ from sympy.printing.pretty.pretty_symbology import greek_unicode
 
 from .mathml_sanitize import clean_mathml, sanitize_mathml
 
-__all__ = ["MathWriter", "to_mathml", "latex_to_mathml", "math_element", "escape"]
+__all__ = ["MathWriter", "to_mathml", "latex_to_mathml", "math_element", "escape", "text_with_math"]
 
 MATHML_NS = "http://www.w3.org/1998/Math/MathML"
 DOT, DDOT = "\u02d9", "\u00a8"  # spacing dot above / diaeresis, as MathML Core's accents
@@ -117,6 +117,24 @@ def latex_to_mathml(latex: str) -> str | None:
     except ValueError:
         return None
     return None if clean.dropped else clean.markup
+
+
+# math delimited in running text: $...$ or \(...\) (an escaped \$ is not a delimiter)
+_DELIMITED = re.compile(r"(?<!\\)\$(?!\$)(.+?)(?<!\\)\$|\\\((.+?)\\\)", re.S)
+
+
+def text_with_math(text: str) -> str:
+    """HTML of running text (a grader's message) whose delimited math (``$...$``,
+    ``\\(...\\)``) becomes inline MathML, through the whitelist sanitizer like all
+    math here; the rest, and math that does not convert, is escaped text."""
+    out, at = [], 0
+    for m in _DELIMITED.finditer(text):
+        inner = latex_to_mathml(m.group(1) if m.group(1) is not None else m.group(2))
+        out.append(escape(text[at:m.start()]))
+        out.append(math_element(inner) if inner is not None else escape(m.group(0)))
+        at = m.end()
+    out.append(escape(text[at:]))
+    return "".join(out)
 
 
 class _Printer(MathMLPresentationPrinter):

@@ -684,11 +684,11 @@ class Robot(metaclass=_FreezeAfterInit):
         # links ordered base first, then children in joint order
         self.links = {base: self.links[base], **{j.child: self.links[j.child] for j in self.joints}}
 
-        if parameters is None:
-            parameters = {}
-        if not isinstance(parameters, Mapping):
-            parameters = {s.name: s for s in parameters}
-        self.parameters: dict[str, sp.Symbol] = dict(parameters)
+        if isinstance(parameters, Mapping):
+            self.parameters: dict[str, sp.Symbol] = dict(parameters)
+        else:
+            symbols: Iterable[sp.Symbol] = parameters or ()
+            self.parameters = {s.name: s for s in symbols}
         self.defaults: dict[str, float] = dict(defaults or {})
         stray = set(self.defaults) - set(self.parameters)
         if stray:
@@ -736,7 +736,8 @@ class Robot(metaclass=_FreezeAfterInit):
                                  f"robot '{self.name}'")
 
     def _tree_order(self, joints: list[Joint]) -> list[Joint]:
-        names, child_of = set(), {}
+        names: set[str] = set()
+        child_of: dict[str, Joint] = {}
         for j in joints:
             where = f"joint '{j.name}'"
             if j.name in names:
@@ -785,14 +786,21 @@ class Robot(metaclass=_FreezeAfterInit):
         with a coordinate. A missing or fixed leader, a leader of another type, and a
         loop are ModelErrors naming the mimic joint."""
         by_name = {j.name: j for j in self.joints}
-        follows = {j.name: (self._coord_index[j.name], sp.Integer(1), sp.Integer(0)) for j in self.movable_joints}
+        follows: dict[str, tuple[int, sp.Expr, sp.Expr]] = {}
+        for j in self.movable_joints:
+            k = self._coord_index[j.name]
+            assert k is not None  # a movable joint has a coordinate of its own
+            follows[j.name] = (k, sp.Integer(1), sp.Integer(0))
         for start in self.mimic_joints:
-            chain, joint, seen = [], start, {start.name}
+            chain: list[Joint] = []
+            joint, seen = start, {start.name}
             while joint.name not in follows:  # walk up to a resolved joint (memoised: O(n) overall)
                 where = f"joint '{joint.name}'"
-                leader = by_name.get(joint.mimic.joint)
+                mimic = joint.mimic
+                assert mimic is not None  # only mimic joints are still unresolved
+                leader = by_name.get(mimic.joint)
                 if leader is None:
-                    raise ModelError(f"mimics joint '{joint.mimic.joint}', which does not exist", where)
+                    raise ModelError(f"mimics joint '{mimic.joint}', which does not exist", where)
                 if leader.type == "fixed":
                     raise ModelError(f"mimics joint '{leader.name}', which is fixed", where)
                 if leader.type != joint.type:
@@ -808,8 +816,10 @@ class Robot(metaclass=_FreezeAfterInit):
                 seen.add(leader.name)
                 joint = leader
             for j in reversed(chain):  # q_j = m_j q_leader + o_j, q_leader = m q_k + o
-                k, m, o = follows[j.mimic.joint]
-                follows[j.name] = (k, j.mimic.multiplier * m, j.mimic.multiplier * o + j.mimic.offset)
+                mimic = j.mimic
+                assert mimic is not None
+                k, m, o = follows[mimic.joint]
+                follows[j.name] = (k, mimic.multiplier * m, mimic.multiplier * o + mimic.offset)
         return follows
 
     # ------------------------------------------------------------------ queries

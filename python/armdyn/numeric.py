@@ -35,6 +35,7 @@ import math
 
 import numpy as np
 import sympy as sp
+from numpy.typing import ArrayLike
 
 from . import _core
 from .errors import ModelError, UnboundParameterError
@@ -68,6 +69,10 @@ __all__ = [
 #: ``link_names``, ``coordinate_names``, ``gravity`` (3,), ``name``.
 NumericModel = _core.NumericModel
 
+#: what the functions below accept as ``robot``: a bound Robot (compiled on first use,
+#: then cached on it) or an already compiled model
+RobotLike = Robot | NumericModel | MimicModel
+
 _TYPE_CODES = {"revolute": 0, "prismatic": 1, "fixed": 2}
 
 
@@ -85,7 +90,7 @@ def _floats(values, where: str) -> list[float]:
     return out
 
 
-def _field(obj, name: str, where: str) -> list:
+def _field(obj, name: str, where: str) -> list | float:
     """A Link/Joint field as floats (nested lists): read from the floats it was built
     from when it has them (no SymPy per joint for big URDFs), else from SymPy."""
     f = obj.floats(name)
@@ -98,8 +103,9 @@ def _field(obj, name: str, where: str) -> list:
     return _floats([value], where)[0]
 
 
-def compile_model(robot: Robot | NumericModel) -> NumericModel:
-    """The compiled numeric model of ``robot`` (built on first use, then cached on it).
+def compile_model(robot: Robot | NumericModel | MimicModel) -> NumericModel | MimicModel:
+    """The compiled numeric model of ``robot`` (built on first use, then cached on it):
+    for a robot with mimic joints, a :class:`~armdyn.mimic.MimicModel` around one.
 
     Raises UnboundParameterError if the robot still has free symbols, TypeError if
     ``robot`` is neither a Robot nor a NumericModel.
@@ -138,26 +144,25 @@ def compile_model(robot: Robot | NumericModel) -> NumericModel:
     # per movable joint [armature, viscous, coulomb, offset] (absent = 0); None when all zero
     # one row per joint the compiled model frees (mimic joints too); a mimic joint's own
     # friction and armature are not modelled (yet): zeros, as in the reference
-    joint_dynamics = [
+    rows = [
         [0.0 if j.mimic is not None or j.floats(k) is None else float(j.floats(k))
          for k in ("armature", "damping", "friction", "torque_offset")]
         for j in robot.joints if j.movable
     ]
-    if not any(any(row) for row in joint_dynamics):
-        joint_dynamics = None
+    joint_dynamics = rows if any(any(row) for row in rows) else None
     gravity_vec = _floats(robot.gravity, f"robot '{robot.name}'")
     base = robot.links[robot.base]
     where = f"link '{base.name}'"
     try:
-        model = NumericModel(
+        core = NumericModel(
             parents, types, rotations, translations, axes, masses, coms, inertias, gravity_vec,
             list(robot.links), [j.name for j in robot.joints if j.movable], robot.name,
             _field(base, "mass", where), _field(base, "com", where), joint_dynamics,
         )
     except ValueError as err:
         raise ModelError(str(err), f"robot '{robot.name}'") from None
-    if robot.mimic_joints:  # every non-fixed joint is free in `model`; see armdyn.mimic
-        model = MimicModel(model, robot)
+    # every non-fixed joint is free in `core`; see armdyn.mimic
+    model = MimicModel(core, robot) if robot.mimic_joints else core
     source._numeric_model = model
     return model
 
@@ -205,7 +210,7 @@ def _frame_offsets(robot) -> np.ndarray | None:
     return out
 
 
-def _model(robot) -> NumericModel:
+def _model(robot) -> NumericModel | MimicModel:
     # Fast path: a Robot already compiled, or a NumericModel (whose
     # ``_numeric_model`` is itself).
     try:
@@ -214,7 +219,8 @@ def _model(robot) -> NumericModel:
         return compile_model(robot)
 
 
-def rnea(robot, q, qd, qdd, *, f_ext=None, frame="local", threads=None):
+def rnea(robot: RobotLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, *, f_ext: ArrayLike | None = None,
+         frame: str = "local", threads: int | None = None) -> np.ndarray:
     """Inverse dynamics by the recursive Newton-Euler algorithm.
 
     q, qd, qdd: (n,) or (N, n). Returns tau = M(q) qdd + C(q, qd) qd + g(q), same shape;
@@ -231,7 +237,7 @@ def rnea(robot, q, qd, qdd, *, f_ext=None, frame="local", threads=None):
     raise _overflow("rnea", {"q": q, "qd": qd, "qdd": qdd})
 
 
-def crba(robot, q, *, threads=None):
+def crba(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Joint-space inertia matrix M(q) by the composite rigid-body algorithm.
 
     q: (n,) or (N, n). Returns the full symmetric M: (n, n) or (N, n, n).
@@ -240,7 +246,8 @@ def crba(robot, q, *, threads=None):
     return _finite(_model(robot).crba(q, threads), "crba", q=q)
 
 
-def aba(robot, q, qd, tau, *, f_ext=None, frame="local", threads=None):
+def aba(robot: RobotLike, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, *, f_ext: ArrayLike | None = None,
+        frame: str = "local", threads: int | None = None) -> np.ndarray:
     """Forward dynamics by the articulated-body algorithm.
 
     q, qd, tau: (n,) or (N, n). Returns qdd = M^-1 (tau - C qd - g), same shape; with
@@ -260,13 +267,13 @@ def aba(robot, q, qd, tau, *, f_ext=None, frame="local", threads=None):
         raise
 
 
-def gravity(robot, q, *, threads=None):
+def gravity(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Gravity torques g(q) = rnea(q, 0, 0). q: (n,) or (N, n); same shape out."""
     threads = _threads(threads)
     return _finite(_model(robot).gravity_torques(q, threads), "gravity", q=q)
 
 
-def bias(robot, q, qd, *, threads=None):
+def bias(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Nonlinear effects h(q, qd) = C(q, qd) qd + g(q) = rnea(q, qd, 0).
 
     q, qd: (n,) or (N, n); same shape out.
@@ -275,7 +282,7 @@ def bias(robot, q, qd, *, threads=None):
     return _finite(_model(robot).bias(q, qd, threads), "bias", q=q, qd=qd)
 
 
-def coriolis_matrix(robot, q, qd, *, threads=None):
+def coriolis_matrix(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """The Coriolis matrix C(q, qd) built from the Christoffel symbols of M.
 
     C qd = h - g, and Mdot - 2C is skew-symmetric. q, qd: (n,) or (N, n).
@@ -285,13 +292,14 @@ def coriolis_matrix(robot, q, qd, *, threads=None):
     return _finite(_model(robot).coriolis_matrix(q, qd, threads), "coriolis_matrix", q=q, qd=qd)
 
 
-def kinetic_energy(robot, q, qd, *, threads=None):
+def kinetic_energy(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *,
+                   threads: int | None = None) -> float | np.ndarray:
     """Kinetic energy T = 1/2 qd^T M(q) qd. q, qd: (n,) -> float, or (N, n) -> (N,)."""
     threads = _threads(threads)
     return _finite(_model(robot).kinetic_energy(q, qd, threads), "kinetic_energy", q=q, qd=qd)
 
 
-def potential_energy(robot, q, *, threads=None):
+def potential_energy(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> float | np.ndarray:
     """Potential energy V = -sum_i m_i gravity . p_ci over every link (the base and links
     welded to it included, a constant), zero with every centre of mass at the base
     origin (p_ci: link i's centre of mass in the base frame).
@@ -302,7 +310,7 @@ def potential_energy(robot, q, *, threads=None):
     return _finite(_model(robot).potential_energy(q, threads), "potential_energy", q=q)
 
 
-def forward_kinematics(robot, q, *, threads=None):
+def forward_kinematics(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Homogeneous pose of every link frame in the base frame.
 
     q: (n,) or (N, n). Returns (nlinks, 4, 4) or (N, nlinks, 4, 4), links in
@@ -318,7 +326,10 @@ def forward_kinematics(robot, q, *, threads=None):
 REFERENCE_FRAMES = ("local_world_aligned", "local", "world")
 
 
-def jacobian(robot, q, link, *, reference_frame: str = "local_world_aligned", threads=None):
+def jacobian(
+    robot: RobotLike, q: ArrayLike, link: str | int | Link, *, reference_frame: str = "local_world_aligned",
+    threads: int | None = None,
+) -> np.ndarray:
     """Geometric Jacobian of a link frame.
 
     q: (n,) or (N, n); link: a link name, index in ``list(robot.links)``, or Link.
@@ -355,7 +366,7 @@ def _aligned_jacobian(robot, q, link, threads):
         link = link.name
     J = _model(robot).jacobian(q, link, threads)
     offsets = _frame_offsets(robot)
-    if offsets is None:
+    if offsets is None or not isinstance(robot, Robot):  # offsets: only a Robot has them
         return J
     # the compiled model's link frame is on the joint; move the point to the link frame's
     # origin: v' = v + w x (R pf), so J_v' = J_v - [R pf]x J_w
@@ -446,7 +457,7 @@ def _minverse_python(robot, q, threads, out):
     return _into(out, _mimic(robot, "minverse").minverse(q, threads))
 
 
-def gravity_derivatives(robot, q, *, threads=None):
+def gravity_derivatives(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """``dg/dq`` of the gravity torques: (n, n) or (N, n, n), ``[i, j] = d g_i / d q_j``."""
     mimic = _mimic(robot, "gravity_derivatives")
     if mimic is not None:
@@ -454,7 +465,8 @@ def gravity_derivatives(robot, q, *, threads=None):
     return _core.gravity_derivatives(_core_model(robot, "gravity_derivatives"), q, threads)
 
 
-def jacobian_dot(robot, q, qd, link, *, threads=None):
+def jacobian_dot(robot: RobotLike, q: ArrayLike, qd: ArrayLike, link: str | int | Link, *,
+                 threads: int | None = None) -> np.ndarray:
     """Time derivative of :func:`jacobian`: ``dJ/dt`` (6, n) or (N, 6, n), same rows
     ``[v; w]`` in base-frame axes (Pinocchio's LOCAL_WORLD_ALIGNED), so that the link
     origin's acceleration and the link's angular acceleration are ``J qdd + Jdot qd``.
@@ -467,7 +479,7 @@ def jacobian_dot(robot, q, qd, link, *, threads=None):
     else:
         Jd = _core.jacobian_dot(_core_model(robot, "jacobian_dot"), q, qd, link, threads)
     offsets = _frame_offsets(robot)
-    if offsets is None:
+    if offsets is None or not isinstance(robot, Robot):  # offsets: only a Robot has them
         return Jd
     # the point at r = R pf from the compiled (on-joint) frame's origin: J_v' = J_v - [r]x J_w,
     # so Jdot_v' = Jdot_v - [w x r]x J_w - [r]x Jdot_w, with w = J_w qd
@@ -485,7 +497,8 @@ def jacobian_dot(robot, q, qd, link, *, threads=None):
     return np.concatenate([Jdv, Jd[..., 3:, :]], axis=-2)
 
 
-def regressor(robot, q, qd, qdd, *, threads=None, columns: str = "model"):
+def regressor(robot: RobotLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, *, threads: int | None = None,
+              columns: str = "model") -> np.ndarray:
     """The joint torque regressor Y with ``rnea(q, qd, qdd) = Y @ pi`` (Rust core,
     algo/regressor.rs). q, qd, qdd: (n,) or (N, n). Returns (n, P) or (N, n, P).
 

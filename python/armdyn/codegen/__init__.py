@@ -296,21 +296,23 @@ def _base_programs(robot: Robot, what) -> tuple[dict, dict, list]:
         programs, sources, extra_defs = custom
         definitions = definitions + extra_defs
     tau = None
+    shape: tuple[int, ...]
     for w in what:
         if w in programs:
             continue
-        if tau is None and w != "regressor":
-            tau = Yb * sp.Matrix(beta)  # only for what the customized algorithms did not give
-        if w == "tau":
-            expr, shape = list(tau), (n,)
-        elif w == "g":
-            expr, shape = list(tau.xreplace({s: 0 for s in list(robot.qd) + list(robot.qdd)})), (n,)
-        elif w == "M":
-            expr, shape = list(tau.jacobian(robot.qdd)), (n, n)
-        elif w == "C":
-            expr, shape = list(christoffel_coriolis(tau.jacobian(robot.qdd), robot.q, robot.qd)), (n, n)
-        else:
+        if w == "regressor":
             expr, shape = list(Yb), Yb.shape
+        else:
+            if tau is None:  # only for what the customized algorithms did not give
+                tau = Yb * sp.Matrix(beta)
+            if w == "tau":
+                expr, shape = list(tau), (n,)
+            elif w == "g":
+                expr, shape = list(tau.xreplace({s: 0 for s in list(robot.qd) + list(robot.qdd)})), (n,)
+            elif w == "M":
+                expr, shape = list(tau.jacobian(robot.qdd)), (n, n)
+            else:  # "C"
+                expr, shape = list(christoffel_coriolis(tau.jacobian(robot.qdd), robot.q, robot.qd)), (n, n)
         programs[w] = from_expressions(expr, shape, reserved=reserved)
         sources[w] = "base regressor x base parameters, CSE" if w != "regressor" else "base regressor, CSE"
     return programs, sources, definitions

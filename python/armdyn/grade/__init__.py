@@ -18,6 +18,7 @@ from __future__ import annotations
 import os
 import sys
 import types
+from collections.abc import Mapping
 
 import symengine as se
 import sympy as sp
@@ -261,7 +262,8 @@ class _Grader:
     def _check_index(self, ref: StepRef, eq):
         n = len(self.robot.links) - 1
         if ref.key in VECTOR_KEYS:
-            if not 0 <= ref.index <= n or (ref.index == 0 and ref.key not in ("omega", "omega_dot", "v_dot")):
+            if ref.index is None or not 0 <= ref.index <= n \
+                    or (ref.index == 0 and ref.key not in ("omega", "omega_dot", "v_dot")):
                 raise ModelError(f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}",
                                  source=self.where(eq))
             if ref.frame is not None and not 0 <= ref.frame <= n:
@@ -276,7 +278,7 @@ class _Grader:
                                  source=self.where(eq))
         elif ref.key == "R":
             for k in (ref.index, ref.frame):
-                if not 0 <= k <= n:
+                if k is None or not 0 <= k <= n:
                     raise ModelError(f"{ref.name}: frame {k} does not exist (frames 0..{n})", source=self.where(eq))
         elif ref.index is not None and not 1 <= ref.index <= self.robot.dof:
             raise ModelError(f"{ref.name} names joint {ref.index}, but '{self.robot.name}' has joints "
@@ -284,6 +286,7 @@ class _Grader:
 
     def _rotation(self, ref: StepRef, eq, value):
         ctx = self.world("newton-euler").ctx
+        assert ref.index is not None and ref.frame is not None  # _check_index ran
         expected = rotation_between(ctx, ref.index, ref.frame)
         fp = self.sampler.fingerprint
         got_fp = fp(value)
@@ -359,6 +362,7 @@ class _Grader:
         link = ""
         own = value
         if ref.key in VECTOR_KEYS:
+            assert ref.index is not None  # _check_index ran
             link = list(self.robot.links)[ref.index]
             if ref.frame is not None and ref.frame != ref.index:
                 value = own = to_sympy(value)
@@ -386,17 +390,18 @@ class _Grader:
         # what their own earlier values give (wrong) or the expected value
         exp_shown = j.conv.forward(world.expected[key].sym(), world.ctx,
                                    *(world.expected[r].sym() for r in j.conv.extra))
-        if ref.key in VECTOR_KEYS and ref.frame is not None and ref.frame != ref.index:
+        if ref.key in VECTOR_KEYS and ref.frame is not None and ref.index is not None and ref.frame != ref.index:
             exp_shown = rotation_between(world.ctx, ref.index, ref.frame) * exp_shown
         difference, components, message = None, [], ""
         if j.status in ("wrong", "follows-from-earlier-error", "correct-but-unsupported"):
             value = to_sympy(value)
-            ref_value = j.reference.sym() if j.status != "correct-but-unsupported" else exp_shown
+            ref_value = j.reference.sym() if j.status != "correct-but-unsupported" and j.reference is not None \
+                else exp_shown
             if j.status == "correct-but-unsupported":
                 carried = world.carried(key)
                 ref_value = carried[0].sym() if carried else exp_shown
                 ref_value = j.conv.forward(ref_value, world.ctx, *(e.sym() for e in extras))
-            if ref.key in VECTOR_KEYS and ref.frame is not None and ref.frame != ref.index:
+            if ref.key in VECTOR_KEYS and ref.frame is not None and ref.index is not None and ref.frame != ref.index:
                 ref_value = rotation_between(world.ctx, ref.index, ref.frame) * ref_value
             got_m, ref_m = _matrix(value), _matrix(ref_value)
             ok = equal(self.sampler.fingerprint(got_m), self.sampler.fingerprint(ref_m)).ravel()
@@ -434,7 +439,7 @@ class _Grader:
                                     + (f" (from the error in {src[0]})" if src else "")
                                     + " (copied, or two slips that cancel?)")
         elif j.status == "correct-by-convention":
-            message = j.convention
+            message = j.convention or ""
         self.verdicts.append(StepVerdict(
             name=name, key=ref.key, link=link, status=j.status, label=eq.lhs, source=eq.source, line=eq.line,
             expected=exp_shown, got=value, difference=difference, components=components,
@@ -472,7 +477,8 @@ def _symbol_latex(robot: Robot) -> dict:
     return out
 
 
-def grade(submission, robot: str | Robot | None = None, symbols: dict | None = None) -> GradeReport:
+def grade(submission: str | os.PathLike[str] | Submission, robot: str | Robot | None = None,
+          symbols: dict | None = None) -> GradeReport:
     """Grade a derivation.
 
     submission: path of a Markdown (.md) or YAML (.yaml) file, or a :class:`Submission`.
@@ -490,7 +496,8 @@ def grade(submission, robot: str | Robot | None = None, symbols: dict | None = N
         model = _load_robot(name, sub)
     if sub.values is not None:
         try:
-            model = model.bind(None if sub.values == "published" else sub.values)
+            # the reader admits "published" or a mapping parameter -> number
+            model = model.bind(sub.values if isinstance(sub.values, Mapping) else None)
         except ModelError as err:
             raise err.located(source=sub.path) from None
     hint = sub.method if sub.method in ("newton-euler", "lagrange") else None

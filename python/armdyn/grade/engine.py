@@ -33,7 +33,7 @@ import numpy as np
 import symengine as se
 import sympy as sp
 
-from .methods import Method, evaluate_context
+from .methods import Convention, Method, evaluate_context
 
 #: sample points for the numeric comparison
 SAMPLES = 4
@@ -280,7 +280,7 @@ class Judgement:
     convention: str | None
     origins: frozenset
     reference: Value | None  # what the student's value is compared with when wrong
-    conv: object = None
+    conv: Convention  # the convention the value was judged in
     canon: Value | None = None  # the reference in canonical form
 
 

@@ -26,7 +26,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..htmlpage import fragment, page
-from ..mathml import MathWriter, escape, latex_to_mathml, math_element
+from ..mathml import MathWriter, escape, latex_to_mathml, math_element, text_with_math
 from .verdict import STATUSES, GradeReport, StepVerdict
 
 __all__ = ["report_html", "write_report_html", "repr_html", "STATUS_TEXT"]
@@ -188,10 +188,10 @@ def _step_card(i: int, step: StepVerdict, w: _Writer, anchors: dict, first: int 
             f'{_badge(step.status)}<span class="where">{" · ".join(where)}</span></div>')
     parts = [head]
 
-    message = escape(step.message)
+    message = text_with_math(step.message)
     said = [message] if message else []
     if step.convention and step.convention not in step.message:
-        said.append(f'<span class="why">convention:</span> {escape(step.convention)}')
+        said.append(f'<span class="why">convention:</span> {text_with_math(step.convention)}')
     if step.caused_by:
         target = anchors.get(step.caused_by)
         name = escape(step.caused_by)
@@ -243,11 +243,28 @@ def _unrecognised_card(run: list[tuple[int, StepVerdict]]) -> str:
     common = reasons.pop() if len(reasons) == 1 and all(s.message for _, s in run) else None
     rows = []
     for i, s in run:
-        why = "" if common or not s.message else f'<div class="why">{escape(s.message)}</div>'
+        why = "" if common or not s.message else f'<div class="why">{text_with_math(s.message)}</div>'
         rows.append(f'<div class="skip" id="step-{i}"><span class="ln">{s.line or ""}</span>'
-                    f'<div><pre>{escape(s.source or s.label)}</pre>{why}</div></div>')
-    note = f'<p class="message"><span class="why">{escape(common)}</span></p>' if common else ""
+                    f'<div>{_as_written(s.source or s.label)}{why}</div></div>')
+    note = f'<p class="message"><span class="why">{text_with_math(common)}</span></p>' if common else ""
     return f'<li class="step st-unrecognised">{head}{note}{"".join(rows)}</li>'
+
+
+def _as_written(source: str) -> str:
+    """An equation the grader skipped, as math when its LaTeX converts (through the
+    sanitizer: :func:`armdyn.mathml.latex_to_mathml`), with the source under "as
+    written"; else the source as escaped text."""
+    inner = latex_to_mathml(source.strip().strip("$").strip()) if _looks_like_latex(source) else None
+    if inner is None:
+        return f"<pre>{escape(source)}</pre>"
+    return (f'<div class="written">{math_element(inner, display=True)}</div>'
+            f"<details><summary>as written</summary><pre>{escape(source)}</pre></details>")
+
+
+def _looks_like_latex(source: str) -> bool:
+    """TeX markup (a command, a script, a group): plain text like ``tau1 = m*x`` would
+    come out of a LaTeX conversion as a product of letters."""
+    return any(c in source for c in "\\_^{")
 
 
 def _tau_step(report: GradeReport, i: int) -> StepVerdict | None:

@@ -85,7 +85,7 @@ def _published(path: Path) -> Robot:
                  robot.base, robot.defaults, strict=False)
 
 
-def load(source, strict: bool | None = None) -> Robot:
+def load(source: str | os.PathLike[str], strict: bool | None = None) -> Robot:
     """A :class:`~armdyn.Robot` from a bundled model's name or a model file.
 
     source: a bundled name (see :func:`bundled_robots`, e.g. ``"rp-arm"``, ``"puma560"``)
@@ -123,7 +123,7 @@ def bundled_robots() -> list[dict]:
     file does not load, with ``dof`` None)."""
     out = []
     for name, path in _bundled_files().items():
-        entry = {"name": name, "path": os.fspath(path)}
+        entry: dict[str, object] = {"name": name, "path": os.fspath(path)}
         try:
             robot = _load_file(path, strict=False, source=path.name)
         except ModelError as err:

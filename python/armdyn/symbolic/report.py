@@ -11,9 +11,12 @@ derivations themselves never call ``simplify``.
 from __future__ import annotations
 
 import functools
+import re
+import weakref
 
 import symengine as se
 import sympy as sp
+from sympy.printing.precedence import precedence
 
 from . import dag
 from .agreement import trig_reduce
@@ -40,7 +43,7 @@ _GREEK = {
 }
 _DOTS = {"": "", "_dot": "\u0307", "_ddot": "\u0308"}  # combining dot / diaeresis above
 _SUP = str.maketrans("0123456789-", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻")
-_NAME_PARTS = __import__("re").compile(r"([A-Za-z]+?)_?(\d*)")
+_NAME_PARTS = re.compile(r"([A-Za-z]+?)_?(\d*)")
 
 
 def unicode_name(name: str, dots: str = "") -> str | None:
@@ -55,7 +58,9 @@ def unicode_name(name: str, dots: str = "") -> str | None:
 
 
 class _UnicodeTextPrinter(sp.printing.str.StrPrinter):
-    """SymPy's str printer with θ̇₁-style symbol names and superscript integer powers."""
+    """SymPy's str printer with θ̇₁-style symbol names, superscript integer powers and
+    factors side by side as written by hand (``d₂² m₂ θ̈₁``, not ``d₂**2*m₂*θ̈₁``). A
+    visible ``·`` stays where juxtaposition would merge two numbers (``2·3^x``)."""
 
     def __init__(self, names: dict, **settings):
         super().__init__(settings)
@@ -66,9 +71,26 @@ class _UnicodeTextPrinter(sp.printing.str.StrPrinter):
 
     def _print_Pow(self, expr, rational=False):
         exp = expr.exp
-        if exp.is_Integer and 2 <= exp <= 9 and expr.base.is_Symbol:
-            return self._print(expr.base) + str(exp).translate(_SUP)
+        if exp.is_Integer and 2 <= exp <= 9:
+            # a compound base keeps its parentheses: (m₁ + m₂)²
+            return self.parenthesize(expr.base, precedence(expr), strict=True) + str(exp).translate(_SUP)
         return super()._print_Pow(expr, rational)
+
+    def _print_Mul(self, expr):
+        return _juxtapose(super()._print_Mul(expr))
+
+
+def _juxtapose(text: str) -> str:
+    """``a*b`` -> ``a b`` in printed text (``**`` untouched), ``2*3`` -> ``2·3``."""
+    def sub(m):
+        left, right = m.group(1), m.string[m.end()]
+        return f"{left}{'·' if left.isdigit() and right.isdigit() else ' '}"
+
+    return _STAR.sub(sub, text)
+
+
+# a lone "*" (not part of "**") between two printed factors
+_STAR = re.compile(r"([^*\s])\*(?=[^*\s])")
 
 
 def _text_names(eom: EquationsOfMotion) -> dict:
@@ -85,6 +107,92 @@ def _text_names(eom: EquationsOfMotion) -> dict:
         if u:
             names[sym] = u
     return names
+
+
+def latex_name(name: str, dots: str = "") -> str | None:
+    """``theta1`` -> ``\\theta_{1}``, with ``dots`` "_dot"/"_ddot": ``\\dot{\\theta}_{1}``,
+    ``\\ddot{d}_{2}`` (the accent on the letter, the index outside); ``l1`` -> ``l_{1}``,
+    ``lc1`` -> ``l_{c1}``.
+    None for names that are not letters + optional digits."""
+    m = _NAME_PARTS.fullmatch(name)
+    if not m:
+        return None
+    base, digits = m.groups()
+    if len(base) == 2 and base not in _GREEK and not dots:
+        return f"{base[0]}_{{{base[1]}{digits}}}"  # lc1 -> l_{c1}, as the field writes it
+    letter = f"\\{base}" if base in _GREEK else base
+    if len(base) > 1 and base not in _GREEK:
+        letter = rf"\mathit{{{base}}}"  # a multi-letter name is one symbol, not a product
+    if dots:
+        letter = {"_dot": r"\dot", "_ddot": r"\ddot"}[dots] + f"{{{letter}}}"
+    return f"{letter}_{{{digits}}}" if digits else letter
+
+
+_LATEX_NAMES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def latex_symbol_names(robot) -> dict:
+    """Symbol -> LaTeX for a robot's q, qd, qdd and parameters, for SymPy's printer:
+    ``sp.latex(expr, symbol_names=latex_symbol_names(robot))`` writes
+    ``\\dot{\\theta}_{1}`` where SymPy alone writes ``\\theta_{1 dot}``. Built once per
+    robot. In Jupyter, ``sympy.init_printing(symbol_names=latex_symbol_names(robot))``
+    displays every SymPy result of that robot this way. A coordinate whose name is not
+    letters + digits (``shoulder_pan``) keeps SymPy's name, dotted as a whole."""
+    try:
+        return _LATEX_NAMES[robot]
+    except (KeyError, TypeError):
+        pass
+    names = {}
+    for q, qd, qdd in zip(robot.q, robot.qd, robot.qdd):
+        plain = sp.latex(q)
+        for sym, dots in ((q, ""), (qd, "_dot"), (qdd, "_ddot")):
+            tex = latex_name(q.name, dots)
+            if tex is None and dots:
+                tex = {"_dot": r"\dot", "_ddot": r"\ddot"}[dots] + f"{{{plain}}}"
+            if tex is not None:
+                names[sym] = tex
+    for sym in robot.parameters.values():
+        tex = latex_name(sym.name)
+        if tex is not None:
+            names[sym] = tex
+    try:
+        _LATEX_NAMES[robot] = names
+    except TypeError:  # not weak-referenceable: rebuilt on each call
+        pass
+    return names
+
+
+#: formulas in the derivations' step notes (plain ASCII there, so --ascii keeps them):
+#: (ASCII, Unicode for the text report, LaTeX for HTML/MathML captions)
+NOTE_FORMULAS = (
+    ("m vcd", "m v̇_C", r"m \dot{v}_C"),
+    ("I wd + w x I w", "I ω̇ + ω × I ω", r"I \dot{\omega} + \omega \times I \omega"),
+    ("1/2 m vc.vc", "½ m v_Cᵀ v_C", r"\tfrac{1}{2} m \, v_C^{\mathsf{T}} v_C"),
+    ("1/2 w^T I w", "½ ωᵀ I ω", r"\tfrac{1}{2} \omega^{\mathsf{T}} I \omega"),
+    ("1/2 Ia qd^2", "½ I_a q̇²", r"\tfrac{1}{2} I_a \dot{q}^{2}"),
+    ("-m gravity.pc", "−m gᵀ p_C", r"-m \, g^{\mathsf{T}} p_C"),
+    ("d/dt dL/dqd - dL/dq", "d/dt ∂L/∂q̇ − ∂L/∂q",
+     r"\frac{d}{dt} \frac{\partial L}{\partial \dot{q}} - \frac{\partial L}{\partial q}"),
+    ("dL/dq", "∂L/∂q", r"\frac{\partial L}{\partial q}"),
+    ("T - V", "T − V", "T - V"),
+)
+
+
+def note_parts(note: str) -> list[tuple[str, int | None]]:
+    """A step note split into ``(text, None)`` and ``(ascii_formula, k)`` pieces, ``k``
+    indexing :data:`NOTE_FORMULAS` (the first, longest formula found wins)."""
+    for k, (ascii_form, _, _) in enumerate(NOTE_FORMULAS):
+        at = note.find(ascii_form)
+        if at >= 0:
+            tail = note[at + len(ascii_form):]
+            head = [(note[:at], None)] if at else []
+            return head + [(ascii_form, k)] + (note_parts(tail) if tail else [])
+    return [(note, None)] if note else []
+
+
+def note_text(note: str) -> str:
+    """The note with its formulas in Unicode: ``inertial force m v̇_C``."""
+    return "".join(text if k is None else NOTE_FORMULAS[k][1] for text, k in note_parts(note))
 
 
 def unicode_supported(stream=None) -> bool:
@@ -123,12 +231,14 @@ def _tidy_terms(expr, q, qd, qdd) -> tuple:
     return tuple(terms)
 
 
-def _join(terms, render, text: bool | None = None) -> str:
+def _join(terms, render, text: bool | None = None, times: str | None = None) -> str:
     """Render ``(coefficient, monomial)`` terms coefficient first, signs folded.
-    ``text``: plain-text layout (``*`` between factors); default: ``render is str``."""
+    ``text``: plain-text layout (default: ``render is str``); ``times``: what goes between
+    coefficient and monomial in text (default ``*`` for SymPy's ``str``, else a space)."""
     if not terms:
         return "0"
     text = render is str if text is None else text
+    star = ("*" if render is str else " ") if times is None else times
     out = []
     for coef, mono in terms:
         negative = coef.could_extract_minus_sign()
@@ -139,16 +249,16 @@ def _join(terms, render, text: bool | None = None) -> str:
         elif coef == 1:  # a unit coefficient is not written: d2_ddot, not 1*d2_ddot
             body = render(mono)
         elif isinstance(coef, sp.Add):  # a factored sum stays in front, in parentheses
-            body = f"({render(coef)})*{render(mono)}" if text else f"\\left({render(coef)}\\right) {render(mono)}"
+            body = f"({render(coef)}){star}{render(mono)}" if text else f"\\left({render(coef)}\\right) {render(mono)}"
         elif any((f.is_Rational and f.q != 1) or (f.is_Pow and f.exp.is_negative) for f in sp.Mul.make_args(coef)):
             body = render(coef * mono)  # a fraction reads best as SymPy writes it: l1*cos(q1)/2
-        else:  # coefficient first, as by hand: l1*m2*d2_ddot
-            body = f"{render(coef)}*{render(mono)}" if text else f"{render(coef)} {render(mono)}"
+        else:  # coefficient first, as by hand: l₁ m₂ d̈₂
+            body = f"{render(coef)}{star}{render(mono)}" if text else f"{render(coef)} {render(mono)}"
         out.append(("-" if negative else "+", body))
-    text = ("-" if out[0][0] == "-" else "") + out[0][1]
+    joined = ("-" if out[0][0] == "-" else "") + out[0][1]
     for sign, body in out[1:]:
-        text += f" {sign} {body}"
-    return text
+        joined += f" {sign} {body}"
+    return joined
 
 
 class Renderer:
@@ -160,12 +270,7 @@ class Renderer:
         self.eom, self.fmt, self.ascii = eom, fmt, ascii
         # text: θ̇₁, d̈₂, m₂ (Unicode), or SymPy's own names with ascii (theta1_dot)
         self._text = str if ascii else _UnicodeTextPrinter(_text_names(eom)).doprint
-        names = {}
-        for q, qd, qdd in zip(eom.q, eom.qd, eom.qdd):
-            base = sp.latex(q)
-            names[qd] = rf"\dot{{{base}}}"
-            names[qdd] = rf"\ddot{{{base}}}"
-        self._latex_names = names
+        self._latex_names = latex_symbol_names(eom.robot)
 
     def atom(self, expr) -> str:
         if self.fmt == "text":
@@ -177,7 +282,8 @@ class Renderer:
         if dag.larger_than(expr, TIDY_NODE_LIMIT):
             return self.atom(expr)
         render = self._text if self.fmt == "text" else self.atom
-        return _join(tidy_terms(expr, eom.q, eom.qd, eom.qdd), render, text=self.fmt == "text")
+        times = "*" if self.ascii else " "
+        return _join(tidy_terms(expr, eom.q, eom.qd, eom.qdd), render, text=self.fmt == "text", times=times)
 
     def value(self, value) -> str:
         if isinstance(value, sp.MatrixBase):
@@ -201,7 +307,7 @@ class Renderer:
             q, qd = self.atom(self.eom.q[k]), self.atom(self.eom.qd[k])
             return {"tau": f"τ{str(k + 1).translate(_SUB)}", "dL_dqd": f"∂L/∂{qd}", "dL_dq": f"∂L/∂{q}"}[step.name]
         if step.name == "tau":
-            return "τ" + str(self.eom.robot.coordinate_index(self._joint_of(step.link)) + 1).translate(_SUB)
+            return "τ" + str(self._tau_index(step.link) + 1).translate(_SUB)
         return step.name
 
     def _ascii_label(self, step: Step, i: str) -> str:
@@ -211,11 +317,17 @@ class Renderer:
             k = robot.coordinate_names.index(step.link)
             return {"tau": f"tau{k + 1}", "dL_dqd": f"dL/d{self.eom.qd[k]}", "dL_dq": f"dL/d{self.eom.q[k]}"}[step.name]
         if step.name == "tau":
-            return f"tau{robot.coordinate_index(self._joint_of(step.link)) + 1}"
+            return f"tau{self._tau_index(step.link) + 1}"
         return f"{step.name}{i}"
 
     def _joint_of(self, link: str):
         return self.eom.robot.parent_joint(link)
+
+    def _tau_index(self, link: str) -> int:
+        """0-based coordinate of the joint moving ``link`` (a tau step's joint has one)."""
+        k = self.eom.robot.coordinate_index(self._joint_of(link))
+        assert k is not None
+        return k
 
     def equation(self, lhs: str, rhs: str) -> str:
         if self.fmt == "text":
@@ -280,7 +392,8 @@ def steps_lines(eom: EquationsOfMotion, fmt: str = "text", ascii: bool = False) 
             head = titles.get(stage, stage)
             lines.append(f" {head}:" if fmt == "text" else (rf"\intertext{{{head}}}" if fmt == "latex" else f"**{head}**"))
         eq = r.equation(r.label(s), r.value(s.value))
-        where = f"{s.link}: {s.note}" if s.link else s.note
+        note = s.note if ascii else note_text(s.note)
+        where = f"{s.link}: {note}" if s.link else note
         lines.append(f"{eq}    # {where}" if fmt == "text" else eq)
     return lines
 

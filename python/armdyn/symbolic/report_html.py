@@ -68,8 +68,23 @@ class _Writer:
         return self.w.value(value, scalar=self.scalar)
 
 
+def caption(note: str) -> str:
+    """A step note as HTML, its formulas as inline MathML (``inertial force m v̇_C``),
+    the rest escaped text (see :data:`armdyn.symbolic.report.NOTE_FORMULAS`)."""
+    from .report import NOTE_FORMULAS, note_parts
+
+    out = []
+    for text, k in note_parts(note):
+        inner = None if k is None else latex_to_mathml(NOTE_FORMULAS[k][2])
+        if inner is None:
+            out.append(escape(text if k is None else NOTE_FORMULAS[k][1]))
+        else:
+            out.append(math_element(inner))
+    return "".join(out)
+
+
 def _equation(lhs: str, rhs: str, note: str = "") -> str:
-    note = f' <span class="note">{escape(note)}</span>' if note else ""
+    note = f' <span class="note">{caption(note)}</span>' if note else ""
     return f'<div class="eq">{math_element(f"<mrow>{lhs}<mo>=</mo>{rhs}</mrow>", display=True)}{note}</div>'
 
 
@@ -187,13 +202,23 @@ def robot_body(robot) -> str:
     def vec(v):
         return math_element(w.value(sp.Matrix(v).T))  # a row reads best in a table
 
+    def rotation(r):
+        return "" if r == sp.eye(3) else math_element(w.value(r))
+
+    # frames off the joint axis (the child link's frame placed in the moved joint frame):
+    # columns only when some joint has one
+    offsets = any(j.has_frame_offset for j in robot.joints)
     joints = []
     for j in robot.joints:
         k = robot.coordinate_index(j)
         q = m(robot.q[k]) if k is not None else ""
+        frame = (f"<td>{vec(j.frame_xyz) if j.has_frame_offset else ''}</td>"
+                 f"<td>{rotation(j.frame_rotation)}</td>") if offsets else ""
         joints.append(f"<tr><td>{escape(j.name)}</td><td>{escape(j.type)}</td><td>{q}</td>"
                       f"<td>{escape(j.parent)} \u2192 {escape(j.child)}</td><td>{vec(j.xyz)}</td>"
-                      f"<td>{vec(j.axis) if j.movable else ''}</td></tr>")
+                      f"<td>{rotation(j.rotation)}</td>"
+                      f"<td>{vec(j.axis) if j.movable else ''}</td>{frame}</tr>")
+    frame_heads = ("<th>frame_xyz (joint frame)</th><th>frame_rotation</th>") if offsets else ""
     links = []
     for name, link in robot.links.items():
         if name == robot.base:
@@ -205,7 +230,8 @@ def robot_body(robot) -> str:
     return (f'<p class="meta"><b>{escape(robot.name)}</b> · {robot.dof} dof · gravity '
             f'{math_element(w.value(robot.gravity.T))} · parameters: {escape(params)}</p>'
             '<table class="plain"><tr><th>joint</th><th>type</th><th>q</th><th>parent \u2192 child</th>'
-            "<th>xyz (parent frame)</th><th>axis</th></tr>" + "".join(joints) + "</table>"
+            "<th>xyz (parent frame)</th><th>rotation</th><th>axis</th>" + frame_heads + "</tr>"
+            + "".join(joints) + "</table>"
             '<table class="plain"><tr><th>link</th><th>mass</th><th>centre of mass</th>'
             "<th>inertia about it</th></tr>" + "".join(links) + "</table>")
 

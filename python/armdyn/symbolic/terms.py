@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Any, Callable
 
 import symengine as se
 import sympy as sp
@@ -53,7 +54,7 @@ def christoffel_coriolis(M: sp.Matrix, q: sp.Matrix, qd: sp.Matrix) -> sp.Matrix
     q_, qd_ = list(se.sympify(list(q))), list(se.sympify(list(qd)))
     M_ = [[se.sympify(M[k, j]) for j in range(n)] for k in range(n)]
     # dM[i][k][j] = dM[k, j]/dq_i, each entry differentiated once (M is symmetric)
-    dM = [[[None] * n for _ in range(n)] for _ in range(n)]
+    dM: list[list[list[Any]]] = [[[None] * n for _ in range(n)] for _ in range(n)]
     for i in range(n):
         for k in range(n):
             for j in range(k, n):
@@ -62,7 +63,9 @@ def christoffel_coriolis(M: sp.Matrix, q: sp.Matrix, qd: sp.Matrix) -> sp.Matrix
     C = sp.zeros(n, n)
     for k in range(n):
         for j in range(n):
-            c = sum((half * (dM[i][k][j] + dM[j][k][i] - dM[k][i][j]) * qd_[i] for i in range(n)), se.Integer(0))
+            c = se.Integer(0)
+            for i in range(n):
+                c += half * (dM[i][k][j] + dM[j][k][i] - dM[k][i][j]) * qd_[i]
             C[k, j] = sp.sympify(c)
     return C
 
@@ -96,7 +99,7 @@ class EquationsOfMotion:
     steps: list[Step] = field(default_factory=list)
     # a method may supply a function computing M on first use (Lagrange: the Hessian of
     # T; Newton-Euler: Walker-Orin unit-acceleration passes); otherwise d tau/d qdd
-    _M_builder: object = None
+    _M_builder: Callable[[], sp.Matrix] | None = None
 
     @property
     def q(self) -> sp.Matrix:
