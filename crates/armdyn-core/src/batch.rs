@@ -9,8 +9,8 @@
 //!
 //! * AVX-512F CPUs: 8 states per step ([`F64x8`], one 512-bit register);
 //! * AVX2 CPUs: 4 states per step ([`F64x4`], one 256-bit register);
-//! * any other x86-64 (and other architectures): 4 states per step compiled for the
-//!   baseline (SSE2 on x86-64: two 128-bit registers per `F64x4`).
+//! * any other x86-64: one state per step (the scalar path, see [`BaselineLanes`]);
+//! * other architectures: 4 states per step compiled for the baseline ([`F64x4`]).
 //!
 //! FMA is never used (Rust does not contract `a * b + c`), which keeps every kernel's
 //! bits identical to the scalar path. No `-C target-cpu` is needed: the shipped build
@@ -35,6 +35,18 @@ pub enum Kernels {
     /// 8 lanes, compiled for AVX-512F.
     Avx512,
 }
+
+/// The lane type of the baseline kernels.
+///
+/// On x86-64 one state at a time: every x86-64 CPU since 2013 has AVX2, and a third
+/// copy of every lane kernel (`F64x4` in SSE2 registers) cost about a quarter of the
+/// core's compile time for CPUs that hardly exist. `f64` is the scalar path, compiled
+/// anyway (the leftover rows of every batch), so this adds no code. Elsewhere
+/// (aarch64: NEON) four lanes, the only lane kernels compiled there.
+#[cfg(target_arch = "x86_64")]
+pub(crate) type BaselineLanes = f64;
+#[cfg(not(target_arch = "x86_64"))]
+pub(crate) type BaselineLanes = F64x4;
 
 /// 0: not decided yet, else `1 + Kernels as u8`.
 static KERNELS: AtomicU8 = AtomicU8::new(0);
@@ -288,7 +300,7 @@ macro_rules! lanes_kernel {
                     // SAFETY: the CPU supports AVX2 (checked by `kernels`).
                     unsafe { rows_avx2(model, w, all, first, chunk) }
                 }),
-                _ => par_rows(nrows, [out], [per_row], threads, || Work::<F64x4>::new(model), |w, first, [chunk]| {
+                _ => par_rows(nrows, [out], [per_row], threads, || Work::<BaselineLanes>::new(model), |w, first, [chunk]| {
                     rows(model, w, all, first, chunk)
                 }),
             }

@@ -35,29 +35,40 @@ trait Kernel: Sync {
     );
 }
 
+/// Workspace of a chunk for one state at a time.
+struct One {
+    d: Data<f64>,
+    dd: DerivData<f64>,
+    res: [Vec<f64>; 3],
+}
+
+impl One {
+    fn new(model: &Model, out_len: usize) -> Self {
+        One { d: Data::new(model), dd: DerivData::new(model), res: std::array::from_fn(|_| vec![0.0; out_len]) }
+    }
+}
+
+/// Workspace of a chunk: `L`-lane data and the lane-transposed arguments/results of one
+/// group of rows, and a scalar workspace for the leftover rows.
 struct Work<L> {
-    d1: Data<f64>,
-    dd1: DerivData<f64>,
+    one: One,
     dl: Data<L>,
     ddl: DerivData<L>,
     args: [Vec<L>; 3],
     ext: Vec<L>,
     res: [Vec<L>; 3],
-    res1: [Vec<f64>; 3],
 }
 
 impl<L: Real> Work<L> {
     fn new(model: &Model, out_len: usize) -> Self {
         let n = model.nv;
         Work {
-            d1: Data::new(model),
-            dd1: DerivData::new(model),
+            one: One::new(model, out_len),
             dl: Data::new(model),
             ddl: DerivData::new(model),
             args: std::array::from_fn(|_| vec![L::zero(); n]),
             ext: vec![L::zero(); 6 * model.nlinks()],
             res: std::array::from_fn(|_| vec![L::zero(); out_len]),
-            res1: std::array::from_fn(|_| vec![0.0; out_len]),
         }
     }
 }
@@ -210,12 +221,37 @@ fn rows<L: Real, K: Kernel>(
         }
         r += L::LANES;
     }
-    for r in r..rows {
+    one_by_one(k, model, &mut w.one, args, ext, first, r, outs);
+}
+
+/// The rows `first + from..` of the chunk one state at a time: the leftover rows of
+/// every lane width, and every row of the x86-64 baseline kernels.
+///
+/// Out of line on purpose: one copy of the scalar algorithm per kernel, shared by all
+/// callers, instead of one inlined into each lane width's `rows` (the scalar path is
+/// not the hot one, and every copy of an algorithm costs compile time).
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn one_by_one<K: Kernel>(
+    k: &K,
+    model: &Model,
+    w: &mut One,
+    args: [&[f64]; 3],
+    ext: Option<(&[f64], ForceFrame)>,
+    first: usize,
+    from: usize,
+    mut outs: [&mut [f64]; 3],
+) {
+    let n = model.nv;
+    let per = K::out_len(model);
+    let ne = 6 * model.nlinks();
+    let rows = if per == 0 { 0 } else { outs[0].len() / per };
+    for r in from..rows {
         let a = args.map(|a| if a.is_empty() { a } else { &a[(first + r) * n..(first + r + 1) * n] });
         let e = ext.map(|(e, frame)| ExternalForces { wrenches: &e[(first + r) * ne..(first + r + 1) * ne], frame });
-        let [r0, r1, r2] = &mut w.res1;
-        k.run(model, &mut w.d1, &mut w.dd1, a, e.as_ref(), [r0, r1, r2]);
-        for (o, res) in outs.iter_mut().zip(&w.res1).take(K::NOUT) {
+        let [r0, r1, r2] = &mut w.res;
+        k.run(model, &mut w.d, &mut w.dd, a, e.as_ref(), [r0, r1, r2]);
+        for (o, res) in outs.iter_mut().zip(&w.res).take(K::NOUT) {
             o[r * per..(r + 1) * per].copy_from_slice(res);
         }
     }
@@ -282,6 +318,12 @@ fn drive<K: Kernel>(
             // SAFETY: the CPU supports AVX2 (checked by `kernels`).
             unsafe { rows_avx2(k, model, w, all, ext, first, o) }
         }),
+        // x86-64 without AVX2: one state at a time (see `batch::BaselineLanes`).
+        #[cfg(target_arch = "x86_64")]
+        _ => par_rows(nrows, outs, per_row, threads, || One::new(model, per), |w, first, o| {
+            one_by_one(k, model, w, all, ext, first, 0, o)
+        }),
+        #[cfg(not(target_arch = "x86_64"))]
         _ => par_rows(nrows, outs, per_row, threads, || Work::<F64x4>::new(model, per), |w, first, o| {
             rows(k, model, w, all, ext, first, o)
         }),

@@ -308,6 +308,11 @@ impl Task<'_> {
             Kernels::Avx512 => unsafe { avx512(self, first, out) },
             #[cfg(target_arch = "x86_64")]
             Kernels::Avx2 => unsafe { avx2(self, first, out) },
+            // x86-64 without AVX2: every row by the scalar loop below (see
+            // `batch::BaselineLanes`: no third copy of the integrator for such CPUs).
+            #[cfg(target_arch = "x86_64")]
+            _ => 0,
+            #[cfg(not(target_arch = "x86_64"))]
             _ => self.groups::<F64x4>(first, out),
         };
         let mut w = Work::<f64>::new(self.model);
