@@ -149,7 +149,14 @@ def standard_dh_robot(name, rows, inertials, base_link=None) -> Robot:
     for i, ((d, a, alpha), (m, com, inertia)) in enumerate(zip(rows, inertials), start=1):
         p, R = prev
         joints.append(
-            Joint(f"joint{i}", "revolute", links[-1].name, f"link{i}", xyz=(p + R @ [0, 0, d]).tolist(), rotation=R.tolist())
+            Joint(
+                f"joint{i}",
+                "revolute",
+                links[-1].name,
+                f"link{i}",
+                xyz=(p + R @ [0, 0, d]).tolist(),
+                rotation=R.tolist(),
+            )
         )
         prev = (np.array([a, 0.0, 0.0]), _rx(alpha))
         links.append(_link(f"link{i}", m, com, inertia, prev[1], prev[0]))
@@ -170,7 +177,14 @@ def modified_dh_robot(name, rows, inertials, base_link=None) -> Robot:
     for i, ((a, d, alpha), (m, com, inertia)) in enumerate(zip(rows, inertials), start=1):
         R = _rx(alpha)
         joints.append(
-            Joint(f"joint{i}", "revolute", links[-1].name, f"link{i}", xyz=(np.array([a, 0, 0]) + R @ [0, 0, d]).tolist(), rotation=R.tolist())
+            Joint(
+                f"joint{i}",
+                "revolute",
+                links[-1].name,
+                f"link{i}",
+                xyz=(np.array([a, 0, 0]) + R @ [0, 0, d]).tolist(),
+                rotation=R.tolist(),
+            )
         )
         links.append(_link(f"link{i}", m, com, inertia))
     return Robot(name, links, joints)

@@ -50,7 +50,12 @@ THEIRS = {
     ("M", "OpenSYMORO"): (302, 215),
     ("tau", "SymPyBotics"): (365, 300),
 }
-TARGETS = {"tau": 0.8 * (345 + 296), "tau, ungrouped": 0.8 * (345 + 296), "tau (base parameters)": 433, "M": 0.8 * (302 + 215)}
+TARGETS = {
+    "tau": 0.8 * (345 + 296),
+    "tau, ungrouped": 0.8 * (345 + 296),
+    "tau (base parameters)": 433,
+    "M": 0.8 * (302 + 215),
+}
 
 
 def cse_counts(exprs) -> tuple[int, int]:
@@ -69,14 +74,21 @@ def load(name):
 
 def op_count_table(have_identification: bool) -> None:
     print("## Operation counts, PUMA 560, all parameters symbolic (mul + add = total)\n")
-    print("| quantity | model | armdyn codegen | armdyn.derive + sympy.cse | OpenSYMORO (quoted) | SymPyBotics (quoted) | target | codegen / OpenSYMORO |")
+    print(
+        "| quantity | model | armdyn codegen | armdyn.derive + sympy.cse | OpenSYMORO (quoted) | SymPyBotics (quoted) | target | codegen / OpenSYMORO |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for name in ("puma560-craig", "puma560"):
         robot = load(name)
         eom = armdyn.derive(robot)
         what = ["tau", "M", "g", "C"]
         code = codegen.codegen(robot, what=what)
-        derived = {"tau": list(eom.tau), "tau, ungrouped": list(eom.tau), "M": [eom.M[i, j] for i in range(6) for j in range(i, 6)], "g": list(eom.g)}
+        derived = {
+            "tau": list(eom.tau),
+            "tau, ungrouped": list(eom.tau),
+            "M": [eom.M[i, j] for i in range(6) for j in range(i, 6)],
+            "g": list(eom.g),
+        }
         rows = [(w, code.op_counts[w]) for w in what]
         from armdyn.programs.customized_ne import customized_newton_euler
 
@@ -97,7 +109,10 @@ def op_count_table(have_identification: bool) -> None:
             spb = THEIRS.get((w, "SymPyBotics"))
             ratio = f"{c['total'] / sum(sym):.2f}" if sym else "-"
             target = f"<= {TARGETS[w]:.0f}" if w in TARGETS else "-"
-            fmt = (lambda t: f"{t[0]} + {t[1]} = {sum(t)}" if t else "-")
+
+            def fmt(t):
+                return f"{t[0]} + {t[1]} = {sum(t)}" if t else "-"
+
             print(f"| {w} | {label} | {ours} | {before} | {fmt(sym)} | {fmt(spb)} | {target} | {ratio} |")
     print("\n(C: the Christoffel C matrix of M; OpenSYMORO and SymPyBotics quote no count for it.)\n")
 
@@ -146,22 +161,45 @@ def generation_times(have_identification: bool, repeat: int) -> None:
         grouped, _ = grouped_parameters(robot, params, definitions)
         customized_newton_euler(robot, parameters=grouped)
 
-    rows = [(f"{', '.join(what)}{' + base parameters (tau, regressor)' if have_identification else ''} -> C",
-             _timed(everything, repeat), 3.0, "SymPyBotics 3.5-9.7 s (its set)")]
+    rows = [
+        (
+            f"{', '.join(what)}{' + base parameters (tau, regressor)' if have_identification else ''} -> C",
+            _timed(everything, repeat),
+            3.0,
+            "SymPyBotics 3.5-9.7 s (its set)",
+        )
+    ]
     rows.append(("  of which " + ", ".join(what) + " -> C", _timed(standard, repeat), None, "-"))
     if have_identification:
         rows.append(("  of which base parameters + tau, regressor in them -> C", _timed(base, repeat), None, "-"))
     rows += [
-        ("tau alone: customized Newton-Euler program", _timed(tau_program, repeat), 0.1, "0.16-0.18 s (issue 8, before)"),
-        ("tau alone: armdyn.codegen(what='tau') -> C", _timed(lambda: codegen.codegen(robot, what="tau"), repeat),
-         None, "-"),
-        ("armdyn.derive(robot).tau (Craig's Newton-Euler, no CSE)",
-         _timed(lambda: armdyn.derive(robot, "newton-euler"), repeat), None, "-"),
+        (
+            "tau alone: customized Newton-Euler program",
+            _timed(tau_program, repeat),
+            0.1,
+            "0.16-0.18 s (issue 8, before)",
+        ),
+        (
+            "tau alone: armdyn.codegen(what='tau') -> C",
+            _timed(lambda: codegen.codegen(robot, what="tau"), repeat),
+            None,
+            "-",
+        ),
+        (
+            "armdyn.derive(robot).tau (Craig's Newton-Euler, no CSE)",
+            _timed(lambda: armdyn.derive(robot, "newton-euler"), repeat),
+            None,
+            "-",
+        ),
     ]
-    print(f"## Time to derive and generate C, puma560-craig, all parameters symbolic (median of {repeat}, "
-          "first run apart)\n")
-    print("| what | median (wall) | median (CPU) | first run | target | wall / target | CPU / target | reference "
-          "| wall / SymPyBotics best |")
+    print(
+        f"## Time to derive and generate C, puma560-craig, all parameters symbolic (median of {repeat}, "
+        "first run apart)\n"
+    )
+    print(
+        "| what | median (wall) | median (CPU) | first run | target | wall / target | CPU / target | reference "
+        "| wall / SymPyBotics best |"
+    )
     print("|---|---|---|---|---|---|---|---|---|")
     for k, (label, (first, median, cpu), target, ref) in enumerate(rows):
         cold = f"{first:.3f} s" if k == 0 else "-"  # only the first row's first run has cold caches
@@ -204,13 +242,15 @@ def breakdown() -> None:
         if sum(a + b for a, b in cells) == 0:
             continue
         print(f"| {k} | " + " | ".join(f"{a}+{b}" for a, b in cells) + f" | {sum(a + b for a, b in cells)} |")
-    print("\n(wi: R^T w of the parent; w: w, its products and differences; wd, vd: accelerations;"
-          " Up, a: U_parent p + vd_parent (link 2: a point's acceleration in the basis (u, v, z));"
-          " A, B, C, D, J: links 2 and 3's inertia seen along joint 1's axis u (their Euler moments'"
-          " two projections; A of both summed in link 2's row); W: link 2's own rates on u and v; p: link 3's origin along u and v;"
-          " U: skew(wd) + skew(w)^2; F, N: the link's force and moment;"
-          " Rf: a child's force rotated; f, n: inward sums; q: q + th of a leaf link's turned frame, q2 + q3 of"
-          " the parallel joints; tau: joint 1's torque, formed from the moments of links 1-3 directly)\n")
+    print(
+        "\n(wi: R^T w of the parent; w: w, its products and differences; wd, vd: accelerations;"
+        " Up, a: U_parent p + vd_parent (link 2: a point's acceleration in the basis (u, v, z));"
+        " A, B, C, D, J: links 2 and 3's inertia seen along joint 1's axis u (their Euler moments'"
+        " two projections; A of both summed in link 2's row); W: link 2's own rates on u and v; p: link 3's origin along u and v;"
+        " U: skew(wd) + skew(w)^2; F, N: the link's force and moment;"
+        " Rf: a child's force rotated; f, n: inward sums; q: q + th of a leaf link's turned frame, q2 + q3 of"
+        " the parallel joints; tau: joint 1's torque, formed from the moments of links 1-3 directly)\n"
+    )
 
 
 # tau alone by the customized Newton-Euler in a fresh process: SymPy's first sum (its
@@ -253,22 +293,27 @@ def tau_in_processes(n: int) -> None:
     import subprocess
     import sys
 
-    print(f"## tau alone by the customized Newton-Euler in {n} fresh processes, puma560-craig "
-          f"(CPU s; SYMPY_CACHE_SIZE={os.environ.get('SYMPY_CACHE_SIZE', 'default')})\n")
+    print(
+        f"## tau alone by the customized Newton-Euler in {n} fresh processes, puma560-craig "
+        f"(CPU s; SYMPY_CACHE_SIZE={os.environ.get('SYMPY_CACHE_SIZE', 'default')})\n"
+    )
     print("| PYTHONHASHSEED | SymPy's first sum (one-time import) | first build | median of the next 9 | target |")
     print("|---|---|---|---|---|")
     sums, firsts, medians = [], [], []
     for seed in range(n):
         env = dict(os.environ, PYTHONHASHSEED=str(seed))
-        out = subprocess.run([sys.executable, "-c", _TAU_IN_A_PROCESS], env=env, check=True,
-                             capture_output=True, text=True).stdout.split()
+        out = subprocess.run(
+            [sys.executable, "-c", _TAU_IN_A_PROCESS], env=env, check=True, capture_output=True, text=True
+        ).stdout.split()
         first_sum, first, median = (float(v) for v in out)
         sums.append(first_sum)
         firsts.append(first)
         medians.append(median)
         print(f"| {seed} | {first_sum:.3f} | {first:.3f} | {median:.3f} | <= 0.1 |")
-    print(f"| all | {min(sums):.3f}-{max(sums):.3f} | {min(firsts):.3f}-{max(firsts):.3f} | "
-          f"{min(medians):.3f}-{max(medians):.3f} | <= 0.1 |\n")
+    print(
+        f"| all | {min(sums):.3f}-{max(sums):.3f} | {min(firsts):.3f}-{max(firsts):.3f} | "
+        f"{min(medians):.3f}-{max(medians):.3f} | <= 0.1 |\n"
+    )
 
 
 def numeric(n_states: int, repeat: int) -> None:
@@ -288,25 +333,36 @@ def numeric(n_states: int, repeat: int) -> None:
     assert np.abs(sse2.tau(Q, QD, QDD) - got).max() == 0.0
     t_c, t_rust, t_sse2 = [], [], []
     for _ in range(repeat):
-        for fn, runs in ((lambda: lib.tau(Q, QD, QDD), t_c), (lambda: armdyn.rnea(robot, Q, QD, QDD, threads=1), t_rust),
-                         (lambda: sse2.tau(Q, QD, QDD), t_sse2)):
+        for fn, runs in (
+            (lambda: lib.tau(Q, QD, QDD), t_c),
+            (lambda: armdyn.rnea(robot, Q, QD, QDD, threads=1), t_rust),
+            (lambda: sse2.tau(Q, QD, QDD), t_sse2),
+        ):
             t0 = time.perf_counter()
             fn()
             runs.append(time.perf_counter() - t0)
     c, r = statistics.median(t_c), statistics.median(t_rust)
-    print(f"## Generated C vs the Rust core, puma560 tau, {n_states:.0e} states, one thread "
-          f"(runs alternating, {repeat} each)\n")
+    print(
+        f"## Generated C vs the Rust core, puma560 tau, {n_states:.0e} states, one thread "
+        f"(runs alternating, {repeat} each)\n"
+    )
     print("                               median        best")
     print(f"generated C (cc -O2, ctypes): {c * 1e9 / n_states:7.1f} ns/state {min(t_c) * 1e9 / n_states:7.1f} ns/state")
-    print(f"armdyn.rnea(threads=1):       {r * 1e9 / n_states:7.1f} ns/state {min(t_rust) * 1e9 / n_states:7.1f} ns/state")
+    print(
+        f"armdyn.rnea(threads=1):       {r * 1e9 / n_states:7.1f} ns/state {min(t_rust) * 1e9 / n_states:7.1f} ns/state"
+    )
     s2 = statistics.median(t_sse2)
-    print(f"generated C, SSE2 only:       {s2 * 1e9 / n_states:7.1f} ns/state {min(t_sse2) * 1e9 / n_states:7.1f} ns/state"
-          f"   (-DARMDYN_NO_CLONES; ratio to Rust: median {s2 / r:.2f}, best {min(t_sse2) / min(t_rust):.2f})")
+    print(
+        f"generated C, SSE2 only:       {s2 * 1e9 / n_states:7.1f} ns/state {min(t_sse2) * 1e9 / n_states:7.1f} ns/state"
+        f"   (-DARMDYN_NO_CLONES; ratio to Rust: median {s2 / r:.2f}, best {min(t_sse2) / min(t_rust):.2f})"
+    )
     # each round's own ratio too: C and Rust run back to back there, so a slow spell of the
     # machine hits both alike
     rounds = statistics.median(a / b for a, b in zip(t_c, t_rust))
-    print(f"ratio generated C / Rust rnea: median {c / r:.2f}, best {min(t_c) / min(t_rust):.2f}, "
-          f"median of the rounds' ratios {rounds:.2f}  (max rel. difference {err:.1e})")
+    print(
+        f"ratio generated C / Rust rnea: median {c / r:.2f}, best {min(t_c) / min(t_rust):.2f}, "
+        f"median of the rounds' ratios {rounds:.2f}  (max rel. difference {err:.1e})"
+    )
 
 
 def every_arm() -> None:
@@ -361,10 +417,12 @@ def ledger_text(arms: dict) -> str:
     the counts is a one-line diff)."""
     import re
 
-    ledger = {"about": "operation counts per state of armdyn's generated code (mul + add = total; "
-                       "sympy.count_ops(visual=True) kinds), written by "
-                       "PYTHONPATH=python python3 benchmarks/bench_codegen.py --ledger",
-              "arms": arms}
+    ledger = {
+        "about": "operation counts per state of armdyn's generated code (mul + add = total; "
+        "sympy.count_ops(visual=True) kinds), written by "
+        "PYTHONPATH=python python3 benchmarks/bench_codegen.py --ledger",
+        "arms": arms,
+    }
     text = json.dumps(ledger, indent=1, sort_keys=True)
     # the innermost objects (the counts) on one line each
     return re.sub(r"\{\n\s+([^{}]*?)\n\s*\}", lambda m: "{" + " ".join(m.group(1).split()) + "}", text) + "\n"
@@ -377,11 +435,18 @@ def main() -> None:
     ap.add_argument("--skip-numeric", action="store_true")
     ap.add_argument("--numeric-only", action="store_true", help="only the generated C vs the Rust core")
     ap.add_argument("--numeric-repeat", type=int, default=15)
-    ap.add_argument("--processes", type=int, default=0,
-                    help="only time tau alone in this many fresh processes (PYTHONHASHSEED 0, 1, ...)")
+    ap.add_argument(
+        "--processes",
+        type=int,
+        default=0,
+        help="only time tau alone in this many fresh processes (PYTHONHASHSEED 0, 1, ...)",
+    )
     ap.add_argument("--arms", action="store_true", help="only the operation counts of every bundled arm")
-    ap.add_argument("--ledger", action="store_true",
-                    help=f"only write the operation-count ledger ({os.path.relpath(LEDGER)}) of every bundled arm")
+    ap.add_argument(
+        "--ledger",
+        action="store_true",
+        help=f"only write the operation-count ledger ({os.path.relpath(LEDGER)}) of every bundled arm",
+    )
     args = ap.parse_args()
     if args.ledger:
         write_ledger()

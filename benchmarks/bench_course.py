@@ -75,8 +75,20 @@ def main() -> int:
         subs = tmp / "submissions"
         subs.mkdir()
         make_class(subs, args.count, args.seed)
-        cmd = [sys.executable, "-m", "armdyn", "grade", str(subs), "--gradebook", str(tmp / "out" / "grades.csv"),
-               "--html-dir", str(tmp / "reports"), "--jobs", str(args.jobs), "--no-cache"]
+        cmd = [
+            sys.executable,
+            "-m",
+            "armdyn",
+            "grade",
+            str(subs),
+            "--gradebook",
+            str(tmp / "out" / "grades.csv"),
+            "--html-dir",
+            str(tmp / "reports"),
+            "--jobs",
+            str(args.jobs),
+            "--no-cache",
+        ]
         (tmp / "out").mkdir()
         env = {**os.environ, "PYTHONPATH": str(ROOT / "python")}
         t0 = time.perf_counter()
@@ -95,11 +107,15 @@ def main() -> int:
     if err.strip():
         print(err.strip(), file=sys.stderr)
     load = os.getloadavg()[0]
-    print("| submissions | jobs | wall time (s) | CPU time, all processes (s) | peak RSS, process tree (MB) "
-          "| reports | gradebook rows | load average |")
+    print(
+        "| submissions | jobs | wall time (s) | CPU time, all processes (s) | peak RSS, process tree (MB) "
+        "| reports | gradebook rows | load average |"
+    )
     print("|---|---|---|---|---|---|---|---|")
-    print(f"| {args.count} | {args.jobs} | {seconds:.1f} | {cpu:.1f} | {peak / 1024:.0f} | {reports} | {rows} "
-          f"| {load:.1f} |")
+    print(
+        f"| {args.count} | {args.jobs} | {seconds:.1f} | {cpu:.1f} | {peak / 1024:.0f} | {reports} | {rows} "
+        f"| {load:.1f} |"
+    )
     return proc.returncode
 
 

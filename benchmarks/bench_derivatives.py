@@ -93,8 +93,10 @@ def main(argv=None) -> int:
         args.number, args.repeat, args.batch, args.batch_repeat = 2000, 5, 2e4, 3
     N = int(args.batch)
     threads = [int(t) for t in args.threads.split(",")]
-    print(f"armdyn vs Pinocchio {pin.__version__}; Python {platform.python_version()}; {os.cpu_count()} CPUs; "
-          f"SIMD kernels {num._core.simd_kernels()}; load average {os.getloadavg()[0]:.2f}")
+    print(
+        f"armdyn vs Pinocchio {pin.__version__}; Python {platform.python_version()}; {os.cpu_count()} CPUs; "
+        f"SIMD kernels {num._core.simd_kernels()}; load average {os.getloadavg()[0]:.2f}"
+    )
     print(f"per call: median of {args.repeat} x {args.number} calls; batch: N = {N}, median of {args.batch_repeat}\n")
     rows, batch_rows = [], []
     cpp, cpp_models, cpp_module = {}, None, None
@@ -117,22 +119,32 @@ def main(argv=None) -> int:
         tau = pin.rnea(model, data, q, v, a)
         pin_call = {}
         for fn, mine, theirs in (
-            ("rnea_derivatives", (num.rnea_derivatives, (robot, q, v, a)),
-             (pin.computeRNEADerivatives, (model, data, q, v, a))),
-            ("aba_derivatives", (num.aba_derivatives, (robot, q, v, tau)),
-             (pin.computeABADerivatives, (model, data, q, v, tau))),
+            (
+                "rnea_derivatives",
+                (num.rnea_derivatives, (robot, q, v, a)),
+                (pin.computeRNEADerivatives, (model, data, q, v, a)),
+            ),
+            (
+                "aba_derivatives",
+                (num.aba_derivatives, (robot, q, v, tau)),
+                (pin.computeABADerivatives, (model, data, q, v, tau)),
+            ),
             ("minverse", (num.minverse, (robot, q)), (pin.computeMinverse, (model, data, q))),
         ):
-            t_mine, t_pin = paired_medians(per_call_run(*mine, args.number), per_call_run(*theirs, args.number),
-                                           args.repeat)
+            t_mine, t_pin = paired_medians(
+                per_call_run(*mine, args.number), per_call_run(*theirs, args.number), args.repeat
+            )
             rows.append((name, fn, t_mine, t_pin))
             pin_call[fn] = t_pin
         Q, V, A = (np.ascontiguousarray(rng.uniform(-np.pi, np.pi, (N, robot.dof))) for _ in range(3))
         TAU = num.rnea(robot, Q, V, A)
         n = robot.dof
         calls = {}  # (function, threads, "fresh" outputs or the caller's "out") -> a timed batch call
-        for fn, f, X in (("rnea_derivatives", num.rnea_derivatives, A), ("aba_derivatives", num.aba_derivatives, TAU),
-                         ("minverse", None, None)):
+        for fn, f, X in (
+            ("rnea_derivatives", num.rnea_derivatives, A),
+            ("aba_derivatives", num.aba_derivatives, TAU),
+            ("minverse", None, None),
+        ):
             out = np.empty((N, n, n)) if f is None else tuple(np.empty((N, n, n)) for _ in range(3))
             for t in threads:
                 for kind, o in (("fresh", None), ("out", out)):
@@ -154,38 +166,51 @@ def main(argv=None) -> int:
                 times[key].append(timed())
         for (fn, t, kind), ts in times.items():
             if kind == "fresh":
-                batch_rows.append((name, fn, t, statistics.median(ts), statistics.median(times[fn, t, "out"]),
-                                   pin_call[fn]))
+                batch_rows.append(
+                    (name, fn, t, statistics.median(ts), statistics.median(times[fn, t, "out"]), pin_call[fn])
+                )
         if cpp_rounds:
             cpp[name] = {k: statistics.median(r[k] for r in cpp_rounds) for k in ("rnea", *pin_call)}
 
     print(f"{'arm':7} {'function':17} {'armdyn':>9} {'Pinocchio':>10} {'ratio':>6}")
     for name, fn, t_mine, t_pin in rows:
         print(f"{name:7} {fn:17} {t_mine * 1e6:7.2f}us {t_pin * 1e6:8.2f}us {t_mine / t_pin:6.2f}")
-    print(f"\nbatch of N = {N}: armdyn M states/s (fresh outputs; out=: into the caller's arrays) vs the rate of "
-          "Pinocchio's per-call time (Python call: 1 core, 2 cores)")
-    print(f"{'arm':7} {'function':17} {'thr':>3} {'armdyn':>9} {'M/s':>6} {'out= M/s':>8} {'pin 1 core':>10} "
-          f"{'pin 2 cores':>11} {'x (2 cores)':>11} {'x out=':>6}")
+    print(
+        f"\nbatch of N = {N}: armdyn M states/s (fresh outputs; out=: into the caller's arrays) vs the rate of "
+        "Pinocchio's per-call time (Python call: 1 core, 2 cores)"
+    )
+    print(
+        f"{'arm':7} {'function':17} {'thr':>3} {'armdyn':>9} {'M/s':>6} {'out= M/s':>8} {'pin 1 core':>10} "
+        f"{'pin 2 cores':>11} {'x (2 cores)':>11} {'x out=':>6}"
+    )
     for name, fn, t, tb, tb_out, t_pin in batch_rows:
         rate, rate_out = N / tb / 1e6, N / tb_out / 1e6
         r1 = 1 / t_pin / 1e6
-        print(f"{name:7} {fn:17} {t:3d} {tb * 1e3:7.1f}ms {rate:6.2f} {rate_out:8.2f} {r1:10.2f} {2 * r1:11.2f} "
-              f"{rate / (2 * r1):11.2f} {rate_out / (2 * r1):6.2f}")
+        print(
+            f"{name:7} {fn:17} {t:3d} {tb * 1e3:7.1f}ms {rate:6.2f} {rate_out:8.2f} {r1:10.2f} {2 * r1:11.2f} "
+            f"{rate / (2 * r1):11.2f} {rate_out / (2 * r1):6.2f}"
+        )
     if cpp:
         t = max(threads)
-        print(f"\nPinocchio C++ per call (g++ -O3 -march=native; per round the median of 3 x {args.number} calls, "
-              f"then the median of {args.batch_repeat} rounds alternating with armdyn's batches) vs armdyn's "
-              f"batch of N = {N} on {t} threads; target: armdyn rate >= 4 x 2 / t_C++ (both cores)")
-        print(f"{'arm':7} {'function':17} {'C++ us':>7} {'C++ 2 cores M/s':>15} {'armdyn M/s':>10} {'x':>6} "
-              f"{'out= M/s':>8} {'x out=':>6}")
+        print(
+            f"\nPinocchio C++ per call (g++ -O3 -march=native; per round the median of 3 x {args.number} calls, "
+            f"then the median of {args.batch_repeat} rounds alternating with armdyn's batches) vs armdyn's "
+            f"batch of N = {N} on {t} threads; target: armdyn rate >= 4 x 2 / t_C++ (both cores)"
+        )
+        print(
+            f"{'arm':7} {'function':17} {'C++ us':>7} {'C++ 2 cores M/s':>15} {'armdyn M/s':>10} {'x':>6} "
+            f"{'out= M/s':>8} {'x out=':>6}"
+        )
         for name, fn, tt, tb, tb_out, _ in batch_rows:
             if tt != t or name not in cpp:
                 continue
             t_cpp = cpp[name][fn]
             rate_cpp = 2 / t_cpp / 1e6
             rate, rate_out = N / tb / 1e6, N / tb_out / 1e6
-            print(f"{name:7} {fn:17} {t_cpp * 1e6:7.3f} {rate_cpp:15.2f} {rate:10.2f} {rate / rate_cpp:6.2f} "
-                  f"{rate_out:8.2f} {rate_out / rate_cpp:6.2f}")
+            print(
+                f"{name:7} {fn:17} {t_cpp * 1e6:7.3f} {rate_cpp:15.2f} {rate:10.2f} {rate / rate_cpp:6.2f} "
+                f"{rate_out:8.2f} {rate_out / rate_cpp:6.2f}"
+            )
         for name, r in cpp.items():
             print(f"{name:7} {'rnea':17} {r['rnea'] * 1e6:7.3f} (for scale)")
     print(f"\nload average at the end: {os.getloadavg()[0]:.2f}")

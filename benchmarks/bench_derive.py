@@ -65,12 +65,19 @@ def main() -> None:
         tau_m = plain_symbols(eqs, names)
         t2 = time.perf_counter()
         mech = t2 - t0
-        print(f"sympy.physics.mechanics LagrangesMethod: {t1 - t0:8.3f} s  + xreplace to plain symbols "
-              f"{t2 - t1:.3f} s = {mech:.3f} s  (1 run)")
-        print(f"ratio armdyn/mechanics (same representation: unsimplified tau in plain symbols): "
-              f"newton-euler {ne / mech:.4f}, lagrange {la / mech:.4f}")
-        results = {"armdyn newton-euler": derive(robot, "newton-euler").tau,
-                   "armdyn lagrange": derive(robot, "lagrange").tau, "mechanics": tau_m}
+        print(
+            f"sympy.physics.mechanics LagrangesMethod: {t1 - t0:8.3f} s  + xreplace to plain symbols "
+            f"{t2 - t1:.3f} s = {mech:.3f} s  (1 run)"
+        )
+        print(
+            f"ratio armdyn/mechanics (same representation: unsimplified tau in plain symbols): "
+            f"newton-euler {ne / mech:.4f}, lagrange {la / mech:.4f}"
+        )
+        results = {
+            "armdyn newton-euler": derive(robot, "newton-euler").tau,
+            "armdyn lagrange": derive(robot, "lagrange").tau,
+            "mechanics": tau_m,
+        }
         if args.sizes:
             for k, v in results.items():
                 print(f"size of tau, {k:<20}: {sum(sp.count_ops(e) for e in v):>9} operations")
@@ -78,8 +85,10 @@ def main() -> None:
             for k, v in results.items():
                 t0 = time.perf_counter()
                 expanded = v.applyfunc(sp.expand)
-                print(f"sympy.expand of tau, {k:<20}: {time.perf_counter() - t0:8.3f} s, "
-                      f"{sum(sp.count_ops(e) for e in expanded)} operations")
+                print(
+                    f"sympy.expand of tau, {k:<20}: {time.perf_counter() - t0:8.3f} s, "
+                    f"{sum(sp.count_ops(e) for e in expanded)} operations"
+                )
 
 
 if __name__ == "__main__":

@@ -47,7 +47,9 @@ def puma_submission(path: Path, altered: str = "vc_dot_3") -> None:
         value = s.value
         if key == altered:
             value = value + sp.Matrix([sp.Rational(1, 2) * robot.qd[1] * robot.qd[2], 0, 0])
-        steps.append({"step": key, "value": [str(x) for x in value] if isinstance(value, sp.MatrixBase) else str(value)})
+        steps.append(
+            {"step": key, "value": [str(x) for x in value] if isinstance(value, sp.MatrixBase) else str(value)}
+        )
     doc = {"robot": "puma560", "method": "newton-euler", "values": "published", "steps": steps}
     path.write_text(yaml.safe_dump(doc, width=10**9))
 
@@ -87,9 +89,15 @@ def proof_line_times(runs: int) -> list[tuple[str, float, list[float], float]]:
         t0 = time.perf_counter()
         check_text(exercise)
         whole.append(time.perf_counter() - t0)
-    return [("check one proof line (the energy chain: 3 links, 1 wrong + its counterexample)",
-             statistics.median(one[1:]), one[1:], 0.2),
-            ("check all the exercise's proof lines (20 links)", statistics.median(whole[1:]), whole[1:], None)]
+    return [
+        (
+            "check one proof line (the energy chain: 3 links, 1 wrong + its counterexample)",
+            statistics.median(one[1:]),
+            one[1:],
+            0.2,
+        ),
+        ("check all the exercise's proof lines (20 links)", statistics.median(whole[1:]), whole[1:], None),
+    ]
 
 
 def main() -> None:
@@ -102,12 +110,18 @@ def main() -> None:
         puma_submission(puma)
         cases = [
             ("armdyn derive rp-arm (for scale)", py + ["derive", "rp-arm"], None),
-            ("grade the exercise (rp-arm, 46 equations, proofs checked)",
-             py + ["grade", "examples/grading/rp-arm-exercise.md"], 3.0),
-            (f"grade PUMA 560, 54 steps, one altered ({puma.stat().st_size / 1e6:.1f} MB)",
-             py + ["grade", str(puma)], 10.0),
+            (
+                "grade the exercise (rp-arm, 46 equations, proofs checked)",
+                py + ["grade", "examples/grading/rp-arm-exercise.md"],
+                3.0,
+            ),
+            (
+                f"grade PUMA 560, 54 steps, one altered ({puma.stat().st_size / 1e6:.1f} MB)",
+                py + ["grade", str(puma)],
+                10.0,
+            ),
         ]
-        print(f"| case | median wall time (s) | runs | target |\n|---|---|---|---|")
+        print("| case | median wall time (s) | runs | target |\n|---|---|---|---|")
         for label, argv, target in cases:
             med, times, out = timed(argv, args.runs)
             spread = f"{min(times):.2f}-{max(times):.2f}"
@@ -116,8 +130,10 @@ def main() -> None:
                 raise SystemExit(f"unexpected output of {' '.join(argv)}:\n{out}")
         for label, med, times, target in proof_line_times(args.runs):
             spread = f"{min(times):.3f}-{max(times):.3f}"
-            print(f"| {label}, in process | {med:.3f} ({spread}) | {len(times)} | "
-                  f"{'' if target is None else f'< {target:g} s'} |")
+            print(
+                f"| {label}, in process | {med:.3f} ({spread}) | {len(times)} | "
+                f"{'' if target is None else f'< {target:g} s'} |"
+            )
 
 
 if __name__ == "__main__":

@@ -74,8 +74,14 @@ def sympybotics_puma():
     q, pi = sympybotics.robotdef.q, sp.pi
     robot = puma_craig()
     d = {k: float(v) for k, v in armdyn.load("puma560-craig", strict=False).defaults.items()}
-    rows = [(0, 0, 0, q), (-pi / 2, 0, 0, q), (0, d["a2"], d["d3"], q), (-pi / 2, d["a3"], d["d4"], q),
-            (pi / 2, 0, 0, q), (-pi / 2, 0, 0, q)]
+    rows = [
+        (0, 0, 0, q),
+        (-pi / 2, 0, 0, q),
+        (0, d["a2"], d["d3"], q),
+        (-pi / 2, d["a3"], d["d4"], q),
+        (pi / 2, 0, 0, q),
+        (-pi / 2, 0, 0, q),
+    ]
     rbt = sympybotics.RobotDef("Puma", rows, dh_convention="modified")
     rbt.frictionmodel = None
     return rbt, robot
@@ -90,15 +96,19 @@ def symbolic_part(repeat: int):
     t_fric, base_f = median_time(lambda: base_parameters(friction), repeat)
     symbolic = puma_craig(symbolic_geometry=True)
     t_sym, base_s = median_time(lambda: base_parameters(symbolic), repeat)
-    print(f"armdyn regressor ({reg.Y.shape[0]}x{reg.Y.shape[1]}):                       {t_reg:7.3f} s  (median of {repeat})")
+    print(
+        f"armdyn regressor ({reg.Y.shape[0]}x{reg.Y.shape[1]}):                       {t_reg:7.3f} s  (median of {repeat})"
+    )
     print(f"armdyn base parameters, regressor included ({len(base.names)}):     {t_base:7.3f} s")
     print(f"armdyn base parameters with Fv, Fc, Ia ({len(base_f.names)}):          {t_fric:7.3f} s")
     print(f"armdyn base parameters, geometry symbolic too ({len(base_s.names)}):   {t_sym:7.3f} s")
     try:
         import sympybotics  # noqa: F401
     except ImportError as exc:
-        print(f"\nSymPyBotics: not importable ({exc}); it is not on PyPI (`pip install sympybotics`:"
-              " 'No matching distribution found'): put a source checkout on PYTHONPATH to compare.")
+        print(
+            f"\nSymPyBotics: not importable ({exc}); it is not on PyPI (`pip install sympybotics`:"
+            " 'No matching distribution found'): put a source checkout on PYTHONPATH to compare."
+        )
         return
     np.mat = np.asmatrix  # SymPyBotics predates NumPy 2 (see the module docstring)
     from sympybotics.dynamics.dynamics import Dynamics
@@ -116,7 +126,9 @@ def symbolic_part(repeat: int):
     code.calc_base_parms()
     t_spb_base = time.perf_counter() - t
     print(f"SymPyBotics gen_regressor ({dyn.H.shape[0]}x{dyn.H.shape[1]}):                {t_spb_reg:7.3f} s  (1 run)")
-    print(f"SymPyBotics RobotDynCode + calc_base_parms ({dyn.n_base if hasattr(dyn, 'n_base') else code.dyn.n_base}): {t_spb_base:7.3f} s  (1 run)")
+    print(
+        f"SymPyBotics RobotDynCode + calc_base_parms ({dyn.n_base if hasattr(dyn, 'n_base') else code.dyn.n_base}): {t_spb_base:7.3f} s  (1 run)"
+    )
     print(f"ratio armdyn/SymPyBotics: regressor {t_reg / t_spb_reg:.3f}, base parameters {t_base / t_spb_base:.3f}")
     beta = code.dyn.baseparms
     print(f"SymPyBotics' beta[0]: {sp.sympify(beta[0])}")
@@ -140,8 +152,10 @@ def numeric_part(repeat: int, number: int):
         theirs = pin.computeJointTorqueRegressor(P.model, P.data, q, qd, qdd)
         assert np.allclose(ours, theirs, rtol=1e-11, atol=1e-11), "regressors differ"
         f_ours = timeit.Timer("f(r, a, b, c)", globals={"f": num.regressor, "r": robot, "a": q, "b": qd, "c": qdd})
-        f_pin = timeit.Timer("f(m, d, a, b, c)", globals={"f": pin.computeJointTorqueRegressor, "m": P.model,
-                                                           "d": P.data, "a": q, "b": qd, "c": qdd})
+        f_pin = timeit.Timer(
+            "f(m, d, a, b, c)",
+            globals={"f": pin.computeJointTorqueRegressor, "m": P.model, "d": P.data, "a": q, "b": qd, "c": qdd},
+        )
         a_times, p_times = [], []
         for _ in range(repeat):
             a_times.append(f_ours.timeit(number) / number)
@@ -150,8 +164,10 @@ def numeric_part(repeat: int, number: int):
         N = 10_000
         Q, QD, QDD = (rng.uniform(-1, 1, (N, n)) for _ in range(3))
         tb = min(timeit.repeat(lambda: num.regressor(robot, Q, QD, QDD, threads=1), number=1, repeat=repeat)) / N
-        print(f"{name:8s} armdyn {ta * 1e6:6.2f} us/call, Pinocchio {tp * 1e6:6.2f} us/call, ratio {ta / tp:.2f};"
-              f" armdyn batch (N=1e4, 1 thread) {tb * 1e6:6.2f} us/state, ratio {tb / tp:.2f}")
+        print(
+            f"{name:8s} armdyn {ta * 1e6:6.2f} us/call, Pinocchio {tp * 1e6:6.2f} us/call, ratio {ta / tp:.2f};"
+            f" armdyn batch (N=1e4, 1 thread) {tb * 1e6:6.2f} us/state, ratio {tb / tp:.2f}"
+        )
 
 
 def main():

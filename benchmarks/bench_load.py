@@ -94,8 +94,10 @@ def main() -> None:
                     compile_times.append(time.perf_counter() - t0)
                 t_compile = statistics.median(compile_times)
                 kind = "tree " if tree else "chain"
-                line = (f"{n:>6} joints, {kind} ({robot.dof} dof): armdyn load {t_load:7.3f} s, "
-                        f"compile (first rnea) {t_compile:6.3f} s")
+                line = (
+                    f"{n:>6} joints, {kind} ({robot.dof} dof): armdyn load {t_load:7.3f} s, "
+                    f"compile (first rnea) {t_compile:6.3f} s"
+                )
                 if pin is not None:
                     t_pin = _in_big_stack(lambda: _time(lambda: pin.buildModelFromUrdf(path), args.repeat)[0])
                     line += f" | pinocchio load {t_pin:6.3f} s | ratio armdyn/pinocchio {t_load / t_pin:5.1f}"

@@ -75,8 +75,11 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true")
     args = parser.parse_args()
     number, repeat, N, batch_repeat = (2000, 5, 5_000, 3) if args.quick else (5000, 9, 20_000, 5)
-    root = Path(importlib.metadata.distribution("example-robot-data").locate_file(
-        "cmeel.prefix/share/example-robot-data/robots"))
+    root = Path(
+        importlib.metadata.distribution("example-robot-data").locate_file(
+            "cmeel.prefix/share/example-robot-data/robots"
+        )
+    )
     rng = np.random.default_rng(0)
     print(f"Pinocchio {pin.__version__}; N = {N} for batches; times are medians, ratio = armdyn / Pinocchio")
     for label, rel in ROBOTS.items():
@@ -108,7 +111,9 @@ def main() -> None:
         ]
         for name, fa, fb in rows:
             ta, tb = pair(fa, fb, number, repeat)
-            print(f"  per call {name:17s} armdyn {ta * 1e6:7.2f} us   Pinocchio {tb * 1e6:7.2f} us   ratio {ta / tb:5.2f}")
+            print(
+                f"  per call {name:17s} armdyn {ta * 1e6:7.2f} us   Pinocchio {tb * 1e6:7.2f} us   ratio {ta / tb:5.2f}"
+            )
         t_free = median_time(lambda: num.rnea(free, qf, qf, qf), number, repeat)
         print(f"  per call rnea, URDF without <mimic> (Rust model alone): {t_free * 1e6:.2f} us")
 
@@ -120,10 +125,16 @@ def main() -> None:
         ours = num.rnea(robot, Q, QD, QDD, threads=2)
         pin.rneaInParallel(2, pool, q_b, v_b, a_b, out)
         assert np.abs(ours[:, perm].T - out).max() < 1e-9 * max(1, np.abs(out).max())
-        ta, tb = pair(lambda: num.rnea(robot, Q, QD, QDD, threads=2),
-                      lambda: pin.rneaInParallel(2, pool, q_b, v_b, a_b, out), 1, batch_repeat)
-        print(f"  batch rnea, 2 threads: armdyn {N / ta / 1e6:6.2f} M states/s   "
-              f"Pinocchio rneaInParallel {N / tb / 1e6:6.2f} M states/s   time ratio {ta / tb:5.2f}")
+        ta, tb = pair(
+            lambda: num.rnea(robot, Q, QD, QDD, threads=2),
+            lambda: pin.rneaInParallel(2, pool, q_b, v_b, a_b, out),
+            1,
+            batch_repeat,
+        )
+        print(
+            f"  batch rnea, 2 threads: armdyn {N / ta / 1e6:6.2f} M states/s   "
+            f"Pinocchio rneaInParallel {N / tb / 1e6:6.2f} M states/s   time ratio {ta / tb:5.2f}"
+        )
         ta = median_time(lambda: num.aba(robot, Q, QD, ours, threads=2), 1, batch_repeat)
         print(f"  batch forward dynamics, 2 threads: armdyn {N / ta / 1e3:6.1f} k states/s (no Pinocchio counterpart)")
 

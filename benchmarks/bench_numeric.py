@@ -103,10 +103,14 @@ def main(argv=None) -> int:
     N = int(args.batch)
     threads = [int(t) for t in args.threads.split(",")]
 
-    print(f"armdyn vs Pinocchio {pin.__version__}; Python {platform.python_version()}, numpy {np.__version__}; "
-          f"{os.cpu_count()} CPUs, {platform.machine()}")
-    print(f"per call: median of {args.repeat} x {args.number} calls; batch: N = {N}, median of {args.batch_repeat}; "
-          f"OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY')}; load average {os.getloadavg()[0]:.2f}")
+    print(
+        f"armdyn vs Pinocchio {pin.__version__}; Python {platform.python_version()}, numpy {np.__version__}; "
+        f"{os.cpu_count()} CPUs, {platform.machine()}"
+    )
+    print(
+        f"per call: median of {args.repeat} x {args.number} calls; batch: N = {N}, median of {args.batch_repeat}; "
+        f"OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY')}; load average {os.getloadavg()[0]:.2f}"
+    )
     print("ratio = armdyn time / Pinocchio time (< 1: armdyn faster)\n")
 
     rows = []
@@ -125,7 +129,9 @@ def main(argv=None) -> int:
             ("crba", (num.crba, (robot, q)), (pin.crba, (model, data, q))),
             ("aba", (num.aba, (robot, q, v, tau)), (pin.aba, (model, data, q, v, tau))),
         ):
-            t_mine, t_pin = paired_medians(per_call_run(*mine, args.number), per_call_run(*theirs, args.number), args.repeat)
+            t_mine, t_pin = paired_medians(
+                per_call_run(*mine, args.number), per_call_run(*theirs, args.number), args.repeat
+            )
             rows.append((name, fn, "1 state", t_mine, t_pin))
 
         Q, V, A = (np.ascontiguousarray(rng.uniform(-np.pi, np.pi, (N, robot.dof))) for _ in range(3))
@@ -137,8 +143,16 @@ def main(argv=None) -> int:
         for t in threads:
             pool = pin.ModelPool(model, t)
             for fn, mine, theirs in (
-                ("rnea", lambda: num.rnea(robot, Q, V, A, threads=t), lambda: pin.rneaInParallel(t, pool, q_p, v_p, a_p, out)),
-                ("aba", lambda: num.aba(robot, Q, V, TAU, threads=t), lambda: pin.abaInParallel(t, pool, q_p, v_p, tau_p, out)),
+                (
+                    "rnea",
+                    lambda: num.rnea(robot, Q, V, A, threads=t),
+                    lambda: pin.rneaInParallel(t, pool, q_p, v_p, a_p, out),
+                ),
+                (
+                    "aba",
+                    lambda: num.aba(robot, Q, V, TAU, threads=t),
+                    lambda: pin.abaInParallel(t, pool, q_p, v_p, tau_p, out),
+                ),
             ):
                 t_mine, t_pin = paired_medians(batch_run(mine), batch_run(theirs), args.batch_repeat)
                 rows.append((name, fn, f"N={N}, {t} thr", t_mine, t_pin))
@@ -154,8 +168,10 @@ def main(argv=None) -> int:
         n_states = 1 if what == "1 state" else N
         ratio = f"{t_mine / t_pin:6.2f}" if t_pin else "     -"
         rate = lambda t: f"{n_states / t / 1e6:10.2f}" if t else " " * 10  # noqa: E731
-        print(f"{name:7} {fn:5} {what:15} {fmt_time(t_mine):>11} {fmt_time(t_pin) if t_pin else '-':>11} {ratio}   "
-              f"{rate(t_mine) if n_states > 1 else '':>10} {(rate(t_pin) if t_pin else '') if n_states > 1 else '':>13}")
+        print(
+            f"{name:7} {fn:5} {what:15} {fmt_time(t_mine):>11} {fmt_time(t_pin) if t_pin else '-':>11} {ratio}   "
+            f"{rate(t_mine) if n_states > 1 else '':>10} {(rate(t_pin) if t_pin else '') if n_states > 1 else '':>13}"
+        )
     print(f"\nload average at the end: {os.getloadavg()[0]:.2f} (other processes share the cores: rerun if high)")
     return 0
 

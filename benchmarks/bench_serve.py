@@ -48,8 +48,9 @@ def pct(values: list[float], p: float) -> float:
 
 def post(base: str, text: str) -> tuple[int, dict, float]:
     """Submit, wait for the verdict (POST waits up to 120 s, then poll GET); (status, body, seconds)."""
-    req = urllib.request.Request(f"{base}/api/grade?wait=120", data=text.encode(), method="POST",
-                                 headers={"content-type": "text/markdown"})
+    req = urllib.request.Request(
+        f"{base}/api/grade?wait=120", data=text.encode(), method="POST", headers={"content-type": "text/markdown"}
+    )
     t0 = time.perf_counter()
     with urllib.request.urlopen(req, timeout=300) as r:
         status, body = r.status, json.loads(r.read())
@@ -68,8 +69,21 @@ def start(workers: int, tmp: str) -> tuple[subprocess.Popen, str]:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
     env = dict(os.environ, PYTHONPATH=str(ROOT / "python"))
-    proc = subprocess.Popen([sys.executable, "-m", "armdyn", "serve", "--port", str(port), "--workers", str(workers),
-                             "--db", f"sqlite:///{tmp}/bench.db"], env=env)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "armdyn",
+            "serve",
+            "--port",
+            str(port),
+            "--workers",
+            str(workers),
+            "--db",
+            f"sqlite:///{tmp}/bench.db",
+        ],
+        env=env,
+    )
     base = f"http://127.0.0.1:{port}"
     for _ in range(600):
         try:
@@ -106,18 +120,33 @@ def run(base: str, mode: str, clients: int, per_client: int, expected: dict) -> 
     for t in threads:
         t.join()
     wall = time.perf_counter() - t0
-    wrong = [b["id"] for s, b, _ in results
-             if s != 200 or b["status"] != "done" or b.get("first_wrong") != expected["first_wrong"]
-             or b.get("tau_correct") != expected["tau_correct"]
-             or [(x["name"], x["status"]) for x in b.get("steps", [])] != expected["steps"]]
+    wrong = [
+        b["id"]
+        for s, b, _ in results
+        if s != 200
+        or b["status"] != "done"
+        or b.get("first_wrong") != expected["first_wrong"]
+        or b.get("tau_correct") != expected["tau_correct"]
+        or [(x["name"], x["status"]) for x in b.get("steps", [])] != expected["steps"]
+    ]
     client_lat = [sec for _, _, sec in results]
     server_lat = [b["finished_at"] - b["created_at"] for _, b, _ in results if b.get("finished_at")]
     grading = [b["finished_at"] - b["started_at"] for _, b, _ in results if not b["cached"] and b.get("started_at")]
-    return {"mode": mode, "n": clients * per_client, "answered": len(results), "lost": len(errors),
-            "wrong": len(wrong), "cached": sum(bool(b["cached"]) for _, b, _ in results), "wall": wall,
-            "client_p50": pct(client_lat, 50), "client_p95": pct(client_lat, 95),
-            "server_p50": pct(server_lat, 50), "server_p95": pct(server_lat, 95),
-            "grading_p50": pct(grading, 50) if grading else float("nan"), "errors": errors[:3]}
+    return {
+        "mode": mode,
+        "n": clients * per_client,
+        "answered": len(results),
+        "lost": len(errors),
+        "wrong": len(wrong),
+        "cached": sum(bool(b["cached"]) for _, b, _ in results),
+        "wall": wall,
+        "client_p50": pct(client_lat, 50),
+        "client_p95": pct(client_lat, 95),
+        "server_p50": pct(server_lat, 50),
+        "server_p95": pct(server_lat, 95),
+        "grading_p50": pct(grading, 50) if grading else float("nan"),
+        "errors": errors[:3],
+    }
 
 
 def main() -> None:
@@ -131,8 +160,11 @@ def main() -> None:
     from armdyn.grade.reader import read_markdown
 
     report = json.loads(grade(read_markdown("submission.md", EXERCISE.read_text(encoding="utf-8"))).to_json())
-    expected = {"first_wrong": report["first_wrong"], "tau_correct": report["tau_correct"],
-                "steps": [(s["name"], s["status"]) for s in report["steps"]]}
+    expected = {
+        "first_wrong": report["first_wrong"],
+        "tau_correct": report["tau_correct"],
+        "steps": [(s["name"], s["status"]) for s in report["steps"]],
+    }
     modes = ["identical", "distinct"] if args.mode == "both" else [args.mode]
     rows = []
     with tempfile.TemporaryDirectory(prefix="armdyn-bench-serve-") as tmp:
@@ -144,15 +176,21 @@ def main() -> None:
             finally:
                 proc.send_signal(signal.SIGTERM)
                 proc.wait(60)
-    print(f"{args.clients} clients x {args.per_client} submissions of the exercise, {args.workers} workers, "
-          f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}")
-    print("| workload | submissions | lost | verdict != armdyn grade | from cache | wall (s) | "
-          "client p50 / p95 (s) | server accept->verdict p50 / p95 (s) | one grading p50 (s) |")
+    print(
+        f"{args.clients} clients x {args.per_client} submissions of the exercise, {args.workers} workers, "
+        f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}"
+    )
+    print(
+        "| workload | submissions | lost | verdict != armdyn grade | from cache | wall (s) | "
+        "client p50 / p95 (s) | server accept->verdict p50 / p95 (s) | one grading p50 (s) |"
+    )
     print("|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        print(f"| {r['mode']} | {r['answered']}/{r['n']} | {r['lost']} | {r['wrong']} | {r['cached']} | "
-              f"{r['wall']:.1f} | {r['client_p50']:.2f} / {r['client_p95']:.2f} | "
-              f"{r['server_p50']:.2f} / {r['server_p95']:.2f} | {r['grading_p50']:.2f} |")
+        print(
+            f"| {r['mode']} | {r['answered']}/{r['n']} | {r['lost']} | {r['wrong']} | {r['cached']} | "
+            f"{r['wall']:.1f} | {r['client_p50']:.2f} / {r['client_p95']:.2f} | "
+            f"{r['server_p50']:.2f} / {r['server_p95']:.2f} | {r['grading_p50']:.2f} |"
+        )
         for e in r["errors"]:
             print("  lost:", e)
 

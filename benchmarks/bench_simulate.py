@@ -62,8 +62,11 @@ def urdf_path() -> str:
         pass
     import glob
 
-    hits = glob.glob(os.path.join(sys.prefix, "lib", "python*", "site-packages", "cmeel.prefix", "share",
-                                  "example-robot-data", "robots", URDF))
+    hits = glob.glob(
+        os.path.join(
+            sys.prefix, "lib", "python*", "site-packages", "cmeel.prefix", "share", "example-robot-data", "robots", URDF
+        )
+    )
     if not hits:
         sys.exit(f"cannot find example-robot-data's {URDF}: pip install example-robot-data")
     return hits[0]
@@ -83,11 +86,23 @@ def rtb_ur5():
     for row in table:
         alpha = {"pi/2": np.pi / 2, "-pi/2": -np.pi / 2, "0": 0.0}[str(row["alpha"])]
         i = row["inertia"]
-        inertia = [[i.get("ixx", 0), i.get("ixy", 0), i.get("ixz", 0)],
-                   [i.get("ixy", 0), i.get("iyy", 0), i.get("iyz", 0)],
-                   [i.get("ixz", 0), i.get("iyz", 0), i.get("izz", 0)]]
-        links.append(rtb.RevoluteDH(d=float(row["d"]), a=float(row["a"]), alpha=alpha, m=float(row["mass"]),
-                                    r=[float(c) for c in row["com"]], I=np.array(inertia, dtype=float), G=0, Jm=0))
+        inertia = [
+            [i.get("ixx", 0), i.get("ixy", 0), i.get("ixz", 0)],
+            [i.get("ixy", 0), i.get("iyy", 0), i.get("iyz", 0)],
+            [i.get("ixz", 0), i.get("iyz", 0), i.get("izz", 0)],
+        ]
+        links.append(
+            rtb.RevoluteDH(
+                d=float(row["d"]),
+                a=float(row["a"]),
+                alpha=alpha,
+                m=float(row["mass"]),
+                r=[float(c) for c in row["com"]],
+                I=np.array(inertia, dtype=float),
+                G=0,
+                Jm=0,
+            )
+        )
     robot = rtb.DHRobot(links, name="ur5-armdyn", gravity=[0, 0, -9.81])
     return robot
 
@@ -157,7 +172,9 @@ def main() -> None:
     q0 = rng.uniform(-np.pi, np.pi, (n, dof))
     qd0 = rng.uniform(-1, 1, (n, dof))
     print(f"# UR5 from {os.path.basename(path)}, {n} states x {steps} steps, dt = {dt}, {threads} threads")
-    print(f"# {platform.processor() or platform.machine()}, {os.cpu_count()} cores, simd {armdyn.numeric._core.simd_kernels()}")
+    print(
+        f"# {platform.processor() or platform.machine()}, {os.cpu_count()} cores, simd {armdyn.numeric._core.simd_kernels()}"
+    )
 
     results = {}
 
@@ -177,8 +194,17 @@ def main() -> None:
         def run_with(core, model, stride):
             sim_module._core = core
             try:
-                return simulate(model, q0, qd0, dt=dt, steps=steps, stride=stride, threads=threads, energies=False,
-                                limits=(lower, upper))
+                return simulate(
+                    model,
+                    q0,
+                    qd0,
+                    dt=dt,
+                    steps=steps,
+                    stride=stride,
+                    threads=threads,
+                    energies=False,
+                    limits=(lower, upper),
+                )
             finally:
                 sim_module._core = now_core
 
@@ -222,7 +248,7 @@ def main() -> None:
         def run_mujoco():
             for b in range(0, n, block):
                 k = min(block, n - b)
-                rollout.rollout(mj, datas, x0[b:b + k], nstep=steps, state=buf[:k], persistent_pool=True)
+                rollout.rollout(mj, datas, x0[b : b + k], nstep=steps, state=buf[:k], persistent_pool=True)
             return buf
 
         # same model, same integrator: the final positions agree
@@ -243,7 +269,7 @@ def main() -> None:
 
     rtb_per_traj = None
     try:
-        import roboticstoolbox as rtb
+        import roboticstoolbox as rtb  # noqa: F401 - availability only
     except ImportError as err:
         print(f"# Robotics Toolbox: not importable ({err})")
     else:
@@ -267,8 +293,10 @@ def main() -> None:
         t = results[k]
         print(f"{k:28s} {t:10.3f} {n * steps / t:12.3e} {t / n * 1e6:12.1f} us")
     if rtb_per_traj is not None:
-        print(f"{'Robotics Toolbox fdyn':28s} {'':10s} {steps / rtb_per_traj:12.3e} {rtb_per_traj * 1e6:12.1f} us"
-              f"   (median of {args.rtb_trajectories} trajectories, 1 thread)")
+        print(
+            f"{'Robotics Toolbox fdyn':28s} {'':10s} {steps / rtb_per_traj:12.3e} {rtb_per_traj * 1e6:12.1f} us"
+            f"   (median of {args.rtb_trajectories} trajectories, 1 thread)"
+        )
     print()
     for k in [k for k in names if k.startswith("armdyn")]:
         if "MuJoCo rollout" in results:
@@ -286,7 +314,9 @@ def main() -> None:
         _, peak = tracemalloc.get_traced_memory()
         tracemalloc.stop()
         stored = 4 * 1000 * (steps // stride + 1) * dof * 8
-        print(f"memory, 1000 states, stride {stride:4d}: peak {peak / 2**20:8.1f} MiB, stored arrays {stored / 2**20:8.1f} MiB")
+        print(
+            f"memory, 1000 states, stride {stride:4d}: peak {peak / 2**20:8.1f} MiB, stored arrays {stored / 2**20:8.1f} MiB"
+        )
 
 
 if __name__ == "__main__":

@@ -108,32 +108,42 @@ def study(name, count, pin_states, out):
         runs[dt] = simulate(robot, q0, qd0, dt=dt, duration=DURATION, stride=round(1e-3 / dt), threads=1)
         d = runs[dt].energy_drift()
         assert np.all(np.isfinite(d)) and d.shape == (count + 1,)
-        say(f"dt = {dt:g}: from rest {d[0]:.2e}; random states: {quantiles(d[1:])}; "
-            f"{np.sum(d[1:] < 1e-6)}/{count} below 1e-6  ({time.perf_counter() - t0:.1f} s)")
+        say(
+            f"dt = {dt:g}: from rest {d[0]:.2e}; random states: {quantiles(d[1:])}; "
+            f"{np.sum(d[1:] < 1e-6)}/{count} below 1e-6  ({time.perf_counter() - t0:.1f} s)"
+        )
     d1, d2, d4 = (runs[dt].energy_drift() for dt in (1e-3, 5e-4, 2.5e-4))
     big = d2 > 1e-8  # where truncation, not round-off, dominates
-    say(f"order check (states with drift > 1e-8 at dt/2: {big.sum()}): drift(dt)/drift(dt/2) "
+    say(
+        f"order check (states with drift > 1e-8 at dt/2: {big.sum()}): drift(dt)/drift(dt/2) "
         f"median {np.median(d1[big] / d2[big]):.1f} (min {np.min(d1[big] / d2[big]):.1f}); "
-        f"drift(dt/2)/drift(dt/4) median {np.median(d2[big] / d4[big]):.1f} (4th order: 16)")
+        f"drift(dt/2)/drift(dt/4) median {np.median(d2[big] / d4[big]):.1f} (4th order: 16)"
+    )
 
     run = runs[1e-3]
     speed = np.abs(run.qd).max(axis=1)  # (N, dof) max |qd_j| over the run
     limits = np.array([float(j.velocity) if j.velocity is not None else np.nan for j in robot.joints if j.movable])
     names = robot.coordinate_names
     fastest = speed[1:].argmax(axis=1)
-    say(f"max |qd| over the run (random states): median {np.median(speed[1:].max(axis=1)):.0f} rad/s, "
+    say(
+        f"max |qd| over the run (random states): median {np.median(speed[1:].max(axis=1)):.0f} rad/s, "
         f"max {speed[1:].max():.0f} rad/s; fastest joint: "
-        + ", ".join(f"{names[j]} x{np.sum(fastest == j)}" for j in np.unique(fastest)))
+        + ", ".join(f"{names[j]} x{np.sum(fastest == j)}" for j in np.unique(fastest))
+    )
     if np.all(np.isfinite(limits)):
-        say(f"published velocity limits: {np.array2string(limits, precision=2)} rad/s; "
+        say(
+            f"published velocity limits: {np.array2string(limits, precision=2)} rad/s; "
             f"random states exceeding a limit during the run: {np.sum((speed[1:] > limits).any(axis=1))}/{count}; "
-            f"from rest: max |qd| {speed[0].max():.1f} rad/s")
+            f"from rest: max |qd| {speed[0].max():.1f} rad/s"
+        )
     r = np.corrcoef(np.log(speed[1:].max(axis=1)), np.log(d1[1:]))[0, 1]
     say(f"log drift vs log max |qd|: correlation {r:.2f}")
     top, ok = speed.max(axis=1), d1 < 1e-6
     if np.any(~ok):
-        say(f"dt = 1e-3: every state whose joints stayed below {top[~ok].min():.0f} rad/s met 1e-6 "
-            f"({np.sum(top < top[~ok].min())} states); the fastest state that met it reached {top[ok].max():.0f} rad/s")
+        say(
+            f"dt = 1e-3: every state whose joints stayed below {top[~ok].min():.0f} rad/s met 1e-6 "
+            f"({np.sum(top < top[~ok].min())} states); the fastest state that met it reached {top[ok].max():.0f} rad/s"
+        )
     for dt in (5e-4, 2.5e-4):
         d = runs[dt].energy_drift()
         if np.all(d < 1e-6):
@@ -148,15 +158,19 @@ def study(name, count, pin_states, out):
     say(f"normalisation (random states, dt = 1e-3): energy_drift {quantiles(d1[1:])}")
     say(f"  / max T instead: {quantiles(by_kinetic[1:])}")
     say(f"  / energy exchanged (max of ptp V, ptp T): {quantiles(by_exchange[1:])}")
-    say(f"  energy_drift <= /max T everywhere: {bool(np.all(d1 <= by_kinetic * (1 + 1e-12)))}; "
-        f"denominator = |E0| for {np.sum(np.abs(e[:, 0]) > kin.max(axis=1))}/{count + 1} states")
+    say(
+        f"  energy_drift <= /max T everywhere: {bool(np.all(d1 <= by_kinetic * (1 + 1e-12)))}; "
+        f"denominator = |E0| for {np.sum(np.abs(e[:, 0]) > kin.max(axis=1))}/{count + 1} states"
+    )
 
     # (d) Rust loop (SIMD lanes, threads) vs the NumPy slow path (scalar RK4 in Python)
     few = slice(0, 4)
     slow = simulate(robot, q0[few], qd0[few], dt=1e-3, duration=1.0, torque=lambda t, q, qd: np.zeros(dof))
     fast = simulate(robot, q0[few], qd0[few], dt=1e-3, duration=1.0, threads=2)
-    say(f"Rust loop vs NumPy slow path, 4 states x 1 s: max |dq| {np.abs(slow.q - fast.q).max():.1e}, "
-        f"max |dqd| {np.abs(slow.qd - fast.qd).max():.1e}")
+    say(
+        f"Rust loop vs NumPy slow path, 4 states x 1 s: max |dq| {np.abs(slow.q - fast.q).max():.1e}, "
+        f"max |dqd| {np.abs(slow.qd - fast.qd).max():.1e}"
+    )
 
     # (b) energies along armdyn's trajectory, three other ways
     flat_q, flat_qd = run.q.reshape(-1, dof), run.qd.reshape(-1, dof)
@@ -167,8 +181,10 @@ def study(name, count, pin_states, out):
     M = num.crba(robot, qs)
     T_crba = 0.5 * np.einsum("ni,nij,nj->n", qds, M, qds)
     scale = np.maximum(np.abs(T), 1.0)
-    say(f"energy check on 5000 trajectory samples: |T - 1/2 qd^T M qd| / max(T, 1 J) max "
-        f"{np.max(np.abs(T - T_crba) / scale):.1e}")
+    say(
+        f"energy check on 5000 trajectory samples: |T - 1/2 qd^T M qd| / max(T, 1 J) max "
+        f"{np.max(np.abs(T - T_crba) / scale):.1e}"
+    )
     try:
         from pinocchio_bridge import PinocchioRobot
     except ImportError as err:
@@ -177,15 +193,17 @@ def study(name, count, pin_states, out):
     pr = PinocchioRobot(robot)
     T_pin = np.array([pr.kinetic_energy(a, b) for a, b in zip(qs, qds)])
     V_pin = np.array([pr.potential_energy(a) for a in qs])
-    say(f"  vs Pinocchio: kinetic max |dT| / max(T, 1 J) {np.max(np.abs(T - T_pin) / scale):.1e}; "
-        f"potential max |dV| {np.max(np.abs(V - V_pin)):.1e} J (|V| up to {np.abs(V).max():.1f} J)")
+    say(
+        f"  vs Pinocchio: kinetic max |dT| / max(T, 1 J) {np.max(np.abs(T - T_pin) / scale):.1e}; "
+        f"potential max |dV| {np.max(np.abs(V - V_pin)):.1e} J (|V| up to {np.abs(V).max():.1f} J)"
+    )
 
     # (a) independent RK4 on Pinocchio's aba, the same initial states. The passive arms are
     # chaotic: two correct integrations whose aba differ by round-off (1e-16) part ways
     # exponentially, so per state the two are compared while they still follow the same
     # trajectory, and over 10 s as distributions.
     steps = round(DURATION / 1e-3)
-    picks = range(count + 1) if pin_states <= 0 else [0] + list(np.argsort(d1[1:])[::-1][:pin_states - 1] + 1)
+    picks = range(count + 1) if pin_states <= 0 else [0] + list(np.argsort(d1[1:])[::-1][: pin_states - 1] + 1)
     t0 = time.perf_counter()
     d_pin, horizon, early = [], [], []
     for i in picks:
@@ -206,24 +224,28 @@ def study(name, count, pin_states, out):
     say(f"independent RK4 on Pinocchio's aba, {len(picks)} states x {DURATION:g} s ({time.perf_counter() - t0:.0f} s):")
     say(f"  drift armdyn  {quantiles(d1[picks])}; {np.sum(d1[picks] < 1e-6)}/{len(picks)} below 1e-6")
     say(f"  drift Pinocchio {quantiles(d_pin)}; {np.sum(d_pin < 1e-6)}/{len(picks)} below 1e-6")
-    say(f"  the two trajectories agree to 1e-6 rad for {quantiles(np.array(horizon))} s; over that common "
+    say(
+        f"  the two trajectories agree to 1e-6 rad for {quantiles(np.array(horizon))} s; over that common "
         f"stretch max |drift(armdyn)/drift(Pinocchio) - 1| = "
-        f"{np.abs(np.array(early) - 1).max() if early else float('nan'):.1e} ({len(early)} states)")
+        f"{np.abs(np.array(early) - 1).max() if early else float('nan'):.1e} ({len(early)} states)"
+    )
     # the same sensitivity within armdyn alone: q0 moved by 1e-14 rad
     nudged = simulate(robot, q0[picks] + 1e-14, qd0[picks], dt=1e-3, duration=DURATION, threads=1, energies=False)
     self_apart = np.abs(nudged.q - run.q[picks]).max(axis=(1, 2))
-    pin_apart = np.array([np.abs(run.q[i] - pinocchio_rk4(pr, q0[i], qd0[i], 1e-3, steps)[0]).max()
-                          for i in picks[:3]])
-    say(f"  chaos: armdyn vs armdyn with q0 + 1e-14 rad, max |dq| over 10 s {quantiles(self_apart)}; "
-        f"armdyn vs Pinocchio (first 3) {np.array2string(pin_apart, precision=1)}")
+    pin_apart = np.array([np.abs(run.q[i] - pinocchio_rk4(pr, q0[i], qd0[i], 1e-3, steps)[0]).max() for i in picks[:3]])
+    say(
+        f"  chaos: armdyn vs armdyn with q0 + 1e-14 rad, max |dq| over 10 s {quantiles(self_apart)}; "
+        f"armdyn vs Pinocchio (first 3) {np.array2string(pin_apart, precision=1)}"
+    )
     say()
 
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--states", type=int, default=50)
-    p.add_argument("--pin-states", type=int, default=0,
-                   help="states integrated on Pinocchio (rest + the worst); 0: all")
+    p.add_argument(
+        "--pin-states", type=int, default=0, help="states integrated on Pinocchio (rest + the worst); 0: all"
+    )
     p.add_argument("--robots", default="ur5,panda")
     args = p.parse_args(argv)
     if args.states < 1:

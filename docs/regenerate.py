@@ -37,10 +37,32 @@ PICTURES = {
 #: the README's simulate examples: CLI arguments (after ``armdyn``); the pictures they
 #: write are part of the docs
 SIMULATIONS = [
-    ["simulate", "ur5", "--duration", "3", "--dt", "1e-3", "--q0", "0,-0.3,0.3,0,0,0",
-     "--plot", "docs/ur5-falling.png", "--animate", "docs/ur5-falling.gif"],
-    ["simulate", "ur5", "--duration", "4", "--dt", "1e-3", "--controller", "pd-gravity",
-     "--target", "0.4,-1,1,0.2,0.3,0.1"],
+    [
+        "simulate",
+        "ur5",
+        "--duration",
+        "3",
+        "--dt",
+        "1e-3",
+        "--q0",
+        "0,-0.3,0.3,0,0,0",
+        "--plot",
+        "docs/ur5-falling.png",
+        "--animate",
+        "docs/ur5-falling.gif",
+    ],
+    [
+        "simulate",
+        "ur5",
+        "--duration",
+        "4",
+        "--dt",
+        "1e-3",
+        "--controller",
+        "pd-gravity",
+        "--target",
+        "0.4,-1,1,0.2,0.3,0.1",
+    ],
 ]
 
 #: console lines left out of the README (long vectors)

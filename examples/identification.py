@@ -24,8 +24,12 @@ rng = np.random.default_rng(0)
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")  # the published PUMA set breaks a triangle inequality
     arm = armdyn.load("puma560", strict=False).bind()
-    joints = [replace(j, damping=rng.uniform(0.5, 2), friction=rng.uniform(0.5, 2), armature=rng.uniform(0.1, 1))
-              if j.movable else j for j in arm.joints]
+    joints = [
+        replace(j, damping=rng.uniform(0.5, 2), friction=rng.uniform(0.5, 2), armature=rng.uniform(0.1, 1))
+        if j.movable
+        else j
+        for j in arm.joints
+    ]
     arm = Robot(arm.name, arm.links.values(), joints, arm.gravity, strict=False)
 
 base = base_parameters(arm)  # exact: grouped in the standard parameters' symbols
@@ -34,7 +38,7 @@ truth = np.array([float(v) for v in base.values])
 
 N = 400
 Q, QD, QDD = rng.uniform(-np.pi, np.pi, (N, 6)), rng.uniform(-2, 2, (N, 6)), rng.uniform(-4, 4, (N, 6))
-tau = num.rnea(arm, Q, QD, QDD) + rng.normal(0.0, 0.01, (N, 6))        # "measured" torques
+tau = num.rnea(arm, Q, QD, QDD) + rng.normal(0.0, 0.01, (N, 6))  # "measured" torques
 W = num.regressor(arm, Q, QD, QDD)[:, :, base.columns].reshape(N * 6, -1)  # stacked base regressor
 estimate, *_ = np.linalg.lstsq(W, tau.ravel(), rcond=None)
 

@@ -20,8 +20,8 @@ from armdyn.symbolic.report import steps_lines, tau_lines
 ms = sp.symbols("m1:4", positive=True)
 pts = [sp.Matrix(sp.symbols(f"x{i} y{i} z{i}")) for i in range(1, 4)]
 M = sum(ms)
-c = sum((m * p for m, p in zip(ms, pts)), sp.zeros(3, 1)) / M          # centre of mass
-d = sp.Matrix(sp.symbols("dx dy dz"))                                    # from C to P
+c = sum((m * p for m, p in zip(ms, pts)), sp.zeros(3, 1)) / M  # centre of mass
+d = sp.Matrix(sp.symbols("dx dy dz"))  # from C to P
 I_C = sum((inertia.point_inertia(m, p - c) for m, p in zip(ms, pts)), sp.zeros(3, 3))
 I_P = sum((inertia.point_inertia(m, p - (c + d)) for m, p in zip(ms, pts)), sp.zeros(3, 3))
 assert sp.simplify(I_P - inertia.parallel_axis(I_C, M, -d)) == sp.zeros(3, 3)

@@ -24,6 +24,7 @@ import numpy as np
 
 def rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
     """URDF rpy: Rz(y) Ry(p) Rx(r), here from elementary rotations (not armdyn's code)."""
+
     def rx(a):
         c, s = np.cos(a), np.sin(a)
         return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
@@ -91,13 +92,20 @@ def big_urdf(n: int, tree: bool = False, seed: int = 0) -> tuple[str, Spec]:
     joints = []
     for k in range(n):
         urdf_type = {"R": "continuous" if continuous[k] else "revolute", "P": "prismatic", "F": "fixed"}[kind[k]]
-        limit = '<limit lower="-3" upper="3" effort="10" velocity="2"/>' if urdf_type in ("revolute", "prismatic") else ""
+        limit = (
+            '<limit lower="-3" upper="3" effort="10" velocity="2"/>' if urdf_type in ("revolute", "prismatic") else ""
+        )
         joints.append(
             f'<joint name="j{k}" type="{urdf_type}"><parent link="{"base" if parent[k] < 0 else f"l{parent[k]}"}"/>'
             f'<child link="l{k}"/><origin xyz="{" ".join(map(_fmt, xyz[k]))}" rpy="{" ".join(map(_fmt, rpy[k]))}"/>'
             f'<axis xyz="{" ".join(map(_fmt, axis[k]))}"/>{limit}</joint>'
         )
     order = rng.permutation(n)
-    text = ('<?xml version="1.0"?>\n<robot name="big">\n' + "\n".join(links) + "\n"
-            + "\n".join(joints[k] for k in order) + "\n</robot>\n")
+    text = (
+        '<?xml version="1.0"?>\n<robot name="big">\n'
+        + "\n".join(links)
+        + "\n"
+        + "\n".join(joints[k] for k in order)
+        + "\n</robot>\n"
+    )
     return text, Spec(parent, kind, xyz, R, axis, mass, com, inertia)

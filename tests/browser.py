@@ -47,8 +47,15 @@ INSTALL_HINT = (
 )
 CANDIDATES = ("chromium-headless-shell", "chromium", "chromium-browser", "google-chrome", "headless_shell")
 FLAGS = (
-    "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking",
-    "--disable-component-update", "--disable-sync", "--hide-scrollbars", "--mute-audio",
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--hide-scrollbars",
+    "--mute-audio",
     # the reports are self-contained: any host lookup is a bug, so make it fail
     "--host-resolver-rules=MAP * ~NOTFOUND",
 )
@@ -155,8 +162,14 @@ def _run(chromium: str, args: list[str], timeout: float) -> subprocess.Completed
             raise AssertionError(f"Chromium did not finish within {timeout} s: {' '.join(cmd)}") from None
 
 
-def render(page: str | Path, chromium: str, screenshot: str | Path | None = None, width: int = 1000,
-           timeout: float = 90.0, max_height: int = 30000) -> Rendered:
+def render(
+    page: str | Path,
+    chromium: str,
+    screenshot: str | Path | None = None,
+    width: int = 1000,
+    timeout: float = 90.0,
+    max_height: int = 30000,
+) -> Rendered:
     """Load the HTML file ``page`` in headless Chromium at ``width`` CSS px, measure its
     math (see :class:`Rendered`) and, when ``screenshot`` is given, save a PNG of the
     whole page there."""
@@ -169,10 +182,21 @@ def render(page: str | Path, chromium: str, screenshot: str | Path | None = None
         done = _run(chromium, [f"--window-size={width},900", "--dump-dom", probe.as_uri()], timeout)
     m = re.search(r'<pre id="armdyn-measure">(.*?)</pre>', done.stdout, re.S)
     if m is None:
-        raise AssertionError(f"Chromium produced no measurement (exit {done.returncode}); stderr:\n{done.stderr[-2000:]}")
+        raise AssertionError(
+            f"Chromium produced no measurement (exit {done.returncode}); stderr:\n{done.stderr[-2000:]}"
+        )
     data = json.loads(html.unescape(m.group(1)))
-    out = Rendered(math=data["math"], merror=data["merror"], latex=data["latex"], hl=data["hl"], fences=data["fences"],
-                   height=data["height"], width=data["width"], title=data["title"], body_text=data["bodyText"])
+    out = Rendered(
+        math=data["math"],
+        merror=data["merror"],
+        latex=data["latex"],
+        hl=data["hl"],
+        fences=data["fences"],
+        height=data["height"],
+        width=data["width"],
+        title=data["title"],
+        body_text=data["bodyText"],
+    )
     if screenshot is not None:
         shot = Path(screenshot).resolve()
         shot.parent.mkdir(parents=True, exist_ok=True)
@@ -181,7 +205,9 @@ def render(page: str | Path, chromium: str, screenshot: str | Path | None = None
         height = max(200, min(out.height, max_height))
         done = _run(chromium, [f"--window-size={width},{height}", f"--screenshot={shot}", page.as_uri()], timeout)
         if not shot.exists() or shot.stat().st_size == 0:
-            raise AssertionError(f"Chromium wrote no screenshot (exit {done.returncode}); stderr:\n{done.stderr[-2000:]}")
+            raise AssertionError(
+                f"Chromium wrote no screenshot (exit {done.returncode}); stderr:\n{done.stderr[-2000:]}"
+            )
         out.screenshot = shot
     return out
 
@@ -190,8 +216,7 @@ def dump_dom(page: str | Path, chromium: str, timeout: float = 90.0, budget_ms: 
     """The DOM of the HTML file ``page`` as Chromium serializes it after loading it as
     it is (no script added, its own policy in force) and letting ``budget_ms`` of
     virtual time pass (timers, image errors, load events run)."""
-    done = _run(chromium, [f"--virtual-time-budget={budget_ms}", "--dump-dom", Path(page).resolve().as_uri()],
-                timeout)
+    done = _run(chromium, [f"--virtual-time-budget={budget_ms}", "--dump-dom", Path(page).resolve().as_uri()], timeout)
     if "<html" not in done.stdout:
         raise AssertionError(f"Chromium dumped no document (exit {done.returncode}); stderr:\n{done.stderr[-2000:]}")
     return done.stdout
@@ -212,5 +237,7 @@ def assert_parentheses_stretch(r: Rendered, min_count: int = 1) -> None:
     with an OpenType MATH table: Debian's fonts-dejavu-extra has DejaVu Math TeX Gyre)."""
     assert len(r.fences) >= min_count, f"expected at least {min_count} column vectors, found {len(r.fences)}"
     short = [f for f in r.fences if not f["paren"] >= 0.8 * f["table"] > 0]
-    assert not short, (f"{len(short)} parentheses do not stretch around their vector, e.g. {short[:3]}: "
-                       "is a math font installed? (apt-get install -y fonts-dejavu-extra)")
+    assert not short, (
+        f"{len(short)} parentheses do not stretch around their vector, e.g. {short[:3]}: "
+        "is a math font installed? (apt-get install -y fonts-dejavu-extra)"
+    )

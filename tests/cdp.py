@@ -24,17 +24,30 @@ import pytest
 from browser import FLAGS as _FLAGS
 
 # every host lookup fails, as for the reports; the server under test is 127.0.0.1
-FLAGS = tuple("--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1" if f.startswith("--host-resolver-rules")
-              else f for f in _FLAGS)
+FLAGS = tuple(
+    "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1" if f.startswith("--host-resolver-rules") else f
+    for f in _FLAGS
+)
+
 
 class Browser:
     def __init__(self, chromium: str, downloads: str | None = None):
         websocket = pytest.importorskip("websocket")
         self._profile = tempfile.TemporaryDirectory(prefix="armdyn-cdp-")
-        self.proc = subprocess.Popen([chromium, *FLAGS, f"--user-data-dir={self._profile.name}",
-                                      "--remote-debugging-port=0", "--window-size=1280,900", "about:blank"],
-                                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                                     start_new_session=True)  # Debian's binary is a wrapper script: kill the group
+        self.proc = subprocess.Popen(
+            [
+                chromium,
+                *FLAGS,
+                f"--user-data-dir={self._profile.name}",
+                "--remote-debugging-port=0",
+                "--window-size=1280,900",
+                "about:blank",
+            ],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+            start_new_session=True,
+        )  # Debian's binary is a wrapper script: kill the group
         url, deadline, seen = None, time.monotonic() + 60, []
         while time.monotonic() < deadline and url is None:
             line = self.proc.stderr.readline()
@@ -52,8 +65,9 @@ class Browser:
         self.console: list[str] = []
         self.events: list[dict] = []
         if downloads:
-            self.call("Browser.setDownloadBehavior", {"behavior": "allow", "downloadPath": downloads,
-                                                      "eventsEnabled": True})
+            self.call(
+                "Browser.setDownloadBehavior", {"behavior": "allow", "downloadPath": downloads, "eventsEnabled": True}
+            )
 
     def call(self, method: str, params: dict | None = None, session: str | None = None, timeout: float = 60):
         self._id += 1
@@ -76,8 +90,16 @@ class Browser:
         method = ev.get("method")
         if method == "Page.javascriptDialogOpening":
             self.dialogs.append(ev["params"].get("message", ""))
-            self.ws.send(json.dumps({"id": 10**9 + len(self.dialogs), "method": "Page.handleJavaScriptDialog",
-                                     "params": {"accept": False}, "sessionId": ev.get("sessionId")}))
+            self.ws.send(
+                json.dumps(
+                    {
+                        "id": 10**9 + len(self.dialogs),
+                        "method": "Page.handleJavaScriptDialog",
+                        "params": {"accept": False},
+                        "sessionId": ev.get("sessionId"),
+                    }
+                )
+            )
         elif method == "Runtime.consoleAPICalled":
             self.console.append(" ".join(str(a.get("value", a.get("description", ""))) for a in ev["params"]["args"]))
         elif method == "Log.entryAdded":
@@ -108,8 +130,12 @@ class Page:
         self.b, self.session = browser, session
 
     def eval(self, expression: str, timeout: float = 60):
-        r = self.b.call("Runtime.evaluate", {"expression": expression, "returnByValue": True, "awaitPromise": True},
-                        self.session, timeout)
+        r = self.b.call(
+            "Runtime.evaluate",
+            {"expression": expression, "returnByValue": True, "awaitPromise": True},
+            self.session,
+            timeout,
+        )
         if "exceptionDetails" in r:
             raise AssertionError(f"page script failed: {r['exceptionDetails'].get('text')}: {expression[:200]}")
         return r["result"].get("value")
@@ -129,15 +155,19 @@ class Page:
 
     def goto(self, url: str, timeout: float = 60) -> None:
         self.b.call("Page.navigate", {"url": url}, self.session)
-        self.wait_for(f"document.readyState === 'complete' && location.href.startsWith({json.dumps(url[:40])})",
-                      timeout, f"{url} to load")
+        self.wait_for(
+            f"document.readyState === 'complete' && location.href.startsWith({json.dumps(url[:40])})",
+            timeout,
+            f"{url} to load",
+        )
 
     def screenshot(self, path, full: bool = True) -> None:
         params = {"format": "png"}
         if full:
             h = self.eval("Math.ceil(document.documentElement.scrollHeight)")
-            params.update(captureBeyondViewport=True, clip={"x": 0, "y": 0, "width": 1280, "height": min(h, 4000),
-                                                              "scale": 1})
+            params.update(
+                captureBeyondViewport=True, clip={"x": 0, "y": 0, "width": 1280, "height": min(h, 4000), "scale": 1}
+            )
         data = self.b.call("Page.captureScreenshot", params, self.session)["data"]
         with open(path, "wb") as f:
             f.write(base64.b64decode(data))

@@ -45,7 +45,6 @@ from __future__ import annotations
 import argparse
 import copy
 import json
-import math
 import os
 import random
 import re
@@ -65,17 +64,92 @@ DH_SEEDS = ["planar-3r", "scara", "puma560", "puma560-craig", "ur5", "stanford"]
 CHUNK = 1000  # inputs per worker process (a fresh process per chunk: ~1.5 s of imports)
 
 HOSTILE = [
-    float("nan"), float("inf"), -float("inf"), 1e308, -1e308, 5e-324, 0, -1, 1, 2**63, -(2**64), True, None,
-    "", " ", "nan", "inf", ".nan", "1e999999", "-1e999999", "10**10**10", "(" * 300 + "1" + ")" * 300,
-    "-" * 2000 + "1", "sqrt(-1)", "1/0", "log(0)", "exp(exp(exp(100)))", "pi/2", "l1", "m1*l1**2/12",
-    "__import__('os')", "a.b", "x" * 5000, "sin(", "2**(2**(2**(2**2)))", "(l1**1000)**1000", "atan2(0,0)",
-    [], {}, [1, 2], [1, 2, 3], [1, 2, 3, 4], [[1, 0, 0], [0, 1, 0], [0, 0, 1]], [[0] * 3] * 3,
-    {"ixx": 1, "iyy": 1, "izz": 5}, {"ixx": -1}, {"lower": 1, "upper": 0}, [float("nan")] * 3,
-    [[1, 0], [0, 1]], "revolute", "prismatic", "fixed", "floating", "continuous", "base", "link1",
+    float("nan"),
+    float("inf"),
+    -float("inf"),
+    1e308,
+    -1e308,
+    5e-324,
+    0,
+    -1,
+    1,
+    2**63,
+    -(2**64),
+    True,
+    None,
+    "",
+    " ",
+    "nan",
+    "inf",
+    ".nan",
+    "1e999999",
+    "-1e999999",
+    "10**10**10",
+    "(" * 300 + "1" + ")" * 300,
+    "-" * 2000 + "1",
+    "sqrt(-1)",
+    "1/0",
+    "log(0)",
+    "exp(exp(exp(100)))",
+    "pi/2",
+    "l1",
+    "m1*l1**2/12",
+    "__import__('os')",
+    "a.b",
+    "x" * 5000,
+    "sin(",
+    "2**(2**(2**(2**2)))",
+    "(l1**1000)**1000",
+    "atan2(0,0)",
+    [],
+    {},
+    [1, 2],
+    [1, 2, 3],
+    [1, 2, 3, 4],
+    [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
+    [[0] * 3] * 3,
+    {"ixx": 1, "iyy": 1, "izz": 5},
+    {"ixx": -1},
+    {"lower": 1, "upper": 0},
+    [float("nan")] * 3,
+    [[1, 0], [0, 1]],
+    "revolute",
+    "prismatic",
+    "fixed",
+    "floating",
+    "continuous",
+    "base",
+    "link1",
 ]
-HOSTILE_XML = ["nan", "inf", "-inf", "1e999999", "", "0 0", "0 0 0 0", "a b c", "1e308 1e308 1e308",
-               "0 0 0", "1 0 0", "0.6 0.8 0", "-1", "0", "5e-324", "1" * 400, "${x}", "continuous", "fixed",
-               "floating", "planar", "prismatic", "revolute", "base", "l1", "l2", "iiwa_link_3"]
+HOSTILE_XML = [
+    "nan",
+    "inf",
+    "-inf",
+    "1e999999",
+    "",
+    "0 0",
+    "0 0 0 0",
+    "a b c",
+    "1e308 1e308 1e308",
+    "0 0 0",
+    "1 0 0",
+    "0.6 0.8 0",
+    "-1",
+    "0",
+    "5e-324",
+    "1" * 400,
+    "${x}",
+    "continuous",
+    "fixed",
+    "floating",
+    "planar",
+    "prismatic",
+    "revolute",
+    "base",
+    "l1",
+    "l2",
+    "iiwa_link_3",
+]
 
 
 # ------------------------------------------------------------------ mutators
@@ -119,15 +193,42 @@ def mutate_text(text: str, rng: random.Random) -> str:
         i = rng.randrange(len(text) + 1)
         action = rng.random()
         if action < 0.3:
-            text = text[:i] + text[i + rng.randint(1, 40):]
+            text = text[:i] + text[i + rng.randint(1, 40) :]
         elif action < 0.6:
-            text = text[:i] + rng.choice(["\n", ":", "-", "[", "]", "{", "}", "&a", "*a", "!!python/object", "\x00",
-                                          "<", ">", "/>", '"', "'", "é", "\t", "  ", "1e999", "nan"]) + text[i:]
+            text = (
+                text[:i]
+                + rng.choice(
+                    [
+                        "\n",
+                        ":",
+                        "-",
+                        "[",
+                        "]",
+                        "{",
+                        "}",
+                        "&a",
+                        "*a",
+                        "!!python/object",
+                        "\x00",
+                        "<",
+                        ">",
+                        "/>",
+                        '"',
+                        "'",
+                        "é",
+                        "\t",
+                        "  ",
+                        "1e999",
+                        "nan",
+                    ]
+                )
+                + text[i:]
+            )
         elif action < 0.8:
             j = rng.randrange(len(text) + 1)
-            text = text[:i] + text[min(i, j):max(i, j)][:200] + text[i:]
+            text = text[:i] + text[min(i, j) : max(i, j)][:200] + text[i:]
         else:
-            text = text[:i] + chr(rng.randrange(1, 0x3000)) + text[i + 1:]
+            text = text[:i] + chr(rng.randrange(1, 0x3000)) + text[i + 1 :]
     return text
 
 
@@ -251,7 +352,6 @@ def _fill_robots_cache():
 def run_arrays(seed: int, rng: random.Random):
     import numpy as np
 
-    import armdyn
     import armdyn.numeric as numeric
 
     _fill_robots_cache()
@@ -284,8 +384,20 @@ def run_arrays(seed: int, rng: random.Random):
         return a
 
     threads = rng.choice([None, None, 1, 2, 3, 0, -1, 256, 257, 2**40])
-    name = rng.choice(["rnea", "aba", "crba", "gravity", "bias", "coriolis_matrix", "kinetic_energy",
-                       "potential_energy", "forward_kinematics", "jacobian"])
+    name = rng.choice(
+        [
+            "rnea",
+            "aba",
+            "crba",
+            "gravity",
+            "bias",
+            "coriolis_matrix",
+            "kinetic_energy",
+            "potential_energy",
+            "forward_kinematics",
+            "jacobian",
+        ]
+    )
     nargs = {"rnea": 3, "aba": 3, "bias": 2, "coriolis_matrix": 2, "kinetic_energy": 2}.get(name, 1)
     args = [arr() for _ in range(nargs)]
     if rng.random() < 0.7:  # mostly consistent shapes, so that the computation itself runs
@@ -300,8 +412,13 @@ def run_arrays(seed: int, rng: random.Random):
     if name != "aba" and out.size and not np.all(np.isfinite(out)):
         # finite inputs within 1e300 can overflow to inf legitimately (a**2); NaN from
         # finite inputs is a finding
-        small = all(isinstance(a, np.ndarray) and a.dtype.kind in "fiu" and np.all(np.isfinite(a))
-                    and np.max(np.abs(a), initial=0) < 1e100 for a in args)
+        small = all(
+            isinstance(a, np.ndarray)
+            and a.dtype.kind in "fiu"
+            and np.all(np.isfinite(a))
+            and np.max(np.abs(a), initial=0) < 1e100
+            for a in args
+        )
         if np.any(np.isnan(out)) and small:
             raise AssertionError(f"{name} returned NaN for finite inputs")
 
@@ -321,8 +438,12 @@ def _html_text(rng: random.Random) -> str:
         elif r < 0.75:
             parts.append(rng.choice(PAYLOADS)[1])
         elif r < 0.9:
-            parts.append("".join(chr(rng.choice([rng.randrange(32, 127), rng.randrange(0, 0x3000)]))
-                                 for _ in range(rng.randint(1, 6))))
+            parts.append(
+                "".join(
+                    chr(rng.choice([rng.randrange(32, 127), rng.randrange(0, 0x3000)]))
+                    for _ in range(rng.randint(1, 6))
+                )
+            )
         else:
             parts.append(rng.choice(["Q", "theta1", "l_1", "\\omega", "x"]))
     return "".join(parts)
@@ -345,7 +466,7 @@ def _check_math(markup: str) -> None:
         for name, value in el.attrib.items():
             if name not in ATTRIBUTES or not ATTRIBUTES[name].fullmatch(value):
                 raise AssertionError(f"attribute {name}={value!r} in {markup[:200]!r}")
-    inner = markup[markup.index(">") + 1: markup.rindex("</math>")]
+    inner = markup[markup.index(">") + 1 : markup.rindex("</math>")]
     if sanitize_mathml(inner) != inner:
         raise AssertionError(f"the sanitizer is not idempotent on {inner[:200]!r}")
 
@@ -401,10 +522,59 @@ RUNNERS = {"html": run_html}
 # registered in SECURITY_KINDS; each input must end in a result or a ModelError (anything
 # else, or more than SECURITY_SECONDS, is raised as an AssertionError: a finding).
 SECURITY_SECONDS = 5.0
-NAME_PIECES = ["*/", "/*", '"""', "'''", '"', "'", "\\", "??/", "?", "*", "/", "#", "\\n", "`", "$", "{", "}",
-               "q1", "\uff51\uff11", "\u0131", "\u212a", "\ufb01", "\u00b5", "\u03bc", "\u202e", "\u00e9", "e\u0301",
-               "\U0001d42a", "_", "__", "0", "9", " ", "-", ".", "x", "int", "return", "None", "l", "k", "memcpy",
-               "M_PI", "p", "q", "out", "system(\"id\")", "__import__('os')", "\u3000", "\ufeff", "\ud7ff"]
+NAME_PIECES = [
+    "*/",
+    "/*",
+    '"""',
+    "'''",
+    '"',
+    "'",
+    "\\",
+    "??/",
+    "?",
+    "*",
+    "/",
+    "#",
+    "\\n",
+    "`",
+    "$",
+    "{",
+    "}",
+    "q1",
+    "\uff51\uff11",
+    "\u0131",
+    "\u212a",
+    "\ufb01",
+    "\u00b5",
+    "\u03bc",
+    "\u202e",
+    "\u00e9",
+    "e\u0301",
+    "\U0001d42a",
+    "_",
+    "__",
+    "0",
+    "9",
+    " ",
+    "-",
+    ".",
+    "x",
+    "int",
+    "return",
+    "None",
+    "l",
+    "k",
+    "memcpy",
+    "M_PI",
+    "p",
+    "q",
+    "out",
+    'system("id")',
+    "__import__('os')",
+    "\u3000",
+    "\ufeff",
+    "\ud7ff",
+]
 
 
 def _random_name(rng: random.Random) -> str:
@@ -444,10 +614,20 @@ def run_names(seed: int, rng: random.Random):
         raise AssertionError(f"identifiers not unique: {idents}")
     if not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", prefix) or len(prefix) > 48:
         raise AssertionError(f"function prefix {prefix!r}")
-    code = types.SimpleNamespace(robot_name=robot_name, dof=len(q), coordinate_names=names, q=q, qd=qd, qdd=[],
-                                 op_counts={"tau": {"mul": 1, "add": 1, "sin_cos": 0, "other": 0}},
-                                 functions={"tau": f"{prefix}_tau"}, sources={"tau": _random_name(rng)},
-                                 parameters=q[:1], definitions=[(q[0], sp.Symbol(names[-1]) ** 2)], names=table)
+    code = types.SimpleNamespace(
+        robot_name=robot_name,
+        dof=len(q),
+        coordinate_names=names,
+        q=q,
+        qd=qd,
+        qdd=[],
+        op_counts={"tau": {"mul": 1, "add": 1, "sin_cos": 0, "other": 0}},
+        functions={"tau": f"{prefix}_tau"},
+        sources={"tau": _random_name(rng)},
+        parameters=q[:1],
+        definitions=[(q[0], sp.Symbol(names[-1]) ** 2)],
+        names=table,
+    )
     python = '"""\n' + "\n".join(_header_lines(code, "")) + '\n"""\nx = 1\n'
     tree = ast.parse(python)
     if len(tree.body) != 2 or not isinstance(tree.body[1], ast.Assign) or not python.isascii():
@@ -507,8 +687,25 @@ def run_aliases(seed: int, rng: random.Random):
     _must_be_model_error(lambda: load_yaml_string(text, source="fuzz.yaml"), f"seed {seed}")
 
 
-TOWER_ATOMS = ["2", "999", "999.0", "2.0", "1e300", "1e-300", "0.5", "10", "m1", "l1", "pi", "-1", "0", "1",
-               "7" * 400, "7" * 401, "1.5e308"]
+TOWER_ATOMS = [
+    "2",
+    "999",
+    "999.0",
+    "2.0",
+    "1e300",
+    "1e-300",
+    "0.5",
+    "10",
+    "m1",
+    "l1",
+    "pi",
+    "-1",
+    "0",
+    "1",
+    "7" * 400,
+    "7" * 401,
+    "1.5e308",
+]
 TOWER_FUNCTIONS = ["sin", "cos", "tan", "exp", "sinh", "cosh", "log", "sqrt", "atan", "abs"]
 
 
@@ -536,8 +733,9 @@ def run_towers(seed: int, rng: random.Random):
     expr = _tower(rng, rng.randint(1, 6))
     if rng.random() < 0.99:
         params = {"m1": sp.Symbol("m1"), "l1": sp.Symbol("l1")}
-        _must_be_model_error(lambda: parse_expression(expr, params, "link 'l'", "fuzz.yaml:3", "mass"),
-                             f"seed {seed}: {expr[:80]}")
+        _must_be_model_error(
+            lambda: parse_expression(expr, params, "link 'l'", "fuzz.yaml:3", "mass"), f"seed {seed}: {expr[:80]}"
+        )
         return
     text = _seed_text("planar-2r").replace("mass: m2", f"mass: {json.dumps(expr)}", 1)
     _must_be_model_error(lambda: load_yaml_string(text, source="fuzz.yaml"), f"seed {seed}: {expr[:80]}")
@@ -606,8 +804,15 @@ def drive(kinds: list[str], count: int, timeout: float, minutes: float | None, j
     start = time.monotonic()
     for kind in kinds:
         deadline = time.monotonic() + minutes * 60 if minutes else None
-        total[kind] = {"inputs": 0, "loaded_or_ok": 0, "expected_error": 0, "unexpected": 0, "timeout": 0,
-                       "crash": 0, "panic_on_stderr": 0}
+        total[kind] = {
+            "inputs": 0,
+            "loaded_or_ok": 0,
+            "expected_error": 0,
+            "unexpected": 0,
+            "timeout": 0,
+            "crash": 0,
+            "panic_on_stderr": 0,
+        }
         chunks = [(first, min(CHUNK, count - first)) for first in range(0, count, CHUNK)]
         running = []
         t_kind = time.monotonic()
@@ -615,8 +820,18 @@ def drive(kinds: list[str], count: int, timeout: float, minutes: float | None, j
             while chunks and len(running) < jobs and not (deadline and time.monotonic() > deadline):
                 first, n = chunks.pop(0)
                 err = tempfile.TemporaryFile()
-                cmd = [sys.executable, __file__, "--worker", kind, "--first", str(first), "--count", str(n),
-                       "--timeout", str(timeout)]
+                cmd = [
+                    sys.executable,
+                    __file__,
+                    "--worker",
+                    kind,
+                    "--first",
+                    str(first),
+                    "--count",
+                    str(n),
+                    "--timeout",
+                    str(timeout),
+                ]
                 running.append((subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, text=True), err, first))
             if not running:
                 break
@@ -638,10 +853,13 @@ def drive(kinds: list[str], count: int, timeout: float, minutes: float | None, j
                 found.append({"kind": kind, "chunk": first, "what": stderr[-300:]})
         seconds = time.monotonic() - t_kind
         t = total[kind]
-        print(f"{kind:>6}: {t['inputs']} inputs in {seconds:.0f} s: {t['loaded_or_ok']} loaded/evaluated, "
-              f"{t['expected_error']} clear errors, {t['unexpected']} unexpected exceptions, {t['timeout']} "
-              f"timeouts (>{timeout} s), {t['crash']} crashed workers, {t['panic_on_stderr']} chunks with a "
-              f"panic message on stderr", flush=True)
+        print(
+            f"{kind:>6}: {t['inputs']} inputs in {seconds:.0f} s: {t['loaded_or_ok']} loaded/evaluated, "
+            f"{t['expected_error']} clear errors, {t['unexpected']} unexpected exceptions, {t['timeout']} "
+            f"timeouts (>{timeout} s), {t['crash']} crashed workers, {t['panic_on_stderr']} chunks with a "
+            f"panic message on stderr",
+            flush=True,
+        )
         for f in [f for f in found if f["kind"] == kind][:30]:
             print("finding:", json.dumps(f), flush=True)
     print(f"total {sum(t['inputs'] for t in total.values())} inputs in {time.monotonic() - start:.0f} s")

@@ -63,7 +63,9 @@ def to_pinocchio(robot: Robot) -> tuple[pin.Model, dict[str, int], np.ndarray]:
     of the BODY frame placed at that link's frame; and ``perm`` (n,) such that Pinocchio's
     coordinate i is armdyn's coordinate ``perm[i]`` (``q_pin = q[perm]``)."""
     if getattr(robot, "mimic_joints", None):  # the bridge builds free joints only
-        raise NotImplementedError(f"robot '{robot.name}' has mimic joints: use pin.buildModelFromUrdf(path, mimic=True)")
+        raise NotImplementedError(
+            f"robot '{robot.name}' has mimic joints: use pin.buildModelFromUrdf(path, mimic=True)"
+        )
     model = pin.Model()
     model.name = robot.name
     model.gravity = pin.Motion(_floats(robot.gravity).ravel(), np.zeros(3))

@@ -80,8 +80,10 @@ def random_robot(
         rotation = np.eye(3) if rng.random() < 0.2 else random_rotation(rng)
         offset = {}
         if frame_offsets and (k == 0 or rng.random() < 0.6):
-            offset = {"frame_xyz": rng.uniform(-0.4, 0.4, size=3).tolist(),
-                      "frame_rotation": random_rotation(rng).tolist()}
+            offset = {
+                "frame_xyz": rng.uniform(-0.4, 0.4, size=3).tolist(),
+                "frame_rotation": random_rotation(rng).tolist(),
+            }
         joints.append(
             Joint(
                 f"j{k + 1}",

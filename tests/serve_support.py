@@ -27,13 +27,14 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples" / "grading"
-EXERCISE = EXAMPLES / "rp-arm-exercise.md"      # hand-checked: first wrong v_dot_1, both torques right
-RIGHT = EXAMPLES / "rp-arm-dalembert.md"        # hand-checked: every step right
+EXERCISE = EXAMPLES / "rp-arm-exercise.md"  # hand-checked: first wrong v_dot_1, both torques right
+RIGHT = EXAMPLES / "rp-arm-dalembert.md"  # hand-checked: every step right
 PG_ENV = "ARMDYN_TEST_POSTGRES_URL"
 
 
 def _drop_postgres_tables(url: str) -> None:
     import sqlalchemy as sa
+
     from armdyn.serve.storage import _engine
 
     engine = _engine(url)
@@ -88,13 +89,13 @@ class Server:
             raise AssertionError(f"the server did not stop within {timeout} s of {sig!r}") from None
 
 
-def start_server(tmp_path: Path, db: str, workers: int = 1, token: str | None = None, extra=(),
-                 timeout: float = 120.0) -> Server:
+def start_server(
+    tmp_path: Path, db: str, workers: int = 1, token: str | None = None, extra=(), timeout: float = 120.0
+) -> Server:
     port = free_port()
     log = tmp_path / f"server-{port}.log"
     env = dict(os.environ, PYTHONPATH=str(ROOT / "python"))
-    cmd = [sys.executable, "-m", "armdyn", "serve", "--port", str(port), "--db", db, "--workers", str(workers),
-           *extra]
+    cmd = [sys.executable, "-m", "armdyn", "serve", "--port", str(port), "--db", db, "--workers", str(workers), *extra]
     if token:
         cmd += ["--instructor-token", token]
     proc = subprocess.Popen(cmd, stdout=log.open("w"), stderr=subprocess.STDOUT, env=env)

@@ -23,9 +23,9 @@ import warnings
 
 import numpy as np
 import pytest
+from big_urdf import big_urdf
 
 import armdyn
-from big_urdf import big_urdf
 
 N_JOINTS = 10_000
 GRAVITY = np.array([0.0, 0.0, -9.81])
@@ -156,8 +156,9 @@ def test_rnea_power_equals_energy_rate(big):
     h = 1e-4
 
     def energy(t):
-        return _energy(spec, _joint_values(robot, spec, q + t * qd + 0.5 * t * t * qdd),
-                       _joint_values(robot, spec, qd + t * qdd))
+        return _energy(
+            spec, _joint_values(robot, spec, q + t * qd + 0.5 * t * t * qdd), _joint_values(robot, spec, qd + t * qdd)
+        )
 
     rate = (energy(h) - energy(-h)) / (2 * h)
     scale = np.abs(qd) @ np.abs(armdyn.rnea(robot, q, qd, qdd))  # sum of |power| terms
@@ -185,7 +186,7 @@ def test_rnea_equals_pinocchio_reading_the_same_file(tree, tmp_path):
         k = index[model.names[jid]]
         iq, iv = model.joints[jid].idx_q, model.joints[jid].idx_v
         if model.joints[jid].nq == 2:
-            pq[iq:iq + 2] = np.cos(q[k]), np.sin(q[k])
+            pq[iq : iq + 2] = np.cos(q[k]), np.sin(q[k])
         else:
             pq[iq] = q[k]
         pv[iv], pa[iv] = qd[k], qdd[k]

@@ -108,7 +108,10 @@ def test_bad_input_in_a_real_process_has_no_traceback():
     env = dict(os.environ)
     proc = subprocess.run(
         [sys.executable, "-m", "armdyn", "derive", str(HERE / "models" / "bad" / "zero-axis.yaml")],
-        capture_output=True, text=True, timeout=120, env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
     )
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == [proc.stderr.strip()]
@@ -133,8 +136,20 @@ def test_printed_tau_is_the_exercise_result(capsys, ascii_only):
 
     implicit = standard_transformations + (implicit_multiplication,)
     _, out, _ = run(capsys, "derive", "rp-arm", "--method", "lagrange", *(["--ascii"] if ascii_only else []))
-    spelled = {"θ̈₁": "theta1_ddot", "θ̇₁": "theta1_dot", "θ₁": "theta1", "d̈₂": "d2_ddot", "ḋ₂": "d2_dot",
-               "d₂": "d2", "m₁": "m1", "m₂": "m2", "l₁": "l1", "τ₁": "tau1", "τ₂": "tau2", "²": "**2"}
+    spelled = {
+        "θ̈₁": "theta1_ddot",
+        "θ̇₁": "theta1_dot",
+        "θ₁": "theta1",
+        "d̈₂": "d2_ddot",
+        "ḋ₂": "d2_dot",
+        "d₂": "d2",
+        "m₁": "m1",
+        "m₂": "m2",
+        "l₁": "l1",
+        "τ₁": "tau1",
+        "τ₂": "tau2",
+        "²": "**2",
+    }
     printed = {}
     for line in unicodedata.normalize("NFC", out).splitlines():
         for uni, asc in spelled.items():
@@ -144,10 +159,15 @@ def test_printed_tau_is_the_exercise_result(capsys, ascii_only):
             lhs, rhs = line.split(" = ", 1)
             # the Unicode report writes factors side by side: read juxtaposition as a product
             printed[lhs.strip()] = parse_expr(rhs.rsplit("    (", 1)[0], transformations=implicit)
-    m1, m2, l1, g, th, d, thd, dd, thdd, ddd = sp.symbols(
-        "m1 m2 l1 g theta1 d2 theta1_dot d2_dot theta1_ddot d2_ddot")
-    tau1 = ((m1 + m2) * l1**2 * thdd + m2 * l1 * ddd + 2 * m2 * d * thd * dd + m2 * thdd * d**2
-            + (m1 + m2) * g * l1 * sp.cos(th) - m2 * g * d * sp.sin(th))
+    m1, m2, l1, g, th, d, thd, dd, thdd, ddd = sp.symbols("m1 m2 l1 g theta1 d2 theta1_dot d2_dot theta1_ddot d2_ddot")
+    tau1 = (
+        (m1 + m2) * l1**2 * thdd
+        + m2 * l1 * ddd
+        + 2 * m2 * d * thd * dd
+        + m2 * thdd * d**2
+        + (m1 + m2) * g * l1 * sp.cos(th)
+        - m2 * g * d * sp.sin(th)
+    )
     tau2 = m2 * (l1 * thdd - thd**2 * d + ddd + g * sp.cos(th))
     assert sp.expand(printed["tau1"] - tau1) == 0
     assert sp.expand(printed["tau2"] - tau2) == 0

@@ -20,8 +20,23 @@ def run(capsys, *argv):
 
 def test_simulate_writes_plot_and_gif(capsys, tmp_path):
     png, gif = tmp_path / "run.png", tmp_path / "run.gif"
-    code, out, err = run(capsys, "simulate", "ur5", "--duration", "1", "--dt", "1e-3", "--q0", "0,-0.3,0.3,0,0,0",
-                         "--plot", str(png), "--animate", str(gif), "--fps", "10")
+    code, out, err = run(
+        capsys,
+        "simulate",
+        "ur5",
+        "--duration",
+        "1",
+        "--dt",
+        "1e-3",
+        "--q0",
+        "0,-0.3,0.3,0,0,0",
+        "--plot",
+        str(png),
+        "--animate",
+        str(gif),
+        "--fps",
+        "10",
+    )
     assert code == 0, err
     assert "1000 steps" in out and "relative drift" in out
     drift = float(out.split("relative drift ")[1].split()[0])
@@ -36,8 +51,19 @@ def test_simulate_writes_plot_and_gif(capsys, tmp_path):
 def test_simulate_pd_controller_reaches_target(capsys):
     target = [0.4, -1.0, 1.0, 0.2, 0.3, 0.1]
     for controller in ("pd-gravity", "computed-torque"):
-        code, out, err = run(capsys, "simulate", "ur5", "--duration", "4", "--dt", "1e-3",
-                             "--controller", controller, "--target", ",".join(map(str, target)))
+        code, out, err = run(
+            capsys,
+            "simulate",
+            "ur5",
+            "--duration",
+            "4",
+            "--dt",
+            "1e-3",
+            "--controller",
+            controller,
+            "--target",
+            ",".join(map(str, target)),
+        )
         assert code == 0, err
         final = [float(x) for x in out.split("q_final  = [")[1].split("]")[0].split(",")]
         np.testing.assert_allclose(final, target, atol=1e-3)

@@ -197,8 +197,8 @@ def test_customized_algorithms_equal_derive_at_random_points(name):
     samples = 4
     symbols = sorted(robot.free_symbols() | set(robot.q) | set(robot.qd) | set(robot.qdd), key=str)
     values = {s: rng.uniform(-1.5, 1.5, samples) for s in symbols}
-    tau_ref = dag.evaluate(eom.tau, values)[:, 0, :]          # (n, samples)
-    M_ref = dag.evaluate(eom.M, values)                      # (n, n, samples)
+    tau_ref = dag.evaluate(eom.tau, values)[:, 0, :]  # (n, samples)
+    M_ref = dag.evaluate(eom.M, values)  # (n, n, samples)
     tau_prog, defs = customized_newton_euler(robot)
     M_prog, _ = composite_mass_matrix(robot)
     assert samples > 0
@@ -258,8 +258,12 @@ def test_python_and_numpy_code_equal_rust_core(name):
     robot = _numeric(_load(name), _values(_load(name), rng))
     q, qd, qdd = _states(rng, robot.dof, samples=3)
     n = robot.dof
-    want = {"tau": armdyn.rnea(robot, q, qd, qdd), "M": armdyn.crba(robot, q),
-            "C": armdyn.coriolis_matrix(robot, q, qd), "g": armdyn.gravity(robot, q)}
+    want = {
+        "tau": armdyn.rnea(robot, q, qd, qdd),
+        "M": armdyn.crba(robot, q),
+        "C": armdyn.coriolis_matrix(robot, q, qd),
+        "g": armdyn.gravity(robot, q),
+    }
     args = {"tau": (q, qd, qdd), "M": (q,), "C": (q, qd), "g": (q,)}
     py = codegen.codegen(robot, lang="python")
     ns = _exec(py.source)
@@ -270,8 +274,8 @@ def test_python_and_numpy_code_equal_rust_core(name):
     npy = codegen.codegen(robot, lang="numpy")
     ns = _exec(npy.source)
     for what, fn in npy.functions.items():
-        _close(ns[fn](*args[what]), want[what])          # a batch (N, n)
-        _close(ns[fn](*(a[1] for a in args[what])), want[what][1])   # one state (n,)
+        _close(ns[fn](*args[what]), want[what])  # a batch (N, n)
+        _close(ns[fn](*(a[1] for a in args[what])), want[what][1])  # one state (n,)
     assert want["M"].shape == (len(q), n, n)
 
 
@@ -284,8 +288,11 @@ def test_fast_op_count_equals_sympy_count_ops():
             fast = _fast_count(e)
             visual = sp.count_ops(e, visual=True)
             d = {} if visual == 0 else {k.name: int(v) for k, v in visual.as_coefficients_dict().items()}
-            want = (d.get("MUL", 0) + d.get("DIV", 0) + d.get("POW", 0), d.get("ADD", 0) + d.get("SUB", 0),
-                    d.get("SIN", 0) + d.get("COS", 0))
+            want = (
+                d.get("MUL", 0) + d.get("DIV", 0) + d.get("POW", 0),
+                d.get("ADD", 0) + d.get("SUB", 0),
+                d.get("SIN", 0) + d.get("COS", 0),
+            )
             if fast is not None:
                 assert (fast["mul"], fast["add"], fast["sin_cos"]) == want, e
                 checked += 1
@@ -359,8 +366,9 @@ def test_compiler_failure_shows_its_message(tmp_path):
 # --------------------------------------------------------------------------- CLI
 def _cli(*args, cwd=None):
     env = dict(os.environ, PYTHONPATH=os.path.join(os.path.dirname(__file__), "..", "python"))
-    return subprocess.run([sys.executable, "-m", "armdyn", *args], capture_output=True, text=True, env=env, cwd=cwd,
-                          timeout=600)
+    return subprocess.run(
+        [sys.executable, "-m", "armdyn", *args], capture_output=True, text=True, env=env, cwd=cwd, timeout=600
+    )
 
 
 @needs_cc
@@ -390,11 +398,18 @@ def _symbolic_planar_2r():
     P = {n_: sp.Symbol(n_) for n_ in names + ["l1", "g"]}
     links = [armdyn.Link("base")]
     for i in (1, 2):
-        I = sp.Matrix([[P[f"Ixx{i}"], P[f"Ixy{i}"], P[f"Ixz{i}"]], [P[f"Ixy{i}"], P[f"Iyy{i}"], P[f"Iyz{i}"]],
-                       [P[f"Ixz{i}"], P[f"Iyz{i}"], P[f"Izz{i}"]]])
+        I = sp.Matrix(
+            [
+                [P[f"Ixx{i}"], P[f"Ixy{i}"], P[f"Ixz{i}"]],
+                [P[f"Ixy{i}"], P[f"Iyy{i}"], P[f"Iyz{i}"]],
+                [P[f"Ixz{i}"], P[f"Iyz{i}"], P[f"Izz{i}"]],
+            ]
+        )
         links.append(armdyn.Link(f"link{i}", P[f"m{i}"], [P[f"cx{i}"], P[f"cy{i}"], P[f"cz{i}"]], I))
-    joints = [armdyn.Joint("q1", "revolute", "base", "link1"),
-              armdyn.Joint("q2", "revolute", "link1", "link2", xyz=[P["l1"], 0, 0])]
+    joints = [
+        armdyn.Joint("q1", "revolute", "base", "link1"),
+        armdyn.Joint("q2", "revolute", "link1", "link2", xyz=[P["l1"], 0, 0]),
+    ]
     return armdyn.Robot("planar-2r-full", links, joints, gravity=[0, -P["g"], 0], parameters=P)
 
 

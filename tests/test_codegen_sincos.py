@@ -28,26 +28,34 @@ from armdyn.programs.program import Program
 
 HAVE_CC = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc")
 needs_cc = pytest.mark.skipif(not HAVE_CC, reason="no C compiler")
-UNIT = 2.0 ** -52  # absolute error unit: the values are <= 1
+UNIT = 2.0**-52  # absolute error unit: the values are <= 1
 
 
 def test_kernel_coefficients_are_the_computed_ones():
     (sin_c, cos_c), (sin_err, cos_err) = sincos_coefficients.fit()
     assert sin_c == sincos_coefficients.SIN and cos_c == sincos_coefficients.COS
     # the polynomials' own relative error, well below the double arithmetic's 2^-53
-    assert 0 < sin_err < 2.0 ** -57 and 0 < cos_err < 2.0 ** -63
+    assert 0 < sin_err < 2.0**-57 and 0 < cos_err < 2.0**-63
     assert repr(sin_c[-1]) in printers._SINCOS_KERNEL and repr(cos_c[-1]) in printers._SINCOS_KERNEL
 
 
 def _kernel_library(tmp_path, flags):
     """The kernel alone over an array, compiled as the generated batch code is (with
     its AVX2 clone where the platform has them)."""
-    source = "\n".join(["#include <math.h>", "#include <stddef.h>", "#include <stdint.h>", "#include <string.h>",
-                        printers._SIMD_CLONES, printers._SINCOS_KERNEL,
-                        "ARMDYN_SIMD_CLONES void sincos_many(size_t n, const double *x, double *s, double *c)",
-                        "{",
-                        "    for (size_t k = 0; k < n; ++k) armdyn_sincos_kernel(x[k], &s[k], &c[k]);",
-                        "}"])
+    source = "\n".join(
+        [
+            "#include <math.h>",
+            "#include <stddef.h>",
+            "#include <stdint.h>",
+            "#include <string.h>",
+            printers._SIMD_CLONES,
+            printers._SINCOS_KERNEL,
+            "ARMDYN_SIMD_CLONES void sincos_many(size_t n, const double *x, double *s, double *c)",
+            "{",
+            "    for (size_t k = 0; k < n; ++k) armdyn_sincos_kernel(x[k], &s[k], &c[k]);",
+            "}",
+        ]
+    )
     lib = ctypes.CDLL(build_shared_library(source, tmp_path, name="sincos", flags=flags))
     ptr = ctypes.POINTER(ctypes.c_double)
 
@@ -66,11 +74,17 @@ def _arguments():
     multiples = j * (np.pi / 2)  # |j| pi/2 <= 1e8
     return {
         "dense on [-50, 50]": np.concatenate([np.linspace(-50, 50, 300_001), rng.uniform(-50, 50, 100_000)]),
-        "multiples of pi/2": np.concatenate([multiples, np.nextafter(multiples, np.inf),
-                                             np.nextafter(multiples, -np.inf), (j + 0.5) * (np.pi / 2)]),
-        "tiny": np.array([0.0, -0.0, 5e-324, -5e-324, 1e-300, 2.0 ** -600, 1e-20, -1e-10, 2.0 ** -27, 1e-5, -1e-3]),
-        "large": np.concatenate([rng.uniform(-1e8, 1e8, 100_000), rng.uniform(-1e4, 1e4, 10_000),
-                                 [1e8, -1e8, np.nextafter(1e8, 0), 2.0 ** 26, 1e7 + 0.5]]),
+        "multiples of pi/2": np.concatenate(
+            [multiples, np.nextafter(multiples, np.inf), np.nextafter(multiples, -np.inf), (j + 0.5) * (np.pi / 2)]
+        ),
+        "tiny": np.array([0.0, -0.0, 5e-324, -5e-324, 1e-300, 2.0**-600, 1e-20, -1e-10, 2.0**-27, 1e-5, -1e-3]),
+        "large": np.concatenate(
+            [
+                rng.uniform(-1e8, 1e8, 100_000),
+                rng.uniform(-1e4, 1e4, 10_000),
+                [1e8, -1e8, np.nextafter(1e8, 0), 2.0**26, 1e7 + 0.5],
+            ]
+        ),
     }
 
 
@@ -94,8 +108,16 @@ def test_addition_formula_signs_and_chains():
     of the program (libm), as does a lone sine of an angle that is no such sum."""
     a, b, c, t = sp.symbols("a b c t")
     known = {a, b, c, t}  # the inputs
-    lines = [("d", a - b), ("e", -a - b), ("f", a - b + c), ("g", c - a),
-             ("u", t * a), ("w", a * b), ("h", sp.Symbol("w") + c), ("v", t + a)]
+    lines = [
+        ("d", a - b),
+        ("e", -a - b),
+        ("f", a - b + c),
+        ("g", c - a),
+        ("u", t * a),
+        ("w", a * b),
+        ("h", sp.Symbol("w") + c),
+        ("v", t + a),
+    ]
     alone = {"g", "v"}  # only the sine needed
     assignments = []
     for x in (a, b, c):
@@ -141,7 +163,7 @@ def test_batch_forms_compound_angles_by_the_addition_formula(tmp_path):
     robot = _load("ur5")
     lib = codegen.compile(robot, what="tau", directory=tmp_path)
     source = lib.code.source
-    batch = source[source.index("_batch("):]
+    batch = source[source.index("_batch(") :]
     for angle, sin in (("q23", "s23"), ("q234", "s234")):
         assert f"armdyn_sincos_kernel({angle}[l]" not in batch and f"fabs({angle}[l])" not in batch
         assert f"{sin}[l] = " in batch

@@ -25,10 +25,10 @@ import warnings
 import numpy as np
 import pytest
 import sympy as sp
+from random_models import random_robot, random_state
 
 import armdyn
 from armdyn.symbolic import dag, derive
-from random_models import random_robot, random_state
 
 
 def close(actual, expected, rtol: float, scale: float, what: str) -> None:
@@ -190,5 +190,10 @@ def test_symbolic_christoffel_c_equals_rust_c(name, method):
     for k in range(samples):
         scale = np.abs(armdyn.crba(robot, q[k])).max() * np.abs(qd[k]).max()
         close(C_sym[k], C_num[k], 1e-10, scale, f"{name} ({method}): symbolic C == Rust C")
-        close(C_sym[k] @ qd[k], h[k], 1e-10, scale * np.abs(qd[k]).max(),
-              f"{name} ({method}): symbolic C qd == rnea(q, qd, 0) - g")
+        close(
+            C_sym[k] @ qd[k],
+            h[k],
+            1e-10,
+            scale * np.abs(qd[k]).max(),
+            f"{name} ({method}): symbolic C qd == rnea(q, qd, 0) - g",
+        )

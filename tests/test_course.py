@@ -97,9 +97,9 @@ def test_three_frame_conventions_give_the_same_torques(kind):
 def test_assignment_arm_gives_the_exercise_torques():
     """The rp kind, off-axis frames, point masses, gravity along -y0: exercise 7-4's arm.
     Its torques are the hand-derived ones of the assignment's Lagrangian check."""
-    from armdyn.symbolic import derive
-
     import yaml
+
+    from armdyn.symbolic import derive
 
     for seed in range(40):  # the variant whose draw is the assignment's gravity
         v = draw_variant("rp", "a", seed=seed, convention="offaxis", masses="point", symbolic=True)
@@ -111,8 +111,14 @@ def test_assignment_arm_gives_the_exercise_torques():
     thd, dd = robot.qd
     thdd, ddd = robot.qdd
     m1, m2, l1, g = (sp.Symbol(n) for n in ("m1", "m2", "l1", "g"))
-    tau1 = ((m1 + m2) * l1**2 * thdd + m2 * l1 * ddd + 2 * m2 * d * thd * dd + m2 * thdd * d**2
-            + (m1 + m2) * g * l1 * sp.cos(th) - m2 * g * d * sp.sin(th))
+    tau1 = (
+        (m1 + m2) * l1**2 * thdd
+        + m2 * l1 * ddd
+        + 2 * m2 * d * thd * dd
+        + m2 * thdd * d**2
+        + (m1 + m2) * g * l1 * sp.cos(th)
+        - m2 * g * d * sp.sin(th)
+    )
     tau2 = m2 * (l1 * thdd - thd**2 * d + ddd + g * sp.cos(th))
     assert sp.simplify(tau[0] - tau1) == 0
     assert sp.simplify(tau[1] - tau2) == 0
@@ -190,15 +196,18 @@ def test_rubric_default_and_file(tmp_path):
     assert r.step_points("tau_1", "tau") == 0.5 and r.parts == {"lagrange": 4.0} and r.credit["wrong"] == 0.25
 
 
-@pytest.mark.parametrize("text, line, what", [
-    ("points:\n  tau: [1\n", 3, "YAML syntax error"),
-    ("points:\n  tau: 2\ncredits:\n  wrong: 0\n", 3, "unknown key 'credits'"),
-    ("credit:\n  wrong: 2\n", 2, "credit.wrong must be a fraction"),
-    ("credit:\n  wronng: 0\n", 2, "unknown status 'wronng'"),
-    ("points:\n  tau: two\n", 2, "points.tau must be a number"),
-    ("default: .nan\n", 1, "default must be a number in"),
-    ("points:\n  tau: 1\npoints:\n  F: 2\n", 3, "duplicate key"),
-])
+@pytest.mark.parametrize(
+    "text, line, what",
+    [
+        ("points:\n  tau: [1\n", 3, "YAML syntax error"),
+        ("points:\n  tau: 2\ncredits:\n  wrong: 0\n", 3, "unknown key 'credits'"),
+        ("credit:\n  wrong: 2\n", 2, "credit.wrong must be a fraction"),
+        ("credit:\n  wronng: 0\n", 2, "unknown status 'wronng'"),
+        ("points:\n  tau: two\n", 2, "points.tau must be a number"),
+        ("default: .nan\n", 1, "default must be a number in"),
+        ("points:\n  tau: 1\npoints:\n  F: 2\n", 3, "duplicate key"),
+    ],
+)
 def test_rubric_errors_name_file_and_line(tmp_path, text, line, what):
     p = tmp_path / "rubric.yaml"
     p.write_text(text)
@@ -214,16 +223,26 @@ def _step(name, status, message=""):
 
 
 def test_gradebook_points_by_hand():
-    report = {"method": "newton-euler+lagrange", "first_wrong": "v_dot_1", "tau_correct": [True, False],
-              "steps": [_step("", "unrecognised"), _step("omega_1", "correct"),
-                        _step("v_dot_1", "wrong", "missing term −l1·θ̇1² in the x component"),
-                        _step("F_1", "follows-from-earlier-error"), _step("F_2", "correct-by-convention"),
-                        _step("tau_1", "correct-but-unsupported"),
-                        _step("tau_2", "wrong", "θ̇1 written where θ̈1 belongs"),
-                        _step("T", "correct"), _step("tau_1", "correct")]}
+    report = {
+        "method": "newton-euler+lagrange",
+        "first_wrong": "v_dot_1",
+        "tau_correct": [True, False],
+        "steps": [
+            _step("", "unrecognised"),
+            _step("omega_1", "correct"),
+            _step("v_dot_1", "wrong", "missing term −l1·θ̇1² in the x component"),
+            _step("F_1", "follows-from-earlier-error"),
+            _step("F_2", "correct-by-convention"),
+            _step("tau_1", "correct-but-unsupported"),
+            _step("tau_2", "wrong", "θ̇1 written where θ̈1 belongs"),
+            _step("T", "correct"),
+            _step("tau_1", "correct"),
+        ],
+    }
     rubric = Rubric.from_text("points:\n  tau: 4\n  F_2: 3\ndefault: 1\nrequired: [n_1, V]\n")
-    gb = Gradebook.from_results([("bob", "v1", report, None), ("amy", None, None, "timeout: more than 60 s")],
-                                rubric=rubric)
+    gb = Gradebook.from_results(
+        [("bob", "v1", report, None), ("amy", None, None, "timeout: more than 60 s")], rubric=rubric
+    )
     amy, bob = gb.rows
     # Newton-Euler: omega 1 + v_dot 0 + F_1 0.5 + F_2 3 + tau_1 4*0.5 + tau_2 0, of 1+1+1+3+4+4 (+ n_1 required: 1)
     assert bob["points_newton-euler"] == 6.5
@@ -243,33 +262,45 @@ def test_gradebook_points_by_hand():
 
 
 def test_gradebook_part_totals_scale_and_csv_formulas_are_quoted():
-    report = {"method": "newton-euler", "first_wrong": None, "tau_correct": [True],
-              "steps": [_step("omega_1", "correct"), _step("tau_1", "follows-from-earlier-error")]}
-    gb = Gradebook.from_results([("=HYPERLINK(1)", None, report, None)],
-                                rubric=Rubric.from_text("parts:\n  newton-euler: 10\n  lagrange: 5\n"))
+    report = {
+        "method": "newton-euler",
+        "first_wrong": None,
+        "tau_correct": [True],
+        "steps": [_step("omega_1", "correct"), _step("tau_1", "follows-from-earlier-error")],
+    }
+    gb = Gradebook.from_results(
+        [("=HYPERLINK(1)", None, report, None)], rubric=Rubric.from_text("parts:\n  newton-euler: 10\n  lagrange: 5\n")
+    )
     row = gb.rows[0]
     assert row["points_newton-euler"] == pytest.approx(10 * (1 + 1) / 3, abs=0.01)  # (1 + 2*0.5) of 3
     assert row["points_lagrange"] == 0 and row["max"] == 15
     assert "\n'=HYPERLINK(1)," in gb.to_csv()
 
 
-@pytest.mark.parametrize("message, kind", [
-    ("missing term −l1·θ̇1² in the x component", "missing term"),
-    ("extra terms a + b in the y component", "extra term"),
-    ("sign flipped", "wrong sign"),
-    ("wrong sign on the term m2·θ̈1 in the z component", "wrong sign"),
-    ("θ̇1 written where θ̈1 belongs in the x component", "derivative mixed up"),
-    ("a factor l1 missing on m2·d2 in the z component", "factor missing"),
-    ("an extra factor m2 on l1", "extra factor"),
-    ("differs by −l1", "other"),
-])
+@pytest.mark.parametrize(
+    "message, kind",
+    [
+        ("missing term −l1·θ̇1² in the x component", "missing term"),
+        ("extra terms a + b in the y component", "extra term"),
+        ("sign flipped", "wrong sign"),
+        ("wrong sign on the term m2·θ̈1 in the z component", "wrong sign"),
+        ("θ̇1 written where θ̈1 belongs in the x component", "derivative mixed up"),
+        ("a factor l1 missing on m2·d2 in the z component", "factor missing"),
+        ("an extra factor m2 on l1", "extra factor"),
+        ("differs by −l1", "other"),
+    ],
+)
 def test_error_kinds(message, kind):
     assert classify(message) == kind
 
 
 def test_summary_page_is_self_contained_and_escaped():
-    report = {"method": "newton-euler", "first_wrong": "F_2", "tau_correct": [False],
-              "steps": [_step("F_2", "wrong", "missing term <script>alert(1)</script>")]}
+    report = {
+        "method": "newton-euler",
+        "first_wrong": "F_2",
+        "tau_correct": [False],
+        "steps": [_step("F_2", "wrong", "missing term <script>alert(1)</script>")],
+    }
     gb = Gradebook.from_results([("mallory <b>", "v", report, None), ("x", "v", None, "error: a.md:3: bad")])
     page = summary_html(gb)
     assert 'http-equiv="Content-Security-Policy"' in page and "default-src 'none'" in page
@@ -291,8 +322,9 @@ def test_proof_solutions_grade_correct_and_slips_are_found(tmp_path, kind):
         (tmp_path / "proof.md").write_text(text)
         report = armdyn.grade(str(tmp_path / "proof.md"))
         links = [s for s in report.steps if s.name.startswith("proof_")]
-        assert len(links) >= len(where) and all(s.status == "correct" for s in links), \
-            [(s.name, s.status, s.message) for s in links]
+        assert len(links) >= len(where) and all(s.status == "correct" for s in links), [
+            (s.name, s.status, s.message) for s in links
+        ]
         for k in slippable_lines(blocks):
             for j in range(len(blocks[k].slips)):
                 text, where = proof_markdown(blocks, {"robot": "model.yaml"}, title, slip=(k, j))

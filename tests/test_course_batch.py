@@ -27,8 +27,7 @@ from armdyn.course.variants import draw_variant
 RUBRIC = "points:\n  tau: 3\n  T: 2\ndefault: 1\ncredit:\n  wrong: 0\n"
 POINTS = {"tau": 3, "T": 2}
 KIND_OF_SLIP = {"drop": "missing term", "sign": "wrong sign"}
-VARIANTS = [("rp", "offaxis"), ("rp", "craig"), ("rr", "spong"), ("pr", "craig"), ("rr", "offaxis"),
-            ("pr", "spong")]
+VARIANTS = [("rp", "offaxis"), ("rp", "craig"), ("rr", "spong"), ("pr", "craig"), ("rr", "offaxis"), ("pr", "spong")]
 
 
 def _points(name: str) -> float:
@@ -83,8 +82,22 @@ def test_class_of_60_against_the_injected_truth(course, tmp_path, capsys):
     book = tmp_path / "out" / "grades.csv"
     book.parent.mkdir()
     t0 = time.perf_counter()
-    code = main(["grade", str(subs), "--variants", str(root / "variants"), "--gradebook", str(book),
-                 "--rubric", str(root / "rubric.yaml"), "--html-dir", str(tmp_path / "reports"), "--jobs", "2"])
+    code = main(
+        [
+            "grade",
+            str(subs),
+            "--variants",
+            str(root / "variants"),
+            "--gradebook",
+            str(book),
+            "--rubric",
+            str(root / "rubric.yaml"),
+            "--html-dir",
+            str(tmp_path / "reports"),
+            "--jobs",
+            "2",
+        ]
+    )
     seconds = time.perf_counter() - t0
     assert code == 0, capsys.readouterr().err
     data = json.loads((tmp_path / "out" / "grades.json").read_text())
@@ -104,12 +117,11 @@ def test_class_of_60_against_the_injected_truth(course, tmp_path, capsys):
     firsts = collections.Counter(s.name for _, s, _, _ in truth.values() if s)
     kinds = collections.Counter(KIND_OF_SLIP[s.how] for _, s, _, _ in truth.values() if s)
     page = (tmp_path / "out" / "summary.html").read_text()
-    shown = {k: int(n) for k, n in re.findall(r'<tr><td><code>([^<]+)</code></td><td class="num">(\d+)</td>',
-                                                    page)}
+    shown = {k: int(n) for k, n in re.findall(r'<tr><td><code>([^<]+)</code></td><td class="num">(\d+)</td>', page)}
     assert shown == dict(firsts)
     shown_kinds = {k: int(n) for k, n in re.findall(r'<tr><td>([a-z ]+)</td><td class="num">(\d+)</td>', page)}
     assert shown_kinds == dict(kinds)
-    assert f"<b>{sum(1 for *_x, in truth.values())}</b> submissions" in page
+    assert f"<b>{sum(1 for (*_x,) in truth.values())}</b> submissions" in page
     assert len(list((tmp_path / "reports").glob("*.html"))) == 60
     print(f"60 submissions graded in {seconds:.1f} s with --jobs 2")
 
@@ -129,8 +141,9 @@ def small_class(course, tmp_path):
 def _run(root, subs, tmp_path, *extra):
     book = tmp_path / "out" / "grades.csv"
     book.parent.mkdir(exist_ok=True)
-    code = main(["grade", str(subs), "--variants", str(root / "variants"), "--gradebook", str(book),
-                 "--jobs", "2", *extra])
+    code = main(
+        ["grade", str(subs), "--variants", str(root / "variants"), "--gradebook", str(book), "--jobs", "2", *extra]
+    )
     return code, book
 
 
@@ -143,8 +156,9 @@ def test_bad_files_are_reported_alone(small_class, tmp_path, capsys):
     code, book = _run(root, subs, tmp_path)
     err = capsys.readouterr().err
     assert code == 1
-    rows = {r["student"]: r for r in json.loads(book.with_suffix(".json").read_text())["rows"]
-            if r["status"] != "duplicate"}
+    rows = {
+        r["student"]: r for r in json.loads(book.with_suffix(".json").read_text())["rows"] if r["status"] != "duplicate"
+    }
     assert [rows[f"s{k}"]["status"] for k in range(3)] == ["graded"] * 3
     assert all(rows[f"s{k}"]["first_wrong"] is None for k in range(3))
     # a file that is not UTF-8 cannot say who handed it in: the file's stem stands for the student
@@ -179,7 +193,9 @@ def test_cache_regrades_only_what_changed(small_class, tmp_path, capsys):
     assert code == 0 and "(3 unchanged" in capsys.readouterr().out
     assert {p: p.read_bytes() for p in book.parent.glob("*.*") if p.is_file()} == outputs  # same bytes
     text = (subs / "s2.md").read_text()
-    (subs / "s2.md").write_text(re.sub(r"^(\$\$\\tau_\{1\} = .*)\$\$$", r"\1 + 2 m_{1}$$", text, count=1, flags=re.MULTILINE))
+    (subs / "s2.md").write_text(
+        re.sub(r"^(\$\$\\tau_\{1\} = .*)\$\$$", r"\1 + 2 m_{1}$$", text, count=1, flags=re.MULTILINE)
+    )
     code, _ = _run(root, subs, tmp_path)
     assert code == 0 and "(2 unchanged" in capsys.readouterr().out
     rows = {r["student"]: r for r in json.loads(book.with_suffix(".json").read_text())["rows"]}

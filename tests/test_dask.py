@@ -57,8 +57,19 @@ def test_simulate_on_cluster_equal_in_process(client, ur5):
     kw = dict(dt=1e-3, steps=200, stride=20, controller=ComputedTorque(25.0, 10.0, np.full(6, 0.2)))
     lazy = ad.simulate(ur5, q0, qd0, chunks=10, **kw)
     ref = simulate(ur5, q0, qd0, **kw)
-    for name in ("q", "qd", "qdd", "tau", "kinetic", "potential", "q_final", "qd_final",
-                 "limit_step", "limit_joint", "nonfinite_step"):
+    for name in (
+        "q",
+        "qd",
+        "qdd",
+        "tau",
+        "kinetic",
+        "potential",
+        "q_final",
+        "qd_final",
+        "limit_step",
+        "limit_joint",
+        "nonfinite_step",
+    ):
         got = getattr(lazy, name).compute()
         want = getattr(ref, name)
         assert got.shape == want.shape and got.dtype == want.dtype, name

@@ -22,11 +22,11 @@ import warnings
 
 import numpy as np
 import pytest
+from random_models import random_robot, random_state
 
 import armdyn
 from armdyn import numeric as num
 from armdyn import reference as ref
-from random_models import random_robot, random_state
 
 RTOL = 1e-10
 
@@ -123,16 +123,23 @@ def test_against_pinocchio(name, robot, pin_bridge):
         assert_rel(num.gravity_derivatives(robot, q), P.gravity_derivatives(q), what=f"{name} dg/dq")
         for link in robot.links:
             Jd = P.jacobian_dot(q, qd, link)
-            assert_rel(num.jacobian_dot(robot, q, qd, link), Jd, what=f"{name} jacobian_dot {link}",
-                       scale=_jd_scale(Jd, qd))
+            assert_rel(
+                num.jacobian_dot(robot, q, qd, link), Jd, what=f"{name} jacobian_dot {link}", scale=_jd_scale(Jd, qd)
+            )
         # external wrenches in link frames (Pinocchio's fext move with the joints)
         W = _wrenches(robot, rng)
         assert_rel(num.rnea(robot, q, qd, x, f_ext=W), P.rnea_ext(q, qd, x, W), what=f"{name} rnea f_ext")
         assert_rel(num.aba(robot, q, qd, x, f_ext=W), P.aba_ext(q, qd, x, W), what=f"{name} aba f_ext")
-        assert_rel(num.rnea(robot, q, qd, x, f_ext=W, frame="world"), P.rnea_ext(q, qd, x, W, "world"),
-                   what=f"{name} rnea f_ext world")
-        assert_rel(num.aba(robot, q, qd, x, f_ext=W, frame="world"), P.aba_ext(q, qd, x, W, "world"),
-                   what=f"{name} aba f_ext world")
+        assert_rel(
+            num.rnea(robot, q, qd, x, f_ext=W, frame="world"),
+            P.rnea_ext(q, qd, x, W, "world"),
+            what=f"{name} rnea f_ext world",
+        )
+        assert_rel(
+            num.aba(robot, q, qd, x, f_ext=W, frame="world"),
+            P.aba_ext(q, qd, x, W, "world"),
+            what=f"{name} aba f_ext world",
+        )
         mine = num.rnea_derivatives(robot, q, qd, x, f_ext=W)
         theirs = P.rnea_derivatives(q, qd, x, W)
         for a, b, what, sc in zip(mine, theirs, ("dtau_dq", "dtau_dqd", "M"), _scales(robot, q, qd, theirs, "rnea")):
@@ -152,28 +159,39 @@ REF_CASES = ALL[::3]  # the NumPy oracle is slow: every third robot
 @pytest.mark.parametrize("name, robot", REF_CASES, ids=[a for a, _ in REF_CASES])
 def test_against_reference(name, robot):
     rng = np.random.default_rng(41)
-    (q, qd, x), = _states(robot, 23, count=1)
+    ((q, qd, x),) = _states(robot, 23, count=1)
     W = _wrenches(robot, rng)
     for frame in ("local", "world"):
         for f_ext in (None, W):
             mine = num.rnea_derivatives(robot, q, qd, x, f_ext=f_ext, frame=frame)
             theirs = ref.rnea_derivatives(robot, q, qd, x, f_ext, frame)
-            for a, b, what, sc in zip(mine, theirs, ("dtau_dq", "dtau_dqd", "M"), _scales(robot, q, qd, theirs, "rnea")):
+            for a, b, what, sc in zip(
+                mine, theirs, ("dtau_dq", "dtau_dqd", "M"), _scales(robot, q, qd, theirs, "rnea")
+            ):
                 assert_rel(a, b, what=f"{name} rnea {what} {frame} {f_ext is not None}", scale=sc)
             mine = num.aba_derivatives(robot, q, qd, x, f_ext=f_ext, frame=frame)
             theirs = ref.aba_derivatives(robot, q, qd, x, f_ext, frame)
-            for a, b, what, sc in zip(mine, theirs, ("dqdd_dq", "dqdd_dqd", "Minv"), _scales(robot, q, qd, theirs, "aba")):
+            for a, b, what, sc in zip(
+                mine, theirs, ("dqdd_dq", "dqdd_dqd", "Minv"), _scales(robot, q, qd, theirs, "aba")
+            ):
                 assert_rel(a, b, what=f"{name} aba {what} {frame} {f_ext is not None}", scale=sc)
-        assert_rel(num.rnea(robot, q, qd, x, f_ext=W, frame=frame), ref.rnea_ext(robot, q, qd, x, W, frame),
-                   what=f"{name} rnea f_ext {frame}")
-        assert_rel(num.aba(robot, q, qd, x, f_ext=W, frame=frame), ref.aba_ext(robot, q, qd, x, W, frame),
-                   what=f"{name} aba f_ext {frame}")
+        assert_rel(
+            num.rnea(robot, q, qd, x, f_ext=W, frame=frame),
+            ref.rnea_ext(robot, q, qd, x, W, frame),
+            what=f"{name} rnea f_ext {frame}",
+        )
+        assert_rel(
+            num.aba(robot, q, qd, x, f_ext=W, frame=frame),
+            ref.aba_ext(robot, q, qd, x, W, frame),
+            what=f"{name} aba f_ext {frame}",
+        )
     assert_rel(num.minverse(robot, q), ref.minverse(robot, q), what=f"{name} minverse")
     assert_rel(num.gravity_derivatives(robot, q), ref.gravity_derivatives(robot, q), what=f"{name} dg/dq")
     for link in robot.links:
         Jd = ref.jacobian_dot(robot, q, qd, link)
-        assert_rel(num.jacobian_dot(robot, q, qd, link), Jd, what=f"{name} jacobian_dot {link}",
-                   scale=_jd_scale(Jd, qd))
+        assert_rel(
+            num.jacobian_dot(robot, q, qd, link), Jd, what=f"{name} jacobian_dot {link}", scale=_jd_scale(Jd, qd)
+        )
 
 
 # ------------------------------------------------------------------ finite differences, identities
@@ -193,29 +211,34 @@ def _central(f, x, h=1e-6):
 @pytest.mark.parametrize("name, robot", FD_CASES, ids=[a for a, _ in FD_CASES])
 def test_against_central_differences(name, robot):
     rng = np.random.default_rng(53)
-    (q, qd, x), = _states(robot, 29, count=1)
+    ((q, qd, x),) = _states(robot, 29, count=1)
     W = _wrenches(robot, rng)
     tol = 1e-6
     for frame in ("local", "world"):
         for f_ext in (None, W):
             kw = {"f_ext": f_ext, "frame": frame}
             mine = num.rnea_derivatives(robot, q, qd, x, **kw)
-            fd = (_central(lambda y: num.rnea(robot, y, qd, x, **kw), q),
-                  _central(lambda y: num.rnea(robot, q, y, x, **kw), qd),
-                  _central(lambda y: num.rnea(robot, q, qd, y, **kw), x))
+            fd = (
+                _central(lambda y: num.rnea(robot, y, qd, x, **kw), q),
+                _central(lambda y: num.rnea(robot, q, y, x, **kw), qd),
+                _central(lambda y: num.rnea(robot, q, qd, y, **kw), x),
+            )
             for a, b, what, sc in zip(mine, fd, ("dtau_dq", "dtau_dqd", "M"), _scales(robot, q, qd, fd, "rnea")):
                 assert_rel(a, b, tol, f"{name} {what} {frame}", scale=sc)
             mine = num.aba_derivatives(robot, q, qd, x, **kw)
-            fd = (_central(lambda y: num.aba(robot, y, qd, x, **kw), q),
-                  _central(lambda y: num.aba(robot, q, y, x, **kw), qd),
-                  _central(lambda y: num.aba(robot, q, qd, y, **kw), x))
+            fd = (
+                _central(lambda y: num.aba(robot, y, qd, x, **kw), q),
+                _central(lambda y: num.aba(robot, q, y, x, **kw), qd),
+                _central(lambda y: num.aba(robot, q, qd, y, **kw), x),
+            )
             for a, b, what, sc in zip(mine, fd, ("dqdd_dq", "dqdd_dqd", "Minv"), _scales(robot, q, qd, fd, "aba")):
                 assert_rel(a, b, tol, f"{name} {what} {frame}", scale=sc)
     assert_rel(num.gravity_derivatives(robot, q), _central(lambda y: num.gravity(robot, y), q), tol, f"{name} dg/dq")
     for link in robot.links:
         fd = _central(lambda t: num.jacobian(robot, q + t[0] * qd, link), np.zeros(1))[..., 0]
-        assert_rel(num.jacobian_dot(robot, q, qd, link), fd, tol, f"{name} jacobian_dot {link}",
-                   scale=_jd_scale(fd, qd))
+        assert_rel(
+            num.jacobian_dot(robot, q, qd, link), fd, tol, f"{name} jacobian_dot {link}", scale=_jd_scale(fd, qd)
+        )
 
 
 @pytest.mark.parametrize("name, robot", ALL[::4], ids=[a for a, _ in ALL[::4]])
@@ -240,11 +263,17 @@ def test_identities(name, robot):
         assert_rel(Minv2, Minv, tol, what=f"{name} aba_derivatives Minv = minverse")
         # dg/dq = dtau/dq at qd = qdd = 0; M = dtau/dqdd is the CRBA's
         z = np.zeros(n)
-        assert_rel(num.gravity_derivatives(robot, q), num.rnea_derivatives(robot, q, z, z)[0], 1e-12,
-                   what=f"{name} dg/dq")
+        assert_rel(
+            num.gravity_derivatives(robot, q), num.rnea_derivatives(robot, q, z, z)[0], 1e-12, what=f"{name} dg/dq"
+        )
         # dtau/dqdd does not depend on qd; dtau/dqd is linear in qd: dtau/dqd(2 qd) = 2 dtau/dqd(qd)
-        assert_rel(num.rnea_derivatives(robot, q, 2 * qd, qdd)[1], 2 * dtau_dqd, 1e-12, what=f"{name} linear in qd",
-                   scale=2 * _scales(robot, q, qd, (dtau_dqd,), "rnea")[0])
+        assert_rel(
+            num.rnea_derivatives(robot, q, 2 * qd, qdd)[1],
+            2 * dtau_dqd,
+            1e-12,
+            what=f"{name} linear in qd",
+            scale=2 * _scales(robot, q, qd, (dtau_dqd,), "rnea")[0],
+        )
 
 
 # ------------------------------------------------------------------ batches
@@ -265,13 +294,22 @@ def test_batches_equal_single_calls_bit_for_bit(name, robot):
             "aba_derivatives": lambda i, **kw: num.aba_derivatives(robot, Q[i], QD[i], X[i], **kw),
         }
         for name_, call in calls.items():
-            for kw_single, kw_batch in (({}, {}), ({"f_ext": W[0]}, {"f_ext": W}), ({"f_ext": W[0], "frame": "world"}, {"f_ext": W, "frame": "world"})):
+            for kw_single, kw_batch in (
+                ({}, {}),
+                ({"f_ext": W[0]}, {"f_ext": W}),
+                ({"f_ext": W[0], "frame": "world"}, {"f_ext": W, "frame": "world"}),
+            ):
                 for threads in (1, 2):
                     batch = getattr(num, name_)(robot, Q, QD, X, threads=threads, **kw_batch)
                     assert len(batch) == 3
                     for k in range(3):
                         assert batch[k].shape == (N, n, n) and batch[k].flags.c_contiguous
-                        want = np.array([call(i, **{**kw_single, **({"f_ext": W[i]} if "f_ext" in kw_single else {})})[k] for i in range(N)])
+                        want = np.array(
+                            [
+                                call(i, **{**kw_single, **({"f_ext": W[i]} if "f_ext" in kw_single else {})})[k]
+                                for i in range(N)
+                            ]
+                        )
                         assert np.array_equal(batch[k], want), f"{name_}[{k}] N={N} threads={threads} {kw_batch.keys()}"
         for threads in (1, 2):
             for f, args, single in (
@@ -283,9 +321,13 @@ def test_batches_equal_single_calls_bit_for_bit(name, robot):
                 assert np.array_equal(batch, np.array([single(i) for i in range(N)])), (f.__name__, N, threads)
             for frame in ("local", "world"):
                 tau = num.rnea(robot, Q, QD, X, f_ext=W, frame=frame, threads=threads)
-                assert np.array_equal(tau, np.array([num.rnea(robot, Q[i], QD[i], X[i], f_ext=W[i], frame=frame) for i in range(N)]))
+                assert np.array_equal(
+                    tau, np.array([num.rnea(robot, Q[i], QD[i], X[i], f_ext=W[i], frame=frame) for i in range(N)])
+                )
                 qdd = num.aba(robot, Q, QD, X, f_ext=W, frame=frame, threads=threads)
-                assert np.array_equal(qdd, np.array([num.aba(robot, Q[i], QD[i], X[i], f_ext=W[i], frame=frame) for i in range(N)]))
+                assert np.array_equal(
+                    qdd, np.array([num.aba(robot, Q[i], QD[i], X[i], f_ext=W[i], frame=frame) for i in range(N)])
+                )
 
 
 # ------------------------------------------------------------------ bad input
@@ -308,10 +350,14 @@ def _robot():
         (lambda r, z, W: num.rnea(r, z, z, z, f_ext=W[:-1]), r"f_ext: expected shape \(5, 6\)"),
         (lambda r, z, W: num.aba(r, z, z, z, f_ext=W[:, :3]), r"f_ext: expected shape \(5, 6\)"),
         (lambda r, z, W: num.rnea_derivatives(r, z, z, z, f_ext=W.ravel()), "f_ext: expected shape"),
-        (lambda r, z, W: num.aba_derivatives(r, np.zeros((2, 4)), np.zeros((2, 4)), np.zeros((2, 4)), f_ext=W),
-         r"f_ext: expected shape \(2, 5, 6\)"),
-        (lambda r, z, W: num.rnea(r, z, z, z, f_ext=np.where(np.arange(30).reshape(5, 6) == 14, np.nan, W)),
-         r"f_ext contains NaN or inf \(at f_ext\[2, 2\], link 'link2'\)"),
+        (
+            lambda r, z, W: num.aba_derivatives(r, np.zeros((2, 4)), np.zeros((2, 4)), np.zeros((2, 4)), f_ext=W),
+            r"f_ext: expected shape \(2, 5, 6\)",
+        ),
+        (
+            lambda r, z, W: num.rnea(r, z, z, z, f_ext=np.where(np.arange(30).reshape(5, 6) == 14, np.nan, W)),
+            r"f_ext contains NaN or inf \(at f_ext\[2, 2\], link 'link2'\)",
+        ),
         (lambda r, z, W: num.rnea(r, z, z, z, f_ext=W, frame="body"), "frame: expected 'local' or 'world'"),
         (lambda r, z, W: num.rnea_derivatives(r, z, z, z, threads=0), "threads must be"),
     ],

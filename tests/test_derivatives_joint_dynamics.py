@@ -1,5 +1,5 @@
 """Derivatives of the dynamics and M^-1 with joint friction, rotor inertia and offset
-(DESIGN.md: ``tau = M qdd + C qd + g + Ia qdd + Fv qd + Fc sign(qd) + offset``).
+(docs/architecture.md: ``tau = M qdd + C qd + g + Ia qdd + Fv qd + Fc sign(qd) + offset``).
 
 The derivative functions must agree with rnea/aba, which include those terms:
 ``M`` and ``Minv`` get ``diag(Ia)``, ``dtau/dqd`` gets ``diag(Fv)``; the Coulomb term is
@@ -21,9 +21,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_joint_dynamics import numeric_arm, with_terms
 
 from armdyn import numeric as num
-from test_joint_dynamics import numeric_arm, with_terms
 
 ARMS = ["puma560", "ur5", "panda", "iiwa14", "stanford"]
 H = 1e-6
@@ -75,9 +75,11 @@ def test_rnea_derivatives_against_central_differences(arm):
     name, robot = arm
     q, qd, qdd = _state(robot, 11)
     mine = num.rnea_derivatives(robot, q, qd, qdd)
-    fd = (_central(lambda y: num.rnea(robot, y, qd, qdd), q),
-          _central(lambda y: num.rnea(robot, q, y, qdd), qd),
-          _central(lambda y: num.rnea(robot, q, qd, y), qdd))
+    fd = (
+        _central(lambda y: num.rnea(robot, y, qd, qdd), q),
+        _central(lambda y: num.rnea(robot, q, y, qdd), qd),
+        _central(lambda y: num.rnea(robot, q, qd, y), qdd),
+    )
     for a, b, what in zip(mine, fd, ("dtau_dq", "dtau_dqd", "M")):
         assert_close(a, b, 1e-6, f"{name} {what}")
     # the terms are really in there: without diag(Ia), diag(Fv) the check above would fail
@@ -92,9 +94,11 @@ def test_aba_derivatives_and_minverse_against_central_differences(arm):
     q, qd, qdd = _state(robot, 12)
     tau = num.rnea(robot, q, qd, qdd)
     dq, dqd, Minv = num.aba_derivatives(robot, q, qd, tau)
-    fd = (_central(lambda y: num.aba(robot, y, qd, tau), q),
-          _central(lambda y: num.aba(robot, q, y, tau), qd),
-          _central(lambda y: num.aba(robot, q, qd, y), tau))
+    fd = (
+        _central(lambda y: num.aba(robot, y, qd, tau), q),
+        _central(lambda y: num.aba(robot, q, y, tau), qd),
+        _central(lambda y: num.aba(robot, q, qd, y), tau),
+    )
     for a, b, what in zip((dq, dqd, Minv), fd, ("dqdd_dq", "dqdd_dqd", "Minv")):
         assert_close(a, b, 1e-6, f"{name} {what}")
     M = num.crba(robot, q)  # M + diag(Ia)
@@ -111,8 +115,7 @@ def test_gravity_derivatives_unchanged_by_the_terms(arm):
     """g = rnea(q, 0, 0) has the offset (a constant) and Fc sign(0) = 0: dg/dq has no term."""
     name, robot = arm
     q, _, _ = _state(robot, 13)
-    assert_close(num.gravity_derivatives(robot, q), _central(lambda y: num.gravity(robot, y), q), 1e-6,
-                 f"{name} dg/dq")
+    assert_close(num.gravity_derivatives(robot, q), _central(lambda y: num.gravity(robot, y), q), 1e-6, f"{name} dg/dq")
 
 
 def test_coulomb_at_rest_is_the_derivative_of_both_branches(arm):
@@ -136,10 +139,18 @@ def test_coulomb_at_rest_is_the_derivative_of_both_branches(arm):
         return (-2.5 * f1 + 4 * f2 - 1.5 * f3) / (side * h)
 
     for side in (1.0, -1.0):
-        assert_close(dtau_dqd, branch_slope(lambda v: num.rnea(robot, q, v, qdd), side), 1e-6,
-                     f"{name} dtau/dqd_{k} side {side:+}")
-        assert_close(dqdd_dqd, branch_slope(lambda v: num.aba(robot, q, v, tau), side), 1e-6,
-                     f"{name} dqdd/dqd_{k} side {side:+}")
+        assert_close(
+            dtau_dqd,
+            branch_slope(lambda v: num.rnea(robot, q, v, qdd), side),
+            1e-6,
+            f"{name} dtau/dqd_{k} side {side:+}",
+        )
+        assert_close(
+            dqdd_dqd,
+            branch_slope(lambda v: num.aba(robot, q, v, tau), side),
+            1e-6,
+            f"{name} dqdd/dqd_{k} side {side:+}",
+        )
     # and the jump is really there (so the sides above were needed)
     jump = num.rnea(robot, q, qd + 1e-9 * e, qdd) - tau
     assert abs(jump[k] - _terms(robot)[2][k]) < 1e-6
@@ -207,5 +218,9 @@ def test_against_the_reference(arm):
         for a, b, k in zip(mine, theirs, range(3), strict=True):
             assert_close(a, b, 1e-10, f"{name} {what} output {k}")
     assert_close(num.minverse(robot, q), ref.minverse(robot, q), 1e-10, f"{name} minverse")
-    np.testing.assert_allclose(ref.rnea_ext(robot, q, qd, qdd, np.zeros((len(robot.links), 6))),
-                               num.rnea(robot, q, qd, qdd), rtol=0, atol=1e-10 * max(1, np.abs(qdd).max()))
+    np.testing.assert_allclose(
+        ref.rnea_ext(robot, q, qd, qdd, np.zeros((len(robot.links), 6))),
+        num.rnea(robot, q, qd, qdd),
+        rtol=0,
+        atol=1e-10 * max(1, np.abs(qdd).max()),
+    )

@@ -20,11 +20,11 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from test_mimic import ARM
 
 from armdyn import numeric as num
 from armdyn.io.urdf import load_urdf
 from armdyn.model import Robot
-from test_mimic import ARM
 
 H = 1e-6
 
@@ -45,11 +45,29 @@ def assert_close(actual, expected, rtol, what):
 def _with_terms(robot: Robot) -> Robot:
     """Friction, rotor inertia and offset on the independent joints."""
     rng = np.random.default_rng(3)
-    joints = [replace(j, armature=rng.uniform(0.01, 0.1), damping=rng.uniform(0.1, 0.5),
-                      friction=rng.uniform(0.1, 0.3), torque_offset=rng.uniform(-0.2, 0.2))
-              if j.movable and j.mimic is None else j for j in robot.joints]
-    return Robot(robot.name, robot.links.values(), joints, robot.gravity, robot.parameters, robot.meta,
-                 robot.base, robot.defaults, strict=False)
+    joints = [
+        replace(
+            j,
+            armature=rng.uniform(0.01, 0.1),
+            damping=rng.uniform(0.1, 0.5),
+            friction=rng.uniform(0.1, 0.3),
+            torque_offset=rng.uniform(-0.2, 0.2),
+        )
+        if j.movable and j.mimic is None
+        else j
+        for j in robot.joints
+    ]
+    return Robot(
+        robot.name,
+        robot.links.values(),
+        joints,
+        robot.gravity,
+        robot.parameters,
+        robot.meta,
+        robot.base,
+        robot.defaults,
+        strict=False,
+    )
 
 
 ROBOTS = {"plain": lambda: load_urdf(ARM), "terms": lambda: _with_terms(load_urdf(ARM))}
@@ -74,20 +92,25 @@ def test_against_central_differences(arm):
     for seed in (1, 2):
         q, qd, x = _state(robot, seed)
         mine = num.rnea_derivatives(robot, q, qd, x)
-        fd = (_central(lambda y: num.rnea(robot, y, qd, x), q),
-              _central(lambda y: num.rnea(robot, q, y, x), qd),
-              _central(lambda y: num.rnea(robot, q, qd, y), x))
+        fd = (
+            _central(lambda y: num.rnea(robot, y, qd, x), q),
+            _central(lambda y: num.rnea(robot, q, y, x), qd),
+            _central(lambda y: num.rnea(robot, q, qd, y), x),
+        )
         for a, b, what in zip(mine, fd, ("dtau_dq", "dtau_dqd", "M")):
             assert_close(a, b, 1e-7, f"{name} {what}")
         mine = num.aba_derivatives(robot, q, qd, x)
-        fd = (_central(lambda y: num.aba(robot, y, qd, x), q),
-              _central(lambda y: num.aba(robot, q, y, x), qd),
-              _central(lambda y: num.aba(robot, q, qd, y), x))
+        fd = (
+            _central(lambda y: num.aba(robot, y, qd, x), q),
+            _central(lambda y: num.aba(robot, q, y, x), qd),
+            _central(lambda y: num.aba(robot, q, qd, y), x),
+        )
         for a, b, what in zip(mine, fd, ("dqdd_dq", "dqdd_dqd", "Minv"), strict=True):
             assert_close(a, b, 1e-7, f"{name} {what}")
         assert_close(num.minverse(robot, q), fd[2], 1e-7, f"{name} minverse")
-        assert_close(num.gravity_derivatives(robot, q), _central(lambda y: num.gravity(robot, y), q), 1e-7,
-                     f"{name} dg/dq")
+        assert_close(
+            num.gravity_derivatives(robot, q), _central(lambda y: num.gravity(robot, y), q), 1e-7, f"{name} dg/dq"
+        )
         for link in robot.links:
             fdj = _central(lambda t: num.jacobian(robot, q + t[0] * qd, link), np.zeros(1))[..., 0]
             assert_close(num.jacobian_dot(robot, q, qd, link), fdj, 1e-7, f"{name} jacobian_dot {link}")
@@ -158,8 +181,11 @@ def test_batches_equal_single_calls(arm):
             for i in range(len(Q)):
                 for b, s in zip(batch, fn(robot, Q[i], QD[i], X[i]), strict=True):
                     np.testing.assert_allclose(b[i], s, rtol=1e-14, atol=1e-14 * max(1.0, np.abs(s).max()))
-        for fn, args in ((num.minverse, (Q,)), (num.gravity_derivatives, (Q,)),
-                         (lambda r, q, qd, **k: num.jacobian_dot(r, q, qd, "hand", **k), (Q, QD))):
+        for fn, args in (
+            (num.minverse, (Q,)),
+            (num.gravity_derivatives, (Q,)),
+            (lambda r, q, qd, **k: num.jacobian_dot(r, q, qd, "hand", **k), (Q, QD)),
+        ):
             batch = fn(robot, *args, threads=threads)
             for i in range(len(Q)):
                 s = fn(robot, *(a[i] for a in args))

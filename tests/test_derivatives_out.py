@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_mimic import ARM
 
 import armdyn
 from armdyn import numeric as num
 from armdyn.io.urdf import load_urdf
-from test_mimic import ARM
 
 N = 37  # not a multiple of the SIMD width: lanes and the one-by-one tail both write
 
@@ -100,7 +100,7 @@ def test_bad_out_is_refused_before_anything_is_written(ur5):
         ((good[0], good[0], good[2]), r"out\[1\]: shares memory with out\[0\]"),
         (good[:2], "out: expected 3 arrays, got 2"),
         (good[0], "out: expected a tuple of numpy arrays"),
-        ((buffer[N * 6 - 6:N * 6 - 6 + N * 36].reshape(N, 6, 6),) + good[1:], r"out\[0\]: shares memory with q"),
+        ((buffer[N * 6 - 6 : N * 6 - 6 + N * 36].reshape(N, 6, 6),) + good[1:], r"out\[0\]: shares memory with q"),
     ]
     q_in = buffer[: N * 6].reshape(N, 6)
     q_in[...] = q

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import sympy as sp
+from random_models import random_robot
 
 import armdyn
 from armdyn import inertia
 from armdyn.model import Joint, Link, Robot
 from armdyn.symbolic import dag, derive
-from random_models import random_robot
 
 
 def merge_fixed_joints(robot: Robot) -> Robot:
@@ -55,12 +55,17 @@ def test_merged_fixed_joints_same_numeric_dynamics(seed):
 def test_merged_fixed_joint_same_symbolic_tau():
     """A symbolic two-link arm with a symbolic tool welded on by a fixed joint."""
     m1, m2, mt, l1, l2, d, g = sp.symbols("m1 m2 mt l1 l2 d g")
-    links = [Link("base"), Link("l1", m1, [l1 / 2, 0, 0], sp.diag(0, m1 * l1**2 / 12, m1 * l1**2 / 12)),
-             Link("l2", m2, [l2 / 2, 0, 0], sp.diag(0, m2 * l2**2 / 12, m2 * l2**2 / 12)),
-             Link("tool", mt, [0, 0, d], sp.diag(mt * d**2, mt * d**2, 0))]
-    joints = [Joint("q1", "revolute", "base", "l1", axis=[0, 1, 0]),
-              Joint("q2", "revolute", "l1", "l2", xyz=[l1, 0, 0], axis=[0, 1, 0]),
-              Joint("weld", "fixed", "l2", "tool", xyz=[l2, 0, 0], rotation=armdyn.model.rot_y(sp.pi / 2))]
+    links = [
+        Link("base"),
+        Link("l1", m1, [l1 / 2, 0, 0], sp.diag(0, m1 * l1**2 / 12, m1 * l1**2 / 12)),
+        Link("l2", m2, [l2 / 2, 0, 0], sp.diag(0, m2 * l2**2 / 12, m2 * l2**2 / 12)),
+        Link("tool", mt, [0, 0, d], sp.diag(mt * d**2, mt * d**2, 0)),
+    ]
+    joints = [
+        Joint("q1", "revolute", "base", "l1", axis=[0, 1, 0]),
+        Joint("q2", "revolute", "l1", "l2", xyz=[l1, 0, 0], axis=[0, 1, 0]),
+        Joint("weld", "fixed", "l2", "tool", xyz=[l2, 0, 0], rotation=armdyn.model.rot_y(sp.pi / 2)),
+    ]
     robot = Robot("welded", links, joints, [0, 0, -g], [m1, m2, mt, l1, l2, d, g])
     merged = merge_fixed_joints(robot)
     kept, lumped = derive(robot).tau, derive(merged, "lagrange").tau

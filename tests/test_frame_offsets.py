@@ -12,10 +12,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import sympy as sp
+from random_models import random_robot, random_state
 
 import armdyn
 from armdyn import reference
-from random_models import random_robot, random_state
 
 SEEDS = [11, 12, 13, 14, 15, 16]
 
@@ -60,7 +60,9 @@ def test_jacobian_of_an_offset_frame_is_the_derivative_of_its_position(seed):
     for j in range(robot.dof):
         dq = np.zeros(robot.dof)
         dq[j] = h
-        dp = (armdyn.forward_kinematics(robot, q + dq)[k, :3, 3] - armdyn.forward_kinematics(robot, q - dq)[k, :3, 3]) / (2 * h)
+        dp = (
+            armdyn.forward_kinematics(robot, q + dq)[k, :3, 3] - armdyn.forward_kinematics(robot, q - dq)[k, :3, 3]
+        ) / (2 * h)
         np.testing.assert_allclose(J[:3, j], dp, atol=1e-7)
 
 
@@ -110,6 +112,7 @@ def test_yaml_reads_frame_offsets_and_rejects_bad_ones(tmp_path):
     bad.write_text(
         "name: x\nparameters: [l1]\njoints:\n  - {name: j1, type: revolute, parent: base, child: a,"
         " frame_xyz: [l1, 0, 0], frame_rotation: [[1, 0, 0], [0, 1, 0], [0, 0, 2]]}\nlinks:\n"
-        "  - {name: a, mass: 1, inertia: 0}\n")
+        "  - {name: a, mass: 1, inertia: 0}\n"
+    )
     with pytest.raises(armdyn.ModelError, match="frame_rotation"):
         armdyn.load(str(bad))

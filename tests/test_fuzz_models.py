@@ -246,7 +246,7 @@ def test_mutated_urdf_gives_robot_or_model_error(data, rounds):
 @settings(max_examples=100, deadline=None)
 @given(cut=st.integers(0, len(VALID_URDF)), insert=st.text(max_size=8))
 def test_cut_or_spliced_urdf_text(cut, insert):
-    _loads_or_model_error(load_urdf, VALID_URDF[:cut] + insert + VALID_URDF[cut:][len(insert):])
+    _loads_or_model_error(load_urdf, VALID_URDF[:cut] + insert + VALID_URDF[cut:][len(insert) :])
 
 
 # ------------------------------------------------------------ Hypothesis: YAML
@@ -257,6 +257,8 @@ YAML_MODELS = [ROBOTS / "rp-arm.yaml", ROBOTS / "panda.yaml", ROBOTS / "puma560.
 def test_seed_models_exist():
     # the mutation tests below draw from these: a missing one is a failure, not a skip
     assert all(p.is_file() for p in YAML_MODELS), [str(p) for p in YAML_MODELS if not p.is_file()]
+
+
 YAML_GARBAGE = st.one_of(
     GARBAGE,
     st.none(),
@@ -317,4 +319,4 @@ def test_mutated_yaml_gives_robot_or_model_error(data, rounds):
 def test_cut_or_spliced_yaml_text(data, insert):
     text = data.draw(st.sampled_from(YAML_MODELS)).read_text()
     cut = data.draw(st.integers(0, len(text)))
-    _loads_or_model_error(load_yaml_string, text[:cut] + insert + text[cut:][len(insert):])
+    _loads_or_model_error(load_yaml_string, text[:cut] + insert + text[cut:][len(insert) :])

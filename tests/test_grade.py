@@ -58,8 +58,22 @@ def test_exercise_verdict_is_the_one_worked_out_by_hand(exercise):
     tau = [v for v in r.steps if v.key == "tau"]
     assert [(v.name, v.status) for v in tau[:2]] == [("tau_1", "correct-but-unsupported"), ("tau_2", "correct")]
     assert "−d₂·l₁·m₂·θ̇₁²" in tau[0].message  # what the first slip would leave, carried through
-    for name in ("omega_0", "omega_dot_0", "v_dot_0", "omega_1", "omega_dot_1", "omega_2", "omega_dot_2",
-                 "N_1", "N_2", "R_0^1", "R_1^2", "T", "V", "L"):
+    for name in (
+        "omega_0",
+        "omega_dot_0",
+        "v_dot_0",
+        "omega_1",
+        "omega_dot_1",
+        "omega_2",
+        "omega_dot_2",
+        "N_1",
+        "N_2",
+        "R_0^1",
+        "R_1^2",
+        "T",
+        "V",
+        "L",
+    ):
         assert first_status(r, name).status == "correct", name
     assert [v.status for v in tau[2:]] == ["correct", "correct"]  # the Lagrange check
     assert r.tau_correct == [True, True]
@@ -130,8 +144,9 @@ def test_markdown_read_back_as_yaml_grades_the_same(tmp_path, capsys):
     a, b = grade(EXERCISE), grade(path)
     proof_lines = {v.line for v in a.steps if v.key == "proof"}  # proofs need the prose: Markdown only
     assert proof_lines
-    assert [(v.name, v.status) for v in a.steps if v.key != "proof"] == \
-        [(v.name, v.status) for v in b.steps if v.line not in proof_lines]
+    assert [(v.name, v.status) for v in a.steps if v.key != "proof"] == [
+        (v.name, v.status) for v in b.steps if v.line not in proof_lines
+    ]
 
 
 def test_yaml_in_sympy_syntax(tmp_path):
@@ -139,7 +154,8 @@ def test_yaml_in_sympy_syntax(tmp_path):
     path.write_text(
         "robot: planar-2r\nmethod: lagrange\nsteps:\n"
         "  T: 'm1*lc1**2*q1_dot**2/2 + I1*q1_dot**2/2'\n"  # link 2's kinetic energy forgotten
-        "  V: 'm1*g*lc1*sin(q1) + m2*g*(l1*sin(q1) + lc2*sin(q1 + q2))'\n")
+        "  V: 'm1*g*lc1*sin(q1) + m2*g*(l1*sin(q1) + lc2*sin(q1 + q2))'\n"
+    )
     r = grade(path)
     assert r.first_wrong == "T"
     assert first_status(r, "V").status == "correct"
@@ -157,7 +173,9 @@ def test_generated_derivation_with_one_term_altered(tmp_path):
         value = s.value
         if key == "f_3":
             value = value + sp.Matrix([0, robot.qd[0] * robot.qd[1], 0])
-        steps.append({"step": key, "value": [str(x) for x in value] if isinstance(value, sp.MatrixBase) else str(value)})
+        steps.append(
+            {"step": key, "value": [str(x) for x in value] if isinstance(value, sp.MatrixBase) else str(value)}
+        )
     path = tmp_path / "scara.yaml"
     path.write_text(yaml.safe_dump({"robot": "scara", "values": "published", "steps": steps}, width=10**6))
     r = grade(path)
@@ -169,9 +187,14 @@ def test_generated_derivation_with_one_term_altered(tmp_path):
 
 BAD = {
     "no-equation.md": ("---\nrobot: rp-arm\n---\nJust prose, $x$ inline.\n", "no step"),
-    "unknown-symbol.md": ("---\nrobot: rp-arm\n---\n\n$$\\tau_2 = k_7 \\ddot{d}_2$$\n", ":5: tau_2: unknown symbol k_{7}"),
-    "short-vector.md": ("---\nrobot: rp-arm\n---\n$$\\omega_1^1 = \\begin{pmatrix} 0 \\\\ 0 \\end{pmatrix}$$\n",
-                        ":4: omega_1 must be a vector of 3 components"),
+    "unknown-symbol.md": (
+        "---\nrobot: rp-arm\n---\n\n$$\\tau_2 = k_7 \\ddot{d}_2$$\n",
+        ":5: tau_2: unknown symbol k_{7}",
+    ),
+    "short-vector.md": (
+        "---\nrobot: rp-arm\n---\n$$\\omega_1^1 = \\begin{pmatrix} 0 \\\\ 0 \\end{pmatrix}$$\n",
+        ":4: omega_1 must be a vector of 3 components",
+    ),
     "no-link.md": ("---\nrobot: rp-arm\n---\n$$F_5^5 = \\mathbf{0}$$\n", ":4: F_5 names link 5"),
     "front.md": ("---\nrobot: [rp-arm\n---\n$$\\tau_1 = 0$$\n", "malformed YAML"),
     "robot.md": ("---\nrobot: no-such-arm\n---\n$$\\tau_1 = 0$$\n", "no-such-arm"),
@@ -202,15 +225,20 @@ def test_a_huge_file_and_a_missing_file_are_refused(tmp_path, capsys):
 def test_unreadable_single_equations_are_skipped_not_fatal(tmp_path):
     nested = "(" * 500 + "x" + ")" * 500
     path = tmp_path / "mixed.md"
-    path.write_text("---\nrobot: rp-arm\n---\n$$\\omega_1^1 = \\begin{pmatrix} 0 \\\\ 0 \\\\ \\dot\\theta_1 \\end{pmatrix}$$\n"
-                    "$$\\omega_2^2 = \\frac{1}{$$\n"
-                    f"$$\\tau_2 = {nested}$$\n"
-                    "$$\\tau_1 = \\frac{0}{0}$$\n")
+    path.write_text(
+        "---\nrobot: rp-arm\n---\n$$\\omega_1^1 = \\begin{pmatrix} 0 \\\\ 0 \\\\ \\dot\\theta_1 \\end{pmatrix}$$\n"
+        "$$\\omega_2^2 = \\frac{1}{$$\n"
+        f"$$\\tau_2 = {nested}$$\n"
+        "$$\\tau_1 = \\frac{0}{0}$$\n"
+    )
     r = grade(path)
     status = {v.line: v.status for v in r.steps}
     assert status == {4: "correct", 5: "unrecognised", 6: "unrecognised", 7: "unrecognised"} or (
-        status[4] == "correct" and status[5] == "unrecognised" and status[6] == "unrecognised"
-        and status[7] != "correct")  # 0/0 is never equal to anything
+        status[4] == "correct"
+        and status[5] == "unrecognised"
+        and status[6] == "unrecognised"
+        and status[7] != "correct"
+    )  # 0/0 is never equal to anything
 
 
 def test_nan_never_passes(tmp_path):
@@ -224,9 +252,13 @@ def test_latex_reader_pieces():
     def resolve(n):
         return sp.Symbol(n.base + n.sub + "_dot" * n.dots)
 
-    assert parse(r"\frac{1}{2} m_1 (l_1 \dot{\theta}_1)^2", resolve) == sp.Rational(1, 2) * sp.Symbol("m1") * (
-        sp.Symbol("l1") * sp.Symbol("theta1_dot")) ** 2
-    assert parse(r"\sin^2\theta_1 + \cos(\theta_1)", resolve) == sp.sin(sp.Symbol("theta1")) ** 2 + sp.cos(sp.Symbol("theta1"))
+    assert (
+        parse(r"\frac{1}{2} m_1 (l_1 \dot{\theta}_1)^2", resolve)
+        == sp.Rational(1, 2) * sp.Symbol("m1") * (sp.Symbol("l1") * sp.Symbol("theta1_dot")) ** 2
+    )
+    assert parse(r"\sin^2\theta_1 + \cos(\theta_1)", resolve) == sp.sin(sp.Symbol("theta1")) ** 2 + sp.cos(
+        sp.Symbol("theta1")
+    )
     with pytest.raises(LatexError):
         parse("(" * 100 + "x" + ")" * 100, resolve)
     eqs = split_equations(r"a &= 0, b = \begin{pmatrix} 1, 2 \\ 3 \end{pmatrix} \\ c = 1")
@@ -245,10 +277,12 @@ def test_hostile_values_are_refused_in_bounded_time(tmp_path):
     import time
 
     path = tmp_path / "hostile.md"
-    path.write_text("---\nrobot: rp-arm\n---\n"
-                    "$$\\tau_1 = 10^{10^{10}}$$\n"
-                    "$$\\tau_2 = " + "\\dot{" * 3000 + "x" + "}" * 3000 + "$$\n"
-                    "$$T = " + "{" * 5000 + "m_1" + "}" * 5000 + "$$\n")
+    path.write_text(
+        "---\nrobot: rp-arm\n---\n"
+        "$$\\tau_1 = 10^{10^{10}}$$\n"
+        "$$\\tau_2 = " + "\\dot{" * 3000 + "x" + "}" * 3000 + "$$\n"
+        "$$T = " + "{" * 5000 + "m_1" + "}" * 5000 + "$$\n"
+    )
     t0 = time.perf_counter()
     r = grade(path)
     assert time.perf_counter() - t0 < 20

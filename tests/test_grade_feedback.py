@@ -52,10 +52,14 @@ def by_line(report, line):
 
 # ---------------------------------------------------------------- 1. every non-proof equation read
 
+
 def test_position_vectors_and_rotations_are_kinematics_steps(tmp_path):
     # by hand: P_1^0 = l1 (cos θ1, sin θ1, 0); in frame 1 that is (l1, 0, 0); P_2^1 = (0, d2, 0);
     # point masses at the frame origins: P_{C_i}^i = 0; R_1^0 = Rz(θ1), R_0^1 its transpose
-    path = write(tmp_path, "kin.md", r"""
+    path = write(
+        tmp_path,
+        "kin.md",
+        r"""
 $$\mathbf{P}_1^0 = \begin{pmatrix} l_1 \cos\theta_1 \\ l_1 \sin\theta_1 \\ 0 \end{pmatrix}$$
 $$\mathbf{P}_1^1 = (l_1,\ 0,\ 0)^T, \mathbf{P}_{C_1}^1 = \mathbf{0},
 \mathbf{P}_2^1 = \begin{pmatrix} 0 \\ d_2 \\ 0 \end{pmatrix}$$
@@ -65,11 +69,17 @@ $$R_1^0 = \begin{pmatrix} \cos\theta_1 & -\sin\theta_1 & 0 \\ \sin\theta_1 & \co
 0 & 0 & 1 \end{pmatrix}$$
 $$R_0^1 = \begin{pmatrix} \cos\theta_1 & -\sin\theta_1 & 0 \\ \sin\theta_1 & \cos\theta_1 & 0 \\
 0 & 0 & 1 \end{pmatrix}$$
-""")
+""",
+    )
     r = grade(path)
     status = [(v.name, v.status) for v in r.steps]
-    assert status[:5] == [("P_1^0", "correct"), ("P_1^1", "correct"), ("P_C1^1", "correct"),
-                          ("P_2^1", "correct"), ("P_C2^2", "correct")]
+    assert status[:5] == [
+        ("P_1^0", "correct"),
+        ("P_1^1", "correct"),
+        ("P_C1^1", "correct"),
+        ("P_2^1", "correct"),
+        ("P_C2^2", "correct"),
+    ]
     wrong = r.steps[5]
     assert (wrong.name, wrong.status, wrong.components) == ("P_2^1", "wrong", [1, 2])
     assert r.steps[6].status == "correct"  # R_1^0 maps frame-1 coordinates into frame 0: Rz(θ1)
@@ -80,10 +90,8 @@ $$R_0^1 = \begin{pmatrix} \cos\theta_1 & -\sin\theta_1 & 0 \\ \sin\theta_1 & \co
 def test_lagrange_law_is_read_as_a_statement(tmp_path):
     laws = {
         r"\frac{d}{dt}\frac{\partial L}{\partial \dot{q}_i} - \frac{\partial L}{\partial q_i} = \tau_i": None,
-        r"\frac{\partial L}{\partial \theta} - \frac{d}{dt}\frac{\partial L}{\partial \dot{\theta}} = \tau":
-            "wrong order",
-        r"\frac{d}{dt}\frac{\partial L}{\partial \dot{\theta}} + \frac{\partial L}{\partial \theta} = \tau":
-            "wrong sign",
+        r"\frac{\partial L}{\partial \theta} - \frac{d}{dt}\frac{\partial L}{\partial \dot{\theta}} = \tau": "wrong order",
+        r"\frac{d}{dt}\frac{\partial L}{\partial \dot{\theta}} + \frac{\partial L}{\partial \theta} = \tau": "wrong sign",
         r"\frac{\partial L}{\partial \dot{\theta}} - \frac{\partial L}{\partial \theta} = \tau": "d/dt missing",
     }
     body = "".join(f"$${law}$$\n\n" for law in laws) + "$$\\tau_2 = 0$$\n"
@@ -134,14 +142,22 @@ def test_exercise_every_non_proof_equation_read_and_parts_labelled(capsys):
 
 
 def test_free_end_condition_is_a_step_not_an_abort(tmp_path):
-    path = write(tmp_path, "free.md", r"""
+    path = write(
+        tmp_path,
+        "free.md",
+        r"""
 $$f_3^3 = \mathbf{0}, n_3^3 = 0$$
 $$f_3^3 = \begin{pmatrix} m_2 g \\ 0 \\ 0 \end{pmatrix}$$
 $$\tau_2 = m_2 l_1 \ddot{\theta}_1 + m_2 \ddot{d}_2 - m_2 d_2 \dot{\theta}_1^2 + m_2 g \cos\theta_1$$
-""")
+""",
+    )
     r = grade(path)
-    assert [(v.name, v.status) for v in r.steps] == [("f_3", "correct"), ("n_3", "correct"), ("f_3", "wrong"),
-                                                       ("tau_2", "correct")]
+    assert [(v.name, v.status) for v in r.steps] == [
+        ("f_3", "correct"),
+        ("n_3", "correct"),
+        ("f_3", "wrong"),
+        ("tau_2", "correct"),
+    ]
     assert r.steps[2].components == [0] and "free end" in r.steps[2].message
 
 
@@ -160,6 +176,7 @@ def test_reaction_convention_recognised_for_n(tmp_path):
 
 
 # ---------------------------------------------------------------- 2. messages
+
 
 def test_exit_status_is_zero_only_when_every_equation_was_read(tmp_path, capsys):
     good = (EXAMPLES / "rp-arm-dalembert.md").read_text()
@@ -194,14 +211,21 @@ def test_unreadable_value_reports_its_exact_column_and_a_hint(tmp_path):
 
 
 def test_row_transposed_and_big_delimiters_are_read(tmp_path):
-    path = write(tmp_path, "forms.md", r"""
+    path = write(
+        tmp_path,
+        "forms.md",
+        r"""
 $$\omega_1^1 = (0,\ 0,\ \dot{\theta}_1)^T$$
 $$\dot{\omega}_1^1 = (0, 0, \ddot{\theta}_1)^{\mathrm{T}}$$
 $$\tau_2 = m_2 \big( l_1 \ddot{\theta}_1 + \ddot{d}_2 \bigr) - m_2 \Big[ d_2 \dot{\theta}_1^2 - g \cos\theta_1 \Big]$$
-""")
+""",
+    )
     r = grade(path)
-    assert [(v.name, v.status) for v in r.steps] == [("omega_1", "correct"), ("omega_dot_1", "correct"),
-                                                       ("tau_2", "correct")]
+    assert [(v.name, v.status) for v in r.steps] == [
+        ("omega_1", "correct"),
+        ("omega_dot_1", "correct"),
+        ("tau_2", "correct"),
+    ]
 
 
 @pytest.fixture(scope="module")
@@ -210,7 +234,7 @@ def craig_slip(tmp_path_factory):
     text = (EXAMPLES / "planar-2r-craig.md").read_text().split("\n")
     k = next(i for i, t in enumerate(text) if t.startswith(r"$${}^{2}\dot{v}_{2} ="))
     j = text[k].rindex(r"- l_1 c_2 \dot{\theta}_1^2")
-    text[k] = text[k][:j] + "+" + text[k][j + 1:]
+    text[k] = text[k][:j] + "+" + text[k][j + 1 :]
     path = tmp_path_factory.mktemp("slip") / "craig-slip.md"
     path.write_text("\n".join(text))
     return path
@@ -228,7 +252,7 @@ def test_difference_is_simplified_and_expected_in_the_students_shorthand(craig_s
     code, out, _ = run(capsys, "grade", craig_slip)
     line = next(t for t in out.split("\n") if "v̇_2" in t and "WRONG" in t)
     assert "wrong sign on the term −c₂·l₁·q̇₁²" in line
-    expected = next(t for t in out.split("\n")[out.split("\n").index(line):] if "expected:" in t)
+    expected = next(t for t in out.split("\n")[out.split("\n").index(line) :] if "expected:" in t)
     assert "g·s₁₂" in expected and "c₁₂·g" in expected  # the student's s_{12}, c_{12}
 
 
@@ -258,10 +282,16 @@ def test_text_uses_derives_symbol_names(capsys):
 
 # ---------------------------------------------------------------- 3. hostile input, bounded time
 
+
 def _grade_subprocess(path, *extra):
     env = dict(os.environ, PYTHONPATH=str(ROOT / "python") + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    return subprocess.run([sys.executable, "-m", "armdyn", "grade", str(path), *extra], capture_output=True,
-                          text=True, timeout=GUARD, env=env)
+    return subprocess.run(
+        [sys.executable, "-m", "armdyn", "grade", str(path), *extra],
+        capture_output=True,
+        text=True,
+        timeout=GUARD,
+        env=env,
+    )
 
 
 HOSTILE_VALUES = {
@@ -316,9 +346,11 @@ def test_a_file_just_under_the_size_limit_ends_in_bounded_time(tmp_path, shape):
 def test_hostile_yaml_values_in_sympy_syntax_are_refused_naming_the_line(tmp_path):
     digits = "1" + "0" * 5000
     path = tmp_path / "tower.yaml"
-    path.write_text(f'robot: rp-arm\nsteps:\n  tau_2: "(((9**99)**99)**99)**99"\n  tau_1: "{digits}"\n'
-                    f'  T: "{"+".join(["m1"] * 3000)}+((9**99)**99)**99"\n'
-                    '  V: "((m1*9**99)**99)**99"\n')  # a symbol's numeric coefficient grows too
+    path.write_text(
+        f'robot: rp-arm\nsteps:\n  tau_2: "(((9**99)**99)**99)**99"\n  tau_1: "{digits}"\n'
+        f'  T: "{"+".join(["m1"] * 3000)}+((9**99)**99)**99"\n'
+        '  V: "((m1*9**99)**99)**99"\n'
+    )  # a symbol's numeric coefficient grows too
     done = _grade_subprocess(path)
     assert done.returncode == 1, done.stderr
     for line, words in ((3, "digits"), (4, "5001 digits"), (5, "digits"), (6, "digits")):

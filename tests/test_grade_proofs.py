@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from armdyn.errors import ModelError
 from armdyn.grade import grade
 from armdyn.grade.proofs import check_text
@@ -60,6 +61,7 @@ def inertia_about(masses, points, point) -> np.ndarray:
 
 
 # ---------------------------------------------------------------- the exercise
+
 
 @pytest.fixture(scope="module")
 def exercise():
@@ -123,10 +125,17 @@ def test_json_has_one_entry_per_link_and_the_counterexample():
 
 # ---------------------------------------------------------------- the examples
 
+
 def test_parallel_axis_example_verdict():
     r = grade(PARALLEL)
-    assert proof_status(r) == {16: ["correct"], 20: ["correct"], 24: ["correct"], 28: ["wrong"],
-                               32: ["correct", "correct"], 36: ["correct"]}
+    assert proof_status(r) == {
+        16: ["correct"],
+        20: ["correct"],
+        24: ["correct"],
+        28: ["wrong"],
+        32: ["correct", "correct"],
+        36: ["correct"],
+    }
     assert r.first_wrong == "proof_28" and not r.passed
     wrong = next(v for v in r.steps if v.status == "wrong")
     ce = wrong.counterexample
@@ -144,8 +153,14 @@ def test_parallel_axis_example_verdict():
 
 def test_rotational_energy_example_verdict():
     r = grade(ENERGY)
-    assert proof_status(r) == {16: ["correct", "correct"], 20: ["wrong"], 24: ["correct", "correct"],
-                               28: ["correct"], 30: ["correct"], 34: ["correct"] * 3}
+    assert proof_status(r) == {
+        16: ["correct", "correct"],
+        20: ["wrong"],
+        24: ["correct", "correct"],
+        28: ["correct"],
+        30: ["correct"],
+        34: ["correct"] * 3,
+    }
     wrong = next(v for v in r.steps if v.status == "wrong")
     ce = wrong.counterexample
     masses, points = body(ce)
@@ -172,9 +187,12 @@ def test_cli_json_and_exit_status(capsys, tmp_path):
 
 # ---------------------------------------------------------------- mutations
 
+
 def fixed_parallel() -> str:
-    return PARALLEL.read_text().replace(r"+ \mathbf{p}^T \mathbf{r}_C + \mathbf{p}^T \mathbf{p}$$",
-                                        r"+ 2 \mathbf{p}^T \mathbf{r}_C + \mathbf{p}^T \mathbf{p}$$")
+    return PARALLEL.read_text().replace(
+        r"+ \mathbf{p}^T \mathbf{r}_C + \mathbf{p}^T \mathbf{p}$$",
+        r"+ 2 \mathbf{p}^T \mathbf{r}_C + \mathbf{p}^T \mathbf{p}$$",
+    )
 
 
 def fixed_energy() -> str:
@@ -185,30 +203,65 @@ LAST = r"M \left( \mathbf{p}^T \mathbf{p} \mathbf{1} - \mathbf{p} \mathbf{p}^T \
 MUTATIONS = [
     # (text, old, new, what students do)
     (fixed_parallel, r"\mathbf{1} - \mathbf{r}_A \mathbf{r}_A^T", r"\mathbf{1} + \mathbf{r}_A \mathbf{r}_A^T", "sign"),
-    (fixed_parallel, r"+ 2 \mathbf{p}^T \mathbf{r}_C + \mathbf{p}^T \mathbf{p}$$",
-     r"- 2 \mathbf{p}^T \mathbf{r}_C + \mathbf{p}^T \mathbf{p}$$", "sign"),
+    (
+        fixed_parallel,
+        r"+ 2 \mathbf{p}^T \mathbf{r}_C + \mathbf{p}^T \mathbf{p}$$",
+        r"- 2 \mathbf{p}^T \mathbf{r}_C + \mathbf{p}^T \mathbf{p}$$",
+        "sign",
+    ),
     (fixed_parallel, "= \\mathbf{I}_C + " + LAST, "= \\mathbf{I}_C + 2 " + LAST, "factor 2"),
-    (fixed_parallel, "= \\mathbf{I}_C + " + LAST,
-     "= \\mathbf{I}_C + " + LAST.replace(r"\mathbf{p} \mathbf{p}^T", r"\mathbf{p} \mathbf{p}"), "transpose dropped"),
-    (fixed_parallel, r"\int_{\mathcal{B}} \mathbf{r}_C \, dm", r"\int_{\mathcal{B}} \mathbf{r}_A \, dm",
-     "mass-center fact about A"),
+    (
+        fixed_parallel,
+        "= \\mathbf{I}_C + " + LAST,
+        "= \\mathbf{I}_C + " + LAST.replace(r"\mathbf{p} \mathbf{p}^T", r"\mathbf{p} \mathbf{p}"),
+        "transpose dropped",
+    ),
+    (
+        fixed_parallel,
+        r"\int_{\mathcal{B}} \mathbf{r}_C \, dm",
+        r"\int_{\mathcal{B}} \mathbf{r}_A \, dm",
+        "mass-center fact about A",
+    ),
     (fixed_energy, r"= -S(r_i) \omega_i", r"= S(r_i) \omega_i", "sign"),
     (fixed_energy, r"S^T(r_i) S(r_i) \rho dV", r"S(r_i) S(r_i) \rho dV", "transpose dropped"),
     (fixed_energy, r"E_{rot} = \frac{1}{2} \int", r"E_{rot} = \int", "factor 2"),
-    (fixed_energy, r"$$\frac{1}{2}\omega^{c\mathrm{T}} I^c_{l_i} \omega^c",
-     r"$$\frac{1}{2}\omega_i^T I^c_{l_i} \omega^c",
-     "frame change applied to one factor only"),
-    (fixed_energy, r"I^c_{l_i} = \mathbf{R}^c I_{l_i} \mathbf{R}^{c\mathrm{T}}",
-     r"I^c_{l_i} = \mathbf{R}^c I_{l_i}", "frame change applied to one side only"),
-    (lambda: EXERCISE.read_text(), r"2\mathbf{d}^T\mathbf{r}_C + \|\mathbf{d}\|^2.$$",
-     r"\mathbf{d}^T\mathbf{r}_C + \|\mathbf{d}\|^2.$$", "factor 2"),
-    (lambda: EXERCISE.read_text(), r"\int_{\mathcal{B}} \mathbf{r}_C dm = \mathbf{0}",
-     r"\int_{\mathcal{B}} \mathbf{r}_P dm = \mathbf{0}", "mass-center fact about P"),
+    (
+        fixed_energy,
+        r"$$\frac{1}{2}\omega^{c\mathrm{T}} I^c_{l_i} \omega^c",
+        r"$$\frac{1}{2}\omega_i^T I^c_{l_i} \omega^c",
+        "frame change applied to one factor only",
+    ),
+    (
+        fixed_energy,
+        r"I^c_{l_i} = \mathbf{R}^c I_{l_i} \mathbf{R}^{c\mathrm{T}}",
+        r"I^c_{l_i} = \mathbf{R}^c I_{l_i}",
+        "frame change applied to one side only",
+    ),
+    (
+        lambda: EXERCISE.read_text(),
+        r"2\mathbf{d}^T\mathbf{r}_C + \|\mathbf{d}\|^2.$$",
+        r"\mathbf{d}^T\mathbf{r}_C + \|\mathbf{d}\|^2.$$",
+        "factor 2",
+    ),
+    (
+        lambda: EXERCISE.read_text(),
+        r"\int_{\mathcal{B}} \mathbf{r}_C dm = \mathbf{0}",
+        r"\int_{\mathcal{B}} \mathbf{r}_P dm = \mathbf{0}",
+        "mass-center fact about P",
+    ),
     (lambda: EXERCISE.read_text(), r"$$M\left(\|\mathbf{d}\|^2", r"$$2M\left(\|\mathbf{d}\|^2", "factor 2"),
-    (lambda: EXERCISE.read_text(), r"\mathbf{d} \mathbf{r}_C^T + \mathbf{d} \mathbf{d}^T.$$",
-     r"\mathbf{d} \mathbf{r}_C + \mathbf{d} \mathbf{d}^T.$$", "transpose dropped"),
-    (lambda: EXERCISE.read_text(), r"\mathbf{I}_P = \mathbf{I}_C + M \left(", r"\mathbf{I}_P = \mathbf{I}_C - M \left(",
-     "sign"),
+    (
+        lambda: EXERCISE.read_text(),
+        r"\mathbf{d} \mathbf{r}_C^T + \mathbf{d} \mathbf{d}^T.$$",
+        r"\mathbf{d} \mathbf{r}_C + \mathbf{d} \mathbf{d}^T.$$",
+        "transpose dropped",
+    ),
+    (
+        lambda: EXERCISE.read_text(),
+        r"\mathbf{I}_P = \mathbf{I}_C + M \left(",
+        r"\mathbf{I}_P = \mathbf{I}_C - M \left(",
+        "sign",
+    ),
 ]
 
 
@@ -229,30 +282,42 @@ def test_one_line_mutations_are_caught(make, old, new, kind):
     verdicts = check_text(mutated)
     bad = [v for v in verdicts if v.status in ("wrong", "follows-from-earlier-error")]
     assert bad, f"{kind}: not caught"
-    assert any(v.line in (line, block_line) and v.status == "wrong" for v in bad), \
-        [(v.line, v.status, v.message) for v in bad]
+    assert any(v.line in (line, block_line) and v.status == "wrong" for v in bad), [
+        (v.line, v.status, v.message) for v in bad
+    ]
     before = {v.line: v.status for v in check_text(text) if v.status == "wrong"}
     assert line not in before and block_line not in before  # the line was right before the mutation
 
 
 def test_definitions_facts_and_unknown_names():
-    text = "\n\n".join([
-        "Prove it.",
-        r"$$\int_{\mathcal{B}} dm = M$$",
-        r"$$\mathbf{I}_C = \int_{\mathcal{B}} \left( \|\mathbf{r}_C\|^2 \mathbf{I} + "
-        r"\mathbf{r}_C \mathbf{r}_C^T \right) dm$$",
-        r"$$\mathbf{I}_C - 2 \int_{\mathcal{B}} \mathbf{r}_C \mathbf{r}_C^T dm = "
-        r"\int_{\mathcal{B}} \left( \|\mathbf{r}_C\|^2 \mathbf{I} - \mathbf{r}_C \mathbf{r}_C^T \right) dm$$",
-        r"$$J = \int_{\mathcal{B}} \mathbf{r}_C \mathbf{r}_C^T dm$$",
-        r"$$\mathbf{I}_C = \int_{\mathcal{B}} \|\mathbf{r}_C\|^2 dm \, \mathbf{I} - J$$",
-        r"$$\mathbf{I}_C = \sum_k m_k \mathbf{r}_k$$",
-        r"$$\mathbf{r}_C \cdot \mathbf{r}_C = \|\mathbf{r}_C\|$$",
-        r"$$\mathbf{r}_P = \mathbf{r}_C + \mathbf{d}$$",
-        r"$$\mathbf{r}_C = \mathbf{r} + \mathbf{a} + \mathbf{r}_P$$",
-    ])
+    text = "\n\n".join(
+        [
+            "Prove it.",
+            r"$$\int_{\mathcal{B}} dm = M$$",
+            r"$$\mathbf{I}_C = \int_{\mathcal{B}} \left( \|\mathbf{r}_C\|^2 \mathbf{I} + "
+            r"\mathbf{r}_C \mathbf{r}_C^T \right) dm$$",
+            r"$$\mathbf{I}_C - 2 \int_{\mathcal{B}} \mathbf{r}_C \mathbf{r}_C^T dm = "
+            r"\int_{\mathcal{B}} \left( \|\mathbf{r}_C\|^2 \mathbf{I} - \mathbf{r}_C \mathbf{r}_C^T \right) dm$$",
+            r"$$J = \int_{\mathcal{B}} \mathbf{r}_C \mathbf{r}_C^T dm$$",
+            r"$$\mathbf{I}_C = \int_{\mathcal{B}} \|\mathbf{r}_C\|^2 dm \, \mathbf{I} - J$$",
+            r"$$\mathbf{I}_C = \sum_k m_k \mathbf{r}_k$$",
+            r"$$\mathbf{r}_C \cdot \mathbf{r}_C = \|\mathbf{r}_C\|$$",
+            r"$$\mathbf{r}_P = \mathbf{r}_C + \mathbf{d}$$",
+            r"$$\mathbf{r}_C = \mathbf{r} + \mathbf{a} + \mathbf{r}_P$$",
+        ]
+    )
     got = [(v.line, v.status) for v in check_text(text)]
-    assert got == [(3, "correct"), (5, "wrong"), (7, "follows-from-earlier-error"), (9, "correct"),
-                   (11, "correct"), (13, "unrecognised"), (15, "unrecognised"), (17, "correct"), (19, "wrong")]
+    assert got == [
+        (3, "correct"),
+        (5, "wrong"),
+        (7, "follows-from-earlier-error"),
+        (9, "correct"),
+        (11, "correct"),
+        (13, "unrecognised"),
+        (15, "unrecognised"),
+        (17, "correct"),
+        (19, "wrong"),
+    ]
     v = {v.line: v for v in check_text(text)}
     assert "not the inertia tensor about C" in v[5].message and v[7].caused_by == "proof_5"
     assert "defines J" in v[9].message and "unknown name sum" in v[13].message and "squared" in v[15].message
@@ -260,25 +325,36 @@ def test_definitions_facts_and_unknown_names():
 
 
 def test_other_notations_and_a_bare_proof_heading():
-    text = "\n\n".join([
-        "Proof.",
-        r"$$[\mathbf{r}]_\times \boldsymbol{\omega} = -\boldsymbol{\omega} \times \mathbf{r} = "
-        r"\mathbf{r} \times \boldsymbol{\omega}$$",
-        r"$$\left\| \mathbf{r} \right\|^2 = \mathbf{r}^\top \mathbf{r} = \mathbf{r} \cdot \mathbf{r}$$",
-        r"$$S^T(\mathbf{r}) S(\mathbf{r}) = \|\mathbf{r}\|^2 \mathbf{1} - \mathbf{r}\mathbf{r}^T$$",
-        r"$$\int_{\mathcal{B}} \int_{\mathcal{B}} \mathbf{r}^T \mathbf{r} \, dm \, dm = "
-        r"M \int_{\mathcal{B}} \mathbf{r}^T \mathbf{r} \, dm$$",
-        r"$$S(\mathbf{r}) S(\mathbf{r}) = \|\mathbf{r}\|^2 \mathbf{1} - \mathbf{r}\mathbf{r}^T$$",
-    ])
+    text = "\n\n".join(
+        [
+            "Proof.",
+            r"$$[\mathbf{r}]_\times \boldsymbol{\omega} = -\boldsymbol{\omega} \times \mathbf{r} = "
+            r"\mathbf{r} \times \boldsymbol{\omega}$$",
+            r"$$\left\| \mathbf{r} \right\|^2 = \mathbf{r}^\top \mathbf{r} = \mathbf{r} \cdot \mathbf{r}$$",
+            r"$$S^T(\mathbf{r}) S(\mathbf{r}) = \|\mathbf{r}\|^2 \mathbf{1} - \mathbf{r}\mathbf{r}^T$$",
+            r"$$\int_{\mathcal{B}} \int_{\mathcal{B}} \mathbf{r}^T \mathbf{r} \, dm \, dm = "
+            r"M \int_{\mathcal{B}} \mathbf{r}^T \mathbf{r} \, dm$$",
+            r"$$S(\mathbf{r}) S(\mathbf{r}) = \|\mathbf{r}\|^2 \mathbf{1} - \mathbf{r}\mathbf{r}^T$$",
+        ]
+    )
     got = [(v.line, v.status) for v in check_text(text)]
-    assert got == [(3, "correct"), (3, "correct"), (5, "correct"), (5, "correct"), (7, "correct"), (9, "correct"),
-                   (11, "wrong")]  # S(r) S(r) = -S^T(r) S(r)
+    assert got == [
+        (3, "correct"),
+        (3, "correct"),
+        (5, "correct"),
+        (5, "correct"),
+        (7, "correct"),
+        (9, "correct"),
+        (11, "wrong"),
+    ]  # S(r) S(r) = -S^T(r) S(r)
 
 
 def test_a_chain_that_names_its_first_expression():
-    text = ("Proof.\n\n$$K = \\frac{1}{2} \\int_{\\mathcal{B}} (\\omega \\times \\mathbf{r})^T "
-            "(\\omega \\times \\mathbf{r}) dm"
-            " = \\frac{1}{2} \\omega^T \\mathbf{I}_O \\omega = \\omega^T \\mathbf{I}_O \\omega$$\n")
+    text = (
+        "Proof.\n\n$$K = \\frac{1}{2} \\int_{\\mathcal{B}} (\\omega \\times \\mathbf{r})^T "
+        "(\\omega \\times \\mathbf{r}) dm"
+        " = \\frac{1}{2} \\omega^T \\mathbf{I}_O \\omega = \\omega^T \\mathbf{I}_O \\omega$$\n"
+    )
     v = check_text(text)
     assert [x.status for x in v] == ["correct", "correct", "wrong"] and "defines K" in v[0].message
     ce = v[2].counterexample  # NumPy: w^T I_O w on the counterexample is twice the left side
@@ -294,14 +370,17 @@ def test_a_chain_that_names_its_first_expression():
 HEAD = "---\nrobot: rp-arm\n---\nProve it.\n\n"
 
 
-@pytest.mark.parametrize("line", [
-    "(" * 500 + r"\mathbf{d}" + ")" * 500 + " = 0",
-    r"E_{rot} = {{{9}^{99}}^{99}}^{99}",
-    r"M = \int \int \int \int \mathbf{r} dm dm dm dm",
-    r"\mathbf{I}_O = " + " ".join([r"\mathbf{I}_O"] * 3000),
-    r"\|" * 200 + "x" + r"\|" * 200 + " = 1",
-    r"E_{rot} = <script>alert(1)</script>",
-])
+@pytest.mark.parametrize(
+    "line",
+    [
+        "(" * 500 + r"\mathbf{d}" + ")" * 500 + " = 0",
+        r"E_{rot} = {{{9}^{99}}^{99}}^{99}",
+        r"M = \int \int \int \int \mathbf{r} dm dm dm dm",
+        r"\mathbf{I}_O = " + " ".join([r"\mathbf{I}_O"] * 3000),
+        r"\|" * 200 + "x" + r"\|" * 200 + " = 1",
+        r"E_{rot} = <script>alert(1)</script>",
+    ],
+)
 def test_hostile_proof_lines_end_quickly_with_a_clear_verdict(tmp_path, line):
     path = tmp_path / "hostile.md"
     path.write_text(HEAD + f"$${line}$$\n\n$$\\tau_2 = 0$$\n")
@@ -314,8 +393,9 @@ def test_hostile_proof_lines_end_quickly_with_a_clear_verdict(tmp_path, line):
 
 def test_ten_thousand_proof_lines_are_refused_naming_the_file(tmp_path):
     path = tmp_path / "long.md"
-    path.write_text(HEAD + "".join(f"$$\\mathbf{{r}}_P = \\mathbf{{r}}_C + \\mathbf{{d}}_{{{k}}}$$\n"
-                                   for k in range(10_000)))
+    path.write_text(
+        HEAD + "".join(f"$$\\mathbf{{r}}_P = \\mathbf{{r}}_C + \\mathbf{{d}}_{{{k}}}$$\n" for k in range(10_000))
+    )
     t0 = time.perf_counter()
     with pytest.raises(ModelError, match="proof lines") as err:
         check_text(path.read_text(), str(path))

@@ -16,7 +16,6 @@ from collections import Counter
 
 import numpy as np
 import pytest
-
 import sympy as sp
 
 import armdyn

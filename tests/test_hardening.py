@@ -18,12 +18,17 @@ TESTS = Path(__file__).resolve().parent
 
 def arm(tip_mass=1.0, tip_inertia=0.01):
     """A 3R arm; link3 (after joint j3) gets ``tip_mass`` and a diagonal tensor."""
-    links = [Link("base"), Link("l1", 2.0, [0, 0, 0.1], np.diag([0.02, 0.02, 0.01]).tolist()),
-             Link("l2", 1.5, [0.2, 0, 0], np.diag([0.01, 0.03, 0.03]).tolist()),
-             Link("l3", tip_mass, [0.1, 0, 0], (tip_inertia * np.eye(3)).tolist())]
-    joints = [Joint("j1", "revolute", "base", "l1"),
-              Joint("j2", "revolute", "l1", "l2", xyz=[0, 0, 0.3], axis=[0, 1, 0]),
-              Joint("j3", "revolute", "l2", "l3", xyz=[0.4, 0, 0], axis=[0, 1, 0])]
+    links = [
+        Link("base"),
+        Link("l1", 2.0, [0, 0, 0.1], np.diag([0.02, 0.02, 0.01]).tolist()),
+        Link("l2", 1.5, [0.2, 0, 0], np.diag([0.01, 0.03, 0.03]).tolist()),
+        Link("l3", tip_mass, [0.1, 0, 0], (tip_inertia * np.eye(3)).tolist()),
+    ]
+    joints = [
+        Joint("j1", "revolute", "base", "l1"),
+        Joint("j2", "revolute", "l1", "l2", xyz=[0, 0, 0.3], axis=[0, 1, 0]),
+        Joint("j3", "revolute", "l2", "l3", xyz=[0.4, 0, 0], axis=[0, 1, 0]),
+    ]
     return Robot("arm3", links, joints)
 
 
@@ -122,10 +127,15 @@ def test_aba_of_a_massless_subtree_names_the_joints():
 def test_aba_singular_at_a_state_is_an_error():
     """A point mass on the last joint's axis: M is singular although no subtree is
     massless; aba must not hand back inf or NaN."""
-    links = [Link("base"), Link("l1", 1.0, [0, 0, 0], np.diag([0.01, 0.01, 0.01]).tolist()),
-             Link("l2", 1.0, [0, 0, 0.5], np.zeros((3, 3)).tolist())]
-    joints = [Joint("j1", "revolute", "base", "l1", axis=[1, 0, 0]),
-              Joint("j2", "revolute", "l1", "l2", axis=[0, 0, 1])]  # the point mass sits on j2's axis
+    links = [
+        Link("base"),
+        Link("l1", 1.0, [0, 0, 0], np.diag([0.01, 0.01, 0.01]).tolist()),
+        Link("l2", 1.0, [0, 0, 0.5], np.zeros((3, 3)).tolist()),
+    ]
+    joints = [
+        Joint("j1", "revolute", "base", "l1", axis=[1, 0, 0]),
+        Joint("j2", "revolute", "l1", "l2", axis=[0, 0, 1]),
+    ]  # the point mass sits on j2's axis
     robot = Robot("on-axis", links, joints)
     q = np.zeros(2)
     try:
@@ -139,9 +149,13 @@ def test_aba_singular_at_a_state_is_an_error():
 def test_seeds_are_fixed_not_hashed():
     """hash(str) changes with every process (PYTHONHASHSEED): a failure seeded from it
     cannot be reproduced."""
-    offenders = [f"{p.name}:{i}" for p in sorted(TESTS.glob("*.py")) if p.name != Path(__file__).name
-                 for i, line in enumerate(p.read_text().splitlines(), 1)
-                 if re.search(r"(seed|default_rng|Random)\(.*\bhash\(", line)]
+    offenders = [
+        f"{p.name}:{i}"
+        for p in sorted(TESTS.glob("*.py"))
+        if p.name != Path(__file__).name
+        for i, line in enumerate(p.read_text().splitlines(), 1)
+        if re.search(r"(seed|default_rng|Random)\(.*\bhash\(", line)
+    ]
     assert offenders == []
 
 
@@ -169,8 +183,8 @@ from contextlib import contextmanager  # noqa: E402
 
 from armdyn.cli import main  # noqa: E402
 from armdyn.errors import ModelError  # noqa: E402
-from armdyn.io.yaml import load_yaml_string  # noqa: E402
 from armdyn.io.expressions import parse_expression  # noqa: E402
+from armdyn.io.yaml import load_yaml_string  # noqa: E402
 
 PLANAR = (TESTS.parent / "python" / "armdyn" / "robots" / "planar-2r.yaml").read_text()
 
@@ -235,9 +249,18 @@ def test_ordinary_expressions_still_parse():
     import sympy as sp
 
     l1 = sp.Symbol("l1")
-    for text, want in [("2**3**2", 512), ("-l1**2", -(l1**2)), ("(((l1)))", l1), ("l1**1000", l1**1000),
-                       ("0.4318", sp.Float(0.4318)), ("1/12", sp.Rational(1, 12)), ("2**-3", sp.Rational(1, 8)),
-                       ("-" * 50 + "l1", l1), ("(" * 50 + "l1" + ")" * 50, l1), ("sqrt(2)**1000", 2**500)]:
+    for text, want in [
+        ("2**3**2", 512),
+        ("-l1**2", -(l1**2)),
+        ("(((l1)))", l1),
+        ("l1**1000", l1**1000),
+        ("0.4318", sp.Float(0.4318)),
+        ("1/12", sp.Rational(1, 12)),
+        ("2**-3", sp.Rational(1, 8)),
+        ("-" * 50 + "l1", l1),
+        ("(" * 50 + "l1" + ")" * 50, l1),
+        ("sqrt(2)**1000", 2**500),
+    ]:
         assert parse_expression(text, {"l1": l1}) == want, text
 
 
@@ -354,8 +377,9 @@ def test_robot_cannot_change_under_its_compiled_model():
     np.testing.assert_array_equal(numeric.gravity(robot, q), g0)
 
     # building new robots still works: bind/subs, list + list, a with_* style copy
-    lighter = Robot("arm3b", [*robot.links.values()][:-1] + [Link("l3", 0.5, [0.1, 0, 0], np.eye(3) * 0.01)],
-                    robot.joints + [])
+    lighter = Robot(
+        "arm3b", [*robot.links.values()][:-1] + [Link("l3", 0.5, [0.1, 0, 0], np.eye(3) * 0.01)], robot.joints + []
+    )
     assert numeric.gravity(lighter, q)[1] != g0[1]
     thawed = copy.copy(robot)
     assert "_numeric_model" not in thawed.__dict__

@@ -21,34 +21,56 @@ from pathlib import Path
 
 import pytest
 import sympy as sp
+from browser import assert_math_rendered, assert_parentheses_stretch, render, require_chromium
 
 from armdyn.grade.html import report_html, repr_html
 from armdyn.grade.verdict import STATUSES, GradeReport, StepVerdict
 
-from browser import assert_math_rendered, assert_parentheses_stretch, render, require_chromium
-
 ROOT = Path(__file__).resolve().parents[1]
 SHOTS = Path(os.environ.get("ARMDYN_SCREENSHOTS", ROOT / "target" / "screenshots"))
 
-th, thd, thdd, d, dd, ddd, l1, m1, m2, g = sp.symbols(
-    "theta1 theta1_dot theta1_ddot d2 d2_dot d2_ddot l1 m1 m2 g")
+th, thd, thdd, d, dd, ddd, l1, m1, m2, g = sp.symbols("theta1 theta1_dot theta1_ddot d2 d2_dot d2_ddot l1 m1 m2 g")
 s1, c1 = sp.sin(th), sp.cos(th)
 V = sp.Matrix
 
-STUDENT_LATEX = {th: r"\theta_1", thd: r"\dot{\theta}_1", thdd: r"\ddot{\theta}_1", d: "d_2",
-                 dd: r"\dot{d}_2", ddd: r"\ddot{d}_2", l1: "l_1", m1: "m_1", m2: "m_2", g: "g"}
+STUDENT_LATEX = {
+    th: r"\theta_1",
+    thd: r"\dot{\theta}_1",
+    thdd: r"\ddot{\theta}_1",
+    d: "d_2",
+    dd: r"\dot{d}_2",
+    ddd: r"\ddot{d}_2",
+    l1: "l_1",
+    m1: "m_1",
+    m2: "m_2",
+    g: "g",
+}
 
 HOSTILE = r"m_2^2 = \mathbf{P}_2^2 \times f_2^2 </pre><script>alert('x')</script> & <b>bold</b>"
 
 
 def _step(name, key, status, label, expected, got, components=(), **kw):
     diff = None
-    if expected is not None and got is not None and status not in ("correct", "correct-by-convention",
-                                                                     "correct-but-unsupported"):
+    if (
+        expected is not None
+        and got is not None
+        and status not in ("correct", "correct-by-convention", "correct-but-unsupported")
+    ):
         diff = (got - expected).applyfunc(sp.expand) if isinstance(got, sp.MatrixBase) else sp.expand(got - expected)
-    return StepVerdict(name=name, key=key, link=kw.pop("link", ""), status=status, label=label,
-                       source=kw.pop("source", f"{label} = ..."), line=kw.pop("line", 0), expected=expected,
-                       got=got, difference=diff, components=list(components), **kw)
+    return StepVerdict(
+        name=name,
+        key=key,
+        link=kw.pop("link", ""),
+        status=status,
+        label=label,
+        source=kw.pop("source", f"{label} = ..."),
+        line=kw.pop("line", 0),
+        expected=expected,
+        got=got,
+        difference=diff,
+        components=list(components),
+        **kw,
+    )
 
 
 def exercise_like_report() -> GradeReport:
@@ -59,31 +81,114 @@ def exercise_like_report() -> GradeReport:
     vc2_true = V([-d * thdd - l1 * thd**2 - 2 * dd * thd + g * s1, 0, l1 * thdd + ddd - d * thd**2 + g * c1])
     vc2_student = V([-d * thdd - 2 * dd * thd + g * s1, 0, l1 * thdd + ddd - d * thd**2 + g * c1])
     F2_student = V([-m2 * (-thd * d - 2 * thd * dd + g * s1), 0, -m2 * (l1 * thdd - thd**2 * d + ddd + g * c1)])
-    tau1 = ((m1 + m2) * l1**2 * thdd + m2 * l1 * ddd + 2 * m2 * d * thd * dd + m2 * thdd * d**2
-            + (m1 + m2) * g * l1 * c1 - m2 * g * d * s1)
+    tau1 = (
+        (m1 + m2) * l1**2 * thdd
+        + m2 * l1 * ddd
+        + 2 * m2 * d * thd * dd
+        + m2 * thdd * d**2
+        + (m1 + m2) * g * l1 * c1
+        - m2 * g * d * s1
+    )
     tau2 = m2 * (l1 * thdd - thd**2 * d + ddd + g * c1)
     steps = [
-        _step("omega_1", "omega", "correct", r"\boldsymbol{\omega}_1^1", V([0, 0, thd]), V([0, 0, thd]),
-              link="link1", line=14, frame="1"),
-        _step("v_dot_1", "v_dot", "wrong", r"\dot{\boldsymbol{v}}_1^1", vd1_true, vd1_student, [0], link="link1",
-              line=16, frame="1", message="missing term \u2212l1\u00b7\u03b8\u03071\u00b2 in the x component"),
-        _step("v_dot_C2", "vc_dot", "follows-from-earlier-error", r"\dot{v}_{C_2}^2", vc2_true, vc2_student, [0],
-              link="link2", line=22, frame="2", caused_by="v_dot_1",
-              message="what your v\u03071 gives: carried forward"),
-        _step("F_2", "F", "wrong", r"F_2^2", -m2 * vc2_true, F2_student, [0], link="link2", line=26, frame="2",
-              convention="d'Alembert sign F = \u2212m v\u0307_C",
-              message="\u03b8\u03071 where \u03b8\u03081 belongs in the x component"),
-        _step("N_2", "N", "correct-by-convention", r"N_2^2", V([0, 0, 0]), V([0, 0, 0]), link="link2", line=30,
-              frame="2", convention="d'Alembert sign N = \u2212I \u03c9\u0307 \u2212 \u03c9 \u00d7 I\u03c9"),
-        _step("m_2", "", "unrecognised", r"m_2^2", None, None, line=40, source=HOSTILE,
-              message="m_2^2 is not a step name (the moment n_2 about frame 1's origin?): skipped"),
+        _step(
+            "omega_1",
+            "omega",
+            "correct",
+            r"\boldsymbol{\omega}_1^1",
+            V([0, 0, thd]),
+            V([0, 0, thd]),
+            link="link1",
+            line=14,
+            frame="1",
+        ),
+        _step(
+            "v_dot_1",
+            "v_dot",
+            "wrong",
+            r"\dot{\boldsymbol{v}}_1^1",
+            vd1_true,
+            vd1_student,
+            [0],
+            link="link1",
+            line=16,
+            frame="1",
+            message="missing term \u2212l1\u00b7\u03b8\u03071\u00b2 in the x component",
+        ),
+        _step(
+            "v_dot_C2",
+            "vc_dot",
+            "follows-from-earlier-error",
+            r"\dot{v}_{C_2}^2",
+            vc2_true,
+            vc2_student,
+            [0],
+            link="link2",
+            line=22,
+            frame="2",
+            caused_by="v_dot_1",
+            message="what your v\u03071 gives: carried forward",
+        ),
+        _step(
+            "F_2",
+            "F",
+            "wrong",
+            r"F_2^2",
+            -m2 * vc2_true,
+            F2_student,
+            [0],
+            link="link2",
+            line=26,
+            frame="2",
+            convention="d'Alembert sign F = \u2212m v\u0307_C",
+            message="\u03b8\u03071 where \u03b8\u03081 belongs in the x component",
+        ),
+        _step(
+            "N_2",
+            "N",
+            "correct-by-convention",
+            r"N_2^2",
+            V([0, 0, 0]),
+            V([0, 0, 0]),
+            link="link2",
+            line=30,
+            frame="2",
+            convention="d'Alembert sign N = \u2212I \u03c9\u0307 \u2212 \u03c9 \u00d7 I\u03c9",
+        ),
+        _step(
+            "m_2",
+            "",
+            "unrecognised",
+            r"m_2^2",
+            None,
+            None,
+            line=40,
+            source=HOSTILE,
+            message="m_2^2 is not a step name (the moment n_2 about frame 1's origin?): skipped",
+        ),
         _step("tau_2", "tau", "correct", r"\tau_2", tau2, tau2, link="d2", line=52),
-        _step("tau_1", "tau", "correct-but-unsupported", r"\tau_1", tau1, tau1, link="theta1", line=50,
-              message="right, but your n_1 gives a different value"),
+        _step(
+            "tau_1",
+            "tau",
+            "correct-but-unsupported",
+            r"\tau_1",
+            tau1,
+            tau1,
+            link="theta1",
+            line=50,
+            message="right, but your n_1 gives a different value",
+        ),
     ]
-    return GradeReport(robot="rp-arm", method="newton-euler", submission="assignment-7.md", steps=steps,
-                       first_wrong="v_dot_1", tau_correct=[True, True], symbol_latex=STUDENT_LATEX,
-                       notes=["symbols mapped: \u03b8_1 \u2194 theta1, d_2 \u2194 d2, l_1 \u2194 l1"])
+    return GradeReport(
+        robot="rp-arm",
+        method="newton-euler",
+        submission="assignment-7.md",
+        steps=steps,
+        first_wrong="v_dot_1",
+        tau_correct=[True, True],
+        symbol_latex=STUDENT_LATEX,
+        notes=["symbols mapped: \u03b8_1 \u2194 theta1, d_2 \u2194 d2, l_1 \u2194 l1"],
+    )
 
 
 # ------------------------------------------------------------------ static structure
@@ -142,7 +247,7 @@ def test_grade_page_cards_badges_and_highlights():
     # highlighted cells: v_dot_1, v_dot_C2, F_2 each show yours, expected, difference with row 0 marked
     assert page.count('<mtd class="hl">') == 3 * 3
     # the unrecognised step shows its source and no comparison
-    unrec = page[page.index('id="step-5"'):page.index('id="step-6"')]
+    unrec = page[page.index('id="step-5"') : page.index('id="step-6"')]
     assert "<pre>" in unrec and 'class="compare"' not in unrec
 
 
@@ -161,8 +266,8 @@ def test_grade_page_math_is_wellformed_and_in_students_notation():
     assert accents > 10  # theta-dots are accents on the letter
     # the difference of v_dot_1 is l1*theta1_dot^2 in x: shown as l_1 θ̇_1^2 in the highlighted row
     start = page.index('id="step-1"')
-    card = page[start:page.index('id="step-2"')]
-    diff = card[card.index("difference"):]
+    card = page[start : page.index('id="step-2"')]
+    diff = card[card.index("difference") :]
     row = re.search(r'<mtd class="hl">(.*?)</mtd>', diff, re.S).group(1)
     root = ET.fromstring(f'<mrow xmlns="http://www.w3.org/1998/Math/MathML">{row}</mrow>')
     texts = [e.text for e in root.iter() if e.text]
@@ -241,8 +346,12 @@ def test_derive_html_page_structure(rp_arm):
     assert eqs == len(ne.steps) + len(la.steps) + 2 * robot.dof + 3
     assert len(maths) > eqs
     # steps grouped per link: one group per (stage, link) run of the derivation
-    runs = sum(1 for eom in (ne, la) for k, s in enumerate(eom.steps)
-               if k == 0 or (s.stage, s.link) != (eom.steps[k - 1].stage, eom.steps[k - 1].link))
+    runs = sum(
+        1
+        for eom in (ne, la)
+        for k, s in enumerate(eom.steps)
+        if k == 0 or (s.stage, s.link) != (eom.steps[k - 1].stage, eom.steps[k - 1].link)
+    )
     assert page.count('<div class="group">') == runs
     assert "all passed" in page
 
@@ -291,10 +400,15 @@ def test_browser_check_can_fail(tmp_path):
         with pytest.raises(AssertionError):
             assert_math_rendered(render(path, chromium))
     # a vector in a text font: its parentheses keep the height of one line
-    vec = '<mrow><mo stretchy="true">(</mo><mtable>' + "<mtr><mtd><mi>x</mi></mtd></mtr>" * 3 + \
-          '</mtable><mo stretchy="true">)</mo></mrow>'
-    path.write_text(f'<!DOCTYPE html><html><body><math style="font-family:\'Liberation Serif\',serif">{vec}</math>'
-                    "</body></html>", encoding="utf-8")
+    vec = (
+        '<mrow><mo stretchy="true">(</mo><mtable>'
+        + "<mtr><mtd><mi>x</mi></mtd></mtr>" * 3
+        + '</mtable><mo stretchy="true">)</mo></mrow>'
+    )
+    path.write_text(
+        f"<!DOCTYPE html><html><body><math style=\"font-family:'Liberation Serif',serif\">{vec}</math></body></html>",
+        encoding="utf-8",
+    )
     with pytest.raises(AssertionError, match="do not stretch"):
         assert_parentheses_stretch(render(path, chromium))
 
@@ -310,30 +424,55 @@ def test_huge_values_are_not_printed_and_the_page_stays_fast():
     huge = sp.Add(*[sp.Mul(*[x[(k + j) % 60] for j in range(20)]) * sp.sin(x[k]) for k in range(60)])
     assert sum(1 for _ in sp.preorder_traversal(huge)) > grade_html.PRINT_NODE_LIMIT
     small = x[0] * x[1]
-    steps = [StepVerdict(name="tau_1", key="tau", link="q1", status="wrong", label=r"\tau_1", source="", line=3,
-                         expected=huge, got=huge + small, difference=small)]
+    steps = [
+        StepVerdict(
+            name="tau_1",
+            key="tau",
+            link="q1",
+            status="wrong",
+            label=r"\tau_1",
+            source="",
+            line=3,
+            expected=huge,
+            got=huge + small,
+            difference=small,
+        )
+    ]
     report = GradeReport("big", "newton-euler", "big.md", steps, "tau_1", [False])
     t0 = time.perf_counter()
     page = report_html(report)
     assert time.perf_counter() - t0 < 10
     assert page.count("too long to print") == 2  # yours and expected; the difference is shown
-    diff = page[page.index("difference"):]
+    diff = page[page.index("difference") :]
     assert "<msub><mi>x</mi><mn>0</mn></msub>" in diff
 
 
-@pytest.mark.parametrize("statuses, verdict", [
-    (["correct", "correct-by-convention"], "Every step is right"),
-    (["correct", "correct-but-unsupported"], "No step is wrong"),
-    (["unrecognised"], "No step was recognised"),
-])
+@pytest.mark.parametrize(
+    "statuses, verdict",
+    [
+        (["correct", "correct-by-convention"], "Every step is right"),
+        (["correct", "correct-but-unsupported"], "No step is wrong"),
+        (["unrecognised"], "No step was recognised"),
+    ],
+)
 def test_summary_verdict_without_a_wrong_step(statuses, verdict):
     x = sp.Symbol("theta1_dot")
-    steps = [StepVerdict(name=f"s{k}", key="omega" if st != "unrecognised" else "", link="", status=st,
-                         label=r"\omega_1", source=r"\omega_1 = x", line=k + 1,
-                         expected=None if st == "unrecognised" else x, got=None if st == "unrecognised" else x)
-             for k, st in enumerate(statuses)]
+    steps = [
+        StepVerdict(
+            name=f"s{k}",
+            key="omega" if st != "unrecognised" else "",
+            link="",
+            status=st,
+            label=r"\omega_1",
+            source=r"\omega_1 = x",
+            line=k + 1,
+            expected=None if st == "unrecognised" else x,
+            got=None if st == "unrecognised" else x,
+        )
+        for k, st in enumerate(statuses)
+    ]
     page = report_html(GradeReport("r", "newton-euler", "s.md", steps, None, []))
-    head = page[page.index('<section class="summary">'):page.index("</section>")]
+    head = page[page.index('<section class="summary">') : page.index("</section>")]
     assert verdict in head
     assert ("verdict pass" in head) == (verdict == "Every step is right")
 
@@ -361,23 +500,55 @@ def test_grouped_unrecognised_and_inherited_rows():
     the expected value; a difference taken against the student's own earlier values
     (not the expected one) is captioned so."""
     x, y = sp.symbols("theta1_dot l1")
-    un = [StepVerdict(name=f"u{k}", key="", link="", status="unrecognised", label=r"I_P", line=10 + k,
-                      source=f"I_P = {k} <x>", message="not a step") for k in range(3)]
-    carried = StepVerdict(name="F_1", key="F", link="link1", status="follows-from-earlier-error", label="F_1^1",
-                          source="", line=20, expected=V([x, y, 0]), got=V([x, 0, 0]), difference=V([0, -y, 0]),
-                          caused_by="u0")
-    own = StepVerdict(name="F_2", key="F", link="link2", status="wrong", label="F_2^2", source="", line=21,
-                      expected=V([x, y, 0]), got=V([2 * x, 0, 0]), difference=V([x, 0, 0]), components=[0],
-                      message="x wrong (compared with what your own earlier steps give)")
+    un = [
+        StepVerdict(
+            name=f"u{k}",
+            key="",
+            link="",
+            status="unrecognised",
+            label=r"I_P",
+            line=10 + k,
+            source=f"I_P = {k} <x>",
+            message="not a step",
+        )
+        for k in range(3)
+    ]
+    carried = StepVerdict(
+        name="F_1",
+        key="F",
+        link="link1",
+        status="follows-from-earlier-error",
+        label="F_1^1",
+        source="",
+        line=20,
+        expected=V([x, y, 0]),
+        got=V([x, 0, 0]),
+        difference=V([0, -y, 0]),
+        caused_by="u0",
+    )
+    own = StepVerdict(
+        name="F_2",
+        key="F",
+        link="link2",
+        status="wrong",
+        label="F_2^2",
+        source="",
+        line=21,
+        expected=V([x, y, 0]),
+        got=V([2 * x, 0, 0]),
+        difference=V([x, 0, 0]),
+        components=[0],
+        message="x wrong (compared with what your own earlier steps give)",
+    )
     report = GradeReport("r", "newton-euler+lagrange", "s.md", un + [carried, own], "F_2", [])
     page = report_html(report)
     assert "3 equations not recognised as steps" in page and "lines 10\u201312" in page
     assert page.count('<div class="skip"') == 3 and "I_P = 2 &lt;x&gt;" in page
     assert "Newton\u2013Euler and Lagrange" in page
-    card = page[page.index('id="step-3"'):page.index('id="step-4"')]
+    card = page[page.index('id="step-3"') : page.index('id="step-4"')]
     assert card.count('<mtd class="hl">') == 3  # row 1 (y) on yours, expected and the difference
     assert "difference: yours \u2212 expected" in card
-    card = page[page.index('id="step-4"'):]
+    card = page[page.index('id="step-4"') :]
     assert "difference: yours \u2212 what your own earlier steps give" in card
 
 
@@ -396,7 +567,7 @@ def test_exercise_grade_report_renders_in_chromium(tmp_path):
     k = next(i for i, s in enumerate(report.steps) if s.name == report.first_wrong)
     text = page.read_text(encoding="utf-8")
     assert f'<a href="#step-{k}">' in text
-    card = text[text.index(f'id="step-{k}"'):]
-    card = card[:card.index("</li>")]
+    card = text[text.index(f'id="step-{k}"') :]
+    card = card[: card.index("</li>")]
     assert card.count('<mtr class="hl">') == 3  # x row of yours, expected and the difference
     assert card.count('<mtable><mtr class="hl">') == 3  # ... and it is the first row, x

@@ -39,15 +39,14 @@ from pathlib import Path
 import pytest
 import sympy as sp
 import yaml
+from browser import dump_dom, require_chromium, without_csp
+from html_payloads import CANARY, PAYLOADS, html_findings, scan, visible_text
 
 from armdyn.grade.html import report_html
 from armdyn.grade.verdict import GradeReport, StepVerdict
 from armdyn.htmlpage import CSP, page
 from armdyn.mathml import escape, latex_to_mathml, math_element
 from armdyn.mathml_sanitize import ATTRIBUTES, ELEMENTS, MAX_DEPTH, clean_mathml, sanitize_mathml
-
-from browser import dump_dom, require_chromium, without_csp
-from html_payloads import CANARY, PAYLOADS, html_findings, scan, visible_text
 
 ROOT = Path(__file__).resolve().parents[1]
 RP_ARM = (ROOT / "python" / "armdyn" / "robots" / "rp-arm.yaml").read_text()
@@ -73,15 +72,22 @@ def _groups() -> list[dict]:
     out = []
     printable = [(t, p) for t, p in PAYLOADS if p.isprintable()]
     for k in range(0, len(printable), len(_SLOTS)):
-        chunk = printable[k:k + len(_SLOTS)]
+        chunk = printable[k : k + len(_SLOTS)]
         out.append({slot: p for slot, (_, p) in zip(_SLOTS, chunk)})
     return out
 
 
 def _cli(*args, cwd: Path) -> subprocess.CompletedProcess:
     env = {**os.environ, "PYTHONPATH": str(ROOT / "python")}
-    return subprocess.run([sys.executable, "-m", "armdyn", *args], cwd=cwd, env=env, capture_output=True,
-                          text=True, timeout=300, check=False)
+    return subprocess.run(
+        [sys.executable, "-m", "armdyn", *args],
+        cwd=cwd,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
 
 
 def _assert_static(markup: str, tokens: list[str], csp: bool) -> None:
@@ -130,23 +136,29 @@ def test_payload_list_is_long_and_distinct():
 
 def test_sanitizer_keeps_mathml_and_drops_the_rest():
     # what latex2mathml writes for a label in the field's notation survives unchanged
-    good = ('<mrow><msub><mover accent="true"><mi>&#952;</mi><mo>&#729;</mo></mover><mn>1</mn></msub>'
-            '<mo stretchy="true" fence="true" form="prefix">(</mo><mfrac><mi>a</mi><mi>b</mi></mfrac>'
-            '<mo stretchy="true" fence="true" form="postfix">)</mo><mspace width="0.1667em"></mspace>'
-            '<mtable columnalign="left right"><mtr><mtd class="hl"><mi mathvariant="bold">x</mi></mtd></mtr>'
-            '</mtable></mrow>')
+    good = (
+        '<mrow><msub><mover accent="true"><mi>&#952;</mi><mo>&#729;</mo></mover><mn>1</mn></msub>'
+        '<mo stretchy="true" fence="true" form="prefix">(</mo><mfrac><mi>a</mi><mi>b</mi></mfrac>'
+        '<mo stretchy="true" fence="true" form="postfix">)</mo><mspace width="0.1667em"></mspace>'
+        '<mtable columnalign="left right"><mtr><mtd class="hl"><mi mathvariant="bold">x</mi></mtd></mtr>'
+        "</mtable></mrow>"
+    )
     assert clean_mathml(good).markup == good and clean_mathml(good).dropped == clean_mathml(good).stripped == 0
-    bad = ('<mrow href="javascript:alert(1)" style="color:red" onclick="x()" id="main" xlink:href="x">'
-           '<mi onmouseover="x()">a</mi><script>alert(1)</script><svg onload="x()"><text>t</text></svg>'
-           '<mtext>&lt;img src=x onerror=alert(1)&gt;</mtext><annotation-xml encoding="text/html">'
-           '<img src="x"/></annotation-xml><mstyle mathcolor="url(javascript:x)" displaystyle="true">'
-           '<mi>b</mi></mstyle><mi class="hl evil">c</mi><mspace width="calc(1em)" height="99999em"/><math><mi>d</mi></math></mrow>')
+    bad = (
+        '<mrow href="javascript:alert(1)" style="color:red" onclick="x()" id="main" xlink:href="x">'
+        '<mi onmouseover="x()">a</mi><script>alert(1)</script><svg onload="x()"><text>t</text></svg>'
+        '<mtext>&lt;img src=x onerror=alert(1)&gt;</mtext><annotation-xml encoding="text/html">'
+        '<img src="x"/></annotation-xml><mstyle mathcolor="url(javascript:x)" displaystyle="true">'
+        '<mi>b</mi></mstyle><mi class="hl evil">c</mi><mspace width="calc(1em)" height="99999em"/><math><mi>d</mi></math></mrow>'
+    )
     with pytest.raises(ValueError):  # xlink: undeclared prefix: not well-formed
         clean_mathml(bad)
     bad = bad.replace(' xlink:href="x"', "")
     out = clean_mathml(bad)
-    assert out.markup == ('<mrow><mi>a</mi><mtext>&lt;img src=x onerror=alert(1)&gt;</mtext>'
-                          '<mstyle displaystyle="true"><mi>b</mi></mstyle><mi>c</mi><mspace></mspace></mrow>')
+    assert out.markup == (
+        "<mrow><mi>a</mi><mtext>&lt;img src=x onerror=alert(1)&gt;</mtext>"
+        '<mstyle displaystyle="true"><mi>b</mi></mstyle><mi>c</mi><mspace></mspace></mrow>'
+    )
     assert out.dropped == 4  # script, svg, annotation-xml, the nested math
     assert out.stripped == 9  # href, style, onclick, id, onmouseover, mathcolor, class, width, height
 
@@ -178,7 +190,7 @@ def test_sanitizer_is_idempotent_and_bounded():
         inner = latex_to_mathml(payload)
         if inner is not None:
             assert sanitize_mathml(inner) == inner
-    assert sanitize_mathml("<mi>a</mi></mrow><script>") .startswith("<merror>")
+    assert sanitize_mathml("<mi>a</mi></mrow><script>").startswith("<merror>")
     assert sanitize_mathml('<!DOCTYPE x [<!ENTITY a "b">]><mi>&a;</mi>').startswith("<merror>")
 
 
@@ -199,10 +211,19 @@ def _grade_model(tmp_path: Path) -> Path:
 
 
 def _markdown_submission(model: Path) -> str:
-    front = yaml.safe_dump({"robot": model.name, "method": "newton-euler",
-                            "symbols": {f"L_{{{p}}}": "l1" for _, p in PAYLOADS[:3]}})
-    lines = ["---", front.strip(), "---", "", "A wrong first step, so the expected values show the model's names:", "",
-             r"$$ \omega_1 = \begin{pmatrix} 0 \\ 0 \\ 0 \end{pmatrix} $$", ""]
+    front = yaml.safe_dump(
+        {"robot": model.name, "method": "newton-euler", "symbols": {f"L_{{{p}}}": "l1" for _, p in PAYLOADS[:3]}}
+    )
+    lines = [
+        "---",
+        front.strip(),
+        "---",
+        "",
+        "A wrong first step, so the expected values show the model's names:",
+        "",
+        r"$$ \omega_1 = \begin{pmatrix} 0 \\ 0 \\ 0 \end{pmatrix} $$",
+        "",
+    ]
     for _, p in PAYLOADS:
         lines += [f"$$ {p} = 0 $$", ""]  # a hostile left-hand side
     for k, (_, p) in enumerate(PAYLOADS):
@@ -214,9 +235,15 @@ def _yaml_submission(model: Path) -> str:
     steps = {r"\omega_1": [0, 0, 0]}
     steps.update({p: "0" for _, p in PAYLOADS})
     steps.update({f"x_{{{k}}}": p for k, (_, p) in enumerate(PAYLOADS)})
-    return yaml.safe_dump({"robot": model.name, "method": "newton-euler",
-                           "symbols": {f"L_{{{p}}}": "l1" for _, p in PAYLOADS[:3]}, "steps": steps},
-                          allow_unicode=False)
+    return yaml.safe_dump(
+        {
+            "robot": model.name,
+            "method": "newton-euler",
+            "symbols": {f"L_{{{p}}}": "l1" for _, p in PAYLOADS[:3]},
+            "steps": steps,
+        },
+        allow_unicode=False,
+    )
 
 
 @pytest.mark.parametrize("fmt", ["md", "yaml"])
@@ -243,15 +270,49 @@ def _hand_report() -> GradeReport:
         status = statuses[k % len(statuses)]
         exp, got = sp.Matrix([0, 0, thd]), sp.Matrix([0, 0, thd if status != "wrong" else 2 * thd])
         diff = got - exp if status in ("wrong", "follows-from-earlier-error") else None
-        steps.append(StepVerdict(name=f"step{k}", key="omega", link="link1", status=status, label=p, source=p,
-                                 line=k + 1, expected=exp, got=got, difference=diff, message=p, convention=p,
-                                 frame=p, caused_by="step0" if k else ""))
-    steps.append(StepVerdict(name=PAYLOADS[1][1], key="", link="", status="unrecognised", label=PAYLOADS[1][1],
-                             source=PAYLOADS[1][1], line=99, expected=None, got=None, difference=None,
-                             message=PAYLOADS[3][1]))
-    return GradeReport(robot=PAYLOADS[4][1], method=PAYLOADS[5][1], submission=PAYLOADS[6][1], steps=steps,
-                       first_wrong="step1", tau_correct=[False], notes=[p for _, p in PAYLOADS],
-                       symbol_latex={th: PAYLOADS[7][1], thd: PAYLOADS[8][1]})
+        steps.append(
+            StepVerdict(
+                name=f"step{k}",
+                key="omega",
+                link="link1",
+                status=status,
+                label=p,
+                source=p,
+                line=k + 1,
+                expected=exp,
+                got=got,
+                difference=diff,
+                message=p,
+                convention=p,
+                frame=p,
+                caused_by="step0" if k else "",
+            )
+        )
+    steps.append(
+        StepVerdict(
+            name=PAYLOADS[1][1],
+            key="",
+            link="",
+            status="unrecognised",
+            label=PAYLOADS[1][1],
+            source=PAYLOADS[1][1],
+            line=99,
+            expected=None,
+            got=None,
+            difference=None,
+            message=PAYLOADS[3][1],
+        )
+    )
+    return GradeReport(
+        robot=PAYLOADS[4][1],
+        method=PAYLOADS[5][1],
+        submission=PAYLOADS[6][1],
+        steps=steps,
+        first_wrong="step1",
+        tau_correct=[False],
+        notes=[p for _, p in PAYLOADS],
+        symbol_latex={th: PAYLOADS[7][1], thd: PAYLOADS[8][1]},
+    )
 
 
 def test_grade_report_with_hostile_labels(tmp_path):
@@ -279,8 +340,7 @@ def test_derive_html_of_hostile_model(tmp_path):
         else:  # the same function in-process (faster)
             robot = load_yaml_string(model.read_text(encoding="utf-8"), source=str(model))
             eoms = [armdyn.derive(robot, "newton-euler"), armdyn.derive(robot, "lagrange")]
-            out.write_text(derivation_report(eoms, "html", steps=True, agreement=armdyn.check(*eoms)),
-                           encoding="utf-8")
+            out.write_text(derivation_report(eoms, "html", steps=True, agreement=armdyn.check(*eoms)), encoding="utf-8")
         markup = out.read_text(encoding="utf-8")
         tokens = [t for t, p in PAYLOADS if p in names.values()]
         _assert_static(markup, tokens, csp=True)
@@ -306,8 +366,11 @@ def test_jupyter_fragments_of_hostile_objects(tmp_path):
     for k, names in enumerate(_groups()):
         robot = load_yaml_string(_hostile_model(names), source=f"hostile-{k}.yaml")
         eom = armdyn.derive(robot)
-        parts += [robot._repr_html_(), eom._repr_html_(), armdyn.check(eom, armdyn.derive(robot, "lagrange"))
-                  ._repr_html_()]
+        parts += [
+            robot._repr_html_(),
+            eom._repr_html_(),
+            armdyn.check(eom, armdyn.derive(robot, "lagrange"))._repr_html_(),
+        ]
         tokens += [t for t, p in PAYLOADS if p in names.values()]
     parts.append(_hand_report()._repr_html_())
     for part in parts:
@@ -315,9 +378,12 @@ def test_jupyter_fragments_of_hostile_objects(tmp_path):
         assert "<html" not in part and "Content-Security-Policy" not in part  # a fragment
     # a notebook-like page holding the fragments, with no policy of its own
     notebook = tmp_path / "notebook.html"
-    notebook.write_text('<!DOCTYPE html><html><head><meta charset="utf-8"><title>notebook</title></head><body>'
-                        + "".join(f'<div class="cell">{p}</div>' for p in parts) + "</body></html>",
-                        encoding="utf-8")
+    notebook.write_text(
+        '<!DOCTYPE html><html><head><meta charset="utf-8"><title>notebook</title></head><body>'
+        + "".join(f'<div class="cell">{p}</div>' for p in parts)
+        + "</body></html>",
+        encoding="utf-8",
+    )
     _assert_static(notebook.read_text(encoding="utf-8"), tokens, csp=False)
     _assert_nothing_ran(notebook, require_chromium(), tmp_path)
 

@@ -20,6 +20,7 @@ import warnings
 import numpy as np
 import pytest
 import sympy as sp
+from test_joint_dynamics import BUNDLED, numeric_arm, states, with_terms
 
 import armdyn
 from armdyn import numeric as num
@@ -33,7 +34,6 @@ from armdyn.identification import (
 )
 from armdyn.symbolic import dag
 from armdyn.symbolic.agreement import trig_reduce
-from test_joint_dynamics import BUNDLED, numeric_arm, states, with_terms
 
 SMALL = ["rp-arm", "planar-2r", "planar-3r"]
 BIG = [n for n in BUNDLED if n not in SMALL]
@@ -44,8 +44,10 @@ def floats(matrix) -> np.ndarray:
 
 
 def evaluate(Y: sp.Matrix, robot, q, qd, qdd) -> np.ndarray:
-    values = {s: np.array([v]) for s, v in zip(list(robot.q) + list(robot.qd) + list(robot.qdd),
-                                                 list(q) + list(qd) + list(qdd))}
+    values = {
+        s: np.array([v])
+        for s, v in zip(list(robot.q) + list(robot.qd) + list(robot.qdd), list(q) + list(qd) + list(qdd))
+    }
     return dag.evaluate(Y, values)[:, :, 0]
 
 
@@ -145,10 +147,12 @@ def test_numeric_regressor_matches_pinocchio(name):
         theirs = np.asarray(theirs)[P.inv]  # rows in armdyn's order
         for jid in range(1, P.model.njoints):
             name_j = P.model.names[jid]
-            a = ours[:, blocks[name_j]: blocks[name_j] + 10]
-            b = theirs[:, 10 * (jid - 1): 10 * jid]
-            if not any(j.parent == robot.movable_joints[robot.coordinate_names.index(name_j)].child and not j.movable
-                       for j in robot.joints):
+            a = ours[:, blocks[name_j] : blocks[name_j] + 10]
+            b = theirs[:, 10 * (jid - 1) : 10 * jid]
+            if not any(
+                j.parent == robot.movable_joints[robot.coordinate_names.index(name_j)].child and not j.movable
+                for j in robot.joints
+            ):
                 np.testing.assert_allclose(a, b, rtol=0, atol=1e-11 * max(1.0, np.abs(b).max()))
                 checked += 1
         pin_pi = np.concatenate([P.model.inertias[j].toDynamicParameters() for j in range(1, P.model.njoints)])
@@ -183,7 +187,11 @@ def test_base_parameter_count_equals_numeric_rank(name, terms):
     base = base_parameters(symbolic)
     numeric = with_terms(robot, terms=joint_terms) if terms else robot
     B = len(base.names)
-    assert B == numeric_rank(numeric) == exact_rank(base.regressor.Y, state_symbols=list(robot.q) + list(robot.qd) + list(robot.qdd))
+    assert (
+        B
+        == numeric_rank(numeric)
+        == exact_rank(base.regressor.Y, state_symbols=list(robot.q) + list(robot.qd) + list(robot.qdd))
+    )
     assert base.Y.shape == (robot.dof, B) and len(base.beta) == B
     # zero columns of the numeric regressor are the unidentifiable parameters
     rng = np.random.default_rng(32)
@@ -216,8 +224,14 @@ def test_planar_2r_grouping_by_hand():
     base = base_parameters(robot)
     s = {n: sp.Symbol(n) for n in ("MX1", "MY1", "ZZ1", "M2", "MX2", "MY2", "ZZ2")}
     l1 = robot.parameters["l1"]
-    expected = {"MX1R": s["MX1"] + l1 * s["M2"], "MY1": s["MY1"], "ZZ1R": s["ZZ1"] + l1**2 * s["M2"],
-                "MX2": s["MX2"], "MY2": s["MY2"], "ZZ2": s["ZZ2"]}
+    expected = {
+        "MX1R": s["MX1"] + l1 * s["M2"],
+        "MY1": s["MY1"],
+        "ZZ1R": s["ZZ1"] + l1**2 * s["M2"],
+        "MX2": s["MX2"],
+        "MY2": s["MY2"],
+        "ZZ2": s["ZZ2"],
+    }
     assert dict(zip(base.names, base.beta)) == expected
     assert not any(isinstance(a, sp.Float) for b in base.beta for a in sp.preorder_traversal(b))
     assert {"M1", "XX1", "XX2"} <= set(base.unidentifiable) and "M2" not in base.unidentifiable
@@ -267,7 +281,9 @@ def test_base_parameters_symbolic_geometry():
     rank at random rational geometry."""
     robot = armdyn.load("rp-arm")
     base = base_parameters(with_symbolic_joint_terms(robot))
-    assert len(base.names) == exact_rank(base.regressor.Y, state_symbols=list(robot.q) + list(robot.qd) + list(robot.qdd))
+    assert len(base.names) == exact_rank(
+        base.regressor.Y, state_symbols=list(robot.q) + list(robot.qd) + list(robot.qdd)
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         bound = robot.bind({"l1": 0.7, "g": 9.81, "m1": 1.0, "m2": 2.0})

@@ -12,10 +12,10 @@ import sympy as sp
 
 from armdyn import inertia as inr
 from armdyn.errors import ModelError
+from armdyn.io import ROBOTS_DIR
 from armdyn.model import rot_x, rot_y, rot_z, rpy_matrix
 
 RNG = np.random.default_rng(7)
-from armdyn.io import ROBOTS_DIR
 
 URDF = Path(ROBOTS_DIR) / "iiwa14.urdf"  # the KUKA iiwa 14 of shared/data, bundled
 
@@ -176,7 +176,9 @@ def integrate_tensor(density, pos, *limits):
             lambda: integrate_tensor(
                 m / (sp.pi * (r**2 - ri**2) * h) * s,
                 [s * sp.cos(phi), s * sp.sin(phi), z],
-                (s, ri, r), (phi, 0, 2 * sp.pi), (z, -h / 2, h / 2),
+                (s, ri, r),
+                (phi, 0, 2 * sp.pi),
+                (z, -h / 2, h / 2),
             ),
         ),
         (
@@ -184,7 +186,9 @@ def integrate_tensor(density, pos, *limits):
             lambda: integrate_tensor(
                 m / (sp.Rational(4, 3) * sp.pi * r**3) * s**2 * sp.sin(theta),
                 [s * sp.sin(theta) * sp.cos(phi), s * sp.sin(theta) * sp.sin(phi), s * sp.cos(theta)],
-                (s, 0, r), (theta, 0, sp.pi), (phi, 0, 2 * sp.pi),
+                (s, 0, r),
+                (theta, 0, sp.pi),
+                (phi, 0, 2 * sp.pi),
             ),
         ),
         (
@@ -192,7 +196,8 @@ def integrate_tensor(density, pos, *limits):
             lambda: integrate_tensor(
                 m / (4 * sp.pi * r**2) * r**2 * sp.sin(theta),
                 [r * sp.sin(theta) * sp.cos(phi), r * sp.sin(theta) * sp.sin(phi), r * sp.cos(theta)],
-                (theta, 0, sp.pi), (phi, 0, 2 * sp.pi),
+                (theta, 0, sp.pi),
+                (phi, 0, 2 * sp.pi),
             ),
         ),
     ],
@@ -318,8 +323,15 @@ def test_flags_bad_bodies():
 def test_accepts_physical_bodies():
     for _ in range(20):
         mass, (p, q, t) = RNG.uniform(0.1, 5), RNG.uniform(0.01, 2, 3)
-        shapes = (inr.box(mass, p, q, t), inr.box(mass, p, q, 0), inr.rod(mass, p), inr.point_mass(mass),
-                  inr.cylinder(mass, p, q, "y", t * p / 2), inr.sphere(mass, p), inr.sphere(mass, q, hollow=True))
+        shapes = (
+            inr.box(mass, p, q, t),
+            inr.box(mass, p, q, 0),
+            inr.rod(mass, p),
+            inr.point_mass(mass),
+            inr.cylinder(mass, p, q, "y", t * p / 2),
+            inr.sphere(mass, p),
+            inr.sphere(mass, q, hollow=True),
+        )
         for I in shapes:
             assert inr.physical_violations(mass, inr.rotate(I, random_rotation())) == []
         masses, points = cloud(RNG.integers(2, 30))

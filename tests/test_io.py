@@ -363,7 +363,6 @@ def test_physical_checks_are_the_strict_ones(filename):
     assert robot.dof == 2
 
 
-
 def test_bundled_models_keep_their_names():
     """Each bundled file's `name:` is the robot's name (a DH table must not overwrite it)."""
     import yaml as pyyaml

@@ -66,8 +66,13 @@ def test_three_frames_against_pinocchio(name):
         fid = P.frames[link]
         for frame, ref in frames.items():
             J = pin.getFrameJacobian(P.model, P.data, fid, ref)
-            np.testing.assert_allclose(num.jacobian(robot, q, link, reference_frame=frame), _columns(P, J),
-                                       rtol=0, atol=1e-10, err_msg=f"{link} {frame}")
+            np.testing.assert_allclose(
+                num.jacobian(robot, q, link, reference_frame=frame),
+                _columns(P, J),
+                rtol=0,
+                atol=1e-10,
+                err_msg=f"{link} {frame}",
+            )
     # where a joint's frame is its child link's frame, getJointJacobian agrees too
     checked = 0
     for joint in robot.movable_joints:
@@ -77,8 +82,13 @@ def test_three_frames_against_pinocchio(name):
         checked += 1
         for frame, ref in frames.items():
             J = pin.getJointJacobian(P.model, P.data, jid, ref)
-            np.testing.assert_allclose(num.jacobian(robot, q, joint.child, reference_frame=frame), _columns(P, J),
-                                       rtol=0, atol=1e-10, err_msg=f"{joint.name} {frame}")
+            np.testing.assert_allclose(
+                num.jacobian(robot, q, joint.child, reference_frame=frame),
+                _columns(P, J),
+                rtol=0,
+                atol=1e-10,
+                err_msg=f"{joint.name} {frame}",
+            )
     assert checked >= 1
 
 

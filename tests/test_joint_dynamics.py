@@ -1,5 +1,5 @@
 """Joint friction (viscous Fv, Coulomb Fc), rotor inertia Ia, torque offset and payloads
-(DESIGN.md: ``tau = M qdd + C qd + g + Ia qdd + Fv qd + Fc sign(qd) + offset``).
+(docs/architecture.md: ``tau = M qdd + C qd + g + Ia qdd + Fv qd + Fc sign(qd) + offset``).
 
 Second opinions:
 * symbolic: Newton-Euler (terms added joint by joint) == Lagrange (the rotor inertia as
@@ -42,7 +42,9 @@ def numeric_arm(name: str, seed: int = 0) -> Robot:
         warnings.simplefilter("ignore")
         robot = armdyn.load(name, strict=False).bind()
         missing = sorted(s.name for s in robot.free_symbols())
-        values = {n: (rng.uniform(0.01, 0.1) if n[:3] in ("Ixy", "Ixz", "Iyz") else rng.uniform(0.5, 2.0)) for n in missing}
+        values = {
+            n: (rng.uniform(0.01, 0.1) if n[:3] in ("Ixy", "Ixz", "Iyz") else rng.uniform(0.5, 2.0)) for n in missing
+        }
         return robot.bind(values) if values else robot
 
 
@@ -57,8 +59,17 @@ def with_terms(robot: Robot, seed: int = 1, terms=TERMS) -> Robot:
         joints.append(j)
     with warnings.catch_warnings():  # published non-physical sets, warned about elsewhere
         warnings.simplefilter("ignore")
-        return Robot(robot.name, robot.links.values(), joints, robot.gravity, robot.parameters, robot.meta,
-                     robot.base, robot.defaults, strict=False)
+        return Robot(
+            robot.name,
+            robot.links.values(),
+            joints,
+            robot.gravity,
+            robot.parameters,
+            robot.meta,
+            robot.base,
+            robot.defaults,
+            strict=False,
+        )
 
 
 def closed_form(robot, qd, qdd):
@@ -105,14 +116,17 @@ def test_yaml_terms_and_gear_ratio():
     assert math.isclose(float(bound.joints[0].armature), 25.0)
 
 
-@pytest.mark.parametrize("entry, message", [
-    ("damping: -1", "damping -1"),
-    ("friction: .nan", "friction"),
-    ("armature: .inf", "armature"),
-    ("armature: 1, rotor_inertia: 2", "either armature or rotor_inertia"),
-    ("gear_ratio: 3", "gear_ratio without rotor_inertia"),
-    ("rotor_inertia: -1, gear_ratio: 2", "armature -4 is negative"),
-])
+@pytest.mark.parametrize(
+    "entry, message",
+    [
+        ("damping: -1", "damping -1"),
+        ("friction: .nan", "friction"),
+        ("armature: .inf", "armature"),
+        ("armature: 1, rotor_inertia: 2", "either armature or rotor_inertia"),
+        ("gear_ratio: 3", "gear_ratio without rotor_inertia"),
+        ("rotor_inertia: -1, gear_ratio: 2", "armature -4 is negative"),
+    ],
+)
 def test_bad_yaml_terms_name_file_and_joint(entry, message):
     text = f"""
 name: bad
@@ -145,9 +159,17 @@ def test_urdf_dynamics_read_and_validated(tmp_path):
     tau = num.rnea(robot, [0.1], [-2.0], [0.0])
     assert np.isfinite(tau).all()
     np.testing.assert_allclose(tau - ref.rnea(robot.subs({}), [0.1], [-2.0], [0.0]), 0, atol=1e-14)
-    np.testing.assert_allclose(tau - num.rnea(Robot(robot.name, robot.links.values(),
-                               [replace(j, damping=None, friction=None)], robot.gravity), [0.1], [-2.0], [0.0]),
-                               [0.3 * -2.0 - 0.2], rtol=1e-14)
+    np.testing.assert_allclose(
+        tau
+        - num.rnea(
+            Robot(robot.name, robot.links.values(), [replace(j, damping=None, friction=None)], robot.gravity),
+            [0.1],
+            [-2.0],
+            [0.0],
+        ),
+        [0.3 * -2.0 - 0.2],
+        rtol=1e-14,
+    )
     bad = tmp_path / "bad.urdf"
     bad.write_text(urdf.replace("DAMP", "-0.3"))
     with pytest.raises(ModelError) as err:
@@ -167,7 +189,9 @@ dh:
     assert float(robot.joints[0].damping) == 0.2 and float(robot.joints[1].torque_offset) == 0.05
     q, qd, qdd = np.array([0.3, -0.2]), np.array([0.5, -1.0]), np.array([1.0, 2.0])
     expected = [0.1 * 1.0 + 0.2 * 0.5, -0.3 + 0.05]
-    plain = load_yaml_string(text.replace(", damping: 0.2, armature: 0.1", "").replace(", friction: 0.3, torque_offset: 0.05", ""))
+    plain = load_yaml_string(
+        text.replace(", damping: 0.2, armature: 0.1", "").replace(", friction: 0.3, torque_offset: 0.05", "")
+    )
     np.testing.assert_allclose(num.rnea(robot, q, qd, qdd) - num.rnea(plain, q, qd, qdd), expected, rtol=1e-13)
 
 
@@ -181,8 +205,17 @@ def symbolic_terms(robot: Robot) -> Robot:
             k = robot.link_index(j.child)
             j = replace(j, **{t: sp.Symbol(f"{t[:3]}{k}") for t in TERMS})
         joints.append(j)
-    return Robot(robot.name, robot.links.values(), joints, robot.gravity, robot.parameters, robot.meta,
-                 robot.base, robot.defaults, strict=False)
+    return Robot(
+        robot.name,
+        robot.links.values(),
+        joints,
+        robot.gravity,
+        robot.parameters,
+        robot.meta,
+        robot.base,
+        robot.defaults,
+        strict=False,
+    )
 
 
 @pytest.mark.parametrize("name", ["rp-arm", "planar-2r", "planar-3r"])
@@ -196,9 +229,11 @@ def test_newton_euler_equals_lagrange_with_terms(name):
     rigid = armdyn.derive(armdyn.load(name), "lagrange")
     ia = [sp.Symbol(f"arm{robot.link_index(j.child)}") for j in robot.movable_joints]
     assert sp.expand(eom.M - rigid.M - sp.diag(*ia)) == sp.zeros(robot.dof, robot.dof)
-    assert list(eom.friction) == [sp.Symbol(f"dam{robot.link_index(j.child)}") * robot.qd[k]
-                                  + sp.Symbol(f"fri{robot.link_index(j.child)}") * sp.sign(robot.qd[k])
-                                  for k, j in enumerate(robot.movable_joints)]
+    assert list(eom.friction) == [
+        sp.Symbol(f"dam{robot.link_index(j.child)}") * robot.qd[k]
+        + sp.Symbol(f"fri{robot.link_index(j.child)}") * sp.sign(robot.qd[k])
+        for k, j in enumerate(robot.movable_joints)
+    ]
 
 
 def test_no_terms_no_change():
@@ -224,7 +259,9 @@ def test_engines_agree_with_terms(name):
         assert np.isfinite(tau).all()
         scale = max(1.0, np.abs(tau).max())
         np.testing.assert_allclose(tau, ref.rnea(robot, q, qd, qdd), rtol=0, atol=1e-12 * scale)
-        np.testing.assert_allclose(tau - num.rnea(rigid, q, qd, qdd), closed_form(robot, qd, qdd), rtol=0, atol=1e-12 * scale)
+        np.testing.assert_allclose(
+            tau - num.rnea(rigid, q, qd, qdd), closed_form(robot, qd, qdd), rtol=0, atol=1e-12 * scale
+        )
         if f is not None:
             np.testing.assert_allclose(np.ravel(f(q, qd, qdd)), tau, rtol=0, atol=1e-11 * scale)
         M = num.crba(robot, q)
@@ -254,7 +291,7 @@ def test_batch_equals_loop_with_terms():
 
 @pytest.mark.parametrize("name", ["puma560", "ur5", "panda", "iiwa14", "stanford"])
 def test_pinocchio_armature_and_closed_form(name):
-    pin = pytest.importorskip("pinocchio")
+    pytest.importorskip("pinocchio")
     from pinocchio_bridge import PinocchioRobot
 
     robot = with_terms(numeric_arm(name))
@@ -275,7 +312,9 @@ def test_pinocchio_armature_and_closed_form(name):
 
 # ------------------------------------------------------------------ payload
 
-PAYLOAD = dict(mass=1.7, com=[0.02, -0.03, 0.11], inertia=[[0.012, 0.001, 0.0], [0.001, 0.015, 0.002], [0.0, 0.002, 0.009]])
+PAYLOAD = dict(
+    mass=1.7, com=[0.02, -0.03, 0.11], inertia=[[0.012, 0.001, 0.0], [0.001, 0.015, 0.002], [0.0, 0.002, 0.009]]
+)
 
 
 def as_fixed_link(robot: Robot, link: str) -> Robot:
@@ -284,8 +323,17 @@ def as_fixed_link(robot: Robot, link: str) -> Robot:
     joint = Joint("payload_joint", "fixed", link, "payload")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return Robot(robot.name, list(robot.links.values()) + [load], robot.joints + [joint], robot.gravity,
-                     robot.parameters, robot.meta, robot.base, robot.defaults, strict=False)
+        return Robot(
+            robot.name,
+            list(robot.links.values()) + [load],
+            robot.joints + [joint],
+            robot.gravity,
+            robot.parameters,
+            robot.meta,
+            robot.base,
+            robot.defaults,
+            strict=False,
+        )
 
 
 @pytest.mark.parametrize("name", BUNDLED)
@@ -332,16 +380,19 @@ def test_payload_symbolic_agrees():
     assert armdyn.prove_agreement(loaded, exact=True)
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    (dict(mass=-1.0), "mass -1 is negative"),
-    (dict(mass=1.0, inertia=[[1, 0, 0], [0, 1, 0], [0, 0, 3]]), "triangle inequality"),
-    (dict(mass=1.0, inertia=[[1, 0, 0], [0, -1, 0], [0, 0, 1]]), "positive semi-definite"),
-    (dict(mass=float("nan")), "not finite"),
-    (dict(mass=1.0, com=[0, float("inf"), 0]), "not finite"),
-    (dict(mass=1.0, com=[0, 0]), "3 components"),
-    (dict(mass=1.0, link="nope"), "no link named 'nope'"),
-    (dict(mass=1.0, link="base"), "does not move"),
-])
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(mass=-1.0), "mass -1 is negative"),
+        (dict(mass=1.0, inertia=[[1, 0, 0], [0, 1, 0], [0, 0, 3]]), "triangle inequality"),
+        (dict(mass=1.0, inertia=[[1, 0, 0], [0, -1, 0], [0, 0, 1]]), "positive semi-definite"),
+        (dict(mass=float("nan")), "not finite"),
+        (dict(mass=1.0, com=[0, float("inf"), 0]), "not finite"),
+        (dict(mass=1.0, com=[0, 0]), "3 components"),
+        (dict(mass=1.0, link="nope"), "no link named 'nope'"),
+        (dict(mass=1.0, link="base"), "does not move"),
+    ],
+)
 def test_bad_payload(kwargs, message):
     robot = armdyn.load("ur5")
     if kwargs.get("link") == "base":

@@ -30,12 +30,31 @@ from armdyn.symbolic.report import derivation_report, latex_symbol_names, steps_
 
 IMPLICIT = standard_transformations + (implicit_multiplication,)
 # the exercise's symbols spelled in ASCII, written out here (not taken from the printer)
-SPELLED = {"θ̈₁": "theta1_ddot", "θ̇₁": "theta1_dot", "θ₁": "theta1", "d̈₂": "d2_ddot", "ḋ₂": "d2_dot", "d₂": "d2",
-           "m₁": "m1", "m₂": "m2", "l₁": "l1", "²": "**2", "³": "**3", "·": "*", "−": "-"}
+SPELLED = {
+    "θ̈₁": "theta1_ddot",
+    "θ̇₁": "theta1_dot",
+    "θ₁": "theta1",
+    "d̈₂": "d2_ddot",
+    "ḋ₂": "d2_dot",
+    "d₂": "d2",
+    "m₁": "m1",
+    "m₂": "m2",
+    "l₁": "l1",
+    "²": "**2",
+    "³": "**3",
+    "·": "*",
+    "−": "-",
+}
 M1, M2, L1, G, TH, D, THD, DD, THDD, DDD = sp.symbols("m1 m2 l1 g theta1 d2 theta1_dot d2_dot theta1_ddot d2_ddot")
 # the exercise's result (assignment 7, by hand)
-TAU1 = ((M1 + M2) * L1**2 * THDD + M2 * L1 * DDD + 2 * M2 * D * THD * DD + M2 * THDD * D**2
-        + (M1 + M2) * G * L1 * sp.cos(TH) - M2 * G * D * sp.sin(TH))
+TAU1 = (
+    (M1 + M2) * L1**2 * THDD
+    + M2 * L1 * DDD
+    + 2 * M2 * D * THD * DD
+    + M2 * THDD * D**2
+    + (M1 + M2) * G * L1 * sp.cos(TH)
+    - M2 * G * D * sp.sin(TH)
+)
 TAU2 = M2 * (L1 * THDD - THD**2 * D + DDD + G * sp.cos(TH))
 LOCALS = {str(s): s for s in (M1, M2, L1, G, TH, D, THD, DD, THDD, DDD)}
 
@@ -127,9 +146,18 @@ def test_ascii_keeps_a_plain_parseable_form(rp):
 def test_latex_symbol_names_as_written_by_hand(rp):
     robot, ne, _ = rp
     names = {str(k): v for k, v in latex_symbol_names(robot).items()}
-    expected = {"theta1": r"\theta_{1}", "theta1_dot": r"\dot{\theta}_{1}", "theta1_ddot": r"\ddot{\theta}_{1}",
-                "d2": "d_{2}", "d2_dot": r"\dot{d}_{2}", "d2_ddot": r"\ddot{d}_{2}", "l1": "l_{1}", "m1": "m_{1}",
-                "m2": "m_{2}", "g": "g"}
+    expected = {
+        "theta1": r"\theta_{1}",
+        "theta1_dot": r"\dot{\theta}_{1}",
+        "theta1_ddot": r"\ddot{\theta}_{1}",
+        "d2": "d_{2}",
+        "d2_dot": r"\dot{d}_{2}",
+        "d2_ddot": r"\ddot{d}_{2}",
+        "l1": "l_{1}",
+        "m1": "m_{1}",
+        "m2": "m_{2}",
+        "g": "g",
+    }
     assert names == expected
     assert latex_symbol_names(robot) is latex_symbol_names(robot)  # built once per robot
     planar = armdyn.load("planar-2r")  # the field's l_{c1}: distance to the centre of mass
@@ -278,11 +306,13 @@ def test_grade_html_shows_skipped_equations_as_math(tmp_path):
     from armdyn.grade.html import report_html
 
     sub = tmp_path / "sub.md"
-    sub.write_text("---\nrobot: rp-arm\nmethod: newton-euler\n---\n"
-                   "$$\\mathbf{r}_P = \\mathbf{r}_C + \\mathbf{d}$$\n\n"
-                   "$$\\text{<script>alert(1)</script>} = 1$$\n\n"
-                   "$$\\omega_1 = \\begin{pmatrix} 0 \\\\ 0 \\\\ \\dot{\\theta}_1 \\end{pmatrix}$$\n",
-                   encoding="utf-8")
+    sub.write_text(
+        "---\nrobot: rp-arm\nmethod: newton-euler\n---\n"
+        "$$\\mathbf{r}_P = \\mathbf{r}_C + \\mathbf{d}$$\n\n"
+        "$$\\text{<script>alert(1)</script>} = 1$$\n\n"
+        "$$\\omega_1 = \\begin{pmatrix} 0 \\\\ 0 \\\\ \\dot{\\theta}_1 \\end{pmatrix}$$\n",
+        encoding="utf-8",
+    )
     report = armdyn.grade.grade(sub)
     skipped = [s for s in report.steps if s.status == "unrecognised"]
     assert len(skipped) == 2

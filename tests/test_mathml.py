@@ -66,18 +66,29 @@ def test_double_dot_and_latin_coordinate():
 
 def test_same_structure_as_latex_written_by_hand():
     pytest.importorskip("latex2mathml")
-    for name, latex in [("theta1_dot", r"\dot{\theta}_1"), ("d2_ddot", r"\ddot{d}_2"), ("l1", "l_1"),
-                        ("alpha3", r"\alpha_3"), ("theta12", r"\theta_{12}")]:
+    for name, latex in [
+        ("theta1_dot", r"\dot{\theta}_1"),
+        ("d2_ddot", r"\ddot{d}_2"),
+        ("l1", "l_1"),
+        ("alpha3", r"\alpha_3"),
+        ("theta12", r"\theta_{12}"),
+    ]:
         ours = shape(body(parse(to_mathml(sym(name)))))
         theirs = shape(body(parse(latex_to_mathml(latex))))
         assert ours == theirs, (name, ours, theirs)
 
 
-@pytest.mark.parametrize("name, base, index", [
-    ("l1", "l", ("mn", "1")), ("m2", "m", ("mn", "2")), ("theta12", "\u03b8", ("mn", "12")),
-    ("Theta3", "\u0398", ("mn", "3")), ("a_i", "a", ("mi", "i")),
-    ("I1xx", "I", ("mrow", (("mn", "1"), ("mi", "x"), ("mi", "x")))),
-])
+@pytest.mark.parametrize(
+    "name, base, index",
+    [
+        ("l1", "l", ("mn", "1")),
+        ("m2", "m", ("mn", "2")),
+        ("theta12", "\u03b8", ("mn", "12")),
+        ("Theta3", "\u0398", ("mn", "3")),
+        ("a_i", "a", ("mi", "i")),
+        ("I1xx", "I", ("mrow", (("mn", "1"), ("mi", "x"), ("mi", "x")))),
+    ],
+)
 def test_indices_and_greek(name, base, index):
     e = body(parse(to_mathml(sym(name))))
     assert e.tag == "msub" and e[0].text == base and shape(e[1]) == index

@@ -189,13 +189,19 @@ def test_a_leader_moving_nothing_is_not_idle_when_its_mimic_moves_mass():
     """The leader's own link is massless but its mimic moves a mass: M is regular, no
     warning; with the mimic's link massless too, the warning names the leader."""
     xml = ARM.replace('<mass value="0.1"/>', '<mass value="0"/>').replace(
-        'ixx="0.0001" iyy="0.0001" izz="0.0001"', 'ixx="0" iyy="0" izz="0"')
+        'ixx="0.0001" iyy="0.0001" izz="0.0001"', 'ixx="0" iyy="0" izz="0"'
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("error", MasslessWarning)
         load_urdf(xml)
-    xml = xml.replace('<mass value="0.12"/>', '<mass value="0"/>').replace(
-        'ixx="0.0001" iyy="0.0002" izz="0.0001"', 'ixx="0" iyy="0" izz="0"').replace(
-        '<mass value="0.05"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5"', '<mass value="0"/><inertia ixx="0" iyy="0" izz="0"')
+    xml = (
+        xml.replace('<mass value="0.12"/>', '<mass value="0"/>')
+        .replace('ixx="0.0001" iyy="0.0002" izz="0.0001"', 'ixx="0" iyy="0" izz="0"')
+        .replace(
+            '<mass value="0.05"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5"',
+            '<mass value="0"/><inertia ixx="0" iyy="0" izz="0"',
+        )
+    )
     with pytest.warns(MasslessWarning, match="finger_left"):
         load_urdf(xml)
 
@@ -208,8 +214,9 @@ def test_symbolic_multiplier_binds():
         numeric.rnea(robot, [0.1], [0.2], [0.3])
     bound = robot.bind({"k": 2, "o": sp.Rational(1, 2)})
     direct = _chain(Mimic("a", 2, sp.Rational(1, 2)), Mimic("a", 1, 0))
-    np.testing.assert_allclose(numeric.rnea(bound, [0.1], [0.2], [0.3]), numeric.rnea(direct, [0.1], [0.2], [0.3]),
-                               rtol=1e-14)
+    np.testing.assert_allclose(
+        numeric.rnea(bound, [0.1], [0.2], [0.3]), numeric.rnea(direct, [0.1], [0.2], [0.3]), rtol=1e-14
+    )
 
 
 # ------------------------------------------------------------------ Pinocchio
@@ -235,7 +242,8 @@ def test_arm_agrees_with_pinocchio_mimic_model(arm):
         T = sum(0.5 * data.v[j].np @ (model.inertias[j] * data.v[j]).np for j in range(1, model.njoints))
         V = welded_potential_energy(arm) - sum(
             model.inertias[j].mass * model.gravity.linear @ (data.oMi[j] * model.inertias[j].lever)
-            for j in range(1, model.njoints))
+            for j in range(1, model.njoints)
+        )
         pin.computeJointJacobians(model, data, qp)
         for engine in ENGINES:
             np.testing.assert_allclose(engine.kinetic_energy(arm, q, qd), T, rtol=1e-12)
@@ -304,8 +312,10 @@ def test_identities(arm):
         N = Mdot - 2 * C
         np.testing.assert_allclose(N, -N.T, atol=1e-8)
         # g = dV/dq and J qd = d/dt of every link's origin and orientation
-        dV = [(numeric.potential_energy(arm, q + eps * e) - numeric.potential_energy(arm, q - eps * e)) / (2 * eps)
-              for e in np.eye(arm.dof)]
+        dV = [
+            (numeric.potential_energy(arm, q + eps * e) - numeric.potential_energy(arm, q - eps * e)) / (2 * eps)
+            for e in np.eye(arm.dof)
+        ]
         np.testing.assert_allclose(dV, g, rtol=1e-7, atol=1e-8)
         X1, X0 = numeric.forward_kinematics(arm, q + eps * qd), numeric.forward_kinematics(arm, q - eps * qd)
         for i, name in enumerate(arm.links):

@@ -55,8 +55,9 @@ def test_notebooks_are_stored_without_outputs():
 @pytest.mark.parametrize("name", NAMES)
 def test_notebook_runs(name, kernel_env):
     book = nbformat.read(NOTEBOOKS / f"{name}.ipynb", as_version=4)
-    client = nbclient.NotebookClient(book, timeout=CELL_TIMEOUT, kernel_name=KERNEL,
-                                     resources={"metadata": {"path": str(NOTEBOOKS)}})
+    client = nbclient.NotebookClient(
+        book, timeout=CELL_TIMEOUT, kernel_name=KERNEL, resources={"metadata": {"path": str(NOTEBOOKS)}}
+    )
     client.execute()  # raises CellExecutionError on the first failing cell
     last = [c for c in book.cells if c.cell_type == "code"][-1]
     printed = "".join(o.get("text", "") for o in last.outputs if o.output_type == "stream")

@@ -3,7 +3,7 @@
 * Pinocchio and armdyn.reference to 1e-12 relative, for every function, on random chains and
   branched trees with mixed revolute/prismatic/fixed joints and arbitrary frames;
 * the symbolic engine (lambdified Newton-Euler tau) on every bundled model;
-* the identities of DESIGN.md on random branched trees;
+* the identities of docs/architecture.md on random branched trees;
 * batches == loops of single calls, bit for bit; threads=1 == threads=2, bit for bit;
 * bad input: wrong shapes, NaN/inf -> ValueError naming the argument; unbound parameters ->
   UnboundParameterError naming them.
@@ -17,14 +17,14 @@ import warnings
 import numpy as np
 import pytest
 import sympy as sp
+from pinocchio_bridge import PinocchioRobot
+from random_models import random_case, random_robot, random_state
 
 import armdyn
 from armdyn import numeric as num
 from armdyn import reference as ref
 from armdyn.errors import UnboundParameterError
 from armdyn.model import Joint, Link, Robot
-from pinocchio_bridge import PinocchioRobot
-from random_models import random_case, random_robot, random_state
 
 RTOL = 1e-12
 
@@ -163,7 +163,7 @@ def test_other_dtypes_and_layouts_are_converted(case):
     assert np.array_equal(num.crba(robot, f32), num.crba(robot, f32.astype(np.float64)))
 
 
-# ------------------------------------------------------------------ identities (DESIGN.md)
+# ------------------------------------------------------------------ identities (docs/architecture.md)
 
 
 def test_identities_on_branched_trees(trees):

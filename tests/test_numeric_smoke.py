@@ -5,11 +5,10 @@ independently in both libraries from the same numbers; plus the input checks."""
 import numpy as np
 import pytest
 import sympy as sp
-
-from armdyn import Joint, Link, Robot
-from armdyn import numeric
-from armdyn.errors import UnboundParameterError
 from optional import needs_pinocchio, pin
+
+from armdyn import Joint, Link, Robot, numeric
+from armdyn.errors import UnboundParameterError
 
 RNG = np.random.default_rng(20240611)
 
@@ -74,7 +73,9 @@ def build_pair(rng=RNG):
         if jtype == "fixed":
             carrier[name] = (pj, placement)
         else:
-            jm = pin.JointModelRevoluteUnaligned(axis) if jtype == "revolute" else pin.JointModelPrismaticUnaligned(axis)
+            jm = (
+                pin.JointModelRevoluteUnaligned(axis) if jtype == "revolute" else pin.JointModelPrismaticUnaligned(axis)
+            )
             pj = pmodel.addJoint(pj, jm, placement, f"j{k}")
             carrier[name] = (pj, pin.SE3.Identity())
         pj, offset = carrier[name]
@@ -118,7 +119,9 @@ def test_matches_pinocchio(pair):
         pin.framesForwardKinematics(pmodel, pdata, q)
         # Pinocchio leaves out links welded to the base (l8); armdyn counts their constant
         l8 = robot.links["l8"]
-        welded = -float(l8.mass) * pmodel.gravity.linear @ pdata.oMf[frame_ids["l8"]].act(np.array(l8.com, float).ravel())
+        welded = (
+            -float(l8.mass) * pmodel.gravity.linear @ pdata.oMf[frame_ids["l8"]].act(np.array(l8.com, float).ravel())
+        )
         close(numeric.potential_energy(robot, q), pin.computePotentialEnergy(pmodel, pdata, q) + welded)
         x = numeric.forward_kinematics(robot, q)
         assert x.shape == (len(robot.links), 4, 4)
@@ -135,10 +138,17 @@ def test_batch_equals_single_calls(pair):
     for rows in (1, 5, 300):
         q, qd, qdd = (RNG.uniform(-3, 3, (rows, n)) for _ in range(3))
         for threads in (1, 2, None):
-            for name, args in [("rnea", (q, qd, qdd)), ("aba", (q, qd, qdd)), ("crba", (q,)),
-                               ("gravity", (q,)), ("bias", (q, qd)), ("coriolis_matrix", (q, qd)),
-                               ("kinetic_energy", (q, qd)), ("potential_energy", (q,)),
-                               ("forward_kinematics", (q,))]:
+            for name, args in [
+                ("rnea", (q, qd, qdd)),
+                ("aba", (q, qd, qdd)),
+                ("crba", (q,)),
+                ("gravity", (q,)),
+                ("bias", (q, qd)),
+                ("coriolis_matrix", (q, qd)),
+                ("kinetic_energy", (q, qd)),
+                ("potential_energy", (q,)),
+                ("forward_kinematics", (q,)),
+            ]:
                 f = getattr(numeric, name)
                 out = f(robot, *args, threads=threads)
                 loop = np.array([f(robot, *(a[r] for a in args)) for r in range(rows)])
@@ -158,7 +168,9 @@ def test_inputs_are_converted_and_checked(pair):
     assert np.array_equal(numeric.rnea(robot, q32, q32, q32), numeric.rnea(robot, *[q32.astype(float)] * 3))
     qf = np.asfortranarray(np.stack([q, q]))
     assert np.array_equal(numeric.rnea(robot, qf, qf, qf)[1], want)
-    assert np.array_equal(numeric.rnea(robot, np.stack([q, q])[:, ::1], q[None].repeat(2, 0), np.stack([q, q]))[0], want)
+    assert np.array_equal(
+        numeric.rnea(robot, np.stack([q, q])[:, ::1], q[None].repeat(2, 0), np.stack([q, q]))[0], want
+    )
     with pytest.raises(ValueError, match="qd: expected shape"):
         numeric.rnea(robot, q, q[:-1], q)
     with pytest.raises(ValueError, match="qdd: shape"):

@@ -45,7 +45,7 @@ def test_numeric_equals_symbolic_on_bundled(name):
     q, qd, qdd = (rng.uniform(-np.pi, np.pi, (samples, n)) for _ in range(3))
     eom = derive(robot, "newton-euler")
     values = {s: col for s, col in zip(list(eom.q) + list(eom.qd) + list(eom.qdd), np.hstack([q, qd, qdd]).T)}
-    tau_sym = dag.evaluate(eom.tau, values)[:, 0, :].T      # (samples, n)
+    tau_sym = dag.evaluate(eom.tau, values)[:, 0, :].T  # (samples, n)
     M_sym = np.moveaxis(dag.evaluate(eom.M, values), -1, 0)  # (samples, n, n)
     g_sym = dag.evaluate(eom.g, values)[:, 0, :].T
     scale = max(1.0, np.abs(tau_sym).max())

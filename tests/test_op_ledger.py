@@ -35,8 +35,12 @@ def _ledger() -> dict:
 
 
 def _cases():
-    return [(entry["name"], key) for entry in bundled_robots() for key in ("standard", "base")
-            if (entry["name"], key) not in TOO_SLOW]
+    return [
+        (entry["name"], key)
+        for entry in bundled_robots()
+        for key in ("standard", "base")
+        if (entry["name"], key) not in TOO_SLOW
+    ]
 
 
 def test_ledger_covers_every_bundled_arm():
@@ -75,5 +79,6 @@ def test_operation_counts_do_not_rise(name, key):
             elif now < was:
                 falls.append(f"{w} {kind} {was} -> {now}")
     assert not rises, f"{name} ({key} parameters): operation counts rose: {'; '.join(rises)}"
-    assert not falls, (f"{name} ({key} parameters): operation counts fell ({'; '.join(falls)}): "
-                       f"write the new ledger with {REGENERATE}")
+    assert not falls, (
+        f"{name} ({key} parameters): operation counts fell ({'; '.join(falls)}): write the new ledger with {REGENERATE}"
+    )

@@ -7,12 +7,12 @@ from __future__ import annotations
 
 import numpy as np
 import sympy as sp
+from test_codegen import WRIST_3R, _close, _load, _model_point, _numeric, _states, _substituted, _values, needs_cc
 
 import armdyn
 import armdyn.codegen as codegen
 from armdyn.programs.customized_ne import customized_newton_euler, standard_parameters
 from armdyn.symbolic import derive
-from test_codegen import WRIST_3R, _close, _load, _model_point, _numeric, _states, _substituted, _values, needs_cc
 
 
 def _wrist_3r(tmp_path):
@@ -20,7 +20,6 @@ def _wrist_3r(tmp_path):
     path = tmp_path / "wrist-3r.yaml"
     path.write_text(WRIST_3R)
     return _load(str(path))
-
 
 
 def _is_zero_in(expr, angles) -> bool:

@@ -7,11 +7,11 @@ from __future__ import annotations
 
 import numpy as np
 import sympy as sp
+from test_codegen import WRIST_3R, _is_zero, _load
 
 from armdyn.programs.customized_ne import joint_frames
 from armdyn.programs.link_terms import column_from_parent, parent_invariant, squares
 from armdyn.programs.program import Builder, Program
-from test_codegen import WRIST_3R, _is_zero, _load
 
 
 def _wrist_3r(tmp_path):
@@ -19,7 +19,6 @@ def _wrist_3r(tmp_path):
     path = tmp_path / "wrist-3r.yaml"
     path.write_text(WRIST_3R)
     return _load(str(path))
-
 
 
 def test_child_angular_velocity_norm_is_read_off_the_parent(tmp_path):
@@ -42,7 +41,7 @@ def test_child_angular_velocity_norm_is_read_off_the_parent(tmp_path):
             used += 1
             values = dict(b.assignments)  # c2 = cos(q2), ... of the frames
             assert _is_zero((S + wj[0] ** 2 + wj[1] ** 2).xreplace(values), robot), joint.child
-        sq = {"U11": -wj[1] ** 2 - wj[2] ** 2, "U22": -wj[0] ** 2 - wj[2] ** 2, "U33": -wj[0] ** 2 - wj[1] ** 2}
+        sq = {"U11": -(wj[1] ** 2) - wj[2] ** 2, "U22": -(wj[0] ** 2) - wj[2] ** 2, "U33": -(wj[0] ** 2) - wj[1] ** 2}
         U[joint.child] = sp.diag(sq["U11"], sq["U22"], sq["U33"]).tolist()
         w[joint.child] = wj
     assert used == robot.dof

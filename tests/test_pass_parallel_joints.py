@@ -6,17 +6,19 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_codegen import WRIST_3R, _close, _customized_tau_equals_derive, _load
 
 import armdyn
 from armdyn.programs.customized_ne import Forms, customized_newton_euler, standard_parameters
 from armdyn.programs.grouping import grouped_parameters
-from test_codegen import WRIST_3R, _close, _customized_tau_equals_derive, _load
-
 
 # a shoulder, then two parallel joints (alpha 0) with both offsets of the PUMA 560's
 # (a2 along x, d3 along the common axis), every inertial parameter symbolic
-RUN_3R = WRIST_3R.replace("name: wrist-3r", "name: run-3r").replace(
-    "a: 0, alpha: pi/2, d: 0", "a: L2, alpha: 0, d: D3").replace("L1: 0.3,", "L1: 0.3, L2: null, D3: null,")
+RUN_3R = (
+    WRIST_3R.replace("name: wrist-3r", "name: run-3r")
+    .replace("a: 0, alpha: pi/2, d: 0", "a: L2, alpha: 0, d: D3")
+    .replace("L1: 0.3,", "L1: 0.3, L2: null, D3: null,")
+)
 
 
 @pytest.mark.parametrize("grouped", [False, True])
@@ -44,8 +46,9 @@ def test_runs_of_parallel_joints_on_a_tree_agree_with_the_rust_core():
     child of the run's middle link), random physical inertias. The customized
     Newton-Euler with its compound angles evaluated at random states equals the Rust
     core's rnea (a different algorithm: spatial vectors, no runs)."""
-    from armdyn.model import Joint, Robot
     from random_models import random_link
+
+    from armdyn.model import Joint, Robot
 
     rng = np.random.default_rng(21)
     rx = [[1, 0, 0], [0, 0, 1], [0, -1, 0]]  # alpha = -90 deg

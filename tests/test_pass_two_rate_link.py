@@ -8,13 +8,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import sympy as sp
+from random_models import random_link
 
 import armdyn
 from armdyn.model import Joint, Robot
 from armdyn.programs.customized_ne import Forms, customized_newton_euler
 from armdyn.programs.program import Builder
 from armdyn.programs.two_rate_link import TwoRateLink, euler_projections, in_frame, lower_column, point_acceleration
-from random_models import random_link
 
 RX = [[1, 0, 0], [0, 0, 1], [0, -1, 0]]  # alpha = -90 deg: the next axis perpendicular
 
@@ -66,8 +66,9 @@ def test_euler_projections_equal_the_moment_projected(grouped):
         np.testing.assert_allclose(float(along_z), E[2], rtol=1e-12, atol=1e-12)
         # with gravity gz along the root's axis folded in: + ((gz MS) x u)_z; the u part the same
         gMS = rng.uniform(-1, 1, 3)
-        A, rest, along_zg = euler_projections(Builder(), Js, _second(u, rates), "2",
-                                              gravity=[sp.Float(x) for x in gMS[:2]])
+        A, rest, along_zg = euler_projections(
+            Builder(), Js, _second(u, rates), "2", gravity=[sp.Float(x) for x in gMS[:2]]
+        )
         np.testing.assert_allclose(float(A) * rates[1] + float(rest), u @ E, rtol=1e-12, atol=1e-12)
         np.testing.assert_allclose(float(along_zg), E[2] + np.cross(gMS, u)[2], rtol=1e-12, atol=1e-12)
 
@@ -116,14 +117,25 @@ def _arm(origin, gravity, run: bool):
     return Robot("second-link-arm", links, joints, gravity=gravity)
 
 
-@pytest.mark.parametrize("origin, gravity, run", [
-    ([0, 0, 0], (0, 0, -9.81), True),      # PUMA-like: every closed form on
-    ([0, 0, 0.2], (0, 0, -9.81), False),   # origin on the root axis, no run
-    ([0.1, 0.05, 0], (0, 0, -9.81), True),  # origin off the axis: L's origin accelerates otherwise
-    ([0, 0, 0], (1.5, -3.0, -9.0), True),  # gravity off the root axis
-])
-@pytest.mark.parametrize("forms", [Forms(run_links="never"), Forms(run_links="always"), Forms(two_rate_links=False),
-                                   Forms(two_rate_links=False, run_links="never")], ids=repr)
+@pytest.mark.parametrize(
+    "origin, gravity, run",
+    [
+        ([0, 0, 0], (0, 0, -9.81), True),  # PUMA-like: every closed form on
+        ([0, 0, 0.2], (0, 0, -9.81), False),  # origin on the root axis, no run
+        ([0.1, 0.05, 0], (0, 0, -9.81), True),  # origin off the axis: L's origin accelerates otherwise
+        ([0, 0, 0], (1.5, -3.0, -9.0), True),  # gravity off the root axis
+    ],
+)
+@pytest.mark.parametrize(
+    "forms",
+    [
+        Forms(run_links="never"),
+        Forms(run_links="always"),
+        Forms(two_rate_links=False),
+        Forms(two_rate_links=False, run_links="never"),
+    ],
+    ids=repr,
+)
 def test_customized_tau_with_two_rate_links_equals_rust_rnea(origin, gravity, run, forms):
     """tau of the customized Newton-Euler (standard parameters) == the Rust rnea at random
     states, on arms where the second link's closed forms apply in full, in part, or not
@@ -152,8 +164,10 @@ def test_default_keeps_the_shorter_of_with_and_without_run_links(run):
     """The default (run_links "shorter") gives the program of the two, with and without the
     run links' closed forms, that has fewer operations."""
     robot = _arm([0, 0, 0], (0, 0, -9.81), run)
-    totals = [customized_newton_euler(robot, forms=Forms(run_links=r))[0].operation_counts()["total"]
-              for r in ("always", "never")]
+    totals = [
+        customized_newton_euler(robot, forms=Forms(run_links=r))[0].operation_counts()["total"]
+        for r in ("always", "never")
+    ]
     assert customized_newton_euler(robot)[0].operation_counts()["total"] == min(totals)
 
 

@@ -2,7 +2,7 @@
 
 * Pinocchio (an independent implementation, via tests/pinocchio_bridge.py) on random chains
   and branched trees with mixed revolute/prismatic/fixed joints and arbitrary frames;
-* the identities of DESIGN.md;
+* the identities of docs/architecture.md;
 * Spong's hand-derived closed form of the planar 2R arm.
 """
 
@@ -11,11 +11,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import sympy as sp
+from random_models import random_case, random_robot, random_state
 
 from armdyn import reference as ref
 from armdyn.errors import UnboundParameterError
 from armdyn.model import Joint, Link, Robot
-from random_models import random_case, random_robot, random_state
 
 RTOL = 1e-12
 
@@ -87,7 +87,7 @@ def test_kinematics_match_pinocchio(case):
             assert np.array_equal(J, ref.jacobian(robot, q, i))  # by index, same link
 
 
-# ------------------------------------------------------------------ identities (DESIGN.md)
+# ------------------------------------------------------------------ identities (docs/architecture.md)
 
 
 def test_rnea_is_crba_times_qdd_plus_bias(case):
@@ -179,7 +179,9 @@ def test_planar_2r_closed_form():
         c1, s1, c2, s2 = np.cos(q[0]), np.sin(q[0]), np.cos(q[1]), np.sin(q[1])
         c12, s12 = np.cos(q.sum()), np.sin(q.sum())
         d12 = m2 * (lc2**2 + l1 * lc2 * c2) + I2
-        M = np.array([[m1 * lc1**2 + m2 * (l1**2 + lc2**2 + 2 * l1 * lc2 * c2) + I1 + I2, d12], [d12, m2 * lc2**2 + I2]])
+        M = np.array(
+            [[m1 * lc1**2 + m2 * (l1**2 + lc2**2 + 2 * l1 * lc2 * c2) + I1 + I2, d12], [d12, m2 * lc2**2 + I2]]
+        )
         h = -m2 * l1 * lc2 * s2
         C = np.array([[h * qd[1], h * (qd[0] + qd[1])], [-h * qd[0], 0.0]])
         G = np.array([(m1 * lc1 + m2 * l1) * g * c1 + m2 * lc2 * g * c12, m2 * lc2 * g * c12])
@@ -211,7 +213,9 @@ def test_planar_2r_closed_form():
 
 def test_unbound_robot_is_refused():
     m = sp.Symbol("m")
-    robot = Robot("r", [Link("base"), Link("a", m, [0, 0, 0], np.eye(3).tolist())], [Joint("j", "revolute", "base", "a")])
+    robot = Robot(
+        "r", [Link("base"), Link("a", m, [0, 0, 0], np.eye(3).tolist())], [Joint("j", "revolute", "base", "a")]
+    )
     with pytest.raises(UnboundParameterError, match="m"):
         ref.rnea(robot, [0.0], [0.0], [0.0])
     assert ref.rnea(robot.subs({m: 1.0}), [0.0], [0.0], [0.0]).shape == (1,)

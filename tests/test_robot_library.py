@@ -18,13 +18,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from optional import example_robot_data_dir, needs_pinocchio, pin
+from test_urdf import compare_with_pinocchio, pin_configuration
 
 import armdyn.reference as reference
 from armdyn.errors import ModelError
 from armdyn.io import bundled_robots, load
 from armdyn.show import frame_poses
-from optional import example_robot_data_dir, needs_pinocchio, pin
-from test_urdf import compare_with_pinocchio, pin_configuration
 
 ROBOTS = Path(__file__).resolve().parent.parent / "python" / "armdyn" / "robots"
 MINE = ["planar-3r", "scara", "stanford", "ur5", "panda", "iiwa14"]
@@ -213,8 +213,21 @@ def _transplant_inertials(urdf: Path, robot, base_frame: str) -> str:
         inertial = ET.SubElement(elem, "inertial")
         ET.SubElement(inertial, "origin", xyz=" ".join(repr(float(v)) for v in com), rpy="0 0 0")
         ET.SubElement(inertial, "mass", value=repr(float(link.mass)))
-        ET.SubElement(inertial, "inertia", **{k: repr(float(I[i, j])) for k, (i, j) in {
-            "ixx": (0, 0), "iyy": (1, 1), "izz": (2, 2), "ixy": (0, 1), "ixz": (0, 2), "iyz": (1, 2)}.items()})
+        ET.SubElement(
+            inertial,
+            "inertia",
+            **{
+                k: repr(float(I[i, j]))
+                for k, (i, j) in {
+                    "ixx": (0, 0),
+                    "iyy": (1, 1),
+                    "izz": (2, 2),
+                    "ixy": (0, 1),
+                    "ixz": (0, 2),
+                    "iyz": (1, 2),
+                }.items()
+            },
+        )
     return ET.tostring(root, encoding="unicode")
 
 

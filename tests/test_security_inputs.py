@@ -58,8 +58,10 @@ def two_link_urdf(robot: str, j1: str, link: str) -> bytes:
     from xml.sax.saxutils import quoteattr
 
     r, j, lk = (quoteattr(x) for x in (robot, j1, link))
-    inertial = ('<inertial><origin xyz="0.3 0.05 0"/><mass value="1.3"/>'
-                '<inertia ixx="0.02" iyy="0.05" izz="0.06" ixy="0" ixz="0" iyz="0"/></inertial>')
+    inertial = (
+        '<inertial><origin xyz="0.3 0.05 0"/><mass value="1.3"/>'
+        '<inertia ixx="0.02" iyy="0.05" izz="0.06" ixy="0" ixz="0" iyz="0"/></inertial>'
+    )
     return f"""<robot name={r}>
   <link name="base"/>
   <link name={lk}>{inertial}</link>
@@ -72,8 +74,10 @@ def two_link_urdf(robot: str, j1: str, link: str) -> bytes:
 
 def payloads(canary: Path) -> list[str]:
     """Names that end a C comment or a Python docstring and then create ``canary``."""
-    c = ('x */ __attribute__((constructor)) static void armdyn_pwn(void) { extern int system(const char *); '
-         f'system("touch {canary}"); }} /* ')
+    c = (
+        "x */ __attribute__((constructor)) static void armdyn_pwn(void) { extern int system(const char *); "
+        f'system("touch {canary}"); }} /* '
+    )
     py = f'x """ + str(open({str(canary)!r}, "w").close()) + """'
     py2 = f"x ''' + str(open({str(canary)!r}, 'w').close()) + '''"
     trigraph = f'x *??/\n/ int armdyn_pwn = system("touch {canary}"); /*'.replace("\n", " ")
@@ -147,7 +151,7 @@ def test_names_equal_under_nfkc_stay_two_variables(tmp_path, lang):
 
 def test_comment_text_and_identifiers_invariants():
     rng = np.random.default_rng(5)
-    alphabet = list('*/"\\?\'\n\t\x00 ab_1') + ["\uff51", "\u202e", "\u00e9", "\ud7ff"]
+    alphabet = list("*/\"\\?'\n\t\x00 ab_1") + ["\uff51", "\u202e", "\u00e9", "\ud7ff"]
     for _ in range(3000):
         s = "".join(rng.choice(alphabet, size=int(rng.integers(0, 12))))
         t = comment_text(s)
@@ -276,8 +280,9 @@ def deadline(seconds: int):
 def _cli_in_subprocess(args, timeout=60):
     start = time.perf_counter()
     try:
-        res = subprocess.run([sys.executable, "-m", "armdyn", *args], capture_output=True, text=True,
-                             timeout=timeout, env=PYTHON_ENV)
+        res = subprocess.run(
+            [sys.executable, "-m", "armdyn", *args], capture_output=True, text=True, timeout=timeout, env=PYTHON_ENV
+        )
     except subprocess.TimeoutExpired:
         pytest.fail(f"armdyn {' '.join(args)[:80]} still running after {timeout} s")
     return res, time.perf_counter() - start
@@ -295,9 +300,14 @@ def test_alias_bomb_in_a_mapping_field_is_refused_fast(tmp_path, field):
     assert str(info.value).startswith(f"{path}:{bomb_line}: YAML aliases"), str(info.value)
 
 
-@pytest.mark.parametrize("text", ["links: " + "[" * 10_000 + "]" * 10_000,
-                                  "links: " + "{a: " * 3000 + "1" + "}" * 3000,
-                                  "links:\n" + "".join(" " * k + "-\n" for k in range(0, 600, 2)) + " " * 600 + "1"])
+@pytest.mark.parametrize(
+    "text",
+    [
+        "links: " + "[" * 10_000 + "]" * 10_000,
+        "links: " + "{a: " * 3000 + "1" + "}" * 3000,
+        "links:\n" + "".join(" " * k + "-\n" for k in range(0, 600, 2)) + " " * 600 + "1",
+    ],
+)
 def test_deep_nesting_is_a_model_error(tmp_path, text):
     path = tmp_path / "deep.yaml"
     path.write_text("name: deep\n" + text + "\n")
@@ -311,8 +321,10 @@ def test_deep_nesting_is_a_model_error(tmp_path, text):
 def test_huge_integers_name_file_and_line(tmp_path, where):
     n = 2000 if where == "expression" else 5000  # an expression is at most 10^4 characters
     digits = "7" * n
-    text = two_link_yaml("big").replace("mass: 0.8", {"mass": f"mass: {digits}", "parameter": "mass: m",
-                                                      "expression": f'mass: "{digits}/{digits}"'}[where])
+    text = two_link_yaml("big").replace(
+        "mass: 0.8",
+        {"mass": f"mass: {digits}", "parameter": "mass: m", "expression": f'mass: "{digits}/{digits}"'}[where],
+    )
     if where == "parameter":
         text = f"parameters: {{m: {digits}}}\n" + text
     path = tmp_path / "big.yaml"
@@ -324,10 +336,19 @@ def test_huge_integers_name_file_and_line(tmp_path, where):
     assert "4300" not in message
 
 
-@pytest.mark.parametrize("expr", ["(((2**999)**999)**999)**999", "2.0**999.0**999.0**999.0",
-                                  "sin(999.0**999.0**999.0)", "sin(exp(1e300))", "sinh(sinh(sinh(1000.0)))",
-                                  "tan(10.0**300*10.0**300*10.0**300)", "(((2.0**999)**999)**999)**999",
-                                  "m**999.0**999.0"])
+@pytest.mark.parametrize(
+    "expr",
+    [
+        "(((2**999)**999)**999)**999",
+        "2.0**999.0**999.0**999.0",
+        "sin(999.0**999.0**999.0)",
+        "sin(exp(1e300))",
+        "sinh(sinh(sinh(1000.0)))",
+        "tan(10.0**300*10.0**300*10.0**300)",
+        "(((2.0**999)**999)**999)**999",
+        "m**999.0**999.0",
+    ],
+)
 def test_power_towers_end_in_a_message_not_a_signal(tmp_path, expr):
     text = "parameters: {m: 2.0}\n" + two_link_yaml("tower").replace("mass: 0.8", f'mass: "{expr}"')
     path = tmp_path / "tower.yaml"
@@ -337,9 +358,14 @@ def test_power_towers_end_in_a_message_not_a_signal(tmp_path, expr):
     assert res.stderr.startswith(f"armdyn: error: {path}:") and res.stderr.count("\n") == 1, res.stderr
 
 
-@pytest.mark.parametrize("body,message", [("x: &a [1]\ny: *a\n", "aliases"),
-                                          ("x: " + "[" * 5000 + "]" * 5000 + "\n", "nesting deeper"),
-                                          ("x: " + "9" * 5000 + "\n", "5000 digits")])
+@pytest.mark.parametrize(
+    "body,message",
+    [
+        ("x: &a [1]\ny: *a\n", "aliases"),
+        ("x: " + "[" * 5000 + "]" * 5000 + "\n", "nesting deeper"),
+        ("x: " + "9" * 5000 + "\n", "5000 digits"),
+    ],
+)
 def test_submissions_share_the_screen(tmp_path, body, message):
     from armdyn.grade.reader import read
 
@@ -359,13 +385,18 @@ def arm():
 @pytest.mark.parametrize("threads", [True, False, 2**64, 0, -1, 1.5, "2"])
 def test_threads_must_be_a_count(arm, threads):
     q = np.zeros(2)
-    for call in (lambda: armdyn.rnea(arm, q, q, q, threads=threads), lambda: armdyn.crba(arm, q, threads=threads),
-                 lambda: armdyn.aba(arm, q, q, q, threads=threads),
-                 lambda: armdyn.forward_kinematics(arm, q, threads=threads)):
+    for call in (
+        lambda: armdyn.rnea(arm, q, q, q, threads=threads),
+        lambda: armdyn.crba(arm, q, threads=threads),
+        lambda: armdyn.aba(arm, q, q, q, threads=threads),
+        lambda: armdyn.forward_kinematics(arm, q, threads=threads),
+    ):
         with pytest.raises(ValueError, match="^threads: expected None or an integer"):
             call()
-    np.testing.assert_array_equal(armdyn.rnea(arm, np.zeros((3, 2)), np.zeros((3, 2)), np.zeros((3, 2)),
-                                              threads=np.int64(2))[1], armdyn.gravity(arm, q))
+    np.testing.assert_array_equal(
+        armdyn.rnea(arm, np.zeros((3, 2)), np.zeros((3, 2)), np.zeros((3, 2)), threads=np.int64(2))[1],
+        armdyn.gravity(arm, q),
+    )
 
 
 def test_overflow_is_an_error_not_nan_or_singular(arm):
@@ -411,8 +442,10 @@ DTD_URDF = """<?xml version="1.0" encoding="{enc}"?>
 <!DOCTYPE robot [<!ENTITY n "evil"> <!ATTLIST link name CDATA "dflt">]>
 <robot name="&n;"><link name="base"/><link>{inertial}</link>
 <joint name="j1" type="continuous"><parent link="base"/><child link="dflt"/><axis xyz="0 0 1"/></joint></robot>"""
-INERTIAL = ('<inertial><mass value="1"/><origin xyz="0.2 0 0"/>'
-            '<inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>')
+INERTIAL = (
+    '<inertial><mass value="1"/><origin xyz="0.2 0 0"/>'
+    '<inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>'
+)
 
 
 @pytest.mark.parametrize("enc", ["UTF-8", "UTF-16", "UTF-16-LE", "UTF-16-BE", "ISO-8859-1"])
@@ -424,9 +457,11 @@ def test_urdf_dtd_refused_in_every_encoding(enc):
 
 
 def test_urdf_in_utf16_without_dtd_loads_as_utf8():
-    text = ('<?xml version="1.0" encoding="{enc}"?>\n<robot name="r\u00e9"><link name="base"/>'
-            f'<link name="l1">{INERTIAL}</link><joint name="j1" type="continuous"><parent link="base"/>'
-            '<child link="l1"/><axis xyz="0 0 1"/></joint></robot>')
+    text = (
+        '<?xml version="1.0" encoding="{enc}"?>\n<robot name="r\u00e9"><link name="base"/>'
+        f'<link name="l1">{INERTIAL}</link><joint name="j1" type="continuous"><parent link="base"/>'
+        '<child link="l1"/><axis xyz="0 0 1"/></joint></robot>'
+    )
     a = load_urdf(text.format(enc="UTF-16").encode("utf-16"))
     b = load_urdf(text.format(enc="UTF-8").encode("utf-8"))
     q = np.array([0.4])
@@ -436,8 +471,10 @@ def test_urdf_in_utf16_without_dtd_loads_as_utf8():
 
 def test_urdf_names_are_one_line_like_yaml():
     """A character reference put a line break into a URDF name (YAML refused it)."""
-    body = (f'<link name="base"/><link name="l1">{INERTIAL}</link><joint name="j&#10;1" type="continuous">'
-            '<parent link="base"/><child link="l1"/><axis xyz="0 0 1"/></joint>')
+    body = (
+        f'<link name="base"/><link name="l1">{INERTIAL}</link><joint name="j&#10;1" type="continuous">'
+        '<parent link="base"/><child link="l1"/><axis xyz="0 0 1"/></joint>'
+    )
     with pytest.raises(ModelError, match=r"joint #1: name: expected a name \(a one-line string\), got 'j\\n1'"):
         load_urdf(f'<robot name="r">{body}</robot>'.encode())
     with pytest.raises(ModelError, match="<robot>: name: expected a name"):

@@ -19,18 +19,20 @@ pytest.importorskip("starlette")
 pytest.importorskip("sqlalchemy")
 pytest.importorskip("httpx")
 
+from serve_support import EXERCISE, RIGHT, db_url  # noqa: F401
+
 from armdyn.grade import grade
 from armdyn.grade.reader import read_markdown
-from serve_support import EXERCISE, RIGHT, db_url  # noqa: F401
 
 TOKEN = "instructor-secret-for-tests"
 MD = {"content-type": "text/markdown"}
 
 
 def client_for(url: str, **kw):
+    from starlette.testclient import TestClient
+
     from armdyn.serve.app import Settings, build_app
     from armdyn.serve.exercises import catalogue
-    from starlette.testclient import TestClient
 
     kw.setdefault("exercises", catalogue())
     settings = Settings(db=url, workers=1, instructor_token=TOKEN, **kw)
@@ -108,8 +110,10 @@ def test_bad_input_is_a_verdict_not_a_crash(tmp_path):
         body = r.json()
         assert r.status_code == 200 and body["status"] == "done" and "unknown exercise" in body["error"]
         assert c.post("/api/grade?robot=/etc/passwd", content=b"x", headers=MD).status_code == 400
-        assert c.post("/api/grade?robot=rp-arm", content=b"x", headers={"content-type": "application/json"}
-                      ).status_code == 400
+        assert (
+            c.post("/api/grade?robot=rp-arm", content=b"x", headers={"content-type": "application/json"}).status_code
+            == 400
+        )
         assert c.post("/api/grade?robot=rp-arm", content=b"\xff\xfe", headers=MD).status_code == 400
         no_step = c.post("/api/grade?robot=rp-arm", content=b"$$x = 1$$", headers=MD).json()
         assert no_step["status"] == "done" and "no step" in no_step["error"]
@@ -127,9 +131,11 @@ def test_headers_preview_and_openapi(tmp_path):
         assert page.headers["referrer-policy"] == "no-referrer"
         assert "<script" not in page.text.replace('<script src="/static/app.js" defer></script>', "")
         # the preview: MathML for each equation, the step it names, nothing executable
-        hostile = ("$$\\dot{v}_1^1 = \\begin{pmatrix} g \\\\ 0 \\\\ 0 \\end{pmatrix}$$\n"
-                   "$$\\tau_1 = \\text{<script>alert(1)</script>} + \\href{javascript:alert(2)}{x}$$\n"
-                   "<img src=x onerror=alert(3)>\n")
+        hostile = (
+            "$$\\dot{v}_1^1 = \\begin{pmatrix} g \\\\ 0 \\\\ 0 \\end{pmatrix}$$\n"
+            "$$\\tau_1 = \\text{<script>alert(1)</script>} + \\href{javascript:alert(2)}{x}$$\n"
+            "<img src=x onerror=alert(3)>\n"
+        )
         r = c.post("/api/preview?exercise=rp-arm", content=hostile.encode(), headers=MD)
         assert r.status_code == 200
         html = r.json()["html"]
@@ -139,7 +145,8 @@ def test_headers_preview_and_openapi(tmp_path):
         assert "&lt;script&gt;" in html  # the student's markup shown as text
         spec = c.get("/openapi.json").json()
         assert spec["openapi"].startswith("3.") and {"/api/grade", "/api/submissions/{id}", "/api/health"} <= set(
-            spec["paths"])
+            spec["paths"]
+        )
 
 
 def test_forms_need_csrf_and_instructor_token(tmp_path):
@@ -149,8 +156,11 @@ def test_forms_need_csrf_and_instructor_token(tmp_path):
         page = c.get("/")
         csrf = re.search(r'name="csrf" value="([^"]+)"', page.text).group(1)
         assert c.post("/grade", data={"markdown": text, "csrf": "forged"}).status_code == 403
-        r = c.post("/grade", data={"markdown": text, "csrf": csrf, "exercise": "rp-arm", "student": "Ada"},
-                   follow_redirects=False)
+        r = c.post(
+            "/grade",
+            data={"markdown": text, "csrf": csrf, "exercise": "rp-arm", "student": "Ada"},
+            follow_redirects=False,
+        )
         assert r.status_code == 303 and "/submissions/" in r.headers["location"]
         mine = c.get("/")
         assert "Your earlier submissions" in mine.text and "v_dot_1" in mine.text

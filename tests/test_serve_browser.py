@@ -74,8 +74,11 @@ def browser(tmp_path):
 def expected_first_wrong_line(text: str) -> int:
     """The line of the $$ block holding the student's v_dot_1 (the hand-checked first slip)."""
     lines = text.splitlines()
-    return next(i + 1 for i, line in enumerate(lines)
-                if "\\dot{\\boldsymbol{v}}_1^1 &=" in line and line.lstrip().startswith("$$"))
+    return next(
+        i + 1
+        for i, line in enumerate(lines)
+        if "\\dot{\\boldsymbol{v}}_1^1 &=" in line and line.lstrip().startswith("$$")
+    )
 
 
 def test_student_submits_and_sees_first_wrong_step(server, browser, tmp_path):
@@ -90,21 +93,26 @@ def test_student_submits_and_sees_first_wrong_step(server, browser, tmp_path):
     assert n >= 10 and "v_dot_1" in steps and "tau_1" in steps, steps
     shot = os.environ.get("ARMDYN_SERVE_SCREENSHOT")
     if shot:
-        page.eval("var t = document.getElementById('markdown'); document.getElementById('preview').scrollTop = 1400;"
-                  "t.scrollTop = t.scrollHeight * t.value.indexOf('\\\\begin{split}') / t.value.length - 60")
+        page.eval(
+            "var t = document.getElementById('markdown'); document.getElementById('preview').scrollTop = 1400;"
+            "t.scrollTop = t.scrollHeight * t.value.indexOf('\\\\begin{split}') / t.value.length - 60"
+        )
         page.screenshot(shot, full=False)
     page.eval("document.getElementById('grade-button').click()")
-    page.wait_for("location.pathname.startsWith('/submissions/') && document.readyState === 'complete'", 90,
-                  "the submission page")
+    page.wait_for(
+        "location.pathname.startsWith('/submissions/') && document.readyState === 'complete'", 90, "the submission page"
+    )
     page.wait_for("!!document.querySelector('.report .step.first')", 90, "the report")
-    got = json.loads(page.eval("""JSON.stringify((function () {
+    got = json.loads(
+        page.eval("""JSON.stringify((function () {
         var first = document.querySelector('.report .step.first');
         var link = document.querySelector('.report .verdict.fail a');
         var hl = Array.from(first.querySelectorAll('mtd.hl')).map(c => getComputedStyle(c).backgroundColor);
         return {cls: first.className, id: first.id, href: link && link.getAttribute('href'),
                 verdict: document.querySelector('.report .verdict').textContent, hl: hl,
                 shadow: getComputedStyle(first).boxShadow};
-    })())"""))
+    })())""")
+    )
     assert "st-wrong" in got["cls"] and got["href"] == "#" + got["id"]
     assert f"(line {expected_first_wrong_line(text)})" in got["verdict"]
     assert got["hl"] and all(bg not in ("rgba(0, 0, 0, 0)", "transparent") for bg in got["hl"]), got
@@ -147,15 +155,18 @@ def test_script_in_a_submission_never_runs(server, browser):
 
 def login(page, server):
     page.goto(server.base + "/instructor")
-    page.eval(f"document.getElementById('token').value = {json.dumps(TOKEN)}; "
-              "document.querySelector('#login button').click(); true")
+    page.eval(
+        f"document.getElementById('token').value = {json.dumps(TOKEN)}; "
+        "document.querySelector('#login button').click(); true"
+    )
     page.wait_for("!!document.getElementById('gradebook-link')", 30, "the instructor page")
 
 
 def test_instructor_downloads_gradebook(server, browser, tmp_path):
     text = EXERCISE.read_text(encoding="utf-8")
-    status, body = http("POST", f"{server.base}/api/grade?student=Grace", text.encode(),
-                        {"content-type": "text/markdown"})
+    status, body = http(
+        "POST", f"{server.base}/api/grade?student=Grace", text.encode(), {"content-type": "text/markdown"}
+    )
     assert status == 200 and body["first_wrong"] == "v_dot_1"
     page = browser.page()
     login(page, server)

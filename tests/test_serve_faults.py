@@ -27,12 +27,14 @@ AUTH = {"authorization": f"Bearer {TOKEN}"}
 def submit(base: str, n: int, tag: str) -> list[dict]:
     """``n`` distinct submissions (a comment line makes each text unique: no cache),
     alternating the exercise and the right derivation; accepted without waiting."""
-    texts = [(EXERCISE if i % 2 == 0 else RIGHT).read_text(encoding="utf-8") + f"\n<!-- {tag} {i} -->\n"
-             for i in range(n)]
+    texts = [
+        (EXERCISE if i % 2 == 0 else RIGHT).read_text(encoding="utf-8") + f"\n<!-- {tag} {i} -->\n" for i in range(n)
+    ]
 
     def one(i):
-        status, body = http("POST", f"{base}/api/grade?wait=0&student=s{i}", texts[i].encode(),
-                            {"content-type": "text/markdown"})
+        status, body = http(
+            "POST", f"{base}/api/grade?wait=0&student=s{i}", texts[i].encode(), {"content-type": "text/markdown"}
+        )
         assert status in (200, 202), body
         return {"id": body["id"], "token": body["token"], "right": i % 2 == 1}
 

@@ -41,12 +41,20 @@ def test_timeout_kills_the_worker_and_fails_the_submission(tmp_path):
 
 
 def test_memory_limit_caps_the_address_space():
-    code = ("from armdyn.serve.worker import limit_memory\n"
-            "limit_memory(300)\n"
-            "try:\n    block = bytearray(600 * 2**20)\nexcept MemoryError:\n    print('capped')\n"
-            "else:\n    print('allocated', len(block))\n")
-    out = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True, text=True, timeout=120,
-                         env={"PYTHONPATH": str(ROOT / "python"), "PATH": "/usr/bin:/bin"})
+    code = (
+        "from armdyn.serve.worker import limit_memory\n"
+        "limit_memory(300)\n"
+        "try:\n    block = bytearray(600 * 2**20)\nexcept MemoryError:\n    print('capped')\n"
+        "else:\n    print('allocated', len(block))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={"PYTHONPATH": str(ROOT / "python"), "PATH": "/usr/bin:/bin"},
+    )
     assert out.stdout.strip() == "capped", out.stdout + out.stderr
 
 

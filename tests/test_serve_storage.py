@@ -14,12 +14,20 @@ import pytest
 pytest.importorskip("sqlalchemy")
 pytest.importorskip("alembic")
 
-from armdyn.serve.migrations import MIGRATIONS, current_version
-from armdyn.serve.storage import DONE, FAILED, QUEUED, RUNNING, Repository
 from serve_support import db_url  # noqa: F401 - the parametrized fixture
 
-RESULT = {"graded_as": "rp-arm", "passed": False, "first_wrong": "v_dot_1", "error": None,
-          "report_json": '{"first_wrong": "v_dot_1"}', "report_html": "<p>page</p>", "report_fragment": "<p>f</p>"}
+from armdyn.serve.migrations import MIGRATIONS, current_version
+from armdyn.serve.storage import DONE, FAILED, QUEUED, RUNNING, Repository
+
+RESULT = {
+    "graded_as": "rp-arm",
+    "passed": False,
+    "first_wrong": "v_dot_1",
+    "error": None,
+    "report_json": '{"first_wrong": "v_dot_1"}',
+    "report_html": "<p>page</p>",
+    "report_fragment": "<p>f</p>",
+}
 
 
 def test_schema_versioned_and_idempotent(db_url):  # noqa: F811

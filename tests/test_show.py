@@ -110,7 +110,7 @@ def test_joint_names_do_not_overlap(name, q):
     boxes = [matplotlib.text.Text.get_window_extent(t, renderer) for t in names]  # the text, not its leader line
     for i, a in enumerate(boxes):
         assert a.x0 >= 0 and a.y0 >= 0 and a.x1 <= fig.bbox.width and a.y1 <= fig.bbox.height, names[i].get_text()
-        for b in boxes[i + 1:]:
+        for b in boxes[i + 1 :]:
             assert not a.overlaps(b), (names[i].get_text(), a, b)
 
 

@@ -36,8 +36,19 @@ def pendulum(m=1.3, l=0.7, izz=0.02, gravity=(0.0, 0.0, -9.81), n_extra=0):
     eye = np.eye(3).tolist()
     inertia = np.diag([izz, izz, izz]).tolist()
     return num.NumericModel(
-        [-1], [0], [eye], [[0.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]], [m], [[0.0, 0.0, -l]], [inertia],
-        list(gravity), ["base", "bob"], ["theta"], "pendulum")
+        [-1],
+        [0],
+        [eye],
+        [[0.0, 0.0, 0.0]],
+        [[0.0, 1.0, 0.0]],
+        [m],
+        [[0.0, 0.0, -l]],
+        [inertia],
+        list(gravity),
+        ["base", "bob"],
+        ["theta"],
+        "pendulum",
+    )
 
 
 @pytest.fixture(scope="module")
@@ -117,8 +128,7 @@ def test_rk4_matches_solve_ivp_on_pinocchio_aba(ur5, pinocchio_ur5):
     def f(t, x):
         return np.concatenate([x[dof:], pinocchio_ur5.aba(x[:dof], x[dof:], np.zeros(dof))])
 
-    sol = solve_ivp(f, (0, duration), np.concatenate([q0, qd0]), method="DOP853", rtol=1e-12, atol=1e-12,
-                    t_eval=run.t)
+    sol = solve_ivp(f, (0, duration), np.concatenate([q0, qd0]), method="DOP853", rtol=1e-12, atol=1e-12, t_eval=run.t)
     assert sol.success
     np.testing.assert_allclose(run.q, sol.y[:dof].T, rtol=0, atol=1e-6)
     np.testing.assert_allclose(run.qd, sol.y[dof:].T, rtol=0, atol=1e-5)
@@ -140,8 +150,14 @@ def _rk4_on_pinocchio(pr, q0, qd0, dt, steps):
     q, v = np.array(q0[pr.perm]), np.array(qd0[pr.perm])
     zero = np.zeros_like(q)
     acc = lambda q, v: np.array(pin.aba(pr.model, pr.data, q, v, zero))  # noqa: E731
-    energy = lambda q, v: (pin.computeKineticEnergy(pr.model, pr.data, q, v)  # noqa: E731
-                           + pin.computePotentialEnergy(pr.model, pr.data, q) + pr.welded)
+
+    def energy(q, v):
+        return (
+            pin.computeKineticEnergy(pr.model, pr.data, q, v)  # noqa: E731
+            + pin.computePotentialEnergy(pr.model, pr.data, q)
+            + pr.welded
+        )
+
     qs, es = [q], [energy(q, v)]
     for _ in range(steps):
         a1 = acc(q, v)
@@ -195,7 +211,7 @@ def test_orders_of_rk4_and_euler(ur5):
         for dt in (2e-3, 1e-3):
             errs.append(np.abs(simulate(ur5, q0, dt=dt, duration=0.5, method=method).q_final - exact).max())
         ratio = errs[0] / errs[1]
-        assert 2 ** order * 0.8 < ratio < 2 ** order * 1.25, (method, errs)
+        assert 2**order * 0.8 < ratio < 2**order * 1.25, (method, errs)
 
 
 def test_pd_with_gravity_compensation_reaches_target(ur5):
@@ -228,8 +244,9 @@ def test_computed_torque_follows_closed_form(panda):
     w = 4.0
     target = np.full(dof, 0.3)
     q0 = np.linspace(-0.4, 0.5, dof)
-    run = simulate(panda, q0, dt=1e-3, duration=2.0, stride=50,
-                   controller=ComputedTorque(kp=w * w, kd=2 * w, target=target))
+    run = simulate(
+        panda, q0, dt=1e-3, duration=2.0, stride=50, controller=ComputedTorque(kp=w * w, kd=2 * w, target=target)
+    )
     e0 = target - q0
     t = run.t[:, None]
     expect = target - e0 * (1 + w * t) * np.exp(-w * t)
@@ -273,8 +290,18 @@ def test_batch_threads_pieces_equal_single_bitwise(ur5):
             ref = simulate(ur5, q0, qd0, dt=1e-3, steps=30, stride=3, method=method, threads=1, **kw)
             two = simulate(ur5, q0, qd0, dt=1e-3, steps=30, stride=3, method=method, threads=2, **kw)
             calls = []
-            pieces = simulate(ur5, q0, qd0, dt=1e-3, steps=30, stride=3, method=method, threads=2,
-                              progress=lambda d, n: calls.append(d), **kw)
+            pieces = simulate(
+                ur5,
+                q0,
+                qd0,
+                dt=1e-3,
+                steps=30,
+                stride=3,
+                method=method,
+                threads=2,
+                progress=lambda d, n: calls.append(d),
+                **kw,
+            )
             assert calls[0] == 0 and calls[-1] == 30 and len(calls) > 2
             for other in (two, pieces):
                 for name in ("q", "qd", "qdd", "tau", "q_final", "qd_final"):
@@ -282,10 +309,10 @@ def test_batch_threads_pieces_equal_single_bitwise(ur5):
             for i in (0, 7, 20):
                 kw1 = dict(kw)
                 if "torque" in kw:
-                    kw1["torque"] = per_state[i:i + 1]
+                    kw1["torque"] = per_state[i : i + 1]
                 if "controller" in kw:
                     kw1["controller"] = ComputedTorque(9.0, 6.0, q0[::-1][i])
-                one = simulate(ur5, q0[i:i + 1], qd0[i:i + 1], dt=1e-3, steps=30, stride=3, method=method, **kw1)
+                one = simulate(ur5, q0[i : i + 1], qd0[i : i + 1], dt=1e-3, steps=30, stride=3, method=method, **kw1)
                 assert np.array_equal(one.q[0], ref.q[i]) and np.array_equal(one.tau[0], ref.tau[i])
 
 
@@ -367,8 +394,10 @@ def test_pickled_model_gives_same_results(ur5):
         (dict(dt=1e-3, steps=10, controller=PD([1, 2], 1, 0)), "controller.kp"),
         (dict(dt=1e-3, steps=10, controller="pd"), "controller must be"),
         (dict(dt=1e-3, steps=10, torque=lambda t, q, qd: 1 / 0), "torque callable failed at step 0 .*ZeroDivision"),
-        (dict(dt=1e-3, steps=10, torque=lambda t, q, qd: np.zeros(6) if t < 3e-3 else np.zeros(5)),
-         r"returned shape \(5,\) at step 2 \(t = 0.003 s\)"),
+        (
+            dict(dt=1e-3, steps=10, torque=lambda t, q, qd: np.zeros(6) if t < 3e-3 else np.zeros(5)),
+            r"returned shape \(5,\) at step 2 \(t = 0.003 s\)",
+        ),
     ],
 )
 def test_bad_input(ur5, kwargs, match):

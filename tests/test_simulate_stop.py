@@ -84,8 +84,26 @@ def test_diverging_python_torque_is_not_called_singular(ur5):
 
 def test_cli_diverging_run_exit_4_writes_what_it_has(capsys, tmp_path):
     png = tmp_path / "run.png"
-    code = main(["simulate", "ur5", "--duration", "4", "--dt", "1e-2", "--controller", "pd", "--target", "0.5",
-                 "--kp", "1e7", "--kd", "0", "--plot", str(png)])
+    code = main(
+        [
+            "simulate",
+            "ur5",
+            "--duration",
+            "4",
+            "--dt",
+            "1e-2",
+            "--controller",
+            "pd",
+            "--target",
+            "0.5",
+            "--kp",
+            "1e7",
+            "--kd",
+            "0",
+            "--plot",
+            str(png),
+        ]
+    )
     out, err = capsys.readouterr()
     assert code == 4, err
     assert "singular" not in err + out
@@ -128,7 +146,20 @@ def test_work_energy_balance_of_a_pd_run(ur5):
 
 
 def test_cli_reports_balance_for_controlled_and_drift_for_passive(capsys):
-    main(["simulate", "ur5", "--duration", "1", "--dt", "1e-3", "--controller", "pd-gravity", "--target", "0.4,-1,1,0,0,0"])
+    main(
+        [
+            "simulate",
+            "ur5",
+            "--duration",
+            "1",
+            "--dt",
+            "1e-3",
+            "--controller",
+            "pd-gravity",
+            "--target",
+            "0.4,-1,1,0,0,0",
+        ]
+    )
     out = capsys.readouterr().out
     assert "balance max |E - E(0) - W| / scale" in out and "drift" not in out
     assert float(out.split("/ scale ")[1].split()[0]) < 1e-5
@@ -139,8 +170,10 @@ def test_cli_reports_balance_for_controlled_and_drift_for_passive(capsys):
 
 def test_gif_plays_in_real_time(capsys, tmp_path):
     gif = tmp_path / "run.gif"
-    assert main(["simulate", "ur5", "--duration", "2", "--dt", "1e-3", "--q0", "0,-0.3,0.3,0,0,0",
-                 "--animate", str(gif)]) == 0
+    assert (
+        main(["simulate", "ur5", "--duration", "2", "--dt", "1e-3", "--q0", "0,-0.3,0.3,0,0,0", "--animate", str(gif)])
+        == 0
+    )
     out = capsys.readouterr().out
     with Image.open(gif) as im:
         durations = []
@@ -163,9 +196,27 @@ def test_ctrl_c_stops_a_long_run_within_a_second(tmp_path):
     follows after the interpreter's teardown (slow on a loaded machine, so bounded
     loosely); nothing is written."""
     env = dict(os.environ, PYTHONPATH=str(ROOT / "python"))
-    proc = subprocess.Popen([sys.executable, "-m", "armdyn", "simulate", "ur5", "--duration", "1e5", "--dt", "1e-6",
-                             "--plot", "run.png", "--quiet"], cwd=tmp_path, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "armdyn",
+            "simulate",
+            "ur5",
+            "--duration",
+            "1e5",
+            "--dt",
+            "1e-6",
+            "--plot",
+            "run.png",
+            "--quiet",
+        ],
+        cwd=tmp_path,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         time.sleep(8.0)  # imports, model, and well into the integration (a loaded machine imports slowly)
         assert proc.poll() is None, proc.communicate()

@@ -15,11 +15,11 @@ import warnings
 import numpy as np
 import pytest
 import sympy as sp
+from random_models import random_robot
 
 import armdyn
 from armdyn.symbolic import check, derive
 from armdyn.symbolic.agreement import trig_reduce
-from random_models import random_robot
 
 
 def zero(expr, q) -> bool:
@@ -39,8 +39,14 @@ def exercise_tau(robot):
     th, d = robot.q
     thd, dd = robot.qd
     thdd, ddd = robot.qdd
-    tau1 = ((m1 + m2) * l1**2 * thdd + m2 * l1 * ddd + 2 * m2 * d * thd * dd + m2 * thdd * d**2
-            + (m1 + m2) * g * l1 * sp.cos(th) - m2 * g * d * sp.sin(th))
+    tau1 = (
+        (m1 + m2) * l1**2 * thdd
+        + m2 * l1 * ddd
+        + 2 * m2 * d * thd * dd
+        + m2 * thdd * d**2
+        + (m1 + m2) * g * l1 * sp.cos(th)
+        - m2 * g * d * sp.sin(th)
+    )
     tau2 = m2 * l1 * thdd + m2 * ddd - m2 * thd**2 * d + m2 * g * sp.cos(th)
     return tau1, tau2
 
@@ -70,13 +76,19 @@ def _hand_accelerations(robot):
     l1, g = robot.parameters["l1"], robot.parameters["g"]
     R01 = sp.Matrix([[sp.cos(th), -sp.sin(th), 0], [sp.sin(th), sp.cos(th), 0], [0, 0, 1]])
     R12 = sp.Matrix([[1, 0, 0], [0, 0, -1], [0, 1, 0]]).T  # the exercise's R_1^2 maps 1 -> 2
-    p1 = R01 * sp.Matrix([l1, 0, 0])              # mass 1
-    p2 = p1 + R01 * sp.Matrix([0, d, 0])          # mass 2 on the slider along y1
+    p1 = R01 * sp.Matrix([l1, 0, 0])  # mass 1
+    p2 = p1 + R01 * sp.Matrix([0, d, 0])  # mass 2 on the slider along y1
     gravity = sp.Matrix([0, -g, 0])
     acc1 = R01.T * (p1.diff(t, 2) - gravity)
     acc2 = (R01 * R12).T * (p2.diff(t, 2) - gravity)
-    names = {th.diff(t, 2): robot.qdd[0], d.diff(t, 2): robot.qdd[1],
-             th.diff(t): robot.qd[0], d.diff(t): robot.qd[1], th: robot.q[0], d: robot.q[1]}
+    names = {
+        th.diff(t, 2): robot.qdd[0],
+        d.diff(t, 2): robot.qdd[1],
+        th.diff(t): robot.qd[0],
+        d.diff(t): robot.qd[1],
+        th: robot.q[0],
+        d: robot.q[1],
+    }
     return acc1.subs(names), acc2.subs(names)
 
 
@@ -128,14 +140,17 @@ def test_planar_2r_textbook_closed_form():
     q1, q2 = robot.q
     qd1, qd2 = robot.qd
     c2 = sp.cos(q2)
-    M = sp.Matrix([
-        [m1 * lc1**2 + m2 * (l1**2 + lc2**2 + 2 * l1 * lc2 * c2) + I1 + I2, m2 * (lc2**2 + l1 * lc2 * c2) + I2],
-        [m2 * (lc2**2 + l1 * lc2 * c2) + I2, m2 * lc2**2 + I2],
-    ])
+    M = sp.Matrix(
+        [
+            [m1 * lc1**2 + m2 * (l1**2 + lc2**2 + 2 * l1 * lc2 * c2) + I1 + I2, m2 * (lc2**2 + l1 * lc2 * c2) + I2],
+            [m2 * (lc2**2 + l1 * lc2 * c2) + I2, m2 * lc2**2 + I2],
+        ]
+    )
     h = -m2 * l1 * lc2 * sp.sin(q2)
     C = sp.Matrix([[h * qd2, h * qd2 + h * qd1], [-h * qd1, 0]])
-    G = sp.Matrix([(m1 * lc1 + m2 * l1) * g * sp.cos(q1) + m2 * lc2 * g * sp.cos(q1 + q2),
-                   m2 * lc2 * g * sp.cos(q1 + q2)])
+    G = sp.Matrix(
+        [(m1 * lc1 + m2 * l1) * g * sp.cos(q1) + m2 * lc2 * g * sp.cos(q1 + q2), m2 * lc2 * g * sp.cos(q1 + q2)]
+    )
     for ours, book in ((eom.M, M), (eom.C, C), (eom.g, G)):
         assert all(zero(sp.expand_trig(e), robot.q) for e in ours - book)
 
@@ -235,7 +250,7 @@ def test_structure_checks_notice_wrong_velocity_terms():
     robot = armdyn.load("rp-arm")
     ne, la = derive(robot), derive(robot, "lagrange")
     broken = derive(robot)
-    m1, (q1, q2), (qd1, qd2) = robot.parameters["m1"], robot.q, robot.qd
+    m1, (_q1, q2), (qd1, qd2) = robot.parameters["m1"], robot.q, robot.qd
     broken.tau = ne.tau + sp.Matrix([m1 * sp.sin(q2) * qd1 * qd2, 0])  # M, g unchanged
     for exact in (True, False):
         report = check(broken, exact=exact, samples=5)

@@ -14,7 +14,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 
-CLIENT = '''
+CLIENT = """
 import numpy as np
 import armdyn
 
@@ -28,14 +28,21 @@ wrong_tau: str = tau
 wrong_eom: str = eom
 wrong_report: str = report
 wrong_robot: str = armdyn.load("rp-arm")
-'''
+"""
 
 
 def _mypy(*args: str, cwd: Path, cache: Path) -> subprocess.CompletedProcess:
     pytest.importorskip("mypy")
     env = {**os.environ, "PYTHONPATH": str(ROOT / "python"), "MYPY_CACHE_DIR": str(cache / ".mypy_cache")}
-    return subprocess.run([sys.executable, "-m", "mypy", *args], cwd=cwd, env=env, capture_output=True, text=True,
-                          timeout=600, check=False)
+    return subprocess.run(
+        [sys.executable, "-m", "mypy", *args],
+        cwd=cwd,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
 
 
 def test_package_is_marked_typed():

@@ -17,19 +17,26 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
+from optional import example_robot_data_dir, needs_pinocchio, pin
 
 import armdyn.reference as reference
 from armdyn.errors import ModelError
 from armdyn.io.urdf import MasslessWarning, load_urdf
 from armdyn.show import frame_poses
-from optional import example_robot_data_dir, needs_pinocchio, pin
 
 # shared/ sits beside the repository (CI) or at /work/shared (development machines)
-IIWA = next(
-    (p for p in (Path(__file__).resolve().parents[2] / "shared", Path("/work/shared"))
-     if (p / "data" / "iiwa14_dynamics_only.urdf").is_file()),
-    Path("/work/shared"),
-) / "data" / "iiwa14_dynamics_only.urdf"
+IIWA = (
+    next(
+        (
+            p
+            for p in (Path(__file__).resolve().parents[2] / "shared", Path("/work/shared"))
+            if (p / "data" / "iiwa14_dynamics_only.urdf").is_file()
+        ),
+        Path("/work/shared"),
+    )
+    / "data"
+    / "iiwa14_dynamics_only.urdf"
+)
 BUNDLED_IIWA = Path(__file__).resolve().parent.parent / "python" / "armdyn" / "robots" / "iiwa14.urdf"
 RTOL = 1e-12
 SINGULAR = 1e12  # condition number of M above which forward dynamics is not compared
@@ -74,8 +81,9 @@ def pin_configuration(model, robot, q: np.ndarray):
 
 
 def random_coordinates(robot, rng) -> np.ndarray:
-    return np.array([rng.uniform(-np.pi, np.pi) if j.type == "revolute" else rng.uniform(-0.3, 0.3)
-                     for j in robot.movable_joints])
+    return np.array(
+        [rng.uniform(-np.pi, np.pi) if j.type == "revolute" else rng.uniform(-0.3, 0.3) for j in robot.movable_joints]
+    )
 
 
 def floats(m) -> np.ndarray:
@@ -151,8 +159,12 @@ def compare_with_pinocchio(
             # URDF <dynamics damping friction> enter armdyn's tau (Fv qd + Fc sign(qd)),
             # not Pinocchio's rnea/aba: compared with that closed form added (a mimic
             # joint's own damping is not modelled: its leader's coordinate carries none)
-            fr = np.array([float(j.damping or 0) * v + float(j.friction or 0) * np.sign(v)
-                           for j, v in zip(robot.movable_joints, qd)])[perm]
+            fr = np.array(
+                [
+                    float(j.damping or 0) * v + float(j.friction or 0) * np.sign(v)
+                    for j, v in zip(robot.movable_joints, qd)
+                ]
+            )[perm]
             assert close(engine.rnea(robot, q, qd, qdd)[perm] - fr, tau) < rtol, f"{engine.__name__}.rnea"
             M = pin_mass_matrix(model, data, qp)
             assert close(engine.crba(robot, q)[np.ix_(perm, perm)], M) < rtol, f"{engine.__name__}.crba"
@@ -332,14 +344,23 @@ def test_slightly_unnormalised_axis_is_normalised():
     [
         (('type="continuous"', 'type="floating"'), "joint 'spin'", "floating joints are not supported yet"),
         (('type="continuous"', 'type="planar"'), "joint 'spin'", "planar joints are not supported yet"),
-        (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="slide"/>'), "joint 'spin'",
-         "a revolute joint cannot mimic the prismatic joint 'slide'"),
-        (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="elbow"/>'), "joint 'spin'",
-         "mimics joint 'elbow', which does not exist"),
+        (
+            ('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="slide"/>'),
+            "joint 'spin'",
+            "a revolute joint cannot mimic the prismatic joint 'slide'",
+        ),
+        (
+            ('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="elbow"/>'),
+            "joint 'spin'",
+            "mimics joint 'elbow', which does not exist",
+        ),
         (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="weld"/>'), "joint 'spin'", "'weld', which is fixed"),
         (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="spin"/>'), "joint 'spin'", "loop (spin -> spin)"),
-        (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="roll" multiplier="x"/>'), "joint 'spin'",
-         "<mimic> multiplier is 'x', not a finite number"),
+        (
+            ('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="roll" multiplier="x"/>'),
+            "joint 'spin'",
+            "<mimic> multiplier is 'x', not a finite number",
+        ),
         (('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic/>'), "joint 'spin'", "<mimic> has no 'joint' attribute"),
         (('"0 0.6 0.8"', '"0 0.6 0.9"'), "joint 'slide'", "not a unit vector"),
         (('"0 0.6 0.8"', '"0 0 0"'), "joint 'slide'", "axis is zero"),
@@ -437,8 +458,12 @@ def compare_reduced_with_pinocchio(robot, path: Path, rng, states: int = 1, rtol
                     qp[iq] = x
             # URDF damping/friction of the independent joints enter armdyn's tau, not
             # Pinocchio's rnea: added in closed form (as in check_against_pinocchio)
-            fr = np.array([float(j.damping or 0) * v + float(j.friction or 0) * np.sign(v)
-                           for j, v in zip(robot.movable_joints, qd)])
+            fr = np.array(
+                [
+                    float(j.damping or 0) * v + float(j.friction or 0) * np.sign(v)
+                    for j, v in zip(robot.movable_joints, qd)
+                ]
+            )
             tau = G.T @ pin.rnea(model, data, qp, G @ qd, G @ qdd) + fr
             tau_ours = engine.rnea(robot, q, qd, qdd)
             assert close(tau_ours, tau) < rtol, f"{engine.__name__}.rnea"
@@ -476,10 +501,20 @@ def test_example_robot_data_sweep(capsys):
     assert len(files) >= 60
     rng = np.random.default_rng(2024)
     counts = dict.fromkeys(
-        ["agree", "agree (non-physical, strict=False)", "rejected as unsupported", "rejected: mimic leader missing",
-         "rejected: no robot"], 0
+        [
+            "agree",
+            "agree (non-physical, strict=False)",
+            "rejected as unsupported",
+            "rejected: mimic leader missing",
+            "rejected: no robot",
+        ],
+        0,
     )
-    with_mimic = {"Pinocchio mimic model": 0, "Pinocchio free model reduced by G": 0, "(<mimic> on fixed joints only)": 0}
+    with_mimic = {
+        "Pinocchio mimic model": 0,
+        "Pinocchio free model reduced by G": 0,
+        "(<mimic> on fixed joints only)": 0,
+    }
     singular = []  # mass matrix singular: aba not compared
     start = time.perf_counter()
     for path in files:

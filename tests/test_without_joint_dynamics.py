@@ -58,7 +58,8 @@ def test_rigid_rnea_aba_equal_pinocchio():
         expect = pin.rnea(model, data, q, qd, qdd).copy()
         np.testing.assert_allclose(num.rnea(rigid, q, qd, qdd), expect, rtol=0, atol=1e-12)
         # the full model adds the URDF's joint terms, and Pinocchio has none of them
-        np.testing.assert_allclose(num.rnea(robot, q, qd, qdd), expect + damping * qd + friction * np.sign(qd),
-                                   rtol=0, atol=1e-12)
+        np.testing.assert_allclose(
+            num.rnea(robot, q, qd, qdd), expect + damping * qd + friction * np.sign(qd), rtol=0, atol=1e-12
+        )
         tau = rng.uniform(-5, 5, 2)
         np.testing.assert_allclose(num.aba(rigid, q, qd, tau), pin.aba(model, data, q, qd, tau), rtol=0, atol=1e-10)

@@ -52,9 +52,11 @@ def missing_headers(root: str | None) -> str | None:
         return "Pinocchio (pip install pin) is not installed"
     if shutil.which("g++") is None:
         return "g++ is not installed"
-    needs = {"Pinocchio": "include/pinocchio/algorithm/rnea-derivatives.hpp",
-             "Boost": "include/boost/variant.hpp",
-             "Eigen (pip install cmeel-eigen)": "include/eigen3/Eigen/Core"}
+    needs = {
+        "Pinocchio": "include/pinocchio/algorithm/rnea-derivatives.hpp",
+        "Boost": "include/boost/variant.hpp",
+        "Eigen (pip install cmeel-eigen)": "include/eigen3/Eigen/Core",
+    }
     for what, rel in needs.items():
         if not os.path.exists(os.path.join(root, rel)):
             return f"{what} headers are missing ({os.path.join(root, rel)})"
@@ -70,12 +72,24 @@ def build(root: str) -> str:
     if os.path.exists(exe):
         return exe
     os.makedirs(cache, exist_ok=True)
-    cmd = ["g++", "-O3", "-march=native", "-DNDEBUG", "-std=c++17",
-           # the Boost.MPL limits Pinocchio's CMake config asks of its users (its joint variant
-           # has more than Boost's default 20 alternatives)
-           "-DBOOST_MPL_LIMIT_LIST_SIZE=30", "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30",
-           "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS", "-DBOOST_FUSION_INVOKE_MAX_ARITY=12",
-           f"-I{root}/include", f"-I{root}/include/eigen3", SOURCE, "-o", exe + ".tmp"]
+    cmd = [
+        "g++",
+        "-O3",
+        "-march=native",
+        "-DNDEBUG",
+        "-std=c++17",
+        # the Boost.MPL limits Pinocchio's CMake config asks of its users (its joint variant
+        # has more than Boost's default 20 alternatives)
+        "-DBOOST_MPL_LIMIT_LIST_SIZE=30",
+        "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30",
+        "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS",
+        "-DBOOST_FUSION_INVOKE_MAX_ARITY=12",
+        f"-I{root}/include",
+        f"-I{root}/include/eigen3",
+        SOURCE,
+        "-o",
+        exe + ".tmp",
+    ]
     done = subprocess.run(cmd, capture_output=True, text=True)
     if done.returncode != 0:
         raise RuntimeError("compiling bench.cpp failed:\n" + done.stderr[-3000:])
@@ -83,8 +97,16 @@ def build(root: str) -> str:
     return exe
 
 
-_TYPES = {"JointModelRX": "RX", "JointModelRY": "RY", "JointModelRZ": "RZ", "JointModelRevoluteUnaligned": "RU",
-          "JointModelPX": "PX", "JointModelPY": "PY", "JointModelPZ": "PZ", "JointModelPrismaticUnaligned": "PU"}
+_TYPES = {
+    "JointModelRX": "RX",
+    "JointModelRY": "RY",
+    "JointModelRZ": "RZ",
+    "JointModelRevoluteUnaligned": "RU",
+    "JointModelPX": "PX",
+    "JointModelPY": "PY",
+    "JointModelPZ": "PZ",
+    "JointModelPrismaticUnaligned": "PU",
+}
 
 
 def describe(model) -> str:
@@ -98,8 +120,19 @@ def describe(model) -> str:
         axis = np.asarray(jm.extract().axis, dtype=float) if kind in ("RU", "PU") else np.zeros(3)
         X, inertia = model.jointPlacements[j], model.inertias[j]
         I = inertia.inertia
-        numbers = [*axis, *X.rotation.reshape(-1), *X.translation, inertia.mass, *inertia.lever,
-                   I[0, 0], I[0, 1], I[1, 1], I[0, 2], I[1, 2], I[2, 2]]
+        numbers = [
+            *axis,
+            *X.rotation.reshape(-1),
+            *X.translation,
+            inertia.mass,
+            *inertia.lever,
+            I[0, 0],
+            I[0, 1],
+            I[1, 1],
+            I[0, 2],
+            I[1, 2],
+            I[2, 2],
+        ]
         lines.append(f"{model.parents[j]} {kind} " + " ".join(repr(float(x)) for x in numbers))
     return "\n".join(lines) + "\n"
 
@@ -160,7 +193,9 @@ def main(argv=None) -> None:
     res = run(args.number, args.repeat)
     if res is None:
         return
-    print(f"Pinocchio {__import__('pinocchio').__version__} C++ per call (median of {args.repeat} x {args.number}), us:")
+    print(
+        f"Pinocchio {__import__('pinocchio').__version__} C++ per call (median of {args.repeat} x {args.number}), us:"
+    )
     print(f"{'arm':8} {'nv':>3} " + " ".join(f"{a:>17}" for a in ALGORITHMS))
     for name, r in res.items():
         print(f"{name:8} {r['nv']:>3} " + " ".join(f"{r[a] * 1e6:>17.3f}" for a in ALGORITHMS))

@@ -13,28 +13,60 @@ Conventions: SI units, radians, ``M(q) qdd + C(q, qd) qd + g(q) = tau``; frames 
 #: the package version (kept equal to pyproject.toml's; tests/test_hardening.py checks)
 __version__ = "0.1.0"
 
-from . import inertia, io  # noqa: E402
+from typing import TYPE_CHECKING  # noqa: E402
+
+from . import (  # noqa: E402
+    codegen,  # noqa: E402  armdyn.codegen(robot, ...) and armdyn.codegen.compile(...)
+    inertia,
+    io,
+)
 from .errors import ModelError, UnboundParameterError  # noqa: E402
 from .io import bundled_robots, load  # noqa: E402
 from .model import Joint, Link, Robot  # noqa: E402
 from .symbolic import EquationsOfMotion, check, derive, prove_agreement  # noqa: E402
-from . import codegen  # noqa: E402  armdyn.codegen(robot, ...) and armdyn.codegen.compile(...)
-
-from typing import TYPE_CHECKING  # noqa: E402
 
 if TYPE_CHECKING:  # what __getattr__ below imports on first use, for type checkers (py.typed)
     # armdyn.grade is the package made callable: typed as its grade() function
     from .grade import grade  # noqa: F401
     from .identification import base_parameters, regressor  # noqa: F401
-    from .numeric import NumericModel, aba, aba_derivatives, bias, compile_model, coriolis_matrix  # noqa: F401
-    from .numeric import crba, forward_kinematics, gravity, gravity_derivatives, jacobian  # noqa: F401
-    from .numeric import jacobian_dot, kinetic_energy, minverse, potential_energy, rnea  # noqa: F401
-    from .numeric import rnea_derivatives  # noqa: F401
+    from .numeric import (  # noqa: F401  # noqa: F401  # noqa: F401
+        NumericModel,
+        aba,
+        aba_derivatives,
+        bias,
+        compile_model,
+        coriolis_matrix,
+        crba,
+        forward_kinematics,
+        gravity,
+        gravity_derivatives,
+        jacobian,
+        jacobian_dot,
+        kinetic_energy,
+        minverse,
+        potential_energy,
+        rnea,
+        rnea_derivatives,  # noqa: F401
+    )
 
 _NUMERIC = (
-    "rnea", "crba", "aba", "gravity", "bias", "coriolis_matrix", "kinetic_energy",
-    "potential_energy", "forward_kinematics", "jacobian", "NumericModel", "compile_model",
-    "rnea_derivatives", "aba_derivatives", "minverse", "gravity_derivatives", "jacobian_dot",
+    "rnea",
+    "crba",
+    "aba",
+    "gravity",
+    "bias",
+    "coriolis_matrix",
+    "kinetic_energy",
+    "potential_energy",
+    "forward_kinematics",
+    "jacobian",
+    "NumericModel",
+    "compile_model",
+    "rnea_derivatives",
+    "aba_derivatives",
+    "minverse",
+    "gravity_derivatives",
+    "jacobian_dot",
 )
 _IDENTIFICATION = ("regressor", "base_parameters")
 
@@ -63,8 +95,21 @@ def __getattr__(name):
 
 __all__ = [
     "__version__",
-    *_NUMERIC, *_IDENTIFICATION,
-    "inertia", "io", "ModelError", "UnboundParameterError", "Joint", "Link", "Robot",
-    "load", "bundled_robots", "derive", "check", "prove_agreement", "EquationsOfMotion", "grade",
+    *_NUMERIC,
+    *_IDENTIFICATION,
+    "inertia",
+    "io",
+    "ModelError",
+    "UnboundParameterError",
+    "Joint",
+    "Link",
+    "Robot",
+    "load",
+    "bundled_robots",
+    "derive",
+    "check",
+    "prove_agreement",
+    "EquationsOfMotion",
+    "grade",
     "codegen",
 ]

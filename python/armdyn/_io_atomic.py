@@ -38,8 +38,13 @@ class OutputPathError(ValueError):
     """An output path armdyn will not write: one line naming the path and why."""
 
 
-_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
-          (stat.S_ISFIFO, "a FIFO"), (stat.S_ISSOCK, "a socket"))
+_KINDS = (
+    (stat.S_ISDIR, "a directory"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISFIFO, "a FIFO"),
+    (stat.S_ISSOCK, "a socket"),
+)
 
 
 def destination(path: str | os.PathLike) -> tuple[Path, int | None]:
@@ -63,8 +68,9 @@ def destination(path: str | os.PathLike) -> tuple[Path, int | None]:
         try:
             st = os.stat(final)
         except OSError as exc:
-            raise OutputPathError(f"{shown}: a symbolic link whose target {final} cannot be written "
-                                  f"({exc.strerror}); not followed") from None
+            raise OutputPathError(
+                f"{shown}: a symbolic link whose target {final} cannot be written ({exc.strerror}); not followed"
+            ) from None
     if st is not None:
         kind = next((name for test, name in _KINDS if test(st.st_mode)), None)
         if kind or not stat.S_ISREG(st.st_mode):

@@ -178,7 +178,9 @@ def cmd_simulate(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="armdyn", description="Dynamics of robot arms: derive and check equations of motion.")
+    p = argparse.ArgumentParser(
+        prog="armdyn", description="Dynamics of robot arms: derive and check equations of motion."
+    )
     from . import __version__
 
     p.add_argument("--version", action="version", version=f"armdyn {__version__}")
@@ -186,11 +188,17 @@ def build_parser() -> argparse.ArgumentParser:
 
     def robot_arg(sp_):
         sp_.add_argument("robot", help="bundled model name (armdyn robots) or a .yaml/.urdf file")
-        sp_.add_argument("--allow-nonphysical", action="store_true",
-                         help="load model files whose inertias break physical validity, with a warning")
-        sp_.add_argument("--strict", action="store_true",
-                         help="refuse non-physical inertias in bundled models too (they load as published, "
-                              "with one warning, by default)")
+        sp_.add_argument(
+            "--allow-nonphysical",
+            action="store_true",
+            help="load model files whose inertias break physical validity, with a warning",
+        )
+        sp_.add_argument(
+            "--strict",
+            action="store_true",
+            help="refuse non-physical inertias in bundled models too (they load as published, "
+            "with one warning, by default)",
+        )
 
     d = sub.add_parser("derive", help="derive the equations of motion symbolically")
     robot_arg(d)
@@ -198,9 +206,12 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--steps", action="store_true", help="show every intermediate step")
     d.add_argument("--format", choices=["text", "latex", "markdown", "html"], default="text")
     d.add_argument("--timing", action="store_true", help="print derivation times to stderr")
-    d.add_argument("--ascii", action="store_true",
-                   help="text in plain ASCII (theta1_dot, tau1) instead of Unicode (θ̇₁, τ₁); "
-                        "automatic when the terminal cannot print Unicode")
+    d.add_argument(
+        "--ascii",
+        action="store_true",
+        help="text in plain ASCII (theta1_dot, tau1) instead of Unicode (θ̇₁, τ₁); "
+        "automatic when the terminal cannot print Unicode",
+    )
     d.set_defaults(func=cmd_derive)
 
     c = sub.add_parser("check", help="prove Newton-Euler == Lagrange, M symmetric, tau == M qdd + C qd + g")
@@ -208,7 +219,12 @@ def build_parser() -> argparse.ArgumentParser:
     g = c.add_mutually_exclusive_group()
     g.add_argument("--exact", action="store_true", help="force exact symbolic checks")
     g.add_argument("--numeric", action="store_true", help="force checks at random numeric points")
-    c.add_argument("--samples", type=int, default=25, help="random points for numeric checks (at least 1; the report says how many were used)")
+    c.add_argument(
+        "--samples",
+        type=int,
+        default=25,
+        help="random points for numeric checks (at least 1; the report says how many were used)",
+    )
     c.set_defaults(func=cmd_check)
 
     r = sub.add_parser("robots", help="list the bundled robot models")
@@ -220,11 +236,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", help="write a PNG picture of the arm here")
     s.set_defaults(func=cmd_show)
 
-    gr = sub.add_parser("grade", help="check a student's own derivation step by step (first wrong step)",
-                        description="Grade a derivation written in Markdown with LaTeX display math (or YAML). "
-                                    "Exit status: 0 every step correct, 1 some step wrong, 2 bad input.")
-    gr.add_argument("submission", help="the derivation: a .md file (LaTeX display math) or a .yaml file; "
-                    "or a folder of them: the whole class (see --gradebook)")
+    gr = sub.add_parser(
+        "grade",
+        help="check a student's own derivation step by step (first wrong step)",
+        description="Grade a derivation written in Markdown with LaTeX display math (or YAML). "
+        "Exit status: 0 every step correct, 1 some step wrong, 2 bad input.",
+    )
+    gr.add_argument(
+        "submission",
+        help="the derivation: a .md file (LaTeX display math) or a .yaml file; "
+        "or a folder of them: the whole class (see --gradebook)",
+    )
     gr.add_argument("--robot", help="the model whose frames the student used (default: the front matter's robot)")
     gr.add_argument("--json", action="store_true", help="print the verdicts as one JSON object")
     gr.add_argument("--html", metavar="OUT.html", help="also write a self-contained HTML report")
@@ -235,8 +257,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     add_batch_arguments(gr)
     add_exercise_parser(sub)
-    sv = sub.add_parser("serve", help="web app: students submit derivations, instructors see the class",
-                        description="Serve the grading web app (docs/serve.md). Needs: pip install 'armdyn[serve]'.")
+    sv = sub.add_parser(
+        "serve",
+        help="web app: students submit derivations, instructors see the class",
+        description="Serve the grading web app (docs/serve.md). Needs: pip install 'armdyn[serve]'.",
+    )
     sv.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1)")
     sv.add_argument("--port", type=int, default=8000)
     sv.add_argument("--db", help="sqlite:///PATH (default sqlite:///armdyn-serve.db) or postgresql://USER@HOST/DB")
@@ -245,8 +270,11 @@ def build_parser() -> argparse.ArgumentParser:
     sv.add_argument("--instructor-token", help="the instructor's login token (or env ARMDYN_INSTRUCTOR_TOKEN)")
     sv.add_argument("--timeout", type=float, default=60.0, help="seconds one grading may take (default 60)")
     sv.add_argument("--memory-mb", type=int, default=2048, help="address-space limit of a worker (default 2048)")
-    sv.add_argument("--forwarded-allow-ips", default="127.0.0.1",
-                    help="proxies whose X-Forwarded-* headers are trusted (default 127.0.0.1)")
+    sv.add_argument(
+        "--forwarded-allow-ips",
+        default="127.0.0.1",
+        help="proxies whose X-Forwarded-* headers are trusted (default 127.0.0.1)",
+    )
     sv.set_defaults(func=cmd_serve)
     cg = sub.add_parser("codegen", help="generate C, Python or NumPy code for tau, M, C, g, the regressor")
     robot_arg(cg)
@@ -256,27 +284,36 @@ def build_parser() -> argparse.ArgumentParser:
     cg.add_argument("--bind", action="store_true", help="bind the model's published parameter values first")
     cg.add_argument("--out", help="directory to write the source file into (default: print it)")
     cg.set_defaults(func=cmd_codegen)
-    m = sub.add_parser("simulate", help="integrate the forward dynamics; plot and animate the run",
-                       description="Integrate the forward dynamics; plot and animate the run. Exit status: 0 done, "
-                                   "2 bad input, 4 the state became NaN/inf (the run stopped there; what was "
-                                   "computed is reported and written), 130 interrupted (nothing written).")
+    m = sub.add_parser(
+        "simulate",
+        help="integrate the forward dynamics; plot and animate the run",
+        description="Integrate the forward dynamics; plot and animate the run. Exit status: 0 done, "
+        "2 bad input, 4 the state became NaN/inf (the run stopped there; what was "
+        "computed is reported and written), 130 interrupted (nothing written).",
+    )
     robot_arg(m)
     m.add_argument("--duration", type=float, required=True, help="seconds")
     m.add_argument("--dt", type=float, required=True, help="fixed step (s)")
     m.add_argument("--method", choices=["rk4", "euler"], default="rk4")
     m.add_argument("--q0", help="initial joint values, comma-separated (one value: all joints; default 0)")
     m.add_argument("--qd0", help="initial joint velocities, comma-separated (default 0)")
-    m.add_argument("--controller", choices=["pd", "pd-gravity", "computed-torque"],
-                   help="joint PD, PD with gravity compensation, or computed torque (default: passive)")
+    m.add_argument(
+        "--controller",
+        choices=["pd", "pd-gravity", "computed-torque"],
+        help="joint PD, PD with gravity compensation, or computed torque (default: passive)",
+    )
     m.add_argument("--target", help="controller set point, comma-separated joint values")
     m.add_argument("--kp", help="controller gains, comma-separated (pd: 100 M_ii(target), computed-torque: 25)")
     m.add_argument("--kd", help="controller damping, comma-separated (pd: 20 M_ii(target), computed-torque: 10)")
     m.add_argument("--stride", type=int, help="store every k-th step (default: about 2000 samples)")
     m.add_argument("--plot", help="write q, qd, tau and energy plots here (.png/.svg/.pdf)")
     m.add_argument("--animate", help="write an animation of the arm here (.gif)")
-    m.add_argument("--fps", type=float, default=20.0,
-                   help="animation frame rate (the GIF plays in real time; at most 300 frames, longer runs get "
-                        "longer frames)")
+    m.add_argument(
+        "--fps",
+        type=float,
+        default=20.0,
+        help="animation frame rate (the GIF plays in real time; at most 300 frames, longer runs get longer frames)",
+    )
     m.add_argument("--quiet", action="store_true", help="no progress bar")
     m.set_defaults(func=cmd_simulate)
     return p
@@ -304,8 +341,9 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as err:
         if os.environ.get("ARMDYN_DEBUG"):
             raise
-        print(f"armdyn: internal error: {type(err).__name__}: {err} (set ARMDYN_DEBUG=1 for a traceback)",
-              file=sys.stderr)
+        print(
+            f"armdyn: internal error: {type(err).__name__}: {err} (set ARMDYN_DEBUG=1 for a traceback)", file=sys.stderr
+        )
         return 3
     finally:
         warnings.showwarning = shown

@@ -18,7 +18,7 @@ along the states only (the joint axis is made one chunk). Within a block the cor
 equal the in-process functions bit for bit (each row is computed alone, whatever the
 blocking).
 
-Conventions (DESIGN.md): SI units, radians; ``M(q) qdd + C(q, qd) qd + g(q) = tau``.
+Conventions (docs/architecture.md): SI units, radians; ``M(q) qdd + C(q, qd) qd + g(q) = tau``.
 """
 
 from __future__ import annotations
@@ -27,8 +27,7 @@ import numpy as np
 
 from .numeric import _core_model, _model
 
-__all__ = ["rnea", "aba", "crba", "simulate", "rnea_derivatives", "aba_derivatives", "minverse",
-           "gravity_derivatives"]
+__all__ = ["rnea", "aba", "crba", "simulate", "rnea_derivatives", "aba_derivatives", "minverse", "gravity_derivatives"]
 
 
 def _arrays(dof: int, chunks, *xs):
@@ -86,7 +85,15 @@ def crba(robot, q, *, chunks=None, threads=1):
     model = _model(robot)
     (q,) = _arrays(model.dof, chunks, q)
     n = model.dof
-    return q.map_blocks(_crba, model=model, threads=threads, dtype=float, meta=np.empty((0, 0, 0)), new_axis=2, chunks=(q.chunks[0], (n,), (n,)))
+    return q.map_blocks(
+        _crba,
+        model=model,
+        threads=threads,
+        dtype=float,
+        meta=np.empty((0, 0, 0)),
+        new_axis=2,
+        chunks=(q.chunks[0], (n,), (n,)),
+    )
 
 
 _PER_ROW = ("q_final", "qd_final")
@@ -106,8 +113,23 @@ def _simulate(q0, qd0, model, options, samples, energies, threads):
     return np.concatenate(parts, axis=1)
 
 
-def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4", torque=None,
-             controller=None, stride=1, energies=True, limits=None, chunks=None, threads=1):
+def simulate(
+    robot,
+    q0,
+    qd0=None,
+    *,
+    dt,
+    duration=None,
+    steps=None,
+    method="rk4",
+    torque=None,
+    controller=None,
+    stride=1,
+    energies=True,
+    limits=None,
+    chunks=None,
+    threads=1,
+):
     """Lazy :func:`armdyn.simulate.simulate` of the states ``q0``, ``qd0`` (N, dof), one
     block of rows per task. Returns a :class:`armdyn.simulate.Trajectory` whose arrays are
     Dask arrays (``t`` is NumPy): ``q``, ``qd``, ``qdd``, ``tau`` (N, S, dof); ``kinetic``,
@@ -131,35 +153,53 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
     q0, qd0 = _arrays(dof, chunks, q0, qd0)
     if limits is None:
         limits = joint_limits(robot)
-    options = dict(dt=dt, steps=steps, method=method, torque=torque, controller=controller, stride=stride,
-                   limits=limits)
+    options = dict(
+        dt=dt, steps=steps, method=method, torque=torque, controller=controller, stride=stride, limits=limits
+    )
     samples = steps // stride + 1
     width = samples * dof * 4 + samples + (2 * samples if energies else 0) + 2 * dof + len(_FLAGS)
-    packed = q0.map_blocks(_simulate, qd0, model=model, options=options, samples=samples, energies=energies,
-                           threads=threads, dtype=float, meta=np.empty((0, 0)),
-                           chunks=(q0.chunks[0], (width,)))
+    packed = q0.map_blocks(
+        _simulate,
+        qd0,
+        model=model,
+        options=options,
+        samples=samples,
+        energies=energies,
+        threads=threads,
+        dtype=float,
+        meta=np.empty((0, 0)),
+        chunks=(q0.chunks[0], (width,)),
+    )
     n = q0.shape[0]
     at = samples * dof * 4
     states = packed[:, :at].reshape(n, samples, 4, dof)
     out = {name: states[:, :, k, :] for k, name in enumerate(("q", "qd", "qdd", "tau"))}
-    out["work"] = packed[:, at:at + samples]
+    out["work"] = packed[:, at : at + samples]
     at += samples
     kinetic = potential = None
     if energies:
-        e = packed[:, at:at + 2 * samples].reshape(n, samples, 2)
+        e = packed[:, at : at + 2 * samples].reshape(n, samples, 2)
         kinetic, potential = e[:, :, 0], e[:, :, 1]
         at += 2 * samples
-    out["q_final"], out["qd_final"] = packed[:, at:at + dof], packed[:, at + dof:at + 2 * dof]
+    out["q_final"], out["qd_final"] = packed[:, at : at + dof], packed[:, at + dof : at + 2 * dof]
     at += 2 * dof
     for k, name in enumerate(_FLAGS):
         out[name] = packed[:, at + k].astype(np.int64)
     t = np.arange(samples) * (stride * float(dt))
-    return Trajectory(t=t, dt=float(dt), stride=stride, method=method, coordinate_names=list(model.coordinate_names),
-                      kinetic=kinetic, potential=potential, **out)
+    return Trajectory(
+        t=t,
+        dt=float(dt),
+        stride=stride,
+        method=method,
+        coordinate_names=list(model.coordinate_names),
+        kinetic=kinetic,
+        potential=potential,
+        **out,
+    )
 
 
 # ------------------------------------------------------------------ derivatives
-# Batches of (dof, dof) matrices, row = output, column = input (DESIGN.md), chunked along
+# Batches of (dof, dof) matrices, row = output, column = input (docs/architecture.md), chunked along
 # the states like crba: a block of rows (r, dof) maps to (r, dof, dof). The functions
 # with three results compute them in one call per block, packed as (r, 3, dof, dof), and
 # hand back three lazy views of that one graph: compute them together
@@ -193,15 +233,31 @@ def _gravity_derivatives(q, model, threads):
 def _matrices(function, model, q, *more, threads):
     """Map ``function`` (block rows (r, dof) -> (r, dof, dof)) over the row blocks."""
     n = model.dof
-    return q.map_blocks(function, *more, model=model, threads=threads, dtype=float, meta=np.empty((0, 0, 0)),
-                        new_axis=2, chunks=(q.chunks[0], (n,), (n,)))
+    return q.map_blocks(
+        function,
+        *more,
+        model=model,
+        threads=threads,
+        dtype=float,
+        meta=np.empty((0, 0, 0)),
+        new_axis=2,
+        chunks=(q.chunks[0], (n,), (n,)),
+    )
 
 
 def _triple(function, model, q, *more, threads):
     """Map ``function`` (block rows -> (r, 3, dof, dof)) and split its three results."""
     n = model.dof
-    packed = q.map_blocks(function, *more, model=model, threads=threads, dtype=float,
-                          meta=np.empty((0, 0, 0, 0)), new_axis=[2, 3], chunks=(q.chunks[0], (3,), (n,), (n,)))
+    packed = q.map_blocks(
+        function,
+        *more,
+        model=model,
+        threads=threads,
+        dtype=float,
+        meta=np.empty((0, 0, 0, 0)),
+        new_axis=[2, 3],
+        chunks=(q.chunks[0], (3,), (n,), (n,)),
+    )
     return packed[:, 0], packed[:, 1], packed[:, 2]
 
 

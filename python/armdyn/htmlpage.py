@@ -20,8 +20,7 @@ from __future__ import annotations
 from .mathml import escape
 
 #: every page: no script, no fetch, no frame, no form, no base URL; inline CSS only
-CSP = ("default-src 'none'; style-src 'unsafe-inline'; img-src data:; "
-       "base-uri 'none'; form-action 'none'")
+CSP = "default-src 'none'; style-src 'unsafe-inline'; img-src data:; base-uri 'none'; form-action 'none'"
 
 CSS = """
 .armdyn { --ink:#1f2328; --muted:#59636e; --rule:#d1d9e0; --paper:#ffffff; --tint:#f6f8fa;

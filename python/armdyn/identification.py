@@ -3,7 +3,7 @@
     reg = regressor(robot)          # tau == reg.Y * reg.pi, exactly
     base = base_parameters(robot)   # tau == base.Y * base.beta, beta minimal
 
-Standard parameters (DESIGN.md), link by link (every link but the base, in
+Standard parameters (docs/architecture.md), link by link (every link but the base, in
 ``list(robot.links)`` order), about the link frame's origin, in the link frame::
 
     [M, MX, MY, MZ, XX, XY, YY, XZ, YZ, ZZ]_j = [m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]
@@ -71,9 +71,8 @@ from .model import Robot
 from .programs.grouping import moved_to_parent
 from .programs.vectors import rows
 from .symbolic import dag
-from .symbolic.joint_terms import _value
 
-#: standard inertial parameter names per link, DESIGN.md's (Pinocchio's) order
+#: standard inertial parameter names per link, the architecture's (Pinocchio's) order
 INERTIAL = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")
 #: joint terms: (Joint attribute, Khalil-style name)
 JOINT_TERMS = (("armature", "IA"), ("damping", "FV"), ("friction", "FC"), ("torque_offset", "OFF"))
@@ -206,7 +205,7 @@ def _unit_wrenches(w, wd, vd):
     for i in range(3):  # MX, MY, MZ
         e = [se.Integer(int(i == j)) for j in range(3)]
         out.append((_add(_cross(wd, e), _cross(w, _cross(w, e))), _cross(e, vd)))
-    for (a, b) in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):  # XX, XY, YY, XZ, YZ, ZZ
+    for a, b in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):  # XX, XY, YY, XZ, YZ, ZZ
         E = [[se.Integer(0)] * 3 for _ in range(3)]
         E[a][b] = E[b][a] = se.Integer(1)
         out.append((zero, _add(_mul(E, wd), _cross(w, _mul(E, w)))))
@@ -242,8 +241,12 @@ def regressor(robot: Robot) -> Regressor:
     for joint in robot.movable_joints:
         k = robot.coordinate_index(joint)
         assert k is not None  # a movable joint has a coordinate
-        coefficient = {"armature": robot.qdd[k], "damping": robot.qd[k], "friction": sp.sign(robot.qd[k]),
-                       "torque_offset": sp.Integer(1)}
+        coefficient = {
+            "armature": robot.qdd[k],
+            "damping": robot.qd[k],
+            "friction": sp.sign(robot.qd[k]),
+            "torque_offset": sp.Integer(1),
+        }
         for attr, _ in JOINT_TERMS:
             if getattr(joint, attr) is not None:
                 col = [sp.Integer(0)] * n
@@ -461,7 +464,7 @@ def _grouped(robot: Robot, reg: Regressor):
     candidate (kept) standard-parameter indices and, for each, its grouped expression in
     the standard parameter symbols."""
     nlinks = len(robot.joints)
-    vec = {j.child: list(reg.symbols[10 * i: 10 * i + 10]) for i, j in enumerate(robot.joints)}
+    vec = {j.child: list(reg.symbols[10 * i : 10 * i + 10]) for i, j in enumerate(robot.joints)}
     dropped = set()
     for i in reversed(range(nlinks)):
         joint = robot.joints[i]
@@ -513,7 +516,9 @@ def _symbolic_coefficients(Yk, d, pivots, Rs, geometry, robot, seed):
                 values[sp.cos(x)] = sp.Rational(t.denominator**2 - t.numerator**2, t.denominator**2 + t.numerator**2)
             values[x] = sp.Rational(t.numerator, t.denominator)
         signs = {sp.sign(x): sp.sign(values[x]) for x in state if x in values}
-        rows += [[sp.expand(sp.sympify(e).xreplace(signs).xreplace(values)) for e in sub.row(i)] for i in range(sub.rows)]
+        rows += [
+            [sp.expand(sp.sympify(e).xreplace(signs).xreplace(values)) for e in sub.row(i)] for i in range(sub.rows)
+        ]
     A = sp.Matrix([r[:-1] for r in rows])
     b = sp.Matrix([r[-1] for r in rows])
     # least squares normal equations are exact here: the system is consistent
@@ -554,8 +559,17 @@ def rationalized(robot: Robot) -> Robot:
 
     with warnings.catch_warnings():  # the links were checked when the robot was built
         warnings.simplefilter("ignore")
-        return Robot(robot.name, robot.links.values(), joints, exact(robot.gravity), robot.parameters, robot.meta,
-                     robot.base, robot.defaults, strict=robot.strict)
+        return Robot(
+            robot.name,
+            robot.links.values(),
+            joints,
+            exact(robot.gravity),
+            robot.parameters,
+            robot.meta,
+            robot.base,
+            robot.defaults,
+            strict=robot.strict,
+        )
 
 
 def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
@@ -607,8 +621,7 @@ def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
             continue
         k = [sp.Rational(R[r][d].numerator, R[r][d].denominator) for r in range(len(pivots))]
         if len(coefficient_sets) > 1 and any(R[r][d] != coefficient_sets[1][0][r][d] for r in range(len(pivots))):
-            k = _symbolic_coefficients(Yk, d, pivots, [coefficient_sets[t][0] for t in range(2)], geometry,
-                                       robot, seed)
+            k = _symbolic_coefficients(Yk, d, pivots, [coefficient_sets[t][0] for t in range(2)], geometry, robot, seed)
         for r in range(len(pivots)):
             if k[r] != 0:
                 beta[r] = beta[r] + k[r] * exprs[d]
@@ -639,8 +652,17 @@ def with_symbolic_joint_terms(robot: Robot, terms=("armature", "damping", "frict
                 params[s.name] = s
             joint = replace(joint, **new)
         joints.append(joint)
-    return Robot(robot.name, robot.links.values(), joints, robot.gravity, params, robot.meta, robot.base,
-                 robot.defaults, strict=robot.strict)
+    return Robot(
+        robot.name,
+        robot.links.values(),
+        joints,
+        robot.gravity,
+        params,
+        robot.meta,
+        robot.base,
+        robot.defaults,
+        strict=robot.strict,
+    )
 
 
 def symbolic_inertias(robot: Robot) -> Robot:
@@ -660,11 +682,21 @@ def symbolic_inertias(robot: Robot) -> Robot:
         I = sp.Matrix([[s["Ixx"], s["Ixy"], s["Ixz"]], [s["Ixy"], s["Iyy"], s["Iyz"]], [s["Ixz"], s["Iyz"], s["Izz"]]])
         links.append(Link(name, s["m"], sp.Matrix([s["cx"], s["cy"], s["cz"]]), I))
     defaults = {k: v for k, v in robot.defaults.items()}
-    return Robot(robot.name, links, robot.joints, robot.gravity, params, robot.meta, robot.base, defaults,
-                 strict=robot.strict)
+    return Robot(
+        robot.name, links, robot.joints, robot.gravity, params, robot.meta, robot.base, defaults, strict=robot.strict
+    )
 
 
 __all__ = [
-    "Regressor", "BaseParameters", "regressor", "base_parameters", "standard_parameters",
-    "exact_rank", "stacked_exact", "with_symbolic_joint_terms", "symbolic_inertias", "rationalized", "INERTIAL",
+    "Regressor",
+    "BaseParameters",
+    "regressor",
+    "base_parameters",
+    "standard_parameters",
+    "exact_rank",
+    "stacked_exact",
+    "with_symbolic_joint_terms",
+    "symbolic_inertias",
+    "rationalized",
+    "INERTIAL",
 ]

@@ -308,7 +308,11 @@ def physical_violations(mass, inertia, rtol: float = 1e-6) -> list[str]:
             return out + [f"inertia must be 3x3, got shape {I.shape}"]
         if I.free_symbols:
             return out
-    I = I.astype(complex) if isinstance(I, np.ndarray) else np.array([complex(x) for x in I], dtype=complex).reshape(3, 3)
+    I = (
+        I.astype(complex)
+        if isinstance(I, np.ndarray)
+        else np.array([complex(x) for x in I], dtype=complex).reshape(3, 3)
+    )
     if np.any(I.imag != 0) or not np.all(np.isfinite(I.real)):
         return out + ["inertia has entries that are not finite real numbers"]
     I = I.real

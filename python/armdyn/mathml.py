@@ -107,8 +107,12 @@ def latex_to_mathml(latex: str) -> str | None:
         return None
     for mover in doc.getElementsByTagName("mover"):
         kids = [k for k in mover.childNodes if k.nodeType == k.ELEMENT_NODE]
-        if len(kids) == 2 and kids[1].tagName == "mo" and kids[1].firstChild is not None \
-                and kids[1].firstChild.data in _ACCENTS:
+        if (
+            len(kids) == 2
+            and kids[1].tagName == "mo"
+            and kids[1].firstChild is not None
+            and kids[1].firstChild.data in _ACCENTS
+        ):
             mover.setAttribute("accent", "true")
     root = doc.documentElement
     inner = "".join(k.toxml() for k in root.childNodes)
@@ -130,7 +134,7 @@ def text_with_math(text: str) -> str:
     out, at = [], 0
     for m in _DELIMITED.finditer(text):
         inner = latex_to_mathml(m.group(1) if m.group(1) is not None else m.group(2))
-        out.append(escape(text[at:m.start()]))
+        out.append(escape(text[at : m.start()]))
         out.append(math_element(inner) if inner is not None else escape(m.group(0)))
         at = m.end()
     out.append(escape(text[at:]))
@@ -176,8 +180,7 @@ class _Printer(MathMLPresentationPrinter):
             return self._el("mn", text=text)
         m = re.match(r"^(\d+)([A-Za-z]+)$", text)  # "1xx": index then axes
         if m:
-            return self._el("mrow", self._el("mn", text=m.group(1)),
-                            *[self._el("mi", text=ch) for ch in m.group(2)])
+            return self._el("mrow", self._el("mn", text=m.group(1)), *[self._el("mi", text=ch) for ch in m.group(2)])
         if len(text) > 1 and text.isascii() and text.isalpha():
             # Ixx, cx: italic letters as TeX sets them (a multi-letter <mi> would be upright)
             return self._el("mrow", *[self._el("mi", text=ch) for ch in text])
@@ -236,8 +239,9 @@ class _Printer(MathMLPresentationPrinter):
         else:
             inner = self._el("mrow", self._l_paren(), self._print(arg), self._r_paren())
         # thin spaces around the name, as TeX sets \sin (an operator between ordinary atoms)
-        return self._el("mrow", self._el("mspace", width="0.1667em"), head,
-                        self._mo(_APPLY, lspace="0", rspace="0.1667em"), inner)
+        return self._el(
+            "mrow", self._el("mspace", width="0.1667em"), head, self._mo(_APPLY, lspace="0", rspace="0.1667em"), inner
+        )
 
     def _print_Function(self, e):
         name = type(e).__name__
@@ -254,8 +258,7 @@ class _Printer(MathMLPresentationPrinter):
 
     def _print_Pow(self, e):
         base, exp = e.base, e.exp
-        if (isinstance(base, sp.Function) and type(base).__name__ in _FUNCTIONS
-                and exp.is_Integer and exp > 0):
+        if isinstance(base, sp.Function) and type(base).__name__ in _FUNCTIONS and exp.is_Integer and exp > 0:
             head = self._el("msup", self._el("mi", text=type(base).__name__), self._print(exp))
             return self._apply(head, base.args[0])  # sin²θ₁, as written by hand
         if base.is_Symbol and exp.is_Integer and exp > 1:
@@ -311,7 +314,7 @@ def typeset_width(expr) -> float:
         return 2.2 + args + (0 if all(a.is_Atom for a in e.args) else 1.0)
     if e.is_Pow:
         if e.exp.is_negative:
-            return typeset_width(e.base ** -e.exp)
+            return typeset_width(e.base**-e.exp)
         return typeset_width(e.base) + 0.5
     if e.is_Mul:
         num, den = sp.fraction(e)
@@ -354,8 +357,7 @@ class MathWriter:
             cls = ' class="hl"' if i in highlight else ""
             td = cls or (' class="zero"' if i in muted else "")
             rows.append(f"<mtr{cls}><mtd{td}>{cell}</mtd></mtr>")
-        return ('<mrow><mo stretchy="true">(</mo><mtable>' + "".join(rows)
-                + '</mtable><mo stretchy="true">)</mo></mrow>')
+        return '<mrow><mo stretchy="true">(</mo><mtable>' + "".join(rows) + '</mtable><mo stretchy="true">)</mo></mrow>'
 
     def terms(self, terms: list[tuple], width: float | None = None) -> str:
         """``(coefficient, monomial)`` terms (see :func:`armdyn.symbolic.report.tidy_terms`)
@@ -377,8 +379,10 @@ class MathWriter:
             elif coef == 1:
                 body = self.expr(mono)
             elif isinstance(coef, sp.Add):
-                body = (f'<mrow><mo stretchy="true">(</mo>{self.expr(coef)}<mo stretchy="true">)</mo></mrow>'
-                        f"<mo>{_TIMES}</mo>{self.expr(mono)}")
+                body = (
+                    f'<mrow><mo stretchy="true">(</mo>{self.expr(coef)}<mo stretchy="true">)</mo></mrow>'
+                    f"<mo>{_TIMES}</mo>{self.expr(mono)}"
+                )
             elif any((f.is_Rational and f.q != 1) or (f.is_Pow and f.exp.is_negative) for f in sp.Mul.make_args(coef)):
                 body = self.expr(coef * mono)
             else:
@@ -398,8 +402,10 @@ class MathWriter:
         rows = []
         for k, line in enumerate(lines):
             # a line's leading sign is a prefix operator (no gap as after a binary one)
-            cells = "".join((f'<mo form="{"prefix" if i == 0 else "infix"}">{sg}</mo>' if sg else "") + b
-                            for i, (sg, b) in enumerate(line))
+            cells = "".join(
+                (f'<mo form="{"prefix" if i == 0 else "infix"}">{sg}</mo>' if sg else "") + b
+                for i, (sg, b) in enumerate(line)
+            )
             indent = '<mspace width="1.5em"/>' if k else ""
             rows.append(f'<mtr><mtd class="left">{indent}<mrow>{cells}</mrow></mtd></mtr>')
         return "<mtable>" + "".join(rows) + "</mtable>"

@@ -38,11 +38,40 @@ __all__ = ["ATTRIBUTES", "CLASSES", "ELEMENTS", "MAX_DEPTH", "Sanitized", "clean
 MATHML_NS = "http://www.w3.org/1998/Math/MathML"
 
 #: MathML elements that may appear in a report (``math`` only as the outermost one)
-ELEMENTS = frozenset({
-    "math", "mrow", "mi", "mn", "mo", "ms", "mtext", "mspace", "msub", "msup", "msubsup", "munder", "mover",
-    "munderover", "mmultiscripts", "mprescripts", "none", "mfrac", "msqrt", "mroot", "mtable", "mtr", "mtd",
-    "mstyle", "mpadded", "mphantom", "menclose", "merror", "semantics", "annotation",
-})
+ELEMENTS = frozenset(
+    {
+        "math",
+        "mrow",
+        "mi",
+        "mn",
+        "mo",
+        "ms",
+        "mtext",
+        "mspace",
+        "msub",
+        "msup",
+        "msubsup",
+        "munder",
+        "mover",
+        "munderover",
+        "mmultiscripts",
+        "mprescripts",
+        "none",
+        "mfrac",
+        "msqrt",
+        "mroot",
+        "mtable",
+        "mtr",
+        "mtd",
+        "mstyle",
+        "mpadded",
+        "mphantom",
+        "menclose",
+        "merror",
+        "semantics",
+        "annotation",
+    }
+)
 #: class names armdyn's stylesheet gives meaning to (htmlpage.CSS)
 CLASSES = frozenset({"hl", "zero", "long", "left"})
 #: deeper subtrees are dropped (a browser's parser gives up nesting at a few hundred)
@@ -52,17 +81,23 @@ _NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
 
 # at most 9999 units: a label cannot push the page kilometres wide
 _NUMBER = r"[+-]?(?:\d{1,4}(?:\.\d{0,6})?|\.\d{1,6})"
-_LENGTH = (rf"{_NUMBER}(?:em|ex|px|pt|pc|in|cm|mm|%|mu)?"
-           r"|(?:negative)?(?:very){0,2}(?:thin|thick)mathspace|(?:negative)?mediummathspace|infinity")
+_LENGTH = (
+    rf"{_NUMBER}(?:em|ex|px|pt|pc|in|cm|mm|%|mu)?"
+    r"|(?:negative)?(?:very){0,2}(?:thin|thick)mathspace|(?:negative)?mediummathspace|infinity"
+)
 _BOOL = r"true|false"
 _ALIGN = r"left|center|right|top|bottom|baseline|axis|decimalpoint"
 _LINES = r"none|solid|dashed"
-_NOTATION = (r"longdiv|actuarial|phasorangle|radical|box|roundedbox|circle|left|right|top|bottom"
-             r"|updiagonalstrike|downdiagonalstrike|verticalstrike|horizontalstrike|northeastarrow"
-             r"|madruwb|updiagonalarrow")
-_VARIANT = (r"normal|bold|italic|bold-italic|double-struck|bold-fraktur|script|bold-script|fraktur"
-            r"|sans-serif|bold-sans-serif|sans-serif-italic|sans-serif-bold-italic|monospace|initial"
-            r"|tailed|looped|stretched")
+_NOTATION = (
+    r"longdiv|actuarial|phasorangle|radical|box|roundedbox|circle|left|right|top|bottom"
+    r"|updiagonalstrike|downdiagonalstrike|verticalstrike|horizontalstrike|northeastarrow"
+    r"|madruwb|updiagonalarrow"
+)
+_VARIANT = (
+    r"normal|bold|italic|bold-italic|double-struck|bold-fraktur|script|bold-script|fraktur"
+    r"|sans-serif|bold-sans-serif|sans-serif-italic|sans-serif-bold-italic|monospace|initial"
+    r"|tailed|looped|stretched"
+)
 
 
 def _words(word: str, most: int = 64) -> str:
@@ -71,27 +106,54 @@ def _words(word: str, most: int = 64) -> str:
 
 
 #: attribute -> the whole value must match this pattern (any element of ELEMENTS)
-ATTRIBUTES = {name: re.compile(rf"\s*(?:{pattern})\s*") for name, pattern in {
-    "display": r"block|inline",
-    "mathvariant": _VARIANT,
-    "displaystyle": _BOOL, "stretchy": _BOOL, "fence": _BOOL, "separator": _BOOL, "symmetric": _BOOL,
-    "largeop": _BOOL, "movablelimits": _BOOL, "accent": _BOOL, "accentunder": _BOOL, "bevelled": _BOOL,
-    "equalrows": _BOOL, "equalcolumns": _BOOL,
-    "form": r"prefix|infix|postfix",
-    "lspace": _LENGTH, "rspace": _LENGTH, "width": _LENGTH, "height": _LENGTH, "depth": _LENGTH,
-    "voffset": _LENGTH, "minsize": _LENGTH, "maxsize": _LENGTH, "linethickness": _LENGTH + r"|thin|medium|thick",
-    "mathsize": _LENGTH + r"|small|normal|big",
-    "scriptlevel": r"[+-]?\d{1,2}",
-    "columnalign": _words(r"left|center|right"), "rowalign": _words(_ALIGN), "align": _words(_ALIGN),
-    "columnlines": _words(_LINES), "rowlines": _words(_LINES), "frame": _LINES,
-    "columnspacing": _words(_LENGTH), "rowspacing": _words(_LENGTH), "framespacing": _words(_LENGTH, 2),
-    "columnspan": r"\d{1,3}", "rowspan": r"\d{1,3}",
-    "notation": _words(_NOTATION, 8),
-    "mathcolor": r"#[0-9A-Fa-f]{3,8}|[A-Za-z]{1,20}", "mathbackground": r"#[0-9A-Fa-f]{3,8}|[A-Za-z]{1,20}",
-    "dir": r"ltr|rtl",
-    "encoding": r"[A-Za-z0-9.+/-]{1,40}",
-    "class": _words("|".join(sorted(CLASSES)), 4),
-}.items()}
+ATTRIBUTES = {
+    name: re.compile(rf"\s*(?:{pattern})\s*")
+    for name, pattern in {
+        "display": r"block|inline",
+        "mathvariant": _VARIANT,
+        "displaystyle": _BOOL,
+        "stretchy": _BOOL,
+        "fence": _BOOL,
+        "separator": _BOOL,
+        "symmetric": _BOOL,
+        "largeop": _BOOL,
+        "movablelimits": _BOOL,
+        "accent": _BOOL,
+        "accentunder": _BOOL,
+        "bevelled": _BOOL,
+        "equalrows": _BOOL,
+        "equalcolumns": _BOOL,
+        "form": r"prefix|infix|postfix",
+        "lspace": _LENGTH,
+        "rspace": _LENGTH,
+        "width": _LENGTH,
+        "height": _LENGTH,
+        "depth": _LENGTH,
+        "voffset": _LENGTH,
+        "minsize": _LENGTH,
+        "maxsize": _LENGTH,
+        "linethickness": _LENGTH + r"|thin|medium|thick",
+        "mathsize": _LENGTH + r"|small|normal|big",
+        "scriptlevel": r"[+-]?\d{1,2}",
+        "columnalign": _words(r"left|center|right"),
+        "rowalign": _words(_ALIGN),
+        "align": _words(_ALIGN),
+        "columnlines": _words(_LINES),
+        "rowlines": _words(_LINES),
+        "frame": _LINES,
+        "columnspacing": _words(_LENGTH),
+        "rowspacing": _words(_LENGTH),
+        "framespacing": _words(_LENGTH, 2),
+        "columnspan": r"\d{1,3}",
+        "rowspan": r"\d{1,3}",
+        "notation": _words(_NOTATION, 8),
+        "mathcolor": r"#[0-9A-Fa-f]{3,8}|[A-Za-z]{1,20}",
+        "mathbackground": r"#[0-9A-Fa-f]{3,8}|[A-Za-z]{1,20}",
+        "dir": r"ltr|rtl",
+        "encoding": r"[A-Za-z0-9.+/-]{1,40}",
+        "class": _words("|".join(sorted(CLASSES)), 4),
+    }.items()
+}
 
 
 @dataclass

@@ -78,7 +78,9 @@ class MimicModel:
         self._source = source
         self._multiplier = self.G[np.arange(len(moving)), source]
         self._own = np.array([a for a, j in enumerate(moving) if j.mimic is None], dtype=np.intp)  # (dof,)
-        self._terms = [(a, int(source[a]), float(self._multiplier[a])) for a, j in enumerate(moving) if j.mimic is not None]
+        self._terms = [
+            (a, int(source[a]), float(self._multiplier[a])) for a, j in enumerate(moving) if j.mimic is not None
+        ]
 
     # ---------------------------------------------------------------- description
     @property
@@ -270,8 +272,9 @@ class MimicModel:
         analytical derivatives reduced, ``G^T D_full G``."""
         q, qd, qdd = self._states(("q", q), ("qd", qd), ("qdd", qdd))
         named = {"q": q, "qd": qd, "qdd": qdd}
-        full = self._call_core("rnea_derivatives", named, self._position(q), self._rate(qd), self._rate(qdd),
-                               threads=threads)
+        full = self._call_core(
+            "rnea_derivatives", named, self._position(q), self._rate(qd), self._rate(qdd), threads=threads
+        )
         return tuple(self._reduce_matrix(D) for D in full)
 
     def aba_derivatives(self, q, qd, tau, threads=None):

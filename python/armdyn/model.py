@@ -1,6 +1,6 @@
 """The robot description: one model shared by the symbolic and the numeric engines.
 
-Conventions (see DESIGN.md):
+Conventions (see docs/architecture.md):
 
 * SI units, radians.
 * A joint sits at a fixed placement in its parent link's frame: a translation ``xyz``
@@ -38,7 +38,7 @@ from .errors import ModelError
 from .inertia import check_physical, physical_violations
 
 JOINT_TYPES = ("revolute", "prismatic", "fixed")
-#: Joint fields that add to tau (DESIGN.md: Fv, Fc, Ia, offset), in that naming.
+#: Joint fields that add to tau (docs/architecture.md: Fv, Fc, Ia, offset), in that naming.
 JOINT_DYNAMICS = ("damping", "friction", "armature", "torque_offset")
 
 
@@ -349,7 +349,7 @@ class Joint:
               The child frame is ``placement * motion(q) * frame``.
     lower, upper, velocity, effort: optional limits, kept on the model (None when not given).
     damping, friction, armature, torque_offset: joint-space terms added to the rigid-body
-              torque (DESIGN.md): ``tau_k += armature qdd_k + damping qd_k
+              torque (docs/architecture.md): ``tau_k += armature qdd_k + damping qd_k
               + friction sign(qd_k) + torque_offset`` with sign(0) = 0. ``damping`` is the
               viscous coefficient Fv (N m s/rad or N s/m), ``friction`` the Coulomb level Fc,
               ``armature`` the rotor inertia Ia reflected to the joint (gear^2 times the
@@ -732,8 +732,9 @@ class Robot(metaclass=_FreezeAfterInit):
             except (TypeError, ValueError, OverflowError):
                 finite = False
             if not finite:
-                raise ModelError(f"the default value of parameter '{key}' is not a finite number: {value!r}",
-                                 f"robot '{self.name}'")
+                raise ModelError(
+                    f"the default value of parameter '{key}' is not a finite number: {value!r}", f"robot '{self.name}'"
+                )
 
     def _tree_order(self, joints: list[Joint]) -> list[Joint]:
         names: set[str] = set()
@@ -748,9 +749,7 @@ class Robot(metaclass=_FreezeAfterInit):
             if j.child not in self.links:
                 raise ModelError(f"child link '{j.child}' does not exist", where)
             if j.child in child_of:
-                raise ModelError(
-                    f"link '{j.child}' is already the child of joint '{child_of[j.child].name}'", where
-                )
+                raise ModelError(f"link '{j.child}' is already the child of joint '{child_of[j.child].name}'", where)
             if j.child == self.base:
                 raise ModelError(f"the base link '{self.base}' cannot be a child", where)
             child_of[j.child] = j
@@ -772,7 +771,9 @@ class Robot(metaclass=_FreezeAfterInit):
         if len(ordered) != len(joints):
             placed = {j.name for j in ordered}
             stray = [j.name for j in joints if j.name not in placed]
-            raise ModelError(f"joints not connected to the base '{self.base}' (a cycle?): {stray}", f"robot '{self.name}'")
+            raise ModelError(
+                f"joints not connected to the base '{self.base}' (a cycle?): {stray}", f"robot '{self.name}'"
+            )
         # the given order is a tree order when every joint comes after its parent joint
         # (the joint whose child is its parent link): one dict lookup per joint, O(n)
         position = {j.name: i for i, j in enumerate(joints)}
@@ -861,6 +862,7 @@ class Robot(metaclass=_FreezeAfterInit):
 
     def free_symbols(self) -> set[sp.Symbol]:
         """Symbols the model's numbers depend on (the joint coordinates excluded)."""
+
         def free(obj, name):  # Numbers have none (and are not built into SymPy here)
             raw = obj.__dict__[name]  # None, Numbers or SymPy (sympify would copy a Matrix to ask it)
             return set() if raw is None or isinstance(raw, Numbers) else raw.free_symbols
@@ -906,7 +908,14 @@ class Robot(metaclass=_FreezeAfterInit):
                 changes.update(xyz=pf + Rf * j.xyz, rotation=Rf * j.rotation)
             joints.append(replace(j, **changes))
         out = Robot(
-            self.name, links, joints, self.gravity, self.parameters, self.meta, self.base, self.defaults,
+            self.name,
+            links,
+            joints,
+            self.gravity,
+            self.parameters,
+            self.meta,
+            self.base,
+            self.defaults,
             strict=self.strict,
         )
         self.__dict__["_canonical"] = out  # built once: the numeric engines and codegen share it
@@ -937,8 +946,7 @@ class Robot(metaclass=_FreezeAfterInit):
             return None if x is None else sp.sympify(x).xreplace(table)
 
         links = [
-            Link(ln.name, s(ln.mass), ln.com.xreplace(table), ln.inertia.xreplace(table))
-            for ln in self.links.values()
+            Link(ln.name, s(ln.mass), ln.com.xreplace(table), ln.inertia.xreplace(table)) for ln in self.links.values()
         ]
         joints = [
             replace(
@@ -949,7 +957,9 @@ class Robot(metaclass=_FreezeAfterInit):
                 frame_xyz=j.frame_xyz.xreplace(table),
                 frame_rotation=j.frame_rotation.xreplace(table),
                 **{k: s(getattr(j, k)) for k in ("lower", "upper", "velocity", "effort") + JOINT_DYNAMICS},
-                mimic=None if j.mimic is None else replace(j.mimic, multiplier=s(j.mimic.multiplier), offset=s(j.mimic.offset)),
+                mimic=None
+                if j.mimic is None
+                else replace(j.mimic, multiplier=s(j.mimic.multiplier), offset=s(j.mimic.offset)),
             )
             for j in self.joints
         ]
@@ -957,7 +967,14 @@ class Robot(metaclass=_FreezeAfterInit):
         defaults = {n: v for n, v in self.defaults.items() if n in remaining}
         try:
             return Robot(
-                self.name, links, joints, self.gravity.xreplace(table), remaining, self.meta, self.base, defaults,
+                self.name,
+                links,
+                joints,
+                self.gravity.xreplace(table),
+                remaining,
+                self.meta,
+                self.base,
+                defaults,
                 strict=self.strict,
             )
         except ModelError as err:  # e.g. a bound value that is not physical: name the model file
@@ -1030,7 +1047,14 @@ class Robot(metaclass=_FreezeAfterInit):
         with warnings.catch_warnings():  # this robot's own links were warned about when it was built
             warnings.simplefilter("ignore")
             return Robot(
-                self.name, links, self.joints, self.gravity, params, self.meta, self.base, self.defaults,
+                self.name,
+                links,
+                self.joints,
+                self.gravity,
+                params,
+                self.meta,
+                self.base,
+                self.defaults,
                 strict=self.strict,
             )
 
@@ -1059,8 +1083,17 @@ class Robot(metaclass=_FreezeAfterInit):
 
         with warnings.catch_warnings():  # this robot's own links were warned about when it was built
             warnings.simplefilter("ignore")
-            return Robot(self.name, self.links.values(), joints, self.gravity, self.parameters, self.meta, self.base,
-                         self.defaults, strict=self.strict)
+            return Robot(
+                self.name,
+                self.links.values(),
+                joints,
+                self.gravity,
+                self.parameters,
+                self.meta,
+                self.base,
+                self.defaults,
+                strict=self.strict,
+            )
 
     def __repr__(self) -> str:
         kinds = "".join({"revolute": "R", "prismatic": "P", "fixed": "F"}[j.type] for j in self.joints)

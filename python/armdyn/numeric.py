@@ -24,7 +24,7 @@ Every function takes a robot and one state or a batch of states:
   movable joint whose subtree has no mass and no inertia (named in the message), or
   a state where the result is not finite.
 
-Conventions (DESIGN.md): SI units, radians; ``M(q) qdd + C(q, qd) qd + g(q) = tau``;
+Conventions (docs/architecture.md): SI units, radians; ``M(q) qdd + C(q, qd) qd + g(q) = tau``;
 gravity is the robot's vector in the base frame; frames as in :mod:`armdyn.model`.
 """
 
@@ -145,9 +145,12 @@ def compile_model(robot: Robot | NumericModel | MimicModel) -> NumericModel | Mi
     # one row per joint the compiled model frees (mimic joints too); a mimic joint's own
     # friction and armature are not modelled (yet): zeros, as in the reference
     rows = [
-        [0.0 if j.mimic is not None or j.floats(k) is None else float(j.floats(k))
-         for k in ("armature", "damping", "friction", "torque_offset")]
-        for j in robot.joints if j.movable
+        [
+            0.0 if j.mimic is not None or j.floats(k) is None else float(j.floats(k))
+            for k in ("armature", "damping", "friction", "torque_offset")
+        ]
+        for j in robot.joints
+        if j.movable
     ]
     joint_dynamics = rows if any(any(row) for row in rows) else None
     gravity_vec = _floats(robot.gravity, f"robot '{robot.name}'")
@@ -155,9 +158,21 @@ def compile_model(robot: Robot | NumericModel | MimicModel) -> NumericModel | Mi
     where = f"link '{base.name}'"
     try:
         core = NumericModel(
-            parents, types, rotations, translations, axes, masses, coms, inertias, gravity_vec,
-            list(robot.links), [j.name for j in robot.joints if j.movable], robot.name,
-            _field(base, "mass", where), _field(base, "com", where), joint_dynamics,
+            parents,
+            types,
+            rotations,
+            translations,
+            axes,
+            masses,
+            coms,
+            inertias,
+            gravity_vec,
+            list(robot.links),
+            [j.name for j in robot.joints if j.movable],
+            robot.name,
+            _field(base, "mass", where),
+            _field(base, "com", where),
+            joint_dynamics,
         )
     except ValueError as err:
         raise ModelError(str(err), f"robot '{robot.name}'") from None
@@ -175,8 +190,10 @@ def _core_model(robot, what: str, link_frames: bool = False) -> NumericModel:
     if not isinstance(model, NumericModel):
         raise ValueError(f"{what} is not available yet for robots with mimic joints")
     if link_frames and _frame_offsets(robot) is not None:
-        raise ValueError(f"{what}: link frames off their joint's axis are not supported here yet; "
-                         "pass robot.canonical() (frames on the joints, same dynamics)")
+        raise ValueError(
+            f"{what}: link frames off their joint's axis are not supported here yet; "
+            "pass robot.canonical() (frames on the joints, same dynamics)"
+        )
     return model
 
 
@@ -219,8 +236,16 @@ def _model(robot) -> NumericModel | MimicModel:
         return compile_model(robot)
 
 
-def rnea(robot: RobotLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, *, f_ext: ArrayLike | None = None,
-         frame: str = "local", threads: int | None = None) -> np.ndarray:
+def rnea(
+    robot: RobotLike,
+    q: ArrayLike,
+    qd: ArrayLike,
+    qdd: ArrayLike,
+    *,
+    f_ext: ArrayLike | None = None,
+    frame: str = "local",
+    threads: int | None = None,
+) -> np.ndarray:
     """Inverse dynamics by the recursive Newton-Euler algorithm.
 
     q, qd, qdd: (n,) or (N, n). Returns tau = M(q) qdd + C(q, qd) qd + g(q), same shape;
@@ -229,8 +254,13 @@ def rnea(robot: RobotLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, *, f_ext
     threads = _threads(threads)
     if f_ext is not None:
         f_ext = _canonical_wrenches(robot, f_ext, frame)
-        return _finite(_core.rnea_ext(_core_model(robot, "rnea with f_ext"), q, qd, qdd, f_ext, frame, threads),
-                       "rnea", q=q, qd=qd, qdd=qdd)
+        return _finite(
+            _core.rnea_ext(_core_model(robot, "rnea with f_ext"), q, qd, qdd, f_ext, frame, threads),
+            "rnea",
+            q=q,
+            qd=qd,
+            qdd=qdd,
+        )
     tau = _model(robot).rnea(q, qd, qdd, threads)
     if tau.ndim == 1 and tau.size <= 64 and math.isfinite(sum(tau.tolist())) or _all_finite(tau):  # inlined: hot
         return tau
@@ -246,8 +276,16 @@ def crba(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.nd
     return _finite(_model(robot).crba(q, threads), "crba", q=q)
 
 
-def aba(robot: RobotLike, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, *, f_ext: ArrayLike | None = None,
-        frame: str = "local", threads: int | None = None) -> np.ndarray:
+def aba(
+    robot: RobotLike,
+    q: ArrayLike,
+    qd: ArrayLike,
+    tau: ArrayLike,
+    *,
+    f_ext: ArrayLike | None = None,
+    frame: str = "local",
+    threads: int | None = None,
+) -> np.ndarray:
     """Forward dynamics by the articulated-body algorithm.
 
     q, qd, tau: (n,) or (N, n). Returns qdd = M^-1 (tau - C qd - g), same shape; with
@@ -292,8 +330,7 @@ def coriolis_matrix(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: i
     return _finite(_model(robot).coriolis_matrix(q, qd, threads), "coriolis_matrix", q=q, qd=qd)
 
 
-def kinetic_energy(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *,
-                   threads: int | None = None) -> float | np.ndarray:
+def kinetic_energy(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None = None) -> float | np.ndarray:
     """Kinetic energy T = 1/2 qd^T M(q) qd. q, qd: (n,) -> float, or (N, n) -> (N,)."""
     threads = _threads(threads)
     return _finite(_model(robot).kinetic_energy(q, qd, threads), "kinetic_energy", q=q, qd=qd)
@@ -327,7 +364,11 @@ REFERENCE_FRAMES = ("local_world_aligned", "local", "world")
 
 
 def jacobian(
-    robot: RobotLike, q: ArrayLike, link: str | int | Link, *, reference_frame: str = "local_world_aligned",
+    robot: RobotLike,
+    q: ArrayLike,
+    link: str | int | Link,
+    *,
+    reference_frame: str = "local_world_aligned",
     threads: int | None = None,
 ) -> np.ndarray:
     """Geometric Jacobian of a link frame.
@@ -465,8 +506,9 @@ def gravity_derivatives(robot: RobotLike, q: ArrayLike, *, threads: int | None =
     return _core.gravity_derivatives(_core_model(robot, "gravity_derivatives"), q, threads)
 
 
-def jacobian_dot(robot: RobotLike, q: ArrayLike, qd: ArrayLike, link: str | int | Link, *,
-                 threads: int | None = None) -> np.ndarray:
+def jacobian_dot(
+    robot: RobotLike, q: ArrayLike, qd: ArrayLike, link: str | int | Link, *, threads: int | None = None
+) -> np.ndarray:
     """Time derivative of :func:`jacobian`: ``dJ/dt`` (6, n) or (N, 6, n), same rows
     ``[v; w]`` in base-frame axes (Pinocchio's LOCAL_WORLD_ALIGNED), so that the link
     origin's acceleration and the link's angular acceleration are ``J qdd + Jdot qd``.
@@ -497,8 +539,9 @@ def jacobian_dot(robot: RobotLike, q: ArrayLike, qd: ArrayLike, link: str | int 
     return np.concatenate([Jdv, Jd[..., 3:, :]], axis=-2)
 
 
-def regressor(robot: RobotLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, *, threads: int | None = None,
-              columns: str = "model") -> np.ndarray:
+def regressor(
+    robot: RobotLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, *, threads: int | None = None, columns: str = "model"
+) -> np.ndarray:
     """The joint torque regressor Y with ``rnea(q, qd, qdd) = Y @ pi`` (Rust core,
     algo/regressor.rs). q, qd, qdd: (n,) or (N, n). Returns (n, P) or (N, n, P).
 
@@ -525,9 +568,12 @@ def regressor(robot: RobotLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, *, 
         if not isinstance(robot, Robot):
             raise TypeError("columns='model' needs the Robot (a NumericModel does not say which terms a joint has)")
         first = 10 * len(robot.joints)
-        extra = [first + 4 * i + k for i, j in enumerate(robot.movable_joints)
-                 for k, name in enumerate(("armature", "damping", "friction", "torque_offset"))
-                 if getattr(j, name) is not None]
+        extra = [
+            first + 4 * i + k
+            for i, j in enumerate(robot.movable_joints)
+            for k, name in enumerate(("armature", "damping", "friction", "torque_offset"))
+            if getattr(j, name) is not None
+        ]
         # a plain slice (a view, no copy) when the model has no joint terms
         keep = slice(0, first) if not extra else np.array(list(range(first)) + extra)
         robot._regressor_columns = keep  # cached like the compiled model
@@ -543,8 +589,11 @@ def _threads(threads):
     it (True is an int to Python; 2**64 would be PyO3's OverflowError, naming nothing)."""
     if threads is None or type(threads) is int and 1 <= threads <= MAX_THREADS:
         return threads
-    if isinstance(threads, (bool, np.bool_)) or not isinstance(threads, (int, np.integer)) \
-            or not 1 <= threads <= MAX_THREADS:
+    if (
+        isinstance(threads, (bool, np.bool_))
+        or not isinstance(threads, (int, np.integer))
+        or not 1 <= threads <= MAX_THREADS
+    ):
         shown = repr(threads) if len(repr(threads)) <= 40 else f"{type(threads).__name__} {repr(threads)[:30]}..."
         raise ValueError(f"threads: expected None or an integer from 1 to {MAX_THREADS}, got {shown}")
     return int(threads)
@@ -557,8 +606,10 @@ def _overflow(what: str, arrays: dict) -> ValueError:
             sizes.append(f"max |{name}| = {float(np.max(np.abs(np.asarray(a, dtype=float)))):.3g}")
         except (TypeError, ValueError):
             pass
-    return ValueError(f"{what}: the result overflows float64 (not finite) for finite inputs ({', '.join(sizes)}); "
-                      "the state or torque is too large for this arm")
+    return ValueError(
+        f"{what}: the result overflows float64 (not finite) for finite inputs ({', '.join(sizes)}); "
+        "the state or torque is too large for this arm"
+    )
 
 
 def _well_conditioned(M) -> bool:

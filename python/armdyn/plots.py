@@ -66,8 +66,10 @@ def plot_trajectory(run, out=None, *, state: int = 0, title: str | None = None):
             ax.set_title(f"energy drift: max |E - E0| / scale = {np.nanmax(np.abs(error)):.2e}", fontsize=9)
         else:
             ax.set_ylabel("(E - E0 - W) / scale")
-            ax.set_title(f"energy balance (W: work of tau): max |E - E0 - W| / scale = "
-                         f"{np.nanmax(np.abs(error)):.2e}", fontsize=9)
+            ax.set_title(
+                f"energy balance (W: work of tau): max |E - E0 - W| / scale = {np.nanmax(np.abs(error)):.2e}",
+                fontsize=9,
+            )
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel("t (s)")
     method = {"rk4": "RK4", "euler": "semi-implicit Euler"}.get(run.method, run.method)

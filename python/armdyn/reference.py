@@ -5,7 +5,7 @@ Small and readable on purpose, in the style of Featherstone's spatial_v2, for ON
 Every function has the signature of its counterpart in ``armdyn.numeric``:
 
     rnea(robot, q, qd, qdd)       -> tau (n,)       M qdd + C qd + g (+ Fv qd + Fc sign(qd); Ia in M,
-                                                    the torque offset in g, as DESIGN.md)
+                                                    the torque offset in g, as docs/architecture.md)
     crba(robot, q)                -> M (n, n)
     aba(robot, q, qd, tau)        -> qdd (n,)
     gravity(robot, q)             -> g (n,)         = rnea(q, 0, 0)
@@ -126,7 +126,7 @@ class _Tree:
     link_names: list[str]  # base first, then body k's name at k + 1
     follow: list[tuple[float, float]]  # (c, o): joint k's own coordinate is c q[dofs[k]] + o
     mimic: bool  # whether some joint is a mimic joint
-    # per coordinate: rotor inertia Ia, viscous Fv, Coulomb Fc, offset (DESIGN.md), (n,) each
+    # per coordinate: rotor inertia Ia, viscous Fv, Coulomb Fc, offset (docs/architecture.md), (n,) each
     armature: np.ndarray = None
     viscous: np.ndarray = None
     coulomb: np.ndarray = None
@@ -202,8 +202,10 @@ def _tree(robot: Robot) -> _Tree:
         follow=follow,
         mimic=bool(robot.mimic_joints),
     )
-    terms = [[float(getattr(j, k)) if getattr(j, k) is not None else 0.0 for j in robot.movable_joints]
-             for k in ("armature", "damping", "friction", "torque_offset")]
+    terms = [
+        [float(getattr(j, k)) if getattr(j, k) is not None else 0.0 for j in robot.movable_joints]
+        for k in ("armature", "damping", "friction", "torque_offset")
+    ]
     tree.armature, tree.viscous, tree.coulomb, tree.offset = (np.array(x, dtype=float) for x in terms)
     _trees[robot] = tree
     return tree
@@ -264,7 +266,7 @@ def rnea(robot: Robot, q, qd, qdd) -> np.ndarray:
         tau[t.dofs[i]] += t.S[i].T @ f[i]  # += : a mimic joint adds to its leader's
         if t.parent[i] >= 0:
             f[t.parent[i]] = f[t.parent[i]] + Xup[i].T @ f[i]
-    # joint terms (DESIGN.md): Ia qdd + Fv qd + Fc sign(qd) + offset, np.sign(0) = 0
+    # joint terms (docs/architecture.md): Ia qdd + Fv qd + Fc sign(qd) + offset, np.sign(0) = 0
     return tau + t.armature * qdd + t.viscous * qd + t.coulomb * np.sign(qd) + t.offset
 
 
@@ -401,7 +403,7 @@ def coriolis_matrix(robot: Robot, q, qd) -> np.ndarray:
                 continue  # body b is not in k's subtree: it and its Jacobian do not move
             J = jacobian_world(b)
             dJ = np.zeros((6, n))
-            for j in path[b][path[b].index(k):]:  # joints at or below k on b's path move
+            for j in path[b][path[b].index(k) :]:  # joints at or below k on b's path move
                 dJ[:, t.dofs[j]] += crm(s) @ S0[j]
             dI = crf(s) @ I0[b] - I0[b] @ crm(s)
             dM[:, :, t.dofs[k][0]] += dJ.T @ I0[b] @ J + J.T @ dI @ J + J.T @ I0[b] @ dJ
@@ -565,7 +567,7 @@ def _rnea_tangent(t: _Tree, q, qd, qdd, dq, dqd, dqdd, f_ext=None, frame="local"
         if lam >= 0:
             f[lam] = f[lam] + Xup[i].T @ f[i]
             df[lam] = df[lam] + dXup[i].T @ f[i] + Xup[i].T @ df[i]
-    # joint friction, rotor inertia and offset (DESIGN.md) with their tangent (Coulomb's is 0:
+    # joint friction, rotor inertia and offset (docs/architecture.md) with their tangent (Coulomb's is 0:
     # sign(qd) is piecewise constant)
     tau = tau + t.armature * qdd + t.viscous * qd + t.coulomb * np.sign(qd) + t.offset
     dtau = dtau + t.armature * dqdd + t.viscous * dqd
@@ -605,8 +607,14 @@ def _aba_tangent(t: _Tree, q, qd, tau, dq, dqd, dtau, f_ext=None, frame="local")
             Ia = IA[i] - U[i] @ Dinv[i] @ U[i].T
             dIa = dIA[i] - dU[i] @ Dinv[i] @ U[i].T - U[i] @ dDinv[i] @ U[i].T - U[i] @ Dinv[i] @ dU[i].T
             pa = pA[i] + Ia @ c[i] + U[i] @ Dinv[i] @ u[i]
-            dpa = (dpA[i] + dIa @ c[i] + Ia @ dc[i] + dU[i] @ Dinv[i] @ u[i] + U[i] @ dDinv[i] @ u[i]
-                   + U[i] @ Dinv[i] @ du[i])
+            dpa = (
+                dpA[i]
+                + dIa @ c[i]
+                + Ia @ dc[i]
+                + dU[i] @ Dinv[i] @ u[i]
+                + U[i] @ dDinv[i] @ u[i]
+                + U[i] @ Dinv[i] @ du[i]
+            )
             X, dX = Xup[i], dXup[i]
             IA[lam] = IA[lam] + X.T @ Ia @ X
             dIA[lam] = dIA[lam] + dX.T @ Ia @ X + X.T @ dIa @ X + X.T @ Ia @ dX
@@ -665,8 +673,10 @@ def _forward_mode(t, tangent, q, qd, x, f_ext, frame):
     (qdd or tau), ``[i, j] = d out_i / d arg_j``: one tangent pass per coordinate, seeded
     with a unit vector in one argument and zeros in the other two."""
     E, Z = np.eye(t.n), np.zeros(t.n)
-    cols = [[tangent(t, q, qd, x, *(E[c] if k == w else Z for k in range(3)), f_ext, frame)[1]
-             for c in range(t.n)] for w in range(3)]
+    cols = [
+        [tangent(t, q, qd, x, *(E[c] if k == w else Z for k in range(3)), f_ext, frame)[1] for c in range(t.n)]
+        for w in range(3)
+    ]
     return tuple(np.array(c).reshape(t.n, t.n).T for c in cols)
 
 

@@ -123,8 +123,10 @@ def table(robot: Robot) -> str:
     if robot.meta.get("source"):
         lines.append(f"source: {robot.meta['source']}")
     if robot.joint_dynamics:  # a rigid-body library (Pinocchio) leaves these out
-        lines.append(f"joint dynamics: {', '.join(robot.joint_dynamics)} (in rnea/aba; "
-                     "robot.without_joint_dynamics() drops them)")
+        lines.append(
+            f"joint dynamics: {', '.join(robot.joint_dynamics)} (in rnea/aba; "
+            "robot.without_joint_dynamics() drops them)"
+        )
     rows = []
     for j in robot.joints:
         angles = "(" + ", ".join(_num(a) for a in rpy(j.rotation)) + ")" if not j.rotation.free_symbols else "symbolic"
@@ -231,8 +233,9 @@ def _place_labels(ax, labels: list[tuple[str, np.ndarray, str]], avoid: np.ndarr
             return True
         if any(x0 < b[2] and b[0] < x1 and y0 < b[3] and b[1] < y1 for b in taken):
             return True
-        return bool(len(arm)) and bool(np.any((arm[:, 0] > x0 - 4) & (arm[:, 0] < x1 + 4)
-                                              & (arm[:, 1] > y0 - 4) & (arm[:, 1] < y1 + 4)))
+        return bool(len(arm)) and bool(
+            np.any((arm[:, 0] > x0 - 4) & (arm[:, 0] < x1 + 4) & (arm[:, 1] > y0 - 4) & (arm[:, 1] < y1 + 4))
+        )
 
     for text, point, colour in labels:
         xy, at = screen(point)
@@ -258,9 +261,17 @@ def _place_labels(ax, labels: list[tuple[str, np.ndarray, str]], avoid: np.ndarr
             best = ((at[0] + dx, at[1] + dy, at[0] + dx + w, at[1] + dy + h), dx, dy)
         box, dx, dy = best
         taken.append(box)
-        ax.annotate(text, xy=xy, xytext=(box[0] - at[0], box[1] - at[1]), textcoords="offset pixels",
-                    fontsize=fontsize, color=colour, ha="left", va="bottom",
-                    arrowprops=dict(arrowstyle="-", color=colour, linewidth=0.6, shrinkA=0, shrinkB=1))
+        ax.annotate(
+            text,
+            xy=xy,
+            xytext=(box[0] - at[0], box[1] - at[1]),
+            textcoords="offset pixels",
+            fontsize=fontsize,
+            color=colour,
+            ha="left",
+            va="bottom",
+            arrowprops=dict(arrowstyle="-", color=colour, linewidth=0.6, shrinkA=0, shrinkB=1),
+        )
 
 
 def draw_on(ax, robot: Robot, poses: dict[str, np.ndarray], title: str, view: tuple[np.ndarray, float]):
@@ -329,8 +340,18 @@ def show(robot, q=None, out=None) -> str:
 # ------------------------------------------------------------------ animation
 
 
-def animate(robot, q, out, *, t=None, fps: float = 25.0, title: str | None = None, dpi: int = 80,
-            frame_ms: int | None = None, progress=None) -> int:
+def animate(
+    robot,
+    q,
+    out,
+    *,
+    t=None,
+    fps: float = 25.0,
+    title: str | None = None,
+    dpi: int = 80,
+    frame_ms: int | None = None,
+    progress=None,
+) -> int:
     """Write a GIF of the arm moving through the joint coordinates ``q`` (frames, dof), one
     frame per row, drawn as :func:`draw` draws it (same view box for every frame). ``t``
     (frames,): times shown in the title (s). GIFs are written by Pillow (no video tools
@@ -383,6 +404,10 @@ def animate(robot, q, out, *, t=None, fps: float = 25.0, title: str | None = Non
     duration = max(20, round(1000 / fps)) if frame_ms is None else max(20, int(frame_ms))
     from ._io_atomic import atomic_write
 
-    atomic_write(out, lambda tmp: images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
-                                                 duration=duration, loop=0))
+    atomic_write(
+        out,
+        lambda tmp: images[0].save(
+            tmp, format="GIF", save_all=True, append_images=images[1:], duration=duration, loop=0
+        ),
+    )
     return len(images)

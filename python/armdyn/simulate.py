@@ -10,7 +10,7 @@
     run.t, run.energy, run.energy_drift()
 
 Conventions: SI units, radians; the equation of motion is ``M(q) qdd + C(q, qd) qd + g(q)
-= tau`` with gravity the robot's vector in the base frame (DESIGN.md); forward dynamics is
+= tau`` with gravity the robot's vector in the base frame (docs/architecture.md); forward dynamics is
 the Rust core's articulated-body algorithm (``armdyn.aba``), so whatever the model's
 ``aba`` includes (joint friction, damping, rotor inertia where the model has them) is
 integrated. Joint order: ``robot.coordinate_names``.
@@ -161,8 +161,10 @@ class Trajectory:
         if self.work is None:
             raise ValueError("this trajectory has no record of the torques' work")
         w = self.work
-        scale = np.maximum(np.maximum(np.abs(e[..., :1]), np.nanmax(self.kinetic, axis=-1, keepdims=True)),
-                           np.nanmax(np.abs(w), axis=-1, keepdims=True))
+        scale = np.maximum(
+            np.maximum(np.abs(e[..., :1]), np.nanmax(self.kinetic, axis=-1, keepdims=True)),
+            np.nanmax(np.abs(w), axis=-1, keepdims=True),
+        )
         out = np.nanmax(np.abs(e - e[..., :1] - w) / scale, axis=-1)
         return float(out) if out.ndim == 0 else out
 
@@ -176,8 +178,10 @@ class Trajectory:
         (its first crossing)."""
         steps = np.atleast_1d(self.limit_step)
         joints = np.atleast_1d(self.limit_joint)
-        return [(int(i), int(steps[i]), float(steps[i] * self.dt), self.coordinate_names[joints[i]])
-                for i in np.flatnonzero(steps >= 0)]
+        return [
+            (int(i), int(steps[i]), float(steps[i] * self.dt), self.coordinate_names[joints[i]])
+            for i in np.flatnonzero(steps >= 0)
+        ]
 
 
 def joint_limits(robot) -> tuple[np.ndarray, np.ndarray]:
@@ -246,29 +250,50 @@ def _per_state(x, name, rows, dof):
 
 def _steps(duration, steps, dt) -> int:
     # bool is an int to Python: dt=True would be a step of 1 s
-    if isinstance(dt, (bool, np.bool_)) or not (isinstance(dt, (int, float, np.integer, np.floating))
-                                                 and math.isfinite(dt) and dt > 0):
+    if isinstance(dt, (bool, np.bool_)) or not (
+        isinstance(dt, (int, float, np.integer, np.floating)) and math.isfinite(dt) and dt > 0
+    ):
         raise ValueError(f"dt must be a positive finite number of seconds, got {dt!r}")
     if (duration is None) == (steps is None):
         raise ValueError("give exactly one of duration (seconds) and steps")
     if steps is None:
-        if isinstance(duration, (bool, np.bool_)) or not (isinstance(duration, (int, float, np.integer, np.floating))
-                                                           and math.isfinite(duration) and duration > 0):
+        if isinstance(duration, (bool, np.bool_)) or not (
+            isinstance(duration, (int, float, np.integer, np.floating)) and math.isfinite(duration) and duration > 0
+        ):
             raise ValueError(f"duration must be a positive finite number of seconds, got {duration!r}")
         steps = round(duration / dt)
         if abs(steps * dt - duration) > 1e-9 * max(duration, 1.0):
             raise ValueError(f"duration {duration} is not a whole number of steps of dt = {dt}")
-    if isinstance(steps, (bool, np.bool_)) or not isinstance(steps, (int, float, np.integer, np.floating)) \
-            or int(steps) != steps or steps < 1:
+    if (
+        isinstance(steps, (bool, np.bool_))
+        or not isinstance(steps, (int, float, np.integer, np.floating))
+        or int(steps) != steps
+        or steps < 1
+    ):
         raise ValueError(f"steps must be a positive integer, got {steps!r}")
     if steps > 1 << 40:
         raise ValueError(f"{steps} steps is more than armdyn integrates in one call")
     return int(steps)
 
 
-def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4", torque=None,
-             controller=None, stride=1, energies=True, limits=None, threads=None, max_bytes=None,
-             progress: Callable[[int, int], None] | None = None) -> Trajectory:
+def simulate(
+    robot,
+    q0,
+    qd0=None,
+    *,
+    dt,
+    duration=None,
+    steps=None,
+    method="rk4",
+    torque=None,
+    controller=None,
+    stride=1,
+    energies=True,
+    limits=None,
+    threads=None,
+    max_bytes=None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Trajectory:
     """Integrate from ``q0``, ``qd0`` ((dof,) or (N, dof); ``qd0`` default zero) with a fixed
     step ``dt`` (s) for ``duration`` seconds (a whole number of steps) or ``steps`` steps.
 
@@ -302,8 +327,11 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
     if qd0a.shape not in ((dof,), (rows, dof)):
         raise ValueError(f"qd0: shape {qd0a.shape} does not match q0's {q0a.shape}")
     qd0a = _c(np.broadcast_to(qd0a, (rows, dof)))
-    lower, upper = joint_limits(robot) if limits is None else (
-        _per_joint(limits[0], "limits[0] (lower)", dof), _per_joint(limits[1], "limits[1] (upper)", dof))
+    lower, upper = (
+        joint_limits(robot)
+        if limits is None
+        else (_per_joint(limits[0], "limits[0] (lower)", dof), _per_joint(limits[1], "limits[1] (upper)", dof))
+    )
 
     samples = steps // stride + 1
     need = (4 * samples * dof + (3 * samples if energies else 0)) * rows * 8
@@ -311,7 +339,8 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
     if need > budget:
         raise ValueError(
             f"storing {rows} x {samples} samples of {dof} joints needs {need / 2**30:.2f} GiB, more than "
-            f"the {budget / 2**30:.2f} GiB available: store fewer samples (stride), states or steps")
+            f"the {budget / 2**30:.2f} GiB available: store fewer samples (stride), states or steps"
+        )
 
     if torque is not None and controller is not None:
         raise ValueError("give torque or controller, not both")
@@ -326,11 +355,15 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
             elif isinstance(controller, ComputedTorque):
                 kind = "computed-torque"
             else:
-                raise ValueError(f"controller must be an armdyn.simulate.PD or ComputedTorque, got {type(controller).__name__}")
-            args.update(kp=_per_joint(controller.kp, "controller.kp", dof),
-                        kd=_per_joint(controller.kd, "controller.kd", dof),
-                        target=_per_state(controller.target, "controller.target", rows, dof),
-                        target_qd=_per_state(controller.target_qd, "controller.target_qd", rows, dof))
+                raise ValueError(
+                    f"controller must be an armdyn.simulate.PD or ComputedTorque, got {type(controller).__name__}"
+                )
+            args.update(
+                kp=_per_joint(controller.kp, "controller.kp", dof),
+                kd=_per_joint(controller.kd, "controller.kd", dof),
+                target=_per_state(controller.target, "controller.target", rows, dof),
+                target_qd=_per_state(controller.target_qd, "controller.target_qd", rows, dof),
+            )
         elif torque is None:
             kind = "zero"
         else:
@@ -346,7 +379,8 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
             else:
                 raise ValueError(
                     f"torque: shape {tau.shape}; expected ({dof},) constant, ({steps}, {dof}) one row per step, "
-                    f"or ({rows}, {steps}, {dof}) one series per state")
+                    f"or ({rows}, {steps}, {dof}) one series per state"
+                )
             args["torque"] = _c(tau)
         out = _simulate_rust(model, q0a, qd0a, kind, args, dt, steps, stride, method, lower, upper, threads, progress)
 
@@ -381,8 +415,23 @@ def simulate(robot, q0, qd0=None, *, dt, duration=None, steps=None, method="rk4"
 
 def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower, upper, threads, progress):
     call = lambda q, qd, k, tau: _core._simulate(  # noqa: E731
-        model, q, qd, dt, k, stride, method, kind, tau, args["kp"], args["kd"], args["target"],
-        args["target_qd"], lower, upper, threads)
+        model,
+        q,
+        qd,
+        dt,
+        k,
+        stride,
+        method,
+        kind,
+        tau,
+        args["kp"],
+        args["kd"],
+        args["target"],
+        args["target_qd"],
+        lower,
+        upper,
+        threads,
+    )
     if progress is None:
         return call(q0, qd0, steps, args["torque"])
     # In pieces of whole strides: each piece continues from the last one's final state,
@@ -398,9 +447,9 @@ def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower,
         k = min(piece, steps - done)
         tau = args["torque"]
         if kind == "series":
-            tau = tau[done:done + k]
+            tau = tau[done : done + k]
         elif kind == "series-per-state":
-            tau = _c(tau[:, done:done + k])
+            tau = _c(tau[:, done : done + k])
         part = call(q, qd, k, tau)
         if out is None:
             out = {name: np.empty((rows, samples, dof)) for name in ("q", "qd", "qdd", "tau")}
@@ -411,9 +460,9 @@ def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower,
         first = done // stride
         n = part["q"].shape[1]
         for name in ("q", "qd", "qdd", "tau"):
-            out[name][:, first:first + n] = part[name]
+            out[name][:, first : first + n] = part[name]
         # each piece's work starts at 0 from its first state, the previous piece's last sample
-        out["work"][:, first:first + n] = part["work"] + work_before[:, None]
+        out["work"][:, first : first + n] = part["work"] + work_before[:, None]
         work_before = out["work"][:, first + n - 1]
         for name in ("limit_step", "nonfinite_step"):
             new = (out[name] < 0) & (part[name] >= 0)
@@ -447,17 +496,20 @@ def _simulate_python(model, q0, qd0, torque, dt, steps, stride, method, lower, u
         try:
             tau = torque(t, q.copy(), qd.copy())
         except Exception as err:  # noqa: BLE001 - the user's error, shown with the step
-            raise ValueError(f"torque callable failed at step {k} (t = {t:.6g} s): {type(err).__name__}: {err}") from err
+            raise ValueError(
+                f"torque callable failed at step {k} (t = {t:.6g} s): {type(err).__name__}: {err}"
+            ) from err
         if np.iscomplexobj(tau):  # float() would drop the imaginary part with only a warning
-            raise ValueError(f"torque callable returned complex values at step {k} (t = {t:.6g} s); "
-                             "torques are real")
+            raise ValueError(f"torque callable returned complex values at step {k} (t = {t:.6g} s); torques are real")
         try:
             tau = np.asarray(tau, dtype=float)
         except (TypeError, ValueError):
             raise ValueError(f"torque callable returned a non-numeric value at step {k} (t = {t:.6g} s)") from None
         if tau.shape not in ((dof,), (rows, dof)):
-            raise ValueError(f"torque callable returned shape {tau.shape} at step {k} (t = {t:.6g} s); "
-                             f"expected ({dof},) or ({rows}, {dof})")
+            raise ValueError(
+                f"torque callable returned shape {tau.shape} at step {k} (t = {t:.6g} s); "
+                f"expected ({dof},) or ({rows}, {dof})"
+            )
         return _c(np.broadcast_to(tau, (rows, dof)))
 
     def acc(k, t, q, qd):
@@ -512,20 +564,31 @@ def _simulate_python(model, q0, qd0, torque, dt, steps, stride, method, lower, u
                 a3, tau3 = acc(k, t + h / 2, q3, qd3)
                 q4, qd4 = q + h * qd3, qd + h * a3
                 a4, tau4 = acc(k, t + h, q4, qd4)
-                work = work + h / 6 * ((tau1 * qd).sum(axis=1) + 2 * (tau2 * qd2).sum(axis=1)
-                                       + 2 * (tau3 * qd3).sum(axis=1) + (tau4 * qd4).sum(axis=1))
+                work = work + h / 6 * (
+                    (tau1 * qd).sum(axis=1)
+                    + 2 * (tau2 * qd2).sum(axis=1)
+                    + 2 * (tau3 * qd3).sum(axis=1)
+                    + (tau4 * qd4).sum(axis=1)
+                )
                 q = q + h / 6 * (qd + 2 * qd2 + 2 * qd3 + qd4)
                 qd = qd + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
             check(k + 1, q, qd)
             if (nonfinite >= 0).all():
                 break
-    out.update(q_final=q, qd_final=qd, limit_step=limit_step, limit_joint=limit_joint, nonfinite_step=nonfinite,
-               nonfinite_joint=nonfinite_joint)
+    out.update(
+        q_final=q,
+        qd_final=qd,
+        limit_step=limit_step,
+        limit_joint=limit_joint,
+        nonfinite_step=nonfinite,
+        nonfinite_joint=nonfinite_joint,
+    )
     return out
 
 
-def simulate_adaptive(robot, q0, qd0=None, *, duration, torque=None, rtol=1e-10, atol=1e-12,
-                      method="DOP853", t_eval=None) -> Trajectory:
+def simulate_adaptive(
+    robot, q0, qd0=None, *, duration, torque=None, rtol=1e-10, atol=1e-12, method="DOP853", t_eval=None
+) -> Trajectory:
     """One trajectory with SciPy's ``solve_ivp`` (adaptive step, error control) on ``aba``.
 
     q0, qd0: (dof,). torque: None, (dof,) constant, or a callable ``torque(t, q, qd)``
@@ -553,24 +616,38 @@ def simulate_adaptive(robot, q0, qd0=None, *, duration, torque=None, rtol=1e-10,
     t_eval = np.linspace(0.0, duration, 101) if t_eval is None else np.asarray(t_eval, dtype=float)
 
     def f(t, x):  # x = (q, qd, W): the torque's work integrated with the state
-        q, qd = x[:dof], x[dof:2 * dof]
+        q, qd = x[:dof], x[dof : 2 * dof]
         tau = np.asarray(tau_of(t, q, qd), dtype=float)
         return np.concatenate([qd, model.aba(q, qd, tau, None), [tau @ qd]])
 
-    sol = solve_ivp(f, (0.0, duration), np.concatenate([q0, qd0, [0.0]]), method=method, rtol=rtol, atol=atol,
-                    t_eval=t_eval)
+    sol = solve_ivp(
+        f, (0.0, duration), np.concatenate([q0, qd0, [0.0]]), method=method, rtol=rtol, atol=atol, t_eval=t_eval
+    )
     if not sol.success:
         raise ValueError(f"solve_ivp failed: {sol.message}")
-    q, qd = _c(sol.y[:dof].T), _c(sol.y[dof:2 * dof].T)
+    q, qd = _c(sol.y[:dof].T), _c(sol.y[dof : 2 * dof].T)
     tau = np.array([tau_of(t, a, b) for t, a, b in zip(sol.t, q, qd)], dtype=float).reshape(len(sol.t), dof)
     qdd = model.aba(q, qd, tau, None)
     lower, upper = joint_limits(robot)
     outside = (q < lower) | (q > upper)
     first = int(np.flatnonzero(outside.any(axis=1))[0]) if outside.any() else -1
-    run = Trajectory(t=sol.t, q=q, qd=qd, qdd=qdd, tau=tau, q_final=q[-1], qd_final=qd[-1],
-                     limit_step=first, limit_joint=int(outside[first].argmax()) if first >= 0 else -1,
-                     nonfinite_step=-1, dt=float("nan"), stride=1, method=method,
-                     coordinate_names=list(model.coordinate_names), work=sol.y[2 * dof].copy())
+    run = Trajectory(
+        t=sol.t,
+        q=q,
+        qd=qd,
+        qdd=qdd,
+        tau=tau,
+        q_final=q[-1],
+        qd_final=qd[-1],
+        limit_step=first,
+        limit_joint=int(outside[first].argmax()) if first >= 0 else -1,
+        nonfinite_step=-1,
+        dt=float("nan"),
+        stride=1,
+        method=method,
+        coordinate_names=list(model.coordinate_names),
+        work=sol.y[2 * dof].copy(),
+    )
     run.kinetic = kinetic_energy(model, q, qd)
     run.potential = potential_energy(model, q)
     return run

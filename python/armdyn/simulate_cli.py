@@ -40,8 +40,7 @@ def progress_bar(total: int, desc: str, unit: str, enabled: bool = True):
         return None
     from tqdm import tqdm
 
-    bar = tqdm(total=total, desc=desc, unit=unit, unit_scale=True, leave=False, file=sys.stderr,
-               dynamic_ncols=True)
+    bar = tqdm(total=total, desc=desc, unit=unit, unit_scale=True, leave=False, file=sys.stderr, dynamic_ncols=True)
 
     def update(done, _total=None):
         bar.update(done - bar.n)
@@ -86,8 +85,9 @@ def energy_line(run) -> str:
     head = f"energy: E(0) = {e[0]:.6g} J, E(end) = {e[-1]:.6g} J"
     if run.passive:
         return f"{head}, relative drift {run.energy_drift():.3e}"
-    return (f"{head}, work of tau W = {run.work[-1]:.6g} J, "
-            f"balance max |E - E(0) - W| / scale {run.energy_balance():.3e}")
+    return (
+        f"{head}, work of tau W = {run.work[-1]:.6g} J, balance max |E - E(0) - W| / scale {run.energy_balance():.3e}"
+    )
 
 
 def run(args, robot) -> int:
@@ -126,14 +126,25 @@ def run(args, robot) -> int:
     if steps < 1:
         raise ValueError(f"--duration must be at least one step of --dt, got {args.duration}")
     if abs(steps * args.dt - args.duration) > 1e-9 * max(args.duration, 1.0):  # as simulate() checks it
-        raise ValueError(f"--duration {args.duration:g} is not a whole number of steps of --dt {args.dt:g} "
-                         f"({args.duration / args.dt:.6g} steps)")
+        raise ValueError(
+            f"--duration {args.duration:g} is not a whole number of steps of --dt {args.dt:g} "
+            f"({args.duration / args.dt:.6g} steps)"
+        )
     stride = args.stride if args.stride is not None else max(1, steps // 2000)  # keep ~2000 samples
 
     bar = progress_bar(steps, "simulating", "step", not args.quiet and steps * dof >= 600_000)
     try:
-        result = simulate(robot, q0, qd0, dt=args.dt, steps=steps, method=args.method, controller=controller,
-                          stride=stride, progress=bar)
+        result = simulate(
+            robot,
+            q0,
+            qd0,
+            dt=args.dt,
+            steps=steps,
+            method=args.method,
+            controller=controller,
+            stride=stride,
+            progress=bar,
+        )
     finally:
         if bar is not None:
             bar.close()
@@ -142,8 +153,12 @@ def run(args, robot) -> int:
     if args.plot:
         from .plots import plot_trajectory
 
-        outputs.append((args.plot, lambda tmp: plot_trajectory(
-            result, tmp, title=f"{robot.name}: {args.method}, dt = {args.dt:g} s")))
+        outputs.append(
+            (
+                args.plot,
+                lambda tmp: plot_trajectory(result, tmp, title=f"{robot.name}: {args.method}, dt = {args.dt:g} s"),
+            )
+        )
     if args.animate:
         from .show import animate
 
@@ -168,8 +183,10 @@ def run(args, robot) -> int:
     if len(result.t):
         print(energy_line(result))
     if result.limit_step >= 0:
-        print(f"joint limit: '{names[result.limit_joint]}' left its range at step {result.limit_step} "
-              f"(t = {result.limit_step * args.dt:.4g} s); not clamped")
+        print(
+            f"joint limit: '{names[result.limit_joint]}' left its range at step {result.limit_step} "
+            f"(t = {result.limit_step * args.dt:.4g} s); not clamped"
+        )
     for note in notes:
         print(note)
     for path in (args.plot, args.animate):
@@ -177,9 +194,12 @@ def run(args, robot) -> int:
             print(f"wrote {path}")
     if result.nonfinite_step >= 0:
         k = result.nonfinite_step
-        print(f"armdyn: the state became NaN/inf at step {k} (t = {k * args.dt:.6g} s) in joint "
-              f"'{names[result.nonfinite_joint]}': the run stopped there (unstable: try a smaller --dt or "
-              f"gentler gains); {len(result.t)} samples kept", file=sys.stderr)
+        print(
+            f"armdyn: the state became NaN/inf at step {k} (t = {k * args.dt:.6g} s) in joint "
+            f"'{names[result.nonfinite_joint]}': the run stopped there (unstable: try a smaller --dt or "
+            f"gentler gains); {len(result.t)} samples kept",
+            file=sys.stderr,
+        )
         return EXIT_DIVERGED
     return 0
 

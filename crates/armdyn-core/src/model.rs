@@ -38,7 +38,7 @@ pub struct JointSpec {
     pub inertia: [[f64; 3]; 3],
 }
 
-/// What a movable joint adds to the rigid-body torque (DESIGN.md):
+/// What a movable joint adds to the rigid-body torque (docs/architecture.md):
 /// `tau_i += armature qdd_i + viscous qd_i + coulomb sign(qd_i) + offset` (sign(0) = 0).
 /// `armature` is the rotor inertia reflected to the joint (Pinocchio's `armature`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -1,5 +1,5 @@
 //! Physical identities on random branched trees with revolute, prismatic and fixed
-//! joints, arbitrary frames and axes (DESIGN.md "How the engines check each other"),
+//! joints, arbitrary frames and axes (docs/architecture.md, "How the engines check each other"),
 //! and hand-derived closed forms.
 
 mod common;

@@ -321,7 +321,7 @@ impl NumericModel {
     /// first); coordinate_names: the movable joints' names. base_mass and base_com (3,):
     /// the base link, which only enters the potential energy (a constant).
     /// joint_dynamics: None, or per movable joint `[armature, viscous, coulomb, offset]`
-    /// (DESIGN.md: tau += Ia qdd + Fv qd + Fc sign(qd) + offset).
+    /// (docs/architecture.md: tau += Ia qdd + Fv qd + Fc sign(qd) + offset).
     #[new]
     #[pyo3(signature = (parents, types, rotations, translations, axes, masses, coms, inertias, gravity, link_names, coordinate_names, name = String::new(), base_mass = 0.0, base_com = [0.0; 3], joint_dynamics = None))]
     #[allow(clippy::too_many_arguments)]

@@ -7,7 +7,7 @@
     tau = lib.tau(q, qd, qdd)       # q, qd, qdd: (dof,) or (N, dof) float64
 
 Where each quantity comes from (all with the barycentric / standard inertial parameters
-of each link, DESIGN.md's order: mass, first moment m c, inertia about the link origin):
+of each link, the architecture's order: mass, first moment m c, inertia about the link origin):
 
 * tau: customized Newton-Euler (:mod:`armdyn.programs.customized_ne`);
 * g:   the same recursion with ``qd = qdd = 0``;
@@ -25,7 +25,7 @@ per state. For tau and g each leaf link's frame is also turned about its joint a
 that its first moment lies on y (:mod:`armdyn.programs.leaf_frames`; the angle ``th`` and
 the turned parameters are computed once per parameter set, the joint angle becomes
 ``q + th``). Joint friction, rotor inertia and torque offsets, where the model has them, are
-added as DESIGN.md writes them: all to tau, ``Ia`` to M's diagonal, the offset to g.
+added as docs/architecture.md writes them: all to tau, ``Ia`` to M's diagonal, the offset to g.
 
 ``base=True`` (needs :mod:`armdyn.identification`): the base parameters ``beta`` are the
 inputs. When each groups standard parameters onto one whose regressor column it keeps
@@ -52,8 +52,8 @@ import numpy as np
 import sympy as sp
 
 from ..model import Robot
-from ..symbolic import dag
 from ..programs.program import Builder, Program, from_expressions
+from ..symbolic import dag
 from .printers import INPUTS, Names, print_c, print_python
 from .safe_names import identifier_base
 
@@ -159,8 +159,12 @@ def write_files(codes, directory) -> list[str]:
     except OSError as exc:
         raise OutputPathError(f"{shown}: cannot create the directory ({exc.strerror})") from None
     paths = [os.path.join(shown, code.filename) for code in codes]
-    atomic_writes([(path, lambda tmp, c=code: Path(tmp).write_text(c.source, encoding="utf-8"))
-                   for path, code in zip(paths, codes)])
+    atomic_writes(
+        [
+            (path, lambda tmp, c=code: Path(tmp).write_text(c.source, encoding="utf-8"))
+            for path, code in zip(paths, codes)
+        ]
+    )
     return paths
 
 
@@ -168,8 +172,9 @@ def _identification(what: str):
     try:
         from .. import identification  # provided by the regressor/base-parameter work
     except ImportError:
-        raise ValueError(f"codegen: {what} is not available: armdyn.identification is not installed in this "
-                         "version of armdyn") from None
+        raise ValueError(
+            f"codegen: {what} is not available: armdyn.identification is not installed in this version of armdyn"
+        ) from None
     return identification
 
 
@@ -202,8 +207,8 @@ def _in_model_parameters(extra, definitions, chained: bool = False) -> list:
 
 def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
     from ..programs.composite_mass_matrix import composite_mass_matrix
-    from ..programs.customized_ne import customized_newton_euler, standard_parameters
     from ..programs.coriolis_program import christoffel_program
+    from ..programs.customized_ne import customized_newton_euler, standard_parameters
     from ..programs.grouping import grouped_parameters
 
     params, definitions = standard_parameters(robot)
@@ -260,7 +265,7 @@ def _turned_leaves(robot: Robot, params: dict, definitions: list, taken=()):
 
 
 def _add_joint_terms(robot: Robot, programs: dict) -> None:
-    """Joint friction, rotor inertia and torque offsets (DESIGN.md: ``tau = M qdd + C qd +
+    """Joint friction, rotor inertia and torque offsets (docs/architecture.md: ``tau = M qdd + C qd +
     g + Ia qdd + Fv qd + Fc sign(qd) + offset``; :mod:`armdyn.symbolic.joint_terms`) added
     to the rigid-body outputs: all of them to tau, ``Ia`` to M's diagonal, the offset to
     g (``g = tau(qd = 0, qdd = 0)``); C has none."""
@@ -269,8 +274,7 @@ def _add_joint_terms(robot: Robot, programs: dict) -> None:
     if not joint_terms.has_joint_terms(robot):
         return
     n = robot.dof
-    extra = {"tau": list(joint_terms.joint_torques(robot, robot.qd, robot.qdd)),
-             "g": list(joint_terms.offsets(robot))}
+    extra = {"tau": list(joint_terms.joint_torques(robot, robot.qd, robot.qdd)), "g": list(joint_terms.offsets(robot))}
     ia = joint_terms.armature(robot)
     extra["M"] = [ia[k // n] if k // n == k % n else 0 for k in range(n * n)]
     for w, terms in extra.items():
@@ -290,8 +294,9 @@ def _base_programs(robot: Robot, what) -> tuple[dict, dict, list]:
     n = robot.dof
     reserved = robot.free_symbols() | set(beta)
     programs, sources = {}, {}
-    custom = _customized_base_programs(robot, ident, Yb, beta, definitions, [w for w in what if w != "regressor"],
-                                       bp.regressor)
+    custom = _customized_base_programs(
+        robot, ident, Yb, beta, definitions, [w for w in what if w != "regressor"], bp.regressor
+    )
     if custom is not None:
         programs, sources, extra_defs = custom
         definitions = definitions + extra_defs
@@ -322,10 +327,10 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
     """tau, g, M, C by the customized algorithms at the base-parameter point
     (:mod:`armdyn.programs.base_parameters`), checked against ``Yb beta`` at random points; None if
     the base parameters are not a grouping onto standard columns."""
+    from ..programs.base_parameters import base_inertials
     from ..programs.composite_mass_matrix import composite_mass_matrix
     from ..programs.coriolis_program import christoffel_program
     from ..programs.customized_ne import customized_newton_euler
-    from ..programs.base_parameters import base_inertials
 
     if not what:
         return None
@@ -359,8 +364,9 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
             env[s] = float(e.xreplace(env))
         want = Ybn[:, :, k] @ np.array([env[b] for b in beta])
         got = np.array(tau_prog.evaluate(env))
-        if not (np.all(np.isfinite(want)) and
-                np.allclose(got, want, rtol=1e-9, atol=1e-9 * max(1.0, np.abs(want).max()))):
+        if not (
+            np.all(np.isfinite(want)) and np.allclose(got, want, rtol=1e-9, atol=1e-9 * max(1.0, np.abs(want).max()))
+        ):
             return None
     for w in what:
         if w == "tau":
@@ -378,9 +384,12 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
             programs[w] = M_prog
         elif w == "C":
             programs[w] = christoffel_program(robot, M_prog, builder)
-        sources[w] = {"tau": "customized Newton-Euler", "g": "customized Newton-Euler at qd = qdd = 0",
-                      "M": "composite links", "C": "Christoffel symbols of the composite-link M"}[w] + \
-            ", at the base parameters"
+        sources[w] = {
+            "tau": "customized Newton-Euler",
+            "g": "customized Newton-Euler at qd = qdd = 0",
+            "M": "composite links",
+            "C": "Christoffel symbols of the composite-link M",
+        }[w] + ", at the base parameters"
     return programs, sources, _in_model_parameters(defs, definitions, chained=True)
 
 
@@ -422,8 +431,18 @@ def codegen(robot: Robot | str, what=("tau", "M", "C", "g"), lang: str = "c", ba
     taken = [*functions.values(), *(f + "_batch" for f in functions.values())]
     names = Names(list(dict.fromkeys([*robot.q, *robot.qd, *robot.qdd, *order, *temps])), taken=taken)
     code = GeneratedCode(
-        robot.name, lang, robot.dof, list(robot.coordinate_names), robot.q, robot.qd, robot.qdd, programs, sources,
-        order, defs, base,
+        robot.name,
+        lang,
+        robot.dof,
+        list(robot.coordinate_names),
+        robot.q,
+        robot.qd,
+        robot.qdd,
+        programs,
+        sources,
+        order,
+        defs,
+        base,
         functions=functions,
         op_counts={w: p.operation_counts() for w, p in programs.items()},
         names=names,

@@ -40,15 +40,18 @@ def _find_compiler(cc: str | None) -> str:
     )
 
 
-def build_shared_library(source: str, directory=None, cc: str | None = None, name: str = "armdyn_generated",
-                         flags=()) -> str:
+def build_shared_library(
+    source: str, directory=None, cc: str | None = None, name: str = "armdyn_generated", flags=()
+) -> str:
     """Compile C ``source`` into a shared library in ``directory`` (a new temporary
     directory if None); returns its path. ``flags``: extra compiler arguments (e.g.
     ``["-DARMDYN_NO_CLONES"]`` for baseline SIMD only). Raises CompilerError."""
     compiler = _find_compiler(cc)
     directory = directory or tempfile.mkdtemp(prefix="armdyn-codegen-")
     os.makedirs(directory, exist_ok=True)
-    digest = hashlib.sha1((source + "\0".join(flags)).encode()).hexdigest()[:12]  # a new path per source: dlopen caches by path
+    digest = hashlib.sha1((source + "\0".join(flags)).encode()).hexdigest()[
+        :12
+    ]  # a new path per source: dlopen caches by path
     c_path = os.path.join(directory, f"{name}_{digest}.c")
     so_path = os.path.join(directory, f"lib{name}_{digest}.so")
     with open(c_path, "w") as fh:
@@ -85,7 +88,9 @@ class CompiledFunction:
 
     def __call__(self, *arrays, p=None):
         if len(arrays) != len(self.inputs):
-            raise TypeError(f"{self.what} takes {', '.join(self.inputs)} ({len(self.inputs)} arrays), got {len(arrays)}")
+            raise TypeError(
+                f"{self.what} takes {', '.join(self.inputs)} ({len(self.inputs)} arrays), got {len(arrays)}"
+            )
         checked, shape = [], None
         for name, a in zip(self.inputs, arrays):
             a = np.ascontiguousarray(a, dtype=np.float64)
@@ -110,8 +115,12 @@ class CompiledFunction:
         batch = shape[:-1]
         n = int(np.prod(batch)) if batch else 1
         out = np.empty(batch + tuple(self.shape))
-        self._fn(n, *(a.ctypes.data_as(_DOUBLE_P) for a in checked), p.ctypes.data_as(_DOUBLE_P),
-                 out.ctypes.data_as(_DOUBLE_P))
+        self._fn(
+            n,
+            *(a.ctypes.data_as(_DOUBLE_P) for a in checked),
+            p.ctypes.data_as(_DOUBLE_P),
+            out.ctypes.data_as(_DOUBLE_P),
+        )
         return out
 
 
@@ -130,15 +139,18 @@ class CompiledCode:
 
     def __call__(self, *arrays, p=None):
         if len(self.functions) != 1:
-            raise TypeError(f"this library holds {', '.join(self.functions)}: call one of them, e.g. lib.{next(iter(self.functions))}(...)")
+            raise TypeError(
+                f"this library holds {', '.join(self.functions)}: call one of them, e.g. lib.{next(iter(self.functions))}(...)"
+            )
         return next(iter(self.functions.values()))(*arrays, p=p)
 
     def __repr__(self):
         return f"CompiledCode({self.code.robot_name!r}, {list(self.functions)}, path={self.path!r})"
 
 
-def compile(code, what=("tau", "M", "C", "g"), *, base: bool = False, directory=None, cc: str | None = None,
-            flags=()) -> CompiledCode:
+def compile(
+    code, what=("tau", "M", "C", "g"), *, base: bool = False, directory=None, cc: str | None = None, flags=()
+) -> CompiledCode:
     """Build C code into a shared library and load it.
 
     code: a :class:`~armdyn.codegen.GeneratedCode` in C, or a Robot / model name (then

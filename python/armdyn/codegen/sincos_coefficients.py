@@ -29,19 +29,32 @@ import functools
 import mpmath as mp
 
 # printed by main(); tests/test_codegen_sincos.py recomputes them
-SIN = (-0.1666666666666663, 0.00833333333332184, -0.00019841269829358528, 2.7557313538514234e-06,
-       -2.5050734389257543e-08, 1.5895433289345187e-10)
-COS = (0.041666666666666595, -0.0013888888888873342, 2.480158728900208e-05, -2.755731421703886e-07,
-       2.087570539602921e-09, -1.1358749239936787e-11)
+SIN = (
+    -0.1666666666666663,
+    0.00833333333332184,
+    -0.00019841269829358528,
+    2.7557313538514234e-06,
+    -2.5050734389257543e-08,
+    1.5895433289345187e-10,
+)
+COS = (
+    0.041666666666666595,
+    -0.0013888888888873342,
+    2.480158728900208e-05,
+    -2.755731421703886e-07,
+    2.087570539602921e-09,
+    -1.1358749239936787e-11,
+)
 
-DEGREE = 5            # of P and Q in z
-DIGITS = 60           # working precision of the fit (the refits divide by z^k)
-GRID = 200            # points per scan for the error's extrema
+DEGREE = 5  # of P and Q in z
+DIGITS = 60  # working precision of the fit (the refits divide by z^k)
+GRID = 200  # points per scan for the error's extrema
 
 
 def _targets():
     """(f, weight) for sin and for cos, as functions of z > 0 (mpf); sin and cos of
     sqrt(z) cached, as the Remez iterations scan the same grid again and again."""
+
     @functools.lru_cache(maxsize=None)
     def trig(z):
         r = mp.sqrt(z)
@@ -124,8 +137,8 @@ def remez(f, w, degree: int, b):
         rhs = mp.matrix(n, 1)
         for i, z in enumerate(nodes):
             for k in range(degree + 1):
-                A[i, k] = z ** k
-            A[i, degree + 1] = -(-1) ** i / w(z)
+                A[i, k] = z**k
+            A[i, degree + 1] = -((-1) ** i) / w(z)
             rhs[i] = f(z)
         sol = mp.lu_solve(A, rhs)
         c, level = [sol[k] for k in range(degree + 1)], abs(sol[degree + 1])
@@ -155,7 +168,7 @@ def rounded_minimax(f, w, b):
     for k in range(DEGREE + 1):
         # p = fixed(z) + z^k rest(z), rest minimising |w z^k (rest - (f - fixed(z)) / z^k)|
         head = [mp.mpf(ck) for ck in fixed]
-        c, _ = remez(lambda z: (f(z) - _polyval(head, z)) / z ** k, lambda z: w(z) * z ** k, DEGREE - k, b)
+        c, _ = remez(lambda z: (f(z) - _polyval(head, z)) / z**k, lambda z: w(z) * z**k, DEGREE - k, b)
         fixed.append(float(c[0]))
     final = [mp.mpf(ck) for ck in fixed]
 
@@ -180,8 +193,10 @@ def main() -> None:
     (sin_c, cos_c), (sin_e, cos_e) = fit()
     print(f"SIN = {sin_c!r}")
     print(f"COS = {cos_c!r}")
-    print(f"# relative error on |r| <= pi/4 (rounded coefficients, exact arithmetic): "
-          f"sin 2^{math.log2(sin_e):.1f}, cos 2^{math.log2(cos_e):.1f}")
+    print(
+        f"# relative error on |r| <= pi/4 (rounded coefficients, exact arithmetic): "
+        f"sin 2^{math.log2(sin_e):.1f}, cos 2^{math.log2(cos_e):.1f}"
+    )
 
 
 if __name__ == "__main__":

@@ -26,8 +26,13 @@ from __future__ import annotations
 
 __all__ = ["Gradebook", "Rubric", "grade_class", "make_exercise", "summary_html"]
 
-_WHERE = {"Gradebook": "gradebook", "Rubric": "rubric", "summary_html": "summary", "make_exercise": "exercise",
-          "grade_class": "batch"}
+_WHERE = {
+    "Gradebook": "gradebook",
+    "Rubric": "rubric",
+    "summary_html": "summary",
+    "make_exercise": "exercise",
+    "grade_class": "batch",
+}
 
 
 def __getattr__(name: str):

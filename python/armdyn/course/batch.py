@@ -116,7 +116,7 @@ def _front_matter(path: str) -> tuple[dict, str | None]:
         end = re.search(r"^---\s*$", text[3:], re.MULTILINE)
         if end is None:
             return {}, None
-        text = text[3:3 + end.start()]
+        text = text[3 : 3 + end.start()]
     try:
         data = yaml.safe_load(text)
     except (yaml.YAMLError, RecursionError, ValueError):
@@ -143,9 +143,11 @@ def discover(folder, variants=None, want_html: bool = False) -> tuple[list[Task]
     folder = os.fspath(folder)
     if not os.path.isdir(folder):
         raise ModelError("not a folder of submissions", source=folder)
-    files = sorted(f for f in os.listdir(folder)
-                   if f.lower().endswith(SUFFIXES) and not f.startswith(".")
-                   and os.path.isfile(os.path.join(folder, f)))
+    files = sorted(
+        f
+        for f in os.listdir(folder)
+        if f.lower().endswith(SUFFIXES) and not f.startswith(".") and os.path.isfile(os.path.join(folder, f))
+    )
     tasks, refused, owner = [], [], {}
     for f in files:
         path = os.path.join(folder, f)
@@ -162,8 +164,11 @@ def discover(folder, variants=None, want_html: bool = False) -> tuple[list[Task]
                 variant = next((c for c in (student, stem) if os.path.isdir(os.path.join(variants, c))), None)
             model = os.path.join(variants, variant, "model.yaml") if variant else None
             if variant is None or "/" in variant or variant.startswith(".") or not os.path.isfile(model):
-                what = f"no variant {variant!r} in {variants}" if variant else \
-                    f"no variant for student {student!r} (no variant: in the front matter, no folder {student!r})"
+                what = (
+                    f"no variant {variant!r} in {variants}"
+                    if variant
+                    else f"no variant for student {student!r} (no variant: in the front matter, no folder {student!r})"
+                )
                 refused.append((student, variant, f"no-variant: {path}: {what}"))
                 continue
             robot = model
@@ -201,16 +206,32 @@ def _file_bytes(path: str | None) -> bytes:
 
 def cache_key(task: Task, rubric: Rubric, grader: str) -> str:
     h = hashlib.sha256()
-    for part in (_file_bytes(task.path), _file_bytes(task.robot), (task.robot or "").encode(),
-                 rubric.fingerprint().encode(), grader.encode(), b"html" if task.want_html else b""):
+    for part in (
+        _file_bytes(task.path),
+        _file_bytes(task.robot),
+        (task.robot or "").encode(),
+        rubric.fingerprint().encode(),
+        grader.encode(),
+        b"html" if task.want_html else b"",
+    ):
         h.update(hashlib.sha256(part).digest())
     return h.hexdigest()
 
 
 # ------------------------------------------------------------------ the class
-def grade_class(folder, gradebook, rubric: Rubric | None = None, html_dir=None, jobs: int | None = None,
-                variants=None, timeout: float = 60.0, memory_mb: int | None = 1024, use_cache: bool = True,
-                dask: str | None = None, progress: bool | None = None) -> BatchResult:
+def grade_class(
+    folder,
+    gradebook,
+    rubric: Rubric | None = None,
+    html_dir=None,
+    jobs: int | None = None,
+    variants=None,
+    timeout: float = 60.0,
+    memory_mb: int | None = 1024,
+    use_cache: bool = True,
+    dask: str | None = None,
+    progress: bool | None = None,
+) -> BatchResult:
     """Grade every submission in ``folder`` and write the gradebook (see the module docstring)."""
     from .._io_atomic import atomic_writes
     from .summary import summary_html
@@ -259,8 +280,11 @@ def grade_class(folder, gradebook, rubric: Rubric | None = None, html_dir=None, 
         not_graded.append(_why(None, error))
     book = Gradebook.from_results(items, rubric=rubric)
 
-    outputs = [(gradebook, book.to_csv()), (os.path.splitext(gradebook)[0] + ".json", book.to_json()),
-               (os.path.join(out_dir, "summary.html"), summary_html(book))]
+    outputs = [
+        (gradebook, book.to_csv()),
+        (os.path.splitext(gradebook)[0] + ".json", book.to_json()),
+        (os.path.join(out_dir, "summary.html"), summary_html(book)),
+    ]
     if html_dir is not None:
         os.makedirs(html_dir, exist_ok=True)
         for t in tasks:
@@ -283,6 +307,7 @@ def _text_writer(text: str):
     def write(tmp):
         with open(tmp, "w", encoding="utf-8", newline="\n") as fh:
             fh.write(text)
+
     return write
 
 
@@ -290,8 +315,7 @@ def _not_graded_page(student: str, error: str) -> str:
     from ..mathml import escape
     from .page import course_page
 
-    return course_page(f"{student}: not graded", f"<h1>{escape(student)}: not graded</h1>\n"
-                                                  f"<p>{escape(error)}</p>")
+    return course_page(f"{student}: not graded", f"<h1>{escape(student)}: not graded</h1>\n<p>{escape(error)}</p>")
 
 
 def _run(tasks: list[Task], jobs: int, timeout: float, memory_mb, dask: str | None):

@@ -11,8 +11,9 @@ import base64
 import io
 
 
-def bar_chart_uri(labels: list[str], values: list[int], title: str, xlabel: str, ylabel: str,
-                  color: str = "#b42318") -> str:
+def bar_chart_uri(
+    labels: list[str], values: list[int], title: str, xlabel: str, ylabel: str, color: str = "#b42318"
+) -> str:
     """A horizontal bar chart (one bar per label, top to bottom in the given order) as a
     ``data:image/svg+xml;base64,...`` URI."""
     import matplotlib
@@ -20,8 +21,9 @@ def bar_chart_uri(labels: list[str], values: list[int], title: str, xlabel: str,
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
-    with matplotlib.rc_context({"svg.hashsalt": "armdyn-course", "svg.fonttype": "path",
-                                "font.family": "DejaVu Sans", "font.size": 10}):
+    with matplotlib.rc_context(
+        {"svg.hashsalt": "armdyn-course", "svg.fonttype": "path", "font.family": "DejaVu Sans", "font.size": 10}
+    ):
         n = max(len(labels), 1)
         fig, ax = plt.subplots(figsize=(7.0, 0.9 + 0.34 * n))
         try:

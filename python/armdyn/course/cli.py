@@ -20,12 +20,19 @@ import sys
 def add_batch_arguments(parser) -> None:
     """The options of ``armdyn grade DIR`` (a folder argument switches to batch mode)."""
     b = parser.add_argument_group("a whole class (SUBMISSION is a folder)")
-    b.add_argument("--gradebook", metavar="grades.csv", help="write the gradebook here (and grades.json, "
-                   "summary.html beside it); default grades.csv in the folder's parent")
+    b.add_argument(
+        "--gradebook",
+        metavar="grades.csv",
+        help="write the gradebook here (and grades.json, "
+        "summary.html beside it); default grades.csv in the folder's parent",
+    )
     b.add_argument("--rubric", metavar="rubric.yaml", help="points per step or part (default: docs/course.md)")
     b.add_argument("--html-dir", metavar="DIR", help="write one HTML report per student here")
-    b.add_argument("--variants", metavar="DIR", help="the folder armdyn exercise make wrote: grade each "
-                   "submission against its variant's model.yaml")
+    b.add_argument(
+        "--variants",
+        metavar="DIR",
+        help="the folder armdyn exercise make wrote: grade each submission against its variant's model.yaml",
+    )
     b.add_argument("--jobs", type=int, help="submissions graded at once (default: the cores)")
     b.add_argument("--timeout", type=float, default=60.0, help="seconds per submission (default 60)")
     b.add_argument("--memory-mb", type=int, default=1024, help="memory per submission, MB (default 1024)")
@@ -44,17 +51,28 @@ def cmd_grade_class(args) -> int:
         raise ValueError(f"--timeout must be positive, got {args.timeout}")
     rubric = Rubric.load(args.rubric) if args.rubric else Rubric.default()
     gradebook = args.gradebook or os.path.join(os.path.dirname(os.path.abspath(folder)), "grades.csv")
-    result = grade_class(folder, gradebook, rubric=rubric, html_dir=args.html_dir, jobs=args.jobs,
-                         variants=args.variants, timeout=args.timeout, memory_mb=args.memory_mb,
-                         use_cache=not args.no_cache, dask=args.dask)
+    result = grade_class(
+        folder,
+        gradebook,
+        rubric=rubric,
+        html_dir=args.html_dir,
+        jobs=args.jobs,
+        variants=args.variants,
+        timeout=args.timeout,
+        memory_mb=args.memory_mb,
+        use_cache=not args.no_cache,
+        dask=args.dask,
+    )
     for line in result.not_graded:
         print(f"armdyn: not graded: {line}", file=sys.stderr)
     rows = result.gradebook.rows
     graded = sum(1 for r in rows if r["status"] == "graded")
-    print(f"graded {graded} of {len(rows)} submissions ({result.cached} unchanged, from the cache) in "
-          f"{result.seconds:.1f} s; wrote {gradebook}, {os.path.splitext(gradebook)[0]}.json, "
-          f"{os.path.join(os.path.dirname(os.path.abspath(gradebook)), 'summary.html')}"
-          + (f" and reports in {args.html_dir}" if args.html_dir else ""))
+    print(
+        f"graded {graded} of {len(rows)} submissions ({result.cached} unchanged, from the cache) in "
+        f"{result.seconds:.1f} s; wrote {gradebook}, {os.path.splitext(gradebook)[0]}.json, "
+        f"{os.path.join(os.path.dirname(os.path.abspath(gradebook)), 'summary.html')}"
+        + (f" and reports in {args.html_dir}" if args.html_dir else "")
+    )
     return 0 if graded == len(rows) else 1
 
 
@@ -65,9 +83,11 @@ def add_exercise_parser(sub) -> None:
 
     e = sub.add_parser("exercise", help="make a variant of an exercise per student")
     esub = e.add_subparsers(dest="exercise_command", required=True)
-    m = esub.add_parser("make", help="write problem.md/.html, model.yaml, solution.md per student or variant",
-                        description="Exit status: 0 all written, 1 some roster rows refused (named on stderr), "
-                                    "2 bad input.")
+    m = esub.add_parser(
+        "make",
+        help="write problem.md/.html, model.yaml, solution.md per student or variant",
+        description="Exit status: 0 all written, 1 some roster rows refused (named on stderr), 2 bad input.",
+    )
     m.add_argument("kind", choices=[*KINDS, *PROOF_KINDS], help="the arm (or proof) of the exercise")
     g = m.add_mutually_exclusive_group(required=True)
     g.add_argument("--count", type=int, help="this many variants, ids v001, v002, ...")
@@ -81,8 +101,9 @@ def add_exercise_parser(sub) -> None:
 def cmd_exercise_make(args) -> int:
     from .exercise import make_exercise
 
-    result = make_exercise(args.kind, args.out, seed=args.seed, count=args.count, roster=args.roster,
-                           convention=args.convention)
+    result = make_exercise(
+        args.kind, args.out, seed=args.seed, count=args.count, roster=args.roster, convention=args.convention
+    )
     for line in result.problems:
         print(f"armdyn: error: {line}", file=sys.stderr)
     print(f"wrote {len(result.written)} variant(s) of '{args.kind}' into {args.out}")

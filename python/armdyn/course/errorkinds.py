@@ -21,8 +21,16 @@ from __future__ import annotations
 import re
 
 #: the kinds, in the order a summary lists them when counts tie
-KINDS = ("missing term", "extra term", "wrong sign", "derivative mixed up", "factor missing", "extra factor",
-         "wrong shape", "other")
+KINDS = (
+    "missing term",
+    "extra term",
+    "wrong sign",
+    "derivative mixed up",
+    "factor missing",
+    "extra factor",
+    "wrong shape",
+    "other",
+)
 
 _PATTERNS = (
     ("missing term", re.compile(r"^missing terms?\b")),

@@ -30,8 +30,18 @@ FAILURES = ("error", "timeout", "memory", "crashed", "no-variant", "duplicate")
 #: Lagrange's step keys (a tau after one of them belongs to the Lagrange part)
 LAGRANGE_KEYS = ("T", "V", "L", "dL_dqd", "ddt_dL_dqd", "dL_dq")
 #: the fixed columns, in CSV order; ``points_<part>`` columns go after ``error``
-COLUMNS = ("student", "variant", "status", "error", "total", "max", "first_wrong", "first_wrong_kind",
-           "tau_correct", *(f"n_{s.replace('-', '_')}" for s in STATUSES))
+COLUMNS = (
+    "student",
+    "variant",
+    "status",
+    "error",
+    "total",
+    "max",
+    "first_wrong",
+    "first_wrong_kind",
+    "tau_correct",
+    *(f"n_{s.replace('-', '_')}" for s in STATUSES),
+)
 
 
 @dataclass
@@ -90,8 +100,12 @@ class Gradebook:
         return out.getvalue()
 
     def to_json(self) -> str:
-        data = {"columns": self.columns, "rows": [{c: r[c] for c in self.columns} for r in self.rows],
-                "slips": [s.__dict__ for s in self.slips], "rubric": self.rubric.to_dict()}
+        data = {
+            "columns": self.columns,
+            "rows": [{c: r[c] for c in self.columns} for r in self.rows],
+            "slips": [s.__dict__ for s in self.slips],
+            "rubric": self.rubric.to_dict(),
+        }
         return json.dumps(data, indent=1, sort_keys=True, ensure_ascii=False) + "\n"
 
     # -- what the summary counts
@@ -155,9 +169,19 @@ def _key_of(name: str) -> str:
 
 
 def _row(student: str, variant: str | None, report: dict | None, error: str | None, rubric: Rubric):
-    row = {"student": student, "variant": variant, "status": "graded", "error": None, "total": 0.0, "max": 0.0,
-           "first_wrong": None, "first_wrong_kind": None, "tau_correct": None,
-           **{f"n_{s.replace('-', '_')}": 0 for s in STATUSES}, "_parts": {}}
+    row = {
+        "student": student,
+        "variant": variant,
+        "status": "graded",
+        "error": None,
+        "total": 0.0,
+        "max": 0.0,
+        "first_wrong": None,
+        "first_wrong_kind": None,
+        "tau_correct": None,
+        **{f"n_{s.replace('-', '_')}": 0 for s in STATUSES},
+        "_parts": {},
+    }
     if report is None:
         word = (error or "error").split(":", 1)[0].strip()
         row["status"] = word if word in FAILURES else "error"
@@ -184,8 +208,15 @@ def _row(student: str, variant: str | None, report: dict | None, error: str | No
         acc[1] += pts
         if status == "wrong":
             message = s.get("message") or ""
-            slips.append(Slip(student=student, step=name, kind=classify(message), message=message,
-                              first=name == first and not any(x.first for x in slips)))
+            slips.append(
+                Slip(
+                    student=student,
+                    step=name,
+                    kind=classify(message),
+                    message=message,
+                    first=name == first and not any(x.first for x in slips),
+                )
+            )
     for name in rubric.required:
         if name not in seen:
             key = _key_of(name)

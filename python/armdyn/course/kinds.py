@@ -65,42 +65,66 @@ def _kinds() -> dict[str, Kind]:
     planar_g = ((0, -1, 0), (-1, 0, 0), (0, 0, -1))
     out = {
         "rp": Kind(
-            "rp", (
+            "rp",
+            (
                 Row(z, z, z, z, "revolute", ((z, z, z), (l1, z, z)), "l1"),
                 # the slide runs along y1 at l1 from the axis: z2 = y1 (alpha_1 = -pi/2)
                 Row(-HALF_PI, l1, z, z, "prismatic", ((z, z, -l2), (z, z, z)), "l2"),
-            ), ("l1", "l2"), planar_g,
+            ),
+            ("l1", "l2"),
+            planar_g,
             "an RP arm: joint 1 turns about the z0 axis; joint 2 slides along a line "
-            "perpendicular to link 1, at distance l1 from joint 1's axis", True),
+            "perpendicular to link 1, at distance l1 from joint 1's axis",
+            True,
+        ),
         "rr": Kind(
-            "rr", (
+            "rr",
+            (
                 Row(z, z, z, z, "revolute", ((z, z, z), (l1, z, z)), "l1"),
                 Row(z, l1, z, z, "revolute", ((z, z, z), (l2, z, z)), "l2"),
-            ), ("l1", "l2"), planar_g,
-            "a planar RR (elbow) arm: both joints turn about axes parallel to z0", True),
+            ),
+            ("l1", "l2"),
+            planar_g,
+            "a planar RR (elbow) arm: both joints turn about axes parallel to z0",
+            True,
+        ),
         "rrr": Kind(
-            "rrr", (
+            "rrr",
+            (
                 Row(z, z, z, z, "revolute", ((z, z, z), (l1, z, z)), "l1"),
                 Row(z, l1, z, z, "revolute", ((z, z, z), (l2, z, z)), "l2"),
                 Row(z, l2, z, z, "revolute", ((z, z, z), (l3, z, z)), "l3"),
-            ), ("l1", "l2", "l3"), planar_g,
-            "a planar RRR arm: three joints turning about axes parallel to z0", True),
+            ),
+            ("l1", "l2", "l3"),
+            planar_g,
+            "a planar RRR arm: three joints turning about axes parallel to z0",
+            True,
+        ),
         "pr": Kind(
-            "pr", (
+            "pr",
+            (
                 Row(z, z, z, z, "prismatic", ((z, z, -l1), (z, z, z)), "l1"),
                 # joint 2 turns about an axis across the slide (alpha_1 = pi/2)
                 Row(HALF_PI, z, z, z, "revolute", ((z, z, z), (l2, z, z)), "l2"),
-            ), ("l1", "l2"), ((0, 0, -1), (-1, 0, 0)),
-            "a PR arm: joint 1 slides along z0; joint 2 turns about an axis perpendicular to the slide", True),
+            ),
+            ("l1", "l2"),
+            ((0, 0, -1), (-1, 0, 0)),
+            "a PR arm: joint 1 slides along z0; joint 2 turns about an axis perpendicular to the slide",
+            True,
+        ),
         "rrp": Kind(
-            "rrp", (
+            "rrp",
+            (
                 Row(z, z, l1, z, "revolute", ((z, z, -l1), (z, z, z)), "l1"),
                 Row(-HALF_PI, z, z, z, "revolute", ((z, z, z), (z, z, z)), "l1"),
                 Row(HALF_PI, z, z, z, "prismatic", ((z, z, -l3), (z, z, z)), "l3"),
-            ), ("l1", "l3"), ((0, 0, -1),),
+            ),
+            ("l1", "l3"),
+            ((0, 0, -1),),
             "a spatial RRP arm (Stanford-like): a base turn about the vertical z0 axis, a shoulder turning "
             "about a horizontal axis at height l1, and a telescopic link sliding across the shoulder axis",
-            False),
+            False,
+        ),
     }
     return out
 

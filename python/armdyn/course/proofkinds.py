@@ -52,34 +52,50 @@ def _parallel_axis(rng) -> tuple[str, list]:
     IA, IC = rf"\mathbf{{I}}_{point}", r"\mathbf{I}_C"
     integral = r"\int_{\mathcal{B}}"
     blocks = [
-        (f"Prove that the inertia tensor of a rigid body about a point {point} is the one about its mass center "
-        f"C plus that of the whole mass M placed at C."),
+        (
+            f"Prove that the inertia tensor of a rigid body about a point {point} is the one about its mass center "
+            f"C plus that of the whole mass M placed at C."
+        ),
         "## Proof",
         f"By definition, with ${rA}$ the position of the mass element $dm$ relative to {point},",
-        ProofLine(rf"{IA} = {integral} \left( {rA}^T {rA} {one} - {rA} {rA}^T \right) dm",
-                  (rf"{IA} = {integral} \left( {rA}^T {rA} {one} + {rA} {rA}^T \right) dm",),
-                  ("wrong sign",)),
+        ProofLine(
+            rf"{IA} = {integral} \left( {rA}^T {rA} {one} - {rA} {rA}^T \right) dm",
+            (rf"{IA} = {integral} \left( {rA}^T {rA} {one} + {rA} {rA}^T \right) dm",),
+            ("wrong sign",),
+        ),
         "Every element's position relative to the point is its position relative to C plus a constant:",
         ProofLine(rf"{rA} = {rC} + {d}"),
         "and C is the mass center:",
         ProofLine(rf"{integral} {rC} \, dm = \mathbf{{0}}"),
         "The square of the sum is",
-        ProofLine(rf"({rC} + {d})^T ({rC} + {d}) = {rC}^T {rC} + 2 {d}^T {rC} + {d}^T {d}",
-                  (rf"({rC} + {d})^T ({rC} + {d}) = {rC}^T {rC} + {d}^T {rC} + {d}^T {d}",
-                   rf"({rC} + {d})^T ({rC} + {d}) = {rC}^T {rC} + 2 {d}^T {rC}"),
-                  ("factor missing", "missing term")),
+        ProofLine(
+            rf"({rC} + {d})^T ({rC} + {d}) = {rC}^T {rC} + 2 {d}^T {rC} + {d}^T {d}",
+            (
+                rf"({rC} + {d})^T ({rC} + {d}) = {rC}^T {rC} + {d}^T {rC} + {d}^T {d}",
+                rf"({rC} + {d})^T ({rC} + {d}) = {rC}^T {rC} + 2 {d}^T {rC}",
+            ),
+            ("factor missing", "missing term"),
+        ),
         "Substituting and splitting the integral,",
-        ProofLine(rf"{IA} = {integral} \left( ({rC} + {d})^T ({rC} + {d}) {one} - ({rC} + {d})({rC} + {d})^T \right) dm"
-                  rf" = {IC} + {integral} \left( 2 {d}^T {rC} {one} - {rC} {d}^T - {d} {rC}^T \right) dm"
-                  rf" + M \left( {d}^T {d} {one} - {d} {d}^T \right)",
-                  ((rf"{IA} = {integral} \left( ({rC} + {d})^T ({rC} + {d}) {one} - ({rC} + {d})({rC} + {d})^T \right)"
-                   rf" dm = {IC} + {integral} \left( 2 {d}^T {rC} {one} - {rC} {d}^T - {d} {rC}^T \right) dm"
-                   rf" + M \left( {d}^T {d} {one} + {d} {d}^T \right)"),),
-                  ("wrong sign",)),
+        ProofLine(
+            rf"{IA} = {integral} \left( ({rC} + {d})^T ({rC} + {d}) {one} - ({rC} + {d})({rC} + {d})^T \right) dm"
+            rf" = {IC} + {integral} \left( 2 {d}^T {rC} {one} - {rC} {d}^T - {d} {rC}^T \right) dm"
+            rf" + M \left( {d}^T {d} {one} - {d} {d}^T \right)",
+            (
+                (
+                    rf"{IA} = {integral} \left( ({rC} + {d})^T ({rC} + {d}) {one} - ({rC} + {d})({rC} + {d})^T \right)"
+                    rf" dm = {IC} + {integral} \left( 2 {d}^T {rC} {one} - {rC} {d}^T - {d} {rC}^T \right) dm"
+                    rf" + M \left( {d}^T {d} {one} + {d} {d}^T \right)"
+                ),
+            ),
+            ("wrong sign",),
+        ),
         "The middle integral is linear in the position relative to C, so it vanishes:",
-        ProofLine(rf"{IA} = {IC} + M \left( {d}^T {d} {one} - {d} {d}^T \right)",
-                  (rf"{IA} = {IC} + \left( {d}^T {d} {one} - {d} {d}^T \right)",),
-                  ("factor missing",)),
+        ProofLine(
+            rf"{IA} = {IC} + M \left( {d}^T {d} {one} - {d} {d}^T \right)",
+            (rf"{IA} = {IC} + \left( {d}^T {d} {one} - {d} {d}^T \right)",),
+            ("factor missing",),
+        ),
     ]
     return "the parallel axis theorem", blocks
 
@@ -94,29 +110,44 @@ def _rotational_energy(rng) -> tuple[str, list]:
     else:
         integral, measure = r"\int_{\mathcal{B}}", "dm"
     blocks = [
-        (r"Prove that the kinetic energy of rotation of link i is $E_{rot} = \frac{1}{2}\omega^{cT} I^c \omega^c$ "
-        "in any frame c."),
+        (
+            r"Prove that the kinetic energy of rotation of link i is $E_{rot} = \frac{1}{2}\omega^{cT} I^c \omega^c$ "
+            "in any frame c."
+        ),
         "## Proof",
         r"Each mass element moves with the velocity $\omega_i \times r_i$, so",
-        ProofLine(rf"E_{{rot}} = \frac{{1}}{{2}} {integral} (\omega_i \times r_i)^T (\omega_i \times r_i) {measure}"
-                  rf" = \frac{{1}}{{2}} {integral} r_i^T S^T(\omega_i) S(\omega_i) r_i {measure}",
-                  ((rf"E_{{rot}} = {integral} (\omega_i \times r_i)^T (\omega_i \times r_i) {measure}"
-                   rf" = {integral} r_i^T S^T(\omega_i) S(\omega_i) r_i {measure}"),),
-                  ("factor missing",)),
+        ProofLine(
+            rf"E_{{rot}} = \frac{{1}}{{2}} {integral} (\omega_i \times r_i)^T (\omega_i \times r_i) {measure}"
+            rf" = \frac{{1}}{{2}} {integral} r_i^T S^T(\omega_i) S(\omega_i) r_i {measure}",
+            (
+                (
+                    rf"E_{{rot}} = {integral} (\omega_i \times r_i)^T (\omega_i \times r_i) {measure}"
+                    rf" = {integral} r_i^T S^T(\omega_i) S(\omega_i) r_i {measure}"
+                ),
+            ),
+            ("factor missing",),
+        ),
         "The skew matrix swaps its argument with the vector it multiplies, changing sign:",
         ProofLine(r"S(\omega_i) r_i = -S(r_i) \omega_i", (r"S(\omega_i) r_i = S(r_i) \omega_i",), ("wrong sign",)),
         "so that",
-        ProofLine(rf"\frac{{1}}{{2}} {integral} r_i^T S^T(\omega_i) S(\omega_i) r_i {measure}"
-                  rf" = \frac{{1}}{{2}} \omega_i^T \left( {integral} S^T(r_i) S(r_i) {measure} \right) \omega_i"
-                  rf" = \frac{{1}}{{2}} \omega_i^T I_{{l_i}} \omega_i"),
+        ProofLine(
+            rf"\frac{{1}}{{2}} {integral} r_i^T S^T(\omega_i) S(\omega_i) r_i {measure}"
+            rf" = \frac{{1}}{{2}} \omega_i^T \left( {integral} S^T(r_i) S(r_i) {measure} \right) \omega_i"
+            rf" = \frac{{1}}{{2}} \omega_i^T I_{{l_i}} \omega_i"
+        ),
         "In frame c the tensor and the angular velocity are",
-        ProofLine(rf"I^c_{{l_i}} = {R}^c I_{{l_i}} {R}^{{c{tT}}}",
-                  (rf"I^c_{{l_i}} = {R}^{{c{tT}}} I_{{l_i}} {R}^c",), ("transposed",)),
+        ProofLine(
+            rf"I^c_{{l_i}} = {R}^c I_{{l_i}} {R}^{{c{tT}}}",
+            (rf"I^c_{{l_i}} = {R}^{{c{tT}}} I_{{l_i}} {R}^c",),
+            ("transposed",),
+        ),
         ProofLine(rf"\omega^c = {R}^c \omega_i"),
         rf"hence, with ${R}^{{c{tT}}} {R}^c = {one}$,",
-        ProofLine(rf"\frac{{1}}{{2}}\omega^{{c{tT}}} I^c_{{l_i}} \omega^c"
-                  rf" = \frac{{1}}{{2}}\omega_i^T {R}^{{c{tT}}} {R}^c I_{{l_i}} {R}^{{c{tT}}} {R}^c \omega_i"
-                  rf" = \frac{{1}}{{2}} \omega_i^T I_{{l_i}} \omega_i = E_{{rot}}"),
+        ProofLine(
+            rf"\frac{{1}}{{2}}\omega^{{c{tT}}} I^c_{{l_i}} \omega^c"
+            rf" = \frac{{1}}{{2}}\omega_i^T {R}^{{c{tT}}} {R}^c I_{{l_i}} {R}^{{c{tT}}} {R}^c \omega_i"
+            rf" = \frac{{1}}{{2}} \omega_i^T I_{{l_i}} \omega_i = E_{{rot}}"
+        ),
     ]
     return "the kinetic energy of rotation", blocks
 
@@ -132,8 +163,7 @@ def proof_markdown(blocks: list, front: dict, title: str, slip: tuple[int, int] 
     k-th wrong version instead."""
     import yaml
 
-    head = ["---", yaml.safe_dump(front, sort_keys=True, default_flow_style=False).rstrip(), "---",
-            f"# {title}", ""]
+    head = ["---", yaml.safe_dump(front, sort_keys=True, default_flow_style=False).rstrip(), "---", f"# {title}", ""]
     lines = list(head)
     where = {}
     for k, b in enumerate(blocks):

@@ -83,13 +83,16 @@ class Rubric:
         if data is None:
             data = {}
         if not isinstance(data, dict):
-            raise ModelError("a rubric is a mapping (points:, default:, parts:, required:, credit:)",
-                             source=f"{source}:1")
+            raise ModelError(
+                "a rubric is a mapping (points:, default:, parts:, required:, credit:)", source=f"{source}:1"
+            )
         top = f"{source}:{getattr(data, 'line', 1) or 1}"
         unknown = [k for k in data if k not in _KEYS]
         if unknown:
-            raise ModelError(f"unknown key {unknown[0]!r} (known: {', '.join(_KEYS)})", source=_line_of(text, source,
-                                                                                                   unknown[0], top))
+            raise ModelError(
+                f"unknown key {unknown[0]!r} (known: {', '.join(_KEYS)})",
+                source=_line_of(text, source, unknown[0], top),
+            )
         rubric = cls(source=source)
         rubric.default_points = _number(data.get("default", 1.0), "default", _line_of(text, source, "default", top))
         rubric.points = dict(rubric.points)
@@ -105,12 +108,16 @@ class Rubric:
             if key == "credit":
                 bad = [k for k in table if k not in DEFAULT_CREDIT]
                 if bad:
-                    raise ModelError(f"credit: unknown status {bad[0]!r} (known: {', '.join(DEFAULT_CREDIT)})",
-                                     source=_line_of(text, source, bad[0], at))
+                    raise ModelError(
+                        f"credit: unknown status {bad[0]!r} (known: {', '.join(DEFAULT_CREDIT)})",
+                        source=_line_of(text, source, bad[0], at),
+                    )
                 over = [k for k, v in table.items() if v > 1]
                 if over:
-                    raise ModelError(f"credit.{over[0]} must be a fraction in [0, 1], got {table[over[0]]}",
-                                     source=_line_of(text, source, over[0], at))
+                    raise ModelError(
+                        f"credit.{over[0]} must be a fraction in [0, 1], got {table[over[0]]}",
+                        source=_line_of(text, source, over[0], at),
+                    )
                 rubric.credit = {**DEFAULT_CREDIT, **table}
             elif key == "points":
                 rubric.points = table
@@ -119,8 +126,10 @@ class Rubric:
         if "required" in data:
             req = data["required"]
             if not isinstance(req, list) or not all(isinstance(x, str) for x in req):
-                raise ModelError("required must be a list of step names (tau_1, v_dot_2, ...)",
-                                 source=_line_of(text, source, "required", top))
+                raise ModelError(
+                    "required must be a list of step names (tau_1, v_dot_2, ...)",
+                    source=_line_of(text, source, "required", top),
+                )
             rubric.required = list(req)
         return rubric
 
@@ -132,9 +141,13 @@ class Rubric:
         return self.points.get(key, self.default_points)
 
     def to_dict(self) -> dict:
-        return {"points": dict(sorted(self.points.items())), "default": self.default_points,
-                "parts": dict(sorted(self.parts.items())), "required": list(self.required),
-                "credit": dict(sorted(self.credit.items()))}
+        return {
+            "points": dict(sorted(self.points.items())),
+            "default": self.default_points,
+            "parts": dict(sorted(self.parts.items())),
+            "required": list(self.required),
+            "credit": dict(sorted(self.credit.items())),
+        }
 
     def fingerprint(self) -> str:
         """A stable text of the rubric's content (for the batch cache key)."""

@@ -24,8 +24,10 @@ from ..symbolic.agreement import trig_reduce
 
 NE = "newton-euler"
 LAGRANGE = "lagrange"
-_NE_HEAD = {"outward": "Outward pass (each vector in its own link's frame)",
-            "inward": "Inward pass (force and moment on each link by its parent, in the link's frame)"}
+_NE_HEAD = {
+    "outward": "Outward pass (each vector in its own link's frame)",
+    "inward": "Inward pass (force and moment on each link by its parent, in the link's frame)",
+}
 
 
 @dataclass(frozen=True)
@@ -89,12 +91,21 @@ def solution_steps(robot: Robot) -> list[SolutionStep]:
         p = sp.diff(L, qd[k])
         ddt = sum((sp.diff(p, q[j]) * qd[j] + sp.diff(p, qd[j]) * qdd[j] for j in range(robot.dof)), sp.Integer(0))
         tau = next(s.value for s in la.steps if s.name == "tau" and s.link == robot.coordinate_names[k])
-        out.append(SolutionStep(LAGRANGE, f"dL_dqd_{i}", head, rf"\frac{{\partial L}}{{\partial \dot{{q}}_{{{i}}}}}",
-                                p))
-        out.append(SolutionStep(LAGRANGE, f"ddt_dL_dqd_{i}", head,
-                                rf"\frac{{d}}{{dt}}\frac{{\partial L}}{{\partial \dot{{q}}_{{{i}}}}}", ddt))
-        out.append(SolutionStep(LAGRANGE, f"dL_dq_{i}", head, rf"\frac{{\partial L}}{{\partial q_{{{i}}}}}",
-                                sp.diff(L, q[k])))
+        out.append(
+            SolutionStep(LAGRANGE, f"dL_dqd_{i}", head, rf"\frac{{\partial L}}{{\partial \dot{{q}}_{{{i}}}}}", p)
+        )
+        out.append(
+            SolutionStep(
+                LAGRANGE,
+                f"ddt_dL_dqd_{i}",
+                head,
+                rf"\frac{{d}}{{dt}}\frac{{\partial L}}{{\partial \dot{{q}}_{{{i}}}}}",
+                ddt,
+            )
+        )
+        out.append(
+            SolutionStep(LAGRANGE, f"dL_dq_{i}", head, rf"\frac{{\partial L}}{{\partial q_{{{i}}}}}", sp.diff(L, q[k]))
+        )
         out.append(SolutionStep(LAGRANGE, f"tau_{i}", head, rf"\tau_{{{i}}}", tau))
     return out
 
@@ -175,6 +186,7 @@ def _latex_names(robot: Robot) -> dict:
 def render_value(value, names: dict, q=()) -> str:
     """LaTeX of a step's value (a pmatrix column for vectors); small expressions
     expanded with sin^2 + cos^2 = 1 applied in the coordinates ``q``."""
+
     def one(x):
         if sp.count_ops(x) < 400:
             x = sp.expand(trig_reduce(x, q, keep_trig=True)) if len(q) else sp.expand(x)
@@ -185,16 +197,20 @@ def render_value(value, names: dict, q=()) -> str:
     return one(value)
 
 
-def solution_markdown(robot: Robot, steps: list[SolutionStep], front: dict, title: str,
-                      intro: str = "") -> str:
+def solution_markdown(robot: Robot, steps: list[SolutionStep], front: dict, title: str, intro: str = "") -> str:
     """The solution file: YAML front matter ``front`` (``robot:``, ``student:``...), a
     title, ``intro`` (Markdown), then one ``$$ label = value $$`` line per step under
     its part's and stage's headings."""
     import yaml
 
     names = _latex_names(robot)
-    lines = ["---", yaml.safe_dump(front, sort_keys=True, default_flow_style=False, allow_unicode=True).rstrip(),
-             "---", f"# {title}", ""]
+    lines = [
+        "---",
+        yaml.safe_dump(front, sort_keys=True, default_flow_style=False, allow_unicode=True).rstrip(),
+        "---",
+        f"# {title}",
+        "",
+    ]
     if intro:
         lines += [intro, ""]
     part = stage = None

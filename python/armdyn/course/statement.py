@@ -38,38 +38,61 @@ def statement_blocks(variant: Variant, model: dict) -> list[tuple]:
     rows = variant.rows()
     coords = [f"\\theta_{{{i}}}" if r.kind == "revolute" else f"d_{{{i}}}" for i, r in enumerate(rows, 1)]
     out = [("h1", f"Exercise {variant.ident}: the dynamics of {spec.title.split(':')[0]}")]
-    out.append(("p", f"The arm is {spec.title}. Its joint coordinates are "
-                + ", ".join(f"${c}$" for c in coords) + "."))
+    out.append(
+        ("p", f"The arm is {spec.title}. Its joint coordinates are " + ", ".join(f"${c}$" for c in coords) + ".")
+    )
     g = sp.Matrix(variant.gravity) * sp.Symbol("g")
     out.append(("p", f"Gravity, in the base frame 0, is $\\mathbf{{g}} = {_vec(g)}$ (magnitude $g$)."))
     if variant.masses == "point":
         out.append(("p", "Each link is a point mass $m_i$ at its far end (no rotational inertia)."))
     else:
-        out.append(("p", ("Each link is a uniform thin rod of mass $m_i$: its centre of mass is at its middle and "
-                         "its inertia about the centre of mass is $m_i \\ell^2/12$ about every axis across it "
-                         "(zero along it).")))
+        out.append(
+            (
+                "p",
+                (
+                    "Each link is a uniform thin rod of mass $m_i$: its centre of mass is at its middle and "
+                    "its inertia about the centre of mass is $m_i \\ell^2/12$ about every axis across it "
+                    "(zero along it)."
+                ),
+            )
+        )
     if variant.lengths:
-        out.append(("p", "Lengths: " + ", ".join(f"${_tex(sp.Symbol(k))} = {v:g}$ m" for k, v in variant.lengths)
-                    + "."))
+        out.append(
+            ("p", "Lengths: " + ", ".join(f"${_tex(sp.Symbol(k))} = {v:g}$ m" for k, v in variant.lengths) + ".")
+        )
     out.append(("h2", "Frames"))
-    out.append(("p", (f"Use {variant.describe()}; they are exactly the frames of `model.yaml`, which the "
-                     "grader uses.")))
+    out.append(
+        ("p", (f"Use {variant.describe()}; they are exactly the frames of `model.yaml`, which the grader uses."))
+    )
     if variant.convention in ("craig", "spong"):
-        head = ["$i$", "$\\alpha_{i-1}$", "$a_{i-1}$", "$d_i$", "$\\theta_i$"] if variant.convention == "craig" \
+        head = (
+            ["$i$", "$\\alpha_{i-1}$", "$a_{i-1}$", "$d_i$", "$\\theta_i$"]
+            if variant.convention == "craig"
             else ["$i$", "$a_i$", "$\\alpha_i$", "$d_i$", "$\\theta_i$"]
+        )
         table = []
         for i, row in enumerate(model["dh"], 1):
             d = f"{_tex(row['d'])} + d_{{{i}}}" if row["type"] == "prismatic" else _tex(row["d"])
             th = f"{_tex(row['theta'])} + \\theta_{{{i}}}" if row["type"] == "revolute" else _tex(row["theta"])
             d = d.removeprefix("0 + ")
             th = th.removeprefix("0 + ")
-            cells = [str(i), f"${_tex(row['alpha'])}$", f"${_tex(row['a'])}$"] if variant.convention == "craig" \
+            cells = (
+                [str(i), f"${_tex(row['alpha'])}$", f"${_tex(row['a'])}$"]
+                if variant.convention == "craig"
                 else [str(i), f"${_tex(row['a'])}$", f"${_tex(row['alpha'])}$"]
+            )
             table.append(cells + [f"${d}$", f"${th}$"])
         out.append(("table", head, table))
         if variant.convention == "spong":
-            out.append(("p", ("Write each link's vectors in frame $i$ placed on joint $i$'s axis with $z_i$ along "
-                             "it (DH frame $i-1$ turned by joint $i$), as armdyn's model of this table does.")))
+            out.append(
+                (
+                    "p",
+                    (
+                        "Write each link's vectors in frame $i$ placed on joint $i$'s axis with $z_i$ along "
+                        "it (DH frame $i-1$ turned by joint $i$), as armdyn's model of this table does."
+                    ),
+                )
+            )
         coms = []
         for i, row in enumerate(model["dh"], 1):
             coms.append(f"$p_{{C_{i}}} = {_vec(row['com'])}$")
@@ -80,31 +103,51 @@ def statement_blocks(variant: Variant, model: dict) -> list[tuple]:
             xyz = j.get("xyz", [0, 0, 0])
             text = f"joint {i} (${coords[i - 1]}$, {j['type']}) sits at ${_vec(xyz)}$ in frame {i - 1}"
             if "rotation" in j:
-                text += f", its frame turned by $R = {_tex(sp.Matrix(j['rotation']))}$ (columns: its axes in frame " \
-                        f"{i - 1})"
+                text += (
+                    f", its frame turned by $R = {_tex(sp.Matrix(j['rotation']))}$ (columns: its axes in frame {i - 1})"
+                )
             text += "; it moves about/along its own z axis"
             if "frame_xyz" in j:
-                text += f"; frame {i} is then moved by ${_vec(j['frame_xyz'])}$ to link {i}'s centre of mass, off " \
-                        "the joint's axis"
+                text += (
+                    f"; frame {i} is then moved by ${_vec(j['frame_xyz'])}$ to link {i}'s centre of mass, off "
+                    "the joint's axis"
+                )
             else:
                 text += f"; frame {i} is the joint's frame after the motion"
             items.append(text + ".")
         out.append(("list", items))
     out.append(("h2", "Tasks"))
-    out.append(("list", [
-        ("Write the equations of motion by iterating the Newton-Euler equations: the base's "
-        "$\\omega_0, \\dot\\omega_0, \\dot v_0$ (gravity as an upward acceleration of the base), then for each link "
-        "$\\omega_i, \\dot\\omega_i, \\dot v_i, \\dot v_{C_i}, F_i, N_i$ outwards and $f_i, n_i, \\tau_i$ inwards, "
-        "each vector in link $i$'s own frame."),
-        ("Check the result with Lagrange's equations: $T$, $V$, $L$, and for each coordinate "
-        "$\\partial L/\\partial \\dot q_i$, its time derivative, $\\partial L/\\partial q_i$ and $\\tau_i$."),
-    ]))
+    out.append(
+        (
+            "list",
+            [
+                (
+                    "Write the equations of motion by iterating the Newton-Euler equations: the base's "
+                    "$\\omega_0, \\dot\\omega_0, \\dot v_0$ (gravity as an upward acceleration of the base), then for each link "
+                    "$\\omega_i, \\dot\\omega_i, \\dot v_i, \\dot v_{C_i}, F_i, N_i$ outwards and $f_i, n_i, \\tau_i$ inwards, "
+                    "each vector in link $i$'s own frame."
+                ),
+                (
+                    "Check the result with Lagrange's equations: $T$, $V$, $L$, and for each coordinate "
+                    "$\\partial L/\\partial \\dot q_i$, its time derivative, $\\partial L/\\partial q_i$ and $\\tau_i$."
+                ),
+            ],
+        )
+    )
     out.append(("h2", "Handing in"))
     out.append(("p", "One Markdown file, every equation as display math `$$ ... $$`, with this front matter:"))
-    out.append(("code", (f"---\nstudent: {variant.ident}\nvariant: {variant.ident}\nrobot: model.yaml\n"
-                        "method: both\n---")))
-    out.append(("p", (f"{dof} joints: name the steps as in the textbook (`\\dot v_{{C_1}}`, `F_2`, `\\tau_1`, `T`); "
-                     "`armdyn grade` checks each one against the method and your own earlier steps.")))
+    out.append(
+        ("code", (f"---\nstudent: {variant.ident}\nvariant: {variant.ident}\nrobot: model.yaml\nmethod: both\n---"))
+    )
+    out.append(
+        (
+            "p",
+            (
+                f"{dof} joints: name the steps as in the textbook (`\\dot v_{{C_1}}`, `F_2`, `\\tau_1`, `T`); "
+                "`armdyn grade` checks each one against the method and your own earlier steps."
+            ),
+        )
+    )
     return out
 
 
@@ -138,7 +181,7 @@ def inline_html(text: str) -> str:
     """Text with ``$latex$`` as MathML and ```code``` as <code>, the rest escaped."""
     out, at = [], 0
     for m in _INLINE.finditer(text):
-        out.append(escape(text[at:m.start()]))
+        out.append(escape(text[at : m.start()]))
         if m.group(1) is not None:
             mml = latex_to_mathml(m.group(1))
             out.append(math_element(mml) if mml is not None else f"<code>{escape(m.group(1))}</code>")
@@ -157,8 +200,10 @@ def statement_html(blocks: list[tuple], drawing_uri: str | None) -> str:
             title = b[1]
             body.append(f"<h1>{inline_html(b[1])}</h1>")
             if drawing_uri:
-                body.append(f'<img class="chart" alt="the arm and its frames (x red, y green, z blue)" '
-                            f'src="{escape(drawing_uri)}">')
+                body.append(
+                    f'<img class="chart" alt="the arm and its frames (x red, y green, z blue)" '
+                    f'src="{escape(drawing_uri)}">'
+                )
         elif b[0] == "h2":
             body.append(f"<h2>{inline_html(b[1])}</h2>")
         elif b[0] == "p":

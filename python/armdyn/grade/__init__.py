@@ -25,11 +25,10 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..model import Robot
-from .engine import Sampler, Value, World, canonical, judge, to_sympy
-from .engine import equal
+from .diagnose import unreadable
+from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, split_name, tidy
 from .latex import GREEK, LatexError, UnknownSymbol, parse, parse_sympy_syntax
-from .diagnose import unreadable
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
@@ -40,8 +39,18 @@ from .verdict import PASSING, STATUSES, GradeReport, StepVerdict
 __all__ = ["grade", "GradeReport", "StepVerdict", "STATUSES"]
 
 _NAMED = {  # step names as armdyn reports them, accepted as left-hand sides in YAML
-    "omega": "omega", "omega_dot": "omega_dot", "v_dot": "v_dot", "vc_dot": "vc_dot", "F": "F", "N": "N",
-    "f": "f", "n": "n", "tau": "tau", "dL_dqd": "dL_dqd", "dL_dq": "dL_dq", "ddt_dL_dqd": "ddt_dL_dqd",
+    "omega": "omega",
+    "omega_dot": "omega_dot",
+    "v_dot": "v_dot",
+    "vc_dot": "vc_dot",
+    "F": "F",
+    "N": "N",
+    "f": "f",
+    "n": "n",
+    "tau": "tau",
+    "dL_dqd": "dL_dqd",
+    "dL_dq": "dL_dq",
+    "ddt_dL_dqd": "ddt_dL_dqd",
 }
 
 
@@ -116,8 +125,10 @@ class _Grader:
                 names.update({k: v for k, v in self.symbols.steps.items() if not isinstance(v, sp.MatrixBase)})
                 raw = eq.value
                 items = raw if isinstance(raw, list) else [raw]
-                parsed = [se.sympify(v) if isinstance(v, (int, float)) else
-                          parse_sympy_syntax(str(v), names, symengine=True) for v in items]
+                parsed = [
+                    se.sympify(v) if isinstance(v, (int, float)) else parse_sympy_syntax(str(v), names, symengine=True)
+                    for v in items
+                ]
                 value = se.DenseMatrix(len(parsed), 1, parsed) if isinstance(raw, list) else parsed[0]
         except UnknownSymbol as err:
             raise ModelError(f"{ref.name}: {err}", source=self.where(eq)) from None
@@ -147,27 +158,34 @@ class _Grader:
             value = to_sympy(value)
         if isinstance(value, se.DenseMatrix):
             if value.shape != want:
-                raise ModelError(f"{ref.name} must be a vector of 3 components, but it has {value.shape[0]}",
-                                 source=self.where(eq))
+                raise ModelError(
+                    f"{ref.name} must be a vector of 3 components, but it has {value.shape[0]}", source=self.where(eq)
+                )
             return value
         if want is None:
             if isinstance(value, sp.MatrixBase):
                 if value.shape == (1, 1):
                     return value[0, 0]
-                raise ModelError(f"{ref.name} is a scalar, but the value is a {value.shape[0]}x{value.shape[1]} "
-                                 "matrix", source=self.where(eq))
+                raise ModelError(
+                    f"{ref.name} is a scalar, but the value is a {value.shape[0]}x{value.shape[1]} matrix",
+                    source=self.where(eq),
+                )
             return value
         if not isinstance(value, sp.MatrixBase):
             if value == 0:
                 return sp.zeros(*want)
-            raise ModelError(f"{ref.name} is a {'vector' if vector else '3x3 matrix'}, but the value is a scalar",
-                             source=self.where(eq))
+            raise ModelError(
+                f"{ref.name} is a {'vector' if vector else '3x3 matrix'}, but the value is a scalar",
+                source=self.where(eq),
+            )
         if vector and value.shape == (1, 3):
             value = value.T
         if value.shape != want:
             kind = "vector of 3 components" if vector else "3x3 matrix"
-            raise ModelError(f"{ref.name} must be a {kind}, but it has shape {value.shape[0]}x{value.shape[1]}",
-                             source=self.where(eq))
+            raise ModelError(
+                f"{ref.name} must be a {kind}, but it has shape {value.shape[0]}x{value.shape[1]}",
+                source=self.where(eq),
+            )
         return value
 
     # -- grading
@@ -193,9 +211,18 @@ class _Grader:
         if ref is None:
             ref = _named_ref(eq.lhs) or (parse_lhs(eq.lhs, self.symbols.coordinate_of) if not eq.latex else None)
         if eq.problem:  # cannot be split into sides: shown with where and why, named if its start names a step
-            self.verdicts.append(StepVerdict(
-                name=ref.name if ref else "", key=ref.key if ref else "", link="", status="unrecognised",
-                label=eq.lhs, source=eq.source, line=eq.line, message=self._unreadable(eq, eq.problem)))
+            self.verdicts.append(
+                StepVerdict(
+                    name=ref.name if ref else "",
+                    key=ref.key if ref else "",
+                    link="",
+                    status="unrecognised",
+                    label=eq.lhs,
+                    source=eq.source,
+                    line=eq.line,
+                    message=self._unreadable(eq, eq.problem),
+                )
+            )
             return
         if ref is None:
             law = lagrange_law(eq.lhs, str(eq.value)) if eq.latex else None
@@ -204,13 +231,31 @@ class _Grader:
             if law is not None:
                 if "lagrange" not in seen_methods:
                     seen_methods.append("lagrange")
-                self.verdicts.append(StepVerdict(
-                    name="lagrange_equation", key="law", link="", status="correct" if law[0] else "wrong",
-                    label=eq.lhs, source=eq.source, line=eq.line, message=law[1]))
+                self.verdicts.append(
+                    StepVerdict(
+                        name="lagrange_equation",
+                        key="law",
+                        link="",
+                        status="correct" if law[0] else "wrong",
+                        label=eq.lhs,
+                        source=eq.source,
+                        line=eq.line,
+                        message=law[1],
+                    )
+                )
                 return
-            self.verdicts.append(StepVerdict(
-                name="", key="", link="", status="unrecognised", label=eq.lhs, source=eq.source, line=eq.line,
-                message="not a step of Newton-Euler or Lagrange (skipped)"))
+            self.verdicts.append(
+                StepVerdict(
+                    name="",
+                    key="",
+                    link="",
+                    status="unrecognised",
+                    label=eq.lhs,
+                    source=eq.source,
+                    line=eq.line,
+                    message="not a step of Newton-Euler or Lagrange (skipped)",
+                )
+            )
             return
         n_links = len(self.robot.links) - 1
         if ref.key in ("f", "n") and ref.index == n_links + 1:
@@ -218,16 +263,28 @@ class _Grader:
                 seen_methods.append("newton-euler")
             self._free_end(ref, eq)
             return
-        method = "lagrange" if ref.key in LAGRANGE_KEYS else (
-            context or "newton-euler" if ref.key == "tau" else "newton-euler")
+        method = (
+            "lagrange"
+            if ref.key in LAGRANGE_KEYS
+            else (context or "newton-euler" if ref.key == "tau" else "newton-euler")
+        )
         if method not in seen_methods:
             seen_methods.append(method)
         self._check_index(ref, eq)
         value, problem = self.value(eq, ref)
         if value is None:
-            self.verdicts.append(StepVerdict(
-                name=ref.name, key=ref.key, link="", status="unrecognised", label=eq.lhs, source=eq.source,
-                line=eq.line, message=problem))
+            self.verdicts.append(
+                StepVerdict(
+                    name=ref.name,
+                    key=ref.key,
+                    link="",
+                    status="unrecognised",
+                    label=eq.lhs,
+                    source=eq.source,
+                    line=eq.line,
+                    message=problem,
+                )
+            )
             return
         if ref.key == "R":
             self._rotation(ref, eq, value)
@@ -244,8 +301,11 @@ class _Grader:
         if not recognised and unread:  # nothing graded: the reason is the unreadable equation
             raise ModelError(unread[0].message.split(": ", 1)[1], source=unread[0].message.split(": ", 1)[0])
         if not recognised:
-            raise ModelError("no step of Newton-Euler or Lagrange recognised (expected equations such as "
-                             "\\omega_1^1 = ..., F_2^2 = ..., \\tau_1 = ..., T = ...)", source=self.sub.path)
+            raise ModelError(
+                "no step of Newton-Euler or Lagrange recognised (expected equations such as "
+                "\\omega_1^1 = ..., F_2^2 = ..., \\tau_1 = ..., T = ...)",
+                source=self.sub.path,
+            )
         first_wrong = next((v.name for v in self.verdicts if v.status == "wrong"), None)
         tau_correct = [False] * self.robot.dof
         for v in self.verdicts:
@@ -255,34 +315,52 @@ class _Grader:
             self.notes.append("g read as the magnitude of the model's gravity vector")
         method_name = "+".join(seen_methods) or (method_hint or "newton-euler")
         return GradeReport(
-            robot=self.robot.name, method=method_name, submission=self.sub.path, steps=self.verdicts,
-            first_wrong=first_wrong, tau_correct=tau_correct, symbol_latex=_symbol_latex(self.robot),
-            notes=self.notes, shorthand=dict(self.symbols.shorthand))
+            robot=self.robot.name,
+            method=method_name,
+            submission=self.sub.path,
+            steps=self.verdicts,
+            first_wrong=first_wrong,
+            tau_correct=tau_correct,
+            symbol_latex=_symbol_latex(self.robot),
+            notes=self.notes,
+            shorthand=dict(self.symbols.shorthand),
+        )
 
     def _check_index(self, ref: StepRef, eq):
         n = len(self.robot.links) - 1
         if ref.key in VECTOR_KEYS:
-            if ref.index is None or not 0 <= ref.index <= n \
-                    or (ref.index == 0 and ref.key not in ("omega", "omega_dot", "v_dot")):
-                raise ModelError(f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}",
-                                 source=self.where(eq))
+            if (
+                ref.index is None
+                or not 0 <= ref.index <= n
+                or (ref.index == 0 and ref.key not in ("omega", "omega_dot", "v_dot"))
+            ):
+                raise ModelError(
+                    f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}",
+                    source=self.where(eq),
+                )
             if ref.frame is not None and not 0 <= ref.frame <= n:
-                raise ModelError(f"{ref.name} is written in frame {ref.frame}, which '{self.robot.name}' does not "
-                                 f"have (frames 0..{n})", source=self.where(eq))
+                raise ModelError(
+                    f"{ref.name} is written in frame {ref.frame}, which '{self.robot.name}' does not "
+                    f"have (frames 0..{n})",
+                    source=self.where(eq),
+                )
         elif ref.key in ("P", "Pc"):
             if not 1 <= ref.index <= n:
-                raise ModelError(f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}",
-                                 source=self.where(eq))
+                raise ModelError(
+                    f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}",
+                    source=self.where(eq),
+                )
             if ref.frame is not None and not 0 <= ref.frame <= n:
-                raise ModelError(f"{ref.name}: frame {ref.frame} does not exist (frames 0..{n})",
-                                 source=self.where(eq))
+                raise ModelError(f"{ref.name}: frame {ref.frame} does not exist (frames 0..{n})", source=self.where(eq))
         elif ref.key == "R":
             for k in (ref.index, ref.frame):
                 if k is None or not 0 <= k <= n:
                     raise ModelError(f"{ref.name}: frame {k} does not exist (frames 0..{n})", source=self.where(eq))
         elif ref.index is not None and not 1 <= ref.index <= self.robot.dof:
-            raise ModelError(f"{ref.name} names joint {ref.index}, but '{self.robot.name}' has joints "
-                             f"1..{self.robot.dof}", source=self.where(eq))
+            raise ModelError(
+                f"{ref.name} names joint {ref.index}, but '{self.robot.name}' has joints 1..{self.robot.dof}",
+                source=self.where(eq),
+            )
 
     def _rotation(self, ref: StepRef, eq, value):
         ctx = self.world("newton-euler").ctx
@@ -295,18 +373,33 @@ class _Grader:
         if not ok.all():
             if equal(got_fp, fp(expected.T)).all():
                 status = "correct-by-convention"
-                conv = (f"transposed: the columns are frame {ref.frame}'s axes in frame {ref.index} "
-                        f"(R_{ref.index}^{ref.frame} here maps frame-{ref.index} coordinates to frame {ref.frame})")
+                conv = (
+                    f"transposed: the columns are frame {ref.frame}'s axes in frame {ref.index} "
+                    f"(R_{ref.index}^{ref.frame} here maps frame-{ref.index} coordinates to frame {ref.frame})"
+                )
             else:
                 status = "wrong"
                 bad = [int(i) for i in range(9) if not ok.ravel()[i]]
-                message = "; ".join(f"{component_name(i, (3, 3))}: "
-                                    + self._describe(value[i], expected[i]) for i in bad[:3])
-        self.verdicts.append(StepVerdict(
-            name=ref.name, key="R", link="", status=status, label=eq.lhs, source=eq.source, line=eq.line,
-            expected=expected, got=value, difference=None if status != "wrong" else value - expected,
-            convention=conv, message=message or ("" if status == "correct" else conv or ""),
-            frame=f"{ref.index}->{ref.frame}"))
+                message = "; ".join(
+                    f"{component_name(i, (3, 3))}: " + self._describe(value[i], expected[i]) for i in bad[:3]
+                )
+        self.verdicts.append(
+            StepVerdict(
+                name=ref.name,
+                key="R",
+                link="",
+                status=status,
+                label=eq.lhs,
+                source=eq.source,
+                line=eq.line,
+                expected=expected,
+                got=value,
+                difference=None if status != "wrong" else value - expected,
+                convention=conv,
+                message=message or ("" if status == "correct" else conv or ""),
+                frame=f"{ref.index}->{ref.frame}",
+            )
+        )
 
     def _position(self, ref: StepRef, eq, value):
         """A kinematics step: P_i^j, frame i's origin seen from frame i-1's, or P_{C_i}^j,
@@ -325,39 +418,80 @@ class _Grader:
         fp = self.sampler.fingerprint
         ok = equal(fp(value), fp(expected)).ravel()
         bad = [int(i) for i in range(3) if not ok[i]]
-        message = "; ".join(f"{self._describe(value[i], expected[i])} in "
-                            f"{component_name(i, (3, 1))}" for i in bad)
+        message = "; ".join(f"{self._describe(value[i], expected[i])} in {component_name(i, (3, 1))}" for i in bad)
         if bad:
             message += f" ({what}, in frame {frame})"
-        self.verdicts.append(StepVerdict(
-            name=ref.name, key=ref.key, link=list(self.robot.links)[ref.index], status="wrong" if bad else "correct",
-            label=eq.lhs, source=eq.source, line=eq.line, expected=expected, got=value,
-            difference=sp.Matrix([tidy(value[i] - expected[i], self.robot) for i in range(3)]) if bad else None,
-            components=bad, message=message, frame=str(frame)))
+        self.verdicts.append(
+            StepVerdict(
+                name=ref.name,
+                key=ref.key,
+                link=list(self.robot.links)[ref.index],
+                status="wrong" if bad else "correct",
+                label=eq.lhs,
+                source=eq.source,
+                line=eq.line,
+                expected=expected,
+                got=value,
+                difference=sp.Matrix([tidy(value[i] - expected[i], self.robot) for i in range(3)]) if bad else None,
+                components=bad,
+                message=message,
+                frame=str(frame),
+            )
+        )
 
     def _free_end(self, ref: StepRef, eq):
         """``f_{n+1} = 0``, ``n_{n+1} = 0``: the load at the free end, zero."""
         value, problem = self.value(eq, StepRef(ref.key, ref.index, ref.frame))
         name = f"{ref.key}_{ref.index}"
         if value is None:
-            self.verdicts.append(StepVerdict(
-                name=name, key="free_end", link="", status="unrecognised", label=eq.lhs, source=eq.source,
-                line=eq.line, message=problem))
+            self.verdicts.append(
+                StepVerdict(
+                    name=name,
+                    key="free_end",
+                    link="",
+                    status="unrecognised",
+                    label=eq.lhs,
+                    source=eq.source,
+                    line=eq.line,
+                    message=problem,
+                )
+            )
             return
         zero = sp.zeros(3, 1)
         ok = equal(self.sampler.fingerprint(value), self.sampler.fingerprint(zero)).ravel()
         bad = [int(i) for i in range(3) if not ok[i]]
-        self.verdicts.append(StepVerdict(
-            name=name, key="free_end", link="", status="wrong" if bad else "correct", label=eq.lhs,
-            source=eq.source, line=eq.line, expected=zero, got=value, difference=value if bad else None,
-            components=bad, message=FREE_END if bad else "the free end: no load beyond the last link"))
+        self.verdicts.append(
+            StepVerdict(
+                name=name,
+                key="free_end",
+                link="",
+                status="wrong" if bad else "correct",
+                label=eq.lhs,
+                source=eq.source,
+                line=eq.line,
+                expected=zero,
+                got=value,
+                difference=value if bad else None,
+                components=bad,
+                message=FREE_END if bad else "the free end: no load beyond the last link",
+            )
+        )
 
     def _step(self, world: World, ref: StepRef, eq, value, method: str):
         key = (ref.key, ref.index)
         if key not in world.method.refs:
-            self.verdicts.append(StepVerdict(
-                name=ref.name, key=ref.key, link="", status="unrecognised", label=eq.lhs, source=eq.source,
-                line=eq.line, message=f"{method} has no step {ref.name} for this robot"))
+            self.verdicts.append(
+                StepVerdict(
+                    name=ref.name,
+                    key=ref.key,
+                    link="",
+                    status="unrecognised",
+                    label=eq.lhs,
+                    source=eq.source,
+                    line=eq.line,
+                    message=f"{method} has no step {ref.name} for this robot",
+                )
+            )
             return
         link = ""
         own = value
@@ -388,15 +522,17 @@ class _Grader:
 
         # what is shown: expected in the student's convention, the difference against
         # what their own earlier values give (wrong) or the expected value
-        exp_shown = j.conv.forward(world.expected[key].sym(), world.ctx,
-                                   *(world.expected[r].sym() for r in j.conv.extra))
+        exp_shown = j.conv.forward(
+            world.expected[key].sym(), world.ctx, *(world.expected[r].sym() for r in j.conv.extra)
+        )
         if ref.key in VECTOR_KEYS and ref.frame is not None and ref.index is not None and ref.frame != ref.index:
             exp_shown = rotation_between(world.ctx, ref.index, ref.frame) * exp_shown
         difference, components, message = None, [], ""
         if j.status in ("wrong", "follows-from-earlier-error", "correct-but-unsupported"):
             value = to_sympy(value)
-            ref_value = j.reference.sym() if j.status != "correct-but-unsupported" and j.reference is not None \
-                else exp_shown
+            ref_value = (
+                j.reference.sym() if j.status != "correct-but-unsupported" and j.reference is not None else exp_shown
+            )
             if j.status == "correct-but-unsupported":
                 carried = world.carried(key)
                 ref_value = carried[0].sym() if carried else exp_shown
@@ -420,8 +556,11 @@ class _Grader:
             elif j.status == "follows-from-earlier-error":
                 message = f"follows from the error in {caused_by}" + (f" ({j.convention})" if j.convention else "")
                 diff = _matrix(value) - _matrix(exp_shown)
-                difference = sp.Matrix([tidy(x, self.robot) for x in diff]) if diff.shape != (1, 1) \
+                difference = (
+                    sp.Matrix([tidy(x, self.robot) for x in diff])
+                    if diff.shape != (1, 1)
                     else tidy(diff[0], self.robot)
+                )
             else:
                 # the consistent carry-through: the candidate inheriting the fewest slips
                 carried = sorted(world.carried(key), key=lambda v: len(v.origins))
@@ -434,17 +573,33 @@ class _Grader:
                         src = sorted(carried[0].origins, key=self._order)
                         where = component_name(bad[0], d.shape)
                         left = pretty(tidy(d[bad[0]], self.robot), shorthand=self.symbols.shorthand)
-                        message += (f": carried through they leave {left}"
-                                    + (f" in {where}" if where else "")
-                                    + (f" (from the error in {src[0]})" if src else "")
-                                    + " (copied, or two slips that cancel?)")
+                        message += (
+                            f": carried through they leave {left}"
+                            + (f" in {where}" if where else "")
+                            + (f" (from the error in {src[0]})" if src else "")
+                            + " (copied, or two slips that cancel?)"
+                        )
         elif j.status == "correct-by-convention":
             message = j.convention or ""
-        self.verdicts.append(StepVerdict(
-            name=name, key=ref.key, link=link, status=j.status, label=eq.lhs, source=eq.source, line=eq.line,
-            expected=exp_shown, got=value, difference=difference, components=components,
-            convention=j.convention, caused_by=caused_by, message=message,
-            frame="" if ref.key not in VECTOR_KEYS else str(ref.frame if ref.frame is not None else ref.index)))
+        self.verdicts.append(
+            StepVerdict(
+                name=name,
+                key=ref.key,
+                link=link,
+                status=j.status,
+                label=eq.lhs,
+                source=eq.source,
+                line=eq.line,
+                expected=exp_shown,
+                got=value,
+                difference=difference,
+                components=components,
+                convention=j.convention,
+                caused_by=caused_by,
+                message=message,
+                frame="" if ref.key not in VECTOR_KEYS else str(ref.frame if ref.frame is not None else ref.index),
+            )
+        )
 
     def _describe(self, got, ref) -> str:
         """What differs, in the student's shorthand."""
@@ -477,8 +632,9 @@ def _symbol_latex(robot: Robot) -> dict:
     return out
 
 
-def grade(submission: str | os.PathLike[str] | Submission, robot: str | Robot | None = None,
-          symbols: dict | None = None) -> GradeReport:
+def grade(
+    submission: str | os.PathLike[str] | Submission, robot: str | Robot | None = None, symbols: dict | None = None
+) -> GradeReport:
     """Grade a derivation.
 
     submission: path of a Markdown (.md) or YAML (.yaml) file, or a :class:`Submission`.

@@ -7,15 +7,21 @@ from __future__ import annotations
 import re
 
 _HINTS = [
-    (re.compile(r"unexpected ','|found ','"),
-     "a vector written as a row needs parentheses and a transpose, (a,\\ b,\\ c)^T, or a pmatrix column"),
-    (re.compile(r"expected '\}'|unbalanced '\{'"),
-     "a '{' group (a \\frac{..}{..}, a subscript, a \\dot{..}) is not closed where it should be"),
+    (
+        re.compile(r"unexpected ','|found ','"),
+        "a vector written as a row needs parentheses and a transpose, (a,\\ b,\\ c)^T, or a pmatrix column",
+    ),
+    (
+        re.compile(r"expected '\}'|unbalanced '\{'"),
+        "a '{' group (a \\frac{..}{..}, a subscript, a \\dot{..}) is not closed where it should be",
+    ),
     (re.compile(r"expected '\)'|expected '\]'"), "a '(' or '[' is not closed (or closed by the other kind)"),
     (re.compile(r"unsupported bracket"), "use \\left( ... \\right) or \\left[ ... \\right], or plain ( )"),
     (re.compile(r"unsupported command \\(big|Big)"), "sizing commands go before a bracket: \\big( ... \\big)"),
-    (re.compile(r"unsupported command"),
-     "values are read with + - \\cdot \\frac \\sqrt ^ _, \\sin \\cos \\tan, and pmatrix/bmatrix vectors"),
+    (
+        re.compile(r"unsupported command"),
+        "values are read with + - \\cdot \\frac \\sqrt ^ _, \\sin \\cos \\tan, and pmatrix/bmatrix vectors",
+    ),
     (re.compile(r"nesting deeper"), "write the expression with fewer nested groups"),
     (re.compile(r"exponent|digits|power"), "a derivation's values have small exponents and numbers"),
 ]

@@ -220,9 +220,9 @@ class World:
         """fn(ctx, *inputs) on candidate values: numbers at the points, symbols lazily."""
         origins = frozenset().union(*(v.origins for v in values)) if values else frozenset()
         if self.numeric:
-            fp = np.stack([
-                _from_num(fn(c, *(_as_input(v.fp[k]) for v in values))) for k, c in enumerate(self.ctx_points)
-            ])
+            fp = np.stack(
+                [_from_num(fn(c, *(_as_input(v.fp[k]) for v in values))) for k, c in enumerate(self.ctx_points)]
+            )
             return Value(fp, lambda: to_sympy(fn(self.ctx, *(v.sym() for v in values))), origins)
         sym = fn(self.ctx, *(v.sym() for v in values))
         return Value(self.sampler.fingerprint(sym), sym, origins)
@@ -301,8 +301,11 @@ def judge(world: World, ref, got: Value, extra_candidates) -> Judgement:
         for extras in itertools.product(*([world.expected[r]] for r in conv.extra)):
             if equal(got.fp, shown(conv, exp, list(extras)).fp).all():
                 supported = _supported(world, ref, got, conv, extras_of)
-                status = ("correct" if not conv.name else "correct-by-convention") if supported \
+                status = (
+                    ("correct" if not conv.name else "correct-by-convention")
+                    if supported
                     else "correct-but-unsupported"
+                )
                 return Judgement(status, conv.name or None, frozenset(), None, conv)
     # 2. carried forward from the student's own earlier values?
     carried = world.carried(ref) if ref in method.formulas else []

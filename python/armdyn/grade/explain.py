@@ -24,8 +24,20 @@ from ..symbolic.report import _UnicodeTextPrinter, unicode_name
 
 COMPONENTS = "xyz"
 _GREEK = {
-    "alpha": "α", "beta": "β", "gamma": "γ", "delta": "δ", "theta": "θ", "phi": "φ", "psi": "ψ",
-    "omega": "ω", "tau": "τ", "rho": "ρ", "sigma": "σ", "lambda": "λ", "mu": "μ", "eta": "η",
+    "alpha": "α",
+    "beta": "β",
+    "gamma": "γ",
+    "delta": "δ",
+    "theta": "θ",
+    "phi": "φ",
+    "psi": "ψ",
+    "omega": "ω",
+    "tau": "τ",
+    "rho": "ρ",
+    "sigma": "σ",
+    "lambda": "λ",
+    "mu": "μ",
+    "eta": "η",
 }
 #: expressions larger than this (in nodes) are not tidied for messages
 TIDY_LIMIT = 400
@@ -64,6 +76,7 @@ _SUPERSCRIPT = {c: str(k) for k, c in enumerate("⁰¹²³⁴⁵⁶⁷⁸⁹")}
 
 def to_ascii(text: str) -> str:
     """A message printed with :func:`pretty` back in plain ASCII (``θ̇₁`` -> ``theta1_dot``)."""
+
     def name(m):
         base, accent, digits = m.groups()
         dots = {"\u0307": "_dot", "\u0308": "_ddot"}.get(accent or "", "")
@@ -150,7 +163,6 @@ def contract(value, shorthand: dict | None):
     return one(value)
 
 
-
 def _terms(expr) -> list:
     return list(sp.Add.make_args(sp.expand(expr)))
 
@@ -174,8 +186,10 @@ def describe(got, ref, robot: Robot, sampler, ascii_only: bool = False, shorthan
                 if not ref.has(right):
                     continue
                 if np.allclose(fp(ref.xreplace({right: wrote})), g, rtol=1e-8, atol=1e-10):
-                    return (f"{display_name(wrote.name, ascii_only)} written where "
-                            f"{display_name(right.name, ascii_only)} belongs")
+                    return (
+                        f"{display_name(wrote.name, ascii_only)} written where "
+                        f"{display_name(right.name, ascii_only)} belongs"
+                    )
     d = tidy(got - ref, robot)
     if sp.count_ops(got - ref) > TIDY_LIMIT:
         return f"differs by {_short(d, ascii_only, shorthand)} ({NOT_SIMPLIFIED})"
@@ -187,14 +201,16 @@ def describe(got, ref, robot: Robot, sampler, ascii_only: bool = False, shorthan
             X = sp.factor(sp.cancel(d / (1 - s)))
             ref_terms = len(_terms(ref))
             if len(_terms(sp.expand(ref - s * X))) < ref_terms:
-                return (f"a factor {display_name(s.name, ascii_only)} missing on "
-                        f"{_short(X, ascii_only, shorthand)}")
+                return f"a factor {display_name(s.name, ascii_only)} missing on {_short(X, ascii_only, shorthand)}"
             return f"an extra factor {display_name(s.name, ascii_only)} on {_short(-X, ascii_only, shorthand)}"
     # compare term by term in one form: angle sums expanded when the difference was
     full = reduce(got - ref, robot)
     same_form = full is not None and d == full
-    form = (lambda e: reduce(e, robot) if reduce(e, robot) is not None else tidy(e, robot)) if same_form \
+    form = (
+        (lambda e: reduce(e, robot) if reduce(e, robot) is not None else tidy(e, robot))
+        if same_form
         else (lambda e: tidy(e, robot))
+    )
     ref_terms = set(_terms(form(ref)))
     got_terms = set(_terms(form(got)))
     d_terms = _terms(d)

@@ -61,8 +61,10 @@ def _coordinates(values) -> tuple[list, list, list]:
         if v is not None:
             for s in sp.sympify(v).free_symbols:
                 syms[s.name] = s
-    joints = sorted({n[: -len("_ddot")] for n in syms if n.endswith("_ddot")}
-                    | {n[: -len("_dot")] for n in syms if n.endswith("_dot") and not n.endswith("_ddot")})
+    joints = sorted(
+        {n[: -len("_ddot")] for n in syms if n.endswith("_ddot")}
+        | {n[: -len("_dot")] for n in syms if n.endswith("_dot") and not n.endswith("_ddot")}
+    )
 
     def sym(name):
         return syms.get(name, sp.Symbol(name))
@@ -167,8 +169,11 @@ def _against_expected(step: StepVerdict) -> bool:
     if step.got is None or step.expected is None or step.difference is None:
         return True
     try:
-        gap = sp.Matrix(step.got) - sp.Matrix(step.expected) - sp.Matrix(step.difference) \
-            if isinstance(step.got, sp.MatrixBase) else sp.Matrix([step.got - step.expected - step.difference])
+        gap = (
+            sp.Matrix(step.got) - sp.Matrix(step.expected) - sp.Matrix(step.difference)
+            if isinstance(step.got, sp.MatrixBase)
+            else sp.Matrix([step.got - step.expected - step.difference])
+        )
         if any(dag.larger_than(e, _TIDY_NODE_LIMIT) for e in gap):
             return "own earlier steps" not in step.message
         q = sorted({x for e in gap for x in e.free_symbols}, key=lambda x: x.name)
@@ -184,8 +189,10 @@ def _step_card(i: int, step: StepVerdict, w: _Writer, anchors: dict, first: int 
         where.append(f"in frame {escape(step.frame)}")
     if step.part or step.task:  # the assignment's part (or the unnumbered task's title)
         where.append(f"part {escape(step.part)}" if step.part else escape(step.task[:40]))
-    head = (f'<div class="head"><span class="label">{math_element(_label(step))}</span>'
-            f'{_badge(step.status)}<span class="where">{" · ".join(where)}</span></div>')
+    head = (
+        f'<div class="head"><span class="label">{math_element(_label(step))}</span>'
+        f'{_badge(step.status)}<span class="where">{" · ".join(where)}</span></div>'
+    )
     parts = [head]
 
     message = text_with_math(step.message)
@@ -215,12 +222,14 @@ def _step_card(i: int, step: StepVerdict, w: _Writer, anchors: dict, first: int 
         caption = "yours = expected" if step.status == "correct" else "yours"
         sides.append(_side("left side, on the counterexample" if proof else caption, label, w.value(step.got, hl)))
     if step.expected is not None and (step.status != "correct" or step.got is None):
-        sides.append(_side("right side, on the counterexample" if proof else "expected", label,
-                           w.value(step.expected, hl)))
+        sides.append(
+            _side("right side, on the counterexample" if proof else "expected", label, w.value(step.expected, hl))
+        )
     if step.difference is not None and step.status in ("wrong", "follows-from-earlier-error"):
         than = "expected" if _against_expected(step) else "what your own earlier steps give"
-        sides.append(_side(f"difference: yours \u2212 {than}", "<mi>\u0394</mi>",
-                           w.difference(step.difference, hl), "diff"))
+        sides.append(
+            _side(f"difference: yours \u2212 {than}", "<mi>\u0394</mi>", w.difference(step.difference, hl), "diff")
+        )
     if sides:
         parts.append('<div class="compare">' + "".join(sides) + "</div>")
     if step.source:
@@ -237,15 +246,19 @@ def _unrecognised_card(run: list[tuple[int, StepVerdict]]) -> str:
         span = f"line {lines[0]}" if len(lines) == 1 or lines[0] == lines[-1] else f"lines {lines[0]}\u2013{lines[-1]}"
     n = len(run)
     title = "1 equation not recognised as a step" if n == 1 else f"{n} equations not recognised as steps"
-    head = (f'<div class="head">{_badge("unrecognised")}<span class="title">{title}: skipped</span>'
-            f'<span class="where">{span}</span></div>')
+    head = (
+        f'<div class="head">{_badge("unrecognised")}<span class="title">{title}: skipped</span>'
+        f'<span class="where">{span}</span></div>'
+    )
     reasons = {s.message for _, s in run if s.message}
     common = reasons.pop() if len(reasons) == 1 and all(s.message for _, s in run) else None
     rows = []
     for i, s in run:
         why = "" if common or not s.message else f'<div class="why">{text_with_math(s.message)}</div>'
-        rows.append(f'<div class="skip" id="step-{i}"><span class="ln">{s.line or ""}</span>'
-                    f'<div>{_as_written(s.source or s.label)}{why}</div></div>')
+        rows.append(
+            f'<div class="skip" id="step-{i}"><span class="ln">{s.line or ""}</span>'
+            f"<div>{_as_written(s.source or s.label)}{why}</div></div>"
+        )
     note = f'<p class="message"><span class="why">{text_with_math(common)}</span></p>' if common else ""
     return f'<li class="step st-unrecognised">{head}{note}{"".join(rows)}</li>'
 
@@ -257,8 +270,10 @@ def _as_written(source: str) -> str:
     inner = latex_to_mathml(source.strip().strip("$").strip()) if _looks_like_latex(source) else None
     if inner is None:
         return f"<pre>{escape(source)}</pre>"
-    return (f'<div class="written">{math_element(inner, display=True)}</div>'
-            f"<details><summary>as written</summary><pre>{escape(source)}</pre></details>")
+    return (
+        f'<div class="written">{math_element(inner, display=True)}</div>'
+        f"<details><summary>as written</summary><pre>{escape(source)}</pre></details>"
+    )
 
 
 def _looks_like_latex(source: str) -> bool:
@@ -282,20 +297,28 @@ def _summary(report: GradeReport, anchors: dict, labels: dict) -> str:
         shown = math_element(labels[k]) if k is not None else escape(report.first_wrong)
         line = f" (line {step.line})" if step is not None and step.line else ""
         link = f'<a href="#step-{k}">{shown}</a>' if k is not None else shown
-        verdict = (f'<div class="verdict fail">First wrong step: {link}{line}'
-                   f'<span class="sub">{escape(step.message) if step is not None and step.message else ""}</span></div>')
+        verdict = (
+            f'<div class="verdict fail">First wrong step: {link}{line}'
+            f'<span class="sub">{escape(step.message) if step is not None and step.message else ""}</span></div>'
+        )
     elif not graded:
-        verdict = '<div class="verdict fail">No step was recognised<span class="sub">see the equations below</span></div>'
+        verdict = (
+            '<div class="verdict fail">No step was recognised<span class="sub">see the equations below</span></div>'
+        )
     elif report.passed:
         verdict = '<div class="verdict pass">Every step is right<span class="sub">(correct, or correct by a named convention)</span></div>'
     elif any(s.status == "correct-but-unsupported" for s in graded):
         n = sum(s.status == "correct-but-unsupported" for s in graded)
-        verdict = ('<div class="verdict fail">No step is wrong, but not every one follows from the ones before'
-                   f'<span class="sub">{n} correct but unsupported</span></div>')
+        verdict = (
+            '<div class="verdict fail">No step is wrong, but not every one follows from the ones before'
+            f'<span class="sub">{n} correct but unsupported</span></div>'
+        )
     else:  # every step read is right, but some equations were not read: not checked, not a pass
         n = len(report.steps) - len(graded)
-        verdict = ('<div class="verdict fail">Every step read is right, but not every equation was read'
-                   f'<span class="sub">{n} not recognised or not readable: see below</span></div>')
+        verdict = (
+            '<div class="verdict fail">Every step read is right, but not every equation was read'
+            f'<span class="sub">{n} not recognised or not readable: see below</span></div>'
+        )
 
     taus = []
     for i, ok in enumerate(report.tau_correct):
@@ -306,18 +329,20 @@ def _summary(report: GradeReport, anchors: dict, labels: dict) -> str:
                 word, cls = "right, but not from your steps", "right unsupported"
         else:
             word, cls = ("not given" if step is None else "not right"), "notright"
-        taus.append(f'<span class="tau {cls}">{math_element(_tau_label(i))}<span class="word">{escape(word)}</span></span>')
+        taus.append(
+            f'<span class="tau {cls}">{math_element(_tau_label(i))}<span class="word">{escape(word)}</span></span>'
+        )
 
     counts = {s: 0 for s in STATUSES}
     for s in report.steps:
         counts[s.status] = counts.get(s.status, 0) + 1
     chips = "".join(_badge(s, n) for s, n in counts.items() if n)
     notes = "".join(f"<li>{escape(n)}</li>" for n in report.notes)
-    return ('<section class="summary">'
-            f'{verdict}<div class="taus">{"".join(taus)}</div>'
-            f'<div class="counts">{chips}</div>'
-            + (f'<ul class="notes">{notes}</ul>' if notes else "")
-            + "</section>")
+    return (
+        '<section class="summary">'
+        f'{verdict}<div class="taus">{"".join(taus)}</div>'
+        f'<div class="counts">{chips}</div>' + (f'<ul class="notes">{notes}</ul>' if notes else "") + "</section>"
+    )
 
 
 def _body(report: GradeReport) -> str:
@@ -329,9 +354,11 @@ def _body(report: GradeReport) -> str:
     first = anchors.get(report.first_wrong) if report.first_wrong is not None else None
     names = {"newton-euler": "Newton\u2013Euler", "lagrange": "Lagrange"}
     method = " and ".join(names.get(m, m) for m in report.method.split("+"))
-    head = ('<h1>Grade report</h1>'
-            f'<p class="meta"><b>{escape(report.submission)}</b> · robot <b>{escape(report.robot)}</b> · '
-            f'method <b>{escape(method)}</b> · {len(report.steps)} equations</p>')
+    head = (
+        "<h1>Grade report</h1>"
+        f'<p class="meta"><b>{escape(report.submission)}</b> · robot <b>{escape(report.robot)}</b> · '
+        f"method <b>{escape(method)}</b> · {len(report.steps)} equations</p>"
+    )
     cards, run = [], []
     for i, s in enumerate(report.steps):
         if s.status == "unrecognised":
@@ -344,10 +371,13 @@ def _body(report: GradeReport) -> str:
     if run:
         cards.append(_unrecognised_card(run))
     cards = "".join(cards)
-    return (head + _summary(report, anchors, labels)
-            + "<h2>Steps, in your order</h2>"
-            + '<p class="legend">Highlighted rows are the wrong components; \u0394 is yours minus the value named above it.</p>'
-            + f'<ol class="steps">{cards}</ol>')
+    return (
+        head
+        + _summary(report, anchors, labels)
+        + "<h2>Steps, in your order</h2>"
+        + '<p class="legend">Highlighted rows are the wrong components; \u0394 is yours minus the value named above it.</p>'
+        + f'<ol class="steps">{cards}</ol>'
+    )
 
 
 def report_html(report: GradeReport) -> str:

@@ -38,27 +38,128 @@ MAX_LENGTH = 200_000
 MAX_DIGITS = 400
 
 GREEK = {
-    "alpha", "beta", "gamma", "delta", "epsilon", "varepsilon", "zeta", "eta", "theta",
-    "vartheta", "iota", "kappa", "lambda", "mu", "nu", "xi", "pi", "rho", "sigma", "tau",
-    "upsilon", "phi", "varphi", "chi", "psi", "omega", "Gamma", "Delta", "Theta", "Lambda",
-    "Xi", "Pi", "Sigma", "Phi", "Psi", "Omega",
+    "alpha",
+    "beta",
+    "gamma",
+    "delta",
+    "epsilon",
+    "varepsilon",
+    "zeta",
+    "eta",
+    "theta",
+    "vartheta",
+    "iota",
+    "kappa",
+    "lambda",
+    "mu",
+    "nu",
+    "xi",
+    "pi",
+    "rho",
+    "sigma",
+    "tau",
+    "upsilon",
+    "phi",
+    "varphi",
+    "chi",
+    "psi",
+    "omega",
+    "Gamma",
+    "Delta",
+    "Theta",
+    "Lambda",
+    "Xi",
+    "Pi",
+    "Sigma",
+    "Phi",
+    "Psi",
+    "Omega",
 }
 UNICODE_GREEK = {
-    "α": "alpha", "β": "beta", "γ": "gamma", "δ": "delta", "ε": "epsilon", "ζ": "zeta",
-    "η": "eta", "θ": "theta", "ι": "iota", "κ": "kappa", "λ": "lambda", "μ": "mu", "ν": "nu",
-    "ξ": "xi", "π": "pi", "ρ": "rho", "σ": "sigma", "τ": "tau", "φ": "phi", "χ": "chi",
-    "ψ": "psi", "ω": "omega",
+    "α": "alpha",
+    "β": "beta",
+    "γ": "gamma",
+    "δ": "delta",
+    "ε": "epsilon",
+    "ζ": "zeta",
+    "η": "eta",
+    "θ": "theta",
+    "ι": "iota",
+    "κ": "kappa",
+    "λ": "lambda",
+    "μ": "mu",
+    "ν": "nu",
+    "ξ": "xi",
+    "π": "pi",
+    "ρ": "rho",
+    "σ": "sigma",
+    "τ": "tau",
+    "φ": "phi",
+    "χ": "chi",
+    "ψ": "psi",
+    "ω": "omega",
 }
-FUNCTIONS = {"sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "exp": sp.exp, "ln": sp.log, "log": sp.log,
-             "sec": sp.sec, "csc": sp.csc, "cot": sp.cot}
+FUNCTIONS = {
+    "sin": sp.sin,
+    "cos": sp.cos,
+    "tan": sp.tan,
+    "exp": sp.exp,
+    "ln": sp.log,
+    "log": sp.log,
+    "sec": sp.sec,
+    "csc": sp.csc,
+    "cot": sp.cot,
+}
 #: wrappers that change a symbol's typeface, not its meaning
-WRAPPERS = {"mathbf", "boldsymbol", "bm", "mathrm", "mathit", "vec", "hat", "bar", "mathbold",
-            "pmb", "mathsf", "operatorname", "text", "mathcal", "tilde"}
-SPACES = {",", ";", ":", "!", " ", "quad", "qquad", "displaystyle", "textstyle", "left.", "right.",
-          "limits", "nolimits"}
+WRAPPERS = {
+    "mathbf",
+    "boldsymbol",
+    "bm",
+    "mathrm",
+    "mathit",
+    "vec",
+    "hat",
+    "bar",
+    "mathbold",
+    "pmb",
+    "mathsf",
+    "operatorname",
+    "text",
+    "mathcal",
+    "tilde",
+}
+SPACES = {
+    ",",
+    ";",
+    ":",
+    "!",
+    " ",
+    "quad",
+    "qquad",
+    "displaystyle",
+    "textstyle",
+    "left.",
+    "right.",
+    "limits",
+    "nolimits",
+}
 #: sizing commands before a delimiter (\big( ... \big)): they change its size, not the math
-SIZES = {"big", "Big", "bigg", "Bigg", "bigl", "bigr", "Bigl", "Bigr", "biggl", "biggr", "Biggl", "Biggr",
-         "bigm", "Bigm"}
+SIZES = {
+    "big",
+    "Big",
+    "bigg",
+    "Bigg",
+    "bigl",
+    "bigr",
+    "Bigl",
+    "Bigr",
+    "biggl",
+    "biggr",
+    "Biggl",
+    "Biggr",
+    "bigm",
+    "Bigm",
+}
 MATRIX_ENVS = {"pmatrix", "bmatrix", "Bmatrix", "matrix", "vmatrix", "smallmatrix", "array"}
 
 
@@ -233,9 +334,13 @@ class _Parser:
 
     def _transpose_mark(self) -> bool:
         """After ``^`` on a matrix: ``T``, ``\\top``, ``{T}``, ``{\\mathrm{T}}`` (consumed)."""
-        marks = ([("char", "T")], [("cmd", "top")], [("char", "{"), ("char", "T"), ("char", "}")],
-                 [("char", "{"), ("cmd", "top"), ("char", "}")],
-                 [("char", "{"), ("cmd", "mathrm"), ("char", "{"), ("char", "T"), ("char", "}"), ("char", "}")])
+        marks = (
+            [("char", "T")],
+            [("cmd", "top")],
+            [("char", "{"), ("char", "T"), ("char", "}")],
+            [("char", "{"), ("cmd", "top"), ("char", "}")],
+            [("char", "{"), ("cmd", "mathrm"), ("char", "{"), ("char", "T"), ("char", "}"), ("char", "}")],
+        )
         for mark in marks:
             if all(self.peek(k) == tok for k, tok in enumerate(mark)):
                 self.i += len(mark)
@@ -459,14 +564,18 @@ def _power(base, exponent, at):
             raise LatexError(f"an exponent of {_short_number(exponent)} (at most {MAX_EXPONENT})", at)
         inner = base.exp if base.is_Pow and base.exp.is_Number else 1
         if abs(inner * exponent) > MAX_EXPONENT:
-            raise LatexError(f"a power of a power with exponent {_short_number(inner * exponent)} "
-                             f"(at most {MAX_EXPONENT})", at)
+            raise LatexError(
+                f"a power of a power with exponent {_short_number(inner * exponent)} (at most {MAX_EXPONENT})", at
+            )
         if base.is_Number and base != 0:
-            digits = float(abs(exponent)) * abs(math.log10(abs(float(base))) if abs(base) < 1e300 else 300) \
-                if abs(base) != 1 else 0.0
+            digits = (
+                float(abs(exponent)) * abs(math.log10(abs(float(base))) if abs(base) < 1e300 else 300)
+                if abs(base) != 1
+                else 0.0
+            )
             if not base.is_Float and (base.is_Integer or base.is_Rational) and digits > MAX_DIGITS:
                 raise LatexError(f"a number of about {int(digits)} digits (at most {MAX_DIGITS})", at)
-    return base ** exponent
+    return base**exponent
 
 
 def _short_number(x) -> str:
@@ -519,8 +628,11 @@ def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str
     ``&`` and environment wrappers (split, aligned, align, gather) are blanked out (so
     offsets still point into ``block``). Linear in the block's length; ``limit``: stop
     after that many equations (the caller refuses more)."""
-    text = re.sub(r"\\(begin|end)\{(split|aligned|align\*?|gather\*?|equation\*?|alignedat)\}(\{\d+\})?",
-                  lambda m: " " * len(m.group(0)), block)
+    text = re.sub(
+        r"\\(begin|end)\{(split|aligned|align\*?|gather\*?|equation\*?|alignedat)\}(\{\d+\})?",
+        lambda m: " " * len(m.group(0)),
+        block,
+    )
     marks = [(i, c) for i, c in _top_level(text) if c in ("&", ",", "=", "\\\\")]  # one pass, depth 0
     if any(c == "&" for _, c in marks):
         chars = list(text)
@@ -636,8 +748,9 @@ def _check_numbers(text: str) -> None:
                 pass  # a sign does not change a magnitude
             elif tok in prec:
                 right = tok in ("**", "^")
-                while ops and ops[-1] in prec and (prec[ops[-1]] > prec[tok] or
-                                                   prec[ops[-1]] == prec[tok] and not right):
+                while (
+                    ops and ops[-1] in prec and (prec[ops[-1]] > prec[tok] or prec[ops[-1]] == prec[tok] and not right)
+                ):
                     reduce_one()
                 ops.append(tok)
             elif tok == "(":

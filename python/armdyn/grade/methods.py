@@ -17,18 +17,18 @@ Newton-Euler formulas are those of :mod:`armdyn.symbolic.newton_euler`.
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass, field
 from typing import Callable
 
 import sympy as sp
 
 from ..model import Robot
-import importlib
 
 # the module, not the function of the same name that armdyn.symbolic exports
 ne = importlib.import_module("armdyn.symbolic.newton_euler")
-from ..symbolic.lagrange import _energies
-from ..symbolic.terms import time_derivative
+from ..symbolic.lagrange import _energies  # noqa: E402 - after the module ne above
+from ..symbolic.terms import time_derivative  # noqa: E402
 
 Ref = tuple  # (key, index)
 
@@ -83,6 +83,7 @@ class Method:
 
 # ------------------------------------------------------------------ Newton-Euler
 
+
 def _link_context(robot: Robot):
     """Symbolic model quantities per link index (1..n), base = 0."""
     ctx = {"gravity": robot.gravity, "R0": {0: sp.eye(3)}, "zero": sp.zeros(3, 1)}
@@ -91,15 +92,29 @@ def _link_context(robot: Robot):
         p = robot.link_index(joint.parent)
         follow = robot.follows(joint)  # (k, multiplier, offset); None for a fixed joint
         q = robot.joint_coordinate(joint)
-        qd, qdd = (follow[1] * robot.qd[follow[0]], follow[1] * robot.qdd[follow[0]]) if follow is not None \
+        qd, qdd = (
+            (follow[1] * robot.qd[follow[0]], follow[1] * robot.qdd[follow[0]])
+            if follow is not None
             else (sp.Integer(0), sp.Integer(0))
+        )
         R, P = joint.transform(q)
         V, Vd = joint.origin_motion(qd, qdd)
         link = robot.links[joint.child]
         ctx[i] = {
-            "parent": p, "kind": joint.type, "R": R, "P": P, "V": V, "Vd": Vd, "z": joint.child_axis,
-            "qd": qd, "qdd": qdd, "m": link.mass, "c": link.com, "I": link.inertia,
-            "o": joint.joint_point(q), "children": [robot.link_index(c.child) for c in robot.children(joint.child)],
+            "parent": p,
+            "kind": joint.type,
+            "R": R,
+            "P": P,
+            "V": V,
+            "Vd": Vd,
+            "z": joint.child_axis,
+            "qd": qd,
+            "qdd": qdd,
+            "m": link.mass,
+            "c": link.com,
+            "I": link.inertia,
+            "o": joint.joint_point(q),
+            "children": [robot.link_index(c.child) for c in robot.children(joint.child)],
         }
         ctx["R0"][i] = ctx["R0"][p] * R
     return ctx
@@ -141,37 +156,59 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
 
     for i in range(1, n + 1):
         p = ctx[i]["parent"]
-        m.formulas[("omega", i)] = [Formula((("omega", p),), lambda c, w, i=i: ne.omega(
-            c[i]["R"], w, c[i]["z"], c[i]["qd"], c[i]["kind"]))]
-        m.formulas[("omega_dot", i)] = [Formula((("omega", p), ("omega_dot", p)), lambda c, w, wd, i=i: ne.omega_dot(
-            c[i]["R"], w, wd, c[i]["z"], c[i]["qd"], c[i]["qdd"], c[i]["kind"]))]
-        m.formulas[("v_dot", i)] = [Formula((("omega", p), ("omega_dot", p), ("v_dot", p)),
-                                            lambda c, w, wd, vd, i=i: ne.v_dot(
-            c[i]["R"], w, wd, vd, c[i]["P"], c[i]["V"], c[i]["Vd"]))]
-        m.formulas[("vc_dot", i)] = [Formula((("omega", i), ("omega_dot", i), ("v_dot", i)),
-                                             lambda c, w, wd, vd, i=i: ne.vc_dot(w, wd, vd, c[i]["c"]))]
+        m.formulas[("omega", i)] = [
+            Formula((("omega", p),), lambda c, w, i=i: ne.omega(c[i]["R"], w, c[i]["z"], c[i]["qd"], c[i]["kind"]))
+        ]
+        m.formulas[("omega_dot", i)] = [
+            Formula(
+                (("omega", p), ("omega_dot", p)),
+                lambda c, w, wd, i=i: ne.omega_dot(c[i]["R"], w, wd, c[i]["z"], c[i]["qd"], c[i]["qdd"], c[i]["kind"]),
+            )
+        ]
+        m.formulas[("v_dot", i)] = [
+            Formula(
+                (("omega", p), ("omega_dot", p), ("v_dot", p)),
+                lambda c, w, wd, vd, i=i: ne.v_dot(c[i]["R"], w, wd, vd, c[i]["P"], c[i]["V"], c[i]["Vd"]),
+            )
+        ]
+        m.formulas[("vc_dot", i)] = [
+            Formula(
+                (("omega", i), ("omega_dot", i), ("v_dot", i)),
+                lambda c, w, wd, vd, i=i: ne.vc_dot(w, wd, vd, c[i]["c"]),
+            )
+        ]
         m.formulas[("F", i)] = [Formula((("vc_dot", i),), lambda c, a, i=i: ne.inertial_force(c[i]["m"], a))]
-        m.formulas[("N", i)] = [Formula((("omega", i), ("omega_dot", i)),
-                                        lambda c, w, wd, i=i: ne.inertial_moment(c[i]["I"], w, wd))]
+        m.formulas[("N", i)] = [
+            Formula((("omega", i), ("omega_dot", i)), lambda c, w, wd, i=i: ne.inertial_moment(c[i]["I"], w, wd))
+        ]
         m.refs += [("omega", i), ("omega_dot", i), ("v_dot", i), ("vc_dot", i), ("F", i), ("N", i)]
 
         gravity_free = Convention(
             "gravity as a force (no base acceleration in the accelerations)",
-            lambda v, c, i=i: v - gravity_part(c, i), lambda v, c, i=i: v + gravity_part(c, i))
+            lambda v, c, i=i: v - gravity_part(c, i),
+            lambda v, c, i=i: v + gravity_part(c, i),
+        )
         m.conventions[("v_dot", i)] = [USUAL, gravity_free]
         m.conventions[("vc_dot", i)] = [USUAL, gravity_free]
         dalembert = Convention("d'Alembert inertial force F = -m v̇_C", lambda v, c: -v, lambda v, c: -v)
         m.conventions[("F", i)] = [
-            USUAL, dalembert,
-            Convention("gravity as a force (F = m v̇_C without the base acceleration)",
-                       lambda v, c, i=i: v - c[i]["m"] * gravity_part(c, i),
-                       lambda v, c, i=i: v + c[i]["m"] * gravity_part(c, i)),
-            Convention("d'Alembert inertial force, gravity as a force",
-                       lambda v, c, i=i: -(v - c[i]["m"] * gravity_part(c, i)),
-                       lambda v, c, i=i: -v + c[i]["m"] * gravity_part(c, i)),
+            USUAL,
+            dalembert,
+            Convention(
+                "gravity as a force (F = m v̇_C without the base acceleration)",
+                lambda v, c, i=i: v - c[i]["m"] * gravity_part(c, i),
+                lambda v, c, i=i: v + c[i]["m"] * gravity_part(c, i),
+            ),
+            Convention(
+                "d'Alembert inertial force, gravity as a force",
+                lambda v, c, i=i: -(v - c[i]["m"] * gravity_part(c, i)),
+                lambda v, c, i=i: -v + c[i]["m"] * gravity_part(c, i),
+            ),
         ]
-        m.conventions[("N", i)] = [USUAL, Convention("d'Alembert inertial moment N = -(I ω̇ + ω × I ω)",
-                                                     lambda v, c: -v, lambda v, c: -v)]
+        m.conventions[("N", i)] = [
+            USUAL,
+            Convention("d'Alembert inertial moment N = -(I ω̇ + ω × I ω)", lambda v, c: -v, lambda v, c: -v),
+        ]
 
     # inward: children first
     for i in range(n, 0, -1):
@@ -195,23 +232,39 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
             Convention(f"the reaction: force exerted by link {i} on link {i - 1}", lambda v, c: -v, lambda v, c: -v),
         ]
         about_axis = Convention(
-            f"moment about joint {i}'s axis", lambda v, c, f, i=i: ne.moment_about(v, f, c[i]["o"]),
-            lambda v, c, f, i=i: v + c[i]["o"].cross(f), (("f", i),))
+            f"moment about joint {i}'s axis",
+            lambda v, c, f, i=i: ne.moment_about(v, f, c[i]["o"]),
+            lambda v, c, f, i=i: v + c[i]["o"].cross(f),
+            (("f", i),),
+        )
         about_origin = Convention(f"moment about frame {i}'s origin (off joint {i}'s axis)", _identity, _identity)
         on_axis = ctx[i]["o"] == zero
         if ctx[i]["kind"] == "revolute" and not on_axis:
-            m.conventions[("n", i)] = [Convention("", about_axis.forward, about_axis.inverse, about_axis.extra),
-                                       about_origin]
+            m.conventions[("n", i)] = [
+                Convention("", about_axis.forward, about_axis.inverse, about_axis.extra),
+                about_origin,
+            ]
         elif ctx[i]["kind"] == "prismatic":
-            m.conventions[("n", i)] = [USUAL, Convention(
-                f"moment about joint {i}'s placement origin (where the slide starts), not frame {i}'s origin",
-                about_axis.forward, about_axis.inverse, about_axis.extra)]
+            m.conventions[("n", i)] = [
+                USUAL,
+                Convention(
+                    f"moment about joint {i}'s placement origin (where the slide starts), not frame {i}'s origin",
+                    about_axis.forward,
+                    about_axis.inverse,
+                    about_axis.extra,
+                ),
+            ]
         # the reaction, as for f: the moment exerted by link i on link i-1, in each of the above
-        m.conventions[("n", i)] = [*m.conventions_of(("n", i)), *(
-            _reaction(c, f"the reaction: moment exerted by link {i} on link {i - 1}")
-            for c in m.conventions_of(("n", i)))]
+        m.conventions[("n", i)] = [
+            *m.conventions_of(("n", i)),
+            *(
+                _reaction(c, f"the reaction: moment exerted by link {i} on link {i - 1}")
+                for c in m.conventions_of(("n", i))
+            ),
+        ]
         k = robot.coordinate_index(robot.parent_joint(list(robot.links)[i]))
         if k is not None:
+
             def tau_fn(c, nv, fv, i=i):
                 point = c[i]["o"] if c[i]["kind"] == "revolute" else c["zero"]
                 return ne.joint_torque(c[i]["kind"], c[i]["z"], ne.moment_about(nv, fv, point), fv)
@@ -224,8 +277,9 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
 def _reaction(conv: Convention, name: str) -> Convention:
     """``conv`` with the sign of the reaction (action = -reaction), named."""
     full = f"{name} ({conv.name})" if conv.name else name
-    return Convention(full, lambda v, c, *x: -conv.forward(v, c, *x), lambda v, c, *x: conv.inverse(-v, c, *x),
-                      conv.extra)
+    return Convention(
+        full, lambda v, c, *x: -conv.forward(v, c, *x), lambda v, c, *x: conv.inverse(-v, c, *x), conv.extra
+    )
 
 
 def rotation_between(ctx, frm: int, to: int):
@@ -234,6 +288,7 @@ def rotation_between(ctx, frm: int, to: int):
 
 
 # ------------------------------------------------------------------ Lagrange
+
 
 def lagrange_method(robot: Robot) -> tuple[Method, dict]:
     """The Lagrange steps of ``robot``: T, V, L, the partial derivatives, tau."""

@@ -58,7 +58,8 @@ class StepRef:
             return f"R_{self.index}^{self.frame}"
         if self.key in ("P", "Pc"):
             return f"P_{'C' if self.key == 'Pc' else ''}{self.index}" + (
-                f"^{self.frame}" if self.frame is not None else "")
+                f"^{self.frame}" if self.frame is not None else ""
+            )
         if self.index is None:
             return self.key
         return f"{self.key}_{self.index}"
@@ -93,13 +94,13 @@ def _scripts(s: str, i: int):
             while j < len(s) and depth:
                 depth += {"{": 1, "}": -1}.get(s[j], 0)
                 j += 1
-            text, i = s[i + 1:j - 1], j
+            text, i = s[i + 1 : j - 1], j
         elif i < len(s) and s[i] == "\\":
             m = re.match(r"\\[A-Za-z]+", s[i:])
-            text = m.group(0) if m else s[i:i + 2]
+            text = m.group(0) if m else s[i : i + 2]
             i += len(text)
         else:
-            text, i = s[i:i + 1], i + 1
+            text, i = s[i : i + 1], i + 1
         if mark == "_":
             sub = text if sub is None else sub + "," + text
         else:
@@ -115,8 +116,17 @@ def _int(text: str | None) -> int | None:
 
 
 _BASES = {
-    "\\omega": "omega", "F": "F", "N": "N", "f": "f", "n": "n", "m": "n", "\\tau": "tau",
-    "v": "v", "a": "a", "R": "R", "P": "P",
+    "\\omega": "omega",
+    "F": "F",
+    "N": "N",
+    "f": "f",
+    "n": "n",
+    "m": "n",
+    "\\tau": "tau",
+    "v": "v",
+    "a": "a",
+    "R": "R",
+    "P": "P",
 }
 
 
@@ -150,7 +160,7 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
         while j < len(s) and depth:
             depth += {"{": 1, "}": -1}.get(s[j], 0)
             j += 1
-        inner, rest = s[start:j - 1], s[j:]
+        inner, rest = s[start : j - 1], s[j:]
         s, i = inner + rest, 0
         # scripts may sit inside the accent's braces: \dot{\omega_1}
     m = re.match(r"\\omega|\\tau|[A-Za-z]", s[i:])
@@ -210,7 +220,7 @@ def _lagrange(s: str, coordinate_of) -> StepRef | None:
     ddt = False
     for prefix in (r"\frac{d}{dt}", r"\frac{\mathrm{d}}{\mathrm{d}t}", r"\dfrac{d}{dt}", "d/dt"):
         if s.startswith(prefix):
-            s, ddt = s[len(prefix):], True
+            s, ddt = s[len(prefix) :], True
             break
     if ddt and s.startswith("(") and s.endswith(")"):
         s = s[1:-1]
@@ -231,6 +241,7 @@ def _lagrange(s: str, coordinate_of) -> StepRef | None:
 
 
 # ------------------------------------------------------------------ symbols
+
 
 class SymbolMap:
     """Maps the student's symbols (:class:`~armdyn.grade.latex.Name`) to the model's.
@@ -259,8 +270,10 @@ class SymbolMap:
             key = self._key_of(str(student))
             target = self.names.get(str(model))
             if target is None:
-                raise LatexError(f"symbols: '{student}' maps to '{model}', which the model does not have "
-                                 f"(it has {', '.join(sorted(self.names))})")
+                raise LatexError(
+                    f"symbols: '{student}' maps to '{model}', which the model does not have "
+                    f"(it has {', '.join(sorted(self.names))})"
+                )
             self.explicit[key] = target
 
     @staticmethod
@@ -312,8 +325,10 @@ class SymbolMap:
                 return sp.nsimplify(magnitude) if magnitude.is_Float else magnitude
         if name.base == "pi" and not sub:
             return sp.pi
-        raise UnknownSymbol(f"unknown symbol {name.latex()} (the model '{self.robot.name}' has "
-                            f"{', '.join(sorted(self.names))}; map it in the front matter's 'symbols')")
+        raise UnknownSymbol(
+            f"unknown symbol {name.latex()} (the model '{self.robot.name}' has "
+            f"{', '.join(sorted(self.names))}; map it in the front matter's 'symbols')"
+        )
 
     def _derivative(self, target, dots, name):
         for k, q in enumerate(self.robot.q):
@@ -337,4 +352,3 @@ class SymbolMap:
 def _plain(sub: str) -> str:
     """A subscript as plain text: ``{c1}``, ``c_1``, ``c,1``, ``\\mathrm{c}1`` -> ``c1``."""
     return re.sub(r"[{}\s,_]|\\mathrm|\\text", "", sub or "")
-

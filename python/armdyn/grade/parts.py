@@ -25,9 +25,12 @@ from dataclasses import dataclass
 #: a task's number alone on a line, optionally as a heading or with a word before it
 _NUMBER = re.compile(
     r"^\s*(?:#{1,6}\s*)?(?:\*\*|__)?\s*(?:(?:exercise|problem|question|task|part|aufgabe)\s*)?"
-    r"(\d+(?:[-.]\d+)*[a-z]?)\s*[.:)]?\s*(?:\*\*|__)?\s*$", re.IGNORECASE)
-_SOLUTION = re.compile(r"^\s*(?:#{1,6}\s*)?(?:\*\*|__)?\s*(?:solution|answer|proof)\s*[.:]?\s*(?:\*\*|__)?\s*[.:]?\s*$",
-                       re.IGNORECASE)
+    r"(\d+(?:[-.]\d+)*[a-z]?)\s*[.:)]?\s*(?:\*\*|__)?\s*$",
+    re.IGNORECASE,
+)
+_SOLUTION = re.compile(
+    r"^\s*(?:#{1,6}\s*)?(?:\*\*|__)?\s*(?:solution|answer|proof)\s*[.:]?\s*(?:\*\*|__)?\s*[.:]?\s*$", re.IGNORECASE
+)
 #: characters of a task's statement kept as its title
 TITLE_LENGTH = 80
 
@@ -43,8 +46,11 @@ class Part:
 
 
 #: lines that may be a number or Solution line (found by one scan of the whole text)
-_CANDIDATE = re.compile(r"^[ \t]*(?:#|\*\*|__|\d|exercise|problem|question|task|part|aufgabe|solution|answer|proof)"
-                        r"[^\n]{0,80}$", re.MULTILINE | re.IGNORECASE)
+_CANDIDATE = re.compile(
+    r"^[ \t]*(?:#|\*\*|__|\d|exercise|problem|question|task|part|aufgabe|solution|answer|proof)"
+    r"[^\n]{0,80}$",
+    re.MULTILINE | re.IGNORECASE,
+)
 #: parts beyond this number are not looked for (an assignment has a handful)
 MAX_PARTS = 500
 
@@ -100,7 +106,7 @@ def _title(lines: list[str], k: int, math_lines: set[int], skip_self: bool = Fal
         if not text or j in math_lines or _SOLUTION.match(text):
             continue
         text = re.sub(r"^#+\s*|\*\*|__|`", "", text).strip()
-        return text if len(text) <= TITLE_LENGTH else text[:TITLE_LENGTH - 1] + "…"
+        return text if len(text) <= TITLE_LENGTH else text[: TITLE_LENGTH - 1] + "…"
     return ""
 
 

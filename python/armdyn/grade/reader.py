@@ -97,8 +97,10 @@ class Submission:
             data["symbols"] = dict(self.symbols)
         if self.values is not None:
             data["values"] = self.values
-        data["steps"] = [{"line": e.line, "step": e.lhs, "value": e.value,
-                          **({"part": e.part} if e.part else {})} for e in self.equations]
+        data["steps"] = [
+            {"line": e.line, "step": e.lhs, "value": e.value, **({"part": e.part} if e.part else {})}
+            for e in self.equations
+        ]
         return yaml.safe_dump(data, sort_keys=False, allow_unicode=True, width=100)
 
 
@@ -108,8 +110,9 @@ def _read_text(path: str) -> str:
     except OSError as exc:
         raise ModelError(f"cannot read the submission ({exc.strerror})", source=path) from None
     if size > MAX_BYTES:
-        raise ModelError(f"the file is {size} bytes; a derivation of at most {MAX_BYTES} bytes is expected",
-                         source=path)
+        raise ModelError(
+            f"the file is {size} bytes; a derivation of at most {MAX_BYTES} bytes is expected", source=path
+        )
     try:
         with open(path, encoding="utf-8") as fh:
             return fh.read()
@@ -147,8 +150,7 @@ def _front(meta, path: str, sub: Submission) -> None:
     allowed |= {"student", "variant"}  # a course's bookkeeping (armdyn.course), not graded
     unknown = sorted(str(k) for k in meta if k not in allowed)
     if unknown:
-        raise ModelError(f"unknown key(s) {', '.join(unknown)} (expected {', '.join(sorted(allowed))})",
-                         source=path)
+        raise ModelError(f"unknown key(s) {', '.join(unknown)} (expected {', '.join(sorted(allowed))})", source=path)
     for key in ("robot", "method"):
         value = meta.get(key)
         if value is not None and not isinstance(value, str):
@@ -163,9 +165,14 @@ def _front(meta, path: str, sub: Submission) -> None:
         raise ModelError("'symbols' must map the student's symbols to model names (strings)", source=path)
     sub.symbols = {str(k): v for k, v in symbols.items()}
     values = meta.get("values")
-    if values is not None and values != "published" and not (
-            isinstance(values, dict) and all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                                              for v in values.values())):
+    if (
+        values is not None
+        and values != "published"
+        and not (
+            isinstance(values, dict)
+            and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values.values())
+        )
+    ):
         raise ModelError("'values' must be 'published' or a mapping parameter -> number", source=path)
     sub.values = values
 
@@ -191,7 +198,7 @@ def math_blocks(text: str, start: int = 0):
             pos = m.end()
             continue
         if end > m.end():
-            yield m.start(), end + 2, m.end(), text[m.end():end]
+            yield m.start(), end + 2, m.end(), text[m.end() : end]
         pos = end + 2
 
 
@@ -251,48 +258,86 @@ def read_markdown(path: str, text: str | None = None) -> Submission:
         end = re.search(r"^---\s*$", text[3:], re.M)
         if end is None:
             raise ModelError("front matter opened with '---' is never closed", source=f"{path}:1")
-        _front(_safe_yaml(text[3:3 + end.start()], path), path, sub)
+        _front(_safe_yaml(text[3 : 3 + end.start()], path), path, sub)
         body_start = 3 + end.end()
     hidden = set(range(1, index.line(body_start) + 1))  # front matter and display math: no headings there
     for outer_start, outer_end, block_start, block in math_blocks(text, body_start):
         hidden.update(range(index.line(outer_start), index.line(outer_end) + 1))
         if len(block) > MAX_LENGTH:  # not split: one unreadable equation, refused in bounded time
             line, col = index.locate(block_start)
-            sub.equations.append(Equation(block[:40].strip(), block[:200], line, block[:200].strip(), column=col,
-                                          offset=block_start, problem=f"display math too long ({len(block)} "
-                                          f"characters, at most {MAX_LENGTH})"))
+            sub.equations.append(
+                Equation(
+                    block[:40].strip(),
+                    block[:200],
+                    line,
+                    block[:200].strip(),
+                    column=col,
+                    offset=block_start,
+                    problem=f"display math too long ({len(block)} characters, at most {MAX_LENGTH})",
+                )
+            )
             continue
         for offset, eq in split_equations(block, limit=MAX_EQUATIONS):
             start = block_start + offset
             brace = unbalanced_brace(eq) if len(eq) <= MAX_LENGTH else None
             if len(eq) > MAX_LENGTH:
                 line, col = index.locate(start)
-                sub.equations.append(Equation(eq[:40], eq[:200], line, eq[:200], column=col, offset=start,
-                                              problem=f"equation too long ({len(eq)} characters, at most "
-                                                      f"{MAX_LENGTH})"))
+                sub.equations.append(
+                    Equation(
+                        eq[:40],
+                        eq[:200],
+                        line,
+                        eq[:200],
+                        column=col,
+                        offset=start,
+                        problem=f"equation too long ({len(eq)} characters, at most {MAX_LENGTH})",
+                    )
+                )
                 continue
             if brace is not None:
                 at, what = brace
                 b_line, b_col = index.locate(start + at)
-                problem = (f"the '{{' opened at line {b_line}, column {b_col} is never closed" if what == "open"
-                           else f"the '}}' at line {b_line}, column {b_col} closes no '{{'")
+                problem = (
+                    f"the '{{' opened at line {b_line}, column {b_col} is never closed"
+                    if what == "open"
+                    else f"the '}}' at line {b_line}, column {b_col} closes no '{{'"
+                )
                 lhs = eq.split("=", 1)[0].strip() if "=" in eq else eq[:40]
                 line, col = index.locate(start)
-                sub.equations.append(Equation(lhs, eq, line, " ".join(eq.split()), column=col, offset=start,
-                                              problem=f"unbalanced brace: {problem}"))
+                sub.equations.append(
+                    Equation(
+                        lhs,
+                        eq,
+                        line,
+                        " ".join(eq.split()),
+                        column=col,
+                        offset=start,
+                        problem=f"unbalanced brace: {problem}",
+                    )
+                )
                 continue
             cuts = side_offsets(eq)
             if len(cuts) < 2:
                 continue
-            lhs = eq[:cuts[1] - 1].strip()
-            value = eq[cuts[-1]:]
+            lhs = eq[: cuts[1] - 1].strip()
+            value = eq[cuts[-1] :]
             lead = len(value) - len(value.lstrip())
             line, col = index.locate(start + cuts[-1] + lead)
-            sub.equations.append(Equation(lhs, value.strip(), index.line(start), " ".join(eq.split()),
-                                          column=col, offset=start + cuts[-1] + lead))
+            sub.equations.append(
+                Equation(
+                    lhs,
+                    value.strip(),
+                    index.line(start),
+                    " ".join(eq.split()),
+                    column=col,
+                    offset=start + cuts[-1] + lead,
+                )
+            )
             if len(sub.equations) > MAX_EQUATIONS:
-                raise ModelError(f"more than {MAX_EQUATIONS} equations (a derivation has a few dozen)",
-                                 source=f"{path}:{index.line(start)}")
+                raise ModelError(
+                    f"more than {MAX_EQUATIONS} equations (a derivation has a few dozen)",
+                    source=f"{path}:{index.line(start)}",
+                )
     lines = text.split("\n")
     sub.parts = [with_title(p, lines, hidden) for p in find_parts(text, index.line, lines, hidden)]
     for eq in sub.equations:
@@ -325,11 +370,16 @@ def read_yaml(path: str, text: str | None = None) -> Submission:
     for n, (name, value, line, part) in enumerate(items):
         if isinstance(value, (list, tuple)):
             # components, or rows of components: nothing nested deeper (and no deep repr later)
-            if any(isinstance(v, dict) or isinstance(v, (list, tuple)) and any(
-                    isinstance(x, (list, tuple, dict)) for x in v) for v in value):
+            if any(
+                isinstance(v, dict)
+                or isinstance(v, (list, tuple))
+                and any(isinstance(x, (list, tuple, dict)) for x in v)
+                for v in value
+            ):
                 where = f"{path}:{lines[n]}" if n < len(lines) else path
-                raise ModelError(f"step '{name}': a value is an expression, a list of them or a list of rows",
-                                 source=where)
+                raise ModelError(
+                    f"step '{name}': a value is an expression, a list of them or a list of rows", source=where
+                )
             if any(isinstance(v, list) for v in value):
                 value = [list(v) if isinstance(v, (list, tuple)) else v for v in value]
         elif not isinstance(value, (str, int, float)) or isinstance(value, bool):
@@ -337,8 +387,11 @@ def read_yaml(path: str, text: str | None = None) -> Submission:
             raise ModelError(f"step '{name}': the value must be an expression or a list of them", source=where)
         is_latex = any("\\" in str(v) for v in (value if isinstance(value, list) else [value]))
         line = line if isinstance(line, int) else (lines[n] if n < len(lines) else 0)
-        sub.equations.append(Equation(name, value, line, f"{name}: {value}", latex=is_latex,
-                                      part=str(part) if part is not None else None))
+        sub.equations.append(
+            Equation(
+                name, value, line, f"{name}: {value}", latex=is_latex, part=str(part) if part is not None else None
+            )
+        )
     return sub
 
 

@@ -19,8 +19,7 @@ from .notation import normalise
 #: the law as it is right, for messages
 LAW = "d/dt ∂L/∂q̇ − ∂L/∂q = τ"
 #: what a wrong free-end condition is told
-FREE_END = ("nothing acts on the free end: the iteration starts from f_{n+1} = 0 and n_{n+1} = 0 "
-            "(no load at the tool)")
+FREE_END = "nothing acts on the free end: the iteration starts from f_{n+1} = 0 and n_{n+1} = 0 (no load at the tool)"
 
 _DDT = (r"\frac{d}{dt}", r"\frac{\mathrm{d}}{\mathrm{d}t}", r"\dfrac{d}{dt}", "d/dt", r"\frac{\mathrm{d}}{dt}")
 _PARTIAL_L = re.compile(r"\\partial(?:L|\\mathcal\{?L\}?)")

@@ -22,8 +22,18 @@ _MARK = {
     "unrecognised": ("·", "--"),
 }
 _KEY_TEXT = {
-    "omega": "ω", "omega_dot": "ω̇", "v_dot": "v̇", "vc_dot": "v̇_C", "F": "F", "N": "N", "f": "f", "n": "n",
-    "tau": "τ", "dL_dqd": "∂L/∂q̇", "dL_dq": "∂L/∂q", "ddt_dL_dqd": "d/dt ∂L/∂q̇",
+    "omega": "ω",
+    "omega_dot": "ω̇",
+    "v_dot": "v̇",
+    "vc_dot": "v̇_C",
+    "F": "F",
+    "N": "N",
+    "f": "f",
+    "n": "n",
+    "tau": "τ",
+    "dL_dqd": "∂L/∂q̇",
+    "dL_dq": "∂L/∂q",
+    "ddt_dL_dqd": "d/dt ∂L/∂q̇",
 }
 #: the message of an equation that names no step (listed by line, not one by one)
 NOT_A_STEP = "not a step of Newton-Euler or Lagrange (skipped)"
@@ -47,8 +57,11 @@ def _value(value, ascii_only: bool, shorthand: dict | None = None) -> str:
     if isinstance(value, sp.MatrixBase):
         if value.shape[1] == 1:
             return "[" + ", ".join(pretty(x, ascii_only, shorthand) for x in value) + "]"
-        return "[" + "; ".join(", ".join(pretty(x, ascii_only, shorthand) for x in value.row(i))
-                               for i in range(value.rows)) + "]"
+        return (
+            "["
+            + "; ".join(", ".join(pretty(x, ascii_only, shorthand) for x in value.row(i)) for i in range(value.rows))
+            + "]"
+        )
     return pretty(value, ascii_only, shorthand)
 
 
@@ -74,8 +87,11 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
         if (v.part, v.task) != group:
             group = (v.part, v.task)
             if v.part or v.task:
-                lines.append(f"part {v.part}" + (f": {v.task}" if v.task else "") if v.part
-                             else f"(task without a number) {v.task}")
+                lines.append(
+                    f"part {v.part}" + (f": {v.task}" if v.task else "")
+                    if v.part
+                    else f"(task without a number) {v.task}"
+                )
         mark = _MARK[v.status][1 if ascii_only else 0]
         what = v.status
         if v.status == "follows-from-earlier-error":
@@ -97,8 +113,10 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
                 lines.append(f"{'':>{16 + width}}{other} {_value(v.expected, ascii_only, report.shorthand)}")
     if skipped:
         shown = ", ".join(map(str, skipped[:12])) + (", ..." if len(skipped) > 12 else "")
-        lines.append(f"  {'·' if not ascii_only else '--'} {len(skipped)} equation(s) not recognised as steps, skipped "
-                     f"(lines {shown})")
+        lines.append(
+            f"  {'·' if not ascii_only else '--'} {len(skipped)} equation(s) not recognised as steps, skipped "
+            f"(lines {shown})"
+        )
     lines.append("")
     counts = {}
     for v in report.steps:
@@ -133,8 +151,11 @@ def _str(value):
     if isinstance(value, se.Basic):
         return str(value)
     if isinstance(value, sp.MatrixBase):
-        return [str(x) for x in value] if value.shape[1] == 1 else [[str(x) for x in value.row(i)]
-                                                                    for i in range(value.rows)]
+        return (
+            [str(x) for x in value]
+            if value.shape[1] == 1
+            else [[str(x) for x in value.row(i)] for i in range(value.rows)]
+        )
     return str(value)
 
 
@@ -142,24 +163,26 @@ def to_dict(report: GradeReport) -> dict:
     """The JSON object: robot, method, steps [...], first_wrong, tau_correct."""
     steps = []
     for v in report.steps:
-        steps.append({
-            "name": v.name or None,
-            "link": v.link or None,
-            "status": v.status,
-            "expected": _str(v.expected),
-            "got": _str(v.got),
-            "difference": _str(v.difference),
-            "convention": v.convention,
-            "caused_by": v.caused_by,
-            "line": v.line,
-            "label": v.label,
-            "message": v.message,
-            "components": v.components,
-            "part": v.part,
-            "task": v.task or None,
-            "column": v.column or None,
-            **({"counterexample": v.counterexample} if v.counterexample else {}),
-        })
+        steps.append(
+            {
+                "name": v.name or None,
+                "link": v.link or None,
+                "status": v.status,
+                "expected": _str(v.expected),
+                "got": _str(v.got),
+                "difference": _str(v.difference),
+                "convention": v.convention,
+                "caused_by": v.caused_by,
+                "line": v.line,
+                "label": v.label,
+                "message": v.message,
+                "components": v.components,
+                "part": v.part,
+                "task": v.task or None,
+                "column": v.column or None,
+                **({"counterexample": v.counterexample} if v.counterexample else {}),
+            }
+        )
     return {
         "robot": report.robot,
         "method": report.method,

@@ -69,8 +69,9 @@ def _published(path: Path) -> Robot:
     accepted = []
     for link in bound.links.values():
         mass, inertia = link.floats("mass"), link.floats("inertia")
-        problems = physical_violations(link.mass if mass is None else mass,
-                                       link.inertia if inertia is None else inertia)
+        problems = physical_violations(
+            link.mass if mass is None else mass, link.inertia if inertia is None else inertia
+        )
         if problems:
             accepted.append((link.name, "; ".join(problems)))
     if not accepted:
@@ -78,11 +79,24 @@ def _published(path: Path) -> Robot:
     source = " ".join(str(robot.meta.get("source", "")).split())
     source = source if len(source) <= 90 else source[:87] + "..."
     what = "; ".join(f"link '{name}': {problem}" for name, problem in accepted)
-    warnings.warn(f"{path.stem} as published{f' ({source})' if source else ''} is not physical: {what} "
-                  f"(loaded anyway; strict=True / --strict refuses it)", UserWarning, stacklevel=3)
+    warnings.warn(
+        f"{path.stem} as published{f' ({source})' if source else ''} is not physical: {what} "
+        f"(loaded anyway; strict=True / --strict refuses it)",
+        UserWarning,
+        stacklevel=3,
+    )
     meta = dict(robot.meta, nonphysical_accepted=tuple(accepted))
-    return Robot(robot.name, robot.links.values(), robot.joints, robot.gravity, robot.parameters, meta,
-                 robot.base, robot.defaults, strict=False)
+    return Robot(
+        robot.name,
+        robot.links.values(),
+        robot.joints,
+        robot.gravity,
+        robot.parameters,
+        meta,
+        robot.base,
+        robot.defaults,
+        strict=False,
+    )
 
 
 def load(source: str | os.PathLike[str], strict: bool | None = None) -> Robot:

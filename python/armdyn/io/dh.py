@@ -247,9 +247,7 @@ def from_dh(
     info = dict(meta or {})
     info["convention"] = convention
     info["frames"] = FRAMES_NOTE[convention]
-    info["dh_table"] = [
-        {"joint": row.joint, "type": row.type, "link": row.link, **row.dh} for row in parsed
-    ]
+    info["dh_table"] = [{"joint": row.joint, "type": row.type, "link": row.link, **row.dh} for row in parsed]
     try:
         return Robot(name, links, joints, gravity, params, info, base, defaults, strict=strict)
     except ModelError as err:

@@ -259,8 +259,9 @@ class _Parser:
                     raise _ParseError(f"the number {_clip(tok)} is beyond the float64 range")
                 return sp.Float(x)
             if len(tok) > MAX_INT_DIGITS:  # Python itself refuses int() of > 4300 digits
-                raise _ParseError(f"an integer of {len(tok)} digits is beyond the float64 range "
-                                  f"(at most {MAX_INT_DIGITS} digits)")
+                raise _ParseError(
+                    f"an integer of {len(tok)} digits is beyond the float64 range (at most {MAX_INT_DIGITS} digits)"
+                )
             return sp.Integer(tok)
         if tok == "(":
             value = self.nested(self.expr)
@@ -292,9 +293,19 @@ def _clip(text: str, limit: int = 30) -> str:
 
 #: SymPy functions -> float functions, for :func:`float_value`.
 _MATH = {
-    sp.sin: math.sin, sp.cos: math.cos, sp.tan: math.tan, sp.asin: math.asin, sp.acos: math.acos,
-    sp.atan: math.atan, sp.atan2: math.atan2, sp.sinh: math.sinh, sp.cosh: math.cosh, sp.tanh: math.tanh,
-    sp.exp: math.exp, sp.log: math.log, sp.Abs: abs,
+    sp.sin: math.sin,
+    sp.cos: math.cos,
+    sp.tan: math.tan,
+    sp.asin: math.asin,
+    sp.acos: math.acos,
+    sp.atan: math.atan,
+    sp.atan2: math.atan2,
+    sp.sinh: math.sinh,
+    sp.cosh: math.cosh,
+    sp.tanh: math.tanh,
+    sp.exp: math.exp,
+    sp.log: math.log,
+    sp.Abs: abs,
 }
 
 
@@ -350,8 +361,10 @@ def _check_power_size(base, exponent) -> None:
             size = abs(float_value(base))
             too_big = not (math.isfinite(size) and size > 0 and e * abs(math.log10(size)) <= 308)
         if too_big:
-            raise _ParseError(f"the power {_clip(str(base))}**{_clip(str(exponent))} is too large (exponents up "
-                              f"to {MAX_EXPONENT}, results within float64's range)")
+            raise _ParseError(
+                f"the power {_clip(str(base))}**{_clip(str(exponent))} is too large (exponents up "
+                f"to {MAX_EXPONENT}, results within float64's range)"
+            )
         return
     if not isinstance(exponent, sp.Rational) or exponent == 0:
         return  # symbolic exponent: nothing exact to compute
@@ -376,8 +389,14 @@ def _check_combined_exponents(value) -> None:
     MAX_EXPONENT: ``(a**1000)**1000`` is ``a**1000000``, which binding ``a = 10``
     would turn into a million-digit integer."""
     for f in value.args if value.is_Mul else (value,):
-        if f.is_Pow and isinstance(f.exp, sp.Rational) and abs(int(f.exp.p)) > MAX_EXPONENT or \
-                f.is_Pow and f.exp.is_Float and not abs(float(f.exp)) <= MAX_EXPONENT:
+        if (
+            f.is_Pow
+            and isinstance(f.exp, sp.Rational)
+            and abs(int(f.exp.p)) > MAX_EXPONENT
+            or f.is_Pow
+            and f.exp.is_Float
+            and not abs(float(f.exp)) <= MAX_EXPONENT
+        ):
             raise _ParseError(f"the power {_clip(str(f))} has an exponent beyond {MAX_EXPONENT}")
 
 
@@ -432,7 +451,9 @@ def parse_expression(
             f"{prefix}expected a number or expression, got {type(value).__name__} {shown(value)}", element, source
         )
     if result.has(sp.zoo, sp.nan, sp.oo, -sp.oo):
-        raise ModelError(f"{prefix}expression {quoted(value)} is not finite ({_clip(str(result), 60)})", element, source)
+        raise ModelError(
+            f"{prefix}expression {quoted(value)} is not finite ({_clip(str(result), 60)})", element, source
+        )
     if result.has(sp.I):
         raise ModelError(f"{prefix}expression {quoted(value)} is not real ({_clip(str(result), 60)})", element, source)
     if not result.free_symbols:
@@ -468,8 +489,10 @@ def parse_matrix3(value, parameters, element=None, source=None, what="matrix") -
     """A list of 3 rows of 3 values -> 3x3 Matrix."""
     if isinstance(value, sp.MatrixBase):
         value = value.tolist()
-    if not isinstance(value, (list, tuple)) or len(value) != 3 or not all(
-        isinstance(r, (list, tuple)) and len(r) == 3 for r in value
+    if (
+        not isinstance(value, (list, tuple))
+        or len(value) != 3
+        or not all(isinstance(r, (list, tuple)) and len(r) == 3 for r in value)
     ):
         raise ModelError(f"{what}: expected a 3x3 matrix (3 rows of 3 values), got {shown(value)}", element, source)
     return sp.Matrix([[parse_expression(v, parameters, element, source, what) for v in row] for row in value])
@@ -559,9 +582,7 @@ def parse_inertials(data: Mapping, parameters, element=None, source=None):
     if "inertia" in data:
         inertia = parse_inertia(data["inertia"], parameters, element, source)
     elif not is_zero(mass):
-        raise ModelError(
-            "the link has a mass but no inertia (write 'inertia: 0' for a point mass)", element, source
-        )
+        raise ModelError("the link has a mass but no inertia (write 'inertia: 0' for a point mass)", element, source)
     else:
         inertia = sp.zeros(3, 3)
     return mass, com, inertia

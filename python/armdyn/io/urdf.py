@@ -156,8 +156,9 @@ def _refuse_dtd(text: bytes) -> None:
         parser.Parse(text, True)
     except _DTD:
         where = f"<!DOCTYPE> on line {parser.CurrentLineNumber}"
-        raise ModelError("a DTD is not allowed in URDF (entity declarations are not allowed, nor ATTLIST "
-                         "defaults)", where) from None
+        raise ModelError(
+            "a DTD is not allowed in URDF (entity declarations are not allowed, nor ATTLIST defaults)", where
+        ) from None
     except xml.parsers.expat.ExpatError:
         return  # malformed: ElementTree reports it with its own wording
 
@@ -226,12 +227,21 @@ def _angle(value: float) -> sp.Expr:
 
 def _rpy_floats(roll: float, pitch: float, yaw: float) -> np.ndarray:
     """URDF roll-pitch-yaw in floats: ``Rz(yaw) Ry(pitch) Rx(roll)`` (3, 3)."""
-    cr, sr, cp, sp_, cy, sy = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch), math.cos(yaw), math.sin(yaw)
-    return np.array([
-        [cy * cp, cy * sp_ * sr - sy * cr, cy * sp_ * cr + sy * sr],
-        [sy * cp, sy * sp_ * sr + cy * cr, sy * sp_ * cr - cy * sr],
-        [-sp_, cp * sr, cp * cr],
-    ])
+    cr, sr, cp, sp_, cy, sy = (
+        math.cos(roll),
+        math.sin(roll),
+        math.cos(pitch),
+        math.sin(pitch),
+        math.cos(yaw),
+        math.sin(yaw),
+    )
+    return np.array(
+        [
+            [cy * cp, cy * sp_ * sr - sy * cr, cy * sp_ * cr + sy * sr],
+            [sy * cp, sy * sp_ * sr + cy * cr, sy * sp_ * cr - cy * sr],
+            [-sp_, cp * sr, cp * cr],
+        ]
+    )
 
 
 def _rpy_exact(rpy: tuple) -> sp.Matrix:
@@ -297,8 +307,7 @@ def _link(elem: ET.Element, index: int) -> tuple[Link, bool]:
     mass = _number(_attr(mass_elem, "value", where), "<mass> value", where)
     tensor = _single(inertial, "inertia", where, required=True)
     i = {
-        k: _number(_attr(tensor, k, where), f"<inertia> {k}", where)
-        for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+        k: _number(_attr(tensor, k, where), f"<inertia> {k}", where) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
     }
     tensor = np.array(
         [
@@ -425,8 +434,7 @@ def _warn_inert_joints(robot: Robot, source: str) -> None:
     idle = [j.name for j, moving in zip(robot.movable_joints, moves) if not moving]
     if idle:
         warnings.warn(
-            f"{source}: joints {idle} move no mass or inertia (links without <inertial>?): "
-            "the mass matrix is singular",
+            f"{source}: joints {idle} move no mass or inertia (links without <inertial>?): the mass matrix is singular",
             MasslessWarning,
             stacklevel=3,
         )

@@ -22,8 +22,12 @@ def load_xacro(path, strict: bool = True, mappings: dict[str, str] | None = None
     try:
         import xacro
     except ImportError:
-        raise ModelError("reading .xacro files needs the 'xacro' package: pip install xacro "
-                         "(or expand it first: xacro FILE > FILE.urdf)", None, source) from None
+        raise ModelError(
+            "reading .xacro files needs the 'xacro' package: pip install xacro "
+            "(or expand it first: xacro FILE > FILE.urdf)",
+            None,
+            source,
+        ) from None
     from .urdf import _build, _parse
 
     if not Path(path).is_file():

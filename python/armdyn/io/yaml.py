@@ -108,7 +108,6 @@ for DH models).
 from __future__ import annotations
 
 import math
-
 import os
 from pathlib import Path
 from typing import Mapping
@@ -118,7 +117,6 @@ import yaml
 from ..errors import ModelError
 from ..model import Joint, Link, Robot, rpy_matrix
 from .dh import from_dh
-from .yaml_screen import screen
 from .expressions import (
     check_name,
     check_rotation,
@@ -131,15 +129,31 @@ from .expressions import (
     quoted,
     shown,
 )
+from .yaml_screen import screen
 
 TOP_KEYS = (
     "name", "description", "source", "notes", "convention", "base",
     "parameters", "gravity", "joints", "links", "dh",
 )  # fmt: skip
 JOINT_KEYS = (
-    "name", "type", "parent", "child", "xyz", "rpy", "rotation", "axis",
-    "frame_xyz", "frame_rpy", "frame_rotation", "limits", "damping", "friction",
-    "armature", "rotor_inertia", "gear_ratio", "torque_offset",
+    "name",
+    "type",
+    "parent",
+    "child",
+    "xyz",
+    "rpy",
+    "rotation",
+    "axis",
+    "frame_xyz",
+    "frame_rpy",
+    "frame_rotation",
+    "limits",
+    "damping",
+    "friction",
+    "armature",
+    "rotor_inertia",
+    "gear_ratio",
+    "torque_offset",
 )
 LINK_KEYS = ("name", "mass", "com", "inertia")
 JOINT_TYPES = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic", "fixed": "fixed"}
@@ -348,9 +362,7 @@ def _dh_robot(data, name, params, defaults, gravity, base, meta, source, strict,
                 if isinstance(label, str):
                     lines[f"{kind} '{label}'"] = _at(source, row)
     try:
-        return from_dh(
-            name, rows, convention, gravity, list(params), defaults, base, meta, strict=strict, source=None
-        )
+        return from_dh(name, rows, convention, gravity, list(params), defaults, base, meta, strict=strict, source=None)
     except ModelError as err:
         raise err.located(source=lines.get(err.element or "", source))
 

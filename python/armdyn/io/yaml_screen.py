@@ -48,13 +48,21 @@ def screen(text: str, source: str, what: str = "the file") -> None:
             elif isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
                 depth -= 1
             elif isinstance(event, yaml.AliasEvent):
-                raise _refused(event, source, f"YAML aliases (*{event.anchor}) are not allowed in {what}"
-                               if len(str(event.anchor)) <= 40 else f"YAML aliases are not allowed in {what}")
+                raise _refused(
+                    event,
+                    source,
+                    f"YAML aliases (*{event.anchor}) are not allowed in {what}"
+                    if len(str(event.anchor)) <= 40
+                    else f"YAML aliases are not allowed in {what}",
+                )
             elif isinstance(event, yaml.ScalarEvent) and not event.style and len(event.value) > MAX_INT_DIGITS:
                 digits = sum(c.isdigit() for c in event.value)
                 if digits > MAX_INT_DIGITS and _INTEGER_LIKE.fullmatch(event.value):
-                    raise _refused(event, source, f"a number of {digits} digits is beyond the float64 range "
-                                                  f"(at most {MAX_INT_DIGITS} digits)")
+                    raise _refused(
+                        event,
+                        source,
+                        f"a number of {digits} digits is beyond the float64 range (at most {MAX_INT_DIGITS} digits)",
+                    )
     except yaml.YAMLError:
         return  # a syntax error: the loader reports it, with its line
 

@@ -37,8 +37,10 @@ from .vectors import UPPER, ZERO, cross, dot, minus, mv, plus, rows, times, vadd
 
 def _rotate_symmetric(b: Builder, R, J, hint) -> list:
     """R J R^T (3x3 rows) for a symmetric J (rows), computing the upper triangle only."""
-    A = [[b.let(plus(*[times(R[r][k], J[k][s]) for k in range(3)]), f"{hint}A{r + 1}{s + 1}") for s in range(3)]
-         for r in range(3)]
+    A = [
+        [b.let(plus(*[times(R[r][k], J[k][s]) for k in range(3)]), f"{hint}A{r + 1}{s + 1}") for s in range(3)]
+        for r in range(3)
+    ]
     out = [[None] * 3 for _ in range(3)]
     for r, s in UPPER:
         out[r][s] = out[s][r] = dot(A[r], R[s])

@@ -35,7 +35,7 @@ def _partial(e, a):
         for k, f in enumerate(args):
             df = _partial(f, a)
             if df != 0:
-                terms.append(sp.Mul(*args[:k], df, *args[k + 1:]))
+                terms.append(sp.Mul(*args[:k], df, *args[k + 1 :]))
         return sp.Add(*terms)
     if e.is_Pow and e.exp.is_Integer:
         return e.exp * e.base ** (e.exp - 1) * _partial(e.base, a)

@@ -10,7 +10,7 @@ as :mod:`armdyn.symbolic.newton_euler`, but
   sparse DH frames and the zero velocity of the base cost nothing;
 * the inertial parameters are the barycentric (standard) ones of each link ``j``:
   mass ``M``, first moment ``MS = M c`` and inertia ``J`` about the link frame's origin
-  (DESIGN.md's standard parameters), so that no parallel-axis term is computed per state;
+  (the architecture's standard parameters), so that no parallel-axis term is computed per state;
 * ``U_j = skew(wd_j) + skew(w_j)^2`` is formed once per link and used both for the link's
   own force and its children's accelerations (Khalil eq. 9.79);
 * a rotation about the joint axis keeps ``wx^2 + wy^2``: when the axis is a parent axis
@@ -62,12 +62,36 @@ from ..model import Robot
 from .link_terms import children_need_wd, column_from_parent, euler_moment, parent_invariant, skew2, squares
 from .parallel_joints import Run, about_z, compound_angular, own_revolute_about_z, parallel_runs, root_torque
 from .program import Builder, Program, names
-from .two_rate_link import (TwoRateLink, euler_projections, in_frame, lower_column, point_acceleration, root_axes,
-                            run_link, second_link, second_link_moment)
-from .vectors import (UPPER, ZERO, cross, dot, expanded, expanded_times, minus, mtv, mv, plus, rows, times,
-                      turned_about_z, vadd, vscale)
+from .two_rate_link import (
+    TwoRateLink,
+    euler_projections,
+    in_frame,
+    lower_column,
+    point_acceleration,
+    root_axes,
+    run_link,
+    second_link,
+    second_link_moment,
+)
+from .vectors import (
+    UPPER,
+    ZERO,
+    cross,
+    dot,
+    expanded,
+    expanded_times,
+    minus,
+    mtv,
+    mv,
+    plus,
+    rows,
+    times,
+    turned_about_z,
+    vadd,
+    vscale,
+)
 
-#: per link, in DESIGN.md's (Pinocchio's) order of the standard parameters
+#: per link, in the architecture's (Pinocchio's) order of the standard parameters
 STANDARD_NAMES = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")
 
 
@@ -181,8 +205,6 @@ def joint_frames(robot: Robot, b: Builder, turns: dict | None = None) -> dict:
     return frames
 
 
-
-
 @dataclass(frozen=True)
 class Forms:
     """The special forms :func:`customized_newton_euler` may use, each where it applies
@@ -268,9 +290,16 @@ class RootSum:
     rests: list = field(default_factory=list)
 
 
-def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, parameters=None,
-                            builder: Builder | None = None, turns: dict | None = None,
-                            forms: Forms | None = None) -> tuple[Program, list]:
+def customized_newton_euler(
+    robot: Robot,
+    qd=None,
+    qdd=None,
+    gravity=True,
+    parameters=None,
+    builder: Builder | None = None,
+    turns: dict | None = None,
+    forms: Forms | None = None,
+) -> tuple[Program, list]:
     """tau (n,) of ``robot`` as a :class:`Program` of the joint coordinates, velocities
     ``qd`` and accelerations ``qdd`` (default: the robot's symbols; pass zeros for the
     gravity torques) and the barycentric parameters.
@@ -295,8 +324,17 @@ def customized_newton_euler(robot: Robot, qd=None, qdd=None, gravity=True, param
     return program, definitions
 
 
-def _program(robot: Robot, qd, qdd, gravity, parameters, builder: Builder | None, turns: dict | None, forms: Forms,
-             run_links: bool) -> tuple[Program, list, bool]:
+def _program(
+    robot: Robot,
+    qd,
+    qdd,
+    gravity,
+    parameters,
+    builder: Builder | None,
+    turns: dict | None,
+    forms: Forms,
+    run_links: bool,
+) -> tuple[Program, list, bool]:
     """The program, its definitions, and whether a run link's projections joined another
     link's on a root (then the program without run links may be the shorter)."""
     robot = robot.canonical()  # link frames on their joints (frames off the axis: same dynamics)
@@ -323,8 +361,9 @@ class _Recursion:
     the moment, force and moment), then inward (:meth:`inward`: forces, moments,
     torques). Each form is asked where it applies; the plain recursion does the rest."""
 
-    def __init__(self, robot: Robot, b: Builder, qd, qdd, gravity, parameters, differences, definitions, turns, forms,
-                 run_links):
+    def __init__(
+        self, robot: Robot, b: Builder, qd, qdd, gravity, parameters, differences, definitions, turns, forms, run_links
+    ):
         self.robot, self.b, self.qd, self.qdd = robot, b, qd, qdd
         self.parameters, self.differences, self.definitions = parameters, differences, definitions
         self.forms, self.run_links = forms, run_links
@@ -403,12 +442,17 @@ class _Recursion:
         robot, joint = self.robot, s.joint
         parent = self.links[joint.parent]
         root = self.joint_of.get(joint.parent)
-        if (root is not None and root.parent == robot.base and own_revolute_about_z(robot, root)
-                and own_revolute_about_z(robot, joint)):
+        if (
+            root is not None
+            and root.parent == robot.base
+            and own_revolute_about_z(robot, root)
+            and own_revolute_about_z(robot, joint)
+        ):
             if self.forms.two_rate_links:
                 origin = vadd(mv(parent.U, s.p), parent.vd)  # L's origin's acceleration, root axes
-                s.two_rate = second_link(self.b, joint, s.R, root, parent.w, parent.wd, origin, self.qd[s.k],
-                                         self.qdd[s.k], s.tag)
+                s.two_rate = second_link(
+                    self.b, joint, s.R, root, parent.w, parent.wd, origin, self.qd[s.k], self.qdd[s.k], s.tag
+                )
                 s.root, s.second = root, True
         elif self.run_links and s.compound and s.column is not None and own_revolute_about_z(robot, joint):
             root = self.joint_of[s.run.anchor]
@@ -441,8 +485,10 @@ class _Recursion:
             ms, gMS, root_J33, new = second_link_moment(b, t, MS, s.vd, tag, root, self.parameters[t.root][2])
             self.definitions += new
             # a child continuing a run from the root shares W (two_rate_link.point_acceleration)
-            shared = gMS is not None and any(self.runs.get(c.child) is not None and self.runs[c.child].anchor == t.root
-                                             for c in self.robot.children(name))
+            shared = gMS is not None and any(
+                self.runs.get(c.child) is not None and self.runs[c.child].anchor == t.root
+                for c in self.robot.children(name)
+            )
         A, rest, along_z = euler_projections(b, J, t, tag, root_J33, gMS[:2] if shared else None)
         # with gravity folded in, along_z holds the first moment's z part too
         s.N = b.vector([ms[0], ms[1], along_z if shared else plus(ms[2], along_z)], f"N{tag}")
@@ -469,8 +515,12 @@ class _Recursion:
                 tau[s.k] = dot(s.n if joint.type == "revolute" else s.f, list(joint.axis))
         for joint in robot.joints:  # base-fixed links behind runs: their torque only
             k = robot.coordinate_index(joint)
-            if (joint.parent == robot.base and joint.type == "revolute" and k is not None
-                    and any(s.compound and s.run.anchor == joint.child for s in links.values())):
+            if (
+                joint.parent == robot.base
+                and joint.type == "revolute"
+                and k is not None
+                and any(s.compound and s.run.anchor == joint.child for s in links.values())
+            ):
                 tau[k] = root_torque(robot, joint, links, b)
         for k, total in self.along_root.items():  # the two-rate links' Euler moments on the root axis
             tau[k] = plus(tau[k], times(total.ad, b.let(plus(*total.A), f"A{total.first}")), *total.rests)

@@ -99,8 +99,11 @@ def grouped_parameters(robot: Robot, parameters: dict, definitions: list):
             continue  # the fixed base never moves
         m, h, Jp = moved_to_parent(*moved, rows(R), list(p))
         M_p, MS_p, J_p = work[joint.parent]
-        work[joint.parent] = [plus(M_p, m), [plus(MS_p[i], h[i]) for i in range(3)],
-                              [[plus(J_p[a][b], Jp[a][b]) for b in range(3)] for a in range(3)]]
+        work[joint.parent] = [
+            plus(M_p, m),
+            [plus(MS_p[i], h[i]) for i in range(3)],
+            [[plus(J_p[a][b], Jp[a][b]) for b in range(3)] for a in range(3)],
+        ]
 
     new_definitions = []
 

@@ -37,11 +37,13 @@ def _turned(M, MS, J, c, s):
     """(M, MS', J') of a body seen from its frame turned by the angle with cosine ``c``
     and sine ``s`` about z: ``MS' = Rz^T MS``, ``J' = Rz^T J Rz``."""
     XX, XY, XZ, YY, YZ, ZZ = J[0, 0], J[0, 1], J[0, 2], J[1, 1], J[1, 2], J[2, 2]
-    Jp = sp.Matrix([
-        [c * c * XX + 2 * c * s * XY + s * s * YY, c * s * (YY - XX) + (c * c - s * s) * XY, c * XZ + s * YZ],
-        [0, s * s * XX - 2 * c * s * XY + c * c * YY, -s * XZ + c * YZ],
-        [0, 0, ZZ],
-    ])
+    Jp = sp.Matrix(
+        [
+            [c * c * XX + 2 * c * s * XY + s * s * YY, c * s * (YY - XX) + (c * c - s * s) * XY, c * XZ + s * YZ],
+            [0, s * s * XX - 2 * c * s * XY + c * c * YY, -s * XZ + c * YZ],
+            [0, 0, ZZ],
+        ]
+    )
     for a, b in ((1, 0), (2, 0), (2, 1)):
         Jp[a, b] = Jp[b, a]
     return M, sp.Matrix([c * MS[0] + s * MS[1], -s * MS[0] + c * MS[1], MS[2]]), Jp
@@ -102,7 +104,9 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
             if value.is_Atom:
                 return value
             sym = symbol(label)
-            new.append((sym, value if unturned is None else sp.Piecewise((sp.factor(value), nonzero), (unturned, True))))
+            new.append(
+                (sym, value if unturned is None else sp.Piecewise((sp.factor(value), nonzero), (unturned, True)))
+            )
             return sym
 
         MSn = sp.Matrix([0, named(r, f"MY{tag}L"), MS[2]])  # c MX + s MY = 0; -s MX + c MY = |(MX, MY)|
@@ -115,13 +119,15 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
                 ptag = _safe(str(robot.link_index(joint.parent)))
                 for a, b in UPPER:
                     if not is_value(moved[0][a, b], 0):
-                        Jp[a, b] = Jp[b, a] = named(Jp[a, b] + moved[0][a, b], f"{'XYZ'[a]}{'XYZ'[b]}{ptag}L",
-                                                    Jp[a, b] + moved[1][a, b])
+                        Jp[a, b] = Jp[b, a] = named(
+                            Jp[a, b] + moved[0][a, b], f"{'XYZ'[a]}{'XYZ'[b]}{ptag}L", Jp[a, b] + moved[1][a, b]
+                        )
                 out[joint.parent] = (Mp, MSp, Jp)
         Jn = sp.zeros(3, 3)
         for a, b in UPPER:
-            Jn[a, b] = Jn[b, a] = (named(Jt[a, b], f"{'XYZ'[a]}{'XYZ'[b]}{tag}L", J[a, b])
-                                   if Jt[a, b] != J[a, b] else J[a, b])
+            Jn[a, b] = Jn[b, a] = (
+                named(Jt[a, b], f"{'XYZ'[a]}{'XYZ'[b]}{tag}L", J[a, b]) if Jt[a, b] != J[a, b] else J[a, b]
+            )
         out[link] = (M, MSn, Jn)
         turns[link] = th
     return out, new, turns

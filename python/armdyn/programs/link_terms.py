@@ -43,15 +43,19 @@ def squares(b: Builder, w, tag, S=None) -> dict:
     out = {"xy": b.let(w1 * w2, f"w{tag}xy"), "xz": b.let(w1 * w3, f"w{tag}xz"), "yz": b.let(w2 * w3, f"w{tag}yz")}
     if S is None:
         yy = b.let(w2 * w2, f"w{tag}yy")
-        out.update(U11=b.let(-yy - zz, f"U{tag}_11"), U22=b.let(-xx - zz, f"U{tag}_22"),
-                   U33=b.let(-xx - yy, f"U{tag}_33"), d0=b.let(yy - zz, f"w{tag}_yy_zz"),
-                   d1=b.let(zz - xx, f"w{tag}_zz_xx"), d2=b.let(xx - yy, f"w{tag}_xx_yy"))
+        out.update(
+            U11=b.let(-yy - zz, f"U{tag}_11"),
+            U22=b.let(-xx - zz, f"U{tag}_22"),
+            U33=b.let(-xx - yy, f"U{tag}_33"),
+            d0=b.let(yy - zz, f"w{tag}_yy_zz"),
+            d1=b.let(zz - xx, f"w{tag}_zz_xx"),
+            d2=b.let(xx - yy, f"w{tag}_xx_yy"),
+        )
     else:
         U22, d1 = b.let(-xx - zz, f"U{tag}_22"), b.let(zz - xx, f"w{tag}_zz_xx")
         U11 = b.let(S - d1, f"U{tag}_11")
         out_d0 = b.let(U22 - S, f"w{tag}_yy_zz")
-        out.update(U11=U11, U22=U22, U33=S, d0=out_d0, d1=d1,
-                   d2=b.let(-out_d0 - d1, f"w{tag}_xx_yy"))
+        out.update(U11=U11, U22=U22, U33=S, d0=out_d0, d1=d1, d2=b.let(-out_d0 - d1, f"w{tag}_xx_yy"))
     return out
 
 
@@ -60,7 +64,8 @@ def axis_in_parent(joint, R):
     is the parent's ``sign e_k`` (``R e_z = sign e_k``, as in every DH frame), else None."""
     axis = joint.axis
     if joint.type not in ("revolute", "prismatic") or not (
-            is_value(axis[0], 0) and is_value(axis[1], 0) and is_value(abs(axis[2]), 1)):
+        is_value(axis[0], 0) and is_value(axis[1], 0) and is_value(abs(axis[2]), 1)
+    ):
         return None
     col = [R[i][2] for i in range(3)]
     hits = [i for i, e in enumerate(col) if not is_value(e, 0)]
@@ -116,8 +121,7 @@ def column_from_parent(joint, R, U_parent):
     if found is None or joint.type != "revolute" or not about_z(joint):
         return None
     k, sign = found
-    return tuple(plus(*[times(R[m][i] if sign > 0 else -R[m][i], U_parent[m][k]) for m in range(3)])
-                 for i in range(2))
+    return tuple(plus(*[times(R[m][i] if sign > 0 else -R[m][i], U_parent[m][k]) for m in range(3)]) for i in range(2))
 
 
 def euler_moment(J, differences, wd, U, sq) -> list:

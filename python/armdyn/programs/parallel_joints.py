@@ -63,8 +63,7 @@ def about_z(joint) -> bool:
 def own_revolute_about_z(robot: Robot, joint) -> bool:
     """A revolute joint about +z with a coordinate of its own (not a mimic)."""
     k = robot.coordinate_index(joint)
-    return (joint.type == "revolute" and about_z(joint) and k is not None
-            and robot.joint_coordinate(joint) == robot.q[k])
+    return joint.type == "revolute" and about_z(joint) and k is not None and robot.joint_coordinate(joint) == robot.q[k]
 
 
 def parallel_runs(robot: Robot, angles: dict) -> dict:
@@ -92,8 +91,10 @@ def parallel_runs(robot: Robot, angles: dict) -> dict:
 def cheaper(compound: list, separate: list) -> bool:
     """True when the compound expressions cost fewer operations than the link-by-link
     ones, counting the compound angle's addition."""
+
     def cost(exprs):
         return sum(sp.count_ops(e) for e in exprs if e is not None)
+
     return cost(compound) + 1 < cost(separate)
 
 

@@ -78,7 +78,15 @@ class Program:
     def operation_counts(self) -> dict:
         """{'mul', 'add', 'sin_cos', 'other', 'total'} counted as count_ops(visual=True)."""
         total = {"mul": 0, "add": 0, "sin_cos": 0, "other": 0}
-        kinds = {"MUL": "mul", "DIV": "mul", "POW": "mul", "ADD": "add", "SUB": "add", "SIN": "sin_cos", "COS": "sin_cos"}
+        kinds = {
+            "MUL": "mul",
+            "DIV": "mul",
+            "POW": "mul",
+            "ADD": "add",
+            "SUB": "add",
+            "SIN": "sin_cos",
+            "COS": "sin_cos",
+        }
         exprs = [e for _, e in self.assignments] + [sp.sympify(e) for e in self.outputs]
         for e in exprs:
             fast = _fast_count(e)

@@ -130,10 +130,25 @@ def _two_rates(builder: Builder, root_joint, R, w_root, wd_root, b, bd, tag, gz)
         return None
     (u, v), a, ad = axes, w_root[2], wd_root[2]
     bb = builder.let(times(b, b), f"w{tag}bb")
-    W = None if gz is None else [builder.let(plus(times(bd, u[i]), times(bb, v[i])), f"W{tag}{'xy'[i]}")
-                                 for i in range(2)]
-    return TwoRateLink(root_joint.child, u, v, a, ad, b, bd, builder.let(times(a, a), f"w{tag}aa"), bb,
-                      builder.let(times(2, times(a, b)), f"w{tag}ab2"), W, gz)
+    W = (
+        None
+        if gz is None
+        else [builder.let(plus(times(bd, u[i]), times(bb, v[i])), f"W{tag}{'xy'[i]}") for i in range(2)]
+    )
+    return TwoRateLink(
+        root_joint.child,
+        u,
+        v,
+        a,
+        ad,
+        b,
+        bd,
+        builder.let(times(a, a), f"w{tag}aa"),
+        bb,
+        builder.let(times(2, times(a, b)), f"w{tag}ab2"),
+        W,
+        gz,
+    )
 
 
 def lower_column(s: TwoRateLink, column) -> tuple:
@@ -172,14 +187,18 @@ def euler_projections(b: Builder, J, s: TwoRateLink, tag: str, root_J33=ZERO, gr
         A = plus(root_J33, times(u1, Ju1), times(u2, Ju2))
     C = b.let(minus(times(u2, Ju1), times(u1, Ju2)), f"C{tag}")  # v . J u, v = (u2, -u1, 0)
     if gravity is None:
-        B = b.let(plus(times(J02, u1), times(J12, u2)), f"B{tag}")   # (J e3) . u
+        B = b.let(plus(times(J02, u1), times(J12, u2)), f"B{tag}")  # (J e3) . u
         D = b.let(minus(times(J02, u2), times(J12, u1)), f"D{tag}")  # (J e3) . v
         rest = plus(times(s.bd, B), times(s.ab2, C), times(s.bb, D))
         along_z = plus(times(s.ad, B), times(s.bd, J22), -times(s.aa, C))
     else:
         rest = plus(times(s.ab2, C), times(J02, s.W[0]), times(J12, s.W[1]))
-        along_z = plus(times(u1, minus(times(s.ad, J02), gravity[1])), times(u2, plus(times(s.ad, J12), gravity[0])),
-                       times(s.bd, J22), -times(s.aa, C))
+        along_z = plus(
+            times(u1, minus(times(s.ad, J02), gravity[1])),
+            times(u2, plus(times(s.ad, J12), gravity[0])),
+            times(s.bd, J22),
+            -times(s.aa, C),
+        )
     return A, rest, along_z
 
 

@@ -102,8 +102,11 @@ def mtv(A, v) -> list:
 
 def cross(a, c) -> list:
     """a x c (3,)."""
-    return [minus(times(a[1], c[2]), times(a[2], c[1])), minus(times(a[2], c[0]), times(a[0], c[2])),
-            minus(times(a[0], c[1]), times(a[1], c[0]))]
+    return [
+        minus(times(a[1], c[2]), times(a[2], c[1])),
+        minus(times(a[2], c[0]), times(a[0], c[2])),
+        minus(times(a[0], c[1]), times(a[1], c[0])),
+    ]
 
 
 def vadd(*vs) -> list:

@@ -39,10 +39,10 @@ from .pool import Pool
 from .storage import DONE, FAILED, Repository
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-MAX_BODY = 1_000_000       # bytes of a request; a derivation is a few kB
-MAX_PREVIEW = 200_000      # bytes of text a preview reads
-FORM_WAIT = 20.0           # seconds the Grade button waits for the verdict before showing "queued"
-API_WAIT = 30.0            # default ?wait= of POST /api/grade
+MAX_BODY = 1_000_000  # bytes of a request; a derivation is a few kB
+MAX_PREVIEW = 200_000  # bytes of text a preview reads
+FORM_WAIT = 20.0  # seconds the Grade button waits for the verdict before showing "queued"
+API_WAIT = 30.0  # default ?wait= of POST /api/grade
 
 
 @dataclass
@@ -60,8 +60,9 @@ class Settings:
     grace: float = 10.0
 
 
-_templates = jinja2.Environment(loader=jinja2.FileSystemLoader(os.path.join(HERE, "templates")),
-                                autoescape=True, undefined=jinja2.StrictUndefined)
+_templates = jinja2.Environment(
+    loader=jinja2.FileSystemLoader(os.path.join(HERE, "templates")), autoescape=True, undefined=jinja2.StrictUndefined
+)
 
 
 def _when(t) -> str:
@@ -96,8 +97,15 @@ class Server:
         s = self.settings
         self.repo = await run_in_threadpool(Repository, s.db, s.max_attempts)
         sources = {k: e.source for k, e in s.exercises.items()}
-        self.pool = Pool(self.repo, sources, workers=s.workers, timeout=s.timeout, memory_mb=s.memory_mb,
-                         grace=s.grace, on_done=self._done_from_thread)
+        self.pool = Pool(
+            self.repo,
+            sources,
+            workers=s.workers,
+            timeout=s.timeout,
+            memory_mb=s.memory_mb,
+            grace=s.grace,
+            on_done=self._done_from_thread,
+        )
         await run_in_threadpool(self.pool.start)
 
     async def shutdown(self) -> None:
@@ -134,8 +142,9 @@ class Server:
         """Store a submission; returns (summary row, secret link token)."""
         token = security.new_token()
         owner = security.digest(owner_key) if owner_key else None
-        row = await run_in_threadpool(self.repo.add, security.new_id(), security.digest(token), markdown,
-                                      exercise, student.strip(), owner)
+        row = await run_in_threadpool(
+            self.repo.add, security.new_id(), security.digest(token), markdown, exercise, student.strip(), owner
+        )
         if row["status"] != DONE:
             self.pool.wake()
         return row, token
@@ -164,8 +173,9 @@ class Server:
         if not value:
             return None
         if value not in self.settings.exercises:
-            raise _BadRequest(f"unknown exercise '{value[:64]}': this server grades "
-                              + ", ".join(sorted(self.settings.exercises)))
+            raise _BadRequest(
+                f"unknown exercise '{value[:64]}': this server grades " + ", ".join(sorted(self.settings.exercises))
+            )
         return value
 
 
@@ -183,8 +193,14 @@ def _student_key(request: Request) -> tuple[str, bool]:
 
 def _with_key(response: Response, key: str, new: bool, request: Request) -> Response:
     if new:
-        response.set_cookie(security.STUDENT_COOKIE, key, max_age=180 * 86400, httponly=True, samesite="strict",
-                            secure=request.url.scheme == "https")
+        response.set_cookie(
+            security.STUDENT_COOKIE,
+            key,
+            max_age=180 * 86400,
+            httponly=True,
+            samesite="strict",
+            secure=request.url.scheme == "https",
+        )
     return response
 
 
@@ -193,8 +209,25 @@ def _api_view(row: dict, full: dict | None = None) -> dict:
     out = {}
     if full is not None and full.get("report_json"):
         out.update(json.loads(full["report_json"]))
-    out.update({k: row[k] for k in ("id", "status", "attempts", "exercise", "graded_as", "passed", "first_wrong",
-                                    "error", "cached", "created_at", "started_at", "finished_at")})
+    out.update(
+        {
+            k: row[k]
+            for k in (
+                "id",
+                "status",
+                "attempts",
+                "exercise",
+                "graded_as",
+                "passed",
+                "first_wrong",
+                "error",
+                "cached",
+                "created_at",
+                "started_at",
+                "finished_at",
+            )
+        }
+    )
     return out
 
 
@@ -259,16 +292,23 @@ def build_app(settings: Settings) -> Starlette:
     async def student_page(request: Request):
         key, new = _student_key(request)
         mine = await run_in_threadpool(srv.repo.by_owner, security.digest(key)) if not new else []
-        response = _page("student.html", exercises=menu, default=DEFAULT, csrf=srv.secrets.csrf_token(key),
-                         mine=mine, instructor=False)
+        response = _page(
+            "student.html",
+            exercises=menu,
+            default=DEFAULT,
+            csrf=srv.secrets.csrf_token(key),
+            mine=mine,
+            instructor=False,
+        )
         return _with_key(response, key, new, request)
 
     async def grade_form(request: Request):
         key = request.cookies.get(security.STUDENT_COOKIE)
         form = await request.form()
         if not srv.secrets.csrf_ok(key, form.get("csrf")):
-            return HTMLResponse("The form expired or did not come from this site: reload the page and try again.",
-                                status_code=403)
+            return HTMLResponse(
+                "The form expired or did not come from this site: reload the page and try again.", status_code=403
+            )
         markdown = str(form.get("markdown") or "")
         upload = form.get("upload")
         if not markdown.strip() and upload is not None and hasattr(upload, "read"):
@@ -288,8 +328,13 @@ def build_app(settings: Settings) -> Starlette:
         if full is None or not srv.may_see(request, full):
             return HTMLResponse("No such submission, or not yours (the link needs its token).", status_code=404)
         key, new = _student_key(request)
-        response = _page("submission.html", s=full, token=request.query_params.get("t", ""),
-                         csrf=srv.secrets.csrf_token(key), instructor=srv.is_instructor(request))
+        response = _page(
+            "submission.html",
+            s=full,
+            token=request.query_params.get("t", ""),
+            csrf=srv.secrets.csrf_token(key),
+            instructor=srv.is_instructor(request),
+        )
         return _with_key(response, key, new, request)
 
     async def report_page(request: Request):
@@ -303,8 +348,13 @@ def build_app(settings: Settings) -> Starlette:
         key, new = _student_key(request)
         csrf = srv.secrets.csrf_token(key)
         if not srv.is_instructor(request):
-            response = _page("login.html", csrf=csrf, configured=srv.secrets.instructor_token is not None,
-                             failed=False, instructor=False)
+            response = _page(
+                "login.html",
+                csrf=csrf,
+                configured=srv.secrets.instructor_token is not None,
+                failed=False,
+                instructor=False,
+            )
             return _with_key(response, key, new, request)
         rows = await run_in_threadpool(srv.repo.listing)
         counts = await run_in_threadpool(srv.repo.counts)
@@ -312,8 +362,14 @@ def build_app(settings: Settings) -> Starlette:
         for r in rows:
             by_student.setdefault(r["student"] or "(no name)", []).append(r)
         exercises = sorted({r["graded_as"] or r["exercise"] or "?" for r in rows})
-        return _with_key(_page("instructor.html", by_student=by_student, exercises=exercises, counts=counts,
-                               csrf=csrf, instructor=True), key, new, request)
+        return _with_key(
+            _page(
+                "instructor.html", by_student=by_student, exercises=exercises, counts=counts, csrf=csrf, instructor=True
+            ),
+            key,
+            new,
+            request,
+        )
 
     async def login(request: Request):
         form = await request.form()
@@ -321,11 +377,23 @@ def build_app(settings: Settings) -> Starlette:
             return HTMLResponse("The form expired: reload the page and try again.", status_code=403)
         if not srv.secrets.instructor_ok(str(form.get("token") or "")):
             key, _new = _student_key(request)
-            return _page("login.html", status=403, csrf=srv.secrets.csrf_token(key),
-                         configured=srv.secrets.instructor_token is not None, failed=True, instructor=False)
+            return _page(
+                "login.html",
+                status=403,
+                csrf=srv.secrets.csrf_token(key),
+                configured=srv.secrets.instructor_token is not None,
+                failed=True,
+                instructor=False,
+            )
         response = RedirectResponse("/instructor", status_code=303)
-        response.set_cookie(security.INSTRUCTOR_COOKIE, srv.secrets.instructor_cookie(), httponly=True,
-                            samesite="strict", secure=request.url.scheme == "https", max_age=12 * 3600)
+        response.set_cookie(
+            security.INSTRUCTOR_COOKIE,
+            srv.secrets.instructor_cookie(),
+            httponly=True,
+            samesite="strict",
+            secure=request.url.scheme == "https",
+            max_age=12 * 3600,
+        )
         return response
 
     async def logout(request: Request):
@@ -352,19 +420,28 @@ def build_app(settings: Settings) -> Starlette:
         from ..course import Gradebook
 
         rows = await run_in_threadpool(srv.repo.graded)
-        items = [(r["student"] or "(no name)", r["graded_as"] or r["exercise"],
-                  json.loads(r["report_json"]) if r["report_json"] else None,
-                  None if r["report_json"] else (("failed: " if r["status"] == FAILED else "")
-                                                  + (r["error"] or "no verdict")))
-                 for r in rows]
+        items = [
+            (
+                r["student"] or "(no name)",
+                r["graded_as"] or r["exercise"],
+                json.loads(r["report_json"]) if r["report_json"] else None,
+                None
+                if r["report_json"]
+                else (("failed: " if r["status"] == FAILED else "") + (r["error"] or "no verdict")),
+            )
+            for r in rows
+        ]
         return Gradebook.from_results(items)
 
     async def gradebook_csv(request: Request):
         if not srv.is_instructor(request):
             return RedirectResponse("/instructor", status_code=303)
         gb = await _gradebook()
-        return Response(gb.to_csv(), media_type="text/csv; charset=utf-8",
-                        headers={"content-disposition": 'attachment; filename="gradebook.csv"'})
+        return Response(
+            gb.to_csv(),
+            media_type="text/csv; charset=utf-8",
+            headers={"content-disposition": 'attachment; filename="gradebook.csv"'},
+        )
 
     async def summary_page(request: Request):
         if not srv.is_instructor(request):
@@ -410,8 +487,11 @@ def build_app(settings: Settings) -> Starlette:
         finally:
             await srv.shutdown()
 
-    app = Starlette(routes=routes, lifespan=lifespan,
-                    exception_handlers={_BadRequest: bad_request, security.BodyTooLarge: too_large})
+    app = Starlette(
+        routes=routes,
+        lifespan=lifespan,
+        exception_handlers={_BadRequest: bad_request, security.BodyTooLarge: too_large},
+    )
     app.state.server = srv
     app.add_middleware(security.SecurityHeaders)
     app.add_middleware(security.BodyLimit, max_bytes=MAX_BODY)

@@ -24,7 +24,7 @@ DEFAULT = "rp-arm"
 @dataclass(frozen=True)
 class Exercise:
     id: str
-    source: str          # what armdyn.io.load takes: a bundled name or the variant's model.yaml
+    source: str  # what armdyn.io.load takes: a bundled name or the variant's model.yaml
     title: str
     variant: bool
 
@@ -42,8 +42,7 @@ def catalogue(variants_dir: str | None = None) -> dict[str, Exercise]:
             out[entry["name"]] = Exercise(entry["name"], entry["name"], title, False)
     if variants_dir:
         if not os.path.isdir(variants_dir):
-            raise ModelError("not a directory (expected the output of `armdyn exercise make`)",
-                             source=variants_dir)
+            raise ModelError("not a directory (expected the output of `armdyn exercise make`)", source=variants_dir)
         for name in sorted(os.listdir(variants_dir)):
             model = os.path.join(variants_dir, name, "model.yaml")
             if not ID.match(name) or not os.path.isfile(model):

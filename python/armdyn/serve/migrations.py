@@ -21,23 +21,23 @@ def _v1_submissions(op: Operations) -> None:
     op.create_table(
         "submissions",
         sa.Column("id", sa.String(24), primary_key=True),
-        sa.Column("token_hash", sa.String(64), nullable=False),   # sha256 of the secret link token
-        sa.Column("owner_hash", sa.String(64), nullable=True),    # sha256 of the student's browser key
+        sa.Column("token_hash", sa.String(64), nullable=False),  # sha256 of the secret link token
+        sa.Column("owner_hash", sa.String(64), nullable=True),  # sha256 of the student's browser key
         sa.Column("student", sa.String(200), nullable=False, server_default=""),
-        sa.Column("exercise", sa.String(100), nullable=True),     # as requested (None: the front matter's)
-        sa.Column("graded_as", sa.String(100), nullable=True),    # the exercise id the worker graded against
+        sa.Column("exercise", sa.String(100), nullable=True),  # as requested (None: the front matter's)
+        sa.Column("graded_as", sa.String(100), nullable=True),  # the exercise id the worker graded against
         sa.Column("markdown", sa.Text, nullable=False),
         sa.Column("content_hash", sa.String(64), nullable=False),
-        sa.Column("status", sa.String(16), nullable=False),       # queued, running, done, failed
+        sa.Column("status", sa.String(16), nullable=False),  # queued, running, done, failed
         sa.Column("attempts", sa.Integer, nullable=False, server_default="0"),
         sa.Column("passed", sa.Boolean, nullable=True),
         sa.Column("first_wrong", sa.String(100), nullable=True),
-        sa.Column("error", sa.Text, nullable=True),               # the student's input error (done) or why it failed
+        sa.Column("error", sa.Text, nullable=True),  # the student's input error (done) or why it failed
         sa.Column("report_json", sa.Text, nullable=True),
-        sa.Column("report_html", sa.Text, nullable=True),         # the self-contained page (grade --html)
-        sa.Column("report_fragment", sa.Text, nullable=True),     # the same report, to embed in a page
+        sa.Column("report_html", sa.Text, nullable=True),  # the self-contained page (grade --html)
+        sa.Column("report_fragment", sa.Text, nullable=True),  # the same report, to embed in a page
         sa.Column("cached", sa.Boolean, nullable=False, server_default=sa.false()),
-        sa.Column("created_at", sa.Float, nullable=False),        # Unix seconds
+        sa.Column("created_at", sa.Float, nullable=False),  # Unix seconds
         sa.Column("started_at", sa.Float, nullable=True),
         sa.Column("finished_at", sa.Float, nullable=True),
     )
@@ -63,8 +63,9 @@ def upgrade(engine: sa.Engine) -> int:
     with engine.begin() as conn:
         version = current_version(conn)
         if version > len(MIGRATIONS):
-            raise RuntimeError(f"the database has schema version {version}, newer than this armdyn's "
-                               f"{len(MIGRATIONS)}: upgrade armdyn")
+            raise RuntimeError(
+                f"the database has schema version {version}, newer than this armdyn's {len(MIGRATIONS)}: upgrade armdyn"
+            )
         op = Operations(MigrationContext.configure(conn))
         if version == 0:
             op.create_table("armdyn_schema", sa.Column("version", sa.Integer, nullable=False))

@@ -2,18 +2,38 @@
 
 from __future__ import annotations
 
-_STEP = {"type": "object", "description": "one step's verdict, as `armdyn grade --json` prints it",
-         "properties": {k: {} for k in ("name", "link", "status", "expected", "got", "difference", "convention",
-                                        "caused_by", "line", "label", "message", "components")}}
+_STEP = {
+    "type": "object",
+    "description": "one step's verdict, as `armdyn grade --json` prints it",
+    "properties": {
+        k: {}
+        for k in (
+            "name",
+            "link",
+            "status",
+            "expected",
+            "got",
+            "difference",
+            "convention",
+            "caused_by",
+            "line",
+            "label",
+            "message",
+            "components",
+        )
+    },
+}
 
 _SUBMISSION = {
     "type": "object",
     "required": ["id", "status"],
     "properties": {
         "id": {"type": "string"},
-        "status": {"enum": ["queued", "running", "done", "failed"],
-                   "description": "done: a verdict (or the student's input error in `error`); "
-                                  "failed: grading itself failed (timeout, memory, workers killed): retry"},
+        "status": {
+            "enum": ["queued", "running", "done", "failed"],
+            "description": "done: a verdict (or the student's input error in `error`); "
+            "failed: grading itself failed (timeout, memory, workers killed): retry",
+        },
         "attempts": {"type": "integer"},
         "exercise": {"type": ["string", "null"], "description": "as requested (null: the front matter's robot)"},
         "graded_as": {"type": ["string", "null"]},
@@ -21,9 +41,12 @@ _SUBMISSION = {
         "first_wrong": {"type": ["string", "null"]},
         "error": {"type": ["string", "null"]},
         "cached": {"type": "boolean", "description": "the verdict of an identical earlier submission"},
-        "created_at": {"type": "number"}, "started_at": {"type": ["number", "null"]},
+        "created_at": {"type": "number"},
+        "started_at": {"type": ["number", "null"]},
         "finished_at": {"type": ["number", "null"]},
-        "robot": {"type": "string"}, "method": {"type": "string"}, "submission": {"type": "string"},
+        "robot": {"type": "string"},
+        "method": {"type": "string"},
+        "submission": {"type": "string"},
         "steps": {"type": "array", "items": _STEP},
         "tau_correct": {"type": "array", "items": {"type": "boolean"}},
         "token": {"type": "string", "description": "POST only: the secret that opens this submission"},
@@ -39,41 +62,78 @@ def _json(schema: dict, description: str) -> dict:
 
 
 def schema() -> dict:
-    exercise = {"name": "robot", "in": "query", "schema": {"type": "string"},
-                "description": "exercise id (bundled model name or variant id); `variant=` and `exercise=` "
-                               "are the same; default: the front matter's `robot:`"}
-    token = {"name": "t", "in": "query", "schema": {"type": "string"},
-             "description": "the submission's token (or `Authorization: Bearer TOKEN`)"}
+    exercise = {
+        "name": "robot",
+        "in": "query",
+        "schema": {"type": "string"},
+        "description": "exercise id (bundled model name or variant id); `variant=` and `exercise=` "
+        "are the same; default: the front matter's `robot:`",
+    }
+    token = {
+        "name": "t",
+        "in": "query",
+        "schema": {"type": "string"},
+        "description": "the submission's token (or `Authorization: Bearer TOKEN`)",
+    }
     return {
         "openapi": "3.1.0",
-        "info": {"title": "armdyn serve", "version": "1",
-                 "description": "Grade dynamics derivations (Markdown + LaTeX) step by step."},
+        "info": {
+            "title": "armdyn serve",
+            "version": "1",
+            "description": "Grade dynamics derivations (Markdown + LaTeX) step by step.",
+        },
         "paths": {
-            "/api/health": {"get": {"summary": "ready to grade?", "responses": {
-                "200": _json({"type": "object"}, "workers started"),
-                "503": _json({"type": "object"}, "starting")}}},
-            "/api/grade": {"post": {
-                "summary": "grade a derivation",
-                "parameters": [exercise,
-                               {"name": "student", "in": "query", "schema": {"type": "string"}},
-                               {"name": "wait", "in": "query", "schema": {"type": "number", "maximum": 120},
-                                "description": "seconds to wait for the verdict (default 30; 0: return at once)"}],
-                "requestBody": {"required": True, "content": {"text/markdown": {"schema": {"type": "string"}}}},
-                "responses": {"200": _json(_SUBMISSION, "graded (status done or failed)"),
-                              "202": _json(_SUBMISSION, "accepted, not graded yet: poll GET /api/submissions/{id}"),
-                              "400": _json(_ERROR, "unknown exercise, not UTF-8, wrong content type"),
-                              "413": _json(_ERROR, "body too large")}}},
-            "/api/submissions/{id}": {"get": {
-                "summary": "a submission and its verdict",
-                "parameters": [{"name": "id", "in": "path", "required": True, "schema": {"type": "string"}}, token],
-                "responses": {"200": _json(_SUBMISSION, "the submission"),
-                              "404": _json(_ERROR, "unknown, or the token does not match")}}},
-            "/api/preview": {"post": {
-                "summary": "how each equation is read (sanitized MathML, an HTML fragment)",
-                "parameters": [{"name": "exercise", "in": "query", "schema": {"type": "string"}}],
-                "requestBody": {"required": True, "content": {"text/markdown": {"schema": {"type": "string"}}}},
-                "responses": {"200": _json({"type": "object", "properties": {"html": {"type": "string"}}},
-                                           "the preview"),
-                              "503": _json(_ERROR, "the preview worker was busy or stopped")}}},
+            "/api/health": {
+                "get": {
+                    "summary": "ready to grade?",
+                    "responses": {
+                        "200": _json({"type": "object"}, "workers started"),
+                        "503": _json({"type": "object"}, "starting"),
+                    },
+                }
+            },
+            "/api/grade": {
+                "post": {
+                    "summary": "grade a derivation",
+                    "parameters": [
+                        exercise,
+                        {"name": "student", "in": "query", "schema": {"type": "string"}},
+                        {
+                            "name": "wait",
+                            "in": "query",
+                            "schema": {"type": "number", "maximum": 120},
+                            "description": "seconds to wait for the verdict (default 30; 0: return at once)",
+                        },
+                    ],
+                    "requestBody": {"required": True, "content": {"text/markdown": {"schema": {"type": "string"}}}},
+                    "responses": {
+                        "200": _json(_SUBMISSION, "graded (status done or failed)"),
+                        "202": _json(_SUBMISSION, "accepted, not graded yet: poll GET /api/submissions/{id}"),
+                        "400": _json(_ERROR, "unknown exercise, not UTF-8, wrong content type"),
+                        "413": _json(_ERROR, "body too large"),
+                    },
+                }
+            },
+            "/api/submissions/{id}": {
+                "get": {
+                    "summary": "a submission and its verdict",
+                    "parameters": [{"name": "id", "in": "path", "required": True, "schema": {"type": "string"}}, token],
+                    "responses": {
+                        "200": _json(_SUBMISSION, "the submission"),
+                        "404": _json(_ERROR, "unknown, or the token does not match"),
+                    },
+                }
+            },
+            "/api/preview": {
+                "post": {
+                    "summary": "how each equation is read (sanitized MathML, an HTML fragment)",
+                    "parameters": [{"name": "exercise", "in": "query", "schema": {"type": "string"}}],
+                    "requestBody": {"required": True, "content": {"text/markdown": {"schema": {"type": "string"}}}},
+                    "responses": {
+                        "200": _json({"type": "object", "properties": {"html": {"type": "string"}}}, "the preview"),
+                        "503": _json(_ERROR, "the preview worker was busy or stopped"),
+                    },
+                }
+            },
         },
     }

@@ -42,10 +42,21 @@ class WorkerProcess:
     """One ``python -m armdyn.serve.worker`` and its pipes."""
 
     def __init__(self, exercises: dict[str, str], memory_mb: int, start_timeout: float = 120.0):
-        env = dict(os.environ, ARMDYN_SERVE_EXERCISES=json.dumps(exercises),
-                   ARMDYN_SERVE_MEMORY_MB=str(memory_mb), OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
-        self.proc = subprocess.Popen([sys.executable, "-m", "armdyn.serve.worker"], stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, text=True, encoding="utf-8", env=env)
+        env = dict(
+            os.environ,
+            ARMDYN_SERVE_EXERCISES=json.dumps(exercises),
+            ARMDYN_SERVE_MEMORY_MB=str(memory_mb),
+            OPENBLAS_NUM_THREADS="1",
+            OMP_NUM_THREADS="1",
+        )
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "armdyn.serve.worker"],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+            encoding="utf-8",
+            env=env,
+        )
         self.pid = self.proc.pid
         hello = self._read(start_timeout)
         if not hello.get("ready"):
@@ -92,8 +103,17 @@ class Pool:
              ``done`` or ``failed``.
     """
 
-    def __init__(self, repo: Repository, exercises: dict[str, str], workers: int = 2, timeout: float = 60.0,
-                 memory_mb: int = 2048, preview_timeout: float = 5.0, grace: float = 10.0, on_done=None):
+    def __init__(
+        self,
+        repo: Repository,
+        exercises: dict[str, str],
+        workers: int = 2,
+        timeout: float = 60.0,
+        memory_mb: int = 2048,
+        preview_timeout: float = 5.0,
+        grace: float = 10.0,
+        on_done=None,
+    ):
         self.repo = repo
         self.exercises = exercises
         self.n = max(1, workers)
@@ -185,8 +205,9 @@ class Pool:
                 continue
             ids = [job.id]
             try:
-                reply = proc.request({"kind": "grade", "exercise": job.exercise, "markdown": job.markdown},
-                                     self.timeout)
+                reply = proc.request(
+                    {"kind": "grade", "exercise": job.exercise, "markdown": job.markdown}, self.timeout
+                )
             except WorkerTimeout:
                 proc.kill()
                 proc = None
@@ -226,10 +247,10 @@ class Pool:
                     self._preview = None
                     return {"ok": False, "reason": f"preview unavailable: {err}"}
             try:
-                return self._preview.request({"kind": "preview", "exercise": exercise, "markdown": markdown},
-                                             self.preview_timeout)
+                return self._preview.request(
+                    {"kind": "preview", "exercise": exercise, "markdown": markdown}, self.preview_timeout
+                )
             except (WorkerTimeout, WorkerDied, ValueError) as err:
                 self._preview.kill()
                 self._preview = None
                 return {"ok": False, "reason": f"preview stopped: {err}"}
-

@@ -34,13 +34,28 @@ def run(args) -> int:
     token = args.instructor_token or os.environ.get("ARMDYN_INSTRUCTOR_TOKEN")
     if args.workers < 1:
         raise ModelError("--workers must be at least 1")
-    settings = Settings(db=db_url(args.db), exercises=catalogue(args.exercises), workers=args.workers,
-                        timeout=args.timeout, memory_mb=args.memory_mb, instructor_token=token,
-                        secret=os.environ.get("ARMDYN_SECRET"))
+    settings = Settings(
+        db=db_url(args.db),
+        exercises=catalogue(args.exercises),
+        workers=args.workers,
+        timeout=args.timeout,
+        memory_mb=args.memory_mb,
+        instructor_token=token,
+        secret=os.environ.get("ARMDYN_SECRET"),
+    )
     if token is None:
-        print("armdyn serve: no --instructor-token (or ARMDYN_INSTRUCTOR_TOKEN): the instructor page is closed",
-              file=sys.stderr)
+        print(
+            "armdyn serve: no --instructor-token (or ARMDYN_INSTRUCTOR_TOKEN): the instructor page is closed",
+            file=sys.stderr,
+        )
     app = build_app(settings)
-    uvicorn.run(app, host=args.host, port=args.port, log_level="warning", proxy_headers=True,
-                forwarded_allow_ips=args.forwarded_allow_ips, timeout_graceful_shutdown=GRACEFUL_SECONDS)
+    uvicorn.run(
+        app,
+        host=args.host,
+        port=args.port,
+        log_level="warning",
+        proxy_headers=True,
+        forwarded_allow_ips=args.forwarded_allow_ips,
+        timeout_graceful_shutdown=GRACEFUL_SECONDS,
+    )
     return 0

@@ -64,8 +64,21 @@ T = Submission.__table__
 #: the result columns a verdict fills in (copied to cache hits and queued twins)
 RESULT = ("graded_as", "passed", "first_wrong", "error", "report_json", "report_html", "report_fragment")
 #: the columns of a listing (no text, no report)
-SUMMARY = ("id", "student", "exercise", "graded_as", "status", "attempts", "passed", "first_wrong", "error",
-           "cached", "created_at", "started_at", "finished_at")
+SUMMARY = (
+    "id",
+    "student",
+    "exercise",
+    "graded_as",
+    "status",
+    "attempts",
+    "passed",
+    "first_wrong",
+    "error",
+    "cached",
+    "created_at",
+    "started_at",
+    "finished_at",
+)
 
 
 @dataclass
@@ -116,18 +129,40 @@ class Repository:
         self.engine.dispose()
 
     # -- writing
-    def add(self, sid: str, token_hash: str, markdown: str, exercise: str | None = None, student: str = "",
-            owner_hash: str | None = None) -> dict:
+    def add(
+        self,
+        sid: str,
+        token_hash: str,
+        markdown: str,
+        exercise: str | None = None,
+        student: str = "",
+        owner_hash: str | None = None,
+    ) -> dict:
         """Accept a submission: stored ``queued``, or ``done`` at once when the same
         exercise and text were graded before. Returns its summary row."""
         digest = content_hash(exercise, markdown)
         now = time.time()
-        row = {"id": sid, "token_hash": token_hash, "owner_hash": owner_hash, "student": student[:200],
-               "exercise": exercise, "markdown": markdown, "content_hash": digest, "status": QUEUED,
-               "attempts": 0, "cached": False, "created_at": now}
+        row = {
+            "id": sid,
+            "token_hash": token_hash,
+            "owner_hash": owner_hash,
+            "student": student[:200],
+            "exercise": exercise,
+            "markdown": markdown,
+            "content_hash": digest,
+            "status": QUEUED,
+            "attempts": 0,
+            "cached": False,
+            "created_at": now,
+        }
         with self.engine.begin() as conn:
-            twin = conn.execute(sa.select(*(T.c[k] for k in RESULT)).where(
-                T.c.content_hash == digest, T.c.status == DONE).limit(1)).mappings().first()
+            twin = (
+                conn.execute(
+                    sa.select(*(T.c[k] for k in RESULT)).where(T.c.content_hash == digest, T.c.status == DONE).limit(1)
+                )
+                .mappings()
+                .first()
+            )
             if twin is not None:
                 row.update(dict(twin), status=DONE, cached=True, started_at=now, finished_at=now)
             conn.execute(T.insert().values(**row))
@@ -137,12 +172,19 @@ class Repository:
         """The oldest queued submission, now ``running`` with one more attempt (None: none queued)."""
         with self._claim_lock, self.engine.begin() as conn:
             while True:
-                row = conn.execute(sa.select(T.c.id, T.c.exercise, T.c.markdown, T.c.attempts)
-                                   .where(T.c.status == QUEUED).order_by(T.c.created_at, T.c.id).limit(1)).first()
+                row = conn.execute(
+                    sa.select(T.c.id, T.c.exercise, T.c.markdown, T.c.attempts)
+                    .where(T.c.status == QUEUED)
+                    .order_by(T.c.created_at, T.c.id)
+                    .limit(1)
+                ).first()
                 if row is None:
                     return None
-                done = conn.execute(T.update().where(T.c.id == row.id, T.c.status == QUEUED).values(
-                    status=RUNNING, attempts=T.c.attempts + 1, started_at=time.time()))
+                done = conn.execute(
+                    T.update()
+                    .where(T.c.id == row.id, T.c.status == QUEUED)
+                    .values(status=RUNNING, attempts=T.c.attempts + 1, started_at=time.time())
+                )
                 if done.rowcount == 1:
                     return Job(row.id, row.exercise, row.markdown, row.attempts + 1)
 
@@ -152,15 +194,20 @@ class Repository:
         values = {k: result.get(k) for k in RESULT}
         now = time.time()
         with self.engine.begin() as conn:
-            if not conn.execute(T.update().where(T.c.id == sid, T.c.status == RUNNING).values(
-                    status=DONE, finished_at=now, **values)).rowcount:
+            if not conn.execute(
+                T.update().where(T.c.id == sid, T.c.status == RUNNING).values(status=DONE, finished_at=now, **values)
+            ).rowcount:
                 return []
             digest = conn.execute(sa.select(T.c.content_hash).where(T.c.id == sid)).scalar_one()
-            twins = list(conn.execute(sa.select(T.c.id).where(T.c.content_hash == digest, T.c.status == QUEUED))
-                         .scalars())
+            twins = list(
+                conn.execute(sa.select(T.c.id).where(T.c.content_hash == digest, T.c.status == QUEUED)).scalars()
+            )
             if twins:
-                conn.execute(T.update().where(T.c.id.in_(twins), T.c.status == QUEUED).values(
-                    status=DONE, cached=True, started_at=now, finished_at=now, **values))
+                conn.execute(
+                    T.update()
+                    .where(T.c.id.in_(twins), T.c.status == QUEUED)
+                    .values(status=DONE, cached=True, started_at=now, finished_at=now, **values)
+                )
         return [sid, *twins]
 
     def give_up(self, sid: str, reason: str, retry: bool) -> str:
@@ -170,33 +217,54 @@ class Repository:
             attempts = conn.execute(sa.select(T.c.attempts).where(T.c.id == sid)).scalar_one()
             status = QUEUED if retry and attempts < self.max_attempts else FAILED
             error = reason if status == FAILED else None
-            conn.execute(T.update().where(T.c.id == sid, T.c.status == RUNNING).values(
-                status=status, error=error, finished_at=time.time() if status == FAILED else None))
+            conn.execute(
+                T.update()
+                .where(T.c.id == sid, T.c.status == RUNNING)
+                .values(status=status, error=error, finished_at=time.time() if status == FAILED else None)
+            )
         return status
 
     def release(self, sid: str) -> None:
         """Put a running submission back in the queue without counting the attempt
         (the server is shutting down, the grading was not at fault)."""
         with self.engine.begin() as conn:
-            conn.execute(T.update().where(T.c.id == sid, T.c.status == RUNNING).values(
-                status=QUEUED, attempts=T.c.attempts - 1, started_at=None))
+            conn.execute(
+                T.update()
+                .where(T.c.id == sid, T.c.status == RUNNING)
+                .values(status=QUEUED, attempts=T.c.attempts - 1, started_at=None)
+            )
 
     def recover(self) -> int:
         """At start-up: submissions left ``running`` by a server that died go back to
         the queue (or to ``failed`` once their attempts are used up). Returns how many."""
         with self.engine.begin() as conn:
-            n = conn.execute(T.update().where(T.c.status == RUNNING, T.c.attempts < self.max_attempts)
-                             .values(status=QUEUED, started_at=None)).rowcount
-            n += conn.execute(T.update().where(T.c.status == RUNNING).values(
-                status=FAILED, finished_at=time.time(),
-                error=f"grading was interrupted {self.max_attempts} times (workers killed); retry")).rowcount
+            n = conn.execute(
+                T.update()
+                .where(T.c.status == RUNNING, T.c.attempts < self.max_attempts)
+                .values(status=QUEUED, started_at=None)
+            ).rowcount
+            n += conn.execute(
+                T.update()
+                .where(T.c.status == RUNNING)
+                .values(
+                    status=FAILED,
+                    finished_at=time.time(),
+                    error=f"grading was interrupted {self.max_attempts} times (workers killed); retry",
+                )
+            ).rowcount
         return n
 
     def retry(self, sid: str) -> bool:
         """Queue a failed submission again (the instructor's or student's retry)."""
         with self.engine.begin() as conn:
-            return conn.execute(T.update().where(T.c.id == sid, T.c.status == FAILED).values(
-                status=QUEUED, attempts=0, error=None, finished_at=None)).rowcount == 1
+            return (
+                conn.execute(
+                    T.update()
+                    .where(T.c.id == sid, T.c.status == FAILED)
+                    .values(status=QUEUED, attempts=0, error=None, finished_at=None)
+                ).rowcount
+                == 1
+            )
 
     # -- reading
     def get(self, sid: str) -> dict | None:
@@ -211,24 +279,48 @@ class Repository:
 
     def by_owner(self, owner_hash: str, limit: int = 50) -> list[dict]:
         with self.engine.connect() as conn:
-            rows = conn.execute(sa.select(*(T.c[k] for k in SUMMARY)).where(T.c.owner_hash == owner_hash)
-                                .order_by(T.c.created_at.desc()).limit(limit)).mappings().all()
+            rows = (
+                conn.execute(
+                    sa.select(*(T.c[k] for k in SUMMARY))
+                    .where(T.c.owner_hash == owner_hash)
+                    .order_by(T.c.created_at.desc())
+                    .limit(limit)
+                )
+                .mappings()
+                .all()
+            )
         return [dict(r) for r in rows]
 
     def listing(self) -> list[dict]:
         """Every submission's summary, by student then time (the instructor's table)."""
         with self.engine.connect() as conn:
-            rows = conn.execute(sa.select(*(T.c[k] for k in SUMMARY))
-                                .order_by(T.c.student, T.c.created_at)).mappings().all()
+            rows = (
+                conn.execute(sa.select(*(T.c[k] for k in SUMMARY)).order_by(T.c.student, T.c.created_at))
+                .mappings()
+                .all()
+            )
         return [dict(r) for r in rows]
 
     def graded(self) -> list[dict]:
         """student, exercise, report_json, error of every finished submission (for the gradebook)."""
-        cols = (T.c.id, T.c.student, T.c.exercise, T.c.graded_as, T.c.status, T.c.report_json, T.c.error,
-                T.c.created_at)
+        cols = (
+            T.c.id,
+            T.c.student,
+            T.c.exercise,
+            T.c.graded_as,
+            T.c.status,
+            T.c.report_json,
+            T.c.error,
+            T.c.created_at,
+        )
         with self.engine.connect() as conn:
-            rows = conn.execute(sa.select(*cols).where(T.c.status.in_((DONE, FAILED)))
-                                .order_by(T.c.student, T.c.created_at)).mappings().all()
+            rows = (
+                conn.execute(
+                    sa.select(*cols).where(T.c.status.in_((DONE, FAILED))).order_by(T.c.student, T.c.created_at)
+                )
+                .mappings()
+                .all()
+            )
         return [dict(r) for r in rows]
 
     def counts(self) -> dict:

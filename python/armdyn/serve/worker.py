@@ -51,8 +51,11 @@ class Grader:
         from ..io import load
 
         if not name:
-            raise ModelError("no exercise chosen: choose one on the page, add ?robot=ID, or write "
-                             "'robot: rp-arm' in the front matter", source=SUBMISSION)
+            raise ModelError(
+                "no exercise chosen: choose one on the page, add ?robot=ID, or write "
+                "'robot: rp-arm' in the front matter",
+                source=SUBMISSION,
+            )
         if name not in self.exercises:
             known = ", ".join(sorted(self.exercises)[:12])
             raise ModelError(f"unknown exercise '{name[:64]}' (this server grades: {known})", source=SUBMISSION)
@@ -86,14 +89,27 @@ class Grader:
             name = exercise or self.named(markdown, sub.robot)
             report = grade(sub, robot=self.robot(name))
         except (ModelError, ValueError, RecursionError) as err:
-            return {"ok": True, "graded_as": exercise, "passed": False, "first_wrong": None,
-                    "error": " ".join(str(err).split())[:2000], "report_json": None, "report_html": None,
-                    "report_fragment": None}
+            return {
+                "ok": True,
+                "graded_as": exercise,
+                "passed": False,
+                "first_wrong": None,
+                "error": " ".join(str(err).split())[:2000],
+                "report_json": None,
+                "report_html": None,
+                "report_fragment": None,
+            }
         body = _body(report)
-        return {"ok": True, "graded_as": name, "passed": bool(report.passed), "first_wrong": report.first_wrong,
-                "error": None, "report_json": report.to_json(),
-                "report_html": page(f"armdyn grade: {report.submission}", body),  # = grade.html.report_html
-                "report_fragment": fragment(body)}                                  # = grade.html.repr_html
+        return {
+            "ok": True,
+            "graded_as": name,
+            "passed": bool(report.passed),
+            "first_wrong": report.first_wrong,
+            "error": None,
+            "report_json": report.to_json(),
+            "report_html": page(f"armdyn grade: {report.submission}", body),  # = grade.html.report_html
+            "report_fragment": fragment(body),
+        }  # = grade.html.repr_html
 
     def preview(self, markdown: str, exercise: str | None) -> dict:
         from ..errors import ModelError
@@ -106,8 +122,9 @@ class Grader:
         except (ModelError, ValueError) as err:
             return {"ok": True, "html": f'<p class="error">{escape(str(err))}</p>'}
         try:
-            coordinate_of = SymbolMap(self.robot(exercise or self.named(markdown, sub.robot)),
-                                      sub.symbols).coordinate_of
+            coordinate_of = SymbolMap(
+                self.robot(exercise or self.named(markdown, sub.robot)), sub.symbols
+            ).coordinate_of
         except Exception:  # noqa: BLE001 - no model: show the equations without step names
             coordinate_of = None
         items = []
@@ -125,8 +142,7 @@ class Grader:
                     step = ref.name if ref is not None else None
                 except Exception:  # noqa: BLE001 - an unreadable left side is simply not a step
                     step = None
-            tag = (f'<span class="step">{escape(step)}</span>' if step
-                   else '<span class="step none">not a step</span>')
+            tag = f'<span class="step">{escape(step)}</span>' if step else '<span class="step none">not a step</span>'
             items.append(f'<li><span class="line">line {eq.line}</span>{tag}{shown}</li>')
         more = len(sub.equations) - MAX_PREVIEW_EQUATIONS
         tail = f"<p>… and {more} more equations</p>" if more > 0 else ""

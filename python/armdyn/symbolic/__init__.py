@@ -1,8 +1,8 @@
 """Symbolic equations of motion: Newton-Euler and Lagrange, and the proof they agree.
 
-    eom = derive(robot, method="newton-euler")   # or "lagrange"
-    eom.tau, eom.M, eom.C, eom.g, eom.steps
-    check(derive(robot), derive(robot, "lagrange")).text()
+eom = derive(robot, method="newton-euler")   # or "lagrange"
+eom.tau, eom.M, eom.C, eom.g, eom.steps
+check(derive(robot), derive(robot, "lagrange")).text()
 """
 
 from __future__ import annotations
@@ -41,6 +41,13 @@ def prove_agreement(robot: Robot | str, **kwargs) -> AgreementReport:
 
 
 __all__ = [
-    "derive", "prove_agreement", "check", "newton_euler", "lagrange",
-    "EquationsOfMotion", "Step", "AgreementReport", "METHODS",
+    "derive",
+    "prove_agreement",
+    "check",
+    "newton_euler",
+    "lagrange",
+    "EquationsOfMotion",
+    "Step",
+    "AgreementReport",
+    "METHODS",
 ]

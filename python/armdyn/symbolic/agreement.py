@@ -125,7 +125,6 @@ class _NumericSampler:
         return np.moveaxis(out, -1, 0)
 
 
-
 def _compare(name, a: sp.Matrix, b: sp.Matrix, q, sampler, exact: bool | None, tol: float) -> CheckResult:
     diff = a - b
     if exact is None:
@@ -211,4 +210,3 @@ def check(
         recon, name = recon + e.friction, name + ", + Fv qd + Fc sign(qd)"
     report.results.append(_compare(name, e.tau, recon, e.q, sampler, exact, tol))
     return report
-

@@ -1,6 +1,6 @@
 """Joint friction, rotor inertia and torque offset, symbolically.
 
-DESIGN.md's convention, per movable joint k (sign(0) = 0)::
+the architecture's convention, per movable joint k (sign(0) = 0)::
 
     tau_k = [M qdd + C qd + g]_k + Ia_k qdd_k + Fv_k qd_k + Fc_k sign(qd_k) + offset_k
 
@@ -51,4 +51,8 @@ def joint_torques(robot: Robot, qd, qdd) -> sp.Matrix:
 
 def has_joint_terms(robot: Robot) -> bool:
     """Whether any movable joint has a nonzero friction, armature or offset."""
-    return any(_value(j, name) != 0 for j in robot.movable_joints for name in ("damping", "friction", "armature", "torque_offset"))
+    return any(
+        _value(j, name) != 0
+        for j in robot.movable_joints
+        for name in ("damping", "friction", "armature", "torque_offset")
+    )

@@ -72,10 +72,22 @@ def _energies(robot: Robot):
             Step("energy", name, "omega", rf"{{}}^{{{i}}}\omega_{{{i}}}", w_i, "angular velocity"),
             Step("energy", name, "vc", rf"{{}}^{{{i}}}v_{{C_{i}}}", vc, "velocity of the centre of mass"),
             Step("energy", name, "pc", rf"{{}}^{{0}}p_{{C_{i}}}", pc, "centre of mass in the base frame"),
-            Step("energy", name, "T_trans", rf"T_{{{i},\mathrm{{trans}}}}", T_trans[name],
-                 "translational kinetic energy 1/2 m vc.vc"),
-            Step("energy", name, "T_rot", rf"T_{{{i},\mathrm{{rot}}}}", T_rot[name],
-                 "rotational kinetic energy 1/2 w^T I w"),
+            Step(
+                "energy",
+                name,
+                "T_trans",
+                rf"T_{{{i},\mathrm{{trans}}}}",
+                T_trans[name],
+                "translational kinetic energy 1/2 m vc.vc",
+            ),
+            Step(
+                "energy",
+                name,
+                "T_rot",
+                rf"T_{{{i},\mathrm{{rot}}}}",
+                T_rot[name],
+                "rotational kinetic energy 1/2 w^T I w",
+            ),
             Step("energy", name, "V", rf"V_{{{i}}}", V[name], "potential energy -m gravity.pc"),
         ]
     return T_trans, T_rot, V, steps
@@ -116,12 +128,30 @@ def lagrange(robot: Robot) -> EquationsOfMotion:
         tau_k = sp.sympify(ddt_p - dL_dq) + nonconservative[k]
         tau.append(tau_k)
         steps += [
-            Step("equations", robot.coordinate_names[k], "dL_dqd", rf"\partial L/\partial \dot q_{{{k + 1}}}",
-                 sp.sympify(dT_dqd[k]), "generalised momentum"),
-            Step("equations", robot.coordinate_names[k], "dL_dq", rf"\partial L/\partial q_{{{k + 1}}}",
-                 sp.sympify(dL_dq), "dL/dq"),
-            Step("equations", robot.coordinate_names[k], "tau", rf"\tau_{{{k + 1}}}", tau_k,
-                 "d/dt dL/dqd - dL/dq" + (" + friction + offset" if nonconservative[k] != 0 else "")),
+            Step(
+                "equations",
+                robot.coordinate_names[k],
+                "dL_dqd",
+                rf"\partial L/\partial \dot q_{{{k + 1}}}",
+                sp.sympify(dT_dqd[k]),
+                "generalised momentum",
+            ),
+            Step(
+                "equations",
+                robot.coordinate_names[k],
+                "dL_dq",
+                rf"\partial L/\partial q_{{{k + 1}}}",
+                sp.sympify(dL_dq),
+                "dL/dq",
+            ),
+            Step(
+                "equations",
+                robot.coordinate_names[k],
+                "tau",
+                rf"\tau_{{{k + 1}}}",
+                tau_k,
+                "d/dt dL/dqd - dL/dq" + (" + friction + offset" if nonconservative[k] != 0 else ""),
+            ),
         ]
 
     def mass_matrix():

@@ -70,11 +70,13 @@ def _cross(a, b):
 
     def m(x, y):
         return 0 if x == 0 or y == 0 else x * y
+
     return sp.Matrix([m(a[1], b[2]) - m(a[2], b[1]), m(a[2], b[0]) - m(a[0], b[2]), m(a[0], b[1]) - m(a[1], b[0])])
 
 
 # ------------------------------------------------------------------ step formulas
 # Vectors are (3, 1) SymPy matrices; each formula names its inputs as Craig does.
+
 
 def omega(R, w_p, z, qd, kind):
     """Angular velocity of link i in frame i."""
@@ -171,10 +173,22 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
             outward += [
                 Step("outward", name, "omega", rf"{{}}^{{{i}}}\omega_{{{i}}}", w_i, "angular velocity"),
                 Step("outward", name, "omega_dot", rf"{{}}^{{{i}}}\dot\omega_{{{i}}}", wd_i, "angular acceleration"),
-                Step("outward", name, "v_dot", rf"{{}}^{{{i}}}\dot v_{{{i}}}", vd_i,
-                     "linear acceleration of the frame origin (gravity included as base acceleration)"),
-                Step("outward", name, "vc_dot", rf"{{}}^{{{i}}}\dot v_{{C_{i}}}", vcd,
-                     "linear acceleration of the centre of mass"),
+                Step(
+                    "outward",
+                    name,
+                    "v_dot",
+                    rf"{{}}^{{{i}}}\dot v_{{{i}}}",
+                    vd_i,
+                    "linear acceleration of the frame origin (gravity included as base acceleration)",
+                ),
+                Step(
+                    "outward",
+                    name,
+                    "vc_dot",
+                    rf"{{}}^{{{i}}}\dot v_{{C_{i}}}",
+                    vcd,
+                    "linear acceleration of the centre of mass",
+                ),
                 Step("outward", name, "F", rf"{{}}^{{{i}}}F_{{{i}}}", F[name], "inertial force m vcd"),
                 Step("outward", name, "N", rf"{{}}^{{{i}}}N_{{{i}}}", N[name], "inertial moment I wd + w x I w"),
             ]
@@ -201,17 +215,33 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
             about = "" if point == sp.zeros(3, 1) else f", about joint {i}'s axis point {list(point)} (frame {i})"
             inward += [
                 Step("inward", name, "f", rf"{{}}^{{{i}}}f_{{{i}}}", f_i, "force exerted on the link by its parent"),
-                Step("inward", name, "n", rf"{{}}^{{{i}}}n_{{{i}}}", n_axis,
-                     "moment exerted on the link by its parent" + about),
+                Step(
+                    "inward",
+                    name,
+                    "n",
+                    rf"{{}}^{{{i}}}n_{{{i}}}",
+                    n_axis,
+                    "moment exerted on the link by its parent" + about,
+                ),
             ]
             kind = "torque" if joint.type == "revolute" else "force"
             if joint.mimic is not None:
                 tex = joint.name.replace("_", r"\_")
-                inward.append(Step("inward", name, "tau_mimic", rf"\tau_{{\mathrm{{{tex}}}}}", tau_j,
-                                   f"joint {kind} of mimic joint '{joint.name}', added {mult} times to tau{k + 1}"))
+                inward.append(
+                    Step(
+                        "inward",
+                        name,
+                        "tau_mimic",
+                        rf"\tau_{{\mathrm{{{tex}}}}}",
+                        tau_j,
+                        f"joint {kind} of mimic joint '{joint.name}', added {mult} times to tau{k + 1}",
+                    )
+                )
             elif follow is not None:
                 tau_steps.append((len(inward), k))
-                inward.append(Step("inward", name, "tau", rf"\tau_{{{k + 1}}}", tau[k], f"joint {kind} of '{joint.name}'"))
+                inward.append(
+                    Step("inward", name, "tau", rf"\tau_{{{k + 1}}}", tau[k], f"joint {kind} of '{joint.name}'")
+                )
     for pos, k in tau_steps:  # with mimic joints, tau_k is complete only now
         inward[pos] = replace(inward[pos], value=tau[k])
     if record:
@@ -237,9 +267,17 @@ def newton_euler(robot: Robot) -> EquationsOfMotion:
     steps: list[Step] = []
     tau = _recursion(robot, list(robot.qd), list(robot.qdd), -robot.gravity, steps)
     if has_joint_terms(robot):
-        # DESIGN.md: tau += Ia qdd + Fv qd + Fc sign(qd) + offset, joint by joint
+        # docs/architecture.md: tau += Ia qdd + Fv qd + Fc sign(qd) + offset, joint by joint
         extra = joint_torques(robot, robot.qd, robot.qdd)
         tau = tau + extra
-        steps.append(Step("inward", "", "tau_joint", r"\tau_{\mathrm{joint}}", extra,
-                          "rotor inertia, viscous and Coulomb friction, offset: Ia qdd + Fv qd + Fc sign(qd) + offset"))
+        steps.append(
+            Step(
+                "inward",
+                "",
+                "tau_joint",
+                r"\tau_{\mathrm{joint}}",
+                extra,
+                "rotor inertia, viscous and Coulomb friction, offset: Ia qdd + Fv qd + Fc sign(qd) + offset",
+            )
+        )
     return EquationsOfMotion(robot, "newton-euler", tau, steps, _M_builder=lambda: mass_matrix(robot))

@@ -28,18 +28,56 @@ FORMATS = ("text", "latex", "markdown")
 
 _SUB = str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉")
 _TEXT_NAMES = {
-    "omega": "ω", "omega_dot": "ω̇", "v_dot": "v̇", "vc_dot": "v̇_C", "F": "F", "N": "N",
-    "f": "f", "n": "n", "vc": "v_C", "pc": "p_C", "T_trans": "T_trans", "T_rot": "T_rot", "V": "V",
+    "omega": "ω",
+    "omega_dot": "ω̇",
+    "v_dot": "v̇",
+    "vc_dot": "v̇_C",
+    "F": "F",
+    "N": "N",
+    "f": "f",
+    "n": "n",
+    "vc": "v_C",
+    "pc": "p_C",
+    "T_trans": "T_trans",
+    "T_rot": "T_rot",
+    "V": "V",
 }
 
 
 # ------------------------------------------------------------ text: symbols as the field writes them
 _GREEK = {
-    "alpha": "α", "beta": "β", "gamma": "γ", "delta": "δ", "epsilon": "ε", "zeta": "ζ", "eta": "η",
-    "theta": "θ", "iota": "ι", "kappa": "κ", "lambda": "λ", "mu": "μ", "nu": "ν", "xi": "ξ", "pi": "π",
-    "rho": "ρ", "sigma": "σ", "tau": "τ", "phi": "φ", "chi": "χ", "psi": "ψ", "omega": "ω",
-    "Gamma": "Γ", "Delta": "Δ", "Theta": "Θ", "Lambda": "Λ", "Xi": "Ξ", "Pi": "Π", "Sigma": "Σ",
-    "Phi": "Φ", "Psi": "Ψ", "Omega": "Ω",
+    "alpha": "α",
+    "beta": "β",
+    "gamma": "γ",
+    "delta": "δ",
+    "epsilon": "ε",
+    "zeta": "ζ",
+    "eta": "η",
+    "theta": "θ",
+    "iota": "ι",
+    "kappa": "κ",
+    "lambda": "λ",
+    "mu": "μ",
+    "nu": "ν",
+    "xi": "ξ",
+    "pi": "π",
+    "rho": "ρ",
+    "sigma": "σ",
+    "tau": "τ",
+    "phi": "φ",
+    "chi": "χ",
+    "psi": "ψ",
+    "omega": "ω",
+    "Gamma": "Γ",
+    "Delta": "Δ",
+    "Theta": "Θ",
+    "Lambda": "Λ",
+    "Xi": "Ξ",
+    "Pi": "Π",
+    "Sigma": "Σ",
+    "Phi": "Φ",
+    "Psi": "Ψ",
+    "Omega": "Ω",
 }
 _DOTS = {"": "", "_dot": "\u0307", "_ddot": "\u0308"}  # combining dot / diaeresis above
 _SUP = str.maketrans("0123456789-", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻")
@@ -82,6 +120,7 @@ class _UnicodeTextPrinter(sp.printing.str.StrPrinter):
 
 def _juxtapose(text: str) -> str:
     """``a*b`` -> ``a b`` in printed text (``**`` untouched), ``2*3`` -> ``2·3``."""
+
     def sub(m):
         left, right = m.group(1), m.string[m.end()]
         return f"{left}{'·' if left.isdigit() and right.isdigit() else ' '}"
@@ -171,8 +210,11 @@ NOTE_FORMULAS = (
     ("1/2 w^T I w", "½ ωᵀ I ω", r"\tfrac{1}{2} \omega^{\mathsf{T}} I \omega"),
     ("1/2 Ia qd^2", "½ I_a q̇²", r"\tfrac{1}{2} I_a \dot{q}^{2}"),
     ("-m gravity.pc", "−m gᵀ p_C", r"-m \, g^{\mathsf{T}} p_C"),
-    ("d/dt dL/dqd - dL/dq", "d/dt ∂L/∂q̇ − ∂L/∂q",
-     r"\frac{d}{dt} \frac{\partial L}{\partial \dot{q}} - \frac{\partial L}{\partial q}"),
+    (
+        "d/dt dL/dqd - dL/dq",
+        "d/dt ∂L/∂q̇ − ∂L/∂q",
+        r"\frac{d}{dt} \frac{\partial L}{\partial \dot{q}} - \frac{\partial L}{\partial q}",
+    ),
     ("dL/dq", "∂L/∂q", r"\frac{\partial L}{\partial q}"),
     ("T - V", "T − V", "T - V"),
 )
@@ -184,7 +226,7 @@ def note_parts(note: str) -> list[tuple[str, int | None]]:
     for k, (ascii_form, _, _) in enumerate(NOTE_FORMULAS):
         at = note.find(ascii_form)
         if at >= 0:
-            tail = note[at + len(ascii_form):]
+            tail = note[at + len(ascii_form) :]
             head = [(note[:at], None)] if at else []
             return head + [(ascii_form, k)] + (note_parts(tail) if tail else [])
     return [(note, None)] if note else []
@@ -359,7 +401,8 @@ def tau_lines(eom: EquationsOfMotion, fmt: str = "text", ascii: bool = False) ->
         reduced = [sp.sympify(e) for e in reduced]
         lines.append(
             f"  ({len(subexprs)} common subexpressions x0..x{len(subexprs) - 1}, then tau)"
-            if fmt == "text" else "% common subexpressions, then tau"
+            if fmt == "text"
+            else "% common subexpressions, then tau"
         )
         for sym, sub in subexprs:
             lines.append(r.equation(r.atom(sym), r.atom(sub)))
@@ -390,7 +433,9 @@ def steps_lines(eom: EquationsOfMotion, fmt: str = "text", ascii: bool = False) 
         if s.stage != stage:
             stage = s.stage
             head = titles.get(stage, stage)
-            lines.append(f" {head}:" if fmt == "text" else (rf"\intertext{{{head}}}" if fmt == "latex" else f"**{head}**"))
+            lines.append(
+                f" {head}:" if fmt == "text" else (rf"\intertext{{{head}}}" if fmt == "latex" else f"**{head}**")
+            )
         eq = r.equation(r.label(s), r.value(s.value))
         note = s.note if ascii else note_text(s.note)
         where = f"{s.link}: {note}" if s.link else note
@@ -398,8 +443,9 @@ def steps_lines(eom: EquationsOfMotion, fmt: str = "text", ascii: bool = False) 
     return lines
 
 
-def derivation_report(eoms: list[EquationsOfMotion], fmt: str = "text", steps: bool = False,
-                      agreement=None, ascii: bool = False) -> str:
+def derivation_report(
+    eoms: list[EquationsOfMotion], fmt: str = "text", steps: bool = False, agreement=None, ascii: bool = False
+) -> str:
     """A whole report: the robot, for each method its (steps and) tau, then agreement.
     ascii: text format in plain ASCII (theta1_dot, tau1) instead of Unicode (θ̇₁, τ₁).
 
@@ -419,7 +465,11 @@ def derivation_report(eoms: list[EquationsOfMotion], fmt: str = "text", steps: b
         out.append(f"{title}:" if fmt == "text" else (f"% {title}" if fmt == "latex" else f"## {title}"))
         if steps and robot.meta.get("frames"):
             note = " ".join(str(robot.meta["frames"]).split())
-            out.append(f" frames: {note}" if fmt == "text" else (f"% frames: {note}" if fmt == "latex" else f"*Frames:* {note}"))
+            out.append(
+                f" frames: {note}"
+                if fmt == "text"
+                else (f"% frames: {note}" if fmt == "latex" else f"*Frames:* {note}")
+            )
         if fmt == "latex":
             out.append(r"\begin{align*}")
         if steps:

@@ -63,8 +63,11 @@ class _Writer:
             for i in range(value.rows):
                 cells = "".join(f"<mtd>{self.scalar(value[i, j])}</mtd>" for j in range(value.cols))
                 rows.append(f"<mtr>{cells}</mtr>")
-            return ('<mrow><mo stretchy="true">(</mo><mtable>' + "".join(rows)
-                    + '</mtable><mo stretchy="true">)</mo></mrow>')
+            return (
+                '<mrow><mo stretchy="true">(</mo><mtable>'
+                + "".join(rows)
+                + '</mtable><mo stretchy="true">)</mo></mrow>'
+            )
         return self.w.value(value, scalar=self.scalar)
 
 
@@ -134,8 +137,11 @@ def _steps_block(eom, wr: _Writer) -> str:
                 group = None
             stage = s.stage
             note = _STAGE_NOTES.get(stage, "")
-            out.append(f"<h3>{escape(_STAGE_TITLES.get(stage, stage))}"
-                       + (f' <span class="note">({escape(note)})</span>' if note else "") + "</h3>")
+            out.append(
+                f"<h3>{escape(_STAGE_TITLES.get(stage, stage))}"
+                + (f' <span class="note">({escape(note)})</span>' if note else "")
+                + "</h3>"
+            )
         if s.link != group:
             if group is not None:
                 out.append("</div>")
@@ -185,10 +191,16 @@ def agreement_body(report) -> str:
         mark = '<span class="ok">OK</span>' if r.passed else '<span class="fail">FAIL</span>'
         err = "" if r.how == "exact" else f"{r.max_error:.2e}"
         rows.append(f"<tr><td>{mark}</td><td>{escape(r.name)}</td><td>{escape(r.how)}</td><td>{err}</td></tr>")
-    head = (f'<p>Checks for <b>{escape(report.robot)}</b>: '
-            + ('<span class="ok">all passed</span>' if report else '<span class="fail">FAILED</span>') + "</p>")
-    table = ('<table class="plain"><tr><th></th><th>check</th><th>how</th><th>max |difference|</th></tr>'
-             + "".join(rows) + "</table>")
+    head = (
+        f"<p>Checks for <b>{escape(report.robot)}</b>: "
+        + ('<span class="ok">all passed</span>' if report else '<span class="fail">FAILED</span>')
+        + "</p>"
+    )
+    table = (
+        '<table class="plain"><tr><th></th><th>check</th><th>how</th><th>max |difference|</th></tr>'
+        + "".join(rows)
+        + "</table>"
+    )
     return head + table
 
 
@@ -212,28 +224,39 @@ def robot_body(robot) -> str:
     for j in robot.joints:
         k = robot.coordinate_index(j)
         q = m(robot.q[k]) if k is not None else ""
-        frame = (f"<td>{vec(j.frame_xyz) if j.has_frame_offset else ''}</td>"
-                 f"<td>{rotation(j.frame_rotation)}</td>") if offsets else ""
-        joints.append(f"<tr><td>{escape(j.name)}</td><td>{escape(j.type)}</td><td>{q}</td>"
-                      f"<td>{escape(j.parent)} \u2192 {escape(j.child)}</td><td>{vec(j.xyz)}</td>"
-                      f"<td>{rotation(j.rotation)}</td>"
-                      f"<td>{vec(j.axis) if j.movable else ''}</td>{frame}</tr>")
+        frame = (
+            (f"<td>{vec(j.frame_xyz) if j.has_frame_offset else ''}</td><td>{rotation(j.frame_rotation)}</td>")
+            if offsets
+            else ""
+        )
+        joints.append(
+            f"<tr><td>{escape(j.name)}</td><td>{escape(j.type)}</td><td>{q}</td>"
+            f"<td>{escape(j.parent)} \u2192 {escape(j.child)}</td><td>{vec(j.xyz)}</td>"
+            f"<td>{rotation(j.rotation)}</td>"
+            f"<td>{vec(j.axis) if j.movable else ''}</td>{frame}</tr>"
+        )
     frame_heads = ("<th>frame_xyz (joint frame)</th><th>frame_rotation</th>") if offsets else ""
     links = []
     for name, link in robot.links.items():
         if name == robot.base:
             continue
         inertia = "0" if link.inertia.is_zero_matrix else math_element(w.value(link.inertia))
-        links.append(f"<tr><td>{escape(name)}</td><td>{m(link.mass)}</td><td>{vec(link.com)}</td>"
-                     f"<td>{inertia}</td></tr>")
+        links.append(
+            f"<tr><td>{escape(name)}</td><td>{m(link.mass)}</td><td>{vec(link.com)}</td><td>{inertia}</td></tr>"
+        )
     params = ", ".join(sorted(robot.parameters)) or "none"
-    return (f'<p class="meta"><b>{escape(robot.name)}</b> · {robot.dof} dof · gravity '
-            f'{math_element(w.value(robot.gravity.T))} · parameters: {escape(params)}</p>'
-            '<table class="plain"><tr><th>joint</th><th>type</th><th>q</th><th>parent \u2192 child</th>'
-            "<th>xyz (parent frame)</th><th>rotation</th><th>axis</th>" + frame_heads + "</tr>"
-            + "".join(joints) + "</table>"
-            '<table class="plain"><tr><th>link</th><th>mass</th><th>centre of mass</th>'
-            "<th>inertia about it</th></tr>" + "".join(links) + "</table>")
+    return (
+        f'<p class="meta"><b>{escape(robot.name)}</b> · {robot.dof} dof · gravity '
+        f"{math_element(w.value(robot.gravity.T))} · parameters: {escape(params)}</p>"
+        '<table class="plain"><tr><th>joint</th><th>type</th><th>q</th><th>parent \u2192 child</th>'
+        "<th>xyz (parent frame)</th><th>rotation</th><th>axis</th>"
+        + frame_heads
+        + "</tr>"
+        + "".join(joints)
+        + "</table>"
+        '<table class="plain"><tr><th>link</th><th>mass</th><th>centre of mass</th>'
+        "<th>inertia about it</th></tr>" + "".join(links) + "</table>"
+    )
 
 
 def derivation_html(eoms, steps: bool = False, agreement=None) -> str:
@@ -261,8 +284,10 @@ def derivation_html(eoms, steps: bool = False, agreement=None) -> str:
 
 def eom_html(eom) -> str:
     """``EquationsOfMotion._repr_html_``: tau of one derivation, as a fragment."""
-    head = (f'<p class="meta"><b>{escape(eom.robot.name)}</b> · '
-            f"{escape(_METHODS.get(eom.method, eom.method))} · {eom.robot.dof} dof</p>")
+    head = (
+        f'<p class="meta"><b>{escape(eom.robot.name)}</b> · '
+        f"{escape(_METHODS.get(eom.method, eom.method))} · {eom.robot.dof} dof</p>"
+    )
     return fragment(head + _tau_block(eom, _Writer(eom)))
 
 

@@ -7,7 +7,7 @@
 //!
 //! * `10 nj` inertial columns, link by link, parameters in Pinocchio's order
 //!   `[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]` with the inertia about the
-//!   link frame's origin, in the link frame (DESIGN.md);
+//!   link frame's origin, in the link frame (docs/architecture.md);
 //! * `4 nv` joint columns, joint by joint: `[qdd_i, qd_i, sign(qd_i), 1]`, the
 //!   coefficients of the armature `Ia`, viscous `Fv`, Coulomb `Fc` and `offset`.
 //!

@@ -44,7 +44,7 @@ pub fn rnea<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd: 
     }
 }
 
-/// `tau_i += Ia_i qdd_i + Fv_i qd_i + Fc_i sign(qd_i) + offset_i` (DESIGN.md), all (nv,).
+/// `tau_i += Ia_i qdd_i + Fv_i qd_i + Fc_i sign(qd_i) + offset_i` (docs/architecture.md), all (nv,).
 #[inline(always)]
 pub fn add_joint_dynamics<T: Real>(model: &Model, qd: &[T], qdd: &[T], tau: &mut [T]) {
     for i in 0..model.nv {

@@ -294,7 +294,7 @@ fn is_chain(model: &Model) -> bool {
     model.parent.iter().enumerate().all(|(i, &p)| p == i.checked_sub(1))
 }
 
-/// The joint terms `Ia qdd + Fv qd + Fc sign(qd) + offset` of `rnea` (DESIGN.md), differentiated:
+/// The joint terms `Ia qdd + Fv qd + Fc sign(qd) + offset` of `rnea` (docs/architecture.md), differentiated:
 /// `M += diag(Ia)`, `dtau/dqd += diag(Fv)`. `sign(qd)` is piecewise constant, so the Coulomb
 /// term adds nothing to `dtau/dqd` for `qd != 0`; at `qd = 0` (where it jumps and has no
 /// derivative) we report the same 0, the one-sided derivative of either side, consistent with

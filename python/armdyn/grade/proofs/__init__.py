@@ -65,9 +65,20 @@ def _name(links: list[LinkVerdict]) -> None:
 
 
 def _verdict(v: LinkVerdict) -> StepVerdict:
-    return StepVerdict(name=v.name, key="proof", link="", status=v.status, label=v.label, source=v.source,
-                       line=v.line, expected=_sympy(v.right), got=_sympy(v.left), message=v.message,
-                       caused_by=v.caused_by, counterexample=v.counterexample)
+    return StepVerdict(
+        name=v.name,
+        key="proof",
+        link="",
+        status=v.status,
+        label=v.label,
+        source=v.source,
+        line=v.line,
+        expected=_sympy(v.right),
+        got=_sympy(v.left),
+        message=v.message,
+        caused_by=v.caused_by,
+        counterexample=v.counterexample,
+    )
 
 
 def check_text(text: str, path: str = "<string>", step_lines: set | None = None) -> list[StepVerdict]:

@@ -26,7 +26,7 @@ from fractions import Fraction
 from .matrices import Mat
 
 #: random integers are drawn from [-SPAN, SPAN] (masses from [1, SPAN])
-SPAN = 2 ** 31
+SPAN = 2**31
 #: point masses in a random body (four points in general position span every inertia tensor)
 POINTS = 4
 
@@ -55,8 +55,9 @@ class Instance:
     centered:  point C is the mass center (else an arbitrary point)
     """
 
-    def __init__(self, masses, positions, rng: random.Random, small: bool, centered: bool = True,
-                 rotation_axis: str = "z"):
+    def __init__(
+        self, masses, positions, rng: random.Random, small: bool, centered: bool = True, rotation_axis: str = "z"
+    ):
         self.masses = [Fraction(m) for m in masses]
         self.positions = [p if isinstance(p, Mat) else Mat.col(p) for p in positions]
         self.rng = rng
@@ -70,8 +71,7 @@ class Instance:
         self.cache: dict = {}
         total = sum(self.masses, Fraction(0))
         self.mass = total
-        center = [sum((m * p.v[i] for m, p in zip(self.masses, self.positions)), Fraction(0)) / total
-                  for i in range(3)]
+        center = [sum((m * p.v[i] for m, p in zip(self.masses, self.positions)), Fraction(0)) / total for i in range(3)]
         self.points["C"] = Mat.col(center) if centered else self._draw_vector()
 
     def __len__(self) -> int:
@@ -150,5 +150,4 @@ def small_instances(count: int = 200, seed: int = 7):
         if len({tuple(p) for p in positions}) < n:
             continue
         made += 1
-        yield Instance(masses, positions, random.Random(rng.random()), small=True,
-                       rotation_axis="zxy"[made % 3])
+        yield Instance(masses, positions, random.Random(rng.random()), small=True, rotation_axis="zxy"[made % 3])

@@ -30,8 +30,18 @@ from fractions import Fraction
 from ..latex import LatexError, sides
 from .body import random_instance
 from .counterexample import find, sentence
-from .evaluate import (_VECTORS, MAX_DEGREE, NeedElement, NotRational, ProofState, Scope, UnknownName, degree,
-                       evaluate, key)
+from .evaluate import (
+    _VECTORS,
+    MAX_DEGREE,
+    NeedElement,
+    NotRational,
+    ProofState,
+    Scope,
+    UnknownName,
+    degree,
+    evaluate,
+    key,
+)
 from .expr import Add, Integral, Num, ProofSyntaxError, Sym, parse_side, walk
 from .matrices import ShapeError, SizeError
 from .regions import Display
@@ -41,8 +51,9 @@ from .regions import Display
 K = 3
 _ORDINALS = {"first": 0, "second": 1, "third": 2, "fourth": 3, "fifth": 4}
 _JOIN = re.compile(r"\b(first|second|third|fourth|fifth|last)\s+(integral|term|summand)\b", re.IGNORECASE)
-_VANISH = re.compile(r"\b(first|second|third|fourth|fifth|last)\s+(integral|term|summand)\s+(vanishes|is zero)",
-                     re.IGNORECASE)
+_VANISH = re.compile(
+    r"\b(first|second|third|fourth|fifth|last)\s+(integral|term|summand)\s+(vanishes|is zero)", re.IGNORECASE
+)
 _FROM_TO = re.compile(r"from\s+\$?\s*(?:\\mathbf\{)?([A-Z])\}?\s*\$?\s+to\s+\$?\s*(?:\\mathbf\{)?([A-Z])\b")
 
 
@@ -77,12 +88,12 @@ class ProofChecker:
 
     def __post_init__(self):
         self.state = ProofState()
-        self.defs: dict = {}       # name key -> (tree, line): definitions the text made
+        self.defs: dict = {}  # name key -> (tree, line): definitions the text made
         self.overrides: dict = {}  # name key -> (tree, line): the student's wrong definitions
-        self.seen: set = set()     # constant vectors named so far
-        self.sums: list = []       # (line, tree) of sums met, for "the second integral"
-        self.notes: set = set()    # how the names of the current link were read
-        self.named: set = set()    # inertia tensors whose definition was met
+        self.seen: set = set()  # constant vectors named so far
+        self.sums: list = []  # (line, tree) of sums met, for "the second integral"
+        self.notes: set = set()  # how the names of the current link were read
+        self.named: set = set()  # inertia tensors whose definition was met
         self.instances = [random_instance(seed) for seed in range(K)]
         self.uncentered = random_instance(1000, centered=False)
 
@@ -128,8 +139,9 @@ class ProofChecker:
     # -- one link
     def link(self, left, right, line: int, label: str, source: str, prefix: str = "") -> LinkVerdict:
         if time.perf_counter() > self.deadline:
-            return LinkVerdict(line, label, source, "unrecognised", "not checked: the proof checker's time budget "
-                               "(4 s) is spent")
+            return LinkVerdict(
+                line, label, source, "unrecognised", "not checked: the proof checker's time budget (4 s) is spent"
+            )
         try:
             return self._link(left, right, line, label, source, prefix)
         except _Failure as f:
@@ -156,18 +168,32 @@ class ProofChecker:
         env = {**self.defs, **self.overrides}
         if self.overrides and self._guarded(lambda: self._agree(left, right, env, self.instances)):
             first = min(self.overrides.values(), key=lambda v: v[1])
-            return LinkVerdict(line, label, source, "follows-from-earlier-error",
-                               _join(prefix, f"right with your own definition at line {first[1]}, which is wrong"),
-                               cause=first[2])
-        example = self._guarded(lambda: find(lambda inst: self._pairs(left, right, inst, self.defs),
-                                             self.instances[0], self._defined_values))
+            return LinkVerdict(
+                line,
+                label,
+                source,
+                "follows-from-earlier-error",
+                _join(prefix, f"right with your own definition at line {first[1]}, which is wrong"),
+                cause=first[2],
+            )
+        example = self._guarded(
+            lambda: find(
+                lambda inst: self._pairs(left, right, inst, self.defs), self.instances[0], self._defined_values
+            )
+        )
         msg = _join(prefix, "the two sides differ")
         if example is not None:
             msg = _join(msg, "counterexample: " + sentence(example))
-        return LinkVerdict(line, label, source, "wrong", _join(msg, said),
-                           left=example["left_value"] if example else None,
-                           right=example["right_value"] if example else None,
-                           counterexample=example["data"] if example else None)
+        return LinkVerdict(
+            line,
+            label,
+            source,
+            "wrong",
+            _join(msg, said),
+            left=example["left_value"] if example else None,
+            right=example["right_value"] if example else None,
+            counterexample=example["data"] if example else None,
+        )
 
     def _defined_values(self, inst) -> dict:
         out = {}
@@ -184,10 +210,19 @@ class ProofChecker:
         """``r_P = r_C + d`` with ``d`` met for the first time: d := r_P - r_C."""
         for side, other, flip in ((right, left, False), (left, right, True)):
             terms = side.terms if isinstance(side, Add) else ((1, side),)
-            fresh = [(s, t) for s, t in terms if isinstance(t, Sym) and t.base in _VECTORS and t.base != "omega"
-                     and not t.frame and not t.transposed and key(t) not in self.seen]
-            if len(fresh) != 1 or any(key(n) in self.seen for n in walk(other) if isinstance(n, Sym)
-                                      and key(n) == key(fresh[0][1])):
+            fresh = [
+                (s, t)
+                for s, t in terms
+                if isinstance(t, Sym)
+                and t.base in _VECTORS
+                and t.base != "omega"
+                and not t.frame
+                and not t.transposed
+                and key(t) not in self.seen
+            ]
+            if len(fresh) != 1 or any(
+                key(n) in self.seen for n in walk(other) if isinstance(n, Sym) and key(n) == key(fresh[0][1])
+            ):
                 continue
             sign, sym = fresh[0]
             rest = [(-s, t) for s, t in terms if t is not sym]
@@ -200,8 +235,9 @@ class ProofChecker:
             except (ShapeError, LatexError, NeedElement, ArithmeticError) as err:
                 return LinkVerdict(line, label, source, "unrecognised", f"cannot read {sym.latex()}: {err}")
             if any(v != values[0] for v in values):
-                return LinkVerdict(line, label, source, "wrong",
-                                   f"defines {sym.latex()}, but it is not constant over the body")
+                return LinkVerdict(
+                    line, label, source, "wrong", f"defines {sym.latex()}, but it is not constant over the body"
+                )
             what = ""
             names = [p for p in inst.points if not p.startswith("ref:")]
             for a in names:
@@ -209,8 +245,7 @@ class ProofChecker:
                     if a != b and values[0] == inst.points[a] - inst.points[b]:
                         what = f" = {a} - {b}"
             self.constant_def = (sym.latex(), what)
-            return LinkVerdict(line, label, source, "correct",
-                               f"defines {sym.latex()}{what} (constant over the body)")
+            return LinkVerdict(line, label, source, "correct", f"defines {sym.latex()}{what} (constant over the body)")
         return None
 
     def _is_new_name(self, node) -> bool:
@@ -249,8 +284,11 @@ class ProofChecker:
                 continue
             if j == 0 and self._is_new_name(a):  # K = ... (= ...): names the first expression
                 self.defs[key(a)] = (b, d.line)
-                out.append(LinkVerdict(d.line, label, source, "correct",
-                                       f"defines {a.latex()} (a definition: nothing to check)"))
+                out.append(
+                    LinkVerdict(
+                        d.line, label, source, "correct", f"defines {a.latex()} (a definition: nothing to check)"
+                    )
+                )
                 continue
             if len(raw) == 2:
                 v = self._define_vector(a, b, d.line, label, source)
@@ -263,8 +301,15 @@ class ProofChecker:
             for t in (a, b):
                 self.seen |= {key(n) for n in walk(t) if isinstance(n, Sym) and n.base in _VECTORS}
             v = self.link(a, b, d.line, label, source)
-            if v.status == "correct" and len(raw) == 2 and isinstance(a, Sym) and a.base == "I" and a.sub \
-                    and not a.transposed and key(a) not in self.named:  # a definition: say what it agrees with
+            if (
+                v.status == "correct"
+                and len(raw) == 2
+                and isinstance(a, Sym)
+                and a.base == "I"
+                and a.sub
+                and not a.transposed
+                and key(a) not in self.named
+            ):  # a definition: say what it agrees with
                 self.named.add(key(a))
                 if a.frame:
                     what = f"the frame change of the inertia tensor into frame {a.frame}: R^{a.frame} I R^{a.frame}T"
@@ -309,8 +354,9 @@ class ProofChecker:
             return LinkVerdict(d.line, label, source, "unrecognised", f"cannot read: {tree}")
         m = _JOIN.search(d.prose)
         if m is None:
-            return LinkVerdict(d.line, label, source, "unrecognised",
-                               "an expression without '=' and no sentence saying what it equals")
+            return LinkVerdict(
+                d.line, label, source, "unrecognised", "an expression without '=' and no sentence saying what it equals"
+            )
         word, noun = m.group(1).lower(), m.group(2).lower()
         summand = self._summand(word, noun, exclude=tree)
         if summand is None:
@@ -318,8 +364,7 @@ class ProofChecker:
         line, (sign, term) = summand
         left = term if sign > 0 else Add(((-1, term),))
         prefix = f"the {word} {noun} of line {line} equals this"
-        return self.link(left, tree, d.line, f"\\text{{({word} {noun} of line {line})}} = {d.text}", source,
-                         prefix)
+        return self.link(left, tree, d.line, f"\\text{{({word} {noun} of line {line})}} = {d.text}", source, prefix)
 
     def _summand(self, word: str, noun: str, exclude=None):
         """The latest sum's ``word`` (first, second... last) summand: (line, (sign, tree))."""
@@ -343,8 +388,14 @@ class ProofChecker:
         if summand is None:
             return None
         line, (sign, term) = summand
-        return self.link(term, Num(Fraction(0)), d.line, f"\\text{{({word} {noun} of line {line})}} = 0",
-                         f"the {word} {noun} vanishes", f"the {word} {noun} of line {line} vanishes")
+        return self.link(
+            term,
+            Num(Fraction(0)),
+            d.line,
+            f"\\text{{({word} {noun} of line {line})}} = 0",
+            f"the {word} {noun} vanishes",
+            f"the {word} {noun} of line {line} vanishes",
+        )
 
     def _direction_remark(self, prose: str) -> str:
         m = _FROM_TO.search(prose or "")
@@ -353,8 +404,10 @@ class ProofChecker:
         name, what = self.constant_def
         a, b = m.group(1), m.group(2)
         if what == f" = {a} - {b}":
-            return (f"remark: {name}{what} points from {b} to {a}, while the text says from {a} to {b} "
-                    "(the result is unchanged: only |d|^2 and d d^T enter)")
+            return (
+                f"remark: {name}{what} points from {b} to {a}, while the text says from {a} to {b} "
+                "(the result is unchanged: only |d|^2 and d d^T enter)"
+            )
         return ""
 
 

@@ -157,8 +157,11 @@ def _builtin(s: Sym, sc: Scope) -> Mat:
                 raise UnknownName(f"{s.latex()}: an inertia tensor about which point? (no r_X in the proof yet)")
             point = state.point
             frame = f", in frame {s.frame}" if s.frame else ""
-            sc.notes.add(f"{s.latex()} read as the inertia tensor about the reference point of r_{state.point_sub}"
-                         + frame if state.point_sub else f"{s.latex()} read as the inertia tensor about O" + frame)
+            sc.notes.add(
+                f"{s.latex()} read as the inertia tensor about the reference point of r_{state.point_sub}" + frame
+                if state.point_sub
+                else f"{s.latex()} read as the inertia tensor about O" + frame
+            )
         else:
             if state.inertia is None:
                 raise UnknownName(f"{s.latex()}: the frame-{s.frame} version of which inertia tensor?")
@@ -196,8 +199,10 @@ def _builtin(s: Sym, sc: Scope) -> Mat:
         for k, m in enumerate(inst.masses):
             v = omega.cross(inst.element(k, point))
             total += m * v.dot(v)
-        sc.notes.add("E_rot read as the kinetic energy of rotation 1/2 \\int |omega x r|^2 dm"
-                     + (f" (r = r_{state.point_sub})" if state.point_sub else ""))
+        sc.notes.add(
+            "E_rot read as the kinetic energy of rotation 1/2 \\int |omega x r|^2 dm"
+            + (f" (r = r_{state.point_sub})" if state.point_sub else "")
+        )
         return Mat.scalar(total / 2)
     raise UnknownName(f"unknown name {s.latex()} (not a rigid-body quantity this checker knows)")
 

@@ -33,8 +33,20 @@ MAX_INTEGRALS = 3
 MAX_POWER = 8
 
 _BOLD = {"mathbf", "boldsymbol", "bm", "pmb", "mathbold"}
-_WRAPPERS = {"mathrm", "mathit", "vec", "hat", "bar", "mathsf", "operatorname", "text", "mathcal", "tilde",
-             "textrm", "mathbb"} | _BOLD
+_WRAPPERS = {
+    "mathrm",
+    "mathit",
+    "vec",
+    "hat",
+    "bar",
+    "mathsf",
+    "operatorname",
+    "text",
+    "mathcal",
+    "tilde",
+    "textrm",
+    "mathbb",
+} | _BOLD
 _MATRIX_ENVS = {"pmatrix", "bmatrix", "Bmatrix", "matrix", "smallmatrix", "array"}
 _STOP_CHARS = {"+", "-", ")", "]", "}", "=", "&", ",", ".", ";", "eof"}
 
@@ -205,8 +217,14 @@ class _Parser:
         k, v = self.peek()
         if (k, v) == ("char", "d") and self.peek(1)[1] in ("m", "V"):
             return self.peek(1)[1]
-        if k == "cmd" and v in ("mathrm", "text", "operatorname") and self.peek(1)[1] == "{" \
-                and self.peek(2)[1] == "d" and self.peek(3)[1] == "}" and self.peek(4)[1] in ("m", "V"):
+        if (
+            k == "cmd"
+            and v in ("mathrm", "text", "operatorname")
+            and self.peek(1)[1] == "{"
+            and self.peek(2)[1] == "d"
+            and self.peek(3)[1] == "}"
+            and self.peek(4)[1] in ("m", "V")
+        ):
             return self.peek(4)[1]
         return None
 

@@ -69,8 +69,12 @@ class Mat:
         return self.r == 1 and self.c == 1
 
     def kind(self) -> str:
-        return {(1, 1): "a scalar", (3, 1): "a vector", (1, 3): "a row vector (transposed vector)",
-                (3, 3): "a 3x3 matrix"}.get(self.shape, f"a {self.r}x{self.c} matrix")
+        return {
+            (1, 1): "a scalar",
+            (3, 1): "a vector",
+            (1, 3): "a row vector (transposed vector)",
+            (3, 3): "a 3x3 matrix",
+        }.get(self.shape, f"a {self.r}x{self.c} matrix")
 
     def __getitem__(self, ij):
         i, j = ij
@@ -132,7 +136,7 @@ class Mat:
         bits = max(x.numerator.bit_length(), x.denominator.bit_length())
         if bits * abs(n) > MAX_BITS:
             raise SizeError(f"a power with more than {MAX_BITS} bits")
-        return Mat.scalar(x ** n)
+        return Mat.scalar(x**n)
 
     def __eq__(self, o) -> bool:
         return isinstance(o, Mat) and self.shape == o.shape and self.v == o.v

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 from ..latex import split_equations
 from ..reader import math_blocks
+
 _START = re.compile(r"\b(prove|proof|show that)\b", re.IGNORECASE)
 _KEEP_HEADING = re.compile(r"^\W*(solution|proof|answer|demonstration)\b", re.IGNORECASE)
 _INSTRUCTION = re.compile(r"^\W*(check|formulate|derive|compute|calculate|find|determine|solve|write)\b", re.IGNORECASE)
