@@ -444,7 +444,7 @@ def parse_expression(
             raise ModelError(message, element, source) from None
         except _ParseError as exc:
             raise ModelError(f"{prefix}cannot parse expression {quoted(value)} ({exc})", element, source) from None
-        except (TypeError, ValueError, ZeroDivisionError) as exc:
+        except (TypeError, ValueError, ZeroDivisionError, OverflowError) as exc:
             raise ModelError(f"{prefix}cannot evaluate expression {quoted(value)} ({exc})", element, source) from None
     else:
         raise ModelError(
