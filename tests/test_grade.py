@@ -44,7 +44,7 @@ def test_exercise_verdict_is_the_one_worked_out_by_hand(exercise):
     assert r.first_wrong == "v_dot_1"
     v1 = first_status(r, "v_dot_1")
     assert v1.status == "wrong" and v1.components == [0]
-    assert "missing term −l₁·θ̇₁²" in v1.message  # derive's symbol names and "x component" in v1.message
+    assert "missing term −l₁ θ̇₁²" in v1.message  # derive's symbol names and "x component" in v1.message
     for name in ("vc_dot_1", "v_dot_2", "vc_dot_2", "F_1", "f_2", "n_2", "f_1"):
         v = first_status(r, name)
         assert v.status == "follows-from-earlier-error", name
@@ -57,7 +57,7 @@ def test_exercise_verdict_is_the_one_worked_out_by_hand(exercise):
     assert n1.status == "wrong" and "factor l₁ missing" in n1.message and n1.components == [2]
     tau = [v for v in r.steps if v.key == "tau"]
     assert [(v.name, v.status) for v in tau[:2]] == [("tau_1", "correct-but-unsupported"), ("tau_2", "correct")]
-    assert "−d₂·l₁·m₂·θ̇₁²" in tau[0].message  # what the first slip would leave, carried through
+    assert "−d₂ l₁ m₂ θ̇₁²" in tau[0].message  # what the first slip would leave, carried through
     for name in (
         "omega_0",
         "omega_dot_0",
@@ -119,7 +119,7 @@ def test_correct_derivation_in_dalembert_convention_names_the_convention():
 def test_cli_text_json_and_exit_status(capsys):
     code, out, err = run(capsys, "grade", EXERCISE)
     assert code == 1 and err == ""
-    assert "first wrong step: v̇_1" in out and "missing term −l₁·θ̇₁² in the x component" in out
+    assert "first wrong step: v̇_1" in out and "missing term −l₁ θ̇₁² in the x component" in out
     code, out, _ = run(capsys, "grade", EXERCISE, "--json")
     data = json.loads(out)
     assert {"robot", "method", "steps", "first_wrong", "tau_correct"} <= set(data)
@@ -133,7 +133,7 @@ def test_cli_text_json_and_exit_status(capsys):
     code, _, _ = run(capsys, "grade", EXAMPLES / "rp-arm-dalembert.md")
     assert code == 0
     code, out, _ = run(capsys, "grade", EXERCISE, "--ascii")
-    assert out.isascii() and "missing term -l1*theta1_dot**2" in out
+    assert out.isascii() and "missing term -l1 theta1_dot**2" in out
 
 
 def test_markdown_read_back_as_yaml_grades_the_same(tmp_path, capsys):

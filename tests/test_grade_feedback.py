@@ -251,9 +251,9 @@ def test_difference_is_simplified_and_expected_in_the_students_shorthand(craig_s
     assert [sp.sympify(d) for d in step["difference"][1:]] == [0, 0]
     code, out, _ = run(capsys, "grade", craig_slip)
     line = next(t for t in out.split("\n") if "v̇_2" in t and "WRONG" in t)
-    assert "wrong sign on the term −c₂·l₁·q̇₁²" in line
+    assert "wrong sign on the term −c₂ l₁ q̇₁²" in line
     expected = next(t for t in out.split("\n")[out.split("\n").index(line) :] if "expected:" in t)
-    assert "g·s₁₂" in expected and "c₁₂·g" in expected  # the student's s_{12}, c_{12}
+    assert "g s₁₂" in expected and "c₁₂ g" in expected  # the student's s_{12}, c_{12}
 
 
 def test_large_difference_falls_back_unsimplified_with_a_note(tmp_path):
@@ -274,10 +274,10 @@ def test_json_error_object_on_bad_input(tmp_path, capsys):
 
 def test_text_uses_derives_symbol_names(capsys):
     code, out, _ = run(capsys, "grade", EXERCISE)
-    assert "missing term −l₁·θ̇₁² in the x component" in out
+    assert "missing term −l₁ θ̇₁² in the x component" in out
     assert "θ1" not in out and "l1·" not in out
     code, out, _ = run(capsys, "grade", EXERCISE, "--ascii")
-    assert out.isascii() and "missing term -l1*theta1_dot**2" in out
+    assert out.isascii() and "missing term -l1 theta1_dot**2" in out
 
 
 # ---------------------------------------------------------------- 3. hostile input, bounded time
@@ -363,4 +363,6 @@ def test_deeply_nested_yaml_value_is_a_clear_error(tmp_path):
     path.write_text("robot: rp-arm\nsteps:\n  tau_1: '0'\n  tau_2: " + "[" * 5000 + "]" * 5000 + "\n")
     done = _grade_subprocess(path)
     assert done.returncode == 2 and done.stderr.count("\n") == 1
-    assert done.stderr.startswith(f"armdyn: error: {path}:4: step 'tau_2'") and "internal error" not in done.stderr
+    # refused by the YAML screen (nesting) or by the step reader, at the value's line
+    assert done.stderr.startswith(f"armdyn: error: {path}:4: ") and "internal error" not in done.stderr
+    assert "step 'tau_2'" in done.stderr or "nesting deeper than" in done.stderr

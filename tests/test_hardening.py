@@ -71,7 +71,7 @@ def test_real_arrays_of_every_width_are_accepted():
 def test_threads_out_of_bounds_are_refused(threads):
     robot = arm()
     q = np.zeros((200, 3))
-    with pytest.raises(ValueError, match="threads must be None or an integer from 1 to 256"):
+    with pytest.raises(ValueError, match="threads: expected None or an integer from 1 to 256"):
         numeric.crba(robot, q, threads=threads)
 
 

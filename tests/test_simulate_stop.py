@@ -195,7 +195,8 @@ def test_ctrl_c_stops_a_long_run_within_a_second(tmp_path):
     polls its stop flag every 256 steps, Python's signal handlers every 50 ms); the exit
     follows after the interpreter's teardown (slow on a loaded machine, so bounded
     loosely); nothing is written."""
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "python"))
+    # the armdyn this test imports (a source tree with its built _core, or the installed one)
+    env = dict(os.environ, PYTHONPATH=str(Path(armdyn.__file__).resolve().parent.parent))
     proc = subprocess.Popen(
         [
             sys.executable,

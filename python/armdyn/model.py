@@ -1078,7 +1078,7 @@ class Robot(metaclass=_FreezeAfterInit):
         ``nofriction()``, with armature and offset dropped too). This robot is not changed."""
         if not self.joint_dynamics:
             return self
-        joints = [replace(j, **dict.fromkeys(JOINT_DYNAMICS)) for j in self.joints]
+        joints = [replace(j, **dict.fromkeys(JOINT_DYNAMICS)) for j in self.joints]  # type: ignore[arg-type]
         import warnings
 
         with warnings.catch_warnings():  # this robot's own links were warned about when it was built

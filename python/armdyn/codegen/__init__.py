@@ -161,7 +161,7 @@ def write_files(codes, directory) -> list[str]:
     paths = [os.path.join(shown, code.filename) for code in codes]
     atomic_writes(
         [
-            (path, lambda tmp, c=code: Path(tmp).write_text(c.source, encoding="utf-8"))
+            (path, lambda tmp, c=code: Path(tmp).write_text(c.source, encoding="utf-8"))  # type: ignore[misc]
             for path, code in zip(paths, codes)
         ]
     )

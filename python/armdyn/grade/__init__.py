@@ -191,7 +191,7 @@ class _Grader:
     # -- grading
     def run(self, method_hint: str | None) -> GradeReport:
         context = method_hint if method_hint in ("newton-euler", "lagrange") else None
-        seen_methods = []
+        seen_methods: list[str] = []
         for eq in self.sub.equations:
             done = len(self.verdicts)
             self._equation(eq, seen_methods, context)
@@ -345,7 +345,7 @@ class _Grader:
                     source=self.where(eq),
                 )
         elif ref.key in ("P", "Pc"):
-            if not 1 <= ref.index <= n:
+            if not 1 <= ref.index <= n:  # type: ignore[operator]
                 raise ModelError(
                     f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}",
                     source=self.where(eq),
@@ -425,7 +425,7 @@ class _Grader:
             StepVerdict(
                 name=ref.name,
                 key=ref.key,
-                link=list(self.robot.links)[ref.index],
+                link=list(self.robot.links)[ref.index],  # type: ignore[index]
                 status="wrong" if bad else "correct",
                 label=eq.lhs,
                 source=eq.source,

@@ -63,7 +63,13 @@ def screen(text: str, source: str, what: str = "the file") -> None:
                         source,
                         f"a number of {digits} digits is beyond the float64 range (at most {MAX_INT_DIGITS} digits)",
                     )
-    except yaml.YAMLError:
+    except yaml.YAMLError as exc:
+        # libyaml (PyYAML >= 6.0.4) stops deep flow collections in its scanner, before
+        # their start events reach us: the same refusal, at the line it names
+        mark = getattr(exc, "problem_mark", None)
+        if "nesting depth" in str(getattr(exc, "problem", "")) and mark is not None:
+            message = f"nesting deeper than {MAX_DEPTH} levels in {what}"
+            raise ModelError(message, None, f"{source}:{mark.line + 1}") from None
         return  # a syntax error: the loader reports it, with its line
 
 

@@ -261,7 +261,7 @@ def tidy_terms(expr, q, qd, qdd) -> list[tuple]:
 def _tidy_terms(expr, q, qd, qdd) -> tuple:
     e = trig_reduce(expr, q, keep_trig=True)
     if e == 0:
-        return []
+        return ()
     motion = list(qdd) + [qd[i] * qd[j] for i in range(len(qd)) for j in range(i, len(qd))]
     parts = sp.collect(e, motion, evaluate=False)
     terms = [(sp.factor(parts[m]), m) for m in motion if m in parts]
