@@ -100,6 +100,21 @@ class _Grader:
         return self._worlds[name]
 
     # -- reading one equation
+    def _unrecognised(self, eq, message: str, name: str = "", key: str = "") -> None:
+        """Record ``eq`` as unrecognised (shown, skipped), with why."""
+        self.verdicts.append(
+            StepVerdict(
+                name=name,
+                key=key,
+                link="",
+                status="unrecognised",
+                label=eq.lhs,
+                source=eq.source,
+                line=eq.line,
+                message=message,
+            )
+        )
+
     def where(self, eq) -> str:
         return f"{self.sub.path}:{eq.line}"
 
@@ -211,17 +226,8 @@ class _Grader:
         if ref is None:
             ref = _named_ref(eq.lhs) or (parse_lhs(eq.lhs, self.symbols.coordinate_of) if not eq.latex else None)
         if eq.problem:  # cannot be split into sides: shown with where and why, named if its start names a step
-            self.verdicts.append(
-                StepVerdict(
-                    name=ref.name if ref else "",
-                    key=ref.key if ref else "",
-                    link="",
-                    status="unrecognised",
-                    label=eq.lhs,
-                    source=eq.source,
-                    line=eq.line,
-                    message=self._unreadable(eq, eq.problem),
-                )
+            self._unrecognised(
+                eq, self._unreadable(eq, eq.problem), name=ref.name if ref else "", key=ref.key if ref else ""
             )
             return
         if ref is None:
@@ -244,18 +250,7 @@ class _Grader:
                     )
                 )
                 return
-            self.verdicts.append(
-                StepVerdict(
-                    name="",
-                    key="",
-                    link="",
-                    status="unrecognised",
-                    label=eq.lhs,
-                    source=eq.source,
-                    line=eq.line,
-                    message="not a step of Newton-Euler or Lagrange (skipped)",
-                )
-            )
+            self._unrecognised(eq, "not a step of Newton-Euler or Lagrange (skipped)")
             return
         n_links = len(self.robot.links) - 1
         if ref.key in ("f", "n") and ref.index == n_links + 1:
@@ -273,18 +268,7 @@ class _Grader:
         self._check_index(ref, eq)
         value, problem = self.value(eq, ref)
         if value is None:
-            self.verdicts.append(
-                StepVerdict(
-                    name=ref.name,
-                    key=ref.key,
-                    link="",
-                    status="unrecognised",
-                    label=eq.lhs,
-                    source=eq.source,
-                    line=eq.line,
-                    message=problem,
-                )
-            )
+            self._unrecognised(eq, problem, name=ref.name, key=ref.key)
             return
         if ref.key == "R":
             self._rotation(ref, eq, value)
@@ -444,18 +428,7 @@ class _Grader:
         value, problem = self.value(eq, StepRef(ref.key, ref.index, ref.frame))
         name = f"{ref.key}_{ref.index}"
         if value is None:
-            self.verdicts.append(
-                StepVerdict(
-                    name=name,
-                    key="free_end",
-                    link="",
-                    status="unrecognised",
-                    label=eq.lhs,
-                    source=eq.source,
-                    line=eq.line,
-                    message=problem,
-                )
-            )
+            self._unrecognised(eq, problem, name=name, key="free_end")
             return
         zero = sp.zeros(3, 1)
         ok = equal(self.sampler.fingerprint(value), self.sampler.fingerprint(zero)).ravel()
@@ -480,18 +453,7 @@ class _Grader:
     def _step(self, world: World, ref: StepRef, eq, value, method: str):
         key = (ref.key, ref.index)
         if key not in world.method.refs:
-            self.verdicts.append(
-                StepVerdict(
-                    name=ref.name,
-                    key=ref.key,
-                    link="",
-                    status="unrecognised",
-                    label=eq.lhs,
-                    source=eq.source,
-                    line=eq.line,
-                    message=f"{method} has no step {ref.name} for this robot",
-                )
-            )
+            self._unrecognised(eq, f"{method} has no step {ref.name} for this robot", name=ref.name, key=ref.key)
             return
         link = ""
         own = value
