@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 
 import armdyn
-from armdyn import codegen
+from armdyn import codegen, numeric
 from armdyn.cli import main
 from armdyn.codegen.safe_names import comment_text, identifier_base
 from armdyn.errors import ModelError
@@ -410,6 +410,29 @@ def test_overflow_is_an_error_not_nan_or_singular(arm):
     tau = np.array([1e5, -2e5])
     want = np.linalg.solve(M, tau - armdyn.bias(arm, q, np.zeros(2)))
     np.testing.assert_allclose(armdyn.aba(arm, q, np.zeros(2), tau), want, rtol=1e-10)
+
+
+def test_overflow_in_every_velocity_product(arm):
+    """qd = 1e200 squares to 1e400 in the velocity products: every function quadratic in qd
+    reports an overflow (naming itself), one state or a batch, and the compiled model raises
+    FloatingPointError rather than handing back inf or NaN."""
+    q, qd = np.array([0.3, -0.2]), np.array([1e200, -1e200])
+    for name, call in (
+        ("bias", lambda q, qd: armdyn.bias(arm, q, qd)),
+        ("kinetic_energy", lambda q, qd: armdyn.kinetic_energy(arm, q, qd)),
+        ("regressor", lambda q, qd: numeric.regressor(arm, q, qd, np.zeros_like(q))),
+    ):
+        for qs, qds in ((q, qd), (np.tile(q, (3, 1)), np.tile(qd, (3, 1)))):
+            with pytest.raises(ValueError, match=rf"^{name}: the result overflows float64"):
+                call(qs, qds)
+    # C(q, qd) is linear in qd: no overflow at 1e200
+    assert np.isfinite(armdyn.coriolis_matrix(arm, q, qd)).all()
+    with pytest.raises(FloatingPointError, match="not finite"):
+        armdyn.compile_model(arm).rnea(q, qd, np.zeros(2))
+    # moderate speeds: the same functions are finite and agree with each other (C qd = h - g)
+    qd = np.array([3.0, -2.0])
+    h, g = armdyn.bias(arm, q, qd), armdyn.gravity(arm, q)
+    np.testing.assert_allclose(armdyn.coriolis_matrix(arm, q, qd) @ qd, h - g, rtol=1e-12, atol=1e-12)
 
 
 def test_simulate_arguments(arm):

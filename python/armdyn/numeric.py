@@ -261,10 +261,10 @@ def rnea(
             qd=qd,
             qdd=qdd,
         )
-    tau = _model(robot).rnea(q, qd, qdd, threads)
-    if tau.ndim == 1 and tau.size <= 64 and math.isfinite(sum(tau.tolist())) or _all_finite(tau):  # inlined: hot
-        return tau
-    raise _overflow("rnea", {"q": q, "qd": qd, "qdd": qdd})
+    try:
+        return _model(robot).rnea(q, qd, qdd, threads)
+    except FloatingPointError:  # the core checks its result: an overflow from finite inputs
+        raise _overflow("rnea", {"q": q, "qd": qd, "qdd": qdd}) from None
 
 
 def crba(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
@@ -273,7 +273,10 @@ def crba(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.nd
     q: (n,) or (N, n). Returns the full symmetric M: (n, n) or (N, n, n).
     """
     threads = _threads(threads)
-    return _finite(_model(robot).crba(q, threads), "crba", q=q)
+    try:
+        return _model(robot).crba(q, threads)
+    except FloatingPointError:
+        raise _overflow("crba", {"q": q}) from None
 
 
 def aba(
@@ -308,7 +311,10 @@ def aba(
 def gravity(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Gravity torques g(q) = rnea(q, 0, 0). q: (n,) or (N, n); same shape out."""
     threads = _threads(threads)
-    return _finite(_model(robot).gravity_torques(q, threads), "gravity", q=q)
+    try:
+        return _model(robot).gravity_torques(q, threads)
+    except FloatingPointError:
+        raise _overflow("gravity", {"q": q}) from None
 
 
 def bias(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None = None) -> np.ndarray:
@@ -317,7 +323,10 @@ def bias(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None =
     q, qd: (n,) or (N, n); same shape out.
     """
     threads = _threads(threads)
-    return _finite(_model(robot).bias(q, qd, threads), "bias", q=q, qd=qd)
+    try:
+        return _model(robot).bias(q, qd, threads)
+    except FloatingPointError:
+        raise _overflow("bias", {"q": q, "qd": qd}) from None
 
 
 def coriolis_matrix(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None = None) -> np.ndarray:
@@ -327,13 +336,19 @@ def coriolis_matrix(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: i
     Returns (n, n) or (N, n, n).
     """
     threads = _threads(threads)
-    return _finite(_model(robot).coriolis_matrix(q, qd, threads), "coriolis_matrix", q=q, qd=qd)
+    try:
+        return _model(robot).coriolis_matrix(q, qd, threads)
+    except FloatingPointError:
+        raise _overflow("coriolis_matrix", {"q": q, "qd": qd}) from None
 
 
 def kinetic_energy(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None = None) -> float | np.ndarray:
     """Kinetic energy T = 1/2 qd^T M(q) qd. q, qd: (n,) -> float, or (N, n) -> (N,)."""
     threads = _threads(threads)
-    return _finite(_model(robot).kinetic_energy(q, qd, threads), "kinetic_energy", q=q, qd=qd)
+    try:
+        return _model(robot).kinetic_energy(q, qd, threads)
+    except FloatingPointError:
+        raise _overflow("kinetic_energy", {"q": q, "qd": qd}) from None
 
 
 def potential_energy(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> float | np.ndarray:
@@ -344,7 +359,10 @@ def potential_energy(robot: RobotLike, q: ArrayLike, *, threads: int | None = No
     q: (n,) -> float, or (N, n) -> (N,).
     """
     threads = _threads(threads)
-    return _finite(_model(robot).potential_energy(q, threads), "potential_energy", q=q)
+    try:
+        return _model(robot).potential_energy(q, threads)
+    except FloatingPointError:
+        raise _overflow("potential_energy", {"q": q}) from None
 
 
 def forward_kinematics(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
@@ -633,14 +651,18 @@ def _all_finite(result) -> bool:
     return bool(np.isfinite(result).all())
 
 
-def _checked(fn, finite: bool = False):
-    """``fn`` with ``threads`` checked first (for the functions whose bodies do not)."""
+def _checked(fn):
+    """``fn`` with ``threads`` checked first (for the functions whose bodies do not), and the
+    core's overflow error told as :func:`_overflow` does."""
 
     @functools.wraps(fn)
     def call(robot, *args, threads=None, **kwargs):
         if threads is not None:
             threads = _threads(threads)
-        return fn(robot, *args, threads=threads, **kwargs)
+        try:
+            return fn(robot, *args, threads=threads, **kwargs)
+        except FloatingPointError:
+            raise _overflow(fn.__name__, dict(zip(("q", "qd", "qdd"), args))) from None
 
     return call
 
