@@ -2,7 +2,7 @@
 //! on a number type that counts its own arithmetic (the algorithms are generic over
 //! [`Real`]), and the time per call of the same algorithms on `f64` (one state, no Python,
 //! median of 15 runs of 20 000 calls). `cargo run --release --example flops` prints one
-//! table for a 6 R chain with the UR5's DH frames (`tests/common`'s `ur5_joints`: the
+//! table for a 6 R chain with the UR5's DH frames (`tests/core/common`'s `ur5_joints`: the
 //! structure, hence the counts, of the benchmark UR5) and a random 7-joint chain.
 //!
 //! Counted: `+ - * /` and negation (one each; no FMA is ever used), `sin_cos` apart.
@@ -12,7 +12,7 @@
 //! UR5, N = 20 000, one thread) over and over for about SECONDS seconds and prints its
 //! rate: a target for `perf record` / `perf stat`.
 
-#[path = "../tests/common/mod.rs"]
+#[path = "../tests/core/common/mod.rs"]
 mod common;
 
 use armdyn_core::algo;

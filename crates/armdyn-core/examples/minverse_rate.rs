@@ -7,7 +7,7 @@
 //! iiwa14) runs only that arm's batch loop, 100 x 20 000 states, for `perf record`
 //! (`batch ARM ROWS`: 2e6 / ROWS batches of ROWS states).
 
-#[path = "../tests/common/mod.rs"]
+#[path = "../tests/core/common/mod.rs"]
 mod common;
 
 use armdyn_core::model::{JointSpec, JointType};

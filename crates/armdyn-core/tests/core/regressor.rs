@@ -3,9 +3,8 @@
 //! description (not from the model's merged inertias); the identities with the joint
 //! terms (`rnea = crba qdd + rnea(q, qd, 0)`, `aba(rnea) = qdd`); batch == loop, bit for bit.
 
-mod common;
 use armdyn_core::{algo, batch, Data, JointDynamics, JointType, Model};
-use common::*;
+use crate::common::*;
 
 /// Standard parameters of every description link, in the link frame (about its origin):
 /// `[m, m c, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`, `I = I_c + m (c.c 1 - c c^T)`; then

@@ -2,9 +2,8 @@
 //! joints, arbitrary frames and axes (docs/architecture.md, "How the engines check each other"),
 //! and hand-derived closed forms.
 
-mod common;
 use armdyn_core::{algo, algo::coriolis::CoriolisWork, Data, JointSpec, JointType, Model};
-use common::*;
+use crate::common::*;
 
 struct Case {
     model: Model,

@@ -3,10 +3,9 @@
 //! rnea/aba/jacobian, and M Minv = I. (Pinocchio and the NumPy forward-mode oracle are
 //! the other opinions, in tests/test_derivatives.py.)
 
-mod common;
 use armdyn_core::algo::{self, ExternalForces, ForceFrame};
 use armdyn_core::{batch_derivatives, Data, DerivData, Model};
-use common::*;
+use crate::common::*;
 
 fn cases() -> Vec<(Model, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)> {
     let mut rng = Rng::new(11);

@@ -1,8 +1,7 @@
 //! The comparison every identity test relies on must be able to fail: NaN and inf
 //! never pass, on either side, wherever they sit in the vector.
 
-mod common;
-use common::assert_close;
+use crate::common::assert_close;
 
 #[test]
 fn equal_finite_values_pass() {
@@ -42,6 +41,6 @@ fn a_real_difference_fails() {
 
 #[test]
 fn max_abs_diff_propagates_nan() {
-    assert!(common::max_abs_diff(&[0.0, f64::NAN], &[0.0, 0.0]).is_nan());
-    assert!(common::max_abs(&[f64::NAN, 1.0]).is_nan());
+    assert!(crate::common::max_abs_diff(&[0.0, f64::NAN], &[0.0, 0.0]).is_nan());
+    assert!(crate::common::max_abs(&[f64::NAN, 1.0]).is_nan());
 }

@@ -1,9 +1,8 @@
 //! Batched results equal a loop of single calls bit for bit (SIMD lanes, leftover rows,
 //! one or several threads).
 
-mod common;
 use armdyn_core::{algo, algo::coriolis::CoriolisWork, batch, Data, Model};
-use common::*;
+use crate::common::*;
 
 fn bits(a: &[f64]) -> Vec<u64> {
     a.iter().map(|x| x.to_bits()).collect()

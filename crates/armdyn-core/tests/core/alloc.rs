@@ -34,9 +34,8 @@ fn count(f: impl FnOnce()) -> usize {
     ALLOCS.with(|c| c.get()) - before
 }
 
-mod common;
 use armdyn_core::{algo, algo::coriolis::CoriolisWork, batch, batch_derivatives, Data, DerivData, Model};
-use common::*;
+use crate::common::*;
 
 #[test]
 fn single_state_algorithms_do_not_allocate() {

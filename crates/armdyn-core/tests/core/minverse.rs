@@ -4,11 +4,10 @@
 //! same Minv from `aba_derivatives` (whose inertias come from `rnea_derivatives`'
 //! velocity pass), and batches equal to single calls bit for bit on every kernel.
 
-mod common;
 use armdyn_core::model::{JointSpec, JointType};
 use armdyn_core::spatial::{RigidInertia, Sym3, Xform, M3, V3};
 use armdyn_core::{algo, batch, batch_derivatives, Data, DerivData, Model};
-use common::*;
+use crate::common::*;
 
 fn v3(a: [f64; 3]) -> V3<f64> {
     V3::new(a[0], a[1], a[2])
