@@ -11,11 +11,11 @@
    kinematics and g too), counted as ``sympy.count_ops(visual=True)`` counts them
    (mul = MUL+DIV+POW, add = ADD+SUB) after common-subexpression elimination:
    armdyn's generated code vs armdyn.derive's expressions through ``sympy.cse`` (measured
-   here, in this run) and the figures of OpenSYMORO and SymPyBotics quoted in issue 8
-   (theirs, not measured here).
+   here, in this run) and the published figures of OpenSYMORO and SymPyBotics (theirs,
+   quoted, not measured here).
 2. Time to derive tau, M, C, g, the regressor and the base parameters (tau and the
    regressor in them) and generate C for the PUMA 560, in this process, as one table
-   with issue 8's targets (<= 3 s; SymPyBotics quoted at 3.5-9.7 s for its set) and
+   with the targets (<= 3 s; SymPyBotics quoted at 3.5-9.7 s for its set) and
    ratios: the first run (SymPy's caches cold) and the median of the next ones; tau
    alone by the customized Newton-Euler (target <= 0.1 s); ``armdyn.derive(robot).tau``.
 3. The generated C for the PUMA's tau, numeric parameters (Corke's puma560 values),
@@ -39,7 +39,7 @@ import sympy as sp
 import armdyn
 import armdyn.codegen as codegen
 
-# quoted from issue 8 (OpenSYMORO: Khalil et al., "OpenSYMORO: an open-source software
+# published counts (OpenSYMORO: Khalil et al., "OpenSYMORO: an open-source software
 # package for symbolic modelling of robots", IEEE/ASME AIM 2014, customized Newton-Euler;
 # SymPyBotics: C. D. Sousa's package) -- their counts on the PUMA 560, not measured here
 THEIRS = {
@@ -59,7 +59,7 @@ TARGETS = {
 
 
 def cse_counts(exprs) -> tuple[int, int]:
-    """(mul, add) of expressions after sympy.cse, as issue 8 counts them."""
+    """(mul, add) of expressions after sympy.cse (mul = MUL+DIV+POW, add = ADD+SUB), as published."""
     reps, reduced = sp.cse(list(exprs))
     visual = sp.count_ops([r for _, r in reps] + list(reduced), visual=True)
     d = {} if visual == 0 else {s.name: int(c) for s, c in visual.as_coefficients_dict().items()}
@@ -117,7 +117,7 @@ def op_count_table(have_identification: bool) -> None:
     print("\n(C: the Christoffel C matrix of M; OpenSYMORO and SymPyBotics quote no count for it.)\n")
 
 
-SYMPYBOTICS_SECONDS = (3.5, 9.7)  # quoted from issue 8: its set of quantities for the PUMA 560, not run here
+SYMPYBOTICS_SECONDS = (3.5, 9.7)  # SymPyBotics' quoted time for its set of quantities for the PUMA 560, not run here
 
 
 def _timed(fn, repeat):
@@ -138,7 +138,7 @@ def _timed(fn, repeat):
 
 def generation_times(have_identification: bool, repeat: int) -> None:
     """One table: time to derive and print C, medians of ``repeat`` runs in this process
-    (the first run, SymPy's caches cold, apart), with the targets of issue 8 and ratios."""
+    (the first run, SymPy's caches cold, apart), with the targets and ratios."""
     from armdyn.programs.customized_ne import customized_newton_euler, standard_parameters
     from armdyn.programs.grouping import grouped_parameters
 
@@ -177,7 +177,7 @@ def generation_times(have_identification: bool, repeat: int) -> None:
             "tau alone: customized Newton-Euler program",
             _timed(tau_program, repeat),
             0.1,
-            "0.16-0.18 s (issue 8, before)",
+            "0.16-0.18 s (before the build's speed-up)",
         ),
         (
             "tau alone: armdyn.codegen(what='tau') -> C",

@@ -19,13 +19,13 @@ UR5, Panda and iiwa14.
    a loop over batches does, and what Pinocchio's per-call time does with its ``Data``),
    compared with the rate of Pinocchio's per-call time (Pinocchio has no batched derivatives):
    ``1 / t_call`` for its Python call measured here (an upper bound on its C++ call time, so
-   a lower bound on its rate), and ``2 / t_call`` ("both cores") — the issue's target is
+   a lower bound on its rate), and ``2 / t_call`` ("both cores") — the target is
    ``>= 4 x`` that rate of its C++ call.
 3. Pinocchio's C++ per-call times (benchmarks/pinocchio_cpp: bench.cpp compiled with
    g++ -O3 -march=native when the pip ``pin`` package's headers and ``cmeel-eigen`` are
    there; skipped with a note otherwise, or with ``--no-cpp``), on the models its URDF
    parser builds from the same arms, and armdyn's batch rate on the most threads asked
-   for against ``2 / t_C++`` (both cores): the issue's target is ``>= 4``. The C++ timing
+   for against ``2 / t_C++`` (both cores): the target is ``>= 4``. The C++ timing
    and armdyn's batches alternate in ``--batch-repeat`` rounds per arm (a short C++ run,
    then one batch of each kind), medians over the rounds: on a shared machine both sides
    then see the same stretch of load.

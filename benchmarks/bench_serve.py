@@ -10,7 +10,7 @@ Latency is accept -> verdict, measured two ways: by the client (request sent ->
 response with the verdict) and by the server (``created_at`` -> ``finished_at`` of the
 row). Two workloads:
 
-  identical  the exercise's text every time (the brief's load): after the first
+  identical  the exercise's text every time (the target load): after the first
              grading, the server answers from its content-hash cache
   distinct   a unique comment line in each text (no cache): every submission is
              graded; latency is then queueing behind C*K gradings on W workers

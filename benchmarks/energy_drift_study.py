@@ -1,7 +1,7 @@
-"""Where does RK4's energy drift on the passive UR5 and Panda come from? (issue 10)
+"""Where does RK4's energy drift on the passive UR5 and Panda come from?
 
 Not a benchmark of speed: a study whose numbers go into benchmarks/README.md. It answers,
-for the issue's target "total energy drift over 10 s with RK4 at dt = 1e-3 below 1e-6
+for the target "total energy drift over 10 s with RK4 at dt = 1e-3 below 1e-6
 relative (friction off), from rest and from random states":
 
 (a) the same initial states integrated by an independent RK4 (a plain Python loop written

@@ -1,4 +1,4 @@
-"""A valid URDF with 10^4 joints loads (issue 11) and its dynamics are right.
+"""A valid URDF with 10^4 joints loads and its dynamics are right.
 
 Correctness only, no timing (the load time is in benchmarks/bench_load.py). The model
 comes from tests/big_urdf.py, which also returns it as plain arrays; the checks compute

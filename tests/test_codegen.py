@@ -300,7 +300,7 @@ def test_fast_op_count_equals_sympy_count_ops():
 
 
 def test_puma_mass_matrix_op_count_meets_target():
-    """OpenSYMORO's M for the PUMA 560 takes 302 mul + 215 add (issue 8); target 0.8x."""
+    """OpenSYMORO's published M for the PUMA 560 takes 302 mul + 215 add; target 0.8x."""
     for name in ("puma560-craig", "puma560"):
         counts = codegen.codegen(armdyn.load(name, strict=False), what="M").op_counts["M"]
         assert counts["total"] <= 0.8 * (302 + 215), counts

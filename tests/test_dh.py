@@ -21,7 +21,7 @@ import armdyn
 from armdyn.io import load
 from armdyn.io.dh import from_dh
 
-try:  # the lead exports it at the top level; the package has it in any case
+try:  # armdyn may export it at the top level; the package has it in any case
     derive = armdyn.derive
 except AttributeError:
     from armdyn.symbolic import derive

@@ -1,8 +1,9 @@
 """`armdyn grade`: a student's own derivation checked step by step.
 
-The expected verdicts are not armdyn's output: the exercise's comes from issue 7 (worked
-out by hand) and examples/grading/README.md (each file's slips were put in by hand and
-checked with an independent NumPy script of point positions and momentum balances).
+The expected verdicts are not armdyn's output: they are the ones worked out by hand in
+examples/grading/README.md (the exercise's slips are the student's own; every other file's
+slips were put in by hand and checked with an independent NumPy script of point positions
+and momentum balances).
 """
 
 from __future__ import annotations

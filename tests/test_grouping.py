@@ -6,7 +6,7 @@ opinions:
   random states with random numeric parameters, every bundled arm;
 * the number of parameters the grouped tau program still uses == the number of base
   parameters found by armdyn.identification's exact rank tests (a different method);
-* the op-count target of issue 8 for the PUMA 560's tau.
+* the op-count target for the PUMA 560's tau: <= 0.8 x OpenSYMORO's published count.
 """
 
 from __future__ import annotations
@@ -156,7 +156,7 @@ def test_grouped_tau_uses_as_many_parameters_as_there_are_base_parameters(name):
 
 @pytest.mark.parametrize("name", ["puma560-craig", "puma560"])
 def test_puma_tau_op_count_meets_target(name):
-    """Issue 8: tau <= 0.8 x OpenSYMORO's 345 + 296 for the PUMA 560, every parameter
+    """The op-count target: tau <= 0.8 x OpenSYMORO's 345 + 296 for the PUMA 560, every parameter
     symbolic, counted as count_ops(visual=True) after CSE (mul = MUL+DIV+POW, add = ADD+SUB)."""
     counts = codegen.codegen(_load(name), what="tau").op_counts["tau"]
     assert counts["total"] <= 0.8 * (345 + 296), counts
@@ -165,7 +165,7 @@ def test_puma_tau_op_count_meets_target(name):
 @pytest.mark.parametrize("name", ["puma560-craig", "puma560"])
 def test_puma_base_parameter_tau_takes_fewer_operations_than_opensymoro(name):
     """tau in the base parameters, every parameter symbolic: fewer operations than
-    OpenSYMORO's base-parameter program (301 + 240, quoted in issue 8), counted the same way."""
+    OpenSYMORO's base-parameter program (301 + 240, its published count), counted the same way."""
     counts = codegen.codegen(_load(name), what="tau", base=True).op_counts["tau"]
     assert counts["total"] < 301 + 240, counts
 

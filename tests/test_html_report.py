@@ -6,8 +6,8 @@ Chromium (tests/browser.py): every <math> element must have a non-zero box, none
 <merror>, none raw LaTeX, and the wrong rows must be painted. The browser tests skip
 alone when no Chromium is installed.
 
-The grade report here is built by hand, shaped like the verdict on the exercise of
-shared/reference (assignment 7-4): the student's values are the exercise's own lines,
+The grade report here is built by hand, shaped like the verdict on the RP-arm
+exercise (docs/exercise.md, part 2): the student's values are the exercise's own lines,
 the expected values are worked out by hand from the exercise's frames (point masses
 m1 at l1 along x1 and m2 at the slider's tip, gravity g along -y0).
 """

@@ -17,7 +17,7 @@ from armdyn.model import rot_x, rot_y, rot_z, rpy_matrix
 
 RNG = np.random.default_rng(7)
 
-URDF = Path(ROBOTS_DIR) / "iiwa14.urdf"  # the KUKA iiwa 14 of shared/data, bundled
+URDF = Path(ROBOTS_DIR) / "iiwa14.urdf"  # the KUKA iiwa 14 (Drake's dynamics numbers), bundled
 
 
 # ---------------------------------------------------------------- oracles
