@@ -594,7 +594,7 @@ def run_names(seed: int, rng: random.Random):
 
     import sympy as sp
 
-    from armdyn.codegen import _identifier
+    from armdyn.codegen.generate import identifier
     from armdyn.codegen.printers import _C_RESERVED, Names, _header_lines
 
     names = [_random_name(rng) for _ in range(rng.randint(1, 5))]
@@ -604,7 +604,7 @@ def run_names(seed: int, rng: random.Random):
     q = [sp.Symbol(n) for n in names]
     qd = [sp.Symbol(f"{n}_dot") for n in names]
     robot_name = _random_name(rng)
-    prefix = _identifier(robot_name)
+    prefix = identifier(robot_name)
     table = Names(q + qd, taken=[f"{prefix}_tau"])
     idents = [table.name(s) for s in q + qd]
     for ident in idents:

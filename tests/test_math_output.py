@@ -124,10 +124,10 @@ def _split_vector(text: str) -> list[str]:
 
 
 def test_two_numbers_keep_a_visible_separator():
-    from armdyn.symbolic.report import _UnicodeTextPrinter
+    from armdyn.symbolic.report import UnicodeTextPrinter
 
     x = sp.Symbol("x")
-    out = _UnicodeTextPrinter({}).doprint(sp.Mul(2, sp.Pow(3, x, evaluate=False), evaluate=False))
+    out = UnicodeTextPrinter({}).doprint(sp.Mul(2, sp.Pow(3, x, evaluate=False), evaluate=False))
     assert "2 3" not in out and "·" in out
     assert sp.sympify(out.replace("·", "*")) == 2 * 3**x
 

@@ -360,7 +360,7 @@ class MathWriter:
         return '<mrow><mo stretchy="true">(</mo><mtable>' + "".join(rows) + '</mtable><mo stretchy="true">)</mo></mrow>'
 
     def terms(self, terms: list[tuple], width: float | None = None) -> str:
-        """``(coefficient, monomial)`` terms (see :func:`armdyn.symbolic.report.tidy_terms`)
+        """``(coefficient, monomial)`` terms (see :func:`armdyn.symbolic.tidy.tidy_terms`)
         written coefficient first with folded signs: ``(m₁ + m₂) l₁² θ̈₁ − m₂ g d₂ sin θ₁``.
 
         width: break into lines (a left-aligned ``mtable``, continuation lines starting

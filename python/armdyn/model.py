@@ -34,6 +34,7 @@ from typing import Iterable, Mapping
 import numpy as np
 import sympy as sp
 
+from .dispatch import call
 from .errors import ModelError
 from .inertia import check_physical, physical_violations
 
@@ -923,10 +924,9 @@ class Robot(metaclass=_FreezeAfterInit):
 
     @classmethod
     def from_urdf(cls, source, strict: bool = True) -> "Robot":
-        """A robot from a URDF file path or XML string (see :mod:`armdyn.io.urdf`)."""
-        from .io.urdf import load_urdf
-
-        return load_urdf(source, strict=strict)
+        """A robot from a URDF file path or XML string: :func:`armdyn.io.urdf.load_urdf`
+        (registered with :mod:`armdyn.dispatch`; ``armdyn.load`` reads any format)."""
+        return call("urdf", cls, source, strict=strict)
 
     @property
     def is_numeric(self) -> bool:
@@ -1101,7 +1101,5 @@ class Robot(metaclass=_FreezeAfterInit):
         return f"Robot({self.name!r}, dof={self.dof}, joints={kinds}, parameters={sorted(self.parameters)}{extra})"
 
     def _repr_html_(self) -> str:
-        """Jupyter: tables of the joints and links (see symbolic/report_html.py)."""
-        from .symbolic.report_html import robot_html
-
-        return robot_html(self)
+        """Jupyter: tables of the joints and links (symbolic/report_html.py, through :mod:`armdyn.dispatch`)."""
+        return call("html", self)

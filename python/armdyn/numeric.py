@@ -182,11 +182,11 @@ def compile_model(robot: Robot | NumericModel | MimicModel) -> NumericModel | Mi
     return model
 
 
-def _core_model(robot, what: str, link_frames: bool = False) -> NumericModel:
+def core_model(robot, what: str, link_frames: bool = False) -> NumericModel:
     """The compiled model for the functions that exist only in the plain Rust core: not
     (yet) for robots with mimic joints, nor, where a link frame is involved (wrenches in
     link frames, jacobian_dot), for link frames off their joint's axis."""
-    model = _model(robot)
+    model = compiled_model(robot)
     if not isinstance(model, NumericModel):
         raise ValueError(f"{what} is not available yet for robots with mimic joints")
     if link_frames and _frame_offsets(robot) is not None:
@@ -227,7 +227,9 @@ def _frame_offsets(robot) -> np.ndarray | None:
     return out
 
 
-def _model(robot) -> NumericModel | MimicModel:
+def compiled_model(robot) -> NumericModel | MimicModel:
+    """The compiled model of a Robot (built once, cached on it), or a NumericModel /
+    MimicModel itself: what every function here passes to the Rust core."""
     # Fast path: a Robot already compiled, or a NumericModel (whose
     # ``_numeric_model`` is itself).
     try:
@@ -255,14 +257,14 @@ def rnea(
     if f_ext is not None:
         f_ext = _canonical_wrenches(robot, f_ext, frame)
         return _finite(
-            _core.rnea_ext(_core_model(robot, "rnea with f_ext"), q, qd, qdd, f_ext, frame, threads),
+            _core.rnea_ext(core_model(robot, "rnea with f_ext"), q, qd, qdd, f_ext, frame, threads),
             "rnea",
             q=q,
             qd=qd,
             qdd=qdd,
         )
     try:
-        return _model(robot).rnea(q, qd, qdd, threads)
+        return compiled_model(robot).rnea(q, qd, qdd, threads)
     except FloatingPointError:  # the core checks its result: an overflow from finite inputs
         raise _overflow("rnea", {"q": q, "qd": qd, "qdd": qdd}) from None
 
@@ -274,7 +276,7 @@ def crba(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.nd
     """
     threads = _threads(threads)
     try:
-        return _model(robot).crba(q, threads)
+        return compiled_model(robot).crba(q, threads)
     except FloatingPointError:
         raise _overflow("crba", {"q": q}) from None
 
@@ -297,9 +299,9 @@ def aba(
     threads = _threads(threads)
     if f_ext is not None:
         f_ext = _canonical_wrenches(robot, f_ext, frame)
-        return _core.aba_ext(_core_model(robot, "aba with f_ext"), q, qd, tau, f_ext, frame, threads)
+        return _core.aba_ext(core_model(robot, "aba with f_ext"), q, qd, tau, f_ext, frame, threads)
     try:
-        return _model(robot).aba(q, qd, tau, threads)
+        return compiled_model(robot).aba(q, qd, tau, threads)
     except ValueError as err:
         # the core calls any non-finite result "singular at this state"; an overflow (M
         # well conditioned, tau or qd too large) is told apart by factoring M at that q
@@ -312,7 +314,7 @@ def gravity(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np
     """Gravity torques g(q) = rnea(q, 0, 0). q: (n,) or (N, n); same shape out."""
     threads = _threads(threads)
     try:
-        return _model(robot).gravity_torques(q, threads)
+        return compiled_model(robot).gravity_torques(q, threads)
     except FloatingPointError:
         raise _overflow("gravity", {"q": q}) from None
 
@@ -324,7 +326,7 @@ def bias(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None =
     """
     threads = _threads(threads)
     try:
-        return _model(robot).bias(q, qd, threads)
+        return compiled_model(robot).bias(q, qd, threads)
     except FloatingPointError:
         raise _overflow("bias", {"q": q, "qd": qd}) from None
 
@@ -337,7 +339,7 @@ def coriolis_matrix(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: i
     """
     threads = _threads(threads)
     try:
-        return _model(robot).coriolis_matrix(q, qd, threads)
+        return compiled_model(robot).coriolis_matrix(q, qd, threads)
     except FloatingPointError:
         raise _overflow("coriolis_matrix", {"q": q, "qd": qd}) from None
 
@@ -346,7 +348,7 @@ def kinetic_energy(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: in
     """Kinetic energy T = 1/2 qd^T M(q) qd. q, qd: (n,) -> float, or (N, n) -> (N,)."""
     threads = _threads(threads)
     try:
-        return _model(robot).kinetic_energy(q, qd, threads)
+        return compiled_model(robot).kinetic_energy(q, qd, threads)
     except FloatingPointError:
         raise _overflow("kinetic_energy", {"q": q, "qd": qd}) from None
 
@@ -360,7 +362,7 @@ def potential_energy(robot: RobotLike, q: ArrayLike, *, threads: int | None = No
     """
     threads = _threads(threads)
     try:
-        return _model(robot).potential_energy(q, threads)
+        return compiled_model(robot).potential_energy(q, threads)
     except FloatingPointError:
         raise _overflow("potential_energy", {"q": q}) from None
 
@@ -372,7 +374,7 @@ def forward_kinematics(robot: RobotLike, q: ArrayLike, *, threads: int | None = 
     ``list(robot.links)`` order (base first); each ``[[R, p], [0, 0, 0, 1]]`` with R the
     link's axes in base coordinates and p its origin.
     """
-    poses = _model(robot).forward_kinematics(q, threads)
+    poses = compiled_model(robot).forward_kinematics(q, threads)
     offsets = _frame_offsets(robot)
     return poses if offsets is None else poses @ offsets
 
@@ -408,7 +410,7 @@ def jacobian(
     if frame == "local_world_aligned":
         return J
     name = link.name if isinstance(link, Link) else link
-    k = name if isinstance(name, (int, np.integer)) else list(_model(robot).link_names).index(name)
+    k = name if isinstance(name, (int, np.integer)) else list(compiled_model(robot).link_names).index(name)
     pose = forward_kinematics(robot, q, threads=threads)[..., k, :, :]
     R, p = pose[..., :3, :3], pose[..., :3, 3]
     Jv, Jw = J[..., :3, :], J[..., 3:, :]
@@ -423,14 +425,14 @@ def _aligned_jacobian(robot, q, link, threads):
     """:func:`jacobian` in LOCAL_WORLD_ALIGNED."""
     if isinstance(link, Link):
         link = link.name
-    J = _model(robot).jacobian(q, link, threads)
+    J = compiled_model(robot).jacobian(q, link, threads)
     offsets = _frame_offsets(robot)
     if offsets is None or not isinstance(robot, Robot):  # offsets: only a Robot has them
         return J
     # the compiled model's link frame is on the joint; move the point to the link frame's
     # origin: v' = v + w x (R pf), so J_v' = J_v - [R pf]x J_w
     k = link if isinstance(link, (int, np.integer)) else robot.link_index(link)
-    R = _model(robot).forward_kinematics(q, threads)[..., k, :3, :3]
+    R = compiled_model(robot).forward_kinematics(q, threads)[..., k, :3, :3]
     r = R @ offsets[k, :3, 3]
     Jv, Jw = J[..., :3, :], J[..., 3:, :]
     return np.concatenate([Jv - np.cross(r[..., None, :], Jw.swapaxes(-1, -2)).swapaxes(-1, -2), Jw], axis=-2)
@@ -443,7 +445,7 @@ def _mimic(robot, what: str, f_ext=None, frame: str = "local") -> MimicModel | N
     """The compiled model if ``robot`` has mimic joints (its derivatives are the full
     tree's reduced by the chain rule, see armdyn.mimic), else None. External wrenches are
     not available for those robots (as for rnea/aba)."""
-    model = _model(robot)
+    model = compiled_model(robot)
     if not isinstance(model, MimicModel):
         return None
     if f_ext is not None:
@@ -488,7 +490,7 @@ def _into(out, result):
 def _rnea_derivatives_python(robot, q, qd, qdd, f_ext, frame, threads, out):
     """:func:`rnea_derivatives` for a robot not compiled yet (this compiles and caches
     it), mimic joints, and external wrenches."""
-    model = _model(robot)
+    model = compiled_model(robot)
     if type(model) is not NumericModel:  # mimic joints: the chain rule, see armdyn.mimic
         return _into(out, _mimic(robot, "rnea_derivatives", f_ext, frame).rnea_derivatives(q, qd, qdd, threads))
     if f_ext is not None:
@@ -498,7 +500,7 @@ def _rnea_derivatives_python(robot, q, qd, qdd, f_ext, frame, threads, out):
 
 def _aba_derivatives_python(robot, q, qd, tau, f_ext, frame, threads, out):
     """:func:`aba_derivatives` for what the Rust entry hands back (as above)."""
-    model = _model(robot)
+    model = compiled_model(robot)
     if type(model) is not NumericModel:  # mimic joints: the chain rule, see armdyn.mimic
         return _into(out, _mimic(robot, "aba_derivatives", f_ext, frame).aba_derivatives(q, qd, tau, threads))
     if f_ext is not None:
@@ -509,7 +511,7 @@ def _aba_derivatives_python(robot, q, qd, tau, f_ext, frame, threads, out):
 def _minverse_python(robot, q, threads, out):
     """:func:`minverse` for what the Rust entry hands back (a robot not compiled yet, mimic
     joints)."""
-    model = _model(robot)
+    model = compiled_model(robot)
     if type(model) is NumericModel:
         return _core.minverse(model, q, threads=threads, out=out)
     # mimic joints: (G^T M_full G)^-1 by Cholesky (the constraint couples branches)
@@ -521,7 +523,7 @@ def gravity_derivatives(robot: RobotLike, q: ArrayLike, *, threads: int | None =
     mimic = _mimic(robot, "gravity_derivatives")
     if mimic is not None:
         return mimic.gravity_derivatives(q, threads)
-    return _core.gravity_derivatives(_core_model(robot, "gravity_derivatives"), q, threads)
+    return _core.gravity_derivatives(core_model(robot, "gravity_derivatives"), q, threads)
 
 
 def jacobian_dot(
@@ -537,13 +539,13 @@ def jacobian_dot(
     if mimic is not None:
         Jd = mimic.jacobian_dot(q, qd, link, threads)
     else:
-        Jd = _core.jacobian_dot(_core_model(robot, "jacobian_dot"), q, qd, link, threads)
+        Jd = _core.jacobian_dot(core_model(robot, "jacobian_dot"), q, qd, link, threads)
     offsets = _frame_offsets(robot)
     if offsets is None or not isinstance(robot, Robot):  # offsets: only a Robot has them
         return Jd
     # the point at r = R pf from the compiled (on-joint) frame's origin: J_v' = J_v - [r]x J_w,
     # so Jdot_v' = Jdot_v - [w x r]x J_w - [r]x Jdot_w, with w = J_w qd
-    model = _model(robot)
+    model = compiled_model(robot)
     k = link if isinstance(link, (int, np.integer)) else robot.link_index(link)
     r = model.forward_kinematics(q, threads)[..., k, :3, :3] @ offsets[k, :3, 3]
     Jw = model.jacobian(q, link, threads)[..., 3:, :]
@@ -577,7 +579,7 @@ def regressor(
         raise ValueError(f"columns must be 'model' or 'all', got {columns!r}")
     # parameters about each link's frame on its joint (Robot.canonical), as the symbolic
     # armdyn.identification.regressor defines them
-    model = _core_model(robot, "regressor")
+    model = core_model(robot, "regressor")
     Y = _core.regressor(model, q, qd, qdd, threads)
     if columns == "all":
         return Y

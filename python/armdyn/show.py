@@ -175,7 +175,7 @@ def draw(robot: Robot, q=None, out=None, title: str | None = None):
     fig = plt.figure(figsize=(7, 7))
     ax = fig.add_axes((0, 0, 1, 0.95), projection="3d")
     qtext = ", ".join(f"{v:.3g}" for v in q)
-    draw_on(ax, robot, poses, title or f"{robot.name} at q = [{qtext}]", _view(origins))
+    draw_on(ax, robot, poses, title or f"{robot.name} at q = [{qtext}]", view_of(origins))
     if out is not None:
         from pathlib import Path
 
@@ -189,7 +189,7 @@ def draw(robot: Robot, q=None, out=None, title: str | None = None):
     return fig
 
 
-def _view(origins: np.ndarray) -> tuple[np.ndarray, float]:
+def view_of(origins: np.ndarray) -> tuple[np.ndarray, float]:
     """Centre (3,) and size (m) of a view holding the points ``origins`` (k, 3)."""
     return (origins.max(axis=0) + origins.min(axis=0)) / 2, _reach(origins)
 
@@ -386,7 +386,7 @@ def animate(
     poses = np.asarray(forward_kinematics(robot, np.ascontiguousarray(q)))  # (frames, nlinks, 4, 4)
     names = list(robot.links)
     points = poses[:, :, :3, 3].reshape(-1, 3)
-    centre, size = _view(points)
+    centre, size = view_of(points)
     view = (centre, size, _view_box(points, size))  # one box for every frame: the arm moves in it
     fig = plt.figure(figsize=(6, 6), dpi=dpi)
     ax = fig.add_axes((0.0, 0.03, 0.94, 0.91), projection="3d")  # room for the tick labels

@@ -59,7 +59,7 @@ from typing import Callable
 import numpy as np
 
 from . import _core
-from .numeric import _model, kinetic_energy, potential_energy
+from .numeric import compiled_model, kinetic_energy, potential_energy
 
 __all__ = ["simulate", "simulate_adaptive", "Trajectory", "PD", "ComputedTorque", "joint_limits"]
 
@@ -189,7 +189,7 @@ def joint_limits(robot) -> tuple[np.ndarray, np.ndarray]:
     joint has none, or when ``robot`` is a compiled model without the description)."""
     from .model import Robot
 
-    model = _model(robot)
+    model = compiled_model(robot)
     lower, upper = np.full(model.dof, -np.inf), np.full(model.dof, np.inf)
     if isinstance(robot, Robot):
         for j in robot.joints:
@@ -248,7 +248,9 @@ def _per_state(x, name, rows, dof):
     return _c(np.broadcast_to(a, (rows, dof)))
 
 
-def _steps(duration, steps, dt) -> int:
+def step_count(duration, steps, dt) -> int:
+    """The number of integration steps of ``dt`` seconds: ``steps`` itself, or ``duration``
+    (seconds, a whole number of steps); exactly one of them. ValueError naming the bad one."""
     # bool is an int to Python: dt=True would be a step of 1 s
     if isinstance(dt, (bool, np.bool_)) or not (
         isinstance(dt, (int, float, np.integer, np.floating)) and math.isfinite(dt) and dt > 0
@@ -310,9 +312,9 @@ def simulate(
     Bad input (shapes, NaN, a non-positive dt, a duration that is not a whole number of
     steps, a run that would not fit in memory) raises ``ValueError`` naming it.
     """
-    model = _model(robot)
+    model = compiled_model(robot)
     dof = model.dof
-    steps = _steps(duration, steps, dt)
+    steps = step_count(duration, steps, dt)
     dt = float(dt)
     if method not in ("rk4", "euler"):
         raise ValueError(f"method must be 'rk4' or 'euler', got {method!r}")
@@ -598,7 +600,7 @@ def simulate_adaptive(
     """
     from scipy.integrate import solve_ivp
 
-    model = _model(robot)
+    model = compiled_model(robot)
     dof = model.dof
     q0 = _state(q0, "q0", dof)
     qd0 = np.zeros(dof) if qd0 is None else _state(qd0, "qd0", dof)

@@ -20,6 +20,7 @@ import tempfile
 
 import numpy as np
 
+from .generate import GeneratedCode, codegen, identifier
 from .printers import INPUTS
 
 _DOUBLE_P = ctypes.POINTER(ctypes.c_double)
@@ -159,13 +160,9 @@ def compile(
     cc: the compiler (default ``$CC``, then cc, gcc, clang); flags: extra arguments.
     Raises CompilerError when no compiler is found or it fails.
     """
-    from . import GeneratedCode, codegen
-
     if not isinstance(code, GeneratedCode):
         code = codegen(code, what=what, lang="c", base=base)
     elif code.lang != "c":
         raise ValueError(f"compile needs C code, got lang={code.lang!r}; generate it with lang='c'")
-    from . import _identifier
-
-    path = build_shared_library(code.source, directory, cc, name=_identifier(code.robot_name), flags=list(flags))
+    path = build_shared_library(code.source, directory, cc, name=identifier(code.robot_name), flags=list(flags))
     return CompiledCode(code, path)

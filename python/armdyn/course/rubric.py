@@ -74,10 +74,10 @@ class Rubric:
     @classmethod
     def from_text(cls, text: str, source: str = "<rubric>") -> Rubric:
         # the model loader's YAML reader: lines kept, duplicate keys refused
-        from ..io.yaml import _parse_text
+        from ..io.yaml import parse_text
 
         try:
-            data = _parse_text(text, source)
+            data = parse_text(text, source)
         except RecursionError:
             raise ModelError("rubric nested too deeply", source=source) from None
         if data is None:

@@ -231,7 +231,7 @@ def drawing_uri(variant: Variant, robot) -> str:
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from ..show import _view, draw_on, frame_poses
+    from ..show import draw_on, frame_poses, view_of
 
     bound = robot.bind({s.name: _NOMINAL_LENGTHS.get(s.name, 1.0) for s in robot.free_symbols()})
     q = np.array([0.5 if j.type == "revolute" else 0.4 for j in robot.movable_joints])
@@ -241,7 +241,7 @@ def drawing_uri(variant: Variant, robot) -> str:
         fig = plt.figure(figsize=(5.5, 5.5))
         try:
             ax = fig.add_subplot(projection="3d")
-            draw_on(ax, bound, poses, f"{variant.ident}: frames at a sample pose", _view(origins))
+            draw_on(ax, bound, poses, f"{variant.ident}: frames at a sample pose", view_of(origins))
             if variant.spec.planar and variant.gravity != (0, 0, -1):
                 ax.view_init(elev=90, azim=-90)  # the arm's plane is x0-y0: seen from above
                 ax.set_zticks([])

@@ -25,6 +25,11 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..model import Robot
+
+# the text, JSON and HTML renderers register GradeReport's text, to_dict, to_json and
+# _repr_html_ with armdyn.dispatch when imported
+from . import html as _html_report  # noqa: F401
+from . import text as _text_report  # noqa: F401
 from .diagnose import unreadable
 from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, split_name, tidy

@@ -20,7 +20,7 @@ import sympy as sp
 
 from ..model import Robot
 from ..symbolic.agreement import trig_reduce
-from ..symbolic.report import _UnicodeTextPrinter, unicode_name
+from ..symbolic.report import UnicodeTextPrinter, unicode_name
 
 COMPONENTS = "xyz"
 _GREEK = {
@@ -98,7 +98,7 @@ def pretty(expr, ascii_only: bool = False, shorthand: dict | None = None) -> str
     if ascii_only:
         return to_ascii(sp.sstr(expr, order="none")) if shorthand else sp.sstr(expr, order="none")
     names = {s: display_name(s.name) for s in expr.free_symbols}
-    text = _UnicodeTextPrinter(names, order="none").doprint(expr)
+    text = UnicodeTextPrinter(names, order="none").doprint(expr)
     text = re.sub(r"\*\*2\b", "²", text)
     text = re.sub(r"\*\*3\b", "³", text)
     return text.replace("*", "·").replace("-", "−")

@@ -14,7 +14,7 @@ document (inline CSS, math as MathML, no script, no network), laid out as:
 
 Values are printed in the student's notation (``GradeReport.symbol_latex``) and tidied
 for reading (terms collected by joint accelerations, then velocity products, then the
-rest, as :func:`armdyn.symbolic.report.tidy_terms` does), so the two sides list the
+rest, as :func:`armdyn.symbolic.tidy.tidy_terms` does), so the two sides list the
 same kinds of terms in the same order. Tidying is for display only.
 
 :func:`repr_html` is the same content as a fragment for Jupyter
@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ..dispatch import register
 from ..htmlpage import fragment, page
 from ..mathml import MathWriter, escape, latex_to_mathml, math_element, text_with_math
 from .verdict import STATUSES, GradeReport, StepVerdict
@@ -98,7 +99,7 @@ class _Writer:
 
     def scalar(self, expr) -> str:
         from ..symbolic import dag
-        from ..symbolic.report import tidy_terms
+        from ..symbolic.tidy import tidy_terms
 
         expr = sp.sympify(expr)
         if dag.larger_than(expr, PRINT_NODE_LIMIT):
@@ -345,7 +346,9 @@ def _summary(report: GradeReport, anchors: dict, labels: dict) -> str:
     )
 
 
-def _body(report: GradeReport) -> str:
+def report_body(report: GradeReport) -> str:
+    """The report's content without a page around it: :func:`report_html` wraps it in a
+    page, :func:`repr_html` in a fragment (the web app builds it once and wraps it twice)."""
     w = _Writer(report)
     anchors: dict[str, int] = {}
     for i, s in enumerate(report.steps):
@@ -382,7 +385,7 @@ def _body(report: GradeReport) -> str:
 
 def report_html(report: GradeReport) -> str:
     """The whole report as one self-contained HTML5 page (a string)."""
-    return page(f"armdyn grade: {report.submission}", _body(report))
+    return page(f"armdyn grade: {report.submission}", report_body(report))
 
 
 def write_report_html(report: GradeReport, path) -> None:
@@ -393,6 +396,7 @@ def write_report_html(report: GradeReport, path) -> None:
     atomic_write_text(path, report_html(report))
 
 
+@register("html", GradeReport)
 def repr_html(report: GradeReport) -> str:
     """The report as an HTML fragment, for ``GradeReport._repr_html_`` in Jupyter."""
-    return fragment(_body(report))
+    return fragment(report_body(report))

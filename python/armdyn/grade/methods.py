@@ -27,7 +27,7 @@ from ..model import Robot
 
 # the module, not the function of the same name that armdyn.symbolic exports
 ne = importlib.import_module("armdyn.symbolic.newton_euler")
-from ..symbolic.lagrange import _energies  # noqa: E402 - after the module ne above
+from ..symbolic.lagrange import link_energies  # noqa: E402 - after the module ne above
 from ..symbolic.terms import time_derivative  # noqa: E402
 
 Ref = tuple  # (key, index)
@@ -292,7 +292,7 @@ def rotation_between(ctx, frm: int, to: int):
 
 def lagrange_method(robot: Robot) -> tuple[Method, dict]:
     """The Lagrange steps of ``robot``: T, V, L, the partial derivatives, tau."""
-    T_trans, T_rot, V_links, _ = _energies(robot)
+    T_trans, T_rot, V_links, _ = link_energies(robot)
     T = sum(T_trans.values(), sp.Integer(0)) + sum(T_rot.values(), sp.Integer(0))
     V = sum(V_links.values(), sp.Integer(0))
     q, qd, qdd = robot.q, robot.qd, robot.qdd

@@ -104,7 +104,8 @@ class Submission:
         return yaml.safe_dump(data, sort_keys=False, allow_unicode=True, width=100)
 
 
-def _read_text(path: str) -> str:
+def read_text(path: str) -> str:
+    """A submission file's text: UTF-8, at most ``MAX_BYTES``; else a ModelError naming it."""
     try:
         size = os.path.getsize(path)
     except OSError as exc:
@@ -125,7 +126,7 @@ def _read_text(path: str) -> str:
 _LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when present: 100x faster
 
 
-def _safe_yaml(text: str, where: str):
+def safe_yaml(text: str, where: str):
     """YAML with no aliases (an alias bomb cannot expand), no deep nesting, no huge
     integers (:func:`armdyn.io.yaml_screen.screen`, shared with model files) and no
     Python tags."""
@@ -250,7 +251,7 @@ def read_markdown(path: str, text: str | None = None) -> Submission:
     from .latex import MAX_LENGTH, side_offsets, split_equations
     from .parts import find_parts, with_title
 
-    text = _read_text(path) if text is None else text
+    text = read_text(path) if text is None else text
     index = LineIndex(text)
     sub = Submission(path, base_dir=os.path.dirname(os.path.abspath(path)), lines=index)
     body_start = 0
@@ -258,7 +259,7 @@ def read_markdown(path: str, text: str | None = None) -> Submission:
         end = re.search(r"^---\s*$", text[3:], re.M)
         if end is None:
             raise ModelError("front matter opened with '---' is never closed", source=f"{path}:1")
-        _front(_safe_yaml(text[3 : 3 + end.start()], path), path, sub)
+        _front(safe_yaml(text[3 : 3 + end.start()], path), path, sub)
         body_start = 3 + end.end()
     hidden = set(range(1, index.line(body_start) + 1))  # front matter and display math: no headings there
     for outer_start, outer_end, block_start, block in math_blocks(text, body_start):
@@ -347,8 +348,8 @@ def read_markdown(path: str, text: str | None = None) -> Submission:
 
 def read_yaml(path: str, text: str | None = None) -> Submission:
     """Read a YAML derivation (see the module docstring)."""
-    text = _read_text(path) if text is None else text
-    data = _safe_yaml(text, path)
+    text = read_text(path) if text is None else text
+    data = safe_yaml(text, path)
     if not isinstance(data, dict) or "steps" not in data:
         raise ModelError("a YAML submission is a mapping with 'steps' (and 'robot', 'method')", source=path)
     sub = Submission(path, base_dir=os.path.dirname(os.path.abspath(path)))

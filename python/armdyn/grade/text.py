@@ -1,5 +1,7 @@
 """The grade report as plain text (what a student reads in a terminal) and as JSON
-(what scripts and course graders read; field names are stable)."""
+(what scripts and course graders read; field names are stable).
+
+``GradeReport.text``, ``to_dict`` and ``to_json`` call these through :mod:`armdyn.dispatch`."""
 
 from __future__ import annotations
 
@@ -10,6 +12,7 @@ import unicodedata
 import symengine as se
 import sympy as sp
 
+from ..dispatch import register
 from .explain import display_name, pretty, to_ascii
 from .verdict import GradeReport, StepVerdict
 
@@ -74,6 +77,7 @@ def _pad(s: str, width: int) -> str:
     return s + " " * max(0, width - _width(s))
 
 
+@register("text", GradeReport)
 def text(report: GradeReport, ascii_only: bool = False, details: bool = True) -> str:
     """The report: one line per step, values for the wrong ones, then the summary."""
     lines = [f"armdyn grade {report.submission}: robot '{report.robot}', {report.method}", ""]
@@ -159,6 +163,7 @@ def _str(value):
     return str(value)
 
 
+@register("dict", GradeReport)
 def to_dict(report: GradeReport) -> dict:
     """The JSON object: robot, method, steps [...], first_wrong, tau_correct."""
     steps = []
@@ -194,6 +199,7 @@ def to_dict(report: GradeReport) -> dict:
     }
 
 
+@register("json", GradeReport)
 def to_json(report: GradeReport) -> str:
     return json.dumps(to_dict(report), indent=2, ensure_ascii=False)
 

@@ -29,6 +29,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from ..dispatch import call
+
 STATUSES = (
     "correct",
     "correct-by-convention",
@@ -129,28 +131,21 @@ class GradeReport:
         """Every equation read and right (an unread one is not a pass: it was not checked)."""
         return all(s.status in PASSING for s in self.steps)
 
+    # the text, JSON and HTML renderers (text.py, html.py) register with armdyn.dispatch
     def text(self, ascii_only: bool = False) -> str:
         """The plain-text report (Unicode dots unless ``ascii_only``)."""
-        from .text import text
-
-        return text(self, ascii_only)
+        return call("text", self, ascii_only)
 
     def to_dict(self) -> dict:
         """The JSON object (stable field names), expressions as SymPy strings."""
-        from .text import to_dict
-
-        return to_dict(self)
+        return call("dict", self)
 
     def to_json(self) -> str:
-        from .text import to_json
-
-        return to_json(self)
+        return call("json", self)
 
     def __str__(self) -> str:
         return self.text()
 
     def _repr_html_(self) -> str:
         """Jupyter: the report as HTML (MathML math, no network)."""
-        from .html import repr_html
-
-        return repr_html(self)
+        return call("html", self)

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from ..errors import ModelError
 from ..model import Robot
+from . import urdf  # registers Robot.from_urdf with armdyn.dispatch
 
 #: Directory of the bundled models.
 ROBOTS_DIR = Path(__file__).resolve().parent.parent / "robots"
@@ -44,11 +45,7 @@ def _load_file(path: Path, strict: bool, source: str) -> Robot:
 
         return load_yaml(path, strict=strict, source=source)
     if suffix == ".urdf":
-        try:
-            from .urdf import load_urdf
-        except ImportError:
-            raise ModelError("URDF support not available", None, source) from None
-        return load_urdf(path, strict=strict)
+        return urdf.load_urdf(path, strict=strict)
     if suffix == ".xacro":
         from .xacro import load_xacro
 

@@ -60,6 +60,7 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
+from ..dispatch import register
 from ..errors import ModelError
 from ..inertia import rotate
 from ..model import Joint, Link, Mimic, Numbers, Robot, rpy_matrix
@@ -94,9 +95,15 @@ def load_urdf(path_or_xml, strict: bool = True) -> Robot:
     """
     text, source = _read(path_or_xml)
     try:
-        return _build(_parse(text), text, source, strict)
+        return build_robot(parse_xml(text), text, source, strict)
     except ModelError as err:
         raise err.located(source=source)
+
+
+@register("urdf", Robot)
+def robot_from_urdf(cls: type, path_or_xml, strict: bool = True) -> Robot:
+    """``Robot.from_urdf`` (through :mod:`armdyn.dispatch`): :func:`load_urdf`."""
+    return load_urdf(path_or_xml, strict=strict)
 
 
 # --------------------------------------------------------------------- input
@@ -117,7 +124,8 @@ def _read(path_or_xml) -> tuple[bytes, str]:
         raise ModelError(f"cannot read the file ({exc.strerror or exc})", source=source) from None
 
 
-def _parse(text: bytes) -> ET.Element:
+def parse_xml(text: bytes) -> ET.Element:
+    """The ``<robot>`` root of URDF bytes (no DTD, no entities); ModelError with line and column."""
     _refuse_dtd(text)
     try:
         root = ET.fromstring(text)
@@ -388,7 +396,8 @@ def _mimic(elem: ET.Element, where: str) -> Mimic | None:
 # ----------------------------------------------------------------- the robot
 
 
-def _build(root: ET.Element, text: bytes, source: str, strict: bool) -> Robot:
+def build_robot(root: ET.Element, text: bytes, source: str, strict: bool) -> Robot:
+    """The Robot of a parsed ``<robot>`` element (``text``: the file's bytes, for its leading comment)."""
     if root.find("link") is None:
         raise ModelError("the robot has no <link>", "<robot>")
     name = _name(root, "<robot>")

@@ -28,7 +28,7 @@ def load_xacro(path, strict: bool = True, mappings: dict[str, str] | None = None
             None,
             source,
         ) from None
-    from .urdf import _build, _parse
+    from .urdf import build_robot, parse_xml
 
     if not Path(path).is_file():
         raise ModelError("no such file", None, source)
@@ -39,6 +39,6 @@ def load_xacro(path, strict: bool = True, mappings: dict[str, str] | None = None
         raise ModelError(f"xacro could not expand it: {message}", None, source) from None
     text = doc.toxml(encoding="utf-8")
     try:
-        return _build(_parse(text), text, source, strict)
+        return build_robot(parse_xml(text), text, source, strict)
     except ModelError as err:
         raise err.located(source=source) from None

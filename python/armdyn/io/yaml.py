@@ -203,7 +203,9 @@ def _at(source: str, node) -> str:
     return f"{source}:{line}" if line else source
 
 
-def _parse_text(text: str, source: str):
+def parse_text(text: str, source: str):
+    """A model file's YAML text parsed (screened first, keys unique, line numbers kept);
+    a syntax error is a ModelError naming ``source`` and the line."""
     screen(text, source)  # aliases, deep nesting, huge integers: refused before anything is built
     try:
         return yaml.load(text, Loader=_LineLoader)  # noqa: S506 - a SafeLoader subclass
@@ -410,7 +412,7 @@ def robot_from_dict(data, source: str = "<model>", strict: bool = True, default_
 
 def load_yaml_string(text: str, source: str = "<string>", strict: bool = True) -> Robot:
     """A Robot from YAML text (errors name ``source``)."""
-    data = _parse_text(text, source)
+    data = parse_text(text, source)
     if data is None:
         raise ModelError("the file is empty", None, source)
     return robot_from_dict(data, source, strict)
@@ -431,7 +433,7 @@ def load_yaml(path, strict: bool = True, source: str | None = None) -> Robot:
         raise ModelError("no such file", None, source) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise ModelError(f"cannot read the file ({exc})", None, source) from None
-    data = _parse_text(text, source)
+    data = parse_text(text, source)
     if data is None:
         raise ModelError("the file is empty", None, source)
     robot = robot_from_dict(data, source, strict, default_name=path.stem)

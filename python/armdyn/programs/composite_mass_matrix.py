@@ -30,7 +30,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..model import Robot
-from .customized_ne import _safe, joint_frames, standard_parameters
+from .customized_ne import joint_frames, standard_parameters
 from .program import Builder, Program
 from .vectors import UPPER, ZERO, cross, dot, minus, mv, plus, rows, times, vadd, vscale
 
@@ -61,15 +61,15 @@ def composite_mass_matrix(robot: Robot, parameters=None, builder: Builder | None
     Mc, MSc, Jc = {}, {}, {}
     for joint in reversed(robot.joints):
         name = joint.child
-        tag = _safe(str(robot.link_index(name)))
+        tag = str(robot.link_index(name))
         m, ms, J = parameters[name]
         ms, J = list(ms), rows(J)
         for child in robot.children(name):
             c = child.child
             R, p = frames[c]
-            MSr = b.vector(mv(R, MSc[c]), f"MSr{_safe(str(robot.link_index(c)))}")
+            MSr = b.vector(mv(R, MSc[c]), f"MSr{str(robot.link_index(c))}")
             pMS, pp = dot(p, MSr), dot(p, p)
-            Jr = _rotate_symmetric(b, R, Jc[c], f"Jr{_safe(str(robot.link_index(c)))}")
+            Jr = _rotate_symmetric(b, R, Jc[c], f"Jr{str(robot.link_index(c))}")
             # J + Jr + Mc (pp 1 - p p^T) + 2 pMS 1 - p MSr^T - MSr p^T, summed in this order
             # (floats may round differently in another)
             Jnew = [[None] * 3 for _ in range(3)]
@@ -106,7 +106,7 @@ def composite_mass_matrix(robot: Robot, parameters=None, builder: Builder | None
             if parent == robot.base:
                 break
             R, p = frames[link]
-            hint = f"{j + 1}_{_safe(str(robot.link_index(parent)))}"
+            hint = f"{j + 1}_{str(robot.link_index(parent))}"
             fv = b.vector(mv(R, fv), f"f{hint}")
             nv = b.vector(vadd(mv(R, nv), cross(p, fv)), f"n{hint}")
             pj = robot.parent_joint(parent)

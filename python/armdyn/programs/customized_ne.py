@@ -53,7 +53,6 @@ Dead code (quantities no torque needs, e.g. the first link's force) is removed a
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field
 
 import sympy as sp
@@ -93,10 +92,6 @@ from .vectors import (
 
 #: per link, in the architecture's (Pinocchio's) order of the standard parameters
 STANDARD_NAMES = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")
-
-
-def _safe(name: str) -> str:
-    return re.sub(r"\W", "_", name)
 
 
 def standard_parameters(robot: Robot):
@@ -198,7 +193,7 @@ def joint_frames(robot: Robot, b: Builder, turns: dict | None = None) -> dict:
                 trig = {sp.cos(q): b.let(sp.cos(q), f"c{k + 1}"), sp.sin(q): b.let(sp.sin(q), f"s{k + 1}")}
                 R = R.xreplace(trig)
             R = R.tolist()
-        tag = _safe(str(robot.link_index(joint.child)))
+        tag = str(robot.link_index(joint.child))
         R = [[b.let(R[r][s], f"R{tag}_{r + 1}{s + 1}") for s in range(3)] for r in range(3)]
         p = [b.let(p[r], f"p{tag}_{'xyz'[r]}") for r in range(3)]
         frames[joint.child] = (R, p)
@@ -380,7 +375,7 @@ class _Recursion:
     def outward(self, joint) -> None:
         robot = self.robot
         name = joint.child
-        s = LinkState(joint, _safe(str(robot.link_index(name))), robot.coordinate_index(joint), *self.frames[name])
+        s = LinkState(joint, str(robot.link_index(name)), robot.coordinate_index(joint), *self.frames[name])
         s.run = self.runs.get(name)
         self._angular(s)
         self._origin_acceleration(s)

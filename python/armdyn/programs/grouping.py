@@ -38,7 +38,6 @@ from __future__ import annotations
 import sympy as sp
 
 from ..model import Robot
-from .customized_ne import _safe
 from .program import names
 from .vectors import UPPER, ZERO, dot, expanded, minus, mv, plus, rows, times
 
@@ -121,7 +120,7 @@ def grouped_parameters(robot: Robot, parameters: dict, definitions: list):
 
     out = {}
     for link, (M, MS, J) in work.items():
-        i = _safe(str(robot.link_index(link)))
+        i = str(robot.link_index(link))
         M0, MS0, J0 = parameters[link]
         Mn = named(M, M0, f"M{i}")
         MSn = [named(MS[k], MS0[k], f"M{'XYZ'[k]}{i}") for k in range(3)]

@@ -28,7 +28,6 @@ from __future__ import annotations
 import sympy as sp
 
 from ..model import Robot
-from .customized_ne import _safe
 from .program import is_value, names
 from .vectors import UPPER
 
@@ -85,7 +84,7 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
         M, MS, J = parameters[link]
         if sp.sympify(MS[0]) == 0 or sp.sympify(MS[1]) == 0:
             continue  # already on an axis: turning would only swap x and y
-        tag = _safe(str(robot.link_index(link)))
+        tag = str(robot.link_index(link))
         MX, MY = MS[0], MS[1]
         norm2 = MX**2 + MY**2
         nonzero = sp.Ne(norm2, 0)
@@ -116,7 +115,7 @@ def turn_leaf_frames(robot: Robot, parameters: dict, definitions: list, taken=()
             if joint.parent != robot.base:
                 Mp, MSp, Jp = out[joint.parent]
                 Jp = sp.Matrix(Jp)
-                ptag = _safe(str(robot.link_index(joint.parent)))
+                ptag = str(robot.link_index(joint.parent))
                 for a, b in UPPER:
                     if not is_value(moved[0][a, b], 0):
                         Jp[a, b] = Jp[b, a] = named(

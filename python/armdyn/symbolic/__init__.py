@@ -8,6 +8,10 @@ check(derive(robot), derive(robot, "lagrange")).text()
 from __future__ import annotations
 
 from ..model import Robot
+
+# the LaTeX and HTML renderers register EquationsOfMotion._repr_latex_, the _repr_html_ of
+# EquationsOfMotion, Robot and AgreementReport with armdyn.dispatch when imported
+from . import report, report_html  # noqa: F401
 from .agreement import AgreementReport, check
 from .lagrange import lagrange
 from .newton_euler import newton_euler

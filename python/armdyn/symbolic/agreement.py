@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy as sp
 
+from ..dispatch import call
 from . import dag
 from .terms import EquationsOfMotion
 
@@ -96,10 +97,8 @@ class AgreementReport:
         return "\n".join([head] + ["  " + r.line() for r in self.results])
 
     def _repr_html_(self) -> str:
-        """Jupyter: the checks as a table (see report_html.py)."""
-        from .report_html import agreement_html
-
-        return agreement_html(self)
+        """Jupyter: the checks as a table (report_html.py, through :mod:`armdyn.dispatch`)."""
+        return call("html", self)
 
 
 class _NumericSampler:

@@ -38,7 +38,7 @@ from .joint_terms import armature, friction_torques, offsets
 from .terms import EquationsOfMotion, Step
 
 
-def _energies(robot: Robot):
+def link_energies(robot: Robot):
     """Per-link (T_trans, T_rot, V) and the steps showing them."""
     zero = sp.zeros(3, 1)
     w, v = {robot.base: zero}, {robot.base: zero}
@@ -96,7 +96,7 @@ def _energies(robot: Robot):
 def lagrange(robot: Robot) -> EquationsOfMotion:
     """Derive ``tau`` by the Euler-Lagrange equations; steps show T (trans/rot), V and L."""
     q, qd, qdd, n = robot.q, robot.qd, robot.qdd, robot.dof
-    T_trans, T_rot, V_links, steps = _energies(robot)
+    T_trans, T_rot, V_links, steps = link_energies(robot)
     T = sum(T_trans.values(), sp.Integer(0)) + sum(T_rot.values(), sp.Integer(0))
     ia = armature(robot)
     if any(x != 0 for x in ia):

@@ -1,16 +1,17 @@
-"""Readable reports of derivations: plain text, LaTeX or Markdown.
+"""Readable reports of derivations: plain text, LaTeX or Markdown (HTML: report_html.py).
 
 Small expressions are shown tidied the way one writes them by hand: sin^2 + cos^2
 reduced, terms collected by joint accelerations, then velocity products, then the
 rest (gravity), each coefficient factored. Large ones (a 6-dof arm with symbolic
 inertia) are shown as common subexpressions ``x0 = ...`` followed by the results,
-which is what one would compile anyway. Tidying is for display only: the
-derivations themselves never call ``simplify``.
+which is what one would compile anyway (the rules every format shares: tidy.py).
+Tidying is for display only: the derivations themselves never call ``simplify``.
+
+Registers ``EquationsOfMotion._repr_latex_`` with :mod:`armdyn.dispatch`.
 """
 
 from __future__ import annotations
 
-import functools
 import re
 import weakref
 
@@ -18,12 +19,13 @@ import symengine as se
 import sympy as sp
 from sympy.printing.precedence import precedence
 
+from ..dispatch import register
 from . import dag
-from .agreement import trig_reduce
+from .notes import note_text
+from .report_html import derivation_html
 from .terms import EquationsOfMotion, Step
+from .tidy import TIDY_NODE_LIMIT, tidy_terms, too_big_to_tidy
 
-#: expressions with more nodes than this are printed via common subexpressions
-TIDY_NODE_LIMIT = 3000
 FORMATS = ("text", "latex", "markdown")
 
 _SUB = str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉")
@@ -95,7 +97,7 @@ def unicode_name(name: str, dots: str = "") -> str | None:
     return _GREEK.get(base, base) + _DOTS[dots] + digits.translate(_SUB)
 
 
-class _UnicodeTextPrinter(sp.printing.str.StrPrinter):
+class UnicodeTextPrinter(sp.printing.str.StrPrinter):
     """SymPy's str printer with θ̇₁-style symbol names, superscript integer powers and
     factors side by side as written by hand (``d₂² m₂ θ̈₁``, not ``d₂**2*m₂*θ̈₁``). A
     visible ``·`` stays where juxtaposition would merge two numbers (``2·3^x``)."""
@@ -201,42 +203,6 @@ def latex_symbol_names(robot) -> dict:
     return names
 
 
-#: formulas in the derivations' step notes (plain ASCII there, so --ascii keeps them):
-#: (ASCII, Unicode for the text report, LaTeX for HTML/MathML captions)
-NOTE_FORMULAS = (
-    ("m vcd", "m v̇_C", r"m \dot{v}_C"),
-    ("I wd + w x I w", "I ω̇ + ω × I ω", r"I \dot{\omega} + \omega \times I \omega"),
-    ("1/2 m vc.vc", "½ m v_Cᵀ v_C", r"\tfrac{1}{2} m \, v_C^{\mathsf{T}} v_C"),
-    ("1/2 w^T I w", "½ ωᵀ I ω", r"\tfrac{1}{2} \omega^{\mathsf{T}} I \omega"),
-    ("1/2 Ia qd^2", "½ I_a q̇²", r"\tfrac{1}{2} I_a \dot{q}^{2}"),
-    ("-m gravity.pc", "−m gᵀ p_C", r"-m \, g^{\mathsf{T}} p_C"),
-    (
-        "d/dt dL/dqd - dL/dq",
-        "d/dt ∂L/∂q̇ − ∂L/∂q",
-        r"\frac{d}{dt} \frac{\partial L}{\partial \dot{q}} - \frac{\partial L}{\partial q}",
-    ),
-    ("dL/dq", "∂L/∂q", r"\frac{\partial L}{\partial q}"),
-    ("T - V", "T − V", "T - V"),
-)
-
-
-def note_parts(note: str) -> list[tuple[str, int | None]]:
-    """A step note split into ``(text, None)`` and ``(ascii_formula, k)`` pieces, ``k``
-    indexing :data:`NOTE_FORMULAS` (the first, longest formula found wins)."""
-    for k, (ascii_form, _, _) in enumerate(NOTE_FORMULAS):
-        at = note.find(ascii_form)
-        if at >= 0:
-            tail = note[at + len(ascii_form) :]
-            head = [(note[:at], None)] if at else []
-            return head + [(ascii_form, k)] + (note_parts(tail) if tail else [])
-    return [(note, None)] if note else []
-
-
-def note_text(note: str) -> str:
-    """The note with its formulas in Unicode: ``inertial force m v̇_C``."""
-    return "".join(text if k is None else NOTE_FORMULAS[k][1] for text, k in note_parts(note))
-
-
 def unicode_supported(stream=None) -> bool:
     """Whether ``stream`` (default stdout) can print the Unicode report."""
     import sys
@@ -247,30 +213,6 @@ def unicode_supported(stream=None) -> bool:
     except (UnicodeEncodeError, LookupError):
         return False
     return True
-
-
-def tidy_terms(expr, q, qd, qdd) -> list[tuple]:
-    """``expr`` as an ordered list of ``(coefficient, monomial)``: joint-acceleration
-    terms, velocity-product terms, then the rest (gravity), coefficients factored.
-    Empty list for zero. Memoised: reports show the same values again and again (a
-    class graded against one model), and factoring is the slow part of a report."""
-    return list(_tidy_terms(sp.sympify(expr), tuple(q), tuple(qd), tuple(qdd)))
-
-
-@functools.lru_cache(maxsize=4096)
-def _tidy_terms(expr, q, qd, qdd) -> tuple:
-    e = trig_reduce(expr, q, keep_trig=True)
-    if e == 0:
-        return ()
-    motion = list(qdd) + [qd[i] * qd[j] for i in range(len(qd)) for j in range(i, len(qd))]
-    parts = sp.collect(e, motion, evaluate=False)
-    terms = [(sp.factor(parts[m]), m) for m in motion if m in parts]
-    rest = parts.get(sp.S.One, 0)
-    if rest != 0:
-        trig = [f(qi) for qi in q for f in (sp.sin, sp.cos)]
-        for mono, coef in sp.collect(sp.expand(rest), trig, evaluate=False).items():
-            terms.append((sp.factor(coef), mono))
-    return tuple(terms)
 
 
 def _join(terms, render, text: bool | None = None, times: str | None = None) -> str:
@@ -311,7 +253,7 @@ class Renderer:
             raise ValueError(f"unknown format {fmt!r}; choose one of {', '.join(FORMATS)}")
         self.eom, self.fmt, self.ascii = eom, fmt, ascii
         # text: θ̇₁, d̈₂, m₂ (Unicode), or SymPy's own names with ascii (theta1_dot)
-        self._text = str if ascii else _UnicodeTextPrinter(_text_names(eom)).doprint
+        self._text = str if ascii else UnicodeTextPrinter(_text_names(eom)).doprint
         self._latex_names = latex_symbol_names(eom.robot)
 
     def atom(self, expr) -> str:
@@ -379,10 +321,6 @@ class Renderer:
         return f"$${lhs} = {rhs}$$"
 
 
-def _big(eom: EquationsOfMotion) -> bool:
-    return any(dag.larger_than(t, TIDY_NODE_LIMIT) for t in eom.tau)
-
-
 def tau_lines(eom: EquationsOfMotion, fmt: str = "text", ascii: bool = False) -> list[str]:
     """The joint torques/forces as equations, one per joint (CSE form for big ones).
     ascii: plain ASCII text (tau1, theta1_dot) instead of Unicode (τ₁, θ̇₁)."""
@@ -394,7 +332,7 @@ def tau_lines(eom: EquationsOfMotion, fmt: str = "text", ascii: bool = False) ->
         tau_name = lambda k: f"tau{k + 1}"  # noqa: E731
     else:
         tau_name = lambda k: "τ" + str(k + 1).translate(_SUB)  # noqa: E731
-    if _big(eom):
+    if too_big_to_tidy(eom):
         # SymEngine's CSE: SymPy's walks the expanded tree and takes minutes on a 6-dof arm
         subexprs, reduced = se.cse(se.sympify(list(eom.tau)))
         subexprs = [(sp.sympify(a), sp.sympify(b)) for a, b in subexprs]
@@ -443,6 +381,13 @@ def steps_lines(eom: EquationsOfMotion, fmt: str = "text", ascii: bool = False) 
     return lines
 
 
+@register("latex", EquationsOfMotion)
+def eom_latex(eom: EquationsOfMotion) -> str:
+    """``EquationsOfMotion._repr_latex_``: tau as an ``aligned`` block."""
+    lines = [ln for ln in tau_lines(eom, "latex") if not ln.lstrip().startswith("%")]
+    return "$$\\begin{aligned}\n" + "\n".join(lines) + "\n\\end{aligned}$$"
+
+
 def derivation_report(
     eoms: list[EquationsOfMotion], fmt: str = "text", steps: bool = False, agreement=None, ascii: bool = False
 ) -> str:
@@ -451,8 +396,6 @@ def derivation_report(
 
     ``fmt="html"`` gives a self-contained page with MathML (see report_html.py)."""
     if fmt == "html":
-        from .report_html import derivation_html
-
         return derivation_html(eoms, steps=steps, agreement=agreement)
     robot = eoms[0].robot
     joints = ", ".join(f"{j.name} {j.type}" for j in robot.movable_joints)

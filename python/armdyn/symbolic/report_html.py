@@ -6,9 +6,10 @@
   when they are cheap (small arms), and the agreement checks.
 * :func:`eom_html`, :func:`robot_html`, :func:`agreement_html`: fragments for the
   ``_repr_html_`` of :class:`~armdyn.symbolic.terms.EquationsOfMotion`,
-  :class:`~armdyn.model.Robot` and :class:`~armdyn.symbolic.agreement.AgreementReport`.
+  :class:`~armdyn.model.Robot` and :class:`~armdyn.symbolic.agreement.AgreementReport`,
+  registered with :mod:`armdyn.dispatch`.
 
-Expressions are tidied as in the text report (:func:`armdyn.symbolic.report.tidy_terms`:
+Expressions are tidied as in the text report (:func:`armdyn.symbolic.tidy.tidy_terms`:
 joint accelerations, then velocity products, then gravity, coefficients factored);
 big ones (a 6-dof arm with symbolic inertia) are shown as common subexpressions, as
 the other formats do. Step labels are the derivation's LaTeX, converted to MathML.
@@ -18,9 +19,15 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ..dispatch import register
 from ..htmlpage import fragment, page
-from ..mathml import MathWriter, escape, latex_to_mathml, math_element
+from ..mathml import MathWriter, escape, latex_to_mathml, math_element, typeset_width
+from ..model import Robot
 from . import dag
+from .agreement import AgreementReport
+from .notes import NOTE_FORMULAS, note_parts
+from .terms import EquationsOfMotion
+from .tidy import TIDY_NODE_LIMIT, tidy_terms, too_big_to_tidy
 
 #: show M, C and g on the page for arms with at most this many joints (C costs O(n^3)
 #: derivatives of M)
@@ -44,13 +51,9 @@ _METHODS = {"newton-euler": "Newton\u2013Euler", "lagrange": "Lagrange"}
 
 class _Writer:
     def __init__(self, eom):
-        from .report import TIDY_NODE_LIMIT
-
         self.eom, self.w, self.limit = eom, MathWriter(), TIDY_NODE_LIMIT
 
     def scalar(self, expr) -> str:
-        from .report import tidy_terms
-
         expr = sp.sympify(expr)
         if not expr.free_symbols or dag.larger_than(expr, self.limit):
             return self.w.expr(expr)
@@ -73,9 +76,7 @@ class _Writer:
 
 def caption(note: str) -> str:
     """A step note as HTML, its formulas as inline MathML (``inertial force m v̇_C``),
-    the rest escaped text (see :data:`armdyn.symbolic.report.NOTE_FORMULAS`)."""
-    from .report import NOTE_FORMULAS, note_parts
-
+    the rest escaped text (see :data:`armdyn.symbolic.notes.NOTE_FORMULAS`)."""
     out = []
     for text, k in note_parts(note):
         inner = None if k is None else latex_to_mathml(NOTE_FORMULAS[k][2])
@@ -101,10 +102,8 @@ def _tau(k: int) -> str:
 
 
 def _tau_block(eom, wr: _Writer) -> str:
-    from .report import _big
-
     out = []
-    if _big(eom):
+    if too_big_to_tidy(eom):
         import symengine as se
 
         subexprs, reduced = se.cse(se.sympify(list(eom.tau)))
@@ -157,8 +156,6 @@ def _terms_block(eom, wr: _Writer) -> str:
     """M, g and C of a small arm (``M qdd + C qd + g = tau``): as matrices when their
     rows fit a line, else entry by entry (M's upper triangle: it is symmetric; C's
     non-zero entries)."""
-    from ..mathml import typeset_width
-
     out = ["<h3>Terms: M(q) q\u0308 + C(q, q\u0307) q\u0307 + g(q) = \u03c4</h3>"]
     n = eom.robot.dof
 
@@ -272,17 +269,15 @@ def derivation_html(eoms, steps: bool = False, agreement=None) -> str:
             body.append(_steps_block(eom, wr))
             body.append("<h3>Result</h3>")
         body.append(_tau_block(eom, wr))
-    if robot.dof <= TERMS_MAX_DOF:
-        from .report import _big
-
-        if not _big(eoms[0]):
-            body.append(_terms_block(eoms[0], _Writer(eoms[0])))
+    if robot.dof <= TERMS_MAX_DOF and not too_big_to_tidy(eoms[0]):
+        body.append(_terms_block(eoms[0], _Writer(eoms[0])))
     if agreement is not None:
         body.append("<h2>Agreement</h2>" + agreement_body(agreement))
     return page(f"armdyn derive {robot.name}", "".join(body))
 
 
-def eom_html(eom) -> str:
+@register("html", EquationsOfMotion)
+def eom_html(eom: EquationsOfMotion) -> str:
     """``EquationsOfMotion._repr_html_``: tau of one derivation, as a fragment."""
     head = (
         f'<p class="meta"><b>{escape(eom.robot.name)}</b> · '
@@ -291,19 +286,13 @@ def eom_html(eom) -> str:
     return fragment(head + _tau_block(eom, _Writer(eom)))
 
 
-def eom_latex(eom) -> str:
-    """``EquationsOfMotion._repr_latex_``: tau as an ``aligned`` block."""
-    from .report import tau_lines
-
-    lines = [ln for ln in tau_lines(eom, "latex") if not ln.lstrip().startswith("%")]
-    return "$$\\begin{aligned}\n" + "\n".join(lines) + "\n\\end{aligned}$$"
-
-
-def robot_html(robot) -> str:
+@register("html", Robot)
+def robot_html(robot: Robot) -> str:
     """``Robot._repr_html_``: joint and link tables, as a fragment."""
     return fragment(robot_body(robot))
 
 
-def agreement_html(report) -> str:
+@register("html", AgreementReport)
+def agreement_html(report: AgreementReport) -> str:
     """``AgreementReport._repr_html_``: the checks as a table, as a fragment."""
     return fragment(agreement_body(report))

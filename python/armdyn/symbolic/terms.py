@@ -23,6 +23,7 @@ from typing import Any, Callable
 import symengine as se
 import sympy as sp
 
+from ..dispatch import call
 from ..model import Robot
 from . import dag
 
@@ -160,13 +161,9 @@ class EquationsOfMotion:
         return f"EquationsOfMotion({self.robot.name!r}, method={self.method!r}, dof={self.robot.dof})"
 
     def _repr_html_(self) -> str:
-        """Jupyter: tau as MathML (see report_html.py)."""
-        from .report_html import eom_html
-
-        return eom_html(self)
+        """Jupyter: tau as MathML (report_html.py, through :mod:`armdyn.dispatch`)."""
+        return call("html", self)
 
     def _repr_latex_(self) -> str:
-        """Jupyter: tau as LaTeX."""
-        from .report_html import eom_latex
-
-        return eom_latex(self)
+        """Jupyter: tau as LaTeX (report.py, through :mod:`armdyn.dispatch`)."""
+        return call("latex", self)

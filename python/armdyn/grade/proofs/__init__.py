@@ -114,9 +114,9 @@ def grade_proofs(sub, verdicts: list[StepVerdict]) -> list[StepVerdict]:
     path = getattr(sub, "path", "")
     if not path or path.lower().endswith((".yaml", ".yml")) or not os.path.isfile(path):
         return verdicts
-    from ..reader import _read_text
+    from ..reader import read_text
 
-    proofs = check_text(_read_text(path), path, {v.line for v in verdicts if v.key})
+    proofs = check_text(read_text(path), path, {v.line for v in verdicts if v.key})
     if not proofs:
         return verdicts
     handled = {v.line for v in proofs}

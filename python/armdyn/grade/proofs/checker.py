@@ -31,8 +31,8 @@ from ..latex import LatexError, sides
 from .body import random_instance
 from .counterexample import find, sentence
 from .evaluate import (
-    _VECTORS,
     MAX_DEGREE,
+    VECTOR_NAMES,
     NeedElement,
     NotRational,
     ProofState,
@@ -198,7 +198,7 @@ class ProofChecker:
     def _defined_values(self, inst) -> dict:
         out = {}
         for k, (tree, _) in self.defs.items():
-            if k.split("_")[0] in _VECTORS:
+            if k.split("_")[0] in VECTOR_NAMES:
                 try:
                     out[k.split("^")[0].rstrip("_")] = evaluate(tree, Scope(inst, {}, self.state, elem=0)).tolist()
                 except (ArithmeticError, ShapeError, LatexError, NeedElement):
@@ -214,7 +214,7 @@ class ProofChecker:
                 (s, t)
                 for s, t in terms
                 if isinstance(t, Sym)
-                and t.base in _VECTORS
+                and t.base in VECTOR_NAMES
                 and t.base != "omega"
                 and not t.frame
                 and not t.transposed
@@ -299,7 +299,7 @@ class ProofChecker:
                     out.append(v)
                     continue
             for t in (a, b):
-                self.seen |= {key(n) for n in walk(t) if isinstance(n, Sym) and n.base in _VECTORS}
+                self.seen |= {key(n) for n in walk(t) if isinstance(n, Sym) and n.base in VECTOR_NAMES}
             v = self.link(a, b, d.line, label, source)
             if (
                 v.status == "correct"

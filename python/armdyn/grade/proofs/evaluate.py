@@ -32,7 +32,8 @@ from .body import Instance
 from .expr import Add, Cross, Div, Dot, Integral, Matrix, Mul, Norm, Num, Pow, Skew, Sym, Transpose, walk
 from .matrices import Mat, ShapeError
 
-_VECTORS = {"d", "p", "omega", "a", "b", "u", "v", "w"}
+#: letters a proof line uses for vectors (3, 1): positions, velocities, angular velocity
+VECTOR_NAMES = {"d", "p", "omega", "a", "b", "u", "v", "w"}
 #: a line whose (conservative) polynomial degree exceeds this is not evaluated
 MAX_DEGREE = 400
 
@@ -177,7 +178,7 @@ def _builtin(s: Sym, sc: Scope) -> Mat:
         if comp is not None:
             return Mat.scalar(inst.element(sc.elem, element_point(comp[0])).v[comp[1]])
         return _frame(inst.element(sc.elem, element_point(s.sub)), s, sc, tensor=False)
-    if s.base in _VECTORS:
+    if s.base in VECTOR_NAMES:
         sub = s.sub
         if s.base == "omega" and not sub and s.frame and state.omega is not None:
             sub = state.omega
