@@ -37,7 +37,7 @@ import numpy as np
 import sympy as sp
 
 import armdyn
-import armdyn.codegen as codegen
+import armdyn.printing as printing
 
 # published counts (OpenSYMORO: Khalil et al., "OpenSYMORO: an open-source software
 # package for symbolic modelling of robots", IEEE/ASME AIM 2014, customized Newton-Euler;
@@ -82,7 +82,7 @@ def op_count_table(have_identification: bool) -> None:
         robot = load(name)
         eom = armdyn.derive(robot)
         what = ["tau", "M", "g", "C"]
-        code = codegen.codegen(robot, what=what)
+        code = printing.codegen(robot, what=what)
         derived = {
             "tau": list(eom.tau),
             "tau, ungrouped": list(eom.tau),
@@ -95,7 +95,7 @@ def op_count_table(have_identification: bool) -> None:
         # before the grouping: the customized Newton-Euler in the 60 standard parameters
         rows.insert(1, ("tau, ungrouped", customized_newton_euler(robot)[0].operation_counts()))
         if have_identification:
-            base = codegen.codegen(robot, what="tau", base=True)
+            base = printing.codegen(robot, what="tau", base=True)
             rows.insert(1, ("tau (base parameters)", base.op_counts["tau"]))
         label = {"puma560-craig": "modified DH", "puma560": "standard DH"}[name]
         for w, c in rows:
@@ -146,10 +146,10 @@ def generation_times(have_identification: bool, repeat: int) -> None:
     what = ["tau", "M", "C", "g"] + (["regressor"] if have_identification else [])
 
     def standard():
-        codegen.codegen(robot, what=what, lang="c")
+        printing.codegen(robot, what=what, lang="c")
 
     def base():
-        codegen.codegen(robot, what=["tau", "regressor"], lang="c", base=True)
+        printing.codegen(robot, what=["tau", "regressor"], lang="c", base=True)
 
     def everything():
         standard()
@@ -181,7 +181,7 @@ def generation_times(have_identification: bool, repeat: int) -> None:
         ),
         (
             "tau alone: armdyn.codegen(what='tau') -> C",
-            _timed(lambda: codegen.codegen(robot, what="tau"), repeat),
+            _timed(lambda: printing.codegen(robot, what="tau"), repeat),
             None,
             "-",
         ),
@@ -220,7 +220,7 @@ def breakdown() -> None:
     from armdyn.programs.program import Program
 
     robot = load("puma560-craig")
-    prog = codegen.codegen(robot, what="tau").programs["tau"]
+    prog = printing.codegen(robot, what="tau").programs["tau"]
     table = defaultdict(lambda: [0, 0])
     lines = []
     for sym, expr in prog.assignments:
@@ -321,7 +321,7 @@ def numeric(n_states: int, repeat: int) -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         robot = robot.bind()
-    lib = codegen.compile(robot, what="tau")
+    lib = printing.compile(robot, what="tau")
     rng = np.random.default_rng(0)
     Q, QD, QDD = (rng.uniform(-np.pi, np.pi, (n_states, robot.dof)) for _ in range(3))
     ref = armdyn.rnea(robot, Q, QD, QDD, threads=1)
@@ -329,7 +329,7 @@ def numeric(n_states: int, repeat: int) -> None:
     err = np.abs(got - ref).max() / np.abs(ref).max()
     assert err < 1e-12, err
     # the same code with the AVX2 clone switched off: SSE2 only, like the Rust core's build
-    sse2 = codegen.compile(lib.code, flags=["-DARMDYN_NO_CLONES"])
+    sse2 = printing.compile(lib.code, flags=["-DARMDYN_NO_CLONES"])
     assert np.abs(sse2.tau(Q, QD, QDD) - got).max() == 0.0
     t_c, t_rust, t_sse2 = [], [], []
     for _ in range(repeat):
@@ -376,10 +376,10 @@ def every_arm() -> None:
     print("|---|---|---|---|---|")
     for entry in bundled_robots():
         robot = load(entry["name"])
-        counts = codegen.codegen(robot, what="tau,g").op_counts
+        counts = printing.codegen(robot, what="tau,g").op_counts
         base = "-"
         if robot.dof <= 6 and importlib.util.find_spec("armdyn.identification") is not None:
-            base = codegen.codegen(robot, what="tau", base=True).op_counts["tau"]["total"]
+            base = printing.codegen(robot, what="tau", base=True).op_counts["tau"]["total"]
         print(f"| {entry['name']} | {robot.dof} | {counts['tau']['total']} | {counts['g']['total']} | {base} |")
 
 
@@ -402,7 +402,7 @@ def write_ledger(path: str = LEDGER) -> None:
         row = {"dof": robot.dof}
         for key, base in (("standard", False), ("base", True)):
             t = time.perf_counter()
-            row[key] = codegen.codegen(robot, what=LEDGER_QUANTITIES, base=base).op_counts
+            row[key] = printing.codegen(robot, what=LEDGER_QUANTITIES, base=base).op_counts
             print(f"{entry['name']:14s} {key:8s} {time.perf_counter() - t:6.1f} s", flush=True)
         arms[entry["name"]] = row
     tmp = path + ".tmp"

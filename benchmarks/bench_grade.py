@@ -8,7 +8,7 @@
    target under 10 s. The file is written to a temporary directory (about 2.6 MB: the
    steps are unexpanded expression trees).
 
-3. proofs (grade/proofs): one proof line, the exercise's energy chain
+3. proofs (grading/proofs): one proof line, the exercise's energy chain
    ``E_rot = 1/2 w^T I w = 1/2 w^T R I R^T w = 1/2 w^cT I^c w^c`` (three links, one wrong, so
    its counterexample search included), checked in process: target median under 0.2 s;
    and all the exercise's proof lines (7-3 and the energy proof) in process.
@@ -68,9 +68,9 @@ def proof_line_times(runs: int) -> list[tuple[str, float, list[float], float]]:
     """In-process medians: one proof line (the energy chain, after the lines before it),
     and all the exercise's proof lines."""
     sys.path.insert(0, str(ROOT / "python"))
-    from armdyn.grade.proofs import check_text
-    from armdyn.grade.proofs.checker import ProofChecker
-    from armdyn.grade.proofs.regions import proof_regions
+    from armdyn.grading.proofs import check_text
+    from armdyn.grading.proofs.checker import ProofChecker
+    from armdyn.grading.proofs.regions import proof_regions
 
     exercise = (ROOT / "examples" / "grading" / "rp-arm-exercise.md").read_text()
     energy = proof_regions(exercise, set())[1]

@@ -156,8 +156,8 @@ def main() -> None:
     ap.add_argument("--per-client", type=int, default=10)
     ap.add_argument("--workers", type=int, default=2)
     args = ap.parse_args()
-    from armdyn.grade import grade
-    from armdyn.grade.reader import read_markdown
+    from armdyn.grading import grade
+    from armdyn.grading.reader import read_markdown
 
     report = json.loads(grade(read_markdown("submission.md", EXERCISE.read_text(encoding="utf-8"))).to_json())
     expected = {

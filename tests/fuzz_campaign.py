@@ -594,8 +594,8 @@ def run_names(seed: int, rng: random.Random):
 
     import sympy as sp
 
-    from armdyn.codegen.generate import identifier
-    from armdyn.codegen.printers import _C_RESERVED, Names, _header_lines
+    from armdyn.printing.generate import identifier
+    from armdyn.printing.printers import _C_RESERVED, Names, _header_lines
 
     names = [_random_name(rng) for _ in range(rng.randint(1, 5))]
     if rng.random() < 0.3:  # a pair equal under NFKC, or under case

@@ -22,8 +22,8 @@ import pytest
 import sympy as sp
 
 import armdyn
-import armdyn.codegen as codegen
-from armdyn.codegen.compile import CompilerError, build_shared_library
+import armdyn.printing as printing
+from armdyn.printing.compile import CompilerError, build_shared_library
 from armdyn.programs.composite_mass_matrix import composite_mass_matrix
 from armdyn.programs.coriolis_program import christoffel_program
 from armdyn.programs.customized_ne import customized_newton_euler, standard_parameters
@@ -216,7 +216,7 @@ def test_customized_algorithms_equal_derive_at_random_points(name):
 def test_compiled_c_equals_rust_core(name, tmp_path):
     rng = np.random.default_rng(8)
     robot = _numeric(_load(name), _values(_load(name), rng))
-    lib = codegen.compile(robot, what=("tau", "M", "C", "g"), directory=tmp_path)
+    lib = printing.compile(robot, what=("tau", "M", "C", "g"), directory=tmp_path)
     assert lib.code.parameters == []
     q, qd, qdd = _states(rng, robot.dof)
     _close(lib.tau(q, qd, qdd), armdyn.rnea(robot, q, qd, qdd))
@@ -236,7 +236,7 @@ def test_compiled_c_with_symbolic_parameters_equals_rust_core(name, tmp_path):
     robot = _load(name)
     rng = np.random.default_rng(3)
     values = _values(robot, rng)
-    lib = codegen.compile(robot, directory=tmp_path)
+    lib = printing.compile(robot, directory=tmp_path)
     p = lib.code.parameter_values(values)
     bound = _numeric(robot, values)
     q, qd, qdd = _states(rng, robot.dof)
@@ -265,13 +265,13 @@ def test_python_and_numpy_code_equal_rust_core(name):
         "g": armdyn.gravity(robot, q),
     }
     args = {"tau": (q, qd, qdd), "M": (q,), "C": (q, qd), "g": (q,)}
-    py = codegen.codegen(robot, lang="python")
+    py = printing.codegen(robot, lang="python")
     ns = _exec(py.source)
     for what, fn in py.functions.items():
         for k in range(len(q)):
             got = np.array(ns[fn](*(a[k] for a in args[what])), dtype=float)
             _close(got.reshape(want[what][k].shape), want[what][k])
-    npy = codegen.codegen(robot, lang="numpy")
+    npy = printing.codegen(robot, lang="numpy")
     ns = _exec(npy.source)
     for what, fn in npy.functions.items():
         _close(ns[fn](*args[what]), want[what])  # a batch (N, n)
@@ -281,7 +281,7 @@ def test_python_and_numpy_code_equal_rust_core(name):
 
 # ---------------------------------------------------------------- operation counts
 def test_fast_op_count_equals_sympy_count_ops():
-    code = codegen.codegen(armdyn.load("stanford"), lang="c")
+    code = printing.codegen(armdyn.load("stanford"), lang="c")
     checked = 0
     for prog in code.programs.values():
         for e in [e for _, e in prog.assignments] + [sp.sympify(o) for o in prog.outputs]:
@@ -302,12 +302,12 @@ def test_fast_op_count_equals_sympy_count_ops():
 def test_puma_mass_matrix_op_count_meets_target():
     """OpenSYMORO's published M for the PUMA 560 takes 302 mul + 215 add; target 0.8x."""
     for name in ("puma560-craig", "puma560"):
-        counts = codegen.codegen(armdyn.load(name, strict=False), what="M").op_counts["M"]
+        counts = printing.codegen(armdyn.load(name, strict=False), what="M").op_counts["M"]
         assert counts["total"] <= 0.8 * (302 + 215), counts
 
 
 def test_op_counts_are_in_the_header():
-    code = codegen.codegen(armdyn.load("rp-arm"), what="tau,g", lang="c")
+    code = printing.codegen(armdyn.load("rp-arm"), what="tau,g", lang="c")
     c = code.op_counts["tau"]
     assert f"rp_arm_tau: {c['mul']} mul, {c['add']} add, {c['sin_cos']} sin/cos" in code.source
     assert c["mul"] > 0 and c["add"] > 0
@@ -317,17 +317,17 @@ def test_op_counts_are_in_the_header():
 def test_bad_what_and_lang():
     robot = armdyn.load("rp-arm")
     with pytest.raises(ValueError, match="unknown quantity 'taux'"):
-        codegen.codegen(robot, what="tau,taux")
+        printing.codegen(robot, what="tau,taux")
     with pytest.raises(ValueError, match="unknown language 'fortran'"):
-        codegen.codegen(robot, lang="fortran")
+        printing.codegen(robot, lang="fortran")
     with pytest.raises(ValueError, match="empty"):
-        codegen.codegen(robot, what="")
+        printing.codegen(robot, what="")
 
 
 @needs_cc
 def test_compiled_function_rejects_bad_arrays(tmp_path):
     robot = _numeric(_load("planar-2r"), _values(_load("planar-2r"), np.random.default_rng(1)))
-    lib = codegen.compile(robot, what="tau,M", directory=tmp_path)
+    lib = printing.compile(robot, what="tau,M", directory=tmp_path)
     ok = np.zeros(2)
     with pytest.raises(ValueError, match=r"q must have shape \(2,\) or \(N, 2\)"):
         lib.tau(np.zeros(3), ok, ok)
@@ -345,7 +345,7 @@ def test_compiled_function_rejects_bad_arrays(tmp_path):
 
 @needs_cc
 def test_symbolic_code_needs_p(tmp_path):
-    lib = codegen.compile(armdyn.load("rp-arm"), what="g", directory=tmp_path)
+    lib = printing.compile(armdyn.load("rp-arm"), what="g", directory=tmp_path)
     with pytest.raises(ValueError, match="p is required"):
         lib(np.zeros(2))
     with pytest.raises(ValueError, match=r"p must have shape"):
@@ -421,9 +421,9 @@ def test_base_parameter_code_equals_rust_core(tmp_path):
     from armdyn import identification
 
     robot = _symbolic_planar_2r()
-    code = codegen.codegen(robot, what="tau,g,M,C", base=True)
+    code = printing.codegen(robot, what="tau,g,M,C", base=True)
     assert all("at the base parameters" in code.sources[w] for w in ("tau", "g", "M", "C"))
-    full = codegen.codegen(robot, what="tau,M")
+    full = printing.codegen(robot, what="tau,M")
     # the standard-parameter code groups the parameters too (symbolic/grouping.py): the
     # base code costs no more than it, and less than the ungrouped customized Newton-Euler
     assert code.op_counts["tau"]["total"] <= full.op_counts["tau"]["total"]
@@ -434,7 +434,7 @@ def test_base_parameter_code_equals_rust_core(tmp_path):
     reg = identification.regressor(robot)
     std = {str(s): float(sp.sympify(e).xreplace(sym)) for s, e in zip(reg.symbols, reg.pi)}
     std.update(values)
-    lib = codegen.compile(code, directory=tmp_path)
+    lib = printing.compile(code, directory=tmp_path)
     p = code.parameter_values(std)
     bound = _numeric(robot, values)
     q, qd, qdd = _states(rng, 2)
@@ -456,7 +456,7 @@ def test_compiled_c_with_joint_friction_and_rotor_inertia_equals_rust_core(name,
     rng = np.random.default_rng(12)
     values = _values(robot, rng)
     assert {"IA1", "FV1", "FC1"} <= set(values)
-    lib = codegen.compile(robot, what="tau,M,C,g", directory=tmp_path)
+    lib = printing.compile(robot, what="tau,M,C,g", directory=tmp_path)
     p = lib.code.parameter_values(values)
     bound = _numeric(robot, values)
     q, qd, qdd = _states(rng, robot.dof)
@@ -465,7 +465,7 @@ def test_compiled_c_with_joint_friction_and_rotor_inertia_equals_rust_core(name,
     _close(lib.M(q, p=p), armdyn.crba(bound, q))
     _close(lib.g(q, p=p), armdyn.gravity(bound, q))
     _close(lib.C(q, qd, p=p), armdyn.coriolis_matrix(bound, q, qd))
-    py = codegen.codegen(robot, what="tau", lang="python")
+    py = printing.codegen(robot, what="tau", lang="python")
     ns = _exec(py.source)
     p = py.parameter_values(values)  # this code's own parameter vector (tau alone needs fewer)
     for k in range(len(q)):

@@ -1,4 +1,4 @@
-"""Sines and cosines of the generated batch C (armdyn.codegen.printers):
+"""Sines and cosines of the generated batch C (armdyn.printing.printers):
 
 * the polynomial kernel's coefficients are what sincos_coefficients.fit computes;
 * the compiled kernel against Python's math.sin / math.cos (libm) to 2 units of 2^-52
@@ -21,9 +21,9 @@ import pytest
 import sympy as sp
 
 import armdyn
-import armdyn.codegen as codegen
-from armdyn.codegen import printers, sincos_coefficients
-from armdyn.codegen.compile import build_shared_library
+import armdyn.printing as printing
+from armdyn.printing import printers, sincos_coefficients
+from armdyn.printing.compile import build_shared_library
 from armdyn.programs.program import Program
 
 HAVE_CC = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc")
@@ -161,7 +161,7 @@ def test_batch_forms_compound_angles_by_the_addition_formula(tmp_path):
     bit; a block with an angle beyond the kernel's range is the single-state function's,
     bit for bit."""
     robot = _load("ur5")
-    lib = codegen.compile(robot, what="tau", directory=tmp_path)
+    lib = printing.compile(robot, what="tau", directory=tmp_path)
     source = lib.code.source
     batch = source[source.index("_batch(") :]
     for angle, sin in (("q23", "s23"), ("q234", "s234")):

@@ -101,8 +101,8 @@ def test_every_dispatched_method_finds_its_renderer_in_a_fresh_interpreter():
 
 def test_the_methods_give_what_the_renderers_give():
     import armdyn
-    from armdyn.grade.html import repr_html
-    from armdyn.grade.text import text, to_json
+    from armdyn.grading.html import repr_html
+    from armdyn.grading.text import text, to_json
     from armdyn.io.urdf import load_urdf
     from armdyn.symbolic.report import eom_latex
     from armdyn.symbolic.report_html import agreement_html, eom_html, robot_html

@@ -17,8 +17,8 @@ import yaml
 
 import armdyn
 from armdyn.cli import main
-from armdyn.grade import grade
-from armdyn.grade.latex import LatexError, parse, parse_sympy_syntax, split_equations
+from armdyn.grading import grade
+from armdyn.grading.latex import LatexError, parse, parse_sympy_syntax, split_equations
 
 HERE = Path(__file__).resolve().parent
 EXAMPLES = HERE.parent / "examples" / "grading"

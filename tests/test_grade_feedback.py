@@ -19,7 +19,7 @@ import pytest
 import sympy as sp
 
 from armdyn.cli import main
-from armdyn.grade import grade
+from armdyn.grading import grade
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent

@@ -1,4 +1,4 @@
-"""Proof lines about rigid bodies in ``armdyn grade`` (grade/proofs).
+"""Proof lines about rigid bodies in ``armdyn grade`` (grading/proofs).
 
 Second opinions: the verdicts expected of the examples are worked out by hand (and in
 examples/grading/README.md); every counterexample armdyn shows is re-evaluated here with
@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from armdyn.errors import ModelError
-from armdyn.grade import grade
-from armdyn.grade.proofs import check_text
+from armdyn.grading import grade
+from armdyn.grading.proofs import check_text
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples" / "grading"
 EXERCISE = EXAMPLES / "rp-arm-exercise.md"
@@ -110,7 +110,7 @@ def test_exercise_dynamics_verdict_unchanged(exercise):
 
 
 def test_json_has_one_entry_per_link_and_the_counterexample():
-    from armdyn.grade.text import to_json
+    from armdyn.grading.text import to_json
 
     data = json.loads(to_json(grade(EXERCISE)))
     proofs = [s for s in data["steps"] if (s["name"] or "").startswith("proof_")]
@@ -407,7 +407,7 @@ def test_ten_thousand_proof_lines_are_refused_naming_the_file(tmp_path):
 
 
 def test_html_escapes_proof_text(tmp_path):
-    from armdyn.grade.html import report_html
+    from armdyn.grading.html import report_html
 
     path = tmp_path / "x.md"
     path.write_text(HEAD + "$$E_{rot} = <img src=x onerror=alert(1)>$$\n\n$$\\tau_2 = 0$$\n")

@@ -19,7 +19,7 @@ import pytest
 import sympy as sp
 
 import armdyn
-import armdyn.codegen as codegen
+import armdyn.printing as printing
 from armdyn.programs.composite_mass_matrix import composite_mass_matrix
 from armdyn.programs.customized_ne import customized_newton_euler, standard_parameters
 from armdyn.programs.grouping import grouped_parameters
@@ -110,7 +110,7 @@ def test_puma_tau_program_equals_rust_rnea_with_random_parameters():
     robot = _load("puma560-craig")
     rng = np.random.default_rng(7)
     values = _random_parameters(robot, rng)
-    code = codegen.codegen(robot, what="tau,g", lang="python")
+    code = printing.codegen(robot, what="tau,g", lang="python")
     p = code.parameter_values(values)
     assert len(p) == len(code.parameters) > 0 and np.all(np.isfinite(p))
     with warnings.catch_warnings():
@@ -158,7 +158,7 @@ def test_grouped_tau_uses_as_many_parameters_as_there_are_base_parameters(name):
 def test_puma_tau_op_count_meets_target(name):
     """The op-count target: tau <= 0.8 x OpenSYMORO's 345 + 296 for the PUMA 560, every parameter
     symbolic, counted as count_ops(visual=True) after CSE (mul = MUL+DIV+POW, add = ADD+SUB)."""
-    counts = codegen.codegen(_load(name), what="tau").op_counts["tau"]
+    counts = printing.codegen(_load(name), what="tau").op_counts["tau"]
     assert counts["total"] <= 0.8 * (345 + 296), counts
 
 
@@ -166,7 +166,7 @@ def test_puma_tau_op_count_meets_target(name):
 def test_puma_base_parameter_tau_takes_fewer_operations_than_opensymoro(name):
     """tau in the base parameters, every parameter symbolic: fewer operations than
     OpenSYMORO's base-parameter program (301 + 240, its published count), counted the same way."""
-    counts = codegen.codegen(_load(name), what="tau", base=True).op_counts["tau"]
+    counts = printing.codegen(_load(name), what="tau", base=True).op_counts["tau"]
     assert counts["total"] < 301 + 240, counts
 
 
@@ -176,7 +176,7 @@ def test_puma_tau_program_has_no_sum_with_a_common_factor():
     temporary used only once is put back where it is used (so that a sum split over two
     lines is seen whole): the claim benchmarks/README.md makes about the program,
     checked on the program."""
-    prog = codegen.codegen(_load("puma560-craig"), what="tau", base=True).programs["tau"]
+    prog = printing.codegen(_load("puma560-craig"), what="tau", base=True).programs["tau"]
     lines = [e for _, e in prog.assignments] + [sp.sympify(e) for e in prog.outputs]
     uses = Counter(s for e in lines for s in e.free_symbols)
     once = {s: e for s, e in prog.assignments if uses[s] == 1}

@@ -23,8 +23,8 @@ import pytest
 import sympy as sp
 from browser import assert_math_rendered, assert_parentheses_stretch, render, require_chromium
 
-from armdyn.grade.html import report_html, repr_html
-from armdyn.grade.verdict import STATUSES, GradeReport, StepVerdict
+from armdyn.grading.html import report_html, repr_html
+from armdyn.grading.verdict import STATUSES, GradeReport, StepVerdict
 
 ROOT = Path(__file__).resolve().parents[1]
 SHOTS = Path(os.environ.get("ARMDYN_SCREENSHOTS", ROOT / "target" / "screenshots"))
@@ -418,7 +418,7 @@ def test_huge_values_are_not_printed_and_the_page_stays_fast():
     instead of printing it (SymPy's MathML printer takes ~1 ms a node)."""
     import time
 
-    from armdyn.grade import html as grade_html
+    from armdyn.grading import html as grade_html
 
     x = sp.symbols("x0:60")
     huge = sp.Add(*[sp.Mul(*[x[(k + j) % 60] for j in range(20)]) * sp.sin(x[k]) for k in range(60)])
@@ -478,7 +478,7 @@ def test_summary_verdict_without_a_wrong_step(statuses, verdict):
 
 
 def test_write_report_html_writes_whole_page_or_nothing(tmp_path, monkeypatch):
-    from armdyn.grade import html as grade_html
+    from armdyn.grading import html as grade_html
 
     out = tmp_path / "r.html"
     grade_html.write_report_html(exercise_like_report(), out)
@@ -556,7 +556,7 @@ def test_exercise_grade_report_renders_in_chromium(tmp_path):
     """The real exercise (examples/grading/rp-arm-exercise.md) through the grader:
     the page renders, its first wrong step is v̇_1 with the x row highlighted."""
     chromium = require_chromium()
-    from armdyn.grade import grade
+    from armdyn.grading import grade
 
     report = grade(ROOT / "examples" / "grading" / "rp-arm-exercise.md")
     page = tmp_path / "grade-exercise.html"

@@ -42,8 +42,8 @@ import yaml
 from browser import dump_dom, require_chromium, without_csp
 from html_payloads import CANARY, PAYLOADS, html_findings, scan, visible_text
 
-from armdyn.grade.html import report_html
-from armdyn.grade.verdict import GradeReport, StepVerdict
+from armdyn.grading.html import report_html
+from armdyn.grading.verdict import GradeReport, StepVerdict
 from armdyn.htmlpage import CSP, page
 from armdyn.mathml import escape, latex_to_mathml, math_element
 from armdyn.mathml_sanitize import ATTRIBUTES, ELEMENTS, MAX_DEPTH, clean_mathml, sanitize_mathml

@@ -303,7 +303,7 @@ def test_text_with_math_renders_delimited_math_through_the_sanitizer():
 
 
 def test_grade_html_shows_skipped_equations_as_math(tmp_path):
-    from armdyn.grade.html import report_html
+    from armdyn.grading.html import report_html
 
     sub = tmp_path / "sub.md"
     sub.write_text(
@@ -313,7 +313,7 @@ def test_grade_html_shows_skipped_equations_as_math(tmp_path):
         "$$\\omega_1 = \\begin{pmatrix} 0 \\\\ 0 \\\\ \\dot{\\theta}_1 \\end{pmatrix}$$\n",
         encoding="utf-8",
     )
-    report = armdyn.grade.grade(sub)
+    report = armdyn.grade(sub)
     skipped = [s for s in report.steps if s.status == "unrecognised"]
     assert len(skipped) == 2
     page = report_html(report)

@@ -17,7 +17,7 @@ import warnings
 import pytest
 
 import armdyn
-import armdyn.codegen as codegen
+import armdyn.printing as printing
 from armdyn.io import bundled_robots
 
 LEDGER = os.path.join(os.path.dirname(__file__), "..", "benchmarks", "op_counts.json")
@@ -69,7 +69,7 @@ def test_operation_counts_do_not_rise(name, key):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         robot = armdyn.load(name, strict=False)
-    got = codegen.codegen(robot, what=QUANTITIES, base=(key == "base")).op_counts
+    got = printing.codegen(robot, what=QUANTITIES, base=(key == "base")).op_counts
     rises, falls = [], []
     for w in QUANTITIES:
         for kind in KINDS:

@@ -27,12 +27,12 @@ import numpy as np
 import pytest
 
 import armdyn
-from armdyn import codegen, numeric
+from armdyn import numeric, printing
 from armdyn.cli import main
-from armdyn.codegen.safe_names import comment_text, identifier_base
 from armdyn.errors import ModelError
 from armdyn.io.urdf import load_urdf
 from armdyn.io.yaml import load_yaml, load_yaml_string
+from armdyn.printing.safe_names import comment_text, identifier_base
 
 PYTHON_ENV = {**os.environ, "PYTHONPATH": str(Path(armdyn.__file__).resolve().parents[1])}
 
@@ -114,15 +114,15 @@ def test_hostile_names_do_not_run_code(tmp_path, lang, fmt):
             robot = load_yaml_string(two_link_yaml(name, j1=name + "j", link=name + "l"))
         else:
             robot = load_urdf(two_link_urdf(name, name + "j", name + "l"))
-        code = codegen.codegen(robot, what=("tau",), lang=lang)
+        code = printing.codegen(robot, what=("tau",), lang=lang)
         _check_header_is_safe(code.source)
         work = tmp_path / f"{lang}{k}"
         work.mkdir()
         if lang == "c":
-            lib = codegen.compile(code, directory=work)  # dlopen runs any constructor
+            lib = printing.compile(code, directory=work)  # dlopen runs any constructor
             tau = lib.tau(*STATE)
         else:
-            (path,) = codegen.write_files([code], work)
+            (path,) = printing.write_files([code], work)
             module = _import_file(Path(path))
             tau = np.asarray(getattr(module, code.functions["tau"])(*STATE))
         assert not canary.exists(), f"{lang}: a name ran code: {name!r}"
@@ -134,13 +134,13 @@ def test_names_equal_under_nfkc_stay_two_variables(tmp_path, lang):
     """q1 and the fullwidth q1 are one identifier to Python (NFKC): tau was wrong."""
     robot = load_yaml_string(two_link_yaml("nfkc", "q1", "\uff51" + "1"))
     assert robot.coordinate_names == ["q1", "\uff51" + "1"]
-    code = codegen.codegen(robot, what=("tau", "M"), lang=lang)
+    code = printing.codegen(robot, what=("tau", "M"), lang=lang)
     assert code.source.isascii()
     if lang == "c":
-        lib = codegen.compile(code, directory=tmp_path)
+        lib = printing.compile(code, directory=tmp_path)
         tau, M = lib.tau(*STATE), lib.M(STATE[0])
     else:
-        (path,) = codegen.write_files([code], tmp_path)
+        (path,) = printing.write_files([code], tmp_path)
         module = _import_file(Path(path))
         tau = np.asarray(getattr(module, code.functions["tau"])(*STATE))
         M = np.asarray(getattr(module, code.functions["M"])(STATE[0])).reshape(2, 2)
@@ -367,7 +367,7 @@ def test_power_towers_end_in_a_message_not_a_signal(tmp_path, expr):
     ],
 )
 def test_submissions_share_the_screen(tmp_path, body, message):
-    from armdyn.grade.reader import read
+    from armdyn.grading.reader import read
 
     path = tmp_path / "sub.yaml"
     path.write_text("robot: rp-arm\n" + body + "steps: {T: '0'}\n")

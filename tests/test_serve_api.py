@@ -21,8 +21,8 @@ pytest.importorskip("httpx")
 
 from serve_support import EXERCISE, RIGHT, db_url  # noqa: F401
 
-from armdyn.grade import grade
-from armdyn.grade.reader import read_markdown
+from armdyn.grading import grade
+from armdyn.grading.reader import read_markdown
 
 TOKEN = "instructor-secret-for-tests"
 MD = {"content-type": "text/markdown"}

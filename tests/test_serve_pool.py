@@ -61,9 +61,9 @@ def test_memory_limit_caps_the_address_space():
 def test_worker_report_is_grade_html():
     """The worker builds the report's body once; the page and the fragment must still be
     exactly what ``armdyn grade --html`` (report_html) and Jupyter (repr_html) show."""
-    from armdyn.grade import grade
-    from armdyn.grade.html import report_html, repr_html
-    from armdyn.grade.reader import read_markdown
+    from armdyn.grading import grade
+    from armdyn.grading.html import report_html, repr_html
+    from armdyn.grading.reader import read_markdown
     from armdyn.serve.worker import SUBMISSION, Grader
 
     text = EXERCISE.read_text(encoding="utf-8")

@@ -15,19 +15,15 @@ __version__ = "0.1.0"
 
 from typing import TYPE_CHECKING  # noqa: E402
 
-from . import (  # noqa: E402
-    codegen,  # noqa: E402  armdyn.codegen(robot, ...) and armdyn.codegen.compile(...)
-    inertia,
-    io,
-)
+from . import inertia, io  # noqa: E402
 from .errors import ModelError, UnboundParameterError  # noqa: E402
 from .io import bundled_robots, load  # noqa: E402
 from .model import Joint, Link, Robot  # noqa: E402
+from .printing import codegen  # noqa: E402  (armdyn.printing.compile builds the generated C)
 from .symbolic import EquationsOfMotion, check, derive, prove_agreement  # noqa: E402
 
 if TYPE_CHECKING:  # what __getattr__ below imports on first use, for type checkers (py.typed)
-    # armdyn.grade is the package made callable: typed as its grade() function
-    from .grade import grade  # noqa: F401
+    from .grading import grade  # noqa: F401
     from .identification import base_parameters, regressor  # noqa: F401
     from .numeric import (  # noqa: F401  # noqa: F401  # noqa: F401
         NumericModel,
@@ -72,10 +68,11 @@ _IDENTIFICATION = ("regressor", "base_parameters")
 
 
 def __getattr__(name):
-    if name == "grade":  # armdyn.grade: the package, callable as armdyn.grade(submission, ...)
-        import importlib
+    if name == "grade":  # armdyn.grading.grade, imported on first use (it loads the grader)
+        from .grading import grade
 
-        return importlib.import_module(".grade", __name__)
+        globals()[name] = grade
+        return grade
     # the numeric API lives in armdyn.numeric (over the compiled Rust core), imported on
     # first use so that symbolic work does not load the extension
     if name in _NUMERIC:

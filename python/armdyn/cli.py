@@ -103,8 +103,8 @@ def cmd_grade(args) -> int:
         from .course.cli import cmd_grade_class
 
         return cmd_grade_class(args)
-    from .grade import grade
-    from .grade.reader import read
+    from .grading import grade
+    from .grading.reader import read
 
     try:
         submission = read(args.submission)
@@ -115,12 +115,12 @@ def cmd_grade(args) -> int:
     except ModelError as err:
         if not args.json:
             raise
-        from .grade.text import error_json
+        from .grading.text import error_json
 
         print(error_json(err, args.submission))  # scripts read one JSON object either way
         return 2
     if args.html is not None:  # "" is an error of the writer, not "no report"
-        from .grade.html import write_report_html  # all or nothing
+        from .grading.html import write_report_html  # all or nothing
 
         try:
             write_report_html(report, args.html)
@@ -140,7 +140,7 @@ def cmd_serve(args) -> int:
 
 
 def cmd_codegen(args) -> int:
-    from .codegen import codegen, write_files
+    from .printing import codegen, write_files
 
     robot = _load(args.robot, args.allow_nonphysical, args.strict)
     if args.bind:

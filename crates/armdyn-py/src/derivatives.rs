@@ -9,7 +9,6 @@ use armdyn_core::{batch_derivatives as bd, Model};
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::sync::PyOnceLock;
 use pyo3::types::PyTuple;
 
 fn parse_frame(frame: &str) -> PyResult<ForceFrame> {
@@ -238,56 +237,21 @@ macro_rules! matrix_of_q {
     };
 }
 
-matrix_of_q!(
-    /// M(q)^-1 of a NumericModel, (n, n) or (N, n, n): the entry `minverse` below.
-    minverse_on, algo::minverse, bd::minverse
-);
-
-/// The compiled model to run on: `obj` itself when it is a NumericModel (its `f_ext`, if
-/// any, already in canonical link order), else, without `f_ext`, the NumericModel that
-/// `armdyn.numeric.compile_model` cached on a Robot as `_numeric_model`. None sends the
-/// call to Python: a robot not compiled yet, mimic joints (no plain NumericModel), or a
-/// Robot's `f_ext` (given in `list(robot.links)` order, reordered there).
-fn compiled<'py>(obj: &Bound<'py, PyAny>, f_ext: Option<&Bound<'py, PyAny>>) -> Option<Bound<'py, NumericModel>> {
-    if let Ok(m) = obj.cast::<NumericModel>() {
-        return Some(m.clone());
-    }
-    if f_ext.is_some() {
-        return None;
-    }
-    let cached = obj.getattr(pyo3::intern!(obj.py(), "_numeric_model")).ok()?;
-    cached.cast_into::<NumericModel>().ok()
-}
-
-/// `armdyn.numeric.<name>(*args)`, looked up once: the Python path of the entries below
-/// (a robot not compiled yet, mimic joints, external wrenches).
-fn python_path<'py, A: pyo3::call::PyCallArgs<'py>>(
-    py: Python<'py>,
-    cell: &'static PyOnceLock<Py<PyAny>>,
-    name: &str,
-    args: A,
-) -> PyResult<Bound<'py, PyAny>> {
-    cell.import(py, "armdyn.numeric", name)?.call1(args)
-}
-
-// The entries armdyn.numeric exports as they are (issue 9 times their per-call cost: no
-// Python frame in between). The common call, a compiled plain model and no f_ext, runs
-// here; anything else goes through armdyn.numeric's `_<name>_python`, which compiles the
-// robot, reorders f_ext and calls the same entry again with the NumericModel.
-
-/// Defines the entry `#[pyfunction] $name(robot, q, qd, $third, *, f_ext=None,
+/// Defines the entry `#[pyfunction] $name(model, q, qd, $third, f_ext=None,
 /// frame="local", threads=None, out=None)` returning the tuple of the three (n, n) (or
-/// (N, n, n)) outputs of `$algo` (one state) / `$batch` (a batch) on the compiled model
-/// (see [`compiled`]), else of armdyn.numeric's `$python`.
+/// (N, n, n)) outputs of `$algo` (one state) / `$batch` (a batch) on a compiled model.
+/// `armdyn.numeric` documents the entries and decides which robots they run for (a
+/// Robot's cached NumericModel; mimic joints and a Robot's f_ext are handled there): its
+/// common call, no f_ext, passes every argument by position.
 macro_rules! derivatives_entry {
-    ($(#[$doc:meta])* $name:ident, $third:ident, $algo:path, $batch:path, $python:literal) => {
+    ($(#[$doc:meta])* $name:ident, $third:ident, $algo:path, $batch:path) => {
         $(#[$doc])*
         #[pyfunction]
-        #[pyo3(signature = (robot, q, qd, $third, *, f_ext = None, frame = "local", threads = None, out = None))]
+        #[pyo3(signature = (model, q, qd, $third, f_ext = None, frame = "local", threads = None, out = None))]
         #[allow(clippy::too_many_arguments)]
         fn $name<'py>(
             py: Python<'py>,
-            robot: &Bound<'py, PyAny>,
+            model: &Bound<'py, NumericModel>,
             q: &Bound<'py, PyAny>,
             qd: &Bound<'py, PyAny>,
             $third: &Bound<'py, PyAny>,
@@ -295,11 +259,7 @@ macro_rules! derivatives_entry {
             frame: &str,
             threads: Option<i64>,
             out: Option<&Bound<'py, PyAny>>,
-        ) -> PyResult<Bound<'py, PyAny>> {
-            let Some(model) = compiled(robot, f_ext) else {
-                static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
-                return python_path(py, &PATH, $python, (robot, q, qd, $third, f_ext, frame, threads, out));
-            };
+        ) -> PyResult<Bound<'py, PyTuple>> {
             let m = model.get();
             let n = m.model.nv;
             let o = run(
@@ -317,72 +277,29 @@ macro_rules! derivatives_entry {
                 },
                 |md, a, e, o, t| $batch(md, a, e, o, t),
             )?;
-            Ok(PyTuple::new(py, o)?.into_any())
+            PyTuple::new(py, o)
         }
     };
 }
 
 derivatives_entry!(
-    /// Partial derivatives of inverse dynamics, analytically (Carpentier & Mansard, RSS 2018).
-    ///
-    /// robot: a Robot (or its compiled ``armdyn.numeric.compile_model``, whose f_ext rows
-    /// follow the model's own link order). q, qd, qdd: (n,) or (N, n). Returns ``(dtau_dq, dtau_dqd, M)``, each (n, n) or
-    /// (N, n, n), row = output, column = input: ``dtau_dq[i, j] = d tau_i / d q_j``;
-    /// ``M = d tau / d qdd``.
-    ///
-    /// f_ext: external wrenches, one per link: shape (nlinks, 6) (or (N, nlinks, 6) for a
-    /// batch), rows in ``list(robot.links)`` order (base first; the base's row does not act
-    /// on the joints), each ``[fx, fy, fz, nx, ny, nz]`` (force, then moment). ``frame``
-    /// says where: ``"local"``: in the link's frame, moment about its origin (the wrench
-    /// moves with the link; Pinocchio's LOCAL ``fext``); ``"world"``: in base axes, moment
-    /// about the base frame's origin (the wrench stays fixed in space). Then
-    /// ``tau = M qdd + C qd + g - sum_L J_L^T w_L``.
-    ///
-    /// Joint friction, rotor inertia and offset (as in :func:`rnea`) are included: ``M`` has
-    /// ``diag(Ia)``, ``dtau_dqd`` has ``diag(Fv)``. Coulomb friction ``Fc sign(qd)`` is
-    /// piecewise constant: it adds nothing, also at ``qd_k = 0`` where rnea's term jumps
-    /// (``sign(0) = 0``) and has no derivative; the value given there is that of either side.
-    /// Robots with mimic joints: ``G^T D_full G`` (chain rule, see armdyn.mimic); no f_ext.
-    ///
-    /// out: optionally, the three arrays to write the results into and return (float64,
-    /// C-contiguous, the results' shapes, sharing no memory with the inputs): a loop over
-    /// batches then allocates nothing, and a large batch is spared the first-touch page
-    /// faults of fresh arrays.
-    rnea_derivatives, qdd, algo::rnea_derivatives, bd::rnea_derivatives, "_rnea_derivatives_python"
+    /// ``(dtau_dq, dtau_dqd, M)`` of a NumericModel, each (n, n) or (N, n, n): the entry
+    /// of ``armdyn.numeric.rnea_derivatives`` (documented there).
+    rnea_derivatives, qdd, algo::rnea_derivatives, bd::rnea_derivatives
 );
 derivatives_entry!(
-    /// Partial derivatives of forward dynamics (Carpentier & Mansard, RSS 2018, IV.C).
-    ///
-    /// q, qd, tau: (n,) or (N, n). Returns ``(dqdd_dq, dqdd_dqd, Minv)``, each (n, n) or
-    /// (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
-    /// f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
-    /// joints as there (``Minv`` is that of ``M + diag(Ia)``). out: as there.
-    aba_derivatives, tau, algo::aba_derivatives, bd::aba_derivatives, "_aba_derivatives_python"
+    /// ``(dqdd_dq, dqdd_dqd, Minv)`` of a NumericModel, each (n, n) or (N, n, n): the entry
+    /// of ``armdyn.numeric.aba_derivatives`` (documented there).
+    aba_derivatives, tau, algo::aba_derivatives, bd::aba_derivatives
 );
 
-/// The inverse of the joint-space inertia matrix, by the articulated-body recursion
-/// (without forming or factorising M; Carpentier 2018). q: (n,) or (N, n). Returns (n, n)
-/// or (N, n, n). M includes the rotor inertias, ``diag(Ia)``, as :func:`crba`. Robots
-/// with mimic joints: ``(G^T M_full G)^-1`` by Cholesky (ValueError when M is not
-/// positive definite). out: optionally, the array to write M^-1 into and return (float64,
-/// C-contiguous, the result's shape, not sharing memory with q).
-#[pyfunction]
-#[pyo3(signature = (robot, q, *, threads = None, out = None))]
-fn minverse<'py>(
-    py: Python<'py>,
-    robot: &Bound<'py, PyAny>,
-    q: &Bound<'py, PyAny>,
-    threads: Option<i64>,
-    out: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyAny>> {
-    match compiled(robot, None) {
-        Some(model) => Ok(minverse_on(py, &model, q, threads, out)?.into_any()),
-        None => {
-            static PATH: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
-            python_path(py, &PATH, "_minverse_python", (robot, q, threads, out))
-        }
-    }
-}
+matrix_of_q!(
+    /// M(q)^-1 of a NumericModel, (n, n) or (N, n, n): the entry of
+    /// ``armdyn.numeric.minverse`` (documented there).
+    #[pyfunction]
+    #[pyo3(signature = (model, q, threads = None, out = None))]
+    minverse, algo::minverse, bd::minverse
+);
 
 matrix_of_q!(
     /// dg/dq, (n, n) or (N, n, n).

@@ -73,7 +73,7 @@ class BatchResult:
 def grade_task(task: dict) -> dict:
     """Grade one submission (runs in the child): ``{"report": grade JSON, "html": page}``
     or ``{"error": "error: file:line: what"}`` for a submission the grader refuses."""
-    from ..grade import grade
+    from ..grading import grade
 
     try:
         report = grade(task["path"], robot=task["robot"])
@@ -81,7 +81,7 @@ def grade_task(task: dict) -> dict:
         return {"error": "error: " + " ".join(str(exc).split())}
     out = {"report": json.loads(report.to_json())}
     if task["want_html"]:
-        from ..grade.html import report_html
+        from ..grading.html import report_html
 
         out["html"] = report_html(report)
     return out
@@ -337,8 +337,8 @@ def _run(tasks: list[Task], jobs: int, timeout: float, memory_mb, dask: str | No
                 yield futures[fut], result
         return
     # import the grader once here: every forked child starts with it loaded
-    import armdyn.grade
-    import armdyn.grade.html  # noqa: F401
+    import armdyn.grading
+    import armdyn.grading.html  # noqa: F401
 
     from .isolate import ChildPool
 
@@ -373,8 +373,8 @@ def _warm_up(tasks: list[Task]) -> None:
     import collections
     import tempfile
 
-    from ..grade import grade, text  # text: to_json's module, loaded here once
-    from ..grade.html import report_html
+    from ..grading import grade, text  # text: to_json's module, loaded here once
+    from ..grading.html import report_html
     from ..io import load
     from .solution import solution_markdown, solution_steps
 

@@ -1,4 +1,4 @@
-"""The kind of a wrong step, read from the grader's message (``armdyn.grade.explain``).
+"""The kind of a wrong step, read from the grader's message (``armdyn.grading.explain``).
 
 ``describe`` writes one sentence per wrong component; its opening words name the slip:
 

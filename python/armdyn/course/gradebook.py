@@ -21,7 +21,7 @@ import io
 import json
 from dataclasses import dataclass, field
 
-from ..grade.verdict import STATUSES
+from ..grading.verdict import STATUSES
 from .errorkinds import classify
 from .rubric import Rubric
 

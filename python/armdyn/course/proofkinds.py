@@ -1,6 +1,6 @@
 """Proof exercises: the parallel axis theorem and the rotational kinetic energy, one
 variant per student in its own notation, with the worked proof (graded by
-``armdyn.grade.proofs``) and the slips a test injects.
+``armdyn.grading.proofs``) and the slips a test injects.
 
 A proof is a list of blocks: prose (str) or a display equation (:class:`ProofLine`) with
 the wrong versions a slip may put in its place. What is drawn per variant: the reference

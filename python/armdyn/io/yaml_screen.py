@@ -13,7 +13,7 @@ stack, so depth costs it no recursion) and refuses, with one line naming the fil
   one of more than 4300 digits with a message that names no file, and no model value
   or submission needs a number of that size.
 
-Both loaders of armdyn (:mod:`armdyn.io.yaml` for models, :mod:`armdyn.grade.reader`
+Both loaders of armdyn (:mod:`armdyn.io.yaml` for models, :mod:`armdyn.grading.reader`
 for submissions) call it first.
 """
 

@@ -2,7 +2,7 @@
 
 The operation-count optimiser: each quantity becomes a :class:`~armdyn.programs.program.Program`
 (named temporaries, zeros and ones propagated), built by Khalil's customized algorithms
-and the special forms that shorten them; :mod:`armdyn.codegen` only prints programs.
+and the special forms that shorten them; :mod:`armdyn.printing` only prints programs.
 
 * :mod:`~armdyn.programs.program`: the program, its builder and its operation counts;
 * :mod:`~armdyn.programs.vectors`: 3-vector arithmetic that skips zeros and ones;
@@ -17,6 +17,6 @@ and the special forms that shorten them; :mod:`armdyn.codegen` only prints progr
 * :mod:`~armdyn.programs.composite_mass_matrix`: M by composite links;
 * :mod:`~armdyn.programs.coriolis_program`: C from M's program, differentiated line by line.
 
-Nothing here imports :mod:`armdyn.codegen`; of :mod:`armdyn.symbolic`, only its
+Nothing here imports :mod:`armdyn.printing`; of :mod:`armdyn.symbolic`, only its
 expression-DAG helpers (:mod:`armdyn.symbolic.dag`).
 """

@@ -67,7 +67,7 @@ class Grader:
         """The exercise a submission's front matter names: its ``variant:`` when that is
         a served variant (``armdyn exercise make`` writes ``robot: model.yaml`` beside
         it), else its ``robot:``."""
-        from ..grade.reader import safe_yaml
+        from ..grading.reader import safe_yaml
 
         if markdown.startswith("---"):
             end = markdown.find("\n---", 3)
@@ -79,9 +79,9 @@ class Grader:
 
     def grade(self, markdown: str, exercise: str | None) -> dict:
         from ..errors import ModelError
-        from ..grade import grade
-        from ..grade.html import report_body  # built once, wrapped twice (saves ~0.4 s CPU)
-        from ..grade.reader import read_markdown
+        from ..grading import grade
+        from ..grading.html import report_body  # built once, wrapped twice (saves ~0.4 s CPU)
+        from ..grading.reader import read_markdown
         from ..htmlpage import fragment, page
 
         try:
@@ -113,8 +113,8 @@ class Grader:
 
     def preview(self, markdown: str, exercise: str | None) -> dict:
         from ..errors import ModelError
-        from ..grade.notation import SymbolMap, parse_lhs
-        from ..grade.reader import read_markdown
+        from ..grading.notation import SymbolMap, parse_lhs
+        from ..grading.reader import read_markdown
         from ..mathml import escape, latex_to_mathml, math_element
 
         try:

@@ -37,7 +37,7 @@ the joint torque), ``n_i - o_i x f_i``. ``F_i``/``N_i`` are the rates of change 
 momentum (Craig's sign; the exercise writes the d'Alembert inertial force ``-m vcd``).
 
 The per-step formulas are the functions ``omega`` ... ``joint_torque`` below; the
-derivation and :mod:`armdyn.grade` (which re-applies them to a student's own values)
+derivation and :mod:`armdyn.grading` (which re-applies them to a student's own values)
 share them.
 """
 

@@ -1,6 +1,6 @@
 """Compile generated C with the system C compiler and call it through ctypes.
 
-    lib = armdyn.codegen.compile(robot.bind(), what=("tau", "M"))
+    lib = armdyn.printing.compile(robot.bind(), what=("tau", "M"))
     lib.tau(q, qd, qdd)          # (dof,) -> (dof,);  (N, dof) -> (N, dof)
     lib.M(q)                     # (dof,) -> (dof, dof); (N, dof) -> (N, dof, dof)
 
@@ -73,7 +73,7 @@ def build_shared_library(
 class CompiledFunction:
     """One generated quantity, callable on (dof,) or (N, dof) float64 arrays.
 
-    ``f(q, [qd, [qdd]], p=None)``: the inputs of :data:`~armdyn.codegen.printers.INPUTS`;
+    ``f(q, [qd, [qdd]], p=None)``: the inputs of :data:`~armdyn.printing.printers.INPUTS`;
     ``p`` (len(parameters),) is required when the code has parameters. Wrong shapes,
     NaN or inf raise ValueError naming the argument."""
 
@@ -154,8 +154,8 @@ def compile(
 ) -> CompiledCode:
     """Build C code into a shared library and load it.
 
-    code: a :class:`~armdyn.codegen.GeneratedCode` in C, or a Robot / model name (then
-          :func:`armdyn.codegen.codegen` generates ``what`` in C, with ``base``).
+    code: a :class:`~armdyn.printing.GeneratedCode` in C, or a Robot / model name (then
+          :func:`armdyn.printing.codegen` generates ``what`` in C, with ``base``).
     directory: where the .c and .so go (a new temporary directory if None).
     cc: the compiler (default ``$CC``, then cc, gcc, clang); flags: extra arguments.
     Raises CompilerError when no compiler is found or it fails.

@@ -244,7 +244,7 @@ def _lagrange(s: str, coordinate_of) -> StepRef | None:
 
 
 class SymbolMap:
-    """Maps the student's symbols (:class:`~armdyn.grade.latex.Name`) to the model's.
+    """Maps the student's symbols (:class:`~armdyn.grading.latex.Name`) to the model's.
 
     robot:     the model the student's frames follow
     explicit:  the student's symbol (LaTeX such as ``l_{c1}`` or a plain name such as

@@ -17,7 +17,7 @@ that evaluates them, so the kernel is good to about 1 ulp. Taylor polynomials of
 degrees would be off by up to 2^-45 and 2^-49 at pi/4; the Rust core's kernel
 (``crates/armdyn-core/src/real.rs``) uses Taylor polynomials of degree 17 and 16.
 
-    python3 python/armdyn/codegen/sincos_coefficients.py     # computes and prints SIN, COS (~3 s)
+    python3 python/armdyn/printing/sincos_coefficients.py     # computes and prints SIN, COS (~3 s)
 
 ``tests/test_codegen_sincos.py`` checks that :func:`fit` gives SIN and COS below.
 """

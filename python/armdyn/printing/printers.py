@@ -35,7 +35,7 @@ _C_RESERVED = set(
 
 class Names:
     """Identifier for every symbol: its name made an ASCII identifier
-    (:func:`~armdyn.codegen.safe_names.identifier_base`), unique, none a keyword or a
+    (:func:`~armdyn.printing.safe_names.identifier_base`), unique, none a keyword or a
     name the generated code uses itself (``taken``: e.g. its function names)."""
 
     def __init__(self, symbols, taken=()):
@@ -229,7 +229,7 @@ _SINCOS_KERNEL = f"""\
 /* (sin x, cos x) to about 1 ulp for |x| <= 1e8, branch-free so that loops over lanes
  * vectorise: x = j pi/2 + r (three-part Cody-Waite split of pi/2, exact for |j| < 2^29),
  * minimax polynomials of degree 13 / 14 on |r| <= pi/4 (their coefficients computed by
- * python/armdyn/codegen/sincos_coefficients.py), picked and signed by j mod 4. armdyn's
+ * python/armdyn/printing/sincos_coefficients.py), picked and signed by j mod 4. armdyn's
  * Rust core (crates/armdyn-core/src/real.rs) reduces x the same way but uses Taylor
  * polynomials of degree 17 / 16: the two agree to about 1 ulp, not to the bit. */
 static inline void armdyn_sincos_kernel(double x, double *s, double *c)

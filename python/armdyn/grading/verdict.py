@@ -65,7 +65,7 @@ class StepVerdict:
     message:     one readable sentence, e.g. "missing term −l1·θ̇1² in the x component"
     frame:       the frame the value is expressed in, e.g. "1" (text), "" for scalars
     part:        the assignment's part the equation is in (``"7-4"``), None when the task
-                 has no number or there are no parts (see :mod:`armdyn.grade.parts`)
+                 has no number or there are no parts (see :mod:`armdyn.grading.parts`)
     task:        that task's title (the first line of its statement), "" if none
     column:      1-based column where the value starts (0: not known, e.g. YAML)
     counterexample: for a wrong proof link, the small body on which its sides differ

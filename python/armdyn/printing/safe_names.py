@@ -9,7 +9,7 @@ never become one variable. Two transformations, both pure functions of the name:
   ASCII only; every other character, and every character that could end or bend the
   comment (``"``, ``\\``, ``?``, a ``/`` next to a ``*``), is written ``<U+XXXX>``.
 * :func:`identifier_base`: an ASCII identifier stem (``[A-Za-z_][A-Za-z0-9_]*``), not
-  starting with ``_`` (reserved in C); :class:`~armdyn.codegen.printers.Names` makes the
+  starting with ``_`` (reserved in C); :class:`~armdyn.printing.printers.Names` makes the
   stems unique, so names that differ only under Unicode normalisation (``q1`` and the
   fullwidth ``ｑ1``, one name to Python, which reads identifiers in NFKC) stay two.
 """

@@ -1,6 +1,6 @@
 """The grade report as a page people read: self-contained HTML with MathML.
 
-:func:`report_html` turns a :class:`~armdyn.grade.verdict.GradeReport` into one HTML5
+:func:`report_html` turns a :class:`~armdyn.grading.verdict.GradeReport` into one HTML5
 document (inline CSS, math as MathML, no script, no network), laid out as:
 
 * a summary: the first wrong step (a link to it), each final torque right or not,

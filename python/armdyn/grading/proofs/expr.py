@@ -1,6 +1,6 @@
 """Read one side of a proof line (LaTeX) into a typed expression tree; nothing is executed.
 
-A small recursive-descent parser over :func:`armdyn.grade.latex.tokenize`'s tokens. Its
+A small recursive-descent parser over :func:`armdyn.grading.latex.tokenize`'s tokens. Its
 own tree rather than SymPy because the algebra of a rigid-body proof is not commutative
 (``d r_C^T`` is not ``r_C d^T``, ``R I R^T`` is not ``I``), mixes scalars, vectors and 3x3
 matrices, and holds integrals over the body; the tree is evaluated exactly on point-mass

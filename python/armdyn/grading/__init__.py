@@ -1,4 +1,4 @@
-"""Check a student's own derivation step by step: :func:`grade`.
+"""Check a student's own derivation step by step: :func:`grade` (exported as ``armdyn.grade``).
 
     report = armdyn.grade("my-derivation.md")             # front matter names the robot
     report = armdyn.grade("steps.yaml", robot="rp-arm")
@@ -16,8 +16,6 @@ exist) raises :class:`armdyn.errors.ModelError` naming the file and line.
 from __future__ import annotations
 
 import os
-import sys
-import types
 from collections.abc import Mapping
 
 import symengine as se
@@ -625,13 +623,3 @@ def grade(
             raise err.located(source=sub.path) from None
     hint = sub.method if sub.method in ("newton-euler", "lagrange") else None
     return _Grader(sub, model, symbols).run(hint)
-
-
-class _CallableModule(types.ModuleType):
-    """``armdyn.grade(...)`` calls :func:`grade` (the package is also the function)."""
-
-    def __call__(self, *args, **kwargs):
-        return grade(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule

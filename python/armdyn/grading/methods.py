@@ -17,18 +17,26 @@ Newton-Euler formulas are those of :mod:`armdyn.symbolic.newton_euler`.
 
 from __future__ import annotations
 
-import importlib
 from dataclasses import dataclass, field
 from typing import Callable
 
 import sympy as sp
 
 from ..model import Robot
-
-# the module, not the function of the same name that armdyn.symbolic exports
-ne = importlib.import_module("armdyn.symbolic.newton_euler")
-from ..symbolic.lagrange import link_energies  # noqa: E402 - after the module ne above
-from ..symbolic.terms import time_derivative  # noqa: E402
+from ..symbolic.lagrange import link_energies
+from ..symbolic.newton_euler import (
+    inertial_force,
+    inertial_moment,
+    joint_force,
+    joint_moment,
+    joint_torque,
+    moment_about,
+    omega,
+    omega_dot,
+    v_dot,
+    vc_dot,
+)
+from ..symbolic.terms import time_derivative
 
 Ref = tuple  # (key, index)
 
@@ -157,29 +165,29 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
     for i in range(1, n + 1):
         p = ctx[i]["parent"]
         m.formulas[("omega", i)] = [
-            Formula((("omega", p),), lambda c, w, i=i: ne.omega(c[i]["R"], w, c[i]["z"], c[i]["qd"], c[i]["kind"]))
+            Formula((("omega", p),), lambda c, w, i=i: omega(c[i]["R"], w, c[i]["z"], c[i]["qd"], c[i]["kind"]))
         ]
         m.formulas[("omega_dot", i)] = [
             Formula(
                 (("omega", p), ("omega_dot", p)),
-                lambda c, w, wd, i=i: ne.omega_dot(c[i]["R"], w, wd, c[i]["z"], c[i]["qd"], c[i]["qdd"], c[i]["kind"]),
+                lambda c, w, wd, i=i: omega_dot(c[i]["R"], w, wd, c[i]["z"], c[i]["qd"], c[i]["qdd"], c[i]["kind"]),
             )
         ]
         m.formulas[("v_dot", i)] = [
             Formula(
                 (("omega", p), ("omega_dot", p), ("v_dot", p)),
-                lambda c, w, wd, vd, i=i: ne.v_dot(c[i]["R"], w, wd, vd, c[i]["P"], c[i]["V"], c[i]["Vd"]),
+                lambda c, w, wd, vd, i=i: v_dot(c[i]["R"], w, wd, vd, c[i]["P"], c[i]["V"], c[i]["Vd"]),
             )
         ]
         m.formulas[("vc_dot", i)] = [
             Formula(
                 (("omega", i), ("omega_dot", i), ("v_dot", i)),
-                lambda c, w, wd, vd, i=i: ne.vc_dot(w, wd, vd, c[i]["c"]),
+                lambda c, w, wd, vd, i=i: vc_dot(w, wd, vd, c[i]["c"]),
             )
         ]
-        m.formulas[("F", i)] = [Formula((("vc_dot", i),), lambda c, a, i=i: ne.inertial_force(c[i]["m"], a))]
+        m.formulas[("F", i)] = [Formula((("vc_dot", i),), lambda c, a, i=i: inertial_force(c[i]["m"], a))]
         m.formulas[("N", i)] = [
-            Formula((("omega", i), ("omega_dot", i)), lambda c, w, wd, i=i: ne.inertial_moment(c[i]["I"], w, wd))
+            Formula((("omega", i), ("omega_dot", i)), lambda c, w, wd, i=i: inertial_moment(c[i]["I"], w, wd))
         ]
         m.refs += [("omega", i), ("omega_dot", i), ("v_dot", i), ("vc_dot", i), ("F", i), ("N", i)]
 
@@ -217,12 +225,12 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
         n_inputs = (("N", i), ("F", i)) + tuple(r for k in kids for r in (("n", k), ("f", k)))
 
         def f_fn(c, F, *fs, i=i):
-            return ne.joint_force(F, [(c[k]["R"], fk) for k, fk in zip(c[i]["children"], fs)])
+            return joint_force(F, [(c[k]["R"], fk) for k, fk in zip(c[i]["children"], fs)])
 
         def n_fn(c, N, F, *nfs, i=i):
             kids = c[i]["children"]
             pairs = [(c[k]["R"], c[k]["P"], nfs[2 * j], nfs[2 * j + 1]) for j, k in enumerate(kids)]
-            return ne.joint_moment(N, c[i]["c"], F, pairs)
+            return joint_moment(N, c[i]["c"], F, pairs)
 
         m.formulas[("f", i)] = [Formula(f_inputs, f_fn)]
         m.formulas[("n", i)] = [Formula(n_inputs, n_fn)]
@@ -233,7 +241,7 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
         ]
         about_axis = Convention(
             f"moment about joint {i}'s axis",
-            lambda v, c, f, i=i: ne.moment_about(v, f, c[i]["o"]),
+            lambda v, c, f, i=i: moment_about(v, f, c[i]["o"]),
             lambda v, c, f, i=i: v + c[i]["o"].cross(f),
             (("f", i),),
         )
@@ -267,7 +275,7 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
 
             def tau_fn(c, nv, fv, i=i):
                 point = c[i]["o"] if c[i]["kind"] == "revolute" else c["zero"]
-                return ne.joint_torque(c[i]["kind"], c[i]["z"], ne.moment_about(nv, fv, point), fv)
+                return joint_torque(c[i]["kind"], c[i]["z"], moment_about(nv, fv, point), fv)
 
             m.formulas[("tau", k + 1)] = [Formula((("n", i), ("f", i)), tau_fn)]
             m.refs.append(("tau", k + 1))

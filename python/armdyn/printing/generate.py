@@ -1,8 +1,8 @@
 """Generating code: the driver :func:`codegen` and what it returns, :class:`GeneratedCode`.
 
 :func:`codegen` builds a straight-line program per quantity (``programs/``) and prints
-it (printers.py); where each quantity comes from is in the package's docstring
-(:mod:`armdyn.codegen`), which re-exports everything here. compile.py builds the C.
+it (printers.py); where each quantity comes from is in the docstring of the package
+:mod:`armdyn.printing`, which re-exports everything here. compile.py builds the C.
 """
 
 from __future__ import annotations

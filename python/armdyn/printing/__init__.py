@@ -1,9 +1,10 @@
-"""Generated code for the dynamics of a robot: C99, Python or NumPy.
+"""Generated code for the dynamics of a robot: C99, Python or NumPy. :func:`codegen` is
+exported as ``armdyn.codegen``; this package prints programs and compiles the C.
 
     code = armdyn.codegen(robot, what=("tau", "M", "C", "g"), lang="c")   # GeneratedCode
     print(code.source)              # readable: named temporaries, op counts in the header
     code.op_counts["tau"]           # {'mul': ..., 'add': ..., 'sin_cos': ..., 'total': ...}
-    lib = armdyn.codegen.compile(robot.bind(), what=("tau", "M"))   # system C compiler
+    lib = armdyn.printing.compile(robot.bind(), what=("tau", "M"))  # system C compiler
     tau = lib.tau(q, qd, qdd)       # q, qd, qdd: (dof,) or (N, dof) float64
 
 Where each quantity comes from (all with the barycentric / standard inertial parameters
@@ -44,21 +45,8 @@ Conventions: ``M(q) qdd + C(q, qd) qd + g(q) = tau``, SI units, radians, joints 
 
 from __future__ import annotations
 
-import sys
-import types
-
 from ..programs.program import Program
 from .compile import CompiledCode, compile
 from .generate import LANGUAGES, QUANTITIES, GeneratedCode, codegen, write_files
-
-
-class _CallableModule(types.ModuleType):
-    """``armdyn.codegen(...)`` calls :func:`codegen`; the module stays importable."""
-
-    def __call__(self, *args, **kwargs):
-        return codegen(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule
 
 __all__ = ["codegen", "compile", "GeneratedCode", "CompiledCode", "Program", "QUANTITIES", "LANGUAGES", "write_files"]

@@ -1,7 +1,7 @@
 """Check a proof line by line: each ``=`` of a chain ``A = B = C`` is one link, judged by
 evaluating both sides exactly on random point-mass bodies (:mod:`.body`, :mod:`.evaluate`).
 
-Per link (statuses of :mod:`armdyn.grade.verdict`):
+Per link (statuses of :mod:`armdyn.grading.verdict`):
 
 * ``correct``: the two sides agree on every instance. If they disagree once the point
   named C is *not* the mass center, the link relies on ``\\int r_C dm = 0`` and says so.
