@@ -18,8 +18,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
-#: an issue or ticket number ("issue 8", "Issues #12", "(issue 11)", "test_issue8") or a
-#: design document kept outside the repository
+#: the word issue(s) or ticket(s) followed by a number (with a space, an underscore, a "#" or
+#: nothing between them, as in a test named after one) or a design document kept outside the
+#: repository
 TRACKER_REF = re.compile(r"(?<![A-Za-z])(?:[Ii]ssues?|[Tt]ickets?)[ _]?#?[0-9]+|DESIGN\.md")
 
 
