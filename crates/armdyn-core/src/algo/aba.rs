@@ -146,32 +146,42 @@ pub(crate) fn articulated_inertias<T: Real, F: AbaFrames<T>>(
     frames: &F,
     bias: Option<(&[T], &[T])>,
 ) {
+    // `bias` is a constant at each (inlined) call site, so its tests fold away; plain
+    // matches, as closures here were left out of line.
     for i in (0..model.nv).rev() {
         let u_col = frames.inertia_s(i, &data.ia[i]);
         let jd = &model.joint_dynamics[i];
         let d_inv = T::splat(1.0) / (frames.s_dot(i, &u_col) + T::splat(jd.armature));
-        data.u_col[i] = u_col;
-        data.d_inv[i] = d_inv;
         let u = match bias {
             Some((qd, tau)) => {
                 let mut u = tau[i] - frames.s_dot(i, &data.pa[i]);
                 if model.has_joint_dynamics {
                     u -= jd.passive_torque(qd[i]);
                 }
-                data.u[i] = u;
                 Some(u)
             }
             None => None,
         };
+        data.u_col[i] = u_col;
+        data.d_inv[i] = d_inv;
+        if let Some(u) = u {
+            data.u[i] = u;
+        }
         if let Some(p) = model.parent[i] {
             let ia = data.ia[i].sub_outer(&u_col, d_inv);
-            if let Some(u) = u {
-                let pa = data.pa[i] + ia.mul_motion(&data.c[i]) + u_col.scale(u * d_inv);
-                let pa_p = frames.force_to_parent(data, i, &pa);
-                data.pa[p] += pa_p;
+            match u {
+                Some(u) => {
+                    let pa = data.pa[i] + ia.mul_motion(&data.c[i]) + u_col.scale(u * d_inv);
+                    let ia_p = frames.inertia_to_parent(data, i, &ia);
+                    let pa_p = frames.force_to_parent(data, i, &pa);
+                    data.ia[p] += ia_p;
+                    data.pa[p] += pa_p;
+                }
+                None => {
+                    let ia_p = frames.inertia_to_parent(data, i, &ia);
+                    data.ia[p] += ia_p;
+                }
             }
-            let ia_p = frames.inertia_to_parent(data, i, &ia);
-            data.ia[p] += ia_p;
         }
     }
 }

@@ -114,10 +114,12 @@ pub(crate) fn velocity_pass<T: Real>(
         dd.bs[i] = b_sym(&inertia, &v);
         dd.bn[i] = h.n;
         dd.bp[i] = h.f;
-        dd.f[i] = v.cross_force(&h);
+        // the bias force p_i; external forces enter here, once for both derivative algorithms
+        let mut p = v.cross_force(&h);
         if ext.is_some() {
-            dd.f[i] -= dd.fx[i];
+            p -= dd.fx[i];
         }
+        dd.f[i] = p;
         dd.ic[i] = inertia;
         dd.dvdq[i] = dvdq;
         dd.s[i] = s;
