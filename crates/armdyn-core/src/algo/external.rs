@@ -71,7 +71,9 @@ pub(crate) enum Coordinates {
 /// The external force `f^x_i` on each body, the sum of its links' wrenches, in
 /// `coords`, into `out` (nv,): a link's wrench is first placed on the body carrying it
 /// (its constant pose there for `Local`), then moved by `^iX_0` (`data.x0`, which must
-/// be current) when its frame and `coords` differ.
+/// be current) when its frame and `coords` differ. Inlined, so that `coords` (a constant
+/// at each call) leaves one case per frame in the loop, as when it was written out twice.
+#[inline(always)]
 pub(crate) fn body_forces<T: Real>(
     model: &Model,
     data: &Data<T>,
