@@ -15,6 +15,7 @@
 //! puts `Ia` into `D_i = S^T I^A S + Ia` (so M^-1 is that of `M + diag(Ia)`), and
 //! `rnea_derivatives` adds `diag(Fv)` to `dID/dqd` (Coulomb friction: 0, see there).
 
+use crate::algo::aba::{articulated_inertias, joint_accelerations, BaseFrame};
 use crate::algo::external::ExternalForces;
 use crate::algo::minverse::minverse_sweeps;
 use crate::algo::rnea_derivatives::{acceleration_pass, derivative_terms, subtree_sums, velocity_pass};
@@ -22,7 +23,7 @@ use crate::data::Data;
 use crate::deriv_data::DerivData;
 use crate::model::Model;
 use crate::real::Real;
-use crate::spatial::{ArticulatedInertia, Motion, V3};
+use crate::spatial::ArticulatedInertia;
 
 /// Partial derivatives of `qdd = aba(q, qd, tau)` (with external wrenches `ext`, if any:
 /// `M qdd + C qd + g = tau + sum_L J_L^T w_L`).
@@ -54,8 +55,8 @@ pub fn aba_derivatives<T: Real>(
     assert!(dqdd_dq.len() == n * n && dqdd_dqd.len() == n * n && minv.len() == n * n, "output size");
     velocity_pass(model, data, dd, q, qd, ext);
     let mut qdd = std::mem::take(&mut dd.qdd);
-    aba_world(model, data, dd, qd, tau, ext.is_some(), &mut qdd);
-    acceleration_pass(model, dd, qd, &qdd, ext.is_some());
+    aba_world(model, data, dd, qd, tau, &mut qdd);
+    acceleration_pass(model, dd, qd, &qdd);
     subtree_sums(model, dd, ext);
     minverse_sweeps(model, data, dd, minv);
     // dID/dq and dID/dqd at qdd
@@ -80,53 +81,19 @@ pub fn aba_derivatives<T: Real>(
 }
 
 /// The articulated-body algorithm (RBDA Table 7.1) in base coordinates, after
-/// [`velocity_pass`]: body i's inertia `dd.ic[i]`, momentum `(dd.bn, dd.bp)[i]`, axis
-/// `J_i = dd.s[i]`, velocity-product force `v_i x* I_i v_i` (`dd.f[i]`), external force
-/// `dd.fx[i]` (if `has_ext`), and the velocity-product acceleration
-/// `c_i = (v_i x J_i) qd_i = dV_i qd_i`. Writes `qdd` (nv,) and, in base coordinates,
+/// [`velocity_pass`]: its pass 1 from the velocity pass's body inertias `dd.ic[i]`, bias
+/// forces `dd.f[i]` (`v_i x* I_i v_i - f^x_i`) and `c_i = (v_i x J_i) qd_i = dV_i qd_i`;
+/// passes 2 and 3 shared with `aba` ([`articulated_inertias`], [`joint_accelerations`])
+/// with `J_i = dd.s[i]` for `S_i`. Writes `qdd` (nv,) and, in base coordinates,
 /// `data.ia`, `data.pa`, `data.c`, `data.u_col`, `data.d_inv`, `data.u`, `data.a`.
-/// Joint dynamics as in `aba`: `D_i = J^T I^A J + Ia`, `u_i = tau_i - Fv qd_i -
-/// Fc sign(qd_i) - offset - J^T p^A_i`.
 #[inline(always)]
-fn aba_world<T: Real>(model: &Model, data: &mut Data<T>, dd: &DerivData<T>, qd: &[T], tau: &[T], has_ext: bool, qdd: &mut [T]) {
-    let n = model.nv;
-    for i in 0..n {
+fn aba_world<T: Real>(model: &Model, data: &mut Data<T>, dd: &DerivData<T>, qd: &[T], tau: &[T], qdd: &mut [T]) {
+    for i in 0..model.nv {
         data.ia[i] = ArticulatedInertia::from_rigid(&dd.ic[i]);
-        // v_i x* I_i v_i, from the velocity pass
         data.pa[i] = dd.f[i];
-        if has_ext {
-            data.pa[i] -= dd.fx[i];
-        }
         data.c[i] = dd.dvdq[i].scale(qd[i]);
     }
-    for i in (0..n).rev() {
-        let s = dd.s[i];
-        let u_col = data.ia[i].mul_motion(&s);
-        let jd = &model.joint_dynamics[i];
-        let d_inv = T::splat(1.0) / (s.dot(&u_col) + T::splat(jd.armature));
-        let mut u = tau[i] - s.dot(&data.pa[i]);
-        if model.has_joint_dynamics {
-            u -= jd.passive_torque(qd[i]);
-        }
-        data.u_col[i] = u_col;
-        data.d_inv[i] = d_inv;
-        data.u[i] = u;
-        if let Some(p) = model.parent[i] {
-            let ia = data.ia[i].sub_outer(&u_col, d_inv);
-            let pa = data.pa[i] + ia.mul_motion(&data.c[i]) + u_col.scale(u * d_inv);
-            data.ia[p] += ia;
-            data.pa[p] += pa;
-        }
-    }
-    let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
-    for i in 0..n {
-        let ap = match model.parent[i] {
-            Some(p) => data.a[p],
-            None => a0,
-        };
-        let a = ap + data.c[i];
-        let qddi = (data.u[i] - a.dot(&data.u_col[i])) * data.d_inv[i];
-        qdd[i] = qddi;
-        data.a[i] = a + dd.s[i].scale(qddi);
-    }
+    let frames = BaseFrame(&dd.s[..]);
+    articulated_inertias(model, data, &frames, Some((qd, tau)));
+    joint_accelerations(model, data, &frames, qdd);
 }

@@ -9,7 +9,9 @@
 //! * forward dynamics with external forces is `aba(q, qd, tau + tau_ext)`,
 //!
 //! since `M qdd + C qd + g = tau + tau_ext`. Computing `tau_ext` in its own backward pass
-//! leaves `rnea.rs` and `aba.rs` as they are.
+//! leaves `rnea.rs` and `aba.rs` as they are. The derivative algorithms instead take the
+//! forces into their bodies' bias forces (`rnea_derivatives::velocity_pass`). Both start
+//! from [`body_forces`], the one place a link's wrench is moved to its body.
 
 use crate::algo::kinematics::{update_x0, update_xup};
 use crate::algo::{aba, rnea};
@@ -57,25 +59,47 @@ fn local_in_body<T: Real>(model: &Model, k: usize, w: &Force<T>) -> Force<T> {
     Force::new(r.mul_v(w.n) + V3::splat(lf.translation).cross(f), f)
 }
 
-/// The external force on each body, summed over its links, in base coordinates (about
-/// the base origin), into `out` (nv,). Needs `data.x0`.
-pub fn world_forces<T: Real>(model: &Model, data: &Data<T>, ext: &ExternalForces<T>, out: &mut [Force<T>]) {
+/// The coordinates [`body_forces`] gives each body's external force in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Coordinates {
+    /// The body's own frame (about its origin, in its axes): RBDA's `^iX_0^* f^x_i`.
+    Body,
+    /// The base frame (about the base origin, in base axes) for every body.
+    Base,
+}
+
+/// The external force `f^x_i` on each body, the sum of its links' wrenches, in
+/// `coords`, into `out` (nv,): a link's wrench is first placed on the body carrying it
+/// (its constant pose there for `Local`), then moved by `^iX_0` (`data.x0`, which must
+/// be current) when its frame and `coords` differ. Inlined, so that `coords` (a constant
+/// at each call) leaves one case per frame in the loop, as when it was written out twice.
+#[inline(always)]
+pub(crate) fn body_forces<T: Real>(
+    model: &Model,
+    data: &Data<T>,
+    ext: &ExternalForces<T>,
+    coords: Coordinates,
+    out: &mut [Force<T>],
+) {
     assert_eq!(ext.wrenches.len(), 6 * model.nlinks(), "f_ext size");
     out.iter_mut().for_each(|f| *f = Force::zero());
     for k in 0..model.nlinks() {
         if let Some(b) = model.links[k].body {
             let w = ext.raw(k);
-            out[b] += match ext.frame {
-                ForceFrame::Local => data.x0[b].tr_apply_force(&local_in_body(model, k, &w)),
-                ForceFrame::World => w,
+            out[b] += match (ext.frame, coords) {
+                (ForceFrame::Local, Coordinates::Body) => local_in_body(model, k, &w),
+                (ForceFrame::Local, Coordinates::Base) => data.x0[b].tr_apply_force(&local_in_body(model, k, &w)),
+                (ForceFrame::World, Coordinates::Body) => data.x0[b].apply_force(&w),
+                (ForceFrame::World, Coordinates::Base) => w,
             };
         }
     }
 }
 
 /// `tau_ext = sum_L J_L^T w_L` (nv,): the joint torques balancing the external wrenches,
-/// by one backward pass (`tau_i = S_i^T F_i`, `F_lambda += X^T F_i`, RBDA Table 5.1).
-/// Uses `dd.f` as scratch; writes `data.xup` (and `data.x0` for `World`).
+/// by one backward pass over the body forces of [`body_forces`] (`tau_i = S_i^T F_i`,
+/// `F_lambda += X^T F_i`, RBDA Table 5.1). Uses `dd.f` as scratch; writes `data.xup`
+/// (and `data.x0` for `World`).
 pub fn generalized_forces<T: Real>(
     model: &Model,
     data: &mut Data<T>,
@@ -90,16 +114,7 @@ pub fn generalized_forces<T: Real>(
     if ext.frame == ForceFrame::World {
         update_x0(model, data);
     }
-    dd.f.iter_mut().for_each(|f| *f = Force::zero());
-    for k in 0..model.nlinks() {
-        if let Some(b) = model.links[k].body {
-            let w = ext.raw(k);
-            dd.f[b] += match ext.frame {
-                ForceFrame::Local => local_in_body(model, k, &w),
-                ForceFrame::World => data.x0[b].apply_force(&w),
-            };
-        }
-    }
+    body_forces(model, data, ext, Coordinates::Body, &mut dd.f);
     for i in (0..n).rev() {
         tau_ext[i] = model.kind[i].s_dot(&dd.f[i]);
         if let Some(p) = model.parent[i] {

@@ -33,6 +33,7 @@
 //! inertia about the centre of mass is diagonal in the body's axes, as in most robot
 //! descriptions (UR5, iiwa14; not the Panda's identified inertias).
 
+use crate::algo::aba::{articulated_inertias, BaseFrame};
 use crate::algo::kinematics::{update_x0, update_xup};
 use crate::data::Data;
 use crate::deriv_data::DerivData;
@@ -62,33 +63,15 @@ pub fn minverse<T: Real>(model: &Model, data: &mut Data<T>, dd: &mut DerivData<T
         };
         data.ia[i] = ArticulatedInertia::from_rigid(&inertia);
     }
-    articulated_inertias_world(model, data, dd);
+    // RBDA Table 7.1, pass 2 without bias forces: no transform, all inertias share the base frame
+    articulated_inertias(model, data, &BaseFrame(&dd.s[..]), None);
     minverse_sweeps(model, data, dd, minv);
 }
 
-/// RBDA Table 7.1, pass 2 without bias forces, in base-frame coordinates: given
-/// `data.ia[i]` = body i's own inertia and `dd.s` = `J_i`, turns `data.ia` into the
-/// articulated inertias and writes `data.u_col` (`U_i = I^A_i J_i`) and `data.d_inv`
-/// (`1 / (J_i^T U_i + Ia_i)`). No transform: all inertias share the base frame.
-#[inline(always)]
-pub fn articulated_inertias_world<T: Real>(model: &Model, data: &mut Data<T>, dd: &DerivData<T>) {
-    for i in (0..model.nv).rev() {
-        let u_col = data.ia[i].mul_motion(&dd.s[i]);
-        // the rotor inertia adds to the joint's own inertia: D_i = J^T I^A J + Ia (as in aba)
-        let d_inv = T::splat(1.0) / (dd.s[i].dot(&u_col) + T::splat(model.joint_dynamics[i].armature));
-        data.u_col[i] = u_col;
-        data.d_inv[i] = d_inv;
-        if let Some(p) = model.parent[i] {
-            let ia = data.ia[i].sub_outer(&u_col, d_inv);
-            data.ia[p] += ia;
-        }
-    }
-}
-
 /// The two passes over unit torques (module docs), given the base-frame `dd.s` (`J_i`),
-/// `data.u_col` (`U_i`) and `data.d_inv` (`1 / D_i`) of [`articulated_inertias_world`]
-/// (or of a base-frame ABA). Writes all of `minv` (nv, nv), row-major; uses `dd.fm[..nv]`
-/// and `dd.pm` (its first nv entries on a chain).
+/// `data.u_col` (`U_i`) and `data.d_inv` (`1 / D_i`) of [`articulated_inertias`] in base
+/// coordinates (with or without bias forces). Writes all of `minv` (nv, nv), row-major;
+/// uses `dd.fm[..nv]` and `dd.pm` (its first nv entries on a chain).
 #[inline(always)]
 pub fn minverse_sweeps<T: Real>(model: &Model, data: &Data<T>, dd: &mut DerivData<T>, minv: &mut [T]) {
     let n = model.nv;

@@ -36,7 +36,7 @@
 //!
 //! so the subtree sums are one symmetric 3x3 and two 3-vectors per body.
 
-use crate::algo::external::{world_forces, ExternalForces, ForceFrame};
+use crate::algo::external::{body_forces, Coordinates, ExternalForces, ForceFrame};
 use crate::algo::kinematics::{update_x0, update_xup};
 use crate::data::Data;
 use crate::deriv_data::DerivData;
@@ -76,11 +76,12 @@ fn b_sym<T: Real>(i: &RigidInertia<T>, v: &Motion<T>) -> Sym3<T> {
 
 /// The forward pass's velocity part (independent of `qdd`), shared by
 /// `rnea_derivatives` and `aba_derivatives`: writes `data.xup`, `data.x0`, `dd.fx` (the
-/// external forces in base coordinates, whatever their frame; only if `ext` is given)
-/// and per body the base-frame `dd.s` (`J_i`), `dd.v`, `dd.dvdq`, `dd.ic` (body i's own
-/// inertia), `dd.bn`, `dd.bp` (its momentum `I_i v_i`), `dd.bs`, and in `dd.f` the
-/// velocity-product force `v_i x* I_i v_i` (the acceleration pass adds `I_i a_i`; the
-/// base-frame ABA starts its bias forces from it).
+/// external forces `f^x_i` in base coordinates, whatever their frame; only if `ext` is
+/// given) and per body the base-frame `dd.s` (`J_i`), `dd.v`, `dd.dvdq`, `dd.ic` (body i's
+/// own inertia), `dd.bn`, `dd.bp` (its momentum `I_i v_i`), `dd.bs`, and in `dd.f` the bias
+/// force `p_i = v_i x* I_i v_i - f^x_i` (RBDA 5.3 and Table 7.1): the acceleration pass
+/// adds `I_i a_i`, the base-frame ABA starts its bias forces from it. This is where the
+/// external forces enter both derivative algorithms.
 ///
 /// A root body's parent does not move (`v_lambda = 0`): `v_i = J_i qd_i`, `dV_i = 0`.
 #[inline(always)]
@@ -96,7 +97,7 @@ pub(crate) fn velocity_pass<T: Real>(
     update_x0(model, data);
     // without external forces nothing reads dd.fx
     if let Some(e) = ext {
-        world_forces(model, data, e, &mut dd.fx);
+        body_forces(model, data, e, Coordinates::Base, &mut dd.fx);
     }
     for i in 0..model.nv {
         let x0 = data.x0[i];
@@ -113,7 +114,12 @@ pub(crate) fn velocity_pass<T: Real>(
         dd.bs[i] = b_sym(&inertia, &v);
         dd.bn[i] = h.n;
         dd.bp[i] = h.f;
-        dd.f[i] = v.cross_force(&h);
+        // the bias force p_i; external forces enter here, once for both derivative algorithms
+        let mut p = v.cross_force(&h);
+        if ext.is_some() {
+            p -= dd.fx[i];
+        }
+        dd.f[i] = p;
         dd.ic[i] = inertia;
         dd.dvdq[i] = dvdq;
         dd.s[i] = s;
@@ -122,14 +128,14 @@ pub(crate) fn velocity_pass<T: Real>(
 }
 
 /// The forward pass's acceleration part, after [`velocity_pass`]: `dd.a`, `dd.dadq` and
-/// the net forces `dd.f` of the bodies (`I_i a_i` added to the velocity pass's
-/// `v_i x* I_i v_i`, less `dd.fx` if `has_ext`).
+/// the net forces `f_i = I_i a_i + p_i` of the bodies in `dd.f` (`I_i a_i` added to the
+/// velocity pass's bias force `p_i = v_i x* I_i v_i - f^x_i`).
 /// `a_i = a_lambda + J_i qdd_i + (v_i x J_i) qd_i`, where `v_i x J_i = v_lambda x J_i = dV_i`.
 ///
 /// At a root `v_lambda = 0` and `dV_i = 0`, so `a_i = a_0 + J_i qdd_i` and
 /// `dA_i = a_0 x J_i`, which for `a_0 = [0; -g]` is `[0; -g x J_i^w]`.
 #[inline(always)]
-pub(crate) fn acceleration_pass<T: Real>(model: &Model, dd: &mut DerivData<T>, qd: &[T], qdd: &[T], has_ext: bool) {
+pub(crate) fn acceleration_pass<T: Real>(model: &Model, dd: &mut DerivData<T>, qd: &[T], qdd: &[T]) {
     let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
     let a0_linear = model.a0.w == V3::zero();
     for i in 0..model.nv {
@@ -144,9 +150,6 @@ pub(crate) fn acceleration_pass<T: Real>(model: &Model, dd: &mut DerivData<T>, q
         };
         dd.dadq[i] = dadq;
         dd.f[i] = dd.ic[i].mul_motion(&a) + dd.f[i];
-        if has_ext {
-            dd.f[i] -= dd.fx[i];
-        }
         dd.a[i] = a;
     }
 }
@@ -201,7 +204,7 @@ pub fn rnea_derivatives<T: Real>(
     assert!(q.len() == n && qd.len() == n && qdd.len() == n, "state length");
     assert!(dtau_dq.len() == n * n && dtau_dqd.len() == n * n && m.len() == n * n, "output size");
     velocity_pass(model, data, dd, q, qd, ext);
-    acceleration_pass(model, dd, qd, qdd, ext.is_some());
+    acceleration_pass(model, dd, qd, qdd);
     subtree_sums(model, dd, ext);
     derivative_terms(model, dd, ext, dtau_dq, dtau_dqd, Some(m));
 }

@@ -4,7 +4,7 @@
 //! the other opinions, in tests/test_derivatives.py.)
 
 use armdyn_core::algo::{self, ExternalForces, ForceFrame};
-use armdyn_core::{batch_derivatives, Data, DerivData, Model};
+use armdyn_core::{batch_derivatives, Data, DerivData, JointDynamics, Model};
 use crate::common::*;
 
 fn cases() -> Vec<(Model, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)> {
@@ -70,6 +70,67 @@ fn rnea_and_aba_derivatives_match_central_differences() {
             assert_close(&a, &central(&|y| aba(y, &qd, &x), &q), 1e-6, "dqdd_dq");
             assert_close(&b, &central(&|y| aba(&q, y, &x), &qd), 1e-6, "dqdd_dqd");
             assert_close(&c, &central(&|y| aba(&q, &qd, y), &x), 1e-6, "Minv");
+        }
+    }
+}
+
+/// Joint friction, rotor inertia and offset on every joint, with and without wrenches in
+/// each frame: the articulated-body passes run in body frames (`aba`, `aba_ext`, the
+/// wrenches as generalized forces) and in base coordinates (`aba_derivatives`, the
+/// wrenches in the bias forces; `minverse`, no bias). Second opinions: the body-frame
+/// `qdd` for the base-frame one, central differences of `rnea`/`aba` (which carry the
+/// terms: `diag(Ia)` in M, `diag(Fv)` in `dtau/dqd`) for the derivatives, `crba` for M^-1.
+/// Every `|qd_k| >= 0.2`, so no difference crosses the Coulomb jump at `qd_k = 0`.
+#[test]
+fn joint_dynamics_and_wrenches_through_both_coordinate_systems() {
+    let mut rng = Rng::new(31);
+    for (mut model, q, _, x, w) in cases().into_iter().step_by(2) {
+        let n = model.nv;
+        for b in 0..n {
+            let jd = JointDynamics {
+                armature: rng.uniform(0.05, 1.0),
+                viscous: rng.uniform(0.05, 1.0),
+                coulomb: rng.uniform(0.05, 1.0),
+                offset: rng.uniform(-1.0, 1.0),
+            };
+            model.set_joint_dynamics(b, jd).expect("valid joint dynamics");
+        }
+        assert!(model.has_joint_dynamics);
+        let qd: Vec<f64> = (0..n).map(|_| rng.uniform(0.2, 2.0) * if rng.below(2) == 0 { -1.0 } else { 1.0 }).collect();
+        let (mut d, mut dd) = (Data::new(&model), DerivData::new(&model));
+        let (mut minv, mut m) = (vec![0.0; n * n], vec![0.0; n * n]);
+        algo::minverse(&model, &mut d, &mut dd, &q, &mut minv);
+        algo::crba(&model, &mut d, &q, &mut m);
+        assert_inverse(&m, &minv, n, 1e-10, "(M + diag(Ia)) Minv = I");
+        for ext in [None, Some(ForceFrame::Local), Some(ForceFrame::World)] {
+            let e = ext.map(|frame| ExternalForces { wrenches: &w[..], frame });
+            let rnea = |q: &[f64], qd: &[f64], qdd: &[f64]| {
+                let (mut d, mut dd, mut t) = (Data::new(&model), DerivData::new(&model), vec![0.0; n]);
+                match &e {
+                    Some(e) => algo::rnea_ext(&model, &mut d, &mut dd, q, qd, qdd, e, &mut t),
+                    None => algo::rnea(&model, &mut d, q, qd, qdd, &mut t),
+                }
+                t
+            };
+            let aba = |q: &[f64], qd: &[f64], tau: &[f64]| {
+                let (mut d, mut dd, mut t) = (Data::new(&model), DerivData::new(&model), vec![0.0; n]);
+                match &e {
+                    Some(e) => algo::aba_ext(&model, &mut d, &mut dd, q, qd, tau, e, &mut t),
+                    None => algo::aba(&model, &mut d, q, qd, tau, &mut t),
+                }
+                t
+            };
+            let (mut a, mut b, mut c) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
+            algo::rnea_derivatives(&model, &mut d, &mut dd, &q, &qd, &x, e.as_ref(), &mut a, &mut b, &mut c);
+            assert_close(&a, &central(&|y| rnea(y, &qd, &x), &q), 1e-6, "dtau_dq");
+            assert_close(&b, &central(&|y| rnea(&q, y, &x), &qd), 1e-6, "dtau_dqd");
+            assert_close(&c, &central(&|y| rnea(&q, &qd, y), &x), 1e-6, "M");
+            algo::aba_derivatives(&model, &mut d, &mut dd, &q, &qd, &x, e.as_ref(), &mut a, &mut b, &mut c);
+            assert_close(&dd.qdd, &aba(&q, &qd, &x), 1e-10, "qdd, base vs body coordinates");
+            assert_close(&a, &central(&|y| aba(y, &qd, &x), &q), 1e-6, "dqdd_dq");
+            assert_close(&b, &central(&|y| aba(&q, y, &x), &qd), 1e-6, "dqdd_dqd");
+            assert_close(&c, &central(&|y| aba(&q, &qd, y), &x), 1e-6, "Minv");
+            assert_close(&c, &minv, 1e-10, "Minv of aba_derivatives vs minverse");
         }
     }
 }
