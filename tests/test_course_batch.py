@@ -236,6 +236,27 @@ def test_a_hanging_or_crashing_child_loses_no_other_result():
     assert got[5]["error"].startswith("crashed: KeyError")
 
 
+def _allocate_100_mb(_arg):
+    return {"n": len(bytearray(100 << 20))}
+
+
+def test_the_memory_budget_is_on_top_of_the_parents_address_space():
+    """A parent that has mapped a lot (Jupyter, a test runner) forks children that share
+    its mappings: each child still gets its whole budget. 1.5 GB of address space is
+    reserved here (never touched, so it costs no memory), then a child allocating 100 MB
+    under a 300 MB budget must succeed, and one allocating 2 GB must not."""
+    import mmap
+
+    reserve = mmap.mmap(-1, 3 << 29)  # 1.5 GB of address space in the parent
+    try:
+        got = dict(ChildPool(_allocate_100_mb, jobs=1, timeout=20, memory_mb=300).run([(0, None)]))
+        assert got[0] == {"n": 100 << 20}
+        got = dict(ChildPool(_task, jobs=1, timeout=20, memory_mb=300).run([(0, "memory")]))
+        assert got[0]["error"].startswith("memory: more than 300 MB")
+    finally:
+        reserve.close()
+
+
 def test_same_batch_on_a_dask_cluster(small_class, tmp_path, capsys):
     distributed = pytest.importorskip("distributed")
     root, subs = small_class

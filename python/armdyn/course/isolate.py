@@ -2,8 +2,8 @@
 
 A submission may be hostile (huge expressions, deep nesting): each is graded in a child
 process forked from the (already imported) parent, so it starts in milliseconds, with
-``RLIMIT_AS`` set in the child and a wall-clock deadline kept by the parent, which kills
-the child when it passes. Whatever the child does (hang, exhaust memory, crash), the
+``RLIMIT_AS`` set in the child (the parent's address space plus the budget) and a
+wall-clock deadline kept by the parent, which kills the child when it passes. Whatever the child does (hang, exhaust memory, crash), the
 parent gets one JSON-able dict back: the task's result, or ``{"error": "<status>: why"}``
 with status ``timeout``, ``memory`` or ``crashed``.
 
@@ -25,6 +25,16 @@ from dataclasses import dataclass
 _CHUNK = 1 << 20
 
 
+def _address_space() -> int:
+    """Bytes of address space this process has mapped now (Linux: /proc/self/statm; 0
+    where that is not available, so the cap is then the budget alone)."""
+    try:
+        with open("/proc/self/statm") as f:
+            return int(f.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
 def _child(fn, arg, memory_bytes: int | None, w: int) -> None:
     """In the child: limit memory, run, write the JSON result, exit without cleanup."""
     code = 0
@@ -32,7 +42,10 @@ def _child(fn, arg, memory_bytes: int | None, w: int) -> None:
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
         faulthandler.disable()  # a crash is reported by the parent, in one line
         if memory_bytes:
-            resource.setrlimit(resource.RLIMIT_AS, (memory_bytes, memory_bytes))
+            # on top of what the child shares with its parent: a parent that has loaded
+            # more (Jupyter, a test runner, Dask) must not leave its children less room
+            cap = _address_space() + memory_bytes
+            resource.setrlimit(resource.RLIMIT_AS, (cap, cap))
         try:
             result = fn(arg)
         except MemoryError:
