@@ -35,7 +35,12 @@ def add_batch_arguments(parser) -> None:
     )
     b.add_argument("--jobs", type=int, help="submissions graded at once (default: the cores)")
     b.add_argument("--timeout", type=float, default=60.0, help="seconds per submission (default 60)")
-    b.add_argument("--memory-mb", type=int, default=1024, help="memory each submission may allocate, MB, beyond what the grader has loaded (default 1024)")
+    b.add_argument(
+        "--memory-mb",
+        type=int,
+        default=1024,
+        help="memory each submission may allocate, MB, beyond what the grader has loaded (default 1024)",
+    )
     b.add_argument("--no-cache", action="store_true", help="grade everything again (ignore .armdyn-cache)")
     b.add_argument("--dask", metavar="SCHEDULER", help="grade on this Dask scheduler (address)")
 
