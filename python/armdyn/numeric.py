@@ -14,7 +14,8 @@ Every function takes a robot and one state or a batch of states:
   Float64 C-contiguous arrays are used as they are; anything else is converted once.
   A wrong shape, NaN or inf raises ``ValueError`` naming the argument.
 * ``threads``: for batches, the number of threads: ``None`` (all cores) or an integer
-  from 1 to 256 (anything else is a ``ValueError``). At most that many threads work
+  from 1 to 256 (``TypeError`` for anything but an integer, ``True`` too; ``ValueError``
+  for an integer out of range). At most that many threads work
   on the batch; counts above the number of cores run on one extra pool, grown to the
   largest count asked for and reused. The GIL is released while a batch is computed.
   Batched results equal single calls bit for bit.
@@ -435,13 +436,32 @@ def _mimic(robot, what: str, f_ext=None, frame: str = "local") -> MimicModel | N
     return model
 
 
-# rnea_derivatives, aba_derivatives and minverse are the Rust entries themselves
-# (docstrings there, crates/armdyn-py/src/derivatives.rs): no Python frame per call, as
-# issue 9 times them per call. They run the common call (a compiled plain model, no
-# f_ext) and hand the rest to the `_<name>_python` functions below.
-rnea_derivatives = _core.rnea_derivatives
-aba_derivatives = _core.aba_derivatives
-minverse = _core.minverse
+# rnea_derivatives, aba_derivatives and minverse are thin frames over the Rust entries
+# (docstrings there, crates/armdyn-py/src/derivatives.rs), which run the common call (a
+# compiled plain model, no f_ext) and hand the rest to the `_<name>_python` functions
+# below. The frame is here for one check: Rust reads ``threads`` as an integer, and
+# Python's bool is one (threads=True ran as 1). It costs under a microsecond a call.
+def rnea_derivatives(robot, q, qd, qdd, *, f_ext=None, frame="local", threads=None, out=None):
+    if threads is not None and not (type(threads) is int and 1 <= threads <= MAX_THREADS):
+        threads = _threads(threads)
+    return _core.rnea_derivatives(robot, q, qd, qdd, f_ext=f_ext, frame=frame, threads=threads, out=out)
+
+
+def aba_derivatives(robot, q, qd, tau, *, f_ext=None, frame="local", threads=None, out=None):
+    if threads is not None and not (type(threads) is int and 1 <= threads <= MAX_THREADS):
+        threads = _threads(threads)
+    return _core.aba_derivatives(robot, q, qd, tau, f_ext=f_ext, frame=frame, threads=threads, out=out)
+
+
+def minverse(robot, q, *, threads=None, out=None):
+    if threads is not None and not (type(threads) is int and 1 <= threads <= MAX_THREADS):
+        threads = _threads(threads)
+    return _core.minverse(robot, q, threads=threads, out=out)
+
+
+rnea_derivatives.__doc__ = _core.rnea_derivatives.__doc__
+aba_derivatives.__doc__ = _core.aba_derivatives.__doc__
+minverse.__doc__ = _core.minverse.__doc__
 
 
 def _into(out, result):
@@ -585,17 +605,18 @@ MAX_THREADS = 256
 
 
 def _threads(threads):
-    """Checked ``threads``: ``threads`` if it is None or an integer from 1 to MAX_THREADS, else ValueError naming
-    it (True is an int to Python; 2**64 would be PyO3's OverflowError, naming nothing)."""
+    """Checked ``threads``: ``threads`` if it is None or an integer from 1 to MAX_THREADS;
+    TypeError naming it for anything but an integer (``True`` is an int to Python and to
+    PyO3), ValueError for an integer out of range (2**64 would be PyO3's OverflowError,
+    naming nothing)."""
     if threads is None or type(threads) is int and 1 <= threads <= MAX_THREADS:
         return threads
-    if (
-        isinstance(threads, (bool, np.bool_))
-        or not isinstance(threads, (int, np.integer))
-        or not 1 <= threads <= MAX_THREADS
-    ):
-        shown = repr(threads) if len(repr(threads)) <= 40 else f"{type(threads).__name__} {repr(threads)[:30]}..."
-        raise ValueError(f"threads: expected None or an integer from 1 to {MAX_THREADS}, got {shown}")
+    shown = repr(threads) if len(repr(threads)) <= 40 else f"{type(threads).__name__} {repr(threads)[:30]}..."
+    message = f"threads: expected None or an integer from 1 to {MAX_THREADS}, got {shown}"
+    if isinstance(threads, (bool, np.bool_)) or not isinstance(threads, (int, np.integer)):
+        raise TypeError(message)
+    if not 1 <= threads <= MAX_THREADS:
+        raise ValueError(message)
     return int(threads)
 
 
