@@ -584,7 +584,9 @@ def _power(base, exponent, at):
             raise LatexError(f"an exponent of {_short_number(exponent)} (at most {limit})", at)
         inner = base.exp if base.is_Pow and base.exp.is_Number else 1
         if abs(inner * exponent) > limit:
-            raise LatexError(f"a power of a power with exponent {_short_number(inner * exponent)} (at most {limit})", at)
+            raise LatexError(
+                f"a power of a power with exponent {_short_number(inner * exponent)} (at most {limit})", at
+            )
         if base.is_Number and base != 0:
             digits = (
                 float(abs(exponent)) * abs(math.log10(abs(float(base))) if abs(base) < 1e300 else 300)
