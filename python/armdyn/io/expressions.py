@@ -30,8 +30,12 @@ Hostile input is refused in bounded time: an expression longer than
 function calls, unary signs and exponents each count a level) is an error, and so is
 an exact power whose result would have more than :data:`MAX_POWER_DIGITS` digits
 (``10**10**10`` would otherwise make SymPy compute a 10^10-digit integer) or whose
-exponent exceeds :data:`MAX_EXPONENT`. A decimal number must fit a float64, and a
-constant expression must evaluate to a finite float64 (``exp(exp(exp(100)))`` no).
+exponent exceeds :data:`MAX_EXPONENT`, and so are function calls nested deeper than
+:data:`MAX_CALL_DEPTH` and a value taking more than :data:`MAX_SECONDS` of CPU time. A
+decimal number must fit a float64, and every constant part must evaluate to a finite real
+float64 as it is built: a constant (``exp(exp(exp(100)))`` stops at ``exp(exp(100))``),
+the coefficient of a product (``m1*1e300*1e300``), the constant term of a sum. Powers of
+powers with a non-integer exponent are left as written (see :func:`_power`).
 
 This module also converts the shaped values of a model (scalars, 3-vectors,
 3x3 matrices, inertia tensors, rotations) with the same rules; every failure is a
