@@ -394,9 +394,10 @@ def _float_node(e, memo: dict) -> float:
     if e in memo:
         return memo[e]
     if e.is_Number:
-        if e.is_Rational:
-            return int(e.p) / int(e.q)  # true division: OverflowError when out of range
-        return float(e)
+        value = int(e.p) / int(e.q) if e.is_Rational else float(e)  # true division: OverflowError when out of range
+        if value == 0 and e != 0:  # 1e-300**999 is a SymPy Float of 1e-299700: beyond float64 as well
+            raise OverflowError("underflow")
+        return value
     if e is sp.pi:
         return math.pi
     if e is sp.E:
@@ -453,8 +454,16 @@ def _check_power_size(base, exponent) -> None:
                 f"to {MAX_EXPONENT}, results within float64's range)"
             )
         return
+    if exponent.free_symbols:
+        # b**(y + 999) is b**999 * b**y to SymPy when it works exactly (cos() looks for a
+        # multiple of pi with polynomial gcds: 1e-300**999 as an exact fraction has 300000
+        # digits), so the constant term and the coefficient count as exponents too
+        for constant in (exponent.as_coeff_Add()[0], exponent.as_coeff_Mul()[0]):
+            if constant.is_Number and constant not in (0, 1):
+                _check_power_size(base, constant)
+        return
     if not isinstance(exponent, sp.Rational) or exponent == 0:
-        return  # symbolic exponent: nothing exact to compute
+        return
     p = abs(int(exponent.p))
     too_big = p > MAX_EXPONENT
     if not too_big and not base.free_symbols and base not in (0, 1, -1):
