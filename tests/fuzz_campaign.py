@@ -798,7 +798,9 @@ def worker(kind: str, first: int, count: int, timeout: float) -> dict:
     return {"counts": counts, "findings": findings[:20]}
 
 
-def drive(kinds: list[str], count: int, timeout: float, minutes: float | None, jobs: int) -> int:
+def drive(kinds: list[str], count: int, timeout: float, minutes: float | None, jobs: int, first_seed: int = 0) -> int:
+    """Run seeds ``first_seed`` .. ``first_seed + count - 1`` of each kind (``--first N --count 1``
+    replays seed N)."""
     total = {}
     found = []
     start = time.monotonic()
@@ -813,7 +815,9 @@ def drive(kinds: list[str], count: int, timeout: float, minutes: float | None, j
             "crash": 0,
             "panic_on_stderr": 0,
         }
-        chunks = [(first, min(CHUNK, count - first)) for first in range(0, count, CHUNK)]
+        chunks = [
+            (first, min(CHUNK, first_seed + count - first)) for first in range(first_seed, first_seed + count, CHUNK)
+        ]
         running = []
         t_kind = time.monotonic()
         while chunks or running:
@@ -882,7 +886,7 @@ def main() -> int:
         return 0
     if args.count < 1:
         ap.error("--count must be at least 1")
-    return drive(args.kinds.split(","), args.count, args.timeout, args.minutes, args.jobs)
+    return drive(args.kinds.split(","), args.count, args.timeout, args.minutes, args.jobs, args.first)
 
 
 if __name__ == "__main__":

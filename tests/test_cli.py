@@ -179,3 +179,31 @@ def test_allow_nonphysical_loads_with_one_warning_line(capsys):
     assert code == 0 and "τ₁ =" in out
     assert err.startswith("armdyn: warning: ") and err.count("\n") == 1
     assert "triangle-inequality.yaml" in err and "link 'l2'" in err and "triangle inequality" in err
+
+
+@pytest.mark.parametrize("later", [0.0, 0.1, 0.3])
+def test_ctrl_c_while_the_command_imports_is_one_line_and_130(later):
+    """Ctrl-C during the second `python -m armdyn` spends importing SymPy used to print a
+    traceback from inside the import. The child reports each import as it ends
+    (-X importtime); SIGINT goes `later` seconds after the first import that ends once
+    armdyn's handler is in place (the one after armdyn._interrupt), so it lands in
+    numpy's, SymPy's or armdyn's own import. Before armdyn's first line runs, Ctrl-C is
+    the interpreter's own business."""
+    import signal
+    import time
+
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1] / "python"))
+    cmd = [sys.executable, "-X", "importtime", "-m", "armdyn", "check", "rp-arm"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    seen = False
+    for line in proc.stderr:
+        module = line.split("|")[-1].strip()
+        if seen:
+            break
+        seen = module == "armdyn._interrupt"
+    assert seen, "armdyn._interrupt was never imported"
+    time.sleep(later)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=60)
+    rest = [t for t in err.split("\n") if t and not t.startswith("import time:")]
+    assert proc.returncode == 130 and rest == ["armdyn: interrupted"] and out == "", (proc.returncode, rest[-5:])

@@ -359,7 +359,7 @@ def _robot():
             r"f_ext contains NaN or inf \(at f_ext\[2, 2\], link 'link2'\)",
         ),
         (lambda r, z, W: num.rnea(r, z, z, z, f_ext=W, frame="body"), "frame: expected 'local' or 'world'"),
-        (lambda r, z, W: num.rnea_derivatives(r, z, z, z, threads=0), "threads must be"),
+        (lambda r, z, W: num.rnea_derivatives(r, z, z, z, threads=0), "^threads: expected None or an integer"),
     ],
 )
 def test_bad_input_raises_value_error(call, match):

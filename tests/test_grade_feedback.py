@@ -13,6 +13,7 @@ import json
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -257,7 +258,8 @@ def test_difference_is_simplified_and_expected_in_the_students_shorthand(craig_s
 
 
 def test_large_difference_falls_back_unsimplified_with_a_note(tmp_path):
-    extra = " + ".join(f"{k} m_2 d_2^{{{k}}} \\dot{{d}}_2" for k in range(1, 80))
+    # 79 distinct monomials, exponents within the reader's limit for symbols (20)
+    extra = " + ".join(f"{k} m_2 d_2^{{{k % 9 + 1}}} \\dot{{d}}_2^{{{k // 9 + 1}}}" for k in range(1, 80))
     path = write(tmp_path, "large.md", f"$$\\tau_2 = m_2 \\ddot{{d}}_2 + {extra}$$\n")
     v = by_name(grade(path), "tau_2")
     assert v.status == "wrong" and "not simplified" in v.message
@@ -302,6 +304,9 @@ HOSTILE_VALUES = {
     "functions": ("\\sin" * 3000 + " 1", "nesting"),
     "powers": ("d_2^{" * 3000 + "1" + "}" * 3000, "nesting"),
     "sqrt": ("\\sqrt{" * 3000 + "1" + "}" * 3000, "nesting"),
+    # SymPy's real and imaginary parts: exponential in the nesting, cubic in the exponent
+    "nested functions": ("\\sqrt{(" + "\\cos(" * 12 + "m_1" + ")" * 12 + ")^2}", "nesting of functions deeper than 4"),
+    "symbolic power": ("\\sqrt{\\cos(m_1^{999})^2}", "an exponent of 999 (at most 20)"),
 }
 
 
@@ -356,6 +361,20 @@ def test_hostile_yaml_values_in_sympy_syntax_are_refused_naming_the_line(tmp_pat
     for line, words in ((3, "digits"), (4, "5001 digits"), (5, "digits"), (6, "digits")):
         assert any(f"{path}:{line}: cannot read the value" in t and words in t for t in done.stdout.split("\n")), line
     assert "Exceeds the limit" not in done.stdout + done.stderr
+
+
+def test_yaml_values_sympy_cannot_split_in_bounded_time_are_refused_naming_the_line(tmp_path):
+    """Before: showing the difference turned the value into SymPy, which split
+    cos(m1**999) into real and imaginary parts by expanding (a + i b)**999 (minutes), and
+    nested functions in time exponential in the nesting (12 levels: 20 s)."""
+    nested = "cos(" * 6 + "m1" + ")" * 6
+    path = tmp_path / "slow.yaml"
+    path.write_text(f'robot: rp-arm\nsteps:\n  tau_1: "sqrt(cos(m1**999)**2)"\n  tau_2: "sqrt(({nested})**2)"\n')
+    start = time.monotonic()
+    done = _grade_subprocess(path)
+    assert done.returncode == 1 and time.monotonic() - start < GUARD, done.stderr
+    for line, words in ((3, "an exponent of 999 (at most 20)"), (4, "nesting of functions deeper than 4 levels")):
+        assert any(f"{path}:{line}: cannot read the value: {words}" in t for t in done.stdout.split("\n")), line
 
 
 def test_deeply_nested_yaml_value_is_a_clear_error(tmp_path):

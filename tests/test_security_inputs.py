@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import sympy
 
 import armdyn
 from armdyn import numeric, printing
@@ -358,6 +359,116 @@ def test_power_towers_end_in_a_message_not_a_signal(tmp_path, expr):
     assert res.stderr.startswith(f"armdyn: error: {path}:") and res.stderr.count("\n") == 1, res.stderr
 
 
+SEVENS = "7" * 400  # the longest integer literal accepted, 7.8e399: beyond float64
+#: inputs of tests/fuzz_campaign.py --kinds towers that ended in another exception or a hang
+#: (replay: --first SEED --count 1), with the constant each must be refused for, by hand:
+#: 7...7 (400 digits) > 1.8e308; 999**2 = 998001 and cosh(998001) ~ e^998001; and two
+#: symbolic exponents beyond 100 (m1**999, and 1.5e308**m1**(2 - 999) read as m1**-997)
+FUZZ_TOWERS = {
+    963: ("2**(atan(((" + SEVENS + ")/(pi))/(999.0)))^((1e-300)-(((l1)^(999))**(1e-300**pi)))", "7777777"),
+    733: ("(0.5**0.5**sinh(" + SEVENS + "))**(exp(m1)**0**l1)**(sqrt(10**-1))^(0)", "7777777"),
+    1996: (
+        "(sin(abs(cosh(999**2))))**((cosh(pi**999.0**m1**m1))^((exp(m1))**(sinh(-1**m1))))",
+        "the value cosh(998001) is beyond the float64 range",
+    ),
+    2422: ("((cos(m1**999))**(tan(cos(999.0))))**(m1)", "the power m1**999 is too large"),
+    28860: (  # 1e-300**(y + 999) is 1e-300**999 * 1e-300**y to cos()'s search for multiples of pi
+        "cos(cosh(((atan(1e-300))^((1.5e308)^(0)**(l1)+(999)))*(1e300)))",
+        "the power 1.00000000000000e-300**999 is too large",
+    ),
+    2779: (
+        "(abs((1.5e308)^(sin(10)))**-1**2.0**999.0**1.5e308**(m1)^((2)-(999)))/(-1**(2.0**999.0**pi**0.5)**"
+        "(cos((2.0)**(0))))**sin((((0)/(0.5))^((999)*(2)))*(atan(1e300**pi)))**" + SEVENS + "**1e-300",
+        "the power m1**-997 is too large",
+    ),
+}
+
+
+@pytest.mark.parametrize("seed", sorted(FUZZ_TOWERS))
+def test_fuzzed_towers_are_one_line_errors_naming_file_and_line(tmp_path, seed):
+    """Before: OverflowError (963, after 733 had left mpmath's precision at a 1329-bit
+    number), 48 s (1996: a million digits of pi for sin(cosh(998001))), 250 s and more
+    (2422, 2779: SymPy expanding (a + i b)**999); 28860 took 20 s after the fixes for
+    those."""
+    import mpmath
+
+    expr, words = FUZZ_TOWERS[seed]
+    path = tmp_path / "tower.yaml"
+    path.write_text("parameters: [m1, l1]\n" + two_link_yaml("tower").replace("mass: 0.8", f'mass: "{expr}"'))
+    line = next(k for k, text in enumerate(path.read_text().split("\n"), 1) if 'mass: "' in text)
+    start = time.process_time()
+    with deadline(20), pytest.raises(ModelError) as info:
+        load_yaml(path)
+    assert time.process_time() - start < 5
+    message = str(info.value)
+    assert message.startswith(f"{path}:{line}: ") and words in message and "\n" not in message, message
+    assert mpmath.mp.prec == 53 and mpmath.mp.dps == 15  # global state as it was
+
+
+@pytest.mark.parametrize(
+    "expr,words",
+    [
+        ("m1*1e300*1e300", "1.00000000000000e+600 is beyond the float64 range"),  # a coefficient
+        ("l1 + 1e308 + 1e308", "2.00000000000000e+308 is beyond the float64 range"),  # a constant term
+        ("1e-300*1e-300*m1", "1.00000000000000e-600 is beyond the float64 range"),  # nonzero, below float64
+        ("m1*2**(l1 + 101)", "the power 2**101 is too large"),  # an exponent's constant term
+        ("m1*10**99*10**99*10**99*10**99", "is beyond the float64 range"),  # exact: 10**396
+        ("exp(exp(100))*m1", "the value exp(exp(100)) is beyond the float64 range"),
+        ("m1*sqrt(-2)", "sqrt(2)*I is not real"),
+        ("m1 + 1/0", "zoo is not finite"),
+        ("sqrt(" + "cos(" * 20 + "m1" + ")" * 20 + "**2)", "function calls nested more than 6 deep"),
+        ("l1**101", "too large (exponents up to 100"),
+    ],
+)
+def test_constant_parts_and_sympy_work_are_bounded(expr, words):
+    """Each constant part of a value must be a finite real float64 as it is built, also
+    next to a parameter (bound later, m1*1e600 overflows); SymPy's slow paths are cut by
+    limits on exponents and nesting."""
+    from armdyn.io.expressions import parse_expression
+
+    params = {"m1": sympy.Symbol("m1"), "l1": sympy.Symbol("l1")}
+    start = time.process_time()
+    with deadline(20), pytest.raises(ModelError) as info:
+        parse_expression(expr, params, "link 'l'", "arm.yaml:3", "mass")
+    assert time.process_time() - start < 5
+    assert str(info.value).startswith("arm.yaml:3: link 'l': mass: ") and words in str(info.value), str(info.value)
+
+
+def test_bounded_values_still_parse_and_evaluate_like_floats():
+    """What the limits keep: a 1100-term sum of constants (4 s before: SymPy re-sorted the
+    growing sum at each term), powers of powers with float exponents (built unevaluated:
+    SymPy's own evaluation of ((cos^20 m)**1.5)**m never ended), and 6 nested calls. The
+    values are compared with math's floats."""
+    from armdyn.io.expressions import parse_expression
+
+    m = sympy.Symbol("m1")
+    long_sum = "+".join(f"sin({i})" for i in range(1, 1100))
+    start = time.process_time()
+    value = parse_expression(long_sum, {})
+    assert time.process_time() - start < 5
+    assert math.isclose(float(value), math.fsum(math.sin(i) for i in range(1, 1100)), rel_tol=1e-12)
+    nested = "cos(" * 5 + "m1" + ")" * 5
+    for text, at in (
+        (f"(({nested})**1.5)**m1", lambda x: (nested_cos(x, 5) ** 1.5) ** x),
+        (f"sqrt(({nested})**2)*sqrt(({nested})**2)", lambda x: nested_cos(x, 5) ** 2),
+        (
+            "sin(cos(tan(sinh(cosh(tanh(m1))))))",
+            lambda x: math.sin(math.cos(math.tan(math.sinh(math.cosh(math.tanh(x)))))),
+        ),
+        ("m1*7**100", lambda x: x * 7.0**100),
+    ):
+        with deadline(20):
+            expr = parse_expression(text, {"m1": m})
+        for x in (0.3, 0.9):
+            assert math.isclose(float(expr.subs(m, x)), at(x), rel_tol=1e-12), text
+
+
+def nested_cos(x: float, k: int) -> float:
+    for _ in range(k):
+        x = math.cos(x)
+    return x
+
+
 @pytest.mark.parametrize(
     "body,message",
     [
@@ -382,21 +493,80 @@ def arm():
     return load_yaml_string(two_link_yaml("arm"))
 
 
-@pytest.mark.parametrize("threads", [True, False, 2**64, 0, -1, 1.5, "2"])
-def test_threads_must_be_a_count(arm, threads):
-    q = np.zeros(2)
-    for call in (
-        lambda: armdyn.rnea(arm, q, q, q, threads=threads),
-        lambda: armdyn.crba(arm, q, threads=threads),
-        lambda: armdyn.aba(arm, q, q, q, threads=threads),
-        lambda: armdyn.forward_kinematics(arm, q, threads=threads),
-    ):
-        with pytest.raises(ValueError, match="^threads: expected None or an integer"):
-            call()
-    np.testing.assert_array_equal(
-        armdyn.rnea(arm, np.zeros((3, 2)), np.zeros((3, 2)), np.zeros((3, 2)), threads=np.int64(2))[1],
-        armdyn.gravity(arm, q),
-    )
+def _every_threads_call(robot):
+    """Every function of armdyn that takes ``threads``, as ``name -> call(threads)``."""
+    from armdyn import numeric
+    from armdyn.simulate import simulate
+
+    q = np.zeros(robot.dof)
+    link = list(robot.links)[-1]
+    calls = {
+        name: (lambda t, f=getattr(numeric, name), k=k: f(robot, *[q] * k, threads=t))
+        for name, k in [
+            ("rnea", 3),
+            ("crba", 1),
+            ("aba", 3),
+            ("gravity", 1),
+            ("bias", 2),
+            ("coriolis_matrix", 2),
+            ("kinetic_energy", 2),
+            ("potential_energy", 1),
+            ("forward_kinematics", 1),
+            ("rnea_derivatives", 3),
+            ("aba_derivatives", 3),
+            ("minverse", 1),
+            ("gravity_derivatives", 1),
+            ("regressor", 3),
+        ]
+    }
+    calls["jacobian"] = lambda t: numeric.jacobian(robot, q, link, threads=t)
+    calls["jacobian_dot"] = lambda t: numeric.jacobian_dot(robot, q, q, link, threads=t)
+    calls["simulate"] = lambda t: simulate(robot, q, dt=0.01, steps=2, threads=t)
+    return calls
+
+
+@pytest.mark.parametrize("threads", [True, False, np.bool_(True), 1.5, "2", np.float64(2.0)])
+def test_threads_that_is_not_an_integer_is_a_type_error(arm, threads):
+    """Before: rnea_derivatives, aba_derivatives, minverse (the Rust entries, which read
+    ``threads`` as an integer) and simulate ran threads=True as 1."""
+    calls = _every_threads_call(arm)
+    assert len(calls) == 17
+    for name, call in calls.items():
+        with pytest.raises(TypeError, match="^threads: expected None or an integer from 1 to 256, got "):
+            call(threads)
+
+
+@pytest.mark.parametrize("threads", [2**64, 0, -1, 257, np.int64(0)])
+def test_threads_out_of_range_is_a_value_error(arm, threads):
+    for name, call in _every_threads_call(arm).items():
+        with pytest.raises(ValueError, match="^threads: expected None or an integer from 1 to 256, got "):
+            call(threads)
+
+
+def test_threads_that_is_a_count_runs(arm):
+    """Batched with 2 threads (also NumPy's integer) as one row at a time."""
+    q = np.array([[0.1, -0.4], [0.7, 0.2], [-1.0, 0.5]])
+    for threads in (2, np.int64(2)):
+        for name in ("rnea", "rnea_derivatives"):
+            f = getattr(armdyn.numeric, name)
+            batch = f(arm, q, q, q, threads=threads)
+            rows = [f(arm, r, r, r) for r in q]
+            got = batch[0] if isinstance(batch, tuple) else batch
+            want = np.stack([r[0] if isinstance(r, tuple) else r for r in rows])
+            np.testing.assert_array_equal(got, want)
+    np.testing.assert_allclose(armdyn.minverse(arm, q, threads=2)[1], np.linalg.inv(armdyn.crba(arm, q[1])), atol=1e-12)
+
+
+def test_threads_in_dask_functions(arm):
+    da = pytest.importorskip("dask.array")
+    from armdyn import dask as armdyn_dask
+
+    q = da.zeros((4, 2), chunks=2)
+    for name, k in (("rnea", 3), ("aba", 3), ("crba", 1), ("rnea_derivatives", 3), ("minverse", 1)):
+        with pytest.raises(TypeError, match="^threads: "):
+            getattr(armdyn_dask, name)(arm, *[q] * k, threads=True)
+    with pytest.raises(TypeError, match="^threads: "):
+        armdyn_dask.simulate(arm, np.zeros((2, 2)), dt=0.01, steps=2, threads=True)
 
 
 def test_overflow_is_an_error_not_nan_or_singular(arm):

@@ -13,6 +13,10 @@ Conventions: SI units, radians, ``M(q) qdd + C(q, qd) qd + g(q) = tau``; frames 
 #: the package version (kept equal to pyproject.toml's; tests/test_hardening.py checks)
 __version__ = "0.1.0"
 
+from ._interrupt import quiet_until_main  # noqa: E402
+
+quiet_until_main()  # Ctrl-C while `python -m armdyn` imports SymPy: one line, status 130
+
 from typing import TYPE_CHECKING  # noqa: E402
 
 from . import inertia, io  # noqa: E402

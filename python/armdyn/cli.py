@@ -25,6 +25,7 @@ import sys
 import time
 import warnings
 
+from ._interrupt import raise_from_now_on
 from .errors import ModelError
 
 
@@ -328,6 +329,7 @@ def main(argv: list[str] | None = None) -> int:
     shown = warnings.showwarning
     warnings.showwarning = _one_line_warning  # e.g. --allow-nonphysical: one line, no source dump
     try:
+        raise_from_now_on()  # Ctrl-C: KeyboardInterrupt, caught below (before: see armdyn._interrupt)
         return args.func(args)
     except (ModelError, ValueError, FileNotFoundError) as err:
         print(f"armdyn: error: {err}", file=sys.stderr)

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .numeric import compiled_model, core_model
+from .numeric import check_threads, compiled_model, core_model
 
 __all__ = ["rnea", "aba", "crba", "simulate", "rnea_derivatives", "aba_derivatives", "minverse", "gravity_derivatives"]
 
@@ -69,6 +69,7 @@ def rnea(robot, q, qd, qdd, *, chunks=None, threads=1):
     """Lazy inverse dynamics ``tau = M qdd + C qd + g``: (N, dof) Dask arrays in and out.
     NumPy inputs are wrapped with ``chunks`` rows per block (default: Dask's "auto")."""
     model = compiled_model(robot)
+    threads = check_threads(threads)  # Rust reads True as 1
     q, qd, qdd = _arrays(model.dof, chunks, q, qd, qdd)
     return q.map_blocks(_rnea, qd, qdd, model=model, threads=threads, dtype=float, meta=np.empty((0, 0)))
 
@@ -76,6 +77,7 @@ def rnea(robot, q, qd, qdd, *, chunks=None, threads=1):
 def aba(robot, q, qd, tau, *, chunks=None, threads=1):
     """Lazy forward dynamics ``qdd = M^-1 (tau - C qd - g)``: (N, dof) in and out."""
     model = compiled_model(robot)
+    threads = check_threads(threads)  # Rust reads True as 1
     q, qd, tau = _arrays(model.dof, chunks, q, qd, tau)
     return q.map_blocks(_aba, qd, tau, model=model, threads=threads, dtype=float, meta=np.empty((0, 0)))
 
@@ -83,6 +85,7 @@ def aba(robot, q, qd, tau, *, chunks=None, threads=1):
 def crba(robot, q, *, chunks=None, threads=1):
     """Lazy joint-space inertia matrices: q (N, dof) -> M (N, dof, dof)."""
     model = compiled_model(robot)
+    threads = check_threads(threads)  # Rust reads True as 1
     (q,) = _arrays(model.dof, chunks, q)
     n = model.dof
     return q.map_blocks(
@@ -142,6 +145,7 @@ def simulate(
     from .simulate import PD, ComputedTorque, Trajectory, joint_limits, step_count
 
     model = compiled_model(robot)
+    threads = check_threads(threads)  # Rust reads True as 1
     dof = model.dof
     steps = step_count(duration, steps, dt)
     if torque is not None and (callable(torque) or np.ndim(torque) > 2):
@@ -265,7 +269,8 @@ def rnea_derivatives(robot, q, qd, qdd, *, chunks=None, threads=1):
     """Lazy :func:`armdyn.numeric.rnea_derivatives` (without external wrenches): q, qd,
     qdd (N, dof) -> ``(dtau_dq, dtau_dqd, M)``, three (N, dof, dof) Dask arrays,
     ``dtau_dq[k, i, j] = d tau_i / d q_j`` at state k (compute them together, see above)."""
-    model = core_model(robot, "rnea_derivatives")
+    model = corecompiled_model(robot, "rnea_derivatives")
+    threads = check_threads(threads)  # Rust reads True as 1
     q, qd, qdd = _arrays(model.dof, chunks, q, qd, qdd)
     return _triple(_rnea_derivatives, model, q, qd, qdd, threads=threads)
 
@@ -273,14 +278,16 @@ def rnea_derivatives(robot, q, qd, qdd, *, chunks=None, threads=1):
 def aba_derivatives(robot, q, qd, tau, *, chunks=None, threads=1):
     """Lazy :func:`armdyn.numeric.aba_derivatives` (without external wrenches): q, qd, tau
     (N, dof) -> ``(dqdd_dq, dqdd_dqd, Minv)``, three (N, dof, dof) Dask arrays."""
-    model = core_model(robot, "aba_derivatives")
+    model = corecompiled_model(robot, "aba_derivatives")
+    threads = check_threads(threads)  # Rust reads True as 1
     q, qd, tau = _arrays(model.dof, chunks, q, qd, tau)
     return _triple(_aba_derivatives, model, q, qd, tau, threads=threads)
 
 
 def minverse(robot, q, *, chunks=None, threads=1):
     """Lazy :func:`armdyn.numeric.minverse`: q (N, dof) -> M^-1 (N, dof, dof)."""
-    model = core_model(robot, "minverse")
+    model = corecompiled_model(robot, "minverse")
+    threads = check_threads(threads)  # Rust reads True as 1
     (q,) = _arrays(model.dof, chunks, q)
     return _matrices(_minverse, model, q, threads=threads)
 
@@ -288,6 +295,7 @@ def minverse(robot, q, *, chunks=None, threads=1):
 def gravity_derivatives(robot, q, *, chunks=None, threads=1):
     """Lazy :func:`armdyn.numeric.gravity_derivatives`: q (N, dof) -> dg/dq (N, dof, dof),
     ``[k, i, j] = d g_i / d q_j`` at state k."""
-    model = core_model(robot, "gravity_derivatives")
+    model = corecompiled_model(robot, "gravity_derivatives")
+    threads = check_threads(threads)  # Rust reads True as 1
     (q,) = _arrays(model.dof, chunks, q)
     return _matrices(_gravity_derivatives, model, q, threads=threads)

@@ -14,7 +14,8 @@ Every function takes a robot and one state or a batch of states:
   Float64 C-contiguous arrays are used as they are; anything else is converted once.
   A wrong shape, NaN or inf raises ``ValueError`` naming the argument.
 * ``threads``: for batches, the number of threads: ``None`` (all cores) or an integer
-  from 1 to 256 (anything else is a ``ValueError``). At most that many threads work
+  from 1 to 256 (``TypeError`` for anything but an integer, ``True`` too; ``ValueError``
+  for an integer out of range). At most that many threads work
   on the batch; counts above the number of cores run on one extra pool, grown to the
   largest count asked for and reused. The GIL is released while a batch is computed.
   Batched results equal single calls bit for bit.
@@ -252,7 +253,7 @@ def rnea(
     q, qd, qdd: (n,) or (N, n). Returns tau = M(q) qdd + C(q, qd) qd + g(q), same shape;
     with external wrenches ``f_ext`` (see :func:`rnea_derivatives`), minus sum J^T w.
     """
-    threads = _threads(threads)
+    threads = check_threads(threads)
     if f_ext is not None:
         f_ext = _canonical_wrenches(robot, f_ext, frame)
         return _finite(
@@ -273,7 +274,7 @@ def crba(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.nd
 
     q: (n,) or (N, n). Returns the full symmetric M: (n, n) or (N, n, n).
     """
-    threads = _threads(threads)
+    threads = check_threads(threads)
     try:
         return compiled_model(robot).crba(q, threads)
     except FloatingPointError:
@@ -294,7 +295,7 @@ def aba(
     q, qd, tau: (n,) or (N, n). Returns qdd = M^-1 (tau - C qd - g), same shape; with
     external wrenches ``f_ext`` (see :func:`rnea_derivatives`), M^-1 (tau + sum J^T w - C qd - g).
     """
-    threads = _threads(threads)
+    threads = check_threads(threads)
     if f_ext is not None:
         f_ext = _canonical_wrenches(robot, f_ext, frame)
         return _core.aba_ext(core_model(robot, "aba with f_ext"), q, qd, tau, f_ext, frame, threads)
@@ -310,7 +311,7 @@ def aba(
 
 def gravity(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Gravity torques g(q) = rnea(q, 0, 0). q: (n,) or (N, n); same shape out."""
-    threads = _threads(threads)
+    threads = check_threads(threads)
     try:
         return compiled_model(robot).gravity_torques(q, threads)
     except FloatingPointError:
@@ -322,7 +323,7 @@ def bias(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None =
 
     q, qd: (n,) or (N, n); same shape out.
     """
-    threads = _threads(threads)
+    threads = check_threads(threads)
     try:
         return compiled_model(robot).bias(q, qd, threads)
     except FloatingPointError:
@@ -335,7 +336,7 @@ def coriolis_matrix(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: i
     C qd = h - g, and Mdot - 2C is skew-symmetric. q, qd: (n,) or (N, n).
     Returns (n, n) or (N, n, n).
     """
-    threads = _threads(threads)
+    threads = check_threads(threads)
     try:
         return compiled_model(robot).coriolis_matrix(q, qd, threads)
     except FloatingPointError:
@@ -344,7 +345,7 @@ def coriolis_matrix(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: i
 
 def kinetic_energy(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None = None) -> float | np.ndarray:
     """Kinetic energy T = 1/2 qd^T M(q) qd. q, qd: (n,) -> float, or (N, n) -> (N,)."""
-    threads = _threads(threads)
+    threads = check_threads(threads)
     try:
         return compiled_model(robot).kinetic_energy(q, qd, threads)
     except FloatingPointError:
@@ -358,7 +359,7 @@ def potential_energy(robot: RobotLike, q: ArrayLike, *, threads: int | None = No
 
     q: (n,) -> float, or (N, n) -> (N,).
     """
-    threads = _threads(threads)
+    threads = check_threads(threads)
     try:
         return compiled_model(robot).potential_energy(q, threads)
     except FloatingPointError:
@@ -501,6 +502,8 @@ def rnea_derivatives(
     batches then allocates nothing, and a large batch is spared the first-touch page
     faults of fresh arrays.
     """
+    if threads is not None and not (type(threads) is int and 1 <= threads <= MAX_THREADS):
+        threads = check_threads(threads)  # Rust reads True as 1
     if f_ext is None:
         try:  # the core takes a NumericModel only: a Robot's cached one, or the model itself
             return _core.rnea_derivatives(robot._numeric_model, q, qd, qdd, None, frame, threads, out)  # type: ignore[union-attr]
@@ -526,6 +529,8 @@ def aba_derivatives(
     f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
     joints as there (``Minv`` is that of ``M + diag(Ia)``). out: as there.
     """
+    if threads is not None and not (type(threads) is int and 1 <= threads <= MAX_THREADS):
+        threads = check_threads(threads)  # Rust reads True as 1
     if f_ext is None:
         try:  # as in rnea_derivatives
             return _core.aba_derivatives(robot._numeric_model, q, qd, tau, None, frame, threads, out)  # type: ignore[union-attr]
@@ -542,6 +547,8 @@ def minverse(robot: RobotLike, q: ArrayLike, threads: int | None = None, out=Non
     positive definite). out: optionally, the array to write M^-1 into and return (float64,
     C-contiguous, the result's shape, not sharing memory with q).
     """
+    if threads is not None and not (type(threads) is int and 1 <= threads <= MAX_THREADS):
+        threads = check_threads(threads)  # Rust reads True as 1
     try:  # as in rnea_derivatives
         return _core.minverse(robot._numeric_model, q, threads, out)  # type: ignore[union-attr]
     except (AttributeError, TypeError):
@@ -689,18 +696,19 @@ def regressor(
 MAX_THREADS = 256
 
 
-def _threads(threads):
-    """Checked ``threads``: ``threads`` if it is None or an integer from 1 to MAX_THREADS, else ValueError naming
-    it (True is an int to Python; 2**64 would be PyO3's OverflowError, naming nothing)."""
+def check_threads(threads):
+    """Checked ``threads``: ``threads`` if it is None or an integer from 1 to MAX_THREADS;
+    TypeError naming it for anything but an integer (``True`` is an int to Python and to
+    PyO3), ValueError for an integer out of range (2**64 would be PyO3's OverflowError,
+    naming nothing)."""
     if threads is None or type(threads) is int and 1 <= threads <= MAX_THREADS:
         return threads
-    if (
-        isinstance(threads, (bool, np.bool_))
-        or not isinstance(threads, (int, np.integer))
-        or not 1 <= threads <= MAX_THREADS
-    ):
-        shown = repr(threads) if len(repr(threads)) <= 40 else f"{type(threads).__name__} {repr(threads)[:30]}..."
-        raise ValueError(f"threads: expected None or an integer from 1 to {MAX_THREADS}, got {shown}")
+    shown = repr(threads) if len(repr(threads)) <= 40 else f"{type(threads).__name__} {repr(threads)[:30]}..."
+    message = f"threads: expected None or an integer from 1 to {MAX_THREADS}, got {shown}"
+    if isinstance(threads, (bool, np.bool_)) or not isinstance(threads, (int, np.integer)):
+        raise TypeError(message)
+    if not 1 <= threads <= MAX_THREADS:
+        raise ValueError(message)
     return int(threads)
 
 
@@ -745,7 +753,7 @@ def _checked(fn):
     @functools.wraps(fn)
     def call(robot, *args, threads=None, **kwargs):
         if threads is not None:
-            threads = _threads(threads)
+            threads = check_threads(threads)
         try:
             return fn(robot, *args, threads=threads, **kwargs)
         except FloatingPointError:

@@ -59,7 +59,7 @@ from typing import Callable
 import numpy as np
 
 from . import _core
-from .numeric import compiled_model, kinetic_energy, potential_energy
+from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy
 
 __all__ = ["simulate", "simulate_adaptive", "Trajectory", "PD", "ComputedTorque", "joint_limits"]
 
@@ -325,6 +325,7 @@ def simulate(
     single = q0a.ndim == 1
     q0a = _c(np.atleast_2d(q0a))
     rows = q0a.shape[0]
+    threads = check_threads(threads)  # Rust reads True as 1
     qd0a = np.zeros_like(q0a) if qd0 is None else _state(qd0, "qd0", dof)
     if qd0a.shape not in ((dof,), (rows, dof)):
         raise ValueError(f"qd0: shape {qd0a.shape} does not match q0's {q0a.shape}")

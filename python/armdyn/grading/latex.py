@@ -36,6 +36,13 @@ MAX_EXPONENT = 100
 MAX_LENGTH = 200_000
 #: digits of a number written or of a numeric power (9^{99^{99}}) beyond which it is refused
 MAX_DIGITS = 400
+#: largest numeric exponent of an expression in the symbols (x^{999}): SymPy splits x^n into
+#: real and imaginary parts by expanding (a + i b)^n, in time growing as n^3 (0.3 s for 100)
+MAX_SYMBOLIC_EXPONENT = 20
+#: function calls and square roots nested in each other beyond which input is refused: SymPy
+#: works out real and imaginary parts (when it simplifies sqrt(x^2) or shows a difference) in
+#: time exponential in this nesting (12 nested cosines took 20 s, 16 over a minute)
+MAX_CALL_DEPTH = 4
 
 GREEK = {
     "alpha",
@@ -233,6 +240,7 @@ class _Parser:
         self.i = 0
         self.resolve = resolve
         self.depth = 0
+        self.calls = 0  # function calls and square roots open around the current token
         self.positions = positions or []
         self.length = length
 
@@ -267,6 +275,12 @@ class _Parser:
 
     def leave(self):
         self.depth -= 1
+
+    def enter_call(self):
+        """One function call (or square root) deeper; refused beyond MAX_CALL_DEPTH."""
+        self.calls += 1
+        if self.calls > MAX_CALL_DEPTH:
+            raise LatexError(f"nesting of functions deeper than {MAX_CALL_DEPTH} levels", self.at(self.i))
 
     # -- grammar
     def parse(self):
@@ -440,7 +454,10 @@ class _Parser:
                 return num / den
             if tok == "sqrt":
                 self.take()
-                return sp.sqrt(self._braced())
+                self.enter_call()
+                value = sp.sqrt(self._braced())
+                self.calls -= 1
+                return value
             if tok in FUNCTIONS:
                 return self.function()
             if tok in ("dot", "ddot", "dddot") or tok in GREEK or tok in WRAPPERS:
@@ -462,6 +479,7 @@ class _Parser:
     def function(self):
         fn = FUNCTIONS[self.take()[1]]
         self.enter()  # \sin\sin\sin...: each nests one level
+        self.enter_call()
         power = None
         at = self.at(self.i)
         if self.peek() == ("char", "^"):
@@ -469,6 +487,7 @@ class _Parser:
             power = self.script_value()
         value = fn(self.atom())  # a bracketed group, or the next symbol: \sin\theta_1
         self.leave()
+        self.calls -= 1
         return _power(value, power, at) if power is not None else value
 
     def symbol(self):
@@ -560,12 +579,13 @@ def _power(base, exponent, at):
     if isinstance(base, sp.MatrixBase) or isinstance(exponent, sp.MatrixBase):
         raise LatexError("a power of a matrix (only ^T, a transpose, is read)", at)
     if exponent.is_Number:
-        if abs(exponent) > MAX_EXPONENT:
-            raise LatexError(f"an exponent of {_short_number(exponent)} (at most {MAX_EXPONENT})", at)
+        limit = MAX_SYMBOLIC_EXPONENT if base.free_symbols else MAX_EXPONENT
+        if abs(exponent) > limit:
+            raise LatexError(f"an exponent of {_short_number(exponent)} (at most {limit})", at)
         inner = base.exp if base.is_Pow and base.exp.is_Number else 1
-        if abs(inner * exponent) > MAX_EXPONENT:
+        if abs(inner * exponent) > limit:
             raise LatexError(
-                f"a power of a power with exponent {_short_number(inner * exponent)} (at most {MAX_EXPONENT})", at
+                f"a power of a power with exponent {_short_number(inner * exponent)} (at most {limit})", at
             )
         if base.is_Number and base != 0:
             digits = (
@@ -755,6 +775,8 @@ def _check_numbers(text: str) -> None:
                 ops.append(tok)
             elif tok == "(":
                 ops.append("f(" if previous is not None and (previous[0].isalpha() or previous[0] == "_") else "(")
+                if ops[-1] == "f(" and ops.count("f(") > MAX_CALL_DEPTH:
+                    raise LatexError(f"nesting of functions deeper than {MAX_CALL_DEPTH} levels")
             elif tok in (")", ","):
                 while ops and ops[-1] not in ("(", "f("):
                     reduce_one()
@@ -784,8 +806,10 @@ def parse_sympy_syntax(text: str, names: dict, symengine: bool = False):
 
     Parsed by SymEngine's C++ parser (no Python ``eval``) after checks that keep it
     bounded: only names, numbers, ``+ - * / ** ^ ( ) ,``; parentheses nested at most
-    :data:`MAX_DEPTH` deep; no exact power with a huge exponent; then every name must be
-    one of ``names`` (name -> SymPy symbol) or a whitelisted function. ``symengine``:
+    :data:`MAX_DEPTH` deep; no exact power with a huge exponent, no functions nested beyond
+    :data:`MAX_CALL_DEPTH`; then every name must be
+    one of ``names`` (name -> SymPy symbol) or a whitelisted function, and no power of
+    them have an exponent beyond :data:`MAX_SYMBOLIC_EXPONENT`. ``symengine``:
     return the SymEngine expression (no conversion: large generated derivations)."""
     import symengine as se
 
@@ -818,6 +842,9 @@ def parse_sympy_syntax(text: str, names: dict, symengine: bool = False):
         raise LatexError(f"cannot parse {text[:60]!r} ({exc})") from None
     for fn in value.atoms(se.FunctionSymbol) if hasattr(se, "FunctionSymbol") else ():
         raise LatexError(f"unknown function {fn}")
+    for power in value.atoms(se.Pow):
+        if power.exp.is_Number and power.base.free_symbols and abs(power.exp) > MAX_SYMBOLIC_EXPONENT:
+            raise LatexError(f"an exponent of {_short_number(power.exp)} (at most {MAX_SYMBOLIC_EXPONENT})")
     table = {}
     for sym in value.free_symbols:
         name = str(sym)

@@ -30,8 +30,12 @@ Hostile input is refused in bounded time: an expression longer than
 function calls, unary signs and exponents each count a level) is an error, and so is
 an exact power whose result would have more than :data:`MAX_POWER_DIGITS` digits
 (``10**10**10`` would otherwise make SymPy compute a 10^10-digit integer) or whose
-exponent exceeds :data:`MAX_EXPONENT`. A decimal number must fit a float64, and a
-constant expression must evaluate to a finite float64 (``exp(exp(exp(100)))`` no).
+exponent exceeds :data:`MAX_EXPONENT`, and so are function calls nested deeper than
+:data:`MAX_CALL_DEPTH` and a value taking more than :data:`MAX_SECONDS` of CPU time. A
+decimal number must fit a float64, and every constant part must evaluate to a finite real
+float64 as it is built: a constant (``exp(exp(exp(100)))`` stops at ``exp(exp(100))``),
+the coefficient of a product (``m1*1e300*1e300``), the constant term of a sum. Powers of
+powers with a non-integer exponent are left as written (see :func:`_power`).
 
 This module also converts the shaped values of a model (scalars, 3-vectors,
 3x3 matrices, inertia tensors, rotations) with the same rules; every failure is a
@@ -44,6 +48,7 @@ import math
 import numbers
 import re
 import reprlib
+import time
 from typing import Mapping
 
 import sympy as sp
@@ -79,8 +84,16 @@ MAX_DEPTH = 100
 MAX_POWER_DIGITS = 10_000
 #: Most digits of an integer literal (a float64 is at most about 1.8e308).
 MAX_INT_DIGITS = 400
-#: Largest |numerator| of a rational exponent (``a**(10**20)`` would hang once bound).
-MAX_EXPONENT = 1000
+#: Largest |numerator| of a rational exponent (``a**(10**20)`` would hang once bound; SymPy
+#: splits ``x**n`` into real and imaginary parts by expanding ``(a + i b)**n``, in time
+#: growing as n^3: 0.3 s for n = 100, minutes for n = 1000).
+MAX_EXPONENT = 100
+#: Deepest nesting of function calls (SymPy's real and imaginary parts of
+#: ``cos(cos(...(x)))`` take time exponential in it: 20 levels never finished).
+MAX_CALL_DEPTH = 6
+#: CPU seconds one expression may take to read (a backstop: each step above is bounded,
+#: a long expression of many such steps is not).
+MAX_SECONDS = 2.0
 
 #: Names a parameter may not take (they already mean something in an expression).
 RESERVED = frozenset(FUNCTIONS) | frozenset(CONSTANTS)
@@ -168,6 +181,10 @@ class _UnknownName(Exception):
     pass
 
 
+class _ValueProblem(Exception):
+    """A constant in the expression that is not a finite real float64."""
+
+
 class _Parser:
     """Recursive descent over the token list (grammar in the module docstring)."""
 
@@ -176,6 +193,9 @@ class _Parser:
         self.i = 0
         self.parameters = parameters
         self.depth = 0
+        self.floats: dict = {}  # constant node -> its float64 value (see bounded)
+        self.calls = 0  # function calls open around the current position
+        self.started = time.process_time()
 
     def nested(self, parse):
         """``parse()`` one level deeper; refused beyond MAX_DEPTH (the recursion would
@@ -184,14 +204,36 @@ class _Parser:
         try:
             if self.depth > MAX_DEPTH:
                 raise _ParseError(f"nested more than {MAX_DEPTH} levels deep")
-            value = parse()
-            # SymPy's floats have unbounded exponents: sin(exp(1e300)) or sinh(sinh(sinh(1e3)))
-            # would reach the interpreter's int-to-float limits (or worse) one level up
-            if getattr(value, "is_Float", False) and not math.isfinite(float_value(value)):
-                raise _ParseError(f"the value {_clip(str(value))} is beyond the float64 range")
-            return value
+            return self.bounded(parse())
         finally:
             self.depth -= 1
+
+    def bounded(self, value):
+        """``value``, unless it is a constant (no parameter in it) or has a constant part
+        (the numeric coefficient of a product, the constant term of a sum) that is not a
+        finite real float64. SymPy keeps constants exact and its floats have unbounded
+        exponents, so without this ``sin(cosh(999**2))`` makes mpmath compute a million
+        digits of pi (when anything asks whether it is real), ``sinh(7...7)`` leaves
+        mpmath's global precision beyond what it can convert, ``sin(exp(1e300))`` reaches
+        the interpreter's int-to-float limits, and ``m1*1e300*1e300`` overflows once
+        ``m1`` is bound. Values are memoised by node (see :func:`_float_node`)."""
+        if time.process_time() - self.started > MAX_SECONDS:
+            raise _ParseError(f"more than {MAX_SECONDS:g} s of CPU time to read it (too complex)")
+        if not isinstance(value, sp.Basic):
+            return value
+        if value.free_symbols:
+            if not (value.is_Add or value.is_Mul):
+                return value
+            constant = [a for a in value.args if not a.free_symbols]
+            if not constant:
+                return value
+            part = value.func(*constant)
+        else:
+            part = value
+        problem = _constant_problem(part, self.floats)
+        if problem:
+            raise _ValueProblem(f"the value {_clip(str(part))} is {problem}")
+        return value
 
     def peek(self):
         return self.tokens[self.i] if self.i < len(self.tokens) else (None, None)
@@ -214,20 +256,25 @@ class _Parser:
         return value
 
     def expr(self):
-        value = self.term()
+        # the terms are collected and added once: adding them one by one re-sorts the
+        # growing sum each time (quadratic: 1000 terms took seconds)
+        terms = [self.term()]
         while self.peek()[1] in ("+", "-"):
             _, op = self.take()
             rhs = self.term()
-            value = value + rhs if op == "+" else value - rhs
-        return value
+            terms.append(rhs if op == "+" else -rhs)
+        return self.bounded(sp.Add(*terms)) if len(terms) > 1 else terms[0]
 
     def term(self):
-        value = self.unary()
+        factors = [self.unary()]
         while self.peek()[1] in ("*", "/"):
             _, op = self.take()
             rhs = self.unary()
-            value = value * rhs if op == "*" else value / rhs
-            _check_combined_exponents(value)
+            factors.append(rhs if op == "*" else self.bounded(sp.Pow(rhs, -1)))  # a / b is a * b**-1, as in SymPy
+        if len(factors) == 1:
+            return factors[0]
+        value = self.bounded(sp.Mul(*factors))
+        _check_combined_exponents(value)
         return value
 
     def unary(self):
@@ -243,7 +290,7 @@ class _Parser:
             self.take()
             exponent = self.nested(self.unary)
             _check_power_size(base, exponent)
-            value = base**exponent
+            value = self.bounded(_power(base, exponent))
             _check_combined_exponents(value)  # SymPy folds (a**k)**m into a**(k m)
             return value
         return base
@@ -262,7 +309,7 @@ class _Parser:
                 raise _ParseError(
                     f"an integer of {len(tok)} digits is beyond the float64 range (at most {MAX_INT_DIGITS} digits)"
                 )
-            return sp.Integer(tok)
+            return self.bounded(sp.Integer(tok))
         if tok == "(":
             value = self.nested(self.expr)
             self.take(")")
@@ -275,14 +322,20 @@ class _Parser:
             if tok in FUNCTIONS:
                 func, nargs = FUNCTIONS[tok]
                 self.take("(")
+                self.calls += 1
+                if self.calls > MAX_CALL_DEPTH:
+                    raise _ParseError(f"function calls nested more than {MAX_CALL_DEPTH} deep")
                 args = [self.nested(self.expr)]
                 while self.peek()[1] == ",":
                     self.take()
                     args.append(self.nested(self.expr))
                 self.take(")")
+                self.calls -= 1
                 if len(args) != nargs:
                     raise _ParseError(f"{tok}() takes {nargs} argument(s), got {len(args)}")
-                return func(*args)
+                if func is sp.sqrt:  # sqrt(x**2) is (x**2)**(1/2): see _power
+                    return self.bounded(_power(args[0], sp.S.Half))
+                return self.bounded(func(*args))
             raise _UnknownName(tok)
         raise _ParseError(f"unexpected '{tok}'")
 
@@ -315,31 +368,66 @@ def float_value(expr) -> float:
     (SymPy's ``evalf`` of ``exp(exp(exp(100)))`` does not finish). NaN if a step
     overflows, leaves the reals or is not one of the whitelisted functions."""
     try:
-        return _float_node(sp.sympify(expr))
+        return _float_node(sp.sympify(expr), {})
     except (OverflowError, ValueError, TypeError, ZeroDivisionError, KeyError):
         return math.nan
 
 
-def _float_node(e) -> float:
+def _constant_problem(expr, memo: dict) -> str | None:
+    """What keeps a constant expression from being a finite real float64 (``None`` if
+    nothing): its value overflows, is complex or NaN, or is SymPy's infinity."""
+    try:
+        x = _float_node(expr, memo)
+    except OverflowError:
+        return "beyond the float64 range"
+    except (ValueError, ZeroDivisionError):  # a complex power, a math domain error
+        return "not real"
+    except (TypeError, KeyError):  # float(zoo), I, an unknown function
+        return "not real" if expr.has(sp.I) else "not finite"
+    if math.isinf(x):
+        return "beyond the float64 range"
+    return None if x == x else "not finite"
+
+
+def _float_node(e, memo: dict) -> float:
+    """``float_value`` of one node; ``memo`` maps nodes already computed to their value."""
+    if e in memo:
+        return memo[e]
     if e.is_Number:
-        if e.is_Rational:
-            return int(e.p) / int(e.q)  # true division: OverflowError when out of range
-        return float(e)
+        value = int(e.p) / int(e.q) if e.is_Rational else float(e)  # true division: OverflowError when out of range
+        if value == 0 and e != 0:  # 1e-300**999 is a SymPy Float of 1e-299700: beyond float64 as well
+            raise OverflowError("underflow")
+        return value
     if e is sp.pi:
         return math.pi
     if e is sp.E:
         return math.e
-    args = [_float_node(a) for a in e.args]
+    args = [_float_node(a, memo) for a in e.args]
     if e.is_Add:
-        return math.fsum(args)
-    if e.is_Mul:
-        return math.prod(args)
-    if e.is_Pow:
+        value = math.fsum(args)
+    elif e.is_Mul:
+        value = math.prod(args)
+    elif e.is_Pow:
         value = args[0] ** args[1]
         if isinstance(value, complex):
             raise ValueError("not real")
-        return float(value)
-    return float(_MATH[e.func](*args))
+        value = float(value)
+    else:
+        value = float(_MATH[e.func](*args))
+    memo[e] = value
+    return value
+
+
+def _power(base, exponent):
+    """``base**exponent``, left unevaluated when ``base`` is itself a power of an
+    expression in the parameters and ``exponent`` is not an integer. SymPy would decide
+    whether ``(b**e)**x`` may become ``b**(e x)`` by working out the real and imaginary
+    parts and the argument of ``b``, in time exponential in the nesting of ``b``
+    (``sqrt(cos(cos(...cos(m)...))**2)`` with 15 cosines took 30 s, 20 never ended); with
+    parameters that carry no assumptions it can only decide "no" anyway."""
+    if base.is_Pow and base.free_symbols and not exponent.is_Integer:
+        return sp.Pow(base, exponent, evaluate=False)
+    return base**exponent
 
 
 def _digits(x: sp.Rational) -> int:
@@ -366,8 +454,16 @@ def _check_power_size(base, exponent) -> None:
                 f"to {MAX_EXPONENT}, results within float64's range)"
             )
         return
+    if exponent.free_symbols:
+        # b**(y + 999) is b**999 * b**y to SymPy when it works exactly (cos() looks for a
+        # multiple of pi with polynomial gcds: 1e-300**999 as an exact fraction has 300000
+        # digits), so the constant term and the coefficient count as exponents too
+        for constant in (exponent.as_coeff_Add()[0], exponent.as_coeff_Mul()[0]):
+            if constant.is_Number and constant not in (0, 1):
+                _check_power_size(base, constant)
+        return
     if not isinstance(exponent, sp.Rational) or exponent == 0:
-        return  # symbolic exponent: nothing exact to compute
+        return
     p = abs(int(exponent.p))
     too_big = p > MAX_EXPONENT
     if not too_big and not base.free_symbols and base not in (0, 1, -1):
@@ -444,6 +540,8 @@ def parse_expression(
             raise ModelError(message, element, source) from None
         except _ParseError as exc:
             raise ModelError(f"{prefix}cannot parse expression {quoted(value)} ({exc})", element, source) from None
+        except _ValueProblem as exc:
+            raise ModelError(f"{prefix}expression {quoted(value)}: {exc}", element, source) from None
         except (TypeError, ValueError, ZeroDivisionError, OverflowError) as exc:
             raise ModelError(f"{prefix}cannot evaluate expression {quoted(value)} ({exc})", element, source) from None
     else:
@@ -461,7 +559,9 @@ def parse_expression(
         if not math.isfinite(float_value(result)):
             message = f"{prefix}expression {quoted(value)} is not a finite real float64 number"
             raise ModelError(message, element, source)
-    elif result.is_real is False:
+    elif not isinstance(value, str) and result.is_real is False:
+        # (a parsed string had every constant part checked real as it was built; asking
+        # SymPy rebuilds what _power left unevaluated, in exponential time)
         raise ModelError(f"{prefix}expression {quoted(value)} is not real ({_clip(str(result), 60)})", element, source)
     return result
 
