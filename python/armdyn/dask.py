@@ -269,7 +269,7 @@ def rnea_derivatives(robot, q, qd, qdd, *, chunks=None, threads=1):
     """Lazy :func:`armdyn.numeric.rnea_derivatives` (without external wrenches): q, qd,
     qdd (N, dof) -> ``(dtau_dq, dtau_dqd, M)``, three (N, dof, dof) Dask arrays,
     ``dtau_dq[k, i, j] = d tau_i / d q_j`` at state k (compute them together, see above)."""
-    model = corecompiled_model(robot, "rnea_derivatives")
+    model = core_model(robot, "rnea_derivatives")
     threads = check_threads(threads)  # Rust reads True as 1
     q, qd, qdd = _arrays(model.dof, chunks, q, qd, qdd)
     return _triple(_rnea_derivatives, model, q, qd, qdd, threads=threads)
@@ -278,7 +278,7 @@ def rnea_derivatives(robot, q, qd, qdd, *, chunks=None, threads=1):
 def aba_derivatives(robot, q, qd, tau, *, chunks=None, threads=1):
     """Lazy :func:`armdyn.numeric.aba_derivatives` (without external wrenches): q, qd, tau
     (N, dof) -> ``(dqdd_dq, dqdd_dqd, Minv)``, three (N, dof, dof) Dask arrays."""
-    model = corecompiled_model(robot, "aba_derivatives")
+    model = core_model(robot, "aba_derivatives")
     threads = check_threads(threads)  # Rust reads True as 1
     q, qd, tau = _arrays(model.dof, chunks, q, qd, tau)
     return _triple(_aba_derivatives, model, q, qd, tau, threads=threads)
@@ -286,7 +286,7 @@ def aba_derivatives(robot, q, qd, tau, *, chunks=None, threads=1):
 
 def minverse(robot, q, *, chunks=None, threads=1):
     """Lazy :func:`armdyn.numeric.minverse`: q (N, dof) -> M^-1 (N, dof, dof)."""
-    model = corecompiled_model(robot, "minverse")
+    model = core_model(robot, "minverse")
     threads = check_threads(threads)  # Rust reads True as 1
     (q,) = _arrays(model.dof, chunks, q)
     return _matrices(_minverse, model, q, threads=threads)
@@ -295,7 +295,7 @@ def minverse(robot, q, *, chunks=None, threads=1):
 def gravity_derivatives(robot, q, *, chunks=None, threads=1):
     """Lazy :func:`armdyn.numeric.gravity_derivatives`: q (N, dof) -> dg/dq (N, dof, dof),
     ``[k, i, j] = d g_i / d q_j`` at state k."""
-    model = corecompiled_model(robot, "gravity_derivatives")
+    model = core_model(robot, "gravity_derivatives")
     threads = check_threads(threads)  # Rust reads True as 1
     (q,) = _arrays(model.dof, chunks, q)
     return _matrices(_gravity_derivatives, model, q, threads=threads)
