@@ -51,8 +51,26 @@ def db_url(request, tmp_path):
     if not url:
         pytest.skip(f"{PG_ENV} is not set (.ci/run starts a PostgreSQL from Debian's packages)")
     pytest.importorskip("psycopg")
+    url = _worker_schema(url)
     _drop_postgres_tables(url)
     return url
+
+
+def _worker_schema(url: str) -> str:
+    """``url`` with its own schema for this pytest-xdist worker (``gw0``, ``gw1``, ...; ``main``
+    without xdist): test files on different workers run at the same time against the one
+    test database, and each test starts by dropping the tables."""
+    import sqlalchemy as sa
+
+    from armdyn.serve.storage import _engine
+
+    schema = os.environ.get("PYTEST_XDIST_WORKER", "main")
+    assert schema.isidentifier(), schema
+    engine = _engine(url)
+    with engine.begin() as conn:
+        conn.execute(sa.text(f"CREATE SCHEMA IF NOT EXISTS {schema}"))
+    engine.dispose()
+    return f"{url}{'&' if '?' in url else '?'}options=-csearch_path%3D{schema}"
 
 
 def free_port() -> int:
