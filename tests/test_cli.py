@@ -194,7 +194,16 @@ def test_ctrl_c_while_the_command_imports_is_one_line_and_130(later):
 
     env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1] / "python"))
     cmd = [sys.executable, "-X", "importtime", "-m", "armdyn", "check", "rp-arm"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    # SIGINT at its default in the child even when this process ignores it (pytest-xdist's
+    # workers do, and Python then installs no handler in the child)
+    proc = subprocess.Popen(
+        cmd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     seen = False
     for line in proc.stderr:
         module = line.split("|")[-1].strip()

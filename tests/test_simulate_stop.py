@@ -7,6 +7,7 @@ trapezoid integrals of tau.qd and g(q).qd and its own kinetic energy 1/2 qd.M qd
 from __future__ import annotations
 
 import os
+import select
 import signal
 import subprocess
 import sys
@@ -217,12 +218,16 @@ def test_ctrl_c_stops_a_long_run_within_a_second(tmp_path):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        # a child inherits an ignored SIGINT (as under pytest-xdist's workers), and Python
+        # then installs no handler for it: give the child the default a terminal gives
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     try:
         time.sleep(8.0)  # imports, model, and well into the integration (a loaded machine imports slowly)
         assert proc.poll() is None, proc.communicate()
         sent = time.monotonic()
         proc.send_signal(signal.SIGINT)
+        assert select.select([proc.stderr], [], [], 20.0)[0], "no line on stderr within 20 s of SIGINT"
         line = proc.stderr.readline()
         took = time.monotonic() - sent
         out, err = proc.communicate(timeout=30)
