@@ -502,7 +502,7 @@ def rnea_derivatives(
     batches then allocates nothing, and a large batch is spared the first-touch page
     faults of fresh arrays.
     """
-    if threads is not None and not (type(threads) is int and 1 <= threads <= MAX_THREADS):
+    if threads is not None:  # the common call (None) skips the check's frame
         threads = check_threads(threads)  # Rust reads True as 1
     if f_ext is None:
         try:  # the core takes a NumericModel only: a Robot's cached one, or the model itself
@@ -529,7 +529,7 @@ def aba_derivatives(
     f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
     joints as there (``Minv`` is that of ``M + diag(Ia)``). out: as there.
     """
-    if threads is not None and not (type(threads) is int and 1 <= threads <= MAX_THREADS):
+    if threads is not None:  # the common call (None) skips the check's frame
         threads = check_threads(threads)  # Rust reads True as 1
     if f_ext is None:
         try:  # as in rnea_derivatives
@@ -547,7 +547,7 @@ def minverse(robot: RobotLike, q: ArrayLike, threads: int | None = None, out=Non
     positive definite). out: optionally, the array to write M^-1 into and return (float64,
     C-contiguous, the result's shape, not sharing memory with q).
     """
-    if threads is not None and not (type(threads) is int and 1 <= threads <= MAX_THREADS):
+    if threads is not None:  # the common call (None) skips the check's frame
         threads = check_threads(threads)  # Rust reads True as 1
     try:  # as in rnea_derivatives
         return _core.minverse(robot._numeric_model, q, threads, out)  # type: ignore[union-attr]
