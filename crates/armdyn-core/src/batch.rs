@@ -22,6 +22,7 @@ use crate::data::Data;
 use crate::model::Model;
 use crate::real::{F64x4, F64x8, Real};
 use rayon::prelude::*;
+use std::any::Any;
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::{Arc, Mutex};
 
@@ -39,8 +40,8 @@ pub enum Kernels {
 /// The lane type of the baseline kernels.
 ///
 /// On x86-64 one state at a time: every x86-64 CPU since 2013 has AVX2, and a third
-/// copy of every lane kernel (`F64x4` in SSE2 registers) cost about a quarter of the
-/// core's compile time for CPUs that hardly exist. `f64` is the scalar path, compiled
+/// copy of every lane kernel (`F64x4` in SSE2 registers) would cost compile time and
+/// binary size for CPUs that hardly exist. `f64` is the scalar path, compiled
 /// anyway (the leftover rows of every batch), so this adds no code. Elsewhere
 /// (aarch64: NEON) four lanes, the only lane kernels compiled there.
 #[cfg(target_arch = "x86_64")]
@@ -126,8 +127,9 @@ fn pool_of_at_least(n: usize) -> Option<Arc<rayon::ThreadPool>> {
 /// Run `run` with `n` threads' worth of pool: rayon's global pool when it is big enough,
 /// else the shared larger pool of [`pool_of_at_least`]; the global pool if no pool can be
 /// built (never a panic). The batch drivers that split work themselves
-/// (derivatives, integration) use this.
-pub(crate) fn install<R: Send>(n: usize, run: impl FnOnce() -> R + Send) -> R {
+/// (derivatives, integration) use this. `run` is a trait object so that rayon's
+/// `install` is compiled once, not once per caller.
+pub(crate) fn install(n: usize, run: &mut (dyn FnMut() + Send)) {
     let pool = if n <= rayon::current_num_threads() { None } else { pool_of_at_least(n) };
     match pool {
         Some(pool) => pool.install(run),
@@ -159,6 +161,7 @@ pub(crate) fn par_rows<const R: usize, W, M, B>(
     make: M,
     body: B,
 ) where
+    W: Send + 'static,
     M: Fn() -> W + Sync + Send,
     B: Fn(&mut W, usize, [&mut [f64]; R]) + Sync + Send,
 {
@@ -170,6 +173,47 @@ pub(crate) fn par_rows<const R: usize, W, M, B>(
         body(&mut make(), 0, outs);
         return;
     }
+    schedule(rows, outs, per_row, threads, nthreads, &Job { make, body });
+}
+
+/// A batch's work with its workspace type erased: what [`schedule`] runs.
+trait Chunks<const R: usize>: Sync {
+    fn workspace(&self) -> Box<dyn Any + Send>;
+    fn run(&self, w: &mut (dyn Any + Send), first: usize, outs: [&mut [f64]; R]);
+}
+
+struct Job<M, B> {
+    make: M,
+    body: B,
+}
+
+impl<const R: usize, W, M, B> Chunks<R> for Job<M, B>
+where
+    W: Send + 'static,
+    M: Fn() -> W + Sync,
+    B: Fn(&mut W, usize, [&mut [f64]; R]) + Sync,
+{
+    fn workspace(&self) -> Box<dyn Any + Send> {
+        Box::new((self.make)())
+    }
+
+    fn run(&self, w: &mut (dyn Any + Send), first: usize, outs: [&mut [f64]; R]) {
+        let w = w.downcast_mut::<W>().expect("the workspace of this job");
+        (self.body)(w, first, outs)
+    }
+}
+
+/// The parallel part of [`par_rows`]. Generic only over the number of outputs: rayon's
+/// iterator and job types, instantiated here once per `R`, were half of the core's
+/// LLVM IR when every kernel and lane width instantiated them for its own closures.
+fn schedule<const R: usize>(
+    rows: usize,
+    outs: [&mut [f64]; R],
+    per_row: [usize; R],
+    threads: Option<usize>,
+    nthreads: usize,
+    job: &dyn Chunks<R>,
+) {
     // ~8 chunks per thread balance the load when cores are shared.
     let chunk_rows = rows.div_ceil(8 * nthreads).max(32).next_multiple_of(8);
     let mut rest = outs;
@@ -186,18 +230,19 @@ pub(crate) fn par_rows<const R: usize, W, M, B>(
         first += take;
     }
     if threads.is_none() {
-        pieces.into_par_iter().for_each_init(&make, |w, (first, o)| body(w, first, o));
+        pieces.into_par_iter().for_each_init(|| job.workspace(), |w, (first, o)| job.run(&mut **w, first, o));
         return;
     }
     let mut tasks: Vec<Vec<_>> = (0..nthreads).map(|_| Vec::new()).collect();
     for (k, piece) in pieces.into_iter().enumerate() {
         tasks[k % nthreads].push(piece);
     }
-    install(nthreads, || {
-        tasks.into_par_iter().for_each(|task| {
-            let mut w = make();
+    let mut tasks = Some(tasks);
+    install(nthreads, &mut || {
+        tasks.take().expect("install runs this once").into_par_iter().for_each(|task| {
+            let mut w = job.workspace();
             for (first, o) in task {
-                body(&mut w, first, o);
+                job.run(&mut *w, first, o);
             }
         })
     });

@@ -91,7 +91,7 @@ impl Real for f64 {
 /// Defines a lane type: `N` f64 values, one per state, operated on lane-wise with plain
 /// loops over arrays that LLVM turns into SIMD instructions.
 macro_rules! lanes_type {
-    ($(#[$doc:meta])* $name:ident, $n:literal, $align:literal) => {
+    ($(#[$doc:meta])* $name:ident, $n:literal, $align:literal, [$($i:literal)*]) => {
         $(#[$doc])*
         #[derive(Clone, Copy, Debug, PartialEq)]
         #[repr(C, align($align))]
@@ -104,31 +104,16 @@ macro_rules! lanes_type {
             }
         }
 
-        lanewise!($name, $n, Add, add, +, AddAssign, add_assign);
-        lanewise!($name, $n, Sub, sub, -, SubAssign, sub_assign);
-        lanewise!($name, $n, Mul, mul, *, MulAssign, mul_assign);
-
-        impl Div for $name {
-            type Output = $name;
-            #[inline(always)]
-            fn div(self, o: $name) -> $name {
-                let mut r = [0.0; $n];
-                for k in 0..$n {
-                    r[k] = self.0[k] / o.0[k];
-                }
-                $name(r)
-            }
-        }
+        lanewise!($name, [$($i)*], Add, add, +, AddAssign, add_assign);
+        lanewise!($name, [$($i)*], Sub, sub, -, SubAssign, sub_assign);
+        lanewise!($name, [$($i)*], Mul, mul, *, MulAssign, mul_assign);
+        lanewise!($name, [$($i)*], Div, div, /);
 
         impl Neg for $name {
             type Output = $name;
             #[inline(always)]
             fn neg(self) -> $name {
-                let mut r = [0.0; $n];
-                for k in 0..$n {
-                    r[k] = -self.0[k];
-                }
-                $name(r)
+                $name([$(-self.0[$i]),*])
             }
         }
 
@@ -172,35 +157,34 @@ macro_rules! lanes_type {
     };
 }
 
+/// The operator `$op` lane by lane, written out lane by lane (`[$i]` lists the lanes):
+/// a `for` loop per operation left thousands of tiny loops in each batch kernel, and
+/// LLVM's loop passes over them were most of the core's compile time.
 macro_rules! lanewise {
-    ($name:ident, $n:literal, $tr:ident, $f:ident, $op:tt, $tra:ident, $fa:ident) => {
+    ($name:ident, [$($i:literal)*], $tr:ident, $f:ident, $op:tt $(, $tra:ident, $fa:ident)?) => {
         impl $tr for $name {
             type Output = $name;
             #[inline(always)]
             fn $f(self, o: $name) -> $name {
-                let mut r = [0.0; $n];
-                for k in 0..$n {
-                    r[k] = self.0[k] $op o.0[k];
-                }
-                $name(r)
+                $name([$(self.0[$i] $op o.0[$i]),*])
             }
         }
-        impl $tra for $name {
+        $(impl $tra for $name {
             #[inline(always)]
             fn $fa(&mut self, o: $name) {
                 *self = *self $op o;
             }
-        }
+        })?
     };
 }
 
 lanes_type!(
     /// Four states: one AVX register, or two SSE2 registers.
-    F64x4, 4, 32
+    F64x4, 4, 32, [0 1 2 3]
 );
 lanes_type!(
     /// Eight states: one AVX-512 register.
-    F64x8, 8, 64
+    F64x8, 8, 64, [0 1 2 3 4 5 6 7]
 );
 
 /// Whether `x` is outside the range of `sin_cos_kernel` (NaN included).

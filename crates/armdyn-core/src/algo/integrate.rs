@@ -212,10 +212,14 @@ pub fn simulate_until(
         ));
         first += r;
     }
-    let run = || chunks.into_par_iter().for_each(|(first, mut chunk)| task.chunk(first, &mut chunk));
+    let mut chunks = Some(chunks);
+    let mut run = || {
+        let chunks = chunks.take().expect("runs once").into_par_iter();
+        chunks.for_each(|(first, mut chunk)| task.chunk(first, &mut chunk))
+    };
     match threads {
         None => run(),
-        Some(k) => install(k, run),
+        Some(k) => install(k, &mut run),
     }
     !stop.load(Ordering::Relaxed)
 }
