@@ -290,7 +290,7 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
     the base parameters are not a grouping onto standard columns."""
     from ..programs.base_parameters import base_inertials
     from ..programs.composite_mass_matrix import composite_mass_matrix
-    from ..programs.coriolis_program import christoffel_program
+    from ..programs.coriolis_program import christoffel_program, partial_derivative
     from ..programs.customized_ne import customized_newton_euler
 
     if not what:
@@ -339,8 +339,10 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
         elif w in ("M", "C") and M_prog is None:
             builder = Builder(reserved=reserved | {s for s, _ in defs})
             M_prog, _ = composite_mass_matrix(robot, parameters=params, builder=builder)
-            M_extra = extra.jacobian(robot.qdd)
-            M_prog.outputs = [o + M_extra[k // n, k % n] for k, o in enumerate(M_prog.outputs)]
+            # d extra / d qdd by the program differentiator's rules (SymPy's jacobian
+            # recomputes free symbols at every level of these large sums: seconds per entry)
+            M_extra = [partial_derivative(extra[k // n], robot.qdd[k % n]) for k in range(n * n)]
+            M_prog.outputs = [o + M_extra[k] for k, o in enumerate(M_prog.outputs)]
         if w == "M":
             programs[w] = M_prog
         elif w == "C":

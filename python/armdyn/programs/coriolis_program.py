@@ -20,7 +20,7 @@ from ..model import Robot
 from .program import Builder, Program
 
 
-def _partial(e, a):
+def partial_derivative(e, a):
     """de/da for the sums, products, integer powers, sin and cos the builders emit
     (SymPy's diff for anything else); much cheaper than ``sp.diff`` on small terms."""
     if e == a:
@@ -28,17 +28,17 @@ def _partial(e, a):
     if e.is_Atom or a not in e.free_symbols:
         return sp.Integer(0)
     if e.is_Add:
-        return sp.Add(*[_partial(t, a) for t in e.args])
+        return sp.Add(*[partial_derivative(t, a) for t in e.args])
     if e.is_Mul:
         args = e.args
         terms = []
         for k, f in enumerate(args):
-            df = _partial(f, a)
+            df = partial_derivative(f, a)
             if df != 0:
                 terms.append(sp.Mul(*args[:k], df, *args[k + 1 :]))
         return sp.Add(*terms)
     if e.is_Pow and e.exp.is_Integer:
-        return e.exp * e.base ** (e.exp - 1) * _partial(e.base, a)
+        return e.exp * e.base ** (e.exp - 1) * partial_derivative(e.base, a)
     return sp.diff(e, a)
 
 
@@ -67,13 +67,20 @@ def christoffel_program(robot: Robot, M: Program, builder: Builder) -> Program:
             for a in free:
                 da = d_of(a, i)
                 if da != 0:
-                    total += _partial(e, a).xreplace(trig) * da
+                    total += partial_derivative(e, a).xreplace(trig) * da
             row.append(b.let(total, f"d{s.name}_{i + 1}") if total != 0 else sp.Integer(0))
         deriv[s] = row
 
+    # dM[r][c] / d(its symbol a), once per entry of M: each is used for every q_i, and
+    # C uses every dM/dq_i three times (in base parameters M's outputs are large sums, and
+    # recomputing these was most of the time of C)
+    partials: dict = {}
+
     def dM(r, c, i):
-        e = sp.sympify(M.outputs[r * n + c])
-        return sum((_partial(e, a).xreplace(trig) * d_of(a, i) for a in e.free_symbols), sp.Integer(0))
+        if (r, c) not in partials:
+            e = sp.sympify(M.outputs[r * n + c])
+            partials[r, c] = [(partial_derivative(e, a).xreplace(trig), a) for a in e.free_symbols]
+        return sum((p * d_of(a, i) for p, a in partials[r, c]), sp.Integer(0))
 
     qd = list(robot.qd)
     half = sp.Rational(1, 2)
