@@ -26,7 +26,8 @@ from sympy.parsing.sympy_parser import implicit_multiplication, parse_expr, stan
 
 import armdyn
 from armdyn.mathml import latex_to_mathml, text_with_math
-from armdyn.symbolic.report import derivation_report, latex_symbol_names, steps_lines, tau_lines
+from armdyn.symbolic.names import latex_symbol_names
+from armdyn.symbolic.report import derivation_report, steps_lines, tau_lines
 
 IMPLICIT = standard_transformations + (implicit_multiplication,)
 # the exercise's symbols spelled in ASCII, written out here (not taken from the printer)
@@ -124,7 +125,7 @@ def _split_vector(text: str) -> list[str]:
 
 
 def test_two_numbers_keep_a_visible_separator():
-    from armdyn.symbolic.report import UnicodeTextPrinter
+    from armdyn.symbolic.names import UnicodeTextPrinter
 
     x = sp.Symbol("x")
     out = UnicodeTextPrinter({}).doprint(sp.Mul(2, sp.Pow(3, x, evaluate=False), evaluate=False))
@@ -322,3 +323,16 @@ def test_grade_html_shows_skipped_equations_as_math(tmp_path):
     assert '<div class="written"><math' in cards[0] and "<pre>" in cards[0]  # math, source under "as written"
     assert "<script" not in page.split("</style>", 1)[1]
     assert "&lt;script&gt;" in cards[1]
+
+
+def test_grade_and_derive_html_print_model_symbols_alike():
+    """The grade report names the model's symbols as the derivation report does: the
+    field's l_{c1} (l with the subscript c1) in both, never l times c_1."""
+    example = Path(__file__).parent.parent / "examples" / "grading" / "planar-2r-craig.md"
+    graded = armdyn.grade(example)._repr_html_()
+    derived = derivation_report([armdyn.derive(armdyn.load("planar-2r"))], "html")
+    l_c1 = "<msub><mi>l</mi><mrow><mi>c</mi><mn>1</mn></mrow></msub>"
+    l_times_c1 = "<mi>l</mi><msub><mi>c</mi>"
+    for page in (graded, derived):
+        assert l_c1 in page and l_times_c1 not in page
+    assert latex_symbol_names(armdyn.load("planar-2r"))  # the names both take

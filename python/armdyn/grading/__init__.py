@@ -23,6 +23,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..model import Robot
+from ..symbolic.names import latex_symbol_names
 
 # the text, JSON and HTML renderers register GradeReport's text, to_dict, to_json and
 # _repr_html_ with armdyn.dispatch when imported
@@ -30,8 +31,8 @@ from . import html as _html_report  # noqa: F401
 from . import text as _text_report  # noqa: F401
 from .diagnose import unreadable
 from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
-from .explain import component_name, contract, describe, pretty, split_name, tidy
-from .latex import GREEK, LatexError, UnknownSymbol, parse, parse_sympy_syntax
+from .explain import component_name, contract, describe, pretty, tidy
+from .latex import LatexError, UnknownSymbol, parse, parse_sympy_syntax
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
@@ -308,7 +309,7 @@ class _Grader:
             steps=self.verdicts,
             first_wrong=first_wrong,
             tau_correct=tau_correct,
-            symbol_latex=_symbol_latex(self.robot),
+            symbol_latex=dict(latex_symbol_names(self.robot)),
             notes=self.notes,
             shorthand=dict(self.symbols.shorthand),
         )
@@ -579,22 +580,6 @@ class _Grader:
 
 def _matrix(value) -> sp.Matrix:
     return value if isinstance(value, sp.MatrixBase) else sp.Matrix([[value]])
-
-
-def _symbol_latex(robot: Robot) -> dict:
-    """Model symbol -> LaTeX as the field writes it (\\dot{\\theta}_1 for theta1_dot)."""
-    out = {}
-    for s in list(robot.q) + list(robot.qd) + list(robot.qdd) + list(robot.parameters.values()):
-        parts = split_name(s.name)
-        if parts is None:
-            out[s] = s.name
-            continue
-        base, digits, dots = parts
-        tex = f"\\{base}" if base in GREEK else base
-        if dots:
-            tex = f"\\{'d' * (dots - 1)}dot{{{tex}}}"
-        out[s] = tex + (f"_{{{digits}}}" if digits else "")
-    return out
 
 
 def grade(

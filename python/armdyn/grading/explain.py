@@ -20,7 +20,7 @@ import sympy as sp
 
 from ..model import Robot
 from ..symbolic.agreement import trig_reduce
-from ..symbolic.report import UnicodeTextPrinter, unicode_name
+from ..symbolic.names import UnicodeTextPrinter, unicode_name
 
 COMPONENTS = "xyz"
 _GREEK = {
@@ -60,7 +60,7 @@ def split_name(name: str) -> tuple[str, str, int] | None:
 
 def display_name(name: str, ascii_only: bool = False) -> str:
     """``theta1_dot`` -> ``θ̇₁``, ``d2_ddot`` -> ``d̈₂``, ``l1`` -> ``l₁``: the names
-    ``armdyn derive`` prints (:func:`armdyn.symbolic.report.unicode_name`)."""
+    ``armdyn derive`` prints (:func:`armdyn.symbolic.names.unicode_name`)."""
     if ascii_only:
         return name
     m = re.fullmatch(r"(.+?)(_dot|_ddot)?", name)

@@ -12,7 +12,7 @@ document (inline CSS, math as MathML, no script, no network), laid out as:
   the difference ``got - expected``; unrecognised equations greyed, with their source
   text (escaped).
 
-Values are printed in the student's notation (``GradeReport.symbol_latex``) and tidied
+Values are printed in the field's notation, the derivation report's (``GradeReport.symbol_latex``), and tidied
 for reading (terms collected by joint accelerations, then velocity products, then the
 rest, as :func:`armdyn.symbolic.tidy.tidy_terms` does), so the two sides list the
 same kinds of terms in the same order. Tidying is for display only.

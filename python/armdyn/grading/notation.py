@@ -314,7 +314,7 @@ class SymbolMap:
             if all(1 <= k <= self.robot.dof for k in idx):
                 angle = sum((self.robot.q[k - 1] for k in idx), sp.Integer(0))
                 value = (sp.sin if name.base in "sS" else sp.cos)(angle)
-                from ..symbolic.report import unicode_name
+                from ..symbolic.names import unicode_name
 
                 self.shorthand[value] = sp.Symbol(unicode_name(name.base + sub) or name.base + sub)
                 return value

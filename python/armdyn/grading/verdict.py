@@ -22,7 +22,8 @@ Statuses (``StepVerdict.status``):
 
 Values are SymPy: a (3, 1) ``Matrix`` for vectors, an expression for scalars, in the
 robot model's symbols (``theta1``, ``theta1_dot``, ``l1``...); ``symbol_latex`` maps those
-symbols to the student's LaTeX (``\\dot{\\theta}_1``) for printing in their notation.
+symbols to LaTeX as the field writes them (``\\dot{\\theta}_{1}``), the names the derivation
+report prints too (:func:`armdyn.symbolic.names.latex_symbol_names`).
 """
 
 from __future__ import annotations
@@ -110,7 +111,7 @@ class GradeReport:
                    always ``wrong``), or None
     tau_correct:   per joint: the student's final tau_i is right (supported or not);
                    False where the student gave no tau_i
-    symbol_latex:  SymPy symbol -> the student's LaTeX for it, for printing
+    symbol_latex:  SymPy symbol -> its LaTeX, as the derivation report writes it
     notes:         general remarks (mapping used, steps the method has that the student skipped)
     shorthand:     sin/cos terms the student wrote as shorthand -> symbols printing as theirs
                    (``sin(q1 + q2)`` -> ``s₁₂``), for showing values in their notation

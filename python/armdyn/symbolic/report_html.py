@@ -25,6 +25,7 @@ from ..mathml import MathWriter, escape, latex_to_mathml, math_element, typeset_
 from ..model import Robot
 from . import dag
 from .agreement import AgreementReport
+from .names import latex_symbol_names
 from .notes import NOTE_FORMULAS, note_parts
 from .terms import EquationsOfMotion
 from .tidy import TIDY_NODE_LIMIT, tidy_terms, too_big_to_tidy
@@ -51,7 +52,8 @@ _METHODS = {"newton-euler": "Newton\u2013Euler", "lagrange": "Lagrange"}
 
 class _Writer:
     def __init__(self, eom):
-        self.eom, self.w, self.limit = eom, MathWriter(), TIDY_NODE_LIMIT
+        # the robot's symbols as the LaTeX report and the grade report name them (l_{c1})
+        self.eom, self.w, self.limit = eom, MathWriter(latex_symbol_names(eom.robot)), TIDY_NODE_LIMIT
 
     def scalar(self, expr) -> str:
         expr = sp.sympify(expr)
@@ -203,7 +205,7 @@ def agreement_body(report) -> str:
 
 def robot_body(robot) -> str:
     """Tables of the joints (placement, axis) and links (mass, centre of mass)."""
-    w = MathWriter()
+    w = MathWriter(latex_symbol_names(robot))
 
     def m(x):
         return math_element(w.expr(x))
