@@ -41,37 +41,52 @@ fn central(f: &dyn Fn(&[f64]) -> Vec<f64>, x: &[f64]) -> Vec<f64> {
 #[test]
 fn rnea_and_aba_derivatives_match_central_differences() {
     for (model, q, qd, x, w) in cases() {
-        let n = model.nv;
         for ext in [None, Some(ForceFrame::Local), Some(ForceFrame::World)] {
             let e = ext.map(|frame| ExternalForces { wrenches: &w[..], frame });
-            let rnea = |q: &[f64], qd: &[f64], qdd: &[f64]| {
-                let (mut d, mut dd, mut t) = (Data::new(&model), DerivData::new(&model), vec![0.0; n]);
-                match &e {
-                    Some(e) => algo::rnea_ext(&model, &mut d, &mut dd, q, qd, qdd, e, &mut t),
-                    None => algo::rnea(&model, &mut d, q, qd, qdd, &mut t),
-                }
-                t
-            };
-            let aba = |q: &[f64], qd: &[f64], tau: &[f64]| {
-                let (mut d, mut dd, mut t) = (Data::new(&model), DerivData::new(&model), vec![0.0; n]);
-                match &e {
-                    Some(e) => algo::aba_ext(&model, &mut d, &mut dd, q, qd, tau, e, &mut t),
-                    None => algo::aba(&model, &mut d, q, qd, tau, &mut t),
-                }
-                t
-            };
-            let (mut d, mut dd) = (Data::new(&model), DerivData::new(&model));
-            let (mut a, mut b, mut c) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
-            algo::rnea_derivatives(&model, &mut d, &mut dd, &q, &qd, &x, e.as_ref(), &mut a, &mut b, &mut c);
-            assert_close(&a, &central(&|y| rnea(y, &qd, &x), &q), 1e-6, "dtau_dq");
-            assert_close(&b, &central(&|y| rnea(&q, y, &x), &qd), 1e-6, "dtau_dqd");
-            assert_close(&c, &central(&|y| rnea(&q, &qd, y), &x), 1e-6, "M");
-            algo::aba_derivatives(&model, &mut d, &mut dd, &q, &qd, &x, e.as_ref(), &mut a, &mut b, &mut c);
-            assert_close(&a, &central(&|y| aba(y, &qd, &x), &q), 1e-6, "dqdd_dq");
-            assert_close(&b, &central(&|y| aba(&q, y, &x), &qd), 1e-6, "dqdd_dqd");
-            assert_close(&c, &central(&|y| aba(&q, &qd, y), &x), 1e-6, "Minv");
+            derivatives_match_differences(&model, &q, &qd, &x, e.as_ref());
         }
     }
+}
+
+/// `rnea_derivatives` and `aba_derivatives` of `model` at (q, qd, x) against central
+/// differences of `rnea` / `aba` (`_ext` with the wrenches `e`), and aba_derivatives'
+/// qdd against the body-frame `aba`'s. Returns aba_derivatives' M^-1 (n x n).
+fn derivatives_match_differences(
+    model: &Model,
+    q: &[f64],
+    qd: &[f64],
+    x: &[f64],
+    e: Option<&ExternalForces<f64>>,
+) -> Vec<f64> {
+    let n = model.nv;
+    let rnea = |q: &[f64], qd: &[f64], qdd: &[f64]| {
+        let (mut d, mut dd, mut t) = (Data::new(model), DerivData::new(model), vec![0.0; n]);
+        match e {
+            Some(e) => algo::rnea_ext(model, &mut d, &mut dd, q, qd, qdd, e, &mut t),
+            None => algo::rnea(model, &mut d, q, qd, qdd, &mut t),
+        }
+        t
+    };
+    let aba = |q: &[f64], qd: &[f64], tau: &[f64]| {
+        let (mut d, mut dd, mut t) = (Data::new(model), DerivData::new(model), vec![0.0; n]);
+        match e {
+            Some(e) => algo::aba_ext(model, &mut d, &mut dd, q, qd, tau, e, &mut t),
+            None => algo::aba(model, &mut d, q, qd, tau, &mut t),
+        }
+        t
+    };
+    let (mut d, mut dd) = (Data::new(model), DerivData::new(model));
+    let (mut a, mut b, mut c) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
+    algo::rnea_derivatives(model, &mut d, &mut dd, q, qd, x, e, &mut a, &mut b, &mut c);
+    assert_close(&a, &central(&|y| rnea(y, qd, x), q), 1e-6, "dtau_dq");
+    assert_close(&b, &central(&|y| rnea(q, y, x), qd), 1e-6, "dtau_dqd");
+    assert_close(&c, &central(&|y| rnea(q, qd, y), x), 1e-6, "M");
+    algo::aba_derivatives(model, &mut d, &mut dd, q, qd, x, e, &mut a, &mut b, &mut c);
+    assert_close(&dd.qdd, &aba(q, qd, x), 1e-10, "qdd, base vs body coordinates");
+    assert_close(&a, &central(&|y| aba(y, qd, x), q), 1e-6, "dqdd_dq");
+    assert_close(&b, &central(&|y| aba(q, y, x), qd), 1e-6, "dqdd_dqd");
+    assert_close(&c, &central(&|y| aba(q, qd, y), x), 1e-6, "Minv");
+    c
 }
 
 /// Joint friction, rotor inertia and offset on every joint, with and without wrenches in
@@ -104,32 +119,7 @@ fn joint_dynamics_and_wrenches_through_both_coordinate_systems() {
         assert_inverse(&m, &minv, n, 1e-10, "(M + diag(Ia)) Minv = I");
         for ext in [None, Some(ForceFrame::Local), Some(ForceFrame::World)] {
             let e = ext.map(|frame| ExternalForces { wrenches: &w[..], frame });
-            let rnea = |q: &[f64], qd: &[f64], qdd: &[f64]| {
-                let (mut d, mut dd, mut t) = (Data::new(&model), DerivData::new(&model), vec![0.0; n]);
-                match &e {
-                    Some(e) => algo::rnea_ext(&model, &mut d, &mut dd, q, qd, qdd, e, &mut t),
-                    None => algo::rnea(&model, &mut d, q, qd, qdd, &mut t),
-                }
-                t
-            };
-            let aba = |q: &[f64], qd: &[f64], tau: &[f64]| {
-                let (mut d, mut dd, mut t) = (Data::new(&model), DerivData::new(&model), vec![0.0; n]);
-                match &e {
-                    Some(e) => algo::aba_ext(&model, &mut d, &mut dd, q, qd, tau, e, &mut t),
-                    None => algo::aba(&model, &mut d, q, qd, tau, &mut t),
-                }
-                t
-            };
-            let (mut a, mut b, mut c) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
-            algo::rnea_derivatives(&model, &mut d, &mut dd, &q, &qd, &x, e.as_ref(), &mut a, &mut b, &mut c);
-            assert_close(&a, &central(&|y| rnea(y, &qd, &x), &q), 1e-6, "dtau_dq");
-            assert_close(&b, &central(&|y| rnea(&q, y, &x), &qd), 1e-6, "dtau_dqd");
-            assert_close(&c, &central(&|y| rnea(&q, &qd, y), &x), 1e-6, "M");
-            algo::aba_derivatives(&model, &mut d, &mut dd, &q, &qd, &x, e.as_ref(), &mut a, &mut b, &mut c);
-            assert_close(&dd.qdd, &aba(&q, &qd, &x), 1e-10, "qdd, base vs body coordinates");
-            assert_close(&a, &central(&|y| aba(y, &qd, &x), &q), 1e-6, "dqdd_dq");
-            assert_close(&b, &central(&|y| aba(&q, y, &x), &qd), 1e-6, "dqdd_dqd");
-            assert_close(&c, &central(&|y| aba(&q, &qd, y), &x), 1e-6, "Minv");
+            let c = derivatives_match_differences(&model, &q, &qd, &x, e.as_ref());
             assert_close(&c, &minv, 1e-10, "Minv of aba_derivatives vs minverse");
         }
     }
