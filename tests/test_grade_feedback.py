@@ -385,3 +385,15 @@ def test_deeply_nested_yaml_value_is_a_clear_error(tmp_path):
     # refused by the YAML screen (nesting) or by the step reader, at the value's line
     assert done.stderr.startswith(f"armdyn: error: {path}:4: ") and "internal error" not in done.stderr
     assert "step 'tau_2'" in done.stderr or "nesting deeper than" in done.stderr
+
+
+def test_powers_print_as_superscripts_or_caret_never_as_dots():
+    """Grade's one-line values: exponents 2..9 as superscripts, any other power with ^
+    (m₁^999, not m₁··999, which reads as a product)."""
+    from armdyn.grading.explain import pretty
+
+    m1, x = sp.symbols("m1 x")
+    assert pretty(m1**2 * x) in ("m₁² x", "x m₁²")
+    assert pretty(m1**999) == "m₁^999"
+    assert "·" not in pretty(2 * x * m1**999) and "^999" in pretty(2 * x * m1**999)
+    assert pretty(x ** sp.Symbol("k")) == "x^k"

@@ -99,9 +99,8 @@ def pretty(expr, ascii_only: bool = False, shorthand: dict | None = None) -> str
         return to_ascii(sp.sstr(expr, order="none")) if shorthand else sp.sstr(expr, order="none")
     names = {s: display_name(s.name) for s in expr.free_symbols}
     text = UnicodeTextPrinter(names, order="none").doprint(expr)
-    text = re.sub(r"\*\*2\b", "²", text)
-    text = re.sub(r"\*\*3\b", "³", text)
-    return text.replace("*", "·").replace("-", "−")
+    # powers the printer leaves as ** (exponents past 9, symbolic ones): ^, never "··"
+    return text.replace("**", "^").replace("*", "·").replace("-", "−")
 
 
 def reduce(expr, robot: Robot):
