@@ -130,6 +130,12 @@ _BASES = {
 }
 
 
+def _mass_centre(sub: str) -> int | None:
+    """i of a subscript naming link i's mass centre (``C_1``, ``{c1}``, ``\\mathrm{C}_1``)."""
+    m = re.fullmatch(r"[Cc](\d+)", re.sub(r"[{}\s,_]|\\mathrm", "", sub))
+    return int(m.group(1)) if m else None
+
+
 def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
     """The step an equation's left-hand side names, or None.
 
@@ -189,19 +195,17 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
     if key == "P":  # P_i^j: frame i's origin from frame i-1's; P_{C_i}^j: link i's mass centre from frame i's
         if dots or sub is None:
             return None
-        body = re.sub(r"[{}\s,_]|\\mathrm", "", sub)
-        mc = re.fullmatch(r"[Cc](\d+)", body)
-        if mc:
-            return StepRef("Pc", int(mc.group(1)), frame)
+        centre = _mass_centre(sub)
+        if centre is not None:
+            return StepRef("Pc", centre, frame)
         return StepRef("P", _int(sub), frame) if _int(sub) is not None else None
     if key in ("v", "a"):
         want = 1 if key == "v" else 0
         if dots != want or sub is None:
             return None
-        body = re.sub(r"[{}\s,_]|\\mathrm", "", sub)
-        mc = re.fullmatch(r"[Cc](\d+)", body)
-        if mc:
-            return StepRef("vc_dot", int(mc.group(1)), frame)
+        centre = _mass_centre(sub)
+        if centre is not None:
+            return StepRef("vc_dot", centre, frame)
         return StepRef("v_dot", _int(sub), frame) if _int(sub) is not None else None
     if key == "omega":
         key = {0: "omega", 1: "omega_dot"}.get(dots)

@@ -13,6 +13,7 @@ import symengine as se
 import sympy as sp
 
 from ..dispatch import register
+from ..symbolic.names import VECTOR_STEP_TEXT
 from .explain import display_name, pretty, to_ascii
 from .verdict import GradeReport, StepVerdict
 
@@ -25,14 +26,7 @@ _MARK = {
     "unrecognised": ("·", "--"),
 }
 _KEY_TEXT = {
-    "omega": "ω",
-    "omega_dot": "ω̇",
-    "v_dot": "v̇",
-    "vc_dot": "v̇_C",
-    "F": "F",
-    "N": "N",
-    "f": "f",
-    "n": "n",
+    **VECTOR_STEP_TEXT,
     "tau": "τ",
     "dL_dqd": "∂L/∂q̇",
     "dL_dq": "∂L/∂q",

@@ -17,7 +17,7 @@ import sympy as sp
 
 from ..dispatch import register
 from . import dag
-from .names import SUBSCRIPT_DIGITS, UnicodeTextPrinter, latex_symbol_names, unicode_name
+from .names import SUBSCRIPT_DIGITS, VECTOR_STEP_TEXT, UnicodeTextPrinter, latex_symbol_names, unicode_name
 from .notes import note_text
 from .report_html import derivation_html
 from .terms import EquationsOfMotion, Step
@@ -26,14 +26,7 @@ from .tidy import TIDY_NODE_LIMIT, tidy_terms, too_big_to_tidy
 FORMATS = ("text", "latex", "markdown")
 
 _TEXT_NAMES = {
-    "omega": "ω",
-    "omega_dot": "ω̇",
-    "v_dot": "v̇",
-    "vc_dot": "v̇_C",
-    "F": "F",
-    "N": "N",
-    "f": "f",
-    "n": "n",
+    **VECTOR_STEP_TEXT,
     "vc": "v_C",
     "pc": "p_C",
     "T_trans": "T_trans",
