@@ -1,0 +1,594 @@
+"""The grading pass: read a submission's equations one by one, name each one's step
+(:mod:`.notation`), judge it against the method (:mod:`.engine`, :mod:`.methods`) and
+collect the verdicts into a :class:`~.verdict.GradeReport`. :func:`grade` is the entry
+point every path uses (``armdyn.grade``, ``armdyn grade``, the class batch, the web app).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+
+import symengine as se
+import sympy as sp
+
+from ..errors import ModelError
+from ..model import Robot
+from ..symbolic.names import latex_symbol_names
+from .diagnose import unreadable
+from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
+from .explain import component_name, contract, describe, pretty, tidy
+from .latex import LatexError, UnknownSymbol, parse, parse_sympy_syntax
+from .methods import lagrange_method, newton_euler_method, rotation_between
+from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
+from .proofs import grade_proofs
+from .reader import Submission, read
+from .statements import FREE_END, lagrange_law
+from .verdict import PASSING, GradeReport, StepVerdict
+
+_NAMED = {  # step names as armdyn reports them, accepted as left-hand sides in YAML
+    "omega": "omega",
+    "omega_dot": "omega_dot",
+    "v_dot": "v_dot",
+    "vc_dot": "vc_dot",
+    "F": "F",
+    "N": "N",
+    "f": "f",
+    "n": "n",
+    "tau": "tau",
+    "dL_dqd": "dL_dqd",
+    "dL_dq": "dL_dq",
+    "ddt_dL_dqd": "ddt_dL_dqd",
+}
+
+
+def _named_ref(text: str) -> StepRef | None:
+    """``v_dot_1``, ``tau_2``, ``T``: armdyn's own step names."""
+    if text in ("T", "V", "L"):
+        return StepRef(text)
+    head, _, tail = text.rpartition("_")
+    if head in _NAMED and tail.isdigit():
+        return StepRef(_NAMED[head], int(tail))
+    return None
+
+
+def _load_robot(name: str, sub: Submission) -> Robot:
+    from ..io import load
+
+    candidate = os.path.join(sub.base_dir, name)
+    source = candidate if os.path.isfile(candidate) else name
+    try:
+        return load(source, strict=False)
+    except ModelError as err:
+        raise err.located(source=sub.path) from None
+
+
+class _Grader:
+    def __init__(self, sub: Submission, robot: Robot, symbols: dict | None):
+        self.sub = sub
+        self.robot = robot
+        try:
+            self.symbols = SymbolMap(robot, {**sub.symbols, **(symbols or {})})
+        except LatexError as err:
+            raise ModelError(str(err), source=sub.path) from None
+        free = set(robot.q) | set(robot.qd) | set(robot.qdd) | robot.free_symbols()
+        self.sampler = Sampler(free, robot)
+        self._worlds: dict = {}
+        self.verdicts: list[StepVerdict] = []
+        self.notes: list[str] = []
+
+    def world(self, name: str) -> World:
+        if name not in self._worlds:
+            if name == "newton-euler":
+                method, ctx = newton_euler_method(self.robot)
+                self._worlds[name] = World(method, ctx, self.sampler, numeric=True)
+            else:
+                method, ctx = lagrange_method(self.robot)
+                self._worlds[name] = World(method, ctx, self.sampler, numeric=False)
+        return self._worlds[name]
+
+    # -- reading one equation
+    def _unrecognised(self, eq, message: str, name: str = "", key: str = "") -> None:
+        """Record ``eq`` as unrecognised (shown, skipped), with why."""
+        self.verdicts.append(
+            StepVerdict(
+                name=name,
+                key=key,
+                link="",
+                status="unrecognised",
+                label=eq.lhs,
+                source=eq.source,
+                line=eq.line,
+                message=message,
+            )
+        )
+
+    def where(self, eq) -> str:
+        return f"{self.sub.path}:{eq.line}"
+
+    def _unreadable(self, eq, problem: str, pos: int | None = None) -> str:
+        """The message for an equation that cannot be read: file:line:column, a hint."""
+        line, column = eq.line, eq.column
+        if pos is not None and eq.offset >= 0 and isinstance(eq.value, str):
+            line, column = self.sub.locate(eq.offset + pos)
+        return unreadable(self.sub.path, line, column, problem)
+
+    def value(self, eq, ref: StepRef):
+        if eq.problem:
+            return None, self._unreadable(eq, eq.problem)
+        try:
+            if eq.latex:
+                raw = eq.value
+                if isinstance(raw, list):
+                    value = sp.Matrix([parse(str(v), self.symbols) for v in raw])
+                else:
+                    value = parse(str(raw), self.symbols)
+            else:
+                names = dict(self.symbols.names)
+                names.update({k: v for k, v in self.symbols.steps.items() if not isinstance(v, sp.MatrixBase)})
+                raw = eq.value
+                items = raw if isinstance(raw, list) else [raw]
+                parsed = [
+                    se.sympify(v) if isinstance(v, (int, float)) else parse_sympy_syntax(str(v), names, symengine=True)
+                    for v in items
+                ]
+                value = se.DenseMatrix(len(parsed), 1, parsed) if isinstance(raw, list) else parsed[0]
+        except UnknownSymbol as err:
+            raise ModelError(f"{ref.name}: {err}", source=self.where(eq)) from None
+        except ModelError as err:
+            if "unknown parameter" in err.message:
+                raise ModelError(f"{ref.name}: {err.message}", source=self.where(eq)) from None
+            return None, err.message
+        except LatexError as err:
+            return None, self._unreadable(eq, str(err), err.pos)
+        except RecursionError:
+            return None, self._unreadable(eq, "nested too deeply to read")
+        except (TypeError, ValueError) as err:
+            return None, self._unreadable(eq, str(err).split("\n")[0][:200])
+        return self._shape(value, ref, eq), None
+
+    def _shape(self, value, ref: StepRef, eq):
+        vector = ref.key in VECTOR_KEYS or ref.key in ("P", "Pc")
+        if ref.key == "R":
+            want = (3, 3)
+        elif vector:
+            want = (3, 1)
+        else:
+            want = None
+        if isinstance(value, se.DenseMatrix) and (want is None or value.shape == (1, 1) or value.shape[1] != 1):
+            value = to_sympy(value)  # small: shaped by the SymPy rules below
+        elif isinstance(value, se.Basic) and not isinstance(value, se.DenseMatrix) and want is not None:
+            value = to_sympy(value)
+        if isinstance(value, se.DenseMatrix):
+            if value.shape != want:
+                raise ModelError(
+                    f"{ref.name} must be a vector of 3 components, but it has {value.shape[0]}", source=self.where(eq)
+                )
+            return value
+        if want is None:
+            if isinstance(value, sp.MatrixBase):
+                if value.shape == (1, 1):
+                    return value[0, 0]
+                raise ModelError(
+                    f"{ref.name} is a scalar, but the value is a {value.shape[0]}x{value.shape[1]} matrix",
+                    source=self.where(eq),
+                )
+            return value
+        if not isinstance(value, sp.MatrixBase):
+            if value == 0:
+                return sp.zeros(*want)
+            raise ModelError(
+                f"{ref.name} is a {'vector' if vector else '3x3 matrix'}, but the value is a scalar",
+                source=self.where(eq),
+            )
+        if vector and value.shape == (1, 3):
+            value = value.T
+        if value.shape != want:
+            kind = "vector of 3 components" if vector else "3x3 matrix"
+            raise ModelError(
+                f"{ref.name} must be a {kind}, but it has shape {value.shape[0]}x{value.shape[1]}",
+                source=self.where(eq),
+            )
+        return value
+
+    # -- grading
+    def run(self, method_hint: str | None) -> GradeReport:
+        context = method_hint if method_hint in ("newton-euler", "lagrange") else None
+        seen_methods: list[str] = []
+        for eq in self.sub.equations:
+            done = len(self.verdicts)
+            self._equation(eq, seen_methods, context)
+            if self.verdicts[done:] and self.verdicts[-1].key not in ("", "R", "P", "Pc", "law", "tau"):
+                context = "lagrange" if self.verdicts[-1].key in LAGRANGE_KEYS else "newton-euler"
+            for v in self.verdicts[done:]:
+                v.part, v.task, v.column = eq.part, eq.task, eq.column
+        self.verdicts = grade_proofs(self.sub, self.verdicts)  # rigid-body proofs: every link checked
+        for v in self.verdicts:  # proof links (also bare expressions) carry the part they are in
+            if v.part is None and not v.task:
+                v.part, v.task = self.sub.part_at(v.line)
+        return self._report(seen_methods, method_hint)
+
+    def _equation(self, eq, seen_methods: list, context: str | None) -> None:
+        """Grade one equation: append its verdict."""
+        ref = parse_lhs(eq.lhs, self.symbols.coordinate_of) if eq.latex or "\\" in eq.lhs else None
+        if ref is None:
+            ref = _named_ref(eq.lhs) or (parse_lhs(eq.lhs, self.symbols.coordinate_of) if not eq.latex else None)
+        if eq.problem:  # cannot be split into sides: shown with where and why, named if its start names a step
+            self._unrecognised(
+                eq, self._unreadable(eq, eq.problem), name=ref.name if ref else "", key=ref.key if ref else ""
+            )
+            return
+        if ref is None:
+            law = lagrange_law(eq.lhs, str(eq.value)) if eq.latex else None
+            if law is None and eq.latex:
+                law = lagrange_law(str(eq.value), eq.lhs)
+            if law is not None:
+                if "lagrange" not in seen_methods:
+                    seen_methods.append("lagrange")
+                self.verdicts.append(
+                    StepVerdict(
+                        name="lagrange_equation",
+                        key="law",
+                        link="",
+                        status="correct" if law[0] else "wrong",
+                        label=eq.lhs,
+                        source=eq.source,
+                        line=eq.line,
+                        message=law[1],
+                    )
+                )
+                return
+            self._unrecognised(eq, "not a step of Newton-Euler or Lagrange (skipped)")
+            return
+        n_links = len(self.robot.links) - 1
+        if ref.key in ("f", "n") and ref.index == n_links + 1:
+            if "newton-euler" not in seen_methods:
+                seen_methods.append("newton-euler")
+            self._free_end(ref, eq)
+            return
+        method = (
+            "lagrange"
+            if ref.key in LAGRANGE_KEYS
+            else (context or "newton-euler" if ref.key == "tau" else "newton-euler")
+        )
+        if method not in seen_methods:
+            seen_methods.append(method)
+        self._check_index(ref, eq)
+        value, problem = self.value(eq, ref)
+        if value is None:
+            self._unrecognised(eq, problem, name=ref.name, key=ref.key)
+            return
+        if ref.key == "R":
+            self._rotation(ref, eq, value)
+        elif ref.key in ("P", "Pc"):
+            self._position(ref, eq, value)
+        else:
+            self._step(self.world(method), ref, eq, value, method)
+        if ref.key in ("T", "V", "L"):
+            self.symbols.steps[ref.key] = value
+
+    def _report(self, seen_methods: list, method_hint: str | None) -> GradeReport:
+        recognised = [v for v in self.verdicts if v.key]  # a step named, even if its value was unreadable
+        unread = [v for v in self.verdicts if v.status == "unrecognised" and "cannot read" in v.message]
+        if not recognised and unread:  # nothing graded: the reason is the unreadable equation
+            raise ModelError(unread[0].message.split(": ", 1)[1], source=unread[0].message.split(": ", 1)[0])
+        if not recognised:
+            raise ModelError(
+                "no step of Newton-Euler or Lagrange recognised (expected equations such as "
+                "\\omega_1^1 = ..., F_2^2 = ..., \\tau_1 = ..., T = ...)",
+                source=self.sub.path,
+            )
+        first_wrong = next((v.name for v in self.verdicts if v.status == "wrong"), None)
+        tau_correct = [False] * self.robot.dof
+        for v in self.verdicts:
+            if v.key == "tau":
+                tau_correct[int(v.name.split("_")[1]) - 1] = v.status in (*PASSING, "correct-but-unsupported")
+        if self.symbols.used_gravity_magnitude:
+            self.notes.append("g read as the magnitude of the model's gravity vector")
+        method_name = "+".join(seen_methods) or (method_hint or "newton-euler")
+        return GradeReport(
+            robot=self.robot.name,
+            method=method_name,
+            submission=self.sub.path,
+            steps=self.verdicts,
+            first_wrong=first_wrong,
+            tau_correct=tau_correct,
+            symbol_latex=dict(latex_symbol_names(self.robot)),
+            notes=self.notes,
+            shorthand=dict(self.symbols.shorthand),
+        )
+
+    def _check_index(self, ref: StepRef, eq):
+        n = len(self.robot.links) - 1
+        if ref.key in VECTOR_KEYS:
+            if (
+                ref.index is None
+                or not 0 <= ref.index <= n
+                or (ref.index == 0 and ref.key not in ("omega", "omega_dot", "v_dot"))
+            ):
+                raise ModelError(
+                    f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}",
+                    source=self.where(eq),
+                )
+            if ref.frame is not None and not 0 <= ref.frame <= n:
+                raise ModelError(
+                    f"{ref.name} is written in frame {ref.frame}, which '{self.robot.name}' does not "
+                    f"have (frames 0..{n})",
+                    source=self.where(eq),
+                )
+        elif ref.key in ("P", "Pc"):
+            if not 1 <= ref.index <= n:  # type: ignore[operator]
+                raise ModelError(
+                    f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}",
+                    source=self.where(eq),
+                )
+            if ref.frame is not None and not 0 <= ref.frame <= n:
+                raise ModelError(f"{ref.name}: frame {ref.frame} does not exist (frames 0..{n})", source=self.where(eq))
+        elif ref.key == "R":
+            for k in (ref.index, ref.frame):
+                if k is None or not 0 <= k <= n:
+                    raise ModelError(f"{ref.name}: frame {k} does not exist (frames 0..{n})", source=self.where(eq))
+        elif ref.index is not None and not 1 <= ref.index <= self.robot.dof:
+            raise ModelError(
+                f"{ref.name} names joint {ref.index}, but '{self.robot.name}' has joints 1..{self.robot.dof}",
+                source=self.where(eq),
+            )
+
+    def _rotation(self, ref: StepRef, eq, value):
+        ctx = self.world("newton-euler").ctx
+        assert ref.index is not None and ref.frame is not None  # _check_index ran
+        expected = rotation_between(ctx, ref.index, ref.frame)
+        fp = self.sampler.fingerprint
+        got_fp = fp(value)
+        status, conv, message = "correct", None, ""
+        ok = equal(got_fp, fp(expected))
+        if not ok.all():
+            if equal(got_fp, fp(expected.T)).all():
+                status = "correct-by-convention"
+                conv = (
+                    f"transposed: the columns are frame {ref.frame}'s axes in frame {ref.index} "
+                    f"(R_{ref.index}^{ref.frame} here maps frame-{ref.index} coordinates to frame {ref.frame})"
+                )
+            else:
+                status = "wrong"
+                bad = [int(i) for i in range(9) if not ok.ravel()[i]]
+                message = "; ".join(
+                    f"{component_name(i, (3, 3))}: " + self._describe(value[i], expected[i]) for i in bad[:3]
+                )
+        self.verdicts.append(
+            StepVerdict(
+                name=ref.name,
+                key="R",
+                link="",
+                status=status,
+                label=eq.lhs,
+                source=eq.source,
+                line=eq.line,
+                expected=expected,
+                got=value,
+                difference=None if status != "wrong" else value - expected,
+                convention=conv,
+                message=message or ("" if status == "correct" else conv or ""),
+                frame=f"{ref.index}->{ref.frame}",
+            )
+        )
+
+    def _position(self, ref: StepRef, eq, value):
+        """A kinematics step: P_i^j, frame i's origin seen from frame i-1's, or P_{C_i}^j,
+        link i's mass centre seen from frame i's origin, both written in frame j."""
+        ctx = self.world("newton-euler").ctx
+        if ref.key == "P":
+            home = ctx[ref.index]["parent"]
+            vector = ctx[ref.index]["P"]
+            what = f"frame {ref.index}'s origin from frame {home}'s"
+        else:
+            home = ref.index
+            vector = ctx[ref.index]["c"]
+            what = f"link {ref.index}'s mass centre from frame {ref.index}'s origin"
+        frame = home if ref.frame is None else ref.frame
+        expected = sp.Matrix(rotation_between(ctx, home, frame) * vector).applyfunc(lambda x: tidy(x, self.robot))
+        fp = self.sampler.fingerprint
+        ok = equal(fp(value), fp(expected)).ravel()
+        bad = [int(i) for i in range(3) if not ok[i]]
+        message = "; ".join(f"{self._describe(value[i], expected[i])} in {component_name(i, (3, 1))}" for i in bad)
+        if bad:
+            message += f" ({what}, in frame {frame})"
+        self.verdicts.append(
+            StepVerdict(
+                name=ref.name,
+                key=ref.key,
+                link=list(self.robot.links)[ref.index],  # type: ignore[index]
+                status="wrong" if bad else "correct",
+                label=eq.lhs,
+                source=eq.source,
+                line=eq.line,
+                expected=expected,
+                got=value,
+                difference=sp.Matrix([tidy(value[i] - expected[i], self.robot) for i in range(3)]) if bad else None,
+                components=bad,
+                message=message,
+                frame=str(frame),
+            )
+        )
+
+    def _free_end(self, ref: StepRef, eq):
+        """``f_{n+1} = 0``, ``n_{n+1} = 0``: the load at the free end, zero."""
+        value, problem = self.value(eq, StepRef(ref.key, ref.index, ref.frame))
+        name = f"{ref.key}_{ref.index}"
+        if value is None:
+            self._unrecognised(eq, problem, name=name, key="free_end")
+            return
+        zero = sp.zeros(3, 1)
+        ok = equal(self.sampler.fingerprint(value), self.sampler.fingerprint(zero)).ravel()
+        bad = [int(i) for i in range(3) if not ok[i]]
+        self.verdicts.append(
+            StepVerdict(
+                name=name,
+                key="free_end",
+                link="",
+                status="wrong" if bad else "correct",
+                label=eq.lhs,
+                source=eq.source,
+                line=eq.line,
+                expected=zero,
+                got=value,
+                difference=value if bad else None,
+                components=bad,
+                message=FREE_END if bad else "the free end: no load beyond the last link",
+            )
+        )
+
+    def _step(self, world: World, ref: StepRef, eq, value, method: str):
+        key = (ref.key, ref.index)
+        if key not in world.method.refs:
+            self._unrecognised(eq, f"{method} has no step {ref.name} for this robot", name=ref.name, key=ref.key)
+            return
+        link = ""
+        own = value
+        if ref.key in VECTOR_KEYS:
+            assert ref.index is not None  # _check_index ran
+            link = list(self.robot.links)[ref.index]
+            if ref.frame is not None and ref.frame != ref.index:
+                value = own = to_sympy(value)
+                own = rotation_between(world.ctx, ref.frame, ref.index) * value  # into the link's own frame
+        got = Value(self.sampler.fingerprint(own), own)
+        candidates = lambda r: world.candidates(r)  # noqa: E731
+        j = judge(world, key, got, candidates)
+        name = ref.name
+        origins_names = sorted(j.origins, key=self._order)
+        caused_by = origins_names[0] if j.status == "follows-from-earlier-error" and origins_names else None
+        extras = [world.candidates(r)[0] for r in j.conv.extra]
+        if j.status in ("correct", "correct-by-convention"):
+            world.given[key] = [canonical(world, j.conv, got, extras, frozenset())]
+        elif j.status == "correct-but-unsupported":
+            world.given[key] = [canonical(world, j.conv, got, extras, frozenset())] + world.carried(key)
+        elif j.status == "follows-from-earlier-error":
+            world.given[key] = [canonical(world, j.conv, got, extras, j.origins)]
+        else:
+            world.given[key] = [canonical(world, j.conv, got, extras, j.origins | {name})]
+            if j.canon is not None:
+                world.given[key].append(j.canon)
+        world.invalidate()
+
+        # what is shown: expected in the student's convention, the difference against
+        # what their own earlier values give (wrong) or the expected value
+        exp_shown = j.conv.forward(
+            world.expected[key].sym(), world.ctx, *(world.expected[r].sym() for r in j.conv.extra)
+        )
+        if ref.key in VECTOR_KEYS and ref.frame is not None and ref.index is not None and ref.frame != ref.index:
+            exp_shown = rotation_between(world.ctx, ref.index, ref.frame) * exp_shown
+        difference, components, message = None, [], ""
+        if j.status in ("wrong", "follows-from-earlier-error", "correct-but-unsupported"):
+            value = to_sympy(value)
+            ref_value = (
+                j.reference.sym() if j.status != "correct-but-unsupported" and j.reference is not None else exp_shown
+            )
+            if j.status == "correct-but-unsupported":
+                carried = world.carried(key)
+                ref_value = carried[0].sym() if carried else exp_shown
+                ref_value = j.conv.forward(ref_value, world.ctx, *(e.sym() for e in extras))
+            if ref.key in VECTOR_KEYS and ref.frame is not None and ref.index is not None and ref.frame != ref.index:
+                ref_value = rotation_between(world.ctx, ref.index, ref.frame) * ref_value
+            got_m, ref_m = _matrix(value), _matrix(ref_value)
+            ok = equal(self.sampler.fingerprint(got_m), self.sampler.fingerprint(ref_m)).ravel()
+            components = [int(i) for i in range(len(ok)) if not ok[i]]
+            if j.status == "wrong":
+                parts = []
+                for i in components[:3]:
+                    text = self._describe(got_m[i], ref_m[i])
+                    where = component_name(i, got_m.shape)
+                    parts.append(f"{text} in {where}" if where else text)
+                against = "" if not j.origins else " (compared with what your own earlier steps give)"
+                message = "; ".join(parts) + against
+                diff = sp.Matrix([tidy(got_m[i] - ref_m[i], self.robot) for i in range(len(got_m))])
+                difference = diff if got_m.shape != (1, 1) else diff[0]
+                exp_shown = contract(exp_shown, self.symbols.shorthand)  # in the student's s₁₂, c₁₂
+            elif j.status == "follows-from-earlier-error":
+                message = f"follows from the error in {caused_by}" + (f" ({j.convention})" if j.convention else "")
+                diff = _matrix(value) - _matrix(exp_shown)
+                difference = (
+                    sp.Matrix([tidy(x, self.robot) for x in diff])
+                    if diff.shape != (1, 1)
+                    else tidy(diff[0], self.robot)
+                )
+            else:
+                # the consistent carry-through: the candidate inheriting the fewest slips
+                carried = sorted(world.carried(key), key=lambda v: len(v.origins))
+                message = "right, but not what your own earlier steps give"
+                if carried:
+                    through = j.conv.forward(carried[0].sym(), world.ctx, *(e.sym() for e in extras))
+                    d = _matrix(through) - _matrix(exp_shown)
+                    bad = [i for i in range(len(d)) if tidy(d[i], self.robot) != 0]
+                    if bad:
+                        src = sorted(carried[0].origins, key=self._order)
+                        where = component_name(bad[0], d.shape)
+                        left = pretty(tidy(d[bad[0]], self.robot), shorthand=self.symbols.shorthand)
+                        message += (
+                            f": carried through they leave {left}"
+                            + (f" in {where}" if where else "")
+                            + (f" (from the error in {src[0]})" if src else "")
+                            + " (copied, or two slips that cancel?)"
+                        )
+        elif j.status == "correct-by-convention":
+            message = j.convention or ""
+        self.verdicts.append(
+            StepVerdict(
+                name=name,
+                key=ref.key,
+                link=link,
+                status=j.status,
+                label=eq.lhs,
+                source=eq.source,
+                line=eq.line,
+                expected=exp_shown,
+                got=value,
+                difference=difference,
+                components=components,
+                convention=j.convention,
+                caused_by=caused_by,
+                message=message,
+                frame="" if ref.key not in VECTOR_KEYS else str(ref.frame if ref.frame is not None else ref.index),
+            )
+        )
+
+    def _describe(self, got, ref) -> str:
+        """What differs, in the student's shorthand."""
+        return describe(got, ref, self.robot, self.sampler, shorthand=self.symbols.shorthand)
+
+    def _order(self, name: str) -> int:
+        for k, v in enumerate(self.verdicts):
+            if v.name == name:
+                return k
+        return len(self.verdicts)
+
+
+def _matrix(value) -> sp.Matrix:
+    return value if isinstance(value, sp.MatrixBase) else sp.Matrix([[value]])
+
+
+def grade(
+    submission: str | os.PathLike[str] | Submission, robot: str | Robot | None = None, symbols: dict | None = None
+) -> GradeReport:
+    """Grade a derivation.
+
+    submission: path of a Markdown (.md) or YAML (.yaml) file, or a :class:`Submission`.
+    robot:      the model whose frames the student used (bundled name, model file or
+                Robot); default: the submission's front matter ``robot``.
+    symbols:    extra mapping of the student's symbols to model names.
+    """
+    sub = submission if isinstance(submission, Submission) else read(os.fspath(submission))
+    if isinstance(robot, Robot):
+        model = robot
+    else:
+        name = robot or sub.robot
+        if not name:
+            raise ModelError("no robot named: give --robot MODEL or 'robot:' in the front matter", source=sub.path)
+        model = _load_robot(name, sub)
+    if sub.values is not None:
+        try:
+            # the reader admits "published" or a mapping parameter -> number
+            model = model.bind(sub.values if isinstance(sub.values, Mapping) else None)
+        except ModelError as err:
+            raise err.located(source=sub.path) from None
+    hint = sub.method if sub.method in ("newton-euler", "lagrange") else None
+    return _Grader(sub, model, symbols).run(hint)
