@@ -29,6 +29,7 @@ import sympy as sp
 
 from ..model import Robot
 from .latex import LatexError, Name, UnknownSymbol, parse
+from .vocabulary import MODEL_KEYS, energy_lhs, mass_centre, model_name
 
 VECTOR_KEYS = ("omega", "omega_dot", "v_dot", "vc_dot", "F", "N", "f", "n")
 LAGRANGE_KEYS = ("T", "V", "L", "dL_dqd", "ddt_dL_dqd", "dL_dq")
@@ -51,9 +52,19 @@ class StepRef:
     index: int | None = None
     frame: int | None = None
     alias: str = ""
+    #: energy method: "x"/"y"/"z" (one component of a position or velocity), "sq" (a squared speed)
+    part: str = ""
+    #: matrix entry (1-based): (j, k) of M, (i, j, k) of a Christoffel symbol, (k,) of h or G
+    entry: tuple = ()
+    #: the value's shape decides between two readings (see :func:`.vocabulary.by_shape`)
+    by_shape: bool = False
+    #: -1 for a left-hand side written negated (``-\frac{\partial L}{\partial q_1}``)
+    sign: int = 1
 
     @property
     def name(self) -> str:
+        if self.key in MODEL_KEYS or self.key == "Lang":
+            return model_name(self)
         if self.key == "R":
             return f"R_{self.index}^{self.frame}"
         if self.key in ("P", "Pc"):
@@ -130,10 +141,7 @@ _BASES = {
 }
 
 
-def _mass_centre(sub: str) -> int | None:
-    """i of a subscript naming link i's mass centre (``C_1``, ``{c1}``, ``\\mathrm{C}_1``)."""
-    m = re.fullmatch(r"[Cc](\d+)", re.sub(r"[{}\s,_]|\\mathrm", "", sub))
-    return int(m.group(1)) if m else None
+_mass_centre = mass_centre
 
 
 def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
@@ -144,11 +152,18 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
     s = normalise(lhs)
     if not s:
         return None
+    sign = 1
+    if s.startswith("-") and len(s) > 1:  # -\frac{\partial L}{\partial q_1} = ...: the negated partial
+        s, sign = s[1:], -1
     lag = _lagrange(s, coordinate_of)
     if lag is not None:
-        return lag
-    if s in ("T", "V", "L", "\\mathcal{L}", "\\mathcal{T}"):
-        return StepRef(s[-1] if len(s) == 1 else s[-2])
+        return lag if sign == 1 else StepRef(lag.key, lag.index, sign=-1)
+    if sign == -1:
+        return None
+    s = re.sub(r"^\{(\\d?dot\{[^{}]*\})\}", r"\1", s)  # {\dot v}_{c_1}
+    named = energy_lhs(s, lambda key, index=None, **kw: StepRef(key, index, **kw))
+    if named is not None:
+        return named
 
     # pre-scripts: {}^{j}_{a} or ^{j}
     pre_sub = pre_sup = None

@@ -1,0 +1,124 @@
+"""The grader's handling of the textbooks' energy-method vocabulary (a mixin of
+:class:`armdyn.grading.grader._Grader`): names whose step depends on the value's shape
+(:func:`.vocabulary.by_shape`), the quantities checked directly against the model
+(:mod:`.lagrange_terms`), the joint torques given as one column, and the equations of
+motion stated in matrix form."""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from .lagrange_terms import ModelTerms, grade_model_step
+from .notation import StepRef
+from .verdict import PASSING, StepVerdict
+from .vocabulary import by_shape, student_names
+
+#: the steps whose values the matrix form M q̈ + C q̇ + g = τ states
+_MATRICES = ("M", "C", "h", "G", "christoffel")
+
+
+class EnergySteps:
+    """Mixin: needs ``robot``, ``sampler``, ``symbols``, ``verdicts``, ``value``,
+    ``world``, ``_unrecognised``, ``_step`` of the grader."""
+
+    def model_terms(self) -> ModelTerms:
+        """The model's energy-method quantities (mass centres, M, C, g...), built once."""
+        if getattr(self, "_model_terms", None) is None:
+            world = self.world("newton-euler")
+            ne = {ref: world.expected[ref].sym() for ref in world.method.refs if ref[0] == "omega"}
+            self._model_terms = ModelTerms(self.robot, world.ctx, ne)
+        return self._model_terms
+
+    def _by_shape(self, ref: StepRef, eq):
+        """(the reading of ``ref`` its value's shape gives, what was assumed); (None, _)
+        after recording an unrecognised equation."""
+        probe = StepRef(ref.key, ref.index, ref.frame, ref.alias, ref.part, ref.entry, True, ref.sign)
+        value, problem = self.value(eq, probe)
+        if value is None:
+            self._unrecognised(eq, problem, name=ref.name, key=ref.key)
+            return None, ""
+        prismatic = None
+        if ref.key == "f" and ref.index is not None and 1 <= ref.index <= self.robot.dof:
+            prismatic = _prismatic(self.robot, ref.index)
+        new, assumed = by_shape(ref, value, lambda key, index=None, **kw: StepRef(key, index, **kw), prismatic)
+        if new is None:
+            self._unrecognised(eq, assumed, name=ref.name, key=ref.key)
+            return None, ""
+        return new, assumed
+
+    def _model_step(self, ref: StepRef, eq, assumed: str) -> None:
+        """Grade an energy-method quantity (or the torques as one column)."""
+        value, problem = self.value(eq, ref)
+        if value is None:
+            self._unrecognised(eq, problem, name=ref.name, key=ref.key)
+            return
+        if ref.key == "tau_vec":
+            self._torque_column(ref, eq, value)
+            return
+        verdict = grade_model_step(self, ref, eq, value)
+        if assumed:
+            verdict.message = assumed + ("; " + verdict.message if verdict.message else "")
+        self.verdicts.append(verdict)
+        if ref.key in ("Tl", "Vl") and not isinstance(value, sp.MatrixBase):
+            for name in student_names(ref):
+                self.symbols.steps[name] = value
+
+    def _torque_column(self, ref: StepRef, eq, value) -> None:
+        """``(\\tau_1, \\tau_2)^T = ...``: each entry graded as its joint's τ_k."""
+        n = self.robot.dof
+        if not isinstance(value, sp.MatrixBase) or len(value) != n or min(value.shape) != 1:
+            self._unrecognised(eq, f"τ as a column has {n} entries (one per joint)", name="tau", key="tau")
+            return
+        method = "lagrange" if "lagrange" in [v.key for v in self.verdicts[-1:]] else None
+        method = method or ("lagrange" if any(v.key in ("T", "V", "L", "M") for v in self.verdicts) else "newton-euler")
+        for k in range(n):
+            self._step(self.world(method), StepRef("tau", k + 1), eq, value[k], method)
+
+    def _note(self, assumed: str, shift) -> None:
+        """Add what was assumed (and a potential energy's reference level) to the last verdict."""
+        v = self.verdicts[-1] if self.verdicts else None
+        if v is None:
+            return
+        if shift is not None and v.status == "correct":
+            v.status = "correct-by-convention"
+            v.convention = f"another reference level for the potential energy (yours = the model's + {shift})"
+            v.message = v.convention
+        if assumed:
+            v.message = assumed + ("; " + v.message if v.message else "")
+
+    def _matrix_form(self, eq) -> None:
+        """``M q̈ + C q̇ + g = τ`` stated: right when every matrix given before it is."""
+        given = [v for v in self.verdicts if v.key in _MATRICES]
+        bad = [v for v in given if v.status not in PASSING]
+        if bad:
+            status = "wrong"
+            message = "the matrices given earlier are not all right: " + ", ".join(
+                f"{v.name} (line {v.line})" for v in bad[:4]
+            )
+        else:
+            status = "correct"
+            message = (
+                "the equations of motion in matrix form, with the matrices given earlier"
+                if given
+                else "the equations of motion in matrix form (no matrix given before it to check)"
+            )
+        self.verdicts.append(
+            StepVerdict(
+                name="matrix_form",
+                key="law",
+                link="",
+                status=status,
+                label=eq.lhs,
+                source=eq.source,
+                line=eq.line,
+                message=message,
+            )
+        )
+
+
+def _prismatic(robot, k: int) -> bool:
+    """Is the joint of coordinate k (1-based) prismatic?"""
+    for joint in robot.joints:
+        if robot.coordinate_index(joint) == k - 1:
+            return joint.type == "prismatic"
+    return False
