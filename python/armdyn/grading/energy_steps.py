@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import sympy as sp
 
-from .lagrange_terms import ModelTerms, grade_model_step
+from .lagrange_terms import ModelTerms, grade_model_step, potential_shift
 from .notation import StepRef
 from .verdict import PASSING, StepVerdict
-from .vocabulary import by_shape, student_names
+from .vocabulary import MODEL_KEYS, by_shape, student_names
 
 #: the steps whose values the matrix form M q̈ + C q̇ + g = τ states
 _MATRICES = ("M", "C", "h", "G", "christoffel")
@@ -28,6 +28,21 @@ class EnergySteps:
             ne = {ref: world.expected[ref].sym() for ref in world.method.refs if ref[0] == "omega"}
             self._model_terms = ModelTerms(self.robot, world.ctx, ne)
         return self._model_terms
+
+    def _vocabulary(self, ref: StepRef, eq, seen_methods: list):
+        """(the step ``ref`` names, what was assumed), or (None, "") when the equation was
+        graded here (an energy-method quantity) or could not be."""
+        assumed = ""
+        if ref.by_shape or ref.key in ("omega", "f"):  # which step it is depends on the value's shape
+            ref, assumed = self._by_shape(ref, eq)
+            if ref is None:
+                return None, ""
+        if ref.key in MODEL_KEYS or ref.key in ("Lang", "tau_vec"):
+            if "lagrange" not in seen_methods:
+                seen_methods.append("lagrange")
+            self._model_step(ref, eq, assumed)
+            return None, ""
+        return ref, assumed
 
     def _by_shape(self, ref: StepRef, eq):
         """(the reading of ``ref`` its value's shape gives, what was assumed); (None, _)
@@ -73,6 +88,21 @@ class EnergySteps:
         method = method or ("lagrange" if any(v.key in ("T", "V", "L", "M") for v in self.verdicts) else "newton-euler")
         for k in range(n):
             self._step(self.world(method), StepRef("tau", k + 1), eq, value[k], method)
+
+    def _adjust(self, ref: StepRef, value, assumed: str):
+        """(value as the method's step, what was assumed, a potential energy's constant):
+        ``-∂L/∂q_k`` negated back; a potential energy or Lagrangian that differs from the
+        model's by a constant shifted to the model's reference level."""
+        if ref.sign == -1:
+            value = -value
+            assumed = "read as the negated partial (the sign moved across)"
+        shift = None
+        if ref.key in ("V", "L"):
+            expected = self.world("lagrange").expected[(ref.key, None)].sym()
+            shift = potential_shift(value, expected, [*self.robot.q, *self.robot.qd], self.sampler)
+            if shift is not None:
+                value = value - shift
+        return value, assumed, shift
 
     def _note(self, assumed: str, shift) -> None:
         """Add what was assumed (and a potential energy's reference level) to the last verdict."""

@@ -19,7 +19,6 @@ from .diagnose import unreadable
 from .energy_steps import EnergySteps
 from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, tidy
-from .lagrange_terms import potential_shift
 from .latex import LatexError, UnknownSymbol, parse, parse_sympy_syntax
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
@@ -249,16 +248,8 @@ class _Grader(EnergySteps):
                 return
             self._unrecognised(eq, "not a step of Newton-Euler or Lagrange (skipped)")
             return
-        if ref.by_shape or ref.key in ("omega", "f"):  # which step it is depends on the value's shape
-            ref, assumed = self._by_shape(ref, eq)
-            if ref is None:
-                return
-        else:
-            assumed = ""
-        if ref.key in MODEL_KEYS or ref.key in ("Lang", "tau_vec"):
-            if "lagrange" not in seen_methods:
-                seen_methods.append("lagrange")
-            self._model_step(ref, eq, assumed)
+        ref, assumed = self._vocabulary(ref, eq, seen_methods)  # energy-method names; by the value's shape
+        if ref is None:
             return
         n_links = len(self.robot.links) - 1
         if ref.key in ("f", "n") and ref.index == n_links + 1:
@@ -279,15 +270,7 @@ class _Grader(EnergySteps):
             self._unrecognised(eq, problem, name=ref.name, key=ref.key)
             return
         own_value = value
-        if ref.sign == -1:  # -∂L/∂q_k = ...: the negated partial
-            value = -value
-            assumed = "read as the negated partial (the sign moved across)"
-        shift = None
-        if ref.key in ("V", "L"):  # a potential energy is defined up to a constant
-            expected = self.world("lagrange").expected[(ref.key, None)].sym()
-            shift = potential_shift(value, expected, [*self.robot.q, *self.robot.qd], self.sampler)
-            if shift is not None:
-                value = value - shift
+        value, assumed, shift = self._adjust(ref, value, assumed)
         if ref.key == "R":
             self._rotation(ref, eq, value)
         elif ref.key in ("P", "Pc"):
