@@ -378,3 +378,13 @@ def test_every_christoffel_symbol_of_the_elbow_arm(tmp_path):
     )
     r = _grade(tmp_path, body + "\n")
     assert all(s == "correct" for _, s in _status(r)), _status(r)
+
+
+def test_lavalles_unsymmetrised_coriolis_coefficients(tmp_path):
+    # h_ijk = dm_ij/dq_k - 1/2 dm_jk/dq_i: for (1, 1, 2) it is dm_11/dq_2 (m_12 has no q_1),
+    # which is neither Spong's c_112 nor its free-index-first reading c_121
+    value = sp.diff(D[0, 0], q2)
+    assert not zero(value - c_spong(1, 1, 2)) and not zero(value - c_spong(1, 2, 1))
+    r = _grade(tmp_path, f"$$h_{{112}} = {tex(value)}$$\n\n$$h_{{112}} = {tex(value / 2)}$$\n")
+    assert _status(r) == [("c_112", "correct-by-convention"), ("c_112", "correct-by-convention")]
+    assert "LaValle" in r.steps[0].message and "free index first" in r.steps[1].message

@@ -12,8 +12,9 @@ Conventions accepted, each named in the verdict:
 
 * a potential energy (per link or total) that differs from the model's by a constant
   (no dependence on q): another reference level;
-* a Christoffel symbol with the free index first (Murray, Li & Sastry's ``Γ_ijk``), when
-  it is not Spong's ``c_ijk = ½(∂d_kj/∂q_i + ∂d_ki/∂q_j − ∂d_ij/∂q_k)``;
+* a Christoffel symbol with the free index first (Murray, Li & Sastry's ``Γ_ijk``), or
+  LaValle's unsymmetrised ``h_ijk = ∂m_ij/∂q_k − ½ ∂m_jk/∂q_i``, when it is not Spong's
+  ``c_ijk = ½(∂d_kj/∂q_i + ∂d_ki/∂q_j − ∂d_ij/∂q_k)``;
 * a Coriolis matrix that is not the Christoffel one but gives the same ``C q̇`` (any
   factorisation is right; the message says whether ``Ṁ − 2C`` is still skew-symmetric).
 """
@@ -33,6 +34,7 @@ from .explain import describe, tidy
 from .verdict import StepVerdict
 
 SPONG = "Spong's c_ijk = ½(∂d_kj/∂q_i + ∂d_ki/∂q_j − ∂d_ij/∂q_k)"
+LAVALLE = "LaValle's h_ijk = ∂m_ij/∂q_k − ½ ∂m_jk/∂q_i (free index first, not symmetric in j, k)"
 FREE_FIRST = "the free index first (Murray, Li & Sastry's Γ_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_kj/∂q_i))"
 
 
@@ -259,6 +261,8 @@ def _fit(ref, value, expected, sampler):
         return flat, expected[:2, 0], "(x, y) compared: z is 0 in the model"
     if shape == (1, 1) and value == 0 and exp_shape != (1, 1):
         return sp.zeros(*exp_shape), expected, ""
+    if ref.key == "Tl" and shape == (4, 4):
+        return None, expected, "a 4x4 matrix is a homogeneous transform, not graded (a scalar T_i is a kinetic energy)"
     what = "a scalar" if shape == (1, 1) else f"a {shape[0]}x{shape[1]} matrix"
     want = "a scalar" if exp_shape == (1, 1) else f"{exp_shape[0]}x{exp_shape[1]}"
     return None, expected, f"the value is {what}; expected {want}"
@@ -275,6 +279,10 @@ def _convention(ref, got, expected, terms: ModelTerms, sampler) -> str | None:
         i, j, k = ref.entry
         if equal(fp(got), fp(terms.christoffel(j, k, i))).all():
             return f"Christoffel symbol with {FREE_FIRST}, not {SPONG}"
+        M, q = terms.M, terms.q
+        lavalle = sp.diff(M[i - 1, j - 1], q[k - 1]) - sp.diff(M[j - 1, k - 1], q[i - 1]) / 2
+        if equal(fp(got), fp(lavalle)).all():
+            return f"{LAVALLE}, not {SPONG} (the same Coriolis terms once summed over j and k)"
     if ref.key == "C":
         if equal(fp(got * terms.qd), fp(terms.h)).all():
             Mdot = time_derivative(terms.M, terms.q, terms.qd)

@@ -17,7 +17,7 @@ vc             ``v_{c1}``, ``\\dot p_{c1}``, ``\\dot x_{c1}``; squared: ``v_{c1}
 Jv, Jw         ``J_{v_1}``, ``J_{v_{c1}}``, ``J_{\\omega_1}``
 M              ``M``, ``D``, ``H``, ``M(q)``, ``D(q)``, ``M(\\theta)``, ``H(q)``; entries
                ``d_{11}``, ``m_{12}``, ``M_{11}``, ``D_{21}``
-christoffel    ``c_{ijk}``, ``\\Gamma_{ijk}`` (three indices)
+christoffel    ``c_{ijk}``, ``\\Gamma_{ijk}``, ``h_{ijk}`` (three indices)
 C              ``C``, ``C(q,\\dot q)`` (the Coriolis matrix)
 h              ``V(\\theta,\\dot\\theta)`` (Craig), ``h``, ``b(q,\\dot q)``; entries ``h_i``
 G              ``g(q)``, ``G(\\theta)``, ``G``; entries ``g_k``, ``G_k``, ``\\phi_k``
@@ -38,7 +38,10 @@ import re
 _KINETIC = r"K|T|KE|k|E_\{?k\}?|E_\{?kin\}?|KE"
 _POTENTIAL = r"U|V|P|PE|u|E_\{?p\}?|E_\{?pot\}?"
 #: a function's arguments as students write them after a name: (q), (q,\dot{q}), (\theta,\dot\theta)
-_ARGS = re.compile(r"\((?:\\?[A-Za-z]+|\\dot\{\\?[A-Za-z]+\}|,)+\)$")
+_ARGS = re.compile(r"\(([\\A-Za-z{},]+)\)$")  # one character class: linear, no nested repetition
+_ARG = re.compile(r"\\?[A-Za-z]+|\\d?dot\{\\?[A-Za-z]+\}")
+#: a left-hand side longer than this names no quantity (bounds the regular expressions below)
+MAX_LHS = 120
 _MC = r"(?:[CcG]|cm|CM|com)"
 
 
@@ -72,9 +75,11 @@ def energy_lhs(s: str, ref_type):
         r"\((?:\\tau_\{?\d\}?,?)+\)\^(?:\{?T\}?|\\top|\{\\top\}|\{\\mathrm\{T\}\})", s
     ):
         return ref_type("tau_vec")  # the joint torques as one column: (\tau_1, \tau_2)^T = ...
+    if len(s) > MAX_LHS:
+        return None
     had_args = False
     m = _ARGS.search(s)
-    if m and m.start() > 0:
+    if m and m.start() > 0 and all(_ARG.fullmatch(a) for a in m.group(1).split(",")):
         s, had_args = s[: m.start()], True
     # totals
     if re.fullmatch(_KINETIC, s):
@@ -131,7 +136,7 @@ def _indexed(s: str, ref_type):
         return ref_type("Jv" if j.group(1) == "v" else "Jw", int(j.group(2))) if j else None
     if sup is not None:
         return None
-    if base in ("c", "\\Gamma") and _digits(sub, 3):
+    if base in ("c", "\\Gamma", "h") and _digits(sub, 3):
         return ref_type("christoffel", entry=_digits(sub, 3), alias=base)
     if base in ("d", "m", "M", "D") and _digits(sub, 2):
         return ref_type("M", entry=_digits(sub, 2), alias=base)
@@ -221,6 +226,8 @@ def by_shape(ref, value, step_ref, is_prismatic=None):
     if ref.key == "V" and ref.index is None:
         if scalar:
             return ref, ""
+        if column and ref.alias != "V":
+            return None, f"a vector {name} names no step: a position is written with its frame, as P_1^0"
         if column:
             return step_ref("h", alias="V"), (
                 f"{name} read as Craig's centrifugal and Coriolis vector V(θ, θ̇) (a column; the potential energy is a scalar)"
