@@ -12,6 +12,15 @@ frame given neither as a superscript nor as Craig's pre-superscript is the link'
                   given), P_{C_i}^j (link i's mass centre from frame i's origin, in frame j)
     Lagrange      T, V, L, \\frac{\\partial L}{\\partial \\dot q_k}, \\partial L / \\partial \\dot q_k,
                   \\frac{d}{dt}\\frac{\\partial L}{\\partial \\dot q_k}, \\frac{\\partial L}{\\partial q_k}, \\tau_k
+                  (also -\\frac{\\partial L}{\\partial q_k}: the negated partial, sign = -1)
+    energy method the textbooks' names of :mod:`.vocabulary`: energies K, T, KE, E_k, U, V, P,
+                  PE, E_p (per link with an index), mass centres p_{c1}, x_{c1}, v_{c1},
+                  v_{c1}^2, Jacobians J_{v_1}, J_{\\omega_1}, D(q) / M(q) and d_{jk},
+                  c_{ijk}, C(q, \\dot q), V(\\theta, \\dot\\theta) / h, g(q) / G and g_k,
+                  (\\tau_1, \\tau_2)^T; a name marked ``by_shape`` (P_1, V, L, H, f_k, a
+                  scalar \\omega_i) is decided by the value's shape in the grader
+
+Mass centres are written C, c, G, cm in the subscript (``C_1``, ``c1``, ``G_1``, ``{cm,1}``).
 
 Bold, hat and roman wrappers (\\mathbf, \\boldsymbol, \\bm, \\mathrm, \\vec) are looked
 through. Symbols map to the model's by name (``\\theta_1`` -> ``theta1``,
