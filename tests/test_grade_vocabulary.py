@@ -388,3 +388,29 @@ def test_lavalles_unsymmetrised_coriolis_coefficients(tmp_path):
     r = _grade(tmp_path, f"$$h_{{112}} = {tex(value)}$$\n\n$$h_{{112}} = {tex(value / 2)}$$\n")
     assert _status(r) == [("c_112", "correct-by-convention"), ("c_112", "correct-by-convention")]
     assert "LaValle" in r.steps[0].message and "free index first" in r.steps[1].message
+
+
+@pytest.mark.parametrize(
+    "lhs, key, index",
+    [
+        (r"\frac{\partial L}{\partial q_1'}", "dL_dqd", 1),
+        (r"\frac{\partial \mathcal{L}}{\partial \theta_2'}", "dL_dqd", 2),
+        (r"\frac{\partial L}{\partial {\dot q}_1}", "dL_dqd", 1),
+        (r"\frac{\partial L}{\partial \dot{q_2}}", "dL_dqd", 2),
+        (r"\partial L/\partial\dot q_{2}", "dL_dqd", 2),
+        (r"\frac{d}{dt}\left(\frac{\partial L}{\partial \dot{q}_{1}}\right)", "ddt_dL_dqd", 1),
+        (r"\frac{\partial L}{\partial q_{2}}", "dL_dq", 2),
+    ],
+)
+def test_coordinates_in_every_order_of_dots_primes_and_indices(lhs, key, index):
+    ref = _lhs(lhs)
+    assert ref is not None and (ref.key, ref.index) == (key, index), lhs
+
+
+def test_a_hostile_left_hand_side_is_read_in_bounded_time():
+    import time
+
+    start = time.perf_counter()
+    for lhs in ("(" + "a" * 100000 + "!", "|" + "v" * 100000, "x^T" * 30000, "-" + "{" * 5000, "q'" * 50000):
+        assert _lhs(lhs) is None
+    assert time.perf_counter() - start < 5

@@ -33,7 +33,8 @@ class EnergySteps:
         """(the step ``ref`` names, what was assumed), or (None, "") when the equation was
         graded here (an energy-method quantity) or could not be."""
         assumed = ""
-        if ref.by_shape or ref.key in ("omega", "f"):  # which step it is depends on the value's shape
+        # which step it is depends on the value's shape (a frame written, or YAML: a vector)
+        if ref.by_shape or (ref.key in ("omega", "f") and ref.frame is None and eq.latex):
             ref, assumed = self._by_shape(ref, eq)
             if ref is None:
                 return None, ""

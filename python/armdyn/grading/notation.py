@@ -98,9 +98,16 @@ def normalise(lhs: str) -> str:
         if t == s:
             break
         s = t
+    # Lagrange's primes for time derivatives: q_1' -> \dot{q}_1, \theta_1'' -> \ddot{\theta}_1
+    s = re.sub(r"(\\[A-Za-z]+|[A-Za-z])(_\{[^{}]*\}|_[A-Za-z0-9])?('{1,2})", _primed, s)
     s = re.sub(r"\s+", "", s)
     s = re.sub(r"\\(d?dot)(\\[A-Za-z]+|[A-Za-z])", r"\\\1{\2}", s)
+    s = re.sub(r"\{(\\d?dot\{[^{}]*\})\}", r"\1", s)  # {\dot q}_1 -> \dot{q}_1
     return s
+
+
+def _primed(m) -> str:
+    return f"\\{'dot' if len(m.group(3)) == 1 else 'ddot'}{{{m.group(1)}}}{m.group(2) or ''}"
 
 
 def _scripts(s: str, i: int):
