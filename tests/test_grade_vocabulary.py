@@ -414,3 +414,23 @@ def test_a_hostile_left_hand_side_is_read_in_bounded_time():
     for lhs in ("(" + "a" * 100000 + "!", "|" + "v" * 100000, "x^T" * 30000, "-" + "{" * 5000, "q'" * 50000):
         assert _lhs(lhs) is None
     assert time.perf_counter() - start < 5
+
+
+def test_siciliano_and_lynch_park_names(tmp_path):
+    h = CORIOLIS * QD
+    body = (
+        f"$$B(q) = {tex(D)}$$\n\n$$b_{{22}} = {tex(D[1, 1])}$$\n\n"
+        f"$$c(\\theta,\\dot\\theta) = {tex(h)}$$\n\n$$C(q,\\dot q)\\dot q = {tex(h)}$$\n\n"
+        f"$$h(\\theta,\\dot\\theta) = {tex(h + GRAV)}$$\n\n"
+        r"$$M(\theta)\ddot\theta + c(\theta,\dot\theta) + g(\theta) = \tau$$" + "\n"
+    )
+    r = _grade(tmp_path, body)
+    assert _status(r) == [
+        ("M", "correct"),
+        ("M_22", "correct"),
+        ("h", "correct"),
+        ("h", "correct"),
+        ("h", "correct-by-convention"),
+        ("matrix_form", "correct"),
+    ]
+    assert "Lynch & Park" in r.steps[4].message

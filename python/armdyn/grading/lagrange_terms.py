@@ -15,6 +15,7 @@ Conventions accepted, each named in the verdict:
 * a Christoffel symbol with the free index first (Murray, Li & Sastry's ``Γ_ijk``), or
   LaValle's unsymmetrised ``h_ijk = ∂m_ij/∂q_k − ½ ∂m_jk/∂q_i``, when it is not Spong's
   ``c_ijk = ½(∂d_kj/∂q_i + ∂d_ki/∂q_j − ∂d_ij/∂q_k)``;
+* a centrifugal/Coriolis vector with gravity added (Lynch & Park's ``h(θ, θ̇)``);
 * a Coriolis matrix that is not the Christoffel one but gives the same ``C q̇`` (any
   factorisation is right; the message says whether ``Ṁ − 2C`` is still skew-symmetric).
 """
@@ -283,6 +284,12 @@ def _convention(ref, got, expected, terms: ModelTerms, sampler) -> str | None:
         lavalle = sp.diff(M[i - 1, j - 1], q[k - 1]) - sp.diff(M[j - 1, k - 1], q[i - 1]) / 2
         if equal(fp(got), fp(lavalle)).all():
             return f"{LAVALLE}, not {SPONG} (the same Coriolis terms once summed over j and k)"
+    if ref.key == "h":
+        with_gravity = terms.h + terms.G
+        if ref.entry:
+            with_gravity = with_gravity[ref.entry[0] - 1]
+        if equal(fp(got), fp(with_gravity)).all():
+            return "Lynch & Park's h(θ, θ̇) = c(θ, θ̇) + g(θ): the Coriolis and centrifugal terms with gravity"
     if ref.key == "C":
         if equal(fp(got * terms.qd), fp(terms.h)).all():
             Mdot = time_derivative(terms.M, terms.q, terms.qd)

@@ -84,12 +84,13 @@ def lagrange_law(lhs: str, rhs: str) -> tuple[bool, str] | None:
     return False, f"wrong sign on {'∂L/∂q' if kinds['ddt'] == 1 else 'd/dt ∂L/∂q̇'}: the law is {LAW}"
 
 
-_MATRIX_LETTER = re.compile(r"^(?:M|D|H|C|V|G|g|B|N|h|b)(?:\([^()]*\))?")
+_MATRIX_LETTER = re.compile(r"^(?:M|D|H|C|V|G|g|B|N|h|b|c)(?:\([^()]*\))?")
 
 
 def matrix_form(lhs: str, rhs: str) -> bool:
     """Is ``lhs = rhs`` the equations of motion in matrix form, ``M(q) q̈ + C(q, q̇) q̇ +
-    g(q) = τ`` (Spong's ``D``, Craig's ``V(θ, θ̇)`` and ``G(θ)``; either side first)?"""
+    g(q) = τ`` (Spong's ``D``, Craig's ``V(θ, θ̇)`` and ``G(θ)``, Siciliano's ``B(q)``, Lynch &
+    Park's ``c(θ, θ̇)``; either side first)?"""
     left, right = normalise(lhs), normalise(rhs)
     if _RHS_TORQUE.match(left) and not _RHS_TORQUE.match(right):
         left, right = right, left

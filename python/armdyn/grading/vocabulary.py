@@ -15,11 +15,12 @@ pc             ``p_{c1}``, ``r_{c_2}``, ``x_{c1}`` / ``y_{c1}`` / ``z_{c1}`` (on
 vc             ``v_{c1}``, ``\\dot p_{c1}``, ``\\dot x_{c1}``; squared: ``v_{c1}^2``,
                ``|v_{c1}|^2``, ``v_{c1}^T v_{c1}``, ``v_{c1} \\cdot v_{c1}``
 Jv, Jw         ``J_{v_1}``, ``J_{v_{c1}}``, ``J_{\\omega_1}``
-M              ``M``, ``D``, ``H``, ``M(q)``, ``D(q)``, ``M(\\theta)``, ``H(q)``; entries
-               ``d_{11}``, ``m_{12}``, ``M_{11}``, ``D_{21}``
+M              ``M``, ``D``, ``H``, ``B``, ``M(q)``, ``D(q)``, ``M(\\theta)``, ``H(q)``, ``B(q)``;
+               entries ``d_{11}``, ``m_{12}``, ``M_{11}``, ``D_{21}``, ``b_{12}``
 christoffel    ``c_{ijk}``, ``\\Gamma_{ijk}``, ``h_{ijk}`` (three indices)
 C              ``C``, ``C(q,\\dot q)`` (the Coriolis matrix)
-h              ``V(\\theta,\\dot\\theta)`` (Craig), ``h``, ``b(q,\\dot q)``; entries ``h_i``
+h              ``V(\\theta,\\dot\\theta)`` (Craig), ``c(\\theta,\\dot\\theta)`` (Lynch & Park), ``h``,
+               ``b(q,\\dot q)``, ``C(q,\\dot q)\\dot q``; entries ``h_i``
 G              ``g(q)``, ``G(\\theta)``, ``G``; entries ``g_k``, ``G_k``, ``\\phi_k``
                (``g`` alone is the gravity constant, not a step)
 =============  ==================================================================
@@ -90,12 +91,14 @@ def energy_lhs(s: str, ref_type):
         return ref_type("V", alias=s, by_shape=s in ("V", "P"))
     if s in ("L", "H") and not had_args:
         return ref_type("L", alias=s, by_shape=True) if s == "L" else ref_type("M", alias="H", by_shape=True)
-    if s in ("M", "D", "H"):
+    if s in ("M", "D", "H", "B"):  # B(q): Siciliano et al.
         return ref_type("M", alias=s)
     if s == "C":
         return ref_type("C", alias=s)
-    if s in ("h", "b") or (s == "V" and had_args):
+    if s in ("h", "b") or (s in ("V", "c") and had_args):  # c(θ, θ̇): Lynch & Park
         return ref_type("h", alias=s)
+    if re.fullmatch(r"C(?:\([^()]*\))?\\dot\{(?:q|\\theta|\\boldsymbol\{q\})\}", s):  # C(q, q̇) q̇
+        return ref_type("h", alias="C q̇")
     if s in ("G",) or (s == "g" and had_args):
         return ref_type("G", alias=s)
     # |v|^2, v^T v, v . v
@@ -138,7 +141,7 @@ def _indexed(s: str, ref_type):
         return None
     if base in ("c", "\\Gamma", "h") and _digits(sub, 3):
         return ref_type("christoffel", entry=_digits(sub, 3), alias=base)
-    if base in ("d", "m", "M", "D") and _digits(sub, 2):
+    if base in ("d", "m", "M", "D", "b", "B") and _digits(sub, 2):
         return ref_type("M", entry=_digits(sub, 2), alias=base)
     if base in ("h", "b") and _index(sub) is not None:
         return ref_type("h", entry=(_index(sub),), alias=base)
