@@ -434,3 +434,9 @@ def test_siciliano_and_lynch_park_names(tmp_path):
         ("matrix_form", "correct"),
     ]
     assert "Lynch & Park" in r.steps[4].message
+
+
+def test_a_bare_letter_names_a_matrix_only_when_its_value_is_one(tmp_path):
+    # M = m_1 + m_2 (a total mass in a proof), C = 3: not the mass or Coriolis matrix
+    r = _grade(tmp_path, f"$$M = m_1 + m_2$$\n\n$$C = 3$$\n\n$$G = {tex(GRAV)}$$\n")
+    assert [(v.key, v.status) for v in r.steps] == [("", "unrecognised"), ("", "unrecognised"), ("G", "correct")]

@@ -8,10 +8,11 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ..errors import ModelError
 from .lagrange_terms import ModelTerms, grade_model_step, potential_shift
 from .notation import StepRef
 from .verdict import PASSING, StepVerdict
-from .vocabulary import MODEL_KEYS, by_shape, student_names
+from .vocabulary import MODEL_KEYS, NOT_A_STEP, SOFT, by_shape, student_names
 
 #: the steps whose values the matrix form M q̈ + C q̇ + g = τ states
 _MATRICES = ("M", "C", "h", "G", "christoffel")
@@ -49,16 +50,25 @@ class EnergySteps:
         """(the reading of ``ref`` its value's shape gives, what was assumed); (None, _)
         after recording an unrecognised equation."""
         probe = StepRef(ref.key, ref.index, ref.frame, ref.alias, ref.part, ref.entry, True, ref.sign)
-        value, problem = self.value(eq, probe)
+        soft = ref.key in SOFT  # a bare M, C, G, h: unnamed unless its value is a matrix or vector
+        try:
+            value, problem = self.value(eq, probe)
+        except ModelError as err:
+            if not soft:
+                raise
+            value, problem = None, f"{NOT_A_STEP}; read as the {ref.name} of the method: {err.message}"
         if value is None:
-            self._unrecognised(eq, problem, name=ref.name, key=ref.key)
+            self._unrecognised(eq, problem, name="" if soft else ref.name, key="" if soft else ref.key)
             return None, ""
         prismatic = None
         if ref.key == "f" and ref.index is not None and 1 <= ref.index <= self.robot.dof:
             prismatic = _prismatic(self.robot, ref.index)
-        new, assumed = by_shape(ref, value, lambda key, index=None, **kw: StepRef(key, index, **kw), prismatic)
+        new, assumed = by_shape(
+            ref, value, lambda key, index=None, **kw: StepRef(key, index, **kw), prismatic, self.robot.dof
+        )
         if new is None:
-            self._unrecognised(eq, assumed, name=ref.name, key=ref.key)
+            named = not (soft and assumed == NOT_A_STEP)
+            self._unrecognised(eq, assumed, name=ref.name if named else "", key=ref.key if named else "")
             return None, ""
         return new, assumed
 

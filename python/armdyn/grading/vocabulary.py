@@ -91,16 +91,18 @@ def energy_lhs(s: str, ref_type):
         return ref_type("V", alias=s, by_shape=s in ("V", "P"))
     if s in ("L", "H") and not had_args:
         return ref_type("L", alias=s, by_shape=True) if s == "L" else ref_type("M", alias="H", by_shape=True)
+    # a bare letter is a matrix or vector of the method only when its value is one
+    # (M = m_1 + m_2 in a proof is a total mass): by_shape
     if s in ("M", "D", "H", "B"):  # B(q): Siciliano et al.
-        return ref_type("M", alias=s)
+        return ref_type("M", alias=s, by_shape=not had_args)
     if s == "C":
-        return ref_type("C", alias=s)
+        return ref_type("C", alias=s, by_shape=not had_args)
     if s in ("h", "b") or (s in ("V", "c") and had_args):  # c(θ, θ̇): Lynch & Park
-        return ref_type("h", alias=s)
+        return ref_type("h", alias=s, by_shape=not had_args)
     if re.fullmatch(r"C(?:\([^()]*\))?\\dot\{(?:q|\\theta|\\boldsymbol\{q\})\}", s):  # C(q, q̇) q̇
         return ref_type("h", alias="C q̇")
     if s in ("G",) or (s == "g" and had_args):
-        return ref_type("G", alias=s)
+        return ref_type("G", alias=s, by_shape=not had_args)
     # |v|^2, v^T v, v . v
     sq = re.fullmatch(r"(?:\||\\\||\\lVert|\\vert|\\Vert)(.+?)(?:\||\\\||\\rVert|\\vert|\\Vert)\^\{?2\}?", s)
     if sq:
@@ -214,7 +216,12 @@ def model_name(ref) -> str:
     return f"{ref.key}_{entry}" if entry else ref.key
 
 
-def by_shape(ref, value, step_ref, is_prismatic=None):
+#: bare letters that are the method's matrices or vectors only when their value is one
+SOFT = ("M", "C", "G", "h")
+NOT_A_STEP = "not a step of Newton-Euler or Lagrange (skipped)"
+
+
+def by_shape(ref, value, step_ref, is_prismatic=None, dof=0):
     """The reading of a ``by_shape`` left-hand side given its value, and what was assumed
     (None when the shape fits no reading). ``value``: SymPy scalar or matrix;
     ``step_ref(key, index, **kw)`` builds the new reference."""
@@ -247,10 +254,10 @@ def by_shape(ref, value, step_ref, is_prismatic=None):
             f"a {shape[0]}x{shape[1]} {name} is an angular momentum, not the Lagrangian: name its link "
             f"({name}_1) to have it checked"
         )
-    if ref.key == "M" and ref.alias == "H":  # H: the mass matrix (n x n) or an angular momentum
-        if column and shape[0] == 3:
-            return None, "a 3-vector H is an angular momentum: name its link (H_1) to have it checked"
-        return step_ref("M", alias="H"), ""
+    if ref.key == "M" and ref.alias == "H" and column and shape[0] == 3:
+        return None, "a 3-vector H is an angular momentum: name its link (H_1) to have it checked"
+    if ref.key in SOFT and (scalar and not isinstance(value, sp.MatrixBase)) and dof != 1:
+        return None, NOT_A_STEP  # a scalar M, C, G, h: a total mass, a constant, a height...
     if ref.key == "omega":
         if scalar and not vector_reading:
             return step_ref("w", ref.index), (
