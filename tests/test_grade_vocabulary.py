@@ -249,9 +249,9 @@ def test_a_slip_in_the_mass_matrix_makes_the_matrix_form_wrong(tmp_path):
     wrong = D.copy()
     wrong[0, 0] = D[0, 0] - I2  # I_2 forgotten in d11
     r = _grade(tmp_path, f"$$M = {tex(wrong)}$$\n\n$$M\\ddot q + C\\dot q + g = \\tau$$\n")
-    assert _status(r) == [("M", "wrong"), ("matrix_form", "wrong")]
+    assert _status(r) == [("M", "wrong"), ("matrix_form", "follows-from-earlier-error")]
     assert r.steps[0].components == [0]
-    assert "M (line" in r.steps[1].message
+    assert r.steps[1].caused_by == "M" and "M (line" in r.steps[1].message
 
 
 def test_christoffel_other_index_order_is_named(tmp_path):
@@ -440,3 +440,16 @@ def test_a_bare_letter_names_a_matrix_only_when_its_value_is_one(tmp_path):
     # M = m_1 + m_2 (a total mass in a proof), C = 3: not the mass or Coriolis matrix
     r = _grade(tmp_path, f"$$M = m_1 + m_2$$\n\n$$C = 3$$\n\n$$G = {tex(GRAV)}$$\n")
     assert [(v.key, v.status) for v in r.steps] == [("", "unrecognised"), ("", "unrecognised"), ("G", "correct")]
+
+
+def test_the_spong_matrices_example_gives_its_known_verdict():
+    from pathlib import Path
+
+    r = grade(Path(__file__).resolve().parent.parent / "examples" / "grading" / "planar-2r-spong-matrices.md")
+    assert r.first_wrong == "M_12"
+    assert [v.name for v in r.steps if v.status == "wrong"] == ["M_12"]
+    follows = [(v.name, v.caused_by) for v in r.steps if v.status == "follows-from-earlier-error"]
+    assert follows == [("matrix_form", "M_12")]
+    assert sum(v.name.startswith("c_") and v.status == "correct" for v in r.steps) == 8
+    assert all(v.status == "correct" for v in r.steps if v.name not in ("M_12", "matrix_form"))
+    assert r.tau_correct == [False, False]

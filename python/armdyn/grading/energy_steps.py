@@ -11,8 +11,9 @@ import sympy as sp
 from ..errors import ModelError
 from .lagrange_terms import ModelTerms, grade_model_step, potential_shift
 from .notation import StepRef
+from .text import NOT_A_STEP
 from .verdict import PASSING, StepVerdict
-from .vocabulary import MODEL_KEYS, NOT_A_STEP, SOFT, by_shape, student_names
+from .vocabulary import MODEL_KEYS, SOFT, by_shape, student_names
 
 #: the steps whose values the matrix form M q̈ + C q̇ + g = τ states
 _MATRICES = ("M", "C", "h", "G", "christoffel")
@@ -128,13 +129,15 @@ class EnergySteps:
             v.message = assumed + ("; " + v.message if v.message else "")
 
     def _matrix_form(self, eq) -> None:
-        """``M q̈ + C q̇ + g = τ`` stated: right when every matrix given before it is."""
+        """``M q̈ + C q̇ + g = τ`` stated: right when every matrix given before it is, else
+        it follows from the first wrong one."""
         given = [v for v in self.verdicts if v.key in _MATRICES]
         bad = [v for v in given if v.status not in PASSING]
-        if bad:
-            status = "wrong"
-            message = "the matrices given earlier are not all right: " + ", ".join(
-                f"{v.name} (line {v.line})" for v in bad[:4]
+        caused_by = None
+        if bad:  # the law is stated right; it inherits the wrong matrices
+            status, caused_by = "follows-from-earlier-error", bad[0].name
+            message = f"follows from the error in {caused_by}: the matrices given earlier are not all right: " + (
+                ", ".join(f"{v.name} (line {v.line})" for v in bad[:4])
             )
         else:
             status = "correct"
@@ -153,6 +156,7 @@ class EnergySteps:
                 source=eq.source,
                 line=eq.line,
                 message=message,
+                caused_by=caused_by,
             )
         )
 

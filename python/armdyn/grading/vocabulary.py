@@ -36,6 +36,8 @@ from __future__ import annotations
 
 import re
 
+from .text import NOT_A_STEP
+
 _KINETIC = r"K|T|KE|k|E_\{?k\}?|E_\{?kin\}?|KE"
 _POTENTIAL = r"U|V|P|PE|u|E_\{?p\}?|E_\{?pot\}?"
 #: a function's arguments as students write them after a name: (q), (q,\dot{q}), (\theta,\dot\theta)
@@ -218,7 +220,6 @@ def model_name(ref) -> str:
 
 #: bare letters that are the method's matrices or vectors only when their value is one
 SOFT = ("M", "C", "G", "h")
-NOT_A_STEP = "not a step of Newton-Euler or Lagrange (skipped)"
 
 
 def by_shape(ref, value, step_ref, is_prismatic=None, dof=0):
