@@ -211,10 +211,13 @@ def grade_model_step(grader, ref, eq, value) -> StepVerdict:
     if status == "wrong":
         d = _matrix(got) - _matrix(expected)
         diff = d.applyfunc(lambda x: tidy(x, robot)) if d.shape != (1, 1) else tidy(d[0], robot)
+    shown = (
+        expected.applyfunc(lambda x: tidy(x, robot)) if isinstance(expected, sp.MatrixBase) else tidy(expected, robot)
+    )
     return StepVerdict(
         link=link,
         status=status,
-        expected=expected,
+        expected=shown,
         got=got,
         difference=diff,
         components=components,
