@@ -102,6 +102,7 @@ def _lhs(text, robot="planar-2r"):
         (r"{}^{1}f_1", "f", 1, 1),
         (r"{}^{1}n_1", "n", 1, 1),
         (r"{}^{0}P_{1}", "P", 1, 0),
+        (r"{}^{1}P_{2}", "P", 2, 1),
         (r"{}^{1}P_{C_1}", "Pc", 1, 1),
         (r"\vec{\omega}_1", "omega", 1, None),
         (r"\bm{F}_2", "F", 2, None),
@@ -453,3 +454,9 @@ def test_the_spong_matrices_example_gives_its_known_verdict():
     assert sum(v.name.startswith("c_") and v.status == "correct" for v in r.steps) == 8
     assert all(v.status == "correct" for v in r.steps if v.name not in ("M_12", "matrix_form"))
     assert r.tau_correct == [False, False]
+
+
+def test_a_scalar_angular_velocity_only_on_a_planar_arm(tmp_path):
+    # the PUMA's links turn about axes that are not parallel: a scalar ω_2 is no reading of it
+    r = _grade(tmp_path, r"$$\omega_2 = \dot{q}_2$$" + "\n", head="---\nrobot: puma560\n---\n\n")
+    assert r.steps[0].status == "unrecognised" and "more than one axis" in r.steps[0].message

@@ -256,13 +256,10 @@ def _fit(ref, value, expected, sampler):
         return value, expected, ""
     if exp_shape[1] == 1 and shape == (1, exp_shape[0]):
         return value.T, expected, ""
-    if exp_shape == (3, 1) and shape in ((2, 1), (1, 2)) and ref.key in ("pc", "vc", "w"):
-        flat = sp.Matrix(list(value))
-        if not np.allclose(sampler.fingerprint(expected[2]), 0) and ref.key != "w":
+    if exp_shape == (3, 1) and shape in ((2, 1), (1, 2)) and ref.key in ("pc", "vc"):  # a planar (x, y)
+        if not np.allclose(sampler.fingerprint(expected[2]), 0):
             return None, expected, "two components given, but the model's z component is not zero"
-        if ref.key == "w":
-            return None, expected, "an angular velocity has 3 components (or 1 for a planar arm)"
-        return flat, expected[:2, 0], "(x, y) compared: z is 0 in the model"
+        return sp.Matrix(list(value)), expected[:2, 0], "(x, y) compared: z is 0 in the model"
     if shape == (1, 1) and value == 0 and exp_shape != (1, 1):
         return sp.zeros(*exp_shape), expected, ""
     if ref.key == "Tl" and shape == (4, 4):
