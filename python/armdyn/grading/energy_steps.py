@@ -121,10 +121,11 @@ class EnergySteps:
         v = self.verdicts[-1] if self.verdicts else None
         if v is None:
             return
-        if shift is not None and v.status == "correct":
-            v.status = "correct-by-convention"
-            v.convention = f"another reference level for the potential energy (yours = the model's + {shift})"
-            v.message = v.convention
+        if shift is not None:
+            level = f"another reference level for the potential energy (yours = the model's + {shift})"
+            if v.status == "correct":
+                v.status, v.convention = "correct-by-convention", level
+            v.message = level + ("; " + v.message if v.message else "")
         if assumed:
             v.message = assumed + ("; " + v.message if v.message else "")
 
