@@ -460,3 +460,11 @@ def test_a_scalar_angular_velocity_only_on_a_planar_arm(tmp_path):
     # the PUMA's links turn about axes that are not parallel: a scalar ω_2 is no reading of it
     r = _grade(tmp_path, r"$$\omega_2 = \dot{q}_2$$" + "\n", head="---\nrobot: puma560\n---\n\n")
     assert r.steps[0].status == "unrecognised" and "more than one axis" in r.steps[0].message
+
+
+def test_tau_as_one_bold_column_with_a_slip(tmp_path):
+    tau = _rp_tau()
+    slipped = sp.Matrix([tau[0], tau[1] + d2])  # a stray d_2 in τ_2
+    r = _grade(tmp_path, f"$$\\boldsymbol{{\\tau}} = {tex_rp(slipped)}$$\n", head=RP_HEAD, name="rp.md")
+    assert _status(r) == [("tau_1", "correct"), ("tau_2", "wrong")]
+    assert r.tau_correct == [True, False]
