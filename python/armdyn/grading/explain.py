@@ -82,9 +82,19 @@ def to_ascii(text: str) -> str:
         dots = {"\u0307": "_dot", "\u0308": "_ddot"}.get(accent or "", "")
         return _LATIN.get(base, base) + digits.translate(_SUBSCRIPT) + dots
 
+    text = text.replace("ᵀ", "^T").replace("Ṁ", "M\u0307")  # a transpose; Ṁ precomposed
     text = re.sub("([A-Za-z\u0370-\u03ff])([\u0307\u0308])?([\\d₀-₉]*)", name, text)
     text = re.sub("[⁰¹²³⁴⁵⁶⁷⁸⁹]+", lambda m: "**" + "".join(_SUPERSCRIPT[c] for c in m.group(0)), text)
-    for a, b in (("·", "*"), ("−", "-"), ("→", "->"), ("×", "x"), ("…", "...")):
+    for a, b in (
+        ("·", "*"),
+        ("−", "-"),
+        ("→", "->"),
+        ("×", "x"),
+        ("…", "..."),
+        ("½", "1/2"),
+        ("∂", "d"),
+        ("Γ", "Gamma"),
+    ):
         text = text.replace(a, b)
     return text.encode("ascii", "replace").decode()
 

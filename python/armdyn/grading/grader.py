@@ -16,6 +16,7 @@ from ..errors import ModelError
 from ..model import Robot
 from ..symbolic.names import latex_symbol_names
 from .diagnose import unreadable
+from .energy_steps import EnergySteps
 from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, tidy
 from .latex import LatexError, UnknownSymbol, parse, parse_sympy_syntax
@@ -23,8 +24,9 @@ from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
 from .reader import Submission, read
-from .statements import FREE_END, lagrange_law
+from .statements import FREE_END, lagrange_law, matrix_form
 from .verdict import PASSING, GradeReport, StepVerdict
+from .vocabulary import MODEL_KEYS, student_names
 
 _NAMED = {  # step names as armdyn reports them, accepted as left-hand sides in YAML
     "omega": "omega",
@@ -63,7 +65,7 @@ def _load_robot(name: str, sub: Submission) -> Robot:
         raise err.located(source=sub.path) from None
 
 
-class _Grader:
+class _Grader(EnergySteps):
     def __init__(self, sub: Submission, robot: Robot, symbols: dict | None):
         self.sub = sub
         self.robot = robot
@@ -148,6 +150,8 @@ class _Grader:
         return self._shape(value, ref, eq), None
 
     def _shape(self, value, ref: StepRef, eq):
+        if ref.by_shape or ref.key in MODEL_KEYS or ref.key in ("Lang", "tau_vec"):
+            return to_sympy(value)  # shaped where it is read (vocabulary.by_shape, lagrange_terms)
         vector = ref.key in VECTOR_KEYS or ref.key in ("P", "Pc")
         if ref.key == "R":
             want = (3, 3)
@@ -199,7 +203,8 @@ class _Grader:
             done = len(self.verdicts)
             self._equation(eq, seen_methods, context)
             if self.verdicts[done:] and self.verdicts[-1].key not in ("", "R", "P", "Pc", "law", "tau"):
-                context = "lagrange" if self.verdicts[-1].key in LAGRANGE_KEYS else "newton-euler"
+                last = self.verdicts[-1].key
+                context = "lagrange" if last in LAGRANGE_KEYS or last in MODEL_KEYS else "newton-euler"
             for v in self.verdicts[done:]:
                 v.part, v.task, v.column = eq.part, eq.task, eq.column
         self.verdicts = grade_proofs(self.sub, self.verdicts)  # rigid-body proofs: every link checked
@@ -238,7 +243,13 @@ class _Grader:
                     )
                 )
                 return
+            if eq.latex and matrix_form(eq.lhs, str(eq.value)):
+                self._matrix_form(eq)
+                return
             self._unrecognised(eq, "not a step of Newton-Euler or Lagrange (skipped)")
+            return
+        ref, assumed = self._vocabulary(ref, eq, seen_methods)  # energy-method names; by the value's shape
+        if ref is None:
             return
         n_links = len(self.robot.links) - 1
         if ref.key in ("f", "n") and ref.index == n_links + 1:
@@ -258,14 +269,18 @@ class _Grader:
         if value is None:
             self._unrecognised(eq, problem, name=ref.name, key=ref.key)
             return
+        own_value = value
+        value, assumed, shift = self._adjust(ref, value, assumed)
         if ref.key == "R":
             self._rotation(ref, eq, value)
         elif ref.key in ("P", "Pc"):
             self._position(ref, eq, value)
         else:
             self._step(self.world(method), ref, eq, value, method)
+        self._note(assumed, shift)
         if ref.key in ("T", "V", "L"):
-            self.symbols.steps[ref.key] = value
+            for name in student_names(ref):
+                self.symbols.steps[name] = own_value
 
     def _report(self, seen_methods: list, method_hint: str | None) -> GradeReport:
         recognised = [v for v in self.verdicts if v.key]  # a step named, even if its value was unreadable

@@ -12,6 +12,15 @@ frame given neither as a superscript nor as Craig's pre-superscript is the link'
                   given), P_{C_i}^j (link i's mass centre from frame i's origin, in frame j)
     Lagrange      T, V, L, \\frac{\\partial L}{\\partial \\dot q_k}, \\partial L / \\partial \\dot q_k,
                   \\frac{d}{dt}\\frac{\\partial L}{\\partial \\dot q_k}, \\frac{\\partial L}{\\partial q_k}, \\tau_k
+                  (also -\\frac{\\partial L}{\\partial q_k}: the negated partial, sign = -1)
+    energy method the textbooks' names of :mod:`.vocabulary`: energies K, T, KE, E_k, U, V, P,
+                  PE, E_p (per link with an index), mass centres p_{c1}, x_{c1}, v_{c1},
+                  v_{c1}^2, Jacobians J_{v_1}, J_{\\omega_1}, D(q) / M(q) and d_{jk},
+                  c_{ijk}, C(q, \\dot q), V(\\theta, \\dot\\theta) / h, g(q) / G and g_k,
+                  (\\tau_1, \\tau_2)^T; a name marked ``by_shape`` (P_1, V, L, H, f_k, a
+                  scalar \\omega_i) is decided by the value's shape in the grader
+
+Mass centres are written C, c, G, cm in the subscript (``C_1``, ``c1``, ``G_1``, ``{cm,1}``).
 
 Bold, hat and roman wrappers (\\mathbf, \\boldsymbol, \\bm, \\mathrm, \\vec) are looked
 through. Symbols map to the model's by name (``\\theta_1`` -> ``theta1``,
@@ -29,6 +38,7 @@ import sympy as sp
 
 from ..model import Robot
 from .latex import LatexError, Name, UnknownSymbol, parse
+from .vocabulary import MODEL_KEYS, energy_lhs, mass_centre, model_name
 
 VECTOR_KEYS = ("omega", "omega_dot", "v_dot", "vc_dot", "F", "N", "f", "n")
 LAGRANGE_KEYS = ("T", "V", "L", "dL_dqd", "ddt_dL_dqd", "dL_dq")
@@ -51,9 +61,19 @@ class StepRef:
     index: int | None = None
     frame: int | None = None
     alias: str = ""
+    #: energy method: "x"/"y"/"z" (one component of a position or velocity), "sq" (a squared speed)
+    part: str = ""
+    #: matrix entry (1-based): (j, k) of M, (i, j, k) of a Christoffel symbol, (k,) of h or G
+    entry: tuple = ()
+    #: the value's shape decides between two readings (see :func:`.vocabulary.by_shape`)
+    by_shape: bool = False
+    #: -1 for a left-hand side written negated (``-\frac{\partial L}{\partial q_1}``)
+    sign: int = 1
 
     @property
     def name(self) -> str:
+        if self.key in MODEL_KEYS or self.key == "Lang":
+            return model_name(self)
         if self.key == "R":
             return f"R_{self.index}^{self.frame}"
         if self.key in ("P", "Pc"):
@@ -78,9 +98,16 @@ def normalise(lhs: str) -> str:
         if t == s:
             break
         s = t
+    # Lagrange's primes for time derivatives: q_1' -> \dot{q}_1, \theta_1'' -> \ddot{\theta}_1
+    s = re.sub(r"(\\[A-Za-z]+|[A-Za-z])(_\{[^{}]*\}|_[A-Za-z0-9])?('{1,2})", _primed, s)
     s = re.sub(r"\s+", "", s)
     s = re.sub(r"\\(d?dot)(\\[A-Za-z]+|[A-Za-z])", r"\\\1{\2}", s)
+    s = re.sub(r"\{(\\d?dot\{[^{}]*\})\}", r"\1", s)  # {\dot q}_1 -> \dot{q}_1
     return s
+
+
+def _primed(m) -> str:
+    return f"\\{'dot' if len(m.group(3)) == 1 else 'ddot'}{{{m.group(1)}}}{m.group(2) or ''}"
 
 
 def _scripts(s: str, i: int):
@@ -130,10 +157,7 @@ _BASES = {
 }
 
 
-def _mass_centre(sub: str) -> int | None:
-    """i of a subscript naming link i's mass centre (``C_1``, ``{c1}``, ``\\mathrm{C}_1``)."""
-    m = re.fullmatch(r"[Cc](\d+)", re.sub(r"[{}\s,_]|\\mathrm", "", sub))
-    return int(m.group(1)) if m else None
+_mass_centre = mass_centre
 
 
 def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
@@ -144,11 +168,18 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
     s = normalise(lhs)
     if not s:
         return None
+    sign = 1
+    if s.startswith("-") and len(s) > 1:  # -\frac{\partial L}{\partial q_1} = ...: the negated partial
+        s, sign = s[1:], -1
     lag = _lagrange(s, coordinate_of)
     if lag is not None:
-        return lag
-    if s in ("T", "V", "L", "\\mathcal{L}", "\\mathcal{T}"):
-        return StepRef(s[-1] if len(s) == 1 else s[-2])
+        return lag if sign == 1 else StepRef(lag.key, lag.index, sign=-1)
+    if sign == -1:
+        return None
+    s = re.sub(r"^\{(\\d?dot\{[^{}]*\})\}", r"\1", s)  # {\dot v}_{c_1}
+    named = energy_lhs(s, lambda key, index=None, **kw: StepRef(key, index, **kw))
+    if named is not None:
+        return named
 
     # pre-scripts: {}^{j}_{a} or ^{j}
     pre_sub = pre_sup = None

@@ -82,3 +82,21 @@ def lagrange_law(lhs: str, rhs: str) -> tuple[bool, str] | None:
     if kinds["ddt"] == -1 and kinds["dq"] == 1:
         return False, f"the terms are in the wrong order: ∂L/∂q − d/dt ∂L/∂q̇ is −τ; the law is {LAW}"
     return False, f"wrong sign on {'∂L/∂q' if kinds['ddt'] == 1 else 'd/dt ∂L/∂q̇'}: the law is {LAW}"
+
+
+_MATRIX_LETTER = re.compile(r"^(?:M|D|H|C|V|G|g|B|N|h|b|c)(?:\([^()]*\))?")
+
+
+def matrix_form(lhs: str, rhs: str) -> bool:
+    """Is ``lhs = rhs`` the equations of motion in matrix form, ``M(q) q̈ + C(q, q̇) q̇ +
+    g(q) = τ`` (Spong's ``D``, Craig's ``V(θ, θ̇)`` and ``G(θ)``, Siciliano's ``B(q)``, Lynch &
+    Park's ``c(θ, θ̇)``; either side first)?"""
+    left, right = normalise(lhs), normalise(rhs)
+    if _RHS_TORQUE.match(left) and not _RHS_TORQUE.match(right):
+        left, right = right, left
+    if not _RHS_TORQUE.match(right):
+        return False
+    terms = [t for _, t in _signed_terms(left)]
+    if not 2 <= len(terms) <= 5 or not all(_MATRIX_LETTER.match(t) for t in terms):
+        return False
+    return "\\ddot{" in terms[0] and all(len(t) <= 40 for t in terms)

@@ -39,6 +39,8 @@ NOT_A_STEP = "not a step of Newton-Euler or Lagrange (skipped)"
 def step_title(v: StepVerdict, ascii_only: bool = False) -> str:
     """``v̇_1`` (Unicode) or the step's name (ASCII)."""
     if v.key == "law":
+        if v.name == "matrix_form":  # M q̈ + C q̇ + g = τ stated
+            return "matrix form" if not ascii_only else v.name
         return "Lagrange eq." if not ascii_only else "lagrange_equation"
     if ascii_only or v.key not in _KEY_TEXT:
         return v.name or "?"

@@ -1,0 +1,289 @@
+"""The textbooks' names for the energy-method quantities, read from a normalised
+left-hand side (:func:`armdyn.grading.notation.normalise`).
+
+Craig, Spong-Hutchinson-Vidyasagar, Siciliano et al. and Lynch-Park name the same
+quantities differently; each name below maps to one key of
+:class:`~armdyn.grading.notation.StepRef`:
+
+=============  ==================================================================
+key            names
+=============  ==================================================================
+T (total)      ``K``, ``T``, ``KE``, ``k``, ``E_k``, ``\\mathcal{K}``, ``\\mathcal{T}``
+V (total)      ``U``, ``V``, ``P``, ``PE``, ``u``, ``E_p``, ``\\mathcal{U}``, ``\\mathcal{V}``, ``\\mathcal{P}``
+Tl, Vl         the same with a link index: ``K_1``, ``T_2``, ``KE_1``, ``PE_1``, ``u_2``, ``P_1``
+pc             ``p_{c1}``, ``r_{c_2}``, ``x_{c1}`` / ``y_{c1}`` / ``z_{c1}`` (one component)
+vc             ``v_{c1}``, ``\\dot p_{c1}``, ``\\dot x_{c1}``; squared: ``v_{c1}^2``,
+               ``|v_{c1}|^2``, ``v_{c1}^T v_{c1}``, ``v_{c1} \\cdot v_{c1}``
+Jv, Jw         ``J_{v_1}``, ``J_{v_{c1}}``, ``J_{\\omega_1}``
+M              ``M``, ``D``, ``H``, ``B``, ``M(q)``, ``D(q)``, ``M(\\theta)``, ``H(q)``, ``B(q)``;
+               entries ``d_{11}``, ``m_{12}``, ``M_{11}``, ``D_{21}``, ``b_{12}``
+christoffel    ``c_{ijk}``, ``\\Gamma_{ijk}``, ``h_{ijk}`` (three indices)
+C              ``C``, ``C(q,\\dot q)`` (the Coriolis matrix)
+h              ``V(\\theta,\\dot\\theta)`` (Craig), ``c(\\theta,\\dot\\theta)`` (Lynch & Park), ``h``,
+               ``b(q,\\dot q)``, ``C(q,\\dot q)\\dot q``; entries ``h_i``
+G              ``g(q)``, ``G(\\theta)``, ``G``; entries ``g_k``, ``G_k``, ``\\phi_k``
+               (``g`` alone is the gravity constant, not a step)
+=============  ==================================================================
+
+A name whose meaning depends on what it is given (``P_1``: an energy or Craig's
+position; ``V``: the potential energy or Craig's centrifugal/Coriolis vector; ``L``: the
+Lagrangian or an angular momentum; ``f_k``: a joint force or Newton-Euler's force; a
+scalar ``\\omega_1``) is marked ``by_shape``: the grader decides from the value's shape and
+says which reading it took (:func:`by_shape`).
+"""
+
+from __future__ import annotations
+
+import re
+
+from .text import NOT_A_STEP
+
+_KINETIC = r"K|T|KE|k|E_\{?k\}?|E_\{?kin\}?|KE"
+_POTENTIAL = r"U|V|P|PE|u|E_\{?p\}?|E_\{?pot\}?"
+#: a function's arguments as students write them after a name: (q), (q,\dot{q}), (\theta,\dot\theta)
+_ARGS = re.compile(r"\(([\\A-Za-z{},]+)\)$")  # one character class: linear, no nested repetition
+_ARG = re.compile(r"\\?[A-Za-z]+|\\d?dot\{\\?[A-Za-z]+\}")
+#: a left-hand side longer than this names no quantity (bounds the regular expressions below)
+MAX_LHS = 120
+_MC = r"(?:[CcG]|cm|CM|com)"
+
+
+def mass_centre(sub: str | None) -> int | None:
+    """i of a subscript naming link i's mass centre (``C_1``, ``{c1}``, ``G_1``, ``cm,1``)."""
+    if sub is None:
+        return None
+    m = re.fullmatch(_MC + r"(\d+)", re.sub(r"[{}\s,_]|\\mathrm|\\text", "", sub))
+    return int(m.group(1)) if m else None
+
+
+def _digits(sub: str | None, count: int) -> tuple | None:
+    """The ``count`` one-digit indices of ``{12}``, ``{1,2}``, ``{1 2}``, or None."""
+    if sub is None:
+        return None
+    t = re.sub(r"[{}\s,_]", "", sub)
+    return tuple(int(c) for c in t) if len(t) == count and t.isdigit() else None
+
+
+def _index(sub: str | None) -> int | None:
+    if sub is None:
+        return None
+    t = re.sub(r"[{}\s]", "", sub)
+    return int(t) if t.isdigit() else None
+
+
+def energy_lhs(s: str, ref_type):
+    """The StepRef (built by ``ref_type``) of an energy-method name in the normalised
+    left-hand side ``s``, or None."""
+    if s in ("\\tau", "\\boldsymbol{\\tau}") or re.fullmatch(
+        r"\((?:\\tau_\{?\d\}?,?)+\)\^(?:\{?T\}?|\\top|\{\\top\}|\{\\mathrm\{T\}\})", s
+    ):
+        return ref_type("tau_vec")  # the joint torques as one column: (\tau_1, \tau_2)^T = ...
+    if len(s) > MAX_LHS:
+        return None
+    had_args = False
+    m = _ARGS.search(s)
+    if m and m.start() > 0 and all(_ARG.fullmatch(a) for a in m.group(1).split(",")):
+        s, had_args = s[: m.start()], True
+    # totals
+    if re.fullmatch(_KINETIC, s):
+        return ref_type("T", alias=s)
+    if re.fullmatch(_POTENTIAL, s):
+        if s == "V" and had_args and m and "dot" in m.group(0):
+            return ref_type("h", alias="V")  # Craig's V(θ, θ̇): the centrifugal/Coriolis vector
+        return ref_type("V", alias=s, by_shape=s in ("V", "P"))
+    if s in ("L", "H") and not had_args:
+        return ref_type("L", alias=s, by_shape=True) if s == "L" else ref_type("M", alias="H", by_shape=True)
+    # a bare letter is a matrix or vector of the method only when its value is one
+    # (M = m_1 + m_2 in a proof is a total mass): by_shape
+    if s in ("M", "D", "H", "B"):  # B(q): Siciliano et al.
+        return ref_type("M", alias=s, by_shape=not had_args)
+    if s == "C":
+        return ref_type("C", alias=s, by_shape=not had_args)
+    if s in ("h", "b") or (s in ("V", "c") and had_args):  # c(θ, θ̇): Lynch & Park
+        return ref_type("h", alias=s, by_shape=not had_args)
+    if re.fullmatch(r"C(?:\([^()]*\))?\\dot\{(?:q|\\theta|\\boldsymbol\{q\})\}", s):  # C(q, q̇) q̇
+        return ref_type("h", alias="C q̇")
+    if s in ("G",) or (s == "g" and had_args):
+        return ref_type("G", alias=s, by_shape=not had_args)
+    # |v|^2, v^T v, v . v
+    sq = re.fullmatch(r"(?:\||\\\||\\lVert|\\vert|\\Vert)(.+?)(?:\||\\\||\\rVert|\\vert|\\Vert)\^\{?2\}?", s)
+    if sq:
+        inner = energy_lhs(sq.group(1), ref_type)
+        return ref_type("vc", inner.index, part="sq") if inner is not None and inner.key == "vc" else None
+    dot = re.fullmatch(r"(.+?)(?:\^\{?(?:T|\\top|\\mathrm\{T\})\}?|\\cdot)(.+)", s)
+    if dot and dot.group(1) == re.sub(r"\^\{?(?:T|\\top)\}?$", "", dot.group(2)):
+        inner = energy_lhs(dot.group(1), ref_type)
+        return ref_type("vc", inner.index, part="sq") if inner is not None and inner.key == "vc" else None
+    return _indexed(s, ref_type)
+
+
+def _indexed(s: str, ref_type):
+    dots = 0
+    acc = re.match(r"\\(d?dot)\{([^{}]*)\}", s)
+    if acc:
+        dots = 2 if acc.group(1) == "ddot" else 1
+        s = acc.group(2) + s[acc.end() :]
+    m = re.match(r"(\\[A-Za-z]+|[A-Za-z]+?)(?=[_^]|$)", s)
+    if not m:
+        return None
+    base, rest = m.group(1), s[m.end() :]
+    sub, sup = _split_scripts(rest)
+    if sub is False:
+        return None
+    if base in ("x", "y", "z") and mass_centre(sub) is not None and sup is None and dots < 2:
+        return ref_type("vc" if dots else "pc", mass_centre(sub), part=base)
+    if base in ("p", "r", "v") and mass_centre(sub) is not None and dots + (base == "v") == 1 and (sup in (None, "2")):
+        return ref_type("vc", mass_centre(sub), part="sq" if sup == "2" else "")
+    if base in ("p", "r") and mass_centre(sub) is not None and dots == 0 and sup is None:
+        return ref_type("pc", mass_centre(sub))
+    if dots:
+        return None
+    if base == "J" and sub is not None and sup is None:
+        j = re.fullmatch(r"(v|\\omega|w)" + _MC + r"?(\d+)", re.sub(r"[{}\s,_]|\\mathrm", "", sub))
+        return ref_type("Jv" if j.group(1) == "v" else "Jw", int(j.group(2))) if j else None
+    if sup is not None:
+        return None
+    if base in ("c", "\\Gamma", "h") and _digits(sub, 3):
+        return ref_type("christoffel", entry=_digits(sub, 3), alias=base)
+    if base in ("d", "m", "M", "D", "b", "B") and _digits(sub, 2):
+        return ref_type("M", entry=_digits(sub, 2), alias=base)
+    if base in ("h", "b") and _index(sub) is not None:
+        return ref_type("h", entry=(_index(sub),), alias=base)
+    if base in ("g", "G", "\\phi") and _index(sub) is not None:
+        return ref_type("G", entry=(_index(sub),), alias=base)
+    i = _index(sub)
+    if i is None:
+        e = re.fullmatch(r"\{?([kp]),?(\d+)\}?", sub or "")  # E_{k,1}, E_{p1}
+        if base == "E" and e:
+            return ref_type("Tl" if e.group(1) == "k" else "Vl", int(e.group(2)), alias="E_" + e.group(1))
+        return None
+    if re.fullmatch(_KINETIC, base):
+        return ref_type("Tl", i, alias=base)
+    if re.fullmatch(_POTENTIAL, base):
+        return ref_type("Vl", i, alias=base, by_shape=base == "P")
+    if base in ("L", "H"):
+        return ref_type("Lang", i, alias=base)
+    return None
+
+
+def _split_scripts(rest: str):
+    """(sub, sup) of ``_X^Y`` / ``^Y_X`` (braced or one character), or (False, None)."""
+    sub = sup = None
+    i = 0
+    while i < len(rest):
+        mark = rest[i]
+        if mark not in "_^":
+            return False, None
+        i += 1
+        if i < len(rest) and rest[i] == "{":
+            depth, j = 1, i + 1
+            while j < len(rest) and depth:
+                depth += {"{": 1, "}": -1}.get(rest[j], 0)
+                j += 1
+            text, i = rest[i + 1 : j - 1], j
+        elif i < len(rest) and rest[i] == "\\":
+            mm = re.match(r"\\[A-Za-z]+", rest[i:])
+            text = mm.group(0) if mm else rest[i : i + 2]
+            i += len(text)
+        else:
+            text, i = rest[i : i + 1], i + 1
+        if mark == "_":
+            sub = text if sub is None else sub + "," + text
+        else:
+            sup = text if sup is None else sup + "," + text
+    return sub, sup
+
+
+#: steps checked directly against the model's energy-method quantities (no carry-forward)
+MODEL_KEYS = ("Tl", "Vl", "pc", "vc", "w", "Jv", "Jw", "M", "christoffel", "C", "h", "G")
+
+
+def model_name(ref) -> str:
+    """The step name armdyn reports for an energy-method quantity."""
+    entry = "".join(str(k) for k in ref.entry)
+    if ref.key in ("Tl", "Vl"):
+        return f"{ref.key[0]}_{ref.index}"
+    if ref.key == "pc":
+        return f"{ref.part or 'p'}_c{ref.index}"
+    if ref.key == "vc":
+        return {"sq": f"v_c{ref.index}^2", "": f"v_c{ref.index}"}.get(ref.part, f"{ref.part}dot_c{ref.index}")
+    if ref.key == "w":
+        return f"omega_{ref.index}"
+    if ref.key in ("Jv", "Jw"):
+        return f"J_{ref.key[1]}{ref.index}"
+    if ref.key == "Lang":
+        return f"H_{ref.index}"
+    if ref.key == "christoffel":
+        return f"c_{entry}"
+    return f"{ref.key}_{entry}" if entry else ref.key
+
+
+#: bare letters that are the method's matrices or vectors only when their value is one
+SOFT = ("M", "C", "G", "h")
+
+
+def by_shape(ref, value, step_ref, is_prismatic=None, dof=0):
+    """The reading of a ``by_shape`` left-hand side given its value, and what was assumed
+    (None when the shape fits no reading). ``value``: SymPy scalar or matrix;
+    ``step_ref(key, index, **kw)`` builds the new reference."""
+    import sympy as sp
+
+    shape = value.shape if isinstance(value, sp.MatrixBase) else (1, 1)
+    scalar = shape == (1, 1)
+    # a 0 stands for a zero vector as well (\omega_0 = 0); a frame written makes it a vector
+    vector_reading = ref.frame is not None or (scalar and not isinstance(value, sp.MatrixBase) and value == 0)
+    column = shape[1] == 1 and not scalar
+    name = ref.alias or ref.key
+    if ref.key == "V" and ref.index is None:
+        if scalar:
+            return ref, ""
+        if column and ref.alias != "V":
+            return None, f"a vector {name} names no step: a position is written with its frame, as P_1^0"
+        if column:
+            return step_ref("h", alias="V"), (
+                f"{name} read as Craig's centrifugal and Coriolis vector V(θ, θ̇) (a column; the potential energy is a scalar)"
+            )
+    if ref.key == "Vl":
+        if scalar:
+            return ref, f"{name}_{ref.index} read as link {ref.index}'s potential energy (a scalar)"
+        if column:
+            return step_ref("P", ref.index), f"{name}_{ref.index} read as Craig's position vector (a vector)"
+    if ref.key == "L":
+        if scalar:
+            return step_ref("L", alias=ref.alias), ""
+        return None, (
+            f"a {shape[0]}x{shape[1]} {name} is an angular momentum, not the Lagrangian: name its link "
+            f"({name}_1) to have it checked"
+        )
+    if ref.key == "M" and ref.alias == "H" and column and shape[0] == 3:
+        return None, "a 3-vector H is an angular momentum: name its link (H_1) to have it checked"
+    if ref.key in SOFT and (scalar and not isinstance(value, sp.MatrixBase)) and dof != 1:
+        return None, NOT_A_STEP  # a scalar M, C, G, h: a total mass, a constant, a height...
+    if ref.key == "omega":
+        if scalar and not vector_reading:
+            return step_ref("w", ref.index), (
+                f"a scalar ω_{ref.index} read as link {ref.index}'s angular velocity about the (planar) axis"
+            )
+        return ref, ""
+    if ref.key == "f":
+        if scalar and is_prismatic is not None and not vector_reading:
+            return step_ref("tau", ref.index), (
+                f"a scalar f_{ref.index} read as joint {ref.index}'s generalised force τ_{ref.index}"
+                + ("" if is_prismatic else f" (joint {ref.index} is revolute: a torque)")
+            )
+        return ref, ""
+    return ref, ""
+
+
+def student_names(ref) -> list[str]:
+    """The plain names (as :class:`~armdyn.grading.notation.SymbolMap` looks them up) under
+    which the student's value of an energy is kept for later right-hand sides:
+    ``L = K - P`` with their ``K`` and ``P``, ``K = K_1 + K_2``."""
+    names = [ref.key] if ref.key in ("T", "V", "L") else []
+    alias = re.sub(r"[{}_\\]|mathcal|mathrm", "", ref.alias or "")
+    index = "" if ref.index is None else str(ref.index)
+    if alias:
+        names.append(alias + index)
+    elif ref.key in ("Tl", "Vl"):
+        names.append(ref.key[0] + index)
+    return names
