@@ -1,0 +1,703 @@
+"""The robot a derivation describes, read from its own statements.
+
+When no model is named (neither ``--robot`` nor the front matter's ``robot:``), the
+submission's equations are read for what they state about the arm, and a model in
+armdyn's YAML format (docs/model-format.md) is built from them:
+
+- rotations between successive frames: ``R_a^b`` / ``{}^{b}_{a}R`` (maps frame-a
+  coordinates to frame b, so frame b's axes in frame a are its transpose); a joint
+  variable inside a rotation makes that joint revolute;
+- positions: ``P_i^j`` (frame i's origin from frame i-1's, in frame j) and ``P_{C_i}^j``
+  (link i's mass centre from frame i's origin, in frame j);
+- gravity: the base acceleration ``\\dot v_0^0 = (0, g, 0)`` of Newton-Euler means gravity
+  ``(0, -g, 0)``;
+- the potential energy ``V = m_1 g h_1 + ...`` (each mass's height) of an energy-method
+  derivation; for a planar arm whose joints turn about z, a height ``a sin(phi) + b cos(phi)``
+  is the point ``Rz(phi) (a, b)`` (``a cos(phi) - b sin(phi)`` across);
+- the kinetic energy ``T``: its ``I_k`` terms are link k's moment of inertia about z;
+  the whole ``T`` is checked against the positions read.
+
+Symbols keep the text's names (``l_1`` -> ``l1``, ``l_{c1}`` -> ``lc1``, ``\\theta_1`` ->
+``theta1``). Nothing from the text is evaluated as code: the LaTeX is parsed by
+:mod:`.latex`, unknown names become parameters. What is not stated is assumed and named
+(:attr:`TextModel.assumptions`); statements that disagree are named with their lines
+(:attr:`TextModel.conflicts`) and the reading most statements support is used.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+import re
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+from ..errors import ModelError
+from ..model import Robot
+from .latex import LatexError, Name, parse, sides, split_equations
+from .notation import _plain, normalise, parse_lhs
+from .reader import Equation, Submission, math_blocks, read_text
+
+#: more frames than this are refused (a hand derivation has a handful)
+MAX_FRAMES = 24
+#: inline equations read from the prose, at most
+MAX_INLINE = 500
+_TOL = 1e-9
+_JOINT_BASES = ("theta", "vartheta", "q", "d")
+
+
+@dataclass
+class Statement:
+    """One thing the text states: ``what`` (``R``, ``P``, ``Pc``, ``g``, ``V``, ``T``),
+    frames/link, the value read, the line and the equation as written."""
+
+    what: str
+    line: int
+    source: str
+    value: object
+    index: int | None = None
+    frame: int | None = None
+
+
+@dataclass
+class TextModel:
+    """The model read from a text: its YAML (each item with the line it comes from), the
+    Robot, what was assumed and which statements disagree."""
+
+    yaml: str
+    robot: Robot
+    assumptions: list[str] = field(default_factory=list)
+    conflicts: list[str] = field(default_factory=list)
+
+    def note(self) -> str:
+        """The grade report's first note: the model was read from the text."""
+        text = "model read from the text (no robot named; `armdyn grade --show-model` prints it)"
+        if self.assumptions:
+            text += "; assumed: " + "; ".join(self.assumptions)
+        if self.conflicts:
+            text += "; statements that disagree: " + "; ".join(self.conflicts)
+        return text
+
+
+class _Names:
+    """Resolve the text's symbols: joint variables (``\\theta_k``, ``q_k``, ``d_k``) and
+    their rates, ``s_{12}``/``c_1`` shorthand, ``\\pi``; any other name a parameter."""
+
+    def __init__(self, joints: dict[int, str]):
+        self.joints = joints  # joint index -> variable name
+
+    def __call__(self, name: Name):
+        sub = _plain(name.sub)
+        base = "theta" if name.base == "vartheta" else name.base
+        if base == "pi" and not sub:
+            return sp.pi
+        if base in ("s", "c", "S", "C") and not name.dots and sub.isdigit() and all(int(k) in self.joints for k in sub):
+            angle = sum((sp.Symbol(self.joints[int(k)]) for k in sub), sp.Integer(0))
+            return (sp.sin if base in "sS" else sp.cos)(angle)
+        return sp.Symbol(base + sub + {0: "", 1: "_dot", 2: "_ddot"}.get(name.dots, "_d" + str(name.dots)))
+
+
+def _joint_candidates(sub: Submission) -> dict[int, str]:
+    """Joint index -> variable name: ``\\theta_k`` or ``q_k`` first, else ``d_k``."""
+    found: dict[int, str] = {}
+    pattern = re.compile(r"(\\vartheta|\\theta|(?<![A-Za-z\\])q|(?<![A-Za-z\\])d)\}?\s*_\s*\{?\s*(\d+)\s*\}?")
+    for eq in [*sub.equations, *_inline_equations(sub)]:
+        if not eq.latex:
+            continue
+        for text in (eq.lhs, str(eq.value)):
+            for m in pattern.finditer(text):
+                k, base = int(m.group(2)), m.group(1).lstrip("\\").replace("vartheta", "theta")
+                if k < 1 or k > MAX_FRAMES:
+                    continue
+                if k not in found or (found[k].startswith("d") and base != "d"):
+                    found[k] = f"{base}{k}"
+    return found
+
+
+_INERTIA_LHS = re.compile(
+    r"(?:\{\}\^\{?[Cc]_?\{?(\d+)\}?\}?)?I_\{?(?:[Cc]_?\{?)?(\d+)\}?\}?(?:\^\{?[Cc]_?\{?\d+\}?\}?)?"
+)
+
+
+_INLINE = re.compile(r"(?<![$\\])\$([^$\n]{1,2000})\$(?!\$)")
+
+
+def _inline_equations(sub: Submission) -> list[Equation]:
+    """The equations of the prose's inline math (``$P_1^0 = l_1(\\cos\\theta_1, ...)^T$``): a
+    derivation often states its frames there. Display blocks are left to the reader."""
+    try:
+        text = read_text(sub.path)
+    except (OSError, ModelError):
+        return []
+    blocks = [(a, b) for a, b, _, _ in math_blocks(text)]
+    out: list[Equation] = []
+    k = 0
+    for m in _INLINE.finditer(text):
+        while k < len(blocks) and blocks[k][1] <= m.start():
+            k += 1
+        if k < len(blocks) and blocks[k][0] <= m.start() < blocks[k][1]:
+            continue
+        for _, eq in split_equations(m.group(1), limit=20):
+            parts = sides(eq)
+            if len(parts) >= 2 and parts[-1].strip():
+                line = text.count("\n", 0, m.start()) + 1
+                for lhs in parts[:-1]:  # a = b = value: both name the value
+                    if lhs.strip():
+                        out.append(Equation(lhs.strip(), parts[-1].strip(), line, m.group(0)))
+        if len(out) > MAX_INLINE:
+            break
+    return out
+
+
+def _statements(sub: Submission, names: _Names) -> list[Statement]:
+    out: list[Statement] = []
+    for eq in [*sub.equations, *_inline_equations(sub)]:
+        if not eq.latex or eq.problem:
+            continue
+        ref = parse_lhs(eq.lhs, lambda _latex: None)
+        what = index = frame = None
+        if ref is not None and ref.key in ("R", "P", "Pc", "T", "V"):
+            what, index, frame = ref.key, ref.index, ref.frame
+        elif ref is not None and ref.key == "v_dot" and ref.index == 0:
+            what, index, frame = "g", 0, ref.frame
+        else:
+            m = _INERTIA_LHS.fullmatch(normalise(eq.lhs))
+            if m:
+                what, index = "I", int(m.group(2))
+        if what is None:
+            continue
+        try:
+            value = parse(str(eq.value), names)
+        except (LatexError, RecursionError, ValueError, TypeError):
+            continue  # the grader reports it as unreadable
+        out.append(Statement(what, eq.line, " ".join(eq.source.split()), value, index, frame))
+    return out
+
+
+# ------------------------------------------------------------------ numeric checks
+
+
+def _sample(symbols, seed: int) -> dict:
+    rng = random.Random(seed)
+    return {s: sp.Float(rng.uniform(0.3, 1.7) * rng.choice((1, -1) if "theta" in s.name else (1,))) for s in symbols}
+
+
+def _same(a, b, symbols, trials: int = 3) -> bool:
+    """a == b at random values (both scalar or both matrices of one shape)."""
+    a, b = sp.Matrix(a) if isinstance(a, sp.MatrixBase) else a, sp.Matrix(b) if isinstance(b, sp.MatrixBase) else b
+    diff = a - b
+    for seed in range(trials):
+        at = _sample(symbols, seed)
+        values = diff.subs(at).evalf() if isinstance(diff, sp.MatrixBase) else [sp.N(diff.subs(at))]
+        for v in values:
+            try:
+                if not abs(complex(v)) < 1e-8:
+                    return False
+            except TypeError:
+                return False
+    return True
+
+
+def _rotation_ok(m, symbols) -> bool:
+    return isinstance(m, sp.MatrixBase) and m.shape == (3, 3) and _same(m.T * m, sp.eye(3), symbols)
+
+
+def _vector(value) -> sp.Matrix | None:
+    if value == 0 and not isinstance(value, sp.MatrixBase):
+        return sp.zeros(3, 1)
+    if isinstance(value, sp.MatrixBase) and value.shape in ((3, 1), (1, 3)):
+        return sp.Matrix(value).reshape(3, 1)
+    if isinstance(value, sp.MatrixBase) and value.shape in ((2, 1), (1, 2)):
+        return sp.Matrix([value[0], value[1], 0])
+    return None
+
+
+def _rz(angle) -> sp.Matrix:
+    c, s = sp.cos(angle), sp.sin(angle)
+    return sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def _across(height: sp.Expr, revolute: set) -> sp.Expr:
+    """The in-plane coordinate across the height: ``a sin(phi) + b cos(phi)`` -> ``a cos(phi) - b sin(phi)``."""
+    total = sp.Integer(0)
+    for term in sp.Add.make_args(sp.expand(height)):
+        trig = [f for f in sp.Mul.make_args(term) if isinstance(f, (sp.sin, sp.cos))]
+        if len(trig) > 1:
+            raise ValueError("a product of sines and cosines")
+        if not trig:
+            if term.free_symbols & revolute:
+                raise ValueError("a joint angle outside a sine or cosine")
+            continue
+        f = trig[0]
+        rest = term / f
+        total += rest * (sp.cos(f.args[0]) if isinstance(f, sp.sin) else -sp.sin(f.args[0]))
+    return total
+
+
+class _Reader:
+    def __init__(self, sub: Submission):
+        self.sub = sub
+        self.assumptions: list[str] = []
+        self.conflicts: list[str] = []
+        self.unplaced: dict[int, str] = {}  # frame -> why its only rotation stated was not used
+
+    def where(self, st: Statement) -> str:
+        return f"line {st.line}"
+
+    def fail(self, message: str):
+        raise ModelError(f"cannot read the robot from the text: {message}", source=self.sub.path)
+
+    # -- the pass
+    def read(self) -> TextModel:
+        joints = _joint_candidates(self.sub)
+        names = _Names(joints)
+        statements = _statements(self.sub, names)
+        if not joints:
+            self.fail("no joint variable (\\theta_k, q_k, d_k) is written; name the model with --robot")
+        n = max(joints)
+        if n > MAX_FRAMES:
+            self.fail(f"{n} frames is more than a derivation by hand has (at most {MAX_FRAMES})")
+        q = {k: sp.Symbol(v) for k, v in joints.items()}
+        missing = [k for k in range(1, n + 1) if k not in q]
+        if missing:
+            self.fail(f"no variable of joint {missing[0]} is written (joints 1..{n} are used)")
+        qs = [q[k] for k in range(1, n + 1)]
+        self.n, self.q = n, qs
+        free = set().union(*(self._symbols(st.value) for st in statements)) | set(qs)
+        self.free = free
+        rot = self._rotations(statements)
+        revolute = {
+            qs[k - 1] for k in range(1, n + 1) if rot.get(k) is not None and qs[k - 1] in rot[k][0].free_symbols
+        }
+        gravity, g_line = self._gravity(statements)
+        coms = self._coms(statements, gravity, rot, revolute)
+        revolute |= {x for p in coms.values() for x in self._in_trig(p[0])}
+        for k in range(1, n + 1):
+            if rot.get(k) is None and k in self.unplaced:
+                self.fail(f"{self.unplaced[k]}, and no other statement turns frame {k - 1} into frame {k}")
+            if rot.get(k) is None:
+                if qs[k - 1] in revolute:
+                    rot[k] = (_rz(qs[k - 1]), None)
+                    self.assumptions.append(
+                        f"joint {k} turns about z{k - 1} (no rotation between frames {k - 1} and {k} is stated)"
+                    )
+                else:
+                    rot[k] = (sp.eye(3), None)
+        return self._build(statements, rot, revolute, gravity, g_line, coms)
+
+    @staticmethod
+    def _symbols(value) -> set:
+        return set(value.free_symbols) if hasattr(value, "free_symbols") else set()
+
+    @staticmethod
+    def _in_trig(expr) -> set:
+        return {s for f in sp.sympify(expr).atoms(sp.sin, sp.cos) for s in f.free_symbols}
+
+    def _rotations(self, statements) -> dict:
+        """Frame k's axes in frame k-1 (a function of joint k's variable) -> (matrix, statement)."""
+        out: dict[int, tuple] = {}
+        for st in statements:
+            if st.what != "R":
+                continue
+            a, b = st.index, st.frame
+            if a is None or b is None or abs(a - b) != 1 or max(a, b) > self.n:
+                self.conflicts.append(
+                    f"line {st.line}: {st.source[:60]} relates frames {a} and {b}, not successive frames "
+                    f"of joints 1..{self.n} (not used)"
+                )
+                continue
+            m = st.value
+            if not isinstance(m, sp.MatrixBase) or m.shape != (3, 3):
+                continue  # R_2^1 = (R_1^2)^T: a name for another statement, not a matrix
+            if not _rotation_ok(m, self.free):
+                self.conflicts.append(f"line {st.line}: R_{a}^{b} is not a rotation (its columns are not orthonormal)")
+                self.unplaced.setdefault(max(a, b), self.conflicts[-1])
+                continue
+            k = max(a, b)
+            axes = m if a == k else m.T  # R_a^b maps a -> b: frame a's axes in frame b
+            if k in out:
+                if not _same(out[k][0], axes, self.free):
+                    self.conflicts.append(
+                        f"lines {out[k][1].line} and {st.line} state different rotations between frames "
+                        f"{k - 1} and {k} (line {out[k][1].line} used)"
+                    )
+                continue
+            others = (axes.free_symbols & set(self.q)) - {self.q[k - 1]}
+            if others:
+                self.conflicts.append(
+                    f"line {st.line}: the rotation between frames {k - 1} and {k} moves with "
+                    f"{', '.join(sorted(map(str, others)))}, not only joint {k}'s variable (not used)"
+                )
+                continue
+            out[k] = (axes, st)
+        return out
+
+    def _gravity(self, statements):
+        stated = [st for st in statements if st.what == "g" and _vector(st.value) is not None]
+        if stated:
+            first = stated[0]
+            for st in stated[1:]:
+                if not _same(_vector(st.value), _vector(first.value), self.free):
+                    self.conflicts.append(f"lines {first.line} and {st.line} state different base accelerations")
+            g = -_vector(first.value)
+            self.assumptions.append(
+                f"gravity {_pretty_vector(g)}, from line {first.line}: the base accelerates by "
+                f"{_pretty_vector(-g)} (Newton-Euler's way of putting in gravity)"
+            )
+            return g, first.line
+        g = sp.Matrix([0, -sp.Symbol("g"), 0])
+        self.assumptions.append("gravity (0, -g, 0), along -y0: no base acceleration or gravity vector is stated")
+        return g, None
+
+    def _coms(self, statements, gravity, rot, revolute) -> dict:
+        """Link k's mass centre in the base frame -> (position, mass, statement), from V."""
+        found: dict[int, tuple] = {}
+        for st in statements:
+            if st.what != "V" or isinstance(st.value, sp.MatrixBase):
+                continue
+            axis = [i for i in range(3) if gravity[i] != 0]
+            if len(axis) != 1 or axis[0] == 2:
+                self.conflicts.append(f"line {st.line}: V read only for gravity along x0 or y0 (not used)")
+                continue
+            c = gravity[axis[0]]
+            sign = 1 if sp.N(c.subs({x: 1 for x in c.free_symbols})) > 0 else -1
+            g_mag = sign * c  # the magnitude, the parameters taken positive
+            up = sp.zeros(3, 1)
+            up[axis[0]] = -sign
+            across = up.cross(sp.Matrix([0, 0, 1]))
+            V = sp.expand(st.value)
+            masses = sorted(
+                (s for s in V.free_symbols if re.fullmatch(r"m(\d+)", s.name)), key=lambda s: int(s.name[1:])
+            )
+            all_rev = (self._in_trig(V) & set(self.q)) | revolute
+            for m in masses:
+                k = int(m.name[1:])
+                height = sp.expand(V.coeff(m) / g_mag)
+                if k < 1 or k > self.n or height.has(m):
+                    continue
+                try:
+                    w = _across(height, all_rev)
+                except ValueError as err:
+                    self.conflicts.append(f"line {st.line}: the height of m{k} is not a planar arm's ({err})")
+                    continue
+                pos = up * height + across * w
+                if k in found:
+                    if not _same(found[k][0], pos, self.free):
+                        self.conflicts.append(
+                            f"lines {found[k][2].line} and {st.line} place link {k}'s mass centre differently "
+                            f"(line {found[k][2].line} used)"
+                        )
+                    continue
+                found[k] = (pos, m, st)
+            rest = sp.expand(
+                V - sum(m * g_mag * (up.dot(found[int(m.name[1:])][0])) for m in masses if int(m.name[1:]) in found)
+            )
+            if rest != 0 and found:
+                self.conflicts.append(f"line {st.line}: V has a term not of one mass's height: {rest}")
+        return found
+
+    # -- the model
+    def _build(self, statements, rot, revolute, gravity, g_line, coms) -> TextModel:
+        n = self.n
+        pc: dict[int, Statement] = {}
+        pstat: dict[int, Statement] = {}
+        for st in statements:  # the first statement of each vector is the one used
+            if st.what in ("P", "Pc") and _vector(st.value) is not None and st.index is not None:
+                (pc if st.what == "Pc" else pstat).setdefault(st.index, st)
+        # orientation and origin of each frame in the base frame
+        R0 = [sp.eye(3)]
+        o = [sp.zeros(3, 1)]
+        com_local: dict[int, sp.Matrix] = {}
+        for k in range(1, n + 1):
+            Rk = R0[k - 1] * rot[k][0]
+            R0.append(Rk)
+            if k in pstat:
+                st = pstat[k]
+                f = st.frame if st.frame is not None else k - 1
+                if f > k:
+                    self.conflicts.append(f"line {st.line}: P_{k} is written in frame {f}, not yet placed (not used)")
+                    del pstat[k]
+                else:
+                    o.append(o[k - 1] + R0[f] * _vector(st.value))
+                    continue
+            if k in pc and k in coms:
+                c = (
+                    _vector(pc[k].value)
+                    if pc[k].frame in (None, k)
+                    else rot_into(R0, pc[k].frame, k) * _vector(pc[k].value)
+                )
+                o.append(coms[k][0] - Rk * c)
+            elif k in coms:
+                o.append(coms[k][0])
+                com_local[k] = sp.zeros(3, 1)
+            else:
+                self.fail(
+                    f"frame {k}'s origin is not stated (P_{k}^{k - 1}) and link {k}'s mass centre cannot be "
+                    "placed (no V, no P_{C_" + str(k) + "})"
+                )
+        self._duplicates(statements, "P", "frame {k}'s origin", lambda st: R0[_frame(st, st.index - 1)])
+        self._duplicates(statements, "Pc", "link {k}'s mass centre", lambda st: R0[_frame(st, st.index)])
+        for k in range(1, n + 1):
+            if k in com_local:
+                continue
+            if k in pc:
+                st = pc[k]
+                c = _vector(st.value)
+                if st.frame not in (None, k):
+                    c = rot_into(R0, st.frame, k) * c
+                com_local[k] = c
+                if k in coms and not _same(o[k] + R0[k] * c, coms[k][0], self.free):
+                    self.conflicts.append(
+                        f"line {st.line} and line {coms[k][2].line} (V) place link {k}'s mass centre differently "
+                        f"(line {st.line} used)"
+                    )
+            elif k in coms:
+                com_local[k] = R0[k].T * (coms[k][0] - o[k])
+            else:
+                com_local[k] = sp.zeros(3, 1)
+                self.assumptions.append(f"link {k}'s mass centre at frame {k}'s origin (no position of it is stated)")
+        if not pstat and any(k not in pc for k in coms):
+            self.assumptions.append(
+                "each frame's origin at its link's mass centre (no frame origin P_i is stated; "
+                "the dynamics do not depend on where frames sit)"
+            )
+        return self._emit(statements, rot, revolute, gravity, g_line, coms, R0, o, com_local, pstat, pc)
+
+    def _duplicates(self, statements, what: str, label: str, into_base):
+        """Two statements of one vector (each in its own frame) that differ: named, the first used."""
+        seen: dict[int, tuple] = {}
+        for st in statements:
+            if st.what != what or _vector(st.value) is None or _frame(st, 0) > self.n:
+                continue
+            k = st.index
+            in_base = into_base(st) * _vector(st.value)
+            if k in seen and not _same(seen[k][1], in_base, self.free):
+                self.conflicts.append(
+                    f"lines {seen[k][0].line} and {st.line} state {label.format(k=k)} differently "
+                    f"(line {seen[k][0].line} used)"
+                )
+            seen.setdefault(k, (st, in_base))
+
+    def _emit(self, statements, rot, revolute, gravity, g_line, coms, R0, o, com_local, pstat, pc) -> TextModel:
+        n, qs = self.n, self.q
+        zero = {x: 0 for x in qs}
+        lines = [
+            f"# the robot read from {os.path.basename(self.sub.path)} (no model named)",
+            f"name: {_model_name(self.sub.path)}",
+            "description: read from the derivation's own statements",
+        ]
+        joints_yaml, links_yaml = [], []
+        params: set = set()
+        masses = self._masses(statements, coms)
+        inertias = self._inertias(statements, R0, coms, masses, com_local)
+        for k in range(1, n + 1):
+            x = qs[k - 1]
+            axes, st = rot[k]
+            rel = (R0[k - 1].T * (o[k] - o[k - 1])).applyfunc(sp.expand)
+            rel_k = rel.subs({y: 0 for y in qs if y != x})
+            if not _same(rel, rel_k, self.free):
+                self.conflicts.append(f"frame {k}'s origin moves with joints beyond joint {k} in frame {k - 1}")
+            item = [f"  - name: {x}", f"    parent: {'base' if k == 1 else f'link{k - 1}'}", f"    child: link{k}"]
+            src = f"line {st.line}: {st.source[:70]}" if st is not None else "assumed"
+            if x in revolute:
+                A0 = axes.subs(x, 0)
+                S = (A0.T * axes.diff(x)).subs(x, 0)
+                axis = sp.Matrix([S[2, 1], S[0, 2], S[1, 0]]).applyfunc(sp.nsimplify)
+                if not _same(axes, A0 * _axis_angle(axis, x), self.free):
+                    self.fail(f"the rotation of frame {k} ({src}) is not a turn about one axis by {x}")
+                centre = ((rel_k.subs(x, 0) + rel_k.subs(x, sp.pi)) / 2).applyfunc(sp.simplify)
+                fx = (A0.T * (rel_k.subs(x, 0) - centre)).applyfunc(sp.simplify)
+                if not _same(rel_k, centre + A0 * _axis_angle(axis, x) * fx, self.free):
+                    self.conflicts.append(f"frame {k}'s origin does not turn about joint {k}'s axis")
+                item.insert(1, "    type: revolute")
+                if A0 != sp.eye(3):
+                    item.append(f"    rotation: {_yaml_matrix(A0)}    # {src}")
+                item.append(f"    axis: {_yaml_vec(axis)}    # {x} turns frame {k} ({src})")
+                if centre != sp.zeros(3, 1):
+                    item.append(f"    xyz: {_yaml_vec(centre)}")
+                if fx != sp.zeros(3, 1):
+                    item.append(f"    frame_xyz: {_yaml_vec(fx)}    # frame {k}'s origin off the axis")
+                params |= axis.free_symbols | centre.free_symbols | fx.free_symbols
+            else:
+                slide = rel_k.diff(x).applyfunc(sp.simplify)
+                if x not in rel_k.free_symbols:
+                    self.fail(
+                        f"joint variable {x} moves nothing: it is in no rotation and in no position read "
+                        f"(state frame {k}'s origin, P_{k}^{k - 1}, or the heights in V)"
+                    )
+                axis = (axes.T * slide).applyfunc(sp.simplify)
+                if slide.free_symbols or axis.norm() != 1:
+                    self.fail(f"joint {k} ({x}) slides along {_pretty_vector(slide)}, not a unit direction")
+                at = rel_k.subs(x, 0).applyfunc(sp.simplify)
+                item.insert(1, "    type: prismatic")
+                if axes != sp.eye(3):
+                    item.append(f"    rotation: {_yaml_matrix(axes)}    # {src}")
+                item.append(f"    axis: {_yaml_vec(axis)}    # {x} slides frame {k}")
+                if at != sp.zeros(3, 1):
+                    item.append(f"    xyz: {_yaml_vec(at)}")
+                params |= at.free_symbols
+            joints_yaml += item
+            mass, mline = masses.get(k, (None, None))
+            if mass is None:
+                self.fail(f"no mass of link {k} (m_{k}) is stated in V or T")
+            c = com_local[k].subs(zero).applyfunc(sp.simplify)
+            inertia, iline = inertias[k][:2]
+            links_yaml += [
+                f"  - name: link{k}",
+                f"    mass: {mass}    # {mline}",
+                f"    com: {_yaml_vec(c)}    # {self._com_source(k, coms, pc)}",
+                f"    inertia: {inertia}    # {iline}",
+            ]
+            params |= c.free_symbols | {mass}
+        params |= gravity.free_symbols
+        params |= set().union(*(sp.sympify(v).free_symbols for v in inertias.get("symbols", [])))
+        params -= set(qs)
+        g_src = f"line {g_line}" if g_line else "assumed"
+        lines += [
+            f"parameters: [{', '.join(sorted(str(p) for p in params))}]",
+            f"gravity: {_yaml_vec(gravity)}    # {g_src}",
+            "joints:",
+            *joints_yaml,
+            "links:",
+            *links_yaml,
+        ]
+        text = "\n".join(lines) + "\n"
+        from ..io.yaml import load_yaml_string
+
+        robot = load_yaml_string(text, source=f"{self.sub.path} (the model read from it)", strict=False)
+        self._check_T(statements, robot)
+        return TextModel(text, robot, self.assumptions, self.conflicts)
+
+    def _com_source(self, k, coms, pc) -> str:
+        if k in pc:
+            return f"line {pc[k].line}: {pc[k].source[:70]}"
+        if k in coms:
+            return f"line {coms[k][2].line}: from the height of m{k} in V"
+        return "assumed"
+
+    def _masses(self, statements, coms) -> dict:
+        out = {k: (v[1], f"line {v[2].line}: m{k} in V") for k, v in coms.items()}
+        for st in statements:
+            if st.what in ("T", "V") and not isinstance(st.value, sp.MatrixBase):
+                for s in st.value.free_symbols:
+                    m = re.fullmatch(r"m(\d+)", s.name)
+                    if m and int(m.group(1)) not in out:
+                        out[int(m.group(1))] = (s, f"line {st.line}: m{m.group(1)} in {st.what}")
+        for k in range(1, self.n + 1):  # Newton-Euler texts: m_k in F_k = m_k \dot v_{C_k}
+            if k in out:
+                continue
+            pattern = re.compile(r"(?<![A-Za-z\\])m_\{?\s*" + str(k) + r"(?!\d)")
+            for eq in self.sub.equations:
+                if pattern.search(str(eq.value)):
+                    out[k] = (sp.Symbol(f"m{k}"), f"line {eq.line}: m_{k} written there")
+                    self.assumptions.append(f"link {k}'s mass is m{k}, by its name (first used on line {eq.line})")
+                    break
+        return out
+
+    def _inertias(self, statements, R0, coms, masses, com_local) -> dict:
+        """Link k's inertia about its mass centre: a stated tensor, ``I_k`` in T (about z), or a point mass."""
+        out: dict = {"symbols": []}
+        for st in statements:
+            if st.what == "I" and isinstance(st.value, sp.MatrixBase) and st.value.shape == (3, 3):
+                k = st.index
+                if k in out:
+                    if not _same(out[k][2], st.value, self.free):
+                        self.conflicts.append(f"lines {out[k][1]} and {st.line} state link {k}'s inertia differently")
+                    continue
+                out[k] = (_yaml_matrix(st.value), f"line {st.line}: {st.source[:70]}", st.value)
+                out["symbols"] += list(st.value)
+        Ts = [st for st in statements if st.what == "T" and not isinstance(st.value, sp.MatrixBase)]
+        for st in Ts[:1]:
+            for s in st.value.free_symbols:
+                m = re.fullmatch(r"I(?:zz)?(\d+)", s.name)
+                if m and int(m.group(1)) <= self.n and int(m.group(1)) not in out:
+                    k = int(m.group(1))
+                    out[k] = (
+                        f"{{ixx: 0, iyy: {s}, izz: {s}}}",
+                        f"line {st.line}: {s} in T, about z (a thin rod)",
+                        None,
+                    )
+                    out["symbols"].append(s)
+        point = [k for k in range(1, self.n + 1) if k not in out]
+        for k in point:
+            out[k] = ("0", "point mass", None)
+        if point:
+            self.assumptions.append(
+                f"point masses for link{'s' if len(point) > 1 else ''} {', '.join(map(str, point))}: "
+                "no inertia tensor is stated"
+            )
+        return out
+
+    def _check_T(self, statements, robot: Robot):
+        """A stated T must be the kinetic energy of the model read (else the positions or inertias disagree)."""
+        Ts = [st for st in statements if st.what == "T" and not isinstance(st.value, sp.MatrixBase)]
+        if not Ts:
+            return
+        from ..symbolic.lagrange import link_energies
+
+        T_trans, T_rot, _, _ = link_energies(robot)
+        T = sum(T_trans.values(), sp.Integer(0)) + sum(T_rot.values(), sp.Integer(0))
+        ren = {sp.Symbol(f"{q}_dot"): qd for q, qd in zip(robot.q, robot.qd, strict=True)}
+        ren.update({sp.Symbol(str(q)): q for q in robot.q})
+        mine = Ts[0].value.xreplace(ren)
+        if not _same(mine, T, mine.free_symbols | T.free_symbols):
+            self.conflicts.append(
+                f"line {Ts[0].line}: T is not the kinetic energy of the arm the other statements describe"
+            )
+
+
+def _frame(st: Statement, default: int) -> int:
+    return default if st.frame is None else st.frame
+
+
+def rot_into(R0, frm: int, to: int) -> sp.Matrix:
+    """The rotation taking frame-``frm`` coordinates to frame ``to``."""
+    return R0[to].T * R0[frm]
+
+
+def _axis_angle(axis, angle) -> sp.Matrix:
+    x, y, z = axis
+    K = sp.Matrix([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+    return sp.eye(3) + sp.sin(angle) * K + (1 - sp.cos(angle)) * K * K
+
+
+def _yaml_expr(e) -> str:
+    text = str(sp.nsimplify(e) if e.is_Float else e)
+    return text if re.fullmatch(r"-?[\w.]+", text) else f'"{text}"'
+
+
+def _yaml_vec(v) -> str:
+    return "[" + ", ".join(_yaml_expr(c) for c in v) + "]"
+
+
+def _yaml_matrix(m) -> str:
+    return "[" + ", ".join(_yaml_vec(m.row(i)) for i in range(3)) + "]"
+
+
+def _pretty_vector(v) -> str:
+    return "(" + ", ".join(str(c) for c in v) + ")"
+
+
+def _model_name(path: str) -> str:
+    stem = re.sub(r"[^A-Za-z0-9_-]", "-", os.path.splitext(os.path.basename(path))[0])[:40] or "submission"
+    return f"{stem}-from-text"
+
+
+def robot_from_text(sub: Submission) -> TextModel:
+    """The robot ``sub``'s own statements describe (see the module's docstring); a
+    :class:`ModelError` naming the file when they do not fix one."""
+    return _Reader(sub).read()
+
+
+def show_model(sub: Submission, robot: str | None = None) -> str:
+    """``armdyn grade --show-model``: the model read from the text as YAML (loadable with
+    :func:`armdyn.load`), its assumptions and conflicts as comments; or, when a model is
+    named, a line saying that one is used and the text's statements only checked."""
+    named = robot or sub.robot
+    if named:
+        return f"# the model named ({named}) is used: the text's statements are checked as steps, not read\n"
+    model = robot_from_text(sub)
+    head = [f"# assumed: {a}" for a in model.assumptions]
+    head += [f"# statements that disagree: {c}" for c in model.conflicts]
+    return "\n".join(head) + ("\n" if head else "") + model.yaml
