@@ -1,63 +1,31 @@
-"""The robot a derivation describes, read from its own statements.
-
-When no model is named (neither ``--robot`` nor the front matter's ``robot:``), the
-submission's equations are read for what they state about the arm, and a model in
-armdyn's YAML format (docs/model-format.md) is built from them:
-
-- rotations between successive frames: ``R_a^b`` / ``{}^{b}_{a}R`` (maps frame-a
-  coordinates to frame b, so frame b's axes in frame a are its transpose); a joint
-  variable inside a rotation makes that joint revolute;
-- positions: ``P_i^j`` (frame i's origin from frame i-1's, in frame j) and ``P_{C_i}^j``
-  (link i's mass centre from frame i's origin, in frame j);
-- gravity: the base acceleration ``\\dot v_0^0 = (0, g, 0)`` of Newton-Euler means gravity
-  ``(0, -g, 0)``;
-- the potential energy ``V = m_1 g h_1 + ...`` (each mass's height) of an energy-method
-  derivation; for a planar arm whose joints turn about z, a height ``a sin(phi) + b cos(phi)``
-  is the point ``Rz(phi) (a, b)`` (``a cos(phi) - b sin(phi)`` across);
-- the kinetic energy ``T``: its ``I_k`` terms are link k's moment of inertia about z;
-  the whole ``T`` is checked against the positions read.
-
-Symbols keep the text's names (``l_1`` -> ``l1``, ``l_{c1}`` -> ``lc1``, ``\\theta_1`` ->
-``theta1``). Nothing from the text is evaluated as code: the LaTeX is parsed by
-:mod:`.latex`, unknown names become parameters. What is not stated is assumed and named
-(:attr:`TextModel.assumptions`); statements that disagree are named with their lines
-(:attr:`TextModel.conflicts`) and the reading most statements support is used.
-"""
+"""The reading pass: statements -> frames, joints, mass centres -> a model in YAML."""
 
 from __future__ import annotations
 
 import os
-import random
 import re
 from dataclasses import dataclass, field
 
 import sympy as sp
 
-from ..errors import ModelError
-from ..model import Robot
-from .latex import LatexError, Name, parse, sides, split_equations
-from .notation import _plain, normalise, parse_lhs
-from .reader import Equation, Submission, math_blocks, read_text
-
-#: more frames than this are refused (a hand derivation has a handful)
-MAX_FRAMES = 24
-#: inline equations read from the prose, at most
-MAX_INLINE = 500
-_TOL = 1e-9
-_JOINT_BASES = ("theta", "vartheta", "q", "d")
-
-
-@dataclass
-class Statement:
-    """One thing the text states: ``what`` (``R``, ``P``, ``Pc``, ``g``, ``V``, ``T``),
-    frames/link, the value read, the line and the equation as written."""
-
-    what: str
-    line: int
-    source: str
-    value: object
-    index: int | None = None
-    frame: int | None = None
+from ...errors import ModelError
+from ...model import Robot
+from ..reader import Submission
+from .geometry import (
+    across,
+    axis_angle,
+    frame_of,
+    model_name,
+    pretty_vector,
+    rot_into,
+    rotation_ok,
+    rz,
+    same,
+    vector,
+    yaml_matrix,
+    yaml_vec,
+)
+from .statements import MAX_FRAMES, Names, Statement, joint_candidates, read_statements
 
 
 @dataclass
@@ -80,162 +48,7 @@ class TextModel:
         return text
 
 
-class _Names:
-    """Resolve the text's symbols: joint variables (``\\theta_k``, ``q_k``, ``d_k``) and
-    their rates, ``s_{12}``/``c_1`` shorthand, ``\\pi``; any other name a parameter."""
-
-    def __init__(self, joints: dict[int, str]):
-        self.joints = joints  # joint index -> variable name
-
-    def __call__(self, name: Name):
-        sub = _plain(name.sub)
-        base = "theta" if name.base == "vartheta" else name.base
-        if base == "pi" and not sub:
-            return sp.pi
-        if base in ("s", "c", "S", "C") and not name.dots and sub.isdigit() and all(int(k) in self.joints for k in sub):
-            angle = sum((sp.Symbol(self.joints[int(k)]) for k in sub), sp.Integer(0))
-            return (sp.sin if base in "sS" else sp.cos)(angle)
-        return sp.Symbol(base + sub + {0: "", 1: "_dot", 2: "_ddot"}.get(name.dots, "_d" + str(name.dots)))
-
-
-def _joint_candidates(sub: Submission) -> dict[int, str]:
-    """Joint index -> variable name: ``\\theta_k`` or ``q_k`` first, else ``d_k``."""
-    found: dict[int, str] = {}
-    pattern = re.compile(r"(\\vartheta|\\theta|(?<![A-Za-z\\])q|(?<![A-Za-z\\])d)\}?\s*_\s*\{?\s*(\d+)\s*\}?")
-    for eq in [*sub.equations, *_inline_equations(sub)]:
-        if not eq.latex:
-            continue
-        for text in (eq.lhs, str(eq.value)):
-            for m in pattern.finditer(text):
-                k, base = int(m.group(2)), m.group(1).lstrip("\\").replace("vartheta", "theta")
-                if k < 1 or k > MAX_FRAMES:
-                    continue
-                if k not in found or (found[k].startswith("d") and base != "d"):
-                    found[k] = f"{base}{k}"
-    return found
-
-
-_INERTIA_LHS = re.compile(
-    r"(?:\{\}\^\{?[Cc]_?\{?(\d+)\}?\}?)?I_\{?(?:[Cc]_?\{?)?(\d+)\}?\}?(?:\^\{?[Cc]_?\{?\d+\}?\}?)?"
-)
-
-
-_INLINE = re.compile(r"(?<![$\\])\$([^$\n]{1,2000})\$(?!\$)")
-
-
-def _inline_equations(sub: Submission) -> list[Equation]:
-    """The equations of the prose's inline math (``$P_1^0 = l_1(\\cos\\theta_1, ...)^T$``): a
-    derivation often states its frames there. Display blocks are left to the reader."""
-    try:
-        text = read_text(sub.path)
-    except (OSError, ModelError):
-        return []
-    blocks = [(a, b) for a, b, _, _ in math_blocks(text)]
-    out: list[Equation] = []
-    k = 0
-    for m in _INLINE.finditer(text):
-        while k < len(blocks) and blocks[k][1] <= m.start():
-            k += 1
-        if k < len(blocks) and blocks[k][0] <= m.start() < blocks[k][1]:
-            continue
-        for _, eq in split_equations(m.group(1), limit=20):
-            parts = sides(eq)
-            if len(parts) >= 2 and parts[-1].strip():
-                line = text.count("\n", 0, m.start()) + 1
-                for lhs in parts[:-1]:  # a = b = value: both name the value
-                    if lhs.strip():
-                        out.append(Equation(lhs.strip(), parts[-1].strip(), line, m.group(0)))
-        if len(out) > MAX_INLINE:
-            break
-    return out
-
-
-def _statements(sub: Submission, names: _Names) -> list[Statement]:
-    out: list[Statement] = []
-    for eq in [*sub.equations, *_inline_equations(sub)]:
-        if not eq.latex or eq.problem:
-            continue
-        ref = parse_lhs(eq.lhs, lambda _latex: None)
-        what = index = frame = None
-        if ref is not None and ref.key in ("R", "P", "Pc", "T", "V"):
-            what, index, frame = ref.key, ref.index, ref.frame
-        elif ref is not None and ref.key == "v_dot" and ref.index == 0:
-            what, index, frame = "g", 0, ref.frame
-        else:
-            m = _INERTIA_LHS.fullmatch(normalise(eq.lhs))
-            if m:
-                what, index = "I", int(m.group(2))
-        if what is None:
-            continue
-        try:
-            value = parse(str(eq.value), names)
-        except (LatexError, RecursionError, ValueError, TypeError):
-            continue  # the grader reports it as unreadable
-        out.append(Statement(what, eq.line, " ".join(eq.source.split()), value, index, frame))
-    return out
-
-
-# ------------------------------------------------------------------ numeric checks
-
-
-def _sample(symbols, seed: int) -> dict:
-    rng = random.Random(seed)
-    return {s: sp.Float(rng.uniform(0.3, 1.7) * rng.choice((1, -1) if "theta" in s.name else (1,))) for s in symbols}
-
-
-def _same(a, b, symbols, trials: int = 3) -> bool:
-    """a == b at random values (both scalar or both matrices of one shape)."""
-    a, b = sp.Matrix(a) if isinstance(a, sp.MatrixBase) else a, sp.Matrix(b) if isinstance(b, sp.MatrixBase) else b
-    diff = a - b
-    for seed in range(trials):
-        at = _sample(symbols, seed)
-        values = diff.subs(at).evalf() if isinstance(diff, sp.MatrixBase) else [sp.N(diff.subs(at))]
-        for v in values:
-            try:
-                if not abs(complex(v)) < 1e-8:
-                    return False
-            except TypeError:
-                return False
-    return True
-
-
-def _rotation_ok(m, symbols) -> bool:
-    return isinstance(m, sp.MatrixBase) and m.shape == (3, 3) and _same(m.T * m, sp.eye(3), symbols)
-
-
-def _vector(value) -> sp.Matrix | None:
-    if value == 0 and not isinstance(value, sp.MatrixBase):
-        return sp.zeros(3, 1)
-    if isinstance(value, sp.MatrixBase) and value.shape in ((3, 1), (1, 3)):
-        return sp.Matrix(value).reshape(3, 1)
-    if isinstance(value, sp.MatrixBase) and value.shape in ((2, 1), (1, 2)):
-        return sp.Matrix([value[0], value[1], 0])
-    return None
-
-
-def _rz(angle) -> sp.Matrix:
-    c, s = sp.cos(angle), sp.sin(angle)
-    return sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-
-
-def _across(height: sp.Expr, revolute: set) -> sp.Expr:
-    """The in-plane coordinate across the height: ``a sin(phi) + b cos(phi)`` -> ``a cos(phi) - b sin(phi)``."""
-    total = sp.Integer(0)
-    for term in sp.Add.make_args(sp.expand(height)):
-        trig = [f for f in sp.Mul.make_args(term) if isinstance(f, (sp.sin, sp.cos))]
-        if len(trig) > 1:
-            raise ValueError("a product of sines and cosines")
-        if not trig:
-            if term.free_symbols & revolute:
-                raise ValueError("a joint angle outside a sine or cosine")
-            continue
-        f = trig[0]
-        rest = term / f
-        total += rest * (sp.cos(f.args[0]) if isinstance(f, sp.sin) else -sp.sin(f.args[0]))
-    return total
-
-
-class _Reader:
+class TextReader:
     def __init__(self, sub: Submission):
         self.sub = sub
         self.assumptions: list[str] = []
@@ -250,9 +63,9 @@ class _Reader:
 
     # -- the pass
     def read(self) -> TextModel:
-        joints = _joint_candidates(self.sub)
-        names = _Names(joints)
-        statements = _statements(self.sub, names)
+        joints = joint_candidates(self.sub)
+        names = Names(joints)
+        statements = read_statements(self.sub, names)
         if not joints:
             self.fail("no joint variable (\\theta_k, q_k, d_k) is written; name the model with --robot")
         n = max(joints)
@@ -278,7 +91,7 @@ class _Reader:
                 self.fail(f"{self.unplaced[k]}, and no other statement turns frame {k - 1} into frame {k}")
             if rot.get(k) is None:
                 if qs[k - 1] in revolute:
-                    rot[k] = (_rz(qs[k - 1]), None)
+                    rot[k] = (rz(qs[k - 1]), None)
                     self.assumptions.append(
                         f"joint {k} turns about z{k - 1} (no rotation between frames {k - 1} and {k} is stated)"
                     )
@@ -310,14 +123,14 @@ class _Reader:
             m = st.value
             if not isinstance(m, sp.MatrixBase) or m.shape != (3, 3):
                 continue  # R_2^1 = (R_1^2)^T: a name for another statement, not a matrix
-            if not _rotation_ok(m, self.free):
+            if not rotation_ok(m, self.free):
                 self.conflicts.append(f"line {st.line}: R_{a}^{b} is not a rotation (its columns are not orthonormal)")
                 self.unplaced.setdefault(max(a, b), self.conflicts[-1])
                 continue
             k = max(a, b)
             axes = m if a == k else m.T  # R_a^b maps a -> b: frame a's axes in frame b
             if k in out:
-                if not _same(out[k][0], axes, self.free):
+                if not same(out[k][0], axes, self.free):
                     self.conflicts.append(
                         f"lines {out[k][1].line} and {st.line} state different rotations between frames "
                         f"{k - 1} and {k} (line {out[k][1].line} used)"
@@ -334,16 +147,16 @@ class _Reader:
         return out
 
     def _gravity(self, statements):
-        stated = [st for st in statements if st.what == "g" and _vector(st.value) is not None]
+        stated = [st for st in statements if st.what == "g" and vector(st.value) is not None]
         if stated:
             first = stated[0]
             for st in stated[1:]:
-                if not _same(_vector(st.value), _vector(first.value), self.free):
+                if not same(vector(st.value), vector(first.value), self.free):
                     self.conflicts.append(f"lines {first.line} and {st.line} state different base accelerations")
-            g = -_vector(first.value)
+            g = -vector(first.value)
             self.assumptions.append(
-                f"gravity {_pretty_vector(g)}, from line {first.line}: the base accelerates by "
-                f"{_pretty_vector(-g)} (Newton-Euler's way of putting in gravity)"
+                f"gravity {pretty_vector(g)}, from line {first.line}: the base accelerates by "
+                f"{pretty_vector(-g)} (Newton-Euler's way of putting in gravity)"
             )
             return g, first.line
         g = sp.Matrix([0, -sp.Symbol("g"), 0])
@@ -365,7 +178,7 @@ class _Reader:
             g_mag = sign * c  # the magnitude, the parameters taken positive
             up = sp.zeros(3, 1)
             up[axis[0]] = -sign
-            across = up.cross(sp.Matrix([0, 0, 1]))
+            side = up.cross(sp.Matrix([0, 0, 1]))
             V = sp.expand(st.value)
             masses = sorted(
                 (s for s in V.free_symbols if re.fullmatch(r"m(\d+)", s.name)), key=lambda s: int(s.name[1:])
@@ -377,13 +190,13 @@ class _Reader:
                 if k < 1 or k > self.n or height.has(m):
                     continue
                 try:
-                    w = _across(height, all_rev)
+                    w = across(height, all_rev)
                 except ValueError as err:
                     self.conflicts.append(f"line {st.line}: the height of m{k} is not a planar arm's ({err})")
                     continue
-                pos = up * height + across * w
+                pos = up * height + side * w
                 if k in found:
-                    if not _same(found[k][0], pos, self.free):
+                    if not same(found[k][0], pos, self.free):
                         self.conflicts.append(
                             f"lines {found[k][2].line} and {st.line} place link {k}'s mass centre differently "
                             f"(line {found[k][2].line} used)"
@@ -403,7 +216,7 @@ class _Reader:
         pc: dict[int, Statement] = {}
         pstat: dict[int, Statement] = {}
         for st in statements:  # the first statement of each vector is the one used
-            if st.what in ("P", "Pc") and _vector(st.value) is not None and st.index is not None:
+            if st.what in ("P", "Pc") and vector(st.value) is not None and st.index is not None:
                 (pc if st.what == "Pc" else pstat).setdefault(st.index, st)
         # orientation and origin of each frame in the base frame
         R0 = [sp.eye(3)]
@@ -419,13 +232,13 @@ class _Reader:
                     self.conflicts.append(f"line {st.line}: P_{k} is written in frame {f}, not yet placed (not used)")
                     del pstat[k]
                 else:
-                    o.append(o[k - 1] + R0[f] * _vector(st.value))
+                    o.append(o[k - 1] + R0[f] * vector(st.value))
                     continue
             if k in pc and k in coms:
                 c = (
-                    _vector(pc[k].value)
+                    vector(pc[k].value)
                     if pc[k].frame in (None, k)
-                    else rot_into(R0, pc[k].frame, k) * _vector(pc[k].value)
+                    else rot_into(R0, pc[k].frame, k) * vector(pc[k].value)
                 )
                 o.append(coms[k][0] - Rk * c)
             elif k in coms:
@@ -436,18 +249,18 @@ class _Reader:
                     f"frame {k}'s origin is not stated (P_{k}^{k - 1}) and link {k}'s mass centre cannot be "
                     "placed (no V, no P_{C_" + str(k) + "})"
                 )
-        self._duplicates(statements, "P", "frame {k}'s origin", lambda st: R0[_frame(st, st.index - 1)])
-        self._duplicates(statements, "Pc", "link {k}'s mass centre", lambda st: R0[_frame(st, st.index)])
+        self._duplicates(statements, "P", "frame {k}'s origin", lambda st: R0[frame_of(st, st.index - 1)])
+        self._duplicates(statements, "Pc", "link {k}'s mass centre", lambda st: R0[frame_of(st, st.index)])
         for k in range(1, n + 1):
             if k in com_local:
                 continue
             if k in pc:
                 st = pc[k]
-                c = _vector(st.value)
+                c = vector(st.value)
                 if st.frame not in (None, k):
                     c = rot_into(R0, st.frame, k) * c
                 com_local[k] = c
-                if k in coms and not _same(o[k] + R0[k] * c, coms[k][0], self.free):
+                if k in coms and not same(o[k] + R0[k] * c, coms[k][0], self.free):
                     self.conflicts.append(
                         f"line {st.line} and line {coms[k][2].line} (V) place link {k}'s mass centre differently "
                         f"(line {st.line} used)"
@@ -468,11 +281,11 @@ class _Reader:
         """Two statements of one vector (each in its own frame) that differ: named, the first used."""
         seen: dict[int, tuple] = {}
         for st in statements:
-            if st.what != what or _vector(st.value) is None or _frame(st, 0) > self.n:
+            if st.what != what or vector(st.value) is None or frame_of(st, 0) > self.n:
                 continue
             k = st.index
-            in_base = into_base(st) * _vector(st.value)
-            if k in seen and not _same(seen[k][1], in_base, self.free):
+            in_base = into_base(st) * vector(st.value)
+            if k in seen and not same(seen[k][1], in_base, self.free):
                 self.conflicts.append(
                     f"lines {seen[k][0].line} and {st.line} state {label.format(k=k)} differently "
                     f"(line {seen[k][0].line} used)"
@@ -484,7 +297,7 @@ class _Reader:
         zero = {x: 0 for x in qs}
         lines = [
             f"# the robot read from {os.path.basename(self.sub.path)} (no model named)",
-            f"name: {_model_name(self.sub.path)}",
+            f"name: {model_name(self.sub.path)}",
             "description: read from the derivation's own statements",
         ]
         joints_yaml, links_yaml = [], []
@@ -496,7 +309,7 @@ class _Reader:
             axes, st = rot[k]
             rel = (R0[k - 1].T * (o[k] - o[k - 1])).applyfunc(sp.expand)
             rel_k = rel.subs({y: 0 for y in qs if y != x})
-            if not _same(rel, rel_k, self.free):
+            if not same(rel, rel_k, self.free):
                 self.conflicts.append(f"frame {k}'s origin moves with joints beyond joint {k} in frame {k - 1}")
             item = [f"  - name: {x}", f"    parent: {'base' if k == 1 else f'link{k - 1}'}", f"    child: link{k}"]
             src = f"line {st.line}: {st.source[:70]}" if st is not None else "assumed"
@@ -504,20 +317,20 @@ class _Reader:
                 A0 = axes.subs(x, 0)
                 S = (A0.T * axes.diff(x)).subs(x, 0)
                 axis = sp.Matrix([S[2, 1], S[0, 2], S[1, 0]]).applyfunc(sp.nsimplify)
-                if not _same(axes, A0 * _axis_angle(axis, x), self.free):
+                if not same(axes, A0 * axis_angle(axis, x), self.free):
                     self.fail(f"the rotation of frame {k} ({src}) is not a turn about one axis by {x}")
                 centre = ((rel_k.subs(x, 0) + rel_k.subs(x, sp.pi)) / 2).applyfunc(sp.simplify)
                 fx = (A0.T * (rel_k.subs(x, 0) - centre)).applyfunc(sp.simplify)
-                if not _same(rel_k, centre + A0 * _axis_angle(axis, x) * fx, self.free):
+                if not same(rel_k, centre + A0 * axis_angle(axis, x) * fx, self.free):
                     self.conflicts.append(f"frame {k}'s origin does not turn about joint {k}'s axis")
                 item.insert(1, "    type: revolute")
                 if A0 != sp.eye(3):
-                    item.append(f"    rotation: {_yaml_matrix(A0)}    # {src}")
-                item.append(f"    axis: {_yaml_vec(axis)}    # {x} turns frame {k} ({src})")
+                    item.append(f"    rotation: {yaml_matrix(A0)}    # {src}")
+                item.append(f"    axis: {yaml_vec(axis)}    # {x} turns frame {k} ({src})")
                 if centre != sp.zeros(3, 1):
-                    item.append(f"    xyz: {_yaml_vec(centre)}")
+                    item.append(f"    xyz: {yaml_vec(centre)}")
                 if fx != sp.zeros(3, 1):
-                    item.append(f"    frame_xyz: {_yaml_vec(fx)}    # frame {k}'s origin off the axis")
+                    item.append(f"    frame_xyz: {yaml_vec(fx)}    # frame {k}'s origin off the axis")
                 params |= axis.free_symbols | centre.free_symbols | fx.free_symbols
             else:
                 slide = rel_k.diff(x).applyfunc(sp.simplify)
@@ -528,14 +341,14 @@ class _Reader:
                     )
                 axis = (axes.T * slide).applyfunc(sp.simplify)
                 if slide.free_symbols or axis.norm() != 1:
-                    self.fail(f"joint {k} ({x}) slides along {_pretty_vector(slide)}, not a unit direction")
+                    self.fail(f"joint {k} ({x}) slides along {pretty_vector(slide)}, not a unit direction")
                 at = rel_k.subs(x, 0).applyfunc(sp.simplify)
                 item.insert(1, "    type: prismatic")
                 if axes != sp.eye(3):
-                    item.append(f"    rotation: {_yaml_matrix(axes)}    # {src}")
-                item.append(f"    axis: {_yaml_vec(axis)}    # {x} slides frame {k}")
+                    item.append(f"    rotation: {yaml_matrix(axes)}    # {src}")
+                item.append(f"    axis: {yaml_vec(axis)}    # {x} slides frame {k}")
                 if at != sp.zeros(3, 1):
-                    item.append(f"    xyz: {_yaml_vec(at)}")
+                    item.append(f"    xyz: {yaml_vec(at)}")
                 params |= at.free_symbols
             joints_yaml += item
             mass, mline = masses.get(k, (None, None))
@@ -546,7 +359,7 @@ class _Reader:
             links_yaml += [
                 f"  - name: link{k}",
                 f"    mass: {mass}    # {mline}",
-                f"    com: {_yaml_vec(c)}    # {self._com_source(k, coms, pc)}",
+                f"    com: {yaml_vec(c)}    # {self._com_source(k, coms, pc)}",
                 f"    inertia: {inertia}    # {iline}",
             ]
             params |= c.free_symbols | {mass}
@@ -556,14 +369,14 @@ class _Reader:
         g_src = f"line {g_line}" if g_line else "assumed"
         lines += [
             f"parameters: [{', '.join(sorted(str(p) for p in params))}]",
-            f"gravity: {_yaml_vec(gravity)}    # {g_src}",
+            f"gravity: {yaml_vec(gravity)}    # {g_src}",
             "joints:",
             *joints_yaml,
             "links:",
             *links_yaml,
         ]
         text = "\n".join(lines) + "\n"
-        from ..io.yaml import load_yaml_string
+        from ...io.yaml import load_yaml_string
 
         robot = load_yaml_string(text, source=f"{self.sub.path} (the model read from it)", strict=False)
         self._check_T(statements, robot)
@@ -602,10 +415,10 @@ class _Reader:
             if st.what == "I" and isinstance(st.value, sp.MatrixBase) and st.value.shape == (3, 3):
                 k = st.index
                 if k in out:
-                    if not _same(out[k][2], st.value, self.free):
+                    if not same(out[k][2], st.value, self.free):
                         self.conflicts.append(f"lines {out[k][1]} and {st.line} state link {k}'s inertia differently")
                     continue
-                out[k] = (_yaml_matrix(st.value), f"line {st.line}: {st.source[:70]}", st.value)
+                out[k] = (yaml_matrix(st.value), f"line {st.line}: {st.source[:70]}", st.value)
                 out["symbols"] += list(st.value)
         Ts = [st for st in statements if st.what == "T" and not isinstance(st.value, sp.MatrixBase)]
         for st in Ts[:1]:
@@ -634,70 +447,14 @@ class _Reader:
         Ts = [st for st in statements if st.what == "T" and not isinstance(st.value, sp.MatrixBase)]
         if not Ts:
             return
-        from ..symbolic.lagrange import link_energies
+        from ...symbolic.lagrange import link_energies
 
         T_trans, T_rot, _, _ = link_energies(robot)
         T = sum(T_trans.values(), sp.Integer(0)) + sum(T_rot.values(), sp.Integer(0))
         ren = {sp.Symbol(f"{q}_dot"): qd for q, qd in zip(robot.q, robot.qd, strict=True)}
         ren.update({sp.Symbol(str(q)): q for q in robot.q})
         mine = Ts[0].value.xreplace(ren)
-        if not _same(mine, T, mine.free_symbols | T.free_symbols):
+        if not same(mine, T, mine.free_symbols | T.free_symbols):
             self.conflicts.append(
                 f"line {Ts[0].line}: T is not the kinetic energy of the arm the other statements describe"
             )
-
-
-def _frame(st: Statement, default: int) -> int:
-    return default if st.frame is None else st.frame
-
-
-def rot_into(R0, frm: int, to: int) -> sp.Matrix:
-    """The rotation taking frame-``frm`` coordinates to frame ``to``."""
-    return R0[to].T * R0[frm]
-
-
-def _axis_angle(axis, angle) -> sp.Matrix:
-    x, y, z = axis
-    K = sp.Matrix([[0, -z, y], [z, 0, -x], [-y, x, 0]])
-    return sp.eye(3) + sp.sin(angle) * K + (1 - sp.cos(angle)) * K * K
-
-
-def _yaml_expr(e) -> str:
-    text = str(sp.nsimplify(e) if e.is_Float else e)
-    return text if re.fullmatch(r"-?[\w.]+", text) else f'"{text}"'
-
-
-def _yaml_vec(v) -> str:
-    return "[" + ", ".join(_yaml_expr(c) for c in v) + "]"
-
-
-def _yaml_matrix(m) -> str:
-    return "[" + ", ".join(_yaml_vec(m.row(i)) for i in range(3)) + "]"
-
-
-def _pretty_vector(v) -> str:
-    return "(" + ", ".join(str(c) for c in v) + ")"
-
-
-def _model_name(path: str) -> str:
-    stem = re.sub(r"[^A-Za-z0-9_-]", "-", os.path.splitext(os.path.basename(path))[0])[:40] or "submission"
-    return f"{stem}-from-text"
-
-
-def robot_from_text(sub: Submission) -> TextModel:
-    """The robot ``sub``'s own statements describe (see the module's docstring); a
-    :class:`ModelError` naming the file when they do not fix one."""
-    return _Reader(sub).read()
-
-
-def show_model(sub: Submission, robot: str | None = None) -> str:
-    """``armdyn grade --show-model``: the model read from the text as YAML (loadable with
-    :func:`armdyn.load`), its assumptions and conflicts as comments; or, when a model is
-    named, a line saying that one is used and the text's statements only checked."""
-    named = robot or sub.robot
-    if named:
-        return f"# the model named ({named}) is used: the text's statements are checked as steps, not read\n"
-    model = robot_from_text(sub)
-    head = [f"# assumed: {a}" for a in model.assumptions]
-    head += [f"# statements that disagree: {c}" for c in model.conflicts]
-    return "\n".join(head) + ("\n" if head else "") + model.yaml
