@@ -4,7 +4,7 @@
     armdyn check ROBOT [--exact | --numeric] [--samples N]
     armdyn robots
     armdyn show ROBOT [--q Q1,Q2,...] [--out arm.png]
-    armdyn grade SUBMISSION [--robot MODEL] [--json] [--html OUT.html] [--ascii] [--to-yaml]
+    armdyn grade SUBMISSION [--robot MODEL] [--json] [--html OUT.html] [--ascii] [--to-yaml] [--show-model]
     armdyn grade DIR --gradebook grades.csv [--rubric R.yaml] [--html-dir DIR] [--variants DIR] [--jobs N]
     armdyn exercise make KIND (--count N | --roster roster.csv) --seed S --out DIR
     armdyn serve [--host H] [--port P] [--db URL] [--workers N] [--exercises DIR] [--instructor-token T]
