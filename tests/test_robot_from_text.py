@@ -36,7 +36,16 @@ def _verdicts(report):
     return [(v.line, v.name, v.status) for v in report.steps]
 
 
-@pytest.mark.parametrize("name", ["rp-arm-exercise.md", "rp-arm-dalembert.md", "planar-2r-lagrange.md"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "rp-arm-exercise.md",
+        "rp-arm-dalembert.md",
+        "planar-2r-lagrange.md",
+        "planar-2r-craig.md",  # its geometry for a generic link i: ${}^{i}P_{C_i}$, diag(0, I_i, I_i)
+        "planar-3r-spong.md",  # r_{i,c_i}, r_{i,i+1}, R_i^{i-1} = R_z(theta_i), in the prose
+    ],
+)
 def test_same_verdicts_as_the_named_model(name, tmp_path):
     named = grade(os.path.join(EXAMPLES, name))
     unnamed = grade(_unnamed(name, tmp_path))
@@ -45,18 +54,11 @@ def test_same_verdicts_as_the_named_model(name, tmp_path):
     assert not any("read from the text" in n for n in named.notes)
 
 
-@pytest.mark.parametrize(
-    "name, missing",
-    [
-        ("planar-2r-craig.md", "frame 1's origin is not stated"),
-        ("planar-3r-spong.md", "frame 1's origin is not stated"),
-    ],
-)
-def test_geometry_stated_only_for_a_generic_link_is_not_read(name, missing, tmp_path):
-    # both state their geometry in prose for a generic link i (${}^{i}P_{C_i}$, $r_{i,c_i}$)
-    # and a rotation "likewise": the text alone does not fix the model, and says which part
-    with pytest.raises(ModelError, match=missing):
-        grade(_unnamed(name, tmp_path))
+def test_geometry_stated_only_in_words_is_not_read(tmp_path):
+    # the SCARA text states no gravity direction, no rotation and no position: its vertical V,
+    # read with gravity assumed along -y0, places no serial arm, and the reading says so
+    with pytest.raises(ModelError, match="moves with other joints than joint 3: the positions read are not"):
+        grade(_unnamed("scara-lagrange.md", tmp_path))
 
 
 def _tau_at(robot, values: dict):
@@ -103,8 +105,9 @@ def test_rp_arm_read_has_the_exercises_dynamics(tmp_path):
         assert max(abs(a - b) for a, b in zip(got, _tau_at(bundled, renamed), strict=True)) < 1e-9
 
 
-def test_planar_2r_read_from_energies_has_spongs_dynamics(tmp_path):
-    robot = robot_from_text(read(_unnamed("planar-2r-lagrange.md", tmp_path))).robot
+@pytest.mark.parametrize("name", ["planar-2r-lagrange.md", "planar-2r-craig.md"])
+def test_planar_2r_read_has_spongs_dynamics(name, tmp_path):
+    robot = robot_from_text(read(_unnamed(name, tmp_path))).robot
     q1, q2 = robot.q
     qd1, qd2 = robot.qd
     qdd1, qdd2 = robot.qdd

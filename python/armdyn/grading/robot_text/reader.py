@@ -25,7 +25,7 @@ from .geometry import (
     yaml_matrix,
     yaml_vec,
 )
-from .statements import MAX_FRAMES, Names, Statement, joint_candidates, read_statements
+from .statements import MAX_FRAMES, Names, Statement, all_equations, joint_candidates, read_statements
 
 
 @dataclass
@@ -63,14 +63,15 @@ class TextReader:
 
     # -- the pass
     def read(self) -> TextModel:
-        joints = joint_candidates(self.sub)
-        names = Names(joints)
-        statements = read_statements(self.sub, names)
+        equations = all_equations(self.sub)
+        joints, written = joint_candidates(equations, self.sub.symbols)
         if not joints:
             self.fail("no joint variable (\\theta_k, q_k, d_k) is written; name the model with --robot")
         n = max(joints)
         if n > MAX_FRAMES:
             self.fail(f"{n} frames is more than a derivation by hand has (at most {MAX_FRAMES})")
+        names = Names(joints, self.sub.symbols)
+        statements = read_statements(equations, names, n)
         q = {k: sp.Symbol(v) for k, v in joints.items()}
         missing = [k for k in range(1, n + 1) if k not in q]
         if missing:
@@ -86,6 +87,10 @@ class TextReader:
         gravity, g_line = self._gravity(statements)
         coms = self._coms(statements, gravity, rot, revolute)
         revolute |= {x for p in coms.values() for x in self._in_trig(p[0])}
+        for k in range(1, n + 1):  # an angle's name, turned by no rotation stated: read as revolute, named
+            if rot.get(k) is None and qs[k - 1] not in revolute and written[k] == "theta":
+                revolute.add(qs[k - 1])
+                self.assumptions.append(f"joint {k} is revolute: \\theta_{k} names an angle")
         for k in range(1, n + 1):
             if rot.get(k) is None and k in self.unplaced:
                 self.fail(f"{self.unplaced[k]}, and no other statement turns frame {k - 1} into frame {k}")
@@ -244,6 +249,11 @@ class TextReader:
             elif k in coms:
                 o.append(coms[k][0])
                 com_local[k] = sp.zeros(3, 1)
+            elif k in pc:
+                o.append(o[k - 1])
+                self.assumptions.append(
+                    f"frame {k}'s origin at frame {k - 1}'s (on joint {k}'s axis): no P_{k} is stated"
+                )
             else:
                 self.fail(
                     f"frame {k}'s origin is not stated (P_{k}^{k - 1}) and link {k}'s mass centre cannot be "
@@ -310,7 +320,10 @@ class TextReader:
             rel = (R0[k - 1].T * (o[k] - o[k - 1])).applyfunc(sp.expand)
             rel_k = rel.subs({y: 0 for y in qs if y != x})
             if not same(rel, rel_k, self.free):
-                self.conflicts.append(f"frame {k}'s origin moves with joints beyond joint {k} in frame {k - 1}")
+                self.fail(
+                    f"frame {k}'s origin, seen from frame {k - 1}, moves with other joints than joint {k}: "
+                    "the positions read are not those of a serial arm"
+                )
             item = [f"  - name: {x}", f"    parent: {'base' if k == 1 else f'link{k - 1}'}", f"    child: link{k}"]
             src = f"line {st.line}: {st.source[:70]}" if st is not None else "assumed"
             if x in revolute:
@@ -365,7 +378,9 @@ class TextReader:
             params |= c.free_symbols | {mass}
         params |= gravity.free_symbols
         params |= set().union(*(sp.sympify(v).free_symbols for v in inertias.get("symbols", [])))
-        params -= set(qs)
+        # the front matter's symbols name the model's parameters: each one the model has
+        params |= {sp.Symbol(str(t)) for t in self.sub.symbols.values() if re.fullmatch(r"[A-Za-z]\w{0,40}", str(t))}
+        params -= set(qs) | {sp.Symbol(f"{x}_{d}") for x in qs for d in ("dot", "ddot")}
         g_src = f"line {g_line}" if g_line else "assumed"
         lines += [
             f"parameters: [{', '.join(sorted(str(p) for p in params))}]",
@@ -379,7 +394,7 @@ class TextReader:
         from ...io.yaml import load_yaml_string
 
         robot = load_yaml_string(text, source=f"{self.sub.path} (the model read from it)", strict=False)
-        self._check_T(statements, robot)
+        self._check_T(statements, robot, g_line is None)
         return TextModel(text, robot, self.assumptions, self.conflicts)
 
     def _com_source(self, k, coms, pc) -> str:
@@ -442,7 +457,7 @@ class TextReader:
             )
         return out
 
-    def _check_T(self, statements, robot: Robot):
+    def _check_T(self, statements, robot: Robot, gravity_assumed: bool):
         """A stated T must be the kinetic energy of the model read (else the positions or inertias disagree)."""
         Ts = [st for st in statements if st.what == "T" and not isinstance(st.value, sp.MatrixBase)]
         if not Ts:
@@ -455,6 +470,11 @@ class TextReader:
         ren.update({sp.Symbol(str(q)): q for q in robot.q})
         mine = Ts[0].value.xreplace(ren)
         if not same(mine, T, mine.free_symbols | T.free_symbols):
+            if gravity_assumed:  # the positions rest on an assumed gravity: the reading is not to be trusted
+                self.fail(
+                    f"T (line {Ts[0].line}) is not the kinetic energy of the arm read from V with gravity "
+                    "assumed along -y0: state the base acceleration or the mass centres' positions"
+                )
             self.conflicts.append(
                 f"line {Ts[0].line}: T is not the kinetic energy of the arm the other statements describe"
             )

@@ -35,39 +35,74 @@ class Statement:
     frame: int | None = None
 
 
+def _flat(sub: str) -> str:
+    return re.sub(r"[{}\s,_]|\\mathrm|\\text", "", sub or "")  # l_{c1} -> lc1
+
+
+def symbol_key(latex: str) -> tuple[str, str] | None:
+    """``(base, subscript)`` of one symbol written in LaTeX (``\\theta_1`` -> ("theta", "1"))."""
+    found: list[Name] = []
+    try:
+        parse(latex, lambda name: found.append(name) or sp.Integer(1))
+    except (LatexError, RecursionError):
+        return None
+    return (found[0].base, _flat(found[0].sub)) if len(found) == 1 and not found[0].dots else None
+
+
 class Names:
     """Resolve the text's symbols: joint variables (``\\theta_k``, ``q_k``, ``d_k``) and
-    their rates, ``s_{12}``/``c_1`` shorthand, ``\\pi``; any other name a parameter."""
+    their rates, ``s_{12}``/``c_1`` shorthand, ``\\pi``; any other name a parameter.
+    ``explicit``: the front matter's ``symbols`` (the student's symbol -> the name to use)."""
 
-    def __init__(self, joints: dict[int, str]):
+    def __init__(self, joints: dict[int, str], explicit: dict | None = None):
         self.joints = joints  # joint index -> variable name
+        self.explicit: dict[tuple[str, str], str] = {}
+        for student, target in (explicit or {}).items():
+            key = symbol_key(str(student))
+            if key is not None and re.fullmatch(r"[A-Za-z]\w{0,40}", str(target)):
+                self.explicit[key] = str(target)
+
+    def named(self, base: str, sub: str) -> str:
+        """The name a symbol gets: the front matter's, else the text's own (``l_{c1}`` -> ``lc1``)."""
+        return (
+            self.explicit.get((base, sub)) or self.explicit.get((base.replace("vartheta", "theta"), sub)) or base + sub
+        )
 
     def __call__(self, name: Name):
-        sub = re.sub(r"[{}\s,_]|\\mathrm|\\text", "", name.sub or "")  # l_{c1} -> lc1
+        sub = _flat(name.sub)
         base = "theta" if name.base == "vartheta" else name.base
         if base == "pi" and not sub:
             return sp.pi
         if base in ("s", "c", "S", "C") and not name.dots and sub.isdigit() and all(int(k) in self.joints for k in sub):
             angle = sum((sp.Symbol(self.joints[int(k)]) for k in sub), sp.Integer(0))
             return (sp.sin if base in "sS" else sp.cos)(angle)
-        return sp.Symbol(base + sub + {0: "", 1: "_dot", 2: "_ddot"}.get(name.dots, "_d" + str(name.dots)))
+        suffix = {0: "", 1: "_dot", 2: "_ddot"}.get(name.dots, "_d" + str(name.dots))
+        return sp.Symbol(self.named(base, sub) + suffix)
 
 
-def joint_candidates(sub: Submission) -> dict[int, str]:
-    """Joint index -> variable name: ``\\theta_k`` or ``q_k`` first, else ``d_k``."""
+def all_equations(sub: Submission) -> list[Equation]:
+    """The display equations the reader found, then those of the prose's inline math."""
+    return [*sub.equations, *_inline_equations(sub)]
+
+
+def joint_candidates(equations: list[Equation], explicit: dict | None = None) -> tuple[dict[int, str], dict[int, str]]:
+    """Joint index -> variable name (``\\theta_k`` or ``q_k`` first, else ``d_k``; renamed by
+    the front matter's ``symbols``), and joint index -> the base written (theta, q, d)."""
     found: dict[int, str] = {}
     pattern = re.compile(r"(\\vartheta|\\theta|(?<![A-Za-z\\])q|(?<![A-Za-z\\])d)\}?\s*_\s*\{?\s*(\d+)\s*\}?")
-    for eq in [*sub.equations, *_inline_equations(sub)]:
+    for eq in equations:
         if not eq.latex:
             continue
         for text in (eq.lhs, str(eq.value)):
             for m in pattern.finditer(text):
                 k, base = int(m.group(2)), m.group(1).lstrip("\\").replace("vartheta", "theta")
-                if k < 1 or k > MAX_FRAMES:
+                if k < 1:
                     continue
                 if k not in found or (found[k].startswith("d") and base != "d"):
                     found[k] = f"{base}{k}"
-    return found
+    names = Names({}, explicit)
+    bases = {k: v.rstrip("0123456789") for k, v in found.items()}
+    return {k: names.named(b, str(k)) for k, b in bases.items()}, bases
 
 
 _INERTIA_LHS = re.compile(
@@ -105,28 +140,100 @@ def _inline_equations(sub: Submission) -> list[Equation]:
     return out
 
 
-def read_statements(sub: Submission, names: Names) -> list[Statement]:
+#: a left-hand side written for a generic link i: ``{}^{i}P_{C_i}``, ``r_{i,c_i}``, ``R_i^{i-1}``
+_GENERIC = re.compile(r"(?<![A-Za-z\\])i(?![A-Za-z])")
+_GENERIC_SUB = re.compile(r"(?<![A-Za-z\\])i(?![A-Za-z])|(?<=\{[cC])i(?=\})")
+_SPONG_R = re.compile(r"r_\{(\d+),\s*(?:[cC]_?\{?(\d+)\}?|(\d+))\}")
+_DIAG = re.compile(r"\\(?:mathrm|operatorname|text)\{diag\}\s*\((.*)\)", re.S)
+_ELEMENTARY = re.compile(r"R_\{?([xyz])\}?\s*\((.*)\)", re.S)
+_SPACED = re.compile(r"\[(.*)\]\s*\^\s*\{?(?:T|\\top|\\mathrm\{T\})\}?", re.S)
+
+
+def _instances(eq: Equation, n: int) -> list[tuple[str, str, str]]:
+    """``(lhs, value, note)``: the equation itself, or, when its left-hand side is written
+    for a generic link i, one instance for each link 1..n."""
+    if not _GENERIC.search(normalise(eq.lhs)):
+        return [(eq.lhs, str(eq.value), "")]
+
+    def put(text: str, k: int) -> str:
+        text = text.replace("i-1", str(k - 1)).replace("i+1", str(k + 1))
+        return _GENERIC_SUB.sub(str(k), text)
+
+    return [(put(eq.lhs, k), put(str(eq.value), k), f" (i = {k})") for k in range(1, n + 1)]
+
+
+def _split_top(text: str, seps: str) -> list[str]:
+    parts, depth, start = [], 0, 0
+    for j, ch in enumerate(text):
+        depth += {"(": 1, "{": 1, "[": 1, ")": -1, "}": -1, "]": -1}.get(ch, 0)
+        if depth == 0 and text.startswith(seps, j):
+            parts.append(text[start:j])
+            start = j + len(seps)
+    return [*parts, text[start:]]
+
+
+def _value(text: str, names: Names):
+    """A statement's value: LaTeX, also ``\\mathrm{diag}(a, b, c)``, an elementary rotation
+    ``R_z(\\theta_1)`` and a row ``[a\\ b\\ c]^T`` (each entry parsed on its own)."""
+    text = text.strip()
+    m = _DIAG.fullmatch(text)
+    if m:
+        items = [parse(p, names) for p in _split_top(m.group(1), ",")]
+        return sp.diag(*items) if len(items) == 3 else None
+    m = _ELEMENTARY.fullmatch(text)
+    if m:
+        a = parse(m.group(2), names)
+        c, s = sp.cos(a), sp.sin(a)
+        return {
+            "x": sp.Matrix([[1, 0, 0], [0, c, -s], [0, s, c]]),
+            "y": sp.Matrix([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
+            "z": sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]]),
+        }[m.group(1)]
+    m = _SPACED.fullmatch(text)
+    if m and "," not in m.group(1):
+        items = [p for p in re.split(r"\\[ ,;:]|\\quad|&", m.group(1)) if p.strip()]
+        if len(items) == 3:
+            return sp.Matrix([parse(p, names) for p in items])
+    return parse(text, names)
+
+
+def _what(lhs: str):
+    """``(what, index, frame)`` a left-hand side states, or None."""
+    ref = parse_lhs(lhs, lambda _latex: None)
+    if ref is not None and ref.key in ("R", "P", "Pc", "T", "V"):
+        return ref.key, ref.index, ref.frame
+    if ref is not None and ref.key == "v_dot" and ref.index == 0:
+        return "g", 0, ref.frame
+    s = normalise(lhs)
+    m = _INERTIA_LHS.fullmatch(s)
+    if m:
+        return "I", int(m.group(2)), None
+    m = _SPONG_R.fullmatch(s)  # Spong's r_{i,c_i} (to the mass centre), r_{i,i+1} (to the next joint)
+    if m and m.group(2) and m.group(2) == m.group(1):
+        return "Pc", int(m.group(1)), int(m.group(1))
+    if m and m.group(3) and int(m.group(3)) == int(m.group(1)) + 1:
+        return "P", int(m.group(3)), int(m.group(1))
+    return None
+
+
+def read_statements(equations: list[Equation], names: Names, n: int) -> list[Statement]:
+    """What the equations state about the robot of ``n`` joints, in the order written."""
     out: list[Statement] = []
-    for eq in [*sub.equations, *_inline_equations(sub)]:
+    for eq in equations:
         if not eq.latex or eq.problem:
             continue
-        ref = parse_lhs(eq.lhs, lambda _latex: None)
-        what = index = frame = None
-        if ref is not None and ref.key in ("R", "P", "Pc", "T", "V"):
-            what, index, frame = ref.key, ref.index, ref.frame
-        elif ref is not None and ref.key == "v_dot" and ref.index == 0:
-            what, index, frame = "g", 0, ref.frame
-        else:
-            m = _INERTIA_LHS.fullmatch(normalise(eq.lhs))
-            if m:
-                what, index = "I", int(m.group(2))
-        if what is None:
-            continue
-        try:
-            value = parse(str(eq.value), names)
-        except (LatexError, RecursionError, ValueError, TypeError):
-            continue  # the grader reports it as unreadable
-        out.append(Statement(what, eq.line, " ".join(eq.source.split()), value, index, frame))
+        for lhs, text, note in _instances(eq, n):
+            found = _what(lhs)
+            if found is None:
+                continue
+            try:
+                value = _value(text, names)
+            except (LatexError, RecursionError, ValueError, TypeError):
+                continue  # the grader reports it as unreadable
+            if value is None:
+                continue
+            what, index, frame = found
+            out.append(Statement(what, eq.line, " ".join(eq.source.split()) + note, value, index, frame))
     return out
 
 
