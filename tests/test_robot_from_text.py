@@ -105,9 +105,44 @@ def test_rp_arm_read_has_the_exercises_dynamics(tmp_path):
         assert max(abs(a - b) for a, b in zip(got, _tau_at(bundled, renamed), strict=True)) < 1e-9
 
 
-@pytest.mark.parametrize("name", ["planar-2r-lagrange.md", "planar-2r-craig.md"])
+STANDARD_DH = r"""# Planar 2R, frames from a standard DH table
+
+| i | $a_i$ | $\alpha_i$ | $d_i$ | $\theta_i$ |
+|---|---|---|---|---|
+| 1 | $l_1$ | 0 | 0 | $q_1$ |
+| 2 | $l_2$ | 0 | 0 | $q_2$ |
+
+Mass centres in each DH frame (at the link's far end): $r_{1,c_1} = (l_{c1} - l_1, 0, 0)^T$,
+$r_{2,c_2} = (l_{c2} - l_2, 0, 0)^T$. Gravity: $\dot v_0^0 = (0, g, 0)^T$.
+Inertias: $I_1 = \mathrm{diag}(0, I_1, I_1)$, $I_2 = \mathrm{diag}(0, I_2, I_2)$; masses: $F_1 = m_1 a_1$, $F_2 = m_2 a_2$.
+"""
+
+MODIFIED_DH = r"""# Planar 2R, frames from Craig's DH table
+
+| $i$ | $\alpha_{i-1}$ | $a_{i-1}$ | $d_i$ | $\theta_i$ |
+|:-:|:-:|:-:|:-:|:-:|
+| 1 | 0 | 0 | 0 | $\theta_1$ |
+| 2 | 0 | $l_1$ | 0 | $\theta_2$ |
+
+${}^{1}P_{C_1} = (l_{c1}, 0, 0)^T$, ${}^{2}P_{C_2} = (l_{c2}, 0, 0)^T$, ${}^{0}\dot v_0 = (0, g, 0)^T$,
+${}^{C_1}I_1 = \mathrm{diag}(0, I_1, I_1)$, ${}^{C_2}I_2 = \mathrm{diag}(0, I_2, I_2)$,
+and the masses $m_1$, $m_2$: $F_1 = m_1 a_1$, $F_2 = m_2 a_2$.
+
+$$\tau_1 = m_1 g$$
+$$\tau_2 = m_2 g$$
+"""
+
+
+@pytest.mark.parametrize("name", ["planar-2r-lagrange.md", "planar-2r-craig.md", "standard-dh", "modified-dh"])
 def test_planar_2r_read_has_spongs_dynamics(name, tmp_path):
-    robot = robot_from_text(read(_unnamed(name, tmp_path))).robot
+    if name.endswith("-dh"):
+        path = tmp_path / f"{name}.md"
+        path.write_text(STANDARD_DH if name == "standard-dh" else MODIFIED_DH, encoding="utf-8")
+        model = robot_from_text(read(str(path)))
+        assert any(a.startswith(f"the DH table of line 3 is {name.split('-')[0]} DH") for a in model.assumptions)
+        robot = model.robot
+    else:
+        robot = robot_from_text(read(_unnamed(name, tmp_path))).robot
     q1, q2 = robot.q
     qd1, qd2 = robot.qd
     qdd1, qdd2 = robot.qdd
@@ -120,7 +155,7 @@ def test_planar_2r_read_has_spongs_dynamics(name, tmp_path):
     phi1 = (m1 * lc1 + m2 * l1) * g * sp.cos(q1) + m2 * lc2 * g * sp.cos(q1 + q2)
     phi2 = m2 * lc2 * g * sp.cos(q1 + q2)
     tau = [d11 * qdd1 + d12 * qdd2 + 2 * h * qd1 * qd2 + h * qd2**2 + phi1, d12 * qdd1 + d22 * qdd2 - h * qd1**2 + phi2]
-    names = {str(p): p for p in (m1, m2, l1, lc1, lc2, I1, I2, g)}
+    names = {str(p): p for p in (m1, m2, l1, lc1, lc2, I1, I2, g, sp.Symbol("l2"))}  # l2: the DH frames' own
     for seed in range(3):
         at = _state(robot, names, seed)
         got = _tau_at(robot, at)

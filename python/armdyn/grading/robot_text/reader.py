@@ -11,6 +11,7 @@ import sympy as sp
 from ...errors import ModelError
 from ...model import Robot
 from ..reader import Submission
+from .dh import dh_statements, dh_tables, table_equations
 from .geometry import (
     across,
     axis_angle,
@@ -63,7 +64,10 @@ class TextReader:
 
     # -- the pass
     def read(self) -> TextModel:
-        equations = all_equations(self.sub)
+        equations, text = all_equations(self.sub)
+        tables = dh_tables(text)
+        equations += table_equations(tables)
+        self.equations = equations
         joints, written = joint_candidates(equations, self.sub.symbols)
         if not joints:
             self.fail("no joint variable (\\theta_k, q_k, d_k) is written; name the model with --robot")
@@ -72,6 +76,11 @@ class TextReader:
             self.fail(f"{n} frames is more than a derivation by hand has (at most {MAX_FRAMES})")
         names = Names(joints, self.sub.symbols)
         statements = read_statements(equations, names, n)
+        if tables:
+            from_table, assumed, problems = dh_statements(tables, names)
+            statements = from_table + statements  # the table first: it is the frames' definition
+            self.assumptions += assumed
+            self.conflicts += problems
         q = {k: sp.Symbol(v) for k, v in joints.items()}
         missing = [k for k in range(1, n + 1) if k not in q]
         if missing:
@@ -416,8 +425,8 @@ class TextReader:
             if k in out:
                 continue
             pattern = re.compile(r"(?<![A-Za-z\\])m_\{?\s*" + str(k) + r"(?!\d)")
-            for eq in self.sub.equations:
-                if pattern.search(str(eq.value)):
+            for eq in self.equations:
+                if eq.lhs and pattern.search(str(eq.value)):
                     out[k] = (sp.Symbol(f"m{k}"), f"line {eq.line}: m_{k} written there")
                     self.assumptions.append(f"link {k}'s mass is m{k}, by its name (first used on line {eq.line})")
                     break

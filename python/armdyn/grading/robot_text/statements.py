@@ -80,9 +80,14 @@ class Names:
         return sp.Symbol(self.named(base, sub) + suffix)
 
 
-def all_equations(sub: Submission) -> list[Equation]:
-    """The display equations the reader found, then those of the prose's inline math."""
-    return [*sub.equations, *_inline_equations(sub)]
+def all_equations(sub: Submission) -> tuple[list[Equation], str]:
+    """The display equations the reader found, then those of the prose's inline math; and
+    the Markdown text ("" for a YAML submission or a file that cannot be read again)."""
+    try:
+        text = read_text(sub.path) if sub.path.endswith(".md") else ""
+    except (OSError, ModelError):
+        text = ""
+    return [*sub.equations, *_inline_equations(text)], text
 
 
 def joint_candidates(equations: list[Equation], explicit: dict | None = None) -> tuple[dict[int, str], dict[int, str]]:
@@ -113,13 +118,9 @@ _INERTIA_LHS = re.compile(
 _INLINE = re.compile(r"(?<![$\\])\$([^$\n]{1,2000})\$(?!\$)")
 
 
-def _inline_equations(sub: Submission) -> list[Equation]:
+def _inline_equations(text: str) -> list[Equation]:
     """The equations of the prose's inline math (``$P_1^0 = l_1(\\cos\\theta_1, ...)^T$``): a
     derivation often states its frames there. Display blocks are left to the reader."""
-    try:
-        text = read_text(sub.path)
-    except (OSError, ModelError):
-        return []
     blocks = [(a, b) for a, b, _, _ in math_blocks(text)]
     out: list[Equation] = []
     k = 0
