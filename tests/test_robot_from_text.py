@@ -55,9 +55,9 @@ def test_same_verdicts_as_the_named_model(name, tmp_path):
 
 
 def test_geometry_stated_only_in_words_is_not_read(tmp_path):
-    # the SCARA text states no gravity direction, no rotation and no position: its vertical V,
-    # read with gravity assumed along -y0, places no serial arm, and the reading says so
-    with pytest.raises(ModelError, match="moves with other joints than joint 3: the positions read are not"):
+    # the SCARA text states its gravity (along -z0), its rotations and the heights only in
+    # words; its horizontal p_{ck} leave the quill's slider d_3 moving nothing: it says so
+    with pytest.raises(ModelError, match="cannot read the robot from the text: joint variable q3 moves nothing"):
         grade(_unnamed("scara-lagrange.md", tmp_path))
 
 
@@ -204,6 +204,17 @@ def test_a_mass_centre_stated_twice_is_named_and_the_first_used(tmp_path):
     n = open(path).read().count("\n") + 1
     assert any(f"lines {n - 1} and {n - 1} state link 2's mass centre differently" in c for c in model.conflicts)
     assert "model read from the text" in model.note() and "disagree" in model.note()
+
+
+def test_positions_and_V_that_disagree_are_named(tmp_path):
+    # the 2R text's p_{c2} with a slip (l_2 for l_{c2}): V (line 40) disagrees, p_{c2} is used
+    path = _unnamed(
+        "planar-2r-lagrange.md",
+        tmp_path,
+        lambda t: t.replace(r"l_1(\cos q_1, \sin q_1) + l_{c2}(", r"l_1(\cos q_1, \sin q_1) + l_2("),
+    )
+    model = _model(path)
+    assert "line 40 (V) and line 31 place link 2's mass centre at different heights (line 31 used)" in model.conflicts
 
 
 def test_no_gravity_stated_is_an_assumption_named(tmp_path):

@@ -12,8 +12,8 @@ from ...errors import ModelError
 from ...model import Robot
 from ..reader import Submission
 from .dh import dh_statements, dh_tables, table_equations
+from .energy import mass_centres
 from .geometry import (
-    across,
     axis_angle,
     frame_of,
     model_name,
@@ -178,51 +178,8 @@ class TextReader:
         return g, None
 
     def _coms(self, statements, gravity, rot, revolute) -> dict:
-        """Link k's mass centre in the base frame -> (position, mass, statement), from V."""
-        found: dict[int, tuple] = {}
-        for st in statements:
-            if st.what != "V" or isinstance(st.value, sp.MatrixBase):
-                continue
-            axis = [i for i in range(3) if gravity[i] != 0]
-            if len(axis) != 1 or axis[0] == 2:
-                self.conflicts.append(f"line {st.line}: V read only for gravity along x0 or y0 (not used)")
-                continue
-            c = gravity[axis[0]]
-            sign = 1 if sp.N(c.subs({x: 1 for x in c.free_symbols})) > 0 else -1
-            g_mag = sign * c  # the magnitude, the parameters taken positive
-            up = sp.zeros(3, 1)
-            up[axis[0]] = -sign
-            side = up.cross(sp.Matrix([0, 0, 1]))
-            V = sp.expand(st.value)
-            masses = sorted(
-                (s for s in V.free_symbols if re.fullmatch(r"m(\d+)", s.name)), key=lambda s: int(s.name[1:])
-            )
-            all_rev = (self._in_trig(V) & set(self.q)) | revolute
-            for m in masses:
-                k = int(m.name[1:])
-                height = sp.expand(V.coeff(m) / g_mag)
-                if k < 1 or k > self.n or height.has(m):
-                    continue
-                try:
-                    w = across(height, all_rev)
-                except ValueError as err:
-                    self.conflicts.append(f"line {st.line}: the height of m{k} is not a planar arm's ({err})")
-                    continue
-                pos = up * height + side * w
-                if k in found:
-                    if not same(found[k][0], pos, self.free):
-                        self.conflicts.append(
-                            f"lines {found[k][2].line} and {st.line} place link {k}'s mass centre differently "
-                            f"(line {found[k][2].line} used)"
-                        )
-                    continue
-                found[k] = (pos, m, st)
-            rest = sp.expand(
-                V - sum(m * g_mag * (up.dot(found[int(m.name[1:])][0])) for m in masses if int(m.name[1:]) in found)
-            )
-            if rest != 0 and found:
-                self.conflicts.append(f"line {st.line}: V has a term not of one mass's height: {rest}")
-        return found
+        """Link k's mass centre in the base frame -> (position, mass or None, statement)."""
+        return mass_centres(statements, gravity, self.q, revolute, self.free, self.conflicts)
 
     # -- the model
     def _build(self, statements, rot, revolute, gravity, g_line, coms) -> TextModel:
@@ -403,18 +360,19 @@ class TextReader:
         from ...io.yaml import load_yaml_string
 
         robot = load_yaml_string(text, source=f"{self.sub.path} (the model read from it)", strict=False)
-        self._check_T(statements, robot, g_line is None)
+        self._check_T(statements, robot, g_line is None and any(c[2].what == "V" for c in coms.values()))
         return TextModel(text, robot, self.assumptions, self.conflicts)
 
     def _com_source(self, k, coms, pc) -> str:
         if k in pc:
             return f"line {pc[k].line}: {pc[k].source[:70]}"
         if k in coms:
-            return f"line {coms[k][2].line}: from the height of m{k} in V"
+            how = f"from the height of m{k} in V" if coms[k][2].what == "V" else coms[k][2].source[:70]
+            return f"line {coms[k][2].line}: {how}"
         return "assumed"
 
     def _masses(self, statements, coms) -> dict:
-        out = {k: (v[1], f"line {v[2].line}: m{k} in V") for k, v in coms.items()}
+        out = {k: (v[1], f"line {v[2].line}: m{k} in V") for k, v in coms.items() if v[1] is not None}
         for st in statements:
             if st.what in ("T", "V") and not isinstance(st.value, sp.MatrixBase):
                 for s in st.value.free_symbols:

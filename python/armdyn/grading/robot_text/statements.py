@@ -145,6 +145,7 @@ def _inline_equations(text: str) -> list[Equation]:
 _GENERIC = re.compile(r"(?<![A-Za-z\\])i(?![A-Za-z])")
 _GENERIC_SUB = re.compile(r"(?<![A-Za-z\\])i(?![A-Za-z])|(?<=\{[cC])i(?=\})")
 _SPONG_R = re.compile(r"r_\{(\d+),\s*(?:[cC]_?\{?(\d+)\}?|(\d+))\}")
+_CENTRE = re.compile(r"([prxyz])_\{?[cC]_?\{?(\d+)\}?\}?")
 _DIAG = re.compile(r"\\(?:mathrm|operatorname|text)\{diag\}\s*\((.*)\)", re.S)
 _ELEMENTARY = re.compile(r"R_\{?([xyz])\}?\s*\((.*)\)", re.S)
 _SPACED = re.compile(r"\[(.*)\]\s*\^\s*\{?(?:T|\\top|\\mathrm\{T\})\}?", re.S)
@@ -209,6 +210,9 @@ def _what(lhs: str):
     m = _INERTIA_LHS.fullmatch(s)
     if m:
         return "I", int(m.group(2)), None
+    m = _CENTRE.fullmatch(s)  # an energy method's mass centre in the base frame: p_{c2}, x_{c2}
+    if m:
+        return ("C" if m.group(1) in "pr" else "C" + m.group(1)), int(m.group(2)), 0
     m = _SPONG_R.fullmatch(s)  # Spong's r_{i,c_i} (to the mass centre), r_{i,i+1} (to the next joint)
     if m and m.group(2) and m.group(2) == m.group(1):
         return "Pc", int(m.group(1)), int(m.group(1))
