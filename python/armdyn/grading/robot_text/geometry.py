@@ -6,28 +6,30 @@ import os
 import random
 import re
 
+import symengine as se
 import sympy as sp
 
 from .statements import Statement
 
 
-def sample(symbols, seed: int) -> dict:
-    rng = random.Random(seed)
-    return {s: sp.Float(rng.uniform(0.3, 1.7) * rng.choice((1, -1) if "theta" in s.name else (1,))) for s in symbols}
-
-
-def same(a, b, symbols, trials: int = 3) -> bool:
-    """a == b at random values (both scalar or both matrices of one shape)."""
-    a, b = sp.Matrix(a) if isinstance(a, sp.MatrixBase) else a, sp.Matrix(b) if isinstance(b, sp.MatrixBase) else b
+def same(a, b, symbols=(), trials: int = 3) -> bool:
+    """a == b at random values of every symbol in them (both scalars or both matrices of one
+    shape), evaluated with SymEngine; a value that is not a finite number never passes."""
     diff = a - b
+    items = list(diff) if isinstance(diff, sp.MatrixBase) else [diff]
+    free = sorted(set(symbols).union(*(sp.sympify(x).free_symbols for x in items)), key=str)
+    try:
+        exprs = [se.sympify(x) for x in items]
+    except (TypeError, ValueError, RuntimeError):
+        return False
     for seed in range(trials):
-        at = sample(symbols, seed)
-        values = diff.subs(at).evalf() if isinstance(diff, sp.MatrixBase) else [sp.N(diff.subs(at))]
-        for v in values:
+        rng = random.Random(seed)
+        at = {se.Symbol(s.name): rng.uniform(0.3, 1.7) for s in free}
+        for e in exprs:
             try:
-                if not abs(complex(v)) < 1e-8:
+                if not abs(complex(e.subs(at))) < 1e-8:
                     return False
-            except TypeError:
+            except (TypeError, ValueError, RuntimeError, OverflowError):
                 return False
     return True
 
