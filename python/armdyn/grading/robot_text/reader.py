@@ -73,7 +73,9 @@ class TextReader:
             self.fail("no joint variable (\\theta_k, q_k, d_k) is written; name the model with --robot")
         n = max(joints)
         if n > MAX_FRAMES:
-            self.fail(f"{n} frames is more than a derivation by hand has (at most {MAX_FRAMES})")
+            self.fail(
+                f"joint variables numbered up to {n}: more frames than a derivation by hand has (at most {MAX_FRAMES})"
+            )
         names = Names(joints, self.sub.symbols)
         statements = read_statements(equations, names, n)
         if tables:
@@ -111,6 +113,11 @@ class TextReader:
                     )
                 else:
                     rot[k] = (sp.eye(3), None)
+                    if any(rot.get(j, (None, None))[1] is not None for j in range(1, n + 1)):
+                        self.assumptions.append(
+                            f"frame {k} not turned from frame {k - 1}: no rotation between them is stated, "
+                            "while other frames' are"
+                        )
         return self._build(statements, rot, revolute, gravity, g_line, coms)
 
     @staticmethod
