@@ -265,3 +265,27 @@ def test_reading_the_model_is_fast(tmp_path):
     start = time.perf_counter()
     robot_from_text(sub)
     assert time.perf_counter() - start < 0.5
+
+
+def test_mangled_texts_end_in_a_model_or_one_clear_error(tmp_path):
+    # characters dropped, repeated, digits and signs changed: a model or one ModelError line
+    sources = [_unnamed(n, tmp_path) for n in ("rp-arm-exercise.md", "planar-2r-lagrange.md", "planar-3r-spong.md")]
+    rng = random.Random(7)
+    for trial in range(30):
+        text = open(rng.choice(sources), encoding="utf-8").read()
+        for _ in range(rng.randint(1, 4)):
+            i = rng.randrange(len(text))
+            text = rng.choice(
+                [
+                    text[:i] + text[i + rng.randint(1, 30) :],
+                    text[:i] + text[i : i + rng.randint(1, 40)] + text[i:],
+                    text[:i] + str(rng.randint(0, 9)) + text[i + 1 :],
+                    text[:i] + "-" + text[i:],
+                ]
+            )
+        path = tmp_path / f"mangled{trial}.md"
+        path.write_text(text, encoding="utf-8")
+        try:
+            robot_from_text(read(str(path)))
+        except ModelError as err:
+            assert "\n" not in str(err) and str(path) in str(err)

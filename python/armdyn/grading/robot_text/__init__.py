@@ -26,6 +26,7 @@ Symbols keep the text's names (``l_1`` -> ``l1``, ``l_{c1}`` -> ``lc1``, ``\\the
 
 from __future__ import annotations
 
+from ...errors import ModelError
 from ..reader import Submission
 from .reader import TextModel, TextReader
 from .statements import MAX_FRAMES, MAX_INLINE
@@ -36,7 +37,14 @@ __all__ = ["MAX_FRAMES", "MAX_INLINE", "TextModel", "robot_from_text", "show_mod
 def robot_from_text(sub: Submission) -> TextModel:
     """The robot ``sub``'s own statements describe (see the module's docstring); a
     :class:`ModelError` naming the file when they do not fix one."""
-    return TextReader(sub).read()
+    try:
+        return TextReader(sub).read()
+    except ModelError:
+        raise
+    except (ArithmeticError, TypeError, ValueError, AttributeError, IndexError, KeyError, RecursionError) as err:
+        # a statement shaped like none the reading knows: one line, never a traceback
+        what = " ".join(str(err).split())[:160] or type(err).__name__
+        raise ModelError(f"cannot read the robot from the text: {what}", source=sub.path) from None
 
 
 def show_model(sub: Submission, robot: str | None = None) -> str:
