@@ -289,3 +289,23 @@ def test_mangled_texts_end_in_a_model_or_one_clear_error(tmp_path):
             robot_from_text(read(str(path)))
         except ModelError as err:
             assert "\n" not in str(err) and str(path) in str(err)
+
+
+def test_principal_moments_used_by_name_are_the_links_inertia(tmp_path):
+    path = tmp_path / "pendulum.md"
+    path.write_text(
+        "$$R_0^1 = \\begin{pmatrix} \\cos\\theta_1 & \\sin\\theta_1 & 0 \\\\ -\\sin\\theta_1 & \\cos\\theta_1 & 0"
+        " \\\\ 0 & 0 & 1 \\end{pmatrix}$$\n\n$$P_{C_1}^1 = (l_{c1}, 0, 0)^T, \\dot v_0^0 = (0, g, 0)^T$$\n\n"
+        "$$N_1^1 = \\begin{pmatrix} 0 \\\\ 0 \\\\ I_{zz1} \\ddot\\theta_1 \\end{pmatrix}$$\n\n"
+        "$$F_1^1 = m_1 \\dot v_{C_1}^1$$\n",
+        encoding="utf-8",
+    )
+    model = _model(str(path))
+    assert "link 1's inertia diagonal in frame 1, from the moments named on line 5 (others 0)" in model.assumptions
+    assert any("frame 1's origin at frame 0's" in a for a in model.assumptions)
+    th, thdd = model.robot.q[0], model.robot.qdd[0]
+    izz, m1, lc1, g = sp.symbols("Izz1 m1 lc1 g")
+    pendulum = (izz + m1 * lc1**2) * thdd + m1 * g * lc1 * sp.cos(th)  # a physical pendulum, by hand
+    for seed in range(3):
+        at = _state(model.robot, {"Izz1": izz, "m1": m1, "lc1": lc1, "g": g}, seed)
+        assert abs(_tau_at(model.robot, at)[0] - sp.N(pendulum.subs(at))) < 1e-9

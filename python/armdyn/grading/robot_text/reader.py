@@ -421,6 +421,23 @@ class TextReader:
                         None,
                     )
                     out["symbols"].append(s)
+        for k in range(1, self.n + 1):  # principal moments used by name: I_{xx1}, I_{zz1}
+            if k in out:
+                continue
+            pattern = re.compile(r"I_\{?\s*(xx|yy|zz)\s*,?\s*" + str(k) + r"(?!\d)")
+            used: dict[str, int] = {}
+            for eq in self.equations:
+                for m in pattern.finditer(str(eq.value)):
+                    used.setdefault(m.group(1), eq.line)
+            if used:
+                entries = ", ".join(f"i{a}: {f'I{a}{k}' if a in used else 0}" for a in ("xx", "yy", "zz"))
+                lines = sorted(set(used.values()))
+                out[k] = (f"{{{entries}}}", f"line {lines[0]}: I_{{..{k}}} used there", None)
+                out["symbols"] += [sp.Symbol(f"I{a}{k}") for a in used]
+                self.assumptions.append(
+                    f"link {k}'s inertia diagonal in frame {k}, from the moments named on line"
+                    f"{'s' if len(lines) > 1 else ''} {', '.join(map(str, lines))} (others 0)"
+                )
         point = [k for k in range(1, self.n + 1) if k not in out]
         for k in point:
             out[k] = ("0", "point mass", None)
