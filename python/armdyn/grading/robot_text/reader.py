@@ -179,6 +179,7 @@ class TextReader:
                 f"gravity {pretty_vector(g)}, from line {first.line}: the base accelerates by "
                 f"{pretty_vector(-g)} (Newton-Euler's way of putting in gravity)"
             )
+            self.gravity_source = f"line {first.line}: {first.source[:70]}"
             return g, first.line
         g = sp.Matrix([0, -sp.Symbol("g"), 0])
         self.assumptions.append("gravity (0, -g, 0), along -y0: no base acceleration or gravity vector is stated")
@@ -354,7 +355,7 @@ class TextReader:
         # the front matter's symbols name the model's parameters: each one the model has
         params |= {sp.Symbol(str(t)) for t in self.sub.symbols.values() if re.fullmatch(r"[A-Za-z]\w{0,40}", str(t))}
         params -= set(qs) | {sp.Symbol(f"{x}_{d}") for x in qs for d in ("dot", "ddot")}
-        g_src = f"line {g_line}" if g_line else "assumed"
+        g_src = self.gravity_source if g_line else "assumed: none stated"
         lines += [
             f"parameters: [{', '.join(sorted(str(p) for p in params))}]",
             f"gravity: {yaml_vec(gravity)}    # {g_src}",

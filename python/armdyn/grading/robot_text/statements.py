@@ -77,7 +77,10 @@ class Names:
             angle = sum((sp.Symbol(self.joints[int(k)]) for k in sub), sp.Integer(0))
             return (sp.sin if base in "sS" else sp.cos)(angle)
         suffix = {0: "", 1: "_dot", 2: "_ddot"}.get(name.dots, "_d" + str(name.dots))
-        return sp.Symbol(self.named(base, sub) + suffix)
+        named = self.named(base, sub) + suffix
+        if not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]{0,60}", named):  # it becomes a model parameter's name
+            raise LatexError(f"the symbol {name.latex()} cannot name a parameter")
+        return sp.Symbol(named)
 
 
 def all_equations(sub: Submission) -> tuple[list[Equation], str]:
