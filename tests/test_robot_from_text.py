@@ -198,12 +198,30 @@ def test_a_rotation_with_a_slip_is_named_with_its_line(tmp_path):
 
 
 def test_a_mass_centre_stated_twice_is_named_and_the_first_used(tmp_path):
-    extra = "\n$P_{C_2}^2 = (0, 0, 0)^T$ and later $P_{C_2}^2 = (0, l_1, 0)^T$.\n"
+    extra = "\n$P_{C_2}^2 = (0, 0, 0)^T$\n\nand later $P_{C_2}^2 = (0, l_1, 0)^T$.\n"
     path = _unnamed("rp-arm-exercise.md", tmp_path, lambda t: t + extra)
     model = _model(path)
-    n = open(path).read().count("\n") + 1
-    assert any(f"lines {n - 1} and {n - 1} state link 2's mass centre differently" in c for c in model.conflicts)
+    n = open(path).read().count("\n")  # the last line's number
+    expected = (
+        f"line {n - 2} and line {n} state link 2's mass centre differently (line {n - 2} used: the first written)"
+    )
+    assert expected in model.conflicts
     assert "model read from the text" in model.note() and "disagree" in model.note()
+    assert list(model.robot.links["link2"].com) == [0, 0, 0]
+
+
+def test_the_position_most_statements_give_is_used(tmp_path):
+    # a slip first, then the same vector twice, once in frame 2 and once in frame 1 (x2 = x1, y2 = -z1, z2 = y1)
+    extra = "\n$P_{C_2}^2 = (0, l_1, 0)^T$\n\n$P_{C_2}^2 = (l_1, 0, 0)^T$\n\n$P_{C_2}^1 = (l_1, 0, 0)^T$\n"
+    path = _unnamed("rp-arm-exercise.md", tmp_path, lambda t: t + extra)
+    model = _model(path)
+    n = open(path).read().count("\n")
+    expected = (
+        f"lines {n - 2}, {n} and line {n - 4} state link 2's mass centre differently "
+        f"(lines {n - 2}, {n} used: most statements)"
+    )
+    assert expected in model.conflicts
+    assert list(model.robot.links["link2"].com) == [sp.Symbol("l1"), 0, 0]
 
 
 def test_positions_and_V_that_disagree_are_named(tmp_path):

@@ -192,18 +192,16 @@ class TextReader:
     # -- the model
     def _build(self, statements, rot, revolute, gravity, g_line, coms) -> TextModel:
         n = self.n
-        pc: dict[int, Statement] = {}
-        pstat: dict[int, Statement] = {}
-        for st in statements:  # the first statement of each vector is the one used
-            if st.what in ("P", "Pc") and vector(st.value) is not None and st.index is not None:
-                (pc if st.what == "Pc" else pstat).setdefault(st.index, st)
         # orientation and origin of each frame in the base frame
         R0 = [sp.eye(3)]
+        for k in range(1, n + 1):
+            R0.append(R0[k - 1] * rot[k][0])
+        pstat = self._vote(statements, "P", "frame {k}'s origin", R0, -1)
+        pc = self._vote(statements, "Pc", "link {k}'s mass centre", R0, 0)
         o = [sp.zeros(3, 1)]
         com_local: dict[int, sp.Matrix] = {}
         for k in range(1, n + 1):
-            Rk = R0[k - 1] * rot[k][0]
-            R0.append(Rk)
+            Rk = R0[k]
             if k in pstat:
                 st = pstat[k]
                 f = st.frame if st.frame is not None else k - 1
@@ -233,8 +231,6 @@ class TextReader:
                     f"frame {k}'s origin is not stated (P_{k}^{k - 1}) and link {k}'s mass centre cannot be "
                     "placed (no V, no P_{C_" + str(k) + "})"
                 )
-        self._duplicates(statements, "P", "frame {k}'s origin", lambda st: R0[frame_of(st, st.index - 1)])
-        self._duplicates(statements, "Pc", "link {k}'s mass centre", lambda st: R0[frame_of(st, st.index)])
         for k in range(1, n + 1):
             if k in com_local:
                 continue
@@ -261,20 +257,40 @@ class TextReader:
             )
         return self._emit(statements, rot, revolute, gravity, g_line, coms, R0, o, com_local, pstat, pc)
 
-    def _duplicates(self, statements, what: str, label: str, into_base):
-        """Two statements of one vector (each in its own frame) that differ: named, the first used."""
-        seen: dict[int, tuple] = {}
+    def _vote(self, statements, what: str, label: str, R0, shift: int) -> dict[int, Statement]:
+        """Link/frame k -> the statement of one vector that most statements agree with (compared
+        in the base frame; a tie: the first written); each disagreement named with its lines."""
+        groups: dict[int, list[list]] = {}
         for st in statements:
-            if st.what != what or vector(st.value) is None or frame_of(st, 0) > self.n:
-                continue
             k = st.index
-            in_base = into_base(st) * vector(st.value)
-            if k in seen and not same(seen[k][1], in_base, self.free):
+            if st.what != what or vector(st.value) is None or k is None or not 1 <= k <= self.n:
+                continue
+            f = frame_of(st, k + shift)
+            if not 0 <= f <= self.n:
                 self.conflicts.append(
-                    f"lines {seen[k][0].line} and {st.line} state {label.format(k=k)} differently "
-                    f"(line {seen[k][0].line} used)"
+                    f"line {st.line}: {label.format(k=k)} is written in frame {f}, which no statement places (not used)"
                 )
-            seen.setdefault(k, (st, in_base))
+                continue
+            in_base = R0[f] * vector(st.value)
+            for group in groups.setdefault(k, []):
+                if same(group[0][1], in_base, self.free):
+                    group.append((st, in_base))
+                    break
+            else:
+                groups[k].append([(st, in_base)])
+        chosen: dict[int, Statement] = {}
+        for k, gs in groups.items():
+            best = max(gs, key=lambda g: (len(g), -g[0][0].line))
+            chosen[k] = best[0][0]
+            if len(gs) > 1:
+                used = ", ".join(str(st.line) for st, _ in best)
+                others = ", ".join(str(st.line) for g in gs if g is not best for st, _ in g)
+                why = "most statements" if len(best) > max(len(g) for g in gs if g is not best) else "the first written"
+                self.conflicts.append(
+                    f"line{'s' if len(best) > 1 else ''} {used} and line{'s' if ',' in others else ''} {others} "
+                    f"state {label.format(k=k)} differently (line{'s' if len(best) > 1 else ''} {used} used: {why})"
+                )
+        return chosen
 
     def _emit(self, statements, rot, revolute, gravity, g_line, coms, R0, o, com_local, pstat, pc) -> TextModel:
         n, qs = self.n, self.q
