@@ -4,7 +4,7 @@
     armdyn check ROBOT [--exact | --numeric] [--samples N]
     armdyn robots
     armdyn show ROBOT [--q Q1,Q2,...] [--out arm.png]
-    armdyn grade SUBMISSION [--robot MODEL] [--json] [--html OUT.html] [--ascii] [--to-yaml]
+    armdyn grade SUBMISSION [--robot MODEL] [--json] [--html OUT.html] [--ascii] [--to-yaml] [--show-model]
     armdyn grade DIR --gradebook grades.csv [--rubric R.yaml] [--html-dir DIR] [--variants DIR] [--jobs N]
     armdyn exercise make KIND (--count N | --roster roster.csv) --seed S --out DIR
     armdyn serve [--host H] [--port P] [--db URL] [--workers N] [--exercises DIR] [--instructor-token T]
@@ -111,6 +111,11 @@ def cmd_grade(args) -> int:
         submission = read(args.submission)
         if args.to_yaml:
             print(submission.to_yaml(), end="")
+            return 0
+        if args.show_model:
+            from .grading.robot_text import show_model
+
+            print(show_model(submission, args.robot), end="")
             return 0
         report = grade(submission, robot=args.robot)
     except ModelError as err:
@@ -253,6 +258,11 @@ def build_parser() -> argparse.ArgumentParser:
     gr.add_argument("--html", metavar="OUT.html", help="also write a self-contained HTML report")
     gr.add_argument("--ascii", action="store_true", help="plain ASCII text (no Unicode dots and marks)")
     gr.add_argument("--to-yaml", action="store_true", help="print the steps as read (the YAML format) and stop")
+    gr.add_argument(
+        "--show-model",
+        action="store_true",
+        help="print the robot read from the text (YAML, each item with its line; what was assumed) and stop",
+    )
     gr.set_defaults(func=cmd_grade)
     from .course.cli import add_batch_arguments, add_exercise_parser
 

@@ -592,13 +592,16 @@ def grade(
     symbols:    extra mapping of the student's symbols to model names.
     """
     sub = submission if isinstance(submission, Submission) else read(os.fspath(submission))
+    read_model = None
     if isinstance(robot, Robot):
         model = robot
+    elif robot or sub.robot:
+        model = _load_robot(robot or sub.robot, sub)  # a stated model wins: the text's statements are only checked
     else:
-        name = robot or sub.robot
-        if not name:
-            raise ModelError("no robot named: give --robot MODEL or 'robot:' in the front matter", source=sub.path)
-        model = _load_robot(name, sub)
+        from .robot_text import robot_from_text
+
+        read_model = robot_from_text(sub)  # the robot the text itself describes
+        model = read_model.robot
     if sub.values is not None:
         try:
             # the reader admits "published" or a mapping parameter -> number
@@ -606,4 +609,7 @@ def grade(
         except ModelError as err:
             raise err.located(source=sub.path) from None
     hint = sub.method if sub.method in ("newton-euler", "lagrange") else None
-    return _Grader(sub, model, symbols).run(hint)
+    report = _Grader(sub, model, symbols).run(hint)
+    if read_model is not None:
+        report.notes.insert(0, read_model.note())
+    return report

@@ -1,0 +1,92 @@
+"""Where the masses are, from an energy-method derivation: the mass centres' positions as
+functions of q (``p_{c2} = l_1(\\cos q_1, \\sin q_1) + ...``, ``x_{c2} = l_1 c_1 + l_{c2} c_{12}``)
+or, failing those, the heights in the potential energy ``V = m_1 g h_1 + ...``: for a planar
+arm turning about z with gravity in its plane, the height ``a sin(phi) + b cos(phi)`` is the
+point ``Rz(phi) (a, b)``. Positions and V stated both are checked against each other.
+"""
+
+from __future__ import annotations
+
+import re
+
+import sympy as sp
+
+from .geometry import across, same, vector
+
+
+def _stated(statements, n: int, conflicts: list) -> dict:
+    """Link k -> (position in the base frame, None, statement) from p_{ck}, x_{ck}, y_{ck}, z_{ck}."""
+    found: dict[int, tuple] = {}
+    parts: dict[int, dict] = {}
+    for st in statements:
+        k = st.index
+        if st.what not in ("C", "Cx", "Cy", "Cz") or k is None or not 1 <= k <= n:
+            continue
+        if st.what == "C":
+            pos = vector(st.value)
+            if pos is None:
+                continue
+            if k in found:
+                if not same(found[k][0], pos, pos.free_symbols | found[k][0].free_symbols):
+                    conflicts.append(
+                        f"lines {found[k][2].line} and {st.line} place link {k}'s mass centre differently "
+                        f"(line {found[k][2].line} used)"
+                    )
+                continue
+            found[k] = (pos, None, st)
+        elif not isinstance(st.value, sp.MatrixBase):
+            parts.setdefault(k, {}).setdefault("xyz".index(st.what[1]), (st.value, st))
+    for k, comps in parts.items():
+        if k in found:
+            continue
+        first = min((s for _, s in comps.values()), key=lambda s: s.line)
+        found[k] = (sp.Matrix([comps[i][0] if i in comps else 0 for i in range(3)]), None, first)
+    return found
+
+
+def mass_centres(statements, gravity, q: list, revolute: set, free: set, conflicts: list) -> dict:
+    """Link k's mass centre in the base frame -> (position, mass symbol or None, statement)."""
+    n = len(q)
+    found = _stated(statements, n, conflicts)
+    for st in statements:
+        if st.what != "V" or isinstance(st.value, sp.MatrixBase):
+            continue
+        axis = [i for i in range(3) if gravity[i] != 0]
+        if len(axis) != 1 or axis[0] == 2:
+            if not found:
+                conflicts.append(f"line {st.line}: V read only for gravity along x0 or y0 (not used)")
+            continue
+        c = gravity[axis[0]]
+        sign = 1 if sp.N(c.subs({x: 1 for x in c.free_symbols})) > 0 else -1
+        g_mag = sign * c  # the magnitude, the parameters taken positive
+        up = sp.zeros(3, 1)
+        up[axis[0]] = -sign
+        side = up.cross(sp.Matrix([0, 0, 1]))
+        V = sp.expand(st.value)
+        masses = sorted((s for s in V.free_symbols if re.fullmatch(r"m(\d+)", s.name)), key=lambda s: int(s.name[1:]))
+        in_trig = {s for f in V.atoms(sp.sin, sp.cos) for s in f.free_symbols}
+        all_rev = (in_trig & set(q)) | revolute
+        for m in masses:
+            k = int(m.name[1:])
+            height = sp.expand(V.coeff(m) / g_mag)
+            if k < 1 or k > n or height.has(m):
+                continue
+            if k in found:  # stated: V must give its height
+                if not same(up.dot(found[k][0]), height, free):
+                    conflicts.append(
+                        f"line {st.line} (V) and line {found[k][2].line} place link {k}'s mass centre at different "
+                        f"heights (line {found[k][2].line} used)"
+                    )
+                continue
+            try:
+                w = across(height, all_rev)
+            except ValueError as err:
+                conflicts.append(f"line {st.line}: the height of m{k} is not a planar arm's ({err})")
+                continue
+            found[k] = (up * height + side * w, m, st)
+        rest = sp.expand(
+            V - sum(m * g_mag * (up.dot(found[int(m.name[1:])][0])) for m in masses if int(m.name[1:]) in found)
+        )
+        if rest != 0 and found and not same(rest, sp.Integer(0), free):
+            conflicts.append(f"line {st.line}: V has a term not of one mass's height: {rest}")
+    return found
