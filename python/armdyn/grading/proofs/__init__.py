@@ -27,8 +27,6 @@ executed (no eval, no sympify).
 
 from __future__ import annotations
 
-import os
-
 import sympy as sp
 
 from ...errors import ModelError
@@ -111,12 +109,10 @@ def _fresh(previous: ProofChecker) -> ProofChecker:
 def grade_proofs(sub, verdicts: list[StepVerdict]) -> list[StepVerdict]:
     """The grader's verdicts with every unrecognised equation inside a proof replaced by
     the verdicts on its links (and bare expressions that continue a proof line added)."""
-    path = getattr(sub, "path", "")
-    if not path or path.lower().endswith((".yaml", ".yml")) or not os.path.isfile(path):
+    text = getattr(sub, "text", "")  # the text as read: a file, the web app's post, a batch's file alike
+    if not text:
         return verdicts
-    from ..reader import read_text
-
-    proofs = check_text(read_text(path), path, {v.line for v in verdicts if v.key})
+    proofs = check_text(text, getattr(sub, "path", "") or "<string>", {v.line for v in verdicts if v.key})
     if not proofs:
         return verdicts
     handled = {v.line for v in proofs}
