@@ -537,7 +537,7 @@ class _Parser:
     def scripts_after(self, node):
         if not isinstance(node, Sym):
             return node
-        sub, sup = node.sub, ""
+        sub, sup = node.sub, node.frame + ("T" if node.transposed else "")
         while self.peek()[1] in ("_", "^"):
             mark = self.peek()[1]
             save = self.i
