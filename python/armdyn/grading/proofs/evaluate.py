@@ -289,7 +289,11 @@ def evaluate(node, sc: Scope) -> Mat:
             if node.n % 2:
                 raise NotRational("an odd power of a norm (only squared norms are rational)")
             return sq.power(node.n // 2)
-        return evaluate(node.base, sc).power(node.n)
+        value = evaluate(node.base, sc)
+        if value.shape == (3, 1) and node.n % 2 == 0 and node.n > 0:  # (w x r)^2: the squared norm
+            sc.notes.add("a vector squared read as its squared norm")
+            return Mat.scalar(value.dot(value)).power(node.n // 2)
+        return value.power(node.n)
     if isinstance(node, Norm):
         x = evaluate(node.arg, sc)
         if x.is_scalar:

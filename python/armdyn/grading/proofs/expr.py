@@ -30,10 +30,28 @@ when it is evaluated. Limits (bounded time on hostile input): :data:`MAX_TOKENS`
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from fractions import Fraction
 
 from ..latex import LatexError, tokenize
+from .nodes import (  # noqa: F401  (re-exported: the tree's node types)
+    Add,
+    Cross,
+    Deriv,
+    Div,
+    Dot,
+    Integral,
+    Mass,
+    Matrix,
+    Mul,
+    Norm,
+    Num,
+    Pow,
+    Skew,
+    Sum,
+    Sym,
+    Transpose,
+    walk,
+)
 
 MAX_TOKENS = 4000
 MAX_DEPTH = 40
@@ -54,115 +72,13 @@ _WRAPPERS = {
     "mathbb",
 } | _BOLD
 _MATRIX_ENVS = {"pmatrix", "bmatrix", "Bmatrix", "matrix", "smallmatrix", "array"}
+#: subscripts that name the mass center: read as C
+_CENTER = {"G": "C", "cm": "C", "CM": "C", "com": "C", "CoM": "C"}
 _STOP_CHARS = {"+", "-", ")", "]", "}", "=", "&", ",", ".", ";", "eof"}
 
 
 class ProofSyntaxError(LatexError):
     """A proof line that could not be read (the message says what)."""
-
-
-@dataclass(frozen=True)
-class Sym:
-    """A name as written: base (``r``, ``omega``, ``I``, ``R``, ``1``...), bold typeface,
-    subscript text (``C``, ``l_i``, ``ix``), frame label from the superscript (``c``) and
-    whether the superscript transposes (``^T``, ``^{c\\mathrm{T}}``)."""
-
-    base: str
-    bold: bool = False
-    sub: str = ""
-    frame: str = ""
-    transposed: bool = False
-
-    def latex(self) -> str:
-        """The name as plain text for messages: ``d``, ``omega_i``, ``I_{l_i}^c``, ``r_C^T``."""
-        sub = "" if not self.sub else f"_{self.sub}" if len(self.sub) == 1 else f"_{{{self.sub}}}"
-        sup = self.frame + ("T" if self.transposed else "")
-        return self.base + sub + ("" if not sup else f"^{sup}" if len(sup) == 1 else f"^{{{sup}}}")
-
-
-@dataclass(frozen=True)
-class Num:
-    value: Fraction
-
-
-@dataclass(frozen=True)
-class Add:
-    terms: tuple  # ((sign +1/-1, node), ...)
-
-
-@dataclass(frozen=True)
-class Mul:
-    factors: tuple  # left to right (matrix products keep their order)
-
-
-@dataclass(frozen=True)
-class Dot:
-    a: object
-    b: object
-
-
-@dataclass(frozen=True)
-class Cross:
-    a: object
-    b: object
-
-
-@dataclass(frozen=True)
-class Div:
-    a: object
-    b: object
-
-
-@dataclass(frozen=True)
-class Pow:
-    base: object
-    n: int
-
-
-@dataclass(frozen=True)
-class Norm:
-    arg: object
-
-
-@dataclass(frozen=True)
-class Transpose:
-    arg: object
-
-
-@dataclass(frozen=True)
-class Skew:
-    arg: object
-    transposed: bool = False
-
-
-@dataclass(frozen=True)
-class Integral:
-    body: object
-    domain: str = ""
-
-
-@dataclass(frozen=True)
-class Sum:
-    """``\\sum_i m_i (...)``: the body summed over the particles (the masses are in it)."""
-
-    body: object
-
-
-@dataclass(frozen=True)
-class Mass:
-    """``m_i`` inside a sum over the particles: the particle's mass."""
-
-
-@dataclass(frozen=True)
-class Deriv:
-    """The time derivative of ``arg`` (``\\dot X``, ``\\frac{d}{dt} X``)."""
-
-    arg: object
-
-
-@dataclass(frozen=True)
-class Matrix:
-    rows: tuple  # ((node, ...), ...)
 
 
 def _script_text(tokens) -> str:
@@ -489,14 +405,15 @@ class _Parser:
     def particle(self, node: Sym):
         """A name inside a sum over particles: ``m_i`` the mass, ``r_i`` the position."""
         index = self.sums[-1]
-        if node.base == "m" and not node.frame and len(node.sub) == 1 and node.sub.islower():
+        if node.base == "m" and not node.frame and node.sub and node.sub.isalpha() and node.sub.islower():
             if index is None:
                 self.sums[-1] = index = node.sub
             if node.sub == index:
                 return Mass()
-        if node.base == "r" and index and node.sub and index in (node.sub[0], node.sub[-1]):
-            sub = node.sub[1:] if node.sub[0] == index else node.sub[:-1]
-            return Sym("r", node.bold, sub.strip(",/ "), node.frame, node.transposed)
+        if node.base == "r" and index and node.sub and (node.sub.startswith(index) or node.sub.endswith(index)):
+            sub = node.sub[len(index) :] if node.sub.startswith(index) else node.sub[: -len(index)]
+            sub = sub.strip(",/ ")
+            return Sym("r", node.bold, _CENTER.get(sub, sub), node.frame, node.transposed)
         return node
 
     def skew_of_name(self):
@@ -555,7 +472,7 @@ class _Parser:
         sup = sup.replace("×", "")
         transposed = sup.endswith("T")
         frame = sup[:-1] if transposed else sup
-        node = Sym(node.base, node.bold, sub, frame, False if skew else transposed)
+        node = Sym(node.base, node.bold, _CENTER.get(sub, sub), frame, False if skew else transposed)
         if self.sums:
             node = self.particle(node)
             if isinstance(node, Mass):
@@ -654,27 +571,3 @@ def parse_side(text: str):
         raise ProofSyntaxError("nested too deeply") from None
     except ValueError as err:  # Fraction of a malformed number
         raise ProofSyntaxError(str(err)) from None
-
-
-def walk(node):
-    """Every node of a tree, depth first."""
-    stack = [node]
-    while stack:
-        n = stack.pop()
-        yield n
-        if isinstance(n, Add):
-            stack.extend(t for _, t in n.terms)
-        elif isinstance(n, Mul):
-            stack.extend(n.factors)
-        elif isinstance(n, (Dot, Cross, Div)):
-            stack.extend((n.a, n.b))
-        elif isinstance(n, (Pow,)):
-            stack.append(n.base)
-        elif isinstance(n, (Norm, Transpose, Skew)):
-            stack.append(n.arg)
-        elif isinstance(n, (Integral, Sum)):
-            stack.append(n.body)
-        elif isinstance(n, Deriv):
-            stack.append(n.arg)
-        elif isinstance(n, Matrix):
-            stack.extend(c for row in n.rows for c in row)
