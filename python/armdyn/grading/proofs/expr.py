@@ -30,6 +30,7 @@ when it is evaluated. Limits (bounded time on hostile input): :data:`MAX_TOKENS`
 
 from __future__ import annotations
 
+import re
 from fractions import Fraction
 
 from ..latex import LatexError, tokenize
@@ -74,6 +75,7 @@ _WRAPPERS = {
 _MATRIX_ENVS = {"pmatrix", "bmatrix", "Bmatrix", "matrix", "smallmatrix", "array"}
 #: subscripts that name the mass center: read as C
 _CENTER = {"G": "C", "cm": "C", "CM": "C", "com": "C", "CoM": "C"}
+_PARTICLE_POINT = re.compile(r"^(?:[a-z]+|\\?[a-z]+)[,/]([A-Z]|cm|G)$|^([A-Z]|cm|G)[,/][a-z]+$")
 _STOP_CHARS = {"+", "-", ")", "]", "}", "=", "&", ",", ".", ";", "eof"}
 
 
@@ -367,7 +369,7 @@ class _Parser:
                 return None
             self.i += after + 3 + m
             self.enter()
-            node = Deriv(self.factor())
+            node = Deriv(self.term())  # d/dt 1/2 w^T I w: the whole product after it
             self.depth -= 1
             return node
         save = self.i
@@ -472,6 +474,9 @@ class _Parser:
         sup = sup.replace("×", "")
         transposed = sup.endswith("T")
         frame = sup[:-1] if transposed else sup
+        if node.base == "r":
+            m = _PARTICLE_POINT.match(sub)  # r_{k,P}: particle k relative to P, in a line about each particle
+            sub = next(g for g in m.groups() if g) if m else sub
         node = Sym(node.base, node.bold, _CENTER.get(sub, sub), frame, False if skew else transposed)
         if self.sums:
             node = self.particle(node)

@@ -117,6 +117,7 @@ class _Where:
     in_proof: bool = False
     level: int = 0
     boundary: bool = False  # a heading, exercise number or instruction since last asked
+    by_heading: bool = False  # the proof started at a heading "Proof" (its section's lines are its setup)
 
     def end(self) -> None:
         self.in_proof, self.level = False, 0
@@ -136,12 +137,12 @@ def _update(where: _Where, prose: str) -> bool:
                 where.level = where.level or level  # the proof's own sub-headings
                 continue
             where.end()
-        if level:
-            where.boundary = True
+        if level and not _KEEP_HEADING.match(body):
+            where.boundary = True  # a new section (a proof's own headings keep what came before)
         if _START.search(body):
             started = started or not where.in_proof  # "Proof" inside a proof continues it
             if not where.in_proof:
-                where.in_proof, where.level = True, 0
+                where.in_proof, where.level, where.by_heading = True, 0, bool(level)
         elif _EXERCISE_NUMBER.match(body) or _INSTRUCTION.match(body):
             where.end()
             where.boundary = True
@@ -159,7 +160,7 @@ def proof_regions(text: str, step_lines: set[int]) -> list[list[Display]]:
         prose = text[pos:outer_start]
         pos = outer_end
         if _update(where, prose) or (where.in_proof and not regions):
-            regions.append([])
+            regions.append(before[-MAX_BEFORE:] if where.by_heading else [])
         if where.boundary or where.in_proof:
             before, where.boundary = [], False
         first = True
