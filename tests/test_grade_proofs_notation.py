@@ -346,3 +346,13 @@ def test_hostile_notation_ends_quickly(line):  # within the 4 s budget of all pr
 def test_too_many_equations_on_one_line_are_refused_naming_the_line():
     with pytest.raises(ModelError, match=r"x.md:3: .*proof lines"):
         check_text(lines(r"a = b \qquad" * 2000), "x.md")
+
+
+def test_old_style_fonts_and_a_tilde_that_marks_the_tensor():
+    # K = 1/2 w^T I_O w = 1/2 sum_i m_i |r_i x w|^2 (|r x w| = |w x r|): true; without the 1/2: false
+    text = lines(
+        r"\frac{1}{2}\,\boldsymbol\omega^T\,\tilde{\bf I}_O\,\boldsymbol\omega = "
+        r"\frac{1}{2}\sum_{i=1,N} m_i ({\bf r}_i \times \boldsymbol\omega)^2",
+        r"\boldsymbol\omega^T\,\tilde{\bf I}_O\,\boldsymbol\omega = \frac{1}{2}\sum_{i=1,N} m_i ({\bf r}_i \times \omega)^2",
+    )
+    assert statuses(text) == [(3, "correct"), (5, "wrong")]

@@ -276,7 +276,8 @@ class _Parser:
                 return Skew(node)
             return node
         if k == "char" and v == "{":
-            return self.group("}")
+            node = self.group("}")
+            return self.scripts_after(node) if isinstance(node, Sym) else node  # {\bf r}_i
         if k == "cmd" and v == "left":
             d = self.take()
             if d[1] in ("|", "Vert", "lVert"):
@@ -309,6 +310,8 @@ class _Parser:
             raise ProofSyntaxError("second time derivatives are not understood in a rigid-body proof")
         if k == "begin":
             return self.matrix(v)
+        if k == "cmd" and v in ("bf", "rm", "it", "sf"):  # {\bf I}: an old-style font switch
+            return self.name(self.take(), v == "bf")
         if k == "cmd" and v in _WRAPPERS:
             bold = v in _BOLD
             if self.peek()[1] != "{":
@@ -428,6 +431,8 @@ class _Parser:
             inner = self.atom()
         if isinstance(inner, Sym):
             inner = self.scripts_after(inner)
+        if isinstance(inner, Sym) and inner.base in ("I", "R", "M", "E", "1"):
+            return inner  # \tilde{\mathbf{I}}: a tilde that marks a tensor, not a skew matrix
         transposed = isinstance(inner, Sym) and inner.transposed
         if transposed:
             inner = Sym(inner.base, inner.bold, inner.sub, inner.frame, False)
