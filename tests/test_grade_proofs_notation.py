@@ -227,6 +227,7 @@ DERIVATIVES_TRUE = [
     r"\dot I_C = S(\omega) I_C - I_C S(\omega)",
     r"\frac{dE_{rot}}{dt} = \frac{\mathrm{d}}{\mathrm{d}t} \frac12 \omega^T I_C \omega = \omega^T I_C \dot\omega",
     r"\frac{d}{dt} \int \mathbf{r}_C^T \mathbf{r}_C \, dm = 0",
+    r"\frac{d\mathbf{L}_C}{dt} = \mathbf{N}_C",
 ]
 DERIVATIVES_WRONG = [
     (r"\dot R = R S(\omega)", "the body-frame order with a world-frame omega"),
@@ -242,7 +243,7 @@ def test_time_derivatives_of_a_turning_body():
     assert got and all(s == "correct" for _, s in got), [
         (v.line, v.message) for v in check_text(lines(*DERIVATIVES_TRUE))
     ]
-    assert len(got) == 1 + 1 + 2 + 4 + 1 + 2 + 1
+    assert len(got) == 1 + 1 + 2 + 4 + 1 + 2 + 1 + 1
     messages = " ".join(v.message for v in check_text(lines(*DERIVATIVES_TRUE)))
     assert "S(omega) R" in messages and "angular acceleration" in messages and "Euler" in messages
 
@@ -356,3 +357,20 @@ def test_old_style_fonts_and_a_tilde_that_marks_the_tensor():
         r"\boldsymbol\omega^T\,\tilde{\bf I}_O\,\boldsymbol\omega = \frac{1}{2}\sum_{i=1,N} m_i ({\bf r}_i \times \omega)^2",
     )
     assert statuses(text) == [(3, "correct"), (5, "wrong")]
+
+
+def test_a_sum_without_an_index_and_a_body_frame_angular_velocity():
+    # sum m_i = M and sum m_i r_{i,C} = 0 (C the mass center); omega_B := R^T omega is a new
+    # name (a definition), and |omega_B|^2 = |omega|^2 since R is a rotation; 2 |omega|^2 is not
+    text = lines(
+        r"\sum m_i = M, \quad \sum m_i \mathbf{r}_{i,C} = \mathbf{0}",
+        r"\boldsymbol\omega_B = \mathbf{R}^T \boldsymbol\omega",
+        r"\boldsymbol\omega_B^T \boldsymbol\omega_B = \boldsymbol\omega^T \boldsymbol\omega",
+        r"\boldsymbol\omega_B^T \boldsymbol\omega_B = 2 \boldsymbol\omega^T \boldsymbol\omega",
+    )
+    got = check_text(text)
+    assert [(v.line, v.status) for v in got] == [(3, "correct"), (3, "correct"), (5, "correct")] + [
+        (7, "correct"),
+        (9, "wrong"),
+    ]
+    assert "defines omega_B" in got[2].message

@@ -215,7 +215,7 @@ class ProofChecker:
                 for s, t in terms
                 if isinstance(t, Sym)
                 and t.base in VECTOR_NAMES
-                and t.base != "omega"
+                and (t.base != "omega" or (t.sub and len(terms) == 1))  # omega_B = R^T omega: a new name
                 and not t.frame
                 and not t.transposed
                 and key(t) not in self.seen
@@ -248,7 +248,7 @@ class ProofChecker:
             return LinkVerdict(line, label, source, "correct", f"defines {sym.latex()}{what} (constant over the body)")
         return None
 
-    def _rotation_alias(self, left, right) -> str:
+    def _rotation_alias(self, left, right, line: int) -> str:
         """``\\omega^c = R \\omega``, ``I^c = R I R^T``: a quantity in frame c defined with a
         rotation ``R`` the proof has not named. The line defines R: it is read as R^c (or
         R^{cT}) when that makes the line true; "" (nothing defined) otherwise."""
@@ -259,7 +259,7 @@ class ProofChecker:
             return ""
         name = key(plain[0])
         for transposed in (False, True):
-            self.defs[name] = (Sym("R", False, "", left.frame, transposed), 0)
+            self.defs[name] = (Sym("R", False, "", left.frame, transposed), line)
             try:
                 if self._guarded(lambda: self._agree(left, right, self.defs, self.instances)):
                     what = f"R^{{{left.frame}T}}" if transposed else f"R^{left.frame}"
@@ -315,7 +315,7 @@ class ProofChecker:
                 )
                 continue
             if j == 0:
-                alias = self._rotation_alias(a, b)
+                alias = self._rotation_alias(a, b, d.line)
                 if alias:
                     out.append(LinkVerdict(d.line, label, source, "correct", alias))
                     continue
