@@ -30,7 +30,16 @@ def steps(report_json: dict) -> list[tuple]:
 
 
 def file_verdicts() -> list[tuple]:
-    return steps(json.loads(grade(EXERCISE).to_json()))
+    """The CLI's verdicts on the exercise file (``armdyn grade FILE --json``)."""
+    import contextlib
+    import io
+
+    from armdyn.cli import main
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        main(["grade", str(EXERCISE), "--json"])
+    return steps(json.loads(out.getvalue()))
 
 
 # ------------------------------------------------------------------ one grading path
@@ -44,6 +53,7 @@ def test_the_text_alone_carries_the_proofs():
     assert posted == from_file
     elsewhere = steps(json.loads(grade(read_markdown("/nonexistent/dir/x.md", text)).to_json()))
     assert elsewhere == from_file  # no file on disk: the same proofs
+    assert steps(json.loads(grade(EXERCISE).to_json())) == from_file  # armdyn.grade(path)
 
 
 def test_the_web_app_grades_the_proofs_as_the_cli(tmp_path):
