@@ -384,3 +384,14 @@ def test_a_sum_without_an_index_and_a_body_frame_angular_velocity():
         (9, "wrong"),
     ]
     assert "defines omega_B" in got[2].message
+
+
+@pytest.mark.parametrize("piece", [r"\int ", r"\sum ", r"\omega^{", r"E_{", r"\qquad a", "{"])
+def test_finding_proofs_in_a_long_hostile_block_is_linear(piece):
+    from armdyn.grading.proofs.regions import about_a_body, several
+
+    t0 = time.perf_counter()
+    text = piece * 40_000
+    about_a_body(text)
+    several(text)
+    assert time.perf_counter() - t0 < 2.0

@@ -52,18 +52,26 @@ def _body_start(text: str) -> int:
     return 0
 
 
-#: what a display line about a body's mass distribution has (a proof without a "Prove")
+#: what a display line about a body's mass distribution has (a proof without a "Prove"):
+#: an integral sign then a mass differential, a sum sign then a particle's mass, the
+#: rotational energy, w^T I (each a linear search)
+_INTEGRAL = re.compile(r"\\int(?![A-Za-z])")
+_DIFFERENTIAL = re.compile(r"\bd\s*m\b|\\mathrm\{d\}\s*m|\\rho\s*(?:\\,\s*)?d\s*V")
+_SUM = re.compile(r"\\sum(?![A-Za-z])")
+_PARTICLE_MASS = re.compile(r"\bm_")
 _BODY = re.compile(
-    r"\\int(?![A-Za-z])[^$]{0,2000}?(?:\bd\s*m\b|\\mathrm\{d\}\s*m|\\rho\s*(?:\\,\s*)?d\s*V)"  # an integral over the body
-    r"|\\sum(?![A-Za-z])[^=]{0,200}?\bm_"  # a sum over the particles
-    r"|E_\{?\s*(?:\\(?:mathrm|text)\{)?rot"  # the rotational energy
-    r"|\\omega\S*\^\{?\s*(?:T|\\top|\\mathrm\{T\})\}?\s*(?:\\mathbf\{)?I"  # w^T I w
+    r"E_\{?\s*(?:\\(?:mathrm|text)\{)?rot"  # the rotational energy
+    r"|\\omega[^\s^]{0,40}\^\{?\s*(?:T|\\top|\\mathrm\{T\})\}?\s*(?:\\mathbf\{)?I"  # w^T I w
 )
 _SEPARATORS = re.compile(r"\\qquad|\\quad|\\text\{\s*(?:and|,)\s*\}|;")
 
 
 def about_a_body(equation: str) -> bool:
     """Does a display line speak of a rigid body's mass distribution (see the module docstring)?"""
+    for sign, inside in ((_INTEGRAL, _DIFFERENTIAL), (_SUM, _PARTICLE_MASS)):
+        m = sign.search(equation)
+        if m is not None and inside.search(equation, m.end()) is not None:
+            return True
     return _BODY.search(equation) is not None
 
 
