@@ -386,7 +386,7 @@ def test_a_sum_without_an_index_and_a_body_frame_angular_velocity():
     assert "defines omega_B" in got[2].message
 
 
-@pytest.mark.parametrize("piece", [r"\int ", r"\sum ", r"\omega^{", r"E_{", r"\qquad a", "{"])
+@pytest.mark.parametrize("piece", [r"\int ", r"\sum ", r"\omega^{", r"E_{", r"\qquad a", "{", r"a = b \qquad "])
 def test_finding_proofs_in_a_long_hostile_block_is_linear(piece):
     from armdyn.grading.proofs.regions import about_a_body, several
 

@@ -18,6 +18,7 @@ lines, each with the same line number.
 
 from __future__ import annotations
 
+import bisect
 import re
 from dataclasses import dataclass
 
@@ -82,7 +83,7 @@ def several(equation: str) -> list[tuple[int, str]]:
 
     if _SEPARATORS.search(equation) is None:
         return [(0, equation)]
-    top = {i for i, c in _top_level(equation)}
+    equals = [i for i, c in _top_level(equation) if c == "="]  # in order
     depth_zero = _depth_zero(equation)
     cuts = [m for m in _SEPARATORS.finditer(equation) if depth_zero[m.start()]]
     pieces, start = [], 0
@@ -91,11 +92,9 @@ def several(equation: str) -> list[tuple[int, str]]:
         start = m.end()
     pieces.append((start, equation[start:]))
     pieces = [(o, t) for o, t in pieces if t.strip(" ,.;")]
-    if (
-        len(pieces) == 1
-        and pieces[0][0] == 0
-        or not all(any(equation[j] == "=" for j in top if o <= j < o + len(t)) for o, t in pieces)
-    ):
+    if (len(pieces) == 1 and pieces[0][0] == 0) or not all(
+        bisect.bisect_left(equals, o) < bisect.bisect_left(equals, o + len(t)) for o, t in pieces
+    ):  # every piece has an '=' of its own
         return [(0, equation)]
     out = []
     for o, t in pieces:
