@@ -395,3 +395,12 @@ def test_finding_proofs_in_a_long_hostile_block_is_linear(piece):
     about_a_body(text)
     several(text)
     assert time.perf_counter() - t0 < 2.0
+
+
+def test_a_bold_i_outside_an_integral_is_the_identity_and_the_verdict_says_so():
+    # L_C = I_C w is true; with the identity in place of I_C it is false (L_C = w only for I_C = 1)
+    got = check_text(
+        lines(r"\mathbf{L}_C = \mathbf{I}_C \boldsymbol\omega", r"\mathbf{L}_C = \mathbf{I} \boldsymbol\omega")
+    )
+    assert [v.status for v in got] == ["correct", "wrong"]
+    assert "\\mathbf{I} (bold, no subscript) read as the identity" in got[1].message

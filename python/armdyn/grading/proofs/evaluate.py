@@ -183,6 +183,8 @@ def is_identity(s: Sym, in_integral: bool) -> bool:
 def _builtin(s: Sym, sc: Scope) -> Mat:
     inst, state = sc.inst, sc.state
     if is_identity(s, sc.in_integral):
+        if s.base == "I" and s.bold and not s.sub and not sc.in_integral:
+            sc.notes.add("\\mathbf{I} (bold, no subscript) read as the identity: an inertia tensor is I_O, I_C")
         return Mat.identity()
     if s.base in MOMENTUM | MOMENT and not s.frame and (not s.sub or is_point(s.sub)):
         tree = momentum(s, state)
