@@ -404,3 +404,21 @@ def test_a_bold_i_outside_an_integral_is_the_identity_and_the_verdict_says_so():
     )
     assert [v.status for v in got] == ["correct", "wrong"]
     assert "\\mathbf{I} (bold, no subscript) read as the identity" in got[1].message
+
+
+def test_a_plain_e_is_the_identity_where_it_multiplies_a_scalar_and_the_energy_alone():
+    # parallel axis theorem with E for the identity (true), then E = 1/2 w^T I_O w (true: the energy)
+    text = lines(
+        r"\mathbf{r}_P = \mathbf{r}_C + \mathbf{d}",
+        r"\mathbf{I}_P = \mathbf{I}_C + M \left( \|\mathbf{d}\|^2 E - \mathbf{d} \mathbf{d}^T \right)"
+        r" = \mathbf{I}_C + M \left( \mathbf{d}^T \mathbf{d} E - \mathbf{d} \mathbf{d}^T \right)",
+        r"E = \frac12 \omega^T I_O \omega \qquad 2 E = \omega^T I_O \omega",
+        r"E = \omega^T I_O \omega",  # a factor 1/2 lost: wrong
+    )
+    got = check_text(text)
+    assert [(v.line, v.status) for v in got] == [(3, "correct"), (5, "correct"), (5, "correct")] + [
+        (7, "correct"),
+        (7, "correct"),
+        (9, "wrong"),
+    ]
+    assert "E read as the identity" in got[1].message

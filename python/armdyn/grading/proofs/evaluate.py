@@ -246,7 +246,7 @@ def _builtin(s: Sym, sc: Scope) -> Mat:
             total += m * v.dot(v)
         sc.notes.add(
             f"{s.latex()} read as the kinetic energy of rotation 1/2 \\int |omega x r|^2 dm"
-            + (f" (r = r_{state.point_sub})" if state.point_sub else "")
+            + (f" (r = r_{state.point_sub})" if state.point_sub else f" (r relative to {point})")
         )
         return Mat.scalar(total / 2)
     raise UnknownName(f"unknown name {s.latex()} (not a rigid-body quantity this checker knows)")
@@ -266,9 +266,10 @@ def evaluate(node, sc: Scope) -> Mat:
             total = v if total is None else total + v
         return total
     if isinstance(node, Mul):
-        value = evaluate(node.factors[0], sc)
-        for f in node.factors[1:]:
-            value = value @ evaluate(f, sc)
+        value = None
+        for f in node.factors:
+            v = Mat.identity() if _identity_e(f, node, sc) else evaluate(f, sc)
+            value = v if value is None else value @ v
         return value
     if isinstance(node, Dot):
         a, b = evaluate(node.a, sc), evaluate(node.b, sc)
@@ -335,6 +336,23 @@ def evaluate(node, sc: Scope) -> Mat:
                 cells.append(v.v[0])
         return Mat(len(node.rows), len(node.rows[0]), cells)
     raise TypeError(f"cannot evaluate {type(node).__name__}")
+
+
+def _identity_e(factor, product: Mul, sc: Scope) -> bool:
+    """A plain ``E`` outside an integral that multiplies a scalar made of vectors
+    (``\\|d\\|^2 E``, ``d^T d E``) is the identity, not the energy (said in the verdict)."""
+    if not (isinstance(factor, Sym) and factor.base == "E" and not factor.sub and not factor.frame):
+        return False
+    if factor.bold or sc.in_integral:
+        return False  # the identity anyway
+    for other in product.factors:
+        if other is not factor and any(
+            isinstance(n, (Norm, Dot)) or (isinstance(n, (Sym, Transpose)) and getattr(n, "transposed", True))
+            for n in walk(other)
+        ):
+            sc.notes.add("E read as the identity (it multiplies a scalar such as |d|^2)")
+            return True
+    return False
 
 
 def per_element(node, env: dict) -> bool:
