@@ -422,3 +422,42 @@ def test_a_plain_e_is_the_identity_where_it_multiplies_a_scalar_and_the_energy_a
         (9, "wrong"),
     ]
     assert "E read as the identity" in got[1].message
+
+
+# ------------------------------------------------------------------ the example
+def _rotation(w: np.ndarray, t: float) -> np.ndarray:
+    """exp(t [w]x) by Rodrigues' formula."""
+    theta = np.linalg.norm(w) * t
+    k = w / np.linalg.norm(w)
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + np.sin(theta) * kx + (1 - np.cos(theta)) * kx @ kx
+
+
+def test_the_euler_example_one_slip_and_numpy_agrees():
+    path = EXAMPLES / "euler-particles-proof.md"
+    report = json.loads(grade(path).to_json())
+    wrong = [s for s in report["steps"] if s["status"] != "correct"]
+    assert report["first_wrong"] == "proof_29" and [(s["name"], s["status"]) for s in wrong] == [("proof_29", "wrong")]
+    assert {s["line"] for s in report["steps"]} == {15, 21, 25, 29, 33}
+    ce = wrong[0]["counterexample"]  # by hand (examples/grading/README.md)
+    assert ce["left"] == ["-16", "24", "-8"] and ce["right"] == ["-16", "-8", "24"]
+    # Euler's equation and the turning tensor, by a central difference on a random body
+    rng = np.random.default_rng(7)
+    masses, points = rng.uniform(1, 3, 5), rng.normal(size=(5, 3))
+    r = points - masses @ points / masses.sum()
+    inertia = sum(m * (p @ p * np.eye(3) - np.outer(p, p)) for m, p in zip(masses, r))
+    w, wdot, h = rng.normal(size=3), rng.normal(size=3), 1e-5
+
+    def momentum(t):
+        rot = _rotation(w, t)
+        return rot @ inertia @ rot.T @ (w + t * wdot)
+
+    derivative = (momentum(h) - momentum(-h)) / (2 * h)
+    assert np.allclose(derivative, inertia @ wdot + np.cross(w, inertia @ w), atol=1e-6)
+    assert not np.allclose(derivative, inertia @ wdot - np.cross(w, inertia @ w), atol=1e-3)
+    turning = (_rotation(w, h) @ inertia @ _rotation(w, h).T - _rotation(w, -h) @ inertia @ _rotation(w, -h).T) / (
+        2 * h
+    )
+    wx = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+    assert np.allclose(turning, wx @ inertia - inertia @ wx, atol=1e-6)
+    assert np.allclose(sum(m * np.cross(p, np.cross(w, p)) for m, p in zip(masses, r)), inertia @ w)

@@ -10,7 +10,8 @@ Name rules (the typeface and the scripts decide; ``r_i``, ``I_{l_i}`` as in the 
 * ``I_X`` with a point ``X`` (one capital letter: ``O``, ``C``, ``P``): the inertia tensor
   about ``X``, ``sum_k m_k (|p_k - X|^2 1 - (p_k - X)(p_k - X)^T)``. ``I`` with any other
   subscript (``I_{l_i}``) or none: the inertia tensor about the reference point of the
-  proof's per-element vector (``r_i``: link i's reference point), said in the verdict.
+  proof's per-element vector (``r_i``: link i's reference point; C when it has none yet),
+  said in the verdict.
 * ``I^c``, ``I^c_{l_i}``: the same tensor in frame c, ``R^c I R^{cT}`` (``I^c`` alone: the
   inertia tensor the proof last named).
 * ``r`` (relative to ``O``), ``r_X`` (relative to point ``X``; ``r_i``: to link i's reference
