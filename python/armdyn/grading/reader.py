@@ -78,7 +78,7 @@ class Submission:
     lines: LineIndex | None = None  # line/column of offsets in the Markdown text
 
     parts: list = field(default_factory=list)  # the assignment's parts (.parts.Part), Markdown only
-    text: str = ""  # the Markdown text as read (its proofs are graded from it), "" for YAML
+    text: str = field(default="", repr=False)  # the Markdown text as read (its proofs are graded from it)
 
     def part_at(self, line: int) -> tuple[str | None, str]:
         """(part number or None, task title or "") of a 1-based line (see :mod:`.parts`)."""
