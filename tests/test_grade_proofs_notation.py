@@ -281,8 +281,11 @@ def test_the_counterexample_of_a_dropped_gyroscopic_term_checks_with_numpy():
 
 
 def test_what_is_not_understood_is_said():
-    got = check_text(lines(r"\ddot{R} = 0", r"\frac{d}{dt} \omega^c = R \dot\omega", r"\sum_i r_i = 0"))
-    assert [v.status for v in got] == ["unrecognised"] * 3
+    got = check_text(
+        lines(r"\ddot{R} = 0", r"\frac{d}{dt} \omega^c = R \dot\omega", r"\sum_i r_i = 0", r"\dot r_{ix} = 0")
+    )
+    assert [v.status for v in got] == ["unrecognised"] * 4
+    assert "component" in got[3].message
     assert "second time derivatives" in got[0].message
     assert "frame c" in got[1].message
     assert "without their masses" in got[2].message

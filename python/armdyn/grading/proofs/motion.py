@@ -25,7 +25,7 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-from .evaluate import ENERGY, UnknownName, key
+from .evaluate import ENERGY, UnknownName, component, key
 from .expr import Add, Cross, Deriv, Div, Dot, Integral, Mass, Matrix, Mul, Norm, Num, Pow, Skew, Sum, Sym, Transpose
 
 #: names of the angular momentum and of the moment (torque) about a point
@@ -134,6 +134,8 @@ def _sym(s: Sym, sc):
         d = Mul((Skew(omega(state)), plain))
         sc.notes.add("\\dot R read as S(omega) R (omega in the world frame)")
     elif s.base == "r":
+        if component(s) is not None:
+            raise UnknownName(f"the time derivative of a component ({s.latex()}) is not understood")
         d = Cross(omega(state), plain)
         sc.notes.add("\\dot r read as omega x r (a point of the body)")
     elif s.base == "I":
