@@ -313,14 +313,14 @@ def test_definitions_facts_and_unknown_names():
         (7, "follows-from-earlier-error"),
         (9, "correct"),
         (11, "correct"),
-        (13, "unrecognised"),
+        (13, "wrong"),  # a sum over the particles is read: I_C is a matrix, sum m_k r_k a vector
         (15, "unrecognised"),
         (17, "correct"),
         (19, "wrong"),
     ]
     v = {v.line: v for v in check_text(text)}
     assert "not the inertia tensor about C" in v[5].message and v[7].caused_by == "proof_5"
-    assert "defines J" in v[9].message and "unknown name sum" in v[13].message and "squared" in v[15].message
+    assert "defines J" in v[9].message and "the right side a vector" in v[13].message and "squared" in v[15].message
     assert "not constant over the body" in v[19].message  # a = r_C - r - r_P varies with the element
 
 

@@ -78,6 +78,7 @@ class Submission:
     lines: LineIndex | None = None  # line/column of offsets in the Markdown text
 
     parts: list = field(default_factory=list)  # the assignment's parts (.parts.Part), Markdown only
+    text: str = field(default="", repr=False)  # the Markdown text as read (its proofs are graded from it)
 
     def part_at(self, line: int) -> tuple[str | None, str]:
         """(part number or None, task title or "") of a 1-based line (see :mod:`.parts`)."""
@@ -253,7 +254,7 @@ def read_markdown(path: str, text: str | None = None) -> Submission:
 
     text = read_text(path) if text is None else text
     index = LineIndex(text)
-    sub = Submission(path, base_dir=os.path.dirname(os.path.abspath(path)), lines=index)
+    sub = Submission(path, base_dir=os.path.dirname(os.path.abspath(path)), lines=index, text=text)
     body_start = 0
     if text.startswith("---"):
         end = re.search(r"^---\s*$", text[3:], re.M)

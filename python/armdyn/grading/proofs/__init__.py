@@ -6,10 +6,12 @@ matrices ``S(.)``, rotations and inertia tensors. A proof line can be false whil
 proof's conclusion is a well-known true formula, so each link ``A = B`` is checked on its
 own (:mod:`.checker`):
 
-* :mod:`.regions` finds the proofs in the Markdown text and their display lines;
-* :mod:`.expr` reads each side into a typed, non-commutative expression tree;
+* :mod:`.regions` finds the proofs in the Markdown text (by their prose or by what their
+  lines say) and their display lines;
+* :mod:`.expr` reads each side into a typed, non-commutative expression tree (:mod:`.nodes`);
 * :mod:`.evaluate` gives the names their meaning (rules in its docstring) and evaluates a
   tree exactly (Fractions, :mod:`.matrices`) on a body of point masses (:mod:`.body`);
+  :mod:`.motion` takes time derivatives (``\\dot R``, ``\\dot L``) by the product rule;
 * :mod:`.counterexample` finds a small body on which a wrong link's sides differ.
 
 How equality is decided. Both sides are evaluated on ``K = 3`` random bodies of 4 point
@@ -26,8 +28,6 @@ executed (no eval, no sympify).
 """
 
 from __future__ import annotations
-
-import os
 
 import sympy as sp
 
@@ -110,13 +110,13 @@ def _fresh(previous: ProofChecker) -> ProofChecker:
 
 def grade_proofs(sub, verdicts: list[StepVerdict]) -> list[StepVerdict]:
     """The grader's verdicts with every unrecognised equation inside a proof replaced by
-    the verdicts on its links (and bare expressions that continue a proof line added)."""
-    path = getattr(sub, "path", "")
-    if not path or path.lower().endswith((".yaml", ".yml")) or not os.path.isfile(path):
+    the verdicts on its links (and bare expressions that continue a proof line added).
+    The proofs are read from the text the submission was read from (``sub.text``), so a
+    file, a posted text and a batch's file are graded alike; a YAML submission has none."""
+    text = getattr(sub, "text", "")  # the text as read: a file, the web app's post, a batch's file alike
+    if not text:
         return verdicts
-    from ..reader import read_text
-
-    proofs = check_text(read_text(path), path, {v.line for v in verdicts if v.key})
+    proofs = check_text(text, getattr(sub, "path", "") or "<string>", {v.line for v in verdicts if v.key})
     if not proofs:
         return verdicts
     handled = {v.line for v in proofs}

@@ -215,7 +215,7 @@ class ProofChecker:
                 for s, t in terms
                 if isinstance(t, Sym)
                 and t.base in VECTOR_NAMES
-                and t.base != "omega"
+                and (t.base != "omega" or (t.sub and len(terms) == 1))  # omega_B = R^T omega: a new name
                 and not t.frame
                 and not t.transposed
                 and key(t) not in self.seen
@@ -247,6 +247,30 @@ class ProofChecker:
             self.constant_def = (sym.latex(), what)
             return LinkVerdict(line, label, source, "correct", f"defines {sym.latex()}{what} (constant over the body)")
         return None
+
+    def _rotation_alias(self, left, right, line: int) -> str:
+        """``\\omega^c = R \\omega``, ``I^c = R I R^T``: a quantity in frame c defined with a
+        rotation ``R`` the proof has not named. The line defines R: it is read as R^c (or
+        R^{cT}) when that makes the line true; "" (nothing defined) otherwise."""
+        if not isinstance(left, Sym) or not left.frame or left.transposed or isinstance(right, Exception):
+            return ""
+        plain = [n for n in walk(right) if isinstance(n, Sym) and n.base == "R" and not n.frame and not n.sub]
+        if not plain or key(plain[0]) in self.defs:
+            return ""
+        name = key(plain[0])
+        for transposed in (False, True):
+            self.defs[name] = (Sym("R", False, "", left.frame, transposed), line)
+            try:
+                if self._guarded(lambda: self._agree(left, right, self.defs, self.instances)):
+                    what = f"R^{{{left.frame}T}}" if transposed else f"R^{left.frame}"
+                    return (
+                        f"defines {left.latex()} with R read as {what}, the rotation "
+                        f"{'from' if transposed else 'into'} frame {left.frame} (a definition: consistent)"
+                    )
+            except _Failure:
+                pass
+            del self.defs[name]
+        return ""
 
     def _is_new_name(self, node) -> bool:
         if not isinstance(node, Sym) or node.transposed or key(node) in self.defs:
@@ -290,6 +314,11 @@ class ProofChecker:
                     )
                 )
                 continue
+            if j == 0:
+                alias = self._rotation_alias(a, b, d.line)
+                if alias:
+                    out.append(LinkVerdict(d.line, label, source, "correct", alias))
+                    continue
             if len(raw) == 2:
                 v = self._define_vector(a, b, d.line, label, source)
                 if v is not None:

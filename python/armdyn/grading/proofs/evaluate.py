@@ -3,12 +3,15 @@
 
 Name rules (the typeface and the scripts decide; ``r_i``, ``I_{l_i}`` as in the exercise):
 
-* ``\\mathbf{I}``, ``\\mathbf{1}`` (bold, no script): the 3x3 identity. A plain ``I`` with no
-  script is the identity inside an integral, an inertia tensor outside one (rule below).
+* ``\\mathbf{I}``, ``\\mathbf{1}``, ``\\mathbb{1}``, ``\\mathbb{I}``, ``\\mathbf{E}`` (bold, no
+  script), ``I_3``, ``E_3``, ``1_3``: the 3x3 identity. A plain ``I`` or ``E`` with no script is
+  the identity inside an integral or a sum over the particles; outside one, ``I`` is an
+  inertia tensor (rule below), ``E`` the kinetic energy of rotation.
 * ``I_X`` with a point ``X`` (one capital letter: ``O``, ``C``, ``P``): the inertia tensor
   about ``X``, ``sum_k m_k (|p_k - X|^2 1 - (p_k - X)(p_k - X)^T)``. ``I`` with any other
   subscript (``I_{l_i}``) or none: the inertia tensor about the reference point of the
-  proof's per-element vector (``r_i``: link i's reference point), said in the verdict.
+  proof's per-element vector (``r_i``: link i's reference point; C when it has none yet),
+  said in the verdict.
 * ``I^c``, ``I^c_{l_i}``: the same tensor in frame c, ``R^c I R^{cT}`` (``I^c`` alone: the
   inertia tensor the proof last named).
 * ``r`` (relative to ``O``), ``r_X`` (relative to point ``X``; ``r_i``: to link i's reference
@@ -18,7 +21,12 @@ Name rules (the typeface and the scripts decide; ``r_i``, ``I_{l_i}`` as in the 
 * ``d``, ``p``, ``\\omega``, ``\\omega_i``, ``a``, ``b``, ``u``, ``v``, ``w``: constant vectors (``d`` is
   bound by a definition such as ``r_P = r_C + d``); ``\\omega^c``: ``R^c \\omega`` (the angular
   velocity the proof last named); ``R``, ``R^c``, ``R_c``: rotations.
-* ``M``: the body's mass; ``E_{rot}``: ``1/2 sum_k m_k |\\omega x r_k|^2``.
+* ``M``: the body's mass; ``m_i`` inside a sum over the particles: the particle's mass;
+  ``E_{rot}`` (``E``, ``T_{rot}``, ``E_{kin}`` outside an integral):
+  ``1/2 sum_k m_k |\\omega x r_k|^2``.
+* ``L``, ``H``, ``h`` (``L_X``: about point X): the angular momentum ``I_X \\omega``; ``N``,
+  ``\\tau`` (``N_X``): the moment, ``I_X \\dot\\omega + \\omega x I_X \\omega`` (Euler's law);
+  ``\\dot\\omega``: the angular acceleration, a constant vector of its own (:mod:`.motion`).
 * Any other name: :class:`UnknownName` (the line is ``unrecognised``).
 """
 
@@ -29,11 +37,31 @@ from fractions import Fraction
 
 from ..latex import LatexError
 from .body import Instance
-from .expr import Add, Cross, Div, Dot, Integral, Matrix, Mul, Norm, Num, Pow, Skew, Sym, Transpose, walk
+from .expr import (
+    Add,
+    Cross,
+    Deriv,
+    Div,
+    Dot,
+    Integral,
+    Mass,
+    Matrix,
+    Mul,
+    Norm,
+    Num,
+    Pow,
+    Skew,
+    Sum,
+    Sym,
+    Transpose,
+    walk,
+)
 from .matrices import Mat, ShapeError
 
 #: letters a proof line uses for vectors (3, 1): positions, velocities, angular velocity
-VECTOR_NAMES = {"d", "p", "omega", "a", "b", "u", "v", "w"}
+VECTOR_NAMES = {"d", "p", "omega", "a", "b", "u", "v", "w", "omegadot"}
+#: kinetic energy of rotation: (name, subscript) as people write it
+ENERGY = {("E", "rot"), ("E", "r"), ("E", "k"), ("E", "kin"), ("T", "rot"), ("E", "")}
 #: a line whose (conservative) polynomial degree exceeds this is not evaluated
 MAX_DEGREE = 400
 
@@ -144,24 +172,41 @@ def _frame(value: Mat, s: Sym, sc: Scope, tensor: bool) -> Mat:
     return rot @ value @ rot.T if tensor else rot @ value
 
 
+def is_identity(s: Sym, in_integral: bool) -> bool:
+    """The 3x3 identity as people write it (see the module docstring)."""
+    if s.frame or s.base not in ("I", "1", "E"):
+        return False
+    if s.sub == "3":
+        return True
+    return not s.sub and (s.bold or (in_integral and s.base != "1") or s.base == "1")
+
+
 def _builtin(s: Sym, sc: Scope) -> Mat:
     inst, state = sc.inst, sc.state
-    if s.base in ("I", "1") and s.bold and not s.sub and not s.frame:
+    if is_identity(s, sc.in_integral):
+        if s.base == "I" and s.bold and not s.sub and not sc.in_integral:
+            sc.notes.add("\\mathbf{I} (bold, no subscript) read as the identity: an inertia tensor is I_O, I_C")
         return Mat.identity()
-    if s.base == "I" and not s.sub and not s.frame and sc.in_integral:
-        return Mat.identity()
+    if s.base in MOMENTUM | MOMENT and not s.frame and (not s.sub or is_point(s.sub)):
+        tree = momentum(s, state)
+        if s.base in MOMENT:
+            tree = derivative(tree, sc)
+        point = s.sub or state.point or "C"
+        what = "angular momentum I omega" if s.base in MOMENTUM else "moment dL/dt (Euler's law)"
+        sc.notes.add(f"{s.latex()} read as the {what} about {point}")
+        return evaluate(tree, sc)
     if s.base == "I":
         if is_point(s.sub):
             point = s.sub
         elif s.sub or not s.frame:
+            point = state.point or "C"
             if state.point is None:
-                raise UnknownName(f"{s.latex()}: an inertia tensor about which point? (no r_X in the proof yet)")
-            point = state.point
+                sc.notes.add(f"{s.latex()} read as the inertia tensor about the mass center C (no point named yet)")
             frame = f", in frame {s.frame}" if s.frame else ""
             sc.notes.add(
                 f"{s.latex()} read as the inertia tensor about the reference point of r_{state.point_sub}" + frame
                 if state.point_sub
-                else f"{s.latex()} read as the inertia tensor about O" + frame
+                else f"{s.latex()} read as the inertia tensor about {point}" + frame
             )
         else:
             if state.inertia is None:
@@ -193,7 +238,7 @@ def _builtin(s: Sym, sc: Scope) -> Mat:
         return inst.rotation(s.frame or s.sub)
     if s.base == "M" and not s.sub and not s.frame:
         return Mat.scalar(inst.mass)
-    if s.base == "E" and s.sub in ("rot", "r", "k"):
+    if (s.base, s.sub) in ENERGY and not s.frame:
         omega = inst.vector(f"omega_{state.omega}" if state.omega else "omega")
         point = state.point or "O"
         total = Fraction(0)
@@ -201,8 +246,8 @@ def _builtin(s: Sym, sc: Scope) -> Mat:
             v = omega.cross(inst.element(k, point))
             total += m * v.dot(v)
         sc.notes.add(
-            "E_rot read as the kinetic energy of rotation 1/2 \\int |omega x r|^2 dm"
-            + (f" (r = r_{state.point_sub})" if state.point_sub else "")
+            f"{s.latex()} read as the kinetic energy of rotation 1/2 \\int |omega x r|^2 dm"
+            + (f" (r = r_{state.point_sub})" if state.point_sub else f" (r relative to {point})")
         )
         return Mat.scalar(total / 2)
     raise UnknownName(f"unknown name {s.latex()} (not a rigid-body quantity this checker knows)")
@@ -222,9 +267,10 @@ def evaluate(node, sc: Scope) -> Mat:
             total = v if total is None else total + v
         return total
     if isinstance(node, Mul):
-        value = evaluate(node.factors[0], sc)
-        for f in node.factors[1:]:
-            value = value @ evaluate(f, sc)
+        value = None
+        for f in node.factors:
+            v = Mat.identity() if _identity_e(f, node, sc) else evaluate(f, sc)
+            value = v if value is None else value @ v
         return value
     if isinstance(node, Dot):
         a, b = evaluate(node.a, sc), evaluate(node.b, sc)
@@ -247,7 +293,11 @@ def evaluate(node, sc: Scope) -> Mat:
             if node.n % 2:
                 raise NotRational("an odd power of a norm (only squared norms are rational)")
             return sq.power(node.n // 2)
-        return evaluate(node.base, sc).power(node.n)
+        value = evaluate(node.base, sc)
+        if value.shape == (3, 1) and node.n % 2 == 0 and node.n > 0:  # (w x r)^2: the squared norm
+            sc.notes.add("a vector squared read as its squared norm")
+            return Mat.scalar(value.dot(value)).power(node.n // 2)
+        return value.power(node.n)
     if isinstance(node, Norm):
         x = evaluate(node.arg, sc)
         if x.is_scalar:
@@ -265,6 +315,18 @@ def evaluate(node, sc: Scope) -> Mat:
             v = evaluate(node.body, sc.at(k, True)).scale(m)
             total = v if total is None else total + v
         return total
+    if isinstance(node, Sum):
+        total = None
+        for k in range(len(sc.inst.masses)):
+            v = evaluate(node.body, sc.at(k, True))
+            total = v if total is None else total + v
+        return total
+    if isinstance(node, Mass):
+        if sc.elem is None:
+            raise UnknownName("a particle's mass m_i outside a sum over the particles")
+        return Mat.scalar(sc.inst.masses[sc.elem])
+    if isinstance(node, Deriv):
+        return evaluate(derivative(node.arg, sc), sc)
     if isinstance(node, Matrix):
         cells = []
         for row in node.rows:
@@ -277,12 +339,29 @@ def evaluate(node, sc: Scope) -> Mat:
     raise TypeError(f"cannot evaluate {type(node).__name__}")
 
 
+def _identity_e(factor, product: Mul, sc: Scope) -> bool:
+    """A plain ``E`` outside an integral that multiplies a scalar made of vectors
+    (``\\|d\\|^2 E``, ``d^T d E``) is the identity, not the energy (said in the verdict)."""
+    if not (isinstance(factor, Sym) and factor.base == "E" and not factor.sub and not factor.frame):
+        return False
+    if factor.bold or sc.in_integral:
+        return False  # the identity anyway
+    for other in product.factors:
+        if other is not factor and any(
+            isinstance(n, (Norm, Dot)) or (isinstance(n, (Sym, Transpose)) and getattr(n, "transposed", True))
+            for n in walk(other)
+        ):
+            sc.notes.add("E read as the identity (it multiplies a scalar such as |d|^2)")
+            return True
+    return False
+
+
 def per_element(node, env: dict) -> bool:
     """Does the tree hold a per-element vector outside every integral (a pointwise line)?"""
     stack, seen = [node], set()
     while stack:
         n = stack.pop()
-        if isinstance(n, Integral):
+        if isinstance(n, (Integral, Sum)):
             continue
         if isinstance(n, Sym):
             if n.base == "r":
@@ -305,7 +384,7 @@ def _children(n):
         return [n.a, n.b]
     if isinstance(n, Pow):
         return [n.base]
-    if isinstance(n, (Norm, Transpose, Skew)):
+    if isinstance(n, (Norm, Transpose, Skew, Deriv)):
         return [n.arg]
     if isinstance(n, Matrix):
         return [c for row in n.rows for c in row]
@@ -320,11 +399,15 @@ def degree(node) -> int:
     if isinstance(node, Num):
         return 0
     if isinstance(node, Sym):
-        if node.base in ("I", "1") and node.bold and not node.sub and not node.frame:
+        if is_identity(node, False):
             return 0
         if node.base == "I":
             return 7 + (8 if node.frame else 0)
-        if node.base == "E":
+        if node.base in MOMENTUM:
+            return 10
+        if node.base in MOMENT:
+            return 16
+        if node.base in ("E", "T"):
             return 12
         if node.base == "R":
             return 4
@@ -343,8 +426,17 @@ def degree(node) -> int:
         return degree(node.arg)
     if isinstance(node, (Transpose, Skew)):
         return degree(node.arg)
+    if isinstance(node, Deriv):  # each rule multiplies by omega (degree 3) at most once per factor
+        return 2 * degree(node.arg) + 3
+    if isinstance(node, Sum):
+        return degree(node.body)
+    if isinstance(node, Mass):
+        return 1
     if isinstance(node, Integral):
         return 1 + degree(node.body)
     if isinstance(node, Matrix):
         return max(degree(c) for row in node.rows for c in row)
     return 0
+
+
+from .motion import MOMENT, MOMENTUM, derivative, momentum  # noqa: E402  (motion uses this module)

@@ -11,7 +11,15 @@ bodies (:mod:`.evaluate`), which decides equality without any symbolic simplifie
     factor  := atom ["^" script]           (script: an integer power, T / \\top / \\mathrm{T})
     atom    := number | name [scripts] | "(" expr ")" | "[" expr "]" ["_\\times"] | "{" expr "}"
              | "\\|" expr "\\|" | "\\frac{expr}{expr}" | "S" ["^T"] "(" expr ")"
-             | "\\int" ["_" script] expr ("dm" | "\\rho dV") | matrix environment
+             | "\\int" ["_" script] expr ("dm" | "\\rho dV") | "\\sum" ["_" index] term
+             | ("\\tilde" | "\\hat") name | "\\dot" atom | "\\frac{d}{dt}" factor | "\\frac{dX}{dt}"
+             | matrix environment
+
+A sum over the particles ``\\sum_i m_i (...)`` is read with its index: ``m_i`` is the
+particle's mass (:class:`Mass`), ``r_i`` its position (relative to O; ``r_{i,C}`` or
+``r_{C,i}`` relative to C). ``\\tilde r``, ``\\hat r`` and ``r^\\times`` are the skew matrix
+of ``r``; ``\\dot X``, ``\\frac{dX}{dt}``, ``\\frac{d}{dt}(...)`` its time derivative
+(:class:`Deriv`, evaluated in :mod:`.motion`).
 
 Names keep their typeface (bold ``\\mathbf{I}`` is the identity, plain ``I_{l_i}`` an inertia
 tensor), subscript and superscript as text (:class:`Sym`); what a name means is decided
@@ -22,122 +30,57 @@ when it is evaluated. Limits (bounded time on hostile input): :data:`MAX_TOKENS`
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import re
 from fractions import Fraction
 
 from ..latex import LatexError, tokenize
+from .nodes import (  # noqa: F401  (re-exported: the tree's node types)
+    Add,
+    Cross,
+    Deriv,
+    Div,
+    Dot,
+    Integral,
+    Mass,
+    Matrix,
+    Mul,
+    Norm,
+    Num,
+    Pow,
+    Skew,
+    Sum,
+    Sym,
+    Transpose,
+    walk,
+)
 
 MAX_TOKENS = 4000
 MAX_DEPTH = 40
 MAX_INTEGRALS = 3
 MAX_POWER = 8
 
-_BOLD = {"mathbf", "boldsymbol", "bm", "pmb", "mathbold"}
+_BOLD = {"mathbf", "boldsymbol", "bm", "pmb", "mathbold", "mathbb"}  # \mathbb{1}: the identity too
 _WRAPPERS = {
     "mathrm",
     "mathit",
     "vec",
-    "hat",
     "bar",
     "mathsf",
     "operatorname",
     "text",
     "mathcal",
-    "tilde",
     "textrm",
     "mathbb",
 } | _BOLD
 _MATRIX_ENVS = {"pmatrix", "bmatrix", "Bmatrix", "matrix", "smallmatrix", "array"}
+#: subscripts that name the mass center: read as C
+_CENTER = {"G": "C", "cm": "C", "CM": "C", "com": "C", "CoM": "C"}
+_PARTICLE_POINT = re.compile(r"^(?:[a-z]+|\\?[a-z]+)[,/]([A-Z]|cm|G)$|^([A-Z]|cm|G)[,/][a-z]+$")
 _STOP_CHARS = {"+", "-", ")", "]", "}", "=", "&", ",", ".", ";", "eof"}
 
 
 class ProofSyntaxError(LatexError):
     """A proof line that could not be read (the message says what)."""
-
-
-@dataclass(frozen=True)
-class Sym:
-    """A name as written: base (``r``, ``omega``, ``I``, ``R``, ``1``...), bold typeface,
-    subscript text (``C``, ``l_i``, ``ix``), frame label from the superscript (``c``) and
-    whether the superscript transposes (``^T``, ``^{c\\mathrm{T}}``)."""
-
-    base: str
-    bold: bool = False
-    sub: str = ""
-    frame: str = ""
-    transposed: bool = False
-
-    def latex(self) -> str:
-        """The name as plain text for messages: ``d``, ``omega_i``, ``I_{l_i}^c``, ``r_C^T``."""
-        sub = "" if not self.sub else f"_{self.sub}" if len(self.sub) == 1 else f"_{{{self.sub}}}"
-        sup = self.frame + ("T" if self.transposed else "")
-        return self.base + sub + ("" if not sup else f"^{sup}" if len(sup) == 1 else f"^{{{sup}}}")
-
-
-@dataclass(frozen=True)
-class Num:
-    value: Fraction
-
-
-@dataclass(frozen=True)
-class Add:
-    terms: tuple  # ((sign +1/-1, node), ...)
-
-
-@dataclass(frozen=True)
-class Mul:
-    factors: tuple  # left to right (matrix products keep their order)
-
-
-@dataclass(frozen=True)
-class Dot:
-    a: object
-    b: object
-
-
-@dataclass(frozen=True)
-class Cross:
-    a: object
-    b: object
-
-
-@dataclass(frozen=True)
-class Div:
-    a: object
-    b: object
-
-
-@dataclass(frozen=True)
-class Pow:
-    base: object
-    n: int
-
-
-@dataclass(frozen=True)
-class Norm:
-    arg: object
-
-
-@dataclass(frozen=True)
-class Transpose:
-    arg: object
-
-
-@dataclass(frozen=True)
-class Skew:
-    arg: object
-    transposed: bool = False
-
-
-@dataclass(frozen=True)
-class Integral:
-    body: object
-    domain: str = ""
-
-
-@dataclass(frozen=True)
-class Matrix:
-    rows: tuple  # ((node, ...), ...)
 
 
 def _script_text(tokens) -> str:
@@ -168,6 +111,7 @@ class _Parser:
         self.depth = 0
         self.integrals = 0
         self.norms = 0
+        self.sums: list = []  # the indices of the sums over particles being read
 
     def peek(self, k=0):
         j = self.i + k
@@ -253,9 +197,14 @@ class _Parser:
             if k == "cmd" and v == "cdot":
                 self.take()
                 factors = [Dot(_mul(factors), self.factor())]
-            elif k == "cmd" and v == "times":
+            elif k == "cmd" and v == "times":  # w \times I w: the product after it, w x (I w)
                 self.take()
-                factors = [Cross(_mul(factors), self.factor())]
+                right = [self.factor()]
+                while not self.at_term_end() and not (self.peek()[0] == "cmd" and self.peek()[1] in ("cdot", "times")):
+                    if self.peek()[1] in ("*", "/"):
+                        break
+                    right.append(self.factor())
+                factors = [Cross(_mul(factors), _mul(right))]
             elif (k, v) == ("char", "*"):
                 self.take()
                 factors.append(self.factor())
@@ -327,7 +276,8 @@ class _Parser:
                 return Skew(node)
             return node
         if k == "char" and v == "{":
-            return self.group("}")
+            node = self.group("}")
+            return self.scripts_after(node) if isinstance(node, Sym) else node  # {\bf r}_i
         if k == "cmd" and v == "left":
             d = self.take()
             if d[1] in ("|", "Vert", "lVert"):
@@ -339,15 +289,29 @@ class _Parser:
         if (k == "cmd" and v in ("|", "Vert", "lVert")) or (k == "char" and v == "|"):
             return self.norm_rest()
         if k == "cmd" and v in ("frac", "dfrac", "tfrac"):
-            self.expect("{")
-            a = self.group("}")
-            self.expect("{")
-            b = self.group("}")
+            derivative = self.time_derivative()
+            if derivative is not None:
+                return derivative
+            a = self.frac_argument()
+            b = self.frac_argument()
             return Div(a, b)
         if k == "cmd" and v == "int":
             return self.integral()
+        if k == "cmd" and v == "sum":
+            return self.particle_sum()
+        if k == "cmd" and v in ("tilde", "hat", "widetilde", "widehat"):
+            return self.skew_of_name()
+        if k == "cmd" and v == "dot":
+            self.enter()
+            inner = self.atom()
+            self.depth -= 1
+            return Deriv(self.scripts_after(inner) if isinstance(inner, Sym) else inner)
+        if k == "cmd" and v == "ddot":
+            raise ProofSyntaxError("second time derivatives are not understood in a rigid-body proof")
         if k == "begin":
             return self.matrix(v)
+        if k == "cmd" and v in ("bf", "rm", "it", "sf"):  # {\bf I}: an old-style font switch
+            return self.name(self.take(), v == "bf")
         if k == "cmd" and v in _WRAPPERS:
             bold = v in _BOLD
             if self.peek()[1] != "{":
@@ -368,6 +332,114 @@ class _Parser:
             return self.name((k, v), False)
         raise ProofSyntaxError(f"unexpected '{v}'")
 
+    def frac_argument(self):
+        """``{expr}``, or one digit of ``\\frac12``."""
+        k, v = self.peek()
+        if k == "num" and v.isdigit():
+            if len(v) > 1:
+                self.t[self.i] = ("num", v[1:])  # \frac12: numerator 1, the rest follows
+            else:
+                self.i += 1
+            return Num(Fraction(int(v[0])))
+        self.expect("{")
+        return self.group("}")
+
+    def _is_d(self, k: int) -> int:
+        """Tokens of a ``d`` (or ``\\mathrm{d}``) at offset k, 0 if none."""
+        if self.peek(k) == ("char", "d"):
+            return 1
+        if self.peek(k)[1] in ("mathrm", "text", "operatorname") and [self.peek(k + j)[1] for j in (1, 2, 3)] == [
+            "{",
+            "d",
+            "}",
+        ]:
+            return 4
+        return 0
+
+    def time_derivative(self):
+        """``\\frac{d}{dt} X`` or ``\\frac{dX}{dt}`` after ``\\frac``, else None (nothing taken)."""
+        if self.peek()[1] != "{":
+            return None
+        n = self._is_d(1)
+        if not n:
+            return None
+        if self.peek(1 + n)[1] == "}":  # \frac{d}{dt}
+            after = 2 + n
+            m = self._is_d(after + 1)
+            if self.peek(after)[1] != "{" or not m or self.peek(after + 1 + m) != ("char", "t"):
+                return None
+            if self.peek(after + 2 + m)[1] != "}":
+                return None
+            self.i += after + 3 + m
+            self.enter()
+            node = Deriv(self.term())  # d/dt 1/2 w^T I w: the whole product after it
+            self.depth -= 1
+            return node
+        save = self.i
+        self.i += 1 + n
+        try:
+            inner = self.expr()
+            self.expect("}")
+            self.expect("{")
+            m = self._is_d(0)
+            if not m or self.peek(m) != ("char", "t") or self.peek(m + 1)[1] != "}":
+                raise ProofSyntaxError("not a time derivative")
+            self.i += m + 2
+        except ProofSyntaxError:
+            self.i = save
+            return None
+        return Deriv(inner)
+
+    def particle_sum(self):
+        """``\\sum_i m_i ...`` (the index from the script, else from the first ``m_x``)."""
+        index = None
+        while self.peek()[1] in ("_", "^"):
+            mark = self.take()[1]
+            text = _script_text(self.script_tokens())
+            if mark == "_":
+                index = text.split("=")[0].strip() or None
+        if len(self.sums) >= MAX_INTEGRALS:
+            raise ProofSyntaxError(f"sums nested deeper than {MAX_INTEGRALS}")
+        self.sums.append(index)
+        body = self.term()
+        self.sums.pop()
+        if not any(isinstance(n, Mass) for n in walk(body)):
+            raise ProofSyntaxError("a sum over the particles without their masses m_i")
+        return Sum(body)
+
+    def particle(self, node: Sym):
+        """A name inside a sum over particles: ``m_i`` the mass, ``r_i`` the position."""
+        index = self.sums[-1]
+        if node.base == "m" and not node.frame and node.sub and node.sub.isalpha() and node.sub.islower():
+            if index is None:
+                self.sums[-1] = index = node.sub
+            if node.sub == index:
+                return Mass()
+        if node.base == "r" and index and node.sub and (node.sub.startswith(index) or node.sub.endswith(index)):
+            sub = node.sub[len(index) :] if node.sub.startswith(index) else node.sub[: -len(index)]
+            sub = sub.strip(",/ ")
+            return Sym("r", node.bold, _CENTER.get(sub, sub), node.frame, node.transposed)
+        return node
+
+    def skew_of_name(self):
+        """``\\tilde{r}_C``, ``\\hat\\omega``: the skew matrix of the name (scripts after it)."""
+        if self.peek()[1] == "{":
+            self.take()
+            inner = self.atom()
+            self.expect("}")
+        else:
+            inner = self.atom()
+        if isinstance(inner, Sym):
+            inner = self.scripts_after(inner)
+        if isinstance(inner, Sym) and inner.base in ("I", "R", "M", "E", "1"):
+            return inner  # \tilde{\mathbf{I}}: a tilde that marks a tensor, not a skew matrix
+        transposed = isinstance(inner, Sym) and inner.transposed
+        if transposed:
+            inner = Sym(inner.base, inner.bold, inner.sub, inner.frame, False)
+        if isinstance(inner, Transpose):
+            inner, transposed = inner.arg, True
+        return Skew(inner, transposed)
+
     def norm_rest(self):
         self.norms += 1
         node = self.expr()
@@ -383,13 +455,13 @@ class _Parser:
         kind, value = tok
         if kind not in ("char", "cmd", "num") or not (value.isalpha() or value == "1"):
             raise ProofSyntaxError(f"unexpected '{value}'")
-        if kind == "cmd" and value in ("dot", "ddot"):
-            raise ProofSyntaxError("time derivatives are not part of a rigid-body proof here")
         node = Sym(value, bold)
         return self.scripts_after(node)
 
-    def scripts_after(self, node: Sym):
-        sub, sup = node.sub, ""
+    def scripts_after(self, node):
+        if not isinstance(node, Sym):
+            return node
+        sub, sup = node.sub, node.frame + ("T" if node.transposed else "")
         while self.peek()[1] in ("_", "^"):
             mark = self.peek()[1]
             save = self.i
@@ -403,9 +475,20 @@ class _Parser:
                     self.i = save  # a power: handled by factor()
                     break
                 sup += text
+        skew = "×" in sup  # r^\times: the skew matrix of r
+        sup = sup.replace("×", "")
         transposed = sup.endswith("T")
         frame = sup[:-1] if transposed else sup
-        node = Sym(node.base, node.bold, sub, frame, transposed)
+        if node.base == "r":
+            m = _PARTICLE_POINT.match(sub)  # r_{k,P}: particle k relative to P, in a line about each particle
+            sub = next(g for g in m.groups() if g) if m else sub
+        node = Sym(node.base, node.bold, _CENTER.get(sub, sub), frame, False if skew else transposed)
+        if self.sums:
+            node = self.particle(node)
+            if isinstance(node, Mass):
+                return node
+        if skew:
+            return Skew(Sym(node.base, node.bold, node.sub, node.frame), transposed)
         if node.base == "S" and self.peek()[1] in ("(", "left"):
             if self.peek()[1] == "left":
                 self.take()
@@ -498,25 +581,3 @@ def parse_side(text: str):
         raise ProofSyntaxError("nested too deeply") from None
     except ValueError as err:  # Fraction of a malformed number
         raise ProofSyntaxError(str(err)) from None
-
-
-def walk(node):
-    """Every node of a tree, depth first."""
-    stack = [node]
-    while stack:
-        n = stack.pop()
-        yield n
-        if isinstance(n, Add):
-            stack.extend(t for _, t in n.terms)
-        elif isinstance(n, Mul):
-            stack.extend(n.factors)
-        elif isinstance(n, (Dot, Cross, Div)):
-            stack.extend((n.a, n.b))
-        elif isinstance(n, (Pow,)):
-            stack.append(n.base)
-        elif isinstance(n, (Norm, Transpose, Skew)):
-            stack.append(n.arg)
-        elif isinstance(n, Integral):
-            stack.append(n.body)
-        elif isinstance(n, Matrix):
-            stack.extend(c for row in n.rows for c in row)

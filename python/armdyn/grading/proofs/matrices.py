@@ -129,7 +129,12 @@ class Mat:
 
     def power(self, n: int) -> Mat:
         if not self.is_scalar:
-            raise ShapeError(f"raises {self.kind()} to a power")
+            if self.r != self.c or n < 1:  # S(r)^2 = S(r) S(r); no inverses
+                raise ShapeError(f"raises {self.kind()} to a power")
+            out = self
+            for _ in range(n - 1):
+                out = out @ self
+            return out
         x = self.v[0]
         if x == 0 and n < 0:
             raise ZeroDivisionError("0 to a negative power")
