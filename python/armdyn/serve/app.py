@@ -50,6 +50,7 @@ PREVIEW_SLOTS = 4  # previews running or waiting per server; past it 503 + Retry
 PREVIEW_RETRY = 2  # seconds, the Retry-After of a preview refused for load
 STALL_SLACK = 30.0  # seconds past the grading timeout before a quiet queue counts as stuck
 SID = re.compile(r"^[A-Za-z0-9_-]{1,24}$")  # a submission id (security.new_id)
+PLAIN_PATH = re.compile(r"^[A-Za-z0-9/_.-]{1,200}$")  # a path redirected without its trailing slash
 
 
 @dataclass
@@ -557,7 +558,7 @@ def build_app(settings: Settings) -> Starlette:
         """404; a path with a trailing slash goes to the same path without it, by a
         relative ``Location`` (never built from the ``Host`` header)."""
         path = request.url.path
-        if exc.status_code == 404 and len(path) > 1 and path.endswith("/"):
+        if exc.status_code == 404 and len(path) > 1 and path.endswith("/") and PLAIN_PATH.match(path):
             target = "/" + path.strip("/")  # one leading slash: "//host" would leave the site
             query = request.url.query
             return RedirectResponse(target + ("?" + query if query else ""), status_code=307)
