@@ -347,17 +347,18 @@ def build_app(settings: Settings) -> Starlette:
 
     async def api_preview(request: Request):
         """One preview worker, at most :data:`PREVIEW_SLOTS` previews running or waiting
-        (more: 503 with Retry-After); one whose client has left is dropped unread."""
-        markdown = await _text_body(request)
-        if len(markdown.encode()) > MAX_PREVIEW:
-            return _error(413, f"a preview reads at most {MAX_PREVIEW} bytes")
-        exercise = srv.exercise_of(request.query_params.get("exercise"))
+        (more: 503 with Retry-After, before their body is read); one whose client has
+        left is dropped unmade."""
         if srv.previews >= PREVIEW_SLOTS:
             busy = _error(503, f"too many previews at once; try again in {PREVIEW_RETRY} s")
             busy.headers["retry-after"] = str(PREVIEW_RETRY)
             return busy
         srv.previews += 1
         try:
+            markdown = await _text_body(request)
+            if len(markdown.encode()) > MAX_PREVIEW:
+                return _error(413, f"a preview reads at most {MAX_PREVIEW} bytes")
+            exercise = srv.exercise_of(request.query_params.get("exercise"))
             async with srv.preview_lock:
                 if await request.is_disconnected():
                     return Response(status_code=204)  # nobody reads it: do not make it
