@@ -145,9 +145,9 @@ def test_nul_is_refused_at_the_door(db_url):  # noqa: F811
 
 
 def test_health_tells_a_queue_that_does_not_move(tmp_path, monkeypatch):
-    from armdyn.serve import app as app_mod
+    from armdyn.serve import pool as pool_mod
 
-    monkeypatch.setattr(app_mod, "STALL_SLACK", -28.0)  # stuck after 2 s instead of timeout + 30 s
+    monkeypatch.setattr(pool_mod, "STALL_SLACK", -28.0)  # stuck after 2 s instead of timeout + 30 s
     with client_for(f"sqlite:///{tmp_path / 'db.sqlite'}", timeout=30.0) as c:
         wait_ready(c)
         repo = c.app.state.server.repo

@@ -48,7 +48,6 @@ FORM_WAIT = 20.0  # seconds the Grade button waits for the verdict before showin
 API_WAIT = 30.0  # default ?wait= of POST /api/grade
 PREVIEW_SLOTS = 4  # previews running or waiting per server; past it 503 + Retry-After
 PREVIEW_RETRY = 2  # seconds, the Retry-After of a preview refused for load
-STALL_SLACK = 30.0  # seconds past the grading timeout before a quiet queue counts as stuck
 SID = re.compile(r"^[A-Za-z0-9_-]{1,24}$")  # a submission id (security.new_id)
 PLAIN_PATH = re.compile(r"^[A-Za-z0-9/_.-]{1,200}$")  # a path redirected without its trailing slash
 
@@ -306,16 +305,7 @@ def build_app(settings: Settings) -> Starlette:
             counts = {}
             problems.append(f"the database does not answer ({type(err).__name__})")
         if ready:
-            h = srv.pool.health()
-            limit = settings.timeout + STALL_SLACK
-            if h["threads"] < srv.pool.n:
-                problems.append(f"{srv.pool.n - h['threads']} of {srv.pool.n} grading threads ended")
-            if h["last_round"] > limit:
-                problems.append(f"a grading thread has been stuck for {h['last_round']:g} s")
-            if counts.get("queued") and h["since_progress"] > limit:
-                problems.append(f"the queue has not moved for {h['since_progress']:g} s")
-            if h["unsettled"]:
-                problems.append(f"{h['unsettled']} outcomes wait for the database")
+            problems += srv.pool.problems(counts.get("queued", 0))
         status = "starting" if not ready else "degraded" if problems else "ok"
         body = {"status": status, "workers": settings.workers, "queue": counts}
         if problems:

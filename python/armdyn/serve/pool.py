@@ -44,6 +44,7 @@ from .storage import FAILED, Repository
 WORKER_ENV = ("PATH", "PYTHONPATH", "HOME", "LANG", "LC_ALL", "LC_CTYPE", "TMPDIR", "VIRTUAL_ENV", "SYMPY_CACHE_SIZE")
 STORE_TRIES = 4  # a database write: tried this often, with back-off 0.25, 0.5, 1 s
 LOOP_BACKOFF = 2.0  # seconds a grading thread waits after its database failed
+STALL_SLACK = 30.0  # seconds past the grading timeout before a quiet thread or queue counts as stuck
 
 
 def worker_env(exercises: dict[str, str], memory_mb: int) -> dict[str, str]:
@@ -296,6 +297,7 @@ class Pool:
                 self.on_done(ids)
         job = self.repo.claim()
         if job is None:
+            self._progress = time.monotonic()  # the queue is empty: nothing is held up
             self._wake.wait(0.5)
             self._wake.clear()
             return proc
@@ -333,18 +335,31 @@ class Pool:
         return proc
 
     def health(self) -> dict:
-        """``threads``: grading threads alive (of ``workers``); ``stalled_for``: seconds
-        since a grading thread last claimed or stored work (0 while it is idle and
-        turning); ``unsettled``: submissions whose outcome waits for the database."""
+        """``threads``: grading threads alive; ``last_round``: seconds since the quietest
+        thread began a round; ``since_progress``: seconds since a thread last claimed,
+        stored or found the queue empty; ``unsettled``: outcomes waiting for the database."""
         now = time.monotonic()
-        alive = sum(t.is_alive() for t in self._threads)
-        quiet = now - max(self._beats.values(), default=now)
         return {
-            "threads": alive,
-            "last_round": round(quiet, 1),
+            "threads": sum(t.is_alive() for t in self._threads),
+            "last_round": round(now - min(self._beats.values(), default=now), 1),
             "since_progress": round(now - self._progress, 1),
             "unsettled": len(self._unsettled),
         }
+
+    def problems(self, queued: int) -> list[str]:
+        """What ``/api/health`` reports as degraded (empty: all well). A round may take a
+        grading's ``timeout``; :data:`STALL_SLACK` more is stuck."""
+        h, limit = self.health(), self.timeout + STALL_SLACK
+        out = []
+        if h["threads"] < self.n:
+            out.append(f"{self.n - h['threads']} of {self.n} grading threads ended")
+        if h["last_round"] > limit:
+            out.append(f"a grading thread has been stuck for {h['last_round']:g} s")
+        if queued and h["since_progress"] > limit:
+            out.append(f"the queue has not moved for {h['since_progress']:g} s")
+        if h["unsettled"]:
+            out.append(f"{h['unsettled']} outcomes wait for the database")
+        return out
 
     # -- preview
     def preview(self, markdown: str, exercise: str | None) -> dict:
