@@ -78,8 +78,8 @@ def settled(c, body: dict, timeout: float = 120.0) -> dict:
 
 def test_refused_verdict_fails_the_submission_and_the_thread_lives(tmp_path, monkeypatch):
     """A verdict the database refuses (DataError) fails that submission with a reason; a
-    database away for a moment (OperationalError) only delays the write; the same thread
-    then grades the next submission."""
+    database away for a moment or longer (OperationalError) only delays the write, the
+    verdict is kept; the same thread then grades the next submission."""
     from armdyn.serve import pool as pool_mod
     from armdyn.serve.storage import Repository
 
@@ -92,6 +92,8 @@ def test_refused_verdict_fails_the_submission_and_the_thread_lives(tmp_path, mon
             raise sa.exc.DataError("INSERT", {}, ValueError("PostgreSQL text cannot contain NUL (0x00) bytes"))
         if sid == "blip" and calls.count("blip") <= 2:
             raise sa.exc.OperationalError("UPDATE", {}, ConnectionError("server closed the connection"))
+        if sid == "outage" and calls.count("outage") <= 6:  # longer than the write's own tries
+            raise sa.exc.OperationalError("UPDATE", {}, ConnectionError("the database system is starting up"))
         return real_finish(sid, result)
 
     monkeypatch.setattr(repo, "finish", finish)
@@ -103,10 +105,13 @@ def test_refused_verdict_fails_the_submission_and_the_thread_lives(tmp_path, mon
         text = EXERCISE.read_text(encoding="utf-8")
         repo.add("poison", "t", text + "\n<!-- 1 -->\n", "rp-arm")
         repo.add("blip", "t", text + "\n<!-- 2 -->\n", "rp-arm")
+        repo.add("outage", "t", text + "\n<!-- 3 -->\n", "rp-arm")
         repo.add("after", "t", RIGHT.read_text(encoding="utf-8"), "rp-arm")
         pool.wake()
-        wait_until(lambda: {"poison", "blip", "after"} <= set(done), 120, "all three settled")
+        wait_until(lambda: {"poison", "blip", "outage", "after"} <= set(done), 120, "all four settled")
         poison, blip, after = repo.get("poison"), repo.get("blip"), repo.get("after")
+        outage = repo.get("outage")  # its verdict waited for the database, then was written
+        assert outage["status"] == "done" and outage["first_wrong"] == "v_dot_1" and calls.count("outage") == 7
         assert poison["status"] == "failed" and "could not be stored" in poison["error"], poison
         assert poison["attempts"] == 1 and calls.count("poison") == 1  # a refused value is not retried
         assert blip["status"] == "done" and blip["first_wrong"] == "v_dot_1"  # hand-checked verdict

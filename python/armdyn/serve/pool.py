@@ -160,7 +160,7 @@ class Pool:
         self._lock = threading.Lock()
         self._preview_lock = threading.Lock()
         self._preview: WorkerProcess | None = None
-        self._unsettled: dict[str, str] = {}  # id -> reason, outcomes the database did not take
+        self._unsettled: dict = {}  # id -> its outcome (a write) that the database did not take
         self._beats: dict[int, float] = {}  # thread -> when it last began a round
         self._progress = time.monotonic()  # when a thread last claimed or stored work
 
@@ -239,34 +239,43 @@ class Pool:
     def _settle(self, sid: str, outcome) -> list[str]:
         """Write a grading's outcome (a callable doing the write, returning the ids it
         completed). A verdict the database refuses fails the submission with the reason;
-        when nothing can be written, the id is kept in ``_unsettled`` (written later)."""
+        while the database is away the outcome waits in ``_unsettled`` (written later)."""
         try:
             return self._store(outcome)
-        except sa.exc.SQLAlchemyError as err:
+        except (sa.exc.DataError, sa.exc.IntegrityError) as err:
             reason = f"the verdict could not be stored ({type(err).__name__}); retry"
             print(f"armdyn serve: submission {sid}: {reason}: {str(err)[:300]}", file=sys.stderr)
+            outcome = lambda: [sid] if self.repo.give_up(sid, reason, False) else []  # noqa: E731
             try:
-                self._store(self.repo.give_up, sid, reason, False)
-                return [sid]
+                return self._store(outcome)
             except sa.exc.SQLAlchemyError:
-                with self._lock:
-                    self._unsettled[sid] = reason
-                return []
+                pass
+        except sa.exc.SQLAlchemyError as err:
+            print(f"armdyn serve: submission {sid}: kept until the database answers: {str(err)[:200]}", file=sys.stderr)
+        with self._lock:
+            self._unsettled[sid] = outcome
+        return []
 
     def _settle_backlog(self) -> list[str]:
-        """Fail the submissions whose outcome could not be written earlier."""
+        """Write the outcomes the database did not take earlier (oldest first)."""
         with self._lock:
-            backlog = dict(self._unsettled)
+            backlog = list(self._unsettled.items())
         done = []
-        for sid, reason in backlog.items():
-            try:
-                self._store(self.repo.give_up, sid, reason, False)
-            except sa.exc.SQLAlchemyError:
-                break  # the database is still away: try again on the next round
+        for sid, outcome in backlog:
+            if not self._ping():
+                break  # still away: the next round tries again
             with self._lock:
                 self._unsettled.pop(sid, None)
-            done.append(sid)
+            done += self._settle(sid, outcome)  # kept again if it fails again
         return done
+
+    def _ping(self) -> bool:
+        """Does the database answer? (one cheap read)"""
+        try:
+            self.repo.counts()
+            return True
+        except sa.exc.SQLAlchemyError:
+            return False
 
     def _loop(self, i: int) -> None:
         proc = None
