@@ -293,7 +293,7 @@ class LiveServer:
         from armdyn.serve.server import config
 
         self.port = free_port()
-        app = build_app(Settings(db=f"sqlite:///{tmp_path / 'db.sqlite'}", workers=1, exercises=catalogue()))
+        self.app = app = build_app(Settings(db=f"sqlite:///{tmp_path / 'db.sqlite'}", workers=1, exercises=catalogue()))
         self.server = uvicorn.Server(config(app, "127.0.0.1", self.port, **limits))
         self.thread = threading.Thread(target=self.server.run, daemon=True)
         self.base = f"http://127.0.0.1:{self.port}"
@@ -393,6 +393,36 @@ def raw_get(port: int, target: str, host: str) -> bytes:
                 break
             data += chunk
     return data.split(b"\r\n\r\n")[0].lower()
+
+
+def test_a_preview_whose_client_left_is_not_made(tmp_path):
+    with LiveServer(tmp_path) as live:
+        pool = live.app.state.server.pool
+        made, release = [], threading.Event()
+
+        def preview(markdown, exercise):
+            made.append(markdown)
+            release.wait(20)  # the first one holds the preview worker
+            return {"ok": True, "html": "<p>ok</p>"}
+
+        pool.preview = preview
+        url = live.base + "/api/preview"
+        first = threading.Thread(target=lambda: http("POST", url, b"$$first = 1$$", MD, timeout=30))
+        first.start()
+        wait_until(lambda: made, 10, "the first preview started")
+        body = b"$$second = 2$$"
+        with socket.create_connection(("127.0.0.1", live.port), timeout=5) as s:
+            s.sendall(
+                b"POST /api/preview HTTP/1.1\r\nHost: x\r\nContent-Type: text/markdown\r\n"
+                + f"Content-Length: {len(body)}\r\n\r\n".encode()
+                + body
+            )
+            time.sleep(0.5)  # it waits behind the first, then its client leaves
+        time.sleep(0.5)
+        release.set()
+        first.join(30)
+        time.sleep(1.0)
+        assert made == ["$$first = 1$$"], made
 
 
 def test_trailing_slash_redirect_is_relative(tmp_path):
