@@ -314,11 +314,11 @@ class LiveServer:
         self.thread.join(60)
 
 
-def half_open(port: int, n: int) -> list[socket.socket]:
-    """``n`` connections that send part of a request head and then nothing."""
+def half_open(port: int, n: int, source: str = "127.0.0.1") -> list[socket.socket]:
+    """``n`` connections from ``source`` that send part of a request head and then nothing."""
     socks = []
     for _ in range(n):
-        s = socket.create_connection(("127.0.0.1", port), timeout=5)
+        s = socket.create_connection(("127.0.0.1", port), timeout=5, source_address=(source, 0))
         s.sendall(b"GET /api/health HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ")
         socks.append(s)
     return socks
@@ -348,6 +348,21 @@ def test_unfinished_request_heads_are_closed_and_connections_capped(tmp_path):
             deadline = time.monotonic() + 10
             assert all(closed_by_server(s, max(0.1, deadline - time.monotonic())) for s in socks)
             assert http("GET", live.base + "/api/health", timeout=5)[0] == 200
+        finally:
+            for s in socks:
+                s.close()
+
+
+def test_one_address_cannot_take_every_connection(tmp_path):
+    """From an address that is not a trusted proxy at most a quarter of the connections;
+    the attacker here is 127.0.0.2, the student 127.0.0.1 (Linux answers on all of 127/8)."""
+    with LiveServer(tmp_path, header_seconds=30.0, max_connections=40, forwarded_allow_ips="127.0.0.1") as live:
+        socks = half_open(live.port, 30, source="127.0.0.2")
+        try:
+            assert sum(closed_by_server(s, 1.0) for s in socks[-5:]) == 5  # past 10 from one address
+            t0 = time.monotonic()
+            assert http("GET", live.base + "/api/health", timeout=5)[0] == 200
+            assert time.monotonic() - t0 < 2.0
         finally:
             for s in socks:
                 s.close()

@@ -6,9 +6,11 @@ which stops the grading pool (:meth:`armdyn.serve.pool.Pool.stop`).
 
 Connections are bounded (:class:`GuardedH11`): a request whose headers are not complete
 within ``HEADER_SECONDS`` of the connection (or of the previous response) is closed, an
-idle keep-alive connection after ``KEEP_ALIVE_SECONDS``, and past ``MAX_CONNECTIONS``
-open ones a new connection is closed at once, below the open-file limit, so that
-half-open connections can neither pile up nor starve the server of file descriptors.
+idle keep-alive connection after ``KEEP_ALIVE_SECONDS``; past ``MAX_CONNECTIONS`` open
+ones (kept below the open-file limit), or past a quarter of them from one address that
+is not a trusted proxy, a new connection is closed at once. So half-open connections
+can neither pile up nor starve the server of file descriptors, and one client cannot
+take every connection.
 """
 
 from __future__ import annotations
@@ -48,17 +50,28 @@ def open_file_budget(wanted: int = MAX_CONNECTIONS) -> int:
     return max(16, min(wanted, soft - FILES_RESERVED))
 
 
-def guarded_protocol(header_seconds: float, max_connections: int):
-    """uvicorn's h11 protocol with a deadline on request heads and a connection cap."""
+def guarded_protocol(header_seconds: float, max_connections: int, proxies: str = "127.0.0.1"):
+    """uvicorn's h11 protocol with a deadline on request heads and connection caps (all,
+    and per address for addresses not in ``proxies``, the trusted proxies: behind a
+    proxy every student comes from its address)."""
+    from collections import Counter
+
     from uvicorn.protocols.http.h11_impl import H11Protocol
+
+    trusted = {p.strip() for p in proxies.split(",")}
+    per_peer = None if "*" in trusted else max(4, max_connections // 4)
+    peers: Counter = Counter()
 
     class GuardedH11(H11Protocol):
         def connection_made(self, transport) -> None:
             super().connection_made(transport)
             self._head_timer = None
             self._awaited = self.cycle
-            if len(self.connections) > max_connections:
-                transport.abort()  # over the cap: free the descriptor now
+            self._peer = self.client[0] if self.client else "?"
+            peers[self._peer] += 1
+            crowded = per_peer is not None and self._peer not in trusted and peers[self._peer] > per_peer
+            if len(self.connections) > max_connections or crowded:
+                transport.abort()  # over a cap: free the descriptor now
                 return
             self._arm()
 
@@ -91,6 +104,9 @@ def guarded_protocol(header_seconds: float, max_connections: int):
 
         def connection_lost(self, exc) -> None:
             self._disarm()
+            peers[self._peer] -= 1
+            if peers[self._peer] <= 0:
+                del peers[self._peer]
             super().connection_lost(exc)
 
     return GuardedH11
@@ -107,7 +123,7 @@ def config(app, host: str, port: int, forwarded_allow_ips: str = "127.0.0.1", **
         app,
         host=host,
         port=port,
-        http=guarded_protocol(header_seconds, max_connections),
+        http=guarded_protocol(header_seconds, max_connections, forwarded_allow_ips),
         log_level="warning",
         proxy_headers=True,
         forwarded_allow_ips=forwarded_allow_ips,
