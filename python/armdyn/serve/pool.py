@@ -14,9 +14,10 @@ the oldest queued submission from the database, send it, wait for the verdict at
   then their workers are killed and the submissions returned to the queue uncounted;
 - the database fails (restarting, disk full, a value it refuses): the thread never
   dies of it. A write is tried ``STORE_TRIES`` times with back-off; a verdict the
-  database refuses marks the submission ``failed`` with the reason; a submission whose
-  state cannot be written at all is remembered and written once the database answers.
-  :meth:`Pool.health` tells a dead thread or a queue that does not move.
+  database refuses marks the submission ``failed`` with the reason; an outcome that
+  cannot be written yet is kept (one per thread at most: a thread cannot claim
+  meanwhile) and written once the database answers. :meth:`Pool.problems` tells an
+  ended or stuck thread and a queue that does not move.
 
 Workers start with a scrubbed environment (:func:`worker_env`): the instructor token and
 the server's secret never reach the process that reads a student's text.
