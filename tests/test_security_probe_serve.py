@@ -144,9 +144,11 @@ def test_nul_is_refused_at_the_door(db_url):  # noqa: F811
         assert r.status_code == 400 and "NUL" in r.json()["error"] and "line 3" in r.json()["error"]
         r = c.post("/api/grade?robot=rp-arm&student=a%00b", content=RIGHT.read_bytes(), headers=MD)
         assert r.status_code == 400 and "student name" in r.json()["error"]
-        assert c.get("/api/submissions/ab%00cd").status_code == 404
-        assert c.get("/submissions/ab%00cd").status_code == 404
-        assert c.get("/submissions/ab%00cd/report.html").status_code == 404
+        r = c.get("/api/submissions/ab%00cd")
+        assert r.status_code == 400 and "not a submission id" in r.json()["error"]
+        assert c.get("/submissions/ab%00cd").status_code == 400
+        assert c.get("/submissions/ab%00cd/report.html").status_code == 400
+        assert c.get("/api/submissions/abcd").status_code == 404  # well-formed, not there
 
 
 def test_health_tells_a_queue_that_does_not_move(tmp_path, monkeypatch):
@@ -175,6 +177,23 @@ def test_health_tells_a_queue_that_does_not_move(tmp_path, monkeypatch):
         final = settled(c, body)
         assert final["passed"] is True, final
         wait_until(lambda: c.get("/api/health").status_code == 200, 20, "health ok again")
+
+
+def test_health_tells_a_worker_that_cannot_start(tmp_path):
+    """A grading worker that dies before it is ready (here: an address-space limit too
+    small to import armdyn) is named among the problems, with why."""
+    from armdyn.serve.pool import Pool
+    from armdyn.serve.storage import Repository
+
+    repo = Repository(f"sqlite:///{tmp_path / 'db.sqlite'}")
+    pool = Pool(repo, {"rp-arm": "rp-arm"}, workers=1, memory_mb=40)
+    pool.start()
+    try:
+        problems = wait_until(lambda: pool.problems(0), 120, "a problem reported")
+        assert any("grading worker 0 cannot be started" in p for p in problems), problems
+    finally:
+        pool.stop()
+        repo.dispose()
 
 
 # -- F5, F6: the instructor's login

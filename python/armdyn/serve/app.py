@@ -224,10 +224,10 @@ def _client(request: Request) -> str:
 
 
 def _sid(request: Request) -> str:
-    """The submission id of the path; a value that cannot be an id is simply not found."""
+    """The submission id of the path; a value that cannot be one (a NUL, a slash...) is 400."""
     sid = request.path_params["sid"]
     if not SID.match(sid):
-        raise HTTPException(404)
+        raise _BadRequest("not a submission id (ids are up to 24 letters, digits, '-' and '_')")
     return sid
 
 

@@ -163,6 +163,7 @@ class Pool:
         self._preview: WorkerProcess | None = None
         self._unsettled: dict = {}  # id -> its outcome (a write) that the database did not take
         self._beats: dict[int, float] = {}  # thread -> when it last began a round
+        self._no_start: dict[int, str] = {}  # thread -> why its worker did not start (last try)
         self._progress = time.monotonic()  # when a thread last claimed or stored work
 
     # -- life cycle
@@ -215,7 +216,9 @@ class Pool:
             proc = WorkerProcess(self.exercises, self.memory_mb)
         except (WorkerDied, WorkerTimeout, OSError) as err:
             print(f"armdyn serve: cannot start a grading worker: {err}", file=sys.stderr)
+            self._no_start[i] = str(err)[:200]
             return None
+        self._no_start.pop(i, None)
         with self._lock:
             self._procs[i] = proc
             self._started = len([p for p in self._procs.values() if p is not None])
@@ -369,6 +372,8 @@ class Pool:
             out.append(f"the queue has not moved for {h['since_progress']:g} s")
         if h["unsettled"]:
             out.append(f"{h['unsettled']} outcomes wait for the database")
+        for i, why in sorted(self._no_start.items()):
+            out.append(f"grading worker {i} cannot be started: {why}")
         return out
 
     # -- preview
