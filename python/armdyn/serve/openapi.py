@@ -123,6 +123,7 @@ def schema() -> dict:
                     "parameters": [{"name": "id", "in": "path", "required": True, "schema": {"type": "string"}}, token],
                     "responses": {
                         "200": _json(_SUBMISSION, "the submission"),
+                        "400": _json(_ERROR, "not a submission id (up to 24 of A-Z a-z 0-9 - _)"),
                         "404": _json(_ERROR, "unknown, or the token does not match"),
                     },
                 }
