@@ -42,7 +42,10 @@ from .storage import FAILED, Repository
 
 #: environment variables a worker inherits (everything else, the server's secrets
 #: among it, stays in the web process)
-WORKER_ENV = ("PATH", "PYTHONPATH", "HOME", "LANG", "LC_ALL", "LC_CTYPE", "TMPDIR", "VIRTUAL_ENV", "SYMPY_CACHE_SIZE")
+WORKER_ENV = (
+    *("PATH", "PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV", "LD_LIBRARY_PATH"),  # to find Python and armdyn
+    *("HOME", "LANG", "LC_ALL", "LC_CTYPE", "TMPDIR", "SYMPY_CACHE_SIZE"),
+)
 STORE_TRIES = 4  # a database write: tried this often, with back-off 0.25, 0.5, 1 s
 LOOP_BACKOFF = 2.0  # seconds a grading thread waits after its database failed
 STALL_SLACK = 30.0  # seconds past the grading timeout before a quiet thread or queue counts as stuck
