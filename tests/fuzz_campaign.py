@@ -768,6 +768,7 @@ def _serve_base() -> str:
     """The worker's server (started once; stopped when the worker exits)."""
     if "base" not in _SERVE:
         import atexit
+        import shutil
         import socket
         import urllib.request
 
@@ -781,7 +782,7 @@ def _serve_base() -> str:
         cmd += ["--db", db, "--instructor-token", token, "--timeout", "10"]
         env = dict(os.environ, PYTHONPATH=str(ROOT / "python"))
         proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        atexit.register(lambda: (proc.terminate(), proc.wait(30)))
+        atexit.register(lambda: (proc.terminate(), proc.wait(30), shutil.rmtree(tmp, ignore_errors=True)))
         base = f"http://127.0.0.1:{port}"
         for _ in range(600):  # at most 2 minutes
             try:
