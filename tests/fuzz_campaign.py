@@ -27,6 +27,13 @@ Kinds of input (each from a fixed seed, so a finding can be replayed):
   (no compiling: the header must parse as one docstring and hold no comment end; the
   identifiers must be ASCII, unique, no keyword);
 * ``aliases``: alias bombs in every field of planar-2r (and deep nesting, huge integers);
+* ``serve``:  hostile sizes and timings against ``armdyn serve`` on 127.0.0.1 (a server
+  per worker process): bodies of 0 B to 3 MB, NUL and invalid UTF-8, odd content types,
+  query values and submission ids, and raw connections that stop mid-head, trickle,
+  lie about their length or send a 200 kB head. Each answer must be below 500 (503
+  with Retry-After only for previews) and ``/api/health`` 200 afterwards (the database:
+  a fresh SQLite file, or ``ARMDYN_FUZZ_SERVE_DB``, e.g. a throwaway PostgreSQL). Use a small
+  ``--count`` (each input is a request; ~1000 take a minute or two);
 * ``towers``: power towers (powers, exponentials, products of huge numbers) in model
   expressions. For these three anything but a result or a ``ModelError`` within 5 s is a
   finding.
@@ -745,6 +752,135 @@ SECURITY_KINDS = {"names": run_names, "aliases": run_aliases, "towers": run_towe
 RUNNERS.update(SECURITY_KINDS)
 
 
+# ------------------------------------------------------------------ armdyn serve's endpoints
+# Kind "serve": hostile sizes and timings against a real `armdyn serve` on 127.0.0.1 (one
+# per worker process, started before the first input, with one grading worker and a
+# throwaway SQLite file). Each input is one request (or one raw connection that stops,
+# trickles or lies about its length); afterwards the answer must be below 500 (503 with
+# Retry-After only for previews), and /api/health must answer 200 within 5 s. A 5xx, a
+# dropped answer to a well-formed request or an unhealthy server is a finding.
+SERVE_PATHS = ["/api/grade", "/api/preview", "/grade", "/instructor/login", "/instructor/logout", "/api/health"]
+SERVE_IDS = ["x", "a" * 25, "ab%00cd", "..%2F..%2Fetc", "%C3%A9t%C3%A9", "%FF%FE", "A" * 4000, "%0d%0aX:y"]
+_SERVE: dict = {}
+
+
+def _serve_base() -> str:
+    """The worker's server (started once; stopped when the worker exits)."""
+    if "base" not in _SERVE:
+        import atexit
+        import shutil
+        import socket
+        import urllib.request
+
+        with socket.socket() as sock:
+            sock.bind(("127.0.0.1", 0))
+            port = sock.getsockname()[1]
+        tmp = tempfile.mkdtemp(prefix="armdyn-fuzz-serve-")
+        token = "fuzz-" + os.urandom(12).hex()
+        cmd = [sys.executable, "-m", "armdyn", "serve", "--port", str(port), "--workers", "1"]
+        db = os.environ.get("ARMDYN_FUZZ_SERVE_DB") or f"sqlite:///{tmp}/fuzz.db"  # e.g. a throwaway PostgreSQL
+        cmd += ["--db", db, "--instructor-token", token, "--timeout", "10"]
+        env = dict(os.environ, PYTHONPATH=str(ROOT / "python"))
+        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        atexit.register(lambda: (proc.terminate(), proc.wait(30), shutil.rmtree(tmp, ignore_errors=True)))
+        base = f"http://127.0.0.1:{port}"
+        for _ in range(600):  # at most 2 minutes
+            try:
+                with urllib.request.urlopen(base + "/api/health", timeout=5) as r:
+                    if r.status == 200:
+                        break
+            except OSError:
+                time.sleep(0.2)
+        else:
+            raise RuntimeError("the fuzz server did not start")
+        _SERVE.update(base=base, port=port, proc=proc)
+    return _SERVE["base"]
+
+
+def _serve_body(rng: random.Random) -> bytes:
+    size = rng.choice([0, 1, 100, 10_000, 199_999, 200_001, 999_999, 1_000_001, 3_000_000])
+    pieces = [b"$$", b"\\frac{", b"}", b"{", b"\x00", b"\xff", b"\n", b"---\nrobot: rp-arm\n---\n", b"\\tau_1 = "]
+    piece = rng.choice(pieces) if rng.random() < 0.5 else os.urandom(rng.randint(1, 64))
+    return (piece * (size // max(1, len(piece)) + 1))[:size]
+
+
+def _serve_raw(port: int, rng: random.Random) -> None:
+    """A connection that misbehaves: stops mid-head, trickles its head, lies about its
+    length, sends an oversized head or broken chunks. The server may close it or answer
+    4xx; it must stay healthy."""
+    import socket
+
+    how = rng.choice(["stop", "trickle", "short-body", "huge-head", "bad-chunks", "garbage"])
+    with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
+        head = b"POST /api/grade?wait=0 HTTP/1.1\r\nHost: x\r\nContent-Type: text/markdown\r\n"
+        if how == "stop":
+            sock.sendall(head[: rng.randint(1, len(head))])
+        elif how == "trickle":  # at most 1 s of trickling
+            for i in range(0, len(head), 8):
+                sock.sendall(head[i : i + 8])
+                time.sleep(0.02)
+        elif how == "short-body":
+            sock.sendall(head + b"Content-Length: 5000\r\n\r\n" + b"$$x=1$$")
+        elif how == "huge-head":
+            sock.sendall(head + b"X-Big: " + b"a" * rng.choice([70_000, 200_000]) + b"\r\n\r\n")
+        elif how == "bad-chunks":
+            sock.sendall(head + b"Transfer-Encoding: chunked\r\n\r\nzz\r\nabc\r\n0\r\n\r\n")
+        else:
+            sock.sendall(os.urandom(rng.randint(1, 4096)))
+        sock.settimeout(1.0)
+        try:
+            answer = sock.recv(64)
+        except OSError:
+            answer = b""
+    if answer.startswith(b"HTTP/1.1 5") and not answer.startswith(b"HTTP/1.1 503"):
+        raise AssertionError(f"raw {how}: {answer!r}")
+
+
+def run_serve(seed: int, rng: random.Random):
+    import http.client
+    import urllib.parse
+
+    base = _serve_base()
+    port = _SERVE["port"]
+    if rng.random() < 0.25:
+        _serve_raw(port, rng)
+    else:
+        if rng.random() < 0.3:
+            sid = rng.choice(SERVE_IDS)
+            path = rng.choice([f"/api/submissions/{sid}", f"/submissions/{sid}", f"/submissions/{sid}/report.html"])
+            method, body = "GET", b""
+        else:
+            path, method, body = rng.choice(SERVE_PATHS), "POST", _serve_body(rng)
+        query = {
+            "wait": rng.choice(["0", "-1", "nan", "inf", "1e308", "0.1"]),
+            "student": rng.choice(["Ada", "a\x00b", "\u202e" * 50, "x" * 5000]),
+            "robot": rng.choice(["rp-arm", "../../etc/passwd", "rp\x00arm", ""]),
+        }
+        kind = rng.choice(["text/markdown", "text/plain", "application/x-www-form-urlencoded", "multipart/form-data"])
+        headers = {"Content-Type": kind, "Authorization": rng.choice(["", "Bearer " + "x" * 300, "Bearer short"])}
+        conn = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+        try:
+            conn.request(method, path + "?" + urllib.parse.urlencode(query), body=body, headers=headers)
+            r = conn.getresponse()
+            r.read()
+            status, retry = r.status, r.getheader("retry-after")
+        except (ConnectionResetError, BrokenPipeError):
+            status, retry = 413, None  # the server may close on a body past its limit
+        finally:
+            conn.close()
+        if status >= 500 and not (status == 503 and path == "/api/preview" and retry):
+            raise AssertionError(f"{method} {path} ({len(body)} bytes, {kind}): {status}")
+    import urllib.request
+
+    with urllib.request.urlopen(base + "/api/health", timeout=5) as r:
+        if r.status != 200:
+            raise AssertionError(f"/api/health {r.status} after seed {seed}")
+
+
+RUNNERS["serve"] = run_serve
+PREPARE = {"serve": _serve_base}  # kinds whose set-up must not count against an input's timeout
+
+
 # ------------------------------------------------------------------ worker / driver
 
 
@@ -766,6 +902,8 @@ def worker(kind: str, first: int, count: int, timeout: float) -> dict:
 
     if kind == "arrays":  # likewise the robots it feeds (the first input built them)
         _fill_robots_cache()
+    if kind in PREPARE:
+        PREPARE[kind]()
     for seed in range(first, first + count):
         rng = random.Random(seed)
         counts["inputs"] += 1

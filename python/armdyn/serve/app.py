@@ -21,12 +21,15 @@ from __future__ import annotations
 import asyncio
 import json
 import os
+import re
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import jinja2
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
+from starlette.exceptions import HTTPException
 from starlette.requests import Request
 from starlette.responses import HTMLResponse, JSONResponse, RedirectResponse, Response
 from starlette.routing import Mount, Route
@@ -43,6 +46,10 @@ MAX_BODY = 1_000_000  # bytes of a request; a derivation is a few kB
 MAX_PREVIEW = 200_000  # bytes of text a preview reads
 FORM_WAIT = 20.0  # seconds the Grade button waits for the verdict before showing "queued"
 API_WAIT = 30.0  # default ?wait= of POST /api/grade
+PREVIEW_SLOTS = 4  # previews running or waiting per server; past it 503 + Retry-After
+PREVIEW_RETRY = 2  # seconds, the Retry-After of a preview refused for load
+SID = re.compile(r"^[A-Za-z0-9_-]{1,24}$")  # a submission id (security.new_id)
+PLAIN_PATH = re.compile(r"^[A-Za-z0-9/_.-]{1,200}$")  # a path redirected without its trailing slash
 
 
 @dataclass
@@ -58,6 +65,8 @@ class Settings:
     secret: str | None = None
     max_attempts: int = 3
     grace: float = 10.0
+    login_per_client: int = 10  # failed instructor logins per client in 5 min
+    login_overall: int = 100  # failed instructor logins from everyone in 5 min
 
 
 _templates = jinja2.Environment(
@@ -86,6 +95,11 @@ class Server:
     def __init__(self, settings: Settings):
         self.settings = settings
         self.secrets = security.Secrets(settings.instructor_token, settings.secret)
+        self.throttle = security.Throttle(settings.login_per_client, settings.login_overall)
+        # previews wait on their own thread, never in the request threads the database uses
+        self.preview_thread = ThreadPoolExecutor(1, thread_name_prefix="armdyn-preview")
+        self.preview_lock = asyncio.Lock()
+        self.previews = 0  # running or waiting (the event loop's thread only)
         self.repo: Repository | None = None
         self.pool: Pool | None = None
         self.loop: asyncio.AbstractEventLoop | None = None
@@ -113,6 +127,7 @@ class Server:
             await run_in_threadpool(self.pool.stop)
         if self.repo is not None:
             self.repo.dispose()
+        self.preview_thread.shutdown(wait=False, cancel_futures=True)
 
     def _done_from_thread(self, ids: list[str]) -> None:
         if self.loop is not None:
@@ -140,6 +155,8 @@ class Server:
 
     async def accept(self, markdown: str, exercise: str | None, student: str, owner_key: str | None) -> tuple:
         """Store a submission; returns (summary row, secret link token)."""
+        _no_nul(markdown, "the derivation")
+        _no_nul(student, "the student name")
         token = security.new_token()
         owner = security.digest(owner_key) if owner_key else None
         row = await run_in_threadpool(
@@ -151,10 +168,20 @@ class Server:
 
     # -- who may see what
     def is_instructor(self, request: Request) -> bool:
-        if self.secrets.instructor_cookie_ok(request.cookies.get(security.INSTRUCTOR_COOKIE)):
+        """A live instructor session, or the instructor token as ``Bearer`` (a wrong one
+        counts as a failed login, and is not even compared while its client is throttled)."""
+        if self.secrets.session_ok(request.cookies.get(security.INSTRUCTOR_COOKIE)):
             return True
         auth = request.headers.get("authorization", "")
-        return auth.startswith("Bearer ") and self.secrets.instructor_ok(auth[7:])
+        if not auth.startswith("Bearer ") or self.secrets.instructor_token is None:
+            return False
+        client = _client(request)
+        if self.throttle.wait(client) > 0:
+            return False
+        if self.secrets.instructor_ok(auth[7:]):
+            return True
+        self.throttle.failed(client)
+        return False
 
     def may_see(self, request: Request, row: dict) -> bool:
         token = request.query_params.get("t")
@@ -181,6 +208,27 @@ class Server:
 
 class _BadRequest(Exception):
     pass
+
+
+def _no_nul(text: str, what: str) -> None:
+    """Refuse a NUL character (no derivation holds one; PostgreSQL's text cannot)."""
+    at = text.find("\0")
+    if at >= 0:
+        line = text.count("\n", 0, at) + 1
+        raise _BadRequest(f"{what} holds a NUL character (byte 0) on line {line}: remove it and send again")
+
+
+def _client(request: Request) -> str:
+    """The client's address (the proxy's X-Forwarded-For when it is trusted)."""
+    return request.client.host if request.client else "?"
+
+
+def _sid(request: Request) -> str:
+    """The submission id of the path; a value that cannot be one (a NUL, a slash...) is 400."""
+    sid = request.path_params["sid"]
+    if not SID.match(sid):
+        raise _BadRequest("not a submission id (ids are up to 24 letters, digits, '-' and '_')")
+    return sid
 
 
 def _student_key(request: Request) -> tuple[str, bool]:
@@ -247,12 +295,24 @@ def build_app(settings: Settings) -> Starlette:
     menu = ordered(settings.exercises)
 
     async def health(request: Request):
+        """ok (200); starting, or degraded with its ``problems`` (503): a grading thread
+        ended or stuck, a queue that does not move, the database away."""
         ready = srv.pool is not None and srv.pool.ready
-        counts = await run_in_threadpool(srv.repo.counts) if srv.repo is not None else {}
-        body = {"status": "ok" if ready else "starting", "workers": settings.workers, "queue": counts}
+        problems = []
+        try:
+            counts = await run_in_threadpool(srv.repo.counts) if srv.repo is not None else {}
+        except Exception as err:  # noqa: BLE001 - any database failure is what health must tell
+            counts = {}
+            problems.append(f"the database does not answer ({type(err).__name__})")
+        if ready:
+            problems += srv.pool.problems(counts.get("queued", 0))
+        status = "starting" if not ready else "degraded" if problems else "ok"
+        body = {"status": status, "workers": settings.workers, "queue": counts}
+        if problems:
+            body["problems"] = problems
         if srv.is_instructor(request) and srv.pool is not None:
             body["worker_pids"] = srv.pool.pids()
-        return JSONResponse(body, status_code=200 if ready else 503)
+        return JSONResponse(body, status_code=200 if status == "ok" else 503)
 
     async def api_grade(request: Request):
         q = request.query_params
@@ -270,17 +330,32 @@ def build_app(settings: Settings) -> Starlette:
         return JSONResponse(body, status_code=200 if row["status"] in (DONE, FAILED) else 202)
 
     async def api_submission(request: Request):
-        full = await run_in_threadpool(srv.repo.get, request.path_params["sid"])
+        full = await run_in_threadpool(srv.repo.get, _sid(request))
         if full is None or not srv.may_see(request, full):
             return _error(404, "no such submission (or not yours: give its token as ?t=)")
         return JSONResponse(_api_view(full, full))
 
     async def api_preview(request: Request):
-        markdown = await _text_body(request)
-        if len(markdown.encode()) > MAX_PREVIEW:
-            return _error(413, f"a preview reads at most {MAX_PREVIEW} bytes")
-        exercise = srv.exercise_of(request.query_params.get("exercise"))
-        reply = await run_in_threadpool(srv.pool.preview, markdown, exercise)
+        """One preview worker, at most :data:`PREVIEW_SLOTS` previews running or waiting
+        (more: 503 with Retry-After, before their body is read); one whose client has
+        left is dropped unmade."""
+        if srv.previews >= PREVIEW_SLOTS:
+            busy = _error(503, f"too many previews at once; try again in {PREVIEW_RETRY} s")
+            busy.headers["retry-after"] = str(PREVIEW_RETRY)
+            return busy
+        srv.previews += 1
+        try:
+            markdown = await _text_body(request)
+            if len(markdown.encode()) > MAX_PREVIEW:
+                return _error(413, f"a preview reads at most {MAX_PREVIEW} bytes")
+            exercise = srv.exercise_of(request.query_params.get("exercise"))
+            async with srv.preview_lock:
+                if await request.is_disconnected():
+                    return Response(status_code=204)  # nobody reads it: do not make it
+                loop = asyncio.get_running_loop()
+                reply = await loop.run_in_executor(srv.preview_thread, srv.pool.preview, markdown, exercise)
+        finally:
+            srv.previews -= 1
         if not reply.get("ok"):
             return _error(503, reply.get("reason", "preview unavailable"))
         return JSONResponse({"html": reply["html"]})
@@ -324,7 +399,7 @@ def build_app(settings: Settings) -> Starlette:
         return RedirectResponse(f"/submissions/{row['id']}?t={token}", status_code=303)
 
     async def submission_page(request: Request):
-        full = await run_in_threadpool(srv.repo.get, request.path_params["sid"])
+        full = await run_in_threadpool(srv.repo.get, _sid(request))
         if full is None or not srv.may_see(request, full):
             return HTMLResponse("No such submission, or not yours (the link needs its token).", status_code=404)
         key, new = _student_key(request)
@@ -338,7 +413,7 @@ def build_app(settings: Settings) -> Starlette:
         return _with_key(response, key, new, request)
 
     async def report_page(request: Request):
-        full = await run_in_threadpool(srv.repo.get, request.path_params["sid"])
+        full = await run_in_threadpool(srv.repo.get, _sid(request))
         if full is None or not srv.may_see(request, full) or not full.get("report_html"):
             return HTMLResponse("No report (yet) for this submission.", status_code=404)
         return HTMLResponse(full["report_html"])
@@ -375,7 +450,18 @@ def build_app(settings: Settings) -> Starlette:
         form = await request.form()
         if not srv.secrets.csrf_ok(request.cookies.get(security.STUDENT_COOKIE), form.get("csrf")):
             return HTMLResponse("The form expired: reload the page and try again.", status_code=403)
+        client = _client(request)
+        wait = srv.throttle.wait(client)
+        if wait > 0:
+            seconds = int(wait) + 1
+            return HTMLResponse(
+                f"Too many wrong instructor tokens: try again in {seconds} s.",
+                status_code=429,
+                headers={"retry-after": str(seconds)},
+            )
         if not srv.secrets.instructor_ok(str(form.get("token") or "")):
+            if srv.secrets.instructor_token is not None:
+                srv.throttle.failed(client)
             key, _new = _student_key(request)
             return _page(
                 "login.html",
@@ -388,11 +474,11 @@ def build_app(settings: Settings) -> Starlette:
         response = RedirectResponse("/instructor", status_code=303)
         response.set_cookie(
             security.INSTRUCTOR_COOKIE,
-            srv.secrets.instructor_cookie(),
+            srv.secrets.new_session(),
             httponly=True,
             samesite="strict",
             secure=request.url.scheme == "https",
-            max_age=12 * 3600,
+            max_age=security.SESSION_SECONDS,
         )
         return response
 
@@ -400,6 +486,7 @@ def build_app(settings: Settings) -> Starlette:
         form = await request.form()
         if not srv.secrets.csrf_ok(request.cookies.get(security.STUDENT_COOKIE), form.get("csrf")):
             return HTMLResponse("The form expired: reload the page and try again.", status_code=403)
+        srv.secrets.end_session(request.cookies.get(security.INSTRUCTOR_COOKIE))
         response = RedirectResponse("/instructor", status_code=303)
         response.delete_cookie(security.INSTRUCTOR_COOKIE)
         return response
@@ -408,7 +495,7 @@ def build_app(settings: Settings) -> Starlette:
         form = await request.form()
         if not srv.secrets.csrf_ok(request.cookies.get(security.STUDENT_COOKIE), form.get("csrf")):
             return HTMLResponse("The form expired: reload the page and try again.", status_code=403)
-        full = await run_in_threadpool(srv.repo.get, request.path_params["sid"])
+        full = await run_in_threadpool(srv.repo.get, _sid(request))
         if full is None or not srv.may_see(request, full):
             return HTMLResponse("No such submission.", status_code=404)
         if await run_in_threadpool(srv.repo.retry, full["id"]):
@@ -458,6 +545,20 @@ def build_app(settings: Settings) -> Starlette:
     async def too_large(request: Request, exc: security.BodyTooLarge):
         return _error(413, f"request body larger than {MAX_BODY} bytes")
 
+    async def not_found(request: Request, exc: HTTPException):
+        """404; a path with a trailing slash goes to the same path without it, by a
+        relative ``Location`` (never built from the ``Host`` header)."""
+        path = request.url.path
+        if exc.status_code == 404 and len(path) > 1 and path.endswith("/") and PLAIN_PATH.match(path):
+            target = "/" + path.strip("/")  # one leading slash: "//host" would leave the site
+            query = request.url.query
+            return RedirectResponse(target + ("?" + query if query else ""), status_code=307)
+        if path.startswith("/api/"):
+            return JSONResponse({"error": exc.detail}, status_code=exc.status_code, headers=exc.headers)
+        return HTMLResponse(
+            jinja2.utils.markupsafe.escape(exc.detail), status_code=exc.status_code, headers=exc.headers
+        )
+
     routes = [
         Route("/", student_page),
         Route("/grade", grade_form, methods=["POST"]),
@@ -490,8 +591,9 @@ def build_app(settings: Settings) -> Starlette:
     app = Starlette(
         routes=routes,
         lifespan=lifespan,
-        exception_handlers={_BadRequest: bad_request, security.BodyTooLarge: too_large},
+        exception_handlers={_BadRequest: bad_request, security.BodyTooLarge: too_large, HTTPException: not_found},
     )
+    app.router.redirect_slashes = False  # Starlette's would build an absolute URL from Host
     app.state.server = srv
     app.add_middleware(security.SecurityHeaders)
     app.add_middleware(security.BodyLimit, max_bytes=MAX_BODY)

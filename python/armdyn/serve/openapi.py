@@ -88,7 +88,10 @@ def schema() -> dict:
                     "summary": "ready to grade?",
                     "responses": {
                         "200": _json({"type": "object"}, "workers started"),
-                        "503": _json({"type": "object"}, "starting"),
+                        "503": _json(
+                            {"type": "object"},
+                            "starting, or degraded: its problems (a grading thread ended or stuck, a queue that does not move, the database away)",
+                        ),
                     },
                 }
             },
@@ -120,6 +123,7 @@ def schema() -> dict:
                     "parameters": [{"name": "id", "in": "path", "required": True, "schema": {"type": "string"}}, token],
                     "responses": {
                         "200": _json(_SUBMISSION, "the submission"),
+                        "400": _json(_ERROR, "not a submission id (up to 24 of A-Z a-z 0-9 - _)"),
                         "404": _json(_ERROR, "unknown, or the token does not match"),
                     },
                 }
@@ -131,7 +135,7 @@ def schema() -> dict:
                     "requestBody": {"required": True, "content": {"text/markdown": {"schema": {"type": "string"}}}},
                     "responses": {
                         "200": _json({"type": "object", "properties": {"html": {"type": "string"}}}, "the preview"),
-                        "503": _json(_ERROR, "the preview worker was busy or stopped"),
+                        "503": _json(_ERROR, "too many previews at once (Retry-After), or the preview worker stopped"),
                     },
                 }
             },

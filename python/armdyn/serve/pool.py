@@ -11,7 +11,16 @@ the oldest queued submission from the database, send it, wait for the verdict at
 - the worker dies (killed, crashed): the submission goes back to the queue, and is
   ``failed`` after ``max_attempts`` claims (see :mod:`.storage`);
 - the server stops (SIGTERM): no new claims; running gradings get ``grace`` seconds,
-  then their workers are killed and the submissions returned to the queue uncounted.
+  then their workers are killed and the submissions returned to the queue uncounted;
+- the database fails (restarting, disk full, a value it refuses): the thread never
+  dies of it. A write is tried ``STORE_TRIES`` times with back-off; a verdict the
+  database refuses marks the submission ``failed`` with the reason; an outcome that
+  cannot be written yet is kept (one per thread at most: a thread cannot claim
+  meanwhile) and written once the database answers. :meth:`Pool.problems` tells an
+  ended or stuck thread and a queue that does not move.
+
+Workers start with a scrubbed environment (:func:`worker_env`): the instructor token and
+the server's secret never reach the process that reads a student's text.
 
 Previews go to one more worker of their own with a short timeout, so a preview never
 waits behind gradings and the web process never parses a student's text itself.
@@ -27,7 +36,37 @@ import sys
 import threading
 import time
 
-from .storage import Repository
+import sqlalchemy as sa
+
+from .storage import FAILED, Repository
+
+#: environment variables a worker inherits (everything else, the server's secrets
+#: among it, stays in the web process)
+WORKER_ENV = (
+    *("PATH", "PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV", "LD_LIBRARY_PATH"),  # to find Python and armdyn
+    *("HOME", "LANG", "LC_ALL", "LC_CTYPE", "TMPDIR", "SYMPY_CACHE_SIZE"),
+)
+STORE_TRIES = 4  # a database write: tried this often, with back-off 0.25, 0.5, 1 s
+LOOP_BACKOFF = 2.0  # seconds a grading thread waits after its database failed
+STALL_SLACK = 30.0  # seconds past the grading timeout before a quiet thread or queue counts as stuck
+
+
+def worker_env(exercises: dict[str, str], memory_mb: int) -> dict[str, str]:
+    """The environment of a grading worker: :data:`WORKER_ENV` and its own settings."""
+    env = {k: v for k, v in os.environ.items() if k in WORKER_ENV}
+    env.update(
+        ARMDYN_SERVE_EXERCISES=json.dumps(exercises),
+        ARMDYN_SERVE_MEMORY_MB=str(memory_mb),
+        OPENBLAS_NUM_THREADS="1",
+        OMP_NUM_THREADS="1",
+    )
+    return env
+
+
+def clean_result(reply: dict) -> dict:
+    """A worker's strings without NUL (PostgreSQL's text refuses it: an exercise name
+    written ``rp\\0arm`` in YAML comes back in the error message as a real NUL)."""
+    return {k: v.replace("\0", "\\0") if isinstance(v, str) else v for k, v in reply.items()}
 
 
 class WorkerDied(RuntimeError):
@@ -42,13 +81,7 @@ class WorkerProcess:
     """One ``python -m armdyn.serve.worker`` and its pipes."""
 
     def __init__(self, exercises: dict[str, str], memory_mb: int, start_timeout: float = 120.0):
-        env = dict(
-            os.environ,
-            ARMDYN_SERVE_EXERCISES=json.dumps(exercises),
-            ARMDYN_SERVE_MEMORY_MB=str(memory_mb),
-            OPENBLAS_NUM_THREADS="1",
-            OMP_NUM_THREADS="1",
-        )
+        env = worker_env(exercises, memory_mb)
         self.proc = subprocess.Popen(
             [sys.executable, "-m", "armdyn.serve.worker"],
             stdin=subprocess.PIPE,
@@ -131,6 +164,10 @@ class Pool:
         self._lock = threading.Lock()
         self._preview_lock = threading.Lock()
         self._preview: WorkerProcess | None = None
+        self._unsettled: dict = {}  # id -> its outcome (a write) that the database did not take
+        self._beats: dict[int, float] = {}  # thread -> when it last began a round
+        self._no_start: dict[int, str] = {}  # thread -> why its worker did not start (last try)
+        self._progress = time.monotonic()  # when a thread last claimed or stored work
 
     # -- life cycle
     def start(self) -> int:
@@ -182,7 +219,9 @@ class Pool:
             proc = WorkerProcess(self.exercises, self.memory_mb)
         except (WorkerDied, WorkerTimeout, OSError) as err:
             print(f"armdyn serve: cannot start a grading worker: {err}", file=sys.stderr)
+            self._no_start[i] = str(err)[:200]
             return None
+        self._no_start.pop(i, None)
         with self._lock:
             self._procs[i] = proc
             self._started = len([p for p in self._procs.values() if p is not None])
@@ -190,48 +229,155 @@ class Pool:
                 self._ready.set()
         return proc
 
+    def _store(self, what, *args):
+        """``what(*args)`` (a database write), tried :data:`STORE_TRIES` times with
+        back-off while the database is unavailable; a value the database refuses
+        (``DataError``, ``IntegrityError``) is not retried. Raises the last error."""
+        for k in range(STORE_TRIES):
+            try:
+                return what(*args)
+            except (sa.exc.DataError, sa.exc.IntegrityError):
+                raise
+            except sa.exc.SQLAlchemyError:
+                if k == STORE_TRIES - 1 or self._stopping.wait(0.25 * 2**k):
+                    raise
+        raise AssertionError("unreachable")
+
+    def _settle(self, sid: str, outcome) -> list[str]:
+        """Write a grading's outcome (a callable doing the write, returning the ids it
+        completed). A verdict the database refuses fails the submission with the reason;
+        while the database is away the outcome waits in ``_unsettled`` (written later)."""
+        try:
+            return self._store(outcome)
+        except (sa.exc.DataError, sa.exc.IntegrityError) as err:
+            reason = f"the verdict could not be stored ({type(err).__name__}); retry"
+            print(f"armdyn serve: submission {sid}: {reason}: {str(err)[:300]}", file=sys.stderr)
+            outcome = lambda: [sid] if self.repo.give_up(sid, reason, False) else []  # noqa: E731
+            try:
+                return self._store(outcome)
+            except sa.exc.SQLAlchemyError:
+                pass
+        except sa.exc.SQLAlchemyError as err:
+            print(f"armdyn serve: submission {sid}: kept until the database answers: {str(err)[:200]}", file=sys.stderr)
+        with self._lock:
+            self._unsettled[sid] = outcome
+        return []
+
+    def _settle_backlog(self) -> list[str]:
+        """Write the outcomes the database did not take earlier (oldest first)."""
+        with self._lock:
+            backlog = list(self._unsettled.items())
+        done = []
+        for sid, outcome in backlog:
+            if not self._ping():
+                break  # still away: the next round tries again
+            with self._lock:
+                self._unsettled.pop(sid, None)
+            done += self._settle(sid, outcome)  # kept again if it fails again
+        return done
+
+    def _ping(self) -> bool:
+        """Does the database answer? (one cheap read)"""
+        try:
+            self.repo.counts()
+            return True
+        except sa.exc.SQLAlchemyError:
+            return False
+
     def _loop(self, i: int) -> None:
         proc = None
         while not self._stopping.is_set():
-            if proc is None or not proc.alive():
-                proc = self._spawn(i)
-                if proc is None:
-                    self._stopping.wait(2.0)
-                    continue
-            job = self.repo.claim()
-            if job is None:
-                self._wake.wait(0.5)
-                self._wake.clear()
-                continue
-            ids = [job.id]
+            self._beats[i] = time.monotonic()
             try:
-                reply = proc.request(
-                    {"kind": "grade", "exercise": job.exercise, "markdown": job.markdown}, self.timeout
-                )
-            except WorkerTimeout:
-                proc.kill()
-                proc = None
-                self.repo.give_up(job.id, f"grading took longer than {self.timeout:g} s (stopped)", retry=False)
-            except (WorkerDied, ValueError) as err:
-                proc.kill()
-                proc = None
-                if self._stopping.is_set():
-                    self.repo.release(job.id)
-                    ids = []
-                elif self.repo.give_up(job.id, f"{err}; retry", retry=True) != "failed":
-                    ids = []
-                    self._wake.set()
-            else:
-                if reply.get("ok"):
-                    ids = self.repo.finish(job.id, reply)
-                else:
-                    self.repo.give_up(job.id, str(reply.get("reason", "grading failed")), retry=False)
-            if ids:
-                self.on_done(ids)
+                proc = self._round(i, proc)
+            except Exception as err:  # noqa: BLE001 - the thread outlives any one failure
+                print(f"armdyn serve: grading thread {i}: {type(err).__name__}: {str(err)[:300]}", file=sys.stderr)
+                with self._lock:
+                    proc = self._procs.get(i)
+                self._stopping.wait(LOOP_BACKOFF)
         if proc is not None:
             proc.kill()
         with self._lock:
             self._procs[i] = None
+
+    def _round(self, i: int, proc: WorkerProcess | None) -> WorkerProcess | None:
+        """One claim-grade-store round of thread ``i``; returns its worker (None: gone)."""
+        if proc is None or not proc.alive():
+            proc = self._spawn(i)
+            if proc is None:
+                self._stopping.wait(2.0)
+                return None
+        if self._unsettled:
+            ids = self._settle_backlog()
+            if ids:
+                self.on_done(ids)
+        job = self.repo.claim()
+        if job is None:
+            self._progress = time.monotonic()  # the queue is empty: nothing is held up
+            self._wake.wait(0.5)
+            self._wake.clear()
+            return proc
+        self._progress = time.monotonic()
+        ids = [job.id]
+        try:
+            reply = proc.request({"kind": "grade", "exercise": job.exercise, "markdown": job.markdown}, self.timeout)
+        except WorkerTimeout:
+            proc.kill()
+            proc = None
+            reason = f"grading took longer than {self.timeout:g} s (stopped)"
+            ids = self._settle(job.id, lambda: [job.id] if self.repo.give_up(job.id, reason, retry=False) else [])
+        except (WorkerDied, ValueError) as err:
+            proc.kill()
+            proc = None
+            if self._stopping.is_set():
+                self._store(self.repo.release, job.id)
+                ids = []
+            else:
+                reason = f"{err}; retry"
+                ids = self._settle(
+                    job.id, lambda: [job.id] if self.repo.give_up(job.id, reason, True) == FAILED else []
+                )
+                if not ids:
+                    self._wake.set()  # queued again
+        else:
+            if reply.get("ok"):
+                ids = self._settle(job.id, lambda: self.repo.finish(job.id, clean_result(reply)))
+            else:
+                reason = str(reply.get("reason", "grading failed")).replace("\0", "\\0")
+                ids = self._settle(job.id, lambda: [job.id] if self.repo.give_up(job.id, reason, retry=False) else [])
+        self._progress = time.monotonic()
+        if ids:
+            self.on_done(ids)
+        return proc
+
+    def health(self) -> dict:
+        """``threads``: grading threads alive; ``last_round``: seconds since the quietest
+        thread began a round; ``since_progress``: seconds since a thread last claimed,
+        stored or found the queue empty; ``unsettled``: outcomes waiting for the database."""
+        now = time.monotonic()
+        return {
+            "threads": sum(t.is_alive() for t in self._threads),
+            "last_round": round(now - min(self._beats.values(), default=now), 1),
+            "since_progress": round(now - self._progress, 1),
+            "unsettled": len(self._unsettled),
+        }
+
+    def problems(self, queued: int) -> list[str]:
+        """What ``/api/health`` reports as degraded (empty: all well). A round may take a
+        grading's ``timeout``; :data:`STALL_SLACK` more is stuck."""
+        h, limit = self.health(), self.timeout + STALL_SLACK
+        out = []
+        if h["threads"] < self.n:
+            out.append(f"{self.n - h['threads']} of {self.n} grading threads ended")
+        if h["last_round"] > limit:
+            out.append(f"a grading thread has been stuck for {h['last_round']:g} s")
+        if queued and h["since_progress"] > limit:
+            out.append(f"the queue has not moved for {h['since_progress']:g} s")
+        if h["unsettled"]:
+            out.append(f"{h['unsettled']} outcomes wait for the database")
+        for i, why in sorted(self._no_start.items()):
+            out.append(f"grading worker {i} cannot be started: {why}")
+        return out
 
     # -- preview
     def preview(self, markdown: str, exercise: str | None) -> dict:

@@ -60,7 +60,11 @@ class Grader:
             known = ", ".join(sorted(self.exercises)[:12])
             raise ModelError(f"unknown exercise '{name[:64]}' (this server grades: {known})", source=SUBMISSION)
         if name not in self._robots:
-            self._robots[name] = load(self.exercises[name], strict=False)
+            source = self.exercises[name]
+            if os.path.splitext(source)[1].lower() not in ("", ".yaml", ".yml"):
+                # a bundled name or a variant's model.yaml; never a .xacro (it runs code) or other file
+                raise ModelError(f"exercise '{name}' is not a YAML model; this server grades YAML models only")
+            self._robots[name] = load(source, strict=False)
         return self._robots[name]
 
     def named(self, markdown: str, robot: str | None) -> str | None:

@@ -22,7 +22,12 @@
       state.textContent = "…";
       var url = "/api/preview" + (exercise && exercise.value ? "?exercise=" + encodeURIComponent(exercise.value) : "");
       fetch(url, {method: "POST", headers: {"Content-Type": "text/markdown"}, body: text.value})
-        .then(function (r) { return r.json().then(function (j) { return [r.ok, j]; }); })
+        .then(function (r) {
+          // a busy server says when to come back (Retry-After): the preview tries once more then
+          var wait = r.status === 503 ? parseInt(r.headers.get("Retry-After") || "", 10) : NaN;
+          if (wait > 0 && wait <= 60) { clearTimeout(timer); timer = setTimeout(run, wait * 1000); }
+          return r.json().then(function (j) { return [r.ok, j]; });
+        })
         .then(function (res) {
           if (res[0]) { show(res[1].html); state.textContent = ""; }
           else { state.textContent = "(" + (res[1].error || "preview unavailable") + ")"; }
