@@ -1,0 +1,133 @@
+"""Hand transcriptions of the Lagrange corpus files (see truth.py)."""
+
+SPECS: dict = {}
+
+from specs_common import (  # noqa: E402
+    I1,
+    I2,
+    Eq,
+    c1,
+    c2,
+    c12,
+    ddt,
+    g,
+    half,
+    l1,
+    lc1,
+    lc2,
+    m1,
+    m2,
+    q2,
+    qd1,
+    qd2,
+    qdd1,
+    qdd2,
+    s1,
+    s2,
+    s12,
+)
+from sympy import diff  # noqa: E402
+
+# ---------------------------------------------------------------- planar-2r-energy-slip.md
+_w, _a = qd1 + qd2, qdd1 + qdd2
+_v2sq_slip = l1**2 * qd1**2 + lc2**2 * _w**2 + l1 * lc2 * c2 * qd1 * _w
+_WHY_V2 = "the cross term of v_c2^2 is 2 l1 lc2 cos(q2) q1'(q1' + q2'): the factor 2 is missing"
+_P = m1 * g * lc1 * s1 + m2 * g * (l1 * s1 + lc2 * s12)
+_L_slip = half * (m1 * lc1**2 + I1) * qd1**2 + half * m2 * _v2sq_slip + half * I2 * _w**2 - _P
+
+
+def _follow(anchor, quantity, rhs, carried, id=""):
+    return Eq(anchor, quantity, rhs, id=id, after="v2sq", carried=carried)
+
+
+ENERGY_SLIP = [
+    Eq(r"x_{c1} =", "pc1[0]", lc1 * c1),
+    Eq(r"y_{c1} =", "pc1[1]", lc1 * s1),
+    Eq(r"x_{c2} =", "pc2[0]", l1 * c1 + lc2 * c12),
+    Eq(r"y_{c2} =", "pc2[1]", l1 * s1 + lc2 * s12),
+    Eq(r"\dot x_{c2} =", "vc2[0]", -l1 * s1 * qd1 - lc2 * s12 * _w),
+    Eq(r"\dot y_{c2} =", "vc2[1]", l1 * c1 * qd1 + lc2 * c12 * _w),
+    Eq(r"v_{c1}^2 =", "vc1_sq", lc1**2 * qd1**2),
+    Eq(r"v_{c2}^2 =", "vc2_sq", _v2sq_slip, id="v2sq", why=_WHY_V2),
+    Eq(r"K_1 =", "K1", half * m1 * lc1**2 * qd1**2 + half * I1 * qd1**2, id="K1"),
+    _follow(
+        r"K_2 =",
+        "K2",
+        half * m2 * _v2sq_slip + half * I2 * _w**2,
+        lambda v: half * m2 * v["v2sq"] + half * I2 * _w**2,
+        "K2",
+    ),
+    Eq(r"P_1 =", "P1", m1 * g * lc1 * s1, id="P1"),
+    Eq(r"P_2 =", "P2", m2 * g * (l1 * s1 + lc2 * s12), id="P2"),
+    _follow(r"\mathcal{L} =", "L", _L_slip, lambda v: v["K1"] + v["K2"] - v["P1"] - v["P2"], "L"),
+    _follow(
+        r"\[ \frac{\partial \mathcal{L}}{\partial \dot\theta_1} =",
+        "dL_dqd1",
+        (m1 * lc1**2 + I1) * qd1 + m2 * (l1**2 * qd1 + lc2**2 * _w + half * l1 * lc2 * c2 * (2 * qd1 + qd2)) + I2 * _w,
+        lambda v: diff(v["L"], qd1),
+        "p1",
+    ),
+    _follow(
+        r"\[ \frac{d}{dt}\frac{\partial \mathcal{L}}{\partial \dot\theta_1} =",
+        "ddt_dL_dqd1",
+        (m1 * lc1**2 + I1) * qdd1
+        + m2
+        * (
+            l1**2 * qdd1
+            + lc2**2 * _a
+            + half * l1 * lc2 * c2 * (2 * qdd1 + qdd2)
+            - half * l1 * lc2 * s2 * qd2 * (2 * qd1 + qd2)
+        )
+        + I2 * _a,
+        lambda v: ddt(v["p1"]),
+        "d1",
+    ),
+    Eq(
+        r"\[ \frac{\partial \mathcal{L}}{\partial \theta_1} =",
+        "dL_dq1",
+        -m1 * g * lc1 * c1 - m2 * g * (l1 * c1 + lc2 * c12),
+        id="q1",
+    ),
+    _follow(
+        r"\[ \frac{\partial \mathcal{L}}{\partial \dot\theta_2} =",
+        "dL_dqd2",
+        m2 * (lc2**2 * _w + half * l1 * lc2 * c2 * qd1) + I2 * _w,
+        lambda v: diff(v["L"], qd2),
+        "p2",
+    ),
+    _follow(
+        r"\[ \frac{d}{dt}\frac{\partial \mathcal{L}}{\partial \dot\theta_2} =",
+        "ddt_dL_dqd2",
+        m2 * (lc2**2 * _a + half * l1 * lc2 * c2 * qdd1 - half * l1 * lc2 * s2 * qd1 * qd2) + I2 * _a,
+        lambda v: ddt(v["p2"]),
+        "d2",
+    ),
+    _follow(
+        r"\[ \frac{\partial \mathcal{L}}{\partial \theta_2} =",
+        "dL_dq2",
+        -half * m2 * l1 * lc2 * s2 * qd1 * _w - m2 * g * lc2 * c12,
+        lambda v: diff(v["L"], q2),
+        "q2",
+    ),
+    _follow(
+        r"\[ \tau_1 =",
+        "tau1",
+        (m1 * lc1**2 + I1 + I2 + m2 * (l1**2 + lc2**2 + l1 * lc2 * c2)) * qdd1
+        + (I2 + m2 * (lc2**2 + half * l1 * lc2 * c2)) * qdd2
+        - half * m2 * l1 * lc2 * s2 * (2 * qd1 * qd2 + qd2**2)
+        + (m1 * lc1 + m2 * l1) * g * c1
+        + m2 * g * lc2 * c12,
+        lambda v: v["d1"] - v["q1"],
+    ),
+    _follow(
+        r"\[ \tau_2 =",
+        "tau2",
+        (I2 + m2 * (lc2**2 + half * l1 * lc2 * c2)) * qdd1
+        + (I2 + m2 * lc2**2) * qdd2
+        + half * m2 * l1 * lc2 * s2 * qd1**2
+        + m2 * g * lc2 * c12,
+        lambda v: v["d2"] - v["q2"],
+    ),
+]
+
+SPECS["planar-2r-energy-slip.md"] = {"robot": "planar-2r", "eqs": ENERGY_SLIP}

@@ -1,0 +1,79 @@
+"""Hand transcriptions of the Newton-Euler corpus files (see truth.py)."""
+
+from specs_common import (
+    I1,
+    I2,
+    Eq,
+    Matrix,
+    c1,
+    c2,
+    c12,
+    g,
+    l1,
+    lc1,
+    lc2,
+    m1,
+    m2,
+    qd1,
+    qd2,
+    qdd1,
+    qdd2,
+    s1,
+    s2,
+    s12,
+    vec,
+    z,
+)
+
+# ---------------------------------------------------------------- planar-2r-craig-align.md
+_w2, _a2 = qd1 + qd2, qdd1 + qdd2
+_vd2 = vec(l1 * s2 * qdd1 - l1 * c2 * qd1**2 + g * s12, l1 * c2 * qdd1 + l1 * s2 * qd1**2 + g * c12, 0)
+_vc2 = vec(_vd2[0] - lc2 * _w2**2, _vd2[1] + lc2 * _a2, 0)
+_f1 = vec(
+    m2 * (-l1 * qd1**2 - lc2 * c2 * _w2**2 - lc2 * s2 * _a2 + g * s1) - m1 * lc1 * qd1**2 + m1 * g * s1,
+    m2 * (l1 * qdd1 - lc2 * s2 * _w2**2 + lc2 * c2 * _a2 + g * c1) + m1 * lc1 * qdd1 + m1 * g * c1,
+    0,
+)
+_n2z = I2 * _a2 + m2 * lc2 * (l1 * c2 * qdd1 + l1 * s2 * qd1**2 + lc2 * _a2 + g * c12)
+_n1z = (
+    I1 * qdd1
+    + _n2z
+    + m1 * lc1 * (lc1 * qdd1 + g * c1)
+    + m2 * l1 * (l1 * qdd1 - lc2 * s2 * _w2**2 + lc2 * c2 * _a2 + g * c1)
+)
+TAU1_2R = (
+    (I1 + I2 + m1 * lc1**2 + m2 * (l1**2 + lc2**2 + 2 * l1 * lc2 * c2)) * qdd1
+    + (I2 + m2 * (lc2**2 + l1 * lc2 * c2)) * qdd2
+    - m2 * l1 * lc2 * s2 * (2 * qd1 * qd2 + qd2**2)
+    + (m1 * lc1 + m2 * l1) * g * c1
+    + m2 * lc2 * g * c12
+)
+TAU2_2R = (I2 + m2 * (lc2**2 + l1 * lc2 * c2)) * qdd1 + (I2 + m2 * lc2**2) * qdd2 + m2 * l1 * lc2 * s2 * qd1**2
+TAU2_2R += m2 * lc2 * g * c12
+
+CRAIG_ALIGN = [
+    Eq(r"{}^{1}_{0}R &=", "R10", Matrix([[c1, s1, 0], [-s1, c1, 0], [0, 0, 1]])),
+    Eq(r"{}^{1}_{2}R &=", "R12", Matrix([[c2, -s2, 0], [s2, c2, 0], [0, 0, 1]])),
+    Eq(r"{}^{1}\omega_{1} &=", "omega1", z(qd1)),
+    Eq(r"{}^{1}\dot\omega_{1} &=", "omegadot1", z(qdd1)),
+    Eq(r"{}^{1}\dot v_{1} &=", "vdot1", vec(g * s1, g * c1, 0)),
+    Eq(r"{}^{1}\dot v_{C_1} &=", "vcdot1", vec(-lc1 * qd1**2 + g * s1, lc1 * qdd1 + g * c1, 0), span=1),
+    Eq(r"{}^{1}F_{1} &=", "F1", vec(-m1 * lc1 * qd1**2 + m1 * g * s1, m1 * lc1 * qdd1 + m1 * g * c1, 0)),
+    Eq(r"{}^{1}N_{1} &=", "N1", z(I1 * qdd1)),
+    Eq(r"{}^{2}\omega_{2} &=", "omega2", z(_w2)),
+    Eq(r"{}^{2}\dot\omega_{2} &=", "omegadot2", z(_a2)),
+    Eq(r"{}^{2}\dot v_{2} &=", "vdot2", _vd2, span=1),
+    Eq(r"{}^{2}\dot v_{C_2} &=", "vcdot2", _vc2),
+    Eq(r"{}^{2}F_{2} &=", "F2", m2 * _vc2),
+    Eq(r"{}^{2}N_{2} &=", "N2", z(I2 * _a2)),
+    Eq(r"{}^{2}f_{2} &=", "f2", m2 * _vc2),
+    Eq(r"{}^{2}n_{2} &=", "n2", z(_n2z)),
+    Eq(r"{}^{1}f_{1} &=", "f1", _f1, span=1),
+    Eq(r"{}^{1}n_{1} &=", "n1", z(_n1z), span=1),
+    Eq(r"\tau_1 &=", "tau1", TAU1_2R),
+    Eq(r"\tau_2 &=", "tau2", TAU2_2R),
+]
+
+SPECS = {
+    "planar-2r-craig-align.md": {"robot": "planar-2r", "eqs": CRAIG_ALIGN},
+}

@@ -1,0 +1,3 @@
+"""Hand transcriptions of the proof corpus files (see truth.py)."""
+
+SPECS: dict = {}
