@@ -6,6 +6,7 @@ from specs_common import (  # noqa: E402
     I1,
     I2,
     Eq,
+    Matrix,
     c1,
     c2,
     c12,
@@ -131,3 +132,77 @@ ENERGY_SLIP = [
 ]
 
 SPECS["planar-2r-energy-slip.md"] = {"robot": "planar-2r", "eqs": ENERGY_SLIP}
+
+# ---------------------------------------------------------------- planar-2r-spong-christoffel.md
+_h = -m2 * l1 * lc2 * s2
+_d11 = m1 * lc1**2 + m2 * (l1**2 + lc2**2 + 2 * l1 * lc2 * c2) + I1 + I2
+_d12 = m2 * (lc2**2 + l1 * lc2 * c2) + I2
+_d22 = m2 * lc2**2 + I2
+_phi1 = (m1 * lc1 + m2 * l1) * g * c1 + m2 * lc2 * g * c12
+_phi2 = m2 * lc2 * g * c12
+SPONG_CHRISTOFFEL = [
+    Eq(r"d_{11} &=", "d11", _d11),
+    Eq(r"d_{12} &=", "d12", _d12),
+    Eq(r"d_{21} &=", "d21", _d12),
+    Eq(r"d_{22} &=", "d22", _d22),
+    Eq(r"c_{111} &=", "c111", 0),
+    Eq(r"c_{121} &=", "c121", _h),
+    Eq(r"c_{221} &=", "c221", _h),
+    Eq(r"c_{112} &=", "c112", -_h),
+    Eq(r"c_{122} &=", "c122", 0),
+    Eq(r"c_{222} &=", "c222", 0),
+    Eq(r"$$\phi_1 =", "phi1", _phi1),
+    Eq(r"$$\phi_2 =", "phi2", _phi2),
+    Eq(r"$$C(q,\dot q) =", "C", Matrix([[_h * qd2, _h * (qd1 + qd2)], [-_h * qd1, 0]])),
+    Eq(r"$$g(q) =", "G", Matrix([_phi1, _phi2])),
+    Eq(r"\tau_1 &=", "tau1", _d11 * qdd1 + _d12 * qdd2 + 2 * _h * qd1 * qd2 + _h * qd2**2 + _phi1),
+    Eq(r"\tau_2 &=", "tau2", _d12 * qdd1 + _d22 * qdd2 - _h * qd1**2 + _phi2),
+]
+SPECS["planar-2r-spong-christoffel.md"] = {"robot": "planar-2r", "eqs": SPONG_CHRISTOFFEL}
+
+# ---------------------------------------------------------------- rp-arm-kepe-slip.md
+# theta1 -> q1, d2 -> q2
+_v2sq = (l1**2 + q2**2) * qd1**2 + 2 * l1 * qd1 * qd2 + qd2**2
+_KE = half * m1 * l1**2 * qd1**2 + half * m2 * _v2sq
+_PE = m1 * g * l1 * s1 + m2 * g * (l1 * s1 + q2 * c1)
+_WHY_RP = "d/dt of m1 l1^2 theta1' is m1 l1^2 theta1'': theta1' written where theta1'' belongs"
+RP_KEPE = [
+    Eq(r"$$x_1 =", "pc1[0]", l1 * c1),
+    Eq(r"$$y_1 =", "pc1[1]", l1 * s1),
+    Eq(r"$$x_2 =", "pc2[0]", l1 * c1 - q2 * s1),
+    Eq(r"$$y_2 =", "pc2[1]", l1 * s1 + q2 * c1),
+    Eq(r"$$v_2^2 =", "vc2_sq", _v2sq, span=2),
+    Eq(r"$$KE =", "K", _KE),
+    Eq(r"$$PE =", "P", _PE),
+    Eq(r"$$L = KE - PE$$", "L", _KE - _PE),
+    Eq(
+        r"$$\frac{\partial L}{\partial\dot\theta_1} =",
+        "dL_dqd1",
+        m1 * l1**2 * qd1 + m2 * (l1**2 + q2**2) * qd1 + m2 * l1 * qd2,
+    ),
+    Eq(
+        r"$$\frac{d}{dt}\left(\frac{\partial L}{\partial\dot\theta_1}\right) =",
+        "ddt_dL_dqd1",
+        m1 * l1**2 * qd1 + m2 * (l1**2 + q2**2) * qdd1 + 2 * m2 * q2 * qd2 * qd1 + m2 * l1 * qdd2,
+        id="rd1",
+        why=_WHY_RP,
+    ),
+    Eq(r"$$\frac{\partial L}{\partial\theta_1} =", "dL_dq1", -(m1 + m2) * g * l1 * c1 + m2 * g * q2 * s1, id="rq1"),
+    Eq(
+        r"$$\tau_1 =",
+        "tau1",
+        m1 * l1**2 * qd1
+        + m2 * (l1**2 + q2**2) * qdd1
+        + 2 * m2 * q2 * qd2 * qd1
+        + m2 * l1 * qdd2
+        + (m1 + m2) * g * l1 * c1
+        - m2 * g * q2 * s1,
+        after="rd1",
+        carried=lambda v: v["rd1"] - v["rq1"],
+    ),
+    Eq(r"$$\frac{\partial L}{\partial\dot d_2} =", "dL_dqd2", m2 * l1 * qd1 + m2 * qd2),
+    Eq(r"$$\frac{d}{dt}\left(\frac{\partial L}{\partial\dot d_2}\right) =", "ddt_dL_dqd2", m2 * l1 * qdd1 + m2 * qdd2),
+    Eq(r"$$\frac{\partial L}{\partial d_2} =", "dL_dq2", m2 * q2 * qd1**2 - m2 * g * c1),
+    Eq(r"$$\tau_2 =", "tau2", m2 * l1 * qdd1 + m2 * qdd2 - m2 * q2 * qd1**2 + m2 * g * c1),
+]
+SPECS["rp-arm-kepe-slip.md"] = {"robot": "rp-arm", "eqs": RP_KEPE}

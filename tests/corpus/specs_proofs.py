@@ -1,3 +1,75 @@
-"""Hand transcriptions of the proof corpus files (see truth.py)."""
+"""Hand transcriptions of the proof corpus files (see truth.py): both sides of every link
+as functions of a random body of particles (``truth.body``)."""
+
+import sympy as sp
+from specs_common import Proof
 
 SPECS: dict = {}
+
+
+def _pts(b):
+    """(m_i, x_i, y_i) about the mass centre."""
+    return [(mi, r[0], r[1]) for mi, r in zip(b["m"], b["rc"], strict=True)]
+
+
+def _inertia(b, about):
+    out = sp.zeros(3, 3)
+    for mi, ri in zip(b["m"], b["r"], strict=True):
+        d = ri - about
+        out += mi * ((d.T * d)[0] * sp.eye(3) - d * d.T)
+    return out
+
+
+def _ab(b):
+    return b["p"][0], b["p"][1]
+
+
+def _A(b):
+    """The point A = C + (a, b, 0)."""
+    return b["c"] + sp.Matrix([b["p"][0], b["p"][1], 0])
+
+
+def _IA_sum(b):
+    a, bb = _ab(b)
+    return sum(m * ((x - a) ** 2 + (y - bb) ** 2) for m, x, y in _pts(b))
+
+
+def _IA_split(b):
+    a, bb = _ab(b)
+    P = _pts(b)
+    return (
+        sum(m * (x**2 + y**2) for m, x, y in P)
+        - 2 * a * sum(m * x for m, x, y in P)
+        - 2 * bb * sum(m * y for m, x, y in P)
+        + (a**2 + bb**2) * sum(m for m, x, y in P)
+    )
+
+
+def _IC(b):
+    return sum(m * (x**2 + y**2) for m, x, y in _pts(b))
+
+
+def _pvec(b):
+    return sp.Matrix([b["p"][0], b["p"][1], 0])
+
+
+PARALLEL_PARTICLES = [
+    Proof(r"I_A &= \sum_i", lambda b: _inertia(b, _A(b))[2, 2], _IA_sum),
+    Proof(r"&= \sum_i m_i (x_i^2 + y_i^2) - 2a", _IA_sum, _IA_split),
+    Proof(r"$$\sum_i m_i x_i = 0$$", lambda b: sum(m * x for m, x, y in _pts(b)), lambda b: 0),
+    Proof(r"$$\sum_i m_i y_i = 0$$", lambda b: sum(m * y for m, x, y in _pts(b)), lambda b: 0),
+    Proof(r"$$I_C = ", lambda b: _inertia(b, b["c"])[2, 2], _IC),
+    Proof(r"$$\sum_i m_i = M$$", lambda b: sum(b["m"]), lambda b: b["M"]),
+    Proof(r"I_A &= I_C + M(a^2 + b^2)", _IA_split, lambda b: _IC(b) + b["M"] * (_ab(b)[0] ** 2 + _ab(b)[1] ** 2)),
+    Proof(
+        r"&= I_C + M d^2",
+        lambda b: _IC(b) + b["M"] * (_ab(b)[0] ** 2 + _ab(b)[1] ** 2),
+        lambda b: _IC(b) + b["M"] * (b["p"][0] ** 2 + b["p"][1] ** 2),
+    ),
+    Proof(
+        r"$$\mathbf{I}_A = \mathbf{I}_C",
+        lambda b: _inertia(b, _A(b)),
+        lambda b: _inertia(b, b["c"]) + b["M"] * ((_pvec(b).T * _pvec(b))[0] * sp.eye(3) - _pvec(b) * _pvec(b).T),
+    ),
+]
+SPECS["parallel-axis-particles.md"] = {"robot": "planar-2r", "eqs": PARALLEL_PARTICLES}
