@@ -7,25 +7,44 @@ from specs_common import (  # noqa: E402
     I2,
     Eq,
     Matrix,
+    Rational,
+    a1,
+    a2,
     c1,
     c2,
+    c3,
     c12,
+    c23,
+    c123,
+    d1,
     ddt,
     g,
     half,
     l1,
+    l2,
+    l3,
     lc1,
     lc2,
     m1,
     m2,
+    m3,
+    m4,
     q2,
+    q3,
     qd1,
     qd2,
+    qd3,
+    qd4,
     qdd1,
     qdd2,
+    qdd3,
+    qdd4,
     s1,
     s2,
+    s3,
     s12,
+    s23,
+    s123,
 )
 from sympy import diff  # noqa: E402
 
@@ -206,3 +225,70 @@ RP_KEPE = [
     Eq(r"$$\tau_2 =", "tau2", m2 * l1 * qdd1 + m2 * qdd2 - m2 * q2 * qd1**2 + m2 * g * c1),
 ]
 SPECS["rp-arm-kepe-slip.md"] = {"robot": "rp-arm", "eqs": RP_KEPE}
+
+# ---------------------------------------------------------------- planar-2r-lynch-park.md
+_c_vec = Matrix([2 * _h * qd1 * qd2 + _h * qd2**2, -_h * qd1**2])
+LYNCH_PARK = [
+    Eq(r"M(\theta) = \begin{bmatrix}", "D", Matrix([[_d11, _d12], [_d12, _d22]])),
+    Eq(r"c(\theta,\dot\theta) = \begin{bmatrix}", "Cqd", _c_vec),
+    Eq(r"g(\theta) = \begin{bmatrix}", "G", Matrix([_phi1, _phi2])),
+    Eq(r"\tau_1 =", "tau1", _d11 * qdd1 + _d12 * qdd2 + _c_vec[0] + _phi1),
+    Eq(r"\tau_2 =", "tau2", _d12 * qdd1 + _d22 * qdd2 + _c_vec[1] + _phi2),
+]
+SPECS["planar-2r-lynch-park.md"] = {"robot": "planar-2r", "eqs": LYNCH_PARK}
+
+# ---------------------------------------------------------------- planar-3r-rods-energy.md
+_phi3 = half * m3 * g * l3 * c123
+RODS = [
+    Eq(r"$$x_{c1} =", "pc1[0]", l1 / 2 * c1),
+    Eq(r"$$y_{c3} =", "pc3[1]", l1 * s1 + l2 * s12 + l3 / 2 * s123),
+    Eq(
+        r"$$K_1 =",
+        "K1",
+        half * Rational(1, 3) * m1 * l1**2 * qd1**2 + half * m1 * l1**2 / 4 * qd1**2,
+        why="the rod's inertia about its end (m1 l1^2/3) used with the translation of its centre: "
+        "the centroidal m1 l1^2/12 belongs with it (K1 = m1 l1^2 q1'^2/6)",
+    ),
+    Eq(r"$$P_1 =", "P1", m1 * g * l1 / 2 * s1),
+    Eq(r"$$P_3 =", "P3", m3 * g * (l1 * s1 + l2 * s12 + l3 / 2 * s123)),
+    Eq(r"$$\phi_3 =", "phi3", _phi3),
+    Eq(r"$$\phi_2 =", "phi2", (m2 / 2 + m3) * g * l2 * c12 + half * m3 * g * l3 * c123),
+    Eq(r"$$d_{33} =", "d33", Rational(1, 3) * m3 * l3**2),
+    Eq(r"$$d_{23} =", "d23", Rational(1, 3) * m3 * l3**2 + half * m3 * l2 * l3 * c3),
+    Eq(
+        r"$$\tau_3 =",
+        "tau3",
+        m3 * l3**2 / 3 * (qdd1 + qdd2 + qdd3)
+        + m3 * l3 / 2 * (l1 * c23 * qdd1 + l1 * s23 * qd1**2 + l2 * c3 * (qdd1 + qdd2) + l2 * s3 * (qd1 + qd2) ** 2)
+        + _phi3,
+    ),
+]
+SPECS["planar-3r-rods-energy.md"] = {"robot": "planar-3r", "eqs": RODS}
+
+# ---------------------------------------------------------------- scara-mathfence-slip.md
+_vs = a1**2 * qd1**2 + a2**2 * (qd1 + qd2) ** 2 + 2 * a1 * a2 * c2 * qd1 * (qd1 + qd2) + qd3**2
+_izz = Rational(45, 100000) * m4
+SCARA_FENCE = [
+    Eq(r"z_{c3} =", "pc3[2]", d1 - q3),
+    Eq(r"PE =", "P", (m1 + m2) * g * d1 + (m3 + m4) * g * (d1 - q3)),
+    Eq(r"v_{c3}^2 =", "vc3_sq", _vs),
+    Eq(r"K_3 =", "K3", half * m3 * _vs),
+    Eq(
+        r"K_4 =",
+        "K4",
+        half * m4 * _vs + half * _izz * (qd1 + qd2 + qd4) ** 2,
+        id="K4",
+        why="z4 points down: the tool turns at q1' + q2' - q4' about the vertical, not q1' + q2' + q4'",
+    ),
+    Eq(
+        r"\frac{\partial L}{\partial\dot\theta_4} =",
+        "dL_dqd4",
+        _izz * (qd1 + qd2 + qd4),
+        id="p4",
+        after="K4",
+        carried=lambda v: diff(v["K4"], qd4),
+    ),
+    Eq(r"\tau_4 =", "tau4", _izz * (qdd1 + qdd2 + qdd4), after="K4", carried=lambda v: ddt(v["p4"])),
+    Eq(r"\tau_3 =", "tau3", (m3 + m4) * qdd3 - (m3 + m4) * g),
+]
+SPECS["scara-mathfence-slip.md"] = {"robot": "scara", "eqs": SCARA_FENCE}

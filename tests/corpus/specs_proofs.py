@@ -73,3 +73,37 @@ PARALLEL_PARTICLES = [
     ),
 ]
 SPECS["parallel-axis-particles.md"] = {"robot": "planar-2r", "eqs": PARALLEL_PARTICLES}
+
+
+# ---------------------------------------------------------------- rotational-energy-particles.md
+def _skew(v):
+    return sp.Matrix([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+
+def _rot_K(b):
+    return sum(mi * (b["w"].cross(r)).dot(b["w"].cross(r)) for mi, r in zip(b["m"], b["rc"], strict=True)) / 2
+
+
+def _SS(b):
+    return sum((mi * _skew(r).T * _skew(r) for mi, r in zip(b["m"], b["rc"], strict=True)), sp.zeros(3, 3))
+
+
+def _I_def(b):
+    return sum(
+        (mi * ((r.T * r)[0] * sp.eye(3) - r * r.T) for mi, r in zip(b["m"], b["rc"], strict=True)), sp.zeros(3, 3)
+    )
+
+
+ROT_PARTICLES = [
+    Proof(r"$$K_{rot} = \frac{1}{2}\sum_i", _rot_K, _rot_K),
+    Proof(
+        r"$$\frac{1}{2}\sum_i m_i (\boldsymbol{\omega} \times r_i)^T",
+        _rot_K,
+        lambda b: (
+            sum(mi * (b["w"].T * _skew(r).T * _skew(r) * b["w"])[0] for mi, r in zip(b["m"], b["rc"], strict=True)) / 2
+        ),
+    ),
+    Proof(r"$$I = \sum_i m_i S(r_i)^T", lambda b: _inertia(b, b["c"]), [_SS, _I_def]),
+    Proof(r"$$K_{rot} = \frac{1}{2}\boldsymbol{\omega}^T I", _rot_K, lambda b: (b["w"].T * _I_def(b) * b["w"])[0] / 2),
+]
+SPECS["rotational-energy-particles.md"] = {"robot": "planar-2r", "eqs": ROT_PARTICLES}

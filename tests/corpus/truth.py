@@ -124,7 +124,8 @@ def establish(name: str, spec: dict) -> dict:
         if e.span:
             entry["last_line"] = i + 1 + e.span
         if isinstance(e, Proof):
-            ok = all(same(e.lhs(b), e.rhs(b)) for b in bodies)
+            forms = e.rhs if isinstance(e.rhs, list | tuple) else [e.rhs]
+            ok = all(same(e.lhs(b), f(b)) for b in bodies for f in forms)
             entry["quantity"] = "proof"
         else:
             entry["quantity"] = e.quantity
