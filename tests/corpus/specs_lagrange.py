@@ -292,3 +292,73 @@ SCARA_FENCE = [
     Eq(r"\tau_3 =", "tau3", (m3 + m4) * qdd3 - (m3 + m4) * g),
 ]
 SPECS["scara-mathfence-slip.md"] = {"robot": "scara", "eqs": SCARA_FENCE}
+
+# ---------------------------------------------------------------- planar-2r-siciliano.md
+# Siciliano's c_ijk names the equation first: his c_ijk is Spong's c_jki (truth_models' key).
+SICILIANO = [
+    Eq(r"$$b_{11} =", "d11", _d11),
+    Eq(r"$$b_{12} =", "d12", _d12),
+    Eq(r"$$b_{22} =", "d22", _d22),
+    Eq(r"$$c_{112} =", "c121", _h),
+    Eq(r"$$c_{211} =", "c112", -_h),
+    Eq(r"$$g_1 =", "phi1", _phi1),
+    Eq(r"$$g_2 =", "phi2", _phi2),
+    Eq(r"$$\tau_1 =", "tau1", _d11 * qdd1 + _d12 * qdd2 + 2 * _h * qd1 * qd2 + _h * qd2**2 + _phi1),
+    Eq(r"$$\tau_2 =", "tau2", _d12 * qdd1 + _d22 * qdd2 - _h * qd1**2 + _phi2),
+]
+SPECS["planar-2r-siciliano.md"] = {"robot": "planar-2r", "eqs": SICILIANO}
+
+# ---------------------------------------------------------------- planar-2r-continuation.md
+_T = (
+    half * (m1 * lc1**2 + I1) * qd1**2
+    + half * m2 * (l1**2 * qd1**2 + lc2**2 * _w**2 + 2 * l1 * lc2 * c2 * qd1 * _w)
+    + half * I2 * _w**2
+)
+CONTINUATION = [
+    Eq(r"$$T = \frac{1}{2} m_1 v_{c1}^2", "K", _T, span=2),
+    Eq(r"$$V = ", "P", m1 * g * lc1 * s1 + m2 * g * (l1 * s1 + lc2 * s12)),
+    Eq(
+        r"$$\frac{\partial T}{\partial \dot{\theta}_2} =",
+        "dL_dqd2",
+        m2 * lc2**2 * _w + m2 * l1 * lc2 * c2 * qd1 + I2 * _w,
+    ),
+    Eq(
+        r"$$\frac{d}{dt}\left(\frac{\partial T}{\partial \dot{\theta}_2}\right) =",
+        "ddt_dL_dqd2",
+        (m2 * lc2**2 + I2) * _a + m2 * l1 * lc2 * c2 * qdd1 - m2 * l1 * lc2 * s2 * qd1 * qd2,
+    ),
+    Eq(r"$$\frac{\partial T}{\partial \theta_2} =", "dK_dq2", -m2 * l1 * lc2 * s2 * qd1 * _w),
+    Eq(r"$$\frac{\partial V}{\partial \theta_2} =", "phi2", m2 * g * lc2 * c12),
+    Eq(
+        r"$$\tau_2 =",
+        "tau2",
+        (m2 * (lc2**2 + l1 * lc2 * c2) + I2) * qdd1
+        + (m2 * lc2**2 + I2) * qdd2
+        + m2 * l1 * lc2 * s2 * qd1**2
+        + m2 * g * lc2 * c12,
+        span=2,
+    ),
+]
+SPECS["planar-2r-continuation.md"] = {"robot": "planar-2r", "eqs": CONTINUATION}
+
+# ---------------------------------------------------------------- rp-arm-matrix-form.md
+RP_MATRIX = [
+    Eq(r"$$M(\mathbf{q}) =", "D", Matrix([[(m1 + m2) * l1**2 + m2 * q2**2, m2 * l1], [m2 * l1, m2]])),
+    Eq(r"$$C(\mathbf{q},\dot{\mathbf{q}}) =", "C", Matrix([[m2 * q2 * qd2, m2 * q2 * qd1], [-m2 * q2 * qd1, 0]])),
+    Eq(r"$$G(\mathbf{q}) =", "G", Matrix([(m1 + m2) * g * l1 * c1 - m2 * g * q2 * s1, m2 * g * c1])),
+    Eq(
+        r"$$\boldsymbol{\tau} =",
+        "tau",
+        Matrix(
+            [
+                ((m1 + m2) * l1**2 + m2 * q2**2) * qdd1
+                + m2 * l1 * qdd2
+                + 2 * m2 * q2 * qd1 * qd2
+                + (m1 + m2) * g * l1 * c1
+                - m2 * g * q2 * s1,
+                m2 * l1 * qdd1 + m2 * qdd2 - m2 * q2 * qd1**2 + m2 * g * c1,
+            ]
+        ),
+    ),
+]
+SPECS["rp-arm-matrix-form.md"] = {"robot": "rp-arm", "eqs": RP_MATRIX}

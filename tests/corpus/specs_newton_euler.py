@@ -14,6 +14,8 @@ from specs_common import (
     lc2,
     m1,
     m2,
+    q1,
+    q2,
     qd1,
     qd2,
     qdd1,
@@ -24,6 +26,7 @@ from specs_common import (
     vec,
     z,
 )
+from sympy import cos, sin
 
 # ---------------------------------------------------------------- planar-2r-craig-align.md
 _w2, _a2 = qd1 + qd2, qdd1 + qdd2
@@ -77,3 +80,55 @@ CRAIG_ALIGN = [
 SPECS = {
     "planar-2r-craig-align.md": {"robot": "planar-2r", "eqs": CRAIG_ALIGN},
 }
+
+# ---------------------------------------------------------------- planar-2r-craig-transposed.md
+_R21_slip = Matrix([[c2, -s2, 0], [s2, c2, 0], [0, 0, 1]])
+_s1m2, _c1m2 = sin(q1 - q2), cos(q1 - q2)
+_vd2_slip = vec(-l1 * s2 * qdd1 - l1 * c2 * qd1**2 + g * _s1m2, l1 * c2 * qdd1 - l1 * s2 * qd1**2 + g * _c1m2, 0)
+_vc2_slip = _vd2_slip + vec(-lc2 * _w2**2, lc2 * _a2, 0)
+_n2z_slip = I2 * _a2 + m2 * lc2 * _vc2_slip[1]
+CRAIG_TRANSPOSED = [
+    Eq(
+        r"$${}^{2}_{1}R =",
+        "R21",
+        _R21_slip,
+        id="R",
+        why="this is {}^{1}_{2}R: {}^{2}_{1}R, mapping frame-1 coordinates into frame 2, is its transpose "
+        "(+S_2 in the first row, -S_2 in the second)",
+    ),
+    Eq(r"$${}^{1}\dot v_{1} =", "vdot1", vec(g * s1, g * c1, 0)),
+    Eq(
+        r"$${}^{2}\dot v_{2} =",
+        "vdot2",
+        _vd2_slip,
+        id="vd2",
+        after="R",
+        carried=lambda v: v["R"] * vec(-l1 * qd1**2 + g * s1, l1 * qdd1 + g * c1, 0),
+    ),
+    Eq(
+        r"$${}^{2}\dot v_{C_2} =",
+        "vcdot2",
+        _vc2_slip,
+        id="vc2",
+        after="R",
+        carried=lambda v: v["vd2"] + vec(-lc2 * _w2**2, lc2 * _a2, 0),
+    ),
+    Eq(r"$${}^{2}F_{2} =", "F2", m2 * _vc2_slip, id="F2", after="R", carried=lambda v: m2 * v["vc2"]),
+    Eq(r"$${}^{2}N_{2} =", "N2", z(I2 * _a2), id="N2"),
+    Eq(
+        r"$${}^{2}n_{2} =",
+        "n2",
+        z(_n2z_slip),
+        id="n2",
+        after="R",
+        carried=lambda v: v["N2"] + vec(lc2, 0, 0).cross(v["F2"]),
+    ),
+    Eq(
+        r"$$\tau_2 =",
+        "tau2",
+        (I2 + m2 * lc2**2) * _a2 + m2 * l1 * lc2 * (c2 * qdd1 - s2 * qd1**2) + m2 * lc2 * g * _c1m2,
+        after="R",
+        carried=lambda v: v["n2"][2],
+    ),
+]
+SPECS["planar-2r-craig-transposed.md"] = {"robot": "planar-2r", "eqs": CRAIG_TRANSPOSED}

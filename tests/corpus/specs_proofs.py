@@ -107,3 +107,45 @@ ROT_PARTICLES = [
     Proof(r"$$K_{rot} = \frac{1}{2}\boldsymbol{\omega}^T I", _rot_K, lambda b: (b["w"].T * _I_def(b) * b["w"])[0] / 2),
 ]
 SPECS["rotational-energy-particles.md"] = {"robot": "planar-2r", "eqs": ROT_PARTICLES}
+
+
+# ---------------------------------------------------------------- parallel-axis-integral.md
+# A = C - p, so d (from A to C) = p; r_i = position from A.
+def _r_A(b):
+    return [ri - (b["c"] - b["p"]) for ri in b["r"]]
+
+
+def _tensor(ms, vs):
+    return sum((mi * ((v.T * v)[0] * sp.eye(3) - v * v.T) for mi, v in zip(ms, vs, strict=True)), sp.zeros(3, 3))
+
+
+PARALLEL_INTEGRAL = [
+    Proof(r"$$\mathbf{I}_A = \int_B", lambda b: _inertia(b, b["c"] - b["p"]), lambda b: _tensor(b["m"], _r_A(b))),
+    Proof(r"$$\mathbf{r} = \boldsymbol{\rho} + \mathbf{d}$$", _r_A, lambda b: [rc + b["p"] for rc in b["rc"]]),
+    Proof(
+        r"$$\int_B \boldsymbol{\rho}\, dm",
+        lambda b: sum((mi * rc for mi, rc in zip(b["m"], b["rc"], strict=True)), sp.zeros(3, 1)),
+        lambda b: sp.zeros(3, 1),
+    ),
+    Proof(
+        r"$$\mathbf{r}^T\mathbf{r} =",
+        lambda b: [(r.T * r)[0] for r in _r_A(b)],
+        lambda b: [(rc.T * rc)[0] + 2 * (b["p"].T * rc)[0] + (b["p"].T * b["p"])[0] for rc in b["rc"]],
+    ),
+    Proof(
+        r"$$\mathbf{r}\,\mathbf{r}^T =",
+        lambda b: [r * r.T for r in _r_A(b)],
+        lambda b: [rc * rc.T + rc * b["p"].T + b["p"] * rc.T + b["p"] * b["p"].T for rc in b["rc"]],
+    ),
+    Proof(
+        r"$$\mathbf{I}_A = \mathbf{I}_C",
+        lambda b: _inertia(b, b["c"] - b["p"]),
+        lambda b: _inertia(b, b["c"]) + b["M"] * ((b["p"].T * b["p"])[0] * sp.eye(3) - b["p"] * b["p"].T),
+    ),
+    Proof(
+        r"$$I_{end} =",
+        lambda b: b["M"] * b["u"][0] ** 2 / 12 + b["M"] * (b["u"][0] / 2) ** 2,
+        lambda b: b["M"] * b["u"][0] ** 2 / 3,
+    ),
+]
+SPECS["parallel-axis-integral.md"] = {"robot": "planar-2r", "eqs": PARALLEL_INTEGRAL}

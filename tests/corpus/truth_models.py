@@ -89,6 +89,10 @@ class Arm:
             Q[f"omegadot{i}"] = wd
             Q[f"vdot{i}"] = RT * (lk.p.diff(t, 2) - g)
             Q[f"vcdot{i}"] = RT * (lk.pc.diff(t, 2) - g)
+            # Spong's a_{c,i}, a_{e,i}: the true accelerations (gravity kept apart as g_i)
+            Q[f"ac{i}"] = RT * lk.pc.diff(t, 2)
+            Q[f"ae{i}"] = RT * lk.p.diff(t, 2)
+            Q[f"g{i}"] = RT * g
             Q[f"F{i}"] = lk.m * Q[f"vcdot{i}"]
             Q[f"N{i}"] = lk.Ic * wd + w.cross(lk.Ic * w)
         for i, lk in enumerate(L, start=1):
