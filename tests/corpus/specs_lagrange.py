@@ -362,3 +362,37 @@ RP_MATRIX = [
     ),
 ]
 SPECS["rp-arm-matrix-form.md"] = {"robot": "rp-arm", "eqs": RP_MATRIX}
+
+# ---------------------------------------------------------------- planar-2r-craig-ku.md
+CRAIG_KU = [
+    Eq(r"{}^{0}P_{C_2} = \begin{bmatrix}", "pc2", Matrix([l1 * c1 + lc2 * c12, l1 * s1 + lc2 * s12, 0])),
+    Eq(r"k_1 =", "K1", half * m1 * lc1**2 * qd1**2 + half * I1 * qd1**2),
+    Eq(
+        r"k_2 =",
+        "K2",
+        half * m2 * (l1**2 * qd1**2 + 2 * l1 * lc2 * c2 * qd1 * _w + lc2**2 * _w**2) + half * I2 * _w**2,
+    ),
+    Eq(r"u_1 =", "P1", m1 * g * lc1 * s1),
+    Eq(r"u_2 =", "P2", m2 * g * (l1 * s1 + lc2 * s12)),
+    Eq(
+        r"\frac{\partial k}{\partial\dot\Theta} =",
+        "dL_dqd",
+        Matrix(
+            [
+                (m1 * lc1**2 + I1) * qd1 + m2 * (l1**2 * qd1 + l1 * lc2 * c2 * (2 * qd1 + qd2) + lc2**2 * _w) + I2 * _w,
+                m2 * (l1 * lc2 * c2 * qd1 + lc2**2 * _w) + I2 * _w,
+            ]
+        ),
+    ),
+    Eq(r"\frac{\partial k}{\partial\Theta} =", "dK_dq", Matrix([0, -m2 * l1 * lc2 * s2 * qd1 * _w])),
+    Eq(r"\frac{\partial u}{\partial\Theta} =", "G", Matrix([_phi1, _phi2])),
+    Eq(
+        r"\tau_1 =",
+        "tau1",
+        (m1 * lc1**2 + I1 + I2 + m2 * (l1**2 + 2 * l1 * lc2 * c2 + lc2**2)) * qdd1
+        + (I2 + m2 * (l1 * lc2 * c2 + lc2**2)) * qdd2
+        - m2 * l1 * lc2 * s2 * qd2 * (2 * qd1 + qd2)
+        + _phi1,
+    ),
+]
+SPECS["planar-2r-craig-ku.md"] = {"robot": "planar-2r", "eqs": CRAIG_KU}

@@ -7,22 +7,31 @@ from specs_common import (
     Matrix,
     c1,
     c2,
+    c3,
     c12,
+    c123,
     g,
     l1,
+    l2,
+    l3,
     lc1,
     lc2,
     m1,
     m2,
+    m3,
     q1,
     q2,
     qd1,
     qd2,
+    qd3,
     qdd1,
     qdd2,
+    qdd3,
     s1,
     s2,
+    s3,
     s12,
+    s123,
     vec,
     z,
 )
@@ -132,3 +141,36 @@ CRAIG_TRANSPOSED = [
     ),
 ]
 SPECS["planar-2r-craig-transposed.md"] = {"robot": "planar-2r", "eqs": CRAIG_TRANSPOSED}
+
+# ---------------------------------------------------------------- planar-3r-spong-ne-slip.md
+_w3, _a3 = qd1 + qd2 + qd3, qdd1 + qdd2 + qdd3
+_X = l1 * s2 * qdd1 - l1 * c2 * qd1**2 - l2 * _w2**2
+_Y = l1 * c2 * qdd1 + l1 * s2 * qd1**2 + l2 * _a2
+_ac3_slip = vec(c3 * _X + s3 * _Y - l3 * _w3**2, -s3 * _X + c3 * _Y + l3 / 2 * _a3, 0)
+_g3 = vec(-g * s123, -g * c123, 0)
+SPONG_NE = [
+    Eq(r"$$\omega_1 =", "omega1", z(qd1)),
+    Eq(r"$$a_{c,1} =", "ac1", vec(-l1 / 2 * qd1**2, l1 / 2 * qdd1, 0)),
+    Eq(r"$$a_{e,1} =", "ae1", vec(-l1 * qd1**2, l1 * qdd1, 0)),
+    Eq(r"$$g_1 =", "g1", vec(-g * s1, -g * c1, 0)),
+    Eq(r"$$\alpha_2 =", "omegadot2", z(_a2)),
+    Eq(r"$$a_{e,2} =", "ae2", vec(_X, _Y, 0)),
+    Eq(
+        r"$$a_{c,3} =",
+        "ac3",
+        _ac3_slip,
+        id="ac3",
+        why="the centre of link 3 is l3/2 from joint 3: its centripetal term is -(l3/2)(q1' + q2' + q3')^2, "
+        "not -l3 (...)^2",
+    ),
+    Eq(r"$$X =", "ae2[0]", _X),
+    Eq(r"$$Y =", "ae2[1]", _Y),
+    Eq(r"$$g_3 =", "g3", _g3, id="g3"),
+    Eq(r"$$f_3 =", "f3", m3 * _ac3_slip - m3 * _g3, after="ac3", carried=lambda v: m3 * v["ac3"] - m3 * v["g3"]),
+    Eq(
+        r"$$\tau_3 =",
+        "n3",
+        z(m3 * l3**2 / 12 * _a3 + m3 * l3 / 2 * (-s3 * _X + c3 * _Y + l3 / 2 * _a3 + g * c123)),
+    ),
+]
+SPECS["planar-3r-spong-ne-slip.md"] = {"robot": "planar-3r", "eqs": SPONG_NE}

@@ -162,6 +162,8 @@ class Arm:
         Q["C"] = C
         Q["Cqd"] = C * sp.Matrix(self.qd)
         Q["G"] = sp.Matrix([Q[f"phi{k + 1}"] for k in range(n)])
+        Q["dL_dqd"] = sp.Matrix([Q[f"dL_dqd{k + 1}"] for k in range(n)])
+        Q["dK_dq"] = sp.Matrix([Q[f"dK_dq{k + 1}"] for k in range(n)])
         Q["tau"] = sp.Matrix([Q[f"tau{k + 1}"] for k in range(n)])
         Q["qdd"] = sp.Matrix(self.qdd)
         Q["qd"] = sp.Matrix(self.qd)
