@@ -69,3 +69,22 @@ def test_grader_agrees_with_truth(md):
     assert not fs.refused, f"{md.name} refused: {fs.refused}"
     assert not fs.false_alarms, f"{md.name}: false alarms at lines {fs.false_alarms}"
     assert not fs.missed, f"{md.name}: missed slips / carried errors at lines {fs.missed}"
+
+
+def test_truth_refuses_an_unexplained_wrong_transcription():
+    # a right equation transcribed wrong (theta1-ddot for theta1-dot in omega_1) with no
+    # 'why' must stop truth.py: a wrong equation is never silently accepted
+    sys.path.insert(0, str(CORPUS))
+    import dataclasses
+
+    import sympy as sp
+    import truth
+
+    name = "planar-2r-craig-align.md"
+    spec = dict(truth.all_specs()[name])
+    eqs = list(spec["eqs"])
+    k = next(i for i, e in enumerate(eqs) if e.quantity == "omega1")
+    eqs[k] = dataclasses.replace(eqs[k], rhs=sp.Matrix([0, 0, sp.Symbol("qdd1")]))
+    spec["eqs"] = eqs[: k + 1]
+    with pytest.raises(SystemExit, match="says nothing"):
+        truth.establish(name, spec)

@@ -29,6 +29,7 @@ from specs_common import (  # noqa: E402
     m2,
     m3,
     m4,
+    q1,
     q2,
     q3,
     qd1,
@@ -396,3 +397,59 @@ CRAIG_KU = [
     ),
 ]
 SPECS["planar-2r-craig-ku.md"] = {"robot": "planar-2r", "eqs": CRAIG_KU}
+
+# ---------------------------------------------------------------- scara-inertia-matrix-slip.md
+_k = m2 / 3 + m3 + m4
+_b11 = Rational(1, 3) * m1 * a1**2 + (m2 + m3 + m4) * a1**2 + _k * a2**2 + (m2 + 2 * m3 + 2 * m4) * a1 * a2 * c2 + _izz
+_b12_slip = _k * a2**2 + (m2 + m3 + m4) * a1 * a2 * c2 + _izz
+SCARA_B = [
+    Eq(r"b_{11} &=", "d11", _b11, id="b11"),
+    Eq(
+        r"b_{12} &=",
+        "d12",
+        _b12_slip,
+        id="b12",
+        why="link 2's centre is at a2/2: its share of the coupling is (1/2) a1 a2 m2 cos q2, not a1 a2 m2 cos q2",
+    ),
+    Eq(r"b_{22} &=", "d22", _k * a2**2 + _izz, id="b22"),
+    Eq(r"b_{33} &=", "d33", m3 + m4),
+    Eq(r"b_{14} &=", "d14", -_izz),
+    Eq(r"b_{24} &=", "d24", -_izz, id="b24"),
+    Eq(r"b_{44} &=", "d44", _izz),
+    Eq(
+        r"\tau_2 &=",
+        "tau2",
+        _b12_slip * qdd1
+        + (_k * a2**2 + _izz) * qdd2
+        - _izz * qdd4
+        + half * (m2 + 2 * m3 + 2 * m4) * a1 * a2 * s2 * qd1**2,
+        after="b12",
+        carried=lambda v: v["b12"] * qdd1 + v["b22"] * qdd2 + v["b24"] * qdd4 - half * diff(v["b11"], q2) * qd1**2,
+    ),
+    Eq(r"\tau_4 &=", "tau4", _izz * (qdd4 - qdd1 - qdd2)),
+]
+SPECS["scara-inertia-matrix-slip.md"] = {"robot": "scara", "eqs": SCARA_B}
+
+# ---------------------------------------------------------------- planar-3r-gravity-slip.md
+_P3_slip = m3 * g * (l1 * s1 + l3 / 2 * s123)
+_WHY_P3 = "link 3's centre is at height l1 sin q1 + l2 sin(q1 + q2) + (l3/2) sin(q1 + q2 + q3): the l2 term is dropped"
+_Pall = (m1 / 2 + m2 + m3) * g * l1 * s1 + m2 / 2 * g * l2 * s12 + m3 / 2 * g * l3 * s123
+_ph1 = (m1 / 2 + m2 + m3) * g * l1 * c1 + m2 / 2 * g * l2 * c12 + m3 / 2 * g * l3 * c123
+_ph2 = m2 / 2 * g * l2 * c12 + m3 / 2 * g * l3 * c123
+GRAVITY_3R = [
+    Eq(r"P_1 = m_1 g", "P1", m1 * g * l1 / 2 * s1, id="P1"),
+    Eq(r"P_2 = m_2 g", "P2", m2 * g * (l1 * s1 + l2 / 2 * s12), id="P2"),
+    Eq(r"P_3 = m_3 g", "P3", _P3_slip, id="P3", why=_WHY_P3),
+    Eq(r"$$P = ", "P", _Pall, id="P", after="P3", carried=lambda v: v["P1"] + v["P2"] + v["P3"]),
+    Eq(r"$$\phi_1 =", "phi1", _ph1, after="P3", carried=lambda v: diff(v["P"], q1)),
+    Eq(r"$$\phi_2 =", "phi2", _ph2, after="P3", carried=lambda v: diff(v["P"], q2)),
+    Eq(r"$$\phi_3 =", "phi3", m3 / 2 * g * l3 * c123),
+    Eq(
+        r"$$g(q) =",
+        "G",
+        Matrix([_ph1, _ph2, m3 / 2 * g * l3 * c123]),
+        after="P3",
+        carried=lambda v: Matrix([diff(v["P"], q) for q in (q1, q2, q3)]),
+    ),
+]
+SPECS["planar-3r-gravity-slip.md"] = {"robot": "planar-3r", "eqs": GRAVITY_3R}
