@@ -15,6 +15,7 @@ step the grader reports is matched to the truth's equation by line (an equation 
   or ``follows`` equation;
 * slips found: ``wrong`` equations given ``wrong`` at their line;
 * refused: the grader raised (what ``armdyn grade`` exits 2 for);
+* steps the grader reported at lines no truth equation spans;
 * the median time per file.
 
 Targets: >= 95 % of equations read, every slip found at its line, no false alarm.
@@ -23,6 +24,7 @@ Targets: >= 95 % of equations read, every slip found at its line, no false alarm
 from __future__ import annotations
 
 import argparse
+import re
 import statistics
 import sys
 import time
@@ -54,6 +56,7 @@ class FileScore:
     missed: list = field(default_factory=list)
     refused: str = ""
     seconds: float = 0.0
+    extra: int = 0  # steps at lines no truth equation spans (prose read as an equation?)
 
 
 def pairs(directory: Path):
@@ -64,12 +67,29 @@ def pairs(directory: Path):
             yield md, truth
 
 
-def match(steps, equations):
+# a line that only opens a display (the grader may report an equation at its block's opener)
+_OPENER = re.compile(r"^\s*(\$\$|\\\[|\\begin\{[A-Za-z*]+\}|```math)\s*$")
+
+
+def spans(equations, lines: list[str]) -> list[tuple[int, int]]:
+    """(first, last) line of each truth equation: its lines, and the opener lines just above
+    the first when it is the block's first equation."""
+    out = []
+    for e in equations:
+        first = e["line"]
+        while first > 1 and _OPENER.match(lines[first - 2]):
+            first -= 1
+        out.append((first, e.get("last_line", e["line"])))
+    return out
+
+
+def match(steps, equations, lines: list[str]):
     """Steps by the index of the truth equation whose lines hold them."""
     out: dict[int, list] = {}
+    bounds = spans(equations, lines)
     for st in steps:
-        for k, e in enumerate(equations):
-            if e["line"] <= (st.line or 0) <= e.get("last_line", e["line"]):
+        for k, (first, last) in enumerate(bounds):
+            if first <= (st.line or 0) <= last:
                 out.setdefault(k, []).append(st)
                 break
     return out
@@ -109,7 +129,8 @@ def score(md: Path, truth_path: Path) -> FileScore:
         fs.refused = f"{type(err).__name__}: {str(err).splitlines()[0][:160]}"
         return fs
     fs.seconds = time.perf_counter() - t0
-    by_eq = match(report.steps, eqs)
+    by_eq = match(report.steps, eqs, md.read_text(encoding="utf-8").splitlines())
+    fs.extra = len(report.steps) - sum(len(v) for v in by_eq.values())
     for k, e in enumerate(eqs):
         steps = by_eq.get(k, [])
         read, problem = judge(e, steps)
@@ -160,6 +181,7 @@ def main(argv=None) -> int:
     print(f"slips found at their line {found}/{slips}                  (target: all)")
     print(f"false alarms {fa}                                  (target: 0)")
     print(f"missed slips or carried errors {missed}                  (target: 0)")
+    print(f"steps at lines the truth does not list {sum(s.extra for s in scores)}")
     print(f"median time per file {med:.2f} s")
     return 0
 

@@ -174,3 +174,22 @@ SPONG_NE = [
     ),
 ]
 SPECS["planar-3r-spong-ne-slip.md"] = {"robot": "planar-3r", "eqs": SPONG_NE}
+
+# ---------------------------------------------------------------- planar-3r-spong-superscripts.md
+SPONG_SUPERSCRIPTS = [
+    Eq(r"$$R_2^1 =", "R12", Matrix([[c2, -s2, 0], [s2, c2, 0], [0, 0, 1]])),
+    Eq(r"$$\omega_2^2 =", "omega2", z(_w2)),
+    Eq(r"$$\alpha_2^2 =", "omegadot2", z(_a2)),
+    Eq(r"$$a_{e,1}^1 =", "ae1", vec(-l1 * qd1**2, l1 * qdd1, 0)),
+    Eq(
+        r"$$a_{c,2}^2 =",
+        "ac2",
+        vec(
+            l1 * s2 * qdd1 - l1 * c2 * qd1**2 - l2 / 2 * _w2**2,
+            l1 * c2 * qdd1 + l1 * s2 * qd1**2 + l2 / 2 * _a2,
+            0,
+        ),
+    ),
+    Eq(r"$$g_2^2 =", "g2", vec(-g * s12, -g * c12, 0)),
+]
+SPECS["planar-3r-spong-superscripts.md"] = {"robot": "planar-3r", "eqs": SPONG_SUPERSCRIPTS}

@@ -41,6 +41,7 @@ from specs_common import Eq, Proof  # noqa: E402
 
 TRIALS = 4
 RTOL = 1e-8
+_CHECKED: set[str] = set()
 
 
 def body(rng: random.Random, n: int = 5) -> dict:
@@ -112,6 +113,9 @@ def establish(name: str, spec: dict) -> dict:
     values: dict[str, Any] = {}
     where: dict[str, int] = {}
     arm = truth_models.arm(spec["robot"]) if any(isinstance(e, Eq) for e in spec["eqs"]) else None
+    if arm is not None and arm.name not in _CHECKED:
+        arm.check()  # Newton-Euler and Lagrange agree on this arm's torques
+        _CHECKED.add(arm.name)
     states = []
     if arm is not None:
         for _ in range(TRIALS):
@@ -120,7 +124,11 @@ def establish(name: str, spec: dict) -> dict:
     for e in spec["eqs"]:
         i = _locate(lines, e.anchor, pos)
         pos = i + 1
-        entry: dict[str, Any] = {"line": i + 1, "lhs": e.anchor.rstrip("= &").strip()}
+        entry: dict[str, Any] = {"line": i + 1, "lhs": _lhs(e.anchor)}
+        if not entry["lhs"]:  # an align* row '&= ...': one more link of the equation above
+            prev = out["equations"][-1]
+            entry["lhs"] = prev["lhs"]
+            entry["continues"] = prev["line"]
         if e.span:
             entry["last_line"] = i + 1 + e.span
         if isinstance(e, Proof):
@@ -155,6 +163,15 @@ def establish(name: str, spec: dict) -> dict:
             raise SystemExit(f"{label}: SymPy finds it wrong, and the spec says nothing about it")
         out["equations"].append(entry)
     return out
+
+
+def _lhs(anchor: str) -> str:
+    """The left-hand side as written: the anchor up to its first '=', without the display
+    delimiters and alignment marks."""
+    head = anchor.split("=", 1)[0]
+    for mark in ("$$", "\\[", "&"):
+        head = head.replace(mark, "")
+    return head.strip()
 
 
 def _at(expr, state):

@@ -42,10 +42,13 @@ def vee(S):
 
 class Link:
     """One link: R (frame in base), p (frame origin), a (joint point), pc (mass centre), all
-    in the base frame and functions of t; mass m, inertia Ic about pc in the link frame."""
+    in the base frame and functions of t; mass m, inertia Ic about pc in the link frame; the
+    joint's unit axis in the base frame (default z0) and whether it slides."""
 
-    def __init__(self, R, p, a, pc, m, Ic):
+    def __init__(self, R, p, a, pc, m, Ic, axis=None, prismatic=False):
         self.R, self.p, self.a, self.pc, self.m, self.Ic = R, p, a, pc, m, Ic
+        self.axis = sp.Matrix([0, 0, 1]) if axis is None else axis
+        self.prismatic = prismatic
 
 
 class Arm:
@@ -168,6 +171,20 @@ class Arm:
         Q["qdd"] = sp.Matrix(self.qdd)
         Q["qd"] = sp.Matrix(self.qd)
 
+    def check(self, trials: int = 3, seed: int = 0) -> None:
+        """Assert that Newton-Euler's joint loads (the axis component of n_i, or of f_i for a
+        sliding joint) equal Lagrange's torques at random states: two methods, one answer."""
+        import random
+
+        rng = random.Random(seed)
+        for _ in range(trials):
+            vals = {s: rng.uniform(0.3, 1.7) for s in self.symbols()}
+            for i, lk in enumerate(self.links, start=1):
+                load = self.Q[f"f{i}"] if lk.prismatic else self.Q[f"n{i}"]
+                ne = (self.state(lk.axis).T * self.state(lk.R) * load)[0]
+                a, b = float(ne.subs(vals)), float(self.Q[f"tau{i}"].subs(vals))
+                assert abs(a - b) <= 1e-8 * max(1.0, abs(a), abs(b)), f"{self.name} joint {i}: NE {a} != Lagrange {b}"
+
     def symbols(self):
         """Every symbol a value of this arm may hold."""
         return list(self.q) + list(self.qd) + list(self.qdd) + list(self.params)
@@ -216,7 +233,10 @@ def _rp_arm():
         # frame 2: x2 = x1, y2 = -z1, z2 = y1; origin d2 along y1 from frame 1's origin
         R2 = R1 * sp.Matrix([[1, 0, 0], [0, 0, 1], [0, -1, 0]])
         p2 = p1 + R1 * sp.Matrix([0, d2, 0])
-        return [Link(R1, p1, sp.zeros(3, 1), p1, m1, sp.zeros(3, 3)), Link(R2, p2, p1, p2, m2, sp.zeros(3, 3))]
+        return [
+            Link(R1, p1, sp.zeros(3, 1), p1, m1, sp.zeros(3, 3)),
+            Link(R2, p2, p1, p2, m2, sp.zeros(3, 3), axis=R2[:, 2], prismatic=True),
+        ]
 
     return Arm("rp-arm", 2, [m1, m2, l1, g], build, sp.Matrix([0, -g, 0]))
 
@@ -238,12 +258,12 @@ def _scara():
         r = sp.Rational(3, 100)
         rows.append((q4, 0, 0, 0, m4, [0, 0, 0], sp.diag(m4 * r**2 / 4, m4 * r**2 / 4, m4 * r**2 / 2)))
         links = []
-        for th, d, a, al, m, com, Ic in rows:
-            a_pt = p
+        for k, (th, d, a, al, m, com, Ic) in enumerate(rows):
+            a_pt, axis = p, R[:, 2]
             Rz, off, Rx = A(th, d, a, al)
             p = p + R * off
             R = R * Rz * Rx
-            links.append(Link(R, p, a_pt, p + R * sp.Matrix(com), m, Ic))
+            links.append(Link(R, p, a_pt, p + R * sp.Matrix(com), m, Ic, axis=axis, prismatic=k == 2))
         return links
 
     return Arm("scara", 4, [m1, m2, m3, m4, a1, a2, d1, lq, g], build, sp.Matrix([0, 0, -g]))
