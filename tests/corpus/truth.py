@@ -175,7 +175,8 @@ def _lhs(anchor: str) -> str:
 
 
 def _at(expr, state):
-    return expr.subs(state) if hasattr(expr, "subs") else expr
+    # xreplace with Floats evaluates at once (subs would re-simplify the big unexpanded trees)
+    return expr.xreplace(state) if hasattr(expr, "xreplace") else expr
 
 
 def all_specs() -> dict[str, dict]:

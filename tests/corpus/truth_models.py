@@ -51,6 +51,24 @@ class Link:
         self.prismatic = prismatic
 
 
+class Quantities(dict):
+    """The arm's quantities by name; some (Christoffel symbols, C) computed when first asked."""
+
+    def __init__(self):
+        super().__init__()
+        self._later = {}
+
+    def later(self, key, make):
+        """Compute ``key`` with ``make()`` when it is first looked up."""
+        self._later[key] = make
+
+    def __missing__(self, key):
+        if key not in self._later:
+            raise KeyError(key)
+        self[key] = value = self._later.pop(key)()
+        return value
+
+
 class Arm:
     """A serial arm: ``n`` joint coordinates ``q1..qn`` (rates ``qd``, accelerations ``qdd``),
     links built by ``build(qt)`` from the coordinates as functions of time, gravity vector
@@ -65,7 +83,7 @@ class Arm:
         self.qt = [sp.Function(f"q{i + 1}")(t) for i in range(n)]
         self.links = build(self.qt)
         self.g_vec = g_vec
-        self.Q = {}
+        self.Q = Quantities()
         self._newton_euler()
         self._lagrange()
 
@@ -75,9 +93,9 @@ class Arm:
         for qt, q, qd, qdd in zip(self.qt, self.q, self.qd, self.qdd, strict=True):
             rep[sp.Derivative(qt, (t, 2))] = qdd
             rep[sp.Derivative(qt, t)] = qd
-        expr = expr.subs({k: v for k, v in rep.items() if k.derivative_count == 2})
-        expr = expr.subs({k: v for k, v in rep.items() if k.derivative_count == 1})
-        return expr.subs(dict(zip(self.qt, self.q, strict=True)))
+            rep[qt] = q
+        # xreplace matches whole nodes first: a derivative is replaced before the q(t) in it
+        return expr.xreplace(rep)
 
     def _newton_euler(self):
         Q, L, g = self.Q, self.links, self.g_vec
@@ -153,17 +171,12 @@ class Arm:
             for j in range(n):
                 Q[f"d{i + 1}{j + 1}"] = D[i, j]
         Q["D"] = D
+        Q.later("C", lambda: self._coriolis(D))
         for i in range(n):
             for j in range(n):
                 for k in range(n):
-                    c = (sp.diff(D[k, j], self.q[i]) + sp.diff(D[k, i], self.q[j]) - sp.diff(D[i, j], self.q[k])) / 2
-                    Q[f"c{i + 1}{j + 1}{k + 1}"] = c  # Spong: c_ijk, k = the equation
-        C = sp.zeros(n, n)
-        for k in range(n):
-            for j in range(n):
-                C[k, j] = sum(Q[f"c{i + 1}{j + 1}{k + 1}"] * self.qd[i] for i in range(n))
-        Q["C"] = C
-        Q["Cqd"] = C * sp.Matrix(self.qd)
+                    Q.later(f"c{i + 1}{j + 1}{k + 1}", lambda i=i, j=j, k=k: self._christoffel(D, i, j, k))
+        Q.later("Cqd", lambda: Q["C"] * sp.Matrix(self.qd))
         Q["G"] = sp.Matrix([Q[f"phi{k + 1}"] for k in range(n)])
         Q["dL_dqd"] = sp.Matrix([Q[f"dL_dqd{k + 1}"] for k in range(n)])
         Q["dK_dq"] = sp.Matrix([Q[f"dK_dq{k + 1}"] for k in range(n)])
@@ -178,12 +191,26 @@ class Arm:
 
         rng = random.Random(seed)
         for _ in range(trials):
-            vals = {s: rng.uniform(0.3, 1.7) for s in self.symbols()}
+            vals = {s: sp.Float(rng.uniform(0.3, 1.7)) for s in self.symbols()}
             for i, lk in enumerate(self.links, start=1):
                 load = self.Q[f"f{i}"] if lk.prismatic else self.Q[f"n{i}"]
                 ne = (self.state(lk.axis).T * self.state(lk.R) * load)[0]
-                a, b = float(ne.subs(vals)), float(self.Q[f"tau{i}"].subs(vals))
+                a, b = float(ne.xreplace(vals)), float(self.Q[f"tau{i}"].xreplace(vals))
                 assert abs(a - b) <= 1e-8 * max(1.0, abs(a), abs(b)), f"{self.name} joint {i}: NE {a} != Lagrange {b}"
+
+    def _christoffel(self, D, i, j, k):
+        """Spong's c_ijk (k names the equation), from D(q)."""
+        q = self.q
+        return (sp.diff(D[k, j], q[i]) + sp.diff(D[k, i], q[j]) - sp.diff(D[i, j], q[k])) / 2
+
+    def _coriolis(self, D):
+        """C(q, qd) with C_kj = sum_i c_ijk qd_i."""
+        n = len(self.q)
+        C = sp.zeros(n, n)
+        for k in range(n):
+            for j in range(n):
+                C[k, j] = sum(self.Q[f"c{i + 1}{j + 1}{k + 1}"] * self.qd[i] for i in range(n))
+        return C
 
     def symbols(self):
         """Every symbol a value of this arm may hold."""
