@@ -453,3 +453,43 @@ GRAVITY_3R = [
     ),
 ]
 SPECS["planar-3r-gravity-slip.md"] = {"robot": "planar-3r", "eqs": GRAVITY_3R}
+
+# ---------------------------------------------------------------- planar-2r-spong-jacobians.md
+SPONG_JACOBIANS = [
+    Eq(r"$$J_{v_{c1}} =", "Jvc1", Matrix([[-lc1 * s1, 0], [lc1 * c1, 0], [0, 0]])),
+    Eq(
+        r"$$J_{v_{c2}} =",
+        "Jvc2",
+        Matrix([[-l1 * s1 - lc2 * s12, -lc2 * s12], [l1 * c1 + lc2 * c12, lc2 * c12], [0, 0]]),
+    ),
+    Eq(r"$$J_{\omega_1} =", "Jw1", Matrix([[0, 0], [0, 0], [1, 0]])),
+    Eq(r"$$J_{\omega_2} =", "Jw2", Matrix([[0, 0], [0, 0], [1, 1]])),
+    Eq(r"D(q) = \begin{pmatrix}", "D", Matrix([[_d11, _d12], [_d12, _d22]])),
+    Eq(r"K = \frac{1}{2}\left(", "K", half * _d11 * qd1**2 + _d12 * qd1 * qd2 + half * _d22 * qd2**2),
+    Eq(
+        r"$$\frac{\mathrm{d}}{\mathrm{d}t}\frac{\partial K}{\partial\dot q_2} =",
+        "ddt_dL_dqd2",
+        _d12 * qdd1 - m2 * l1 * lc2 * s2 * qd1 * qd2 + _d22 * qdd2,
+    ),
+]
+SPECS["planar-2r-spong-jacobians.md"] = {"robot": "planar-2r", "eqs": SPONG_JACOBIANS}
+
+# ---------------------------------------------------------------- rp-arm-slash-notation.md
+_A = m1 * l1**2 + m2 * (l1**2 + q2**2)
+RP_SLASH = [
+    Eq(r"$$\partial L/\partial\dot q_1 =", "dL_dqd1", _A * qd1 + m2 * l1 * qd2),
+    Eq(
+        r"$$\frac{\mathrm{d}}{\mathrm{d}t}\left(\partial L/\partial\dot q_1\right) =",
+        "ddt_dL_dqd1",
+        _A * qdd1 + 2 * m2 * q2 * qd2 * qd1 + m2 * l1 * qdd2,
+    ),
+    Eq(r"$$\partial L/\partial q_1 =", "dL_dq1", -(m1 + m2) * g * l1 * c1 + m2 * g * q2 * s1),
+    Eq(r"$$\partial L/\partial q_2 =", "dL_dq2", m2 * q2 * qd1**2 - m2 * g * c1),
+    Eq(
+        r"$$\tau_1 =",
+        "tau1",
+        _A * qdd1 + m2 * l1 * qdd2 + 2 * m2 * q2 * qd1 * qd2 + (m1 + m2) * g * l1 * c1 - m2 * g * q2 * s1,
+    ),
+    Eq(r"$$\tau_2 =", "tau2", m2 * l1 * qdd1 + m2 * qdd2 - m2 * q2 * qd1**2 + m2 * g * c1),
+]
+SPECS["rp-arm-slash-notation.md"] = {"robot": "rp-arm", "eqs": RP_SLASH}

@@ -150,6 +150,9 @@ class Arm:
             Q[f"vc{i}"] = self.state(v)
             Q[f"pc{i}"] = self.state(lk.pc)
             Q[f"vc{i}_sq"] = self.state(v.dot(v))
+            # Spong's Jacobians of the mass centre's velocity and of the angular velocity (base frame)
+            Q[f"Jvc{i}"] = self.state(lk.pc).jacobian(self.q)
+            Q[f"Jw{i}"] = self.state(lk.R * w).jacobian(self.qd)
             K += Ki
             P += Pi
         Lag = K - P
