@@ -10,6 +10,7 @@ step the grader reports is matched to the truth's equation by line (an equation 
 
 * equations: how many the truth file lists;
 * read: equations with a step whose status is not ``unrecognised``;
+* agree: read equations whose verdicts agree with the truth (neither of the two below);
 * false alarms: a ``wrong`` / ``follows-from-earlier-error`` verdict on a ``right`` equation;
 * missed: ``correct`` / ``correct-by-convention`` / ``correct-but-unsupported`` on a ``wrong``
   or ``follows`` equation;
@@ -57,6 +58,7 @@ class FileScore:
     refused: str = ""
     seconds: float = 0.0
     extra: int = 0  # steps at lines no truth equation spans (prose read as an equation?)
+    agree: int = 0  # read equations whose verdict agrees with the truth
 
 
 def pairs(directory: Path):
@@ -135,6 +137,7 @@ def score(md: Path, truth_path: Path) -> FileScore:
         steps = by_eq.get(k, [])
         read, problem = judge(e, steps)
         fs.read += read
+        fs.agree += read and not problem
         if problem == "false alarm":
             fs.false_alarms.append(e["line"])
         elif problem == "missed":
@@ -154,7 +157,7 @@ def main(argv=None) -> int:
         print("no .md with a .truth.yaml found", file=sys.stderr)
         return 2
     w = max(len(s.name) for s in scores)
-    head = f"{'file':<{w}}  eqs  read  slips found  false alarms  missed   time"
+    head = f"{'file':<{w}}  eqs  read  agree  slips found  false alarms  missed   time"
     print(head)
     print("-" * len(head))
     for s in scores:
@@ -164,7 +167,7 @@ def main(argv=None) -> int:
         fa = ",".join(map(str, s.false_alarms)) or "0"
         mi = ",".join(map(str, s.missed)) or "0"
         print(
-            f"{s.name:<{w}}  {s.equations:>3}  {s.read:>4}  {s.slips_found:>2}/{s.slips:<2}"
+            f"{s.name:<{w}}  {s.equations:>3}  {s.read:>4}  {s.agree:>5}  {s.slips_found:>2}/{s.slips:<2}"
             f"       {fa:<12}  {mi:<6}  {s.seconds:5.2f}s"
         )
     n = sum(s.equations for s in scores)
@@ -178,6 +181,8 @@ def main(argv=None) -> int:
     print("-" * len(head))
     print(f"files {len(scores)}, refused {refused}                        (target: 0 refused)")
     print(f"equations {n}, read {read} = {100 * read / n:.1f} %               (target: >= 95 %)")
+    agree = sum(s.agree for s in scores)
+    print(f"verdicts that agree with the truth {agree}/{read} of the equations read")
     print(f"slips found at their line {found}/{slips}                  (target: all)")
     print(f"false alarms {fa}                                  (target: 0)")
     print(f"missed slips or carried errors {missed}                  (target: 0)")
