@@ -493,3 +493,16 @@ RP_SLASH = [
     Eq(r"$$\tau_2 =", "tau2", m2 * l1 * qdd1 + m2 * qdd2 - m2 * q2 * qd1**2 + m2 * g * c1),
 ]
 SPECS["rp-arm-slash-notation.md"] = {"robot": "rp-arm", "eqs": RP_SLASH}
+
+# ---------------------------------------------------------------- planar-2r-lynch-park-gamma.md
+# Lynch & Park's Gamma_ijk names the equation first: it is Spong's c_jki (truth_models' key).
+LP_GAMMA = [
+    Eq(r"\Gamma_{112} &=", "c121", _h),
+    Eq(r"\Gamma_{121} &=", "c211", _h),
+    Eq(r"\Gamma_{122} &=", "c221", _h),
+    Eq(r"\Gamma_{211} &=", "c112", -_h),
+    Eq(r"\Gamma_{222} &=", "c222", 0),
+    Eq(r"c_1 &=", "Cqd[0]", _h * (2 * qd1 * qd2 + qd2**2)),
+    Eq(r"c_2 &=", "Cqd[1]", -_h * qd1**2),
+]
+SPECS["planar-2r-lynch-park-gamma.md"] = {"robot": "planar-2r", "eqs": LP_GAMMA}
