@@ -1,7 +1,8 @@
 """How well `armdyn grade` reads and judges derivations in the field's notations.
 
     python benchmarks/bench_corpus.py                 # tests/corpus/
-    python benchmarks/bench_corpus.py --dir DIR ...   # any other directory of .md + .truth.yaml
+    python benchmarks/bench_corpus.py --dir DIR ...   # and any other directory of .md + .truth.yaml
+    python benchmarks/bench_corpus.py --no-corpus --dir DIR   # that directory only
 
 Every ``X.md`` with a sidecar ``X.truth.yaml`` (written by ``tests/corpus/truth.py`` with
 plain SymPy, independently of armdyn) is graded in process with ``armdyn.grade``. Each
@@ -149,9 +150,10 @@ def score(md: Path, truth_path: Path) -> FileScore:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--dir", action="append", type=Path, help="a directory of .md + .truth.yaml (repeatable)")
+    ap.add_argument("--dir", action="append", type=Path, help="also a directory of .md + .truth.yaml (repeatable)")
+    ap.add_argument("--no-corpus", action="store_true", help="only the --dir directories, not tests/corpus/")
     args = ap.parse_args(argv)
-    dirs = args.dir or [CORPUS]
+    dirs = ([] if args.no_corpus else [CORPUS]) + (args.dir or [])
     scores = [score(md, tr) for d in dirs for md, tr in pairs(d)]
     if not scores:
         print("no .md with a .truth.yaml found", file=sys.stderr)
