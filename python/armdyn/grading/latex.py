@@ -191,17 +191,28 @@ class Name:
     dots: int = 0
     sub: str = ""
     sup: str = ""
+    pre_sup: str = ""  # {}^{2}_{1}R: the scripts written before the name (a step's frames)
+    pre_sub: str = ""
 
     def latex(self) -> str:
         base = f"\\{self.base}" if self.base in GREEK else self.base
         if self.dots:
             base = "\\" + "d" * self.dots + "ot{" + base + "}"
         sub = f"_{{{self.sub}}}" if self.sub else ""
-        return base + sub
+        pre = ""
+        if self.pre_sup or self.pre_sub:
+            pre = (
+                "{}"
+                + (f"^{{{self.pre_sup}}}" if self.pre_sup else "")
+                + (f"_{{{self.pre_sub}}}" if self.pre_sub else "")
+            )
+        return pre + base + sub
 
 
 _TOKEN = re.compile(
-    r"\\begin\{(?P<begin>[A-Za-z*]+)\}(?:\{[^{}]*\})?"
+    r"(?P<skip>\\(?:color|textcolor)\s*\{[^{}]*\}|\\(?:left|right)\.|\\[hv]space\*?\{[^{}]*\}|~)"
+    r"|\\(?:operatorname|mathrm)\s*\{\s*(?P<fn>sin|cos|tan|exp|ln|log|sec|csc|cot)\s*\}"
+    r"|\\begin\{(?P<begin>[A-Za-z*]+)\}(?:\{[^{}]*\})?"
     r"|\\end\{(?P<end>[A-Za-z*]+)\}"
     r"|\\(?P<cmd>[A-Za-z]+|.)"
     r"|(?P<num>\d+(?:\.\d*)?|\.\d+)"
@@ -212,16 +223,18 @@ _TOKEN = re.compile(
 
 
 def tokenize(text: str, positions: list | None = None) -> list[tuple[str, str]]:
-    """Tokens ``(kind, value)``: kind is begin, end, cmd, num or char; spaces and sizing
-    commands dropped. ``positions``, if given, receives each token's offset in ``text``."""
+    """Tokens ``(kind, value)``: kind is begin, end, cmd, num or char; spaces, sizing
+    commands and colours (``\\color{red}``, ``\\textcolor{red}``) dropped. ``positions``, if given, receives each token's offset in ``text``."""
     if len(text) > MAX_LENGTH:
         raise LatexError(f"equation too long ({len(text)} characters, at most {MAX_LENGTH})")
     out = []
     for m in _TOKEN.finditer(text):
         kind = m.lastgroup
-        if kind == "space":
+        if kind in ("space", "skip"):  # \color{red}, \left., ~: how it looks, not what it says
             continue
         value = m.group(kind)
+        if kind == "fn":  # \operatorname{sin}: \sin
+            kind = "cmd"
         if kind == "cmd" and (value in SPACES or value in SIZES):
             continue
         if kind == "num" and len(value) > MAX_DIGITS:
@@ -290,6 +303,8 @@ class _Parser:
             if err.pos is None:
                 err.pos = self.at(self.i)
             raise
+        while self.peek() in (("char", "."), ("char", ","), ("char", ";")):  # the sentence's end
+            self.take()
         if self.peek()[0] != "eof":
             raise LatexError(f"unexpected '{self.peek()[1]}'", self.at(self.i))
         return value
@@ -423,6 +438,8 @@ class _Parser:
                 self.take()
                 if self.peek() == ("char", "}"):  # an empty group, e.g. {}^{1}
                     self.take()
+                    if self.peek() in (("char", "^"), ("char", "_")):
+                        return self._prescripted()
                     return sp.Integer(1)
                 value = self.expr()
                 self.expect("char", "}")
@@ -448,8 +465,8 @@ class _Parser:
             if tok in ("frac", "dfrac", "tfrac"):
                 self.take()
                 self.enter()
-                num = self._braced()
-                den = self._braced()
+                num = self._frac_arg()
+                den = self._frac_arg()
                 self.leave()
                 return num / den
             if tok == "sqrt":
@@ -469,6 +486,39 @@ class _Parser:
                 return value
             raise LatexError(f"unsupported command \\{tok}")
         raise LatexError("unexpected end of equation" if kind == "eof" else f"unexpected '{tok}'")
+
+    def _prescripted(self):
+        """``{}^{2}_{1}R``: a name with its scripts written before it (a step's frames)."""
+        scripts, start = {"^": "", "_": ""}, self.at(self.i - 2)  # at the "{}"
+        while self.peek() in (("char", "^"), ("char", "_")) and not scripts[self.peek()[1]]:
+            mark = self.take()[1]
+            scripts[mark] = self.group_text()
+        kind, tok = self.peek()
+        if not (
+            kind == "char" and tok.isalpha() or kind == "cmd" and (tok in GREEK or tok in WRAPPERS or "dot" in tok)
+        ):
+            raise LatexError("scripts written before nothing ({}^{..} needs a name after it)", self.at(self.i))
+        return self._symbol(pre_sup=scripts["^"], pre_sub=scripts["_"], start=start)
+
+    def _frac_arg(self):
+        """A fraction's numerator or denominator: a group, or one digit or symbol (``\\frac12``)."""
+        kind, tok = self.peek()
+        if (kind, tok) == ("char", "{"):
+            return self._braced()
+        if kind == "num":
+            self.take()
+            if len(tok) > 1 and tok[1].isdigit():  # \frac12: the digits are two arguments
+                self.i -= 1
+                self.t[self.i] = ("num", tok[1:])
+                if self.i < len(self.positions):
+                    self.positions[self.i] += 1
+                return sp.Integer(tok[0])
+            return sp.Integer(tok) if tok.isdigit() else sp.Rational(tok)
+        if kind == "char" and tok.isalpha() or kind == "cmd" and tok in GREEK:
+            start = self.at(self.i)
+            _, base, _ = self._accented()
+            return self._resolve(Name(base), start)
+        return self._braced()
 
     def _braced(self):
         self.expect("char", "{")
@@ -493,13 +543,72 @@ class _Parser:
     def symbol(self):
         """[accents/wrappers] name [_sub] -> resolve(Name). A ``^`` after it is an
         exponent, read by :meth:`factor`."""
+        return self._symbol()
+
+    def _symbol(self, pre_sup: str = "", pre_sub: str = "", start: int | None = None):
+        start = self.at(self.i) if start is None else start
         dots, base, sub = self._accented()
-        if base[0].isdigit():  # \mathbf{0}: a number in bold
+        if base[0].isdigit() and not (pre_sup or pre_sub):  # \mathbf{0}: a number in bold
             return sp.Rational(base)
+        primes = self._primes()
         if not sub and self.peek() == ("char", "_"):
             self.take()
             sub = self.group_text()
-        return self.resolve(Name(base, dots, sub))
+        primes += self._primes()
+        exponent, at = None, self.at(self.i)
+        if not sub and self.peek() == ("char", "^") and self.peek(self._script_length(1) + 1) == ("char", "_"):
+            self.take()  # \dot{\theta}^2_1: the power written before the subscript
+            exponent = self.script_value()
+            self.take()
+            sub = self.group_text()
+        name = Name(base, dots + primes, sub, pre_sup=pre_sup, pre_sub=pre_sub)
+        try:
+            value = self._resolve(name, start)
+        except UnknownSymbol as err:
+            if pre_sup or pre_sub:
+                raise UnknownSymbol(
+                    f"{name.latex()} names a step (its frames written before it): a value is read in the "
+                    "joint variables and parameters, not through an earlier step's name",
+                    start,
+                ) from None
+            if primes:
+                raise UnknownSymbol(f"{err} (a prime ' is read as a time derivative)", err.pos) from None
+            raise
+        return _power(value, exponent, at) if exponent is not None else value
+
+    def _primes(self) -> int:
+        """How many primes follow (``\\theta_1''``): each a time derivative."""
+        n = 0
+        while self.peek() == ("char", "'"):
+            self.take()
+            n += 1
+        return n
+
+    def _script_length(self, k: int) -> int:
+        """Tokens in the script starting ``k`` tokens ahead: a ``{...}`` group or one token."""
+        if self.peek(k) != ("char", "{"):
+            return 1
+        depth, n = 0, 0
+        while True:
+            tok = self.peek(k + n)
+            n += 1
+            if tok[0] == "eof":
+                return n
+            if tok == ("char", "{"):
+                depth += 1
+            elif tok == ("char", "}"):
+                depth -= 1
+                if depth == 0:
+                    return n
+
+    def _resolve(self, name: Name, start: int | None):
+        """``resolve(name)``; an unknown symbol's error points at where it starts."""
+        try:
+            return self.resolve(name)
+        except LatexError as err:
+            if err.pos is None:
+                err.pos = start
+            raise
 
     def _accented(self) -> tuple[int, str, str]:
         """(number of dots, base name, subscript written inside the braces) of an
@@ -615,13 +724,14 @@ def parse(text: str, resolve) -> sp.Expr | sp.Matrix:
 _OPEN = {"{": "}", "(": ")", "[": "]"}
 
 
-_MARKS = re.compile(r"\\(?:begin|end)\{[^}]*\}?|\\\\|\\[A-Za-z]+|\\.?|[{}()\[\]&,=]", re.S)
+_MARKS = re.compile(r"\\(?:begin|end)\{[^}]*\}?|\\\\|\\[A-Za-z]+|\\.?|[{}()\[\]&,;=]", re.S)
 
 
-def _top_level(text: str):
-    """Yield ``(index, mark)`` of the marks ``&``, ``,``, ``=`` and ``\\\\`` at nesting depth 0:
-    outside braces, brackets and matrix environments. One regular-expression pass over
-    the text (only the characters that matter are looked at in Python)."""
+def _top_level(text: str, commands: bool = False):
+    """Yield ``(index, mark)`` of the marks ``&``, ``,``, ``;``, ``=`` and ``\\\\`` at nesting
+    depth 0: outside braces, brackets and matrix environments (with ``commands``, also
+    every command there, ``\\quad``, ``\\text``...). One regular-expression pass over the
+    text (only the characters that matter are looked at in Python)."""
     depth, env = 0, 0
     for m in _MARKS.finditer(text):
         tok = m.group(0)
@@ -631,7 +741,7 @@ def _top_level(text: str):
                 env += 1
             elif tok.startswith("\\end{"):
                 env -= 1
-            elif tok == "\\\\" and env == 0 and depth == 0:
+            elif env == 0 and depth == 0 and (tok == "\\\\" or commands):
                 yield m.start(), tok
             continue
         if c in "{([":
@@ -642,18 +752,62 @@ def _top_level(text: str):
             yield m.start(), c
 
 
+#: what a display block holds besides its equations: environment wrappers, tags and labels,
+#: a row's extra space (\\[2pt]); blanked out (offsets stay those of the block)
+_DROPPED = re.compile(
+    r"\\(?:begin|end)\{(?:split|aligned|align\*?|gather\*?|gathered|equation\*?|alignedat|alignat\*?|multline\*?"
+    r"|eqnarray\*?|flalign\*?)\}(?:\{\d+\})?"
+    r"|\\(?:tag\*?|label)\{[^{}]*\}|\\(?:nonumber|notag)\b"
+    r"|(?<=\\\\)\[\s*-?\d*\.?\d+\s*(?:pt|mm|cm|em|ex|in|bp)\s*\]"
+)
+#: prose in a display: \text{and} separates two equations, \text{for ...} ends one
+_PROSE = re.compile(r"\\(?:text|textrm|textit|textbf|mbox|mathrm)\s*\{([^{}]*)\}")
+_JOINER = re.compile(r"\s*(?:and|,|;|und|&)?\s*", re.IGNORECASE)
+_SEPARATORS = (",", ";", "\\quad", "\\qquad")
+
+
+def _blank(chars: list[str], start: int, end: int) -> None:
+    chars[start:end] = " " * (end - start)
+
+
+def _prose_out(text: str) -> str:
+    """``text`` with its top-level prose handled: ``\\text{and}`` (``\\text{,}``...) becomes a
+    separator ``;``; a ``\\text{ for ...}`` with words is a trailing condition or comment:
+    blanked with the rest of its row. Offsets are kept."""
+    marks = list(_top_level(text, commands=True))
+    chars = None
+    rows = [i for i, c in marks if c == "\\\\"] + [len(text)]
+    for i, c in marks:
+        if c not in ("\\text", "\\textrm", "\\textit", "\\textbf", "\\mbox", "\\mathrm"):
+            continue
+        m = _PROSE.match(text, i)
+        j = i - 1
+        while j >= 0 and text[j].isspace():
+            j -= 1
+        if m is None or j >= 0 and text[j] in "_^":  # a name's script (m_\text{link}): not prose
+            continue
+        chars = chars if chars is not None else list(text)
+        words = m.group(1)
+        if _JOINER.fullmatch(words):
+            _blank(chars, m.start(), m.end())
+            chars[m.start()] = ";"
+        elif c != "\\mathrm" and re.search(r"[A-Za-z]{2,}", words):
+            _blank(chars, m.start(), next(r for r in rows if r > i))
+    return text if chars is None else "".join(chars)
+
+
 def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str]]:
     """Split a display-math block into equations: at top-level ``\\\\`` and at top-level
-    commas followed by another ``LHS = ...``. Returns ``(offset, text)`` pairs; alignment
-    ``&`` and environment wrappers (split, aligned, align, gather) are blanked out (so
+    ``,``, ``;``, ``\\quad``, ``\\qquad`` or ``\\text{and}`` followed by another
+    ``LHS = ...``. Returns ``(offset, text)`` pairs; alignment ``&``, environment wrappers
+    (split, aligned, align, gather, multline, eqnarray, alignat...), ``\\tag``,
+    ``\\label``, ``\\nonumber`` and a trailing ``\\text{ for ...}`` are blanked out (so
     offsets still point into ``block``). Linear in the block's length; ``limit``: stop
     after that many equations (the caller refuses more)."""
-    text = re.sub(
-        r"\\(begin|end)\{(split|aligned|align\*?|gather\*?|equation\*?|alignedat)\}(\{\d+\})?",
-        lambda m: " " * len(m.group(0)),
-        block,
-    )
-    marks = [(i, c) for i, c in _top_level(text) if c in ("&", ",", "=", "\\\\")]  # one pass, depth 0
+    text = _DROPPED.sub(lambda m: " " * len(m.group(0)), block)
+    if "\\" in text:
+        text = _prose_out(text)
+    marks = [(i, c) for i, c in _top_level(text, commands=True) if c in ("&", "=", "\\\\", *_SEPARATORS)]
     if any(c == "&" for _, c in marks):
         chars = list(text)
         for i, c in marks:
@@ -665,13 +819,13 @@ def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str
     pieces = [i for i, c in marks if c == "\\\\"] + [len(text)]
     k = 0  # index into marks
     for cut in pieces:
-        # segments of this piece at top-level commas, each flagged: has a top-level '='?
+        # segments of this piece at top-level separators, each flagged: has a top-level '='?
         segments, s0, has_eq = [], start, False
         while k < len(marks) and marks[k][0] < cut:
             i, c = marks[k]
-            if c == ",":
+            if c in _SEPARATORS:
                 segments.append((s0, i, has_eq))
-                s0, has_eq = i + 1, False
+                s0, has_eq = i + (1 if c in ",;" else len(c)), False
             elif c == "=":
                 has_eq = True
             k += 1

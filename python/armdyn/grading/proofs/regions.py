@@ -13,8 +13,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from ..display import front_matter, math_blocks
 from ..latex import split_equations
-from ..reader import math_blocks
 
 _START = re.compile(r"\b(prove|proof|show that)\b", re.IGNORECASE)
 _KEEP_HEADING = re.compile(r"^\W*(solution|proof|answer|demonstration)\b", re.IGNORECASE)
@@ -33,11 +33,8 @@ class Display:
 
 
 def _body_start(text: str) -> int:
-    if text.startswith("---"):
-        end = re.search(r"^---\s*$", text[3:], re.MULTILINE)
-        if end is not None:
-            return 3 + end.end()
-    return 0
+    front = front_matter(text)
+    return front[2] if front is not None else 0
 
 
 def _update(in_proof: bool, prose: str) -> tuple[bool, bool]:
