@@ -292,7 +292,7 @@ class _Grader:
         first_wrong = next((v.name for v in self.verdicts if v.status == "wrong"), None)
         tau_correct = [False] * self.robot.dof
         for v in self.verdicts:
-            if v.key == "tau":
+            if v.key == "tau" and 1 <= int(v.name.split("_")[1]) <= self.robot.dof:  # tau_3 of 2: unrecognised
                 tau_correct[int(v.name.split("_")[1]) - 1] = v.status in (*PASSING, "correct-but-unsupported")
         if self.symbols.used_gravity_magnitude:
             self.notes.append("g read as the magnitude of the model's gravity vector")

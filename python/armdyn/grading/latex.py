@@ -16,9 +16,13 @@ symbols to the model's (or refuses them)::
     matrix  := "\\begin{pmatrix}" cell ("&" cell)* ("\\\\" ...)* "\\end{pmatrix}"  (also
                bmatrix, matrix, Bmatrix, vmatrix: rows by \\\\, cells by &)
 
-Functions: \\sin \\cos \\tan \\exp \\ln \\log; ``\\sin\\theta_1`` takes the next atom,
-``\\sin^2\\theta`` is ``(\\sin\\theta)^2``. A symbol reaches ``resolve`` as a
-:class:`Name` (letter or Greek name, number of dots, subscript and superscript as text).
+Functions: \\sin \\cos \\tan \\exp \\ln \\log (also ``\\operatorname{sin}``);
+``\\sin\\theta_1`` takes the next atom, ``\\sin^2\\theta`` is ``(\\sin\\theta)^2``. A symbol
+reaches ``resolve`` as a :class:`Name` (letter or Greek name, number of dots, subscript and
+superscript as text, and the scripts of ``{}^{2}_{1}R`` written before it). Primes
+(``\\theta_1'``) count as dots: time derivatives. ``x^2_1`` is ``(x_1)^2``. Colours, spacing
+and ``\\left.`` are dropped by the tokenizer; a ``{`` group starting with a sign after a
+term (``a {\\color{red} - b}``) is added, not multiplied (braces are invisible in LaTeX).
 """
 
 from __future__ import annotations
@@ -315,7 +319,10 @@ class _Parser:
         while self.peek() in (("char", "+"), ("char", "-")):
             sign *= -1 if self.take()[1] == "-" else 1
         value = sign * self.term()
-        while self.peek() in (("char", "+"), ("char", "-")):
+        while self.peek() in (("char", "+"), ("char", "-")) or self._signed_group():
+            if self._signed_group():  # a {\color{red} - b} term: the sign is inside
+                value = value + self.term()
+                continue
             op = self.take()[1]
             nxt = self.term()
             value = value + nxt if op == "+" else value - nxt
@@ -332,9 +339,14 @@ class _Parser:
             return value not in ("right", "end", "\\", "cdot", "times", "}", "&") and value != "rbrace"
         return False
 
+    def _signed_group(self) -> bool:
+        """Is a ``{`` group starting with a sign next (``a {- b}``: braces are invisible in
+        LaTeX, so that reads a - b, as a colour or an underbrace around a term writes it)?"""
+        return self.peek() == ("char", "{") and self.peek(1) in (("char", "+"), ("char", "-"))
+
     def term(self):
         value = self.factor()
-        while True:
+        while not self._signed_group():
             kind, tok = self.peek()
             if (kind, tok) in (("char", "*"), ("cmd", "cdot"), ("cmd", "times"), ("cmd", "ast")):
                 self.take()
@@ -346,6 +358,7 @@ class _Parser:
                 value = value * self.factor()
             else:
                 return value
+        return value
 
     def factor(self):
         self.enter()  # a^b^c...: each exponent nests one level

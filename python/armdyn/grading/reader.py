@@ -5,11 +5,14 @@ mapping) and the equations in the order written, each with its line number. The
 Markdown reader's output is exactly what a YAML submission states directly
 (:meth:`Submission.to_yaml` prints it), so the two formats grade alike.
 
-Markdown: an optional front matter between ``---`` lines at the top (YAML: ``robot``,
-``method``, ``symbols``), then any text; every ``$$ ... $$`` or ``\\[ ... \\]`` block is
-split into equations (at ``\\\\`` and at commas before another ``LHS = ...``), each with
-its line, the column where its value starts, and the part of the assignment it is in
-(:mod:`.parts`). Reading is linear in the file's size and bounded: at most
+Markdown: an optional front matter between ``---`` lines at the top (after blank lines
+or ``<!-- -->`` comments; YAML: ``robot``, ``method``, ``symbols``), then any text; every
+display block (``$$``, ``\\[``, ```` ```math ````, a bare ``align``... environment, a lone
+``$ ... $`` paragraph: :mod:`.display`) is split into equations (at ``\\\\`` and at
+separators before another ``LHS = ...``: :func:`.latex.split_equations`), each with its
+line, the column where its value starts, and the part of the assignment it is in
+(:mod:`.parts`). A row or block with no left-hand side that starts with ``=``, ``+`` or
+``-`` continues the equation before it (:func:`_continue`). Reading is linear in the file's size and bounded: at most
 :data:`MAX_BYTES` bytes and :data:`MAX_EQUATIONS` equations; an equation with an
 unbalanced brace is kept with ``problem`` naming the brace's line and column.
 
