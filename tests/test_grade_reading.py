@@ -321,3 +321,20 @@ def test_hostile_layout_is_bounded_and_one_equation_at_most(tmp_path):
     assert time.monotonic() - start < GUARD and done.returncode == 1, done.stderr
     assert "Traceback" not in done.stdout + done.stderr
     assert any("τ_2" in t and "correct" in t for t in done.stdout.split("\n")), done.stdout
+
+
+def test_code_fences_are_neither_math_nor_headings(tmp_path):
+    body = "# 7-3\n```python\n# 7-4\nprint('$$\\tau_2 = 0$$')\n```\n" + f"$$\\tau_2 = {TAU_2}$$\n"
+    report = grade(write(tmp_path, "code.md", body))
+    assert [(v.name, v.status, v.part) for v in report.steps] == [("tau_2", "correct", "7-3")]
+
+
+def test_an_equation_continued_without_end_is_one_unrecognised_line(tmp_path):
+    from armdyn.grading.reader import MAX_ROWS
+
+    body = f"$$\\tau_2 = {TAU_2}$$\n$$\\tau_1 = 0$$\n" + "$$+ 0$$\n" * (MAX_ROWS + 5)
+    start = time.monotonic()
+    report = grade(write(tmp_path, "rows.md", body))
+    assert time.monotonic() - start < GUARD
+    assert statuses(report) == [("tau_2", "correct"), ("tau_1", "unrecognised")]
+    assert f"more than {MAX_ROWS} rows" in report.steps[1].message and ":5:" in report.steps[1].message

@@ -72,6 +72,12 @@ def _alone(text: str, at: int, step: int) -> bool:
 def math_blocks(text: str, start: int = 0):
     """``(block_start, block_end, body_start, body)`` of each display block from ``start``
     on (see the module docstring), in the order written."""
+    return (block for block in regions(text, start) if block[3] is not None)
+
+
+def regions(text: str, start: int = 0):
+    """As :func:`math_blocks`, with fenced code blocks too (``body`` None): what is not
+    prose (no heading or task number is looked for there)."""
     closed_off: set[str] = set()  # kinds ($$, \[, an environment's name) never closed further on
     pos = start
     while True:
@@ -87,8 +93,9 @@ def math_blocks(text: str, start: int = 0):
             body = text[body_start:close_start]
             lang = m.group("lang").lower()
             if lang == "math" or lang in ("latex", "tex") and "=" in body and not _DOCUMENT.search(body):
-                if body.strip():
-                    yield m.start(), close_end, body_start, body
+                yield m.start(), close_end, body_start, body
+            else:
+                yield m.start(), close_end, body_start, None
             pos = max(close_end, m.end())
             continue
         if kind == "inline":

@@ -27,6 +27,7 @@ term (``a {\\color{red} - b}``) is added, not multiplied (braces are invisible i
 
 from __future__ import annotations
 
+import bisect
 import re
 from dataclasses import dataclass
 
@@ -790,8 +791,9 @@ def _prose_out(text: str) -> str:
     marks = list(_top_level(text, commands=True))
     chars = None
     rows = [i for i, c in marks if c == "\\\\"] + [len(text)]
+    blanked = -1  # blanked up to here already (each row's prose blanked once: linear)
     for i, c in marks:
-        if c not in ("\\text", "\\textrm", "\\textit", "\\textbf", "\\mbox", "\\mathrm"):
+        if i < blanked or c not in ("\\text", "\\textrm", "\\textit", "\\textbf", "\\mbox", "\\mathrm"):
             continue
         m = _PROSE.match(text, i)
         j = i - 1
@@ -805,7 +807,8 @@ def _prose_out(text: str) -> str:
             _blank(chars, m.start(), m.end())
             chars[m.start()] = ";"
         elif c != "\\mathrm" and re.search(r"[A-Za-z]{2,}", words):
-            _blank(chars, m.start(), next(r for r in rows if r > i))
+            blanked = rows[bisect.bisect_right(rows, i)]  # the end of its row
+            _blank(chars, m.start(), blanked)
     return text if chars is None else "".join(chars)
 
 

@@ -39,7 +39,7 @@ import yaml
 
 from ..errors import ModelError
 from ..io.yaml_screen import screen
-from .display import front_matter, math_blocks
+from .display import front_matter, regions
 
 #: a submission larger than this is refused (a derivation is a few kB)
 MAX_BYTES = 5_000_000
@@ -69,6 +69,7 @@ class Equation:
     part: str | None = None
     task: str = ""
     spans: tuple = ()  # (offset in value, offset in the file) of each piece of a joined value
+    rows: int = 1  # rows or blocks joined into this equation (see _continue)
 
     def offset_of(self, pos: int) -> int:
         """The file offset of character ``pos`` of ``value`` (a value joined from rows
@@ -244,9 +245,10 @@ def read_markdown(path: str, text: str | None = None) -> Submission:
         blank = "\n" * (index.line(yaml_start) - 1)  # YAML's error lines count from the file's top
         _front(safe_yaml(blank + text[yaml_start:yaml_end], path), path, sub)
     hidden = set(range(1, index.line(body_start) + 1))  # front matter and display math: no headings there
-    for outer_start, outer_end, block_start, block in math_blocks(text, body_start):
+    for outer_start, outer_end, block_start, block in regions(text, body_start):
         hidden.update(range(index.line(outer_start), index.line(outer_end) + 1))
-        _read_block(sub, index, block_start, block)
+        if block is not None:  # math, not code
+            _read_block(sub, index, block_start, block)
     lines = text.split("\n")
     sub.parts = [with_title(p, lines, hidden) for p in find_parts(text, index.line, lines, hidden)]
     for eq in sub.equations:
@@ -321,13 +323,24 @@ def _read_block(sub: Submission, index: LineIndex, block_start: int, block: str)
             )
 
 
+#: rows (or blocks) continuing one equation beyond which it is refused (bounds the joining)
+MAX_ROWS = 200
+
+
 def _continue(sub: Submission, index: LineIndex, eq: str, start: int, cuts: list[int]) -> None:
     """Join a row or block with no left-hand side (``= ...``, ``+ ...``) to the equation
     before it: the value becomes its last right-hand side (``= ...``) or grows by it
-    (``+ ...``). Nothing before it to continue: not an equation (skipped)."""
+    (``+ ...``). Nothing before it to continue: not an equation (skipped). More than
+    :data:`MAX_ROWS` rows, or a joined value over ``MAX_LENGTH``: the equation is refused."""
+    from .latex import MAX_LENGTH
+
     if not sub.equations or sub.equations[-1].problem or not isinstance(sub.equations[-1].value, str):
         return
     prev = sub.equations[-1]
+    prev.rows += 1
+    if prev.rows > MAX_ROWS or max(len(prev.value), len(prev.source)) + len(eq) > MAX_LENGTH:
+        prev.problem = f"more than {MAX_ROWS} rows or {MAX_LENGTH} characters continue this equation"
+        return
     prev.source = f"{prev.source} {' '.join(eq.split())}"
     if len(cuts) >= 2:  # "= b" or "= b = c": the last side is the value now
         value = eq[cuts[-1] :]
@@ -335,9 +348,7 @@ def _continue(sub: Submission, index: LineIndex, eq: str, start: int, cuts: list
         prev.value, prev.offset, prev.spans = value.strip(), start + cuts[-1] + skip, ()
         prev.column = index.locate(prev.offset)[1]
         return
-    if not prev.spans:
-        prev.spans = ((0, prev.offset),)
-    prev.spans = (*prev.spans, (len(prev.value) + 1, start))
+    prev.spans = (*(prev.spans or ((0, prev.offset),)), (len(prev.value) + 1, start))
     prev.value = f"{prev.value} {eq}"
 
 
