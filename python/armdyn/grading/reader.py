@@ -9,7 +9,7 @@ Markdown: an optional front matter between ``---`` lines at the top (after blank
 or ``<!-- -->`` comments; YAML: ``robot``, ``method``, ``symbols``), then any text; every
 display block (``$$``, ``\\[``, ```` ```math ````, a bare ``align``... environment, a lone
 ``$ ... $`` paragraph: :mod:`.display`) is split into equations (at ``\\\\`` and at
-separators before another ``LHS = ...``: :func:`.latex.split_equations`), each with its
+separators before another ``LHS = ...``: :func:`.equations.split_equations`), each with its
 line, the column where its value starts, and the part of the assignment it is in
 (:mod:`.parts`). A row or block with no left-hand side that starts with ``=``, ``+`` or
 ``-`` continues the equation before it (:func:`_continue`). Reading is linear in the file's size and bounded: at most
@@ -264,7 +264,8 @@ def _read_block(sub: Submission, index: LineIndex, block_start: int, block: str)
     """Append the equations of one display block to ``sub`` (a row or block that starts
     with ``=``, ``+`` or ``-`` and has no left-hand side of its own continues the
     equation before it)."""
-    from .latex import MAX_LENGTH, side_offsets, split_equations
+    from .equations import side_offsets, split_equations
+    from .latex import MAX_LENGTH
 
     def unreadable(head: str, text: str, start: int, problem: str) -> None:
         line, col = index.locate(start)
