@@ -338,3 +338,17 @@ def test_an_equation_continued_without_end_is_one_unrecognised_line(tmp_path):
     assert time.monotonic() - start < GUARD
     assert statuses(report) == [("tau_2", "correct"), ("tau_1", "unrecognised")]
     assert f"more than {MAX_ROWS} rows" in report.steps[1].message and ":5:" in report.steps[1].message
+
+
+def test_eqnarray_rows_underbraces_and_a_boxed_answer(tmp_path):
+    body = (
+        "\\begin{eqnarray}\n"
+        "\\tau_1 &=& (m_1 + m_2) l_1^2 \\ddot{\\theta}_1 + m_2 l_1 \\ddot{d}_2"
+        " + \\underbrace{2 m_2 d_2 \\dot{\\theta}_1 \\dot{d}_2}_{\\text{Coriolis}} \\nonumber \\\\\n"
+        "& & + m_2 d_2^2 \\ddot{\\theta}_1 + \\overbrace{(m_1 + m_2) g l_1 \\cos\\theta_1 - m_2 g d_2 \\sin\\theta_1}^{G_1}\n"
+        "\\end{eqnarray}\n"
+        f"$$\\boxed{{\\tau_2 = {TAU_2}}}$$\n"
+    )
+    report = grade(write(tmp_path, "eqnarray.md", body))
+    assert statuses(report) == [("tau_1", "correct"), ("tau_2", "correct")]
+    assert [v.line for v in report.steps] == [5, 8]

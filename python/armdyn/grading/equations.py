@@ -85,15 +85,44 @@ def _prose_out(text: str) -> str:
     return text if chars is None else "".join(chars)
 
 
+def _unboxed(text: str) -> str:
+    """``text`` with each top-level ``\\boxed{...}`` (a final answer framed) blanked to its
+    content, so the equation inside is split as any other. Each box's content is scanned
+    once (only top-level boxes: linear)."""
+    chars = list(text)
+    for i, c in list(_top_level(text, commands=True)):
+        if c != "\\boxed":
+            continue
+        j = i + len(c)
+        while j < len(text) and text[j].isspace():
+            j += 1
+        if j >= len(text) or text[j] != "{":
+            continue
+        depth, k = 0, j
+        while k < len(text):
+            if text[k] == "\\":
+                k += 2
+                continue
+            depth += {"{": 1, "}": -1}.get(text[k], 0)
+            if depth == 0:
+                _blank(chars, i, j + 1)
+                chars[k] = " "
+                break
+            k += 1
+    return "".join(chars)
+
+
 def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str]]:
     """Split a display-math block into equations: at top-level ``\\\\`` and at top-level
     ``,``, ``;``, ``\\quad``, ``\\qquad`` or ``\\text{and}`` followed by another
     ``LHS = ...``. Returns ``(offset, text)`` pairs; alignment ``&``, environment wrappers
     (split, aligned, align, gather, multline, eqnarray, alignat...), ``\\tag``,
-    ``\\label``, ``\\nonumber`` and a trailing ``\\text{ for ...}`` are blanked out (so
+    ``\\label``, ``\\nonumber``, a ``\\boxed{..}`` frame and a trailing ``\\text{ for ...}`` are blanked out (so
     offsets still point into ``block``). Linear in the block's length; ``limit``: stop
     after that many equations (the caller refuses more)."""
     text = _DROPPED.sub(lambda m: " " * len(m.group(0)), block)
+    if "\\boxed" in text:
+        text = _unboxed(text)
     if "\\" in text:
         text = _prose_out(text)
     marks = [(i, c) for i, c in _top_level(text, commands=True) if c in ("&", "=", "\\\\", *_SEPARATORS)]

@@ -478,6 +478,13 @@ class _Parser:
                     self.take()
                     return value
                 raise LatexError(f"unsupported bracket \\left{opener}")
+            if tok in ("underbrace", "overbrace", "boxed"):  # a term's label or frame: the term is read
+                self.take()
+                value = self._braced()
+                if tok != "boxed" and self.peek() in (("char", "_"), ("char", "^")):
+                    self.take()
+                    self.group_text()  # the label, words or a name: not part of the value
+                return value
             if tok in ("frac", "dfrac", "tfrac"):
                 self.take()
                 self.enter()
