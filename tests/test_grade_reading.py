@@ -352,3 +352,15 @@ def test_eqnarray_rows_underbraces_and_a_boxed_answer(tmp_path):
     report = grade(write(tmp_path, "eqnarray.md", body))
     assert statuses(report) == [("tau_1", "correct"), ("tau_2", "correct")]
     assert [v.line for v in report.steps] == [5, 8]
+
+
+def test_an_unworked_derivative_is_refused_with_its_reason_and_mathrm_d_is_a_name(tmp_path):
+    body = (
+        "$$\\tau_1 = \\frac{\\mathrm{d}}{\\mathrm{d}t} \\frac{\\partial L}{\\partial \\dot\\theta_1}"
+        " - \\frac{\\partial L}{\\partial \\theta_1}$$\n"
+        "$$\\tau_2 = m_2 (l_1 \\ddot{\\theta}_1 - \\mathrm{d}_2 \\dot{\\theta}_1^2 + \\ddot{\\mathrm{d}}_2"
+        " + g \\cos\\theta_1)$$\n"
+    )
+    report = grade(write(tmp_path, "d.md", body))
+    assert statuses(report) == [("tau_1", "unrecognised"), ("tau_2", "correct")]
+    assert ":4:12: cannot read the value: a derivative written as a fraction" in report.steps[0].message

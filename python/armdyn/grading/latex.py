@@ -486,6 +486,12 @@ class _Parser:
                     self.group_text()  # the label, words or a name: not part of the value
                 return value
             if tok in ("frac", "dfrac", "tfrac"):
+                if self._derivative_fraction():
+                    raise LatexError(
+                        "a derivative written as a fraction (d/dt, \\partial): a value is read worked out, "
+                        "in the joint variables and parameters",
+                        self.at(self.i),
+                    )
                 self.take()
                 self.enter()
                 num = self._frac_arg()
@@ -509,6 +515,24 @@ class _Parser:
                 return value
             raise LatexError(f"unsupported command \\{tok}")
         raise LatexError("unexpected end of equation" if kind == "eof" else f"unexpected '{tok}'")
+
+    def _derivative_fraction(self) -> bool:
+        """Is the ``\\frac`` next ``\\frac{d}{dt}``, ``\\frac{\\mathrm{d}}{\\mathrm{d}t}`` or
+        ``\\frac{\\partial L}{\\partial q}`` (an operator, not a quotient)?"""
+
+        def starts_d(k: int, alone: bool) -> bool:  # the group at k starts with d, \mathrm{d}, \partial
+            if self.peek(k) != ("char", "{"):
+                return False
+            first = self.peek(k + 1)
+            if first == ("cmd", "partial"):
+                return True
+            if first == ("cmd", "mathrm"):
+                return self.peek(k + 2) == ("char", "{") and self.peek(k + 3) == ("char", "d")
+            after = self.peek(k + 2)  # d then a letter or a command: dt, d\theta (d_2 is a name)
+            letter = after[0] == "cmd" or after[0] == "char" and after[1].isalpha()
+            return first == ("char", "d") and (letter or alone and after == ("char", "}"))
+
+        return starts_d(1, True) and starts_d(1 + self._script_length(1), False)
 
     def _prescripted(self):
         """``{}^{2}_{1}R``: a name with its scripts written before it (a step's frames)."""
