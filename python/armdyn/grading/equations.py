@@ -59,13 +59,16 @@ def _blank(chars: list[str], start: int, end: int) -> None:
 
 def _prose_out(text: str) -> str:
     """``text`` with its top-level prose handled: ``\\text{and}`` (``\\text{,}``...) becomes a
-    separator ``;``; a ``\\text{ for ...}`` with words is a trailing condition or comment:
-    blanked with the rest of its row. Offsets are kept."""
+    separator ``;``; a ``\\text{ for ...}`` with words after a value (``= v \\text{ for } ...``)
+    is a trailing condition or comment: blanked with the rest of its row. Offsets are kept."""
     marks = list(_top_level(text, commands=True))
     chars = None
     rows = [i for i, c in marks if c == "\\\\"] + [len(text)]
     blanked = -1  # blanked up to here already (each row's prose blanked once: linear)
+    equals = -1  # the last top-level '=' of the current row
     for i, c in marks:
+        if c in ("=", "\\\\"):
+            equals = i if c == "=" else -1
         if i < blanked or c not in ("\\text", "\\textrm", "\\textit", "\\textbf", "\\mbox", "\\mathrm"):
             continue
         m = _PROSE.match(text, i)
@@ -79,7 +82,8 @@ def _prose_out(text: str) -> str:
         if _JOINER.fullmatch(words):
             _blank(chars, m.start(), m.end())
             chars[m.start()] = ";"
-        elif c != "\\mathrm" and re.search(r"[A-Za-z]{2,}", words):
+        elif c != "\\mathrm" and equals >= 0 and text[equals + 1 : i].strip() and re.search(r"[A-Za-z]{2,}", words):
+            # words after a value (not a left-hand side, not the value itself): a comment
             blanked = rows[bisect.bisect_right(rows, i)]  # the end of its row
             _blank(chars, m.start(), blanked)
     return text if chars is None else "".join(chars)
