@@ -240,10 +240,9 @@ def test_separators_between_equations_of_one_block(tmp_path):
         f"$$\\tau_2 = {TAU_2}; \\qquad \\tau_1 = {TAU_1}$$\n"
         f"$$\\tau_2 = {TAU_2} \\text{{ and }} \\tau_1 = {TAU_1}$$\n"
         f"$$\\tau_2 = {TAU_2} \\quad \\text{{for all }} t \\geq 0, \\; d_2 = 0$$\n"
+        f"$$\\tau_1 = {TAU_1} \\qquad (\\text{{by Lagrange}})$$\n"
     )
-    assert statuses(grade(write(tmp_path, "sep.md", body))) == [("tau_2", "correct"), ("tau_1", "correct")] * 2 + [
-        ("tau_2", "correct")
-    ]
+    assert statuses(grade(write(tmp_path, "sep.md", body))) == [("tau_2", "correct"), ("tau_1", "correct")] * 3
 
 
 # ---------------------------------------------------------------- 4. syntax inside values

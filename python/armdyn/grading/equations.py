@@ -49,6 +49,7 @@ _DROPPED = re.compile(
 )
 #: prose in a display: \text{and} separates two equations, \text{for ...} ends one
 _PROSE = re.compile(r"\\(?:text|textrm|textit|textbf|mbox|mathrm)\s*\{([^{}]*)\}")
+_PAREN_PROSE = re.compile(r"\(\s*\\text\s*\{[^{}]*[A-Za-z]{2,}[^{}]*\}\s*\)")
 _JOINER = re.compile(r"\s*(?:and|,|;|und|&)?\s*", re.IGNORECASE)
 _SEPARATORS = (",", ";", "\\quad", "\\qquad")
 
@@ -86,6 +87,14 @@ def _prose_out(text: str) -> str:
             # words after a value (not a left-hand side, not the value itself): a comment
             blanked = rows[bisect.bisect_right(rows, i)]  # the end of its row
             _blank(chars, m.start(), blanked)
+    equals_at = [i for i, c in marks if c == "="]
+    for m in _PAREN_PROSE.finditer(text):  # "= v (\text{Coriolis})": a comment in parentheses
+        k = bisect.bisect_right(rows, m.start())
+        row = rows[k - 1] if k else -1  # where its row starts (-1: the first row)
+        k = bisect.bisect_left(equals_at, m.start())
+        if k and equals_at[k - 1] > row:
+            chars = chars if chars is not None else list(text)
+            _blank(chars, m.start(), m.end())
     return text if chars is None else "".join(chars)
 
 
