@@ -188,19 +188,34 @@ def test_generated_derivation_with_one_term_altered(tmp_path):
 
 BAD = {
     "no-equation.md": ("---\nrobot: rp-arm\n---\nJust prose, $x$ inline.\n", "no step"),
-    "unknown-symbol.md": (
-        "---\nrobot: rp-arm\n---\n\n$$\\tau_2 = k_7 \\ddot{d}_2$$\n",
-        ":5: tau_2: unknown symbol k_{7}",
-    ),
-    "short-vector.md": (
-        "---\nrobot: rp-arm\n---\n$$\\omega_1^1 = \\begin{pmatrix} 0 \\\\ 0 \\end{pmatrix}$$\n",
-        ":4: omega_1 must be a vector of 3 components",
-    ),
-    "no-link.md": ("---\nrobot: rp-arm\n---\n$$F_5^5 = \\mathbf{0}$$\n", ":4: F_5 names link 5"),
     "front.md": ("---\nrobot: [rp-arm\n---\n$$\\tau_1 = 0$$\n", "malformed YAML"),
     "robot.md": ("---\nrobot: no-such-arm\n---\n$$\\tau_1 = 0$$\n", "no-such-arm"),
     "alias.yaml": ("robot: rp-arm\nx: &a [1, 2]\ny: *a\nsteps: {T: '0'}\n", "aliases"),
 }
+
+
+#: an equation that names a step but cannot be graded: one unrecognised line, the rest graded
+#: (before, each of these refused the whole file)
+UNGRADABLE = {
+    "unknown-symbol.md": ("\n$$\\tau_2 = k_7 \\ddot{d}_2$$\n", ":5:12: tau_2: unknown symbol k_{7}"),
+    "short-vector.md": (
+        "$$\\omega_1^1 = \\begin{pmatrix} 0 \\\\ 0 \\end{pmatrix}$$\n",
+        ":4:16: omega_1 must be a vector of 3 components",
+    ),
+    "no-link.md": ("$$F_5^5 = \\mathbf{0}$$\n", ":4: F_5 names link 5"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(UNGRADABLE))
+def test_an_equation_that_cannot_be_graded_is_one_unrecognised_line(tmp_path, capsys, name):
+    text, expected = UNGRADABLE[name]
+    path = tmp_path / name
+    path.write_text("---\nrobot: rp-arm\n---\n" + text + "\n$$\\tau_1 = 0$$\n")
+    code, out, err = run(capsys, "grade", path)
+    assert code == 1 and err == ""
+    bad = [t for t in out.split("\n") if "unrecognised:" in t]
+    assert len(bad) == 1 and f"{path}{expected}" in bad[0], out
+    assert any("τ_1" in t and "wrong" in t for t in out.split("\n")), out  # the other equation graded
 
 
 @pytest.mark.parametrize("name", sorted(BAD))

@@ -266,11 +266,14 @@ def test_large_difference_falls_back_unsimplified_with_a_note(tmp_path):
 
 
 def test_json_error_object_on_bad_input(tmp_path, capsys):
-    path = write(tmp_path, "bad.md", "\n$$F_5^5 = \\mathbf{0}$$\n")
+    # nothing can be graded (the front matter cannot be read); before, a link the robot
+    # does not have (F_5^5 = 0) refused the whole file: it is one unrecognised step now
+    text = "<!-- a comment -->\n---\nrobot: rp-arm\nmethod: [newton\n---\n$$\\tau_1 = 0$$\n"
+    path = write(tmp_path, "bad.md", text, header="")
     code, out, err = run(capsys, "grade", path, "--json")
     assert code == 2 and err == ""
     data = json.loads(out)
-    assert data["file"] == str(path) and data["line"] == 5 and "F_5 names link 5" in data["error"]
+    assert data["file"] == str(path) and data["line"] == 5 and "malformed YAML" in data["error"]
     assert set(data) == {"error", "file", "line", "column"}
 
 

@@ -111,12 +111,12 @@ def _front_matter(path: str) -> tuple[dict, str | None]:
         line = raw[: exc.start].count(b"\n") + 1
         return {}, f"{path}:{line}: not UTF-8 text (byte {exc.start + 1})"
     if path.lower().endswith(".md"):
-        if not text.startswith("---"):
+        from ..grading.display import front_matter
+
+        front = front_matter(text)  # after blank lines or comments too, as the grader reads it
+        if front is None or front[1] < 0:
             return {}, None
-        end = re.search(r"^---\s*$", text[3:], re.MULTILINE)
-        if end is None:
-            return {}, None
-        text = text[3 : 3 + end.start()]
+        text = text[front[0] : front[1]]
     try:
         data = yaml.safe_load(text)
     except (yaml.YAMLError, RecursionError, ValueError):

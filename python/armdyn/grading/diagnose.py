@@ -35,8 +35,12 @@ def hint(problem: str) -> str:
     return ""
 
 
-def unreadable(path: str, line: int, column: int, problem: str) -> str:
-    """``path:line:column: cannot read the value: <problem> (hint: ...)``, one line."""
-    where = f"{path}:{line}:{column}" if column else f"{path}:{line}"
+def location(path: str, line: int, column: int) -> str:
+    """``path:line:column`` (``path:line`` when the column is not known)."""
+    return f"{path}:{line}:{column}" if column else f"{path}:{line}"
+
+
+def cannot_read(problem: str) -> str:
+    """``cannot read the value: <problem> (hint: ...)``."""
     extra = hint(problem)
-    return f"{where}: cannot read the value: {problem}" + (f" (hint: {extra})" if extra else "")
+    return f"cannot read the value: {problem}" + (f" (hint: {extra})" if extra else "")

@@ -15,7 +15,7 @@ import sympy as sp
 from ..errors import ModelError
 from ..model import Robot
 from ..symbolic.names import latex_symbol_names
-from .diagnose import unreadable
+from .diagnose import cannot_read, location
 from .energy_steps import EnergySteps
 from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, tidy
@@ -78,6 +78,8 @@ class _Grader(EnergySteps):
         self._worlds: dict = {}
         self.verdicts: list[StepVerdict] = []
         self.notes: list[str] = []
+        self.refusals: list[tuple[str, str]] = []  # (file:line:column, why) of equations not graded
+        self._primes_noted = False
 
     def world(self, name: str) -> World:
         if name not in self._worlds:
@@ -105,15 +107,25 @@ class _Grader(EnergySteps):
             )
         )
 
-    def where(self, eq) -> str:
-        return f"{self.sub.path}:{eq.line}"
+    def _locate(self, eq, pos: int | None) -> tuple[int, int]:
+        """(line, column) of offset ``pos`` in ``eq``'s value (its start if not known)."""
+        if pos is not None and eq.offset >= 0 and isinstance(eq.value, str):
+            return self.sub.locate(eq.offset_of(pos))
+        return eq.line, eq.column
 
     def _unreadable(self, eq, problem: str, pos: int | None = None) -> str:
         """The message for an equation that cannot be read: file:line:column, a hint."""
-        line, column = eq.line, eq.column
-        if pos is not None and eq.offset >= 0 and isinstance(eq.value, str):
-            line, column = self.sub.locate(eq.offset + pos)
-        return unreadable(self.sub.path, line, column, problem)
+        return self._refuse(eq, cannot_read(problem), pos)
+
+    def _refuse(self, eq, problem: str, pos: int | None = None, column: bool = True) -> str:
+        """The message for an equation that names a step but cannot be graded (a link
+        the robot does not have, a value of the wrong shape, an unknown symbol):
+        ``file:line:column: problem`` (no column: the left-hand side is the problem).
+        Kept in :attr:`refusals` (the file's error when nothing else can be graded)."""
+        line, col = self._locate(eq, pos)
+        where = location(self.sub.path, line, col if column else 0)
+        self.refusals.append((where, problem))
+        return f"{where}: {problem}"
 
     def value(self, eq, ref: StepRef):
         if eq.problem:
@@ -136,20 +148,28 @@ class _Grader(EnergySteps):
                 ]
                 value = se.DenseMatrix(len(parsed), 1, parsed) if isinstance(raw, list) else parsed[0]
         except UnknownSymbol as err:
-            raise ModelError(f"{ref.name}: {err}", source=self.where(eq)) from None
+            return None, self._refuse(eq, f"{ref.name}: {err}", err.pos)
         except ModelError as err:
-            if "unknown parameter" in err.message:
-                raise ModelError(f"{ref.name}: {err.message}", source=self.where(eq)) from None
-            return None, err.message
+            return None, self._refuse(eq, f"{ref.name}: {err.message}")
         except LatexError as err:
             return None, self._unreadable(eq, str(err), err.pos)
         except RecursionError:
             return None, self._unreadable(eq, "nested too deeply to read")
         except (TypeError, ValueError) as err:
             return None, self._unreadable(eq, str(err).split("\n")[0][:200])
-        return self._shape(value, ref, eq), None
+        if eq.latex and "'" in str(eq.value) and not self._primes_noted:
+            self._primes_noted = True
+            self.notes.append(
+                "a prime on a joint coordinate (\\theta_1') read as its time derivative (\\dot{\\theta}_1)"
+            )
+        shaped = self._shape(value, ref)
+        if isinstance(shaped, str):
+            return None, self._refuse(eq, shaped)
+        return shaped, None
 
-    def _shape(self, value, ref: StepRef, eq):
+    def _shape(self, value, ref: StepRef):
+        """``value`` in the shape ``ref`` has (a 3-vector, a 3x3 matrix, a scalar), or why
+        it cannot be (a str)."""
         if ref.by_shape or ref.key in MODEL_KEYS or ref.key in ("Lang", "tau_vec"):
             return to_sympy(value)  # shaped where it is read (vocabulary.by_shape, lagrange_terms)
         vector = ref.key in VECTOR_KEYS or ref.key in ("P", "Pc")
@@ -165,34 +185,23 @@ class _Grader(EnergySteps):
             value = to_sympy(value)
         if isinstance(value, se.DenseMatrix):
             if value.shape != want:
-                raise ModelError(
-                    f"{ref.name} must be a vector of 3 components, but it has {value.shape[0]}", source=self.where(eq)
-                )
+                return f"{ref.name} must be a vector of 3 components, but it has {value.shape[0]}"
             return value
         if want is None:
             if isinstance(value, sp.MatrixBase):
                 if value.shape == (1, 1):
                     return value[0, 0]
-                raise ModelError(
-                    f"{ref.name} is a scalar, but the value is a {value.shape[0]}x{value.shape[1]} matrix",
-                    source=self.where(eq),
-                )
+                return f"{ref.name} is a scalar, but the value is a {value.shape[0]}x{value.shape[1]} matrix"
             return value
         if not isinstance(value, sp.MatrixBase):
             if value == 0:
                 return sp.zeros(*want)
-            raise ModelError(
-                f"{ref.name} is a {'vector' if vector else '3x3 matrix'}, but the value is a scalar",
-                source=self.where(eq),
-            )
+            return f"{ref.name} is a {'vector' if vector else '3x3 matrix'}, but the value is a scalar"
         if vector and value.shape == (1, 3):
             value = value.T
         if value.shape != want:
             kind = "vector of 3 components" if vector else "3x3 matrix"
-            raise ModelError(
-                f"{ref.name} must be a {kind}, but it has shape {value.shape[0]}x{value.shape[1]}",
-                source=self.where(eq),
-            )
+            return f"{ref.name} must be a {kind}, but it has shape {value.shape[0]}x{value.shape[1]}"
         return value
 
     # -- grading
@@ -264,7 +273,10 @@ class _Grader(EnergySteps):
         )
         if method not in seen_methods:
             seen_methods.append(method)
-        self._check_index(ref, eq)
+        problem = self._check_index(ref)
+        if problem:
+            self._unrecognised(eq, self._refuse(eq, problem, column=False), name=ref.name, key=ref.key)
+            return
         value, problem = self.value(eq, ref)
         if value is None:
             self._unrecognised(eq, problem, name=ref.name, key=ref.key)
@@ -283,11 +295,10 @@ class _Grader(EnergySteps):
                 self.symbols.steps[name] = own_value
 
     def _report(self, seen_methods: list, method_hint: str | None) -> GradeReport:
-        recognised = [v for v in self.verdicts if v.key]  # a step named, even if its value was unreadable
-        unread = [v for v in self.verdicts if v.status == "unrecognised" and "cannot read" in v.message]
-        if not recognised and unread:  # nothing graded: the reason is the unreadable equation
-            raise ModelError(unread[0].message.split(": ", 1)[1], source=unread[0].message.split(": ", 1)[0])
-        if not recognised:
+        if not any(v.key for v in self.verdicts):  # no equation names a step: nothing to grade
+            if self.refusals:  # the reason is the first equation that could not be read
+                where, why = self.refusals[0]
+                raise ModelError(why, source=where)
             raise ModelError(
                 "no step of Newton-Euler or Lagrange recognised (expected equations such as "
                 "\\omega_1^1 = ..., F_2^2 = ..., \\tau_1 = ..., T = ...)",
@@ -296,7 +307,7 @@ class _Grader(EnergySteps):
         first_wrong = next((v.name for v in self.verdicts if v.status == "wrong"), None)
         tau_correct = [False] * self.robot.dof
         for v in self.verdicts:
-            if v.key == "tau":
+            if v.key == "tau" and 1 <= int(v.name.split("_")[1]) <= self.robot.dof:  # tau_3 of 2: unrecognised
                 tau_correct[int(v.name.split("_")[1]) - 1] = v.status in (*PASSING, "correct-but-unsupported")
         if self.symbols.used_gravity_magnitude:
             self.notes.append("g read as the magnitude of the model's gravity vector")
@@ -313,7 +324,8 @@ class _Grader(EnergySteps):
             shorthand=dict(self.symbols.shorthand),
         )
 
-    def _check_index(self, ref: StepRef, eq):
+    def _check_index(self, ref: StepRef) -> str | None:
+        """Why ``ref`` names a link, joint or frame the robot does not have, or None."""
         n = len(self.robot.links) - 1
         if ref.key in VECTOR_KEYS:
             if (
@@ -321,33 +333,24 @@ class _Grader(EnergySteps):
                 or not 0 <= ref.index <= n
                 or (ref.index == 0 and ref.key not in ("omega", "omega_dot", "v_dot"))
             ):
-                raise ModelError(
-                    f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}",
-                    source=self.where(eq),
-                )
+                return f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}"
             if ref.frame is not None and not 0 <= ref.frame <= n:
-                raise ModelError(
+                return (
                     f"{ref.name} is written in frame {ref.frame}, which '{self.robot.name}' does not "
-                    f"have (frames 0..{n})",
-                    source=self.where(eq),
+                    f"have (frames 0..{n})"
                 )
         elif ref.key in ("P", "Pc"):
             if not 1 <= ref.index <= n:  # type: ignore[operator]
-                raise ModelError(
-                    f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}",
-                    source=self.where(eq),
-                )
+                return f"{ref.name} names link {ref.index}, but '{self.robot.name}' has links 1..{n}"
             if ref.frame is not None and not 0 <= ref.frame <= n:
-                raise ModelError(f"{ref.name}: frame {ref.frame} does not exist (frames 0..{n})", source=self.where(eq))
+                return f"{ref.name}: frame {ref.frame} does not exist (frames 0..{n})"
         elif ref.key == "R":
             for k in (ref.index, ref.frame):
                 if k is None or not 0 <= k <= n:
-                    raise ModelError(f"{ref.name}: frame {k} does not exist (frames 0..{n})", source=self.where(eq))
+                    return f"{ref.name}: frame {k} does not exist (frames 0..{n})"
         elif ref.index is not None and not 1 <= ref.index <= self.robot.dof:
-            raise ModelError(
-                f"{ref.name} names joint {ref.index}, but '{self.robot.name}' has joints 1..{self.robot.dof}",
-                source=self.where(eq),
-            )
+            return f"{ref.name} names joint {ref.index}, but '{self.robot.name}' has joints 1..{self.robot.dof}"
+        return None
 
     def _rotation(self, ref: StepRef, eq, value):
         ctx = self.world("newton-euler").ctx

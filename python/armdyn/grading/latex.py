@@ -16,9 +16,13 @@ symbols to the model's (or refuses them)::
     matrix  := "\\begin{pmatrix}" cell ("&" cell)* ("\\\\" ...)* "\\end{pmatrix}"  (also
                bmatrix, matrix, Bmatrix, vmatrix: rows by \\\\, cells by &)
 
-Functions: \\sin \\cos \\tan \\exp \\ln \\log; ``\\sin\\theta_1`` takes the next atom,
-``\\sin^2\\theta`` is ``(\\sin\\theta)^2``. A symbol reaches ``resolve`` as a
-:class:`Name` (letter or Greek name, number of dots, subscript and superscript as text).
+Functions: \\sin \\cos \\tan \\exp \\ln \\log (also ``\\operatorname{sin}``);
+``\\sin\\theta_1`` takes the next atom, ``\\sin^2\\theta`` is ``(\\sin\\theta)^2``. A symbol
+reaches ``resolve`` as a :class:`Name` (letter or Greek name, number of dots, subscript and
+superscript as text, and the scripts of ``{}^{2}_{1}R`` written before it). Primes
+(``\\theta_1'``) count as dots: time derivatives. ``x^2_1`` is ``(x_1)^2``. Colours, spacing
+and ``\\left.`` are dropped by the tokenizer; a ``{`` group starting with a sign after a
+term (``a {\\color{red} - b}``) is added, not multiplied (braces are invisible in LaTeX).
 """
 
 from __future__ import annotations
@@ -27,6 +31,9 @@ import re
 from dataclasses import dataclass
 
 import sympy as sp
+
+# the equations of a display block (split, sides): their own module, re-exported here
+from .equations import side_offsets, sides, split_equations  # noqa: F401
 
 #: nesting depth (parentheses, groups, fractions, matrices) beyond which input is refused
 MAX_DEPTH = 60
@@ -191,17 +198,28 @@ class Name:
     dots: int = 0
     sub: str = ""
     sup: str = ""
+    pre_sup: str = ""  # {}^{2}_{1}R: the scripts written before the name (a step's frames)
+    pre_sub: str = ""
 
     def latex(self) -> str:
         base = f"\\{self.base}" if self.base in GREEK else self.base
         if self.dots:
             base = "\\" + "d" * self.dots + "ot{" + base + "}"
         sub = f"_{{{self.sub}}}" if self.sub else ""
-        return base + sub
+        pre = ""
+        if self.pre_sup or self.pre_sub:
+            pre = (
+                "{}"
+                + (f"^{{{self.pre_sup}}}" if self.pre_sup else "")
+                + (f"_{{{self.pre_sub}}}" if self.pre_sub else "")
+            )
+        return pre + base + sub
 
 
 _TOKEN = re.compile(
-    r"\\begin\{(?P<begin>[A-Za-z*]+)\}(?:\{[^{}]*\})?"
+    r"(?P<skip>\\(?:color|textcolor)\s*\{[^{}]*\}|\\(?:left|right)\.|\\[hv]space\*?\{[^{}]*\}|~)"
+    r"|\\(?:operatorname|mathrm)\s*\{\s*(?P<fn>sin|cos|tan|exp|ln|log|sec|csc|cot)\s*\}"
+    r"|\\begin\{(?P<begin>[A-Za-z*]+)\}(?:\{[^{}]*\})?"
     r"|\\end\{(?P<end>[A-Za-z*]+)\}"
     r"|\\(?P<cmd>[A-Za-z]+|.)"
     r"|(?P<num>\d+(?:\.\d*)?|\.\d+)"
@@ -212,16 +230,18 @@ _TOKEN = re.compile(
 
 
 def tokenize(text: str, positions: list | None = None) -> list[tuple[str, str]]:
-    """Tokens ``(kind, value)``: kind is begin, end, cmd, num or char; spaces and sizing
-    commands dropped. ``positions``, if given, receives each token's offset in ``text``."""
+    """Tokens ``(kind, value)``: kind is begin, end, cmd, num or char; spaces, sizing
+    commands and colours (``\\color{red}``, ``\\textcolor{red}``) dropped. ``positions``, if given, receives each token's offset in ``text``."""
     if len(text) > MAX_LENGTH:
         raise LatexError(f"equation too long ({len(text)} characters, at most {MAX_LENGTH})")
     out = []
     for m in _TOKEN.finditer(text):
         kind = m.lastgroup
-        if kind == "space":
+        if kind in ("space", "skip"):  # \color{red}, \left., ~: how it looks, not what it says
             continue
         value = m.group(kind)
+        if kind == "fn":  # \operatorname{sin}: \sin
+            kind = "cmd"
         if kind == "cmd" and (value in SPACES or value in SIZES):
             continue
         if kind == "num" and len(value) > MAX_DIGITS:
@@ -290,6 +310,8 @@ class _Parser:
             if err.pos is None:
                 err.pos = self.at(self.i)
             raise
+        while self.peek() in (("char", "."), ("char", ","), ("char", ";")):  # the sentence's end
+            self.take()
         if self.peek()[0] != "eof":
             raise LatexError(f"unexpected '{self.peek()[1]}'", self.at(self.i))
         return value
@@ -300,7 +322,10 @@ class _Parser:
         while self.peek() in (("char", "+"), ("char", "-")):
             sign *= -1 if self.take()[1] == "-" else 1
         value = sign * self.term()
-        while self.peek() in (("char", "+"), ("char", "-")):
+        while self.peek() in (("char", "+"), ("char", "-")) or self._signed_group():
+            if self._signed_group():  # a {\color{red} - b} term: the sign is inside
+                value = value + self.term()
+                continue
             op = self.take()[1]
             nxt = self.term()
             value = value + nxt if op == "+" else value - nxt
@@ -317,9 +342,14 @@ class _Parser:
             return value not in ("right", "end", "\\", "cdot", "times", "}", "&") and value != "rbrace"
         return False
 
+    def _signed_group(self) -> bool:
+        """Is a ``{`` group starting with a sign next (``a {- b}``: braces are invisible in
+        LaTeX, so that reads a - b, as a colour or an underbrace around a term writes it)?"""
+        return self.peek() == ("char", "{") and self.peek(1) in (("char", "+"), ("char", "-"))
+
     def term(self):
         value = self.factor()
-        while True:
+        while not self._signed_group():
             kind, tok = self.peek()
             if (kind, tok) in (("char", "*"), ("cmd", "cdot"), ("cmd", "times"), ("cmd", "ast")):
                 self.take()
@@ -331,6 +361,7 @@ class _Parser:
                 value = value * self.factor()
             else:
                 return value
+        return value
 
     def factor(self):
         self.enter()  # a^b^c...: each exponent nests one level
@@ -423,6 +454,8 @@ class _Parser:
                 self.take()
                 if self.peek() == ("char", "}"):  # an empty group, e.g. {}^{1}
                     self.take()
+                    if self.peek() in (("char", "^"), ("char", "_")):
+                        return self._prescripted()
                     return sp.Integer(1)
                 value = self.expr()
                 self.expect("char", "}")
@@ -445,11 +478,24 @@ class _Parser:
                     self.take()
                     return value
                 raise LatexError(f"unsupported bracket \\left{opener}")
+            if tok in ("underbrace", "overbrace", "boxed"):  # a term's label or frame: the term is read
+                self.take()
+                value = self._braced()
+                if tok != "boxed" and self.peek() in (("char", "_"), ("char", "^")):
+                    self.take()
+                    self.group_text()  # the label, words or a name: not part of the value
+                return value
             if tok in ("frac", "dfrac", "tfrac"):
+                if self._derivative_fraction():
+                    raise LatexError(
+                        "a derivative written as a fraction (d/dt, \\partial): a value is read worked out, "
+                        "in the joint variables and parameters",
+                        self.at(self.i),
+                    )
                 self.take()
                 self.enter()
-                num = self._braced()
-                den = self._braced()
+                num = self._frac_arg()
+                den = self._frac_arg()
                 self.leave()
                 return num / den
             if tok == "sqrt":
@@ -469,6 +515,57 @@ class _Parser:
                 return value
             raise LatexError(f"unsupported command \\{tok}")
         raise LatexError("unexpected end of equation" if kind == "eof" else f"unexpected '{tok}'")
+
+    def _derivative_fraction(self) -> bool:
+        """Is the ``\\frac`` next ``\\frac{d}{dt}``, ``\\frac{\\mathrm{d}}{\\mathrm{d}t}`` or
+        ``\\frac{\\partial L}{\\partial q}`` (an operator, not a quotient)?"""
+
+        def starts_d(k: int, alone: bool) -> bool:  # the group at k starts with d, \mathrm{d}, \partial
+            if self.peek(k) != ("char", "{"):
+                return False
+            first = self.peek(k + 1)
+            if first == ("cmd", "partial"):
+                return True
+            if first == ("cmd", "mathrm"):
+                return self.peek(k + 2) == ("char", "{") and self.peek(k + 3) == ("char", "d")
+            after = self.peek(k + 2)  # d then a letter or a command: dt, d\theta (d_2 is a name)
+            letter = after[0] == "cmd" or after[0] == "char" and after[1].isalpha()
+            return first == ("char", "d") and (letter or alone and after == ("char", "}"))
+
+        return starts_d(1, True) and starts_d(1 + self._script_length(1), False)
+
+    def _prescripted(self):
+        """``{}^{2}_{1}R``: a name with its scripts written before it (a step's frames)."""
+        scripts, start = {"^": "", "_": ""}, self.at(self.i - 2)  # at the "{}"
+        while self.peek() in (("char", "^"), ("char", "_")) and not scripts[self.peek()[1]]:
+            mark = self.take()[1]
+            scripts[mark] = self.group_text()
+        kind, tok = self.peek()
+        if not (
+            kind == "char" and tok.isalpha() or kind == "cmd" and (tok in GREEK or tok in WRAPPERS or "dot" in tok)
+        ):
+            raise LatexError("scripts written before nothing ({}^{..} needs a name after it)", self.at(self.i))
+        return self._symbol(pre_sup=scripts["^"], pre_sub=scripts["_"], start=start)
+
+    def _frac_arg(self):
+        """A fraction's numerator or denominator: a group, or one digit or symbol (``\\frac12``)."""
+        kind, tok = self.peek()
+        if (kind, tok) == ("char", "{"):
+            return self._braced()
+        if kind == "num":
+            self.take()
+            if len(tok) > 1 and tok[1].isdigit():  # \frac12: the digits are two arguments
+                self.i -= 1
+                self.t[self.i] = ("num", tok[1:])
+                if self.i < len(self.positions):
+                    self.positions[self.i] += 1
+                return sp.Integer(tok[0])
+            return sp.Integer(tok) if tok.isdigit() else sp.Rational(tok)
+        if kind == "char" and tok.isalpha() or kind == "cmd" and tok in GREEK:
+            start = self.at(self.i)
+            _, base, _ = self._accented()
+            return self._resolve(Name(base), start)
+        return self._braced()
 
     def _braced(self):
         self.expect("char", "{")
@@ -493,13 +590,72 @@ class _Parser:
     def symbol(self):
         """[accents/wrappers] name [_sub] -> resolve(Name). A ``^`` after it is an
         exponent, read by :meth:`factor`."""
+        return self._symbol()
+
+    def _symbol(self, pre_sup: str = "", pre_sub: str = "", start: int | None = None):
+        start = self.at(self.i) if start is None else start
         dots, base, sub = self._accented()
-        if base[0].isdigit():  # \mathbf{0}: a number in bold
+        if base[0].isdigit() and not (pre_sup or pre_sub):  # \mathbf{0}: a number in bold
             return sp.Rational(base)
+        primes = self._primes()
         if not sub and self.peek() == ("char", "_"):
             self.take()
             sub = self.group_text()
-        return self.resolve(Name(base, dots, sub))
+        primes += self._primes()
+        exponent, at = None, self.at(self.i)
+        if not sub and self.peek() == ("char", "^") and self.peek(self._script_length(1) + 1) == ("char", "_"):
+            self.take()  # \dot{\theta}^2_1: the power written before the subscript
+            exponent = self.script_value()
+            self.take()
+            sub = self.group_text()
+        name = Name(base, dots + primes, sub, pre_sup=pre_sup, pre_sub=pre_sub)
+        try:
+            value = self._resolve(name, start)
+        except UnknownSymbol as err:
+            if pre_sup or pre_sub:
+                raise UnknownSymbol(
+                    f"{name.latex()} names a step (its frames written before it): a value is read in the "
+                    "joint variables and parameters, not through an earlier step's name",
+                    start,
+                ) from None
+            if primes:
+                raise UnknownSymbol(f"{err} (a prime ' is read as a time derivative)", err.pos) from None
+            raise
+        return _power(value, exponent, at) if exponent is not None else value
+
+    def _primes(self) -> int:
+        """How many primes follow (``\\theta_1''``): each a time derivative."""
+        n = 0
+        while self.peek() == ("char", "'"):
+            self.take()
+            n += 1
+        return n
+
+    def _script_length(self, k: int) -> int:
+        """Tokens in the script starting ``k`` tokens ahead: a ``{...}`` group or one token."""
+        if self.peek(k) != ("char", "{"):
+            return 1
+        depth, n = 0, 0
+        while True:
+            tok = self.peek(k + n)
+            n += 1
+            if tok[0] == "eof":
+                return n
+            if tok == ("char", "{"):
+                depth += 1
+            elif tok == ("char", "}"):
+                depth -= 1
+                if depth == 0:
+                    return n
+
+    def _resolve(self, name: Name, start: int | None):
+        """``resolve(name)``; an unknown symbol's error points at where it starts."""
+        try:
+            return self.resolve(name)
+        except LatexError as err:
+            if err.pos is None:
+                err.pos = start
+            raise
 
     def _accented(self) -> tuple[int, str, str]:
         """(number of dots, base name, subscript written inside the braces) of an
@@ -608,115 +764,6 @@ def parse(text: str, resolve) -> sp.Expr | sp.Matrix:
     :class:`LatexError` carries ``pos``, the offset in ``text`` where reading stopped."""
     positions: list[int] = []
     return _Parser(tokenize(text, positions), resolve, positions, len(text)).parse()
-
-
-# ------------------------------------------------------------------ equations
-
-_OPEN = {"{": "}", "(": ")", "[": "]"}
-
-
-_MARKS = re.compile(r"\\(?:begin|end)\{[^}]*\}?|\\\\|\\[A-Za-z]+|\\.?|[{}()\[\]&,=]", re.S)
-
-
-def _top_level(text: str):
-    """Yield ``(index, mark)`` of the marks ``&``, ``,``, ``=`` and ``\\\\`` at nesting depth 0:
-    outside braces, brackets and matrix environments. One regular-expression pass over
-    the text (only the characters that matter are looked at in Python)."""
-    depth, env = 0, 0
-    for m in _MARKS.finditer(text):
-        tok = m.group(0)
-        c = tok[0]
-        if c == "\\":
-            if tok.startswith("\\begin{"):
-                env += 1
-            elif tok.startswith("\\end{"):
-                env -= 1
-            elif tok == "\\\\" and env == 0 and depth == 0:
-                yield m.start(), tok
-            continue
-        if c in "{([":
-            depth += 1
-        elif c in "})]":
-            depth -= 1
-        elif depth == 0 and env == 0:
-            yield m.start(), c
-
-
-def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str]]:
-    """Split a display-math block into equations: at top-level ``\\\\`` and at top-level
-    commas followed by another ``LHS = ...``. Returns ``(offset, text)`` pairs; alignment
-    ``&`` and environment wrappers (split, aligned, align, gather) are blanked out (so
-    offsets still point into ``block``). Linear in the block's length; ``limit``: stop
-    after that many equations (the caller refuses more)."""
-    text = re.sub(
-        r"\\(begin|end)\{(split|aligned|align\*?|gather\*?|equation\*?|alignedat)\}(\{\d+\})?",
-        lambda m: " " * len(m.group(0)),
-        block,
-    )
-    marks = [(i, c) for i, c in _top_level(text) if c in ("&", ",", "=", "\\\\")]  # one pass, depth 0
-    if any(c == "&" for _, c in marks):
-        chars = list(text)
-        for i, c in marks:
-            if c == "&":
-                chars[i] = " "
-        text = "".join(chars)
-    out: list[tuple[int, str]] = []
-    start = 0
-    pieces = [i for i, c in marks if c == "\\\\"] + [len(text)]
-    k = 0  # index into marks
-    for cut in pieces:
-        # segments of this piece at top-level commas, each flagged: has a top-level '='?
-        segments, s0, has_eq = [], start, False
-        while k < len(marks) and marks[k][0] < cut:
-            i, c = marks[k]
-            if c == ",":
-                segments.append((s0, i, has_eq))
-                s0, has_eq = i + 1, False
-            elif c == "=":
-                has_eq = True
-            k += 1
-        segments.append((s0, cut, has_eq))
-        cur_start, cur_end = segments[0][0], segments[0][1]
-        for seg_start, seg_end, seg_eq in segments[1:]:
-            if seg_eq:
-                out.append((cur_start, text[cur_start:cur_end]))
-                cur_start = seg_start
-            cur_end = seg_end
-            if limit is not None and len(out) > limit:
-                break
-        out.append((cur_start, text[cur_start:cur_end]))
-        start = cut + 2
-        if limit is not None and len(out) > limit:
-            break
-    result = []
-    for off, t in out:
-        stripped = t.strip().rstrip(".,;").strip()
-        if stripped:
-            result.append((off + (len(t) - len(t.lstrip())), stripped))
-    return result
-
-
-def _amps(text: str) -> set[int]:
-    return {i for i, c in _top_level(text) if c == "&"}
-
-
-def _has_top_equals(text: str) -> bool:
-    return any(c == "=" for _, c in _top_level(text))
-
-
-def side_offsets(equation: str) -> list[int]:
-    """Offsets where each side of ``A = B = C`` starts (0, then one past each top-level ``=``)."""
-    return [0] + [i + 1 for i, c in _top_level(equation) if c == "="]
-
-
-def sides(equation: str) -> list[str]:
-    """The sides of ``A = B = C`` split at top-level ``=`` (``\\leq`` etc. not split)."""
-    cuts = [i for i, c in _top_level(equation) if c == "="]
-    out, start = [], 0
-    for cut in cuts + [len(equation)]:
-        out.append(equation[start:cut].strip())
-        start = cut + 1
-    return out
 
 
 # ------------------------------------------------------------------ SymPy syntax

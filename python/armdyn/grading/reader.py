@@ -5,11 +5,14 @@ mapping) and the equations in the order written, each with its line number. The
 Markdown reader's output is exactly what a YAML submission states directly
 (:meth:`Submission.to_yaml` prints it), so the two formats grade alike.
 
-Markdown: an optional front matter between ``---`` lines at the top (YAML: ``robot``,
-``method``, ``symbols``), then any text; every ``$$ ... $$`` or ``\\[ ... \\]`` block is
-split into equations (at ``\\\\`` and at commas before another ``LHS = ...``), each with
-its line, the column where its value starts, and the part of the assignment it is in
-(:mod:`.parts`). Reading is linear in the file's size and bounded: at most
+Markdown: an optional front matter between ``---`` lines at the top (after blank lines
+or ``<!-- -->`` comments; YAML: ``robot``, ``method``, ``symbols``), then any text; every
+display block (``$$``, ``\\[``, ```` ```math ````, a bare ``align``... environment, a lone
+``$ ... $`` paragraph: :mod:`.display`) is split into equations (at ``\\\\`` and at
+separators before another ``LHS = ...``: :func:`.equations.split_equations`), each with its
+line, the column where its value starts, and the part of the assignment it is in
+(:mod:`.parts`). A row or block with no left-hand side that starts with ``=``, ``+`` or
+``-`` continues the equation before it (:func:`_continue`). Reading is linear in the file's size and bounded: at most
 :data:`MAX_BYTES` bytes and :data:`MAX_EQUATIONS` equations; an equation with an
 unbalanced brace is kept with ``problem`` naming the brace's line and column.
 
@@ -36,6 +39,7 @@ import yaml
 
 from ..errors import ModelError
 from ..io.yaml_screen import screen
+from .display import front_matter, regions
 
 #: a submission larger than this is refused (a derivation is a few kB)
 MAX_BYTES = 5_000_000
@@ -64,6 +68,17 @@ class Equation:
     problem: str = ""
     part: str | None = None
     task: str = ""
+    spans: tuple = ()  # (offset in value, offset in the file) of each piece of a joined value
+    rows: int = 1  # rows or blocks joined into this equation (see _continue)
+
+    def offset_of(self, pos: int) -> int:
+        """The file offset of character ``pos`` of ``value`` (a value joined from rows
+        or blocks written apart maps each piece to where it was written)."""
+        start, at = 0, self.offset
+        for piece_start, piece_offset in self.spans:
+            if piece_start <= pos:
+                start, at = piece_start, piece_offset
+        return at + pos - start
 
 
 @dataclass
@@ -179,46 +194,12 @@ def _front(meta, path: str, sub: Submission) -> None:
     sub.values = values
 
 
-_OPENER = re.compile(r"\$\$|\\\[")
-
-
-def math_blocks(text: str, start: int = 0):
-    """``(block_start, block_end, body_start, body)`` of each ``$$ ... $$`` / ``\\[ ... \\]``
-    block from ``start`` on. Linear: each closer is looked for once with ``str.find``,
-    and an opener that is never closed ends the search for that kind."""
-    openers = {"$$": "$$", "\\[": "\\]"}  # opener -> closer, for the kinds still possible
-    pos = start
-    while openers:
-        pattern = _OPENER if len(openers) == 2 else re.compile(re.escape(next(iter(openers))))
-        m = pattern.search(text, pos)
-        if m is None:
-            return
-        opener = m.group(0)
-        end = text.find(openers[opener], m.end())
-        if end < 0:  # never closed: no block of this kind from here on
-            del openers[opener]
-            pos = m.end()
-            continue
-        if end > m.end():
-            yield m.start(), end + 2, m.end(), text[m.end() : end]
-        pos = end + 2
-
-
 class LineIndex:
     """Line and column of any offset in a text, from one pass over its newlines
     (a bisection per lookup: reading stays linear in the file's size)."""
 
     def __init__(self, text: str):
         self.newlines = [m.start() for m in re.finditer("\n", text)]
-
-    parts: list = field(default_factory=list)  # the assignment's parts (.parts.Part), Markdown only
-
-    def part_at(self, line: int) -> tuple[str | None, str]:
-        """(part number or None, task title or "") of a 1-based line (see :mod:`.parts`)."""
-        from .parts import part_of
-
-        part = part_of(self.parts, line)
-        return (part.number, part.title) if part is not None else (None, "")
 
     def locate(self, offset: int) -> tuple[int, int]:
         k = bisect.bisect_left(self.newlines, offset)
@@ -249,102 +230,128 @@ def unbalanced_brace(text: str) -> tuple[int, str] | None:
 
 def read_markdown(path: str, text: str | None = None) -> Submission:
     """Read a Markdown derivation (see the module docstring)."""
-    from .latex import MAX_LENGTH, side_offsets, split_equations
     from .parts import find_parts, with_title
 
     text = read_text(path) if text is None else text
     index = LineIndex(text)
     sub = Submission(path, base_dir=os.path.dirname(os.path.abspath(path)), lines=index, text=text)
     body_start = 0
-    if text.startswith("---"):
-        end = re.search(r"^---\s*$", text[3:], re.M)
-        if end is None:
-            raise ModelError("front matter opened with '---' is never closed", source=f"{path}:1")
-        _front(safe_yaml(text[3 : 3 + end.start()], path), path, sub)
-        body_start = 3 + end.end()
+    front = front_matter(text)
+    if front is not None:
+        yaml_start, yaml_end, body_start = front
+        if yaml_end < 0:
+            raise ModelError(
+                "front matter opened with '---' is never closed", source=f"{path}:{index.line(yaml_start)}"
+            )
+        blank = "\n" * (index.line(yaml_start) - 1)  # YAML's error lines count from the file's top
+        _front(safe_yaml(blank + text[yaml_start:yaml_end], path), path, sub)
     hidden = set(range(1, index.line(body_start) + 1))  # front matter and display math: no headings there
-    for outer_start, outer_end, block_start, block in math_blocks(text, body_start):
+    for outer_start, outer_end, block_start, block in regions(text, body_start):
         hidden.update(range(index.line(outer_start), index.line(outer_end) + 1))
-        if len(block) > MAX_LENGTH:  # not split: one unreadable equation, refused in bounded time
-            line, col = index.locate(block_start)
-            sub.equations.append(
-                Equation(
-                    block[:40].strip(),
-                    block[:200],
-                    line,
-                    block[:200].strip(),
-                    column=col,
-                    offset=block_start,
-                    problem=f"display math too long ({len(block)} characters, at most {MAX_LENGTH})",
-                )
-            )
-            continue
-        for offset, eq in split_equations(block, limit=MAX_EQUATIONS):
-            start = block_start + offset
-            brace = unbalanced_brace(eq) if len(eq) <= MAX_LENGTH else None
-            if len(eq) > MAX_LENGTH:
-                line, col = index.locate(start)
-                sub.equations.append(
-                    Equation(
-                        eq[:40],
-                        eq[:200],
-                        line,
-                        eq[:200],
-                        column=col,
-                        offset=start,
-                        problem=f"equation too long ({len(eq)} characters, at most {MAX_LENGTH})",
-                    )
-                )
-                continue
-            if brace is not None:
-                at, what = brace
-                b_line, b_col = index.locate(start + at)
-                problem = (
-                    f"the '{{' opened at line {b_line}, column {b_col} is never closed"
-                    if what == "open"
-                    else f"the '}}' at line {b_line}, column {b_col} closes no '{{'"
-                )
-                lhs = eq.split("=", 1)[0].strip() if "=" in eq else eq[:40]
-                line, col = index.locate(start)
-                sub.equations.append(
-                    Equation(
-                        lhs,
-                        eq,
-                        line,
-                        " ".join(eq.split()),
-                        column=col,
-                        offset=start,
-                        problem=f"unbalanced brace: {problem}",
-                    )
-                )
-                continue
-            cuts = side_offsets(eq)
-            if len(cuts) < 2:
-                continue
-            lhs = eq[: cuts[1] - 1].strip()
-            value = eq[cuts[-1] :]
-            lead = len(value) - len(value.lstrip())
-            line, col = index.locate(start + cuts[-1] + lead)
-            sub.equations.append(
-                Equation(
-                    lhs,
-                    value.strip(),
-                    index.line(start),
-                    " ".join(eq.split()),
-                    column=col,
-                    offset=start + cuts[-1] + lead,
-                )
-            )
-            if len(sub.equations) > MAX_EQUATIONS:
-                raise ModelError(
-                    f"more than {MAX_EQUATIONS} equations (a derivation has a few dozen)",
-                    source=f"{path}:{index.line(start)}",
-                )
+        if block is not None:  # math, not code
+            _read_block(sub, index, block_start, block)
     lines = text.split("\n")
     sub.parts = [with_title(p, lines, hidden) for p in find_parts(text, index.line, lines, hidden)]
     for eq in sub.equations:
         eq.part, eq.task = sub.part_at(eq.line)
     return sub
+
+
+#: spacing before a row's content (``&\quad + ...``)
+_LEAD = re.compile(r"(?:\s|~|\\(?:quad|qquad|[,;:! ])|\\(?:hspace\*?|phantom|hphantom)\{[^{}]*\})*")
+
+
+def _read_block(sub: Submission, index: LineIndex, block_start: int, block: str) -> None:
+    """Append the equations of one display block to ``sub`` (a row or block that starts
+    with ``=``, ``+`` or ``-`` and has no left-hand side of its own continues the
+    equation before it)."""
+    from .equations import side_offsets, split_equations
+    from .latex import MAX_LENGTH
+
+    def unreadable(head: str, text: str, start: int, problem: str) -> None:
+        line, col = index.locate(start)
+        sub.equations.append(
+            Equation(head, text, line, " ".join(text.split()), column=col, offset=start, problem=problem)
+        )
+
+    if len(block) > MAX_LENGTH:  # not split: one unreadable equation, refused in bounded time
+        unreadable(
+            block[:40].strip(),
+            block[:200],
+            block_start,
+            f"display math too long ({len(block)} characters, at most {MAX_LENGTH})",
+        )
+        return
+    for offset, eq in split_equations(block, limit=MAX_EQUATIONS):
+        start = block_start + offset
+        if len(eq) > MAX_LENGTH:
+            unreadable(eq[:40], eq[:200], start, f"equation too long ({len(eq)} characters, at most {MAX_LENGTH})")
+            continue
+        brace = unbalanced_brace(eq)
+        if brace is not None:
+            at, what = brace
+            b_line, b_col = index.locate(start + at)
+            problem = (
+                f"the '{{' opened at line {b_line}, column {b_col} is never closed"
+                if what == "open"
+                else f"the '}}' at line {b_line}, column {b_col} closes no '{{'"
+            )
+            unreadable(eq.split("=", 1)[0].strip() if "=" in eq else eq[:40], eq, start, f"unbalanced brace: {problem}")
+            continue
+        cuts = side_offsets(eq)
+        lead = _LEAD.match(eq).end()
+        if eq.startswith("=", lead) or eq.startswith(("+", "-"), lead) and len(cuts) < 2:
+            _continue(sub, index, eq, start, cuts)
+            continue
+        if len(cuts) < 2:
+            continue
+        value = eq[cuts[-1] :]
+        skip = len(value) - len(value.lstrip())
+        line, col = index.locate(start + cuts[-1] + skip)
+        sub.equations.append(
+            Equation(
+                eq[: cuts[1] - 1].strip(),
+                value.strip(),
+                index.line(start),
+                " ".join(eq.split()),
+                column=col,
+                offset=start + cuts[-1] + skip,
+            )
+        )
+        if len(sub.equations) > MAX_EQUATIONS:
+            raise ModelError(
+                f"more than {MAX_EQUATIONS} equations (a derivation has a few dozen)",
+                source=f"{sub.path}:{index.line(start)}",
+            )
+
+
+#: rows (or blocks) continuing one equation beyond which it is refused (bounds the joining)
+MAX_ROWS = 200
+
+
+def _continue(sub: Submission, index: LineIndex, eq: str, start: int, cuts: list[int]) -> None:
+    """Join a row or block with no left-hand side (``= ...``, ``+ ...``) to the equation
+    before it: the value becomes its last right-hand side (``= ...``) or grows by it
+    (``+ ...``). Nothing before it to continue: not an equation (skipped). More than
+    :data:`MAX_ROWS` rows, or a joined value over ``MAX_LENGTH``: the equation is refused."""
+    from .latex import MAX_LENGTH
+
+    if not sub.equations or sub.equations[-1].problem or not isinstance(sub.equations[-1].value, str):
+        return
+    prev = sub.equations[-1]
+    prev.rows += 1
+    if prev.rows > MAX_ROWS or max(len(prev.value), len(prev.source)) + len(eq) > MAX_LENGTH:
+        prev.problem = f"more than {MAX_ROWS} rows or {MAX_LENGTH} characters continue this equation"
+        return
+    prev.source = f"{prev.source} {' '.join(eq.split())}"
+    if len(cuts) >= 2:  # "= b" or "= b = c": the last side is the value now
+        value = eq[cuts[-1] :]
+        skip = len(value) - len(value.lstrip())
+        prev.value, prev.offset, prev.spans = value.strip(), start + cuts[-1] + skip, ()
+        prev.column = index.locate(prev.offset)[1]
+        return
+    prev.spans = (*(prev.spans or ((0, prev.offset),)), (len(prev.value) + 1, start))
+    prev.value = f"{prev.value} {eq}"
 
 
 def read_yaml(path: str, text: str | None = None) -> Submission:

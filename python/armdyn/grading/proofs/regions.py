@@ -22,8 +22,8 @@ import bisect
 import re
 from dataclasses import dataclass
 
+from ..display import front_matter, math_blocks
 from ..latex import split_equations
-from ..reader import math_blocks
 
 _START = re.compile(r"\b(prove|proof|show that)\b", re.IGNORECASE)
 _KEEP_HEADING = re.compile(r"^\W*(solution|proof|answer|demonstration|step|case|lemma|claim)\b", re.IGNORECASE)
@@ -46,11 +46,8 @@ class Display:
 
 
 def _body_start(text: str) -> int:
-    if text.startswith("---"):
-        end = re.search(r"^---\s*$", text[3:], re.MULTILINE)
-        if end is not None:
-            return 3 + end.end()
-    return 0
+    front = front_matter(text)
+    return front[2] if front is not None else 0
 
 
 #: what a display line about a body's mass distribution has (a proof without a "Prove"):

@@ -1,0 +1,196 @@
+"""The equations of a display-math block: where it splits into equations (rows at
+``\\\\``, separators ``,`` ``;`` ``\\quad`` ``\\text{and}`` before another ``LHS = ...``),
+what is blanked out (alignment ``&``, environment wrappers, ``\\tag``, ``\\label``, a
+trailing ``\\text{for ...}``) and where the sides of ``A = B = C`` start. Everything here
+keeps offsets into the block (for line and column in messages) and is linear in its
+length: one regular-expression pass finds the marks at nesting depth 0.
+"""
+
+from __future__ import annotations
+
+import bisect
+import re
+
+_MARKS = re.compile(r"\\(?:begin|end)\{[^}]*\}?|\\\\|\\[A-Za-z]+|\\.?|[{}()\[\]&,;=]", re.S)
+
+
+def _top_level(text: str, commands: bool = False):
+    """Yield ``(index, mark)`` of the marks ``&``, ``,``, ``;``, ``=`` and ``\\\\`` at nesting
+    depth 0: outside braces, brackets and matrix environments (with ``commands``, also
+    every command there, ``\\quad``, ``\\text``...). One regular-expression pass over the
+    text (only the characters that matter are looked at in Python)."""
+    depth, env = 0, 0
+    for m in _MARKS.finditer(text):
+        tok = m.group(0)
+        c = tok[0]
+        if c == "\\":
+            if tok.startswith("\\begin{"):
+                env += 1
+            elif tok.startswith("\\end{"):
+                env -= 1
+            elif env == 0 and depth == 0 and (tok == "\\\\" or commands):
+                yield m.start(), tok
+            continue
+        if c in "{([":
+            depth += 1
+        elif c in "})]":
+            depth -= 1
+        elif depth == 0 and env == 0:
+            yield m.start(), c
+
+
+#: what a display block holds besides its equations: environment wrappers, tags and labels,
+#: a row's extra space (\\[2pt]); blanked out (offsets stay those of the block)
+_DROPPED = re.compile(
+    r"\\(?:begin|end)\{(?:split|aligned|align\*?|gather\*?|gathered|equation\*?|alignedat|alignat\*?|multline\*?"
+    r"|eqnarray\*?|flalign\*?)\}(?:\{\d+\})?"
+    r"|\\(?:tag\*?|label)\{[^{}]*\}|\\(?:nonumber|notag)\b"
+    r"|(?<=\\\\)\[\s*-?\d*\.?\d+\s*(?:pt|mm|cm|em|ex|in|bp)\s*\]"
+)
+#: prose in a display: \text{and} separates two equations, \text{for ...} ends one
+_PROSE = re.compile(r"\\(?:text|textrm|textit|textbf|mbox|mathrm)\s*\{([^{}]*)\}")
+_PAREN_PROSE = re.compile(r"\(\s*\\text\s*\{[^{}]*[A-Za-z]{2,}[^{}]*\}\s*\)")
+_JOINER = re.compile(r"\s*(?:and|,|;|und|&)?\s*", re.IGNORECASE)
+_SEPARATORS = (",", ";", "\\quad", "\\qquad")
+
+
+def _blank(chars: list[str], start: int, end: int) -> None:
+    chars[start:end] = " " * (end - start)
+
+
+def _prose_out(text: str) -> str:
+    """``text`` with its top-level prose handled: ``\\text{and}`` (``\\text{,}``...) becomes a
+    separator ``;``; a ``\\text{ for ...}`` with words after a value (``= v \\text{ for } ...``)
+    is a trailing condition or comment: blanked with the rest of its row. Offsets are kept."""
+    marks = list(_top_level(text, commands=True))
+    chars = None
+    rows = [i for i, c in marks if c == "\\\\"] + [len(text)]
+    blanked = -1  # blanked up to here already (each row's prose blanked once: linear)
+    equals = -1  # the last top-level '=' of the current row
+    for i, c in marks:
+        if c in ("=", "\\\\"):
+            equals = i if c == "=" else -1
+        if i < blanked or c not in ("\\text", "\\textrm", "\\textit", "\\textbf", "\\mbox", "\\mathrm"):
+            continue
+        m = _PROSE.match(text, i)
+        j = i - 1
+        while j >= 0 and text[j].isspace():
+            j -= 1
+        if m is None or j >= 0 and text[j] in "_^":  # a name's script (m_\text{link}): not prose
+            continue
+        chars = chars if chars is not None else list(text)
+        words = m.group(1)
+        if _JOINER.fullmatch(words):
+            _blank(chars, m.start(), m.end())
+            chars[m.start()] = ";"
+        elif c != "\\mathrm" and equals >= 0 and text[equals + 1 : i].strip() and re.search(r"[A-Za-z]{2,}", words):
+            # words after a value (not a left-hand side, not the value itself): a comment
+            blanked = rows[bisect.bisect_right(rows, i)]  # the end of its row
+            _blank(chars, m.start(), blanked)
+    equals_at = [i for i, c in marks if c == "="]
+    for m in _PAREN_PROSE.finditer(text):  # "= v (\text{Coriolis})": a comment in parentheses
+        k = bisect.bisect_right(rows, m.start())
+        row = rows[k - 1] if k else -1  # where its row starts (-1: the first row)
+        k = bisect.bisect_left(equals_at, m.start())
+        if k and equals_at[k - 1] > row:
+            chars = chars if chars is not None else list(text)
+            _blank(chars, m.start(), m.end())
+    return text if chars is None else "".join(chars)
+
+
+def _unboxed(text: str) -> str:
+    """``text`` with each top-level ``\\boxed{...}`` (a final answer framed) blanked to its
+    content, so the equation inside is split as any other. Each box's content is scanned
+    once (only top-level boxes: linear)."""
+    chars = list(text)
+    for i, c in list(_top_level(text, commands=True)):
+        if c != "\\boxed":
+            continue
+        j = i + len(c)
+        while j < len(text) and text[j].isspace():
+            j += 1
+        if j >= len(text) or text[j] != "{":
+            continue
+        depth, k = 0, j
+        while k < len(text):
+            if text[k] == "\\":
+                k += 2
+                continue
+            depth += {"{": 1, "}": -1}.get(text[k], 0)
+            if depth == 0:
+                _blank(chars, i, j + 1)
+                chars[k] = " "
+                break
+            k += 1
+    return "".join(chars)
+
+
+def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str]]:
+    """Split a display-math block into equations: at top-level ``\\\\`` and at top-level
+    ``,``, ``;``, ``\\quad``, ``\\qquad`` or ``\\text{and}`` followed by another
+    ``LHS = ...``. Returns ``(offset, text)`` pairs; alignment ``&``, environment wrappers
+    (split, aligned, align, gather, multline, eqnarray, alignat...), ``\\tag``,
+    ``\\label``, ``\\nonumber``, a ``\\boxed{..}`` frame and a trailing ``\\text{ for ...}`` are blanked out (so
+    offsets still point into ``block``). Linear in the block's length; ``limit``: stop
+    after that many equations (the caller refuses more)."""
+    text = _DROPPED.sub(lambda m: " " * len(m.group(0)), block)
+    if "\\boxed" in text:
+        text = _unboxed(text)
+    if "\\" in text:
+        text = _prose_out(text)
+    marks = [(i, c) for i, c in _top_level(text, commands=True) if c in ("&", "=", "\\\\", *_SEPARATORS)]
+    if any(c == "&" for _, c in marks):
+        chars = list(text)
+        for i, c in marks:
+            if c == "&":
+                chars[i] = " "
+        text = "".join(chars)
+    out: list[tuple[int, str]] = []
+    start = 0
+    pieces = [i for i, c in marks if c == "\\\\"] + [len(text)]
+    k = 0  # index into marks
+    for cut in pieces:
+        # segments of this piece at top-level separators, each flagged: has a top-level '='?
+        segments, s0, has_eq = [], start, False
+        while k < len(marks) and marks[k][0] < cut:
+            i, c = marks[k]
+            if c in _SEPARATORS:
+                segments.append((s0, i, has_eq))
+                s0, has_eq = i + (1 if c in ",;" else len(c)), False
+            elif c == "=":
+                has_eq = True
+            k += 1
+        segments.append((s0, cut, has_eq))
+        cur_start, cur_end = segments[0][0], segments[0][1]
+        for seg_start, seg_end, seg_eq in segments[1:]:
+            if seg_eq:
+                out.append((cur_start, text[cur_start:cur_end]))
+                cur_start = seg_start
+            cur_end = seg_end
+            if limit is not None and len(out) > limit:
+                break
+        out.append((cur_start, text[cur_start:cur_end]))
+        start = cut + 2
+        if limit is not None and len(out) > limit:
+            break
+    result = []
+    for off, t in out:
+        stripped = t.strip().rstrip(".,;").strip()
+        if stripped:
+            result.append((off + (len(t) - len(t.lstrip())), stripped))
+    return result
+
+
+def side_offsets(equation: str) -> list[int]:
+    """Offsets where each side of ``A = B = C`` starts (0, then one past each top-level ``=``)."""
+    return [0] + [i + 1 for i, c in _top_level(equation) if c == "="]
+
+
+def sides(equation: str) -> list[str]:
+    """The sides of ``A = B = C`` split at top-level ``=`` (``\\leq`` etc. not split)."""
+    cuts = [i for i, c in _top_level(equation) if c == "="]
+    out, start = [], 0
+    for cut in cuts + [len(equation)]:
+        out.append(equation[start:cut].strip())
+        start = cut + 1
+    return out
