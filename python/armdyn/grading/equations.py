@@ -14,7 +14,7 @@ import re
 _MARKS = re.compile(r"\\(?:begin|end)\{[^}]*\}?|\\\\|\\[A-Za-z]+|\\.?|[{}()\[\]&,;=]", re.S)
 
 
-def _top_level(text: str, commands: bool = False):
+def top_level(text: str, commands: bool = False):
     """Yield ``(index, mark)`` of the marks ``&``, ``,``, ``;``, ``=`` and ``\\\\`` at nesting
     depth 0: outside braces, brackets and matrix environments (with ``commands``, also
     every command there, ``\\quad``, ``\\text``...). One regular-expression pass over the
@@ -62,7 +62,7 @@ def _prose_out(text: str) -> str:
     """``text`` with its top-level prose handled: ``\\text{and}`` (``\\text{,}``...) becomes a
     separator ``;``; a ``\\text{ for ...}`` with words after a value (``= v \\text{ for } ...``)
     is a trailing condition or comment: blanked with the rest of its row. Offsets are kept."""
-    marks = list(_top_level(text, commands=True))
+    marks = list(top_level(text, commands=True))
     chars = None
     rows = [i for i, c in marks if c == "\\\\"] + [len(text)]
     blanked = -1  # blanked up to here already (each row's prose blanked once: linear)
@@ -103,7 +103,7 @@ def _unboxed(text: str) -> str:
     content, so the equation inside is split as any other. Each box's content is scanned
     once (only top-level boxes: linear)."""
     chars = list(text)
-    for i, c in list(_top_level(text, commands=True)):
+    for i, c in list(top_level(text, commands=True)):
         if c != "\\boxed":
             continue
         j = i + len(c)
@@ -138,7 +138,7 @@ def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str
         text = _unboxed(text)
     if "\\" in text:
         text = _prose_out(text)
-    marks = [(i, c) for i, c in _top_level(text, commands=True) if c in ("&", "=", "\\\\", *_SEPARATORS)]
+    marks = [(i, c) for i, c in top_level(text, commands=True) if c in ("&", "=", "\\\\", *_SEPARATORS)]
     if any(c == "&" for _, c in marks):
         chars = list(text)
         for i, c in marks:
@@ -183,12 +183,12 @@ def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str
 
 def side_offsets(equation: str) -> list[int]:
     """Offsets where each side of ``A = B = C`` starts (0, then one past each top-level ``=``)."""
-    return [0] + [i + 1 for i, c in _top_level(equation) if c == "="]
+    return [0] + [i + 1 for i, c in top_level(equation) if c == "="]
 
 
 def sides(equation: str) -> list[str]:
     """The sides of ``A = B = C`` split at top-level ``=`` (``\\leq`` etc. not split)."""
-    cuts = [i for i, c in _top_level(equation) if c == "="]
+    cuts = [i for i, c in top_level(equation) if c == "="]
     out, start = [], 0
     for cut in cuts + [len(equation)]:
         out.append(equation[start:cut].strip())

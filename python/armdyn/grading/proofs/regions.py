@@ -76,11 +76,11 @@ def about_a_body(equation: str) -> bool:
 def several(equation: str) -> list[tuple[int, str]]:
     """``A = B \\qquad C = D`` -> [(0, "A = B"), (offset, "C = D")]: split at top-level
     separators when every piece has an ``=`` (else the line as it is)."""
-    from ..latex import _top_level
+    from ..equations import top_level
 
     if _SEPARATORS.search(equation) is None:
         return [(0, equation)]
-    equals = [i for i, c in _top_level(equation) if c == "="]  # in order
+    equals = [i for i, c in top_level(equation) if c == "="]  # in order
     depth_zero = _depth_zero(equation)
     cuts = [m for m in _SEPARATORS.finditer(equation) if depth_zero[m.start()]]
     pieces, start = [], 0

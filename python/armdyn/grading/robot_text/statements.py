@@ -10,9 +10,10 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ...errors import ModelError
+from ..display import math_blocks
 from ..latex import LatexError, Name, parse, sides, split_equations
 from ..notation import normalise, parse_lhs
-from ..reader import Equation, Submission, math_blocks, read_text
+from ..reader import Equation, Submission, read_text
 
 #: more frames than this are refused (a hand derivation has a handful)
 MAX_FRAMES = 24
