@@ -52,13 +52,13 @@ def _named_ref(text: str) -> StepRef | None:
     return None
 
 
-def _load_robot(name: str, sub: Submission) -> Robot:
+def _load_robot(name: str, sub: Submission, trusted: bool = False) -> Robot:
     from ..io import load
 
     candidate = os.path.join(sub.base_dir, name)
     source = candidate if os.path.isfile(candidate) else name
     try:
-        return load(source, strict=False)
+        return load(source, strict=False, trusted=trusted)
     except ModelError as err:
         raise err.located(source=sub.path) from None
 
@@ -567,7 +567,10 @@ def _matrix(value) -> sp.Matrix:
 
 
 def grade(
-    submission: str | os.PathLike[str] | Submission, robot: str | Robot | None = None, symbols: dict | None = None
+    submission: str | os.PathLike[str] | Submission,
+    robot: str | Robot | None = None,
+    symbols: dict | None = None,
+    trusted: bool = False,
 ) -> GradeReport:
     """Grade a derivation.
 
@@ -575,6 +578,8 @@ def grade(
     robot:      the model whose frames the student used (bundled name, model file or
                 Robot); default: the submission's front matter ``robot``.
     symbols:    extra mapping of the student's symbols to model names.
+    trusted:    the model named by ``robot`` may be a ``.xacro`` file (expanding one runs
+                its Python code); never applies to a model the front matter names.
     """
     sub = submission if isinstance(submission, Submission) else read(os.fspath(submission))
     if isinstance(robot, Robot):
@@ -583,7 +588,7 @@ def grade(
         name = robot or sub.robot
         if not name:
             raise ModelError("no robot named: give --robot MODEL or 'robot:' in the front matter", source=sub.path)
-        model = _load_robot(name, sub)
+        model = _load_robot(name, sub, trusted=bool(trusted and robot))
     if sub.values is not None:
         try:
             # the reader admits "published" or a mapping parameter -> number

@@ -1,0 +1,129 @@
+"""Findings of an independent security probe in the model readers, the grader's messages
+and class grading, each checked by what it must (not) do on disk, in a row of the
+gradebook or on a wall clock, never by armdyn's own output alone.
+
+* a ``.xacro`` model runs Python code when expanded: refused without an explicit opt-in,
+  and always in class grading (a real payload that creates a marker directory);
+* a wrong step whose difference is huge once expanded is described in bounded time;
+* gradebook cells are neutralised for ``,`` and ``;`` separated spreadsheets alike;
+* a student's identity is the file's name, never the text's; report names never
+  collide; symbolic links in a class folder are not followed;
+* the parent's warm-up of a shared model runs under a submission's limits;
+* every text file is read through one bounded reader.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+import armdyn
+from armdyn.cli import main
+from armdyn.errors import ModelError
+
+PYTHON_ENV = {**os.environ, "PYTHONPATH": str(Path(armdyn.__file__).resolve().parents[1])}
+
+# ------------------------------------------------------------------ F1: .xacro runs code
+
+#: a one-joint robot whose ``${...}`` reach ``os`` through xacro's own namespace with
+#: string keys only (no ``__`` name in the compiled code, so xacro's filter passes it)
+#: and create the directory MARKER; the robot itself is a valid URDF once expanded
+PAYLOAD = """<?xml version="1.0"?>
+<robot name="evil" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:property name="d" value="${python.vars(python.type(xacro.arg))['__globals__']}"/>
+  <xacro:property name="g" value="${python.vars(python.type(d))['__get__'](d, xacro.arg)}"/>
+  <link name="base${g['os'].mkdir('MARKER') or ''}"/>
+  <link name="l1"><inertial><origin xyz="0 0 0.2" rpy="0 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.002"/></inertial></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/>
+    <origin xyz="0 0 0.1" rpy="0 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="-2" upper="2" effort="5" velocity="3"/></joint>
+</robot>
+"""
+
+
+def _payload(folder: Path, name: str = "attachment.xacro") -> tuple[Path, Path]:
+    """(the .xacro file, the marker it would create) in ``folder``."""
+    marker = folder.parent / f"MARKER-{folder.name}"
+    path = folder / name
+    path.write_text(PAYLOAD.replace("MARKER", str(marker)))
+    return path, marker
+
+
+def _submission(robot: str) -> str:
+    return f"---\nrobot: {robot}\nmethod: newton-euler\n---\n$$\\tau_1 = m_1 g$$\n"
+
+
+def test_the_payload_is_real_with_the_opt_in(tmp_path):
+    """The payload runs when trusted: the tests below would see it if it ran."""
+    pytest.importorskip("xacro")
+    path, marker = _payload(tmp_path)
+    robot = armdyn.load(path, trusted=True)
+    assert marker.is_dir() and robot.dof == 1
+
+
+def test_load_refuses_xacro_without_the_opt_in(tmp_path):
+    path, marker = _payload(tmp_path)
+    with pytest.raises(ModelError) as err:
+        armdyn.load(path)
+    assert str(path) in str(err.value) and "trusted=True" in str(err.value) and "--trust-xacro" in str(err.value)
+    for trusted in (0, 1.0, "yes", None):  # only True opts in
+        with pytest.raises(ModelError):
+            armdyn.load(path, trusted=trusted)
+    assert not marker.exists()
+
+
+def test_show_refuses_xacro_without_the_flag(tmp_path, capsys):
+    pytest.importorskip("xacro")
+    path, marker = _payload(tmp_path)
+    assert main(["show", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"armdyn: error: {path}: a .xacro file runs Python code") and "--trust-xacro" in err
+    assert not marker.exists()
+    assert main(["show", str(path), "--trust-xacro"]) == 0  # the documented opt-in
+    assert marker.is_dir()
+
+
+def test_grade_never_expands_a_xacro_the_submission_names(tmp_path, capsys):
+    pytest.importorskip("xacro")
+    path, marker = _payload(tmp_path)
+    sub = tmp_path / "alice.md"
+    sub.write_text(_submission(path.name))
+    for extra in ([], ["--trust-xacro"]):  # the flag trusts --robot only, never the front matter
+        assert main(["grade", str(sub), *extra]) == 2
+        assert "a .xacro file runs Python code" in capsys.readouterr().err
+        assert not marker.exists()
+    assert main(["grade", str(sub), "--json"]) == 2
+    assert "a .xacro file runs Python code" in capsys.readouterr().out
+    assert not marker.exists()
+    with pytest.raises(ModelError, match="runs Python code"):
+        armdyn.grade(sub, trusted=True)  # the API: trusted applies to robot= only
+    assert not marker.exists()
+    main(["grade", str(sub), "--robot", str(path), "--trust-xacro"])  # named by the teacher: runs
+    assert marker.is_dir()
+
+
+def test_class_grading_never_expands_a_xacro(tmp_path, capsys):
+    pytest.importorskip("xacro")
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    path, marker = _payload(subs)
+    for k in range(4):  # four submissions share it: the parent would warm it up
+        (subs / f"s{k}.md").write_text(_submission(path.name))
+    book = tmp_path / "grades.csv"
+    code = main(["grade", str(subs), "--gradebook", str(book), "--jobs", "1", "--no-cache"])
+    assert code == 1 and not marker.exists()
+    rows = json.loads(book.with_suffix(".json").read_text())["rows"]
+    assert len(rows) == 4 and all(r["status"] == "error" and "runs Python code" in r["error"] for r in rows)
+    capsys.readouterr()
+    assert main(["grade", str(subs), "--gradebook", str(book), "--trust-xacro"]) == 2
+    assert "--trust-xacro is refused for a class folder" in capsys.readouterr().err
+    assert not marker.exists()
