@@ -18,6 +18,7 @@ import csv
 import io
 import json
 import os
+import re
 import subprocess
 import sys
 import time
@@ -127,3 +128,35 @@ def test_class_grading_never_expands_a_xacro(tmp_path, capsys):
     assert main(["grade", str(subs), "--gradebook", str(book), "--trust-xacro"]) == 2
     assert "--trust-xacro is refused for a class folder" in capsys.readouterr().err
     assert not marker.exists()
+
+
+# ------------------------------------------------------------------ F7: CSV cells for , and ; spreadsheets
+
+HOSTILE_CELLS = [
+    "Ada;=cmd|' /C calc'!A0",
+    "=HYPERLINK(1)",
+    "b,@SUM(1)",
+    "c; +1",
+    "d;\t=1",
+    "e\n-2",
+    "f;;=x;-y",
+]
+
+
+@pytest.mark.parametrize("delimiter", [",", ";"])
+def test_no_gradebook_cell_opens_as_a_formula(delimiter):
+    """Split the CSV as a spreadsheet of either locale would (Python's csv module with
+    that delimiter, blanks at a cell's start ignored): no cell starts a formula."""
+    from armdyn.course.gradebook import Gradebook
+
+    items = [(name, "v1", None, f"error: x.md:1: {name}") for name in HOSTILE_CELLS]
+    text = Gradebook.from_results(items).to_csv()
+    cells = [c for row in csv.reader(io.StringIO(text), delimiter=delimiter) for c in row]
+    assert len(cells) > len(HOSTILE_CELLS)
+    for cell in cells:
+        for line in cell.splitlines() or [""]:
+            assert line.lstrip(" ")[:1] not in ("=", "+", "-", "@", "\t", "\r"), (delimiter, cell)
+    # and the comma-split cells still hold the text, behind the quotes
+    rows = list(csv.DictReader(io.StringIO(text)))
+    shown = [re.sub(r"'(?=[=+\-@\t\r])", "", r["student"]) for r in rows]  # the quotes added, removed
+    assert sorted(shown) == sorted(HOSTILE_CELLS)
