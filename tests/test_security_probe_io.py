@@ -160,3 +160,52 @@ def test_no_gradebook_cell_opens_as_a_formula(delimiter):
     rows = list(csv.DictReader(io.StringIO(text)))
     shown = [re.sub(r"'(?=[=+\-@\t\r])", "", r["student"]) for r in rows]  # the quotes added, removed
     assert sorted(shown) == sorted(HOSTILE_CELLS)
+
+
+# ------------------------------------------------------------------ F4: a wrong step's message is bounded
+
+#: 80 characters of LaTeX whose difference from the right tau_1 expands into 230 230 terms
+BLOW_UP = r"\tau_1 = (l_1\theta_1 + d_2 + \dot\theta_1 + \ddot\theta_1 + m_1 + m_2 + g)^{20}"
+
+
+def test_a_difference_that_expands_hugely_is_graded_in_seconds(tmp_path):
+    """Expanding or factoring the difference for the message took > 10 min and 730 MB;
+    now the step is judged (wrong: rp-arm's tau_1 is linear in the masses, the 20th
+    power is not) and the message shows the difference unsimplified, with the HTML
+    report, in seconds."""
+    sub = tmp_path / "pow.md"
+    sub.write_text(f"---\nrobot: rp-arm\n---\n$${BLOW_UP}$$\n")
+    t0 = time.monotonic()
+    done = subprocess.run(
+        [sys.executable, "-m", "armdyn", "grade", str(sub), "--json", "--html", str(tmp_path / "pow.html")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=PYTHON_ENV,
+    )
+    seconds = time.monotonic() - t0
+    assert done.returncode == 1, done.stderr  # graded: a step wrong
+    step = json.loads(done.stdout)["steps"][0]
+    assert step["status"] == "wrong" and "not simplified" in step["message"]
+    assert seconds < 30, seconds
+    assert (tmp_path / "pow.html").stat().st_size > 0
+
+
+def test_the_expansion_estimate_bounds_what_sympy_makes():
+    """expanded_terms against SymPy's own expansion (small cases) and the multinomial
+    count C(n + k - 1, k - 1) by hand (large ones)."""
+    import math
+
+    import sympy as sp
+
+    from armdyn.grading.explain import EXPAND_LIMIT, affordable, expanded_terms
+
+    a, b, c, d, x = sp.symbols("a b c d x")
+    for e in [(a + b + c) ** 3, (a + b) * (c + d) ** 2, sp.sin(a + b + c), sp.cos(x) ** 4 * (a + b), 1 / (a + b) ** 3]:
+        real = len(sp.Add.make_args(sp.expand(sp.expand_trig(e))))
+        assert real <= expanded_terms(e) <= EXPAND_LIMIT, e
+    seven = sum(sp.symbols("s1:8"))
+    assert math.comb(20 + 7 - 1, 7 - 1) == 230230 > EXPAND_LIMIT
+    assert expanded_terms(seven**20) == EXPAND_LIMIT + 1 and not affordable(seven**20)
+    assert expanded_terms(sp.exp(seven**20) + a) == EXPAND_LIMIT + 1  # inside a function too
+    assert affordable((a + b) ** 2 * sp.sin(x + a))
