@@ -209,3 +209,161 @@ def test_the_expansion_estimate_bounds_what_sympy_makes():
     assert expanded_terms(seven**20) == EXPAND_LIMIT + 1 and not affordable(seven**20)
     assert expanded_terms(sp.exp(seven**20) + a) == EXPAND_LIMIT + 1  # inside a function too
     assert affordable((a + b) ** 2 * sp.sin(x + a))
+
+
+# ------------------------------------------------------------------ F8: who handed it in
+
+
+def _class(folder: Path, files: dict[str, str]) -> Path:
+    folder.mkdir()
+    for name, text in files.items():
+        (folder / name).write_text(text)
+    return folder
+
+
+def _grade_class(subs: Path, tmp_path: Path, *extra: str) -> tuple[int, dict, str]:
+    book = tmp_path / "out" / "grades.csv"
+    book.parent.mkdir(exist_ok=True)
+    code = main(["grade", str(subs), "--gradebook", str(book), "--jobs", "1", "--no-cache", *extra])
+    rows = json.loads(book.with_suffix(".json").read_text())["rows"]
+    return code, rows, book
+
+
+RP = "---\nrobot: rp-arm\nmethod: newton-euler\n{extra}---\n$$\\tau_1 = 0$$\n"
+
+
+def test_the_file_names_the_student_not_the_text(tmp_path, capsys):
+    """alice.md saying student: bob used to be graded as bob, Bob's own file dropped as a
+    duplicate and Alice left without a row."""
+    subs = _class(tmp_path / "subs", {"alice.md": RP.format(extra="student: bob\n"), "bob.md": RP.format(extra="")})
+    code, rows, _ = _grade_class(subs, tmp_path)
+    err = capsys.readouterr().err
+    assert sorted((r["student"], r["status"]) for r in rows) == [("alice", "graded"), ("bob", "graded")]
+    assert f"armdyn: note: {subs / 'alice.md'}: the front matter says student 'bob'; graded as 'alice'" in err
+    assert code == 0
+
+
+def test_report_names_never_collide(tmp_path, capsys):
+    """'a b' and 'a_b' (and 'Ada', 'ada' on a case-blind disk) wrote one report for two."""
+    files = {n: RP.format(extra="") for n in ("a b.md", "a_b.md", "Ada.md", "ada.md")}
+    subs = _class(tmp_path / "subs", files)
+    code, rows, _ = _grade_class(subs, tmp_path, "--html-dir", str(tmp_path / "reports"))
+    err = capsys.readouterr().err
+    status = {r["student"]: r["status"] for r in rows}
+    assert status == {"Ada": "graded", "ada": "duplicate", "a b": "graded", "a_b": "duplicate"} and code == 1
+    assert sorted(p.name for p in (tmp_path / "reports").iterdir()) == ["Ada.html", "a_b.html"]
+    dup = {r["student"]: r["error"] for r in rows if r["status"] == "duplicate"}
+    assert str(subs / "a_b.md") in dup["a_b"] and str(subs / "a b.md") in dup["a_b"]
+    assert str(subs / "ada.md") in dup["ada"] and str(subs / "Ada.md") in dup["ada"]
+    assert "a_b.md" in err
+
+
+def test_links_and_paths_out_of_the_class_folder_are_not_followed(tmp_path, capsys):
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (outside / "eve.md").write_text(RP.format(extra=""))
+    (outside / "arm.yaml").write_text((Path(armdyn.io.ROBOTS_DIR) / "rp-arm.yaml").read_text())
+    subs = _class(
+        tmp_path / "subs",
+        {
+            "far.md": "---\nrobot: ../outside/arm.yaml\n---\n$$\\tau_1 = 0$$\n",
+            "abs.md": f"---\nrobot: {outside / 'arm.yaml'}\n---\n$$\\tau_1 = 0$$\n",
+            "linked.md": "---\nrobot: arm.yaml\n---\n$$\\tau_1 = 0$$\n",
+        },
+    )
+    (subs / "eve.md").symlink_to(outside / "eve.md")
+    (subs / "arm.yaml").symlink_to(outside / "arm.yaml")  # a model by link: not read either
+    code, rows, _ = _grade_class(subs, tmp_path)
+    err = capsys.readouterr().err
+    status = {r["student"]: (r["status"], r["error"]) for r in rows}
+    assert sorted(status) == ["abs", "far", "linked"] and code == 1  # no row for the link eve.md
+    for student in status:
+        assert status[student][0] == "error" and "a file directly in the class folder" in status[student][1]
+    assert f"armdyn: note: {subs / 'eve.md'}: a symbolic link, not followed (skipped)" in err
+    assert f"armdyn: note: {subs / 'arm.yaml'}: a symbolic link, not followed (skipped)" in err
+
+
+def test_the_roster_variant_wins_over_the_text(tmp_path):
+    from armdyn.course.batch import discover
+
+    variants = tmp_path / "variants"
+    for vid in ("alice", "bob", "v001"):
+        (variants / vid).mkdir(parents=True)
+        (variants / vid / "model.yaml").write_text("name: x\n")
+    subs = _class(
+        tmp_path / "subs",
+        {"alice.md": "---\nvariant: bob\n---\n", "carol.md": "---\nvariant: v001\n---\n"},
+    )
+    found = discover(subs, variants)
+    assert {t.student: t.variant for t in found.tasks} == {"alice": "alice", "carol": "v001"}
+    assert found.notes == [
+        f"{subs / 'alice.md'}: the front matter says variant 'bob'; graded against 'alice' (the roster's)"
+    ]
+
+
+# ------------------------------------------------------------------ F9: the parent's warm-up is bounded
+
+
+def test_the_warm_up_of_a_shared_model_keeps_the_time_limit(tmp_path):
+    """Three submissions naming the 7-dof iiwa14 made the parent derive and typeset it
+    first with no limit (minutes with --timeout 5); now it is tried in a child under the
+    same limit, given up with a note, and the batch ends in about the limit per file."""
+    subs = _class(tmp_path / "subs", {f"s{k}.md": "---\nrobot: iiwa14\n---\n$$\\tau_1 = 0$$\n" for k in range(3)})
+    book = tmp_path / "grades.csv"
+    t0 = time.monotonic()
+    done = subprocess.run(
+        [sys.executable, "-m", "armdyn", "grade", str(subs), "--gradebook", str(book)]
+        + ["--timeout", "3", "--jobs", "1", "--no-cache"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=PYTHON_ENV,
+    )
+    seconds = time.monotonic() - t0
+    assert done.returncode in (0, 1), done.stderr
+    assert "armdyn: note: iiwa14: not warmed up (timeout: more than 3 s)" in done.stderr
+    assert seconds < 60, seconds
+    rows = json.loads(book.with_suffix(".json").read_text())["rows"]
+    assert len(rows) == 3
+
+
+# ------------------------------------------------------------------ one bounded text reader
+
+
+@pytest.mark.parametrize("kind", ["fifo", "device"])
+def test_a_submission_or_model_that_is_no_regular_file_is_refused_at_once(tmp_path, kind):
+    """A FIFO blocked the reader for ever; /dev/zero has size 0 and never ends."""
+    for name in ("sub.md", "model.urdf", "model.yaml", "roster.csv"):
+        path = tmp_path / f"{kind}-{name}"
+        if kind == "fifo":
+            os.mkfifo(path)
+        else:
+            path.symlink_to("/dev/zero")
+        if name == "sub.md":
+            args = ["grade", str(path)]
+        elif name == "roster.csv":
+            args = ["exercise", "make", "rp", "--roster", str(path), "--out", str(tmp_path / "ex")]
+        else:
+            args = ["show", str(path)]
+        done = subprocess.run(
+            [sys.executable, "-m", "armdyn", *args], capture_output=True, text=True, timeout=60, env=PYTHON_ENV
+        )
+        assert done.returncode == 2, (name, done.stderr)
+        assert f"{path}: cannot read the " in done.stderr and "not a regular file" in done.stderr, done.stderr
+
+
+def test_one_reader_for_every_text_file():
+    """The submission reader, the course's roster and rubric readers and the model readers
+    are the one function; no other module measures a file's size itself."""
+    from armdyn.course import exercise, rubric
+    from armdyn.grading import reader
+    from armdyn.io import textfile, yaml
+
+    assert exercise.read_text is rubric.read_text is yaml.read_text is textfile.read_text
+    assert reader.textfile is textfile
+    root = Path(armdyn.__file__).parent
+    for path in root.rglob("*.py"):
+        if "serve" in path.parts or path.name == "textfile.py":
+            continue
+        text = path.read_text()
+        assert "getsize(" not in text and ".read_text(encoding" not in text, path

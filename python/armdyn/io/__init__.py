@@ -128,7 +128,8 @@ def load(source: str | os.PathLike[str], strict: bool | None = None, trusted: bo
     strict = True if strict is None else strict
     if looks_like_path or path.is_file():
         if not path.is_file():
-            raise ModelError("no such file", None, text)
+            what = "cannot read the model (not a regular file)" if path.exists() else "no such file"
+            raise ModelError(what, None, text)
         return _load_file(path, strict, text, trusted)
     names = ", ".join(bundled) or "none"
     raise ModelError(f"unknown robot '{text}': not a file, and not a bundled model ({names})")
