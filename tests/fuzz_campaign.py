@@ -36,7 +36,17 @@ Kinds of input (each from a fixed seed, so a finding can be replayed):
   ``--count`` (each input is a request; ~1000 take a minute or two);
 * ``towers``: power towers (powers, exponentials, products of huge numbers) in model
   expressions. For these three anything but a result or a ``ModelError`` within 5 s is a
-  finding.
+  finding;
+* ``codemodels``: model files that try to run code (run it with ``--kinds codemodels``):
+  xacro ``${...}`` payloads (the ``vars()``/``type()`` bypass of xacro's filter),
+  ``.xacro`` files, includes and ``package://``/``file://`` URIs in URDF, YAML tags that
+  construct Python objects, Python in DH and frame expressions; loaded untrusted, each
+  must end in a result or a ``ModelError`` within 5 s and leave no marker file;
+* ``classes``: hostile class folders for ``armdyn grade DIR``'s discovery (spoofed
+  ``student:``/``variant:``, colliding report names, models named by paths out of the
+  folder, symbolic links to files outside, to /dev/zero and FIFOs): every student is
+  the file's name, no link is followed, no two reports share a name, every model is
+  bundled or a regular file in the folder, and no payload runs.
 
 A model that loads is bound to its defaults and, when numeric, compiled and evaluated
 once. Each input must end in a result or an expected error (``ModelError``,
@@ -50,6 +60,7 @@ processes; stderr of each is captured at the file-descriptor level and searched 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import copy
 import json
 import os
@@ -879,6 +890,177 @@ def run_serve(seed: int, rng: random.Random):
 
 RUNNERS["serve"] = run_serve
 PREPARE = {"serve": _serve_base}  # kinds whose set-up must not count against an input's timeout
+
+# ------------------------------------------------------------------ model files that run code, hostile classes
+# Kinds "codemodels" and "classes" (registered in IO_KINDS): each input gets a fresh
+# folder and a marker path in it that the input's payload would create if any of it ran;
+# the input must end in a result or a ModelError within SECURITY_SECONDS, and the marker
+# must not exist afterwards.
+
+#: ways a model file could reach code: xacro's eval (with the vars()/type() bypass of its
+#: ``__`` filter), includes, YAML tags that construct objects, Python in DH expressions
+CODE_SNIPPETS = [
+    "${python.vars(python.type(python.vars(python.type(xacro.arg))['__globals__']))['__get__']"
+    "(python.vars(python.type(xacro.arg))['__globals__'], xacro.arg)['os'].mkdir('MARKER')}",
+    "${__import__('os').mkdir('MARKER')}",
+    "$(eval __import__('os').mkdir('MARKER'))",
+    "__import__('os').mkdir('MARKER')",
+    "eval(\"__import__('os').mkdir('MARKER')\")",
+    "(lambda: 0)()",
+    "().__class__.__base__.__subclasses__()",
+    "m1.__class__",
+    "os.mkdir('MARKER')",
+    "exec('1')",
+    "getattr(m1, 'x')",
+]
+CODE_TAGS = [
+    "!!python/object/apply:os.mkdir ['MARKER']",
+    "!!python/name:os.mkdir",
+    "!!python/object/new:os.mkdir ['MARKER']",
+    "!!python/module:os",
+    "!<tag:yaml.org,2002:python/object/apply:os.mkdir> ['MARKER']",
+]
+URDF_INCLUDES = [
+    '<xacro:include filename="MARKER.xacro"/>',
+    '<mesh filename="package://armdyn/MARKER"/>',
+    '<mesh filename="file://MARKER"/>',
+    '<?xml-stylesheet href="file://MARKER"?>',
+    '<xi:include href="file://MARKER" xmlns:xi="http://www.w3.org/2001/XInclude"/>',
+    '<!DOCTYPE r [<!ENTITY e SYSTEM "file://MARKER">]><robot name="&e;"/>',
+]
+
+
+def _planted(marker: str, text: str) -> str:
+    return text.replace("MARKER", marker)
+
+
+def run_codemodels(seed: int, rng: random.Random):
+    """A model file that tries to run code: a snippet as a YAML field's value (frame model
+    or DH table), a tag as a value, an include or URI in a URDF, or a whole ``.xacro``
+    file; loaded through ``armdyn.load`` untrusted (never with the opt-in)."""
+    import yaml
+
+    import armdyn
+
+    with tempfile.TemporaryDirectory() as tmp:
+        marker = os.path.join(tmp, "MARKER-RAN")
+        r = rng.random()
+        if r < 0.45:
+            base = rng.choice(YAML_SEEDS + DH_SEEDS)
+            doc = yaml.load(_seed_text(base), Loader=_SAFE_LOADER)
+            container, key = rng.choice(list(_paths(doc)))
+            container[key] = "FUZZ_VALUE_MARKER"
+            text = yaml.dump(doc, Dumper=_SAFE_DUMPER, sort_keys=False, allow_unicode=True, width=10**6)
+            value = (
+                rng.choice(CODE_TAGS) if rng.random() < 0.3 else json.dumps(_planted(marker, rng.choice(CODE_SNIPPETS)))
+            )
+            path = os.path.join(tmp, "m.yaml")
+            Path(path).write_text(text.replace("FUZZ_VALUE_MARKER", _planted(marker, value), 1))
+        elif r < 0.75:
+            text = _seed_text("iiwa14.urdf")
+            cut = rng.choice([m.end() for m in re.finditer(r"<robot[^>]*>|</link>|</joint>", text)])
+            piece = rng.choice(URDF_INCLUDES + CODE_SNIPPETS)
+            text = text[:cut] + _planted(marker, piece) + text[cut:]
+            path = os.path.join(tmp, rng.choice(["m.urdf", "m.urdf", "m.xacro"]))
+            Path(path).write_text(text)
+        else:
+            lines = [f'<link name="l{k}"/>' for k in range(3)]
+            lines.insert(rng.randrange(len(lines) + 1), f'<link name="{_planted(marker, rng.choice(CODE_SNIPPETS))}"/>')
+            path = os.path.join(tmp, "m.xacro")
+            Path(path).write_text(
+                '<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">' + "".join(lines) + "</robot>"
+            )
+        try:
+            _must_be_model_error(lambda: armdyn.load(path), f"seed {seed}: {os.path.basename(path)}")
+        finally:
+            if os.path.exists(marker) or os.path.exists(marker + ".xacro"):
+                raise AssertionError(f"seed {seed}: a model file ran code ({os.path.basename(path)})")
+
+
+#: front matters of hostile submissions in a class folder
+CLASS_FRONTS = [
+    "student: bob\n",
+    "student: ../../x\n",
+    "student: a_b\n",
+    "variant: bob\n",
+    "robot: ../outside.yaml\n",
+    "robot: /etc/hostname\n",
+    "robot: attachment.xacro\n",
+    "robot: link.yaml\n",
+    "robot: rp-arm\n",
+    "robot: planar-2r\n",
+    "student: &a [*a]\n",
+    "student: !!python/object/apply:os.mkdir ['MARKER']\n",
+]
+CLASS_NAMES = ["alice", "bob", "a b", "a_b", "Ada", "ada", "x.y", "-rf", "=cmd", "\u00e9", "e\u0301", "..x"]
+
+
+def run_classes(seed: int, rng: random.Random):
+    """A class folder of hostile submissions: spoofed ``student:`` and ``variant:``, names
+    whose reports collide, models named by paths out of the folder, a ``.xacro`` payload,
+    symbolic links (to files outside, to /dev/zero, to a FIFO) and FIFOs. :func:`discover`
+    must keep each student's identity to the file name, follow no link, give every task
+    its own report name and a model that is bundled or a regular file in the folder; and
+    no payload may run (loading each task's model untrusted)."""
+    import armdyn
+    from armdyn.course.batch import discover, safe_file_name
+    from armdyn.errors import ModelError
+
+    with tempfile.TemporaryDirectory() as tmp:
+        marker = os.path.join(tmp, "MARKER-RAN")
+        subs = os.path.join(tmp, "subs")
+        variants = os.path.join(tmp, "variants")
+        os.makedirs(subs)
+        Path(tmp, "outside.yaml").write_text(_seed_text("rp-arm"))
+        Path(subs, "attachment.xacro").write_text(
+            '<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="'
+            + _planted(marker, CODE_SNIPPETS[0])
+            + '"/></robot>'
+        )
+        for name in rng.sample(CLASS_NAMES, rng.randint(1, len(CLASS_NAMES))):
+            ext = rng.choice([".md", ".md", ".yaml"])
+            path = os.path.join(subs, name + ext)
+            r = rng.random()
+            if r < 0.1:
+                os.symlink(os.path.join(tmp, "outside.yaml"), path)
+            elif r < 0.15:
+                os.symlink("/dev/zero", path)
+            elif r < 0.2:
+                os.mkfifo(path)
+            else:
+                front = "".join(rng.sample(CLASS_FRONTS, rng.randint(0, 3)))
+                front = _planted(marker, front)
+                text = f"---\n{front}---\n$$\\tau_1 = 0$$\n" if ext == ".md" else front + "steps: {}\n"
+                Path(path).write_text(text)
+        if rng.random() < 0.5:
+            os.symlink(os.path.join(tmp, "outside.yaml"), os.path.join(subs, "link.yaml"))
+        if rng.random() < 0.5:
+            for vid in ("alice", "bob"):
+                os.makedirs(os.path.join(variants, vid))
+                Path(variants, vid, "model.yaml").write_text(_seed_text("rp-arm"))
+        found = discover(subs, variants if os.path.isdir(variants) else None)
+        reports = set()
+        for t in found.tasks:
+            stem = os.path.splitext(os.path.basename(t.path))[0]
+            if t.student != stem or os.path.islink(t.path):
+                raise AssertionError(f"seed {seed}: {t.path} graded as {t.student!r}")
+            report = safe_file_name(t.student).casefold()
+            if report in reports:
+                raise AssertionError(f"seed {seed}: two tasks write {report}.html")
+            reports.add(report)
+            if t.robot and os.sep in t.robot:
+                inside = os.path.dirname(t.robot) in (subs, os.path.join(variants, t.variant or ""))
+                if not inside or os.path.islink(t.robot):
+                    raise AssertionError(f"seed {seed}: {t.path} graded against {t.robot}")
+            if t.robot:
+                with contextlib.suppress(ModelError):
+                    armdyn.load(t.robot, strict=False)
+        if os.path.exists(marker):
+            raise AssertionError(f"seed {seed}: a class folder ran code")
+
+
+IO_KINDS = {"codemodels": run_codemodels, "classes": run_classes}
+RUNNERS.update(IO_KINDS)
 
 
 # ------------------------------------------------------------------ worker / driver

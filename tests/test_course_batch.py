@@ -151,7 +151,8 @@ def test_bad_files_are_reported_alone(small_class, tmp_path, capsys):
     root, subs = small_class
     (subs / "corrupt.md").write_bytes(b"---\nstudent: c\nvariant: w0\n---\n$$\\tau_1 = \xff\xfe$$\n")
     (subs / "lost.md").write_text("---\nstudent: lost\nvariant: w99\n---\n$$T = 0$$\n")
-    (subs / "twice.md").write_text((subs / "s1.md").read_text())
+    (subs / "twice.md").write_text((subs / "s1.md").read_text())  # says student: s1, but is 'twice'
+    (subs / "s1.yaml").write_text("student: s1\nvariant: w1\nsteps: {}\n")  # s1 a second time
     (subs / "nameless.md").write_text("$$T = 0$$\n")  # no front matter, no variant folder 'nameless'
     code, book = _run(root, subs, tmp_path)
     err = capsys.readouterr().err
@@ -167,7 +168,9 @@ def test_bad_files_are_reported_alone(small_class, tmp_path, capsys):
     assert rows["lost"]["status"] == "no-variant" and "w99" in rows["lost"]["error"]
     assert rows["nameless"]["status"] == "no-variant"
     dup = [r for r in json.loads(book.with_suffix(".json").read_text())["rows"] if r["status"] == "duplicate"]
-    assert len(dup) == 1 and dup[0]["student"] == "s1" and "twice.md" in dup[0]["error"]
+    assert len(dup) == 1 and dup[0]["student"] == "s1" and "s1.yaml" in dup[0]["error"] and "s1.md" in dup[0]["error"]
+    assert rows["twice"]["status"] == "graded" and rows["twice"]["variant"] == "w1"
+    assert f"armdyn: note: {subs / 'twice.md'}: the front matter says student 's1'" in err
     not_graded = [line for line in err.splitlines() if line.startswith("armdyn: not graded: ")]
     assert len(not_graded) == 4
     assert any(str(subs / "corrupt.md") in line and "UTF-8" in line for line in not_graded), err
@@ -281,6 +284,7 @@ def test_hostile_student_names_stay_inside_the_report_folder(tmp_path):
     subs = tmp_path / "subs"
     subs.mkdir()
     (subs / "a.md").write_text("---\nstudent: ../../x\nvariant: {a: 1}\n---\n$$T = 0$$\n")
-    tasks, refused = discover(subs)
-    assert [t.student for t in tasks] == ["../../x"] and tasks[0].variant is None and refused == []
-    assert "/" not in safe_file_name(tasks[0].student)
+    found = discover(subs)
+    # the file names the student; the text's claim is only noted
+    assert [t.student for t in found.tasks] == ["a"] and found.tasks[0].variant is None and found.refused == []
+    assert found.notes == [f"{subs / 'a.md'}: the front matter says student '../../x'; graded as 'a' (the file's name)"]

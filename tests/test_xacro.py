@@ -1,6 +1,7 @@
-"""``.xacro`` models: expanded by the ``xacro`` package and read as URDF. The expanded
-robot equals the same robot written out by hand (its rnea and M); without the package
-the error names the file and the package."""
+"""``.xacro`` models, trusted (untrusted ones are refused: test_security_probe_io.py):
+expanded by the ``xacro`` package and read as URDF. The expanded robot equals the same
+robot written out by hand (its rnea and M); without the package the error names the
+file and the package."""
 
 from __future__ import annotations
 
@@ -50,7 +51,7 @@ def test_xacro_equals_hand_expanded_urdf(tmp_path):
     pytest.importorskip("xacro")
     path = tmp_path / "two.urdf.xacro"
     path.write_text(XACRO)
-    robot = armdyn.load(path)
+    robot = armdyn.load(path, trusted=True)
     hand = armdyn.Robot.from_urdf(EXPANDED)
     assert robot.coordinate_names == hand.coordinate_names == ["j1", "j2"]
     rng = np.random.default_rng(2)
@@ -65,7 +66,7 @@ def test_bad_xacro_names_the_file(tmp_path):
     path = tmp_path / "bad.xacro"
     path.write_text(XACRO.replace("${len/2}", "${nosuch}"))
     with pytest.raises(ModelError, match="bad.xacro.*xacro could not expand it"):
-        armdyn.load(path)
+        armdyn.load(path, trusted=True)
 
 
 def test_without_the_package_the_error_names_it(tmp_path, monkeypatch):
@@ -80,4 +81,4 @@ def test_without_the_package_the_error_names_it(tmp_path, monkeypatch):
 
     monkeypatch.setattr(builtins, "__import__", no_xacro)
     with pytest.raises(ModelError, match=r"two.xacro.*needs the 'xacro' package: pip install xacro"):
-        armdyn.load(path)
+        armdyn.load(path, trusted=True)

@@ -29,19 +29,20 @@ from ._interrupt import raise_from_now_on
 from .errors import ModelError
 
 
-def _load(source: str, allow_nonphysical: bool = False, strict: bool = False):
+def _load(source: str, allow_nonphysical: bool = False, strict: bool = False, trusted: bool = False):
     """A model file (strict unless --allow-nonphysical) or a bundled model (as published,
-    one warning if it is not physical, unless --strict)."""
+    one warning if it is not physical, unless --strict); a .xacro file only with
+    --trust-xacro (``trusted``: expanding one runs its Python code)."""
     from .io import load
 
-    return load(source, strict=True if strict else (False if allow_nonphysical else None))
+    return load(source, strict=True if strict else (False if allow_nonphysical else None), trusted=trusted)
 
 
 def cmd_derive(args) -> int:
     from .symbolic import check, derive
     from .symbolic.report import derivation_report, unicode_supported
 
-    robot = _load(args.robot, args.allow_nonphysical, args.strict)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict, args.trust_xacro)
     methods = ["newton-euler", "lagrange"] if args.method == "both" else [args.method]
     eoms = []
     for m in methods:
@@ -60,7 +61,7 @@ def cmd_check(args) -> int:
 
     if args.samples < 1:  # before the (slow) derivation: zero samples would check nothing
         raise ValueError(f"--samples must be at least 1, got {args.samples}")
-    robot = _load(args.robot, args.allow_nonphysical, args.strict)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict, args.trust_xacro)
     exact = True if args.exact else (False if args.numeric else None)
     report = prove_agreement(robot, exact=exact, samples=args.samples)
     print(report.text())
@@ -86,7 +87,7 @@ def cmd_robots(args) -> int:
 def cmd_show(args) -> int:
     from .show import show
 
-    robot = _load(args.robot, args.allow_nonphysical, args.strict)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict, args.trust_xacro)
     q = None
     if args.q is not None:
         try:
@@ -103,6 +104,8 @@ def cmd_grade(args) -> int:
     if os.path.isdir(args.submission):  # a folder: the whole class (armdyn.course)
         from .course.cli import cmd_grade_class
 
+        if args.trust_xacro:
+            raise ValueError("--trust-xacro is refused for a class folder: a student's model is never trusted")
         return cmd_grade_class(args)
     from .grading import grade
     from .grading.reader import read
@@ -117,7 +120,7 @@ def cmd_grade(args) -> int:
 
             print(show_model(submission, args.robot), end="")
             return 0
-        report = grade(submission, robot=args.robot)
+        report = grade(submission, robot=args.robot, trusted=args.trust_xacro)
     except ModelError as err:
         if not args.json:
             raise
@@ -148,7 +151,7 @@ def cmd_serve(args) -> int:
 def cmd_codegen(args) -> int:
     from .printing import codegen, write_files
 
-    robot = _load(args.robot, args.allow_nonphysical, args.strict)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict, args.trust_xacro)
     if args.bind:
         robot = robot.bind()
     code = codegen(robot, what=args.what, lang=args.lang, base=args.base)
@@ -180,7 +183,7 @@ def cmd_simulate(args) -> int:
                 raise ValueError(f"{path}: folder {folder} does not exist")
     if not (np.isfinite(args.fps) and args.fps > 0):
         raise ValueError(f"--fps must be positive, got {args.fps}")
-    return run(args, _load(args.robot, args.allow_nonphysical, args.strict))
+    return run(args, _load(args.robot, args.allow_nonphysical, args.strict, args.trust_xacro))
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -204,6 +207,14 @@ def build_parser() -> argparse.ArgumentParser:
             action="store_true",
             help="refuse non-physical inertias in bundled models too (they load as published, "
             "with one warning, by default)",
+        )
+        trust_xacro_arg(sp_)
+
+    def trust_xacro_arg(sp_, what="a .xacro model"):
+        sp_.add_argument(
+            "--trust-xacro",
+            action="store_true",
+            help=f"allow {what}: expanding it runs the Python code in its ${{...}} (only for files you trust)",
         )
 
     d = sub.add_parser("derive", help="derive the equations of motion symbolically")
@@ -263,6 +274,7 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="print the robot read from the text (YAML, each item with its line; what was assumed) and stop",
     )
+    trust_xacro_arg(gr, "a .xacro model given with --robot (never one the front matter names, never for a folder)")
     gr.set_defaults(func=cmd_grade)
     from .course.cli import add_batch_arguments, add_exercise_parser
 

@@ -4,14 +4,17 @@
                          html_dir="reports/", jobs=2)
     result.gradebook.rows; result.not_graded      # lines "file: why", one per submission not graded
 
-Every ``*.md``, ``*.yaml``, ``*.yml`` file directly in the folder is a submission. Its
-student is the front matter's ``student:`` (else the file's stem); its variant the front
-matter's ``variant:``, else the student's id, else the stem, when ``variants/<that>/``
-exists. With ``variants`` (the folder ``armdyn exercise make`` wrote) each submission is
-graded against ``variants/<variant>/model.yaml``; a submission whose variant is not
-there is not graded (status ``no-variant``). Without it, the front matter's ``robot:``
-is used as ``armdyn grade FILE`` would. A second file for the same student is not graded
-(``duplicate``).
+Every ``*.md``, ``*.yaml``, ``*.yml`` file directly in the folder is a submission
+(symbolic links are skipped, with a note). Its student is the file's stem, never what
+the text says (a front matter ``student:`` that differs gets a note); its variant the
+roster's (``variants/<student>/``) when there is one, else the front matter's
+``variant:``. With ``variants`` (the folder ``armdyn exercise make`` wrote) each
+submission is graded against ``variants/<variant>/model.yaml``; a submission whose
+variant is not there is not graded (status ``no-variant``). Without it, against the
+front matter's ``robot:``: a bundled name or a file directly in the folder (never a
+``.xacro`` file: models are loaded untrusted). A second file for the same student, or
+one whose report would have the same file name (``a b`` and ``a_b``), is not graded
+(``duplicate``, naming both files).
 
 Each submission is graded in its own forked child (:mod:`.isolate`) with a time and
 memory limit; one that times out, runs out of memory or crashes is reported as such
@@ -35,15 +38,11 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import yaml
-
 from ..errors import ModelError
 from .gradebook import Gradebook
 from .rubric import Rubric
 
 SUFFIXES = (".md", ".yaml", ".yml")
-#: files larger than this are not read for their front matter (the grader refuses them too)
-MAX_BYTES = 5_000_000
 CACHE_DIR = ".armdyn-cache"
 
 
@@ -61,12 +60,14 @@ class Task:
 @dataclass
 class BatchResult:
     """The gradebook, one line per submission not graded (``file: status: why``),
-    how many were taken from the cache, and the seconds it took."""
+    how many were taken from the cache, the seconds it took, and notes (``file: what``:
+    a link skipped, a front matter overruled, a warm-up given up)."""
 
     gradebook: Gradebook
     not_graded: list[str] = field(default_factory=list)
     cached: int = 0
     seconds: float = 0.0
+    notes: list[str] = field(default_factory=list)
 
 
 # ------------------------------------------------------------------ one submission
@@ -97,19 +98,14 @@ def _dask_task(task: dict, timeout: float, memory_mb: int | None) -> dict:
 def _front_matter(path: str) -> tuple[dict, str | None]:
     """The submission's front matter (Markdown) or top-level mapping (YAML), and why the
     file cannot be graded at all (too large, not UTF-8: ``path:line: what``) or None.
-    A front matter that does not parse gives {} (the grader then says why)."""
+    A front matter that does not parse gives {} (the grader then says why). Read as the
+    grader reads it: the one bounded reader, YAML through the alias and depth screen."""
+    from ..grading.reader import read_text, safe_yaml
+
     try:
-        if os.path.getsize(path) > MAX_BYTES:
-            return {}, f"{path}: larger than {MAX_BYTES} bytes"
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except OSError as exc:
-        return {}, f"{path}: cannot read it ({exc.strerror})"
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        return {}, f"{path}:{line}: not UTF-8 text (byte {exc.start + 1})"
+        text = read_text(path)
+    except ModelError as exc:
+        return {}, str(exc)
     if path.lower().endswith(".md"):
         from ..grading.display import front_matter
 
@@ -118,8 +114,8 @@ def _front_matter(path: str) -> tuple[dict, str | None]:
             return {}, None
         text = text[front[0] : front[1]]
     try:
-        data = yaml.safe_load(text)
-    except (yaml.YAMLError, RecursionError, ValueError):
+        data = safe_yaml(text, path)
+    except (ModelError, RecursionError, ValueError):
         return {}, None
     return (data if isinstance(data, dict) else {}), None
 
@@ -137,31 +133,52 @@ def safe_file_name(student: str) -> str:
     return name or "_"
 
 
-def discover(folder, variants=None, want_html: bool = False) -> tuple[list[Task], list[tuple]]:
-    """The submissions of ``folder`` as tasks, and the rows of those that cannot be graded:
-    ``(student, variant, error)``."""
+@dataclass
+class Found:
+    """What :func:`discover` found: the tasks, the rows of submissions that cannot be
+    graded (``(student, variant, error)``) and notes (``file: what``) on what was
+    skipped or overruled."""
+
+    tasks: list[Task]
+    refused: list[tuple]
+    notes: list[str]
+
+
+def discover(folder, variants=None, want_html: bool = False) -> Found:
+    """The submissions of ``folder`` (see the module docstring). A student is the file's
+    name: the text cannot speak for someone else (``student:`` in the front matter is
+    only compared, with a note when it differs); nor pick another student's variant
+    when the roster made one for this student. Symbolic links are not followed."""
     folder = os.fspath(folder)
     if not os.path.isdir(folder):
         raise ModelError("not a folder of submissions", source=folder)
-    files = sorted(
-        f
-        for f in os.listdir(folder)
-        if f.lower().endswith(SUFFIXES) and not f.startswith(".") and os.path.isfile(os.path.join(folder, f))
-    )
-    tasks, refused, owner = [], [], {}
-    for f in files:
+    tasks, refused, notes, owner, reports = [], [], [], {}, {}
+    for f in sorted(os.listdir(folder)):
         path = os.path.join(folder, f)
+        if not f.lower().endswith(SUFFIXES) or f.startswith("."):
+            continue
+        if os.path.islink(path):
+            notes.append(f"{path}: a symbolic link, not followed (skipped)")
+            continue
+        if not os.path.isfile(path):
+            continue
         meta, unreadable = _front_matter(path)
-        stem = os.path.splitext(f)[0]
-        student = _name(meta.get("student")) or stem
+        student = os.path.splitext(f)[0]
+        claimed = _name(meta.get("student"))
+        if claimed is not None and claimed != student:
+            notes.append(f"{path}: the front matter says student {claimed!r}; graded as {student!r} (the file's name)")
         variant = _name(meta.get("variant"))
         if unreadable:
             refused.append((student, variant, f"error: {unreadable}"))
             continue
         robot = None
         if variants is not None:
-            if variant is None:
-                variant = next((c for c in (student, stem) if os.path.isdir(os.path.join(variants, c))), None)
+            own = student if os.path.isdir(os.path.join(variants, student)) else None
+            if own is not None and variant not in (None, own):
+                notes.append(
+                    f"{path}: the front matter says variant {variant!r}; graded against {own!r} (the roster's)"
+                )
+            variant = own or variant
             model = os.path.join(variants, variant, "model.yaml") if variant else None
             if variant is None or "/" in variant or variant.startswith(".") or not os.path.isfile(model):
                 what = (
@@ -172,13 +189,43 @@ def discover(folder, variants=None, want_html: bool = False) -> tuple[list[Task]
                 refused.append((student, variant, f"no-variant: {path}: {what}"))
                 continue
             robot = model
+        else:
+            robot, why = _class_model(folder, _name(meta.get("robot")))
+            if why:
+                refused.append((student, variant, f"error: {path}: {why}"))
+                continue
+        report = safe_file_name(student).casefold()  # one file on a case-blind disk too
         if student in owner:
             why = f"duplicate: {path}: student {student!r} also handed in {owner[student]} (graded that one)"
             refused.append((student, variant, why))
             continue
-        owner[student] = path
+        if report in reports:
+            why = (
+                f"duplicate: {path}: its report would be {safe_file_name(student)}.html, as for "
+                f"{reports[report]} (graded that one; rename one of the two files)"
+            )
+            refused.append((student, variant, why))
+            continue
+        owner[student], reports[report] = path, path
         tasks.append(Task(path=path, student=student, variant=variant, robot=robot, want_html=want_html))
-    return tasks, refused
+    return Found(tasks, refused, notes)
+
+
+def _class_model(folder: str, name: str | None) -> tuple[str | None, str | None]:
+    """(the model a submission of the class names, why it cannot be used): a bundled
+    name, or a regular file directly in the class folder (no path, no link: a student's
+    text does not choose which of the grader's files are read). None: the grader says
+    that no robot is named."""
+    from ..io import _bundled_files
+
+    if name is None or name in _bundled_files():
+        return name, None
+    path = os.path.join(folder, name)
+    if any(c in name for c in "/\\") or name.startswith(".") or os.path.islink(path) or not os.path.isfile(path):
+        return None, (
+            f"robot {name!r}: in class grading a model is a bundled name or a file directly in the class folder"
+        )
+    return os.path.abspath(path), None
 
 
 # ------------------------------------------------------------------ cache
@@ -195,12 +242,11 @@ def _grader_fingerprint() -> str:
 
 
 def _file_bytes(path: str | None) -> bytes:
-    if not path:
-        return b""
+    from ..io.textfile import MODEL_MAX_BYTES, read_bytes
+
     try:
-        with open(path, "rb") as fh:
-            return fh.read(MAX_BYTES + 1)
-    except OSError:
+        return read_bytes(path, "file", MODEL_MAX_BYTES) if path and os.path.exists(path) else b""
+    except ModelError:
         return b""
 
 
@@ -241,7 +287,8 @@ def grade_class(
     gradebook = os.fspath(gradebook)
     if variants is not None and not os.path.isdir(variants):
         raise ModelError("not a folder of variants (the output of armdyn exercise make)", source=os.fspath(variants))
-    tasks, refused = discover(folder, variants, want_html=html_dir is not None)
+    found = discover(folder, variants, want_html=html_dir is not None)
+    tasks, refused, notes = found.tasks, found.refused, list(found.notes)
     out_dir = os.path.dirname(os.path.abspath(gradebook))
     cache_dir = os.path.join(out_dir, CACHE_DIR)
     grader = _grader_fingerprint()
@@ -258,7 +305,7 @@ def grade_class(
     jobs = jobs or os.cpu_count() or 1
     bar = _bar(len(todo), progress)
     try:
-        for path, result in _run(todo, jobs, timeout, memory_mb, dask):
+        for path, result in _run(todo, jobs, timeout, memory_mb, dask, notes):
             results[path] = result
             deterministic = "report" in result or str(result.get("error", "")).startswith("error:")
             if use_cache and deterministic:
@@ -292,7 +339,9 @@ def grade_class(
             page = r.get("html") or _not_graded_page(t.student, r.get("error") or "not graded")
             outputs.append((os.path.join(html_dir, safe_file_name(t.student) + ".html"), page))
     atomic_writes([(p, _text_writer(text)) for p, text in outputs])
-    return BatchResult(gradebook=book, not_graded=not_graded, cached=cached, seconds=time.perf_counter() - t0)
+    return BatchResult(
+        gradebook=book, not_graded=not_graded, cached=cached, seconds=time.perf_counter() - t0, notes=notes
+    )
 
 
 def _why(path: str | None, error: str) -> str:
@@ -318,8 +367,9 @@ def _not_graded_page(student: str, error: str) -> str:
     return course_page(f"{student}: not graded", f"<h1>{escape(student)}: not graded</h1>\n<p>{escape(error)}</p>")
 
 
-def _run(tasks: list[Task], jobs: int, timeout: float, memory_mb, dask: str | None):
-    """Yield ``(path, result)`` per task, locally (forked children) or on a Dask cluster."""
+def _run(tasks: list[Task], jobs: int, timeout: float, memory_mb, dask: str | None, notes: list[str]):
+    """Yield ``(path, result)`` per task, locally (forked children) or on a Dask cluster;
+    a warm-up given up is added to ``notes``."""
     if not tasks:
         return
     if dask:
@@ -342,7 +392,7 @@ def _run(tasks: list[Task], jobs: int, timeout: float, memory_mb, dask: str | No
 
     from .isolate import ChildPool
 
-    _warm_up(tasks)  # also imports the grader here: every forked child starts with it loaded
+    notes.extend(_warm_up(tasks, jobs, timeout, memory_mb))
     pool = ChildPool(grade_task, jobs, timeout, memory_mb)
     yield from pool.run((t.path, t.__dict__) for t in tasks)
 
@@ -353,46 +403,54 @@ WARM_SHARED = 3
 WARM_MODELS = 4
 
 
-def _model_of(task: Task) -> str | None:
-    """The model a task is graded against (file or bundled name), as the grader finds it."""
-    if task.robot:
-        return task.robot
-    name = _name(_front_matter(task.path)[0].get("robot"))
-    if not name:
-        return None
-    beside = os.path.join(os.path.dirname(os.path.abspath(task.path)), name)
-    return beside if os.path.isfile(beside) else name
-
-
-def _warm_up(tasks: list[Task]) -> None:
-    """Import the grader, then grade armdyn's own solution of each model that many
-    submissions share, in the parent, before the children fork: they start with the
-    derivation's and the report's caches warm (the expected values they show are the
-    same for the whole class). Trusted input (armdyn's own derivation); a failure here
-    only costs the speed-up."""
-    import collections
+def _warm_one(model: str) -> dict:
+    """Grade armdyn's own solution of ``model`` (derive it, grade it, typeset the
+    report): what fills the derivation's and the report's caches. ``{"ok": True}``, or
+    ``{"error": why}``."""
     import tempfile
 
-    from ..grading import grade, text  # text: to_json's module, loaded here once
+    from ..grading import grade, text  # noqa: F401 - text: to_json's module, loaded here once
     from ..grading.html import report_html
     from ..io import load
     from .solution import solution_markdown, solution_steps
 
-    counts = collections.Counter(m for m in map(_model_of, tasks) if m)
+    try:
+        robot = load(model, strict=False)
+        markdown = solution_markdown(robot, solution_steps(robot), {"method": "both"}, "warm-up")
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "solution.md")
+            with open(path, "w", encoding="utf-8") as fh:
+                fh.write(markdown)
+            report = grade(path, robot=robot)
+            report.to_json()
+            report_html(report)
+    except Exception as exc:  # noqa: BLE001 - a warm-up that fails only costs time
+        return {"error": f"error: {' '.join(str(exc).split())[:200]}"}
+    return {"ok": True}
+
+
+def _warm_up(tasks: list[Task], jobs: int, timeout: float, memory_mb) -> list[str]:
+    """Warm up, in the parent, each model that many submissions share, so that the
+    children fork with the derivation's and the report's caches warm (the expected
+    values they show are the same for the whole class). A model (a student's file too)
+    can be large: each is first warmed up in a child under a submission's time and
+    memory limits (:class:`.isolate.ChildPool`), and only one that finished there is
+    warmed up here; the others are left to each submission's own child. Returns a note
+    per model given up."""
+    import collections
+
+    from .isolate import ChildPool
+
+    counts = collections.Counter(t.robot for t in tasks if t.robot)
     shared = [m for m, n in counts.most_common(WARM_MODELS) if n >= WARM_SHARED]
-    for model in shared:
-        try:
-            robot = load(model, strict=False)
-            text = solution_markdown(robot, solution_steps(robot), {"method": "both"}, "warm-up")
-            with tempfile.TemporaryDirectory() as tmp:
-                path = os.path.join(tmp, "solution.md")
-                with open(path, "w", encoding="utf-8") as fh:
-                    fh.write(text)
-                report = grade(path, robot=robot)
-                report.to_json()
-                report_html(report)
-        except Exception:  # noqa: BLE001, S112 - a warm-up that fails only costs time
-            continue
+    notes = []
+    for model, result in ChildPool(_warm_one, jobs, timeout, memory_mb).run((m, m) for m in shared):
+        if result.get("ok"):
+            _warm_one(model)
+        else:
+            why = result.get("error", "no result")
+            notes.append(f"{model}: not warmed up ({why}); each submission derives it in its own child")
+    return notes
 
 
 def _bar(total: int, progress: bool | None):

@@ -68,6 +68,8 @@ def cmd_grade_class(args) -> int:
         use_cache=not args.no_cache,
         dask=args.dask,
     )
+    for line in result.notes:
+        print(f"armdyn: note: {line}", file=sys.stderr)
     for line in result.not_graded:
         print(f"armdyn: not graded: {line}", file=sys.stderr)
     rows = result.gradebook.rows

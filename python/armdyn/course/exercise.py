@@ -24,9 +24,9 @@ from dataclasses import dataclass, field
 import yaml
 
 from ..errors import ModelError
+from ..io.textfile import read_text
 from .kinds import KINDS
 from .proofkinds import PROOF_KINDS
-from .textfile import read_text
 from .variants import draw_variant
 
 ID_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9._-]{0,63}")
@@ -46,7 +46,8 @@ def read_roster(path) -> tuple[list[str], list[str]]:
     """The ids of a roster CSV and one line per refused row (``file:line: ...``):
     a duplicate id, an empty or unsafe one. A roster without an id column is a
     :class:`ModelError`."""
-    path, text = read_text(path, "roster", MAX_ROSTER_BYTES, encoding="utf-8-sig")
+    path = os.fspath(path)
+    text = read_text(path, "roster", MAX_ROSTER_BYTES, encoding="utf-8-sig")
     reader = csv.reader(io.StringIO(text))
     try:
         header = next(reader)

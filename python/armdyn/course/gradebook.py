@@ -19,6 +19,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import re
 from dataclasses import dataclass, field
 
 from ..grading.verdict import STATUSES
@@ -90,7 +91,7 @@ class Gradebook:
 
     def to_csv(self) -> str:
         """One header line and one line per row (``\\n`` line ends); a cell a spreadsheet
-        would run as a formula (``=``, ``+``, ``-``, ``@`` first) is quoted with ``'``."""
+        would run as a formula, split on ``,`` or on ``;``, is quoted with ``'`` (:func:`_cell`)."""
         out = io.StringIO()
         w = csv.writer(out, lineterminator="\n")
         cols = self.columns
@@ -125,13 +126,22 @@ class Gradebook:
         return counts
 
 
+#: where a spreadsheet may start a cell: the cell's start, or after a separator it splits
+#: on (``,``, or ``;`` in locales whose decimal mark is a comma) or a line break, then
+#: blanks; a formula starts with one of ``= + - @`` (a tab or CR may precede it)
+_FORMULA_START = re.compile(r"(^|[,;\r\n])([ ]*)(?=[=+\-@\t\r])")
+
+
 def _cell(value) -> str:
+    """A CSV cell no spreadsheet opens as a formula, whichever separator it splits on:
+    ``'`` before every ``= + - @ TAB CR`` that starts the cell or follows ``,``, ``;``
+    or a line break (``Ada;=cmd|...`` -> ``'Ada;'=cmd|...``; the text after a quote is
+    shown, not run)."""
     if value is None:
         return ""
     if isinstance(value, float):
         return f"{value:.2f}".rstrip("0").rstrip(".")
-    text = str(value)
-    return "'" + text if text[:1] in ("=", "+", "-", "@", "\t", "\r") else text
+    return _FORMULA_START.sub(lambda m: m.group(1) + m.group(2) + "'", str(value))
 
 
 def part_of_steps(steps: list[dict], method: str | None) -> list[str]:

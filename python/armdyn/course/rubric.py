@@ -28,10 +28,11 @@ not counted. Points are rounded to 2 decimals.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 
 from ..errors import ModelError
-from .textfile import read_text
+from ..io.textfile import read_text
 
 #: credit (fraction of a step's points) per verdict status, by default
 DEFAULT_CREDIT = {
@@ -68,7 +69,8 @@ class Rubric:
     @classmethod
     def load(cls, path) -> Rubric:
         """Read a rubric file; a bad one raises :class:`ModelError` naming ``file:line``."""
-        path, text = read_text(path, "rubric", MAX_BYTES)
+        path = os.fspath(path)
+        text = read_text(path, "rubric", MAX_BYTES)
         return cls.from_text(text, path)
 
     @classmethod

@@ -13,12 +13,15 @@ Expressions print in Unicode with the field's dots (``θ̇1``, ``d̈2``) unless 
 
 from __future__ import annotations
 
+import math
 import re
 
 import numpy as np
 import sympy as sp
+from sympy.functions.elementary.trigonometric import TrigonometricFunction
 
 from ..model import Robot
+from ..symbolic import dag
 from ..symbolic.agreement import trig_reduce
 from ..symbolic.names import UnicodeTextPrinter, unicode_name
 
@@ -46,6 +49,68 @@ TIDY_LIMIT = 400
 EXPAND_LIMIT = 2000
 #: the note added when a difference was too large to simplify
 NOT_SIMPLIFIED = "difference not simplified (too large)"
+#: a difference with more nodes than this is not even printed in a message
+PRINT_LIMIT = 1000
+#: the message for a wrong step whose difference is too large to simplify or print
+TOO_LARGE = "difference too large to simplify"
+
+
+def expanded_terms(expr, cap: int = EXPAND_LIMIT) -> int:
+    """An upper estimate of how many terms SymPy's ``expand`` (and ``expand_trig``, and
+    the sin² + cos² reduction) would make of ``expr``, or of any part of it, counting
+    no further than ``cap`` (more than ``cap``: ``cap + 1``). Linear in the tree's size,
+    so it can guard those calls: ``count_ops`` does not see that ``(a + b + … )^20``
+    of seven symbols expands into 230 230 terms."""
+    worst = 0
+
+    def terms(e) -> int:
+        nonlocal worst
+        if worst > cap:
+            return cap + 1
+        if e.is_Atom:
+            n = 1
+        elif e.is_Add:
+            n = sum(terms(a) for a in e.args)
+        elif e.is_Mul:
+            n = 1
+            for a in e.args:
+                n = min(n * terms(a), cap + 1)
+        elif e.is_Pow:
+            base, exp = terms(e.base), terms(e.exp)
+            if e.exp.is_Integer:
+                k = abs(int(e.exp)) if abs(e.exp) <= cap else cap + 1
+                # a sum of t terms to the k-th: C(k + t - 1, t - 1) monomials; a sine or
+                # cosine to the k-th becomes k / 2 + 1 terms in sin² + cos² = 1
+                if base == 1 or k <= 1:
+                    n = base
+                else:
+                    n = math.comb(k + base - 1, base - 1) if k <= cap else cap + 1
+                if isinstance(e.base, (sp.sin, sp.cos)):
+                    n = min(n * (k // 2 + 1), cap + 1)
+            else:
+                n = max(base, exp)
+        else:  # a function: its arguments are expanded; an angle sum splits in two per term
+            inner = [terms(a) for a in e.args]
+            n = 1
+            if isinstance(e, TrigonometricFunction) and e.args:
+                for t in sp.Add.make_args(e.args[0]):
+                    c = t.as_coeff_Mul()[0]
+                    n = min(n * 2 * (int(min(abs(c), cap)) if c.is_Integer and c != 0 else 1), 2 * cap + 2)
+                n = max(1, n // 2)
+            worst = max(worst, *inner)
+        n = min(n, cap + 1)
+        worst = max(worst, n)
+        return n
+
+    terms(sp.sympify(expr))
+    return min(worst, cap + 1)
+
+
+def affordable(expr) -> bool:
+    """True if ``expr`` may be expanded, factored or simplified for a message: at most
+    :data:`TIDY_LIMIT` operations, at most :data:`EXPAND_LIMIT` terms once expanded."""
+    expr = sp.sympify(expr)
+    return sp.count_ops(expr) <= TIDY_LIMIT and expanded_terms(expr) <= EXPAND_LIMIT
 
 
 def split_name(name: str) -> tuple[str, str, int] | None:
@@ -118,7 +183,7 @@ def reduce(expr, robot: Robot):
     sin² + cos² = 1 applied and everything expanded: terms that cancel are gone. None
     when it is too large to do in bounded time (:data:`TIDY_LIMIT`, :data:`EXPAND_LIMIT`)."""
     expr = sp.sympify(expr)
-    if sp.count_ops(expr) > TIDY_LIMIT:
+    if not affordable(expr):
         return None
     try:
         expanded = sp.expand_trig(expr)
@@ -134,7 +199,7 @@ def tidy(expr, robot: Robot):
     the plain reduction (a sign slip in ``l1 θ̇1² c2`` is ``2 l1 θ̇1² c2``, not four terms
     of which three cancel), else sin² + cos² reduced and expanded; as it is when large."""
     expr = sp.sympify(expr)
-    if sp.count_ops(expr) > TIDY_LIMIT:
+    if not affordable(expr):
         return expr
     try:
         plain = sp.expand(trig_reduce(expr, robot.q, keep_trig=True))
@@ -160,7 +225,7 @@ def contract(value, shorthand: dict | None):
 
     def one(x):
         x = sp.sympify(x)
-        if sp.count_ops(x) > CONTRACT_LIMIT:
+        if sp.count_ops(x) > CONTRACT_LIMIT or not affordable(x):
             return x
         try:
             return sp.trigsimp(sp.expand(x))
@@ -199,9 +264,12 @@ def describe(got, ref, robot: Robot, sampler, ascii_only: bool = False, shorthan
                         f"{display_name(wrote.name, ascii_only)} written where "
                         f"{display_name(right.name, ascii_only)} belongs"
                     )
+    if not (affordable(got - ref) and affordable(got) and affordable(ref)):
+        # printed as it is: expanding or factoring it could take hours
+        if dag.larger_than(got - ref, PRINT_LIMIT):
+            return TOO_LARGE
+        return f"differs by {pretty(got - ref, ascii_only, shorthand)} ({NOT_SIMPLIFIED})"
     d = tidy(got - ref, robot)
-    if sp.count_ops(got - ref) > TIDY_LIMIT:
-        return f"differs by {_short(d, ascii_only, shorthand)} ({NOT_SIMPLIFIED})"
     # a factor missing (got = X where ref has s X) or extra
     for s in sorted((ref.free_symbols | got.free_symbols) - set(robot.q) - set(robot.qd) - set(robot.qdd), key=str):
         if not d.has(s):
@@ -236,6 +304,8 @@ def describe(got, ref, robot: Robot, sampler, ascii_only: bool = False, shorthan
 
 def _short(expr, ascii_only: bool, shorthand: dict | None = None) -> str:
     """The expression, factored when that is shorter: −lc2·(q̇1 + q̇2)²."""
+    if not affordable(expr):
+        return pretty(expr, ascii_only, shorthand)
     # full factorisation only for a few terms (it is the slow part of a report)
     factored = sp.factor(expr) if len(sp.Add.make_args(expr)) <= 4 else sp.factor_terms(expr)
     best = factored if sp.count_ops(factored) < sp.count_ops(expr) else expr

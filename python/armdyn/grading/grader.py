@@ -54,13 +54,13 @@ def _named_ref(text: str) -> StepRef | None:
     return None
 
 
-def _load_robot(name: str, sub: Submission) -> Robot:
+def _load_robot(name: str, sub: Submission, trusted: bool = False) -> Robot:
     from ..io import load
 
     candidate = os.path.join(sub.base_dir, name)
     source = candidate if os.path.isfile(candidate) else name
     try:
-        return load(source, strict=False)
+        return load(source, strict=False, trusted=trusted)
     except ModelError as err:
         raise err.located(source=sub.path) from None
 
@@ -585,7 +585,10 @@ def _matrix(value) -> sp.Matrix:
 
 
 def grade(
-    submission: str | os.PathLike[str] | Submission, robot: str | Robot | None = None, symbols: dict | None = None
+    submission: str | os.PathLike[str] | Submission,
+    robot: str | Robot | None = None,
+    symbols: dict | None = None,
+    trusted: bool = False,
 ) -> GradeReport:
     """Grade a derivation.
 
@@ -593,13 +596,17 @@ def grade(
     robot:      the model whose frames the student used (bundled name, model file or
                 Robot); default: the submission's front matter ``robot``.
     symbols:    extra mapping of the student's symbols to model names.
+    trusted:    the model named by ``robot`` may be a ``.xacro`` file (expanding one runs
+                its Python code); never applies to a model the front matter names.
     """
     sub = submission if isinstance(submission, Submission) else read(os.fspath(submission))
     read_model = None
     if isinstance(robot, Robot):
         model = robot
     elif robot or sub.robot:
-        model = _load_robot(robot or sub.robot, sub)  # a stated model wins: the text's statements are only checked
+        # a stated model wins: the text's statements are only checked; only a model given
+        # by the caller (never the front matter's) may be a trusted .xacro
+        model = _load_robot(robot or sub.robot, sub, trusted=bool(trusted and robot))
     else:
         from .robot_text import robot_from_text
 

@@ -28,6 +28,7 @@ import sympy as sp
 from ..dispatch import register
 from ..htmlpage import fragment, page
 from ..mathml import MathWriter, escape, latex_to_mathml, math_element, text_with_math
+from .explain import affordable
 from .verdict import STATUSES, GradeReport, StepVerdict
 
 __all__ = ["report_html", "write_report_html", "repr_html", "STATUS_TEXT"]
@@ -104,7 +105,7 @@ class _Writer:
         expr = sp.sympify(expr)
         if dag.larger_than(expr, PRINT_NODE_LIMIT):
             return f'<mtext class="long">[more than {PRINT_NODE_LIMIT} nodes: too long to print]</mtext>'
-        if self.tidy and expr.free_symbols and not dag.larger_than(expr, _TIDY_NODE_LIMIT):
+        if self.tidy and expr.free_symbols and not dag.larger_than(expr, _TIDY_NODE_LIMIT) and affordable(expr):
             try:
                 return self.w.terms(tidy_terms(expr, self.q, self.qd, self.qdd), width=LINE_WIDTH)
             except Exception:  # noqa: BLE001 - display only: fall back to SymPy's order

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 import yaml
 
 from ..errors import ModelError
+from ..io import textfile
 from ..io.yaml_screen import screen
 from .display import front_matter, regions
 
@@ -121,22 +122,8 @@ class Submission:
 
 
 def read_text(path: str) -> str:
-    """A submission file's text: UTF-8, at most ``MAX_BYTES``; else a ModelError naming it."""
-    try:
-        size = os.path.getsize(path)
-    except OSError as exc:
-        raise ModelError(f"cannot read the submission ({exc.strerror})", source=path) from None
-    if size > MAX_BYTES:
-        raise ModelError(
-            f"the file is {size} bytes; a derivation of at most {MAX_BYTES} bytes is expected", source=path
-        )
-    try:
-        with open(path, encoding="utf-8") as fh:
-            return fh.read()
-    except UnicodeDecodeError:
-        raise ModelError("not a UTF-8 text file", source=path) from None
-    except OSError as exc:
-        raise ModelError(f"cannot read the submission ({exc.strerror})", source=path) from None
+    """A submission file's text: UTF-8, at most ``MAX_BYTES`` (:mod:`armdyn.io.textfile`)."""
+    return textfile.read_text(path, "submission", MAX_BYTES)
 
 
 _LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when present: 100x faster

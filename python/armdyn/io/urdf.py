@@ -55,7 +55,6 @@ import re
 import warnings
 import xml.etree.ElementTree as ET
 from functools import partial
-from pathlib import Path
 
 import numpy as np
 import sympy as sp
@@ -117,11 +116,9 @@ def _read(path_or_xml) -> tuple[bytes, str]:
         return path_or_xml.encode("utf-8", "surrogatepass"), "<urdf>"
     if not isinstance(path_or_xml, (str, os.PathLike)):
         raise ModelError(f"expected a file path or URDF text, got {type(path_or_xml).__name__}")
-    source = str(path_or_xml)
-    try:
-        return Path(path_or_xml).read_bytes(), source
-    except OSError as exc:
-        raise ModelError(f"cannot read the file ({exc.strerror or exc})", source=source) from None
+    from .textfile import MODEL_MAX_BYTES, read_bytes
+
+    return read_bytes(path_or_xml, "model", MODEL_MAX_BYTES), str(path_or_xml)
 
 
 def parse_xml(text: bytes) -> ET.Element:

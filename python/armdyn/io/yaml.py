@@ -129,6 +129,7 @@ from .expressions import (
     quoted,
     shown,
 )
+from .textfile import MODEL_MAX_BYTES, read_text
 from .yaml_screen import screen
 
 TOP_KEYS = (
@@ -427,12 +428,7 @@ def load_yaml(path, strict: bool = True, source: str | None = None) -> Robot:
     """
     path = Path(path)
     source = source or os.fspath(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ModelError("no such file", None, source) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ModelError(f"cannot read the file ({exc})", None, source) from None
+    text = read_text(path, "model", MODEL_MAX_BYTES, name=source)
     data = parse_text(text, source)
     if data is None:
         raise ModelError("the file is empty", None, source)
