@@ -466,8 +466,9 @@ class _Grader:
             world.given[key] = [canonical(world, j.conv, got, extras, j.origins)]
         else:
             world.given[key] = [canonical(world, j.conv, got, extras, j.origins | {name})]
-            if j.canon is not None:
-                world.given[key].append(j.canon)
+            if j.canon is not None:  # what it should have been: a repair, never support (engine._supported)
+                c = j.canon
+                world.given[key].append(Value(c.fp, c.build, c.origins, c.repaired | {name}))
         world.invalidate()
 
         # what is shown: expected in the student's convention, the difference against
