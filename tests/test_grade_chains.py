@@ -1,0 +1,168 @@
+"""Every member of a chain ``LHS = formula = value`` is checked, and a right value that does
+not follow from the student's own earlier values is ``correct-but-unsupported``.
+
+The second opinion is the mutation itself: each slip below is put by hand into a formula
+member of a derivation checked outside armdyn (examples/grading/README.md), leaving the
+value as it was; each changes what the member is worth (the comment says why), so the step
+must be reported ``wrong`` at its line, and nothing else may change.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from armdyn.grading import grade
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples" / "grading"
+
+#: file -> its documented wrong steps (README: "first wrong step"; none for the clean one)
+DOCUMENTED_WRONG = {
+    "rp-arm-dalembert.md": [],
+    "planar-2r-craig.md": ["vc_dot_2"],
+    "planar-3r-spong.md": ["N_3"],
+    "planar-2r-lagrange.md": ["dL_dq_2"],
+}
+
+# (file, the line's start, text in a formula member, its slip, the step, why the member's worth changes)
+MUTATIONS = [
+    (
+        "rp-arm-dalembert.md",
+        "$$\\dot{v}_2^2 =",
+        "+ \\omega_1^1 \\times (\\omega_1^1 \\times P_2^1) ",
+        "",
+        "v_dot_2",
+        "dropped cross-product term: P_2^1 = (0, d2, 0), so the centripetal -d2 th1'^2 goes",
+    ),
+    (
+        "rp-arm-dalembert.md",
+        "$$\\dot{v}_2^2 =",
+        "[\\dot{\\omega}_1^1 \\times P_2^1",
+        "[\\omega_1^1 \\times P_2^1",
+        "v_dot_2",
+        "omega for omega-dot: th1' in place of th1'' times d2",
+    ),
+    (
+        "rp-arm-dalembert.md",
+        "$$f_1^1 =",
+        "R_2^1 f_2^2",
+        "R_1^2 f_2^2",
+        "f_1",
+        "the rotation the wrong way: f_2's z component lands in y with the opposite sign",
+    ),
+    (
+        "rp-arm-dalembert.md",
+        "$$n_1^1 =",
+        "- P_1^1 \\times F_1^1",
+        "+ P_1^1 \\times F_1^1",
+        "n_1",
+        "a sign: P_1^1 x F_1^1 = (0, 0, -l1 m1 (l1 th1'' + g cos th1)) is not zero",
+    ),
+    (
+        "planar-2r-craig.md",
+        "$${}^{2}\\dot{v}_{2} =",
+        "({}^{1}\\dot{\\omega}_{1} \\times {}^{1}P_{2}",
+        "({}^{1}\\omega_{1} \\times {}^{1}P_{2}",
+        "v_dot_2",
+        "omega for omega-dot: P_2 = (l1, 0, 0), so th1' l1 in place of th1'' l1",
+    ),
+    (
+        "planar-2r-craig.md",
+        "$${}^{1}f_{1} =",
+        "{}^{1}_{2}R\\,{}^{2}f_{2}",
+        "{}^{2}_{1}R\\,{}^{2}f_{2}",
+        "f_1",
+        "the rotation the wrong way (after the file's own slip: a new one, not inherited)",
+    ),
+    (
+        "planar-3r-spong.md",
+        "$$f_2^2 =",
+        "R_3^2 f_3^3",
+        "R_2^3 f_3^3",
+        "f_2",
+        "the rotation the wrong way: f_3 turned by -th3 instead of th3",
+    ),
+    (
+        "planar-3r-spong.md",
+        "$$f_3^3 =",
+        "= F_3^3 =",
+        "= -F_3^3 =",
+        "f_3",
+        "a sign: F_3 is not zero",
+    ),
+    (
+        "planar-2r-lagrange.md",
+        "$$L =",
+        "T - V",
+        "T + V",
+        "L",
+        "a sign: V is not zero",
+    ),
+]
+
+
+def _mutated(tmp_path, name, start, old, new):
+    lines = (EXAMPLES / name).read_text().split("\n")
+    k = next(i for i, t in enumerate(lines) if t.startswith(start))
+    before = lines[k]
+    assert before.count(old) == 1, (name, start, old)
+    value_at = before.rindex("= ")
+    assert before.index(old) < value_at, "the slip must be in a formula member, not in the value"
+    lines[k] = before.replace(old, new)
+    path = tmp_path / name
+    path.write_text("\n".join(lines))
+    return path, k + 1
+
+
+@pytest.mark.parametrize("name", sorted(DOCUMENTED_WRONG))
+def test_clean_chains_raise_no_false_alarm(name):
+    r = grade(EXAMPLES / name)
+    assert [v.name for v in r.steps if v.status == "wrong"] == DOCUMENTED_WRONG[name]
+    assert not any(") differs from the value:" in v.message for v in r.steps)  # no formula member flagged
+
+
+@pytest.mark.parametrize("name, start, old, new, step, why", MUTATIONS, ids=[f"{m[0]}:{m[4]}" for m in MUTATIONS])
+def test_a_slip_in_a_formula_member_is_reported_at_its_line(tmp_path, name, start, old, new, step, why):
+    path, line = _mutated(tmp_path, name, start, old, new)
+    r = grade(path)
+    v = next(v for v in r.steps if v.name == step and v.line == line)
+    assert v.status == "wrong", why
+    assert "formula member" in v.message and "differs from the value" in v.message
+    assert [w.name for w in r.steps if w.status == "wrong"] == sorted(
+        DOCUMENTED_WRONG[name] + [step], key=[s.name for s in r.steps].index
+    )
+
+
+def test_a_member_with_an_unknown_symbol_is_skipped_with_a_note():
+    # the exercise's v_dot_1 chain uses \dot{\mathbf{V}}_1^0, which names nothing
+    r = grade(EXAMPLES / "rp-arm-exercise.md")
+    v = next(v for v in r.steps if v.name == "v_dot_1")
+    assert v.status == "wrong" and "member 1 not checked: unknown symbol" in v.message and "V" in v.message
+
+
+def test_exercise_keeps_its_documented_verdicts_and_says_the_members_are_right():
+    r = grade(EXAMPLES / "rp-arm-exercise.md")
+    status = {v.name: v.status for v in r.steps if v.key and v.key != "tau"}
+    assert status["omega_2"] == "correct"  # its theta_2-dot of the prismatic joint is read as 0, said
+    assert "prismatic" in next(v for v in r.steps if v.name == "omega_2").message
+    n1 = next(v for v in r.steps if v.name == "n_1")
+    assert n1.status == "wrong" and "factor l₁ missing" in n1.message
+    assert "is right: the slip is in the value" in n1.message  # R_2^1 m_2^2 + P_1^1 x f_1^1 gives l1 (f_1)_y
+
+
+def test_right_torque_after_a_wrong_moment_is_unsupported(tmp_path):
+    """The clean d'Alembert derivation with n_1's value dropping m1 l1 (l1 th1'' + g cos th1)
+    (P_1^1 x F_1^1's part): its tau_1 is still the true one, so it cannot follow from the
+    student's own n_1 (tau_1 = z . n_1 = n_1's z component)."""
+    text = (EXAMPLES / "rp-arm-dalembert.md").read_text()
+    term = " + m_1 l_1 (l_1 \\ddot{\\theta}_1 + g \\cos\\theta_1) \\end{pmatrix}"
+    assert text.count(term) == 1
+    path = tmp_path / "n1-slip.md"
+    path.write_text(text.replace(term, " \\end{pmatrix}"))
+    r = grade(path)
+    assert [v.name for v in r.steps if v.status == "wrong"] == ["n_1"]
+    tau1 = next(v for v in r.steps if v.name == "tau_1")
+    assert tau1.status == "correct-but-unsupported"
+    assert "through earlier errors" in tau1.message  # its member n_1^{1T} Z_1^1, with their n_1
+    assert next(v for v in r.steps if v.name == "tau_2").status == "correct"  # tau_2 uses f_2 only
