@@ -92,6 +92,22 @@ MUTATIONS = [
         "a sign: F_3 is not zero",
     ),
     (
+        "planar-3r-spong.md",
+        "$$\\dot{v}_{c,2}^2 =",
+        "+ \\dot{\\omega}_2^2 \\times r_{2,c_2}",
+        "+ \\omega_2^2 \\times r_{2,c_2}",
+        "vc_dot_2",
+        "omega for omega-dot: r_{2,c_2} = (l2/2, 0, 0), so (th1' + th2') in place of (th1'' + th2'')",
+    ),
+    (
+        "planar-3r-spong.md",
+        "$$n_2^2 =",
+        "+ r_{2,c_2} \\times F_2^2 ",
+        "",
+        "n_2",
+        "dropped cross-product term (after the file's own slip in N_3: a new one): l2/2 (F_2)_y in z",
+    ),
+    (
         "planar-2r-lagrange.md",
         "$$L =",
         "T - V",
@@ -166,3 +182,9 @@ def test_right_torque_after_a_wrong_moment_is_unsupported(tmp_path):
     assert tau1.status == "correct-but-unsupported"
     assert "through earlier errors" in tau1.message  # its member n_1^{1T} Z_1^1, with their n_1
     assert next(v for v in r.steps if v.name == "tau_2").status == "correct"  # tau_2 uses f_2 only
+
+
+def test_spongs_r_vectors_are_read_as_positions_and_said():
+    r = grade(EXAMPLES / "planar-3r-spong.md")
+    v = next(v for v in r.steps if v.name == "vc_dot_1")
+    assert v.status == "correct" and "r_{1,c_1} read as P_C1^1" in v.message

@@ -37,7 +37,7 @@ _SCRIPT = rf"\s*(?:_\s*{_ARG}|\^(?!\s*(?:T(?![A-Za-z0-9])|\{{\s*T\s*\}}|\\top|\{
 _DECOR = r"\\(?:d?dot|mathbf|boldsymbol|bm|vec|hat|mathrm|pmb)(?![A-Za-z])"
 _STEP = re.compile(
     rf"(?<![A-Za-z\\])(?P<pre>\{{\}}(?:{_SCRIPT})+\s*)?"
-    rf"(?P<core>(?:{_DECOR}\s*\{{?\s*)*(?:\\omega(?![A-Za-z])|[vaFNfnmRPIZzXxY](?![A-Za-z]))(?:\s*\}})*)"
+    rf"(?P<core>(?:{_DECOR}\s*\{{?\s*)*(?:\\omega(?![A-Za-z])|[vaFNfnmRPIZzXxYr](?![A-Za-z]))(?:\s*\}})*)"
     rf"(?P<scripts>(?:{_SCRIPT})*)"
 )
 _UNIT = {"x": 0, "y": 1, "z": 2}
@@ -51,6 +51,7 @@ class Meaning:
 
     what: object
     transpose: bool = False
+    note: str = ""  # how a name outside the usual ones was read, said in the verdict
 
 
 def _balanced(text: str) -> bool:
@@ -72,6 +73,8 @@ def meaning(text: str, pre: str, core: str, scripts: str, coordinate_of) -> Mean
     if base == "I":
         links = {int(d) for d in re.findall(r"\d+", pre + scripts)}  # I_1^{C_1}, {}^{C_1}I_1, I_{C_1}
         return Meaning(("I", links.pop()), transpose) if len(links) == 1 else None
+    if base == "r":
+        return _spong_r(text, scripts, transpose)
     if base == "a" and not re.search(r"_\s*\{?\s*[Cc]", scripts):
         return None  # a_i is a link length (Spong); a_{C_i} an acceleration
     ref = parse_lhs(text, coordinate_of)
@@ -80,6 +83,23 @@ def meaning(text: str, pre: str, core: str, scripts: str, coordinate_of) -> Mean
     if ref.alias == "m" and ref.frame is None:
         return None  # m_i without a frame: the mass
     return Meaning(ref, transpose)
+
+
+def _spong_r(text: str, scripts: str, transpose: bool) -> Meaning | None:
+    """Spong's ``r_{i,c_i}`` (link i's mass centre from joint i) and ``r_{i,i+1}`` (joint
+    i+1 from joint i), in frame i: with frame i on joint i's axis, ``P_{C_i}^i`` and
+    ``P_{i+1}^i``."""
+    m = re.fullmatch(r"_\s*\{\s*(\d+)\s*,\s*(?:([Cc])_?\{?(\d+)\}?|(\d+))\s*\}", scripts.strip())
+    if m is None:
+        return None
+    i = int(m.group(1))
+    if m.group(2) and int(m.group(3)) == i:
+        ref, what = StepRef("Pc", i, i), f"link {i}'s mass centre from frame {i}'s origin"
+    elif m.group(4) and int(m.group(4)) == i + 1:
+        ref, what = StepRef("P", i + 1, i), f"frame {i + 1}'s origin from frame {i}'s"
+    else:
+        return None
+    return Meaning(ref, transpose, f"{text} read as {ref.name} ({what}, in frame {i})")
 
 
 @dataclass
@@ -157,6 +177,8 @@ class StepNames:
             def resolve(name: Name):
                 if name.base == PLACEHOLDER:
                     what = found[int(name.sub)]
+                    if what.note:
+                        self.assumed.append(what.note)
                     value = self.values(what.what, own)
                     if value is None:
                         raise UnknownSymbol(f"unknown symbol {_shown(what.what)}")
