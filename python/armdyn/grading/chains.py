@@ -29,6 +29,11 @@ from .notation import VECTOR_KEYS, StepRef, parse_lhs
 
 #: the placeholder a step name is replaced by before parsing (a name no student writes)
 PLACEHOLDER = "armdynstep"
+#: step names in one member beyond which it is not checked (a formula names a handful;
+#: each costs a matrix operation, so this bounds a hostile member's work)
+MAX_NAMES = 100
+#: characters of a member quoted in a message
+QUOTE = 80
 
 _GROUP = r"\{(?:[^{}]|\{(?:[^{}]|\{[^{}]*\})*\})*\}"
 _ARG = rf"(?:{_GROUP}|\\[A-Za-z]+|[A-Za-z0-9])"
@@ -166,6 +171,8 @@ class StepNames:
             out.append(text[last : m.start()] + f" \\mathrm{{{PLACEHOLDER}}}_{{{len(found)}}} ")
             last = m.end()
             found.append(what)
+            if len(found) > MAX_NAMES:
+                raise LatexError(f"it names more than {MAX_NAMES} steps")
         out.append(text[last:])
         return "".join(out), found
 
@@ -223,7 +230,7 @@ class Values:
             if key not in self.world.method.refs or (ref.frame is not None and not 0 <= ref.frame <= n):
                 return None
             if key in self.written:
-                value = self.written[key][0 if own else 1]
+                value = to_sympy(self.written[key][0 if own else 1])
             else:  # not written: what the method gives from the student's values (or the right one)
                 value = to_sympy((self.world.candidates(key)[0] if own else self.world.expected[key]).sym())
             frame = ref.index if ref.frame is None else ref.frame
@@ -290,6 +297,11 @@ class MemberFinding:
     member: object = None
 
 
+def quoted(text: str) -> str:
+    """A member as quoted in a message: at most :data:`QUOTE` characters."""
+    return text if len(text) <= QUOTE else text[: QUOTE - 1].rstrip() + "…"
+
+
 def members(source: str) -> list[str]:
     """The members between the left-hand side and the value of ``A = B = ... = value``."""
     return sides(source)[1:-1]
@@ -308,23 +320,23 @@ def check(source: str, value, expected, names: StepNames, fingerprint, equal, va
             own, right = _shaped(reading.own, value), _shaped(reading.right, value)
             ok = equal(fingerprint(own), fingerprint(value))
         except UnknownSymbol as err:
-            out.append(MemberFinding(number, text, "skipped", str(err).split(" (")[0]))
+            out.append(MemberFinding(number, quoted(text), "skipped", str(err).split(" (")[0][:QUOTE]))
             continue
         except (LatexError, TypeError, ValueError, AttributeError, sp.ShapeError, RecursionError) as err:
             why = str(err).split("\n")[0][:120] or type(err).__name__
-            out.append(MemberFinding(number, text, "skipped", f"cannot read it ({why})"))
+            out.append(MemberFinding(number, quoted(text), "skipped", f"cannot read it ({why})"))
             continue
         assumed = "; ".join(reading.assumed)
         if ok.all():
             if assumed:
-                out.append(MemberFinding(number, text, "assumed", assumed))
+                out.append(MemberFinding(number, quoted(text), "assumed", assumed))
             continue
         bad = [int(i) for i in range(ok.size) if not ok.ravel()[i]]
         if not equal(fingerprint(right), fingerprint(expected)).all():
             kind = "wrong"
         else:
             kind = "right" if value_wrong else "inherited"
-        out.append(MemberFinding(number, text, kind, assumed, bad, own))
+        out.append(MemberFinding(number, quoted(text), kind, assumed, bad, own))
     return out
 
 

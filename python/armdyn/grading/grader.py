@@ -479,7 +479,7 @@ class _Grader:
         exp_shown = j.conv.forward(
             world.expected[key].sym(), world.ctx, *(world.expected[r].sym() for r in j.conv.extra)
         )
-        self.written[key] = (to_sympy(own), exp_shown)
+        self.written[key] = (own, exp_shown)  # read by chain members (SymPy when used)
         if ref.key in VECTOR_KEYS and ref.frame is not None and ref.index is not None and ref.frame != ref.index:
             exp_shown = rotation_between(world.ctx, ref.index, ref.frame) * exp_shown
         findings = self._members(eq, as_written, exp_shown, j.status == "wrong") if eq.latex else []
