@@ -200,3 +200,30 @@ def test_a_hostile_member_is_skipped_in_bounded_time(tmp_path):
     v = grade(path).steps[0]
     assert time.monotonic() - start < 10
     assert v.status == "correct" and "member 1 not checked" in v.message and len(v.message) < 300
+
+
+def test_a_member_naming_an_earlier_wrong_lagrange_step_is_inherited_not_wrong(tmp_path):
+    # T drops I_2 (q1' + q2')^2 / 2; L = T - V is then written right: the member T - V, with
+    # the student's T, differs from L only through T's error (the formula is right)
+    text = (EXAMPLES / "planar-2r-lagrange.md").read_text().split("\n")
+    k = next(i for i, t in enumerate(text) if t.startswith("$$T ="))
+    tail = " + \\frac{1}{2} I_2 (\\dot{q}_1 + \\dot{q}_2)^2$$"
+    assert text[k].endswith(tail)
+    text[k] = text[k][: -len(tail)] + "$$"
+    path = tmp_path / "t-slip.md"
+    path.write_text("\n".join(text))
+    r = grade(path)
+    assert [v.name for v in r.steps if v.status == "wrong"] == ["T", "dL_dq_2"]
+    v = next(v for v in r.steps if v.name == "L")
+    assert v.status == "correct-but-unsupported" and "only through earlier errors" in v.message
+
+
+def test_bold_zero_in_a_member_is_the_zero_vector(tmp_path):
+    path = tmp_path / "zero.md"
+    path.write_text(
+        "---\nrobot: rp-arm\n---\n\n$$\\omega_1^1 = \\mathbf{0} + \\dot\\theta_1 \\hat{Z}_1^1 = (0, 0, \\dot\\theta_1)^T$$\n"
+        "\n$$\\dot\\omega_1^1 = \\mathbf{0} + \\dot\\theta_1 \\hat{Z}_1^1 = (0, 0, \\ddot\\theta_1)^T$$\n"
+    )
+    r = grade(path)
+    assert [(v.name, v.status) for v in r.steps] == [("omega_1", "correct"), ("omega_dot_1", "wrong")]
+    assert "formula member" in r.steps[1].message and "not checked" not in r.steps[0].message

@@ -10,8 +10,11 @@ standing for the student's OWN earlier values (:class:`StepNames`: ``\\omega_1^1
 ``{}^{1}\\dot\\omega_1``, ``\\dot v_1^1``, ``F_2^2``, ``f_2^2``, ``n_2^2`` / ``m_2^2``,
 ``R_0^1`` / ``{}^{1}_{0}R`` (``R_2^1`` the transpose of a written ``R_1^2``), ``P_{C_1}^1``,
 ``P_2^1``, ``I_1^{C_1}`` / ``{}^{C_1}I_1``, the unit axes ``\\hat Z_1^1``, ``\\hat z``, ``z``,
-a trailing ``T`` in the frame (``n_1^{1T}``) a transpose) and the model's where the student
-did not write that step; every other symbol is the model's (:class:`~.notation.SymbolMap`).
+a trailing ``T`` in the frame (``n_1^{1T}``) a transpose, ``\\mathbf{0}`` the zero vector,
+Spong's ``r_{i,c_i}``, ``r_{i,i+1}`` read as ``P_{C_i}^i``, ``P_{i+1}^i`` and said) and the
+model's where the student did not write that step; ``T``, ``V``, ``L`` are the student's
+(:attr:`~.notation.SymbolMap.steps`); every other symbol is the model's
+(:class:`~.notation.SymbolMap`).
 A member that differs from the value is a slip of its own unless the difference is only
 inherited: read with the right values of every step it names, it gives the step's right
 value (:func:`check`). A member that cannot be read is skipped with a note saying why.
@@ -46,6 +49,8 @@ _STEP = re.compile(
     rf"(?P<scripts>(?:{_SCRIPT})*)"
 )
 _UNIT = {"x": 0, "y": 1, "z": 2}
+#: a bold zero: the zero vector
+_ZERO = re.compile(r"\\(?:mathbf|boldsymbol|bm|vec)\s*\{\s*0\s*\}")
 
 
 @dataclass
@@ -154,6 +159,7 @@ class StepNames:
         """``text`` with each step name replaced by a numbered placeholder, and their meanings."""
         found: list[Meaning] = []
         out, last = [], 0
+        text = _ZERO.sub(lambda m: f" \\mathrm{{{PLACEHOLDER}}}_{{z}} ", text)
         for m in _STEP.finditer(text):
             name = m.group(0)
             if not _balanced(name):
@@ -182,6 +188,8 @@ class StepNames:
 
         def resolver(own: bool):
             def resolve(name: Name):
+                if name.base == PLACEHOLDER and name.sub == "z":
+                    return sp.zeros(3, 1)
                 if name.base == PLACEHOLDER:
                     what = found[int(name.sub)]
                     if what.note:
@@ -190,6 +198,9 @@ class StepNames:
                     if value is None:
                         raise UnknownSymbol(f"unknown symbol {_shown(what.what)}")
                     return value.T if what.transpose else value
+                if not own and not name.dots and not name.sub and name.base in ("T", "V", "L"):
+                    if name.base in self.symbols.steps:  # the student's T, V, L: read right, the right ones
+                        return self.values(("lagrange", name.base), False)
                 return self.symbol(name)
 
             return resolve
@@ -204,18 +215,21 @@ class Values:
     """The value a step name in a member stands for, in the frame it names.
 
     world:    () -> the Newton-Euler world (its context: the model's kinematics), made when needed
+    lagrange: () -> the Lagrange world (the right T, V, L), made when needed
     written:  (key, index) -> (the student's value, the right value in their convention),
               both in the link's own frame, for the steps they wrote
     verdicts: the verdicts so far (the rotations and positions the student wrote)
     """
 
-    def __init__(self, world, written: dict, verdicts: list):
-        self._world, self.written, self.verdicts = world, written, verdicts
+    def __init__(self, world, written: dict, verdicts: list, lagrange=None):
+        self._world, self.written, self.verdicts, self._lagrange = world, written, verdicts, lagrange
 
     def __call__(self, what, own: bool):
         from .engine import to_sympy
         from .methods import rotation_between
 
+        if isinstance(what, tuple) and what[0] == "lagrange":
+            return to_sympy(self._lagrange().expected[(what[1], None)].sym())
         self.world = self._world()
         ctx = self.world.ctx
         n = len(self.world.method.robot.links) - 1
@@ -344,3 +358,56 @@ def _matrixish(value):
     from .engine import to_sympy
 
     return to_sympy(value)
+
+
+def check_step(grader, eq, value, expected, value_wrong: bool) -> list:
+    """The members of ``eq`` (a step the grader just judged) checked against its ``value``
+    (as written) and ``expected`` (right, same frame and convention): :func:`check` with the
+    grader's symbols, its student's steps so far and its worlds."""
+    from .engine import equal
+
+    values = Values(
+        lambda: grader.world("newton-euler"), grader.written, grader.verdicts, lambda: grader.world("lagrange")
+    )
+    names = StepNames(grader.symbols, values)
+    return check(eq.source, value, expected, names, grader.sampler.fingerprint, equal, value_wrong)
+
+
+def with_members(findings: list, verdict: tuple, value, grader) -> tuple:
+    """``verdict`` = (status, message, difference, components, caused_by) with what the
+    chain's members add: a formula member that differs from the value on its own makes the
+    step wrong (an already wrong step keeps its message first); a right member of a wrong
+    value, an inherited difference, a member read with an assumption or not read at all
+    are said. ``value``: the step's value as a matrix; ``grader``: its ``_describe`` and
+    ``robot`` word the differences."""
+    from .explain import component_name, tidy
+
+    status, message, difference, components, caused_by = verdict
+    said = []
+    for f in findings:
+        if f.kind == "skipped":
+            said.append(f"member {f.number} not checked: {f.why}")
+            continue
+        if f.why:  # read with an assumption
+            said.append(f"member {f.number}: {f.why}")
+        if f.kind == "assumed":
+            continue
+        if f.kind == "right":
+            said.append(f"its formula member `{f.text}` (member {f.number}) is right: the slip is in the value")
+            continue
+        member = f.member if isinstance(f.member, sp.MatrixBase) else sp.Matrix([[f.member]])
+        where = [component_name(i, value.shape) for i in f.components[:3]]
+        what = "; ".join(
+            grader._describe(member[i], value[i]) + (f" in {w}" if w else "") for i, w in zip(f.components, where)
+        )
+        if len(what) > 160:  # a long difference: where, not what
+            what = "a long difference" + (f" in {', '.join(w for w in where if w)}" if any(where) else "")
+        if f.kind == "inherited":
+            said.append(f"member {f.number} `{f.text}` differs from the value only through earlier errors: {what}")
+            continue
+        said.append(f"the formula member `{f.text}` (member {f.number}) differs from the value: {what}")
+        if status != "wrong":
+            status, caused_by, components, message = "wrong", None, list(f.components), ""
+            difference = sp.Matrix([tidy(member[i] - value[i], grader.robot) for i in range(len(value))])
+            difference = difference if value.shape != (1, 1) else difference[0]
+    return status, "; ".join(x for x in [message, *said] if x), difference, components, caused_by

@@ -15,8 +15,7 @@ import sympy as sp
 from ..errors import ModelError
 from ..model import Robot
 from ..symbolic.names import latex_symbol_names
-from .chains import StepNames, Values
-from .chains import check as check_members
+from .chains import check_step, with_members
 from .diagnose import unreadable
 from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, tidy
@@ -482,7 +481,7 @@ class _Grader:
         self.written[key] = (own, exp_shown)  # read by chain members (SymPy when used)
         if ref.key in VECTOR_KEYS and ref.frame is not None and ref.index is not None and ref.frame != ref.index:
             exp_shown = rotation_between(world.ctx, ref.index, ref.frame) * exp_shown
-        findings = self._members(eq, as_written, exp_shown, j.status == "wrong") if eq.latex else []
+        findings = check_step(self, eq, as_written, exp_shown, j.status == "wrong") if eq.latex else []
         difference, components, message = None, [], ""
         if j.status in ("wrong", "follows-from-earlier-error", "correct-but-unsupported"):
             value = to_sympy(value)
@@ -539,8 +538,8 @@ class _Grader:
             message = j.convention or ""
         status = j.status
         if findings:
-            status, message, difference, components, caused_by = self._member_verdict(
-                findings, status, message, difference, components, caused_by, _matrix(to_sympy(as_written))
+            status, message, difference, components, caused_by = with_members(
+                findings, (status, message, difference, components, caused_by), _matrix(to_sympy(as_written)), self
             )
         self.verdicts.append(
             StepVerdict(
@@ -561,49 +560,6 @@ class _Grader:
                 frame="" if ref.key not in VECTOR_KEYS else str(ref.frame if ref.frame is not None else ref.index),
             )
         )
-
-    def _members(self, eq, value, expected, value_wrong: bool) -> list:
-        """The chain's members checked against the value (:mod:`.chains`)."""
-        names = StepNames(self.symbols, Values(lambda: self.world("newton-euler"), self.written, self.verdicts))
-        return check_members(eq.source, value, expected, names, self.sampler.fingerprint, equal, value_wrong)
-
-    def _member_verdict(self, findings, status, message, difference, components, caused_by, value):
-        """The verdict with what its chain's members add: a formula member that differs
-        from the value on its own makes the step wrong (an already wrong step keeps its
-        message first); an inherited difference and a member not read are noted."""
-        said = []
-        for f in findings:
-            if f.kind == "skipped":
-                said.append(f"member {f.number} not checked: {f.why}")
-                continue
-            if f.why:  # read with an assumption
-                said.append(f"member {f.number}: {f.why}")
-            if f.kind == "assumed":
-                continue
-            if f.kind == "right":
-                said.append(f"its formula member `{f.text}` (member {f.number}) is right: the slip is in the value")
-                continue
-            member = _matrix(f.member)
-            what = "; ".join(
-                self._describe(member[i], value[i])
-                + (f" in {component_name(i, value.shape)}" if component_name(i, value.shape) else "")
-                for i in f.components[:3]
-            )
-            if len(what) > 160:  # a long difference: where, not what
-                where = ", ".join(
-                    component_name(i, value.shape) for i in f.components[:3] if component_name(i, value.shape)
-                )
-                what = "a long difference" + (f" in {where}" if where else "")
-            if f.kind == "inherited":
-                said.append(f"member {f.number} `{f.text}` differs from the value only through earlier errors: {what}")
-                continue
-            said.append(f"the formula member `{f.text}` (member {f.number}) differs from the value: {what}")
-            if status != "wrong":
-                status, caused_by, components = "wrong", None, list(f.components)
-                difference = sp.Matrix([tidy(member[i] - value[i], self.robot) for i in range(len(value))])
-                difference = difference if value.shape != (1, 1) else difference[0]
-                message = ""
-        return status, "; ".join(x for x in [message, *said] if x), difference, components, caused_by
 
     def _describe(self, got, ref) -> str:
         """What differs, in the student's shorthand."""
