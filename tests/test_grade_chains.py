@@ -227,3 +227,17 @@ def test_bold_zero_in_a_member_is_the_zero_vector(tmp_path):
     r = grade(path)
     assert [(v.name, v.status) for v in r.steps] == [("omega_1", "correct"), ("omega_dot_1", "wrong")]
     assert "formula member" in r.steps[1].message and "not checked" not in r.steps[0].message
+
+
+def test_members_of_a_chain_written_over_aligned_rows():
+    from armdyn.grading.chains import members
+
+    source = (
+        "\\omega_2^2 &= R_1^2 \\omega_1^1 \\\\ &= \\begin{pmatrix} 0 & 1 \\\\ 0 & 1 \\end{pmatrix} x"
+        " \\\\ &= \\begin{pmatrix} 0 \\\\ 0 \\\\ 1 \\end{pmatrix}"
+    )
+    got = members(source)
+    assert [m.split() for m in got] == [
+        ["R_1^2", "\\omega_1^1"],
+        ["\\begin{pmatrix}", "0", "&", "1", "\\\\", "0", "&", "1", "\\end{pmatrix}", "x"],
+    ]
