@@ -241,3 +241,16 @@ def test_members_of_a_chain_written_over_aligned_rows():
         ["R_1^2", "\\omega_1^1"],
         ["\\begin{pmatrix}", "0", "&", "1", "\\\\", "0", "&", "1", "\\end{pmatrix}", "x"],
     ]
+
+
+def test_a_slip_carried_from_the_formula_member_into_the_value_is_placed_in_the_member(tmp_path):
+    # L = T + V written out consistently: the value is wrong on its own and its formula member is where
+    text = (EXAMPLES / "planar-2r-lagrange.md").read_text().split("\n")
+    k = next(i for i, t in enumerate(text) if t.startswith("$$L ="))
+    old = "- m_1 g l_{c1} \\sin q_1 - m_2 g (l_1"
+    assert text[k].count(old) == 1 and text[k].count("T - V") == 1
+    text[k] = text[k].replace(old, "+ m_1 g l_{c1} \\sin q_1 + m_2 g (l_1").replace("T - V", "T + V")
+    path = tmp_path / "l-slip.md"
+    path.write_text("\n".join(text))
+    v = next(v for v in grade(path).steps if v.name == "L")
+    assert v.status == "wrong" and "the slip is already in its formula member `T + V`" in v.message

@@ -298,7 +298,9 @@ def _shaped(value, like):
 @dataclass
 class MemberFinding:
     """One member that is not simply equal to the value: ``kind`` is "wrong" (a slip of
-    its own), "right" (right, but the value differs from it: the value holds the slip),
+    its own), "source" (equal to a value wrong on its own, and wrong with the right values
+    too: the slip is already in this member), "right" (right, but the value differs from
+    it: the value holds the slip),
     "inherited" (it differs only through earlier errors), "skipped" (cannot be read:
     ``why``) or "assumed" (equal, read with an assumption: ``why``); ``components`` the
     differing components, ``member`` its value."""
@@ -347,7 +349,9 @@ def check(source: str, value, expected, names: StepNames, fingerprint, equal, va
             continue
         assumed = "; ".join(reading.assumed)
         if ok.all():
-            if assumed:
+            if value_wrong and not equal(fingerprint(right), fingerprint(expected)).all():
+                out.append(MemberFinding(number, quoted(text), "source", assumed))  # the slip is already here
+            elif assumed:
                 out.append(MemberFinding(number, quoted(text), "assumed", assumed))
             continue
         bad = [int(i) for i in range(ok.size) if not ok.ravel()[i]]
@@ -396,6 +400,9 @@ def with_members(findings: list, verdict: tuple, value, grader) -> tuple:
         if f.why:  # read with an assumption
             said.append(f"member {f.number}: {f.why}")
         if f.kind == "assumed":
+            continue
+        if f.kind == "source":
+            said.append(f"the slip is already in its formula member `{f.text}` (member {f.number})")
             continue
         if f.kind == "right":
             said.append(f"its formula member `{f.text}` (member {f.number}) is right: the slip is in the value")
