@@ -183,7 +183,12 @@ def test_generated_derivation_with_one_term_altered(tmp_path):
     assert r.first_wrong == "f_3"
     v = first_status(r, "f_3")
     assert v.components == [1] and "extra term" in v.message
-    assert [x.name for x in r.steps if x.status not in ("correct", "follows-from-earlier-error")] == ["f_3"]
+    assert [x.name for x in r.steps if x.status == "wrong"] == ["f_3"]
+    # f_2 = R_3^2 f_3 + F_2 and n_2 (P_3 x R_3^2 f_3) are written right, so they do not follow
+    # from the student's own f_3: right but unsupported; everything after them follows from theirs
+    unsupported = [x.name for x in r.steps if x.status == "correct-but-unsupported"]
+    assert unsupported == ["f_2", "n_2"]
+    assert [x.name for x in r.steps if x.status not in ("correct", "correct-but-unsupported")] == ["f_3"]
 
 
 BAD = {

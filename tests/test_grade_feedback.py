@@ -169,11 +169,16 @@ def test_reaction_convention_recognised_for_n(tmp_path):
     k = next(i for i, t in enumerate(text) if t.startswith("$${}^{2}n_{2}"))
     lhs, _, rhs = text[k].rpartition("= ")
     assert rhs.startswith("\\begin{bmatrix}") and rhs.endswith("$$")
-    text[k] = lhs + "= -" + rhs
+    text[k] = text[k].split(" = ")[0] + " = -" + rhs  # the value alone, its sign flipped
     path = tmp_path / "reaction.md"
     path.write_text("\n".join(text))
     v = by_name(grade(path), "n_2")
     assert v.status == "correct-by-convention" and "reaction" in v.convention
+    # with the formula member N_2 + P_{C_2} x F_2 kept, the chain no longer holds: that member is the action
+    text[k] = lhs + "= -" + rhs
+    path.write_text("\n".join(text))
+    v = by_name(grade(path), "n_2")
+    assert v.status == "wrong" and "formula member" in v.message and v.line == k + 1
 
 
 # ---------------------------------------------------------------- 2. messages

@@ -8,7 +8,9 @@ For each step the student wrote, in their order:
 2. **Supported?** The method's formula for the step is re-applied to the student's own
    earlier values (where they wrote an input step, their value; where they did not, what
    the method gives from theirs). A right value that none of these reproduces is
-   ``correct-but-unsupported``.
+   ``correct-but-unsupported``, whichever earlier step held the error: the value a wrong
+   step should have had (kept for the steps after it, see below) is a *repair*, never
+   the student's own, at any depth.
 3. **Carried forward?** A wrong value that one of those reproduces, with an earlier
    error in its inputs, ``follows-from-earlier-error`` (``caused_by`` names the earliest
    such error). Otherwise it is ``wrong``, explained against what the student's own
@@ -178,11 +180,14 @@ def equal(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 @dataclass
 class Value:
     """A candidate value of a step: numbers at the sample points, a way to build it
-    symbolically, and the student's wrong steps it inherits (``origins``)."""
+    symbolically, the student's wrong steps it inherits (``origins``) and the wrong steps
+    whose value was replaced by what it should have been (``repaired``): a candidate with
+    repairs is not what the student's own values give, so it never supports a step."""
 
     fp: np.ndarray
     build: object  # callable () -> sympy value
     origins: frozenset = frozenset()
+    repaired: frozenset = frozenset()
 
     def sym(self):
         if callable(self.build):
@@ -219,13 +224,14 @@ class World:
     def apply(self, fn, values: list[Value], extra_ctx_fn=None) -> Value:
         """fn(ctx, *inputs) on candidate values: numbers at the points, symbols lazily."""
         origins = frozenset().union(*(v.origins for v in values)) if values else frozenset()
+        repaired = frozenset().union(*(v.repaired for v in values)) if values else frozenset()
         if self.numeric:
             fp = np.stack(
                 [_from_num(fn(c, *(_as_input(v.fp[k]) for v in values))) for k, c in enumerate(self.ctx_points)]
             )
-            return Value(fp, lambda: to_sympy(fn(self.ctx, *(v.sym() for v in values))), origins)
+            return Value(fp, lambda: to_sympy(fn(self.ctx, *(v.sym() for v in values))), origins, repaired)
         sym = fn(self.ctx, *(v.sym() for v in values))
-        return Value(self.sampler.fingerprint(sym), sym, origins)
+        return Value(self.sampler.fingerprint(sym), sym, origins, repaired)
 
     def candidates(self, ref) -> list[Value]:
         """What the student's work gives for ``ref``: their value(s) if they wrote it,
@@ -262,12 +268,15 @@ def _as_input(fp_k: np.ndarray):
 
 
 def _dedupe(values: list[Value]) -> list[Value]:
+    """Candidates with distinct values; of equal ones, the fewest inherited errors and
+    (independently: both are ways to the same numbers) the fewest repairs."""
     out: list[Value] = []
     for v in values:
         for j, w in enumerate(out):
             if equal(v.fp, w.fp).all():
-                if len(v.origins) < len(w.origins):
-                    out[j] = v
+                best = v if len(v.origins) < len(w.origins) else w
+                repaired = min(v.repaired, w.repaired, key=len)
+                out[j] = Value(best.fp, best.build, best.origins, repaired) if repaired != best.repaired else best
                 break
         else:
             out.append(v)
@@ -330,11 +339,17 @@ def judge(world: World, ref, got: Value, extra_candidates) -> Judgement:
 
 
 def _supported(world: World, ref, got: Value, conv, extras_of) -> bool:
-    """Does the formula over the student's own values give ``got``? (Leaves: yes.)"""
+    """Does the formula over the student's own values give ``got``? (Leaves: yes.) A
+    candidate that replaces a wrong earlier step by what it should have been (``repaired``,
+    at any depth) is not the student's own."""
     if ref not in world.method.formulas:
         return True
     for value in world.carried(ref):
+        if value.repaired:
+            continue
         for extras in itertools.product(*extras_of(conv)):
+            if any(e.repaired for e in extras):
+                continue
             s = world.apply(lambda c, v, *x: conv.forward(v, c, *x), [value, *extras])
             if equal(got.fp, s.fp).all():
                 return True

@@ -15,6 +15,7 @@ import sympy as sp
 from ..errors import ModelError
 from ..model import Robot
 from ..symbolic.names import latex_symbol_names
+from .chains import check_step, with_members
 from .diagnose import cannot_read, location
 from .energy_steps import EnergySteps
 from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
@@ -80,6 +81,7 @@ class _Grader(EnergySteps):
         self.notes: list[str] = []
         self.refusals: list[tuple[str, str]] = []  # (file:line:column, why) of equations not graded
         self._primes_noted = False
+        self.written: dict = {}  # (key, index) -> (their value, the right one in their convention), link frame
 
     def world(self, name: str) -> World:
         if name not in self._worlds:
@@ -462,7 +464,7 @@ class _Grader(EnergySteps):
             self._unrecognised(eq, f"{method} has no step {ref.name} for this robot", name=ref.name, key=ref.key)
             return
         link = ""
-        own = value
+        own = as_written = value
         if ref.key in VECTOR_KEYS:
             assert ref.index is not None  # _check_index ran
             link = list(self.robot.links)[ref.index]
@@ -484,8 +486,9 @@ class _Grader(EnergySteps):
             world.given[key] = [canonical(world, j.conv, got, extras, j.origins)]
         else:
             world.given[key] = [canonical(world, j.conv, got, extras, j.origins | {name})]
-            if j.canon is not None:
-                world.given[key].append(j.canon)
+            if j.canon is not None:  # what it should have been: a repair, never support (engine._supported)
+                c = j.canon
+                world.given[key].append(Value(c.fp, c.build, c.origins, c.repaired | {name}))
         world.invalidate()
 
         # what is shown: expected in the student's convention, the difference against
@@ -493,8 +496,10 @@ class _Grader(EnergySteps):
         exp_shown = j.conv.forward(
             world.expected[key].sym(), world.ctx, *(world.expected[r].sym() for r in j.conv.extra)
         )
+        self.written[key] = (own, exp_shown)  # read by chain members (SymPy when used)
         if ref.key in VECTOR_KEYS and ref.frame is not None and ref.index is not None and ref.frame != ref.index:
             exp_shown = rotation_between(world.ctx, ref.index, ref.frame) * exp_shown
+        findings = check_step(self, eq, as_written, exp_shown, j.status == "wrong") if eq.latex else []
         difference, components, message = None, [], ""
         if j.status in ("wrong", "follows-from-earlier-error", "correct-but-unsupported"):
             value = to_sympy(value)
@@ -549,12 +554,17 @@ class _Grader(EnergySteps):
                         )
         elif j.status == "correct-by-convention":
             message = j.convention or ""
+        status = j.status
+        if findings:
+            status, message, difference, components, caused_by = with_members(
+                findings, (status, message, difference, components, caused_by), _matrix(to_sympy(as_written)), self
+            )
         self.verdicts.append(
             StepVerdict(
                 name=name,
                 key=ref.key,
                 link=link,
-                status=j.status,
+                status=status,
                 label=eq.lhs,
                 source=eq.source,
                 line=eq.line,

@@ -7,6 +7,7 @@ symbols to the model's (or refuses them)::
 
     expr    := ["+" | "-"] term (("+" | "-") term)*
     term    := factor (["*" | "\\cdot" | "\\times" | "/" | juxtaposition] factor)*
+               (a 3-vector \\times a 3-vector is the cross product, its right side a juxtaposed product)
     factor  := atom ["^" script]
     atom    := number | symbol | "(" expr ")" | "[" expr "]" | "{" expr "}"
              | "\\left(" expr "\\right)" | "\\frac{expr}{expr}" | "\\sqrt{expr}"
@@ -351,7 +352,14 @@ class _Parser:
         value = self.factor()
         while not self._signed_group():
             kind, tok = self.peek()
-            if (kind, tok) in (("char", "*"), ("cmd", "cdot"), ("cmd", "times"), ("cmd", "ast")):
+            if (kind, tok) == ("cmd", "times"):
+                # a x b c: the cross product binds looser than juxtaposition (w x I w)
+                self.take()
+                right = self.factor()
+                while self._starts_atom():
+                    right = right * self.factor()
+                value = _cross(value, right)
+            elif (kind, tok) in (("char", "*"), ("cmd", "cdot"), ("cmd", "ast")):
                 self.take()
                 value = value * self.factor()
             elif (kind, tok) == ("char", "/"):
@@ -724,6 +732,13 @@ class _Parser:
         if not rows or len({len(r) for r in rows}) != 1:
             raise LatexError("a matrix whose rows have different lengths")
         return sp.Matrix(rows)
+
+
+def _cross(a, b):
+    """``a \\times b``: the cross product of two 3-vectors, else the product."""
+    if isinstance(a, sp.MatrixBase) and isinstance(b, sp.MatrixBase) and a.shape == b.shape == (3, 1):
+        return a.cross(b)
+    return a * b
 
 
 def _power(base, exponent, at):

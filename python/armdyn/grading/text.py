@@ -100,7 +100,9 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
                 what += f" ({v.convention})"
         elif v.status == "correct-by-convention":
             what = f"correct ({v.convention})"
-        elif v.status == "correct" and v.key == "proof" and v.message:
+            extra = v.message.removeprefix(v.convention or "").lstrip("; ")  # e.g. a chain member not checked
+            what += f": {extra}" if extra else ""
+        elif v.status == "correct" and v.message:
             what = f"correct: {v.message}"
         elif v.status in ("wrong", "correct-but-unsupported", "unrecognised"):
             what = f"{v.status.upper() if v.status == 'wrong' else v.status}: {v.message}"
