@@ -186,7 +186,7 @@ def test_continuation_blocks_join_the_equation_before(tmp_path):
         "$$\\tau_2 = m_2 (\\ddot{d}_2 + l_1 \\ddot{\\theta}_1)$$\n"  # line 4
         "and the velocity and gravity terms\n"
         "$$- m_2 d_2 \\dot{\\theta}_1^2 + m_2 g \\cos\\theta_1$$\n"
-        "$$\\tau_1 = 0$$\n"
+        "$$\\tau_1 = \\frac{d}{dt}\\frac{\\partial L}{\\partial \\dot\\theta_1} - \\frac{\\partial L}{\\partial \\theta_1}$$\n"
         "$$= (m_1 + m_2) l_1^2 \\ddot{\\theta}_1 + m_2 l_1 \\ddot{d}_2 + 2 m_2 d_2 \\dot{\\theta}_1 \\dot{d}_2$$\n"
         "$$+ m_2 d_2^2 \\ddot{\\theta}_1 + (m_1 + m_2) g l_1 \\cos\\theta_1 - m_2 g d_2 \\sin\\theta_1$$\n"
     )

@@ -27,7 +27,8 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from .latex import LatexError, Name, UnknownSymbol, _top_level, parse, sides
+from .equations import top_level
+from .latex import LatexError, Name, UnknownSymbol, parse, sides
 from .notation import VECTOR_KEYS, StepRef, parse_lhs
 
 #: the placeholder a step name is replaced by before parsing (a name no student writes)
@@ -322,7 +323,7 @@ def members(source: str) -> list[str]:
     """The members between the left-hand side and the value of ``A = B = ... = value``
     (alignment ``&`` and line breaks ``\\\\`` of a chain written over several rows blanked)."""
     chars = list(source)
-    for i, mark in _top_level(source):
+    for i, mark in top_level(source):
         if mark in ("&", "\\\\"):
             chars[i : i + len(mark)] = " " * len(mark)
     return sides("".join(chars))[1:-1]
