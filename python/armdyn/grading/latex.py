@@ -243,6 +243,8 @@ def tokenize(text: str, positions: list | None = None) -> list[tuple[str, str]]:
         value = m.group(kind)
         if kind == "fn":  # \operatorname{sin}: \sin
             kind = "cmd"
+        if kind == "cmd" and value == "cr":  # plain TeX's row end, as in \pmatrix{a \cr b}
+            value = "\\"
         if kind == "cmd" and (value in SPACES or value in SIZES):
             continue
         if kind == "num" and len(value) > MAX_DIGITS:
@@ -433,9 +435,14 @@ class _Parser:
                     parts.append(tok)
                 elif kind in ("num", "char") and tok not in "{}":
                     parts.append(tok)
-        kind, tok = self.take()
+        kind, tok = self.peek()
+        if kind == "num" and len(tok) > 1:
+            # TeX: an unbraced script is one character, so m_32 l_2 is m_3 * 2 * l_2 (as the
+            # page shows it)
+            return self._first_character()
+        self.take()
         if kind in ("num", "char", "cmd"):
-            return tok[0] if kind == "num" else tok
+            return tok
         raise LatexError("missing subscript or superscript")
 
     def atom(self):
@@ -555,19 +562,24 @@ class _Parser:
             raise LatexError("scripts written before nothing ({}^{..} needs a name after it)", self.at(self.i))
         return self._symbol(pre_sup=scripts["^"], pre_sub=scripts["_"], start=start)
 
+    def _first_character(self) -> str:
+        """Take the first character of the number token here, leaving the rest in the
+        stream (TeX reads an unbraced argument or script as one character)."""
+        tok = self.t[self.i][1]
+        self.t[self.i] = ("num", tok[1:])
+        if self.i < len(self.positions):
+            self.positions[self.i] += 1
+        return tok[0]
+
     def _frac_arg(self):
         """A fraction's numerator or denominator: a group, or one digit or symbol (``\\frac12``)."""
         kind, tok = self.peek()
         if (kind, tok) == ("char", "{"):
             return self._braced()
         if kind == "num":
-            self.take()
             if len(tok) > 1 and tok[1].isdigit():  # \frac12: the digits are two arguments
-                self.i -= 1
-                self.t[self.i] = ("num", tok[1:])
-                if self.i < len(self.positions):
-                    self.positions[self.i] += 1
-                return sp.Integer(tok[0])
+                return sp.Integer(self._first_character())
+            self.take()
             return sp.Integer(tok) if tok.isdigit() else sp.Rational(tok)
         if kind == "char" and tok.isalpha() or kind == "cmd" and tok in GREEK:
             start = self.at(self.i)
