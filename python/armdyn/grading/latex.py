@@ -33,6 +33,8 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from ..symbolic.names import GREEK as GREEK_LETTERS
+
 # the equations of a display block (split, sides): their own module, re-exported here
 from .equations import side_offsets, sides, split_equations  # noqa: F401
 
@@ -52,68 +54,10 @@ MAX_SYMBOLIC_EXPONENT = 20
 #: time exponential in this nesting (12 nested cosines took 20 s, 16 over a minute)
 MAX_CALL_DEPTH = 4
 
-GREEK = {
-    "alpha",
-    "beta",
-    "gamma",
-    "delta",
-    "epsilon",
-    "varepsilon",
-    "zeta",
-    "eta",
-    "theta",
-    "vartheta",
-    "iota",
-    "kappa",
-    "lambda",
-    "mu",
-    "nu",
-    "xi",
-    "pi",
-    "rho",
-    "sigma",
-    "tau",
-    "upsilon",
-    "phi",
-    "varphi",
-    "chi",
-    "psi",
-    "omega",
-    "Gamma",
-    "Delta",
-    "Theta",
-    "Lambda",
-    "Xi",
-    "Pi",
-    "Sigma",
-    "Phi",
-    "Psi",
-    "Omega",
-}
-UNICODE_GREEK = {
-    "α": "alpha",
-    "β": "beta",
-    "γ": "gamma",
-    "δ": "delta",
-    "ε": "epsilon",
-    "ζ": "zeta",
-    "η": "eta",
-    "θ": "theta",
-    "ι": "iota",
-    "κ": "kappa",
-    "λ": "lambda",
-    "μ": "mu",
-    "ν": "nu",
-    "ξ": "xi",
-    "π": "pi",
-    "ρ": "rho",
-    "σ": "sigma",
-    "τ": "tau",
-    "φ": "phi",
-    "χ": "chi",
-    "ψ": "psi",
-    "ω": "omega",
-}
+#: Greek letters written \alpha ... \Omega (symbolic/names.py holds the one table)
+GREEK = frozenset(GREEK_LETTERS)
+#: a Greek letter typed as Unicode -> its LaTeX name
+UNICODE_GREEK = {letter: name for name, letter in GREEK_LETTERS.items()}
 FUNCTIONS = {
     "sin": sp.sin,
     "cos": sp.cos,

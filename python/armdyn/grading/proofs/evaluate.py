@@ -57,17 +57,13 @@ from .expr import (
     walk,
 )
 from .matrices import Mat, ShapeError
+from .motion import MOMENT, MOMENTUM, derivative, momentum
+from .nodes import ENERGY, UnknownName, component, key  # noqa: F401  (importers name them here)
 
 #: letters a proof line uses for vectors (3, 1): positions, velocities, angular velocity
 VECTOR_NAMES = {"d", "p", "omega", "a", "b", "u", "v", "w", "omegadot"}
-#: kinetic energy of rotation: (name, subscript) as people write it
-ENERGY = {("E", "rot"), ("E", "r"), ("E", "k"), ("E", "kin"), ("T", "rot"), ("E", "")}
 #: a line whose (conservative) polynomial degree exceeds this is not evaluated
 MAX_DEGREE = 400
-
-
-class UnknownName(LatexError):
-    """A name the proof checker gives no meaning to."""
 
 
 class NotRational(LatexError):
@@ -83,19 +79,6 @@ def element_point(sub: str) -> str:
     if not sub:
         return "O"
     return sub if is_point(sub) else f"ref:{sub}"
-
-
-def component(sym: Sym) -> tuple[str, int] | None:
-    """``r_{ix}`` -> ("i", 0): a component of a per-element vector."""
-    if sym.base == "r" and sym.sub and sym.sub[-1] in "xyz" and not sym.frame:
-        return sym.sub[:-1], "xyz".index(sym.sub[-1])
-    return None
-
-
-def key(sym: Sym) -> str:
-    """The name as a binding key (typeface of I matters, a transpose does not)."""
-    bold = "b" if sym.bold and sym.base == "I" else ""
-    return f"{sym.base}{bold}_{sym.sub}^{sym.frame}"
 
 
 @dataclass
@@ -437,6 +420,3 @@ def degree(node) -> int:
     if isinstance(node, Matrix):
         return max(degree(c) for row in node.rows for c in row)
     return 0
-
-
-from .motion import MOMENT, MOMENTUM, derivative, momentum  # noqa: E402  (motion uses this module)

@@ -25,8 +25,8 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-from .evaluate import ENERGY, UnknownName, component, key
 from .expr import Add, Cross, Deriv, Div, Dot, Integral, Mass, Matrix, Mul, Norm, Num, Pow, Skew, Sum, Sym, Transpose
+from .nodes import ENERGY, UnknownName, component, key
 
 #: names of the angular momentum and of the moment (torque) about a point
 MOMENTUM = {"L", "H", "h"}
