@@ -415,6 +415,8 @@ class _Parser:
                 self.sums[-1] = index = node.sub
             if node.sub == index:
                 return Mass()
+        if node.base in ("x", "y", "z") and index and node.sub == index and not node.frame:
+            return Sym("r", node.bold, node.base, "", node.transposed)  # x_i: particle i's coordinate
         if node.base == "r" and index and node.sub and (node.sub.startswith(index) or node.sub.endswith(index)):
             sub = node.sub[len(index) :] if node.sub.startswith(index) else node.sub[: -len(index)]
             sub = sub.strip(",/ ")
