@@ -110,7 +110,9 @@ def test_the_origin_comes_from_the_text():
 
 
 def test_tensor_form_with_the_texts_vector():
-    setup = PLANAR_SETUP + "Proof of the tensor form. With $\\mathbf{p} = (a, b, 0)^T$ the position of A relative to C,\n\n"
+    setup = (
+        PLANAR_SETUP + "Proof of the tensor form. With $\\mathbf{p} = (a, b, 0)^T$ the position of A relative to C,\n\n"
+    )
     right = "$$\\mathbf{I}_A = \\mathbf{I}_C + M\\left(\\mathbf{p}^T\\mathbf{p}\\,\\mathbf{1} - \\mathbf{p}\\,\\mathbf{p}^T\\right)$$"
     slip = "$$\\mathbf{I}_A = \\mathbf{I}_C + M\\left(\\mathbf{p}\\,\\mathbf{p}^T - \\mathbf{p}^T\\mathbf{p}\\,\\mathbf{1}\\right)$$"
     text = doc(setup, right, slip)
@@ -170,3 +172,19 @@ def test_a_worked_example_is_an_identity_in_its_scalars():
     assert "defines I_{end}" in v[0].message and "taken as written" in v[0].message
     assert "identity in the example's scalars l, m" in v[1].message
     assert [x.status for x in check_text(slip) if x.line == line_of(slip, "I_{end}")] == ["correct", "wrong"]
+
+
+def test_a_body_of_mass_m_is_not_an_example():
+    # no shape named: m is not a worked example's scalar, so "I_{end} = m" stays unread, not defined
+    text = "# T\n\nProve it for a body of mass $m$.\n\n$$I_{end} = \\frac{1}{3} m$$\n"
+    assert [v.status for v in check_text(text)] == ["unrecognised"]
+
+
+def test_hostile_prose_ends_quickly():
+    import time
+
+    prose = "Let $\\mathbf{r}$ be the position of " + "$a$ the position relative to " * 20000
+    text = "# T\n\n" + prose + "\n\n$$\\int_B \\mathbf{r}\\, dm = \\mathbf{0}$$\n"
+    start = time.perf_counter()
+    check_text(text)
+    assert time.perf_counter() - start < 4

@@ -561,12 +561,14 @@ def _is_rho(node) -> bool:
 
 
 def _strip_density(body):
-    """``f \\rho dV`` is ``f dm``: take the density factor out of the integrand."""
+    """``f \\rho dV`` is ``f dm``: take the density factor out of the integrand (the last
+    plain ``\\rho``: a bold one, as in ``\\boldsymbol{\\rho}\\,\\rho\\,dV``, is a position)."""
     if _is_rho(body):
         return Num(Fraction(1))
     if isinstance(body, Mul) and any(_is_rho(f) for f in body.factors):
         rest = list(body.factors)
-        rest.remove(next(f for f in rest if _is_rho(f)))
+        plain = [j for j, f in enumerate(rest) if _is_rho(f) and not f.bold]
+        del rest[plain[-1] if plain else max(j for j, f in enumerate(rest) if _is_rho(f))]
         return _mul(rest)
     raise ProofSyntaxError("an integral over dV without the density \\rho: only mass integrals (\\rho dV = dm)")
 

@@ -12,7 +12,8 @@ Read from the sentences before each display block, with inline math ``$...$``:
 * "$\\mathbf{p} = (a, b, 0)^T$": a constant vector given by its components;
 * "$d$ the distance between the axis through C along $z$ and the parallel axis through
   A": ``d`` is the offset between the two axes (``d^2`` its square);
-* "a uniform rod of mass $m$ and length $l$": ``m``, ``l`` are a worked example's scalars.
+* "a uniform rod of mass $m$ and length $l$": ``m``, ``l`` are a worked example's scalars
+  (a shape is named: "a body of mass $m$" says nothing).
 
 Only letters and the parser of :mod:`.expr` are used (nothing is evaluated); a sentence
 that does not match says nothing.
@@ -44,9 +45,13 @@ _DISTANCE = re.compile(
     r"\$([^$]{1,20})\$\s*(?:is\s+|be\s+|for\s+)?the\s+distance\s+between\s+the\s+(?:axis|line)\s+through\s+\$?([A-Z])\$?"
     r"(?:\s+(?:along|parallel\s+to)\s+\$?([xyz])\$?)?\s+and\s+the\s+(?:parallel\s+)?(?:axis|line)\s+through\s+\$?([A-Z])\b"
 )
-#: "of mass $m$ and length $l$": a worked example's scalars
+#: "a uniform rod of mass $m$ and length $l$": a worked example's scalars (a named shape, so
+#: that "a body of mass $m$" stays the body's own mass)
+_SHAPE = re.compile(
+    r"\b(?:rod|bar|beam|disk|disc|sphere|ball|cylinder|plate|ring|hoop|cube|block|shell)s?\b[^.;]{0,120}", re.IGNORECASE
+)
 _PARAMETER = re.compile(
-    r"\b(?:mass|length|radius|width|height|side|distance)\s+\$\s*([A-Za-z]|\\[a-z]+)\s*\$",
+    r"\b(?:mass|length|radius|width|height|side|thickness)\s+\$\s*([A-Za-z]|\\[a-z]+)\s*\$",
     re.IGNORECASE,
 )
 
@@ -93,10 +98,11 @@ class ProseFacts:
             sym = _name(m.group(1))
             if sym is not None and not sym.sub:
                 self.distances[sym.base] = (m.group(2), m.group(4), m.group(3) or "")
-        for m in _PARAMETER.finditer(prose):
-            sym = _name(m.group(1))
-            if sym is not None and sym.base not in ("M",):
-                self.scalars.add(sym.base)
+        for shape in _SHAPE.finditer(prose):
+            for m in _PARAMETER.finditer(shape.group(0)):
+                sym = _name(m.group(1))
+                if sym is not None and sym.base not in ("M",):
+                    self.scalars.add(sym.base)
 
     def _scalars(self, trees) -> None:
         for t in trees:
