@@ -157,21 +157,43 @@ def test_the_point_r_is_measured_from_decides_the_line():
 
 
 # ------------------------------------------------------------------ a worked example's scalars
-ROD = (
+THEOREM = (
     "# Parallel axis theorem\n\nProof.\n\n$$\\mathbf{I}_A = \\mathbf{I}_C + M\\left(\\mathbf{d}^T\\mathbf{d}\\,\\mathbf{1}"
     " - \\mathbf{d}\\,\\mathbf{d}^T\\right)$$\n\n"
-    "**Example.** A uniform rod of mass $m$ and length $l$ about an axis through one end:\n\n"
 )
+ROD_END = (
+    THEOREM
+    + "**Example.** A uniform rod of mass $m$ and length $l$ about an axis through one end,\nperpendicular to it:\n\n"
+)
+ROD = THEOREM + "**Example.** A uniform rod of mass $m$ and length $l$:\n\n"
 
 
-def test_a_worked_example_is_an_identity_in_its_scalars():
+def example(text: str) -> list:
+    return [v for v in check_text(text) if v.line == line_of(text, "I_{")]
+
+
+def test_a_rod_about_its_end_is_checked_against_its_mass_distribution():
+    # by hand: int_0^l (m/l) x^2 dx = m l^2 / 3; 1/12 + (1/2)^2 = 1/3
+    right = ROD_END + "$$I_{end} = \\frac{1}{12} m l^2 + m\\left(\\frac{l}{2}\\right)^2 = \\frac{1}{3} m l^2$$\n"
+    v = example(right)
+    assert [x.status for x in v] == ["correct", "correct"]
+    assert "uniform rod" in v[0].message and "through one end" in v[0].message
+    # the distance l for l/2: 1/12 + 1 = 13/12, not 1/3; the arithmetic after it is right
+    slip = ROD_END + "$$I_{end} = \\frac{1}{12} m l^2 + m l^2 = \\frac{13}{12} m l^2$$\n"
+    assert [x.status for x in example(slip)] == ["wrong", "correct"]
+    # about its centre: m l^2 / 12, so the end's value there is a slip
+    centre = ROD_END.replace("one end", "its centre") + "$$I_{mid} = \\frac{1}{3} m l^2$$\n"
+    assert [x.status for x in example(centre)] == ["wrong"]
+
+
+def test_a_worked_example_without_its_axis_is_an_identity_in_its_scalars():
     right = ROD + "$$I_{end} = \\frac{1}{12} m l^2 + m\\left(\\frac{l}{2}\\right)^2 = \\frac{1}{3} m l^2$$\n"
     slip = ROD + "$$I_{end} = \\frac{1}{12} m l^2 + m\\left(\\frac{l}{2}\\right)^2 = \\frac{1}{4} m l^2$$\n"
-    v = [x for x in check_text(right) if x.line == line_of(right, "I_{end}")]
+    v = example(right)
     assert [x.status for x in v] == ["correct", "correct"]
     assert "defines I_{end}" in v[0].message and "taken as written" in v[0].message
     assert "identity in the example's scalars l, m" in v[1].message
-    assert [x.status for x in check_text(slip) if x.line == line_of(slip, "I_{end}")] == ["correct", "wrong"]
+    assert [x.status for x in example(slip)] == ["correct", "wrong"]
 
 
 def test_a_body_of_mass_m_is_not_an_example():

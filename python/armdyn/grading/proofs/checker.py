@@ -44,6 +44,7 @@ from .evaluate import (
 )
 from .expr import Add, Integral, Mass, Mul, Num, ProofSyntaxError, Sum, Sym, parse_side, walk
 from .matrices import Mat, ShapeError, SizeError
+from .prose import rod_moment
 from .regions import Display
 
 #: random instances per link: with the degree cap and at least 2^31 values per draw, a false
@@ -318,6 +319,19 @@ class ProofChecker:
             bad = a if isinstance(a, Exception) else b if isinstance(b, Exception) else None
             if bad is not None:
                 out.append(LinkVerdict(d.line, label, source, "unrecognised", f"cannot read: {bad}"))
+                continue
+            rod = self.state.facts.rod
+            if j == 0 and not continued and example and _named(a) and rod and key(a) not in self.defs:
+                self.defs[key(a)] = (rod_moment(*rod), d.line)  # the example's moment, checked
+                self.state.facts.rod = None
+                v = self.link(a, b, d.line, label, source)
+                where = "one end" if rod[2] == "end" else "its centre"
+                v.message = _join(
+                    f"{a.latex()} read as the moment of inertia of the uniform rod (mass {rod[0]}, length {rod[1]}) "
+                    f"about a perpendicular axis through {where}, from its mass distribution (as the text says)",
+                    v.message,
+                )
+                out.append(v)
                 continue
             if j == 0 and not continued and (self._is_new_name(a) or (example and _named(a))):
                 self.defs[key(a)] = (b, d.line)  # K = ... (= ...): names the first expression

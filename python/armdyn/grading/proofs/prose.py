@@ -13,7 +13,9 @@ Read from the sentences before each display block, with inline math ``$...$``:
 * "$d$ the distance between the axis through C along $z$ and the parallel axis through
   A": ``d`` is the offset between the two axes (``d^2`` its square);
 * "a uniform rod of mass $m$ and length $l$": ``m``, ``l`` are a worked example's scalars
-  (a shape is named: "a body of mass $m$" says nothing).
+  (a shape is named: "a body of mass $m$" says nothing); "... about an axis through one
+  end (its centre), perpendicular to it": the example's moment of inertia, which the first
+  name of the example's line stands for (:func:`rod_moment`).
 
 Only letters and the parser of :mod:`.expr` are used (nothing is evaluated); a sentence
 that does not match says nothing.
@@ -23,8 +25,9 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from fractions import Fraction
 
-from .expr import ProofSyntaxError, Sym, parse_side
+from .expr import Mul, Num, Pow, ProofSyntaxError, Sym, parse_side
 
 _CENTRE = r"(?:the\s+)?(?:mass\s+cent(?:re|er)|cent(?:re|er)\s+of\s+mass|barycent(?:re|er))"
 #: "$X$ [be|is|denotes] the/its position [of ...] relative to|from [a point|the mass centre] P"
@@ -45,6 +48,16 @@ _DISTANCE = re.compile(
     r"\$([^$]{1,20})\$\s*(?:is\s+|be\s+|for\s+)?the\s+distance\s+between\s+the\s+(?:axis|line)\s+through\s+\$?([A-Z])\$?"
     r"(?:\s+(?:along|parallel\s+to)\s+\$?([xyz])\$?)?\s+and\s+the\s+(?:parallel\s+)?(?:axis|line)\s+through\s+\$?([A-Z])\b"
 )
+#: "a uniform rod of mass $m$ and length $l$ about an axis through one end, perpendicular to it"
+_ROD = re.compile(
+    r"\buniform\s+(?:thin\s+|slender\s+)?(?:rod|bar|beam)\s+of\s+mass\s+\$\s*([A-Za-z])\s*\$\s+and\s+length\s+"
+    r"\$\s*([A-Za-z])\s*\$[^.;]{0,40}?\b(?:about|around)\s+(?:an?\s+|the\s+)?axis\s+through\s+(?:one\s+|its\s+|an\s+)?"
+    r"(end|cent(?:re|er)|middle|midpoint)\b[^.;]{0,40}?\bperpendicular",
+    re.IGNORECASE,
+)
+#: a uniform rod's mass distribution for its second moments: Simpson's rule, exact for the
+#: quadratic integrand (position along the rod in units of its length, share of the mass)
+ROD_POINTS = ((Fraction(0), Fraction(1, 6)), (Fraction(1, 2), Fraction(2, 3)), (Fraction(1), Fraction(1, 6)))
 #: "a uniform rod of mass $m$ and length $l$": a worked example's scalars (a named shape, so
 #: that "a body of mass $m$" stays the body's own mass)
 _SHAPE = re.compile(
@@ -66,6 +79,7 @@ class ProseFacts:
     vectors: dict = field(default_factory=dict)  # name base -> (x, y, z) trees
     distances: dict = field(default_factory=dict)  # name base -> (from point, to point, axis or "")
     scalars: set = field(default_factory=set)  # letters read as scalars
+    rod: tuple | None = None  # (mass letter, length letter, axis at "end" or "centre") of a worked example
     said: list = field(default_factory=list)  # how each was read, for the verdicts
 
     def read(self, prose: str) -> None:
@@ -98,6 +112,9 @@ class ProseFacts:
             sym = _name(m.group(1))
             if sym is not None and not sym.sub:
                 self.distances[sym.base] = (m.group(2), m.group(4), m.group(3) or "")
+        m = _ROD.search(prose)
+        if m is not None:
+            self.rod = (m.group(1), m.group(2), "end" if m.group(3).lower() == "end" else "centre")
         for shape in _SHAPE.finditer(prose):
             for m in _PARAMETER.finditer(shape.group(0)):
                 sym = _name(m.group(1))
@@ -112,6 +129,15 @@ class ProseFacts:
     def _say(self, text: str, new: bool) -> None:
         if new:
             self.said.append(text)
+
+
+def rod_moment(mass: str, length: str, axis: str):
+    """The moment of inertia of a uniform rod about a perpendicular axis through its end or
+    its centre, from its mass distribution: ``sum share (x - x_axis)^2 * mass * length^2``
+    (``m l^2 / 3``, ``m l^2 / 12``) as a tree in the example's two scalars."""
+    at = Fraction(0) if axis == "end" else Fraction(1, 2)
+    factor = sum((share * (x - at) ** 2 for x, share in ROD_POINTS), Fraction(0))
+    return Mul((Num(factor), Sym(mass), Pow(Sym(length), 2)))
 
 
 def _name(text: str) -> Sym | None:
