@@ -17,7 +17,13 @@ Name rules (the typeface and the scripts decide; ``r_i``, ``I_{l_i}`` as in the 
 * ``r`` (relative to ``O``), ``r_X`` (relative to point ``X``; ``r_i``: to link i's reference
   point): the position of a mass element, so only meaningful inside an integral or in a
   line that holds for every element (then checked for every element); ``r_{ix}``,
-  ``r_{iy}``, ``r_{iz}``: its components.
+  ``r_{iy}``, ``r_{iz}``: its components (``x_i``, ``y_i``, ``z_i`` inside a sum over the
+  particles, from the origin); ``\\rho`` (outside ``\\rho dV``): the position relative to C.
+  The prose may say otherwise (:mod:`.prose`: the point ``r`` is measured from, the origin).
+* ``I_X`` (plain) in a proof whose components are ``x_i``, ``y_i`` and never ``z_i``: the
+  moment of inertia about the axis through X along z (the zz entry).
+* The letters the prose makes scalars (a point's coordinates ``a``, ``b``; a worked
+  example's ``m``, ``l``): integers drawn like the coordinates.
 * ``d``, ``p``, ``\\omega``, ``\\omega_i``, ``a``, ``b``, ``u``, ``v``, ``w``: constant vectors (``d`` is
   bound by a definition such as ``r_P = r_C + d``); ``\\omega^c``: ``R^c \\omega`` (the angular
   velocity the proof last named); ``R``, ``R^c``, ``R_c``: rotations.
