@@ -17,6 +17,8 @@ from .vocabulary import MODEL_KEYS, SOFT, by_shape, student_names
 
 #: the steps whose values the matrix form M q̈ + C q̇ + g = τ states
 _MATRICES = ("M", "C", "h", "G", "christoffel")
+#: the partial derivatives of the energies (of L, T by q and q̇, V by q)
+_PARTIALS = ("dL_dqd", "ddt_dL_dqd", "dL_dq", "dT_dq", "dV_dq")
 
 
 class EnergySteps:
@@ -40,6 +42,12 @@ class EnergySteps:
             ref, assumed = self._by_shape(ref, eq)
             if ref is None:
                 return None, ""
+        if ref.key in _PARTIALS:
+            if ref.index is None:  # ∂k/∂Θ: the column of partials, one per joint
+                self._partial_column(ref, eq, seen_methods)
+                return None, ""
+            if ref.alias and ref.key.startswith(("dL_", "ddt_dL_")):
+                assumed = f"∂{ref.alias}/∂q̇ read as ∂L/∂q̇ (the potential energy does not depend on the velocities)"
         if ref.key in MODEL_KEYS or ref.key in ("Lang", "tau_vec"):
             if "lagrange" not in seen_methods:
                 seen_methods.append("lagrange")
@@ -89,6 +97,23 @@ class EnergySteps:
         if ref.key in ("Tl", "Vl") and not isinstance(value, sp.MatrixBase):
             for name in student_names(ref):
                 self.symbols.steps[name] = value
+
+    def _partial_column(self, ref: StepRef, eq, seen_methods: list) -> None:
+        """``\\frac{\\partial k}{\\partial\\dot\\Theta} = (...)``: each entry graded as its joint's partial."""
+        if "lagrange" not in seen_methods:
+            seen_methods.append("lagrange")
+        value, problem = self.value(eq, StepRef("tau_vec"))
+        n = self.robot.dof
+        if value is not None and (not isinstance(value, sp.MatrixBase) or len(value) != n or min(value.shape) != 1):
+            value, problem = None, f"{ref.name}: a partial by the joint vector is a column of {n} entries"
+        if value is None:
+            self._unrecognised(eq, problem, name=ref.name, key=ref.key)
+            return
+        for k in range(n):
+            self._step(self.world("lagrange"), StepRef(ref.key, k + 1, alias=ref.alias), eq, value[k], "lagrange")
+            self.verdicts[-1].message = f"entry {k + 1} of the column, read as joint {k + 1}'s partial" + (
+                "; " + self.verdicts[-1].message if self.verdicts[-1].message else ""
+            )
 
     def _torque_column(self, ref: StepRef, eq, value) -> None:
         """``(\\tau_1, \\tau_2)^T = ...``: each entry graded as its joint's τ_k."""

@@ -42,6 +42,8 @@ _NAMED = {  # step names as armdyn reports them, accepted as left-hand sides in 
     "dL_dqd": "dL_dqd",
     "dL_dq": "dL_dq",
     "ddt_dL_dqd": "ddt_dL_dqd",
+    "dT_dq": "dT_dq",
+    "dV_dq": "dV_dq",
 }
 
 

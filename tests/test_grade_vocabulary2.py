@@ -1,0 +1,159 @@
+"""`armdyn grade` reads more of the textbooks' left-hand sides: the energies' partials
+(∂T/∂q̇_k, d/dt ∂K/∂q̇_k, ∂T/∂q_k, ∂V/∂q_k, by the joint vector as a column), point-mass
+positions without the ``c`` (``x_1``, ``\\dot x_1``, ``v_2^2``), and the sine/cosine
+shorthand's definitions (``c_1 = \\cos\\theta_1``).
+
+The truth is derived here by hand in plain SymPy (the planar elbow arm: mass centres
+written out, energies, partials by differentiation; the RP arm's point masses), never
+taken from armdyn's output.
+"""
+
+from __future__ import annotations
+
+import pytest
+import sympy as sp
+
+from armdyn.grading import grade
+from armdyn.grading.notation import SymbolMap, parse_lhs
+from armdyn.io import load
+
+q1, q2, qd1, qd2, qdd1, qdd2 = sp.symbols("q1 q2 q1_dot q2_dot q1_ddot q2_ddot")
+m1, m2, l1, lc1, lc2, I1, I2, g = sp.symbols("m1 m2 l1 lc1 lc2 I1 I2 g")
+Q, QD, QDD = [q1, q2], [qd1, qd2], [qdd1, qdd2]
+NAMES = {
+    q1: r"\theta_1",
+    q2: r"\theta_2",
+    qd1: r"\dot{\theta}_1",
+    qd2: r"\dot{\theta}_2",
+    qdd1: r"\ddot{\theta}_1",
+    qdd2: r"\ddot{\theta}_2",
+    m1: "m_1",
+    m2: "m_2",
+    l1: "l_1",
+    lc1: "l_{c1}",
+    lc2: "l_{c2}",
+    I1: "I_1",
+    I2: "I_2",
+}
+HEAD = "---\nrobot: planar-2r\nmethod: lagrange\nsymbols:\n  'l_{c1}': lc1\n  'l_{c2}': lc2\n---\n\n"
+
+# the planar elbow arm by hand: mass centres, their velocities, energies (gravity along -y)
+PC1 = sp.Matrix([lc1 * sp.cos(q1), lc1 * sp.sin(q1)])
+PC2 = sp.Matrix([l1 * sp.cos(q1) + lc2 * sp.cos(q1 + q2), l1 * sp.sin(q1) + lc2 * sp.sin(q1 + q2)])
+V1, V2 = PC1.jacobian(Q) * sp.Matrix(QD), PC2.jacobian(Q) * sp.Matrix(QD)
+T = (m1 * V1.dot(V1) + m2 * V2.dot(V2) + I1 * qd1**2 + I2 * (qd1 + qd2) ** 2) / 2
+V = g * (m1 * PC1[1] + m2 * PC2[1])
+
+
+def ddt(x):
+    return sum(sp.diff(x, Q[j]) * QD[j] + sp.diff(x, QD[j]) * QDD[j] for j in range(2))
+
+
+def tex(x) -> str:
+    if isinstance(x, sp.MatrixBase):
+        return r"\begin{pmatrix}" + r" \\ ".join(tex(e) for e in x) + r"\end{pmatrix}"
+    return sp.latex(x, symbol_names=NAMES)
+
+
+def _grade(tmp_path, body, head=HEAD, name="d.md"):
+    path = tmp_path / name
+    path.write_text(head + body)
+    return grade(path)
+
+
+def _status(report):
+    return [(v.name, v.status) for v in report.steps]
+
+
+def _lhs(text, robot="planar-2r"):
+    return parse_lhs(text, SymbolMap(load(robot)).coordinate_of)
+
+
+def test_the_hand_derivation_is_the_textbooks_closed_form():
+    d22 = m2 * lc2**2 + I2
+    assert sp.simplify(sp.diff(T, qd2, 2) - d22) == 0
+    assert sp.simplify(sp.diff(V, q2) - m2 * g * lc2 * sp.cos(q1 + q2)) == 0
+
+
+# ------------------------------------------------------------ 1. the energies' partials
+@pytest.mark.parametrize(
+    "lhs, key, index",
+    [
+        (r"\frac{\partial T}{\partial \dot\theta_1}", "dL_dqd", 1),
+        (r"\partial K/\partial \dot q_2", "dL_dqd", 2),
+        (r"\frac{d}{dt}\left(\frac{\partial T}{\partial \dot q_1}\right)", "ddt_dL_dqd", 1),
+        (r"\frac{\mathrm{d}}{\mathrm{d}t}\frac{\partial K}{\partial \dot q_1}", "ddt_dL_dqd", 1),
+        (r"\frac{\partial T}{\partial \theta_2}", "dT_dq", 2),
+        (r"\frac{\partial KE}{\partial q_1}", "dT_dq", 1),
+        (r"\frac{\partial V}{\partial \theta_1}", "dV_dq", 1),
+        (r"\frac{\partial PE}{\partial \theta_2}", "dV_dq", 2),
+        (r"\frac{\partial u}{\partial\Theta_1}", "dV_dq", 1),
+        (r"\frac{\partial k}{\partial\dot\Theta_1}", "dL_dqd", 1),
+        (r"\frac{\partial U}{\partial q}", "dV_dq", None),
+        (r"\frac{\partial k}{\partial\dot\Theta}", "dL_dqd", None),
+        (r"\frac{\partial L}{\partial \theta_1}", "dL_dq", 1),
+    ],
+)
+def test_partials_of_the_energies_are_read(lhs, key, index):
+    ref = _lhs(lhs)
+    assert (ref.key, ref.index) == (key, index)
+
+
+@pytest.mark.parametrize(
+    "lhs", [r"\frac{\partial V}{\partial \dot q_1}", r"\frac{d}{dt}\frac{\partial T}{\partial q_1}"]
+)
+def test_partials_that_are_no_step_are_not_read(lhs):
+    assert _lhs(lhs) is None
+
+
+def test_energy_partials_graded_against_the_energies(tmp_path):
+    p_qd2 = sp.diff(T, qd2)
+    body = [
+        f"$$T = {tex(T)}$$",
+        f"$$V = {tex(V)}$$",
+        rf"$$\frac{{\partial T}}{{\partial \dot\theta_2}} = {tex(p_qd2)}$$",
+        rf"$$\frac{{d}}{{dt}}\left(\frac{{\partial T}}{{\partial \dot\theta_2}}\right) = {tex(ddt(p_qd2))}$$",
+        rf"$$\frac{{\partial T}}{{\partial \theta_2}} = {tex(sp.diff(T, q2))}$$",
+        rf"$$\frac{{\partial V}}{{\partial \theta_2}} = {tex(sp.diff(V, q2))}$$",
+        rf"$$\tau_2 = {tex(ddt(p_qd2) - sp.diff(T, q2) + sp.diff(V, q2))}$$",
+    ]
+    r = _grade(tmp_path, "\n\n".join(body) + "\n")
+    assert [s for _, s in _status(r)] == ["correct"] * 7, _status(r)
+    assert "read as ∂L/∂q̇" in r.steps[2].message
+
+
+def test_a_slip_in_dT_dq_is_found_and_carried_into_tau(tmp_path):
+    wrong = -sp.diff(T, q2)  # a sign slip
+    tau = ddt(sp.diff(T, qd2)) - wrong + sp.diff(V, q2)
+    body = [
+        f"$$T = {tex(T)}$$",
+        f"$$V = {tex(V)}$$",
+        rf"$$\frac{{\partial K}}{{\partial \theta_2}} = {tex(wrong)}$$",
+        rf"$$\frac{{\partial P}}{{\partial \theta_2}} = {tex(sp.diff(V, q2))}$$",
+        rf"$$\tau_2 = {tex(tau)}$$",
+    ]
+    r = _grade(tmp_path, "\n\n".join(body) + "\n")
+    assert _status(r) == [
+        ("T", "correct"),
+        ("V", "correct"),
+        ("dT_dq_2", "wrong"),
+        ("dV_dq_2", "correct"),
+        ("tau_2", "follows-from-earlier-error"),
+    ]
+
+
+def test_a_partial_by_the_joint_vector_is_a_column(tmp_path):
+    dv = sp.Matrix([sp.diff(V, q) for q in Q])
+    dk = sp.Matrix([sp.diff(T, q) for q in QD])
+    body = (
+        rf"$$\frac{{\partial u}}{{\partial\Theta}} = {tex(dv)}$$" + "\n\n"
+        rf"$$\frac{{\partial k}}{{\partial\dot\Theta}} = {tex(sp.Matrix([dk[0], dk[1] + qd1]))}$$" + "\n"
+    )
+    r = _grade(tmp_path, body)
+    assert _status(r) == [
+        ("dV_dq_1", "correct"),
+        ("dV_dq_2", "correct"),
+        ("dL_dqd_1", "correct"),
+        ("dL_dqd_2", "wrong"),
+    ]
+    assert "entry 2 of the column" in r.steps[3].message
