@@ -157,3 +157,49 @@ def test_a_partial_by_the_joint_vector_is_a_column(tmp_path):
         ("dL_dqd_2", "wrong"),
     ]
     assert "entry 2 of the column" in r.steps[3].message
+
+
+# ------------------------------------------------------------ 2. positions without the c
+RP_HEAD = "---\nrobot: rp-arm\nmethod: lagrange\n---\n\n"
+th, d2, thd, d2d = sp.symbols("theta1 d2 theta1_dot d2_dot")
+RP_NAMES = {th: r"\theta_1", d2: "d_2", thd: r"\dot{\theta}_1", d2d: r"\dot{d}_2"}
+# the RP arm's point masses by hand: m1 at l1 (c, s), m2 a further d2 along (-s, c)
+RP_P1 = sp.Matrix([l1 * sp.cos(th), l1 * sp.sin(th)])
+RP_P2 = RP_P1 + d2 * sp.Matrix([-sp.sin(th), sp.cos(th)])
+RP_V2 = RP_P2.jacobian([th, d2]) * sp.Matrix([thd, d2d])
+
+
+def tex_rp(x) -> str:
+    return sp.latex(x, symbol_names=RP_NAMES)
+
+
+def test_point_mass_positions_without_the_c(tmp_path):
+    body = [
+        f"$$x_1 = {tex_rp(RP_P1[0])}$$",
+        f"$$y_2 = {tex_rp(RP_P2[1])}$$",
+        rf"$$\dot x_2 = {tex_rp(RP_V2[0])}$$",
+        f"$$v_2^2 = {tex_rp(sp.expand(RP_V2.dot(RP_V2)))}$$",
+        f"$$v_{{2}}^2 = {tex_rp(sp.expand(RP_V2.dot(RP_V2)) + d2d**2)}$$",
+        f"$$x_2 = {tex_rp(RP_P2[0] + d2 * sp.sin(th))}$$",
+    ]
+    r = _grade(tmp_path, "\n\n".join(body) + "\n", head=RP_HEAD)
+    assert [s for _, s in _status(r)] == ["correct"] * 4 + ["wrong"] * 2, _status(r)
+    assert "read as link 1's mass centre" in r.steps[0].message
+    assert "squared speed of link 2's mass centre" in r.steps[3].message
+    assert "missing term" in r.steps[5].message
+
+
+def test_a_position_that_does_not_move_or_a_vector_names_no_step(tmp_path):
+    body = "$$z_2 = 0$$\n\n$$x_1 = l_1$$\n\n$$v_2^2 = \\begin{pmatrix} 0 \\\\ l_1 \\\\ 0 \\end{pmatrix}$$\n"
+    r = _grade(tmp_path, body + "\n$$y_1 = l_1\\sin\\theta_1$$\n", head=RP_HEAD)
+    assert [v.status for v in r.steps] == ["unrecognised"] * 3 + ["correct"]
+    assert [v.name for v in r.steps[:2]] == ["", ""]
+    assert "Craig's velocity of frame 2's origin" in r.steps[2].message
+
+
+def test_the_end_of_a_link_is_said_so(tmp_path):
+    # planar elbow arm: x_1 = l1 cos q1 is joint 2 (the end of link 1), not its mass centre lc1 cos q1
+    end = (PC2 - lc2 * sp.Matrix([sp.cos(q1 + q2), sp.sin(q1 + q2)]))[0]
+    r = _grade(tmp_path, f"$$x_1 = {tex(end)}$$\n\n$$x_1 = {tex(2 * end)}$$\n")
+    assert _status(r) == [("x_c1", "correct"), ("x_c1", "wrong")]
+    assert "end of link 1" in r.steps[0].message

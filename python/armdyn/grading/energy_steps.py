@@ -9,11 +9,12 @@ from __future__ import annotations
 import sympy as sp
 
 from ..errors import ModelError
+from .engine import equal
 from .lagrange_terms import ModelTerms, grade_model_step, potential_shift
 from .notation import StepRef
 from .text import NOT_A_STEP
 from .verdict import PASSING, StepVerdict
-from .vocabulary import MODEL_KEYS, SOFT, by_shape, student_names
+from .vocabulary import MODEL_KEYS, POINT, SOFT, by_shape, student_names
 
 #: the steps whose values the matrix form M q̈ + C q̇ + g = τ states
 _MATRICES = ("M", "C", "h", "G", "christoffel")
@@ -72,11 +73,13 @@ class EnergySteps:
         prismatic = None
         if ref.key == "f" and ref.index is not None and 1 <= ref.index <= self.robot.dof:
             prismatic = _prismatic(self.robot, ref.index)
+        rates = {*self.robot.q, *self.robot.qd}
+        moves = bool(rates & value.free_symbols) if isinstance(value, sp.Basic) else True
         new, assumed = by_shape(
-            ref, value, lambda key, index=None, **kw: StepRef(key, index, **kw), prismatic, self.robot.dof
+            ref, value, lambda key, index=None, **kw: StepRef(key, index, **kw), prismatic, self.robot.dof, moves
         )
         if new is None:
-            named = not (soft and assumed == NOT_A_STEP)
+            named = not ((soft or ref.alias == POINT) and assumed == NOT_A_STEP)
             self._unrecognised(eq, assumed, name=ref.name if named else "", key=ref.key if named else "")
             return None, ""
         return new, assumed
@@ -91,6 +94,8 @@ class EnergySteps:
             self._torque_column(ref, eq, value)
             return
         verdict = grade_model_step(self, ref, eq, value)
+        if verdict.status == "wrong" and ref.alias == POINT and ref.key == "pc":
+            self._end_of_link(ref, value, verdict)
         if assumed:
             verdict.message = assumed + ("; " + verdict.message if verdict.message else "")
         self.verdicts.append(verdict)
@@ -113,6 +118,21 @@ class EnergySteps:
             self._step(self.world("lagrange"), StepRef(ref.key, k + 1, alias=ref.alias), eq, value[k], "lagrange")
             self.verdicts[-1].message = f"entry {k + 1} of the column, read as joint {k + 1}'s partial" + (
                 "; " + self.verdicts[-1].message if self.verdicts[-1].message else ""
+            )
+
+    def _end_of_link(self, ref: StepRef, value, verdict) -> None:
+        """``x_1`` that is not link 1's mass centre but its far end (frame 2's origin, where
+        the next joint sits): right for that point, and said so."""
+        origins = self.model_terms().origins
+        i, axis = ref.index, "xyz".index(ref.part)
+        if i + 1 not in origins or not isinstance(value, sp.Basic):
+            return
+        fp = self.sampler.fingerprint
+        if equal(fp(value), fp(origins[i + 1][axis])).all():
+            verdict.status, verdict.difference, verdict.components = "correct", None, []
+            verdict.message = (
+                f"{ref.part}_{i} read as the end of link {i} (frame {i + 1}'s origin, joint {i + 1}), "
+                f"not its mass centre: right for that point"
             )
 
     def _torque_column(self, ref: StepRef, eq, value) -> None:

@@ -11,9 +11,10 @@ key            names
 T (total)      ``K``, ``T``, ``KE``, ``k``, ``E_k``, ``\\mathcal{K}``, ``\\mathcal{T}``
 V (total)      ``U``, ``V``, ``P``, ``PE``, ``u``, ``E_p``, ``\\mathcal{U}``, ``\\mathcal{V}``, ``\\mathcal{P}``
 Tl, Vl         the same with a link index: ``K_1``, ``T_2``, ``KE_1``, ``PE_1``, ``u_2``, ``P_1``
-pc             ``p_{c1}``, ``r_{c_2}``, ``x_{c1}`` / ``y_{c1}`` / ``z_{c1}`` (one component)
-vc             ``v_{c1}``, ``\\dot p_{c1}``, ``\\dot x_{c1}``; squared: ``v_{c1}^2``,
-               ``|v_{c1}|^2``, ``v_{c1}^T v_{c1}``, ``v_{c1} \\cdot v_{c1}``
+pc             ``p_{c1}``, ``r_{c_2}``, ``x_{c1}`` / ``y_{c1}`` / ``z_{c1}`` (one component);
+               ``x_1``, ``y_2`` without the c when the value moves with the joints
+vc             ``v_{c1}``, ``\\dot p_{c1}``, ``\\dot x_{c1}``, ``\\dot x_1``; squared: ``v_{c1}^2``,
+               ``|v_{c1}|^2``, ``v_{c1}^T v_{c1}``, ``v_{c1} \\cdot v_{c1}``, a scalar ``v_2^2``
 Jv, Jw         ``J_{v_1}``, ``J_{v_{c1}}``, ``J_{\\omega_1}``
 M              ``M``, ``D``, ``H``, ``B``, ``M(q)``, ``D(q)``, ``M(\\theta)``, ``H(q)``, ``B(q)``;
                entries ``d_{11}``, ``m_{12}``, ``M_{11}``, ``D_{21}``, ``b_{12}``
@@ -46,6 +47,8 @@ _ARG = re.compile(r"\\?[A-Za-z]+|\\d?dot\{\\?[A-Za-z]+\}")
 #: a left-hand side longer than this names no quantity (bounds the regular expressions below)
 MAX_LHS = 120
 _MC = r"(?:[CcG]|cm|CM|com)"
+#: the alias of a position or speed written without the mass centre's c (``x_1``, ``v_2^2``)
+POINT = "point"
 
 
 def mass_centre(sub: str | None) -> int | None:
@@ -136,6 +139,12 @@ def _indexed(s: str, ref_type):
         return ref_type("vc", mass_centre(sub), part="sq" if sup == "2" else "")
     if base in ("p", "r") and mass_centre(sub) is not None and dots == 0 and sup is None:
         return ref_type("pc", mass_centre(sub))
+    # a point mass's (a link's) position or speed without the c: x_1, \dot x_1, v_2^2; read as
+    # link i's mass centre only when the value moves with the joints (decided in the grader)
+    if base in ("x", "y", "z") and _index(sub) is not None and sup is None and dots < 2:
+        return ref_type("vc" if dots else "pc", _index(sub), part=base, alias=POINT, by_shape=True)
+    if base == "v" and _index(sub) is not None and sup == "2" and not dots:
+        return ref_type("vc", _index(sub), part="sq", alias=POINT, by_shape=True)
     if dots:
         return None
     if base == "J" and sub is not None and sup is None:
@@ -222,14 +231,17 @@ def model_name(ref) -> str:
 SOFT = ("M", "C", "G", "h")
 
 
-def by_shape(ref, value, step_ref, is_prismatic=None, dof=0):
+def by_shape(ref, value, step_ref, is_prismatic=None, dof=0, moves=True):
     """The reading of a ``by_shape`` left-hand side given its value, and what was assumed
     (None when the shape fits no reading). ``value``: SymPy scalar or matrix;
-    ``step_ref(key, index, **kw)`` builds the new reference."""
+    ``step_ref(key, index, **kw)`` builds the new reference; ``moves``: the value depends
+    on the joint coordinates or their rates."""
     import sympy as sp
 
     shape = value.shape if isinstance(value, sp.MatrixBase) else (1, 1)
     scalar = shape == (1, 1)
+    if ref.alias == POINT:
+        return _point(ref, scalar, moves)
     # a 0 stands for a zero vector as well (\omega_0 = 0); a frame written makes it a vector
     vector_reading = ref.frame is not None or (scalar and not isinstance(value, sp.MatrixBase) and value == 0)
     column = shape[1] == 1 and not scalar
@@ -273,6 +285,20 @@ def by_shape(ref, value, step_ref, is_prismatic=None, dof=0):
             )
         return ref, ""
     return ref, ""
+
+
+def _point(ref, scalar: bool, moves: bool):
+    """``x_1``, ``\\dot x_1``, ``v_2^2``: link i's mass centre when the value is a scalar that moves."""
+    i = ref.index
+    if not scalar and ref.part == "sq":
+        return None, f"a vector v_{i}^2 is Craig's velocity of frame {i}'s origin in frame {i}, not graded"
+    if not scalar or not moves:
+        return None, NOT_A_STEP  # a constant, a length, a vector: the student's own name
+    if ref.part == "sq":
+        return ref, f"v_{i}^2 read as the squared speed of link {i}'s mass centre (a scalar)"
+    what = "position" if ref.key == "pc" else "velocity"
+    name = {"x": "ẋ", "y": "ẏ", "z": "ż"}[ref.part] if ref.key == "vc" else ref.part
+    return ref, f"{name}_{i} read as link {i}'s mass centre ({ref.part} of its {what} in the base frame)"
 
 
 def student_names(ref) -> list[str]:
