@@ -203,3 +203,43 @@ def test_the_end_of_a_link_is_said_so(tmp_path):
     r = _grade(tmp_path, f"$$x_1 = {tex(end)}$$\n\n$$x_1 = {tex(2 * end)}$$\n")
     assert _status(r) == [("x_c1", "correct"), ("x_c1", "wrong")]
     assert "end of link 1" in r.steps[0].message
+
+
+# ------------------------------------------------------------ 4. the shorthand's definitions
+def test_shorthand_definitions_are_checked(tmp_path):
+    c1c2 = sp.cos(q1) * sp.cos(q2)
+    body = [
+        rf"$$c_1 = {tex(sp.cos(q1))}, \quad s_{{12}} = {tex(sp.sin(q1 + q2))}$$",
+        rf"$$C_{{12}} = {tex(c1c2 - sp.sin(q1) * sp.sin(q2))}$$",  # the angle sum expanded: still cos(q1 + q2)
+        rf"$$S_1 = {tex(sp.cos(q1))}$$",
+        rf"$$c_{{12}} = {tex(c1c2)}$$",
+        r"$$c_1 = l_1$$",
+    ]
+    r = _grade(tmp_path, "\n\n".join(body) + "\n")
+    assert _status(r) == [
+        ("c_1", "correct"),
+        ("s_12", "correct"),
+        ("C_12", "correct"),
+        ("S_1", "wrong"),
+        ("c_12", "wrong"),
+        ("", "unrecognised"),
+    ]
+    assert "sine and cosine swapped" in r.steps[3].message
+    assert "missing term" in r.steps[4].message
+
+
+def test_the_letters_with_joint_rates_are_coriolis_terms(tmp_path):
+    # the Coriolis matrix by hand: Christoffel symbols of D = Hessian of T
+    D = sp.hessian(T, QD)
+    C = sp.Matrix(
+        2,
+        2,
+        lambda k, j: sum(
+            (sp.diff(D[k, j], Q[i]) + sp.diff(D[k, i], Q[j]) - sp.diff(D[i, j], Q[k])) / 2 * QD[i] for i in range(2)
+        ),
+    )
+    cq = C * sp.Matrix(QD)
+    body = f"$$c_1 = {tex(sp.expand(cq[0]))}$$\n\n$$C_{{12}} = {tex(C[0, 1])}$$\n\n$$c_2 = {tex(2 * cq[1])}$$\n"
+    r = _grade(tmp_path, body)
+    assert _status(r) == [("h_1", "correct"), ("C_12", "correct"), ("h_2", "wrong")]
+    assert "Lynch & Park's velocity-product vector" in r.steps[0].message

@@ -12,6 +12,7 @@ from ..errors import ModelError
 from .engine import equal
 from .lagrange_terms import ModelTerms, grade_model_step, potential_shift
 from .notation import StepRef
+from .shorthand import grade_shorthand, shorthand_reading
 from .text import NOT_A_STEP
 from .verdict import PASSING, StepVerdict
 from .vocabulary import MODEL_KEYS, POINT, SOFT, by_shape, student_names
@@ -49,6 +50,10 @@ class EnergySteps:
                 return None, ""
             if ref.alias and ref.key.startswith(("dL_", "ddt_dL_")):
                 assumed = f"∂{ref.alias}/∂q̇ read as ∂L/∂q̇ (the potential energy does not depend on the velocities)"
+        if ref.key == "shorthand":
+            value, _ = self.value(eq, ref)
+            self.verdicts.append(grade_shorthand(ref, eq, value, self.robot, self.sampler))
+            return None, ""
         if ref.key in MODEL_KEYS or ref.key in ("Lang", "tau_vec"):
             if "lagrange" not in seen_methods:
                 seen_methods.append("lagrange")
@@ -73,6 +78,11 @@ class EnergySteps:
         prismatic = None
         if ref.key == "f" and ref.index is not None and 1 <= ref.index <= self.robot.dof:
             prismatic = _prismatic(self.robot, ref.index)
+        if ref.key == "shorthand":  # c_1 = \cos\theta_1, or a Coriolis term by its value
+            new, assumed = shorthand_reading(ref, value, self.robot, lambda key, **kw: StepRef(key, **kw))
+            if new is None:
+                self._unrecognised(eq, assumed)
+            return new, assumed
         rates = {*self.robot.q, *self.robot.qd}
         moves = bool(rates & value.free_symbols) if isinstance(value, sp.Basic) else True
         new, assumed = by_shape(

@@ -215,7 +215,7 @@ class _Grader(EnergySteps):
         for eq in self.sub.equations:
             done = len(self.verdicts)
             self._equation(eq, seen_methods, context)
-            if self.verdicts[done:] and self.verdicts[-1].key not in ("", "R", "P", "Pc", "law", "tau"):
+            if self.verdicts[done:] and self.verdicts[-1].key not in ("", "R", "P", "Pc", "law", "tau", "shorthand"):
                 last = self.verdicts[-1].key
                 context = "lagrange" if last in LAGRANGE_KEYS or last in MODEL_KEYS else "newton-euler"
             for v in self.verdicts[done:]:

@@ -72,7 +72,7 @@ class StepRef:
 
     @property
     def name(self) -> str:
-        if self.key in MODEL_KEYS or self.key == "Lang":
+        if self.key in MODEL_KEYS or self.key in ("Lang", "shorthand"):
             return model_name(self)
         if self.key == "R":
             return f"R_{self.index}^{self.frame}"

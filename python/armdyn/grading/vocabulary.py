@@ -152,6 +152,9 @@ def _indexed(s: str, ref_type):
         return ref_type("Jv" if j.group(1) == "v" else "Jw", int(j.group(2))) if j else None
     if sup is not None:
         return None
+    if base in ("c", "s", "C", "S") and (_digits(sub, 1) or _digits(sub, 2) or (base != "c" and _digits(sub, 3))):
+        digits = _digits(sub, 1) or _digits(sub, 2) or _digits(sub, 3)
+        return ref_type("shorthand", entry=digits, alias=base, by_shape=True)  # c_1 = \cos\theta_1: by the value
     if base in ("c", "\\Gamma", "h") and _digits(sub, 3):
         return ref_type("christoffel", entry=_digits(sub, 3), alias=base)
     if base in ("d", "m", "M", "D", "b", "B") and _digits(sub, 2):
@@ -224,6 +227,8 @@ def model_name(ref) -> str:
         return f"H_{ref.index}"
     if ref.key == "christoffel":
         return f"c_{entry}"
+    if ref.key == "shorthand":
+        return f"{ref.alias}_{entry}"
     return f"{ref.key}_{entry}" if entry else ref.key
 
 
