@@ -243,3 +243,87 @@ def test_the_letters_with_joint_rates_are_coriolis_terms(tmp_path):
     r = _grade(tmp_path, body)
     assert _status(r) == [("h_1", "correct"), ("C_12", "correct"), ("h_2", "wrong")]
     assert "Lynch & Park's velocity-product vector" in r.steps[0].message
+
+
+# ------------------------------------------------------------ 3. Spong's Newton-Euler names
+SPONG_HEAD = "---\nrobot: planar-3r\nmethod: newton-euler\n---\n\n"
+t = sp.Symbol("t")
+l2, l3, m3 = sp.symbols("l2 l3 m3")
+Q3 = sp.symbols("q1 q2 q3")
+QD3 = sp.symbols("q1_dot q2_dot q3_dot")
+QDD3 = sp.symbols("q1_ddot q2_ddot q3_ddot")
+N3 = {**{Q3[k]: rf"\theta_{k + 1}" for k in range(3)}, **{QD3[k]: rf"\dot{{\theta}}_{k + 1}" for k in range(3)}}
+N3.update({QDD3[k]: rf"\ddot{{\theta}}_{k + 1}" for k in range(3)})
+N3.update({l1: "l_1", l2: "l_2", l3: "l_3", m3: "m_3"})
+
+
+def _spong_arm():
+    """The planar 3R arm of rods by hand: link i turned by φ_i = q1 + ... + qi, joint i+1 at
+    the end of link i, the centre halfway; accelerations by differentiating in time."""
+    qt = [sp.Function(f"q{k + 1}")(t) for k in range(3)]
+    phi = [sum(qt[: i + 1]) for i in range(3)]
+    ends, p = [], sp.zeros(2, 1)
+    for i, length in enumerate((l1, l2, l3)):
+        p = p + length * sp.Matrix([sp.cos(phi[i]), sp.sin(phi[i])])
+        ends.append(p)
+    centre3 = ends[1] + l3 / 2 * sp.Matrix([sp.cos(phi[2]), sp.sin(phi[2])])
+
+    def plain(x):
+        x = x.subs({sp.diff(qt[k], t, 2): QDD3[k] for k in range(3)})
+        x = x.subs({sp.diff(qt[k], t): QD3[k] for k in range(3)})
+        return x.subs({qt[k]: Q3[k] for k in range(3)})
+
+    def in_frame(i, v):  # a base-frame planar vector written in frame i (R_i^T v)
+        c, s = sp.cos(phi[i - 1]), sp.sin(phi[i - 1])
+        return sp.Matrix([c * v[0] + s * v[1], -s * v[0] + c * v[1], 0])
+
+    acc = {i: plain(in_frame(i, ends[i - 1].diff(t, 2))) for i in (1, 2)}
+    gravity = {i: plain(in_frame(i, sp.Matrix([0, -g]))) for i in (1, 2, 3)}
+    ac3 = plain(in_frame(3, centre3.diff(t, 2)))
+    # the moment on link 3 at joint 3: I ω̇ + r × m (a_c − g), r = (l3/2, 0, 0) in frame 3
+    n3 = m3 * l3**2 / 12 * sum(QDD3) + l3 / 2 * m3 * (ac3[1] - gravity[3][1])
+    return acc, gravity, sp.Matrix([0, 0, sp.expand(n3)])
+
+
+def tex3(x) -> str:
+    return r"\begin{pmatrix}" + r" \\ ".join(sp.latex(e, symbol_names=N3) for e in x) + r"\end{pmatrix}"
+
+
+def test_spongs_newton_euler_names(tmp_path):
+    acc, gravity, n3 = _spong_arm()
+    body = [
+        rf"$$\alpha_2 = {tex3(sp.Matrix([0, 0, QDD3[0] + QDD3[1]]))}$$",
+        rf"$$\alpha_2^2 = {tex3(sp.Matrix([0, 0, QDD3[0]]))}$$",
+        rf"$$a_{{e,1}} = {tex3(acc[1])}$$",
+        rf"$$a_{{e,2}}^2 = {tex3(acc[2] + sp.Matrix([l2 * QD3[0], 0, 0]))}$$",
+        rf"$$g_1 = {tex3(gravity[1])}$$",
+        rf"$$g_2^2 = {tex3(gravity[1])}$$",
+        rf"$$\tau_3 = {tex3(n3)}$$",
+        r"$$\alpha_1 = 0$$",
+    ]
+    r = _grade(tmp_path, "\n\n".join(body) + "\n", head=SPONG_HEAD)
+    assert _status(r) == [
+        ("omega_dot_2", "correct"),
+        ("omega_dot_2", "wrong"),
+        ("v_dot_2", "correct-by-convention"),  # Spong keeps gravity as a force
+        ("v_dot_3", "wrong"),
+        ("g_1", "correct"),
+        ("g_2", "wrong"),
+        ("n_3", "correct-but-unsupported"),  # right, but not from the a_{e,2} written above
+        ("", "unrecognised"),  # a scalar α_1 is a DH twist
+    ]
+    assert "end of link 1: frame 2's origin (joint 2)" in r.steps[2].message
+    assert "gravity expressed in frame 1" in r.steps[4].message
+    assert "Spong's moment on link 3" in r.steps[6].message
+
+
+def test_a_scalar_g_k_stays_the_gravity_vectors_entry(tmp_path):
+    # planar elbow arm: g_2 = ∂V/∂q2 by hand
+    r = _grade(tmp_path, f"$$g_2 = {tex(sp.diff(V, q2))}$$\n\n$$g_1 = -g$$\n")
+    assert _status(r) == [("G_2", "correct"), ("G_1", "wrong")]
+
+
+def test_spongs_moment_vector_alone_is_right(tmp_path):
+    n3 = _spong_arm()[2]
+    r = _grade(tmp_path, rf"$$\tau_3 = {tex3(n3)}$$" + "\n", head=SPONG_HEAD)
+    assert _status(r) == [("n_3", "correct")]

@@ -10,6 +10,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from .engine import equal
+from .explain import describe, tidy
 from .lagrange_terms import ModelTerms, grade_model_step, potential_shift
 from .notation import StepRef
 from .shorthand import grade_shorthand, shorthand_reading
@@ -39,8 +40,12 @@ class EnergySteps:
         """(the step ``ref`` names, what was assumed), or (None, "") when the equation was
         graded here (an energy-method quantity) or could not be."""
         assumed = ""
+        if ref.key == "ae":  # Spong's a_{e,i}: the end of link i, a frame origin of the model
+            ref, assumed = self._end_of_link_frame(ref, eq)
+            if ref is None:
+                return None, ""
         # which step it is depends on the value's shape (a frame written, or YAML: a vector)
-        if ref.by_shape or (ref.key in ("omega", "f") and ref.frame is None and eq.latex):
+        if ref.by_shape or (ref.key in ("omega", "f", "tau") and ref.frame is None and eq.latex):
             ref, assumed = self._by_shape(ref, eq)
             if ref is None:
                 return None, ""
@@ -50,6 +55,9 @@ class EnergySteps:
                 return None, ""
             if ref.alias and ref.key.startswith(("dL_", "ddt_dL_")):
                 assumed = f"∂{ref.alias}/∂q̇ read as ∂L/∂q̇ (the potential energy does not depend on the velocities)"
+        if ref.key == "gvec":
+            self._gravity_in_frame(ref, eq, assumed)
+            return None, ""
         if ref.key == "shorthand":
             value, _ = self.value(eq, ref)
             self.verdicts.append(grade_shorthand(ref, eq, value, self.robot, self.sampler))
@@ -65,7 +73,7 @@ class EnergySteps:
         """(the reading of ``ref`` its value's shape gives, what was assumed); (None, _)
         after recording an unrecognised equation."""
         probe = StepRef(ref.key, ref.index, ref.frame, ref.alias, ref.part, ref.entry, True, ref.sign)
-        soft = ref.key in SOFT  # a bare M, C, G, h: unnamed unless its value is a matrix or vector
+        soft = ref.key in SOFT and not ref.entry  # a bare M, C, G, h: unnamed unless its value is a matrix or vector
         try:
             value, problem = self.value(eq, probe)
         except ModelError as err:
@@ -89,7 +97,7 @@ class EnergySteps:
             ref, value, lambda key, index=None, **kw: StepRef(key, index, **kw), prismatic, self.robot.dof, moves
         )
         if new is None:
-            named = not ((soft or ref.alias == POINT) and assumed == NOT_A_STEP)
+            named = assumed != NOT_A_STEP
             self._unrecognised(eq, assumed, name=ref.name if named else "", key=ref.key if named else "")
             return None, ""
         return new, assumed
@@ -145,6 +153,73 @@ class EnergySteps:
                 f"not its mass centre: right for that point"
             )
 
+    def _end_of_link_frame(self, ref: StepRef, eq):
+        """(Spong's ``a_{e,i}`` as the model's step, what was assumed): the end of link i is
+        the origin of the one frame that link i carries (joint i+1's, or the flange's), and
+        its acceleration is that frame's v̇, written in frame i (or the frame given)."""
+        ctx = self.world("newton-euler").ctx
+        n = len(self.robot.links) - 1
+        i = ref.index
+        kids = ctx[i]["children"] if i is not None and 1 <= i <= n else []
+        if len(kids) != 1:
+            why = "has no link beyond it" if not kids else "carries more than one frame"
+            problem = f"a_e{i}: the end of link {i} is not one frame's origin of '{self.robot.name}' (link {i} {why})"
+            if i is None or not 1 <= i <= n:
+                problem = f"a_e{i} names link {i}, but '{self.robot.name}' has links 1..{n}"
+            self._unrecognised(eq, self._refuse(eq, problem, column=False), name=f"a_e{i}", key="ae")
+            return None, ""
+        frame = i if ref.frame is None else ref.frame
+        point = f"joint {kids[0]}" if kids[0] <= self.robot.dof else "the flange"
+        return StepRef("v_dot", kids[0], frame), (
+            f"a_e{i} read as the acceleration of the end of link {i}: frame {kids[0]}'s origin "
+            f"({point}), v̇_{kids[0]}, written in frame {frame}"
+        )
+
+    def _gravity_in_frame(self, ref: StepRef, eq, assumed: str) -> None:
+        """Spong's ``g_i``: the gravity vector written in frame i (R_0^i g_0)."""
+        value, problem = self.value(eq, StepRef("gvec", ref.index, ref.frame, by_shape=True))
+        n = len(self.robot.links) - 1
+        if value is not None and not 0 <= ref.index <= n:
+            value, problem = None, self._refuse(eq, f"g_{ref.index}: frame {ref.index} does not exist (frames 0..{n})")
+        if value is None:
+            self._unrecognised(eq, problem, name=f"g_{ref.index}", key="gvec")
+            return
+        ctx = self.world("newton-euler").ctx
+        frame = ref.index if ref.frame is None else ref.frame
+        expected = sp.Matrix(ctx["R0"][frame].T * ctx["gravity"]).applyfunc(lambda x: tidy(x, self.robot))
+        fp = self.sampler.fingerprint
+        ok = equal(fp(value), fp(expected)).ravel()
+        status, convention, message = "correct", None, ""
+        if not ok.all() and equal(fp(value), fp(-expected)).all():
+            status = "correct-by-convention"
+            convention = message = "the base acceleration −g (Craig's v̇_0 = −g), not gravity itself"
+        bad = [k for k in range(3) if not ok[k]] if status == "wrong" or not ok.all() and not convention else []
+        if bad:
+            status = "wrong"
+            message = "; ".join(
+                f"{describe(value[k], expected[k], self.robot, self.sampler)} in {'xyz'[k]}" for k in bad
+            )
+            message += f" (gravity in frame {frame})"
+        message = assumed + ("; " + message if message else "")
+        self.verdicts.append(
+            StepVerdict(
+                name=f"g_{ref.index}",
+                key="gvec",
+                link="",
+                status=status,
+                label=eq.lhs,
+                source=eq.source,
+                line=eq.line,
+                expected=expected,
+                got=value,
+                difference=(value - expected) if bad else None,
+                components=bad,
+                convention=convention,
+                message=message,
+                frame=str(frame),
+            )
+        )
+
     def _torque_column(self, ref: StepRef, eq, value) -> None:
         """``(\\tau_1, \\tau_2)^T = ...``: each entry graded as its joint's τ_k."""
         n = self.robot.dof
@@ -182,7 +257,8 @@ class EnergySteps:
                 v.status, v.convention = "correct-by-convention", level
             v.message = level + ("; " + v.message if v.message else "")
         if assumed:
-            v.message = assumed + ("; " + v.message if v.message else "")
+            same = v.message == v.convention  # the convention is shown beside the status already
+            v.message = assumed + ("; " + v.message if v.message and not same else "")
 
     def _matrix_form(self, eq) -> None:
         """``M q̈ + C q̇ + g = τ`` stated: right when every matrix given before it is, else

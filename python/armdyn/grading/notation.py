@@ -154,6 +154,7 @@ _BASES = {
     "a": "a",
     "R": "R",
     "P": "P",
+    "\\alpha": "alpha",
 }
 
 
@@ -200,7 +201,7 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
         inner, rest = s[start : j - 1], s[j:]
         s, i = inner + rest, 0
         # scripts may sit inside the accent's braces: \dot{\omega_1}
-    m = re.match(r"\\omega|\\tau|[A-Za-z]", s[i:])
+    m = re.match(r"\\omega|\\tau|\\alpha|[A-Za-z]", s[i:])
     if not m:
         return None
     base = m.group(0)
@@ -230,6 +231,14 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
         if centre is not None:
             return StepRef("Pc", centre, frame)
         return StepRef("P", _int(sub), frame) if _int(sub) is not None else None
+    end_of = re.fullmatch(r"e(\d+)", _plain(sub)) if key == "a" and not dots else None
+    if end_of:  # Spong's a_{e,i}: the acceleration of the end of link i (resolved on the model)
+        return StepRef("ae", int(end_of.group(1)), frame)
+    if key == "alpha":  # Spong's \alpha_i = \dot\omega_i; a scalar \alpha_i is a DH twist (by the value)
+        index = _int(sub)
+        return (
+            StepRef("omega_dot", index, frame, alias="alpha", by_shape=True) if index is not None and not dots else None
+        )
     if key in ("v", "a"):
         want = 1 if key == "v" else 0
         if dots != want or sub is None:

@@ -150,6 +150,8 @@ def _indexed(s: str, ref_type):
     if base == "J" and sub is not None and sup is None:
         j = re.fullmatch(r"(v|\\omega|w)" + _MC + r"?(\d+)", re.sub(r"[{}\s,_]|\\mathrm", "", sub))
         return ref_type("Jv" if j.group(1) == "v" else "Jw", int(j.group(2))) if j else None
+    if base == "g" and _index(sub) is not None and sup is not None and _index(sup) is not None:
+        return ref_type("G", entry=(_index(sub),), alias="g", frame=_index(sup), by_shape=True)  # g_2^2: a vector
     if sup is not None:
         return None
     if base in ("c", "s", "C", "S") and (_digits(sub, 1) or _digits(sub, 2) or (base != "c" and _digits(sub, 3))):
@@ -161,8 +163,8 @@ def _indexed(s: str, ref_type):
         return ref_type("M", entry=_digits(sub, 2), alias=base)
     if base in ("h", "b") and _index(sub) is not None:
         return ref_type("h", entry=(_index(sub),), alias=base)
-    if base in ("g", "G", "\\phi") and _index(sub) is not None:
-        return ref_type("G", entry=(_index(sub),), alias=base)
+    if base in ("g", "G", "\\phi") and _index(sub) is not None:  # g_k: an entry, or gravity in frame k (by shape)
+        return ref_type("G", entry=(_index(sub),), alias=base, by_shape=base == "g")
     i = _index(sub)
     if i is None:
         e = re.fullmatch(r"\{?([kp]),?(\d+)\}?", sub or "")  # E_{k,1}, E_{p1}
@@ -247,6 +249,9 @@ def by_shape(ref, value, step_ref, is_prismatic=None, dof=0, moves=True):
     scalar = shape == (1, 1)
     if ref.alias == POINT:
         return _point(ref, scalar, moves)
+    spong = _spong(ref, shape, step_ref)
+    if spong is not None:
+        return spong
     # a 0 stands for a zero vector as well (\omega_0 = 0); a frame written makes it a vector
     vector_reading = ref.frame is not None or (scalar and not isinstance(value, sp.MatrixBase) and value == 0)
     column = shape[1] == 1 and not scalar
@@ -290,6 +295,36 @@ def by_shape(ref, value, step_ref, is_prismatic=None, dof=0, moves=True):
             )
         return ref, ""
     return ref, ""
+
+
+def _spong(ref, shape, step_ref):
+    """Spong's Newton-Euler names read by shape: ``\\alpha_i`` (a vector: ω̇_i; a scalar: a DH
+    twist), ``g_i`` (a 3-vector: gravity in frame i; a scalar: the gravity vector's entry),
+    ``\\tau_i`` (a 3-vector: the moment on link i at joint i, n_i); None for other names."""
+    scalar, vector = shape == (1, 1), shape == (3, 1)
+    if ref.key == "omega_dot" and ref.alias == "alpha":
+        if not vector:
+            return None, NOT_A_STEP  # \alpha_1 = 0: a DH twist
+        return step_ref("omega_dot", ref.index, frame=ref.frame), (
+            f"α_{ref.index} read as link {ref.index}'s angular acceleration ω̇_{ref.index} (Spong)"
+        )
+    if ref.key == "G" and ref.alias == "g":
+        k = ref.entry[0]
+        if vector:
+            return step_ref("gvec", k, frame=ref.frame), (
+                f"g_{k} read as gravity expressed in frame {k} (a 3-vector; a scalar g_{k} is the gravity vector's entry)"
+            )
+        if scalar and ref.frame is None:
+            return step_ref("G", entry=ref.entry, alias="g"), ""
+        return None, f"g_{k}: a {shape[0]}x{shape[1]} value is neither gravity in frame {k} nor an entry of g(q)"
+    if ref.key == "tau" and vector:
+        return step_ref("n", ref.index, frame=ref.frame), (
+            f"a 3-vector τ_{ref.index} read as Spong's moment on link {ref.index} at joint {ref.index}, "
+            f"n_{ref.index} (a scalar τ_{ref.index} is the joint torque)"
+        )
+    if ref.key == "tau":
+        return ref, ""
+    return None
 
 
 def _point(ref, scalar: bool, moves: bool):
