@@ -12,7 +12,12 @@ frame given neither as a superscript nor as Craig's pre-superscript is the link'
                   given), P_{C_i}^j (link i's mass centre from frame i's origin, in frame j)
     Lagrange      T, V, L, \\frac{\\partial L}{\\partial \\dot q_k}, \\partial L / \\partial \\dot q_k,
                   \\frac{d}{dt}\\frac{\\partial L}{\\partial \\dot q_k}, \\frac{\\partial L}{\\partial q_k}, \\tau_k
-                  (also -\\frac{\\partial L}{\\partial q_k}: the negated partial, sign = -1)
+                  (also -\\frac{\\partial L}{\\partial q_k}: the negated partial, sign = -1);
+                  the energies' partials \\frac{\\partial T}{\\partial \\dot q_k} (read as L's),
+                  \\frac{\\partial T}{\\partial q_k}, \\frac{\\partial V}{\\partial q_k} (any energy name;
+                  by the joint vector \\Theta: index None, a column)
+    Spong         \\alpha_i (ω̇_i, by shape), a_{e,i} (the end of link i: key "ae", resolved on
+                  the model's frames), g_i (gravity in frame i, by shape), a 3-vector \\tau_i (n_i)
     energy method the textbooks' names of :mod:`.vocabulary`: energies K, T, KE, E_k, U, V, P,
                   PE, E_p (per link with an index), mass centres p_{c1}, x_{c1}, v_{c1},
                   v_{c1}^2, Jacobians J_{v_1}, J_{\\omega_1}, D(q) / M(q) and d_{jk},
