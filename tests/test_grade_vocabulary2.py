@@ -327,3 +327,18 @@ def test_spongs_moment_vector_alone_is_right(tmp_path):
     n3 = _spong_arm()[2]
     r = _grade(tmp_path, rf"$$\tau_3 = {tex3(n3)}$$" + "\n", head=SPONG_HEAD)
     assert _status(r) == [("n_3", "correct")]
+
+
+def test_an_unreadable_column_of_partials_is_named(tmp_path):
+    r = _grade(tmp_path, r"$$\frac{\partial V}{\partial q} = \begin{pmatrix} m_1 \\ x_7 \end{pmatrix}$$" + "\n")
+    assert [(v.name, v.status) for v in r.steps] == [("dV_dq", "unrecognised")]
+    assert "dV_dq: unknown symbol x_{7}" in r.steps[0].message
+
+
+def test_a_hostile_partial_is_read_in_bounded_time():
+    import time
+
+    start = time.perf_counter()
+    for lhs in (r"\frac{\partial T}{\partial " + "\\dot{" * 3000 + "q", r"\partial K/\partial " + "q_1" * 5000):
+        assert _lhs(lhs) is None
+    assert time.perf_counter() - start < 2.0

@@ -125,8 +125,10 @@ class EnergySteps:
         """``\\frac{\\partial k}{\\partial\\dot\\Theta} = (...)``: each entry graded as its joint's partial."""
         if "lagrange" not in seen_methods:
             seen_methods.append("lagrange")
-        value, problem = self.value(eq, StepRef("tau_vec"))
+        value, problem = self.value(eq, StepRef(ref.key, alias=ref.alias, by_shape=True))
         n = self.robot.dof
+        if value is not None and n == 1 and not isinstance(value, sp.MatrixBase):
+            value = sp.Matrix([value])  # one joint: the column is one entry
         if value is not None and (not isinstance(value, sp.MatrixBase) or len(value) != n or min(value.shape) != 1):
             value, problem = None, f"{ref.name}: a partial by the joint vector is a column of {n} entries"
         if value is None:
