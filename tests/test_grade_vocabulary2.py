@@ -342,3 +342,17 @@ def test_a_hostile_partial_is_read_in_bounded_time():
     for lhs in (r"\frac{\partial T}{\partial " + "\\dot{" * 3000 + "q", r"\partial K/\partial " + "q_1" * 5000):
         assert _lhs(lhs) is None
     assert time.perf_counter() - start < 2.0
+
+
+def test_craigs_position_of_a_mass_centre_in_the_base_frame(tmp_path):
+    # Craig's {}^{0}P_{C_2}: link 2's mass centre seen from frame 0's origin (by hand: PC2);
+    # the usual reading (from frame 2's origin, written in frame 0) is lc2 (c12, s12)
+    from_frame_2 = lc2 * sp.Matrix([sp.cos(q1 + q2), sp.sin(q1 + q2), 0])
+    base = sp.Matrix([PC2[0], PC2[1], 0])
+    body = "\n\n".join(
+        rf"$${{}}^{{0}}P_{{C_2}} = \begin{{bmatrix}} {tex(v[0])} \\ {tex(v[1])} \\ 0 \end{{bmatrix}}$$"
+        for v in (base, from_frame_2, base + from_frame_2)
+    )
+    r = _grade(tmp_path, body + "\n", head=HEAD.replace("lagrange", "newton-euler"))
+    assert [v.status for v in r.steps] == ["correct", "correct", "wrong"]
+    assert "seen from frame 0's origin" in r.steps[0].message

@@ -412,7 +412,11 @@ class _Grader(EnergySteps):
         fp = self.sampler.fingerprint
         ok = equal(fp(value), fp(expected)).ravel()
         bad = [int(i) for i in range(3) if not ok[i]]
-        message = "; ".join(f"{self._describe(value[i], expected[i])} in {component_name(i, (3, 1))}" for i in bad)
+        craig = self._point_in_frame(ref, home, frame, value) if bad else None  # {}^{0}P_{C_2}: from frame 0's origin
+        if craig is not None:
+            expected, bad, message = craig
+        else:
+            message = "; ".join(f"{self._describe(value[i], expected[i])} in {component_name(i, (3, 1))}" for i in bad)
         if bad:
             message += f" ({what}, in frame {frame})"
         self.verdicts.append(
