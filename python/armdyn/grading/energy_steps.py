@@ -9,14 +9,19 @@ from __future__ import annotations
 import sympy as sp
 
 from ..errors import ModelError
+from .engine import equal
+from .explain import describe, tidy
 from .lagrange_terms import ModelTerms, grade_model_step, potential_shift
 from .notation import StepRef
+from .shorthand import grade_shorthand, shorthand_reading
 from .text import NOT_A_STEP
 from .verdict import PASSING, StepVerdict
-from .vocabulary import MODEL_KEYS, SOFT, by_shape, student_names
+from .vocabulary import MODEL_KEYS, POINT, SOFT, by_shape, student_names
 
 #: the steps whose values the matrix form M q̈ + C q̇ + g = τ states
 _MATRICES = ("M", "C", "h", "G", "christoffel")
+#: the partial derivatives of the energies (of L, T by q and q̇, V by q)
+_PARTIALS = ("dL_dqd", "ddt_dL_dqd", "dL_dq", "dT_dq", "dV_dq")
 
 
 class EnergySteps:
@@ -35,11 +40,28 @@ class EnergySteps:
         """(the step ``ref`` names, what was assumed), or (None, "") when the equation was
         graded here (an energy-method quantity) or could not be."""
         assumed = ""
+        if ref.key == "ae":  # Spong's a_{e,i}: the end of link i, a frame origin of the model
+            ref, assumed = self._end_of_link_frame(ref, eq)
+            if ref is None:
+                return None, ""
         # which step it is depends on the value's shape (a frame written, or YAML: a vector)
-        if ref.by_shape or (ref.key in ("omega", "f") and ref.frame is None and eq.latex):
+        if ref.by_shape or (ref.key in ("omega", "f", "tau") and ref.frame is None and eq.latex):
             ref, assumed = self._by_shape(ref, eq)
             if ref is None:
                 return None, ""
+        if ref.key in _PARTIALS:
+            if ref.index is None:  # ∂k/∂Θ: the column of partials, one per joint
+                self._partial_column(ref, eq, seen_methods)
+                return None, ""
+            if ref.alias and ref.key.startswith(("dL_", "ddt_dL_")):
+                assumed = f"∂{ref.alias}/∂q̇ read as ∂L/∂q̇ (the potential energy does not depend on the velocities)"
+        if ref.key == "gvec":
+            self._gravity_in_frame(ref, eq, assumed)
+            return None, ""
+        if ref.key == "shorthand":
+            value, _ = self.value(eq, ref)
+            self.verdicts.append(grade_shorthand(ref, eq, value, self.robot, self.sampler))
+            return None, ""
         if ref.key in MODEL_KEYS or ref.key in ("Lang", "tau_vec"):
             if "lagrange" not in seen_methods:
                 seen_methods.append("lagrange")
@@ -51,7 +73,7 @@ class EnergySteps:
         """(the reading of ``ref`` its value's shape gives, what was assumed); (None, _)
         after recording an unrecognised equation."""
         probe = StepRef(ref.key, ref.index, ref.frame, ref.alias, ref.part, ref.entry, True, ref.sign)
-        soft = ref.key in SOFT  # a bare M, C, G, h: unnamed unless its value is a matrix or vector
+        soft = ref.key in SOFT and not ref.entry  # a bare M, C, G, h: unnamed unless its value is a matrix or vector
         try:
             value, problem = self.value(eq, probe)
         except ModelError as err:
@@ -64,11 +86,18 @@ class EnergySteps:
         prismatic = None
         if ref.key == "f" and ref.index is not None and 1 <= ref.index <= self.robot.dof:
             prismatic = _prismatic(self.robot, ref.index)
+        if ref.key == "shorthand":  # c_1 = \cos\theta_1, or a Coriolis term by its value
+            new, assumed = shorthand_reading(ref, value, self.robot, lambda key, **kw: StepRef(key, **kw))
+            if new is None:
+                self._unrecognised(eq, assumed)
+            return new, assumed
+        rates = {*self.robot.q, *self.robot.qd}
+        moves = bool(rates & value.free_symbols) if isinstance(value, sp.Basic) else True
         new, assumed = by_shape(
-            ref, value, lambda key, index=None, **kw: StepRef(key, index, **kw), prismatic, self.robot.dof
+            ref, value, lambda key, index=None, **kw: StepRef(key, index, **kw), prismatic, self.robot.dof, moves
         )
         if new is None:
-            named = not (soft and assumed == NOT_A_STEP)
+            named = assumed != NOT_A_STEP
             self._unrecognised(eq, assumed, name=ref.name if named else "", key=ref.key if named else "")
             return None, ""
         return new, assumed
@@ -83,12 +112,139 @@ class EnergySteps:
             self._torque_column(ref, eq, value)
             return
         verdict = grade_model_step(self, ref, eq, value)
+        if verdict.status == "wrong" and ref.alias == POINT and ref.key == "pc":
+            self._end_of_link(ref, value, verdict)
         if assumed:
             verdict.message = assumed + ("; " + verdict.message if verdict.message else "")
         self.verdicts.append(verdict)
         if ref.key in ("Tl", "Vl") and not isinstance(value, sp.MatrixBase):
             for name in student_names(ref):
                 self.symbols.steps[name] = value
+
+    def _partial_column(self, ref: StepRef, eq, seen_methods: list) -> None:
+        """``\\frac{\\partial k}{\\partial\\dot\\Theta} = (...)``: each entry graded as its joint's partial."""
+        if "lagrange" not in seen_methods:
+            seen_methods.append("lagrange")
+        value, problem = self.value(eq, StepRef(ref.key, alias=ref.alias, by_shape=True))
+        n = self.robot.dof
+        if value is not None and n == 1 and not isinstance(value, sp.MatrixBase):
+            value = sp.Matrix([value])  # one joint: the column is one entry
+        if value is not None and (not isinstance(value, sp.MatrixBase) or len(value) != n or min(value.shape) != 1):
+            value, problem = None, f"{ref.name}: a partial by the joint vector is a column of {n} entries"
+        if value is None:
+            self._unrecognised(eq, problem, name=ref.name, key=ref.key)
+            return
+        for k in range(n):
+            self._step(self.world("lagrange"), StepRef(ref.key, k + 1, alias=ref.alias), eq, value[k], "lagrange")
+            self.verdicts[-1].message = f"entry {k + 1} of the column, read as joint {k + 1}'s partial" + (
+                "; " + self.verdicts[-1].message if self.verdicts[-1].message else ""
+            )
+
+    def _end_of_link(self, ref: StepRef, value, verdict) -> None:
+        """``x_1`` that is not link 1's mass centre but its far end (frame 2's origin, where
+        the next joint sits): right for that point, and said so."""
+        origins = self.model_terms().origins
+        i, axis = ref.index, "xyz".index(ref.part)
+        if i + 1 not in origins or not isinstance(value, sp.Basic):
+            return
+        fp = self.sampler.fingerprint
+        if equal(fp(value), fp(origins[i + 1][axis])).all():
+            verdict.status, verdict.difference, verdict.components = "correct", None, []
+            verdict.message = (
+                f"{ref.part}_{i} read as the end of link {i} (frame {i + 1}'s origin, joint {i + 1}), "
+                f"not its mass centre: right for that point"
+            )
+
+    def _end_of_link_frame(self, ref: StepRef, eq):
+        """(Spong's ``a_{e,i}`` as the model's step, what was assumed): the end of link i is
+        the origin of the one frame that link i carries (joint i+1's, or the flange's), and
+        its acceleration is that frame's v̇, written in frame i (or the frame given)."""
+        ctx = self.world("newton-euler").ctx
+        n = len(self.robot.links) - 1
+        i = ref.index
+        kids = ctx[i]["children"] if i is not None and 1 <= i <= n else []
+        if len(kids) != 1:
+            why = "has no link beyond it" if not kids else "carries more than one frame"
+            problem = f"a_e{i}: the end of link {i} is not one frame's origin of '{self.robot.name}' (link {i} {why})"
+            if i is None or not 1 <= i <= n:
+                problem = f"a_e{i} names link {i}, but '{self.robot.name}' has links 1..{n}"
+            self._unrecognised(eq, self._refuse(eq, problem, column=False), name=f"a_e{i}", key="ae")
+            return None, ""
+        frame = i if ref.frame is None else ref.frame
+        point = f"joint {kids[0]}" if kids[0] <= self.robot.dof else "the flange"
+        return StepRef("v_dot", kids[0], frame), (
+            f"a_e{i} read as the acceleration of the end of link {i}: frame {kids[0]}'s origin "
+            f"({point}), v̇_{kids[0]}, written in frame {frame}"
+        )
+
+    def _gravity_in_frame(self, ref: StepRef, eq, assumed: str) -> None:
+        """Spong's ``g_i``: the gravity vector written in frame i (R_0^i g_0)."""
+        value, problem = self.value(eq, StepRef("gvec", ref.index, ref.frame, by_shape=True))
+        n = len(self.robot.links) - 1
+        if value is not None and not 0 <= ref.index <= n:
+            value, problem = None, self._refuse(eq, f"g_{ref.index}: frame {ref.index} does not exist (frames 0..{n})")
+        if value is None:
+            self._unrecognised(eq, problem, name=f"g_{ref.index}", key="gvec")
+            return
+        ctx = self.world("newton-euler").ctx
+        frame = ref.index if ref.frame is None else ref.frame
+        expected = sp.Matrix(ctx["R0"][frame].T * ctx["gravity"]).applyfunc(lambda x: tidy(x, self.robot))
+        fp = self.sampler.fingerprint
+        ok = equal(fp(value), fp(expected)).ravel()
+        status, convention, message = "correct", None, ""
+        if not ok.all() and equal(fp(value), fp(-expected)).all():
+            status = "correct-by-convention"
+            convention = message = "the base acceleration −g (Craig's v̇_0 = −g), not gravity itself"
+        bad = [k for k in range(3) if not ok[k]] if status == "wrong" or not ok.all() and not convention else []
+        if bad:
+            status = "wrong"
+            message = "; ".join(
+                f"{describe(value[k], expected[k], self.robot, self.sampler)} in {'xyz'[k]}" for k in bad
+            )
+            message += f" (gravity in frame {frame})"
+        message = assumed + ("; " + message if message else "")
+        self.verdicts.append(
+            StepVerdict(
+                name=f"g_{ref.index}",
+                key="gvec",
+                link="",
+                status=status,
+                label=eq.lhs,
+                source=eq.source,
+                line=eq.line,
+                expected=expected,
+                got=value,
+                difference=(value - expected) if bad else None,
+                components=bad,
+                convention=convention,
+                message=message,
+                frame=str(frame),
+            )
+        )
+
+    def _point_in_frame(self, ref: StepRef, home: int, frame: int, value):
+        """(the expected vector, [], what was read) when a position ``P_i^j`` / ``P_{C_i}^j`` written in a frame
+        j other than its usual one is the point seen from frame j's origin (Craig's
+        ``{}^{0}P_{C_2}``: link 2's mass centre in the base frame), else None."""
+        if frame == home or not isinstance(value, sp.MatrixBase) or value.shape != (3, 1):
+            return None
+        terms = self.model_terms()
+        point = terms.position(ref.index) if ref.key == "Pc" else terms.origins[ref.index]
+        ctx = self.world("newton-euler").ctx
+        seen = sp.Matrix(ctx["R0"][frame].T * (point - terms.origins[frame])).applyfunc(lambda x: tidy(x, self.robot))
+        fp = self.sampler.fingerprint
+        if not equal(fp(value), fp(seen)).all():
+            return None
+        what = f"link {ref.index}'s mass centre" if ref.key == "Pc" else f"frame {ref.index}'s origin"
+        start = f"frame {ref.index}'s" if ref.key == "Pc" else f"frame {home}'s"
+        return (
+            seen,
+            [],
+            (
+                f"{ref.name} read as Craig's {{}}^{{{frame}}}P: {what} seen from frame {frame}'s origin "
+                f"(not from {start}), written in frame {frame}"
+            ),
+        )
 
     def _torque_column(self, ref: StepRef, eq, value) -> None:
         """``(\\tau_1, \\tau_2)^T = ...``: each entry graded as its joint's τ_k."""
@@ -127,7 +283,8 @@ class EnergySteps:
                 v.status, v.convention = "correct-by-convention", level
             v.message = level + ("; " + v.message if v.message else "")
         if assumed:
-            v.message = assumed + ("; " + v.message if v.message else "")
+            same = v.message == v.convention  # the convention is shown beside the status already
+            v.message = assumed + ("; " + v.message if v.message and not same else "")
 
     def _matrix_form(self, eq) -> None:
         """``M q̈ + C q̇ + g = τ`` stated: right when every matrix given before it is, else

@@ -42,6 +42,8 @@ _NAMED = {  # step names as armdyn reports them, accepted as left-hand sides in 
     "dL_dqd": "dL_dqd",
     "dL_dq": "dL_dq",
     "ddt_dL_dqd": "ddt_dL_dqd",
+    "dT_dq": "dT_dq",
+    "dV_dq": "dV_dq",
 }
 
 
@@ -213,7 +215,7 @@ class _Grader(EnergySteps):
         for eq in self.sub.equations:
             done = len(self.verdicts)
             self._equation(eq, seen_methods, context)
-            if self.verdicts[done:] and self.verdicts[-1].key not in ("", "R", "P", "Pc", "law", "tau"):
+            if self.verdicts[done:] and self.verdicts[-1].key not in ("", "R", "P", "Pc", "law", "tau", "shorthand"):
                 last = self.verdicts[-1].key
                 context = "lagrange" if last in LAGRANGE_KEYS or last in MODEL_KEYS else "newton-euler"
             for v in self.verdicts[done:]:
@@ -410,7 +412,11 @@ class _Grader(EnergySteps):
         fp = self.sampler.fingerprint
         ok = equal(fp(value), fp(expected)).ravel()
         bad = [int(i) for i in range(3) if not ok[i]]
-        message = "; ".join(f"{self._describe(value[i], expected[i])} in {component_name(i, (3, 1))}" for i in bad)
+        craig = self._point_in_frame(ref, home, frame, value) if bad else None  # {}^{0}P_{C_2}: from frame 0's origin
+        if craig is not None:
+            expected, bad, message = craig
+        else:
+            message = "; ".join(f"{self._describe(value[i], expected[i])} in {component_name(i, (3, 1))}" for i in bad)
         if bad:
             message += f" ({what}, in frame {frame})"
         self.verdicts.append(

@@ -63,6 +63,11 @@ class ModelTerms:
     def potential(self, i: int):
         return self._energies[2][self.names[i]]
 
+    @property
+    def origins(self) -> dict:
+        """Each frame's origin in the base frame (frame number -> 3-vector)."""
+        return self._origins
+
     @cached_property
     def _origins(self) -> dict:
         p0 = {0: sp.zeros(3, 1)}

@@ -299,7 +299,8 @@ def rotation_between(ctx, frm: int, to: int):
 
 
 def lagrange_method(robot: Robot) -> tuple[Method, dict]:
-    """The Lagrange steps of ``robot``: T, V, L, the partial derivatives, tau."""
+    """The Lagrange steps of ``robot``: T, V, L, the partial derivatives (of L, and of T and V
+    by q), tau."""
     T_trans, T_rot, V_links, _ = link_energies(robot)
     T = sum(T_trans.values(), sp.Integer(0)) + sum(T_rot.values(), sp.Integer(0))
     V = sum(V_links.values(), sp.Integer(0))
@@ -312,10 +313,16 @@ def lagrange_method(robot: Robot) -> tuple[Method, dict]:
     for k in range(1, robot.dof + 1):
         j = k - 1
         m.formulas[("dL_dqd", k)] = [Formula((("L", None),), lambda c, L, j=j: _diff(L, c, "qd", j))]
-        m.formulas[("dL_dq", k)] = [Formula((("L", None),), lambda c, L, j=j: _diff(L, c, "q", j))]
+        # the energies' partials by q_k, written separately (∂T/∂q_k, ∂V/∂q_k), give ∂L/∂q_k too
+        m.formulas[("dT_dq", k)] = [Formula((("T", None),), lambda c, t, j=j: _diff(t, c, "q", j))]
+        m.formulas[("dV_dq", k)] = [Formula((("V", None),), lambda c, v, j=j: _diff(v, c, "q", j))]
+        m.formulas[("dL_dq", k)] = [
+            Formula((("L", None),), lambda c, L, j=j: _diff(L, c, "q", j)),
+            Formula((("dT_dq", k), ("dV_dq", k)), lambda c, t, v: t - v),
+        ]
         m.formulas[("ddt_dL_dqd", k)] = [Formula((("dL_dqd", k),), lambda c, p: _ddt(p, c))]
         m.formulas[("tau", k)] = [Formula((("ddt_dL_dqd", k), ("dL_dq", k)), lambda c, a, b: a - b)]
-        m.refs += [("dL_dqd", k), ("dL_dq", k), ("ddt_dL_dqd", k), ("tau", k)]
+        m.refs += [("dL_dqd", k), ("dT_dq", k), ("dV_dq", k), ("dL_dq", k), ("ddt_dL_dqd", k), ("tau", k)]
     return m, ctx
 
 

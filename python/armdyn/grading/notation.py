@@ -12,7 +12,12 @@ frame given neither as a superscript nor as Craig's pre-superscript is the link'
                   given), P_{C_i}^j (link i's mass centre from frame i's origin, in frame j)
     Lagrange      T, V, L, \\frac{\\partial L}{\\partial \\dot q_k}, \\partial L / \\partial \\dot q_k,
                   \\frac{d}{dt}\\frac{\\partial L}{\\partial \\dot q_k}, \\frac{\\partial L}{\\partial q_k}, \\tau_k
-                  (also -\\frac{\\partial L}{\\partial q_k}: the negated partial, sign = -1)
+                  (also -\\frac{\\partial L}{\\partial q_k}: the negated partial, sign = -1);
+                  the energies' partials \\frac{\\partial T}{\\partial \\dot q_k} (read as L's),
+                  \\frac{\\partial T}{\\partial q_k}, \\frac{\\partial V}{\\partial q_k} (any energy name;
+                  by the joint vector \\Theta: index None, a column)
+    Spong         \\alpha_i (ω̇_i, by shape), a_{e,i} (the end of link i: key "ae", resolved on
+                  the model's frames), g_i (gravity in frame i, by shape), a 3-vector \\tau_i (n_i)
     energy method the textbooks' names of :mod:`.vocabulary`: energies K, T, KE, E_k, U, V, P,
                   PE, E_p (per link with an index), mass centres p_{c1}, x_{c1}, v_{c1},
                   v_{c1}^2, Jacobians J_{v_1}, J_{\\omega_1}, D(q) / M(q) and d_{jk},
@@ -41,7 +46,7 @@ from .latex import LatexError, Name, UnknownSymbol, parse
 from .vocabulary import MODEL_KEYS, energy_lhs, mass_centre, model_name
 
 VECTOR_KEYS = ("omega", "omega_dot", "v_dot", "vc_dot", "F", "N", "f", "n")
-LAGRANGE_KEYS = ("T", "V", "L", "dL_dqd", "ddt_dL_dqd", "dL_dq")
+LAGRANGE_KEYS = ("T", "V", "L", "dL_dqd", "ddt_dL_dqd", "dL_dq", "dT_dq", "dV_dq")
 
 
 @dataclass(frozen=True)
@@ -72,7 +77,7 @@ class StepRef:
 
     @property
     def name(self) -> str:
-        if self.key in MODEL_KEYS or self.key == "Lang":
+        if self.key in MODEL_KEYS or self.key in ("Lang", "shorthand"):
             return model_name(self)
         if self.key == "R":
             return f"R_{self.index}^{self.frame}"
@@ -154,6 +159,7 @@ _BASES = {
     "a": "a",
     "R": "R",
     "P": "P",
+    "\\alpha": "alpha",
 }
 
 
@@ -173,7 +179,7 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
         s, sign = s[1:], -1
     lag = _lagrange(s, coordinate_of)
     if lag is not None:
-        return lag if sign == 1 else StepRef(lag.key, lag.index, sign=-1)
+        return lag if sign == 1 else StepRef(lag.key, lag.index, alias=lag.alias, sign=-1)
     if sign == -1:
         return None
     s = re.sub(r"^\{(\\d?dot\{[^{}]*\})\}", r"\1", s)  # {\dot v}_{c_1}
@@ -200,7 +206,7 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
         inner, rest = s[start : j - 1], s[j:]
         s, i = inner + rest, 0
         # scripts may sit inside the accent's braces: \dot{\omega_1}
-    m = re.match(r"\\omega|\\tau|[A-Za-z]", s[i:])
+    m = re.match(r"\\omega|\\tau|\\alpha|[A-Za-z]", s[i:])
     if not m:
         return None
     base = m.group(0)
@@ -230,6 +236,14 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
         if centre is not None:
             return StepRef("Pc", centre, frame)
         return StepRef("P", _int(sub), frame) if _int(sub) is not None else None
+    end_of = re.fullmatch(r"e(\d+)", _plain(sub)) if key == "a" and not dots else None
+    if end_of:  # Spong's a_{e,i}: the acceleration of the end of link i (resolved on the model)
+        return StepRef("ae", int(end_of.group(1)), frame)
+    if key == "alpha":  # Spong's \alpha_i = \dot\omega_i; a scalar \alpha_i is a DH twist (by the value)
+        index = _int(sub)
+        return (
+            StepRef("omega_dot", index, frame, alias="alpha", by_shape=True) if index is not None and not dots else None
+        )
     if key in ("v", "a"):
         want = 1 if key == "v" else 0
         if dots != want or sub is None:
@@ -248,31 +262,50 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
     return StepRef(key, index, frame, alias)
 
 
-_PARTIAL = r"\\partial(?:L|\\mathcal\{L\}|\\mathcal\{?L\}?)"
+#: the energy differentiated: the Lagrangian, the kinetic or the potential energy (any textbook's name)
+_ENERGY = r"\\partial(L|K|T|KE|k|E_\{?k\}?|E_\{?kin\}?|U|V|P|PE|u|E_\{?p\}?|E_\{?pot\}?)"
+_KINETIC_NAMES = re.compile(r"K|T|KE|k|E_\{?k\}?|E_\{?kin\}?")
+#: the joint vector written without an index (\Theta, q, \dot\theta): a column of partials
+_JOINT_VECTOR = re.compile(r"(\\dot\{)?(?:\\Theta|\\theta|\\vartheta|q)(?(1)\})")
+#: (energy kind, derivative order of the coordinate, d/dt taken) -> the step (a partial of T by
+#: a velocity is that of L: V does not depend on the velocities)
+_PARTIAL_KEYS = {
+    ("L", 1, True): "ddt_dL_dqd",
+    ("L", 1, False): "dL_dqd",
+    ("L", 0, False): "dL_dq",
+    ("T", 1, True): "ddt_dL_dqd",
+    ("T", 1, False): "dL_dqd",
+    ("T", 0, False): "dT_dq",
+    ("V", 0, False): "dV_dq",
+}
 
 
 def _lagrange(s: str, coordinate_of) -> StepRef | None:
     ddt = False
-    for prefix in (r"\frac{d}{dt}", r"\frac{\mathrm{d}}{\mathrm{d}t}", r"\dfrac{d}{dt}", "d/dt"):
+    for prefix in (r"\frac{d}{dt}", r"\dfrac{d}{dt}", "d/dt"):
         if s.startswith(prefix):
             s, ddt = s[len(prefix) :], True
             break
     if ddt and s.startswith("(") and s.endswith(")"):
         s = s[1:-1]
-    m = re.fullmatch(r"\\d?frac\{" + _PARTIAL + r"\}\{\\partial(.+)\}", s) or re.fullmatch(
-        _PARTIAL + r"/\\partial(.+)", s
+    if len(s) > 120:  # names no partial; bounds the expressions below
+        return None
+    m = re.fullmatch(r"\\d?frac\{" + _ENERGY + r"\}\{\\partial(.+)\}", s) or re.fullmatch(
+        _ENERGY + r"/\\partial(.+)", s
     )
     if not m:
         return None
-    found = coordinate_of(m.group(1))
+    energy = "L" if m.group(1) == "L" else "T" if _KINETIC_NAMES.fullmatch(m.group(1)) else "V"
+    alias = "" if energy == "L" else m.group(1)
+    found = coordinate_of(m.group(2))
     if found is None:
-        return None
+        vector = _JOINT_VECTOR.fullmatch(m.group(2))
+        if vector is None:
+            return None
+        found = (None, 1 if vector.group(1) else 0)
     k, order = found
-    if order == 1:
-        return StepRef("ddt_dL_dqd" if ddt else "dL_dqd", k)
-    if order == 0 and not ddt:
-        return StepRef("dL_dq", k)
-    return None
+    key = _PARTIAL_KEYS.get((energy, order, ddt))
+    return StepRef(key, k, alias=alias) if key else None
 
 
 # ------------------------------------------------------------------ symbols
@@ -340,7 +373,7 @@ class SymbolMap:
         candidate = plain + {0: "", 1: "_dot", 2: "_ddot"}.get(name.dots, "?")
         if candidate in self.names:
             return self.names[candidate]
-        if name.base in ("theta", "q", "d", "vartheta") and sub.isdigit():
+        if name.base in ("theta", "Theta", "q", "d", "vartheta") and sub.isdigit():
             k = int(sub)
             if 1 <= k <= self.robot.dof:
                 return [self.robot.q, self.robot.qd, self.robot.qdd][min(name.dots, 2)][k - 1]

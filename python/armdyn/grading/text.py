@@ -31,6 +31,8 @@ _KEY_TEXT = {
     "dL_dqd": "∂L/∂q̇",
     "dL_dq": "∂L/∂q",
     "ddt_dL_dqd": "d/dt ∂L/∂q̇",
+    "dT_dq": "∂T/∂q",
+    "dV_dq": "∂V/∂q",
 }
 #: the message of an equation that names no step (listed by line, not one by one)
 NOT_A_STEP = "not a step of Newton-Euler or Lagrange (skipped)"

@@ -11,9 +11,10 @@ key            names
 T (total)      ``K``, ``T``, ``KE``, ``k``, ``E_k``, ``\\mathcal{K}``, ``\\mathcal{T}``
 V (total)      ``U``, ``V``, ``P``, ``PE``, ``u``, ``E_p``, ``\\mathcal{U}``, ``\\mathcal{V}``, ``\\mathcal{P}``
 Tl, Vl         the same with a link index: ``K_1``, ``T_2``, ``KE_1``, ``PE_1``, ``u_2``, ``P_1``
-pc             ``p_{c1}``, ``r_{c_2}``, ``x_{c1}`` / ``y_{c1}`` / ``z_{c1}`` (one component)
-vc             ``v_{c1}``, ``\\dot p_{c1}``, ``\\dot x_{c1}``; squared: ``v_{c1}^2``,
-               ``|v_{c1}|^2``, ``v_{c1}^T v_{c1}``, ``v_{c1} \\cdot v_{c1}``
+pc             ``p_{c1}``, ``r_{c_2}``, ``x_{c1}`` / ``y_{c1}`` / ``z_{c1}`` (one component);
+               ``x_1``, ``y_2`` without the c when the value moves with the joints
+vc             ``v_{c1}``, ``\\dot p_{c1}``, ``\\dot x_{c1}``, ``\\dot x_1``; squared: ``v_{c1}^2``,
+               ``|v_{c1}|^2``, ``v_{c1}^T v_{c1}``, ``v_{c1} \\cdot v_{c1}``, a scalar ``v_2^2``
 Jv, Jw         ``J_{v_1}``, ``J_{v_{c1}}``, ``J_{\\omega_1}``
 M              ``M``, ``D``, ``H``, ``B``, ``M(q)``, ``D(q)``, ``M(\\theta)``, ``H(q)``, ``B(q)``;
                entries ``d_{11}``, ``m_{12}``, ``M_{11}``, ``D_{21}``, ``b_{12}``
@@ -46,6 +47,8 @@ _ARG = re.compile(r"\\?[A-Za-z]+|\\d?dot\{\\?[A-Za-z]+\}")
 #: a left-hand side longer than this names no quantity (bounds the regular expressions below)
 MAX_LHS = 120
 _MC = r"(?:[CcG]|cm|CM|com)"
+#: the alias of a position or speed written without the mass centre's c (``x_1``, ``v_2^2``)
+POINT = "point"
 
 
 def mass_centre(sub: str | None) -> int | None:
@@ -136,21 +139,32 @@ def _indexed(s: str, ref_type):
         return ref_type("vc", mass_centre(sub), part="sq" if sup == "2" else "")
     if base in ("p", "r") and mass_centre(sub) is not None and dots == 0 and sup is None:
         return ref_type("pc", mass_centre(sub))
+    # a point mass's (a link's) position or speed without the c: x_1, \dot x_1, v_2^2; read as
+    # link i's mass centre only when the value moves with the joints (decided in the grader)
+    if base in ("x", "y", "z") and _index(sub) is not None and sup is None and dots < 2:
+        return ref_type("vc" if dots else "pc", _index(sub), part=base, alias=POINT, by_shape=True)
+    if base == "v" and _index(sub) is not None and sup == "2" and not dots:
+        return ref_type("vc", _index(sub), part="sq", alias=POINT, by_shape=True)
     if dots:
         return None
     if base == "J" and sub is not None and sup is None:
         j = re.fullmatch(r"(v|\\omega|w)" + _MC + r"?(\d+)", re.sub(r"[{}\s,_]|\\mathrm", "", sub))
         return ref_type("Jv" if j.group(1) == "v" else "Jw", int(j.group(2))) if j else None
+    if base == "g" and _index(sub) is not None and sup is not None and _index(sup) is not None:
+        return ref_type("G", entry=(_index(sub),), alias="g", frame=_index(sup), by_shape=True)  # g_2^2: a vector
     if sup is not None:
         return None
+    if base in ("c", "s", "C", "S") and (_digits(sub, 1) or _digits(sub, 2) or (base != "c" and _digits(sub, 3))):
+        digits = _digits(sub, 1) or _digits(sub, 2) or _digits(sub, 3)
+        return ref_type("shorthand", entry=digits, alias=base, by_shape=True)  # c_1 = \cos\theta_1: by the value
     if base in ("c", "\\Gamma", "h") and _digits(sub, 3):
         return ref_type("christoffel", entry=_digits(sub, 3), alias=base)
     if base in ("d", "m", "M", "D", "b", "B") and _digits(sub, 2):
         return ref_type("M", entry=_digits(sub, 2), alias=base)
     if base in ("h", "b") and _index(sub) is not None:
         return ref_type("h", entry=(_index(sub),), alias=base)
-    if base in ("g", "G", "\\phi") and _index(sub) is not None:
-        return ref_type("G", entry=(_index(sub),), alias=base)
+    if base in ("g", "G", "\\phi") and _index(sub) is not None:  # g_k: an entry, or gravity in frame k (by shape)
+        return ref_type("G", entry=(_index(sub),), alias=base, by_shape=base == "g")
     i = _index(sub)
     if i is None:
         e = re.fullmatch(r"\{?([kp]),?(\d+)\}?", sub or "")  # E_{k,1}, E_{p1}
@@ -215,6 +229,8 @@ def model_name(ref) -> str:
         return f"H_{ref.index}"
     if ref.key == "christoffel":
         return f"c_{entry}"
+    if ref.key == "shorthand":
+        return f"{ref.alias}_{entry}"
     return f"{ref.key}_{entry}" if entry else ref.key
 
 
@@ -222,14 +238,20 @@ def model_name(ref) -> str:
 SOFT = ("M", "C", "G", "h")
 
 
-def by_shape(ref, value, step_ref, is_prismatic=None, dof=0):
+def by_shape(ref, value, step_ref, is_prismatic=None, dof=0, moves=True):
     """The reading of a ``by_shape`` left-hand side given its value, and what was assumed
     (None when the shape fits no reading). ``value``: SymPy scalar or matrix;
-    ``step_ref(key, index, **kw)`` builds the new reference."""
+    ``step_ref(key, index, **kw)`` builds the new reference; ``moves``: the value depends
+    on the joint coordinates or their rates."""
     import sympy as sp
 
     shape = value.shape if isinstance(value, sp.MatrixBase) else (1, 1)
     scalar = shape == (1, 1)
+    if ref.alias == POINT:
+        return _point(ref, scalar, moves)
+    spong = _spong(ref, shape, step_ref)
+    if spong is not None:
+        return spong
     # a 0 stands for a zero vector as well (\omega_0 = 0); a frame written makes it a vector
     vector_reading = ref.frame is not None or (scalar and not isinstance(value, sp.MatrixBase) and value == 0)
     column = shape[1] == 1 and not scalar
@@ -273,6 +295,50 @@ def by_shape(ref, value, step_ref, is_prismatic=None, dof=0):
             )
         return ref, ""
     return ref, ""
+
+
+def _spong(ref, shape, step_ref):
+    """Spong's Newton-Euler names read by shape: ``\\alpha_i`` (a vector: ω̇_i; a scalar: a DH
+    twist), ``g_i`` (a 3-vector: gravity in frame i; a scalar: the gravity vector's entry),
+    ``\\tau_i`` (a 3-vector: the moment on link i at joint i, n_i); None for other names."""
+    scalar, vector = shape == (1, 1), shape == (3, 1)
+    if ref.key == "omega_dot" and ref.alias == "alpha":
+        if not vector:
+            return None, NOT_A_STEP  # \alpha_1 = 0: a DH twist
+        return step_ref("omega_dot", ref.index, frame=ref.frame), (
+            f"α_{ref.index} read as link {ref.index}'s angular acceleration ω̇_{ref.index} (Spong)"
+        )
+    if ref.key == "G" and ref.alias == "g":
+        k = ref.entry[0]
+        if vector:
+            return step_ref("gvec", k, frame=ref.frame), (
+                f"g_{k} read as gravity expressed in frame {k} (a 3-vector; a scalar g_{k} is the gravity vector's entry)"
+            )
+        if scalar and ref.frame is None:
+            return step_ref("G", entry=ref.entry, alias="g"), ""
+        return None, f"g_{k}: a {shape[0]}x{shape[1]} value is neither gravity in frame {k} nor an entry of g(q)"
+    if ref.key == "tau" and vector:
+        return step_ref("n", ref.index, frame=ref.frame), (
+            f"a 3-vector τ_{ref.index} read as Spong's moment on link {ref.index} at joint {ref.index}, "
+            f"n_{ref.index} (a scalar τ_{ref.index} is the joint torque)"
+        )
+    if ref.key == "tau":
+        return ref, ""
+    return None
+
+
+def _point(ref, scalar: bool, moves: bool):
+    """``x_1``, ``\\dot x_1``, ``v_2^2``: link i's mass centre when the value is a scalar that moves."""
+    i = ref.index
+    if not scalar and ref.part == "sq":
+        return None, f"a vector v_{i}^2 is Craig's velocity of frame {i}'s origin in frame {i}, not graded"
+    if not scalar or not moves:
+        return None, NOT_A_STEP  # a constant, a length, a vector: the student's own name
+    if ref.part == "sq":
+        return ref, f"v_{i}^2 read as the squared speed of link {i}'s mass centre (a scalar)"
+    what = "position" if ref.key == "pc" else "velocity"
+    name = {"x": "ẋ", "y": "ẏ", "z": "ż"}[ref.part] if ref.key == "vc" else ref.part
+    return ref, f"{name}_{i} read as link {i}'s mass centre ({ref.part} of its {what} in the base frame)"
 
 
 def student_names(ref) -> list[str]:
