@@ -301,6 +301,8 @@ class SymbolMap:
         #: sin/cos of the angles the student wrote as shorthand -> a symbol printing as theirs (s₁₂)
         self.shorthand: dict = {}
         self.used_gravity_magnitude = False
+        #: the names the student gave values to (:class:`~.defined.DefinedNames`), when grading
+        self.defined = None
         for student, model in (explicit or {}).items():
             key = self._key_of(str(student))
             target = self.names.get(str(model))
@@ -337,6 +339,9 @@ class SymbolMap:
         plain = name.base + sub
         if name.dots == 0 and plain in self.steps:
             return self.steps[plain]
+        value = self.defined.lookup(name) if self.defined is not None else None
+        if value is not None:  # a name the student gave a value to (.defined)
+            return value
         candidate = plain + {0: "", 1: "_dot", 2: "_ddot"}.get(name.dots, "?")
         if candidate in self.names:
             return self.names[candidate]
@@ -360,6 +365,9 @@ class SymbolMap:
                 return sp.nsimplify(magnitude) if magnitude.is_Float else magnitude
         if name.base == "pi" and not sub:
             return sp.pi
+        value = self.defined.model(name) if self.defined is not None else None
+        if value is not None:  # a model quantity the student did not write (d_{11}): the model's
+            return value
         raise UnknownSymbol(
             f"unknown symbol {name.latex()} (the model '{self.robot.name}' has "
             f"{', '.join(sorted(self.names))}; map it in the front matter's 'symbols')"
