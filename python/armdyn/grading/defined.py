@@ -84,6 +84,7 @@ class DefinedNames:
         self.right = False  # reading with the right values of the names
         self.used: list[Entry] = []  # the entries the value being read used
         self._stack: list[str] = []
+        self.failed: dict[str, str] = {}  # key -> why its definition cannot be read
         self.active = False
 
     # -- what may be defined
@@ -118,6 +119,8 @@ class DefinedNames:
         if not self.active or name.dots or name.pre_sup or name.pre_sub:
             return None
         key = plain(name)
+        if key in self.failed:
+            raise LatexError(self.failed[key])
         entry = self.entries.get(key)
         if entry is None and key in self.pending:
             entry = self._read_pending(key)
@@ -186,11 +189,15 @@ class DefinedNames:
         key = plain(name)
         self.pending[key] = eq
         self.entries.pop(key, None)
+        self.failed.pop(key, None)
         try:
             return self._read_pending(key)
         except (LatexError, TypeError, ValueError, RecursionError, sp.ShapeError) as err:
             self.pending.pop(key, None)
-            return str(err).split("\n")[0][:200]
+            why = str(err).split("\n")[0][:200]
+            if "defined through itself" in why or "nested more than" in why:
+                self.failed[key] = why  # later uses say why, not "unknown symbol"
+            return why
 
     def record(self, eq, own, right, wrong: str = "") -> None:
         """A step the student wrote under a plain name (``d_{11}``, ``\\phi_3``, ``g_3``):
@@ -293,7 +300,7 @@ def definition(grader, eq) -> str | None:
     entry = grader.names.define(eq) if eq.latex else None
     if not isinstance(entry, Entry):
         return None
-    if entry.note and entry.note.startswith(eq.lhs):
+    if entry.note and f"as defined at line {eq.line}" in entry.note:
         grader.notes.append(f"line {eq.line}: {entry.note}")
     return f"defines {eq.lhs} (used in later steps)" + (f"; {entry.note}" if entry.note else "")
 

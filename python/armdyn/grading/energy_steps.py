@@ -9,6 +9,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..errors import ModelError
+from .defined import definition
 from .lagrange_terms import ModelTerms, grade_model_step, potential_shift
 from .notation import StepRef
 from .text import NOT_A_STEP
@@ -69,6 +70,8 @@ class EnergySteps:
         )
         if new is None:
             named = not (soft and assumed == NOT_A_STEP)
+            if not named:  # a bare h = (scalar): the student's own name, used in later values
+                assumed = definition(self, eq) or assumed
             self._unrecognised(eq, assumed, name=ref.name if named else "", key=ref.key if named else "")
             return None, ""
         return new, assumed

@@ -350,8 +350,8 @@ class SymbolMap:
             if 1 <= k <= self.robot.dof:
                 return [self.robot.q, self.robot.qd, self.robot.qdd][min(name.dots, 2)][k - 1]
         if name.base in ("s", "c", "S", "C") and name.dots == 0 and sub.isdigit() and plain not in self.names:
-            idx = [int(ch) for ch in sub]
-            if all(1 <= k <= self.robot.dof for k in idx):
+            idx = [int(ch) for ch in sub]  # a repeated index (c_{112}) is a Christoffel symbol, not an angle sum
+            if all(1 <= k <= self.robot.dof for k in idx) and len(set(idx)) == len(idx):
                 angle = sum((self.robot.q[k - 1] for k in idx), sp.Integer(0))
                 value = (sp.sin if name.base in "sS" else sp.cos)(angle)
                 from ..symbolic.names import unicode_name
