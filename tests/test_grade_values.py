@@ -262,3 +262,29 @@ def test_spong_names_and_a_where_clause_against_the_corpus_truth():
     assert truth[48]["truth"] == "wrong" and steps[48].status == "wrong"
     assert truth[60]["truth"] == "follows" and steps[60].status == "follows-from-earlier-error"
     assert steps[52].message.startswith("defines X")
+
+
+NE_HEADER = HEADER.replace("method: lagrange", "method: newton-euler")
+
+
+def test_a_torque_of_step_names_only(tmp_path):
+    # τ_1 = n_1ᵀ ẑ_1 is the revolute joint's torque by definition: read through n_1 (not
+    # written: the method's), it is right; through a written n_1 that is wrong, it carries it
+    body = r"$$\tau_1 = n_1^{1T}\hat Z_1^1$$" + "\n"
+    report = grade(write(tmp_path, body, "a.md"))
+    assert report.steps[0].status == "correct", report.steps[0].message
+    body = r"$$n_1^1 = \begin{pmatrix} 0 \\ 0 \\ 0 \end{pmatrix}$$" + "\n\n" + body
+    path = tmp_path / "b.md"
+    path.write_text(NE_HEADER + body)
+    n1, tau = grade(path).steps
+    assert n1.status == "wrong" and tau.status == "follows-from-earlier-error", tau.message
+
+
+def test_a_name_of_another_meaning_is_not_a_wrong_shorthand(tmp_path):
+    # Lynch & Park's c_1 is the velocity-product entry: no note that it contradicts cos q_1
+    body = r"$$c_1 = -m_2\ell_1\ell_{c2}\sin q_2\,(2\dot q_1\dot q_2 + \dot q_2^2)$$" + "\n"
+    report = grade(write(tmp_path, body + r"$$d_{22} = m_2\ell_{c2}^2 + I_2$$" + "\n"))
+    assert report.steps[0].message.startswith("defines c_1") and not report.notes
+    # a shorthand used before a later definition of that name keeps its meaning
+    body = r"$$d_{12} = m_2(\ell_{c2}^2 + \ell_1\ell_{c2} c_2) + I_2$$" + "\n\n" + r"$$c_2 = \dot q_2^2$$" + "\n"
+    assert grade(write(tmp_path, body)).steps[0].status == "correct"

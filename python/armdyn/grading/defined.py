@@ -91,7 +91,7 @@ class DefinedNames:
     def definable(self, name: Name) -> bool:
         """Not a symbol of the model (a length, a joint variable): those keep their meaning.
         The shorthand ``c_1``, ``s_{12}`` may be defined (and is checked)."""
-        if name.base in ("s", "c", "S", "C") and (name.sub or "").strip("{} ").isdigit():
+        if _shorthand(name):
             return True
         saved, self.active = self.active, False
         try:
@@ -109,6 +109,8 @@ class DefinedNames:
                 continue
             name = simple_name(eq.lhs)
             if name is None or parse_lhs(eq.lhs, lambda _: None) is not None or not self.definable(name):
+                continue
+            if _shorthand(name):  # c_1 means cos q_1 until the student defines it otherwise
                 continue
             self.pending.setdefault(plain(name), eq)
         self.active = True
@@ -162,8 +164,10 @@ class DefinedNames:
         return entry
 
     def _check_shorthand(self, name: Name | None, entry: Entry) -> None:
-        """``c_1 = \\sin\\theta_1``: not the model's ``c_1``; later steps use it, said."""
-        if name is None or name.base not in ("s", "c", "S", "C"):
+        """``c_1 = \\sin\\theta_1``: not the model's ``c_1``; later steps use it, said. A value
+        that is no sine or cosine (Lynch & Park's ``c_1``, a velocity-product entry) is another
+        quantity of that name: only said in its own line."""
+        if name is None or not _shorthand(name):
             return
         saved, self.active = self.active, False
         try:
@@ -172,8 +176,15 @@ class DefinedNames:
             return
         finally:
             self.active = saved
+        own = entry.own
+        if not isinstance(own, sp.Expr):
+            return
+        trig = isinstance(-own if own.could_extract_minus_sign() else own, (sp.sin, sp.cos))
+        if not trig:
+            entry.note = f"not the shorthand {name.latex()} = {model}"
+            return
         entry.right = model
-        if sp.simplify(sp.expand_trig(entry.own - model)) != 0:
+        if sp.simplify(sp.expand_trig(own - model)) != 0:
             entry.note = (
                 f"{name.latex()} as defined at line {entry.line} is not the shorthand {name.latex()} = {model} "
                 "(used as defined)"
@@ -207,6 +218,11 @@ class DefinedNames:
             return
         self.entries[plain(name)] = Entry(eq.lhs, own, own if right is None else right, eq.line, wrong)
         self.pending.pop(plain(name), None)
+
+
+def _shorthand(name: Name) -> bool:
+    """``c_1``, ``s_{12}``, ``C_2``: a name the grader reads as the sine or cosine of joint angles."""
+    return name.base in ("s", "c", "S", "C") and (name.sub or "").strip("{} ").isdigit()
 
 
 def _inner_note(used: list) -> str:
