@@ -288,3 +288,21 @@ def test_a_name_of_another_meaning_is_not_a_wrong_shorthand(tmp_path):
     # a shorthand used before a later definition of that name keeps its meaning
     body = r"$$d_{12} = m_2(\ell_{c2}^2 + \ell_1\ell_{c2} c_2) + I_2$$" + "\n\n" + r"$$c_2 = \dot q_2^2$$" + "\n"
     assert grade(write(tmp_path, body)).steps[0].status == "correct"
+
+
+def test_hostile_chains_of_definitions_end_quickly(tmp_path):
+    import time
+
+    # each definition squares the last, or nests a sine: the parser's limits hold through names
+    squares = "".join(f"$$X_{{{k}}} = X_{{{k - 1}}}^{{20}} + q_1$$\n\n" for k in range(1, 40))
+    sines = "".join(f"$$S_{{{k}}} = \\sin(S_{{{k - 1}}})$$\n\n" for k in range(1, 40))
+    for chain, last in ((squares, "X_{39}"), (sines, "S_{39}")):
+        body = "$$X_{0} = q_2$$\n\n$$S_{0} = q_2$$\n\n" + chain + f"$$\\tau_2 = {last}$$\n"
+        start = time.perf_counter()
+        report = grade(write(tmp_path, body))
+        assert time.perf_counter() - start < 20
+        tau = report.steps[-1]
+        if last.startswith("S"):  # sin(sin(...)) 39 deep: refused, as written out it would be
+            assert tau.status == "unrecognised" and "nesting of functions" in tau.message, tau.message
+        else:  # (...(q_2^20 + q_1)^20 ...)^20: a huge degree, never a pass
+            assert tau.status in ("wrong", "unrecognised")

@@ -24,12 +24,15 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from .latex import LatexError, Name, UnknownSymbol, parse
+from .latex import MAX_CALL_DEPTH, MAX_SYMBOLIC_EXPONENT, LatexError, Name, UnknownSymbol, parse
 from .notation import parse_lhs
 from .vocabulary import MODEL_KEYS
 
 #: definitions read through definitions at most this deep (X through Y through Z ...)
 MAX_DEPTH = 4
+#: nodes of a value read through names beyond which it is refused (a chain of definitions
+#: each squaring the last would otherwise grow without bound)
+MAX_NODES = 20000
 #: ``KE``, ``K.E.``, ``\mathrm{KE}``, ``PE``...: one name, the student's earlier energy
 _ENERGY = re.compile(
     r"(?<![A-Za-z\\])(?:\\(?:mathrm|text|mathit|rm)\s*\{\s*)?([KP])(?:E|\.\s*E\.?)(?:\s*\})?(?![A-Za-z])"
@@ -206,8 +209,10 @@ class DefinedNames:
         except (LatexError, TypeError, ValueError, RecursionError, sp.ShapeError) as err:
             self.pending.pop(key, None)
             why = str(err).split("\n")[0][:200]
-            if "defined through itself" in why or "nested more than" in why:
-                self.failed[key] = why  # later uses say why, not "unknown symbol"
+            if "defined through itself" in why or " (defined at line " in why:
+                self.failed[key] = why  # the first definition that cannot be read is named
+            else:  # later uses say why, not "unknown symbol"
+                self.failed[key] = f"{eq.lhs} (defined at line {eq.line}) cannot be read: {why}"
             return why
 
     def record(self, eq, own, right, wrong: str = "") -> None:
@@ -218,6 +223,28 @@ class DefinedNames:
             return
         self.entries[plain(name)] = Entry(eq.lhs, own, own if right is None else right, eq.line, wrong)
         self.pending.pop(plain(name), None)
+
+
+def bounded(value):
+    """``value`` (read through names) within the parser's own limits: functions nested at most
+    :data:`~.latex.MAX_CALL_DEPTH` deep, symbolic exponents at most
+    :data:`~.latex.MAX_SYMBOLIC_EXPONENT`, at most :data:`MAX_NODES` nodes; else LatexError."""
+    items = list(value) if isinstance(value, sp.MatrixBase) else [value]
+    stack = [(x, 0) for x in items if isinstance(x, sp.Basic)]
+    nodes = 0
+    while stack:
+        x, calls = stack.pop()
+        nodes += 1
+        if nodes > MAX_NODES:
+            raise LatexError(f"the value read through its names has more than {MAX_NODES} terms")
+        if isinstance(x, sp.Function) or (isinstance(x, sp.Pow) and not x.exp.is_Integer):
+            calls += 1
+            if calls > MAX_CALL_DEPTH:
+                raise LatexError(f"nesting of functions deeper than {MAX_CALL_DEPTH} levels (through its names)")
+        if isinstance(x, sp.Pow) and x.exp.is_Number and x.base.free_symbols and abs(x.exp) > MAX_SYMBOLIC_EXPONENT:
+            raise LatexError(f"an exponent over {MAX_SYMBOLIC_EXPONENT} (through its names)")
+        stack.extend((a, calls) for a in x.args)
+    return value
 
 
 def _shorthand(name: Name) -> bool:
@@ -269,7 +296,7 @@ def read_pair(grader, text: str):
         if len(names.used) == start:
             return own, own
         names.right = True
-        return own, parse(text, grader.symbols)
+        return bounded(own), bounded(parse(text, grader.symbols))
     finally:
         names.right = saved
 
