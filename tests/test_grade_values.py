@@ -306,3 +306,21 @@ def test_hostile_chains_of_definitions_end_quickly(tmp_path):
             assert tau.status == "unrecognised" and "nesting of functions" in tau.message, tau.message
         else:  # (...(q_2^20 + q_1)^20 ...)^20: a huge degree, never a pass
             assert tau.status in ("wrong", "unrecognised")
+
+
+def test_entries_of_a_matrix_written_whole(tmp_path):
+    # d_{12} and \phi_2 not written by themselves: the entries of the student's D(q), g(q)
+    d = (
+        r"$$D(q) = \begin{pmatrix} m_1\ell_{c1}^2 + m_2(\ell_1^2 + \ell_{c2}^2 + 2\ell_1\ell_{c2}\cos q_2) + I_1 + I_2"
+        r" & m_2(\ell_{c2}^2 + \ell_1\ell_{c2}\cos q_2) + I_2 \\ m_2(\ell_{c2}^2 + \ell_1\ell_{c2}\cos q_2) + I_2"
+        r" & m_2\ell_{c2}^2 + I_2 \end{pmatrix}$$" + "\n\n"
+    )
+    tau = r"$$\tau_2 = d_{21}\ddot q_1 + d_{22}\ddot q_2 + m_2\ell_1\ell_{c2}\sin q_2\,\dot q_1^2 + \phi_2$$" + "\n"
+    report = grade(write(tmp_path, d + tau))
+    last = report.steps[-1]
+    assert last.status == "correct" and "d_{21} read as the entry of D(q) (line 17)" in last.message, last.message
+    assert "\\phi_{2} not written" in last.message
+    wrong = d.replace(r"& m_2\ell_{c2}^2 + I_2 \end", r"& m_2\ell_{c2}^2 \end")  # I_2 missing in d_22
+    report = grade(write(tmp_path, wrong + tau))
+    assert report.steps[0].status == "wrong"
+    assert report.steps[-1].status == "follows-from-earlier-error", report.steps[-1].message

@@ -138,12 +138,11 @@ class DefinedNames:
         """A model quantity not written (``d_{11}``, ``\\phi_3``): the model's value, said."""
         if not self.active or name.dots:
             return None
-        value = self.model_value(name)
-        if value is None:
+        entry = self.model_value(name)
+        if entry is None:
             return None
-        entry = Entry(name.latex(), value, value, note=f"{name.latex()} not written: the model's value used")
         self.used.append(entry)
-        return value
+        return entry.right if self.right else entry.own
 
     def _read_pending(self, key: str) -> Entry:
         eq = self.pending[key]
@@ -315,9 +314,10 @@ def read_value(grader, eq, raw):
     return own
 
 
-def model_value(grader, name: Name):
-    """The model's value of a mass-matrix entry, Christoffel symbol or gravity entry named
-    ``name`` (``d_{11}``, ``c_{112}``, ``\\phi_3``), or None."""
+def model_value(grader, name: Name) -> Entry | None:
+    """A mass-matrix entry, Christoffel symbol or gravity entry named ``name`` (``d_{11}``,
+    ``c_{112}``, ``\\phi_3``) that was not written by itself: the entry of the student's
+    matrix ``D(q)`` or vector ``g(q)`` when written, else the model's value (said); or None."""
     from .lagrange_terms import expected_of
 
     if name.pre_sup or name.pre_sub or not name.sub:
@@ -334,7 +334,19 @@ def model_value(grader, name: Name):
         value = expected_of(grader.model_terms(), ref)
     except (KeyError, IndexError, TypeError, ValueError):
         return None
-    return None if isinstance(value, sp.MatrixBase) else value
+    if isinstance(value, sp.MatrixBase):
+        return None
+    if ref.key in ("M", "G"):  # an entry of the student's whole D(q) or g(q)
+        at = (ref.entry[0] - 1, ref.entry[1] - 1) if ref.key == "M" else (ref.entry[0] - 1, 0)
+        shape = (grader.robot.dof, grader.robot.dof) if ref.key == "M" else (grader.robot.dof, 1)
+        for v in reversed(grader.verdicts):
+            if v.key == ref.key and isinstance(v.got, sp.MatrixBase) and v.got.shape == shape:
+                own = v.got[at]
+                right = v.expected[at] if isinstance(v.expected, sp.MatrixBase) else own
+                wrong = v.name if v.status == "wrong" else ""
+                note = f"{name.latex()} read as the entry of {v.label} (line {v.line})"
+                return Entry(name.latex(), own, right if v.status == "wrong" else own, v.line, wrong, note)
+    return Entry(name.latex(), value, value, note=f"{name.latex()} not written: the model's value used")
 
 
 def definition(grader, eq) -> str | None:
