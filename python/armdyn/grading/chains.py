@@ -207,7 +207,17 @@ class StepNames:
             return resolve
 
         self.assumed = []
-        reading = Reading(parse(body, resolver(True)), parse(body, resolver(False)), found)
+        defined = getattr(self.symbols, "defined", None)  # names the student defined: their right values too
+        own = parse(body, resolver(True))
+        saved = defined is not None and defined.right
+        if defined is not None:
+            defined.right = True
+        try:
+            right = parse(body, resolver(False))
+        finally:
+            if defined is not None:
+                defined.right = saved
+        reading = Reading(own, right, found)
         reading.assumed = sorted(set(self.assumed))
         return reading
 
@@ -376,11 +386,15 @@ def check_step(grader, eq, value, expected, value_wrong: bool) -> list:
     grader's symbols, its student's steps so far and its worlds."""
     from .engine import equal
 
+    return check(eq.source, value, expected, step_names(grader), grader.sampler.fingerprint, equal, value_wrong)
+
+
+def step_names(grader) -> StepNames:
+    """A reader of step names with the grader's symbols, its student's steps so far and its worlds."""
     values = Values(
         lambda: grader.world("newton-euler"), grader.written, grader.verdicts, lambda: grader.world("lagrange")
     )
-    names = StepNames(grader.symbols, values)
-    return check(eq.source, value, expected, names, grader.sampler.fingerprint, equal, value_wrong)
+    return StepNames(grader.symbols, values)
 
 
 def with_members(findings: list, verdict: tuple, value, grader) -> tuple:

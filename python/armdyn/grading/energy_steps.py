@@ -9,6 +9,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..errors import ModelError
+from .defined import definition
 from .engine import equal
 from .explain import describe, tidy
 from .lagrange_terms import ModelTerms, grade_model_step, potential_shift
@@ -98,6 +99,8 @@ class EnergySteps:
         )
         if new is None:
             named = assumed != NOT_A_STEP
+            if not named:  # a bare h = (scalar), a constant x_1: the student's own name, used later
+                assumed = definition(self, eq) or assumed
             self._unrecognised(eq, assumed, name=ref.name if named else "", key=ref.key if named else "")
             return None, ""
         return new, assumed

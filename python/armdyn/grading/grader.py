@@ -16,11 +16,12 @@ from ..errors import ModelError
 from ..model import Robot
 from ..symbolic.names import latex_symbol_names
 from .chains import check_step, with_members
+from .defined import DefinedNames, after_equation, definition, model_value, read_pair, read_value
 from .diagnose import cannot_read, location
 from .energy_steps import EnergySteps
 from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, tidy
-from .latex import LatexError, UnknownSymbol, parse, parse_sympy_syntax
+from .latex import LatexError, UnknownSymbol, parse_sympy_syntax
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
@@ -84,6 +85,11 @@ class _Grader(EnergySteps):
         self.refusals: list[tuple[str, str]] = []  # (file:line:column, why) of equations not graded
         self._primes_noted = False
         self.written: dict = {}  # (key, index) -> (their value, the right one in their convention), link frame
+        # names the student gave values to (d_{11}, X, c_1), read in later values
+        self.names = DefinedNames(self.symbols, lambda n: model_value(self, n), lambda t: read_pair(self, t))
+        self.symbols.defined = self.names
+        self.last_read = None  # (equation, own value, right value, names used): defined.after_equation
+        self._assumed: list[str] = []
 
     def world(self, name: str) -> World:
         if name not in self._worlds:
@@ -137,10 +143,7 @@ class _Grader(EnergySteps):
         try:
             if eq.latex:
                 raw = eq.value
-                if isinstance(raw, list):
-                    value = sp.Matrix([parse(str(v), self.symbols) for v in raw])
-                else:
-                    value = parse(str(raw), self.symbols)
+                value = read_value(self, eq, raw)
             else:
                 names = dict(self.symbols.names)
                 names.update({k: v for k, v in self.symbols.steps.items() if not isinstance(v, sp.MatrixBase)})
@@ -212,9 +215,11 @@ class _Grader(EnergySteps):
     def run(self, method_hint: str | None) -> GradeReport:
         context = method_hint if method_hint in ("newton-euler", "lagrange") else None
         seen_methods: list[str] = []
+        self.names.collect(self.sub.equations)
         for eq in self.sub.equations:
             done = len(self.verdicts)
             self._equation(eq, seen_methods, context)
+            after_equation(self, eq, self.verdicts[done:])
             if self.verdicts[done:] and self.verdicts[-1].key not in ("", "R", "P", "Pc", "law", "tau", "shorthand"):
                 last = self.verdicts[-1].key
                 context = "lagrange" if last in LAGRANGE_KEYS or last in MODEL_KEYS else "newton-euler"
@@ -259,7 +264,7 @@ class _Grader(EnergySteps):
             if eq.latex and matrix_form(eq.lhs, str(eq.value)):
                 self._matrix_form(eq)
                 return
-            self._unrecognised(eq, "not a step of Newton-Euler or Lagrange (skipped)")
+            self._unrecognised(eq, definition(self, eq) or "not a step of Newton-Euler or Lagrange (skipped)")
             return
         ref, assumed = self._vocabulary(ref, eq, seen_methods)  # energy-method names; by the value's shape
         if ref is None:

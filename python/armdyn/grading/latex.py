@@ -195,6 +195,8 @@ def tokenize(text: str, positions: list | None = None) -> list[tuple[str, str]]:
             raise LatexError(f"a number with {len(value)} digits (at most {MAX_DIGITS})", m.start())
         if kind == "char" and value in UNICODE_GREEK:
             kind, value = "cmd", UNICODE_GREEK[value]
+        if (kind, value) in (("cmd", "ell"), ("char", "\u2113")):  # \ell, ℓ: the letter l (a length)
+            kind, value = "char", "l"
         out.append((kind, value))
         if positions is not None:
             positions.append(m.start())

@@ -334,6 +334,8 @@ class SymbolMap:
         #: sin/cos of the angles the student wrote as shorthand -> a symbol printing as theirs (s₁₂)
         self.shorthand: dict = {}
         self.used_gravity_magnitude = False
+        #: the names the student gave values to (:class:`~.defined.DefinedNames`), when grading
+        self.defined = None
         for student, model in (explicit or {}).items():
             key = self._key_of(str(student))
             target = self.names.get(str(model))
@@ -370,6 +372,9 @@ class SymbolMap:
         plain = name.base + sub
         if name.dots == 0 and plain in self.steps:
             return self.steps[plain]
+        value = self.defined.lookup(name) if self.defined is not None else None
+        if value is not None:  # a name the student gave a value to (.defined)
+            return value
         candidate = plain + {0: "", 1: "_dot", 2: "_ddot"}.get(name.dots, "?")
         if candidate in self.names:
             return self.names[candidate]
@@ -378,8 +383,8 @@ class SymbolMap:
             if 1 <= k <= self.robot.dof:
                 return [self.robot.q, self.robot.qd, self.robot.qdd][min(name.dots, 2)][k - 1]
         if name.base in ("s", "c", "S", "C") and name.dots == 0 and sub.isdigit() and plain not in self.names:
-            idx = [int(ch) for ch in sub]
-            if all(1 <= k <= self.robot.dof for k in idx):
+            idx = [int(ch) for ch in sub]  # a repeated index (c_{112}) is a Christoffel symbol, not an angle sum
+            if all(1 <= k <= self.robot.dof for k in idx) and len(set(idx)) == len(idx):
                 angle = sum((self.robot.q[k - 1] for k in idx), sp.Integer(0))
                 value = (sp.sin if name.base in "sS" else sp.cos)(angle)
                 from ..symbolic.names import unicode_name
@@ -393,6 +398,9 @@ class SymbolMap:
                 return sp.nsimplify(magnitude) if magnitude.is_Float else magnitude
         if name.base == "pi" and not sub:
             return sp.pi
+        value = self.defined.model(name) if self.defined is not None else None
+        if value is not None:  # a model quantity the student did not write (d_{11}): the model's
+            return value
         raise UnknownSymbol(
             f"unknown symbol {name.latex()} (the model '{self.robot.name}' has "
             f"{', '.join(sorted(self.names))}; map it in the front matter's 'symbols')"
