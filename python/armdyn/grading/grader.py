@@ -21,10 +21,11 @@ from .energy_steps import EnergySteps
 from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, tidy
 from .latex import LatexError, UnknownSymbol, parse, parse_sympy_syntax
-from .methods import lagrange_method, newton_euler_method, rotation_between
+from .methods import lagrange_method, newton_euler_method, position, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
 from .reader import Submission, read
+from .rotation_use import carry_rotation, confirm_used
 from .statements import FREE_END, lagrange_law, matrix_form
 from .verdict import PASSING, GradeReport, StepVerdict
 from .vocabulary import MODEL_KEYS, student_names
@@ -392,21 +393,14 @@ class _Grader(EnergySteps):
                 frame=f"{ref.index}->{ref.frame}",
             )
         )
+        carry_rotation(self.world("newton-euler"), ref.index, ref.frame, ref.name, value, status)
 
     def _position(self, ref: StepRef, eq, value):
         """A kinematics step: P_i^j, frame i's origin seen from frame i-1's, or P_{C_i}^j,
         link i's mass centre seen from frame i's origin, both written in frame j."""
         ctx = self.world("newton-euler").ctx
-        if ref.key == "P":
-            home = ctx[ref.index]["parent"]
-            vector = ctx[ref.index]["P"]
-            what = f"frame {ref.index}'s origin from frame {home}'s"
-        else:
-            home = ref.index
-            vector = ctx[ref.index]["c"]
-            what = f"link {ref.index}'s mass centre from frame {ref.index}'s origin"
-        frame = home if ref.frame is None else ref.frame
-        expected = sp.Matrix(rotation_between(ctx, home, frame) * vector).applyfunc(lambda x: tidy(x, self.robot))
+        vector, what, frame = position(ctx, ref.key, ref.index, ref.frame, ref.origin)
+        expected = sp.Matrix(vector).applyfunc(lambda x: tidy(x, self.robot))
         fp = self.sampler.fingerprint
         ok = equal(fp(value), fp(expected)).ravel()
         bad = [int(i) for i in range(3) if not ok[i]]
@@ -477,6 +471,8 @@ class _Grader(EnergySteps):
         name = ref.name
         origins_names = sorted(j.origins, key=self._order)
         caused_by = origins_names[0] if j.status == "follows-from-earlier-error" and origins_names else None
+        if caused_by is not None:
+            confirm_used(self.verdicts, world, j.origins, name, eq.line, self.robot)
         extras = [world.candidates(r)[0] for r in j.conv.extra]
         if j.status in ("correct", "correct-by-convention"):
             world.given[key] = [canonical(world, j.conv, got, extras, frozenset())]
@@ -631,5 +627,6 @@ def grade(
     hint = sub.method if sub.method in ("newton-euler", "lagrange") else None
     report = _Grader(sub, model, symbols).run(hint)
     if read_model is not None:
-        report.notes.insert(0, read_model.note())
+        report.model_note = read_model.note()  # the report's first line: what was graded against
+        report.notes.insert(0, report.model_note)
     return report
