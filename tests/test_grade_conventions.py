@@ -148,3 +148,17 @@ def test_model_read_from_text_is_the_reports_first_line(tmp_path):
 def test_named_model_has_no_model_note(tmp_path):
     r = graded(tmp_path, f"$$ {{}}^{{2}}P_{{C_2}} = {column([lc2, 0, 0])} $$\n")
     assert r.model_note == "" and r.text().startswith("armdyn grade")
+
+
+def test_model_read_from_text_takes_craigs_base_position_as_the_mass_centre(tmp_path):
+    # Craig's {}^{0}P_{C_2} (link 2's mass centre from the base origin, by hand above) agrees
+    # with the example's {}^{2}P_{C_2} = (lc2, 0, 0): no disagreement, and it grades right
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parent.parent / "examples" / "grading" / "planar-2r-craig.md"
+    text = "".join(line for line in example.read_text().splitlines(True) if not line.startswith("robot:"))
+    path = tmp_path / "d.md"
+    path.write_text(text + f"\n$$ {{}}^{{0}}P_{{C_2}} = {column(PC2_IN_0)} $$\n")
+    r = grade(path)
+    assert r.model_note.startswith("model read from the text") and "disagree" not in r.model_note
+    assert r.steps[-1].name == "P_C2^0" and r.steps[-1].status == "correct"

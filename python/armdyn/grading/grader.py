@@ -358,7 +358,7 @@ class _Grader(EnergySteps):
     def _rotation(self, ref: StepRef, eq, value):
         ctx = self.world("newton-euler").ctx
         assert ref.index is not None and ref.frame is not None  # _check_index ran
-        expected = rotation_between(ctx, ref.index, ref.frame)
+        expected = rotation_between(ctx, ref.index, ref.frame).applyfunc(lambda x: tidy(x, self.robot))
         fp = self.sampler.fingerprint
         got_fp = fp(value)
         status, conv, message = "correct", None, ""
