@@ -162,3 +162,22 @@ def test_model_read_from_text_takes_craigs_base_position_as_the_mass_centre(tmp_
     r = grade(path)
     assert r.model_note.startswith("model read from the text") and "disagree" not in r.model_note
     assert r.steps[-1].name == "P_C2^0" and r.steps[-1].status == "correct"
+
+
+# -- a wrong step says the convention it was compared in
+
+
+def test_wrong_step_names_the_convention_it_is_read_in(tmp_path):
+    # link 1's mass centre with gravity kept as a force: ω̇ × (lc1, 0, 0) + ω × (ω × (lc1, 0, 0))
+    # = (-lc1 q̇1², lc1 q̈1, 0); the centripetal term dropped. Closest reading: gravity as a force
+    lc1 = sp.Symbol("l_{c1}")
+    slip = sp.Matrix([0, lc1 * qdd1, 0])
+    r = graded(tmp_path, f"$$ \\dot{{v}}_{{C_1}}^1 = {column(slip)} $$\n")
+    v = by_line(r)[6]
+    assert v.status == "wrong" and "in the convention: gravity as a force" in v.message
+    assert v.components == [0]
+    # shown in that convention, simplified: -lc1 q̇1² (no gravity terms left to cancel)
+    x = v.expected[0]
+    assert {s.name for s in x.free_symbols} == {"lc1", "q1_dot"}
+    at = {s: {"lc1": 0.3, "q1_dot": 1.7}[s.name] for s in x.free_symbols}
+    assert abs(float(x.subs(at)) + 0.3 * 1.7**2) < 1e-12

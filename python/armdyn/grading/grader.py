@@ -517,11 +517,12 @@ class _Grader(EnergySteps):
                     text = self._describe(got_m[i], ref_m[i])
                     where = component_name(i, got_m.shape)
                     parts.append(f"{text} in {where}" if where else text)
-                against = "" if not j.origins else " (compared with what your own earlier steps give)"
-                message = "; ".join(parts) + against
+                against = ["compared with what your own earlier steps give"] if j.origins else []
+                against += [f"in the convention: {j.convention}"] if j.convention else []  # the closest: said
+                message = "; ".join(parts) + (f" ({', '.join(against)})" if against else "")
                 diff = sp.Matrix([tidy(got_m[i] - ref_m[i], self.robot) for i in range(len(got_m))])
                 difference = diff if got_m.shape != (1, 1) else diff[0]
-                exp_shown = contract(exp_shown, self.symbols.shorthand)  # in the student's s₁₂, c₁₂
+                exp_shown = contract(_tidied(exp_shown, self.robot), self.symbols.shorthand)  # their s₁₂, c₁₂
             elif j.status == "follows-from-earlier-error":
                 message = f"follows from the error in {caused_by}" + (f" ({j.convention})" if j.convention else "")
                 diff = _matrix(value) - _matrix(exp_shown)
@@ -584,6 +585,11 @@ class _Grader(EnergySteps):
             if v.name == name:
                 return k
         return len(self.verdicts)
+
+
+def _tidied(value, robot):
+    """A value as shown: each entry simplified (a convention's added terms cancel)."""
+    return value.applyfunc(lambda x: tidy(x, robot)) if isinstance(value, sp.MatrixBase) else tidy(value, robot)
 
 
 def _matrix(value) -> sp.Matrix:
