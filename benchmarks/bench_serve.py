@@ -17,6 +17,12 @@ row). Two workloads:
 
     python benchmarks/bench_serve.py                                # both, 50 x 10, 2 workers
     python benchmarks/bench_serve.py --mode distinct --clients 50 --per-client 2
+    python benchmarks/bench_serve.py --mode distinct --clients 20 --per-client 5 \
+        --postgres --restart-db-at 20        # PostgreSQL, stopped for 3 s once mid-run
+
+``--postgres`` starts a throwaway PostgreSQL cluster (Debian's binaries, a Unix socket in
+a temporary folder, as .ci/run does); ``--restart-db-at S`` stops it S seconds into the
+run and starts it again 3 s later: every submission must still get its verdict.
 
 Not a test (pytest does not collect it); the numbers depend on the machine's load.
 """
@@ -26,6 +32,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shutil
 import signal
 import socket
 import subprocess
@@ -33,6 +40,7 @@ import sys
 import tempfile
 import threading
 import time
+import urllib.error
 import urllib.request
 from pathlib import Path
 
@@ -52,19 +60,70 @@ def post(base: str, text: str) -> tuple[int, dict, float]:
         f"{base}/api/grade?wait=120", data=text.encode(), method="POST", headers={"content-type": "text/markdown"}
     )
     t0 = time.perf_counter()
-    with urllib.request.urlopen(req, timeout=300) as r:
-        status, body = r.status, json.loads(r.read())
+    status, body = _send(req, 300)
     poll = f"{base}/api/submissions/{body['id']}?t={body['token']}"
     for _ in range(3600):  # bounded: at most an hour of polling
         if body["status"] in ("done", "failed"):
             break
         time.sleep(0.5)
-        with urllib.request.urlopen(poll, timeout=60) as r:
-            status, body = r.status, json.loads(r.read())
+        status, body = _send(poll, 60)
     return status, body, time.perf_counter() - t0
 
 
-def start(workers: int, tmp: str) -> tuple[subprocess.Popen, str]:
+def _send(req, timeout: float, tries: int = 30) -> tuple[int, dict]:
+    """(status, JSON body); a 503 (the database restarting, a full queue) is sent again
+    after its Retry-After, as a browser or a script should, at most ``tries`` times."""
+    for _ in range(tries - 1):
+        try:
+            with urllib.request.urlopen(req, timeout=timeout) as r:
+                return r.status, json.loads(r.read())
+        except urllib.error.HTTPError as err:
+            if err.code != 503:
+                raise
+            time.sleep(float(err.headers.get("Retry-After") or 2))
+    with urllib.request.urlopen(req, timeout=timeout) as r:
+        return r.status, json.loads(r.read())
+
+
+class Postgres:
+    """A throwaway cluster on a Unix socket (as .ci/run starts one); ``restart`` stops it
+    for ``outage`` seconds."""
+
+    def __init__(self):
+        bins = sorted(Path("/usr/lib/postgresql").glob("*/bin/initdb"))
+        if not bins:
+            raise SystemExit("--postgres: no PostgreSQL found (apt-get install postgresql)")
+        # a folder of its own under /tmp: the postgres user cannot enter the benchmark's
+        self.bin, self.dir = bins[-1].parent, Path(tempfile.mkdtemp(prefix="armdyn-bench-pg-"))
+        self.as_pg = ["runuser", "-u", "postgres", "--"] if os.geteuid() == 0 else []
+        if self.as_pg:
+            shutil.chown(self.dir, "postgres")
+        self._pg("initdb", "-D", str(self.dir / "data"), "-A", "trust", "-U", "postgres")
+        self.start()
+        self._pg("psql", "-h", str(self.dir), "-p", "55433", "-U", "postgres", "-q", "-c", "CREATE DATABASE bench")
+        self.url = f"postgresql://postgres@/bench?host={self.dir}&port=55433"
+
+    def _pg(self, tool: str, *args: str) -> None:
+        subprocess.run([*self.as_pg, str(self.bin / tool), *args], check=True, capture_output=True, timeout=120)
+
+    def start(self) -> None:
+        opts = f"-k {self.dir} -p 55433 -c listen_addresses=''"
+        self._pg("pg_ctl", "-D", str(self.dir / "data"), "-l", str(self.dir / "log"), "-w", "-o", opts, "start")
+
+    def stop(self) -> None:
+        self._pg("pg_ctl", "-D", str(self.dir / "data"), "-m", "fast", "-w", "stop")
+
+    def remove(self) -> None:
+        self.stop()
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def restart(self, outage: float = 3.0) -> None:
+        self.stop()
+        time.sleep(outage)
+        self.start()
+
+
+def start(workers: int, tmp: str, db: str | None = None) -> tuple[subprocess.Popen, str]:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
@@ -80,7 +139,7 @@ def start(workers: int, tmp: str) -> tuple[subprocess.Popen, str]:
             "--workers",
             str(workers),
             "--db",
-            f"sqlite:///{tmp}/bench.db",
+            db or f"sqlite:///{tmp}/bench.db",
         ],
         env=env,
     )
@@ -155,7 +214,11 @@ def main() -> None:
     ap.add_argument("--clients", type=int, default=50)
     ap.add_argument("--per-client", type=int, default=10)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--postgres", action="store_true", help="store in a throwaway PostgreSQL cluster")
+    ap.add_argument("--restart-db-at", type=float, metavar="S", help="stop PostgreSQL S s into a run, for 3 s")
     args = ap.parse_args()
+    if args.restart_db_at is not None and not args.postgres:
+        ap.error("--restart-db-at needs --postgres")
     from armdyn.grading import grade
     from armdyn.grading.reader import read_markdown
 
@@ -170,15 +233,26 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="armdyn-bench-serve-") as tmp:
         for mode in modes:
             os.makedirs(f"{tmp}/{mode}")
-            proc, base = start(args.workers, f"{tmp}/{mode}")
+            pg = Postgres() if args.postgres else None
+            proc, base = start(args.workers, f"{tmp}/{mode}", pg.url if pg else None)
+            restart = None
+            if pg is not None and args.restart_db_at is not None:
+                restart = threading.Timer(args.restart_db_at, pg.restart)
+                restart.start()
             try:
                 rows.append(run(base, mode, args.clients, args.per_client, expected))
             finally:
+                if restart is not None:
+                    restart.join()
                 proc.send_signal(signal.SIGTERM)
                 proc.wait(60)
+                if pg is not None:
+                    pg.remove()
     print(
         f"{args.clients} clients x {args.per_client} submissions of the exercise, {args.workers} workers, "
-        f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}"
+        f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}, "
+        + ("PostgreSQL" if args.postgres else "SQLite")
+        + (f", database stopped for 3 s at {args.restart_db_at:g} s" if args.restart_db_at is not None else "")
     )
     print(
         "| workload | submissions | lost | verdict != armdyn grade | from cache | wall (s) | "

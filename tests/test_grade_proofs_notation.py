@@ -391,13 +391,21 @@ def test_a_sum_without_an_index_and_a_body_frame_angular_velocity():
 
 @pytest.mark.parametrize("piece", [r"\int ", r"\sum ", r"\omega^{", r"E_{", r"\qquad a", "{", r"a = b \qquad "])
 def test_finding_proofs_in_a_long_hostile_block_is_linear(piece):
+    """8x the text takes about 8x the time (quadratic work would take 64x): compared as
+    ratios of the best of three runs, not against a wall-clock limit (the machine is shared)."""
     from armdyn.grading.proofs.regions import about_a_body, several
 
-    t0 = time.perf_counter()
-    text = piece * 40_000
-    about_a_body(text)
-    several(text)
-    assert time.perf_counter() - t0 < 2.0
+    def seconds(text: str) -> float:
+        best = float("inf")
+        for _ in range(3):
+            t0 = time.perf_counter()
+            about_a_body(text)
+            several(text)
+            best = min(best, time.perf_counter() - t0)
+        return best
+
+    small, big = seconds(piece * 5_000), seconds(piece * 40_000)
+    assert big < 24 * small + 0.5, (small, big)
 
 
 def test_a_bold_i_outside_an_integral_is_the_identity_and_the_verdict_says_so():

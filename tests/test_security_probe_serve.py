@@ -179,6 +179,38 @@ def test_health_tells_a_queue_that_does_not_move(tmp_path, monkeypatch):
         wait_until(lambda: c.get("/api/health").status_code == 200, 20, "health ok again")
 
 
+def test_a_database_that_does_not_answer_is_a_503_to_send_again(tmp_path, monkeypatch):
+    """While the database restarts, a request gets 503 with Retry-After (not a 500 and a
+    traceback), and a request waiting for its verdict waits on through the outage."""
+    with client_for(f"sqlite:///{tmp_path / 'db.sqlite'}") as c:
+        wait_ready(c)
+        repo = c.app.state.server.repo
+        real_add, real_summary = repo.add, repo.summary
+        down = sa.exc.OperationalError("INSERT", {}, OSError("the database system is shutting down"))
+
+        def add(*a, **kw):
+            raise down
+
+        monkeypatch.setattr(repo, "add", add)
+        r = c.post("/api/grade?robot=rp-arm&wait=0", content=RIGHT.read_bytes(), headers=MD)
+        assert r.status_code == 503 and r.headers["retry-after"] == "2", r.text
+        assert "database" in r.json()["error"] and "Traceback" not in r.text
+        monkeypatch.setattr(repo, "add", real_add)
+        outage = {"calls": 0, "left": 2}
+
+        def summary(sid):
+            outage["calls"] += 1
+            if outage["calls"] > 1 and outage["left"]:  # the first is the store's own, in add
+                outage["left"] -= 1
+                raise down
+            return real_summary(sid)
+
+        monkeypatch.setattr(repo, "summary", summary)
+        r = c.post("/api/grade?robot=rp-arm&wait=60", content=RIGHT.read_bytes(), headers=MD)
+        assert r.status_code == 200 and outage["left"] == 0, r.text
+        assert settled(c, r.json())["passed"] is True
+
+
 def test_health_tells_a_worker_that_cannot_start(tmp_path):
     """A grading worker that dies before it is ready (here: an address-space limit too
     small to import armdyn) is named among the problems, with why."""

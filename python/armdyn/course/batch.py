@@ -216,9 +216,9 @@ def _class_model(folder: str, name: str | None) -> tuple[str | None, str | None]
     name, or a regular file directly in the class folder (no path, no link: a student's
     text does not choose which of the grader's files are read). None: the grader says
     that no robot is named."""
-    from ..io import _bundled_files
+    from ..io import bundled_files
 
-    if name is None or name in _bundled_files():
+    if name is None or name in bundled_files():
         return name, None
     path = os.path.join(folder, name)
     if any(c in name for c in "/\\") or name.startswith(".") or os.path.islink(path) or not os.path.isfile(path):

@@ -23,25 +23,9 @@ from sympy.functions.elementary.trigonometric import TrigonometricFunction
 from ..model import Robot
 from ..symbolic import dag
 from ..symbolic.agreement import trig_reduce
-from ..symbolic.names import UnicodeTextPrinter, unicode_name
+from ..symbolic.names import GREEK, UnicodeTextPrinter, unicode_name
 
 COMPONENTS = "xyz"
-_GREEK = {
-    "alpha": "α",
-    "beta": "β",
-    "gamma": "γ",
-    "delta": "δ",
-    "theta": "θ",
-    "phi": "φ",
-    "psi": "ψ",
-    "omega": "ω",
-    "tau": "τ",
-    "rho": "ρ",
-    "sigma": "σ",
-    "lambda": "λ",
-    "mu": "μ",
-    "eta": "η",
-}
 #: expressions larger than this (in nodes) are not tidied for messages
 TIDY_LIMIT = 400
 #: angle sums expanded (sin(q1 + q2) -> sin q1 cos q2 + ...) only up to this many nodes after
@@ -132,7 +116,7 @@ def display_name(name: str, ascii_only: bool = False) -> str:
     return unicode_name(m.group(1), m.group(2) or "") or name
 
 
-_LATIN = {v: k for k, v in _GREEK.items()}
+_LATIN = {v: k for k, v in GREEK.items()}
 
 
 _SUBSCRIPT = str.maketrans("₀₁₂₃₄₅₆₇₈₉", "0123456789")

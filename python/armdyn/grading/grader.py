@@ -79,7 +79,7 @@ class _Grader(EnergySteps):
         self.sampler = Sampler(free, robot)
         self._worlds: dict = {}
         self.verdicts: list[StepVerdict] = []
-        self.notes: list[str] = []
+        self.notes: list[str] = list(sub.notes)  # what the reader set aside comes first
         self.refusals: list[tuple[str, str]] = []  # (file:line:column, why) of equations not graded
         self._primes_noted = False
         self.written: dict = {}  # (key, index) -> (their value, the right one in their convention), link frame

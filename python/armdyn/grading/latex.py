@@ -33,6 +33,8 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from ..symbolic.names import GREEK as GREEK_LETTERS
+
 # the equations of a display block (split, sides): their own module, re-exported here
 from .equations import side_offsets, sides, split_equations  # noqa: F401
 
@@ -52,68 +54,10 @@ MAX_SYMBOLIC_EXPONENT = 20
 #: time exponential in this nesting (12 nested cosines took 20 s, 16 over a minute)
 MAX_CALL_DEPTH = 4
 
-GREEK = {
-    "alpha",
-    "beta",
-    "gamma",
-    "delta",
-    "epsilon",
-    "varepsilon",
-    "zeta",
-    "eta",
-    "theta",
-    "vartheta",
-    "iota",
-    "kappa",
-    "lambda",
-    "mu",
-    "nu",
-    "xi",
-    "pi",
-    "rho",
-    "sigma",
-    "tau",
-    "upsilon",
-    "phi",
-    "varphi",
-    "chi",
-    "psi",
-    "omega",
-    "Gamma",
-    "Delta",
-    "Theta",
-    "Lambda",
-    "Xi",
-    "Pi",
-    "Sigma",
-    "Phi",
-    "Psi",
-    "Omega",
-}
-UNICODE_GREEK = {
-    "α": "alpha",
-    "β": "beta",
-    "γ": "gamma",
-    "δ": "delta",
-    "ε": "epsilon",
-    "ζ": "zeta",
-    "η": "eta",
-    "θ": "theta",
-    "ι": "iota",
-    "κ": "kappa",
-    "λ": "lambda",
-    "μ": "mu",
-    "ν": "nu",
-    "ξ": "xi",
-    "π": "pi",
-    "ρ": "rho",
-    "σ": "sigma",
-    "τ": "tau",
-    "φ": "phi",
-    "χ": "chi",
-    "ψ": "psi",
-    "ω": "omega",
-}
+#: Greek letters written \alpha ... \Omega (symbolic/names.py holds the one table)
+GREEK = frozenset(GREEK_LETTERS)
+#: a Greek letter typed as Unicode -> its LaTeX name
+UNICODE_GREEK = {letter: name for name, letter in GREEK_LETTERS.items()}
 FUNCTIONS = {
     "sin": sp.sin,
     "cos": sp.cos,
@@ -243,6 +187,8 @@ def tokenize(text: str, positions: list | None = None) -> list[tuple[str, str]]:
         value = m.group(kind)
         if kind == "fn":  # \operatorname{sin}: \sin
             kind = "cmd"
+        if kind == "cmd" and value == "cr":  # plain TeX's row end, as in \pmatrix{a \cr b}
+            value = "\\"
         if kind == "cmd" and (value in SPACES or value in SIZES):
             continue
         if kind == "num" and len(value) > MAX_DIGITS:
@@ -433,9 +379,14 @@ class _Parser:
                     parts.append(tok)
                 elif kind in ("num", "char") and tok not in "{}":
                     parts.append(tok)
-        kind, tok = self.take()
+        kind, tok = self.peek()
+        if kind == "num" and len(tok) > 1:
+            # TeX: an unbraced script is one character, so m_32 l_2 is m_3 * 2 * l_2 (as the
+            # page shows it)
+            return self._first_character()
+        self.take()
         if kind in ("num", "char", "cmd"):
-            return tok[0] if kind == "num" else tok
+            return tok
         raise LatexError("missing subscript or superscript")
 
     def atom(self):
@@ -555,19 +506,24 @@ class _Parser:
             raise LatexError("scripts written before nothing ({}^{..} needs a name after it)", self.at(self.i))
         return self._symbol(pre_sup=scripts["^"], pre_sub=scripts["_"], start=start)
 
+    def _first_character(self) -> str:
+        """Take the first character of the number token here, leaving the rest in the
+        stream (TeX reads an unbraced argument or script as one character)."""
+        tok = self.t[self.i][1]
+        self.t[self.i] = ("num", tok[1:])
+        if self.i < len(self.positions):
+            self.positions[self.i] += 1
+        return tok[0]
+
     def _frac_arg(self):
         """A fraction's numerator or denominator: a group, or one digit or symbol (``\\frac12``)."""
         kind, tok = self.peek()
         if (kind, tok) == ("char", "{"):
             return self._braced()
         if kind == "num":
-            self.take()
             if len(tok) > 1 and tok[1].isdigit():  # \frac12: the digits are two arguments
-                self.i -= 1
-                self.t[self.i] = ("num", tok[1:])
-                if self.i < len(self.positions):
-                    self.positions[self.i] += 1
-                return sp.Integer(tok[0])
+                return sp.Integer(self._first_character())
+            self.take()
             return sp.Integer(tok) if tok.isdigit() else sp.Rational(tok)
         if kind == "char" and tok.isalpha() or kind == "cmd" and tok in GREEK:
             start = self.at(self.i)

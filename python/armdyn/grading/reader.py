@@ -95,6 +95,7 @@ class Submission:
 
     parts: list = field(default_factory=list)  # the assignment's parts (.parts.Part), Markdown only
     text: str = field(default="", repr=False)  # the Markdown text as read (its proofs are graded from it)
+    notes: list = field(default_factory=list)  # what the reader set aside, said in the report
 
     def part_at(self, line: int) -> tuple[str | None, str]:
         """(part number or None, task title or "") of a 1-based line (see :mod:`.parts`)."""
@@ -145,7 +146,11 @@ def safe_yaml(text: str, where: str):
         raise ModelError(f"a value YAML cannot read ({str(exc).split(';')[0]})", source=where) from None
 
 
-def _front(meta, path: str, sub: Submission) -> None:
+def _front(meta, path: str, sub: Submission, strict: bool = True) -> None:
+    """Read the front matter (or a YAML submission's keys) into ``sub``. ``strict``: an
+    unknown key is an error (YAML submissions); else (a Markdown file, whose front matter
+    may be a blog's or a site generator's: title, layout, tags, ...) it is set aside with
+    a note naming it, so a misspelt ``robot`` is still seen."""
     if meta is None:
         return
     if not isinstance(meta, dict):
@@ -153,7 +158,9 @@ def _front(meta, path: str, sub: Submission) -> None:
     allowed = {"robot", "method", "symbols", "values", "convention", "title", "author", "steps", "notes"}
     allowed |= {"student", "variant"}  # a course's bookkeeping (armdyn.course), not graded
     unknown = sorted(str(k) for k in meta if k not in allowed)
-    if unknown:
+    if unknown and not strict:
+        sub.notes.append(f"front matter: {', '.join(unknown)} set aside (armdyn reads {', '.join(sorted(allowed))})")
+    elif unknown:
         raise ModelError(f"unknown key(s) {', '.join(unknown)} (expected {', '.join(sorted(allowed))})", source=path)
     for key in ("robot", "method"):
         value = meta.get(key)
@@ -231,7 +238,7 @@ def read_markdown(path: str, text: str | None = None) -> Submission:
                 "front matter opened with '---' is never closed", source=f"{path}:{index.line(yaml_start)}"
             )
         blank = "\n" * (index.line(yaml_start) - 1)  # YAML's error lines count from the file's top
-        _front(safe_yaml(blank + text[yaml_start:yaml_end], path), path, sub)
+        _front(safe_yaml(blank + text[yaml_start:yaml_end], path), path, sub, strict=False)
     hidden = set(range(1, index.line(body_start) + 1))  # front matter and display math: no headings there
     for outer_start, outer_end, block_start, block in regions(text, body_start):
         hidden.update(range(index.line(outer_start), index.line(outer_end) + 1))

@@ -29,7 +29,7 @@ ROBOTS_DIR = Path(__file__).resolve().parent.parent / "robots"
 _SUFFIXES = (".yaml", ".yml", ".urdf", ".xacro")
 
 
-def _bundled_files() -> dict[str, Path]:
+def bundled_files() -> dict[str, Path]:
     """name -> file of each bundled model (a .yaml wins over a .urdf of the same name)."""
     out: dict[str, Path] = {}
     if ROBOTS_DIR.is_dir():
@@ -120,7 +120,7 @@ def load(source: str | os.PathLike[str], strict: bool | None = None, trusted: bo
     text = os.fspath(source)
     path = Path(text)
     looks_like_path = path.suffix.lower() in _SUFFIXES or os.sep in text or "/" in text
-    bundled = _bundled_files()
+    bundled = bundled_files()
     if not looks_like_path and text in bundled:
         if strict is None:
             return _published(bundled[text])
@@ -140,7 +140,7 @@ def bundled_robots() -> list[dict]:
     ``convention``, ``description``, ``source`` and ``path`` (plus ``error`` if the
     file does not load, with ``dof`` None)."""
     out = []
-    for name, path in _bundled_files().items():
+    for name, path in bundled_files().items():
         entry: dict[str, object] = {"name": name, "path": os.fspath(path)}
         try:
             robot = _load_file(path, strict=False, source=path.name, trusted=True)

@@ -22,11 +22,13 @@ import asyncio
 import json
 import os
 import re
+import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import jinja2
+import sqlalchemy as sa
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
 from starlette.exceptions import HTTPException
@@ -144,7 +146,13 @@ class Server:
         deadline = time.monotonic() + max(0.0, seconds)
         while True:
             ev = self.waiters.setdefault(sid, asyncio.Event())
-            row = await run_in_threadpool(self.repo.summary, sid)
+            try:
+                row = await run_in_threadpool(self.repo.summary, sid)
+            except sa.exc.OperationalError:  # the database restarting: wait on, within the budget
+                if time.monotonic() + 1.0 >= deadline:
+                    raise
+                await asyncio.sleep(1.0)
+                continue
             left = deadline - time.monotonic()
             if row is None or row["status"] in (DONE, FAILED) or left <= 0:
                 return row
@@ -542,6 +550,22 @@ def build_app(settings: Settings) -> Starlette:
             return _error(400, str(exc))
         return HTMLResponse(jinja2.utils.markupsafe.escape(str(exc)), status_code=400)
 
+    async def database_down(request: Request, exc: sa.exc.OperationalError):
+        """503 with Retry-After while the database does not answer (a restart, a full
+        disk): nothing was stored by this request, the client sends it again."""
+        print(
+            f"armdyn serve: {request.method} {request.url.path}: database not answering: "
+            f"{str(exc.orig or exc).splitlines()[0][:200]}",
+            file=sys.stderr,
+        )
+        message = "the database is not answering (restarting?); send the same request again in a few seconds"
+        if request.url.path.startswith("/api/"):
+            response = _error(503, message)
+        else:
+            response = HTMLResponse(f"<p>{message}.</p>", status_code=503)
+        response.headers["Retry-After"] = "2"
+        return response
+
     async def too_large(request: Request, exc: security.BodyTooLarge):
         return _error(413, f"request body larger than {MAX_BODY} bytes")
 
@@ -591,7 +615,12 @@ def build_app(settings: Settings) -> Starlette:
     app = Starlette(
         routes=routes,
         lifespan=lifespan,
-        exception_handlers={_BadRequest: bad_request, security.BodyTooLarge: too_large, HTTPException: not_found},
+        exception_handlers={
+            _BadRequest: bad_request,
+            security.BodyTooLarge: too_large,
+            HTTPException: not_found,
+            sa.exc.OperationalError: database_down,
+        },
     )
     app.router.redirect_slashes = False  # Starlette's would build an absolute URL from Host
     app.state.server = srv

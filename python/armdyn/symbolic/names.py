@@ -26,7 +26,9 @@ VECTOR_STEP_TEXT = {
     "n": "n",
 }
 
-_GREEK = {
+#: the one table of Greek letters: LaTeX name -> Unicode letter (the grader's reader, its
+#: messages and every printed name use it)
+GREEK = {
     "alpha": "α",
     "beta": "β",
     "gamma": "γ",
@@ -59,6 +61,10 @@ _GREEK = {
     "Phi": "Φ",
     "Psi": "Ψ",
     "Omega": "Ω",
+    "varepsilon": "ϵ",
+    "vartheta": "ϑ",
+    "varphi": "ϕ",
+    "upsilon": "υ",
 }
 _DOTS = {"": "", "_dot": "\u0307", "_ddot": "\u0308"}  # combining dot / diaeresis above
 _SUP = str.maketrans("0123456789-", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻")
@@ -73,7 +79,7 @@ def unicode_name(name: str, dots: str = "") -> str | None:
     if not m:
         return None
     base, digits = m.groups()
-    return _GREEK.get(base, base) + _DOTS[dots] + digits.translate(SUBSCRIPT_DIGITS)
+    return GREEK.get(base, base) + _DOTS[dots] + digits.translate(SUBSCRIPT_DIGITS)
 
 
 class UnicodeTextPrinter(sp.printing.str.StrPrinter):
@@ -122,10 +128,10 @@ def latex_name(name: str, dots: str = "") -> str | None:
     if not m:
         return None
     base, digits = m.groups()
-    if len(base) == 2 and base not in _GREEK and not dots:
+    if len(base) == 2 and base not in GREEK and not dots:
         return f"{base[0]}_{{{base[1]}{digits}}}"  # lc1 -> l_{c1}, as the field writes it
-    letter = f"\\{base}" if base in _GREEK else base
-    if len(base) > 1 and base not in _GREEK:
+    letter = f"\\{base}" if base in GREEK else base
+    if len(base) > 1 and base not in GREEK:
         letter = rf"\mathit{{{base}}}"  # a multi-letter name is one symbol, not a product
     if dots:
         letter = {"_dot": r"\dot", "_ddot": r"\ddot"}[dots] + f"{{{letter}}}"

@@ -8,6 +8,8 @@ own (:mod:`.checker`):
 
 * :mod:`.regions` finds the proofs in the Markdown text (by their prose or by what their
   lines say) and their display lines;
+* :mod:`.prose` reads what the sentences say the names mean (the point ``r`` is measured
+  from, the origin, a point's coordinates, a worked example's scalars);
 * :mod:`.expr` reads each side into a typed, non-commutative expression tree (:mod:`.nodes`);
 * :mod:`.evaluate` gives the names their meaning (rules in its docstring) and evaluates a
   tree exactly (Fractions, :mod:`.matrices`) on a body of point masses (:mod:`.body`);

@@ -69,6 +69,7 @@ class Instance:
         self.rotations: dict[str, Mat] = {}
         self.rotation_text: dict[str, str] = {}
         self.cache: dict = {}
+        self.placed: dict = {}  # (kind, name) -> fn(instance) -> Mat: what the proof's prose fixed
         total = sum(self.masses, Fraction(0))
         self.mass = total
         center = [sum((m * p.v[i] for m, p in zip(self.masses, self.positions)), Fraction(0)) / total for i in range(3)]
@@ -87,14 +88,24 @@ class Instance:
                 return v
 
     def point(self, name: str) -> Mat:
+        if name not in self.points and ("point", name) in self.placed:
+            self.points[name] = self.placed["point", name](self)
         if name not in self.points:
             at_origin = self.small and (name == "O" or name.startswith("ref:"))  # simpler by hand
             self.points[name] = Mat.col([0, 0, 0]) if at_origin else self._draw_vector()
         return self.points[name]
 
     def vector(self, name: str) -> Mat:
+        if name not in self.vectors and ("vector", name) in self.placed:
+            self.vectors[name] = self.placed["vector", name](self)
         if name not in self.vectors:
             self.vectors[name] = self._draw_vector()
+        return self.vectors[name]
+
+    def scalar(self, name: str) -> Mat:
+        """A scalar the proof names (a coordinate ``a``, a worked example's ``l``), drawn on use."""
+        if name not in self.vectors:
+            self.vectors[name] = Mat.scalar(self._int() or 1)
         return self.vectors[name]
 
     def rotation(self, label: str) -> Mat:

@@ -42,8 +42,9 @@ from .evaluate import (
     evaluate,
     key,
 )
-from .expr import Add, Integral, Num, ProofSyntaxError, Sym, parse_side, walk
-from .matrices import ShapeError, SizeError
+from .expr import Add, Integral, Mass, Mul, Num, ProofSyntaxError, Sum, Sym, parse_side, walk
+from .matrices import Mat, ShapeError, SizeError
+from .prose import rod_moment
 from .regions import Display
 
 #: random instances per link: with the degree cap and at least 2^31 values per draw, a false
@@ -96,10 +97,15 @@ class ProofChecker:
         self.named: set = set()  # inertia tensors whose definition was met
         self.instances = [random_instance(seed) for seed in range(K)]
         self.uncentered = random_instance(1000, centered=False)
+        self.placed: dict = {}  # what the prose fixed: points, vectors (shared by every instance)
+        for inst in (*self.instances, self.uncentered):
+            inst.placed = self.placed
+        self.last = None  # (tree, text) of the last expression of the previous line: a row "= ..." continues it
 
     # -- evaluation
     def _pairs(self, left, right, inst, env):
         """[(element or None, left value, right value)] on one instance."""
+        inst.placed = self.placed
         sc = Scope(inst, env, self.state, notes=self.notes)
         try:
             return [(None, evaluate(left, sc), evaluate(right, sc))]
@@ -215,6 +221,7 @@ class ProofChecker:
                 for s, t in terms
                 if isinstance(t, Sym)
                 and t.base in VECTOR_NAMES
+                and t.base not in self.state.facts.scalars
                 and (t.base != "omega" or (t.sub and len(terms) == 1))  # omega_B = R^T omega: a new name
                 and not t.frame
                 and not t.transposed
@@ -285,6 +292,8 @@ class ProofChecker:
 
     # -- one display line
     def display(self, d: Display, next_prose: str) -> list[LinkVerdict]:
+        if d.prose:
+            self._read_prose(d.prose)
         raw = sides(d.text)
         source = " ".join(d.text.split())
         trees = []
@@ -293,6 +302,11 @@ class ProofChecker:
                 trees.append(parse_side(text))
             except ProofSyntaxError as err:
                 trees.append(err)
+        continued = len(raw) > 1 and not raw[0].strip() and self.last is not None
+        if continued:  # a row "= ..." continues the chain of the row before
+            trees[0], raw[0] = self.last
+        self.last = (trees[-1], raw[-1]) if len(raw) > 1 and not isinstance(trees[-1], Exception) else None
+        example = self._example_scalars(trees)
         for t in trees:
             if isinstance(t, Add) and len(t.terms) > 1:
                 self.sums.append((d.line, t))  # a sum whose "second integral" the prose may name
@@ -306,13 +320,28 @@ class ProofChecker:
             if bad is not None:
                 out.append(LinkVerdict(d.line, label, source, "unrecognised", f"cannot read: {bad}"))
                 continue
-            if j == 0 and self._is_new_name(a):  # K = ... (= ...): names the first expression
-                self.defs[key(a)] = (b, d.line)
-                out.append(
-                    LinkVerdict(
-                        d.line, label, source, "correct", f"defines {a.latex()} (a definition: nothing to check)"
-                    )
+            rod = self.state.facts.rod
+            if j == 0 and not continued and example and _named(a) and rod and key(a) not in self.defs:
+                self.defs[key(a)] = (rod_moment(*rod), d.line)  # the example's moment, checked
+                self.state.facts.rod = None
+                v = self.link(a, b, d.line, label, source)
+                where = "one end" if rod[2] == "end" else "its centre"
+                v.message = _join(
+                    f"{a.latex()} read as the moment of inertia of the uniform rod (mass {rod[0]}, length {rod[1]}) "
+                    f"about a perpendicular axis through {where}, from its mass distribution (as the text says)",
+                    v.message,
                 )
+                out.append(v)
+                continue
+            if j == 0 and not continued and (self._is_new_name(a) or (example and _named(a))):
+                self.defs[key(a)] = (b, d.line)  # K = ... (= ...): names the first expression
+                what = "a definition: nothing to check"
+                if example:
+                    what = (
+                        f"a worked example's value in its scalars {example}, taken as written: the checker's "
+                        "bodies are point masses, so it cannot tell whether the formula fits the example's body"
+                    )
+                out.append(LinkVerdict(d.line, label, source, "correct", f"defines {a.latex()} ({what})"))
                 continue
             if j == 0:
                 alias = self._rotation_alias(a, b, d.line)
@@ -330,6 +359,10 @@ class ProofChecker:
             for t in (a, b):
                 self.seen |= {key(n) for n in walk(t) if isinstance(n, Sym) and n.base in VECTOR_NAMES}
             v = self.link(a, b, d.line, label, source)
+            if example and v.status == "correct":
+                v.message = _join(
+                    f"an identity in the example's scalars {example}, checked for all their values", v.message
+                )
             if (
                 v.status == "correct"
                 and len(raw) == 2
@@ -342,6 +375,8 @@ class ProofChecker:
                 self.named.add(key(a))
                 if a.frame:
                     what = f"the frame change of the inertia tensor into frame {a.frame}: R^{a.frame} I R^{a.frame}T"
+                elif len(a.sub) == 1 and a.sub.isupper() and self.state.planar and not a.bold:
+                    what = f"the moment of inertia about the axis through {a.sub} along z"
                 elif len(a.sub) == 1 and a.sub.isupper():
                     what = f"the inertia tensor about {a.sub}"
                 else:
@@ -355,6 +390,32 @@ class ProofChecker:
         if len(raw) > 2:
             self._chain_ends(trees, raw, out)
         return out
+
+    def _read_prose(self, prose: str) -> None:
+        """Take in what the prose says the names mean (:mod:`.prose`) and fix those values."""
+        facts = self.state.facts
+        facts.read(prose)
+        for point, coords in facts.points.items():
+            self.placed["point", point] = _placed_point(coords, self.state)
+        for name, coords in facts.vectors.items():
+            self.placed["vector", name] = _placed_vector(coords, self.state)
+            self.seen.add(key(Sym(name)))
+            self.seen.add(key(Sym(name, True)))
+        for name, (a, b, axis) in facts.distances.items():
+            self.placed["vector", name] = _offset(a, b, axis)
+            self.seen.add(key(Sym(name)))
+            self.seen.add(key(Sym(name, True)))
+
+    def _example_scalars(self, trees) -> str:
+        """A line whose right-hand sides use only a worked example's scalars (``m``, ``l`` of "a rod of
+        mass $m$ and length $l$") and numbers: those scalars as text ("m, l"), else ""."""
+        scalars = self.state.facts.scalars
+        if len(trees) < 2 or any(isinstance(t, Exception) for t in trees):
+            return ""
+        names = {n.base for t in trees[1:] for n in walk(t) if isinstance(n, Sym)}
+        if not names or not names <= scalars:
+            return ""
+        return ", ".join(sorted(names))
 
     def _chain_ends(self, trees, raw, out) -> None:
         failing = [j for j, v in enumerate(out) if v.status == "wrong"]
@@ -440,6 +501,41 @@ class ProofChecker:
         return ""
 
 
+def _named(node) -> bool:
+    """A name with a subscript that no scalar of a worked example could be (``I_{end}``)."""
+    return isinstance(node, Sym) and not node.transposed and not node.frame and bool(node.sub)
+
+
+def _placed_point(coords, state):
+    """A point at the prose's coordinates relative to the origin."""
+
+    def place(inst):
+        sc = Scope(inst, {}, state)
+        values = [evaluate(t, sc).v[0] for t in coords]
+        return inst.point(state.origin()) + Mat.col(values)
+
+    return place
+
+
+def _placed_vector(coords, state):
+    def place(inst):
+        sc = Scope(inst, {}, state)
+        return Mat.col([evaluate(t, sc).v[0] for t in coords])
+
+    return place
+
+
+def _offset(a: str, b: str, axis: str):
+    """The vector from point a to point b; without its component along ``axis`` (the offset
+    between two parallel axes along it)."""
+
+    def place(inst):
+        v = inst.point(b) - inst.point(a)
+        return Mat.col([0 if axis and i == "xyz".index(axis) else x for i, x in enumerate(v.v)])
+
+    return place
+
+
 def _zero(m) -> bool:
     return m.is_scalar and m.v[0] == 0
 
@@ -456,8 +552,16 @@ def _states_center_fact(left, right) -> bool:
     """``\\int r_C dm = 0`` as written (either order)."""
     pair = (left, right)
     zero = any(isinstance(t, Num) and t.value == 0 for t in pair)
-    integral = any(isinstance(t, Integral) and isinstance(t.body, Sym) and t.body.base == "r" for t in pair)
-    return zero and integral
+    integral = any(isinstance(t, Integral) and isinstance(t.body, Sym) and t.body.base in ("r", "rho") for t in pair)
+    moment = any(  # \sum_i m_i x_i = 0: the same fact in one component
+        isinstance(t, Sum)
+        and isinstance(t.body, Mul)
+        and len(t.body.factors) == 2
+        and any(isinstance(f, Mass) for f in t.body.factors)
+        and any(isinstance(f, Sym) and f.base == "r" for f in t.body.factors)
+        for t in pair
+    )
+    return zero and (integral or moment)
 
 
 def _short(text: str, n: int = 60) -> str:

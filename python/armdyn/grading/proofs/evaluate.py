@@ -17,7 +17,13 @@ Name rules (the typeface and the scripts decide; ``r_i``, ``I_{l_i}`` as in the 
 * ``r`` (relative to ``O``), ``r_X`` (relative to point ``X``; ``r_i``: to link i's reference
   point): the position of a mass element, so only meaningful inside an integral or in a
   line that holds for every element (then checked for every element); ``r_{ix}``,
-  ``r_{iy}``, ``r_{iz}``: its components.
+  ``r_{iy}``, ``r_{iz}``: its components (``x_i``, ``y_i``, ``z_i`` inside a sum over the
+  particles, from the origin); ``\\rho`` (outside ``\\rho dV``): the position relative to C.
+  The prose may say otherwise (:mod:`.prose`: the point ``r`` is measured from, the origin).
+* ``I_X`` (plain) in a proof whose components are ``x_i``, ``y_i`` and never ``z_i``: the
+  moment of inertia about the axis through X along z (the zz entry).
+* The letters the prose makes scalars (a point's coordinates ``a``, ``b``; a worked
+  example's ``m``, ``l``): integers drawn like the coordinates.
 * ``d``, ``p``, ``\\omega``, ``\\omega_i``, ``a``, ``b``, ``u``, ``v``, ``w``: constant vectors (``d`` is
   bound by a definition such as ``r_P = r_C + d``); ``\\omega^c``: ``R^c \\omega`` (the angular
   velocity the proof last named); ``R``, ``R^c``, ``R_c``: rotations.
@@ -57,17 +63,14 @@ from .expr import (
     walk,
 )
 from .matrices import Mat, ShapeError
+from .motion import MOMENT, MOMENTUM, derivative, momentum
+from .nodes import ENERGY, UnknownName, component, key  # noqa: F401  (importers name them here)
+from .prose import ProseFacts
 
 #: letters a proof line uses for vectors (3, 1): positions, velocities, angular velocity
 VECTOR_NAMES = {"d", "p", "omega", "a", "b", "u", "v", "w", "omegadot"}
-#: kinetic energy of rotation: (name, subscript) as people write it
-ENERGY = {("E", "rot"), ("E", "r"), ("E", "k"), ("E", "kin"), ("T", "rot"), ("E", "")}
 #: a line whose (conservative) polynomial degree exceeds this is not evaluated
 MAX_DEGREE = 400
-
-
-class UnknownName(LatexError):
-    """A name the proof checker gives no meaning to."""
 
 
 class NotRational(LatexError):
@@ -85,19 +88,6 @@ def element_point(sub: str) -> str:
     return sub if is_point(sub) else f"ref:{sub}"
 
 
-def component(sym: Sym) -> tuple[str, int] | None:
-    """``r_{ix}`` -> ("i", 0): a component of a per-element vector."""
-    if sym.base == "r" and sym.sub and sym.sub[-1] in "xyz" and not sym.frame:
-        return sym.sub[:-1], "xyz".index(sym.sub[-1])
-    return None
-
-
-def key(sym: Sym) -> str:
-    """The name as a binding key (typeface of I matters, a transpose does not)."""
-    bold = "b" if sym.bold and sym.base == "I" else ""
-    return f"{sym.base}{bold}_{sym.sub}^{sym.frame}"
-
-
 @dataclass
 class ProofState:
     """What the proof is about so far: the per-element vector's point, the angular
@@ -107,12 +97,32 @@ class ProofState:
     point_sub: str = ""
     omega: str | None = None
     inertia: str | None = None
+    facts: ProseFacts = field(default_factory=ProseFacts)
+    components: set = field(default_factory=set)  # the coordinate axes the proof's lines use
+
+    @property
+    def planar(self) -> bool:
+        """Components x_i, y_i and never z_i: moments of inertia about axes along z."""
+        return bool(self.components) and "z" not in self.components
+
+    def origin(self) -> str:
+        return self.facts.origin or "O"
+
+    def element_point(self, sym: Sym) -> str:
+        """The point a per-element vector is measured from (the prose's word first)."""
+        if sym.base == "rho":
+            return self.facts.positions.get("rho", "C")
+        if not sym.sub:
+            return self.facts.positions.get("r") or self.origin()
+        return element_point(sym.sub)
 
     def scan(self, nodes) -> None:
         for node in nodes:
             for n in walk(node):
                 if isinstance(n, Sym) and n.base == "r" and component(n) is None:
-                    self.point, self.point_sub = element_point(n.sub), n.sub
+                    self.point, self.point_sub = self.element_point(n), n.sub
+                elif isinstance(n, Sym) and n.base == "r":
+                    self.components.add("xyz"[component(n)[1]])
                 elif isinstance(n, Sym) and n.base == "omega" and n.sub:
                     self.omega = n.sub
 
@@ -187,6 +197,8 @@ def _builtin(s: Sym, sc: Scope) -> Mat:
         if s.base == "I" and s.bold and not s.sub and not sc.in_integral:
             sc.notes.add("\\mathbf{I} (bold, no subscript) read as the identity: an inertia tensor is I_O, I_C")
         return Mat.identity()
+    if not s.sub and not s.frame and s.base in state.facts.scalars:
+        return Mat.scalar(inst.scalar(s.base).v[0])
     if s.base in MOMENTUM | MOMENT and not s.frame and (not s.sub or is_point(s.sub)):
         tree = momentum(s, state)
         if s.base in MOMENT:
@@ -195,6 +207,12 @@ def _builtin(s: Sym, sc: Scope) -> Mat:
         what = "angular momentum I omega" if s.base in MOMENTUM else "moment dL/dt (Euler's law)"
         sc.notes.add(f"{s.latex()} read as the {what} about {point}")
         return evaluate(tree, sc)
+    if s.base == "I" and is_point(s.sub) and not s.bold and not s.frame and state.planar:
+        sc.notes.add(
+            f"{s.latex()} read as the moment of inertia about the axis through {s.sub} along z "
+            "(the proof's components are x_i, y_i)"
+        )
+        return Mat.scalar(inertia(inst, s.sub)[2, 2])
     if s.base == "I":
         if is_point(s.sub):
             point = s.sub
@@ -216,18 +234,33 @@ def _builtin(s: Sym, sc: Scope) -> Mat:
         if not s.frame:
             state.inertia = point
         return _frame(inertia(inst, point), s, sc, tensor=True)
-    if s.base == "r":
+    if s.base in ("r", "rho"):
         comp = component(s)
         if sc.elem is None:
             raise NeedElement()
         if comp is not None:
-            return Mat.scalar(inst.element(sc.elem, element_point(comp[0])).v[comp[1]])
-        return _frame(inst.element(sc.elem, element_point(s.sub)), s, sc, tensor=False)
+            point = element_point(comp[0]) if comp[0] else state.origin()
+            return Mat.scalar(inst.element(sc.elem, point).v[comp[1]])
+        point = state.element_point(s)
+        if s.base == "rho" and "rho" not in state.facts.positions:
+            sc.notes.add(f"{s.base} read as the element's position relative to the mass center C")
+        elif not s.sub and (s.base in state.facts.positions or state.facts.origin):
+            sc.notes.add(f"{s.base} read as the element's position relative to {point} (as the text says)")
+        return _frame(inst.element(sc.elem, point), s, sc, tensor=False)
     if s.base in VECTOR_NAMES:
         sub = s.sub
         if s.base == "omega" and not sub and s.frame and state.omega is not None:
             sub = state.omega
             sc.notes.add(f"{Sym(s.base, False, '', s.frame).latex()} read as R^{s.frame} omega_{sub}")
+        if not sub and s.base in state.facts.distances:
+            a, b, axis = state.facts.distances[s.base]
+            sc.notes.add(
+                f"{s.base} read as the offset between the axes through {a} and {b}"
+                + (f" along {axis}" if axis else "")
+                + " (as the text says)"
+            )
+        elif not sub and s.base in state.facts.vectors:
+            sc.notes.add(f"{s.base} read as the vector of components the text gives")
         base_key = key(Sym(s.base, s.bold, sub))
         if base_key in sc.env:
             value = evaluate(sc.env[base_key][0], sc.at(sc.elem if sc.elem is not None else 0, sc.in_integral))
@@ -364,7 +397,7 @@ def per_element(node, env: dict) -> bool:
         if isinstance(n, (Integral, Sum)):
             continue
         if isinstance(n, Sym):
-            if n.base == "r":
+            if n.base in ("r", "rho"):
                 return True
             k = key(n)
             if k in env and k not in seen:
@@ -437,6 +470,3 @@ def degree(node) -> int:
     if isinstance(node, Matrix):
         return max(degree(c) for row in node.rows for c in row)
     return 0
-
-
-from .motion import MOMENT, MOMENTUM, derivative, momentum  # noqa: E402  (motion uses this module)

@@ -415,6 +415,8 @@ class _Parser:
                 self.sums[-1] = index = node.sub
             if node.sub == index:
                 return Mass()
+        if node.base in ("x", "y", "z") and index and node.sub == index and not node.frame:
+            return Sym("r", node.bold, node.base, "", node.transposed)  # x_i: particle i's coordinate
         if node.base == "r" and index and node.sub and (node.sub.startswith(index) or node.sub.endswith(index)):
             sub = node.sub[len(index) :] if node.sub.startswith(index) else node.sub[: -len(index)]
             sub = sub.strip(",/ ")
@@ -559,12 +561,14 @@ def _is_rho(node) -> bool:
 
 
 def _strip_density(body):
-    """``f \\rho dV`` is ``f dm``: take the density factor out of the integrand."""
+    """``f \\rho dV`` is ``f dm``: take the density factor out of the integrand (the last
+    plain ``\\rho``: a bold one, as in ``\\boldsymbol{\\rho}\\,\\rho\\,dV``, is a position)."""
     if _is_rho(body):
         return Num(Fraction(1))
     if isinstance(body, Mul) and any(_is_rho(f) for f in body.factors):
         rest = list(body.factors)
-        rest.remove(next(f for f in rest if _is_rho(f)))
+        plain = [j for j, f in enumerate(rest) if _is_rho(f) and not f.bold]
+        del rest[plain[-1] if plain else max(j for j, f in enumerate(rest) if _is_rho(f))]
         return _mul(rest)
     raise ProofSyntaxError("an integral over dV without the density \\rho: only mass integrals (\\rho dV = dm)")
 

@@ -25,8 +25,8 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-from .evaluate import ENERGY, UnknownName, component, key
 from .expr import Add, Cross, Deriv, Div, Dot, Integral, Mass, Matrix, Mul, Norm, Num, Pow, Skew, Sum, Sym, Transpose
+from .nodes import ENERGY, UnknownName, component, key
 
 #: names of the angular momentum and of the moment (torque) about a point
 MOMENTUM = {"L", "H", "h"}
@@ -133,11 +133,13 @@ def _sym(s: Sym, sc):
     elif s.base == "R":
         d = Mul((Skew(omega(state)), plain))
         sc.notes.add("\\dot R read as S(omega) R (omega in the world frame)")
-    elif s.base == "r":
+    elif s.base in ("r", "rho"):
         if component(s) is not None:
             raise UnknownName(f"the time derivative of a component ({s.latex()}) is not understood")
         d = Cross(omega(state), plain)
         sc.notes.add("\\dot r read as omega x r (a point of the body)")
+    elif s.base == "I" and state.planar and not s.bold:
+        raise UnknownName(f"the time derivative of a moment about an axis ({s.latex()}) is not understood")
     elif s.base == "I":
         w = Skew(omega(state))
         d = Add(((1, Mul((w, plain))), (-1, Mul((plain, w)))))

@@ -8,6 +8,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 
+from ..latex import LatexError
+
+#: kinetic energy of rotation: (name, subscript) as people write it
+ENERGY = {("E", "rot"), ("E", "r"), ("E", "k"), ("E", "kin"), ("T", "rot"), ("E", "")}
+
+
+class UnknownName(LatexError):
+    """A name the proof checker gives no meaning to."""
+
 
 @dataclass(frozen=True)
 class Sym:
@@ -135,3 +144,16 @@ def walk(node):
             stack.append(n.arg)
         elif isinstance(n, Matrix):
             stack.extend(c for row in n.rows for c in row)
+
+
+def component(sym: Sym) -> tuple[str, int] | None:
+    """``r_{ix}`` -> ("i", 0): a component of a per-element vector."""
+    if sym.base == "r" and sym.sub and sym.sub[-1] in "xyz" and not sym.frame:
+        return sym.sub[:-1], "xyz".index(sym.sub[-1])
+    return None
+
+
+def key(sym: Sym) -> str:
+    """The name as a binding key (typeface of I matters, a transpose does not)."""
+    bold = "b" if sym.bold and sym.base == "I" else ""
+    return f"{sym.base}{bold}_{sym.sub}^{sym.frame}"
