@@ -42,6 +42,8 @@ SAMPLES = 4
 RTOL = 1e-8
 #: candidate combinations tried per step (inputs x conventions), beyond which the rest is skipped
 MAX_COMBINATIONS = 64
+#: the student's own rotations carried through the formulas beside the model's (World.use_rotation)
+MAX_ALTERNATIVES = 3
 
 
 def entries(value) -> tuple[list, tuple]:
@@ -220,11 +222,17 @@ class World:
     def use_rotation(self, name: str, i: int, rotation, confirmed: bool) -> None:
         """Also carry the student's rotation ``rotation`` (frame-i coordinates to its parent
         frame, as the step ``name`` wrote it) through the formulas: a later step that it
-        reproduces follows from ``name``. ``confirmed``: ``name`` is already an error."""
+        reproduces follows from ``name``. ``confirmed``: ``name`` is already an error. One
+        per joint (the first written), at most :data:`MAX_ALTERNATIVES`: each multiplies
+        the candidates of every formula."""
+        if len(self.alternatives) >= MAX_ALTERNATIVES or any(
+            a[1][i]["R"] is not self.ctx[i]["R"] for a in self.alternatives
+        ):
+            return
         ctx = {k: (dict(v) if isinstance(k, int) else v) for k, v in self.ctx.items()}
         ctx[i]["R"] = sp.Matrix(rotation)
         ctx["R0"] = {0: sp.eye(3)}
-        for k in sorted(x for x in ctx if isinstance(x, int)):  # parents have lower indices
+        for k in [x for x in ctx if isinstance(x, int)]:  # in the order the model built them: parents first
             ctx["R0"][k] = ctx["R0"][ctx[k]["parent"]] * ctx[k]["R"]
         points = [_to_num(evaluate_context(ctx, pt)) for pt in self.sampler.points] if self.numeric else None
         self.alternatives.append((name, ctx, points))
