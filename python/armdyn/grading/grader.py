@@ -20,12 +20,12 @@ from .diagnose import cannot_read, location
 from .energy_steps import EnergySteps
 from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, tidy
+from .kinematics_steps import KinematicsSteps, confirm_used
 from .latex import LatexError, UnknownSymbol, parse, parse_sympy_syntax
-from .methods import lagrange_method, newton_euler_method, position, rotation_between
+from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
 from .reader import Submission, read
-from .rotation_use import carry_rotation, confirm_used
 from .statements import FREE_END, lagrange_law, matrix_form
 from .verdict import PASSING, GradeReport, StepVerdict
 from .vocabulary import MODEL_KEYS, student_names
@@ -67,7 +67,7 @@ def _load_robot(name: str, sub: Submission, trusted: bool = False) -> Robot:
         raise err.located(source=sub.path) from None
 
 
-class _Grader(EnergySteps):
+class _Grader(EnergySteps, KinematicsSteps):
     def __init__(self, sub: Submission, robot: Robot, symbols: dict | None):
         self.sub = sub
         self.robot = robot
@@ -354,76 +354,6 @@ class _Grader(EnergySteps):
         elif ref.index is not None and not 1 <= ref.index <= self.robot.dof:
             return f"{ref.name} names joint {ref.index}, but '{self.robot.name}' has joints 1..{self.robot.dof}"
         return None
-
-    def _rotation(self, ref: StepRef, eq, value):
-        ctx = self.world("newton-euler").ctx
-        assert ref.index is not None and ref.frame is not None  # _check_index ran
-        expected = rotation_between(ctx, ref.index, ref.frame).applyfunc(lambda x: tidy(x, self.robot))
-        fp = self.sampler.fingerprint
-        got_fp = fp(value)
-        status, conv, message = "correct", None, ""
-        ok = equal(got_fp, fp(expected))
-        if not ok.all():
-            if equal(got_fp, fp(expected.T)).all():
-                status = "correct-by-convention"
-                conv = (
-                    f"transposed: the columns are frame {ref.frame}'s axes in frame {ref.index} "
-                    f"(R_{ref.index}^{ref.frame} here maps frame-{ref.index} coordinates to frame {ref.frame})"
-                )
-            else:
-                status = "wrong"
-                bad = [int(i) for i in range(9) if not ok.ravel()[i]]
-                message = "; ".join(
-                    f"{component_name(i, (3, 3))}: " + self._describe(value[i], expected[i]) for i in bad[:3]
-                )
-        self.verdicts.append(
-            StepVerdict(
-                name=ref.name,
-                key="R",
-                link="",
-                status=status,
-                label=eq.lhs,
-                source=eq.source,
-                line=eq.line,
-                expected=expected,
-                got=value,
-                difference=None if status != "wrong" else value - expected,
-                convention=conv,
-                message=message or ("" if status == "correct" else conv or ""),
-                frame=f"{ref.index}->{ref.frame}",
-            )
-        )
-        carry_rotation(self.world("newton-euler"), ref.index, ref.frame, ref.name, value, status)
-
-    def _position(self, ref: StepRef, eq, value):
-        """A kinematics step: P_i^j, frame i's origin seen from frame i-1's, or P_{C_i}^j,
-        link i's mass centre seen from frame i's origin, both written in frame j."""
-        ctx = self.world("newton-euler").ctx
-        vector, what, frame = position(ctx, ref.key, ref.index, ref.frame, ref.origin)
-        expected = sp.Matrix(vector).applyfunc(lambda x: tidy(x, self.robot))
-        fp = self.sampler.fingerprint
-        ok = equal(fp(value), fp(expected)).ravel()
-        bad = [int(i) for i in range(3) if not ok[i]]
-        message = "; ".join(f"{self._describe(value[i], expected[i])} in {component_name(i, (3, 1))}" for i in bad)
-        if bad:
-            message += f" ({what}, in frame {frame})"
-        self.verdicts.append(
-            StepVerdict(
-                name=ref.name,
-                key=ref.key,
-                link=list(self.robot.links)[ref.index],  # type: ignore[index]
-                status="wrong" if bad else "correct",
-                label=eq.lhs,
-                source=eq.source,
-                line=eq.line,
-                expected=expected,
-                got=value,
-                difference=sp.Matrix([tidy(value[i] - expected[i], self.robot) for i in range(3)]) if bad else None,
-                components=bad,
-                message=message,
-                frame=str(frame),
-            )
-        )
 
     def _free_end(self, ref: StepRef, eq):
         """``f_{n+1} = 0``, ``n_{n+1} = 0``: the load at the free end, zero."""
