@@ -70,6 +70,13 @@ def test_craig_pre_superscript_intermediate_frame(tmp_path):
     assert by_line(r)[6].status == "correct"
 
 
+def test_right_superscript_base_position_is_read_as_craigs_and_said(tmp_path):
+    # P_{C_2}^0 names only the frame; a value that is the base-frame position is read so, said
+    r = graded(tmp_path, f"$$ P_{{C_2}}^0 = {column(PC2_IN_0)} $$\n")
+    v = by_line(r)[6]
+    assert v.status == "correct" and "read as Craig's" in v.message and "frame 0's origin" in v.message
+
+
 def test_right_superscript_keeps_its_documented_meaning(tmp_path):
     # P_{C_2}^0: from frame 2's origin, written in frame 0 (docs/grading.md)
     own = rz(q1) * rz(q2) * sp.Matrix([lc2, 0, 0])

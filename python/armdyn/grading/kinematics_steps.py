@@ -66,7 +66,9 @@ class KinematicsSteps:
 
     def _position(self, ref: StepRef, eq, value):
         """A kinematics step: P_i^j, frame i's origin seen from frame i-1's, or P_{C_i}^j,
-        link i's mass centre seen from frame i's origin, both written in frame j."""
+        link i's mass centre seen from frame i's origin, both written in frame j; Craig's
+        ``{}^{j}P`` seen from frame j's origin. A right superscript j names only the frame,
+        but a value that is the point seen from frame j's origin is read so, and said."""
         ctx = self.world("newton-euler").ctx
         vector, what, frame = position(ctx, ref.key, ref.index, ref.frame, ref.origin)
         expected = sp.Matrix(vector).applyfunc(lambda x: tidy(x, self.robot))
@@ -76,6 +78,11 @@ class KinematicsSteps:
         message = "; ".join(f"{self._describe(value[i], expected[i])} in {component_name(i, (3, 1))}" for i in bad)
         if bad:
             message += f" ({what}, in frame {frame})"
+            if ref.origin is None and ref.frame is not None:  # P_{C_2}^0: the point in frame 0, as Craig's {}^{0}P?
+                seen, craig, _ = position(ctx, ref.key, ref.index, ref.frame, ref.frame)
+                if equal(fp(value), fp(seen)).all():
+                    expected, bad = sp.Matrix(seen).applyfunc(lambda x: tidy(x, self.robot)), []
+                    message = f"read as Craig's {{}}^{{{frame}}}P: {craig}, in frame {frame} (not {what})"
         self.verdicts.append(
             StepVerdict(
                 name=ref.name,
