@@ -237,7 +237,7 @@ class Values:
 
     def __call__(self, what, own: bool):
         from .engine import to_sympy
-        from .methods import rotation_between
+        from .methods import position, rotation_between
 
         if isinstance(what, tuple) and what[0] == "lagrange":
             return to_sympy(self._lagrange().expected[(what[1], None)].sym())
@@ -275,17 +275,15 @@ class Values:
         if ref.key in ("P", "Pc"):
             if not 1 <= ref.index <= n:
                 return None
-            home = ctx[ref.index]["parent"] if ref.key == "P" else ref.index
-            frame = home if ref.frame is None else ref.frame
-            if not 0 <= frame <= n:
+            if ref.frame is not None and not 0 <= ref.frame <= n:
                 return None
+            right, _, frame = position(ctx, ref.key, ref.index, ref.frame, ref.origin)
             if own:
                 for v in reversed(self.verdicts):
                     if v.key == ref.key and v.got is not None and v.name.split("^")[0] == ref.name.split("^")[0]:
                         if v.frame == str(frame):
                             return v.got
-            vector = ctx[ref.index]["P" if ref.key == "P" else "c"]
-            return rotation_between(ctx, home, frame) * vector
+            return right
         return None
 
 

@@ -225,30 +225,6 @@ class EnergySteps:
             )
         )
 
-    def _point_in_frame(self, ref: StepRef, home: int, frame: int, value):
-        """(the expected vector, [], what was read) when a position ``P_i^j`` / ``P_{C_i}^j`` written in a frame
-        j other than its usual one is the point seen from frame j's origin (Craig's
-        ``{}^{0}P_{C_2}``: link 2's mass centre in the base frame), else None."""
-        if frame == home or not isinstance(value, sp.MatrixBase) or value.shape != (3, 1):
-            return None
-        terms = self.model_terms()
-        point = terms.position(ref.index) if ref.key == "Pc" else terms.origins[ref.index]
-        ctx = self.world("newton-euler").ctx
-        seen = sp.Matrix(ctx["R0"][frame].T * (point - terms.origins[frame])).applyfunc(lambda x: tidy(x, self.robot))
-        fp = self.sampler.fingerprint
-        if not equal(fp(value), fp(seen)).all():
-            return None
-        what = f"link {ref.index}'s mass centre" if ref.key == "Pc" else f"frame {ref.index}'s origin"
-        start = f"frame {ref.index}'s" if ref.key == "Pc" else f"frame {home}'s"
-        return (
-            seen,
-            [],
-            (
-                f"{ref.name} read as Craig's {{}}^{{{frame}}}P: {what} seen from frame {frame}'s origin "
-                f"(not from {start}), written in frame {frame}"
-            ),
-        )
-
     def _torque_column(self, ref: StepRef, eq, value) -> None:
         """``(\\tau_1, \\tau_2)^T = ...``: each entry graded as its joint's τ_k."""
         n = self.robot.dof

@@ -42,6 +42,8 @@ SAMPLES = 4
 RTOL = 1e-8
 #: candidate combinations tried per step (inputs x conventions), beyond which the rest is skipped
 MAX_COMBINATIONS = 64
+#: the student's own rotations carried through the formulas beside the model's (World.use_rotation)
+MAX_ALTERNATIVES = 3
 
 
 def entries(value) -> tuple[list, tuple]:
@@ -212,6 +214,31 @@ class World:
             self.expected[ref] = Value(self._fp_of(ref, exp_sym), exp_sym[ref])
         self.given: dict = {}  # ref -> list[Value]
         self._computed: dict = {}
+        #: the student's own rotations, as the formulas would use them: (step name, ctx, ctx at the points)
+        self.alternatives: list[tuple[str, dict, list | None]] = []
+        #: names of alternatives not (yet) known to be errors: a value through one is never a reference
+        self.unconfirmed: set[str] = set()
+
+    def use_rotation(self, name: str, i: int, rotation, confirmed: bool) -> None:
+        """Also carry the student's rotation ``rotation`` (frame-i coordinates to its parent
+        frame, as the step ``name`` wrote it) through the formulas: a later step that it
+        reproduces follows from ``name``. ``confirmed``: ``name`` is already an error. One
+        per joint (the first written), at most :data:`MAX_ALTERNATIVES`: each multiplies
+        the candidates of every formula."""
+        if len(self.alternatives) >= MAX_ALTERNATIVES or any(
+            a[1][i]["R"] is not self.ctx[i]["R"] for a in self.alternatives
+        ):
+            return
+        ctx = {k: (dict(v) if isinstance(k, int) else v) for k, v in self.ctx.items()}
+        ctx[i]["R"] = sp.Matrix(rotation)
+        ctx["R0"] = {0: sp.eye(3)}
+        for k in [x for x in ctx if isinstance(x, int)]:  # in the order the model built them: parents first
+            ctx["R0"][k] = ctx["R0"][ctx[k]["parent"]] * ctx[k]["R"]
+        points = [_to_num(evaluate_context(ctx, pt)) for pt in self.sampler.points] if self.numeric else None
+        self.alternatives.append((name, ctx, points))
+        if not confirmed:
+            self.unconfirmed.add(name)
+        self.invalidate()
 
     def _fp_of(self, ref, exp_sym):
         if self.numeric:
@@ -221,16 +248,19 @@ class World:
         return self.sampler.fingerprint(exp_sym[ref])
 
     # -- applying formulas and conventions to candidate values
-    def apply(self, fn, values: list[Value], extra_ctx_fn=None) -> Value:
-        """fn(ctx, *inputs) on candidate values: numbers at the points, symbols lazily."""
+    def apply(self, fn, values: list[Value], alternative=None) -> Value:
+        """fn(ctx, *inputs) on candidate values: numbers at the points, symbols lazily
+        (``alternative``: one of :attr:`alternatives`, whose context is used and whose
+        name joins the origins)."""
         origins = frozenset().union(*(v.origins for v in values)) if values else frozenset()
         repaired = frozenset().union(*(v.repaired for v in values)) if values else frozenset()
+        ctx, points = self.ctx, self.ctx_points
+        if alternative is not None:
+            origins, ctx, points = origins | {alternative[0]}, alternative[1], alternative[2]
         if self.numeric:
-            fp = np.stack(
-                [_from_num(fn(c, *(_as_input(v.fp[k]) for v in values))) for k, c in enumerate(self.ctx_points)]
-            )
-            return Value(fp, lambda: to_sympy(fn(self.ctx, *(v.sym() for v in values))), origins, repaired)
-        sym = fn(self.ctx, *(v.sym() for v in values))
+            fp = np.stack([_from_num(fn(c, *(_as_input(v.fp[k]) for v in values))) for k, c in enumerate(points)])
+            return Value(fp, lambda: to_sympy(fn(ctx, *(v.sym() for v in values))), origins, repaired)
+        sym = fn(ctx, *(v.sym() for v in values))
         return Value(self.sampler.fingerprint(sym), sym, origins, repaired)
 
     def candidates(self, ref) -> list[Value]:
@@ -255,6 +285,7 @@ class World:
             pools = [self.candidates(r) for r in formula.inputs]
             for combo in itertools.islice(itertools.product(*pools), MAX_COMBINATIONS):
                 out.append(self.apply(formula.fn, list(combo)))
+                out += [self.apply(formula.fn, list(combo), alt) for alt in self.alternatives]
         return _dedupe(out)
 
     def invalidate(self):
@@ -326,6 +357,8 @@ def judge(world: World, ref, got: Value, extra_candidates) -> Judgement:
                 ok = equal(got.fp, s.fp)
                 if ok.all() and s.origins:
                     return Judgement("follows-from-earlier-error", conv.name or None, s.origins, s, conv, value)
+                if s.origins & world.unconfirmed:
+                    continue  # a rotation not known to be wrong is no reference for a slip
                 key = (int((~ok).sum()), len(s.origins), conventions.index(conv))
                 if best_key is None or key < best_key:
                     best, best_key = Judgement("wrong", conv.name or None, s.origins, s, conv, value), key

@@ -21,6 +21,7 @@ from .diagnose import cannot_read, location
 from .energy_steps import EnergySteps
 from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, tidy
+from .kinematics_steps import KinematicsSteps, confirm_used
 from .latex import LatexError, UnknownSymbol, parse_sympy_syntax
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
@@ -69,7 +70,7 @@ def _load_robot(name: str, sub: Submission, trusted: bool = False) -> Robot:
         raise err.located(source=sub.path) from None
 
 
-class _Grader(EnergySteps):
+class _Grader(EnergySteps, KinematicsSteps):
     def __init__(self, sub: Submission, robot: Robot, symbols: dict | None):
         self.sub = sub
         self.robot = robot
@@ -361,87 +362,6 @@ class _Grader(EnergySteps):
             return f"{ref.name} names joint {ref.index}, but '{self.robot.name}' has joints 1..{self.robot.dof}"
         return None
 
-    def _rotation(self, ref: StepRef, eq, value):
-        ctx = self.world("newton-euler").ctx
-        assert ref.index is not None and ref.frame is not None  # _check_index ran
-        expected = rotation_between(ctx, ref.index, ref.frame)
-        fp = self.sampler.fingerprint
-        got_fp = fp(value)
-        status, conv, message = "correct", None, ""
-        ok = equal(got_fp, fp(expected))
-        if not ok.all():
-            if equal(got_fp, fp(expected.T)).all():
-                status = "correct-by-convention"
-                conv = (
-                    f"transposed: the columns are frame {ref.frame}'s axes in frame {ref.index} "
-                    f"(R_{ref.index}^{ref.frame} here maps frame-{ref.index} coordinates to frame {ref.frame})"
-                )
-            else:
-                status = "wrong"
-                bad = [int(i) for i in range(9) if not ok.ravel()[i]]
-                message = "; ".join(
-                    f"{component_name(i, (3, 3))}: " + self._describe(value[i], expected[i]) for i in bad[:3]
-                )
-        self.verdicts.append(
-            StepVerdict(
-                name=ref.name,
-                key="R",
-                link="",
-                status=status,
-                label=eq.lhs,
-                source=eq.source,
-                line=eq.line,
-                expected=expected,
-                got=value,
-                difference=None if status != "wrong" else value - expected,
-                convention=conv,
-                message=message or ("" if status == "correct" else conv or ""),
-                frame=f"{ref.index}->{ref.frame}",
-            )
-        )
-
-    def _position(self, ref: StepRef, eq, value):
-        """A kinematics step: P_i^j, frame i's origin seen from frame i-1's, or P_{C_i}^j,
-        link i's mass centre seen from frame i's origin, both written in frame j."""
-        ctx = self.world("newton-euler").ctx
-        if ref.key == "P":
-            home = ctx[ref.index]["parent"]
-            vector = ctx[ref.index]["P"]
-            what = f"frame {ref.index}'s origin from frame {home}'s"
-        else:
-            home = ref.index
-            vector = ctx[ref.index]["c"]
-            what = f"link {ref.index}'s mass centre from frame {ref.index}'s origin"
-        frame = home if ref.frame is None else ref.frame
-        expected = sp.Matrix(rotation_between(ctx, home, frame) * vector).applyfunc(lambda x: tidy(x, self.robot))
-        fp = self.sampler.fingerprint
-        ok = equal(fp(value), fp(expected)).ravel()
-        bad = [int(i) for i in range(3) if not ok[i]]
-        craig = self._point_in_frame(ref, home, frame, value) if bad else None  # {}^{0}P_{C_2}: from frame 0's origin
-        if craig is not None:
-            expected, bad, message = craig
-        else:
-            message = "; ".join(f"{self._describe(value[i], expected[i])} in {component_name(i, (3, 1))}" for i in bad)
-        if bad:
-            message += f" ({what}, in frame {frame})"
-        self.verdicts.append(
-            StepVerdict(
-                name=ref.name,
-                key=ref.key,
-                link=list(self.robot.links)[ref.index],  # type: ignore[index]
-                status="wrong" if bad else "correct",
-                label=eq.lhs,
-                source=eq.source,
-                line=eq.line,
-                expected=expected,
-                got=value,
-                difference=sp.Matrix([tidy(value[i] - expected[i], self.robot) for i in range(3)]) if bad else None,
-                components=bad,
-                message=message,
-                frame=str(frame),
-            )
-        )
-
     def _free_end(self, ref: StepRef, eq):
         """``f_{n+1} = 0``, ``n_{n+1} = 0``: the load at the free end, zero."""
         value, problem = self.value(eq, StepRef(ref.key, ref.index, ref.frame))
@@ -488,6 +408,8 @@ class _Grader(EnergySteps):
         name = ref.name
         origins_names = sorted(j.origins, key=self._order)
         caused_by = origins_names[0] if j.status == "follows-from-earlier-error" and origins_names else None
+        if caused_by is not None:
+            confirm_used(self.verdicts, world, j.origins, name, eq.line, self.robot)
         extras = [world.candidates(r)[0] for r in j.conv.extra]
         if j.status in ("correct", "correct-by-convention"):
             world.given[key] = [canonical(world, j.conv, got, extras, frozenset())]
@@ -532,11 +454,12 @@ class _Grader(EnergySteps):
                     text = self._describe(got_m[i], ref_m[i])
                     where = component_name(i, got_m.shape)
                     parts.append(f"{text} in {where}" if where else text)
-                against = "" if not j.origins else " (compared with what your own earlier steps give)"
-                message = "; ".join(parts) + against
+                against = ["compared with what your own earlier steps give"] if j.origins else []
+                against += [f"in the convention: {j.convention}"] if j.convention else []  # the closest: said
+                message = "; ".join(parts) + (f" ({', '.join(against)})" if against else "")
                 diff = sp.Matrix([tidy(got_m[i] - ref_m[i], self.robot) for i in range(len(got_m))])
                 difference = diff if got_m.shape != (1, 1) else diff[0]
-                exp_shown = contract(exp_shown, self.symbols.shorthand)  # in the student's s₁₂, c₁₂
+                exp_shown = contract(_tidied(exp_shown, self.robot), self.symbols.shorthand)  # their s₁₂, c₁₂
             elif j.status == "follows-from-earlier-error":
                 message = f"follows from the error in {caused_by}" + (f" ({j.convention})" if j.convention else "")
                 diff = _matrix(value) - _matrix(exp_shown)
@@ -601,6 +524,11 @@ class _Grader(EnergySteps):
         return len(self.verdicts)
 
 
+def _tidied(value, robot):
+    """A value as shown: each entry simplified (a convention's added terms cancel)."""
+    return value.applyfunc(lambda x: tidy(x, robot)) if isinstance(value, sp.MatrixBase) else tidy(value, robot)
+
+
 def _matrix(value) -> sp.Matrix:
     return value if isinstance(value, sp.MatrixBase) else sp.Matrix([[value]])
 
@@ -642,5 +570,6 @@ def grade(
     hint = sub.method if sub.method in ("newton-euler", "lagrange") else None
     report = _Grader(sub, model, symbols).run(hint)
     if read_model is not None:
-        report.notes.insert(0, read_model.note())
+        report.model_note = read_model.note()  # the report's first line: what was graded against
+        report.notes.insert(0, report.model_note)
     return report

@@ -339,7 +339,7 @@ def _summary(report: GradeReport, anchors: dict, labels: dict) -> str:
     for s in report.steps:
         counts[s.status] = counts.get(s.status, 0) + 1
     chips = "".join(_badge(s, n) for s, n in counts.items() if n)
-    notes = "".join(f"<li>{escape(n)}</li>" for n in report.notes)
+    notes = "".join(f"<li>{escape(n)}</li>" for n in report.notes if n != report.model_note)
     return (
         '<section class="summary">'
         f'{verdict}<div class="taus">{"".join(taus)}</div>'
@@ -359,7 +359,8 @@ def report_body(report: GradeReport) -> str:
     names = {"newton-euler": "Newton\u2013Euler", "lagrange": "Lagrange"}
     method = " and ".join(names.get(m, m) for m in report.method.split("+"))
     head = (
-        "<h1>Grade report</h1>"
+        (f'<p class="meta model-note">{escape(report.model_note)}</p>' if report.model_note else "")
+        + "<h1>Grade report</h1>"
         f'<p class="meta"><b>{escape(report.submission)}</b> · robot <b>{escape(report.robot)}</b> · '
         f"method <b>{escape(method)}</b> · {len(report.steps)} equations</p>"
     )

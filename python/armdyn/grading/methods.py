@@ -295,6 +295,33 @@ def rotation_between(ctx, frm: int, to: int):
     return ctx["R0"][to].T * ctx["R0"][frm]
 
 
+def origin_in_base(ctx, k: int):
+    """Frame ``k``'s origin in base-frame coordinates."""
+    point = sp.zeros(3, 1)
+    while k != 0:
+        point, k = ctx["R0"][ctx[k]["parent"]] * ctx[k]["P"] + point, ctx[k]["parent"]
+    return point
+
+
+def position(ctx, key: str, index: int, frame: int | None, origin: int | None = None):
+    """A kinematics position and what it is: ``key`` "P", frame ``index``'s origin, or
+    "Pc", link ``index``'s mass centre, seen from frame ``origin``'s origin (default: the
+    previous frame's for P, frame ``index``'s for Pc, the textbooks' ``{}^{i-1}P_i``,
+    ``{}^{i}P_{C_i}``), written in ``frame`` (default: that origin's frame).
+    Returns (vector, description, frame)."""
+    home = ctx[index]["parent"] if key == "P" else index
+    if origin is None or origin == home:
+        vector = ctx[index]["P" if key == "P" else "c"]
+        start = home
+    else:  # Craig's {}^{j}P_{C_i}: from frame j's origin, in frame j
+        point = origin_in_base(ctx, index) + (ctx["R0"][index] * ctx[index]["c"] if key == "Pc" else sp.zeros(3, 1))
+        vector = ctx["R0"][origin].T * (point - origin_in_base(ctx, origin))
+        start = home = origin
+    frame = home if frame is None else frame
+    what = f"frame {index}'s origin" if key == "P" else f"link {index}'s mass centre"
+    return rotation_between(ctx, home, frame) * vector, f"{what} from frame {start}'s origin", frame
+
+
 # ------------------------------------------------------------------ Lagrange
 
 

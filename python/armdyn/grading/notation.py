@@ -74,6 +74,8 @@ class StepRef:
     by_shape: bool = False
     #: -1 for a left-hand side written negated (``-\frac{\partial L}{\partial q_1}``)
     sign: int = 1
+    #: P, Pc written with Craig's pre-superscript ``{}^{j}P_{C_i}``: the vector starts at frame j's origin
+    origin: int | None = None
 
     @property
     def name(self) -> str:
@@ -232,10 +234,11 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
     if key == "P":  # P_i^j: frame i's origin from frame i-1's; P_{C_i}^j: link i's mass centre from frame i's
         if dots or sub is None:
             return None
+        origin = _int(pre_sup) if pre_sup is not None else None  # Craig's {}^{j}P: from frame j's origin
         centre = _mass_centre(sub)
         if centre is not None:
-            return StepRef("Pc", centre, frame)
-        return StepRef("P", _int(sub), frame) if _int(sub) is not None else None
+            return StepRef("Pc", centre, frame, origin=origin)
+        return StepRef("P", _int(sub), frame, origin=origin) if _int(sub) is not None else None
     end_of = re.fullmatch(r"e(\d+)", _plain(sub)) if key == "a" and not dots else None
     if end_of:  # Spong's a_{e,i}: the acceleration of the end of link i (resolved on the model)
         return StepRef("ae", int(end_of.group(1)), frame)

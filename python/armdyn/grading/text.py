@@ -78,7 +78,8 @@ def _pad(s: str, width: int) -> str:
 @register("text", GradeReport)
 def text(report: GradeReport, ascii_only: bool = False, details: bool = True) -> str:
     """The report: one line per step, values for the wrong ones, then the summary."""
-    lines = [f"armdyn grade {report.submission}: robot '{report.robot}', {report.method}", ""]
+    lines = [f"note: {report.model_note}"] if report.model_note else []  # first: what it was graded against
+    lines += [f"armdyn grade {report.submission}: robot '{report.robot}', {report.method}", ""]
     skipped = []
     width = max((_width(step_title(v, ascii_only)) for v in report.steps if v.status != "unrecognised"), default=6)
     group = object()
@@ -142,7 +143,8 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
             taus.append(f"tau_{k} {'right' if ok else 'wrong'}")
     lines.append("final torques: " + "; ".join(taus))
     for note in report.notes:
-        lines.append(f"note: {note}")
+        if note != report.model_note:
+            lines.append(f"note: {note}")
     out = "\n".join(lines)
     return to_ascii(out) if ascii_only else out
 

@@ -113,6 +113,8 @@ class GradeReport:
                    False where the student gave no tau_i
     symbol_latex:  SymPy symbol -> its LaTeX, as the derivation report writes it
     notes:         general remarks (mapping used, steps the method has that the student skipped)
+    model_note:    when no model was named and it was read from the text, the note saying so
+                   (also first in ``notes``): the text and HTML reports open with it, else ""
     shorthand:     sin/cos terms the student wrote as shorthand -> symbols printing as theirs
                    (``sin(q1 + q2)`` -> ``s₁₂``), for showing values in their notation
     """
@@ -126,6 +128,7 @@ class GradeReport:
     symbol_latex: dict = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
     shorthand: dict = field(default_factory=dict)
+    model_note: str = ""
 
     @property
     def passed(self) -> bool:

@@ -206,6 +206,9 @@ def _value(text: str, names: Names):
 def _what(lhs: str):
     """``(what, index, frame)`` a left-hand side states, or None."""
     ref = parse_lhs(lhs, lambda _latex: None)
+    if ref is not None and ref.key in ("P", "Pc") and ref.origin not in (None, ref.index - (ref.key == "P")):
+        # Craig's {}^{j}P_{C_i} starts at frame j's origin: at the base's, the mass centre in the base frame
+        return ("C", ref.index, 0) if ref.key == "Pc" and ref.origin == 0 else None
     if ref is not None and ref.key in ("R", "P", "Pc", "T", "V"):
         return ref.key, ref.index, ref.frame
     if ref is not None and ref.key == "v_dot" and ref.index == 0:
