@@ -29,6 +29,17 @@ from .geometry import (
 from .statements import MAX_FRAMES, Names, Statement, all_equations, joint_candidates, read_statements
 
 
+def _energies(statements, what: str) -> list:
+    """The kinetic energies stated as a function of the rates (``K = K_1 + K_2`` names others: left out)."""
+    return [
+        st
+        for st in statements
+        if st.what == what
+        and not isinstance(st.value, sp.MatrixBase)
+        and any(s.name.endswith("_dot") for s in st.value.free_symbols)
+    ]
+
+
 @dataclass
 class TextModel:
     """The model read from a text: its YAML (each item with the line it comes from), the
@@ -70,6 +81,8 @@ class TextReader:
         self.equations = equations
         joints, written = joint_candidates(equations, self.sub.symbols)
         if not joints:
+            if self._proofs_only(text):
+                return self._no_arm()
             self.fail("no joint variable (\\theta_k, q_k, d_k) is written; name the model with --robot")
         n = max(joints)
         if n > MAX_FRAMES:
@@ -119,6 +132,26 @@ class TextReader:
                             "while other frames' are"
                         )
         return self._build(statements, rot, revolute, gravity, g_line, coms)
+
+    def _proofs_only(self, text: str) -> bool:
+        """A text with proofs and no joint variable: a rigid-body proof needs no arm."""
+        from ..proofs import check_text
+
+        return bool(text) and bool(check_text(text, self.sub.path or "<string>", set()))
+
+    def _no_arm(self) -> TextModel:
+        """The model of a proof: no joints, no links (its links are checked on their own)."""
+        from ...io.yaml import load_yaml_string
+
+        text = (
+            f"# the robot read from {os.path.basename(self.sub.path)}: none (a proof, no joint variable)\n"
+            f"name: {model_name(self.sub.path)}\n"
+            "description: no arm; the text proves rigid-body identities\n"
+            "parameters: []\ngravity: [0, 0, 0]\njoints: []\nlinks: []\n"
+        )
+        robot = load_yaml_string(text, source=f"{self.sub.path} (the model read from it)", strict=False)
+        self.assumptions.append("no arm: no joint variable is written, and the text's proofs need none")
+        return TextModel(text, robot, self.assumptions, self.conflicts)
 
     @staticmethod
     def _symbols(value) -> set:
@@ -398,7 +431,7 @@ class TextReader:
     def _masses(self, statements, coms) -> dict:
         out = {k: (v[1], f"line {v[2].line}: m{k} in V") for k, v in coms.items() if v[1] is not None}
         for st in statements:
-            if st.what in ("T", "V") and not isinstance(st.value, sp.MatrixBase):
+            if st.what in ("T", "V", "Tl", "Vl") and not isinstance(st.value, sp.MatrixBase):
                 for s in st.value.free_symbols:
                     m = re.fullmatch(r"m(\d+)", s.name)
                     if m and int(m.group(1)) not in out:
@@ -426,8 +459,8 @@ class TextReader:
                     continue
                 out[k] = (yaml_matrix(st.value), f"line {st.line}: {st.source[:70]}", st.value)
                 out["symbols"] += list(st.value)
-        Ts = [st for st in statements if st.what == "T" and not isinstance(st.value, sp.MatrixBase)]
-        for st in Ts[:1]:
+        Ts, Tl = _energies(statements, "T"), _energies(statements, "Tl")
+        for st in Ts[:1] + Tl:  # the whole T, and each link's own T_k / K_k
             for s in st.value.free_symbols:
                 m = re.fullmatch(r"I(?:zz)?(\d+)", s.name)
                 if m and int(m.group(1)) <= self.n and int(m.group(1)) not in out:
@@ -467,7 +500,7 @@ class TextReader:
 
     def _check_T(self, statements, robot: Robot, gravity_assumed: bool):
         """A stated T must be the kinetic energy of the model read (else the positions or inertias disagree)."""
-        Ts = [st for st in statements if st.what == "T" and not isinstance(st.value, sp.MatrixBase)]
+        Ts = _energies(statements, "T")
         if not Ts:
             return
         from ...symbolic.lagrange import link_energies
