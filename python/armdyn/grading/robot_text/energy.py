@@ -49,7 +49,7 @@ def mass_centres(statements, gravity, q: list, revolute: set, free: set, conflic
     n = len(q)
     found = _stated(statements, n, conflicts)
     for st in statements:
-        if st.what != "V" or isinstance(st.value, sp.MatrixBase):
+        if st.what not in ("V", "Vl") or isinstance(st.value, sp.MatrixBase):  # V, or one link's V_k
             continue
         axis = [i for i in range(3) if gravity[i] != 0]
         if len(axis) != 1 or axis[0] == 2:

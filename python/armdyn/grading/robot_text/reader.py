@@ -417,14 +417,14 @@ class TextReader:
         from ...io.yaml import load_yaml_string
 
         robot = load_yaml_string(text, source=f"{self.sub.path} (the model read from it)", strict=False)
-        self._check_T(statements, robot, g_line is None and any(c[2].what == "V" for c in coms.values()))
+        self._check_T(statements, robot, g_line is None and any(c[2].what in ("V", "Vl") for c in coms.values()))
         return TextModel(text, robot, self.assumptions, self.conflicts)
 
     def _com_source(self, k, coms, pc) -> str:
         if k in pc:
             return f"line {pc[k].line}: {pc[k].source[:70]}"
         if k in coms:
-            how = f"from the height of m{k} in V" if coms[k][2].what == "V" else coms[k][2].source[:70]
+            how = f"from the height of m{k} in V" if coms[k][2].what in ("V", "Vl") else coms[k][2].source[:70]
             return f"line {coms[k][2].line}: {how}"
         return "assumed"
 

@@ -149,6 +149,7 @@ def _inline_equations(text: str) -> list[Equation]:
 _GENERIC = re.compile(r"(?<![A-Za-z\\])i(?![A-Za-z])")
 _GENERIC_SUB = re.compile(r"(?<![A-Za-z\\])i(?![A-Za-z])|(?<=\{[cC])i(?=\})")
 _SPONG_R = re.compile(r"r_\{(\d+),\s*(?:[cC]_?\{?(\d+)\}?|(\d+))\}")
+_CRAIG_BASE = re.compile(r"\{\}\^\{?0\}?")
 _CENTRE = re.compile(r"([prxyz])_\{?[cC]_?\{?(\d+)\}?\}?")
 _DIAG = re.compile(r"\\(?:mathrm|operatorname|text)\{diag\}\s*\((.*)\)", re.S)
 _ELEMENTARY = re.compile(r"R_\{?([xyz])\}?\s*\((.*)\)", re.S)
@@ -206,6 +207,8 @@ def _value(text: str, names: Names):
 def _what(lhs: str):
     """``(what, index, frame)`` a left-hand side states, or None."""
     ref = parse_lhs(lhs, lambda _latex: None)
+    if ref is not None and ref.key == "Pc" and ref.frame == 0 and _CRAIG_BASE.match(normalise(lhs)):
+        return "C", ref.index, 0  # Craig's {}^{0}P_{C_2}: from the base frame's origin, not frame 2's
     if ref is not None and ref.key in ("R", "P", "Pc", "T", "V", "Tl", "Vl"):
         return ref.key, ref.index, ref.frame
     if ref is not None and ref.key == "v_dot" and ref.index == 0:
