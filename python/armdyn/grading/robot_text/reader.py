@@ -28,6 +28,21 @@ from .geometry import (
 )
 from .statements import MAX_FRAMES, Names, Statement, all_equations, joint_candidates, read_statements
 
+#: "gravity acts along $-y_0$", "Gravity pulls along $-\\hat Y_0$", "gravity along -z"
+_GRAVITY_WORDS = re.compile(
+    r"[Gg]ravity\b[^.\n]{0,40}?\b(?:along|towards?|in the direction of)\s*\$?\s*(-|−|\+)?\s*"
+    r"(?:\\hat\s*\{?\s*|\\mathbf\s*\{\s*)?([xyzXYZ])(?![A-Za-z])"
+)
+
+
+def _gravity_in_words(text: str):
+    """(axis, sign, line) of the first sentence saying along which base axis gravity acts, or None."""
+    m = _GRAVITY_WORDS.search(text[:200_000])
+    if m is None:
+        return None
+    sign = 1 if m.group(1) in (None, "+") else -1
+    return "xyz".index(m.group(2).lower()), sign, text.count("\n", 0, m.start()) + 1
+
 
 def _energies(statements, what: str) -> list:
     """The kinetic energies stated as a function of the rates (``K = K_1 + K_2`` names others: left out)."""
@@ -90,6 +105,7 @@ class TextReader:
                 f"joint variables numbered up to {n}: more frames than a derivation by hand has (at most {MAX_FRAMES})"
             )
         names = Names(joints, self.sub.symbols)
+        self.text, self.names = text, names
         statements = read_statements(equations, names, n)
         if tables:
             from_table, assumed, problems = dh_statements(tables, names)
@@ -214,6 +230,16 @@ class TextReader:
             )
             self.gravity_source = f"line {first.line}: {first.source[:70]}"
             return g, first.line
+        worded = _gravity_in_words(getattr(self, "text", ""))
+        if worded is not None:
+            axis, sign, line = worded
+            g = sp.zeros(3, 1)
+            g[axis] = sign * sp.Symbol(self.names.named("g", ""))
+            self.assumptions.append(
+                f"gravity {pretty_vector(g)}, from line {line}'s words (along {'-' if sign < 0 else '+'}{'xyz'[axis]}0)"
+            )
+            self.gravity_source = f"line {line}: in words"
+            return g, line
         g = sp.Matrix([0, -sp.Symbol("g"), 0])
         self.assumptions.append("gravity (0, -g, 0), along -y0: no base acceleration or gravity vector is stated")
         return g, None
