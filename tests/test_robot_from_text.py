@@ -134,11 +134,34 @@ $$\tau_2 = m_2 g$$
 """
 
 
-@pytest.mark.parametrize("name", ["planar-2r-lagrange.md", "planar-2r-craig.md", "standard-dh", "modified-dh"])
+def _as_array(text: str, env: str) -> str:
+    """The text's Markdown DH table written as a LaTeX ``env`` (array or tabular), on as many lines."""
+    lines = text.split("\n")
+    k = next(i for i, ln in enumerate(lines) if ln.startswith("|"))
+    cells = [[c.strip().strip("$") for c in ln.strip().strip("|").split("|")] for ln in lines[k : k + 4]]
+    spec = "{c|cccc}"
+    body = [
+        f"$$\\begin{{{env}}}{spec} " + " & ".join(cells[0]) + r" \\ \hline",
+        " & ".join(cells[2]) + r" \\",
+        " & ".join(cells[3]),
+        f"\\end{{{env}}}$$",
+    ]
+    return "\n".join(lines[:k] + body + lines[k + 4 :])
+
+
+DH_TEXTS = {
+    "standard-dh": STANDARD_DH,
+    "modified-dh": MODIFIED_DH,
+    "standard-dh-array": _as_array(STANDARD_DH, "array"),
+    "modified-dh-tabular": _as_array(MODIFIED_DH, "tabular"),
+}
+
+
+@pytest.mark.parametrize("name", ["planar-2r-lagrange.md", "planar-2r-craig.md", *DH_TEXTS])
 def test_planar_2r_read_has_spongs_dynamics(name, tmp_path):
-    if name.endswith("-dh"):
+    if name in DH_TEXTS:
         path = tmp_path / f"{name}.md"
-        path.write_text(STANDARD_DH if name == "standard-dh" else MODIFIED_DH, encoding="utf-8")
+        path.write_text(DH_TEXTS[name], encoding="utf-8")
         model = robot_from_text(read(str(path)))
         assert any(a.startswith(f"the DH table of line 3 is {name.split('-')[0]} DH") for a in model.assumptions)
         robot = model.robot
