@@ -37,8 +37,6 @@ NOT_SAME: dict[str, str | set[int]] = {
     "planar-2r-lynch-park-gamma.md": _NO_POSITION,
     "planar-2r-siciliano.md": _NO_POSITION,
     "planar-2r-spong-christoffel.md": _NO_POSITION,
-    # the mass centres' velocities as Jacobians J_{v_{ci}}, their positions never
-    "planar-2r-spong-jacobians.md": _NO_POSITION,
     # the forward recursion of link 2 only: links 1 and 3 are placed in words
     "planar-3r-spong-superscripts.md": _NO_POSITION,
     # links 1 and 3 are placed (x_{c1}, y_{c3}, P_1, P_3); link 2 only in words

@@ -89,6 +89,7 @@ GREEK = {
     "Phi",
     "Psi",
     "Omega",
+    "ell",  # not Greek, but a letter command like them: Siciliano's and Spong's \ell_1, \ell_{c1}
 }
 UNICODE_GREEK = {
     "α": "alpha",

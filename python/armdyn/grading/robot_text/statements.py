@@ -211,6 +211,8 @@ def _what(lhs: str):
         return "C", ref.index, 0  # Craig's {}^{0}P_{C_2}: from the base frame's origin, not frame 2's
     if ref is not None and ref.key in ("R", "P", "Pc", "T", "V", "Tl", "Vl"):
         return ref.key, ref.index, ref.frame
+    if ref is not None and ref.key == "Jv" and ref.index is not None:
+        return "CJ", ref.index, 0  # Spong's J_{v_{ck}}: link k's mass centre's velocity Jacobian
     if ref is not None and ref.key == "v_dot" and ref.index == 0:
         return "g", 0, ref.frame
     s = normalise(lhs)
