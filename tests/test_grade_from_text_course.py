@@ -127,3 +127,13 @@ def test_serve_worker_grades_the_texts_robot():
     assert odd["graded_as"] == FROM_TEXT and odd["error"] is None
     with pytest.raises(ModelError, match="unknown exercise"):
         g.robot("../../etc/passwd")
+
+
+def test_the_cache_key_holds_the_graders_source():
+    # a changed grader (robot_text included) must re-grade: its source is in the fingerprint
+    import hashlib
+
+    from armdyn import __version__
+    from armdyn.course.batch import _grader_fingerprint
+
+    assert _grader_fingerprint() != hashlib.sha256(__version__.encode()).hexdigest()

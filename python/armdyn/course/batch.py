@@ -259,9 +259,9 @@ def _grader_fingerprint() -> str:
     from .. import __version__
 
     h = hashlib.sha256(__version__.encode())
-    root = Path(__file__).resolve().parent.parent / "grade"
+    root = Path(__file__).resolve().parent.parent / "grading"  # the grader's package (robot_text, proofs too)
     for p in sorted(root.rglob("*.py")):
-        h.update(p.name.encode())
+        h.update(p.relative_to(root).as_posix().encode())
         h.update(p.read_bytes())
     return h.hexdigest()
 
