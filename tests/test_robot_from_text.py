@@ -3,6 +3,7 @@ same dynamics as the model the text was written from, conflicts and assumptions 
 
 from __future__ import annotations
 
+import math
 import os
 import random
 import time
@@ -133,11 +134,34 @@ $$\tau_2 = m_2 g$$
 """
 
 
-@pytest.mark.parametrize("name", ["planar-2r-lagrange.md", "planar-2r-craig.md", "standard-dh", "modified-dh"])
+def _as_array(text: str, env: str) -> str:
+    """The text's Markdown DH table written as a LaTeX ``env`` (array or tabular), on as many lines."""
+    lines = text.split("\n")
+    k = next(i for i, ln in enumerate(lines) if ln.startswith("|"))
+    cells = [[c.strip().strip("$") for c in ln.strip().strip("|").split("|")] for ln in lines[k : k + 4]]
+    spec = "{c|cccc}"
+    body = [
+        f"$$\\begin{{{env}}}{spec} " + " & ".join(cells[0]) + r" \\ \hline",
+        " & ".join(cells[2]) + r" \\",
+        " & ".join(cells[3]),
+        f"\\end{{{env}}}$$",
+    ]
+    return "\n".join(lines[:k] + body + lines[k + 4 :])
+
+
+DH_TEXTS = {
+    "standard-dh": STANDARD_DH,
+    "modified-dh": MODIFIED_DH,
+    "standard-dh-array": _as_array(STANDARD_DH, "array"),
+    "modified-dh-tabular": _as_array(MODIFIED_DH, "tabular"),
+}
+
+
+@pytest.mark.parametrize("name", ["planar-2r-lagrange.md", "planar-2r-craig.md", *DH_TEXTS])
 def test_planar_2r_read_has_spongs_dynamics(name, tmp_path):
-    if name.endswith("-dh"):
+    if name in DH_TEXTS:
         path = tmp_path / f"{name}.md"
-        path.write_text(STANDARD_DH if name == "standard-dh" else MODIFIED_DH, encoding="utf-8")
+        path.write_text(DH_TEXTS[name], encoding="utf-8")
         model = robot_from_text(read(str(path)))
         assert any(a.startswith(f"the DH table of line 3 is {name.split('-')[0]} DH") for a in model.assumptions)
         robot = model.robot
@@ -327,3 +351,26 @@ def test_principal_moments_used_by_name_are_the_links_inertia(tmp_path):
     for seed in range(3):
         at = _state(model.robot, {"Izz1": izz, "m1": m1, "lc1": lc1, "g": g}, seed)
         assert abs(_tau_at(model.robot, at)[0] - sp.N(pendulum.subs(at))) < 1e-9
+
+
+def test_gravity_stated_in_words_is_read_with_its_line(tmp_path):
+    # "gravity $g$ acts along $-y_0$" (line 27): the base frame's -y, the line named
+    text = show_model(read(_unnamed("planar-2r-lagrange.md", tmp_path)))
+    assert "gravity: [0, -g, 0]    # line 27: in words" in text
+    # turned to -x0 in the words: gravity along -x0, so V = g (m1 x_{c1} + m2 x_{c2}) and by hand
+    # dV/dq1 = -g (m1 lc1 + m2 (l1 + lc2)) at q = (pi/2, 0), zero at q = 0
+    sideways = _unnamed("planar-2r-lagrange.md", tmp_path, lambda t: t.replace("along $-y_0$", "along $-x_0$"))
+    model = robot_from_text(read(sideways))
+    assert "gravity: [-g, 0, 0]    # line 27: in words" in model.yaml
+    from armdyn.numeric import gravity
+
+    values = {"g": 9.81, "m1": 1.3, "m2": 0.7, "l1": 0.9, "lc1": 0.4, "lc2": 0.35, "I1": 0.1, "I2": 0.05}
+    arm = model.robot.bind({k: v for k, v in values.items() if k in model.robot.parameters})
+    hand = -9.81 * (1.3 * 0.4 + 0.7 * (0.9 + 0.35))
+    assert gravity(arm, [math.pi / 2, 0]) == pytest.approx([hand, -9.81 * 0.7 * 0.35], abs=1e-9)
+    assert gravity(arm, [0, 0]) == pytest.approx([0, 0], abs=1e-9)
+    # without the words: assumed along -y0, and said so
+    quiet = _unnamed("planar-2r-lagrange.md", tmp_path, lambda t: t.replace("gravity $g$ acts along $-y_0$", "g"))
+    assert any(
+        "no base acceleration or gravity vector is stated" in a for a in robot_from_text(read(quiet)).assumptions
+    )

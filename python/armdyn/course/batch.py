@@ -10,7 +10,10 @@ the text says (a front matter ``student:`` that differs gets a note); its varian
 roster's (``variants/<student>/``) when there is one, else the front matter's
 ``variant:``. With ``variants`` (the folder ``armdyn exercise make`` wrote) each
 submission is graded against ``variants/<variant>/model.yaml``; a submission whose
-variant is not there is not graded (status ``no-variant``). Without it, against the
+variant is not there is not graded (status ``no-variant``); one whose front matter names
+no ``robot:`` is graded against the robot its text describes, with a warning in its
+report when that differs from the variant's (:mod:`armdyn.grading.robot_text.assigned`;
+the variant's when the text's cannot be read). Without ``variants``, against the
 front matter's ``robot:``: a bundled name or a file directly in the folder (never a
 ``.xacro`` file: models are loaded untrusted). A second file for the same student, or
 one whose report would have the same file name (``a b`` and ``a_b``), is not graded
@@ -55,6 +58,7 @@ class Task:
     variant: str | None
     robot: str | None
     want_html: bool
+    from_text: bool = False  # names no model: graded against its text's, robot the assigned one to compare
 
 
 @dataclass
@@ -77,7 +81,10 @@ def grade_task(task: dict) -> dict:
     from ..grading import grade
 
     try:
-        report = grade(task["path"], robot=task["robot"])
+        if task.get("from_text"):
+            report = _graded_from_text(task)
+        else:
+            report = grade(task["path"], robot=task["robot"])
     except (ModelError, ValueError, OSError) as exc:
         return {"error": "error: " + " ".join(str(exc).split())}
     out = {"report": json.loads(report.to_json())}
@@ -86,6 +93,23 @@ def grade_task(task: dict) -> dict:
 
         out["html"] = report_html(report)
     return out
+
+
+def _graded_from_text(task: dict):
+    """A submission that names no model, in a class with variants: graded against the robot
+    its text describes, warned when that differs from the assigned variant's model (which
+    it is graded against when the text's cannot be read)."""
+    from ..grading import grade
+    from ..grading.reader import read
+    from ..grading.robot_text.assigned import model_for
+    from ..io import load
+
+    sub = read(task["path"])
+    assigned = load(task["robot"], strict=False)  # the course's model.yaml: a YAML file, never .xacro
+    model, notes = model_for(sub, assigned, f"variant {task['variant']}")
+    report = grade(sub, robot=model)
+    report.notes[:0] = notes
+    return report
 
 
 def _dask_task(task: dict, timeout: float, memory_mb: int | None) -> dict:
@@ -171,7 +195,7 @@ def discover(folder, variants=None, want_html: bool = False) -> Found:
         if unreadable:
             refused.append((student, variant, f"error: {unreadable}"))
             continue
-        robot = None
+        robot, from_text = None, False
         if variants is not None:
             own = student if os.path.isdir(os.path.join(variants, student)) else None
             if own is not None and variant not in (None, own):
@@ -189,6 +213,7 @@ def discover(folder, variants=None, want_html: bool = False) -> Found:
                 refused.append((student, variant, f"no-variant: {path}: {what}"))
                 continue
             robot = model
+            from_text = _name(meta.get("robot")) is None
         else:
             robot, why = _class_model(folder, _name(meta.get("robot")))
             if why:
@@ -207,7 +232,7 @@ def discover(folder, variants=None, want_html: bool = False) -> Found:
             refused.append((student, variant, why))
             continue
         owner[student], reports[report] = path, path
-        tasks.append(Task(path=path, student=student, variant=variant, robot=robot, want_html=want_html))
+        tasks.append(Task(path, student, variant, robot, want_html, from_text))
     return Found(tasks, refused, notes)
 
 
@@ -234,9 +259,9 @@ def _grader_fingerprint() -> str:
     from .. import __version__
 
     h = hashlib.sha256(__version__.encode())
-    root = Path(__file__).resolve().parent.parent / "grade"
+    root = Path(__file__).resolve().parent.parent / "grading"  # the grader's package (robot_text, proofs too)
     for p in sorted(root.rglob("*.py")):
-        h.update(p.name.encode())
+        h.update(p.relative_to(root).as_posix().encode())
         h.update(p.read_bytes())
     return h.hexdigest()
 
@@ -259,6 +284,7 @@ def cache_key(task: Task, rubric: Rubric, grader: str) -> str:
         rubric.fingerprint().encode(),
         grader.encode(),
         b"html" if task.want_html else b"",
+        b"from-text" if task.from_text else b"",
     ):
         h.update(hashlib.sha256(part).digest())
     return h.hexdigest()

@@ -9,6 +9,10 @@ then answers one JSON line on stdout for each JSON line on stdin:
       -> {"ok": true, "graded_as", "passed", "first_wrong", "error", "report_json",
           "report_html", "report_fragment"}       (error: the student's input error)
       -> {"ok": false, "reason": "..."}           (grading itself failed: no verdict)
+
+A submission that names no model (no exercise in the request, no ``robot:``) is graded
+against the robot its text describes, with a warning when that differs from the served
+variant its front matter's ``variant:`` names (see :mod:`armdyn.grading.robot_text.assigned`).
     {"kind": "preview", "exercise": ..., "markdown": "..."}
       -> {"ok": true, "html": "<ol>...</ol>"}     (each equation as read: sanitized MathML)
 
@@ -29,6 +33,8 @@ SUBMISSION = "submission.md"  # the name reports show; nothing is read from or w
 #: lazy imports and caches of the grader, the LaTeX reader and the HTML report
 WARM_UP = "$$\\omega_1^1 = \\begin{pmatrix} 0 \\\\ 0 \\\\ \\dot{\\theta}_1 \\end{pmatrix}$$\n$$\\tau_1 = 0$$\n"
 MAX_PREVIEW_EQUATIONS = 200
+#: ``graded_as`` of a submission graded against the robot its own text describes
+FROM_TEXT = "(read from the text)"
 
 
 def limit_memory(memory_mb: int) -> None:
@@ -81,6 +87,20 @@ class Grader:
                 return variant
         return robot
 
+    def from_text(self, sub, variant: str | None):
+        """A submission that names no model (no exercise chosen, no ``robot:``): graded
+        against the robot its text describes, warned when that differs from the served
+        variant its front matter names (graded against that one when the text's cannot be
+        read). ``(graded_as, report)``; graded_as ``FROM_TEXT`` for the text's robot."""
+        from ..grading import grade
+        from ..grading.robot_text.assigned import model_for
+
+        assigned = self.robot(variant) if variant else None  # only a whitelisted exercise
+        model, notes = model_for(sub, assigned, f"exercise {variant}" if variant else None)
+        report = grade(sub, robot=model)
+        report.notes[:0] = notes
+        return (variant if model is assigned else FROM_TEXT), report
+
     def grade(self, markdown: str, exercise: str | None) -> dict:
         from ..errors import ModelError
         from ..grading import grade
@@ -91,7 +111,10 @@ class Grader:
         try:
             sub = read_markdown(SUBMISSION, markdown)
             name = exercise or self.named(markdown, sub.robot)
-            report = grade(sub, robot=self.robot(name))
+            if exercise is None and sub.robot is None:
+                name, report = self.from_text(sub, name)
+            else:
+                report = grade(sub, robot=self.robot(name))
         except (ModelError, ValueError, RecursionError) as err:
             return {
                 "ok": True,

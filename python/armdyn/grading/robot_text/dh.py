@@ -51,30 +51,75 @@ def _cells(line: str) -> list[str]:
     return [c.strip() for c in line.strip().strip("|").split("|")]
 
 
+def _table(header: list[str], line: int, rows: list[tuple[int, list[str]]]) -> DhTable | None:
+    """A DH table from a header's cells (naming a, alpha, d and theta) and its rows' cells."""
+    columns = [_column(c) for c in header]
+    if not {"a", "alpha", "d", "theta"} <= {c[0] for c in columns if c}:
+        return None
+    modified = any(c[1] for c in columns if c and c[0] in ("a", "alpha"))
+    kept = [
+        (at, {c[0]: cell.strip("$ ") for c, cell in zip(columns, cells) if c})
+        for at, cells in rows[: MAX_ROWS + 1]
+        if len(cells) == len(columns)
+    ]
+    return DhTable(modified, line, kept)
+
+
+#: a DH table written in LaTeX: ``\begin{array}{c|cccc} i & a_{i-1} & ... \\ \hline 1 & ...``
+_LATEX_TABLE = re.compile(r"\\begin\{(array|tabular|matrix|bmatrix|pmatrix)\}(\{[^{}]{0,200}\})?")
+#: LaTeX tables looked at, at most, and the length of one (bounded time on any text)
+MAX_LATEX_TABLES = 200
+MAX_LATEX_TABLE_CHARS = 20_000
+
+
+_RULE = re.compile(r"\\(?:hline|toprule|midrule|bottomrule)")
+_RULES = re.compile(r"\s*(?:\\(?:hline|toprule|midrule|bottomrule)\s*)*")
+
+
+def _latex_tables(text: str) -> list[DhTable]:
+    """The DH tables written as a LaTeX array, tabular or matrix (rows split at ``\\\\``, cells at ``&``)."""
+    out: list[DhTable] = []
+    for n, m in enumerate(_LATEX_TABLE.finditer(text)):
+        end = text.find("\\end{" + m.group(1) + "}", m.end(), m.end() + MAX_LATEX_TABLE_CHARS)
+        if n >= MAX_LATEX_TABLES:
+            break
+        if end < 0:
+            continue
+        body, start = text[m.end() : end], m.end()
+        rows, at = [], 0
+        for part in re.split(r"\\\\", body):
+            lead = _RULES.match(part).end()  # the row's line: where its first cell is
+            line = text.count("\n", 0, start + at + lead) + 1
+            at += len(part) + 2
+            cells = [_RULE.sub("", c).strip() for c in part.split("&")]
+            if any(cells):
+                rows.append((line, cells))
+        if len(rows) >= 2:
+            table = _table(rows[0][1], rows[0][0], rows[1:])
+            if table is not None:
+                out.append(table)
+    return out
+
+
 def dh_tables(text: str) -> list[DhTable]:
-    """The DH tables of a Markdown text (a header naming a, alpha, d and theta)."""
+    """The DH tables of a Markdown text (a header naming a, alpha, d and theta): Markdown
+    tables, then tables written as a LaTeX array, tabular or matrix."""
     lines = text.split("\n")
     out: list[DhTable] = []
     k = 0
     while k < len(lines):
         line = lines[k]
         if line.lstrip().startswith("|") and k + 1 < len(lines) and re.fullmatch(r"\s*\|?[\s:|-]+\|?\s*", lines[k + 1]):
-            columns = [_column(c) for c in _cells(line)]
-            names = {c[0] for c in columns if c}
-            if {"a", "alpha", "d", "theta"} <= names:
-                modified = any(c[1] for c in columns if c and c[0] in ("a", "alpha"))
-                rows = []
-                j = k + 2
-                while j < len(lines) and lines[j].lstrip().startswith("|") and len(rows) <= MAX_ROWS:
-                    cells = _cells(lines[j])
-                    if len(cells) == len(columns):
-                        rows.append((j + 1, {c[0]: cell.strip("$ ") for c, cell in zip(columns, cells) if c}))
-                    j += 1
-                out.append(DhTable(modified, k + 1, rows))
+            j = k + 2
+            while j < len(lines) and lines[j].lstrip().startswith("|") and j - k <= MAX_ROWS + 2:
+                j += 1
+            table = _table(_cells(line), k + 1, [(i + 1, _cells(lines[i])) for i in range(k + 2, j)])
+            if table is not None:
+                out.append(table)
                 k = j
                 continue
         k += 1
-    return out
+    return out + _latex_tables(text)
 
 
 def table_equations(tables: list[DhTable]) -> list[Equation]:

@@ -1,5 +1,6 @@
 """Where the masses are, from an energy-method derivation: the mass centres' positions as
 functions of q (``p_{c2} = l_1(\\cos q_1, \\sin q_1) + ...``, ``x_{c2} = l_1 c_1 + l_{c2} c_{12}``)
+or their velocity Jacobians (Spong's ``J_{v_{ck}}``, integrated joint by joint and checked),
 or, failing those, the heights in the potential energy ``V = m_1 g h_1 + ...``: for a planar
 arm turning about z with gravity in its plane, the height ``a sin(phi) + b cos(phi)`` is the
 point ``Rz(phi) (a, b)``. Positions and V stated both are checked against each other.
@@ -14,8 +15,9 @@ import sympy as sp
 from .geometry import across, same, vector
 
 
-def _stated(statements, n: int, conflicts: list) -> dict:
+def _stated(statements, q: list, conflicts: list) -> dict:
     """Link k -> (position in the base frame, None, statement) from p_{ck}, x_{ck}, y_{ck}, z_{ck}."""
+    n = len(q)
     found: dict[int, tuple] = {}
     parts: dict[int, dict] = {}
     for st in statements:
@@ -41,15 +43,42 @@ def _stated(statements, n: int, conflicts: list) -> dict:
             continue
         first = min((s for _, s in comps.values()), key=lambda s: s.line)
         found[k] = (sp.Matrix([comps[i][0] if i in comps else 0 for i in range(3)]), None, first)
+    for st in statements:  # positions stated win; else the position whose Jacobian is stated
+        k = st.index
+        if st.what == "CJ" and k is not None and 1 <= k <= n and k not in found:
+            pos = _integrated(st.value, q)
+            if pos is None:
+                conflicts.append(f"line {st.line}: J_v{k} is not the Jacobian of one position (not used)")
+            else:
+                found[k] = (pos, None, st)
     return found
+
+
+def _integrated(J, q: list):
+    """The position p(q) (up to a constant) whose Jacobian dp/dq is ``J`` (3 x n, a column
+    per joint), or None when no position has it (checked at random values)."""
+    if not isinstance(J, sp.MatrixBase) or J.shape[0] not in (2, 3) or J.shape[1] > len(q):
+        return None
+    J = J if J.shape[0] == 3 else J.col_join(sp.zeros(1, J.shape[1]))
+    p = sp.zeros(3, 1)
+    for j in range(J.shape[1]):  # each column's part that the earlier joints' did not give
+        rest = (J[:, j] - p.diff(q[j])).applyfunc(sp.expand)
+        p += rest.applyfunc(lambda e, x=q[j]: sp.integrate(e, x))
+    p = p.applyfunc(sp.expand)
+    symbols = p.free_symbols | J.free_symbols
+    for j in range(len(q)):
+        column = J[:, j] if j < J.shape[1] else sp.zeros(3, 1)
+        if not same(p.diff(q[j]), column, symbols):
+            return None
+    return p
 
 
 def mass_centres(statements, gravity, q: list, revolute: set, free: set, conflicts: list) -> dict:
     """Link k's mass centre in the base frame -> (position, mass symbol or None, statement)."""
     n = len(q)
-    found = _stated(statements, n, conflicts)
+    found = _stated(statements, q, conflicts)
     for st in statements:
-        if st.what != "V" or isinstance(st.value, sp.MatrixBase):
+        if st.what not in ("V", "Vl") or isinstance(st.value, sp.MatrixBase):  # V, or one link's V_k
             continue
         axis = [i for i in range(3) if gravity[i] != 0]
         if len(axis) != 1 or axis[0] == 2:

@@ -28,6 +28,32 @@ from .geometry import (
 )
 from .statements import MAX_FRAMES, Names, Statement, all_equations, joint_candidates, read_statements
 
+#: "gravity acts along $-y_0$", "Gravity pulls along $-\\hat Y_0$", "gravity along -z"
+_GRAVITY_WORDS = re.compile(
+    r"[Gg]ravity\b[^.\n]{0,40}?\b(?:along|towards?|in the direction of)\s*\$?\s*(-|−|\+)?\s*"
+    r"(?:\\hat\s*\{?\s*|\\mathbf\s*\{\s*)?([xyzXYZ])(?![A-Za-z])"
+)
+
+
+def _gravity_in_words(text: str):
+    """(axis, sign, line) of the first sentence saying along which base axis gravity acts, or None."""
+    m = _GRAVITY_WORDS.search(text[:200_000])
+    if m is None:
+        return None
+    sign = 1 if m.group(1) in (None, "+") else -1
+    return "xyz".index(m.group(2).lower()), sign, text.count("\n", 0, m.start()) + 1
+
+
+def _energies(statements, what: str) -> list:
+    """The kinetic energies stated as a function of the rates (``K = K_1 + K_2`` names others: left out)."""
+    return [
+        st
+        for st in statements
+        if st.what == what
+        and not isinstance(st.value, sp.MatrixBase)
+        and any(s.name.endswith("_dot") for s in st.value.free_symbols)
+    ]
+
 
 @dataclass
 class TextModel:
@@ -70,6 +96,8 @@ class TextReader:
         self.equations = equations
         joints, written = joint_candidates(equations, self.sub.symbols)
         if not joints:
+            if self._proofs_only(text):
+                return self._no_arm()
             self.fail("no joint variable (\\theta_k, q_k, d_k) is written; name the model with --robot")
         n = max(joints)
         if n > MAX_FRAMES:
@@ -77,6 +105,7 @@ class TextReader:
                 f"joint variables numbered up to {n}: more frames than a derivation by hand has (at most {MAX_FRAMES})"
             )
         names = Names(joints, self.sub.symbols)
+        self.text, self.names = text, names
         statements = read_statements(equations, names, n)
         if tables:
             from_table, assumed, problems = dh_statements(tables, names)
@@ -119,6 +148,26 @@ class TextReader:
                             "while other frames' are"
                         )
         return self._build(statements, rot, revolute, gravity, g_line, coms)
+
+    def _proofs_only(self, text: str) -> bool:
+        """A text with proofs and no joint variable: a rigid-body proof needs no arm."""
+        from ..proofs import check_text
+
+        return bool(text) and bool(check_text(text, self.sub.path or "<string>", set()))
+
+    def _no_arm(self) -> TextModel:
+        """The model of a proof: no joints, no links (its links are checked on their own)."""
+        from ...io.yaml import load_yaml_string
+
+        text = (
+            f"# the robot read from {os.path.basename(self.sub.path)}: none (a proof, no joint variable)\n"
+            f"name: {model_name(self.sub.path)}\n"
+            "description: no arm; the text proves rigid-body identities\n"
+            "parameters: []\ngravity: [0, 0, 0]\njoints: []\nlinks: []\n"
+        )
+        robot = load_yaml_string(text, source=f"{self.sub.path} (the model read from it)", strict=False)
+        self.assumptions.append("no arm: no joint variable is written, and the text's proofs need none")
+        return TextModel(text, robot, self.assumptions, self.conflicts)
 
     @staticmethod
     def _symbols(value) -> set:
@@ -181,6 +230,16 @@ class TextReader:
             )
             self.gravity_source = f"line {first.line}: {first.source[:70]}"
             return g, first.line
+        worded = _gravity_in_words(getattr(self, "text", ""))
+        if worded is not None:
+            axis, sign, line = worded
+            g = sp.zeros(3, 1)
+            g[axis] = sign * sp.Symbol(self.names.named("g", ""))
+            self.assumptions.append(
+                f"gravity {pretty_vector(g)}, from line {line}'s words (along {'-' if sign < 0 else '+'}{'xyz'[axis]}0)"
+            )
+            self.gravity_source = f"line {line}: in words"
+            return g, line
         g = sp.Matrix([0, -sp.Symbol("g"), 0])
         self.assumptions.append("gravity (0, -g, 0), along -y0: no base acceleration or gravity vector is stated")
         return g, None
@@ -384,21 +443,21 @@ class TextReader:
         from ...io.yaml import load_yaml_string
 
         robot = load_yaml_string(text, source=f"{self.sub.path} (the model read from it)", strict=False)
-        self._check_T(statements, robot, g_line is None and any(c[2].what == "V" for c in coms.values()))
+        self._check_T(statements, robot, g_line is None and any(c[2].what in ("V", "Vl") for c in coms.values()))
         return TextModel(text, robot, self.assumptions, self.conflicts)
 
     def _com_source(self, k, coms, pc) -> str:
         if k in pc:
             return f"line {pc[k].line}: {pc[k].source[:70]}"
         if k in coms:
-            how = f"from the height of m{k} in V" if coms[k][2].what == "V" else coms[k][2].source[:70]
+            how = f"from the height of m{k} in V" if coms[k][2].what in ("V", "Vl") else coms[k][2].source[:70]
             return f"line {coms[k][2].line}: {how}"
         return "assumed"
 
     def _masses(self, statements, coms) -> dict:
         out = {k: (v[1], f"line {v[2].line}: m{k} in V") for k, v in coms.items() if v[1] is not None}
         for st in statements:
-            if st.what in ("T", "V") and not isinstance(st.value, sp.MatrixBase):
+            if st.what in ("T", "V", "Tl", "Vl") and not isinstance(st.value, sp.MatrixBase):
                 for s in st.value.free_symbols:
                     m = re.fullmatch(r"m(\d+)", s.name)
                     if m and int(m.group(1)) not in out:
@@ -426,8 +485,8 @@ class TextReader:
                     continue
                 out[k] = (yaml_matrix(st.value), f"line {st.line}: {st.source[:70]}", st.value)
                 out["symbols"] += list(st.value)
-        Ts = [st for st in statements if st.what == "T" and not isinstance(st.value, sp.MatrixBase)]
-        for st in Ts[:1]:
+        Ts, Tl = _energies(statements, "T"), _energies(statements, "Tl")
+        for st in Ts[:1] + Tl:  # the whole T, and each link's own T_k / K_k
             for s in st.value.free_symbols:
                 m = re.fullmatch(r"I(?:zz)?(\d+)", s.name)
                 if m and int(m.group(1)) <= self.n and int(m.group(1)) not in out:
@@ -467,7 +526,7 @@ class TextReader:
 
     def _check_T(self, statements, robot: Robot, gravity_assumed: bool):
         """A stated T must be the kinetic energy of the model read (else the positions or inertias disagree)."""
-        Ts = [st for st in statements if st.what == "T" and not isinstance(st.value, sp.MatrixBase)]
+        Ts = _energies(statements, "T")
         if not Ts:
             return
         from ...symbolic.lagrange import link_energies

@@ -105,8 +105,8 @@ def joint_candidates(equations: list[Equation], explicit: dict | None = None) ->
         for text in (eq.lhs, str(eq.value)):
             for m in pattern.finditer(text):
                 k, base = int(m.group(2)), m.group(1).lstrip("\\").replace("vartheta", "theta")
-                if k < 1:
-                    continue
+                if k < 1 or (base == "d" and len(m.group(2)) > 1):
+                    continue  # d_{12}: an entry of Spong's inertia matrix D(q), not a slide
                 if k not in found or (found[k].startswith("d") and base != "d"):
                     found[k] = f"{base}{k}"
     names = Names({}, explicit)
@@ -209,8 +209,10 @@ def _what(lhs: str):
     if ref is not None and ref.key in ("P", "Pc") and ref.origin not in (None, ref.index - (ref.key == "P")):
         # Craig's {}^{j}P_{C_i} starts at frame j's origin: at the base's, the mass centre in the base frame
         return ("C", ref.index, 0) if ref.key == "Pc" and ref.origin == 0 else None
-    if ref is not None and ref.key in ("R", "P", "Pc", "T", "V"):
+    if ref is not None and ref.key in ("R", "P", "Pc", "T", "V", "Tl", "Vl"):
         return ref.key, ref.index, ref.frame
+    if ref is not None and ref.key == "Jv" and ref.index is not None:
+        return "CJ", ref.index, 0  # Spong's J_{v_{ck}}: link k's mass centre's velocity Jacobian
     if ref is not None and ref.key == "v_dot" and ref.index == 0:
         return "g", 0, ref.frame
     s = normalise(lhs)

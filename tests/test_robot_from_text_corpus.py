@@ -1,0 +1,91 @@
+"""Every example and corpus derivation graded with its ``robot:`` line removed (the model
+read from the text) against the same file graded with its bundled model: the same
+verdicts (line, name, status per equation), or the reason it cannot, documented in
+docs/grading.md ("The corpus without `robot:`"), is the error the reading gives."""
+
+from __future__ import annotations
+
+import glob
+import os
+import re
+
+import pytest
+
+from armdyn.errors import ModelError
+from armdyn.grading import grade
+
+HERE = os.path.dirname(__file__)
+ROOT = os.path.join(HERE, "..")
+FILES = sorted(
+    p
+    for d in (os.path.join(ROOT, "examples", "grading"), os.path.join(HERE, "corpus"))
+    for p in glob.glob(os.path.join(d, "*.md"))
+    if not p.endswith("README.md")
+)
+
+_NO_POSITION = "frame 1's origin is not stated"
+#: file -> the error the reading gives (what the text does not state), or the lines whose
+#: verdicts differ (a slip in the only statement of the geometry becomes the geometry read)
+NOT_SAME: dict[str, str | set[int]] = {
+    # the quill's height is stated (z_{c3}), not where links 1 and 2 put it in the plane
+    "scara-lagrange.md": "joint variable q3 moves nothing",
+    # Newton-Euler in Craig's frames: P_1, P_2, {}^{i}P_{C_i} are used but given no value
+    "planar-2r-craig-align.md": _NO_POSITION,
+    "planar-2r-craig-transposed.md": _NO_POSITION,
+    # the closed-form M, c, g only: the geometry is in words
+    "planar-2r-lynch-park.md": _NO_POSITION,
+    "planar-2r-lynch-park-gamma.md": _NO_POSITION,
+    "planar-2r-siciliano.md": _NO_POSITION,
+    "planar-2r-spong-christoffel.md": _NO_POSITION,
+    # the forward recursion of link 2 only: links 1 and 3 are placed in words
+    "planar-3r-spong-superscripts.md": _NO_POSITION,
+    # links 1 and 3 are placed (x_{c1}, y_{c3}, P_1, P_3); link 2 only in words
+    "planar-3r-rods-energy.md": "frame 2's origin is not stated",
+    # vectors in frame i; masses only as m_i of a generic link in the prose
+    "planar-3r-spong-ne-slip.md": "no mass of link 1",
+    # the planar links' geometry in words; only the quill's height and energies stated
+    "scara-inertia-matrix-slip.md": "no variable of joint 3 is written",
+    "scara-mathfence-slip.md": "moves with other joints than joint 3",
+    # link 3's height is stated only by P_3, with its slip (a dropped l_2 sin(q1+q2)): the arm
+    # read hangs link 3 from joint 2, and P_3, P, phi_1, phi_2, g(q) agree with it
+    "planar-3r-gravity-slip.md": {30, 35, 39, 41, 45},
+}
+
+
+def _unnamed(path: str, tmp_path) -> str:
+    """The file with its front matter's ``robot:`` line made a comment (lines kept)."""
+    lines = open(path, encoding="utf-8").read().split("\n")
+    assert sum(ln.startswith("robot:") for ln in lines) == 1, "each file names its robot once"
+    out = tmp_path / os.path.basename(path)
+    out.write_text("\n".join("# (robot removed)" if ln.startswith("robot:") else ln for ln in lines), "utf-8")
+    return str(out)
+
+
+def _verdicts(report):
+    return [(v.line, v.name, v.status) for v in report.steps]
+
+
+def test_every_file_is_listed_here():
+    names = {os.path.basename(p) for p in FILES}
+    assert len(names) == len(FILES) == 32
+    assert set(NOT_SAME) <= names
+
+
+@pytest.mark.parametrize("path", FILES, ids=os.path.basename)
+def test_same_verdicts_without_robot_or_the_documented_reason(path, tmp_path):
+    named = _verdicts(grade(path))
+    assert named, "the file grades some equation with its model"
+    expected = NOT_SAME.get(os.path.basename(path))
+    unnamed_path = _unnamed(path, tmp_path)
+    if isinstance(expected, str):
+        with pytest.raises(ModelError, match="cannot read the robot from the text: .*" + re.escape(expected)):
+            grade(unnamed_path)
+        return
+    report = grade(unnamed_path)
+    assert report.notes[0].startswith("model read from the text")
+    unnamed = _verdicts(report)
+    if expected is None:
+        assert unnamed == named
+    else:
+        assert [v[:2] for v in unnamed] == [v[:2] for v in named]
+        assert {a[0] for a, b in zip(named, unnamed, strict=True) if a != b} == expected
