@@ -18,7 +18,8 @@ import yaml
 import armdyn
 from armdyn.cli import main
 from armdyn.grading import grade
-from armdyn.grading.latex import LatexError, parse, parse_sympy_syntax, split_equations
+from armdyn.grading.latex import LatexError, parse, split_equations
+from armdyn.grading.sympy_syntax import parse_sympy_syntax
 
 HERE = Path(__file__).resolve().parent
 EXAMPLES = HERE.parent / "examples" / "grading"

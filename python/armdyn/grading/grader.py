@@ -22,12 +22,13 @@ from .energy_steps import EnergySteps
 from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, tidy
 from .kinematics_steps import KinematicsSteps, confirm_used
-from .latex import LatexError, UnknownSymbol, parse_sympy_syntax
+from .latex import LatexError, UnknownSymbol
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
 from .reader import Submission, read
 from .statements import FREE_END, lagrange_law, matrix_form
+from .sympy_syntax import parse_sympy_syntax
 from .verdict import PASSING, GradeReport, StepVerdict
 from .vocabulary import MODEL_KEYS, student_names
 
