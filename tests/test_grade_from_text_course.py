@@ -18,7 +18,7 @@ from armdyn.grading import grade
 from armdyn.grading.reader import read
 from armdyn.grading.robot_text import robot_from_text
 from armdyn.grading.robot_text.assigned import dynamics_differ
-from armdyn.io import _bundled_files
+from armdyn.io import bundled_files
 from armdyn.serve.worker import FROM_TEXT, Grader
 
 HERE = os.path.dirname(__file__)
@@ -41,7 +41,7 @@ def klass(tmp_path):
     variants = tmp_path / "variants"
     for vid, model in (("v2r", "planar-2r"), ("vrp", "rp-arm"), ("vsc", "scara")):
         (variants / vid).mkdir(parents=True)
-        shutil.copy(_bundled_files()[model], variants / vid / "model.yaml")
+        shutil.copy(bundled_files()[model], variants / vid / "model.yaml")
     subs = tmp_path / "subs"
     subs.mkdir()
     (subs / "alice.md").write_text(_text("planar-2r-lagrange.md", "variant: v2r"), "utf-8")

@@ -354,5 +354,7 @@ def test_craigs_position_of_a_mass_centre_in_the_base_frame(tmp_path):
         for v in (base, from_frame_2, base + from_frame_2)
     )
     r = _grade(tmp_path, body + "\n", head=HEAD.replace("lagrange", "newton-euler"))
-    assert [v.status for v in r.steps] == ["correct", "correct", "wrong"]
-    assert "seen from frame 0's origin" in r.steps[0].message
+    # the pre-superscript names where the vector starts (Craig): only the base reading is right,
+    # and a wrong one says which reading was checked
+    assert [v.status for v in r.steps] == ["correct", "wrong", "wrong"]
+    assert "from frame 0's origin" in r.steps[1].message, r.steps[1].message

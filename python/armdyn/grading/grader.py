@@ -556,7 +556,7 @@ def grade(
     elif robot or sub.robot:
         # a stated model wins: the text's statements are only checked; only a model given
         # by the caller (never the front matter's) may be a trusted .xacro
-        model = _load_robot(robot or sub.robot, sub, trusted=bool(trusted and robot))
+        model = _load_robot(robot or sub.robot or "", sub, trusted=bool(trusted and robot))
     else:
         from .robot_text import robot_from_text
 

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import Any
 
 import sympy as sp
 
@@ -338,7 +339,7 @@ class SymbolMap:
         self.shorthand: dict = {}
         self.used_gravity_magnitude = False
         #: the names the student gave values to (:class:`~.defined.DefinedNames`), when grading
-        self.defined = None
+        self.defined: Any = None  # duck-typed (lookup, model): .defined imports this module
         for student, model in (explicit or {}).items():
             key = self._key_of(str(student))
             target = self.names.get(str(model))
