@@ -69,6 +69,8 @@ class FileScore:
     extra: int = 0  # steps at lines no truth equation spans (prose read as an equation?)
     agree: int = 0  # read equations whose verdict agrees with the truth
     model_seconds: float = 0.0  # --no-robot: reading the model from the text
+    steps: int = 0  # equations that are dynamics steps (truth not "not-a-step")
+    steps_read: int = 0
 
 
 def pairs(directory: Path):
@@ -115,6 +117,8 @@ def judge(equation: dict, steps: list) -> tuple[bool, str]:
         return False, ""
     statuses = {s.status for s in read}
     truth = equation["truth"]
+    if truth == "not-a-step":  # a law stated, a definition, a prose formula: any verdict but wrong is fine
+        return True, "false alarm" if statuses & FLAGGED else ""
     if truth == "right":
         return True, "false alarm" if statuses & FLAGGED else ""
     if statuses & RIGHT_OK and not statuses & FLAGGED:
@@ -141,6 +145,7 @@ def score(md: Path, truth_path: Path, no_robot: bool = False) -> FileScore:
     fs.right_eqs = sum(e["truth"] == "right" for e in eqs)
     fs.slips = sum(e["truth"] == "wrong" for e in eqs)
     fs.follows = sum(e["truth"] == "follows" for e in eqs)
+    fs.steps = sum(e["truth"] != "not-a-step" for e in eqs)
     graded = md
     if no_robot:
         from armdyn.grading.reader import read
@@ -167,6 +172,7 @@ def score(md: Path, truth_path: Path, no_robot: bool = False) -> FileScore:
         steps = by_eq.get(k, [])
         read, problem = judge(e, steps)
         fs.read += read
+        fs.steps_read += read and e["truth"] != "not-a-step"
         fs.agree += read and not problem
         if problem == "false alarm":
             fs.false_alarms.append(e["line"])
@@ -213,6 +219,10 @@ def main(argv=None) -> int:
     print("-" * len(head))
     print(f"files {len(scores)}, refused {refused}                        (target: 0 refused)")
     print(f"equations {n}, read {read} = {100 * read / n:.1f} %               (target: >= 95 %)")
+    steps = sum(s.steps for s in scores)
+    if steps != n:  # truth files that mark some equations not-a-step (laws stated, definitions)
+        steps_read = sum(s.steps_read for s in scores)
+        print(f"  of them dynamics steps {steps}, read {steps_read} = {100 * steps_read / steps:.1f} %")
     agree = sum(s.agree for s in scores)
     print(f"verdicts that agree with the truth {agree}/{read} of the equations read")
     print(f"slips found at their line {found}/{slips}                  (target: all)")
