@@ -268,6 +268,9 @@ class _Grader(EnergySteps, KinematicsSteps):
                 return
             self._unrecognised(eq, definition(self, eq) or "not a step of Newton-Euler or Lagrange (skipped)")
             return
+        if ref.key in ("tau", "tau_vec") and eq.latex and matrix_form(eq.lhs, str(eq.value)):  # τ = M q̈ + C q̇ + g
+            self._matrix_form(eq)
+            return
         ref, assumed = self._vocabulary(ref, eq, seen_methods)  # energy-method names; by the value's shape
         if ref is None:
             return
