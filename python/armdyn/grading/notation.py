@@ -364,6 +364,8 @@ class SymbolMap:
         return f"{text}|0|"
 
     def __call__(self, name: Name):
+        if name.hat and not name.dots and name.base in UNIT_AXES:  # \hat X_1: the frame's own axis
+            return sp.Matrix([1 if k == UNIT_AXES[name.base] else 0 for k in range(3)])
         sub = _plain(name.sub)
         key = f"{name.base}|{name.dots}|{sub}"
         if key in self.explicit:
@@ -426,6 +428,10 @@ class SymbolMap:
                 if value == sym:
                     return k + 1, order
         return None
+
+
+#: the letters that under \hat are a frame's unit axes (Craig's X̂, Ŷ, Ẑ; x̂; î, ĵ, k̂) -> the axis
+UNIT_AXES = {"X": 0, "Y": 1, "Z": 2, "x": 0, "y": 1, "z": 2, "i": 0, "j": 1, "k": 2}
 
 
 def _plain(sub: str) -> str:
