@@ -88,10 +88,11 @@ _MATRIX_LETTER = re.compile(r"^(?:M|D|H|C|V|G|g|B|N|h|b|c)(?:\([^()]*\))?")
 
 
 #: a whole term of the vector form: a matrix letter (``[M]`` too), its arguments, and an
-#: un-indexed joint vector (``\ddot{q}``, ``\dot{\Theta}``) or none
+#: un-indexed joint vector (``\ddot{q}``, ``\dot{\Theta}``), Craig's configuration-space rate
+#: products (``B(\Theta)(\dot\Theta\dot\Theta)``, ``C(\Theta)[\dot\Theta^2]``) or none
 _VECTOR_TERM = re.compile(
     r"^(?:\[(?:M|D|H|C|V|G|g|B|N|h|b|c)\]|(?:M|D|H|C|V|G|g|B|N|h|b|c)(?:\([^()]*\))?)"
-    r"(?:\\d?dot\{\\?[A-Za-z]+\})?$"
+    r"(?:\\d?dot\{\\?[A-Za-z]+\}|[(\[](?:\\dot\{\\?[A-Za-z]+\}(?:\^\{?2\}?)?){1,2}[)\]])?$"
 )
 
 
