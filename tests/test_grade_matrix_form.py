@@ -129,6 +129,8 @@ def test_a_vector_written_with_unit_axes_is_graded(tmp_path):
     )
     report = _grade(tmp_path, body, head=CRAIG)
     assert [v.status for v in report.steps] == ["correct", "correct", "wrong", "correct"]
+    note = next(n for n in report.notes if "unit axes" in n)  # the reading is said, not silent
+    assert r"\hat Y_{0}" in note and r"\hat Z_{1}" in note
 
 
 # ------------------------------------------------------------ Coriolis entries, Lynch & Park's energies

@@ -337,6 +337,8 @@ class SymbolMap:
         #: sin/cos of the angles the student wrote as shorthand -> a symbol printing as theirs (s₁₂)
         self.shorthand: dict = {}
         self.used_gravity_magnitude = False
+        #: the hatted axes read as unit columns (\hat X_1), for the report's notes
+        self.unit_axes: set[str] = set()
         #: the names the student gave values to (:class:`~.defined.DefinedNames`), when grading
         self.defined = None
         for student, model in (explicit or {}).items():
@@ -365,6 +367,7 @@ class SymbolMap:
 
     def __call__(self, name: Name):
         if name.hat and not name.dots and name.base in UNIT_AXES:  # \hat X_1: the frame's own axis
+            self.unit_axes.add("\\hat " + Name(name.base, sub=name.sub).latex())
             return sp.Matrix([1 if k == UNIT_AXES[name.base] else 0 for k in range(3)])
         sub = _plain(name.sub)
         key = f"{name.base}|{name.dots}|{sub}"
