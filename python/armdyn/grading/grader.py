@@ -268,6 +268,9 @@ class _Grader(EnergySteps, KinematicsSteps):
                 return
             self._unrecognised(eq, definition(self, eq) or "not a step of Newton-Euler or Lagrange (skipped)")
             return
+        if ref.key in ("tau", "tau_vec") and eq.latex and matrix_form(eq.lhs, str(eq.value)):  # τ = M q̈ + C q̇ + g
+            self._matrix_form(eq)
+            return
         ref, assumed = self._vocabulary(ref, eq, seen_methods)  # energy-method names; by the value's shape
         if ref is None:
             return
@@ -322,6 +325,11 @@ class _Grader(EnergySteps, KinematicsSteps):
                 tau_correct[int(v.name.split("_")[1]) - 1] = v.status in (*PASSING, "correct-but-unsupported")
         if self.symbols.used_gravity_magnitude:
             self.notes.append("g read as the magnitude of the model's gravity vector")
+        if self.symbols.unit_axes:
+            self.notes.append(
+                f"{', '.join(sorted(self.symbols.unit_axes))} read as unit axes, (1, 0, 0), (0, 1, 0), (0, 0, 1), "
+                "in the frame of the vector they are written in"
+            )
         method_name = "+".join(seen_methods) or (method_hint or "newton-euler")
         return GradeReport(
             robot=self.robot.name,

@@ -29,7 +29,7 @@ term (``a {\\color{red} - b}``) is added, not multiplied (braces are invisible i
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import sympy as sp
 
@@ -145,6 +145,8 @@ class Name:
     sup: str = ""
     pre_sup: str = ""  # {}^{2}_{1}R: the scripts written before the name (a step's frames)
     pre_sub: str = ""
+    #: written under \hat (``\hat X_1``: a unit vector); not part of the name's identity
+    hat: bool = field(default=False, compare=False)
 
     def latex(self) -> str:
         base = f"\\{self.base}" if self.base in GREEK else self.base
@@ -403,12 +405,9 @@ class _Parser:
                 self.take()
                 value = self.expr()
                 if tok == "(" and self.peek() == ("char", ","):  # (a, b, c): a row, usually ^T after it
-                    row = [value]
-                    while self.peek() == ("char", ","):
-                        self.take()
-                        row.append(self.expr())
+                    row = self._row(value)
                     self.expect("char", ")")
-                    return sp.Matrix([row])
+                    return row
                 self.expect("char", ")" if tok == "(" else "]")
                 return value
             if tok == "{":
@@ -430,6 +429,8 @@ class _Parser:
                 opener = self.take()[1]
                 if opener in ("(", "["):
                     value = self.expr()
+                    if opener == "(" and self.peek() == ("char", ","):  # \left(a, b\right): a row too
+                        value = self._row(value)
                     self.expect("cmd", "right")
                     self.take()
                     return value
@@ -533,6 +534,14 @@ class _Parser:
             return self._resolve(Name(base), start)
         return self._braced()
 
+    def _row(self, first):
+        """``first, b, c``: the rest of a comma-separated row after its first entry, as a 1×n matrix."""
+        row = [first]
+        while self.peek() == ("char", ","):
+            self.take()
+            row.append(self.expr())
+        return sp.Matrix([row])
+
     def _braced(self):
         self.expect("char", "{")
         value = self.expr()
@@ -560,6 +569,7 @@ class _Parser:
 
     def _symbol(self, pre_sup: str = "", pre_sub: str = "", start: int | None = None):
         start = self.at(self.i) if start is None else start
+        hat = self.peek() == ("cmd", "hat")
         dots, base, sub = self._accented()
         if base[0].isdigit() and not (pre_sup or pre_sub):  # \mathbf{0}: a number in bold
             return sp.Rational(base)
@@ -574,7 +584,7 @@ class _Parser:
             exponent = self.script_value()
             self.take()
             sub = self.group_text()
-        name = Name(base, dots + primes, sub, pre_sup=pre_sup, pre_sub=pre_sub)
+        name = Name(base, dots + primes, sub, pre_sup=pre_sup, pre_sub=pre_sub, hat=hat)
         try:
             value = self._resolve(name, start)
         except UnknownSymbol as err:

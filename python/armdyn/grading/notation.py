@@ -338,6 +338,8 @@ class SymbolMap:
         #: sin/cos of the angles the student wrote as shorthand -> a symbol printing as theirs (s₁₂)
         self.shorthand: dict = {}
         self.used_gravity_magnitude = False
+        #: the hatted axes read as unit columns (\hat X_1), for the report's notes
+        self.unit_axes: set[str] = set()
         #: the names the student gave values to (:class:`~.defined.DefinedNames`), when grading
         self.defined: Any = None  # duck-typed (lookup, model): .defined imports this module
         for student, model in (explicit or {}).items():
@@ -365,6 +367,9 @@ class SymbolMap:
         return f"{text}|0|"
 
     def __call__(self, name: Name):
+        if name.hat and not name.dots and name.base in UNIT_AXES:  # \hat X_1: the frame's own axis
+            self.unit_axes.add("\\hat " + Name(name.base, sub=name.sub).latex())
+            return sp.Matrix([1 if k == UNIT_AXES[name.base] else 0 for k in range(3)])
         sub = _plain(name.sub)
         key = f"{name.base}|{name.dots}|{sub}"
         if key in self.explicit:
@@ -427,6 +432,10 @@ class SymbolMap:
                 if value == sym:
                     return k + 1, order
         return None
+
+
+#: the letters that under \hat are a frame's unit axes (Craig's X̂, Ŷ, Ẑ; x̂; î, ĵ, k̂) -> the axis
+UNIT_AXES = {"X": 0, "Y": 1, "Z": 2, "x": 0, "y": 1, "z": 2, "i": 0, "j": 1, "k": 2}
 
 
 def _plain(sub: str) -> str:

@@ -87,13 +87,27 @@ def lagrange_law(lhs: str, rhs: str) -> tuple[bool, str] | None:
 _MATRIX_LETTER = re.compile(r"^(?:M|D|H|C|V|G|g|B|N|h|b|c)(?:\([^()]*\))?")
 
 
+#: a whole term of the vector form: a matrix letter (``[M]`` too), its arguments, and an
+#: un-indexed joint vector (``\ddot{q}``, ``\dot{\Theta}``), Craig's configuration-space rate
+#: products (``B(\Theta)(\dot\Theta\dot\Theta)``, ``C(\Theta)[\dot\Theta^2]``) or none
+_VECTOR_TERM = re.compile(
+    r"^(?:\[(?:M|D|H|C|V|G|g|B|N|h|b|c)\]|(?:M|D|H|C|V|G|g|B|N|h|b|c)(?:\([^()]*\))?)"
+    r"(?:\\d?dot\{\\?[A-Za-z]+\}|[(\[](?:\\dot\{\\?[A-Za-z]+\}(?:\^\{?2\}?)?){1,2}[)\]])?$"
+)
+
+
 def matrix_form(lhs: str, rhs: str) -> bool:
     """Is ``lhs = rhs`` the equations of motion in matrix form, ``M(q) q̈ + C(q, q̇) q̇ +
     g(q) = τ`` (Spong's ``D``, Craig's ``V(θ, θ̇)`` and ``G(θ)``, Siciliano's ``B(q)``, Lynch &
-    Park's ``c(θ, θ̇)``; either side first)?"""
+    Park's ``c(θ, θ̇)``; either side first)? With ``τ`` first every term must be a whole
+    matrix times an un-indexed joint vector (``τ = [M]q̈ + [C]q̇ + [G]``), so that one
+    joint's torque written out with entries (``τ_1 = M_{11} q̈_1 + …``) stays a step."""
     left, right = normalise(lhs), normalise(rhs)
     if _RHS_TORQUE.match(left) and not _RHS_TORQUE.match(right):
-        left, right = right, left
+        terms = [t for _, t in _signed_terms(right)]
+        if not all(_VECTOR_TERM.match(t) for t in terms) or not left.startswith("\\tau"):
+            return False
+        left, right = "+".join(re.sub(r"^\[(\w)\]", r"\1", t) for t in terms), left
     if not _RHS_TORQUE.match(right):
         return False
     terms = [t for _, t in _signed_terms(left)]

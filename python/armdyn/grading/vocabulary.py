@@ -8,9 +8,10 @@ quantities differently; each name below maps to one key of
 =============  ==================================================================
 key            names
 =============  ==================================================================
-T (total)      ``K``, ``T``, ``KE``, ``k``, ``E_k``, ``\\mathcal{K}``, ``\\mathcal{T}``
+T (total)      ``K``, ``T``, ``KE``, ``k``, ``E_k``, ``\\mathcal{E}_K``, ``\\mathcal{K}``, ``\\mathcal{T}``
 V (total)      ``U``, ``V``, ``P``, ``PE``, ``u``, ``E_p``, ``\\mathcal{U}``, ``\\mathcal{V}``, ``\\mathcal{P}``
-Tl, Vl         the same with a link index: ``K_1``, ``T_2``, ``KE_1``, ``PE_1``, ``u_2``, ``P_1``
+Tl, Vl         the same with a link index: ``K_1``, ``T_2``, ``KE_1``, ``PE_1``, ``u_2``, ``P_1``,
+               ``\\mathcal{E}_{K_1}`` (Lynch & Park)
 pc             ``p_{c1}``, ``r_{c_2}``, ``x_{c1}`` / ``y_{c1}`` / ``z_{c1}`` (one component);
                ``x_1``, ``y_2`` without the c when the value moves with the joints
 vc             ``v_{c1}``, ``\\dot p_{c1}``, ``\\dot x_{c1}``, ``\\dot x_1``; squared: ``v_{c1}^2``,
@@ -39,8 +40,8 @@ import re
 
 from .text import NOT_A_STEP
 
-_KINETIC = r"K|T|KE|k|E_\{?k\}?|E_\{?kin\}?|KE"
-_POTENTIAL = r"U|V|P|PE|u|E_\{?p\}?|E_\{?pot\}?"
+_KINETIC = r"K|T|KE|k|E_\{?[kK]\}?|E_\{?kin\}?|KE"
+_POTENTIAL = r"U|V|P|PE|u|E_\{?[pP]\}?|E_\{?pot\}?"
 #: a function's arguments as students write them after a name: (q), (q,\dot{q}), (\theta,\dot\theta)
 _ARGS = re.compile(r"\(([\\A-Za-z{},]+)\)$")  # one character class: linear, no nested repetition
 _ARG = re.compile(r"\\?[A-Za-z]+|\\d?dot\{\\?[A-Za-z]+\}")
@@ -167,9 +168,9 @@ def _indexed(s: str, ref_type):
         return ref_type("G", entry=(_index(sub),), alias=base, by_shape=base == "g")
     i = _index(sub)
     if i is None:
-        e = re.fullmatch(r"\{?([kp]),?(\d+)\}?", sub or "")  # E_{k,1}, E_{p1}
+        e = re.fullmatch(r"\{?([kpKP])[,_]?\{?(\d+)\}?\}?", sub or "")  # E_{k,1}, E_{p1}, E_{K_1} (Lynch & Park)
         if base == "E" and e:
-            return ref_type("Tl" if e.group(1) == "k" else "Vl", int(e.group(2)), alias="E_" + e.group(1))
+            return ref_type("Tl" if e.group(1) in "kK" else "Vl", int(e.group(2)), alias="E_" + e.group(1))
         return None
     if re.fullmatch(_KINETIC, base):
         return ref_type("Tl", i, alias=base)
