@@ -189,3 +189,20 @@ def test_a_partial_by_the_joint_vector_as_a_row(tmp_path):
     )
     report = _grade(tmp_path, body + "\n")
     assert [v.status for v in report.steps] == ["correct"] * 6 + ["wrong", "wrong"]
+
+
+def test_an_unreadable_matrix_before_the_matrix_form_is_not_an_error(tmp_path):
+    """A G that could not be read (here a 2x3 product), then the right G: the matrix form
+    stated after them is the law with a right G, not a consequence of an error."""
+    g = r"\begin{bmatrix} (m_1 l_{c1} + m_2 l_1) g\cos q_1 + m_2 l_{c2} g\cos(q_1 + q_2) \\ m_2 l_{c2} g\cos(q_1 + q_2) \end{bmatrix}"
+    body = (
+        r"$$G = \begin{bmatrix} 1 & 0 & 0 \\ 0 & 1 & 0 \end{bmatrix}$$" + "\n\n"
+        f"$$G = {g}$$\n\n"
+        r"$$\tau = M(q)\ddot{q} + C(q,\dot{q})\dot{q} + G(q)$$" + "\n"
+    )
+    path = tmp_path / "g.md"
+    path.write_text(
+        "---\nrobot: planar-2r\nsymbols: {'l_{c1}': lc1, 'l_{c2}': lc2, 'l_1': l1}\n---\n" + body, encoding="utf-8"
+    )
+    steps = grade(str(path)).steps
+    assert [v.status for v in steps] == ["unrecognised", "correct", "correct"], [(v.status, v.message) for v in steps]

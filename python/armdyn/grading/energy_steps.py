@@ -268,7 +268,11 @@ class EnergySteps:
     def _matrix_form(self, eq) -> None:
         """``M q̈ + C q̇ + g = τ`` stated: right when every matrix given before it is, else
         it follows from the first wrong one."""
-        given = [v for v in self.verdicts if v.key in _MATRICES]
+        latest: dict = {}  # each matrix as last graded (one that could not be read says nothing)
+        for v in self.verdicts:
+            if v.key in _MATRICES and v.status != "unrecognised":
+                latest[v.name] = v
+        given = list(latest.values())
         bad = [v for v in given if v.status not in PASSING]
         caused_by = None
         if bad:  # the law is stated right; it inherits the wrong matrices
