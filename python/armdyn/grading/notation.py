@@ -44,7 +44,7 @@ import sympy as sp
 
 from ..model import Robot
 from .latex import LatexError, Name, UnknownSymbol, parse
-from .vocabulary import MODEL_KEYS, energy_lhs, mass_centre, model_name
+from .vocabulary import MODEL_KEYS, energy_lhs, mass_centre, model_name, scripts
 
 VECTOR_KEYS = ("omega", "omega_dot", "v_dot", "vc_dot", "F", "N", "f", "n")
 LAGRANGE_KEYS = ("T", "V", "L", "dL_dqd", "ddt_dL_dqd", "dL_dq", "dT_dq", "dV_dq")
@@ -118,31 +118,6 @@ def _primed(m) -> str:
     return f"\\{'dot' if len(m.group(3)) == 1 else 'ddot'}{{{m.group(1)}}}{m.group(2) or ''}"
 
 
-def _scripts(s: str, i: int):
-    """Read ``_X`` / ``^X`` pairs from ``s[i:]``; returns (sub, sup, end)."""
-    sub = sup = None
-    while i < len(s) and s[i] in "_^":
-        mark = s[i]
-        i += 1
-        if i < len(s) and s[i] == "{":
-            depth, j = 1, i + 1
-            while j < len(s) and depth:
-                depth += {"{": 1, "}": -1}.get(s[j], 0)
-                j += 1
-            text, i = s[i + 1 : j - 1], j
-        elif i < len(s) and s[i] == "\\":
-            m = re.match(r"\\[A-Za-z]+", s[i:])
-            text = m.group(0) if m else s[i : i + 2]
-            i += len(text)
-        else:
-            text, i = s[i : i + 1], i + 1
-        if mark == "_":
-            sub = text if sub is None else sub + "," + text
-        else:
-            sup = text if sup is None else sup + "," + text
-    return sub, sup, i
-
-
 def _int(text: str | None) -> int | None:
     if text is None:
         return None
@@ -196,7 +171,7 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
     if s.startswith("{}"):
         i = 2
     if i < len(s) and s[i] in "_^":
-        pre_sub, pre_sup, i = _scripts(s, i)
+        pre_sub, pre_sup, i = scripts(s, i)
     dots = 0
     m = re.match(r"\\(d?dot)\{", s[i:])
     if m:
@@ -213,7 +188,7 @@ def parse_lhs(lhs: str, coordinate_of) -> StepRef | None:
     if not m:
         return None
     base = m.group(0)
-    sub, sup, end = _scripts(s, i + len(base))
+    sub, sup, end = scripts(s, i + len(base))
     if end != len(s):
         return None
     if pre_sup is not None and sup is None:

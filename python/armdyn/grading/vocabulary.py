@@ -181,32 +181,35 @@ def _indexed(s: str, ref_type):
     return None
 
 
-def _split_scripts(rest: str):
-    """(sub, sup) of ``_X^Y`` / ``^Y_X`` (braced or one character), or (False, None)."""
+def scripts(s: str, i: int):
+    """Read ``_X`` / ``^X`` pairs from ``s[i:]``; returns (sub, sup, end)."""
     sub = sup = None
-    i = 0
-    while i < len(rest):
-        mark = rest[i]
-        if mark not in "_^":
-            return False, None
+    while i < len(s) and s[i] in "_^":
+        mark = s[i]
         i += 1
-        if i < len(rest) and rest[i] == "{":
+        if i < len(s) and s[i] == "{":
             depth, j = 1, i + 1
-            while j < len(rest) and depth:
-                depth += {"{": 1, "}": -1}.get(rest[j], 0)
+            while j < len(s) and depth:
+                depth += {"{": 1, "}": -1}.get(s[j], 0)
                 j += 1
-            text, i = rest[i + 1 : j - 1], j
-        elif i < len(rest) and rest[i] == "\\":
-            mm = re.match(r"\\[A-Za-z]+", rest[i:])
-            text = mm.group(0) if mm else rest[i : i + 2]
+            text, i = s[i + 1 : j - 1], j
+        elif i < len(s) and s[i] == "\\":
+            m = re.match(r"\\[A-Za-z]+", s[i:])
+            text = m.group(0) if m else s[i : i + 2]
             i += len(text)
         else:
-            text, i = rest[i : i + 1], i + 1
+            text, i = s[i : i + 1], i + 1
         if mark == "_":
             sub = text if sub is None else sub + "," + text
         else:
             sup = text if sup is None else sup + "," + text
-    return sub, sup
+    return sub, sup, i
+
+
+def _split_scripts(rest: str):
+    """(sub, sup) of ``_X^Y`` / ``^Y_X`` (braced or one character), or (False, None)."""
+    sub, sup, end = scripts(rest, 0)
+    return (sub, sup) if end == len(rest) else (False, None)
 
 
 #: steps checked directly against the model's energy-method quantities (no carry-forward)
