@@ -68,9 +68,9 @@ def _fence_end(text: str, ticks: str, pos: int) -> tuple[int, int]:
     return (m.start(), m.end()) if m else (len(text), len(text))
 
 
-#: a line that is math only: inline (after a marker or a short lead), or a display block's edge
+#: a line that is math only: inline (after at most a list marker), or a display block's edge
 _MATH_LINE = re.compile(
-    r"[ \t]*(?:(?:" + _MARKER + r")?(?:" + _PROSE + r")?" + _MATH + r"(?:" + _SEP + _MATH + r")*[ \t]*[.,;:]?"
+    r"[ \t]*(?:(?:" + _MARKER + r")?" + _MATH + r"(?:" + _SEP + _MATH + r")*[ \t]*[.,;:]?"
     r"|(?:\$\$|\\\[|\\\]|\\(?:begin|end)\{)[^\n]*)?[ \t]*"
 )
 #: a line that introduces what follows: a heading, a sentence ending in ``:`` or ``.``, or a
