@@ -122,3 +122,14 @@ def test_many_inline_lines_read_in_bounded_time(tmp_path):
     start = time.perf_counter()
     assert equations(tmp_path, body) == []
     assert time.perf_counter() - start < 5
+
+
+def test_an_entry_written_as_a_function_of_a_joint_is_the_entry(tmp_path):
+    # by hand: |v_2|^2 = (l_1^2 + d_2^2) θ̇_1^2 + 2 l_1 θ̇_1 ḋ_2 + ḋ_2^2, so M_11 = m_1 l_1^2 + m_2 (l_1^2 + d_2^2)
+    body = (
+        "- $M_{11}(d_2) = (m_1 + m_2) l_1^2 + m_2 d_2^2$\n"
+        "- $M_{12}(d_2) = m_2 l_1$\n"
+        "- $M_{22}(\\theta_1, d_2) = 2 m_2$\n"  # a slip: m_2
+    )
+    report = grade(write(tmp_path, "m.md", body))
+    assert statuses(report) == [("M_11", "correct"), ("M_12", "correct"), ("M_22", "wrong")]
