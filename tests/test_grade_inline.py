@@ -119,6 +119,8 @@ def test_a_lone_line_after_a_short_intro_is_read_but_not_in_mid_sentence(tmp_pat
 def test_many_inline_lines_read_in_bounded_time(tmp_path):
     line = "- where " + "$x$, " * 2000 + "and no equation\n"
     body = line * 50 + "$" + "+ x " * 20000 + "$\n" + ("a: " * 3000 + "$y$\n") * 20
+    # long runs of spaces where the math line's pattern allows spaces (before, between, after)
+    body += " " * 200_000 + "y\n" + "- $x$" + " " * 200_000 + "$y$ z\n" + "$x$" + " " * 200_000 + "y\n"
     start = time.perf_counter()
     assert equations(tmp_path, body) == []
     assert time.perf_counter() - start < 5

@@ -41,10 +41,13 @@ _MARKER = r"(?:[*+-]|\d{1,3}[.)]|[A-Za-z][.)]|\([A-Za-z0-9]{1,3}\))[ \t]+"
 #: a short lead before the math: a connective (``where``, ``so``...) or a label ending in ``:``
 _PROSE = (
     r"(?:(?i:where|so|thus|hence|then|therefore|and|with|giving|i\.e\.)\b,?"
-    r"|(?:[^$\n:`]|" + _MATH + r"){1,80}?:)[ \t]+"
+    r"|(?:[^$\s:`]|" + _MATH + r")(?:[^$\n:`]|" + _MATH + r"){0,79}?:)[ \t]+"
 )
 #: between two inline equations of one line
-_SEP = r"[ \t]*(?:[,;]|,?[ \t]*(?i:and|so|thus|hence)\b)?[ \t]*"
+#: (no two runs of spaces side by side: a line of spaces is split one way, in linear time)
+_SEP = r"[ \t]*(?:[,;][ \t]*)?(?:(?i:and|so|thus|hence)\b[ \t]*)?"
+#: what may end a math line: spaces and one of . , ; :
+_END = r"[ \t]*(?:[.,;:][ \t]*)?"
 #: a lead of more words than this is a sentence: its math is prose
 MAX_LEAD_WORDS = 5
 
@@ -54,7 +57,7 @@ _OPENER = re.compile(
     r"|^(?P<fence>[ \t]{0,3}(?P<ticks>`{3,}|~{3,})[ \t]*(?P<lang>[^\s`{]*)[^\n]*)$"
     r"|\\begin\{(?P<env>(?:" + "|".join(DISPLAY_ENVS) + r")\*?)\}(?:\{\d+\})?"
     r"|^(?P<lead>[ \t]*(?:" + _MARKER + r")?(?:" + _PROSE + r")?)"
-    r"(?P<inline>" + _MATH + r"(?:" + _SEP + _MATH + r")*)[ \t]*[.,;:]?[ \t]*$",
+    r"(?P<inline>" + _MATH + r"(?:" + _SEP + _MATH + r")*)" + _END + "$",
     re.MULTILINE,
 )
 #: a ```latex fence holding a document or a preamble, not an equation
@@ -70,8 +73,16 @@ def _fence_end(text: str, ticks: str, pos: int) -> tuple[int, int]:
 
 #: a line that is math only: inline (after at most a list marker), or a display block's edge
 _MATH_LINE = re.compile(
-    r"[ \t]*(?:(?:" + _MARKER + r")?" + _MATH + r"(?:" + _SEP + _MATH + r")*[ \t]*[.,;:]?"
-    r"|(?:\$\$|\\\[|\\\]|\\(?:begin|end)\{)[^\n]*)?[ \t]*"
+    r"[ \t]*(?:(?:"
+    + _MARKER
+    + r")?"
+    + _MATH
+    + r"(?:"
+    + _SEP
+    + _MATH
+    + r")*"
+    + _END
+    + r"|(?:\$\$|\\\[|\\\]|\\(?:begin|end)\{)[^\n]*)?"
 )
 #: a line that introduces what follows: a heading, a sentence ending in ``:`` or ``.``, or a
 #: short one (at most MAX_LEAD_WORDS words) ending in ``,`` or a connective (``So,``, ``where``)
