@@ -4,9 +4,11 @@ Display math is found in the forms derivations use: ``$$ ... $$``, ``\\[ ... \\]
 GitHub ```` ```math ```` fence (```` ```latex ```` / ```` ```tex ```` too when the body is
 math, not a LaTeX document), an environment written in the Markdown body without ``$$``
 (``equation``, ``align``, ``aligned``, ``split``, ``gather``, ``gathered``, ``multline``,
-``eqnarray``, ``alignat``, ``flalign``, starred or not), and a line that is only
-``$ ... $`` (inline math on a line of its own, as notebooks write it). Other fenced code
-blocks are not math: a ``$$`` inside them is not read.
+``eqnarray``, ``alignat``, ``flalign``, starred or not), and inline math written as
+steps: a line that is only ``$ ... $`` after at most a list marker and a short lead
+(``where``, ``So,``, ``Label:``), each ``$LHS = ...$`` of it an equation, and ``$+ ...$``
+lines continuing the equation just above (:func:`_inline`); inline math in a sentence is
+prose. Other fenced code blocks are not math: a ``$$`` inside them is not read.
 
 One regular-expression scan finds the openers in order; each closer is looked for once
 with ``str.find`` (or one search), and an opener of a kind that is never closed ends the
@@ -32,12 +34,30 @@ DISPLAY_ENVS = (
     "flalign",
 )
 
+#: one inline ``$ ... $`` (not empty, not ``$$``, no space just inside the dollars)
+_MATH = r"\$(?=[^$\s])[^$\n]*[^$\s\\]\$"
+#: a list item's marker: ``*``, ``-``, ``+``, ``1.``, ``1)``, ``a)``, ``(a)``
+_MARKER = r"(?:[*+-]|\d{1,3}[.)]|[A-Za-z][.)]|\([A-Za-z0-9]{1,3}\))[ \t]+"
+#: a short lead before the math: a connective (``where``, ``so``...) or a label ending in ``:``
+_PROSE = (
+    r"(?:(?i:where|so|thus|hence|then|therefore|and|with|giving|i\.e\.)\b,?"
+    r"|(?:[^$\s:`]|" + _MATH + r")(?:[^$\n:`]|" + _MATH + r"){0,79}?:)[ \t]+"
+)
+#: between two inline equations of one line
+#: (no two runs of spaces side by side: a line of spaces is split one way, in linear time)
+_SEP = r"[ \t]*(?:[,;][ \t]*)?(?:(?i:and|so|thus|hence)\b[ \t]*)?"
+#: what may end a math line: spaces and one of . , ; :
+_END = r"[ \t]*(?:[.,;:][ \t]*)?"
+#: a lead of more words than this is a sentence: its math is prose
+MAX_LEAD_WORDS = 5
+
 _OPENER = re.compile(
     r"(?P<dollars>\$\$)"
     r"|(?P<bracket>\\\[)"
     r"|^(?P<fence>[ \t]{0,3}(?P<ticks>`{3,}|~{3,})[ \t]*(?P<lang>[^\s`{]*)[^\n]*)$"
     r"|\\begin\{(?P<env>(?:" + "|".join(DISPLAY_ENVS) + r")\*?)\}(?:\{\d+\})?"
-    r"|^[ \t]*(?P<inline>\$(?=[^$\s])[^$\n]*[^$\s\\]\$)[ \t]*[.,;]?[ \t]*$",
+    r"|^(?P<lead>[ \t]*(?:" + _MARKER + r")?(?:" + _PROSE + r")?)"
+    r"(?P<inline>" + _MATH + r"(?:" + _SEP + _MATH + r")*)" + _END + "$",
     re.MULTILINE,
 )
 #: a ```latex fence holding a document or a preamble, not an equation
@@ -51,13 +71,44 @@ def _fence_end(text: str, ticks: str, pos: int) -> tuple[int, int]:
     return (m.start(), m.end()) if m else (len(text), len(text))
 
 
-_LONE = re.compile(r"[ \t]*(?:\$(?=[^$\s])[^$\n]*[^$\s\\]\$[ \t]*[.,;]?)?[ \t]*")
+#: a line that is math only: inline (after at most a list marker), or a display block's edge
+_MATH_LINE = re.compile(
+    r"[ \t]*(?:(?:"
+    + _MARKER
+    + r")?"
+    + _MATH
+    + r"(?:"
+    + _SEP
+    + _MATH
+    + r")*"
+    + _END
+    + r"|(?:\$\$|\\\[|\\\]|\\(?:begin|end)\{)[^\n]*)?"
+)
+#: a line that introduces what follows: a heading, a sentence ending in ``:`` or ``.``, or a
+#: short one (at most MAX_LEAD_WORDS words) ending in ``,`` or a connective (``So,``, ``where``)
+_INTRO = re.compile(
+    r"[ \t]*#{1,6}[ \t][^\n]*|[^\n]*[:.][*_]*[ \t]*"
+    r"|(?P<short>[^\n]*(?:,|\b(?i:where|so|thus|hence|then|therefore|and|with|giving)))[*_]*[ \t]*"
+)
+_ONE_MATH = re.compile(_MATH)
+_MARKER_RE = re.compile(r"[ \t]*(?:" + _MARKER + ")?")
+#: what a continuation's math starts with (after spacing): ``+``, ``-`` or ``=``
+_CONTINUES = re.compile(r"(?:\s|~|\\(?:quad|qquad|[,;:! ]))*[-+=]")
+#: between the end of the block a continuation line continues and that line: one line break
+_NEXT_LINE = re.compile(r"[ \t]*[.,;:]?[ \t]*\n")
+
+
+def _words(prose: str) -> int:
+    """How many words ``prose`` has (an inline ``$ ... $`` counts as one)."""
+    return len(_ONE_MATH.sub("x", prose).split())
 
 
 def _alone(text: str, at: int, step: int) -> bool:
     """Is the line before (``step`` -1, ``at`` its newline) or after (+1, ``at`` past its
-    start's newline) a ``$ ... $`` line blank, missing, or a ``$ ... $`` line too? (A
-    paragraph of lone ``$ ... $`` lines is display math; one inside prose is not.)"""
+    start's newline) a math line blank, missing, or math only (``$ ... $`` lines, a display
+    block's edge)? The line before may also be one that introduces it (:data:`_INTRO`:
+    ``So,``, ``... as follows:``, a heading). (A paragraph of such lines is display math; a math line inside a
+    paragraph of prose is prose.)"""
     if at < 0 or at > len(text):
         return True
     if step < 0:
@@ -66,7 +117,46 @@ def _alone(text: str, at: int, step: int) -> bool:
     else:
         start, end = at, text.find("\n", at)
         end = len(text) if end < 0 else end
-    return _LONE.fullmatch(text, start, end) is not None
+    if _MATH_LINE.fullmatch(text, start, end) is not None:
+        return True
+    intro = _INTRO.fullmatch(text, start, end) if step < 0 else None
+    return intro is not None and (intro.group("short") is None or _words(intro.group("short")) <= MAX_LEAD_WORDS)
+
+
+def _is_equation(body: str) -> bool:
+    """Does ``body`` hold a top-level ``=`` with something on its left?"""
+    from .equations import side_offsets
+
+    cuts = side_offsets(body)
+    return len(cuts) >= 2 and body[: cuts[1] - 1].strip() != ""
+
+
+def _inline(text: str, m: re.Match, last_end: int):
+    """The blocks of a line of inline math ``m`` (see :data:`_OPENER`): after an optional
+    list marker and a short lead (``where``, ``so``, ``Label:``), each ``$ LHS = ... $``
+    is an equation; a line that is only ``$+ ...$`` (``-``, ``=``) continues the block
+    ending on the line just before (``last_end``), else it is not read (it never jumps over
+    a line that was not read). A lead of more than :data:`MAX_LEAD_WORDS` words is a
+    sentence, and a line with no list marker is read only in a paragraph of math lines
+    (:func:`_alone`): otherwise its math is prose."""
+    lead = m.group("lead")
+    marker = _MARKER_RE.match(lead).end()
+    prose = lead[marker:]
+    if _words(prose) > MAX_LEAD_WORDS:
+        return
+    if not lead[:marker].strip() and not (_alone(text, m.start() - 1, -1) and _alone(text, m.end() + 1, 1)):
+        return  # a sentence's math, on a line of the paragraph: prose
+    pieces = [(p.start(), p.end()) for p in _ONE_MATH.finditer(text, m.start("inline"), m.end("inline"))]
+    if len(pieces) == 1 and not prose.strip():
+        start, end = pieces[0]
+        body = text[start + 1 : end - 1]
+        if not _CONTINUES.match(body) or last_end >= 0 and _NEXT_LINE.fullmatch(text, last_end, m.start()):
+            yield start, end, start + 1, body
+        return
+    for start, end in pieces:
+        body = text[start + 1 : end - 1]
+        if not _CONTINUES.match(body) and _is_equation(body):
+            yield start, end, start + 1, body
 
 
 def math_blocks(text: str, start: int = 0):
@@ -80,6 +170,7 @@ def regions(text: str, start: int = 0):
     prose (no heading or task number is looked for there)."""
     closed_off: set[str] = set()  # kinds ($$, \[, an environment's name) never closed further on
     pos = start
+    last_end = -1  # end of the last block that may hold an equation (a `$+ ...$` line continues it)
     while True:
         m = _OPENER.search(text, pos)
         if m is None:
@@ -94,15 +185,16 @@ def regions(text: str, start: int = 0):
             lang = m.group("lang").lower()
             if lang == "math" or lang in ("latex", "tex") and "=" in body and not _DOCUMENT.search(body):
                 yield m.start(), close_end, body_start, body
+                last_end = close_end
             else:
                 yield m.start(), close_end, body_start, None
             pos = max(close_end, m.end())
             continue
         if kind == "inline":
             pos = m.end()
-            if not (_alone(text, m.start() - 1, -1) and _alone(text, m.end() + 1, 1)):
-                continue  # a sentence's math, on a line of the paragraph: prose
-            yield m.start("inline"), m.end("inline"), m.start("inline") + 1, m.group("inline")[1:-1]
+            for block in _inline(text, m, last_end):
+                last_end = block[1]
+                yield block
             continue
         closer = {"dollars": "$$", "bracket": "\\]"}.get(kind) or "\\end{" + m.group("env") + "}"
         key = closer if kind != "env" else m.group("env")
@@ -116,6 +208,7 @@ def regions(text: str, start: int = 0):
             continue
         if end > m.end():
             yield m.start(), end + len(closer), m.end(), text[m.end() : end]
+            last_end = end + len(closer)
         pos = end + len(closer)
 
 

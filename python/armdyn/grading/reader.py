@@ -7,8 +7,8 @@ Markdown reader's output is exactly what a YAML submission states directly
 
 Markdown: an optional front matter between ``---`` lines at the top (after blank lines
 or ``<!-- -->`` comments; YAML: ``robot``, ``method``, ``symbols``), then any text; every
-display block (``$$``, ``\\[``, ```` ```math ````, a bare ``align``... environment, a lone
-``$ ... $`` paragraph: :mod:`.display`) is split into equations (at ``\\\\`` and at
+display block (``$$``, ``\\[``, ```` ```math ````, a bare ``align``... environment, inline
+``$ ... $`` lines written as steps: :mod:`.display`) is split into equations (at ``\\\\`` and at
 separators before another ``LHS = ...``: :func:`.equations.split_equations`), each with its
 line, the column where its value starts, and the part of the assignment it is in
 (:mod:`.parts`). A row or block with no left-hand side that starts with ``=``, ``+`` or

@@ -42,9 +42,10 @@ from .text import NOT_A_STEP
 
 _KINETIC = r"K|T|KE|k|E_\{?[kK]\}?|E_\{?kin\}?|KE"
 _POTENTIAL = r"U|V|P|PE|u|E_\{?[pP]\}?|E_\{?pot\}?"
-#: a function's arguments as students write them after a name: (q), (q,\dot{q}), (\theta,\dot\theta)
-_ARGS = re.compile(r"\(([\\A-Za-z{},]+)\)$")  # one character class: linear, no nested repetition
-_ARG = re.compile(r"\\?[A-Za-z]+|\\d?dot\{\\?[A-Za-z]+\}")
+#: a function's arguments as students write them after a name: (q), (q,\dot{q}), (\theta,\dot\theta),
+#: (\theta_2) (an entry M_{12}(\theta_2) written as a function of the joint it depends on)
+_ARGS = re.compile(r"\(([\\A-Za-z0-9_{},]+)\)$")  # one character class: linear, no nested repetition
+_ARG = re.compile(r"(?:\\?[A-Za-z]+|\\d?dot\{\\?[A-Za-z]+\})(?:_\{?\d\}?)?")
 #: a left-hand side longer than this names no quantity (bounds the regular expressions below)
 MAX_LHS = 120
 _MC = r"(?:[CcG]|cm|CM|com)"
