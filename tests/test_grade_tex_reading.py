@@ -51,3 +51,10 @@ def test_a_yaml_submission_still_refuses_an_unknown_key(tmp_path):
     path.write_text("robot: rp-arm\nrobto: x\nsteps:\n  tau_2: m2*g\n", encoding="utf-8")
     with pytest.raises(ModelError, match="unknown key"):
         grade(str(path))
+
+
+def test_a_torque_that_could_not_be_read_is_said_so_not_called_wrong(tmp_path):
+    path = tmp_path / "t.md"
+    path.write_text(f"---\nrobot: rp-arm\n---\n$$\\tau_1 = {{m_1$$\n\n$$\\tau_2 = {TAU_2}$$\n", encoding="utf-8")
+    text = grade(str(path)).text()
+    assert "final torques: tau_1 not read (line 4); tau_2 right" in text, text

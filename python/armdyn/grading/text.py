@@ -137,6 +137,8 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
         last = [v for v in report.steps if v.key == "tau" and v.name == f"tau_{k}"]
         if not last:
             taus.append(f"tau_{k} not given")
+        elif all(v.status == "unrecognised" for v in last):  # written, but could not be graded
+            taus.append(f"tau_{k} not read (line {last[-1].line})")
         elif ok and last[-1].status == "correct-but-unsupported":
             taus.append(f"tau_{k} right, but not supported by the steps before it")
         else:
