@@ -10,14 +10,12 @@ with a generous timeout as a hang guard only; the real timings are in the report
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
 import sympy as sp
+from cli_support import grade_cli
 
 from armdyn.cli import main
 from armdyn.grading import grade
@@ -294,14 +292,7 @@ def test_text_uses_derives_symbol_names(capsys):
 
 
 def _grade_subprocess(path, *extra):
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "python") + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    return subprocess.run(
-        [sys.executable, "-m", "armdyn", "grade", str(path), *extra],
-        capture_output=True,
-        text=True,
-        timeout=GUARD,
-        env=env,
-    )
+    return grade_cli(path, *extra, timeout=GUARD)
 
 
 HOSTILE_VALUES = {

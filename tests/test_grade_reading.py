@@ -11,14 +11,12 @@ once more below by a plain SymPy Lagrangian: never armdyn's output.
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
 import sympy as sp
+from cli_support import grade_cli
 
 from armdyn.grading import grade
 from armdyn.grading.latex import Name, UnknownSymbol, parse
@@ -73,17 +71,6 @@ def write(tmp_path, name, body, header=HEADER):
 
 def statuses(report):
     return [(v.name, v.status) for v in report.steps]
-
-
-def grade_cli(path, *extra):
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "python") + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    return subprocess.run(
-        [sys.executable, "-m", "armdyn", "grade", str(path), *extra],
-        capture_output=True,
-        text=True,
-        timeout=GUARD,
-        env=env,
-    )
 
 
 # ---------------------------------------------------------------- 1. grade what can be read
