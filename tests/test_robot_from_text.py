@@ -10,6 +10,7 @@ import time
 
 import pytest
 import sympy as sp
+from test_symbolic import exercise_tau
 
 import armdyn
 from armdyn.errors import ModelError
@@ -80,20 +81,8 @@ def _state(robot, names: dict[str, sp.Symbol], seed: int) -> dict:
 
 def test_rp_arm_read_has_the_exercises_dynamics(tmp_path):
     robot = robot_from_text(read(_unnamed("rp-arm-exercise.md", tmp_path))).robot
-    th, d = robot.q
-    thd, dd = robot.qd
-    thdd, ddd = robot.qdd
-    m1, m2, l1, g = sp.symbols("m1 m2 l1 g")
-    # by hand, from the arm's Lagrangian (point masses at l1 and at l1 x1 + d2 y1; gravity -y0)
-    tau1 = (
-        (m1 + m2) * l1**2 * thdd
-        + m2 * l1 * ddd
-        + 2 * m2 * d * thd * dd
-        + m2 * thdd * d**2
-        + (m1 + m2) * g * l1 * sp.cos(th)
-        - m2 * g * d * sp.sin(th)
-    )
-    tau2 = m2 * l1 * thdd + m2 * ddd - m2 * thd**2 * d + m2 * g * sp.cos(th)
+    m1, m2, l1, g = (robot.parameters[n] for n in ("m1", "m2", "l1", "g"))
+    tau1, tau2 = exercise_tau(robot)  # by hand, from the arm's Lagrangian (tests/test_symbolic.py)
     bundled = armdyn.load("rp-arm")
     for seed in range(3):
         at = _state(robot, {"m1": m1, "m2": m2, "l1": l1, "g": g}, seed)
