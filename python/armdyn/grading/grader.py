@@ -32,22 +32,8 @@ from .sympy_syntax import parse_sympy_syntax
 from .verdict import PASSING, GradeReport, StepVerdict
 from .vocabulary import MODEL_KEYS, student_names
 
-_NAMED = {  # step names as armdyn reports them, accepted as left-hand sides in YAML
-    "omega": "omega",
-    "omega_dot": "omega_dot",
-    "v_dot": "v_dot",
-    "vc_dot": "vc_dot",
-    "F": "F",
-    "N": "N",
-    "f": "f",
-    "n": "n",
-    "tau": "tau",
-    "dL_dqd": "dL_dqd",
-    "dL_dq": "dL_dq",
-    "ddt_dL_dqd": "ddt_dL_dqd",
-    "dT_dq": "dT_dq",
-    "dV_dq": "dV_dq",
-}
+#: step names as armdyn reports them (``v_dot_1``, ``tau_2``), accepted as left-hand sides in YAML
+_NAMED = frozenset(VECTOR_KEYS) | frozenset(LAGRANGE_KEYS) - {"T", "V", "L"} | {"tau"}
 
 
 def _named_ref(text: str) -> StepRef | None:
@@ -56,7 +42,7 @@ def _named_ref(text: str) -> StepRef | None:
         return StepRef(text)
     head, _, tail = text.rpartition("_")
     if head in _NAMED and tail.isdigit():
-        return StepRef(_NAMED[head], int(tail))
+        return StepRef(head, int(tail))
     return None
 
 
