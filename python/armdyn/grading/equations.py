@@ -47,6 +47,28 @@ _DROPPED = re.compile(
     r"|\\(?:tag\*?|label)\{[^{}]*\}|\\(?:nonumber|notag)\b"
     r"|(?<=\\\\)\[\s*-?\d*\.?\d+\s*(?:pt|mm|cm|em|ex|in|bp)\s*\]"
 )
+#: a display that is one system of equations, a brace on the left: ``\\begin{cases} x = .. \\\\ y = ..
+#: \\end{cases}`` or ``\\left\\{ \\begin{array}{l} .. \\end{array} \\right.``: its rows are equations
+_SYSTEM_OPEN = re.compile(r"\s*(?:\\begin\{cases\}|\\left\\\{\s*\\begin\{array\}\{[lcr]*\})")
+_SYSTEM_CLOSE = re.compile(r"(?:\\end\{cases\}|\\end\{array\}\s*\\right\s*\.)\s*\Z")
+
+
+def _system_out(text: str) -> str:
+    """``text`` with the brace of a display that is one system of equations blanked (its
+    opening at the start and its closing at the end), so its rows split as any other."""
+    opening = _SYSTEM_OPEN.match(text)
+    if opening is None:
+        return text
+    tail = len(text) - len(text.rstrip()) + 24  # the closing is at most this far from the end
+    closing = _SYSTEM_CLOSE.search(text, max(opening.end(), len(text) - tail))
+    if closing is None:
+        return text
+    chars = list(text)
+    _blank(chars, 0, opening.end())
+    _blank(chars, closing.start(), closing.end())
+    return "".join(chars)
+
+
 #: prose in a display: \text{and} separates two equations, \text{for ...} ends one
 _PROSE = re.compile(r"\\(?:text|textrm|textit|textbf|mbox|mathrm)\s*\{([^{}]*)\}")
 _PAREN_PROSE = re.compile(r"\(\s*\\text\s*\{[^{}]*[A-Za-z]{2,}[^{}]*\}\s*\)")
@@ -125,6 +147,30 @@ def _unboxed(text: str) -> str:
     return "".join(chars)
 
 
+#: SymPy's printed functions of time: ``\\theta_{1}{\\left(t \\right)}``, with
+#: ``\\frac{d}{d t}`` (``\\frac{d^{2}}{d t^{2}}``) before it for a rate (an acceleration)
+_NAME = r"\\?[A-Za-z]+(?:_\{[^{}]*\}|_[A-Za-z0-9])?"
+_OF_TIME = re.compile(
+    r"(?:\\frac\{d(?:\^\{?([12])\}?)?\}\{d\s*t(?:\^\{?[12]\}?)?\}\s*)?"
+    r"(" + _NAME + r")\{\\left\(\s*t\s*\\right\)\}"
+)
+
+
+def _time_functions(text: str) -> str:
+    """``text`` with SymPy's printed functions of time read as the textbooks write them:
+    ``x{\\left(t \\right)}`` as ``x``, ``\\frac{d}{d t} x{\\left(t \\right)}`` as ``\\dot{x}``,
+    ``\\frac{d^{2}}{d t^{2}} x{...}`` as ``\\ddot{x}``. Each is replaced by a shorter text
+    padded with spaces, so offsets after it are kept."""
+
+    def sub(m):
+        order = m.group(1) or ("1" if m.group(0).startswith("\\frac") else "")
+        name = m.group(2)
+        new = {"": name, "1": "\\dot{" + name + "}", "2": "\\ddot{" + name + "}"}[order]
+        return new + " " * (len(m.group(0)) - len(new))
+
+    return _OF_TIME.sub(sub, text)
+
+
 def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str]]:
     """Split a display-math block into equations: at top-level ``\\\\`` and at top-level
     ``,``, ``;``, ``\\quad``, ``\\qquad`` or ``\\text{and}`` followed by another
@@ -134,6 +180,10 @@ def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str
     offsets still point into ``block``). Linear in the block's length; ``limit``: stop
     after that many equations (the caller refuses more)."""
     text = _DROPPED.sub(lambda m: " " * len(m.group(0)), block)
+    if "\\begin" in text:
+        text = _system_out(text)
+    if "\\right)}" in text:
+        text = _time_functions(text)
     if "\\boxed" in text:
         text = _unboxed(text)
     if "\\" in text:

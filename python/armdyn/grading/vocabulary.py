@@ -23,7 +23,7 @@ christoffel    ``c_{ijk}``, ``\\Gamma_{ijk}``, ``h_{ijk}`` (three indices)
 C              ``C``, ``C(q,\\dot q)`` (the Coriolis matrix)
 h              ``V(\\theta,\\dot\\theta)`` (Craig), ``c(\\theta,\\dot\\theta)`` (Lynch & Park), ``h``,
                ``b(q,\\dot q)``, ``C(q,\\dot q)\\dot q``; entries ``h_i``
-G              ``g(q)``, ``G(\\theta)``, ``G``; entries ``g_k``, ``G_k``, ``\\phi_k``
+G              ``g(q)``, ``G(\\theta)``, ``G``, ``N(\\theta,\\dot\\theta)`` (Murray, Li & Sastry); entries ``g_k``, ``G_k``, ``\\phi_k``
                (``g`` alone is the gravity constant, not a step)
 =============  ==================================================================
 
@@ -108,7 +108,7 @@ def energy_lhs(s: str, ref_type):
         return ref_type("h", alias=s, by_shape=not had_args)
     if re.fullmatch(r"C(?:\([^()]*\))?\\dot\{(?:q|\\theta|\\boldsymbol\{q\})\}", s):  # C(q, q̇) q̇
         return ref_type("h", alias="C q̇")
-    if s in ("G",) or (s == "g" and had_args):
+    if s in ("G",) or (s in ("g", "N") and had_args):  # N(θ, θ̇): Murray, Li & Sastry (N alone: a moment)
         return ref_type("G", alias=s, by_shape=not had_args)
     # |v|^2, v^T v, v . v
     sq = re.fullmatch(r"(?:\||\\\||\\lVert|\\vert|\\Vert)(.+?)(?:\||\\\||\\rVert|\\vert|\\Vert)\^\{?2\}?", s)
