@@ -103,3 +103,66 @@ def test_mls_N_is_the_gravity_vector(tmp_path, lhs):
     assert list(graded(tmp_path, f"$${lhs} = {value}$$\n", **syms).values()) == ["correct"]
     slip = value.replace(r"m_2 l_{c2} g\cos(\theta_1+\theta_2) \end", r"m_2 l_1 g\cos(\theta_1+\theta_2) \end")
     assert list(graded(tmp_path, f"$${lhs} = {slip}$$\n", **syms).values()) == ["wrong"]
+
+
+# --- Asada & Slotine's H_{ij} ----------------------------------------------------------
+
+
+def test_asada_H_entries_are_the_inertia_matrix(tmp_path):
+    # d_12 = m2 (lc2^2 + l1 lc2 c2) + I2 (Spong's D(q) of the 2R arm); d_22 has no cos term
+    syms = {"q_1": "q1", "q_2": "q2"}
+    h12 = r"$$H_{12} = m_2(l_{c2}^2 + l_1 l_{c2}\cos q_2) + I_2$$" + "\n"
+    h22 = r"$$H_{22} = m_2(l_{c2}^2 + l_1 l_{c2}\cos q_2) + I_2$$" + "\n"
+    assert graded(tmp_path, h12, **syms) == {"M_12": "correct"}
+    assert graded(tmp_path, h22, **syms) == {"M_22": "wrong"}
+
+
+# --- the Rome course's u_i: the input torque, not an energy -----------------------------
+
+
+def test_u_with_accelerations_is_the_torque_and_without_an_energy(tmp_path):
+    syms = {r"\theta_1": "q1", r"\theta_2": "q2"}
+    # tau_2 of the 2R arm (Spong): d21 q1'' + d22 q2'' + m2 l1 lc2 s2 q1'^2 + m2 g lc2 c12
+    tau2 = (
+        r"(I_2 + m_2(l_{c2}^2 + l_1 l_{c2}\cos\theta_2))\ddot\theta_1 + (I_2 + m_2 l_{c2}^2)\ddot\theta_2"
+        r" + m_2 l_1 l_{c2}\sin\theta_2\dot\theta_1^2 + m_2 g l_{c2}\cos(\theta_1+\theta_2)"
+    )
+    assert graded(tmp_path, f"$$u_2 = {tau2}$$\n", **syms) == {"tau_2": "correct"}
+    assert graded(tmp_path, f"$$u_2 = {tau2.replace('^2 + m_2 g', '^2 - m_2 g')}$$\n", **syms) == {"tau_2": "wrong"}
+    # no acceleration in the value: link 1's potential energy m1 g lc1 sin(theta1), as before
+    assert graded(tmp_path, r"$$u_1 = m_1 g l_{c1}\sin\theta_1$$" + "\n", **syms) == {"V_1": "correct"}
+
+
+# --- a column equal to a column, trigonometric functions typed as letters ---------------
+
+
+def test_column_equations_split_into_their_rows():
+    block = r"\left[ \begin{array}{c} P_{1,x} \\ P_{1,y} \end{array} \right] = \left[ \begin{array}{c} a \\ b \end{array} \right]"
+    rows = split_equations(block)
+    assert [t for _, t in rows] == ["P_{1,x} = a", "P_{1,y} = b"]
+    assert [block[o : o + 7] for o, _ in rows] == ["P_{1,x}", "P_{1,y}"]
+    bm = r"\begin{bmatrix} x_1 \\ y_1 \end{bmatrix} = \begin{bmatrix} c \\ d \end{bmatrix}"
+    assert [t for _, t in split_equations(bm)] == ["x_1 = c", "y_1 = d"]
+    # a matrix times a column, or columns of different lengths: one equation, not split
+    for block in (
+        r"\begin{bmatrix} x \\ y \end{bmatrix} = \begin{bmatrix} a & b \\ c & d \end{bmatrix}\begin{bmatrix} e \\ f \end{bmatrix}",
+        r"\begin{bmatrix} x \\ y \end{bmatrix} = \begin{bmatrix} a \\ b \\ c \end{bmatrix}",
+    ):
+        assert len(split_equations(block)) == 1
+
+
+def test_bare_trig_letters_are_the_functions():
+    ((_, eq),) = split_equations(r"x = r_1 cos(\theta_1) + sin (\theta_2)")
+    assert eq == r"x = r_1\cos(\theta_1) +\sin (\theta_2)"
+    ((_, eq),) = split_equations(r"x = cost(a) + \cos(b)")  # a word ending in cos is not cos
+    assert eq == r"x = cost(a) + \cos(b)"
+
+
+def test_point_components_with_a_comma_and_bare_trig(tmp_path):
+    syms = {r"\theta_1": "q1", r"\theta_2": "q2", "r_2": "lc2"}
+    body = (
+        "$$ \\left[ \\begin{array}{c} P_{2,x} \\\\\nP_{2,y} \\end{array} \\right] = \\left[ \\begin{array}{c} "
+        "l_1 cos(\\theta_1) + r_2 cos(\\theta_1 + \\theta_2) \\\\\nl_1 sin(\\theta_1) + r_2 cos(\\theta_1 + \\theta_2)"
+        " \\end{array} \\right] $$\n"
+    )
+    assert graded(tmp_path, body, **syms) == {"x_c2": "correct", "y_c2": "wrong"}  # cos for sin in y

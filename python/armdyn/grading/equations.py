@@ -171,6 +171,55 @@ def _time_functions(text: str) -> str:
     return _OF_TIME.sub(sub, text)
 
 
+#: trigonometric functions typed as letters before a parenthesis (``r_1 cos(\\theta_1)``, as
+#: blogs and MATLAB-minded notes write them): read as the functions
+_BARE_TRIG = re.compile(r"(?<![\\A-Za-z])( ?)(sin|cos|tan)(?=\s*\()")
+#: one column written as a matrix: ``\\left[ \\begin{array}{c} a \\\\ b \\end{array} \\right]``, bmatrix, pmatrix
+_COLUMN = re.compile(
+    r"\s*(?:\\left\s*[\[(]\s*)?\\begin\{(array|[bpB]?matrix)\}(?(1)(?:\{[lcr]\})?)(?P<body>.*)"
+    r"\\end\{\1\}(?:\s*\\right\s*[\])])?\s*\Z",
+    re.S,
+)
+
+
+def _bare_trig(text: str) -> str:
+    """``cos(x)`` typed without its backslash read as ``\\cos(x)``: the backslash takes the
+    place of the space before it when there is one (offsets after it kept)."""
+    return _BARE_TRIG.sub(lambda m: "\\" + m.group(2), text)
+
+
+def _column(text: str, start: int):
+    """The entries ``(offset, text)`` of ``text`` when it is one column written as a matrix
+    (``\\begin{bmatrix} x_1 \\\\ y_1 \\end{bmatrix}``), else None; offsets from ``start``."""
+    m = _COLUMN.match(text)
+    if m is None or (m.group(1) == "array" and not re.search(r"\\begin\{array\}\{[lcr]\}", text[: m.start("body")])):
+        return None
+    body, base = m.group("body"), start + m.start("body")
+    marks = [i for i, c in top_level(body, commands=True) if c in ("\\\\", "&")]
+    if any(body[i] == "&" for i in marks):
+        return None
+    out, s0 = [], 0
+    for cut in marks + [len(body)]:
+        entry = body[s0:cut]
+        if entry.strip():
+            out.append((base + s0 + len(entry) - len(entry.lstrip()), entry.strip()))
+        s0 = cut + 2
+    return out if len(out) >= 2 else None
+
+
+def _components(off: int, equation: str) -> list[tuple[int, str]] | None:
+    """``[x_1 \\\\ y_1] = [a \\\\ b]``, one column equal to one column: the equations of its
+    rows (``x_1 = a``, ``y_1 = b``), each at its left-hand side's entry; else None."""
+    cuts = [i for i, c in top_level(equation) if c == "="]
+    if len(cuts) != 1 or "\\begin" not in equation[: cuts[0]]:
+        return None
+    left = _column(equation[: cuts[0]], off)
+    right = _column(equation[cuts[0] + 1 :], off + cuts[0] + 1)
+    if left is None or right is None or len(left) != len(right):
+        return None
+    return [(lo, f"{lt} = {rt}") for (lo, lt), (_, rt) in zip(left, right, strict=True)]
+
+
 def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str]]:
     """Split a display-math block into equations: at top-level ``\\\\`` and at top-level
     ``,``, ``;``, ``\\quad``, ``\\qquad`` or ``\\text{and}`` followed by another
@@ -184,6 +233,8 @@ def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str
         text = _system_out(text)
     if "\\right)}" in text:
         text = _time_functions(text)
+    if "(" in text:
+        text = _bare_trig(text)
     if "\\boxed" in text:
         text = _unboxed(text)
     if "\\" in text:
@@ -227,7 +278,9 @@ def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str
     for off, t in out:
         stripped = t.strip().rstrip(".,;").strip()
         if stripped:
-            result.append((off + (len(t) - len(t.lstrip())), stripped))
+            at = off + (len(t) - len(t.lstrip()))
+            rows = _components(at, stripped) if "\\begin" in stripped else None
+            result.extend(rows or [(at, stripped)])
     return result
 
 
