@@ -184,9 +184,10 @@ def all_specs() -> dict[str, dict]:
     import specs_lagrange
     import specs_newton_euler
     import specs_proofs
+    import specs_public
 
     out = {}
-    for mod in (specs_newton_euler, specs_lagrange, specs_proofs):
+    for mod in (specs_newton_euler, specs_lagrange, specs_proofs, specs_public):
         out.update(mod.SPECS)
     return out
 
