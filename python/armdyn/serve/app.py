@@ -306,6 +306,7 @@ def _api_view(row: dict, full: dict | None = None) -> dict:
                 "created_at",
                 "started_at",
                 "finished_at",
+                "late",
             )
         }
     )
@@ -440,9 +441,11 @@ def build_app(settings: Settings) -> Starlette:
             return HTMLResponse("Paste or upload your derivation first.", status_code=400)
         exercise = srv.exercise_of(str(form.get("exercise") or "") or None)
         who = identity.submitter(srv, request, markdown, exercise, str(form.get("student") or ""), form=True)
-        row, token = await srv.accept(markdown, who["exercise"], who["student"], key, who["student_id"], who["late"])
+        owner = key if who["student_id"] is None else None  # a known student's are theirs, not the browser's
+        row, token = await srv.accept(markdown, who["exercise"], who["student"], owner, who["student_id"], who["late"])
         await srv.wait(row["id"], FORM_WAIT)
-        return RedirectResponse(f"/submissions/{row['id']}?t={token}", status_code=303)
+        key_in_url = "" if who["student_id"] else f"?t={token}"  # a known student's session opens it
+        return RedirectResponse(f"/submissions/{row['id']}{key_in_url}", status_code=303)
 
     async def submission_page(request: Request):
         full = await run_in_threadpool(srv.repo.get, _sid(request))
