@@ -251,3 +251,42 @@ def test_roster_errors_name_file_and_line(course, tmp_path):
     assert when["ada"] - when["*"] == 61 * 60
     with pytest.raises(ModelError, match="not a date and time"):
         parse_deadlines(["next friday"])
+
+
+def test_links_command_and_serve_options(course, tmp_path):
+    """``armdyn links`` writes the links owner-only and renews one on demand (the old
+    one stops opening a session); ``armdyn serve``'s options reach the settings."""
+    from armdyn.cli import build_parser, main
+    from armdyn.serve.app import Settings
+    from armdyn.serve.exercises import catalogue
+    from armdyn.serve.identity import Store
+    from armdyn.serve.server import course_settings
+    from armdyn.serve.storage import Repository
+
+    db = f"sqlite:///{tmp_path / 'db.sqlite'}"
+    out = tmp_path / "links.csv"
+    common = ["links", "--roster", str(course / "roster.csv"), "--db", db, "--exercises", str(course / "v")]
+    assert main([*common, "--base-url", "https://armdyn.test/", "--out", str(out)]) == 0
+    assert out.stat().st_mode & 0o077 == 0
+    first = {r["id"]: r["link"] for r in csv.DictReader(io.StringIO(out.read_text()))}
+    assert re.fullmatch(r"https://armdyn\.test/link/[A-Za-z0-9_-]{43}", first["ada"])
+    assert main([*common, "--base-url", "https://armdyn.test", "--out", str(out), "--renew", "ada"]) == 0
+    second = {r["id"]: r["link"] for r in csv.DictReader(io.StringIO(out.read_text()))}
+    assert second["ada"] != first["ada"] and second["bob"].startswith("(issued before")
+    repo = Repository(db)
+    store = Store(repo.engine)
+    assert store.student_of_link(first["ada"].rsplit("/", 1)[1]) is None  # renewed: the old link is dead
+    assert store.student_of_link(second["ada"].rsplit("/", 1)[1]) == "ada"
+    assert store.student_of_link(first["bob"].rsplit("/", 1)[1]) == "bob"
+    repo.dispose()
+    assert main([*common, "--base-url", "https://x", "--renew", "mallory"]) == 2  # not on the roster
+
+    args = build_parser().parse_args(
+        ["serve", "--roster", str(course / "roster.csv"), "--deadline", "ada=2026-12-11T00:00Z", "--policy", "best"]
+    )
+    settings = Settings(exercises=catalogue(str(course / "v")))
+    course_settings(settings, args)
+    assert settings.roster["bob"].variant == "bob" and settings.policy == "best"
+    assert settings.deadlines == {"ada": calendar.timegm((2026, 12, 11, 0, 0, 0))}
+    with pytest.raises(ModelError, match="--lti needs --roster"):
+        course_settings(Settings(exercises=settings.exercises), build_parser().parse_args(["serve", "--lti", "x.yaml"]))

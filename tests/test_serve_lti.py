@@ -132,6 +132,7 @@ def test_forged_and_replayed_launches_are_refused_and_logged(course, db_url, pla
             ("forged signature", dict(key=new_key()), 401, "InvalidSignatureError"),
             ("another tool's token", dict(aud="someone-else"), 403, "wrong audience"),
             ("expired", dict(exp=int(time.time()) - 3600, iat=int(time.time()) - 7200), 401, "expired"),
+            ("issued in the future", dict(iat=int(time.time()) + 3600, exp=int(time.time()) + 7200), 401, "Immature"),
             ("unknown deployment", {LTI + "deployment_id": "deployment-99"}, 403, "unknown deployment"),
             ("not on the roster", dict(sub="lms-user-77", email="eve@example.edu"), 403, "not on the roster"),
             ("no nonce", dict(nonce=None), 401, "nonce"),

@@ -441,6 +441,8 @@ def routes(srv) -> list:
         if who is None:
             return web._page("me.html", status=401, student=None, instructor=False)
         student, exercise = who
+        if exercise not in srv.settings.exercises:  # the server restarted without it
+            return HTMLResponse(f"Your exercise '{exercise}' is not served any more: ask your instructor.", 404)
         key, new = web._student_key(request)
         mine = await run_in_threadpool(srv.repo.by_student, student.id)
         deadline = deadline_of(srv.settings, exercise, student)

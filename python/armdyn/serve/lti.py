@@ -387,11 +387,17 @@ def verify_launch(tool: Tool, ledger: Ledger, id_token: str, state_row: dict) ->
             options={"require": ["exp", "iat", "iss", "aud", "sub", "nonce"]},
         )
     except jwt.ExpiredSignatureError:
-        raise Refused(401, "the launch has expired: start it again from the LMS", "launch with an expired id_token")
+        raise Refused(
+            401, "the launch has expired: start it again from the LMS", "launch with an expired id_token"
+        ) from None
     except jwt.InvalidAudienceError:
         raise Refused(403, "the launch is meant for another tool", "launch with a wrong audience") from None
     except jwt.InvalidIssuerError:
         raise Refused(403, "the launch comes from another platform", "launch with a wrong issuer") from None
+    except jwt.PyJWKClientConnectionError as err:
+        raise Refused(
+            503, "the platform's keys could not be fetched: try again", f"platform key set unreachable ({err})"
+        ) from None
     except jwt.PyJWKClientError as err:
         raise Refused(401, "the launch's key is not the platform's", f"launch signing key not found ({err})") from None
     except jwt.PyJWTError as err:

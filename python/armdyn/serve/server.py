@@ -147,6 +147,8 @@ def course_settings(settings, args) -> None:
     if getattr(args, "lti", None):
         from .lti import Tool
 
+        if settings.roster is None:
+            raise ModelError("--lti needs --roster: a launch is mapped to a roster student (by email or LTI sub)")
         settings.lti = Tool.load(args.lti)
 
 
