@@ -150,9 +150,19 @@ def cmd_serve(args) -> int:
 
 
 def cmd_links(args) -> int:
-    from .serve.identity import cmd_links as links
+    """``armdyn links``: the roster's personal links, as CSV (docs/serve.md)."""
+    from .serve.exercises import catalogue
+    from .serve.identity import make_links
+    from .serve.server import db_url
 
-    return links(args)
+    text = make_links(args.roster, db_url(args.db), args.base_url, catalogue(args.exercises), args.renew)
+    if args.out:
+        fd = os.open(args.out, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)  # secrets: owner only
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+    else:
+        print(text, end="")
+    return 0
 
 
 def cmd_codegen(args) -> int:

@@ -26,6 +26,7 @@ import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import jinja2
 import sqlalchemy as sa
@@ -37,7 +38,7 @@ from starlette.responses import HTMLResponse, JSONResponse, RedirectResponse, Re
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
-from . import identity, security
+from . import identity, lti_web, security
 from .exercises import DEFAULT, Exercise, ordered
 from .openapi import schema
 from .pool import Pool
@@ -170,30 +171,16 @@ class Server:
             except asyncio.TimeoutError:
                 pass
 
-    async def accept(
-        self,
-        markdown: str,
-        exercise: str | None,
-        student: str,
-        owner_key: str | None,
-        student_id: str | None = None,
-        late: bool | None = None,
-    ) -> tuple:
-        """Store a submission; returns (summary row, secret link token)."""
+    async def accept(self, markdown: str, who: dict, owner_key: str | None) -> tuple:
+        """Store a submission of ``who`` (:func:`.identity.submitter`'s exercise, student,
+        student_id, late); returns (summary row, secret link token)."""
         _no_nul(markdown, "the derivation")
-        _no_nul(student, "the student name")
+        _no_nul(who["student"], "the student name")
         token = security.new_token()
         owner = security.digest(owner_key) if owner_key else None
+        fields = {**who, "student": who["student"].strip(), "owner_hash": owner}
         row = await run_in_threadpool(
-            self.repo.add,
-            security.new_id(),
-            security.digest(token),
-            markdown,
-            exercise,
-            student.strip(),
-            owner,
-            student_id,
-            late,
+            lambda: self.repo.add(security.new_id(), security.digest(token), markdown, **fields)
         )
         if row["status"] != DONE:
             self.pool.wake()
@@ -323,19 +310,12 @@ async def _text_body(request: Request) -> str:
         raise _BadRequest(f"the body is not UTF-8 (byte {err.start})") from None
 
 
-def lti_routes(srv) -> list:
-    """LTI 1.3's routes when ``--lti`` configured a tool (:mod:`.lti`)."""
-    if srv.settings.lti is None:
-        return []
-    from . import lti_web
-
-    return lti_web.routes(srv)
-
-
 def build_app(settings: Settings) -> Starlette:
     """The ASGI app for ``settings`` (workers start with the app's lifespan)."""
     srv = Server(settings)
     menu = ordered(settings.exercises)
+    # what identity's and LTI's pages share with these (passed: they do not import this module)
+    web = SimpleNamespace(page=_page, student_key=_student_key, with_key=_with_key)
 
     async def health(request: Request):
         """ok (200); starting, or degraded with its ``problems`` (503): a grading thread
@@ -366,7 +346,7 @@ def build_app(settings: Settings) -> Starlette:
         except ValueError:
             raise _BadRequest("wait must be a number of seconds") from None
         who = identity.submitter(srv, request, markdown, exercise, q.get("student", ""), form=False)
-        row, token = await srv.accept(markdown, who["exercise"], who["student"], None, who["student_id"], who["late"])
+        row, token = await srv.accept(markdown, who, None)
         row = await srv.wait(row["id"], wait) if row["status"] not in (DONE, FAILED) else row
         full = await run_in_threadpool(srv.repo.get, row["id"])
         body = _api_view(row, full)
@@ -442,7 +422,7 @@ def build_app(settings: Settings) -> Starlette:
         exercise = srv.exercise_of(str(form.get("exercise") or "") or None)
         who = identity.submitter(srv, request, markdown, exercise, str(form.get("student") or ""), form=True)
         owner = key if who["student_id"] is None else None  # a known student's are theirs, not the browser's
-        row, token = await srv.accept(markdown, who["exercise"], who["student"], owner, who["student_id"], who["late"])
+        row, token = await srv.accept(markdown, who, owner)
         await srv.wait(row["id"], FORM_WAIT)
         key_in_url = "" if who["student_id"] else f"?t={token}"  # a known student's session opens it
         return RedirectResponse(f"/submissions/{row['id']}{key_in_url}", status_code=303)
@@ -635,8 +615,8 @@ def build_app(settings: Settings) -> Starlette:
         Route("/api/submissions/{sid}", api_submission),
         Route("/api/preview", api_preview, methods=["POST"]),
         Route("/openapi.json", openapi),
-        *identity.routes(srv),
-        *lti_routes(srv),
+        *identity.routes(srv, web),
+        *lti_web.routes(srv, web),
         Mount("/static", StaticFiles(directory=os.path.join(HERE, "static")), name="static"),
     ]
 

@@ -301,21 +301,6 @@ def make_links(roster_path: str, db: str, base_url: str, exercises: dict, renew:
     return out.getvalue()
 
 
-def cmd_links(args) -> int:
-    """``armdyn links``: print the roster's personal links."""
-    from .exercises import catalogue
-    from .server import db_url
-
-    text = make_links(args.roster, db_url(args.db), args.base_url, catalogue(args.exercises), args.renew)
-    if args.out:
-        fd = os.open(args.out, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)  # secrets: owner only
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-    else:
-        print(text, end="")
-    return 0
-
-
 # -- the web side
 
 
@@ -407,13 +392,13 @@ def statement_path(exercise: Exercise | None) -> str | None:
     return path if os.path.isfile(path) else None
 
 
-def routes(srv) -> list:
-    """The personal link, the student's page and statement, logging out."""
+def routes(srv, web) -> list:
+    """The personal link, the student's page and statement, logging out (``web``: the
+    app's page helpers ``page``, ``student_key``, ``with_key``)."""
     from starlette.concurrency import run_in_threadpool
     from starlette.responses import FileResponse, HTMLResponse, RedirectResponse
     from starlette.routing import Route
 
-    from . import app as web
     from .grades import total_of
 
     failed_links = security.Throttle(per_client=20, overall=200)
@@ -439,11 +424,11 @@ def routes(srv) -> list:
     async def me(request):
         who = current(request)
         if who is None:
-            return web._page("me.html", status=401, student=None, instructor=False)
+            return web.page("me.html", status=401, student=None, instructor=False)
         student, exercise = who
         if exercise not in srv.settings.exercises:  # the server restarted without it
             return HTMLResponse(f"Your exercise '{exercise}' is not served any more: ask your instructor.", 404)
-        key, new = web._student_key(request)
+        key, new = web.student_key(request)
         mine = await run_in_threadpool(srv.repo.by_student, student.id)
         deadline = deadline_of(srv.settings, exercise, student)
         finished = [r for r in mine if r["status"] == "done" and r["graded_as"] == exercise]
@@ -454,7 +439,7 @@ def routes(srv) -> list:
             full = [await run_in_threadpool(srv.repo.get, r["id"]) for r in finished]
             pick = choose(full, srv.settings.policy)
             counted = {"id": pick["id"], "score": total_of(pick)}
-        response = web._page(
+        response = web.page(
             "me.html",
             student=student,
             exercise=srv.settings.exercises.get(exercise),
@@ -467,7 +452,7 @@ def routes(srv) -> list:
             csrf=srv.secrets.csrf_token(key),
             instructor=False,
         )
-        return web._with_key(response, key, new, request)
+        return web.with_key(response, key, new, request)
 
     async def statement(request):
         wanted = request.path_params["exercise"]

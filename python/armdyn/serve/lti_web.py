@@ -73,12 +73,14 @@ def passback(srv, tool, ledger: Ledger, sid: str) -> None:
             log.warning("armdyn serve: score of %s to %s not sent: %s", row["student_id"], item["lineitem"], err)
 
 
-def routes(srv) -> list:
+def routes(srv, web) -> list:
+    """The routes above when ``--lti`` configured a tool, else none (``web``: the app's
+    page helpers, ``page``)."""
+    if srv.settings.lti is None:
+        return []
     from starlette.concurrency import run_in_threadpool
     from starlette.responses import JSONResponse, RedirectResponse
     from starlette.routing import Route
-
-    from . import app as web
 
     tool = srv.settings.lti
     ledger_box: list[Ledger] = []
@@ -207,7 +209,7 @@ def routes(srv) -> list:
         )
         choices = [(ASSIGNED, "the exercise: each student their own variant (the roster's)")]
         choices += [(e.id, e.title) for e in srv.settings.exercises.values() if not e.variant]
-        return web._page("lti_pick.html", choices=choices, context=context, instructor=True)
+        return web.page("lti_pick.html", choices=choices, context=context, instructor=True)
 
     async def deep_link_answer(request):
         import jwt
@@ -249,7 +251,7 @@ def routes(srv) -> list:
         }
         if ctx.get("data") is not None:
             claims[DL + "data"] = ctx["data"]
-        response = web._page("lti_return.html", url=ctx["return_url"], jwt=tool.sign(claims), instructor=True)
+        response = web.page("lti_return.html", url=ctx["return_url"], jwt=tool.sign(claims), instructor=True)
         origin = "{0.scheme}://{0.netloc}".format(urllib.parse.urlsplit(ctx["return_url"]))
         # the one form that leaves this site: back to the platform that asked
         response.headers["content-security-policy"] = security.CSP.replace(
