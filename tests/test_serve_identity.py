@@ -131,6 +131,7 @@ def test_personal_links_own_variant_and_nobody_elses(course, db_url, caplog):  #
         assert ada.get("/me").status_code == 401
         anon = ada.post("/api/grade", content=ada_text.encode(), headers=MD)
         assert anon.status_code == 401 and "personal link" in anon.json()["error"]
+        assert ada.post("/api/preview?exercise=bob", content=b"$$x = 1$$", headers=MD).status_code == 401
         assert ada.get("/link/not-a-real-link-token-at-all").status_code == 404
         assert "wrong or renewed personal link" in caplog.text
 
@@ -167,6 +168,9 @@ def test_personal_links_own_variant_and_nobody_elses(course, db_url, caplog):  #
         api = ada.post("/api/grade?variant=bob", content=ada_text.encode(), headers=MD)
         assert api.status_code == 403 and "your exercise is 'ada'" in api.json()["error"]
         assert "ada tried to submit to exercise bob" in caplog.text
+        assert ada.post("/api/preview?exercise=bob", content=b"$$x = 1$$", headers=MD).status_code == 403
+        own = ada.post("/api/preview", content=b"$$\\tau_1 = 0$$", headers=MD)
+        assert own.status_code == 200 and "tau_1" in own.json()["html"]
         # the API, by her session: her variant, whatever the front matter's robot line says
         slip = ada.post("/api/grade", content=wrong(ada_text).encode(), headers=MD).json()
         assert slip["graded_as"] == "ada" and slip["passed"] is False and slip["first_wrong"] == "tau_2", slip

@@ -372,7 +372,7 @@ def build_app(settings: Settings) -> Starlette:
             markdown = await _text_body(request)
             if len(markdown.encode()) > MAX_PREVIEW:
                 return _error(413, f"a preview reads at most {MAX_PREVIEW} bytes")
-            exercise = srv.exercise_of(request.query_params.get("exercise"))
+            exercise = identity.may_preview(srv, request, srv.exercise_of(request.query_params.get("exercise")))
             async with srv.preview_lock:
                 if await request.is_disconnected():
                     return Response(status_code=204)  # nobody reads it: do not make it

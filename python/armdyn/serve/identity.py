@@ -384,6 +384,19 @@ def submitter(srv, request, markdown: str, requested: str | None, typed: str, fo
     return {"exercise": requested, "student": typed, "student_id": None, "late": late}
 
 
+def may_preview(srv, request, exercise: str | None) -> str | None:
+    """The exercise a preview may read against: a student in a session, theirs only
+    (another's: 403, logged); with a roster, nobody without a session but the instructor."""
+    who = current(request)
+    if who is not None:
+        if exercise and exercise != who[1]:
+            raise Refused(403, "this is not your exercise", f"student {who[0].id} asked for a preview of {exercise}")
+        return who[1]
+    if srv.settings.roster is not None and not srv.is_instructor(request):
+        raise Refused(401, "open your personal link first", "a preview without a student session")
+    return exercise
+
+
 def statement_path(exercise: Exercise | None) -> str | None:
     """The variant's ``problem.html`` (written by ``armdyn exercise make``), if any."""
     if exercise is None or not exercise.variant:
