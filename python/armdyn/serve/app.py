@@ -11,6 +11,8 @@ Routes (the JSON API is described in :mod:`.openapi`, served at ``/openapi.json`
     GET  /instructor/gradebook.csv       the gradebook (armdyn.course)
     GET  /instructor/summary             the class summary page (armdyn.course)
     GET  /api/health, POST /api/grade, GET /api/submissions/{id}, POST /api/preview
+    GET  /link/{token}, /me, /exercises/{id}/statement; POST /me/logout     (--roster: :mod:`.identity`)
+    GET|POST /lti/login, POST /lti/launch, /lti/deep-link, GET /lti/jwks     (--lti: :mod:`.lti_web`)
 
 The web process stores and serves; it never reads a student's LaTeX itself: grading
 and previews go to worker processes (:mod:`.pool`).
