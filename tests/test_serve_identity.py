@@ -175,22 +175,21 @@ def test_personal_links_own_variant_and_nobody_elses(course, db_url, caplog):  #
         slip = ada.post("/api/grade", content=wrong(ada_text).encode(), headers=MD).json()
         assert slip["graded_as"] == "ada" and slip["passed"] is False and slip["first_wrong"] == "tau_2", slip
 
-        bob = TestClient(ada.app)
-        with bob:
-            log_in(bob, issued["bob"])
-            caplog.clear()
-            for path in (f"/submissions/{sid}", f"/api/submissions/{sid}", f"/submissions/{sid}/report.html"):
-                assert bob.get(path).status_code == 404, path
-            assert "bob asked for submission" in caplog.text
-            assert sid not in bob.get("/me").text
-            late = submit(bob, bob_text)
-            bob_sid = late.headers["location"].split("/submissions/")[1].split("?")[0]
-            row = bob.get(f"/api/submissions/{bob_sid}").json()
-            assert row["graded_as"] == "bob" and row["passed"] is True and row["late"] is True
-            assert "late" in bob.get("/me").text
-            # logging out ends the session on the server
-            bob.post("/me/logout", data={"csrf": csrf_of(bob.get("/me").text)})
-            assert bob.get(f"/api/submissions/{bob_sid}").status_code == 404
+        bob = TestClient(ada.app)  # another browser; no second lifespan (it would start a second pool)
+        log_in(bob, issued["bob"])
+        caplog.clear()
+        for path in (f"/submissions/{sid}", f"/api/submissions/{sid}", f"/submissions/{sid}/report.html"):
+            assert bob.get(path).status_code == 404, path
+        assert "bob asked for submission" in caplog.text
+        assert sid not in bob.get("/me").text
+        late = submit(bob, bob_text)
+        bob_sid = late.headers["location"].split("/submissions/")[1].split("?")[0]
+        row = bob.get(f"/api/submissions/{bob_sid}").json()
+        assert row["graded_as"] == "bob" and row["passed"] is True and row["late"] is True
+        assert "late" in bob.get("/me").text
+        # logging out ends the session on the server
+        bob.post("/me/logout", data={"csrf": csrf_of(bob.get("/me").text)})
+        assert bob.get(f"/api/submissions/{bob_sid}").status_code == 404
 
         # the gradebook: one row per student, by the stated policy
         def book(client):
@@ -206,7 +205,8 @@ def test_personal_links_own_variant_and_nobody_elses(course, db_url, caplog):  #
 
     with TestClient(build_app(settings_for(course, db_url, policy="best"))) as c:
         best = book(c)
-        assert best["ada"]["policy"] == "best" and best["ada"]["submission"] == sid
+        counted = best["ada"]["submission"]
+        assert best["ada"]["policy"] == "best" and counted == ("'" + sid if sid[0] in "=+-@" else sid)  # CSV guard
         assert float(best["ada"]["total"]) == float(best["ada"]["max"]) > float(latest["ada"]["total"])
 
 

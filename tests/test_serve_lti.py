@@ -131,6 +131,7 @@ def test_forged_and_replayed_launches_are_refused_and_logged(course, db_url, pla
         cases = [
             ("forged signature", dict(key=new_key()), 401, "InvalidSignatureError"),
             ("another tool's token", dict(aud="someone-else"), 403, "wrong audience"),
+            ("another platform's token", dict(iss="https://lms.elsewhere"), 403, "wrong issuer"),
             ("expired", dict(exp=int(time.time()) - 3600, iat=int(time.time()) - 7200), 401, "expired"),
             ("issued in the future", dict(iat=int(time.time()) + 3600, exp=int(time.time()) + 7200), 401, "Immature"),
             ("unknown deployment", {LTI + "deployment_id": "deployment-99"}, 403, "unknown deployment"),
