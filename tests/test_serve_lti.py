@@ -228,3 +228,38 @@ def test_deep_linking_returns_a_signed_resource_link(course, db_url, platform, t
         # a shared exercise (not a variant) named by the link: that one
         r, _, _ = launch(c, platform, **{LTI + "custom": {"exercise": "rp-arm"}})
         assert 'id="my-exercise">rp-arm<' in c.get("/me").text
+
+
+def test_armdyn_serve_with_roster_and_lti(course, platform, tmp_path):  # noqa: F811
+    """The command line: ``armdyn serve --roster --exercises --lti`` publishes the tool's
+    key set, starts logins for the registered platform only, keeps students out of
+    ``/me`` without a session; a broken --lti file stops the start with its name."""
+    from serve_support import http, start_server
+
+    conf = tmp_path / "lti.yaml"
+    conf.write_text(yaml.safe_dump({"url": TOOL_URL, "platforms": [platform.registration()]}))
+    extra = ["--roster", str(course / "roster.csv"), "--exercises", str(course / "v"), "--lti", str(conf)]
+    server = start_server(tmp_path, f"sqlite:///{tmp_path / 'db.sqlite'}", extra=extra)
+    try:
+        status, keys = http("GET", server.base + "/lti/jwks")
+        assert status == 200 and keys["keys"][0]["kty"] == "RSA" and (tmp_path / "lti-key.pem").exists()
+        status, _ = http("GET", server.base + "/me")
+        assert status == 401
+        status, text = http("GET", server.base + "/lti/login?iss=https%3A%2F%2Flms.elsewhere&login_hint=1")
+        assert status == 403 and "not registered" in text
+    finally:
+        assert server.stop() in (0, -15)  # uvicorn re-raises SIGTERM after its graceful shutdown
+    conf.write_text("url: https://armdyn.test\nplatforms: [{issuer: x}]\n")
+    import subprocess
+    import sys
+
+    from serve_support import ROOT
+
+    run = subprocess.run(
+        [sys.executable, "-m", "armdyn", "serve", *extra],
+        capture_output=True,
+        text=True,
+        env={"PYTHONPATH": str(ROOT / "python"), "PATH": "/usr/bin:/bin"},
+        timeout=120,
+    )
+    assert run.returncode == 2 and "lti.yaml" in run.stderr and "platform 1 lacks client_id" in run.stderr
