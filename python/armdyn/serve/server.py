@@ -133,6 +133,25 @@ def config(app, host: str, port: int, forwarded_allow_ips: str = "127.0.0.1", **
     )
 
 
+def course_settings(settings, args) -> None:
+    """``--roster``, ``--deadline``, ``--policy``, ``--lti`` into ``settings``."""
+    from .grades import POLICIES
+    from .identity import load_roster, parse_deadlines
+
+    if getattr(args, "roster", None):
+        settings.roster = load_roster(args.roster, settings.exercises)
+    settings.deadlines = parse_deadlines(getattr(args, "deadline", None))
+    settings.policy = getattr(args, "policy", None) or "latest"
+    if settings.policy not in POLICIES:
+        raise ModelError(f"--policy must be one of {', '.join(POLICIES)}")
+    if getattr(args, "lti", None):
+        from .lti import Tool
+
+        if settings.roster is None:
+            raise ModelError("--lti needs --roster: a launch is mapped to a roster student (by email or LTI sub)")
+        settings.lti = Tool.load(args.lti)
+
+
 def run(args) -> int:
     try:
         import uvicorn
@@ -159,6 +178,7 @@ def run(args) -> int:
         instructor_token=token,
         secret=os.environ.get("ARMDYN_SECRET"),
     )
+    course_settings(settings, args)
     if token is None:
         print(
             "armdyn serve: no --instructor-token (or ARMDYN_INSTRUCTOR_TOKEN): the instructor page is closed",
