@@ -36,7 +36,7 @@ class FrozenDict(dict):
         return (FrozenDict, (dict(self),))
 
 
-class _FreezeAfterInit(type):
+class FreezeAfterInit(type):
     """Robot's metaclass: once ``__init__`` (whatever fields it sets) has returned, the
     instance is frozen (see :meth:`Robot.__setattr__`). No field is listed here."""
 

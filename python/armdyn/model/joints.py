@@ -11,19 +11,19 @@ import sympy as sp
 
 from ..errors import ModelError
 from .numbers import (
-    _EYE3,
-    _I3,
-    _Z_AXIS,
-    _ZERO,
-    _ZERO3,
-    _ZERO33,
+    EYE3,
+    I3,
+    Z_AXIS,
+    ZERO,
+    ZERO3,
+    ZERO33,
+    LazyField,
     Numbers,
-    _field_floats,
-    _is_zero,
-    _lazy_init,
-    _LazyField,
-    _mat3,
-    _vec3,
+    field_floats,
+    is_zero,
+    lazy_init,
+    mat3,
+    vec3,
 )
 from .rotations import axis_angle_matrix
 
@@ -64,16 +64,16 @@ class Link:
     """
 
     name: str
-    mass: sp.Expr = _LazyField()
-    com: sp.Matrix = _LazyField()
-    inertia: sp.Matrix = _LazyField()
+    mass: sp.Expr = LazyField()
+    com: sp.Matrix = LazyField()
+    inertia: sp.Matrix = LazyField()
 
     def __post_init__(self):
         where = f"link '{self.name}'"
         try:
-            _lazy_init(self, "mass", sp.sympify, _ZERO, ())
-            _lazy_init(self, "com", lambda v: _vec3(v, "com"), _ZERO3, (3,))
-            _lazy_init(self, "inertia", lambda v: _mat3(v, "inertia"), _ZERO33, (3, 3))
+            lazy_init(self, "mass", sp.sympify, ZERO, ())
+            lazy_init(self, "com", lambda v: vec3(v, "com"), ZERO3, (3,))
+            lazy_init(self, "inertia", lambda v: mat3(v, "inertia"), ZERO33, (3, 3))
         except ModelError as err:
             raise err.located(element=where)
         except (sp.SympifyError, TypeError) as exc:
@@ -82,7 +82,7 @@ class Link:
     def floats(self, name: str):
         """``mass``, ``com`` or ``inertia`` as a float array of shape ``()``, ``(3,)``
         or ``(3, 3)`` without building SymPy objects; None when it has free symbols."""
-        return _field_floats(self, name)
+        return field_floats(self, name)
 
 
 @dataclass(frozen=True)
@@ -142,20 +142,20 @@ class Joint:
     type: str
     parent: str
     child: str
-    xyz: sp.Matrix = _LazyField()
-    rotation: sp.Matrix = _LazyField()
-    axis: sp.Matrix = _LazyField()
-    frame_xyz: sp.Matrix = _LazyField()
-    frame_rotation: sp.Matrix = _LazyField()
-    lower: sp.Expr | None = _LazyField(optional=True)
-    upper: sp.Expr | None = _LazyField(optional=True)
-    velocity: sp.Expr | None = _LazyField(optional=True)
-    effort: sp.Expr | None = _LazyField(optional=True)
-    damping: sp.Expr | None = _LazyField(optional=True)
-    friction: sp.Expr | None = _LazyField(optional=True)
+    xyz: sp.Matrix = LazyField()
+    rotation: sp.Matrix = LazyField()
+    axis: sp.Matrix = LazyField()
+    frame_xyz: sp.Matrix = LazyField()
+    frame_rotation: sp.Matrix = LazyField()
+    lower: sp.Expr | None = LazyField(optional=True)
+    upper: sp.Expr | None = LazyField(optional=True)
+    velocity: sp.Expr | None = LazyField(optional=True)
+    effort: sp.Expr | None = LazyField(optional=True)
+    damping: sp.Expr | None = LazyField(optional=True)
+    friction: sp.Expr | None = LazyField(optional=True)
     mimic: Mimic | None = None
-    armature: sp.Expr | None = _LazyField(optional=True)
-    torque_offset: sp.Expr | None = _LazyField(optional=True)
+    armature: sp.Expr | None = LazyField(optional=True)
+    torque_offset: sp.Expr | None = LazyField(optional=True)
 
     def __post_init__(self):
         where = f"joint '{self.name}'"
@@ -165,13 +165,13 @@ class Joint:
                 where,
             )
         try:
-            _lazy_init(self, "xyz", lambda v: _vec3(v, "xyz"), _ZERO3, (3,))
-            _lazy_init(self, "rotation", lambda v: _mat3(v, "rotation"), _EYE3, (3, 3))
-            _lazy_init(self, "axis", lambda v: _vec3(v, "axis"), _Z_AXIS, (3,))
-            _lazy_init(self, "frame_xyz", lambda v: _vec3(v, "frame_xyz"), _ZERO3, (3,))
-            _lazy_init(self, "frame_rotation", lambda v: _mat3(v, "frame_rotation"), _EYE3, (3, 3))
+            lazy_init(self, "xyz", lambda v: vec3(v, "xyz"), ZERO3, (3,))
+            lazy_init(self, "rotation", lambda v: mat3(v, "rotation"), EYE3, (3, 3))
+            lazy_init(self, "axis", lambda v: vec3(v, "axis"), Z_AXIS, (3,))
+            lazy_init(self, "frame_xyz", lambda v: vec3(v, "frame_xyz"), ZERO3, (3,))
+            lazy_init(self, "frame_rotation", lambda v: mat3(v, "frame_rotation"), EYE3, (3, 3))
             for name in ("lower", "upper", "velocity", "effort") + JOINT_DYNAMICS:
-                _lazy_init(self, name, sp.sympify, None, ())
+                lazy_init(self, name, sp.sympify, None, ())
         except ModelError as err:
             raise err.located(element=where)
         except (sp.SympifyError, TypeError) as exc:
@@ -183,14 +183,14 @@ class Joint:
                 raise ModelError("a fixed joint cannot mimic another joint", where)
         _check_joint_dynamics(self, where)
         for key in ("rotation", "frame_rotation"):
-            if self.__dict__[key] is _EYE3:  # the default: a rotation, no check needed
+            if self.__dict__[key] is EYE3:  # the default: a rotation, no check needed
                 continue
             R = self.floats(key)
             if R is not None:
                 # R^T R = I (np.allclose's tolerances: atol 1e-9, rtol 1e-5) and det R > 0
                 (a, b, c), (d, e, f), (g, h, i) = R.tolist()
                 det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
-                if not (np.all(np.abs(R.T @ R - _I3) <= 1e-9 + 1e-5 * _I3) and det > 0):
+                if not (np.all(np.abs(R.T @ R - I3) <= 1e-9 + 1e-5 * I3) and det > 0):
                     raise ModelError(f"{key} {R.tolist()} is not a proper rotation matrix", where)
         axis = self.__dict__["axis"]
         if self.type != "fixed" and isinstance(axis, Numbers):  # numbers: checked without SymPy
@@ -201,10 +201,10 @@ class Joint:
                 raise ModelError(f"axis {axis.floats.tolist()} is not a unit vector (norm {norm:.6g})", where)
         elif self.type != "fixed":
             norm2 = sp.expand(sum(c**2 for c in self.axis))
-            zero = _is_zero(norm2)
+            zero = is_zero(norm2)
             if zero:
                 raise ModelError("axis is zero", where)
-            if zero is False and _is_zero(norm2 - 1) is False:
+            if zero is False and is_zero(norm2 - 1) is False:
                 raise ModelError(
                     f"axis {list(self.axis)} is not a unit vector (norm {sp.sqrt(norm2).evalf(6)})",
                     where,
@@ -218,7 +218,7 @@ class Joint:
         """``xyz``, ``axis``, ``frame_xyz`` (shape ``(3,)``), ``rotation`` or
         ``frame_rotation`` (``(3, 3)``) as a float array without building SymPy
         objects; None when it has free symbols."""
-        return _field_floats(self, name)
+        return field_floats(self, name)
 
     @property
     def has_frame_offset(self) -> bool:

@@ -1,7 +1,7 @@
 """Numbers in a model: exact (SymPy) when read, floats when computed with, built lazily.
 
 A model read from a file keeps its numbers as float64 arrays (:class:`Numbers`) and builds
-the SymPy form of a field only when it is read (``_LazyField``), so a 10^4-joint URDF loads
+the SymPy form of a field only when it is read (``LazyField``), so a 10^4-joint URDF loads
 in seconds; :func:`exact_number` turns a float into the rational or surd it stands for."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import sympy as sp
 from ..errors import ModelError
 
 
-def _vec3(value, what: str) -> sp.Matrix:
+def vec3(value, what: str) -> sp.Matrix:
     if isinstance(value, sp.MatrixBase) and value.shape == (3, 1):
         return sp.Matrix(value)  # entries are SymPy objects already (readers pass these)
     try:
@@ -26,7 +26,7 @@ def _vec3(value, what: str) -> sp.Matrix:
     return m.applyfunc(sp.sympify)
 
 
-def _mat3(value, what: str) -> sp.Matrix:
+def mat3(value, what: str) -> sp.Matrix:
     if isinstance(value, sp.MatrixBase) and value.shape == (3, 3):
         return sp.Matrix(value)
     try:
@@ -38,7 +38,7 @@ def _mat3(value, what: str) -> sp.Matrix:
     return m.applyfunc(sp.sympify)
 
 
-def _is_zero(expr) -> bool | None:
+def is_zero(expr) -> bool | None:
     """True/False if decidable, None if it depends on free symbols."""
     expr = sp.sympify(expr)
     if expr.free_symbols:
@@ -92,7 +92,7 @@ class Numbers:
 _DEFAULT = object()  # a lazy field not given: __post_init__ puts its default in
 
 
-class _LazyField:
+class LazyField:
     """Data descriptor for a numeric field of Link/Joint: the instance keeps what it was
     given (SymPy, or :class:`Numbers`) under the field's name and reading the attribute
     always gives SymPy, built from Numbers on first read and cached (``_sym_<name>``)."""
@@ -119,7 +119,7 @@ class _LazyField:
         obj.__dict__[self.name] = value
 
 
-def _field_floats(obj, name: str):
+def field_floats(obj, name: str):
     """Float array of a Link/Joint field (shape () / (3,) / (3, 3)), None when it has
     free symbols; cached on the instance."""
     d = obj.__dict__
@@ -146,7 +146,7 @@ def _field_floats(obj, name: str):
     return d[key]
 
 
-def _lazy_init(obj, name: str, convert, default: "Numbers", shape: tuple) -> None:
+def lazy_init(obj, name: str, convert, default: "Numbers", shape: tuple) -> None:
     """Normalise a lazy field in ``__post_init__``: the default when not given, a
     :class:`Numbers` of the right shape kept as it is, anything else converted to SymPy."""
     raw = obj.__dict__.get(name, _DEFAULT)
@@ -162,9 +162,9 @@ def _lazy_init(obj, name: str, convert, default: "Numbers", shape: tuple) -> Non
     obj.__dict__[name] = raw
 
 
-_I3 = np.eye(3)
-_ZERO3 = Numbers(np.zeros(3))
-_EYE3 = Numbers(np.eye(3))
-_ZERO33 = Numbers(np.zeros((3, 3)))
-_Z_AXIS = Numbers(np.array([0.0, 0.0, 1.0]))
-_ZERO = Numbers(0.0)
+I3 = np.eye(3)
+ZERO3 = Numbers(np.zeros(3))
+EYE3 = Numbers(np.eye(3))
+ZERO33 = Numbers(np.zeros((3, 3)))
+Z_AXIS = Numbers(np.array([0.0, 0.0, 1.0]))
+ZERO = Numbers(0.0)

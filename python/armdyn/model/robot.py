@@ -12,14 +12,14 @@ import sympy as sp
 from ..dispatch import call
 from ..errors import ModelError
 from ..inertia import check_physical, physical_violations
-from .frozen import FrozenDict, FrozenList, _FreezeAfterInit
+from .frozen import FreezeAfterInit, FrozenDict, FrozenList
 from .joints import JOINT_DYNAMICS, Joint, Link, coordinate_symbols
-from .numbers import Numbers, _mat3, _vec3
+from .numbers import Numbers, mat3, vec3
 
 _CACHES = ("_numeric_model", "_canonical")
 
 
-class Robot(metaclass=_FreezeAfterInit):
+class Robot(metaclass=FreezeAfterInit):
     """A fixed-base robot: links and joints in tree order, and gravity.
 
     Immutable once constructed: setting a public attribute raises AttributeError and
@@ -108,7 +108,7 @@ class Robot(metaclass=_FreezeAfterInit):
         joints = list(joints)
         self.meta = dict(meta or {})  # "file" (if any) names the model file in messages
         try:
-            self.gravity = _vec3(gravity, "gravity")
+            self.gravity = vec3(gravity, "gravity")
         except ModelError as err:
             raise err.located(element=f"robot '{name}'")
 
@@ -482,8 +482,8 @@ class Robot(metaclass=_FreezeAfterInit):
             raise ModelError(f"the base link {link!r} does not move: a payload on it has no effect", where)
         try:
             mass = sp.sympify(mass)
-            com = _vec3(com, "com")
-            inertia = sp.zeros(3, 3) if inertia is None else _mat3(inertia, "inertia")
+            com = vec3(com, "com")
+            inertia = sp.zeros(3, 3) if inertia is None else mat3(inertia, "inertia")
         except ModelError as err:
             raise err.located(element=where)
         except (sp.SympifyError, TypeError) as exc:
