@@ -29,6 +29,7 @@ What is read (the part of MJCF that fixes a fixed-base arm's rigid-body dynamics
   never): spheres, capsules, cylinders, boxes and ellipsoids (``size`` or ``fromto``) of
   uniform ``density`` (default 1000) or given ``mass``, in the groups of
   ``inertiagrouprange`` (default 0 5); any other geom there is an error naming the body.
+  A box or ellipsoid given by ``fromto`` has ``size[0]`` as both half-widths (as MuJoCo).
   A body with neither is massless: listed in ``robot.meta["massless_links"]`` and warned.
 * ``<default>`` classes (nested, ``class=``, ``childclass=``) for joint and geom
   attributes; ``<include file>`` (relative to the main file's directory, as in MuJoCo;
@@ -193,16 +194,16 @@ class _Reader:
         stack = [(root, top)]
         while stack:
             elem, chain = stack.pop()
+            pending = [(child, chain) for child in reversed(elem)]
             children, changed = [], False
-            for child in elem:
-                if child.tag != "include":
+            while pending:  # an included file's own includes are expanded in place too
+                child, sub = pending.pop()
+                if child.tag == "include":
+                    changed = True
+                    pending += reversed(self.include(child, sub, seen))
+                else:
                     children.append(child)
-                    stack.append((child, chain))
-                    continue
-                changed = True
-                for grandchild, sub in self.include(child, chain, seen):
-                    children.append(grandchild)
-                    stack.append((grandchild, sub))
+                    stack.append((child, sub))
             if changed:
                 elem[:] = children
 
@@ -634,7 +635,10 @@ class _Reader:
             if length < 1e-10:
                 raise self.error(elem, "fromto has zero length")
             R, p = quat_matrix(zaxis_quat(ends[3:] - ends[:3])), (ends[:3] + ends[3:]) / 2
-            size[1 if kind in ("capsule", "cylinder") else 2] = length / 2
+            if kind in ("capsule", "cylinder"):
+                size[1] = length / 2
+            else:  # a box or an ellipsoid: MuJoCo takes size[0] for both half-widths
+                size[1:] = size[0], length / 2
         else:
             R, p = self.pose(elem, attrs)
         if np.any(size[: GEOM_SIZES[kind]] <= 0):
