@@ -54,12 +54,10 @@ from __future__ import annotations
 
 import math
 import os
-import re
 import warnings
 import xml.etree.ElementTree as ET
 from collections import Counter
 from pathlib import Path
-from xml.parsers import expat
 
 import numpy as np
 
@@ -76,12 +74,11 @@ from .mjcf_math import (
     xyaxes_matrix,
     zaxis_quat,
 )
+from .mjcf_xml import MjcfDocument, clip
 from .textfile import MODEL_MAX_BYTES, read_bytes
-from .urdf import refuse_dtd
 
 __all__ = ["load_mjcf", "MjcfIgnoredWarning"]
 
-MAX_INCLUDE_DEPTH = 16
 MAX_DEFAULT_DEPTH = 100
 ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
 WORLD = "world"
@@ -98,8 +95,6 @@ IGNORED_DEFAULTS = {"site", "camera", "light", "mesh", "material", "pair", "equa
 IGNORED_DEFAULTS |= {"motor", "position", "velocity", "intvelocity", "damper", "cylinder", "adhesion", "muscle"}
 #: compiler options that change masses or inertias: refused when set
 MASS_OPTIONS = {"boundmass": "0", "boundinertia": "0", "settotalmass": "-1", "balanceinertia": "false"}
-
-_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 
 
 class MjcfIgnoredWarning(UserWarning):
@@ -130,12 +125,12 @@ def load_mjcf(path_or_xml, strict: bool = True, floating: str | None = None) -> 
     return _Reader(source, directory, strict, floating).robot(text)
 
 
-class _Reader:
-    """One reading of an MJCF document and its includes."""
+class _Reader(MjcfDocument):
+    """One reading of an MJCF document and its includes: the body tree to a Robot."""
 
     def __init__(self, source: str, directory: Path | None, strict: bool, floating: str | None):
-        self.source, self.directory, self.strict, self.floating = source, directory, strict, floating
-        self.origin: dict[ET.Element, tuple[str, int]] = {}  # element -> (file, line)
+        super().__init__(source, directory)
+        self.strict, self.floating = strict, floating
         self.ignored: Counter[str] = Counter()
         self.classes: dict[str, dict[str, dict[str, str]]] = {}
         self.names: set[str] = {WORLD}
@@ -144,111 +139,6 @@ class _Reader:
         self.joints: list[Joint] = []
         self.massless: list[str] = []
         self.intermediate: list[str] = []
-        self.bytes = 0
-
-    # ------------------------------------------------------------ errors, XML
-
-    def error(self, elem: ET.Element | None, message: str) -> ModelError:
-        if elem is None:
-            return ModelError(message, None, self.source)
-        name = elem.get("name")
-        what = f"<{elem.tag} name='{_clip(name)}'>" if name else f"<{elem.tag}>"
-        file, line = self.origin.get(elem, (self.source, 0))
-        return ModelError(message, what, f"{file}:{line}" if line else file)
-
-    def parse(self, text: bytes, name: str) -> ET.Element:
-        """The ``<mujoco>`` root of ``text``, each element's line kept in ``origin``."""
-        self.bytes += len(text)
-        if self.bytes > MODEL_MAX_BYTES:
-            raise ModelError(f"the model and its includes are larger than {MODEL_MAX_BYTES} bytes", None, name)
-        try:
-            refuse_dtd(text, "MJCF")
-        except ModelError as err:
-            raise err.located(source=name)
-        parser = expat.ParserCreate()
-        stack: list[ET.Element] = []
-        roots: list[ET.Element] = []
-
-        def start(tag, attrs):
-            elem = ET.Element(tag, attrs)
-            self.origin[elem] = (name, parser.CurrentLineNumber)
-            (stack[-1] if stack else roots).append(elem)
-            stack.append(elem)
-
-        parser.StartElementHandler = start
-        parser.EndElementHandler = lambda tag: stack.pop()
-        try:
-            parser.Parse(text, True)
-        except expat.ExpatError as err:
-            where = f"column {err.offset + 1}"
-            raise ModelError(f"malformed XML: {expat.ErrorString(err.code)}", where, f"{name}:{err.lineno}") from None
-        root = roots[0]
-        if root.tag != "mujoco":
-            raise self.error(root, f"the root element is <{root.tag}>, expected <mujoco>")
-        return root
-
-    def expand_includes(self, root: ET.Element) -> None:
-        """Put each ``<include file>``'s children in its place (iteratively, bounded)."""
-        top = () if self.directory is None else (os.path.realpath(self.source),)
-        seen = set(top)
-        stack = [(root, top)]
-        while stack:
-            elem, chain = stack.pop()
-            pending = [(child, chain) for child in reversed(elem)]
-            children, changed = [], False
-            while pending:  # an included file's own includes are expanded in place too
-                child, sub = pending.pop()
-                if child.tag == "include":
-                    changed = True
-                    pending += reversed(self.include(child, sub, seen))
-                else:
-                    children.append(child)
-                    stack.append((child, sub))
-            if changed:
-                elem[:] = children
-
-    def include(self, elem: ET.Element, chain: tuple, seen: set) -> list:
-        file = elem.get("file")
-        if not file or not file.strip():
-            raise self.error(elem, "<include> has no 'file' attribute")
-        if self.directory is None:
-            raise self.error(elem, "an <include> needs the model read from its file (its path is relative to it)")
-        if len(chain) >= MAX_INCLUDE_DEPTH:
-            raise self.error(elem, f"includes nested deeper than {MAX_INCLUDE_DEPTH}")
-        path = self.directory / file.strip()
-        real = os.path.realpath(path)
-        if real in chain:
-            loop = " -> ".join(os.path.basename(p) for p in chain + (real,))
-            raise self.error(elem, f"include loop: {loop}")
-        if real in seen:
-            raise self.error(elem, f"'{_clip(file)}' is included twice (MuJoCo includes a file once)")
-        seen.add(real)
-        try:
-            text = read_bytes(path, "included file", MODEL_MAX_BYTES)
-        except ModelError as err:
-            raise self.error(elem, f"cannot include '{_clip(file)}': {err.message}") from None
-        root = self.parse(text, os.fspath(path))
-        return [(child, chain + (real,)) for child in root]
-
-    # ------------------------------------------------------------- numbers
-
-    def numbers(self, elem, attrs, key, count, default=None, at_least=None) -> np.ndarray | None:
-        """``attrs[key]`` as ``count`` numbers (``at_least``..``count`` when given)."""
-        text = attrs.get(key)
-        if text is None:
-            return None if default is None else np.array(default, dtype=float)
-        parts = text.split()
-        low = count if at_least is None else at_least
-        if not low <= len(parts) <= count:
-            expected = count if at_least is None else f"{at_least} to {count}"
-            raise self.error(elem, f"'{key}' is {_clip(text)!r}: expected {expected} numbers")
-        for part in parts:
-            if not _NUMBER.fullmatch(part) or not math.isfinite(float(part)):
-                raise self.error(elem, f"'{key}' is {_clip(text)!r}: {_clip(part)!r} is not a finite number")
-        return np.array([float(p) for p in parts])
-
-    def number(self, elem, attrs, key, default: float) -> float:
-        return float(self.numbers(elem, attrs, key, 1, [default])[0])
 
     def rotation(self, elem, attrs) -> np.ndarray:
         """The orientation ``attrs`` give (identity when none)."""
@@ -287,12 +177,12 @@ class _Reader:
             attrs = elem.attrib
             if "angle" in attrs:
                 if attrs["angle"] not in ("degree", "radian"):
-                    raise self.error(elem, f"angle is {_clip(attrs['angle'])!r}, expected 'degree' or 'radian'")
+                    raise self.error(elem, f"angle is {clip(attrs['angle'])!r}, expected 'degree' or 'radian'")
                 self.unit = math.pi / 180 if attrs["angle"] == "degree" else 1.0
             if "eulerseq" in attrs:
                 seq = attrs["eulerseq"]
                 if len(seq) != 3 or any(c not in "xyzXYZ" for c in seq):
-                    raise self.error(elem, f"eulerseq is {_clip(seq)!r}: expected three of x y z X Y Z")
+                    raise self.error(elem, f"eulerseq is {clip(seq)!r}: expected three of x y z X Y Z")
                 self.eulerseq = seq
             if "inertiafromgeom" in attrs:
                 if attrs["inertiafromgeom"] not in ("auto", "true", "false"):
@@ -337,7 +227,7 @@ class _Reader:
             if depth > MAX_DEFAULT_DEPTH:
                 raise self.error(elem, f"default classes nested deeper than {MAX_DEFAULT_DEPTH}")
             if parent is not None and name in self.classes or parent is None and self.classes["main"]:
-                raise self.error(elem, f"default class '{_clip(name)}' is defined twice")
+                raise self.error(elem, f"default class '{clip(name)}' is defined twice")
             merged = {tag: dict(values) for tag, values in self.classes.get(parent or "", {}).items()}
             for child in elem:
                 if child.tag == "default":
@@ -360,7 +250,7 @@ class _Reader:
         ``childclass`` in force, else ``main``)."""
         name = elem.get("class", childclass)
         if name not in self.classes:
-            raise self.error(elem, f"unknown default class '{_clip(name)}'")
+            raise self.error(elem, f"unknown default class '{clip(name)}'")
         out = dict(self.classes[name].get(elem.tag, {}))
         own = {k: v for k, v in elem.attrib.items() if k != "class"}
         if set(own) & set(ORIENTATIONS) or "fromto" in own:
@@ -372,7 +262,7 @@ class _Reader:
     def childclass(self, elem: ET.Element, inherited: str) -> str:
         name = elem.get("childclass", inherited)
         if name not in self.classes:
-            raise self.error(elem, f"unknown default class '{_clip(name)}'")
+            raise self.error(elem, f"unknown default class '{clip(name)}'")
         return name
 
     # ---------------------------------------------------------------- names
@@ -393,7 +283,7 @@ class _Reader:
         except ModelError as err:
             raise self.error(elem, err.message) from None
         if name in used:
-            raise self.error(elem, f"the name '{_clip(name)}' is used twice")
+            raise self.error(elem, f"the name '{clip(name)}' is used twice")
         used.add(name)
         return name
 
@@ -516,7 +406,7 @@ class _Reader:
                 )
                 raise self.error(j, f"{kind} joint: armdyn has no {what} joint yet{extra}")
             elif kind not in ("hinge", "slide"):
-                raise self.error(j, f"unknown joint type '{_clip(kind)}' (expected hinge, slide, ball or free)")
+                raise self.error(j, f"unknown joint type '{clip(kind)}' (expected hinge, slide, ball or free)")
         if not read:
             fixed = self.unique(f"{name}_fixed", self.joint_names)
             return [self.joint(elem, fixed, "fixed", parent, name, pb, Rb, {})]
@@ -618,7 +508,7 @@ class _Reader:
         if kind not in GEOM_SIZES:
             raise self.error(
                 elem,
-                f"body '{_clip(body)}' has no <inertial> and MuJoCo would infer it from this {_clip(kind)} geom: "
+                f"body '{clip(body)}' has no <inertial> and MuJoCo would infer it from this {clip(kind)} geom: "
                 "armdyn infers it from sphere, capsule, cylinder, box and ellipsoid geoms only; "
                 "give the body an <inertial>",
             )
@@ -654,9 +544,3 @@ class _Reader:
             raise self.error(elem, "mass (or density) is negative")
         R, p = R0 @ R, p0 + R0 @ p
         return mass, p, R @ (density * unit_inertia) @ R.T
-
-
-def _clip(text: str | None, limit: int = 40) -> str:
-    """``text`` shortened for an error message (a bad file may hold megabytes)."""
-    text = text or ""
-    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} characters)"
