@@ -355,6 +355,11 @@ def one_body(joint: str = "<joint/>", inertial: str = '<inertial pos="0 0 0" mas
         (one_body("<joint damping='nan'/>"), "'nan' is not a finite number"),
         (one_body("<joint damping='-1'/>"), "damping -1.0 is negative"),
         (one_body("<joint class='nope'/>"), "unknown default class 'nope'"),
+        (one_body("<joint dampng='1'/>"), "<joint>: unknown attribute 'dampng'"),
+        (one_body("<joint damping='1 0.5'/>"), "nonlinear damping polynomial is not supported"),
+        (one_body("<joint springdamper='0.1 1'/>"), "springdamper .* is not supported"),
+        ("<mujoco><default><geom sise='1'/></default></mujoco>", "<geom>: unknown attribute 'sise'"),
+        (one_body(inertial="<inertial pos='0 0 0' mass='1' diaginertia='1 1 1' qat='1 0 0 0'/>"), "attribute 'qat'"),
         (one_body(inertial="<inertial mass='1' diaginertia='1 1 1'/>"), "<inertial> has no 'pos'"),
         (one_body(inertial="<inertial pos='0 0 0' mass='1'/>"), "needs one of 'diaginertia' and 'fullinertia'"),
         (

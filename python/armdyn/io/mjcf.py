@@ -233,6 +233,7 @@ class _Reader(MjcfDocument):
                 if child.tag == "default":
                     stack.append((child, name, depth + 1))
                 elif child.tag in ("joint", "geom"):
+                    self.check_attributes(child)
                     own = {k: v for k, v in child.attrib.items() if k != "class"}
                     if child.tag == "geom" and set(own) & set(ORIENTATIONS):  # the latest orientation wins
                         merged.setdefault("geom", {}).update(dict.fromkeys(ORIENTATIONS))
@@ -251,6 +252,7 @@ class _Reader(MjcfDocument):
         name = elem.get("class", childclass)
         if name not in self.classes:
             raise self.error(elem, f"unknown default class '{clip(name)}'")
+        self.check_attributes(elem)
         out = dict(self.classes[name].get(elem.tag, {}))
         own = {k: v for k, v in elem.attrib.items() if k != "class"}
         if set(own) & set(ORIENTATIONS) or "fromto" in own:
@@ -352,6 +354,7 @@ class _Reader(MjcfDocument):
             if tag == "body":
                 bodies.append((child, link, R, p, klass))
             elif tag == "frame":
+                self.check_attributes(child)
                 Rf, pf = self.pose(child, child.attrib)
                 inner = self.childclass(child, klass)
                 stack += [(c, R @ Rf, p + R @ pf, inner, True) for c in reversed(child)]
@@ -375,6 +378,7 @@ class _Reader(MjcfDocument):
 
     def body(self, elem, parent, R0, p0, inherited, number) -> list:
         """Read one body: its link and joints; returns its child bodies."""
+        self.check_attributes(elem)
         cls = self.childclass(elem, inherited)
         name = self.name(elem, self.names, f"body_{number}")
         Rb, pb = self.pose(elem, elem.attrib)
@@ -391,7 +395,7 @@ class _Reader(MjcfDocument):
 
     def body_joints(self, elem, name, parent, Rb, pb, joints) -> list[Joint]:
         """The joints from ``parent`` to body ``name`` at pose ``(Rb, pb)``."""
-        read = [(j, self.attrs(j, cls)) for j, cls in joints]
+        read = [(j, self.attrs(j, cls) if j.tag == "joint" else self.free_attrs(j)) for j, cls in joints]
         for j, attrs in read:
             kind = "free" if j.tag == "freejoint" else attrs.get("type", "hinge")
             if kind == "free" and self.floating == "weld" and parent == WORLD and len(read) == 1:
@@ -434,15 +438,25 @@ class _Reader(MjcfDocument):
             previous = child
         return out
 
+    def free_attrs(self, elem) -> dict[str, str]:
+        self.check_attributes(elem)
+        return dict(elem.attrib, type="free")
+
     def joint_dynamics(self, j, attrs, hinge) -> dict:
         out = {}
+        if np.any(self.numbers(j, attrs, "springdamper", 2, [0, 0])):
+            raise self.error(j, "springdamper (a spring and damper MuJoCo sizes from the masses) is not supported")
+        # damping and stiffness may be polynomials (MuJoCo 4): armdyn's damping is linear
+        damping = self.numbers(j, attrs, "damping", 3, [0], at_least=1)
+        if np.any(damping[1:]):
+            raise self.error(j, f"damping {damping.tolist()}: a nonlinear damping polynomial is not supported")
         for mine, theirs in (("damping", "damping"), ("armature", "armature"), ("friction", "frictionloss")):
-            value = self.number(j, attrs, theirs, 0.0)
+            value = float(damping[0]) if theirs == "damping" else self.number(j, attrs, theirs, 0.0)
             if value < 0:
                 raise self.error(j, f"{theirs} {value} is negative")
             if value:
                 out[mine] = Numbers(value)
-        if self.number(j, attrs, "stiffness", 0.0) != 0:
+        if np.any(self.numbers(j, attrs, "stiffness", 3, [0], at_least=1)):
             self.ignored["joint stiffness (springs are not modelled)"] += 1
         limits = self.numbers(j, attrs, "range", 2)
         if limits is not None and limits[0] < limits[1] and attrs.get("limited", "auto") != "false":
@@ -478,6 +492,7 @@ class _Reader(MjcfDocument):
             raise self.error(elem, err.message) from None
 
     def inertial(self, elem, cls) -> tuple[float, np.ndarray, np.ndarray]:
+        self.check_attributes(elem)
         attrs = elem.attrib
         for key in ("pos", "mass"):
             if key not in attrs:

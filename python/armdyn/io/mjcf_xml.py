@@ -20,9 +20,29 @@ from ..errors import ModelError
 from .textfile import MODEL_MAX_BYTES, read_bytes
 from .urdf import refuse_dtd
 
-__all__ = ["MjcfDocument", "clip", "MAX_INCLUDE_DEPTH"]
+__all__ = ["MjcfDocument", "clip", "MAX_INCLUDE_DEPTH", "ATTRIBUTES"]
 
 MAX_INCLUDE_DEPTH = 16
+
+_ORIENTATION = "quat axisangle xyaxes zaxis euler"
+#: the attributes MJCF allows on the elements this reader reads (MuJoCo refuses any
+#: other, so a misspelt ``dampng`` is an error here too, not a silently missing damping)
+ATTRIBUTES = {
+    tag: frozenset(names.split())
+    for tag, names in {
+        "body": f"name childclass pos {_ORIENTATION} mocap gravcomp sleep simple user",
+        "frame": f"name childclass pos {_ORIENTATION}",
+        "inertial": f"pos mass diaginertia fullinertia {_ORIENTATION}",
+        "joint": "name class type group pos axis springdamper limited actuatorfrclimited solreflimit solimplimit "
+        "solreffriction solimpfriction stiffness range actuatorfrcrange actuatorgravcomp margin ref springref "
+        "armature damping frictionloss user",
+        "freejoint": "name group align",
+        "geom": "name class type contype conaffinity condim group priority size material friction mass density "
+        f"shellinertia solmix solref solimp margin gap surfacevel adhesion fromto pos {_ORIENTATION} hfield mesh "
+        "fitscale rgba fluidshape fluidcoef user",
+        "include": "file",
+    }.items()
+}
 
 # a plain decimal number (no "nan", "inf", hex or "1_000")
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
@@ -44,6 +64,12 @@ class MjcfDocument:
         what = f"<{elem.tag} name='{clip(name)}'>" if name else f"<{elem.tag}>"
         file, line = self.origin.get(elem, (self.source, 0))
         return ModelError(message, what, f"{file}:{line}" if line else file)
+
+    def check_attributes(self, elem: ET.Element) -> None:
+        """ModelError for an attribute MJCF does not define on ``elem``."""
+        unknown = sorted(set(elem.attrib) - ATTRIBUTES[elem.tag])
+        if unknown:
+            raise self.error(elem, f"unknown attribute '{clip(unknown[0])}' (MuJoCo refuses it too)")
 
     def parse(self, text: bytes, name: str) -> ET.Element:
         """The ``<mujoco>`` root of ``text``, each element's line kept in ``origin``."""
@@ -97,6 +123,7 @@ class MjcfDocument:
                 elem[:] = children
 
     def include(self, elem: ET.Element, chain: tuple, seen: set) -> list:
+        self.check_attributes(elem)
         file = elem.get("file")
         if not file or not file.strip():
             raise self.error(elem, "<include> has no 'file' attribute")
