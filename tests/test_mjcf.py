@@ -296,6 +296,27 @@ def test_inertia_from_geoms_against_mujoco(tmp_path):
     assert compare_with_mujoco(path, robot) < TOL
 
 
+@pytest.mark.parametrize("mode", ["auto", "true", "false"])
+def test_inertiafromgeom_and_gravity_flag_against_mujoco(tmp_path, mode):
+    """``inertiafromgeom``: an <inertial> wins unless 'true'; 'false' never uses geoms."""
+    text = f"""<mujoco>
+      <compiler inertiafromgeom="{mode}"/>
+      <option gravity="1 2 -5"><flag gravity="disable" contact="disable"/></option>
+      <worldbody><body name="a"><joint name="j1" axis="0 1 0"/>
+        <inertial pos="0.1 0 0" mass="2" diaginertia="0.1 0.1 0.1"/>
+        <geom type="box" size="0.1 0.2 0.3" pos="0.2 0 0"/>
+        <body name="b" pos="0.5 0 0"><joint name="j2" axis="1 0 0"/>
+          <inertial pos="0 0.1 0" mass="1" diaginertia="0.01 0.02 0.02"/>
+          <geom type="sphere" size="0.1"/>
+        </body></body></worldbody></mujoco>"""
+    path = write(tmp_path, text)
+    with pytest.warns(MjcfIgnoredWarning):
+        robot = load_mjcf(path)
+    assert list(robot.gravity) == [0, 0, 0]
+    assert float(robot.links["a"].floats("mass")) == (2 if mode != "true" else pytest.approx(48))
+    assert compare_with_mujoco(path, robot) < TOL
+
+
 def test_include_files_against_mujoco(tmp_path):
     """Included files are relative to the main file's directory, also inside an included file."""
     (tmp_path / "parts").mkdir()

@@ -41,8 +41,10 @@ actuators, sensors, equality constraints, assets, sites, cameras, lights, visual
 keyframes, the geoms of bodies that have an ``<inertial>``): it is read and listed in
 one :class:`MjcfIgnoredWarning` and ``robot.meta["ignored"]``, never dropped silently.
 Elements that would change the body tree (``composite``, ``flexcomp``, ``replicate``,
-``attach``, ``plugin``) and compiler options that change masses (``boundmass``,
-``boundinertia``, ``settotalmass``, ``balanceinertia``) are refused.
+``attach``, ``plugin``), compiler options that change masses (``boundmass``,
+``boundinertia``, ``settotalmass``, ``balanceinertia``), a joint's ``springdamper`` and a
+damping polynomial past its linear term are refused; so is an attribute MJCF does not
+define (MuJoCo refuses it too: a misspelt ``dampng`` is not a silently absent damping).
 
 Safety: the XML is read with expat without a DTD (no entities: see
 :func:`armdyn.io.urdf.refuse_dtd`); files through :mod:`armdyn.io.textfile`, all of them
@@ -62,7 +64,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError
-from ..model import Joint, Link, Numbers, Robot
+from ..model import Joint, Link, Numbers, Robot, exact_number
 from .expressions import check_name
 from .mjcf_math import (
     GEOM_SIZES,
@@ -326,7 +328,15 @@ class _Reader(MjcfDocument):
         name = root.get("model") or (Path(self.source).stem if self.directory is not None else "mjcf")
         try:
             name = check_name(name, "model", "<mujoco>")
-            robot = Robot(name, self.links, self.joints, gravity, meta=meta, base=WORLD, strict=self.strict)
+            robot = Robot(
+                name,
+                self.links,
+                self.joints,
+                [exact_number(g) for g in gravity],
+                meta=meta,
+                base=WORLD,
+                strict=self.strict,
+            )
         except ModelError as err:
             raise err.located(source=self.source)
         if self.ignored:
@@ -477,6 +487,8 @@ class _Reader(MjcfDocument):
             mass, com, inertia = self.inertial(*inertials[0])
             self.ignored["<geom> (contact and visual shapes)"] += len(geoms)
         elif self.fromgeom != "false" and geoms:
+            if inertials:
+                self.ignored["<inertial> (inertiafromgeom='true')"] += 1
             parts = [self.geom(g, R, p, cls, name) for g, R, p, cls in geoms]
             mass, com, inertia = combine([part for part in parts if part is not None])
         else:
