@@ -16,6 +16,7 @@ from __future__ import annotations
 import re
 import time
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -28,10 +29,14 @@ from armdyn.io.mjcf import MjcfIgnoredWarning, load_mjcf
 TOL = 1e-10
 
 
-def mujoco_model(path):
+def mujoco_model(path, springs: bool = True):
     mujoco = pytest.importorskip("mujoco")
     model = mujoco.MjModel.from_xml_path(str(path))
     model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    if not springs:  # what armdyn reports as ignored: joint springs and fluid forces
+        model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_SPRING
+        model.opt.density = model.opt.viscosity = 0
+        model.opt.wind[:] = 0
     return mujoco, model
 
 
@@ -44,10 +49,11 @@ def full_inertia(mujoco, model, data) -> np.ndarray:
     return M
 
 
-def compare_with_mujoco(path, robot=None, states: int = 6, seed: int = 0) -> float:
+def compare_with_mujoco(path, robot=None, states: int = 6, seed: int = 0, springs: bool = True) -> float:
     """Largest difference of M and inverse dynamics between MuJoCo and armdyn (MuJoCo's
-    joint order mapped to armdyn's by name)."""
-    mujoco, model = mujoco_model(path)
+    joint order mapped to armdyn's by name); ``springs=False``: without MuJoCo's springs
+    and fluid forces."""
+    mujoco, model = mujoco_model(path, springs)
     data = mujoco.MjData(model)
     if robot is None:
         with warnings.catch_warnings():
@@ -338,6 +344,29 @@ def test_include_files_against_mujoco(tmp_path):
     robot = load_mjcf(main)
     assert float(robot.joints[1].damping) == 0.3
     assert compare_with_mujoco(main, robot) < TOL
+
+
+def test_mujoco_test_model_with_its_unsupported_parts_changed(tmp_path):
+    """MuJoCo's own test model (shipped in its wheel): its ball joint made a hinge, its mesh
+    a sphere, its free bodies welded (armdyn: floating='weld'; MuJoCo: the free joints
+    removed); everything else as written: defaults, several joints per body, fromto
+    geoms, tendons, actuators, sensors. MuJoCo's springs and fluid forces are switched off
+    (armdyn lists them as ignored)."""
+    mujoco = pytest.importorskip("mujoco")
+    source = Path(mujoco.__file__).parent / "testdata" / "model.xml"
+    if not source.is_file():
+        pytest.skip(f"mujoco {mujoco.__version__} ships no testdata/model.xml")
+    text = source.read_text().replace('type="ball"', 'type="hinge"')
+    text = text.replace('type="mesh" mesh="icosahedron"', 'type="sphere"')
+    text = text.replace('<joint type="hinge" axis="0 1 0"/>', '<joint name="tilt" type="hinge" axis="0 1 0"/>')
+    path = write(tmp_path, text)
+    with pytest.warns(MjcfIgnoredWarning) as record:
+        robot = load_mjcf(path, floating="weld")
+    for word in ("<tendon>", "joint stiffness", "<option viscosity>", "free joint read as a fixed base"):
+        assert word in str(record[0].message)
+    welded = re.sub(r"<keyframe>.*?</keyframe>", "", text.replace("<freejoint/>", ""), flags=re.S)
+    assert robot.dof == 11
+    assert compare_with_mujoco(write(tmp_path, welded, "welded.xml"), robot, springs=False) < TOL
 
 
 # ------------------------------------------ MuJoCo's own MJCF from example-robot-data
