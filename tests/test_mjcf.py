@@ -61,7 +61,7 @@ def compare_with_mujoco(path, robot=None, states: int = 6, seed: int = 0, spring
             robot = armdyn.load(path)
     assert robot.dof == model.nv == model.nq
     perm = [robot.coordinate_index(model.joint(i).name) for i in range(model.njnt)]
-    assert sorted(perm) == list(range(robot.dof))
+    assert perm == list(range(robot.dof))  # armdyn keeps MuJoCo's joint order
     friction = np.array([model.dof_frictionloss[i] for i in range(model.nv)])
     rng = np.random.default_rng(seed)
     worst = 0.0
@@ -506,6 +506,18 @@ def test_huge_counts_and_deep_nesting_end_in_bounded_time():
     with pytest.raises(ModelError, match="nested deeper than 100"):
         load_mjcf(f"<mujoco><default>{classes}</default></mujoco>")
     assert time.perf_counter() - start < 60
+
+
+def test_made_up_names_never_take_the_files_names():
+    text = """<mujoco><worldbody>
+      <body name="a"><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>
+        <body name="b"><joint name="j"/><joint name="k"/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body>
+        <body name="b_j"><joint name="a_fixed"/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body>
+      </body></worldbody></mujoco>"""
+    robot = load_mjcf(text)
+    assert sorted(j.name for j in robot.joints) == ["a_fixed", "a_fixed_", "j", "k"]
+    assert robot.joints[0].name == "a_fixed_" and robot.joints[0].type == "fixed"
+    assert robot.meta["intermediate_links"] == ["b_j_"]
 
 
 def test_massless_body_is_reported():

@@ -106,7 +106,9 @@ class MjcfIgnoredWarning(UserWarning):
 def load_mjcf(path_or_xml, strict: bool = True, floating: str | None = None) -> Robot:
     """Read an MJCF file (a path) or MJCF text (a string holding ``<`` or a line break).
 
-    Returns a numeric :class:`Robot` whose base is the world body (link ``"world"``).
+    Returns a numeric :class:`Robot` whose base is the world body (link ``"world"``),
+    its coordinates in MuJoCo's order (depth-first through the bodies as written): q is
+    MuJoCo's ``qpos``. Unnamed joints and bodies are called ``joint_<n>``, ``body_<n>``.
     ``strict=False`` loads physically invalid inertias with a warning instead of an error.
     ``floating="weld"``: a ``free`` joint of a body of the world body is read as a fixed
     base (the body welded at its pose); without it a free joint is an error.
@@ -272,8 +274,10 @@ class _Reader(MjcfDocument):
     # ---------------------------------------------------------------- names
 
     def unique(self, wanted: str, used: set[str]) -> str:
+        """``wanted``, or with ``_`` appended until it is neither used nor a name the file
+        gives (so a made-up name never takes one the file uses further on)."""
         name = wanted
-        while name in used:
+        while name in used or name in self.given:
             name += "_"
         used.add(name)
         return name
@@ -296,6 +300,7 @@ class _Reader(MjcfDocument):
     def robot(self, text: bytes) -> Robot:
         root = self.parse(text, self.source)
         self.expand_includes(root)
+        self.given = {e.get("name") for e in root.iter() if e.tag in ("body", "joint", "freejoint")}
         self.compiler(root)
         gravity = self.gravity(root)
         self.defaults(root)
