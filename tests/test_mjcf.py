@@ -280,8 +280,17 @@ GEOMS_ONLY = """<mujoco>
         <frame pos="0.2 0 0.1" euler="0 45 0">
           <geom type="ellipsoid" size="0.05 0.03 0.02"/>
           <body name="c" pos="0.05 0 0">
-            <joint name="j3" type="slide" axis="1 0 0"/>
+            <frame pos="0.01 0.02 0" euler="30 0 0">
+              <joint name="j3" type="slide" axis="1 0 0"/>
+              <joint name="j4" axis="0 1 0" pos="0 0 0.03"/>
+            </frame>
             <geom type="box" size="0.02 0.02 0.04" density="7800"/>
+            <body name="d" pos="0 0 0.1">
+              <joint name="j5" axis="1 0 0"/>
+              <frame pos="0.02 0 0.01" quat="0.9 0.1 0.3 0">
+                <inertial pos="0.01 0 0" mass="0.5" fullinertia="0.002 0.003 0.004 0.0001 0 0"/>
+              </frame>
+            </body>
           </body>
         </frame>
       </body>
@@ -297,7 +306,7 @@ def test_inertia_from_geoms_against_mujoco(tmp_path):
         robot = load_mjcf(path)
     mujoco, model = mujoco_model(path)
     masses = {model.body(i).name: model.body_mass[i] for i in range(model.nbody)}
-    for name in ("a", "b", "c"):
+    for name in ("a", "b", "c", "d"):
         assert abs(float(robot.links[name].floats("mass")) - masses[name]) < 1e-12 * masses[name]
     assert compare_with_mujoco(path, robot) < TOL
 

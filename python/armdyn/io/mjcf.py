@@ -376,9 +376,10 @@ class _Reader(MjcfDocument):
             elif tag == "geom":
                 geoms.append((child, R, p, klass))
             elif tag in ("joint", "freejoint", "inertial"):
-                if world or in_frame:
-                    raise self.error(child, f"<{tag}> cannot be {'in the world body' if world else 'in a <frame>'}")
-                (inertials if tag == "inertial" else joints).append((child, klass))
+                if world:
+                    raise self.error(child, f"<{tag}> cannot be in the world body")
+                # in a <frame>, its pos and axis are in the frame's axes (MuJoCo 3.2 on)
+                (inertials if tag == "inertial" else joints).append((child, klass, R, p))
             elif tag in IGNORED_IN_BODY:
                 self.ignored[f"<{tag}>"] += 1
             elif tag in REFUSED:
@@ -410,8 +411,8 @@ class _Reader(MjcfDocument):
 
     def body_joints(self, elem, name, parent, Rb, pb, joints) -> list[Joint]:
         """The joints from ``parent`` to body ``name`` at pose ``(Rb, pb)``."""
-        read = [(j, self.attrs(j, cls) if j.tag == "joint" else self.free_attrs(j)) for j, cls in joints]
-        for j, attrs in read:
+        read = [(j, self.attrs(j, cls) if j.tag == "joint" else self.free_attrs(j), R, p) for j, cls, R, p in joints]
+        for j, attrs, _, _ in read:
             kind = "free" if j.tag == "freejoint" else attrs.get("type", "hinge")
             if kind == "free" and self.floating == "weld" and parent == WORLD and len(read) == 1:
                 self.ignored["free joint read as a fixed base (floating='weld')"] += 1
@@ -430,14 +431,14 @@ class _Reader(MjcfDocument):
             fixed = self.unique(f"{name}_fixed", self.joint_names)
             return [self.joint(elem, fixed, "fixed", parent, name, pb, Rb, {})]
         out, previous = [], parent
-        for k, (j, attrs) in enumerate(read):
+        for k, (j, attrs, Rf, pf) in enumerate(read):
             jname = self.name(j, self.joint_names, f"joint_{len(self.joint_names) + 1}")
             hinge = attrs.get("type", "hinge") == "hinge"
             axis = self.numbers(j, attrs, "axis", 3, [0, 0, 1])
             if np.linalg.norm(axis) < 1e-10:
                 raise self.error(j, "axis is zero")
-            axis = axis / np.linalg.norm(axis)
-            point = self.numbers(j, attrs, "pos", 3, [0, 0, 0])
+            axis = Rf @ axis / np.linalg.norm(axis)
+            point = pf + Rf @ self.numbers(j, attrs, "pos", 3, [0, 0, 0])
             ref = self.number(j, attrs, "ref", 0.0) * (self.unit if hinge else 1.0)
             # the body is drawn at q = ref: fold the turn (shift) by -ref into the placement
             R = quat_matrix(axis_angle_quat(axis, -ref)) if hinge else np.eye(3)
@@ -508,7 +509,9 @@ class _Reader(MjcfDocument):
         except ModelError as err:
             raise self.error(elem, err.message) from None
 
-    def inertial(self, elem, cls) -> tuple[float, np.ndarray, np.ndarray]:
+    def inertial(self, elem, cls, Rf, pf) -> tuple[float, np.ndarray, np.ndarray]:
+        """``(mass, com, inertia about com)`` in the body frame (``Rf, pf``: the pose of
+        the frame the <inertial> sits in)."""
         self.check_attributes(elem)
         attrs = elem.attrib
         for key in ("pos", "mass"):
@@ -524,9 +527,9 @@ class _Reader(MjcfDocument):
             if set(attrs) & set(ORIENTATIONS):
                 raise self.error(elem, "fullinertia cannot be given with an orientation (it is in the body's axes)")
             xx, yy, zz, xy, xz, yz = self.numbers(elem, attrs, "fullinertia", 6)
-            return mass, com, np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
-        R = self.rotation(elem, attrs)
-        return mass, com, R @ np.diag(self.numbers(elem, attrs, "diaginertia", 3)) @ R.T
+            return mass, pf + Rf @ com, Rf @ np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]) @ Rf.T
+        R = Rf @ self.rotation(elem, attrs)
+        return mass, pf + Rf @ com, R @ np.diag(self.numbers(elem, attrs, "diaginertia", 3)) @ R.T
 
     def geom(self, elem, R0, p0, cls, body) -> tuple | None:
         """``(mass, com, inertia about com)`` of a geom in the body frame, or None when its
