@@ -13,6 +13,7 @@ MuJoCo skip alone; a closed form checks the planar arm without it.
 
 from __future__ import annotations
 
+import random
 import re
 import time
 import warnings
@@ -431,6 +432,10 @@ def one_body(joint: str = "<joint/>", inertial: str = '<inertial pos="0 0 0" mas
         (one_body(inertial="<composite/>"), "<composite> is not supported"),
         (one_body(inertial="<wing/>"), "unknown element <wing> in <body>"),
         ("<robot name='r'/>", "the root element is <robot>, expected <mujoco>"),
+        (
+            "<mujoco><worldbody><body name='a&#10;b'/></worldbody></mujoco>",
+            r"<body name='a\\nb'>: name: expected a name",
+        ),
         ("<mujoco><worldbody><joint/></worldbody></mujoco>", "cannot be in the world body"),
         ("<mujoco><default><inertial mass='1'/></default></mujoco>", "no inertial defaults"),
         ("<mujoco><compiler angle='grad'/></mujoco>", "angle is 'grad'"),
@@ -475,10 +480,33 @@ def test_free_joint_is_welded_only_on_request(tmp_path):
     assert abs(tau[0] - (-0.2 * 9.81)) < 1e-12
 
 
-def test_dtd_and_entities_are_refused():
-    bomb = '<?xml version="1.0"?>\n<!DOCTYPE m [<!ENTITY a "aaaa"><!ENTITY b "&a;&a;&a;">]>\n<mujoco model="&b;"/>'
+@pytest.mark.parametrize("encoding", ["utf-8", "utf-16"])
+def test_dtd_and_entities_are_refused(encoding):
+    bomb = f'<?xml version="1.0" encoding="{encoding}"?>\n<!DOCTYPE m [<!ENTITY a "aaaa"><!ENTITY b "&a;&a;&a;">]>\n'
     with pytest.raises(ModelError, match="<!DOCTYPE> on line 2: a DTD is not allowed in MJCF"):
-        load_mjcf(bomb)
+        load_mjcf((bomb + '<mujoco model="&b;"/>').encode(encoding))
+
+
+def test_mutated_files_give_one_line_model_errors_only():
+    """Random cuts and insertions into the models above: each loads or is one ModelError
+    line (no other exception, no message over several lines)."""
+    rng = random.Random(7)
+    pieces = ['"', "<", ">", "/", " ", "-1", "1e400", "nan", "=", "class", "body", "joint", "frame", "euler"]
+    pieces += ["quat", '"0 0 0"', "type", "ball", "&#10;", "x", "inertial", "geom", "fromto"]
+    for _ in range(300):
+        text = list(rng.choice([SIX_JOINTS, RP_ARM, MULTI_JOINT, GEOMS_ONLY, PLANAR_2R]))
+        for _ in range(rng.randint(1, 4)):
+            k = rng.randrange(len(text))
+            if rng.random() < 0.5:
+                del text[k : k + rng.randint(1, 5)]
+            else:
+                text.insert(k, rng.choice(pieces))
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                load_mjcf("".join(text))
+        except ModelError as err:
+            assert "\n" not in str(err)
 
 
 def test_includes_are_bounded(tmp_path):

@@ -61,6 +61,8 @@ class MjcfDocument:
         if elem is None:
             return ModelError(message, None, self.source)
         name = elem.get("name")
+        if name and not name.isprintable():  # a line break in a name must not split the message
+            name = repr(name)[1:-1]
         what = f"<{elem.tag} name='{clip(name)}'>" if name else f"<{elem.tag}>"
         file, line = self.origin.get(elem, (self.source, 0))
         return ModelError(message, what, f"{file}:{line}" if line else file)
