@@ -474,6 +474,8 @@ def test_free_joint_is_welded_only_on_request(tmp_path):
     with pytest.warns(MjcfIgnoredWarning, match="fixed base"):
         robot = armdyn.load(path, floating="weld")
     assert robot.dof == 1 and robot.joints[0].type == "fixed"
+    with pytest.raises(ModelError, match="floating= applies to MJCF"):
+        armdyn.load("rp-arm", floating="weld")
     # welded at its pose (turned 90 degrees about z): the joint axis is the world's -x, the
     # arm's centre of mass 0.2 along +y from it; holding 1 kg there takes -(0.2 * 9.81) about -x
     tau = numeric.rnea(robot, np.zeros(1), np.zeros(1), np.zeros(1))

@@ -41,8 +41,6 @@ def bundled_files() -> dict[str, Path]:
 
 def _load_file(path: Path, strict: bool, source: str, trusted: bool = False, floating: str | None = None) -> Robot:
     suffix = path.suffix.lower()
-    if floating is not None and suffix != ".xml":
-        raise ModelError("floating= applies to MJCF (.xml) files only", None, source)
     if suffix in (".yaml", ".yml"):
         from .yaml import load_yaml
 
@@ -129,6 +127,8 @@ def load(
     """
     text = os.fspath(source)
     path = Path(text)
+    if floating is not None and path.suffix.lower() != ".xml":
+        raise ModelError("floating= applies to MJCF (.xml) files only", None, text)
     looks_like_path = path.suffix.lower() in _SUFFIXES or os.sep in text or "/" in text
     bundled = bundled_files()
     if not looks_like_path and text in bundled:
