@@ -12,7 +12,7 @@
     armdyn codegen ROBOT [--what tau,M,C,g,regressor] [--base] [--lang c|python|numpy] [--bind] [--out DIR]
     armdyn simulate ROBOT --duration T --dt DT [--q0 ...] [--controller pd --target ...] [--plot run.png] [--animate run.gif]
 
-ROBOT is a bundled model's name (see ``armdyn robots``) or a model file (.yaml, .urdf).
+ROBOT is a bundled model's name (see ``armdyn robots``) or a model file (.yaml, .urdf, MJCF .xml).
 Bad input prints one line ``armdyn: error: ...`` and exits with status 2, no traceback.
 Ctrl-C prints ``armdyn: interrupted`` and exits with status 130, writing nothing.
 ``simulate`` exits with status 4 when the state became NaN/inf (see armdyn.simulate_cli).
@@ -213,7 +213,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
 
     def robot_arg(sp_):
-        sp_.add_argument("robot", help="bundled model name (armdyn robots) or a .yaml/.urdf file")
+        sp_.add_argument("robot", help="bundled model name (armdyn robots) or a .yaml/.urdf/.xml (MJCF) file")
         sp_.add_argument(
             "--allow-nonphysical",
             action="store_true",
