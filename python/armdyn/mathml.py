@@ -164,6 +164,7 @@ def _glue(word: str) -> bool:
 
 def _bare_math(tex: str) -> str | None:
     """Inline MathML of bare LaTeX (closed first if it was cut short), or None."""
+    tex = tex.replace("$", "")  # a delimiter left unpaired by a cut (a title shortened)
     cut = tex.endswith(_CUT)
     if cut:
         for end in _CUT:

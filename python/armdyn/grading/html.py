@@ -209,7 +209,7 @@ def _step_card(i: int, step: StepVerdict, w: _Writer, anchors: dict, first: int 
     if step.frame:
         where.append(f"in frame {escape(step.frame)}")
     if step.part or step.task:  # the assignment's part (or the unnumbered task's title)
-        where.append(f"part {escape(step.part)}" if step.part else escape(step.task))
+        where.append(f"part {escape(step.part)}" if step.part else text_with_math(step.task))
     head = (
         f'<div class="head"><span class="label">{math_element(_label(step))}</span>'
         f'{_badge(step.status)}<span class="where">{" · ".join(where)}</span></div>'
@@ -322,7 +322,8 @@ def _summary(report: GradeReport, anchors: dict, labels: dict) -> str:
         step = report.steps[k] if k is not None else None
         shown = math_element(labels[k]) if k is not None else escape(report.first_wrong)
         line = f" (line {step.line})" if step is not None and step.line else ""
-        link = f'<a href="#step-{k}">{shown}</a>' if k is not None else shown
+        name = f"go to the step {report.first_wrong}" + line  # its math alone names no link for a screen reader
+        link = f'<a href="#step-{k}" aria-label="{escape(name)}">{shown}</a>' if k is not None else shown
         verdict = (
             f'<div class="verdict fail">First wrong step: {link}{line}'
             f'<span class="sub">{text_with_math(step.message) if step is not None and step.message else ""}</span></div>'

@@ -13,7 +13,8 @@ can neither pile up nor starve the server of file descriptors, and one client ca
 take every connection.
 
 What it says (on stderr): one ready line with its address once the workers are up
-(``armdyn serve: listening on http://127.0.0.1:8000/``), one line per request
+(``armdyn serve: listening on http://127.0.0.1:8000/``) and one when the grading workers
+are up, one line per request
 (:mod:`.accesslog`: no query secrets, no cookies, no tokens), and on Ctrl-C or SIGTERM
 that it is stopping and then that it stopped. A port already taken is one sentence and
 exit status 2, before any worker starts. The grading workers ignore SIGINT: a Ctrl-C in
@@ -22,6 +23,7 @@ the terminal reaches the whole process group, and it is the server that stops th
 
 from __future__ import annotations
 
+import asyncio
 import errno
 import os
 import resource
@@ -190,11 +192,21 @@ def _server_class():
 
     class Server(uvicorn.Server):
         url = ""
+        state = None  # the app's Server (armdyn.serve.app): its pool says when workers are up
 
         async def startup(self, sockets=None) -> None:
             await super().startup(sockets=sockets)
             if not self.should_exit:
                 _say(f"listening on {self.url}")
+                self._announce = asyncio.ensure_future(self._workers_ready())
+
+        async def _workers_ready(self) -> None:
+            while not self.should_exit:
+                pool = getattr(self.state, "pool", None)
+                if pool is not None and pool.ready:
+                    _say(f"{self.state.settings.workers} grading worker(s) ready")
+                    return
+                await asyncio.sleep(0.2)
 
         async def shutdown(self, sockets=None) -> None:
             _say("stopping: no new requests; open ones and running gradings may finish")
@@ -237,9 +249,9 @@ def run(args) -> int:
     sock = listen(args.host, args.port)  # before the workers start: a busy port fails at once
     from .accesslog import AccessLog
 
-    app = AccessLog(build_app(settings))
-    server = _server_class()(config(app, args.host, args.port, args.forwarded_allow_ips))
-    server.url = url_of(sock)
+    inner = build_app(settings)
+    server = _server_class()(config(AccessLog(inner), args.host, args.port, args.forwarded_allow_ips))
+    server.url, server.state = url_of(sock), inner.state.server
     try:
         server.run(sockets=[sock])
     except KeyboardInterrupt:  # uvicorn raises the Ctrl-C again once it has shut down
