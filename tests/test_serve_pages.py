@@ -336,7 +336,7 @@ def test_report_explains_in_math_and_names_its_reference(server, browser, graded
             "JSON.stringify((function () { var li = Array.from(document.querySelectorAll('.report li.step')).find("
             f"li => /\\bline {f2}\\b/.test((li.querySelector('.where') || {{}}).textContent || ''));"
             " return li ? {caps: Array.from(li.querySelectorAll('.side .cap')).map(c => c.textContent),"
-            " status: li.className} : null; })())"
+            " status: li.className, id: li.id} : null; })())"
         )
     )
     assert card is not None and "st-wrong" in card["status"], card
@@ -344,6 +344,29 @@ def test_report_explains_in_math_and_names_its_reference(server, browser, graded
     assert "expected from your own earlier steps" in caps, caps
     assert "difference: yours \u2212 expected from your own earlier steps" in caps, caps
     assert "expected (from the exercise's model)" in caps, caps
-    page.eval("document.querySelector('.report .step.first').scrollIntoView(); true")
+    page.eval(f"document.getElementById({json.dumps(card['id'])}).scrollIntoView(); true")
     time.sleep(0.3)
     shoot(page, "serve-report-step.png", tmp_path, full=False)
+
+
+def test_reference_of_a_slip_against_the_students_own_chain():
+    """F_2 of the exercise (hand-checked, examples/grading/README.md): its x component
+    has -θ̇1 d2 where the student's own v̇_C2 gives -θ̈1 d2. The reference shown is
+    the student's own chain, and it is F_2 = -m2 v̇_C2 with that one term put right,
+    worked out here by hand from the student's line."""
+    import sympy as sp
+
+    from armdyn.grading import grade
+    from armdyn.grading.html import OWN_REFERENCE, reference
+    from armdyn.grading.reader import read_markdown
+
+    report = grade(read_markdown(str(EXERCISE)))
+    step = next(s for s in report.steps if s.name == "F_2")
+    value, name = reference(step)
+    assert name == OWN_REFERENCE
+    t, td, tdd, d, dd, m2, g = sp.symbols("theta1 theta1_dot theta1_ddot d2 d2_dot m2 g")
+    by_hand_x = -m2 * (-tdd * d - 2 * td * dd + g * sp.sin(t))
+    names = {s.name: s for s in sp.Matrix(value).free_symbols}
+    x = sp.Matrix(value)[0].subs({names[k.name]: k for k in (t, td, tdd, d, dd, m2, g) if k.name in names})
+    assert sp.simplify(x - by_hand_x) == 0, x
+    assert sp.simplify(sp.Matrix(step.expected)[0] - by_hand_x) != 0  # the exercise's value differs

@@ -105,7 +105,7 @@ def statement_fragment(exercise: Exercise) -> str:
     entry = next((e for e in bundled_robots() if e["name"] == exercise.id), {})
     joints = f"{entry['dof']} joints" if entry.get("dof") else ""
     return (
-        f"<h3>{escape(exercise.title)}</h3>"
+        f"<h3>{escape(exercise.title[:1].upper() + exercise.title[1:])}</h3>"
         f"<p>{escape(entry.get('description', exercise.id))}{' (' + joints + ')' if joints else ''}.</p>"
         "<p>The statement is the one your instructor handed out; the grader uses armdyn's model "
         f"<code>{escape(exercise.id)}</code>: its frames, joints and masses.</p>"
