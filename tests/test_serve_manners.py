@@ -172,6 +172,8 @@ def test_openapi_lists_every_route_with_its_parameters(tmp_path):
             assert op.get("summary") and op.get("responses"), (path, method)
         documented.add(path)
     assert set(paths) == documented  # nothing documented that is not a route
+    ids = [op["operationId"] for ops in paths.values() for op in ops.values()]
+    assert len(ids) == len(set(ids)) and all(re.fullmatch(r"\w+", i) for i in ids), ids
     assert "/api/submissions/{sid}" in paths and "{id}" not in str(paths)
     assert paths["/api/grade"]["post"]["requestBody"]["content"]["text/markdown"]
 

@@ -96,6 +96,23 @@ def test_nav_bar_in_a_self_contained_page():
     assert report_links("sid1", '"><script>', False)[0][0] == "/submissions/sid1"  # not a token: dropped
 
 
+def test_statement_route_names_exercises_only(tmp_path, variants):
+    """The statement of an exercise by its id from the whitelist; nothing else."""
+    from starlette.testclient import TestClient
+
+    from armdyn.serve.app import Settings, build_app
+    from armdyn.serve.exercises import catalogue
+
+    app = build_app(Settings(db=f"sqlite:///{tmp_path / 's.db'}", exercises=catalogue(str(variants)), workers=1))
+    c = TestClient(app)  # no lifespan: no worker is needed to show a statement
+    first = (variants / "v001" / "problem.md").read_text(encoding="utf-8").splitlines()[0][2:]
+    r = c.get("/exercises/v001/statement")
+    assert r.status_code == 200 and f"<h3>{first}</h3>" in r.text and "<script" not in r.text
+    assert "content-security-policy" in r.headers
+    for bad in ("/exercises/nope/statement", "/exercises/..%2Fv001/statement", "/exercises/model.yaml/statement"):
+        assert c.get(bad).status_code == 404, bad
+
+
 # -- in a browser
 
 

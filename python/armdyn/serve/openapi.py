@@ -170,7 +170,7 @@ def schema(routes) -> dict:
             continue
         names = _PARAM.findall(path)
         for method in sorted(m.lower() for m in methods - {"HEAD"}):
-            op = {"summary": summary, "operationId": f"{method}_{path}"}
+            op = {"summary": summary, "operationId": method + "_" + (re.sub(r"\W+", "_", path).strip("_") or "root")}
             extra = details.get((path, method), {})
             op.update({k: v for k, v in extra.items() if k != "parameters"})
             op["parameters"] = [
