@@ -189,14 +189,21 @@ BOXES = """JSON.stringify((function () {
 })())"""
 
 
-def test_editor_keeps_its_size_whatever_is_pasted(server, browser, tmp_path):
+def test_editor_keeps_its_size_whatever_is_pasted(server, browser, tmp_path, variants):
     page = browser.page()
     for width, mobile in ((1280, False), (390, True)):
         viewport(page, width, 900, mobile)
         page.goto(server.base + "/")
+        if width > 1000:  # the variant (an RP arm too): its statement has a drawing
+            page.eval(
+                "var s = document.getElementById('exercise'); s.value = 'v001';"
+                " s.dispatchEvent(new Event('change')); true"
+            )
+            page.wait_for("!!document.querySelector('#statement img')", 30, "the variant's statement")
         before = json.loads(page.eval(BOXES))
         long_line = "$$\\tau_1 = " + " + ".join(f"m_{{{k}}} l_{{{k}}}^2 \\ddot{{\\theta}}_1" for k in range(200)) + "$$"
-        paste(page, EXERCISE.read_text(encoding="utf-8") + "\n" + long_line + "\n" + "x" * 5000 + "\n")
+        text = (variants / "v001" / "solution.md") if width > 1000 else EXERCISE
+        paste(page, text.read_text(encoding="utf-8") + "\n" + long_line + "\n" + "x" * 5000 + "\n")
         page.wait_for("document.querySelectorAll('#preview math').length > 10", 60, "the preview")
         after = json.loads(page.eval(BOXES))
         for key in ("w", "h"):
