@@ -191,7 +191,13 @@ BOXES = """JSON.stringify((function () {
 
 def test_editor_keeps_its_size_whatever_is_pasted(server, browser, tmp_path, variants):
     page = browser.page()
-    for width, mobile in ((1280, False), (390, True)):
+    # (width, a phone?, the editor's least share of the width, screenshot)
+    layouts = (
+        (1280, False, 0.25, "serve-student.png"),
+        (1000, False, 0.4, None),
+        (390, True, 0.8, "serve-student-phone.png"),
+    )
+    for width, mobile, share, name in layouts:
         viewport(page, width, 900, mobile)
         page.goto(server.base + "/")
         if width > 1000:  # the variant (an RP arm too): its statement has a drawing
@@ -208,16 +214,19 @@ def test_editor_keeps_its_size_whatever_is_pasted(server, browser, tmp_path, var
         after = json.loads(page.eval(BOXES))
         for key in ("w", "h"):
             assert abs(after["editor"][key] - before["editor"][key]) <= 1, (width, before, after)
-        assert after["editor"]["w"] >= (0.25 if width > 1000 else 0.8) * width, after
+        assert after["editor"]["w"] >= share * width, after
         assert after["editor"]["h"] >= 240, after
         assert after["scroll"] <= after["inner"], f"the page scrolls sideways at {width} px: {after}"
         if width > 1000:  # the statement, the editor and the preview side by side
             assert after["statement"]["x"] + after["statement"]["w"] <= after["editor"]["x"] + 1
             assert after["editor"]["x"] + after["editor"]["w"] <= after["preview"]["x"] + 1
             assert abs(after["statement"]["y"] - after["editor"]["y"]) < 40
-        name = "serve-student.png" if width > 1000 else "serve-student-phone.png"
-        page.eval("document.getElementById('preview').scrollTop = 900; true")
-        shoot(page, name, tmp_path, full=False)
+        elif width == 1000:  # the statement above, the editor and the preview side by side
+            assert after["statement"]["y"] + after["statement"]["h"] <= after["editor"]["y"]
+            assert after["editor"]["x"] + after["editor"]["w"] <= after["preview"]["x"] + 1
+        if name:
+            page.eval("document.getElementById('preview').scrollTop = 900; true")
+            shoot(page, name, tmp_path, full=False)
         hint = page.eval("document.getElementById('hint').textContent")
         assert "on the right" not in hint and "How each equation is read" in hint
 
