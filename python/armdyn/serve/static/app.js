@@ -48,7 +48,7 @@
     // -- the problem statement of the chosen exercise
     var statement = $("statement");
     if (exercise && statement) {
-      exercise.addEventListener("change", function () {
+      var load = function () {
         if (!exercise.value) {
           statement.replaceChildren();
           var p = document.createElement("p");
@@ -60,7 +60,11 @@
           .then(function (r) { return r.ok ? r.text() : Promise.reject(r.status); })
           .then(function (html) { inert(statement, html); statement.scrollTop = 0; })
           .catch(function () { statement.textContent = "The statement could not be loaded."; });
-      });
+      };
+      exercise.addEventListener("change", load);
+      // a menu the browser restored (back button) to another exercise than the page's
+      var preset = exercise.querySelector("option[selected]");
+      if (exercise.value !== (preset ? preset.value : "")) { load(); }
     }
     if (text.value) { schedule(); }
 
