@@ -192,20 +192,22 @@ def inline_html(text: str) -> str:
     return "".join(out)
 
 
-def statement_html(blocks: list[tuple], drawing_uri: str | None) -> str:
+def statement_body(blocks: list[tuple], drawing_uri: str | None, level: int = 1) -> tuple[str, str]:
+    """(title, HTML) of the blocks, headings from ``<h{level}>`` down (a page: 1; a
+    statement inside another page, as ``armdyn serve``'s, deeper)."""
     body = []
     title = "Exercise"
     for b in blocks:
         if b[0] == "h1":
             title = b[1]
-            body.append(f"<h1>{inline_html(b[1])}</h1>")
+            body.append(f"<h{level}>{inline_html(b[1])}</h{level}>")
             if drawing_uri:
                 body.append(
                     f'<img class="chart" alt="the arm and its frames (x red, y green, z blue)" '
                     f'src="{escape(drawing_uri)}">'
                 )
         elif b[0] == "h2":
-            body.append(f"<h2>{inline_html(b[1])}</h2>")
+            body.append(f"<h{level + 1}>{inline_html(b[1])}</h{level + 1}>")
         elif b[0] == "p":
             body.append(f"<p>{inline_html(b[1])}</p>")
         elif b[0] == "math":
@@ -219,7 +221,11 @@ def statement_html(blocks: list[tuple], drawing_uri: str | None) -> str:
             head = "".join(f"<th>{inline_html(h)}</th>" for h in b[1])
             rows = "".join("<tr>" + "".join(f"<td>{inline_html(c)}</td>" for c in r) + "</tr>" for r in b[2])
             body.append(f'<table class="grid"><tr>{head}</tr>{rows}</table>')
-    return course_page(title, "\n".join(body))
+    return title, "\n".join(body)
+
+
+def statement_html(blocks: list[tuple], drawing_uri: str | None) -> str:
+    return course_page(*statement_body(blocks, drawing_uri))
 
 
 def drawing_uri(variant: Variant, robot) -> str:

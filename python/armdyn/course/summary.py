@@ -11,7 +11,7 @@ The page is byte-identical for the same gradebook.
 
 from __future__ import annotations
 
-from ..mathml import escape
+from ..mathml import escape, text_with_math
 from .chart import bar_chart_uri
 from .errorkinds import KINDS
 from .gradebook import Gradebook
@@ -71,7 +71,7 @@ def summary_html(gb: Gradebook, title: str = "Class summary") -> str:
             ex = mine[0]
             out.append(
                 f'<tr><td>{escape(kind)}</td><td class="num">{n}</td><td class="num">{students}</td>'
-                f"<td><code>{escape(ex.step)}</code>: {escape(ex.message)}</td></tr>"
+                f"<td><code>{escape(ex.step)}</code>: {text_with_math(ex.message)}</td></tr>"
             )
         out.append("</table>")
     else:

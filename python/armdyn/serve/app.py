@@ -2,7 +2,8 @@
 
 Routes (the JSON API is described in :mod:`.openapi`, served at ``/openapi.json``):
 
-    GET  /                               student page: exercise, text, live preview, Grade, earlier ones
+    GET  /                               student page: exercise, its statement, text, live preview, Grade, earlier ones
+    GET  /exercises/{eid}/statement      an exercise's statement (HTML fragment, for the student page)
     POST /grade                          the student's form (CSRF) -> /submissions/{id}?t=TOKEN
     GET  /submissions/{id}               the submission and its report (link token, owner or instructor)
     GET  /submissions/{id}/report.html   the self-contained report (``armdyn grade --html``)
@@ -43,7 +44,9 @@ from starlette.staticfiles import StaticFiles
 from . import identity, lti_web, security
 from .exercises import DEFAULT, Exercise, ordered
 from .openapi import schema
+from .pages import INSTRUCTOR_LINKS, report_links, with_nav
 from .pool import Pool
+from .statement import statements
 from .storage import DONE, FAILED, Repository
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -318,6 +321,7 @@ def build_app(settings: Settings) -> Starlette:
     menu = ordered(settings.exercises)
     # what identity's and LTI's pages share with these (passed: they do not import this module)
     web = SimpleNamespace(page=_page, student_key=_student_key, with_key=_with_key)
+    statement_of = statements(settings.exercises)
 
     async def health(request: Request):
         """ok (200); starting, or degraded with its ``problems`` (503): a grading thread
@@ -387,7 +391,7 @@ def build_app(settings: Settings) -> Starlette:
         return JSONResponse({"html": reply["html"]})
 
     async def openapi(request: Request):
-        return JSONResponse(schema())
+        return JSONResponse(schema(request.app.router.routes))
 
     # -- the student's pages
     async def student_page(request: Request):
@@ -399,11 +403,19 @@ def build_app(settings: Settings) -> Starlette:
             "student.html",
             exercises=menu,
             default=DEFAULT,
+            statement=statement_of.get(DEFAULT, "<p>Choose an exercise to see its statement.</p>"),
             csrf=srv.secrets.csrf_token(key),
             mine=mine,
             instructor=False,
         )
         return _with_key(response, key, new, request)
+
+    async def statement_part(request: Request):
+        """An exercise's statement (HTML fragment: text escaped, math sanitized MathML)."""
+        html = statement_of.get(request.path_params["eid"])
+        if html is None:
+            return HTMLResponse("No such exercise.", status_code=404)
+        return HTMLResponse(html, headers={"cache-control": "private, max-age=300"})
 
     async def grade_form(request: Request):
         key = request.cookies.get(security.STUDENT_COOKIE)
@@ -447,7 +459,8 @@ def build_app(settings: Settings) -> Starlette:
         full = await run_in_threadpool(srv.repo.get, _sid(request))
         if full is None or not srv.may_see(request, full) or not full.get("report_html"):
             return HTMLResponse("No report (yet) for this submission.", status_code=404)
-        return HTMLResponse(full["report_html"])
+        links = report_links(full["id"], request.query_params.get("t"), srv.is_instructor(request))
+        return HTMLResponse(with_nav(full["report_html"], links))
 
     # -- the instructor's pages
     async def instructor_page(request: Request):
@@ -556,7 +569,7 @@ def build_app(settings: Settings) -> Starlette:
             return RedirectResponse("/instructor", status_code=303)
         from ..course import summary_html
 
-        return HTMLResponse(summary_html(await _gradebook()))
+        return HTMLResponse(with_nav(summary_html(await _gradebook()), INSTRUCTOR_LINKS))
 
     async def bad_request(request: Request, exc: _BadRequest):
         if request.url.path.startswith("/api/"):
@@ -603,6 +616,7 @@ def build_app(settings: Settings) -> Starlette:
 
     routes = [
         Route("/", student_page),
+        Route("/exercises/{eid}/statement", statement_part),
         Route("/grade", grade_form, methods=["POST"]),
         Route("/submissions/{sid}", submission_page),
         Route("/submissions/{sid}/report.html", report_page),
