@@ -139,10 +139,11 @@ def test_personal_links_own_variant_and_nobody_elses(course, db_url, caplog):  #
         me = ada.get("/me")
         assert me.status_code == 200 and 'id="my-exercise">ada<' in me.text and "bob" not in me.text
         assert "latest" in me.text  # the policy is stated
-        statement = ada.get("/exercises/ada/statement")
+        statement = ada.get("/me/statement")
         assert statement.status_code == 200 and statement.text == (course / "v" / "ada" / "problem.html").read_text(
             encoding="utf-8"
         )
+        assert ada.get("/exercises/ada/statement").status_code == 200  # the fragment beside her editor
         caplog.clear()
         assert ada.get("/exercises/bob/statement").status_code == 403
         assert "ada asked for the statement of bob" in caplog.text

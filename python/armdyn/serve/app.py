@@ -12,7 +12,7 @@ Routes (the JSON API is described in :mod:`.openapi`, served at ``/openapi.json`
     GET  /instructor/gradebook.csv       the gradebook (armdyn.course)
     GET  /instructor/summary             the class summary page (armdyn.course)
     GET  /api/health, POST /api/grade, GET /api/submissions/{id}, POST /api/preview
-    GET  /link/{token}, /me, /exercises/{id}/statement; POST /me/logout     (--roster: :mod:`.identity`)
+    GET  /link/{token}, /me, /me/statement; POST /me/logout             (--roster: :mod:`.identity`)
     GET|POST /lti/login, POST /lti/launch, /lti/deep-link, GET /lti/jwks     (--lti: :mod:`.lti_web`)
 
 The web process stores and serves; it never reads a student's LaTeX itself: grading
@@ -412,6 +412,7 @@ def build_app(settings: Settings) -> Starlette:
 
     async def statement_part(request: Request):
         """An exercise's statement (HTML fragment: text escaped, math sanitized MathML)."""
+        identity.check_statement(srv, request, request.path_params["eid"])
         html = statement_of.get(request.path_params["eid"])
         if html is None:
             return HTMLResponse("No such exercise.", status_code=404)

@@ -400,6 +400,18 @@ def may_preview(srv, request, exercise: str | None) -> str | None:
     return exercise
 
 
+def check_statement(srv, request, wanted: str) -> None:
+    """With a roster, a student sees only their own exercise's statement: :class:`Refused`
+    (404 without a session, 403 for another's) otherwise; instructors see every one."""
+    if srv.settings.roster is None or srv.is_instructor(request):
+        return
+    who = current(request)
+    if who is None:
+        raise Refused(404, "no such statement", f"statement of {wanted[:64]} asked without a session")
+    if wanted != who[1]:
+        raise Refused(403, "this is not your exercise", f"student {who[0].id} asked for the statement of {wanted[:64]}")
+
+
 def statement_path(exercise: Exercise | None) -> str | None:
     """The variant's ``problem.html`` (written by ``armdyn exercise make``), if any."""
     if exercise is None or not exercise.variant:
@@ -471,16 +483,11 @@ def routes(srv, web) -> list:
         return web.with_key(response, key, new, request)
 
     async def statement(request):
-        wanted = request.path_params["exercise"]
+        """The student's own statement, the variant's whole problem.html (the drawing included)."""
         who = current(request)
-        if not srv.is_instructor(request):
-            if who is None:
-                raise Refused(404, "no such statement", f"statement of {wanted[:64]} asked without a session")
-            if wanted != who[1]:
-                raise Refused(
-                    403, "this is not your exercise", f"student {who[0].id} asked for the statement of {wanted[:64]}"
-                )
-        path = statement_path(srv.settings.exercises.get(wanted))
+        if who is None:
+            raise Refused(404, "no such statement", "a statement asked without a session")
+        path = statement_path(srv.settings.exercises.get(who[1]))
         if path is None:
             return HTMLResponse("No statement for this exercise.", status_code=404)
         return FileResponse(path, media_type="text/html; charset=utf-8")
@@ -498,5 +505,5 @@ def routes(srv, web) -> list:
         Route("/link/{token}", open_link),
         Route("/me", me),
         Route("/me/logout", leave, methods=["POST"]),
-        Route("/exercises/{exercise}/statement", statement),
+        Route("/me/statement", statement),
     ]
