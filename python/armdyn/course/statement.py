@@ -192,6 +192,32 @@ def inline_html(text: str) -> str:
     return "".join(out)
 
 
+def markdown_blocks(text: str) -> list[tuple]:
+    """The blocks of a Markdown file as ``exercise make`` writes it (a solution): the front
+    matter skipped, ``#``/``##`` headings, ``**stage**`` lines, ``$$...$$`` display math,
+    other lines as paragraphs."""
+    lines = text.splitlines()
+    if lines and lines[0] == "---":
+        end = lines.index("---", 1) if "---" in lines[1:] else 0
+        lines = lines[end + 1 :]
+    out = []
+    for line in lines:
+        line = line.strip()
+        if not line:
+            continue
+        if line.startswith("## "):
+            out.append(("h2", line[3:]))
+        elif line.startswith("# "):
+            out.append(("h1", line[2:]))
+        elif line.startswith("$$") and line.endswith("$$") and len(line) > 4:
+            out.append(("math", line[2:-2]))
+        elif line.startswith("**") and line.endswith("**"):
+            out.append(("p", line.strip("*")))
+        else:
+            out.append(("p", line))
+    return out
+
+
 def statement_html(blocks: list[tuple], drawing_uri: str | None) -> str:
     body = []
     title = "Exercise"
@@ -201,7 +227,8 @@ def statement_html(blocks: list[tuple], drawing_uri: str | None) -> str:
             body.append(f"<h1>{inline_html(b[1])}</h1>")
             if drawing_uri:
                 body.append(
-                    f'<img class="chart" alt="the arm and its frames (x red, y green, z blue)" '
+                    f'<img class="chart" alt="the arm at a sample pose: its joints, angles, slides, lengths and frames '
+                    f'(x red, y green, z blue)" '
                     f'src="{escape(drawing_uri)}">'
                 )
         elif b[0] == "h2":
@@ -223,8 +250,9 @@ def statement_html(blocks: list[tuple], drawing_uri: str | None) -> str:
 
 
 def drawing_uri(variant: Variant, robot) -> str:
-    """The arm at a sample pose, its frames and joint axes (armdyn.show's picture), as an
-    SVG ``data:`` URI. Symbolic lengths are drawn at nominal values."""
+    """The arm at a sample pose, its frames and joint axes in 3-D (armdyn.show's picture),
+    as an SVG ``data:`` URI: the spatial arm's drawing (:mod:`.drawing` draws the planar
+    ones). Symbolic lengths are drawn at nominal values."""
     import matplotlib
 
     matplotlib.use("Agg", force=False)
