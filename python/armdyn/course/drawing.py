@@ -77,9 +77,9 @@ def _sample(rows) -> list[float]:
     return [ANGLE if r.kind == "revolute" else SLIDE for r, *_ in rows]
 
 
-def _dimension(ax, a, b, text: str, offset: float, colour="0.25"):
+def _dimension(ax, a, b, text: str, offset: float, colour="0.25", where: float = 0.5):
     """A dimension line from ``a`` to ``b`` (2-D), shifted ``offset`` to its left, with
-    ``text`` at its middle on the outer side."""
+    ``text`` on its outer side, ``where`` of the way along it (the middle by default)."""
     a, b = np.asarray(a, float), np.asarray(b, float)
     t = b - a
     n = np.linalg.norm(t)
@@ -90,7 +90,7 @@ def _dimension(ax, a, b, text: str, offset: float, colour="0.25"):
     for end in (a, b):  # extension lines from the object to the dimension line
         ax.plot(*zip(end + 0.15 * offset * left, end + 1.15 * offset * left), color=colour, lw=0.6)
     ax.annotate("", xy=q, xytext=p, arrowprops=dict(arrowstyle="<->", color=colour, lw=0.9, shrinkA=0, shrinkB=0))
-    mid = (p + q) / 2 + 0.06 * np.sign(offset) * left * max(1.0, abs(offset) / 0.12)
+    mid = p + where * (q - p) + 0.06 * np.sign(offset) * left * max(1.0, abs(offset) / 0.12)
     ax.text(*mid, text, color=colour, fontsize=11, ha="center", va="center", bbox=_BOX, zorder=8)
 
 
@@ -220,7 +220,14 @@ def _figure(variant: Variant, robot):
             radius = min(0.4, 0.4 * np.linalg.norm(p2(b3) - p2(a3)) or 0.4)  # inside a short link
             _arc(ax, at, start, sweep, radius, f"$\\theta_{{{i}}}$")
         prev = p2(b3) if r.kind == "revolute" else at
-    # lengths: each named length beside the segment it is
+    # frames of the model: the variant's own convention
+    poses = frame_poses(robot.bind({s.name: NOMINAL.get(s.name, 1.0) for s in robot.free_symbols()}), np.array(q))
+    for index, (name, P) in enumerate(poses.items()):
+        _frame(ax, p2(P[:3, 3]), P[:3, :3], index, size, (h, v))
+    # masses and gravity
+    # lengths: each named length beside the segment it is, its label at the middle or, when
+    # a frame's origin is there (at a centre of mass), a third of the way: a turning link's
+    # on its left (its angle sweeps on its right), a sliding link's beyond its slide's d
     for i, ((r, *_), (a3, b3)) in enumerate(zip(joints, rods), 1):
         name = r.length
         if sp.Symbol(name) not in subs and name not in dict(variant.lengths):
@@ -229,12 +236,12 @@ def _figure(variant: Variant, robot):
         if np.linalg.norm(b - a) > 1e-6:
             value = dict(variant.lengths).get(name)
             text = f"${name[0]}_{{{name[1:]}}}$" + (f" = {value:g} m" if value is not None else "")
-            _dimension(ax, a, b, text, 0.16)  # on the link's left: its angle sweeps on its right
-    # frames of the model: the variant's own convention
-    poses = frame_poses(robot.bind({s.name: NOMINAL.get(s.name, 1.0) for s in robot.free_symbols()}), np.array(q))
-    for index, (name, P) in enumerate(poses.items()):
-        _frame(ax, p2(P[:3, 3]), P[:3, :3], index, size, (h, v))
-    # masses and gravity
+            offset = 0.16 if r.kind == "revolute" else -0.5
+            origins = [p2(P[:3, 3]) for P in poses.values()]
+            where = next(
+                (w for w in (0.5, 0.3, 0.7) if min(np.linalg.norm(a + w * (b - a) - o) for o in origins) > 0.3), 0.5
+            )
+            _dimension(ax, a, b, text, offset, where=where)
     for link, P in poses.items():  # each mass, named by its link (link1 -> m1)
         body = robot.links.get(link)
         if body is None or link == robot.base or sp.sympify(body.mass) == 0 or not link[-1:].isdigit():
