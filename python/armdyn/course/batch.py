@@ -270,7 +270,8 @@ def _class_model(folder: str, name: str | None) -> tuple[str | None, str | None]
 
 # ------------------------------------------------------------------ cache
 def _grader_fingerprint() -> str:
-    """armdyn's version and a hash of the grader's source (a changed grader re-grades)."""
+    """armdyn's version and a hash of the grader's source and of :mod:`.slipkinds` (a
+    changed grader re-grades)."""
     from .. import __version__
 
     h = hashlib.sha256(__version__.encode())
@@ -278,6 +279,7 @@ def _grader_fingerprint() -> str:
     for p in sorted(root.rglob("*.py")):
         h.update(p.relative_to(root).as_posix().encode())
         h.update(p.read_bytes())
+    h.update((Path(__file__).resolve().parent / "slipkinds.py").read_bytes())  # its kinds are in the result
     return h.hexdigest()
 
 

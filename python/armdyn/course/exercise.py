@@ -183,16 +183,27 @@ def rubric_path(out, kind: str) -> str:
 
 
 def variant_kind(folder) -> str | None:
-    """The exercise kind of a variant folder (its ``variant.yaml``), or None."""
-    path = os.path.join(os.fspath(folder), "variant.yaml")
-    if not os.path.isfile(path) or os.path.islink(path):
+    """The exercise kind of a variant folder: its ``variant.yaml``, else (a folder made
+    before it was written) the arm its ``model.yaml`` description names
+    (``exercise variant ada: rp, ...``); None when neither says."""
+    folder = os.fspath(folder)
+    path = os.path.join(folder, "variant.yaml")
+    if os.path.isfile(path) and not os.path.islink(path):
+        try:
+            data = yaml.safe_load(read_text(path, "variant", 1 << 16))
+        except (ModelError, yaml.YAMLError):
+            data = None
+        kind = data.get("kind") if isinstance(data, dict) else None
+        return kind if kind in KINDS or kind in PROOF_KINDS else None
+    model = os.path.join(folder, "model.yaml")
+    if not os.path.isfile(model) or os.path.islink(model):
         return None
     try:
-        data = yaml.safe_load(read_text(path, "variant", 1 << 16))
-    except (ModelError, yaml.YAMLError):
+        head = read_text(model, "model", MAX_ROSTER_BYTES)[:4000]
+    except ModelError:
         return None
-    kind = data.get("kind") if isinstance(data, dict) else None
-    return kind if kind in KINDS or kind in PROOF_KINDS else None
+    m = re.search(r"^description: ['\"]?exercise variant \S+: ([a-z]+), ", head, re.MULTILINE)
+    return m.group(1) if m and m.group(1) in KINDS else None
 
 
 def _writer(text: str):
