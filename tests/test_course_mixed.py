@@ -168,9 +168,12 @@ def test_summary_per_kind(graded):
 
 
 def test_one_rubric_for_a_mixed_class_counts_each_kinds_parts():
-    """parts: newton-euler 10, lagrange 5, proof 10; required: tau_1, tau_2. A perfect arm
-    scores 15 of 15 and a perfect proof 10 of 10; the proof is not charged for torques."""
-    rubric = Rubric.from_text("parts:\n  newton-euler: 10\n  lagrange: 5\n  proof: 10\nrequired: [tau_1, tau_2]\n")
+    """parts: newton-euler 10, lagrange 5, proof 10; required: tau_1, tau_2 and an RRR arm's
+    omega_3. A perfect RP arm scores 15 of 15 (not charged for a third link it does not
+    have) and a perfect proof 10 of 10 (not charged for torques)."""
+    rubric = Rubric.from_text(
+        "parts:\n  newton-euler: 10\n  lagrange: 5\n  proof: 10\nrequired: [tau_1, tau_2, omega_3]\n"
+    )
     arm = {
         "method": "newton-euler+lagrange",
         "tau_correct": [True, True],
@@ -213,3 +216,23 @@ def test_one_row_per_student_by_policy(policy, total):
     )
     with pytest.raises(ValueError, match="policy"):
         Gradebook.from_results(items, policy="first")
+
+
+def test_cli_policy_and_a_shared_rubric(graded, mixed):
+    """--policy best is stated in every row; --rubric replaces the kinds' rubrics for all,
+    each student still scored on their own kind's parts (from the cache: nothing re-graded)."""
+    root, ex = mixed
+    *_, out = graded
+    shared = root / "shared.yaml"
+    shared.write_text("parts:\n  newton-euler: 10\n  lagrange: 5\n  proof: 10\n")
+    book = out / "best.csv"
+    code = main(
+        ["grade", str(root / "subs"), "--variants", str(ex), "--gradebook", str(book), "--policy", "best"]
+        + ["--rubric", str(shared)]
+    )
+    assert code == 1
+    rows = {r["student"]: r for r in json.loads(book.with_suffix(".json").read_text())["rows"]}
+    assert {r["policy"] for r in rows.values()} == {"best"}
+    assert (rows["ana"]["total"], rows["ana"]["max"]) == (15, 15)  # 10 + 5: no proof part
+    assert (rows["eve"]["total"], rows["eve"]["max"]) == (10, 10)  # the proof part only
+    assert rows["ben"]["points_newton-euler"] == pytest.approx(10 * 15 / RP_NE, abs=0.01)  # 15 of 23 points
