@@ -23,71 +23,21 @@ MAX_DRAWING = 4_000_000  # bytes of problem.html read for its drawing
 _DRAWING = re.compile(r'<img class="chart" alt="[^"<>]*" src="(data:image/svg\+xml;base64,[A-Za-z0-9+/=]+)">')
 
 
-def markdown_blocks(text: str) -> list[tuple]:
-    """The blocks of a statement's Markdown (headings, paragraphs, display math, code,
-    numbered lists, tables), as :func:`armdyn.course.statement.statement_blocks` makes them."""
-    blocks: list[tuple] = []
-    lines = text.splitlines()
-    i = 0
-    while i < len(lines):
-        line = lines[i]
-        if not line.strip():
-            i += 1
-        elif line.startswith("```"):
-            j = i + 1
-            while j < len(lines) and not lines[j].startswith("```"):
-                j += 1
-            blocks.append(("code", "\n".join(lines[i + 1 : j])))
-            i = j + 1
-        elif line.startswith("## "):
-            blocks.append(("h2", line[3:].strip()))
-            i += 1
-        elif line.startswith("# "):
-            blocks.append(("h1", line[2:].strip()))
-            i += 1
-        elif line.startswith("|"):
-            rows = []
-            while i < len(lines) and lines[i].startswith("|"):
-                cells = [c.strip() for c in lines[i].strip().strip("|").split("|")]
-                if not all(re.fullmatch(r"-+", c) for c in cells):
-                    rows.append(cells)
-                i += 1
-            blocks.append(("table", rows[0], rows[1:]))
-        elif re.match(r"\d+\. ", line):
-            items = []
-            while i < len(lines) and re.match(r"\d+\. ", lines[i]):
-                items.append(lines[i].split(". ", 1)[1])
-                i += 1
-            blocks.append(("list", items))
-        elif line.startswith("$$") and line.rstrip().endswith("$$") and len(line.strip()) > 4:
-            blocks.append(("math", line.strip()[2:-2]))
-            i += 1
-        else:
-            para = []
-            while i < len(lines) and lines[i].strip() and not lines[i].startswith(("#", "|", "```", "$$")):
-                para.append(lines[i].strip())
-                i += 1
-            if not para:  # a line no rule above takes: shown as text
-                para.append(lines[i].strip())
-                i += 1
-            blocks.append(("p", " ".join(para)))
-    return blocks
-
-
 def _read(path: str, limit: int) -> str | None:
+    """The file's text, or None when it is missing, too large or not text (the page then
+    says the statement is missing rather than failing)."""
+    from ..errors import ModelError
+    from ..io.textfile import read_text
+
     try:
-        with open(path, "rb") as f:
-            data = f.read(limit + 1)
-    except OSError:
+        return read_text(path, "statement", limit)
+    except ModelError:
         return None
-    if len(data) > limit:
-        return None
-    return data.decode("utf-8", "replace")
 
 
 def statement_fragment(exercise: Exercise) -> str:
     """HTML of ``exercise``'s statement, headings from ``<h3>``."""
-    from ..course.statement import statement_body
+    from ..course.statement import markdown_blocks, statement_body
 
     if exercise.variant:
         folder = os.path.dirname(exercise.source)
