@@ -104,9 +104,7 @@ def submit(c, text: str, **extra):
 
 def wrong(solution: str) -> str:
     """The solution with the centripetal force's sign flipped in tau_2."""
-    slip = solution.replace(
-        r"\tau_{2} = - d_{2} m_{2} \dot{\theta_{1}}^{2}", r"\tau_{2} = d_{2} m_{2} \dot{\theta_{1}}^{2}", 1
-    )
+    slip = solution.replace(r"\tau_{2} = - d_2 m_2 \dot\theta_1^{2}", r"\tau_{2} = d_2 m_2 \dot\theta_1^{2}", 1)
     assert slip != solution
     return slip
 

@@ -74,8 +74,7 @@ def test_plain_text_stays_text():
 def test_statement_markdown_round_trip(tmp_path):
     """A variant's problem.md read back gives the blocks it was written from."""
     from armdyn.course.exercise import make_exercise
-    from armdyn.course.statement import statement_markdown
-    from armdyn.serve.statement import markdown_blocks
+    from armdyn.course.statement import markdown_blocks, statement_markdown
 
     make_exercise("rp", tmp_path, seed=11, count=1)
     text = (tmp_path / "v001" / "problem.md").read_text(encoding="utf-8")
