@@ -23,7 +23,7 @@ FILES = sorted(
     if not p.endswith("README.md")
 )
 
-_NO_POSITION = "frame 1's origin is not stated"
+_NO_POSITION = "frame 2's origin is not stated"
 #: file -> the error the reading gives (what the text does not state), or the lines whose
 #: verdicts differ (a slip in the only statement of the geometry becomes the geometry read)
 NOT_SAME: dict[str, str | set[int]] = {

@@ -107,6 +107,14 @@ def mass_centres(statements, gravity, q: list, revolute: set, free: set, conflic
                         f"heights (line {found[k][2].line} used)"
                     )
                 continue
+            turning = height.atoms(sp.sin, sp.cos)
+            fixed = sum((t for t in sp.Add.make_args(height) if not (t.free_symbols & set(q))), sp.Integer(0))
+            if turning and fixed != 0:  # a constant in a turning link's height: V's zero, not a place
+                height = sp.expand(height - fixed)
+                conflicts.append(
+                    f"line {st.line}: the constant {fixed} in the height of m{k} read as where V is zero "
+                    "(a point turning with its link has none)"
+                )
             try:
                 w = across(height, all_rev)
             except ValueError as err:
@@ -116,6 +124,7 @@ def mass_centres(statements, gravity, q: list, revolute: set, free: set, conflic
         rest = sp.expand(
             V - sum(m * g_mag * (up.dot(found[int(m.name[1:])][0])) for m in masses if int(m.name[1:]) in found)
         )
+        rest = sum((t for t in sp.Add.make_args(rest) if t.free_symbols & set(q)), sp.Integer(0))  # V's zero aside
         if rest != 0 and found and not same(rest, sp.Integer(0), free):
             conflicts.append(f"line {st.line}: V has a term not of one mass's height: {rest}")
     return found

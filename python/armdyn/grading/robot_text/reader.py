@@ -184,6 +184,8 @@ class TextReader:
             if st.what != "R":
                 continue
             a, b = st.index, st.frame
+            if a is not None and b is not None and abs(a - b) == 1 and max(a, b) > self.n and "(i = " in st.source:
+                continue  # a generic link i's rotation, instanced past the last joint: nothing stated
             if a is None or b is None or abs(a - b) != 1 or max(a, b) > self.n:
                 self.conflicts.append(
                     f"line {st.line}: {st.source[:60]} relates frames {a} and {b}, not successive frames "
@@ -219,10 +221,24 @@ class TextReader:
     def _gravity(self, statements):
         stated = [st for st in statements if st.what == "g" and vector(st.value) is not None]
         if stated:
-            first = stated[0]
-            for st in stated[1:]:
-                if not same(vector(st.value), vector(first.value), self.free):
-                    self.conflicts.append(f"lines {first.line} and {st.line} state different base accelerations")
+            # a text may show other cases in passing ("for gravity along -z, set ..."): the one
+            # most statements give is used (a tie: the first written), the others named
+            groups: list[list] = []
+            for st in stated:
+                for group in groups:
+                    if same(vector(st.value), vector(group[0].value), self.free):
+                        group.append(st)
+                        break
+                else:
+                    groups.append([st])
+            best = max(groups, key=lambda g: (len(g), -g[0].line))
+            first = best[0]
+            for group in groups:
+                if group is not best:
+                    self.conflicts.append(
+                        f"line {group[0].line} states another base acceleration than line {first.line} "
+                        f"(line{'s' if len(best) > 1 else ''} {', '.join(str(st.line) for st in best)} used)"
+                    )
             g = -vector(first.value)
             self.assumptions.append(
                 f"gravity {pretty_vector(g)}, from line {first.line}: the base accelerates by "
@@ -285,6 +301,9 @@ class TextReader:
                 self.assumptions.append(
                     f"frame {k}'s origin at frame {k - 1}'s (on joint {k}'s axis): no P_{k} is stated"
                 )
+            elif k == 1:  # where the whole arm sits changes no torque: the base's origin
+                o.append(o[0])
+                self.assumptions.append("frame 1's origin at the base frame's (no P_1^0 is stated)")
             else:
                 self.fail(
                     f"frame {k}'s origin is not stated (P_{k}^{k - 1}) and link {k}'s mass centre cannot be "
@@ -342,8 +361,8 @@ class TextReader:
             best = max(gs, key=lambda g: (len(g), -g[0][0].line))
             chosen[k] = best[0][0]
             if len(gs) > 1:
-                used = ", ".join(str(st.line) for st, _ in best)
-                others = ", ".join(str(st.line) for g in gs if g is not best for st, _ in g)
+                used = ", ".join(str(x) for x in dict.fromkeys(st.line for st, _ in best))
+                others = ", ".join(str(x) for x in dict.fromkeys(st.line for g in gs if g is not best for st, _ in g))
                 why = "most statements" if len(best) > max(len(g) for g in gs if g is not best) else "the first written"
                 self.conflicts.append(
                     f"line{'s' if len(best) > 1 else ''} {used} and line{'s' if ',' in others else ''} {others} "
@@ -536,6 +555,17 @@ class TextReader:
         ren = {sp.Symbol(f"{q}_dot"): qd for q, qd in zip(robot.q, robot.qd, strict=True)}
         ren.update({sp.Symbol(str(q)): q for q in robot.q})
         mine = Ts[0].value.xreplace(ren)
+        parts = {st.index: st for st in reversed(_energies(statements, "Tl")) if st.index is not None}
+        if len(parts) == self.n:  # each link's T_k stated: a slip in the whole T is not the reading's fault
+            whole = sum((st.value for st in parts.values()), sp.Integer(0)).xreplace(ren)
+            if not same(mine, T, mine.free_symbols | T.free_symbols) and same(
+                whole, T, whole.free_symbols | T.free_symbols
+            ):
+                self.conflicts.append(
+                    f"line {Ts[0].line}: T is not the sum of the links' T_k (lines "
+                    f"{', '.join(str(parts[k].line) for k in sorted(parts))}), which the arm read gives"
+                )
+                return
         if not same(mine, T, mine.free_symbols | T.free_symbols):
             if gravity_assumed:  # the positions rest on an assumed gravity: the reading is not to be trusted
                 self.fail(

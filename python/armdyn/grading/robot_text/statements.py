@@ -74,6 +74,9 @@ class Names:
         base = "theta" if name.base == "vartheta" else name.base
         if base == "pi" and not sub:
             return sp.pi
+        if name.hat and base in ("X", "Y", "Z", "x", "y", "z") and not name.dots:
+            # Craig's \hat X_1: the unit vector along frame 1's x axis, written in frame 1
+            return sp.Matrix([1 if base.lower() == a else 0 for a in "xyz"])
         if base in ("s", "c", "S", "C") and not name.dots and sub.isdigit() and all(int(k) in self.joints for k in sub):
             angle = sum((sp.Symbol(self.joints[int(k)]) for k in sub), sp.Integer(0))
             return (sp.sin if base in "sS" else sp.cos)(angle)
@@ -152,6 +155,8 @@ _SPONG_R = re.compile(r"r_\{(\d+),\s*(?:[cC]_?\{?(\d+)\}?|(\d+))\}")
 _CENTRE = re.compile(r"([prxyz])_\{?[cC]_?\{?(\d+)\}?\}?")
 _DIAG = re.compile(r"\\(?:mathrm|operatorname|text)\{diag\}\s*\((.*)\)", re.S)
 _ELEMENTARY = re.compile(r"R_\{?([xyz])\}?\s*\((.*)\)", re.S)
+#: ``m2d_2``: a mass written without its underscore before another factor (m_2 d_2)
+_GLUED_MASS = re.compile(r"(?<![A-Za-z\\_^{])m(\d)(?=[A-Za-z\\])")
 _SPACED = re.compile(r"\[(.*)\]\s*\^\s*\{?(?:T|\\top|\\mathrm\{T\})\}?", re.S)
 
 
@@ -181,7 +186,7 @@ def _split_top(text: str, seps: str) -> list[str]:
 def _value(text: str, names: Names):
     """A statement's value: LaTeX, also ``\\mathrm{diag}(a, b, c)``, an elementary rotation
     ``R_z(\\theta_1)`` and a row ``[a\\ b\\ c]^T`` (each entry parsed on its own)."""
-    text = text.strip()
+    text = _GLUED_MASS.sub(r"m_\1 ", text.strip())
     m = _DIAG.fullmatch(text)
     if m:
         items = [parse(p, names) for p in _split_top(m.group(1), ",")]
