@@ -567,8 +567,14 @@ def grade(
         model = _load_robot(robot or sub.robot or "", sub, trusted=bool(trusted and robot))
     else:
         from .robot_text import robot_from_text
+        from .robot_text.own_values import grade_without_model
 
-        read_model = robot_from_text(sub)  # the robot the text itself describes
+        try:
+            read_model = robot_from_text(sub)  # the robot the text itself describes
+        except ModelError as err:
+            if not sub.equations:
+                raise
+            return grade_without_model(sub, err.message)  # what the text's own values decide
         model = read_model.robot
     if sub.values is not None:
         try:

@@ -43,6 +43,7 @@ def _stated(statements, q: list, conflicts: list) -> dict:
             continue
         first = min((s for _, s in comps.values()), key=lambda s: s.line)
         found[k] = (sp.Matrix([comps[i][0] if i in comps else 0 for i in range(3)]), None, first)
+    _planar_pairs(found, parts, q, conflicts)
     for st in statements:  # positions stated win; else the position whose Jacobian is stated
         k = st.index
         if st.what == "CJ" and k is not None and 1 <= k <= n and k not in found:
@@ -52,6 +53,65 @@ def _stated(statements, q: list, conflicts: list) -> dict:
             else:
                 found[k] = (pos, None, st)
     return found
+
+
+def _planar_pairs(found: dict, parts: dict, q: list, conflicts: list) -> None:
+    """A planar point turning about z has ``x = a cos(phi) - b sin(phi)`` and ``y = a sin(phi) +
+    b cos(phi)``: each coordinate alone gives the other. When the two stated disagree (a slip in
+    one), the reading that keeps the arm serial with its neighbours is used, named."""
+    turning = {x for v in found.values() for f in v[0].atoms(sp.sin, sp.cos) for x in f.free_symbols} & set(q)
+    for k, comps in sorted(parts.items()):
+        if 0 not in comps or 1 not in comps or found[k][2] not in (comps[0][1], comps[1][1]):
+            continue
+        x, y = comps[0][0], comps[1][0]
+        try:
+            from_x, from_y = -across(x, turning), across(y, turning)
+        except ValueError:
+            continue
+        symbols = x.free_symbols | y.free_symbols
+        if same(from_y, x, symbols):
+            continue
+        z = found[k][0][2]
+        options = [
+            (sp.Matrix([x, from_x, z]), f"x_{k}", comps[0][1]),
+            (sp.Matrix([from_y, y, z]), f"y_{k}", comps[1][1]),
+        ]
+        scores = [_serial_score(found, k, p, q, turning) for p, _, _ in options]
+        best = max(range(2), key=lambda j: (scores[j], -options[j][2].line))
+        pos, name, st = options[best]
+        other = options[1 - best]
+        why = (
+            "it keeps the arm serial, a mass at the next joint"
+            if scores[best] > scores[1 - best]
+            else "the first written"
+        )
+        conflicts.append(
+            f"lines {comps[0][1].line} and {comps[1][1].line}: x_{k} and y_{k} are not one point turning in the "
+            f"plane ({name} used: {why}; {other[1]} disagrees)"
+        )
+        found[k] = (pos, None, st)
+
+
+def _serial_score(found: dict, k: int, p, q: list, turning: set) -> int:
+    """How many neighbours of link k's point ``p`` hang from it as a serial arm's do: the step to
+    the next point, seen in the earlier link's frame, moves only with the later joints."""
+    score = 0
+    for a, b, pa, pb in ((k - 1, k, found.get(k - 1, (None,))[0], p), (k, k + 1, p, found.get(k + 1, (None,))[0])):
+        if pa is None or pb is None or a < 1:
+            continue
+        phi = sum((x for x in q[:a] if x in turning), sp.Integer(0))
+        c, s_ = sp.cos(phi), sp.sin(phi)
+        back = sp.Matrix([[c, s_, 0], [-s_, c, 0], [0, 0, 1]]) * (pb - pa)
+        earlier = q[:a]
+        if all(same(back.diff(x), sp.zeros(3, 1), back.free_symbols) for x in earlier):
+            score += 2
+    after = found.get(k + 1, (None,))[0]
+    if after is not None and k < len(q):  # a point mass at the next joint, as a double pendulum's
+        joint = after.applyfunc(
+            lambda e: sum((t for t in sp.Add.make_args(sp.expand(e)) if q[k] not in t.free_symbols), sp.Integer(0))
+        )
+        score += same(joint, p, joint.free_symbols | p.free_symbols)
+    return score
 
 
 def _integrated(J, q: list):

@@ -127,7 +127,13 @@ class TextReader:
         gravity, g_line = self._gravity(statements)
         coms = self._coms(statements, gravity, rot, revolute)
         revolute |= {x for p in coms.values() for x in self._in_trig(p[0])}
+        lengths = {x for p in coms.values() for x in self._outside_trig(p[0])} - revolute
         for k in range(1, n + 1):  # an angle's name, turned by no rotation stated: read as revolute, named
+            if rot.get(k) is None and qs[k - 1] in lengths and written[k] == "theta":
+                self.assumptions.append(
+                    f"joint {k} is prismatic: \\theta_{k} is a length in the positions read (in no sine or cosine)"
+                )
+                continue
             if rot.get(k) is None and qs[k - 1] not in revolute and written[k] == "theta":
                 revolute.add(qs[k - 1])
                 self.assumptions.append(f"joint {k} is revolute: \\theta_{k} names an angle")
@@ -176,6 +182,11 @@ class TextReader:
     @staticmethod
     def _in_trig(expr) -> set:
         return {s for f in sp.sympify(expr).atoms(sp.sin, sp.cos) for s in f.free_symbols}
+
+    def _outside_trig(self, p) -> set:
+        """The joint variables a position holds as lengths (a factor outside every sine and cosine)."""
+        bare = sp.Matrix(p).applyfunc(lambda e: e.replace(lambda f: isinstance(f, (sp.sin, sp.cos)), lambda f: 1))
+        return bare.free_symbols & set(self.q)
 
     def _rotations(self, statements) -> dict:
         """Frame k's axes in frame k-1 (a function of joint k's variable) -> (matrix, statement)."""

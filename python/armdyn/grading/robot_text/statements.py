@@ -152,7 +152,7 @@ def _inline_equations(text: str) -> list[Equation]:
 _GENERIC = re.compile(r"(?<![A-Za-z\\])i(?![A-Za-z])")
 _GENERIC_SUB = re.compile(r"(?<![A-Za-z\\])i(?![A-Za-z])|(?<=\{[cC])i(?=\})")
 _SPONG_R = re.compile(r"r_\{(\d+),\s*(?:[cC]_?\{?(\d+)\}?|(\d+))\}")
-_CENTRE = re.compile(r"([prxyz])_\{?[cC]_?\{?(\d+)\}?\}?")
+_CENTRE = re.compile(r"([prxyz])_\{?[cC]_?\{?(\d+)\}?\}?|([xyz])_\{?(\d)\}?")  # x_1: a point mass's place
 _DIAG = re.compile(r"\\(?:mathrm|operatorname|text)\{diag\}\s*\((.*)\)", re.S)
 _ELEMENTARY = re.compile(r"R_\{?([xyz])\}?\s*\((.*)\)", re.S)
 #: ``m2d_2``: a mass written without its underscore before another factor (m_2 d_2)
@@ -226,7 +226,8 @@ def _what(lhs: str):
         return "I", int(m.group(2)), None
     m = _CENTRE.fullmatch(s)  # an energy method's mass centre in the base frame: p_{c2}, x_{c2}
     if m:
-        return ("C" if m.group(1) in "pr" else "C" + m.group(1)), int(m.group(2)), 0
+        axis, k = (m.group(1), m.group(2)) if m.group(1) else (m.group(3), m.group(4))
+        return ("C" if axis in "pr" else "C" + axis), int(k), 0
     m = _SPONG_R.fullmatch(s)  # Spong's r_{i,c_i} (to the mass centre), r_{i,i+1} (to the next joint)
     if m and m.group(2) and m.group(2) == m.group(1):
         return "Pc", int(m.group(1)), int(m.group(1))
