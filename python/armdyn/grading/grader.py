@@ -584,6 +584,16 @@ def grade(
             raise err.located(source=sub.path) from None
     hint = sub.method if sub.method in ("newton-euler", "lagrange") else None
     report = _Grader(sub, model, symbols).run(hint)
+    if read_model is not None and read_model.alternatives:  # more than one gravity stated
+        from .robot_text.support import most_supported
+
+        def with_model(other):
+            robot = other.robot
+            if sub.values is not None:
+                robot = robot.bind(sub.values if isinstance(sub.values, Mapping) else None)
+            return _Grader(sub, robot, symbols).run(hint)
+
+        read_model, report = most_supported(read_model, report, with_model)
     if read_model is not None:
         report.model_note = read_model.note()  # the report's first line: what was graded against
         report.notes.insert(0, report.model_note)

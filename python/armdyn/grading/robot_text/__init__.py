@@ -42,7 +42,16 @@ def robot_from_text(sub: Submission) -> TextModel:
     """The robot ``sub``'s own statements describe (see the module's docstring); a
     :class:`ModelError` naming the file when they do not fix one."""
     try:
-        return TextReader(sub).read()
+        first = TextReader(sub)
+        model = first.read()
+        for choice in range(1, min(first.gravity_options, 3)):  # other gravities stated: read too
+            other = TextReader(sub)
+            other.gravity_choice = choice
+            try:
+                model.alternatives.append(other.read())
+            except ModelError:
+                continue
+        return model
     except ModelError:
         raise
     except (ArithmeticError, TypeError, ValueError, AttributeError, IndexError, KeyError, RecursionError) as err:

@@ -64,6 +64,9 @@ class TextModel:
     robot: Robot
     assumptions: list[str] = field(default_factory=list)
     conflicts: list[str] = field(default_factory=list)
+    #: the readings with another of the gravities stated (the grading keeps the one the
+    #: text's steps agree with most)
+    alternatives: list = field(default_factory=list)
 
     def note(self) -> str:
         """The grade report's first note: the model was read from the text."""
@@ -81,6 +84,8 @@ class TextReader:
         self.assumptions: list[str] = []
         self.conflicts: list[str] = []
         self.unplaced: dict[int, str] = {}  # frame -> why its only rotation stated was not used
+        self.gravity_choice = 0  # which of the gravities stated (most supported first) is read
+        self.gravity_options = 1
 
     def where(self, st: Statement) -> str:
         return f"line {st.line}"
@@ -230,31 +235,41 @@ class TextReader:
         return out
 
     def _gravity(self, statements):
-        stated = [st for st in statements if st.what == "g" and vector(st.value) is not None]
-        if stated:
-            # a text may show other cases in passing ("for gravity along -z, set ..."): the one
-            # most statements give is used (a tie: the first written), the others named
-            groups: list[list] = []
-            for st in stated:
-                for group in groups:
-                    if same(vector(st.value), vector(group[0].value), self.free):
-                        group.append(st)
-                        break
-                else:
-                    groups.append([st])
-            best = max(groups, key=lambda g: (len(g), -g[0].line))
-            first = best[0]
-            for group in groups:
-                if group is not best:
+        # Newton-Euler's base acceleration (gravity its opposite) or the gravity vector itself;
+        # a text may show other cases in passing ("for gravity along -z, set ..."): the one
+        # most statements give is used (a tie: the first written), the others named and kept
+        # as alternatives (:attr:`TextModel.alternatives`: the grading keeps the reading the
+        # text's later steps agree with)
+        options: list[list] = []  # [gravity, statements giving it]
+        for st in statements:
+            v = vector(st.value) if st.what in ("g", "gv") else None
+            if v is None or (st.what == "gv" and (v == sp.zeros(3, 1) or not v.free_symbols)):
+                continue
+            g = -v if st.what == "g" else v
+            for option in options:
+                if same(option[0], g, self.free):
+                    option[1].append(st)
+                    break
+            else:
+                options.append([g, [st]])
+        if options:
+            ranked = sorted(options, key=lambda o: (-len(o[1]), o[1][0].line))
+            self.gravity_options = len(ranked)
+            best = ranked[min(self.gravity_choice, len(ranked) - 1)]
+            g, first = best[0], best[1][0]
+            lines = ", ".join(str(x) for x in dict.fromkeys(st.line for st in best[1]))
+            for option in ranked:
+                if option is not best:
                     self.conflicts.append(
-                        f"line {group[0].line} states another base acceleration than line {first.line} "
-                        f"(line{'s' if len(best) > 1 else ''} {', '.join(str(st.line) for st in best)} used)"
+                        f"line {option[1][0].line} states another gravity, {pretty_vector(option[0])}, than "
+                        f"line{'s' if ',' in lines else ''} {lines} ({pretty_vector(g)} used)"
                     )
-            g = -vector(first.value)
-            self.assumptions.append(
-                f"gravity {pretty_vector(g)}, from line {first.line}: the base accelerates by "
-                f"{pretty_vector(-g)} (Newton-Euler's way of putting in gravity)"
+            how = (
+                f"the base accelerates by {pretty_vector(-g)} (Newton-Euler's way of putting in gravity)"
+                if first.what == "g"
+                else "the gravity vector stated"
             )
+            self.assumptions.append(f"gravity {pretty_vector(g)}, from line {first.line}: {how}")
             self.gravity_source = f"line {first.line}: {first.source[:70]}"
             return g, first.line
         worded = _gravity_in_words(getattr(self, "text", ""))
@@ -530,7 +545,7 @@ class TextReader:
         for k in range(1, self.n + 1):  # principal moments used by name: I_{xx1}, I_{zz1}
             if k in out:
                 continue
-            pattern = re.compile(r"I_\{?\s*(xx|yy|zz)\s*,?\s*" + str(k) + r"(?!\d)")
+            pattern = re.compile(r"I_\{?\s*(xx|yy|zz)\s*[,_]?\s*\{?\s*" + str(k) + r"(?!\d)")
             used: dict[str, int] = {}
             for eq in self.equations:
                 for m in pattern.finditer(str(eq.value)):

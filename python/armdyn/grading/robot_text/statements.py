@@ -155,6 +155,10 @@ _SPONG_R = re.compile(r"r_\{(\d+),\s*(?:[cC]_?\{?(\d+)\}?|(\d+))\}")
 _CENTRE = re.compile(r"([prxyz])_\{?[cC]_?\{?(\d+)\}?\}?|([xyz])_\{?(\d)\}?")  # x_1: a point mass's place
 _DIAG = re.compile(r"\\(?:mathrm|operatorname|text)\{diag\}\s*\((.*)\)", re.S)
 _ELEMENTARY = re.compile(r"R_\{?([xyz])\}?\s*\((.*)\)", re.S)
+#: ``g``, ``\mathbf{g}``, ``\vec g``, ``\boldsymbol{g}``, ``\vec{g}_0``: the gravity vector stated
+_GRAVITY_LHS = re.compile(
+    r"(?:\\(?:mathbf|vec|boldsymbol|bm|underline)\s*\{?\s*g\s*\}?|g)(?:\s*_\s*\{?\s*0\s*\}?)?(?:\^\{?\s*0\s*\}?)?"
+)
 #: ``m2d_2``: a mass written without its underscore before another factor (m_2 d_2)
 _GLUED_MASS = re.compile(r"(?<![A-Za-z\\_^{])m(\d)(?=[A-Za-z\\])")
 _SPACED = re.compile(r"\[(.*)\]\s*\^\s*\{?(?:T|\\top|\\mathrm\{T\})\}?", re.S)
@@ -220,6 +224,8 @@ def _what(lhs: str):
         return "CJ", ref.index, 0  # Spong's J_{v_{ck}}: link k's mass centre's velocity Jacobian
     if ref is not None and ref.key == "v_dot" and ref.index == 0:
         return "g", 0, ref.frame
+    if _GRAVITY_LHS.fullmatch(lhs.strip()):
+        return "gv", 0, 0  # the gravity vector itself, in the base frame
     s = normalise(lhs)
     m = _INERTIA_LHS.fullmatch(s)
     if m:
