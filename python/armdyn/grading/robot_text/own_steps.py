@@ -82,7 +82,71 @@ def candidates(ov, ref, key: str) -> tuple[list, str]:
         return _coriolis(ov, k, entry), "needs M or τ stated before it"
     if k == "vc":
         return _velocity(ov, ref), "needs the position it differentiates stated before it"
+    if k in _NEWTON_EULER:
+        return _newton_euler(ov, ref, k), _NEWTON_EULER[k]
     return [], "no earlier value of the text decides it"
+
+
+_NEWTON_EULER = {
+    "omega": "an angular velocity needs the frames' rotations, which the text does not fix",
+    "omega_dot": "an angular acceleration needs the frames' rotations, which the text does not fix",
+    "v_dot": "a frame's acceleration needs the frames' rotations and origins, which the text does not fix",
+    "vc_dot": "needs ω, ω̇, v̇ of the link and its P_C stated before it",
+    "F": "needs the mass centre's acceleration v̇_C stated before it",
+    "N": "needs the link's inertia, which the text does not fix",
+    "f": "needs the next link's force and the rotation between them, which the text does not fix",
+    "n": "needs the next link's moment and the rotation between them, which the text does not fix",
+    "R": "a rotation: a starting value, nothing earlier to check it against",
+    "P": "a position: a starting value, nothing earlier to check it against",
+    "Pc": "a position: a starting value, nothing earlier to check it against",
+}
+
+
+def _vec(ov, key: str):
+    v = ov.get(key)
+    if v is None or not isinstance(v.value, sp.MatrixBase) or len(v.value) != 3:
+        return None
+    return v
+
+
+def _newton_euler(ov, ref, k: str) -> list:
+    """The Newton-Euler steps that follow from the link's own earlier vectors, in its own frame:
+    F = m v̇_C; v̇_C = v̇ + ω̇ × P_C + ω × (ω × P_C); at the last link f = F and n = N + P_C × F
+    (no load beyond it); a vector written in another frame is not checked."""
+    i = ref.index
+    if ref.frame is not None and ref.frame != i:
+        return []
+    col = lambda v: sp.Matrix(v.value).reshape(3, 1)  # noqa: E731
+    if k == "F":
+        a = _vec(ov, f"vc_dot_{i}")
+        return [(sp.Symbol(f"m{i}") * col(a), [a], f"m{i} v̇_C{i} of your v̇_C{i}", True)] if a else []
+    if k == "vc_dot":
+        w, dw, a, p = (_vec(ov, f"{x}_{i}") for x in ("omega", "omega_dot", "v_dot", "Pc"))
+        if w and dw and a and p:
+            W, P = col(w), col(p)
+            value = col(a) + col(dw).cross(P) + W.cross(W.cross(P))
+            return [(value, [w, dw, a, p], f"v̇{i} + ω̇{i} × P_C{i} + ω{i} × (ω{i} × P_C{i}) of yours", True)]
+        return []
+    if k in ("f", "n") and i == ov.n:
+        F, N, p = _vec(ov, f"F_{i}"), _vec(ov, f"N_{i}"), _vec(ov, f"Pc_{i}")
+        if k == "f" and F:
+            return [(col(F), [F], f"your F_{i}: no load beyond the last link", True)]
+        if k == "n" and N and p and F:
+            return [(col(N) + col(p).cross(col(F)), [N, p, F], f"N{i} + P_C{i} × F{i} of yours (the last link)", True)]
+    return []
+
+
+def _joint_torque(ov, i: int) -> list:
+    """τ_i as the z component of the text's own n_i (a revolute joint) or f_i (a prismatic d_i)."""
+    out = []
+    for key, kind in (("n", "moment"), ("f", "force")):
+        v = _vec(ov, f"{key}_{i + 1}")
+        if v is not None:
+            prismatic = str(ov.q[i]).startswith("d")
+            if (key == "f") == prismatic:
+                how = f"the z component of your {key}_{i + 1} (joint {i + 1} read as {'prismatic' if prismatic else 'revolute'} by its name)"
+                out.append((sp.Matrix(v.value).reshape(3, 1)[2], [v], how, True))
+    return out
 
 
 def _what(used) -> str:
@@ -95,16 +159,16 @@ def _one(ov, name: str):
 
 
 def _position(ov, k: int):
-    """Link k's position the text stated (x_k, y_k, z_k or p_k), as a column, and the values used."""
-    comps, used = [], []
-    for axis in "xyz":
-        v = ov.get(f"{axis}_c{k}")
-        comps.append(v.value if v is not None else sp.Integer(0))
-        used += [v] if v is not None else []
+    """Link k's position the text stated (p_k, or x_k and y_k, with z_k if stated), as a
+    column, and the values used; None when only part of it is stated (z_k alone)."""
     whole = ov.get(f"p_c{k}", f"r_c{k}")
     if whole is not None and isinstance(whole.value, sp.MatrixBase):
         return sp.Matrix(whole.value).reshape(len(whole.value), 1), [whole]
-    return (sp.Matrix(comps), used) if used else (None, [])
+    x, y, z = (ov.get(f"{axis}_c{k}") for axis in "xyz")
+    if x is None or y is None:
+        return None, []
+    used = [v for v in (x, y, z) if v is not None]
+    return sp.Matrix([v.value if v is not None else 0 for v in (x, y, z)]), used
 
 
 def _link_energy(ov, k) -> list:
@@ -137,7 +201,7 @@ def _velocity(ov, ref) -> list:
 
 
 def _torque(ov, i: int, L, Lused) -> list:
-    out = []
+    out = _joint_torque(ov, i)
     if L is not None:
         tau = ov.ddt(L.diff(ov.qd[i])) - L.diff(ov.q[i])
         out.append((tau, Lused, f"the Lagrange equation applied to your {_what(Lused)}", True))
@@ -152,6 +216,30 @@ def _torque(ov, i: int, L, Lused) -> list:
             tau = (M * sp.Matrix(ov.qdd))[i] + h[i] + G[i]
             out.append((tau, Mused + hused + Gused, f"(M q̈ + {'h' if base == 'h' else 'C q̇'} + G) of yours", True))
             break
+    if M is not None and G is not None:  # the velocity terms written out: those of their M
+        tau = (M * sp.Matrix(ov.qdd))[i] + ov.coriolis(M)[1][i] + G[i]
+        out.append((tau, Mused + Gused, "M q̈ + C(q, q̇) q̇ + G of your M and G", True))
+    return out
+
+
+def _from_christoffel(ov, k: str, entry) -> list:
+    """The velocity-product vector from the text's own Christoffel symbols, with the free index
+    first (Lynch and Park's c_i = sum Gamma_ijk qd_j qd_k) or last (Spong's); symbols not
+    stated are read as zero, so such a candidate can confirm a step but never call it wrong."""
+    n, out = ov.n, []
+    found = {
+        (a, b, c): ov.get(f"christoffel_{a + 1}{b + 1}{c + 1}") for a in range(n) for b in range(n) for c in range(n)
+    }
+    used = [v for v in found.values() if v is not None]
+    if not used:
+        return []
+    value = {key: (v.value if v is not None else sp.Integer(0)) for key, v in found.items()}
+    complete = len(used) == n**3
+    qd = ov.qd
+    first = sp.Matrix([sum(value[(a, b, c)] * qd[b] * qd[c] for b in range(n) for c in range(n)) for a in range(n)])
+    last = sp.Matrix([sum(value[(a, b, c)] * qd[a] * qd[b] for a in range(n) for b in range(n)) for c in range(n)])
+    for h, how in ((first, "free index first"), (last, "free index last")):
+        out.append((_pick(h, entry[:1]), used, f"the velocity terms of your Christoffel symbols ({how})", complete))
     return out
 
 
@@ -204,6 +292,7 @@ def _coriolis(ov, k: str, entry) -> list:
         if k == "C":
             out.append((_pick(C, entry), used, "C from the Christoffel symbols of your M", True))
         out.append((_pick(h, entry if k == "h" else entry[:1]), used, "C(q, q̇) q̇ of your M", True))
+    out += _from_christoffel(ov, k, entry) if k == "h" or len(entry) < 2 else []
     tau, tused = _taus(ov)
     if tau is not None:
         rates = tau.subs({x: 0 for x in ov.qdd})

@@ -22,6 +22,7 @@ text is evaluated as code: values are parsed by :mod:`..latex`.
 
 from __future__ import annotations
 
+import dataclasses
 import re
 
 import sympy as sp
@@ -39,7 +40,8 @@ from .statements import Names, joint_candidates
 MAX_EQUATIONS = 2000
 MAX_VALUE = 20_000
 
-_NEEDS_FRAMES = ("omega", "omega_dot", "v_dot", "vc_dot", "F", "N", "f", "n", "R", "P", "Pc")
+#: Newton-Euler vectors (own_steps checks those that follow without the frames' rotations)
+_VECTORS = ("omega", "omega_dot", "v_dot", "vc_dot", "F", "N", "f", "n", "R", "P", "Pc")
 #: an argument list after a name the text gave a value to: M_{11}(\theta_2), K(\theta, \dot\theta)
 _ARGS = re.compile(r"\(\s*(?:\\(?:dot|ddot)\s*\{?\s*)?\\?(?:theta|Theta|q|mathbf\{q\}|boldsymbol\{q\})[^()$]{0,80}\)")
 
@@ -69,6 +71,7 @@ class OwnValues:
         self.aliases: dict[str, str] = {}  # the symbol the text wrote (K1) -> canonical name (T_1)
         self.verdicts: list[StepVerdict] = []
         self.methods: list[str] = []
+        self.seen: set = set(self.q) | set(self.qd) | set(self.qdd)  # symbols in the text's values so far
 
     # -- reading
     def _resolve(self, name):
@@ -236,17 +239,12 @@ class OwnValues:
         except (LatexError, RecursionError, ValueError, TypeError, ArithmeticError) as err:
             self._add(eq, name, ref.key, "unrecognised", f"{name}: cannot be read: {str(err)[:160]}")
             return
-        if ref.key in _NEEDS_FRAMES:
+        if ref.key in _VECTORS:
             self._method("newton-euler")
-            self._add(
-                eq,
-                name,
-                ref.key,
-                "unrecognised",
-                f"{name}: a Newton-Euler vector needs the frames' geometry, which the text does not fix "
-                "(no model); not checked",
-            )
+            self._judge(eq, ref, got)
             return
+        if ref.key == "shorthand" and _has(got, self.qd):  # Lynch and Park's c_1: velocity products
+            ref = dataclasses.replace(ref, key="h")
         self._method("lagrange")
         self._judge(eq, ref, got)
 
@@ -265,7 +263,7 @@ class OwnValues:
             value, used, how, complete = cand
             if _fits(got, value):
                 tainted = next((u.tainted for u in used if u.tainted), None)
-                lines = ", ".join(str(u.line) for u in used)
+                lines = _lines(used)
                 if tainted:
                     status, caused = "follows-from-earlier-error", tainted
                     message = f"follows from the error in {tainted}: {how} (line{'s' if ',' in lines else ''} {lines})"
@@ -276,9 +274,13 @@ class OwnValues:
                 break
         else:
             complete = [c for c in cands if c[3]]
+            unknown = self._unknown(got, complete)
+            if complete and unknown:  # a name given no value before: not a slip to call
+                complete, cands = [], []
+                starting = f"uses {', '.join(unknown)}, which the text gives no value before"
             if complete:
                 value, used, how, _ = complete[0]
-                lines = ", ".join(str(u.line) for u in used)
+                lines = _lines(used)
                 status, expected = "wrong", _shaped(value, got)
                 message = (
                     f"not {how} (line{'s' if ',' in lines else ''} {lines}), compared with your own earlier values"
@@ -292,7 +294,16 @@ class OwnValues:
         self.own[key] = _Own(got, eq.line, name, tainted)
         for alias in _aliases(eq.lhs, self.names):
             self.aliases.setdefault(alias, key)
+            m = re.fullmatch(r"([A-Za-z]+)(\d)(\d)", alias)
+            if m and key.startswith("M_"):  # b_{12} names b_{21} too: M is symmetric
+                self.aliases.setdefault(m.group(1) + m.group(3) + m.group(2), key)
+        self.seen |= _symbols(got)
         self.aliases.setdefault(key.replace("_", ""), key)
+
+    def _unknown(self, got, candidates) -> list[str]:
+        """Names in ``got`` that no earlier value and no candidate holds (b_{21} never given)."""
+        known = self.seen.union(*(_symbols(c[0]) for c in candidates))
+        return sorted(str(x) for x in _symbols(got) - known)
 
     @staticmethod
     def _key(ref: StepRef) -> str:
@@ -301,8 +312,10 @@ class OwnValues:
         if ref.key in ("vc", "pc", "w", "Jv", "Jw"):
             return ref.name  # x_c1, xdot_c1, v_c1^2: one name each
         base = {"Tl": "T", "Vl": "V"}.get(ref.key, ref.key)
+        if ref.key in _VECTORS and ref.frame is not None and ref.frame != ref.index:
+            return f"{base}_{ref.index}^{ref.frame}"  # a vector in another frame than its link's
         if ref.index is not None:
-            return f"{base}_{ref.index}" + (f"_{ref.frame}" if ref.frame is not None and ref.key == "vc" else "")
+            return f"{base}_{ref.index}"
         return f"{base}_{entry}" if entry else base
 
 
@@ -321,6 +334,18 @@ def _aliases(lhs: str, names: Names) -> list[str]:
     except LatexError:
         return []
     return [value.name] if isinstance(value, sp.Symbol) else []
+
+
+def _lines(used) -> str:
+    return ", ".join(str(x) for x in sorted({u.line for u in used}))
+
+
+def _symbols(value) -> set:
+    return set(getattr(value, "free_symbols", set()))
+
+
+def _has(value, symbols) -> bool:
+    return bool(getattr(value, "free_symbols", set()) & set(symbols))
 
 
 def _flat(x):
