@@ -34,7 +34,7 @@ from ..statements import lagrange_law
 from ..verdict import GradeReport, StepVerdict
 from .geometry import same
 from .own_steps import candidates
-from .statements import Names, joint_candidates
+from .statements import MAX_FRAMES, Names, joint_candidates
 
 #: equations looked at, at most; a value longer than this (characters) is not checked
 MAX_EQUATIONS = 2000
@@ -62,6 +62,8 @@ class OwnValues:
         self.sub, self.why = sub, why
         eqs = [e for e in sub.equations[:MAX_EQUATIONS]]
         joints, _ = joint_candidates(eqs, sub.symbols)
+        # joints past a hand derivation's count are not read (n^3 Christoffel symbols stay small)
+        joints = {k: v for k, v in joints.items() if k <= MAX_FRAMES}
         self.n = max(joints) if joints else 0
         self.names = Names(joints, sub.symbols)
         self.q = [sp.Symbol(joints.get(k, f"q{k}")) for k in range(1, self.n + 1)]
@@ -76,7 +78,7 @@ class OwnValues:
     # -- reading
     def _resolve(self, name):
         value = self.names(name)
-        if isinstance(value, sp.Symbol) and not name.dots:
+        if isinstance(value, sp.Symbol):
             key = self.aliases.get(value.name)
             if key in self.own:
                 return self.own[key].value
@@ -218,15 +220,15 @@ class OwnValues:
             self._add(eq, "", "", "unrecognised", eq.problem or "not LaTeX: no model to read it against")
             return
         value_text = str(eq.value)
-        law = lagrange_law(eq.lhs, value_text) or lagrange_law(value_text, eq.lhs)
-        if law is not None:
-            self._method("lagrange")
-            self._add(eq, "lagrange_equation", "law", "correct" if law[0] else "wrong", law[1])
-            return
         try:
             ref = parse_lhs(eq.lhs, self._coordinate_of)
         except (LatexError, RecursionError, ValueError):
             ref = None
+        law = (lagrange_law(eq.lhs, value_text) or lagrange_law(value_text, eq.lhs)) if ref is None else None
+        if law is not None:
+            self._method("lagrange")
+            self._add(eq, "lagrange_equation", "law", "correct" if law[0] else "wrong", law[1])
+            return
         if ref is None:
             self._add(eq, "", "", "unrecognised", "not a step of Newton-Euler or Lagrange (skipped)")
             return
@@ -327,7 +329,7 @@ def _aliases(lhs: str, names: Names) -> list[str]:
         parse(head, lambda n: found.append(n) or sp.Integer(1))
     except (LatexError, RecursionError):
         return []
-    if len(found) != 1 or found[0].dots:
+    if len(found) != 1:
         return []
     try:
         value = names(found[0])

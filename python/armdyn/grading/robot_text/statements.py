@@ -19,6 +19,8 @@ from ..reader import Equation, Submission, read_text
 MAX_FRAMES = 24
 #: inline equations read from the prose, at most
 MAX_INLINE = 500
+#: a statement's value longer than this (characters) is not read for the robot
+MAX_STATEMENT = 6000
 _TOL = 1e-9
 _JOINT_BASES = ("theta", "vartheta", "q", "d")
 
@@ -250,7 +252,7 @@ def read_statements(equations: list[Equation], names: Names, n: int) -> list[Sta
             continue
         for lhs, text, note in _instances(eq, n):
             found = _what(lhs)
-            if found is None:
+            if found is None or len(text) > MAX_STATEMENT:  # longer than any arm's geometry by hand
                 continue
             try:
                 value = _value(text, names)
