@@ -595,6 +595,12 @@ def grade(
 
         read_model, report = most_supported(read_model, report, with_model)
     if read_model is not None:
+        from .robot_text.support import disagreeing, own_values_instead
+
+        if disagreeing(report):  # the reading, not the text, is likely wrong: the text's own values
+            own = own_values_instead(sub, report)
+            if own is not report:
+                return own
         report.model_note = read_model.note()  # the report's first line: what was graded against
         report.notes.insert(0, report.model_note)
     return report

@@ -37,3 +37,26 @@ def most_supported(
             f"found wrong with it, {counts[0]} with the gravity most statements give"
         )
     return best, best_report
+
+
+def disagreeing(report: GradeReport) -> bool:
+    """Most of the steps graded are found wrong against the model read (at least 3): the
+    reading is more likely wrong than the text."""
+    graded = [v for v in report.steps if v.status != "unrecognised" and v.key]
+    flagged = sum(v.status in _FLAGGED for v in graded)
+    return flagged >= 3 and 2 * flagged > len(graded)
+
+
+def own_values_instead(sub, report: GradeReport) -> GradeReport:
+    """The text graded on its own values when the model read disagrees with most of its steps
+    (and those find fewer wrong); else ``report``, unchanged."""
+    from .own_values import grade_without_model
+
+    flagged = _flagged(report)
+    graded = sum(v.status != "unrecognised" and bool(v.key) for v in report.steps)
+    own = grade_without_model(
+        sub,
+        f"the model read from the text disagrees with most of its steps ({flagged} of {graded} graded "
+        "found wrong against it)",
+    )
+    return own if _flagged(own) < flagged else report
