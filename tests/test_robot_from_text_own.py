@@ -196,3 +196,37 @@ def test_hostile_texts_end_in_bounded_time_and_are_not_refused(tmp_path, body):
     assert time.perf_counter() - t0 < 30
     assert report.model_note.startswith("no model")
     assert report.steps and all(v.status != "correct" or v.name for v in report.steps)
+
+
+def test_a_reading_most_steps_disagree_with_gives_way_to_the_own_values(tmp_path):
+    # the text places a point mass (x_1, y_1) but its energies are of a body of inertia J:
+    # every step from T on disagrees with the point mass read, and follows from the text's T
+    th, thd, thdd, J, m1, l = sp.symbols("th thd thdd J m1 l")
+    L = J * thd**2 / 2 - m1 * g * l * sp.sin(th)
+    tau = sp.diff(L, thd).diff(thd) * thdd - L.diff(th)  # dL/dthd = J thd has no th in it
+    assert sp.simplify(tau - (J * thdd + m1 * g * l * sp.cos(th))) == 0
+    text = r"""---
+method: lagrange
+---
+$$x_1 = l \cos\theta_1, \qquad y_1 = l \sin\theta_1$$
+
+$$T = \frac{1}{2} J \dot\theta_1^2$$
+
+$$V = m_1 g l \sin\theta_1$$
+
+$$L = T - V$$
+
+$$\frac{\partial L}{\partial \dot\theta_1} = J \dot\theta_1$$
+
+$$\frac{d}{dt}\frac{\partial L}{\partial \dot\theta_1} = J \ddot\theta_1$$
+
+$$\tau_1 = J \ddot\theta_1 + m_1 g l \cos\theta_1$$
+"""
+    path = _write(tmp_path, text)
+    robot_from_text(read(path))  # a model is read: the point mass
+    report = grade(path)
+    assert report.model_note.startswith("no model: the robot could not be read from the text (the model read")
+    assert "disagrees with most of its steps" in report.model_note
+    status = {v.name: v.status for v in report.steps}
+    assert status["tau_1"] == "correct" and status["L"] == "correct"
+    assert not any(v.status in ("wrong", "follows-from-earlier-error") for v in report.steps)

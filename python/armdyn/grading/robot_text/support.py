@@ -39,24 +39,31 @@ def most_supported(
     return best, best_report
 
 
+def _unknown_name(v) -> bool:
+    return v.status == "unrecognised" and bool(v.key) and "unknown symbol" in v.message
+
+
+def _read(report: GradeReport) -> int:
+    return sum(v.status != "unrecognised" for v in report.steps)
+
+
 def disagreeing(report: GradeReport) -> bool:
-    """Most of the steps graded are found wrong against the model read (at least 3): the
-    reading is more likely wrong than the text."""
-    graded = [v for v in report.steps if v.status != "unrecognised" and v.key]
-    flagged = sum(v.status in _FLAGGED for v in graded)
-    return flagged >= 3 and 2 * flagged > len(graded)
+    """Most of the steps are found wrong against the model read, or use names it does not
+    have (at least 3): the reading is more likely wrong than the text."""
+    steps = [v for v in report.steps if v.key and (v.status != "unrecognised" or _unknown_name(v))]
+    trouble = sum(v.status in _FLAGGED or _unknown_name(v) for v in steps)
+    return trouble >= 3 and 2 * trouble > len(steps)
 
 
 def own_values_instead(sub, report: GradeReport) -> GradeReport:
-    """The text graded on its own values when the model read disagrees with most of its steps
-    (and those find fewer wrong); else ``report``, unchanged."""
+    """The text graded on its own values when the model read disagrees with most of its steps,
+    kept when it finds fewer steps wrong (or as many, reading more); else ``report``."""
     from .own_values import grade_without_model
 
     flagged = _flagged(report)
-    graded = sum(v.status != "unrecognised" and bool(v.key) for v in report.steps)
-    own = grade_without_model(
-        sub,
-        f"the model read from the text disagrees with most of its steps ({flagged} of {graded} graded "
-        "found wrong against it)",
-    )
-    return own if _flagged(own) < flagged else report
+    unknown = sum(_unknown_name(v) for v in report.steps)
+    why = f"{flagged} found wrong" + (f", {unknown} using names it does not have" if unknown else "")
+    own = grade_without_model(sub, f"the model read from the text disagrees with most of its steps ({why})")
+    if _flagged(own) < flagged or (_flagged(own) == flagged and _read(own) > _read(report)):
+        return own
+    return report
