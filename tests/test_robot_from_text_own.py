@@ -230,3 +230,26 @@ $$\tau_1 = J \ddot\theta_1 + m_1 g l \cos\theta_1$$
     status = {v.name: v.status for v in report.steps}
     assert status["tau_1"] == "correct" and status["L"] == "correct"
     assert not any(v.status in ("wrong", "follows-from-earlier-error") for v in report.steps)
+
+
+def test_the_christoffel_index_order_is_kept_once_a_symbol_decides_it(tmp_path):
+    M = sp.Matrix([[a + 2 * b * sp.cos(q2), c + b * sp.cos(q2)], [c + b * sp.cos(q2), c]])
+    qs = (q1, q2)
+
+    def last(i, j, k):  # Spong: c_ijk with the free index k last
+        return sp.simplify((M[k, j].diff(qs[i]) + M[k, i].diff(qs[j]) - M[i, j].diff(qs[k])) / 2)
+
+    # c_211 is -b sin q2 only with the free index last (first: c_{1,12} by Spong's = b sin q2)
+    assert last(1, 0, 0) == -b * sp.sin(q2) and last(0, 0, 1) == b * sp.sin(q2)
+    text = r"""---
+method: lagrange
+---
+$$m_{11} = a + 2 b \cos q_2, \quad m_{12} = c + b \cos q_2, \quad m_{22} = c$$
+
+$$c_{211} = -b \sin q_2$$
+
+$$c_{112} = -b \sin q_2$$
+"""
+    status = {v.name: v.status for v in grade(_write(tmp_path, text)).steps}
+    assert status["c_211"] == "correct"
+    assert status["c_112"] == "wrong"  # the other order's value: a slip once the order is known

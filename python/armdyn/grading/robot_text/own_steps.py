@@ -75,8 +75,12 @@ def candidates(ov, ref, key: str) -> tuple[list, str]:
         M, used = ov.matrix("M")
         if M is not None and len(entry) == 3 and all(0 <= e < ov.n for e in entry):
             a, b, c = entry
-            out.append((ov.christoffel(M, a, b, c), used, "the Christoffel symbol of your M (free index last)", True))
-            out.append((ov.christoffel(M, b, c, a), used, "the Christoffel symbol of your M (free index first)", True))
+            if ov.christoffel_order != "first":  # once the text's order is known, only that one
+                last = ov.christoffel(M, a, b, c)
+                out.append((last, used, "the Christoffel symbol of your M (free index last)", True))
+            if ov.christoffel_order != "last":
+                first = ov.christoffel(M, b, c, a)
+                out.append((first, used, "the Christoffel symbol of your M (free index first)", True))
         return out, "needs M stated before it"
     if k in ("C", "h"):
         return _coriolis(ov, k, entry), "needs M or τ stated before it"

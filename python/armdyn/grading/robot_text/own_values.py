@@ -74,6 +74,8 @@ class OwnValues:
         self.verdicts: list[StepVerdict] = []
         self.methods: list[str] = []
         self.seen: set = set(self.q) | set(self.qd) | set(self.qdd)  # symbols in the text's values so far
+        #: the Christoffel symbols' index order, once a symbol fits only one ("first", "last")
+        self.christoffel_order: str | None = None
 
     # -- reading
     def _resolve(self, name):
@@ -261,19 +263,21 @@ class OwnValues:
         except (ArithmeticError, TypeError, ValueError, AttributeError, IndexError, RecursionError) as err:
             cands, starting = [], f"could not be derived from the earlier values ({str(err)[:80]})"
         status, message, expected, caused = "unrecognised", "", None, None
-        for cand in cands:
-            value, used, how, complete = cand
-            if _fits(got, value):
-                tainted = next((u.tainted for u in used if u.tainted), None)
-                lines = _lines(used)
-                if tainted:
-                    status, caused = "follows-from-earlier-error", tainted
-                    message = f"follows from the error in {tainted}: {how} (line{'s' if ',' in lines else ''} {lines})"
-                else:
-                    status = "correct"
-                    message = f"{how} (line{'s' if ',' in lines else ''} {lines}); no model to check those against"
-                expected = _shaped(value, got)
-                break
+        fitting = [c for c in cands if _fits(got, c[0])]
+        orders = {o for c in fitting for o in ("first", "last") if f"(free index {o})" in c[2]}
+        if ref.key == "christoffel" and len(orders) == 1:  # the text's index order, kept from here on
+            self.christoffel_order = orders.pop()
+        if fitting:
+            value, used, how, complete = fitting[0]
+            tainted = next((u.tainted for u in used if u.tainted), None)
+            lines = _lines(used)
+            if tainted:
+                status, caused = "follows-from-earlier-error", tainted
+                message = f"follows from the error in {tainted}: {how} (line{'s' if ',' in lines else ''} {lines})"
+            else:
+                status = "correct"
+                message = f"{how} (line{'s' if ',' in lines else ''} {lines}); no model to check those against"
+            expected = _shaped(value, got)
         else:
             complete = [c for c in cands if c[3]]
             unknown = self._unknown(got, complete)
