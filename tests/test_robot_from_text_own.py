@@ -253,3 +253,26 @@ $$c_{112} = -b \sin q_2$$
     status = {v.name: v.status for v in grade(_write(tmp_path, text)).steps}
     assert status["c_211"] == "correct"
     assert status["c_112"] == "wrong"  # the other order's value: a slip once the order is known
+
+
+@pytest.mark.parametrize(
+    "omega2, status", [(r"\dot\theta_1 + \dot\theta_2", "correct"), (r"\dot\theta_2", "unrecognised")]
+)
+def test_angular_velocities_from_the_texts_rotation_confirm_never_condemn(tmp_path, omega2, status):
+    # Rz(theta2)^T (0, 0, w1) + theta2_dot z = (0, 0, w1 + theta2_dot): turning about z keeps z
+    t2, w1 = sp.symbols("t2 w1")
+    Rz = sp.Matrix([[sp.cos(t2), -sp.sin(t2), 0], [sp.sin(t2), sp.cos(t2), 0], [0, 0, 1]])
+    assert list(Rz.T * sp.Matrix([0, 0, w1])) == [0, 0, w1]
+    text = rf"""---
+method: newton-euler
+---
+$$R_2^1 = \begin{{bmatrix}} \cos\theta_2 & -\sin\theta_2 & 0 \\ \sin\theta_2 & \cos\theta_2 & 0 \\ 0 & 0 & 1 \end{{bmatrix}}$$
+
+$$\omega_1^1 = \begin{{bmatrix}} 0 \\ 0 \\ \dot\theta_1 \end{{bmatrix}}$$
+
+$$\omega_2^2 = \begin{{bmatrix}} 0 \\ 0 \\ {omega2} \end{{bmatrix}}$$
+"""
+    found = {v.name: v.status for v in grade(_write(tmp_path, text)).steps}
+    assert found["omega_1"] == "correct"
+    # the joint axis is the convention's, not read: a difference is not called wrong
+    assert found["omega_2"] == status

@@ -121,6 +121,8 @@ def _newton_euler(ov, ref, k: str) -> list:
     if ref.frame is not None and ref.frame != i:
         return []
     col = lambda v: sp.Matrix(v.value).reshape(3, 1)  # noqa: E731
+    if k in ("omega", "omega_dot") and i is not None and 1 <= i <= ov.n:
+        return _turning(ov, i, k, col)
     if k == "F":
         a = _vec(ov, f"vc_dot_{i}")
         return [(sp.Symbol(f"m{i}") * col(a), [a], f"m{i} v̇_C{i} of your v̇_C{i}", True)] if a else []
@@ -138,6 +140,49 @@ def _newton_euler(ov, ref, k: str) -> list:
         if k == "n" and N and p and F:
             return [(col(N) + col(p).cross(col(F)), [N, p, F], f"N{i} + P_C{i} × F{i} of yours (the last link)", True)]
     return []
+
+
+def _rotation_into(ov, i: int):
+    """The text's own rotation taking frame i-1's coordinates to frame i's (R_{i-1}^{i}, or the
+    transpose of R_i^{i-1}), and the value used; frame 0 to 1 is not needed when ω_0 = 0."""
+    direct, inverse = ov.get(f"R_{i - 1}^{i}"), ov.get(f"R_{i}^{i - 1}")
+    for v, flip in ((direct, False), (inverse, True)):
+        if v is not None and isinstance(v.value, sp.MatrixBase) and v.value.shape == (3, 3):
+            return (v.value.T if flip else v.value), [v]
+    return None, []
+
+
+def _turning(ov, i: int, k: str, col) -> list:
+    """ω_i = R ω_{i-1} + q̇_i ẑ and ω̇_i = R ω̇_{i-1} + R ω_{i-1} × q̇_i ẑ + q̈_i ẑ for a joint
+    turning about its frame's z (a d_i slides: no rate term), from the base at rest or the
+    text's own ω_{i-1}, ω̇_{i-1} and rotation. The axis is the convention's, not read: such a
+    candidate can confirm a step, never call it wrong."""
+    z = sp.Matrix([0, 0, 1])
+    turns = not str(ov.q[i - 1]).startswith("d")
+    rate, accel = (ov.qd[i - 1], ov.qdd[i - 1]) if turns else (0, 0)
+    if i == 1:
+        w_prev = dw_prev = sp.zeros(3, 1)
+        R, used = sp.eye(3), []
+    else:
+        w, dw = _vec(ov, f"omega_{i - 1}"), _vec(ov, f"omega_dot_{i - 1}")
+        R, used = _rotation_into(ov, i)
+        if R is None or w is None or (k == "omega_dot" and dw is None):
+            return []
+        w_prev, dw_prev = col(w), (col(dw) if dw is not None else sp.zeros(3, 1))
+        used = used + [w] + ([dw] if k == "omega_dot" else [])
+    if k == "omega":
+        value = R * w_prev + rate * z
+        how = f"R ω{i - 1} + q̇{i} ẑ{' (the base at rest)' if i == 1 else ' of yours'}"
+    else:
+        value = R * dw_prev + (R * w_prev).cross(rate * z) + accel * z
+        how = f"R ω̇{i - 1} + R ω{i - 1} × q̇{i} ẑ + q̈{i} ẑ{' (the base at rest)' if i == 1 else ' of yours'}"
+    return [(value, used or [_Base()], how, False)]
+
+
+class _Base:
+    """The base at rest, as a value 'used' (no line of the text)."""
+
+    line, name, tainted = 0, "the base at rest", None
 
 
 def _joint_torque(ov, i: int) -> list:

@@ -273,10 +273,10 @@ class OwnValues:
             lines = _lines(used)
             if tainted:
                 status, caused = "follows-from-earlier-error", tainted
-                message = f"follows from the error in {tainted}: {how} (line{'s' if ',' in lines else ''} {lines})"
+                message = f"follows from the error in {tainted}: {how}{lines}"
             else:
                 status = "correct"
-                message = f"{how} (line{'s' if ',' in lines else ''} {lines}); no model to check those against"
+                message = f"{how}{lines}; no model to check those against"
             expected = _shaped(value, got)
         else:
             complete = [c for c in cands if c[3]]
@@ -288,9 +288,7 @@ class OwnValues:
                 value, used, how, _ = complete[0]
                 lines = _lines(used)
                 status, expected = "wrong", _shaped(value, got)
-                message = (
-                    f"not {how} (line{'s' if ',' in lines else ''} {lines}), compared with your own earlier values"
-                )
+                message = f"not {how}{lines}, compared with your own earlier values"
             elif cands:
                 message = f"{name}: {cands[0][2]} differs, and what else it holds cannot be checked without a model"
             else:
@@ -343,7 +341,9 @@ def _aliases(lhs: str, names: Names) -> list[str]:
 
 
 def _lines(used) -> str:
-    return ", ".join(str(x) for x in sorted({u.line for u in used}))
+    """`` (lines 3, 5)`` of the values used, or "" (the base at rest: no line)."""
+    lines = sorted({u.line for u in used if u.line})
+    return f" (line{'s' if len(lines) > 1 else ''} {', '.join(map(str, lines))})" if lines else ""
 
 
 def _symbols(value) -> set:
