@@ -209,7 +209,7 @@ class OwnValues:
                 line=eq.line,
                 expected=expected,
                 got=got,
-                difference=(got - expected) if status == "wrong" and expected is not None else None,
+                difference=_difference(got, expected) if status == "wrong" else None,
                 message=message,
                 caused_by=caused_by,
             )
@@ -338,6 +338,16 @@ def _aliases(lhs: str, names: Names) -> list[str]:
     except LatexError:
         return []
     return [value.name] if isinstance(value, sp.Symbol) else []
+
+
+def _difference(got, expected):
+    """got - expected when both are of one shape, else None (nothing to subtract)."""
+    if expected is None or isinstance(got, sp.MatrixBase) != isinstance(expected, sp.MatrixBase):
+        return None
+    try:
+        return got - expected
+    except (TypeError, ValueError, ArithmeticError):
+        return None
 
 
 def _lines(used) -> str:
