@@ -213,3 +213,29 @@ links:
     _same_dynamics(model, rr)
     named = any("T is not the sum of the links' T_k" in c for c in model.conflicts)
     assert named == wrong_sign
+
+
+def test_a_mass_centre_named_with_c_wins_over_a_point_written_without(tmp_path):
+    # x_2, y_2 (first) are the arm's tip here; x_{c2}, y_{c2} link 2's mass centre
+    text = r"""---
+method: lagrange
+---
+$$x_{c1} = l_{c1}\cos\theta_1, \quad y_{c1} = l_{c1}\sin\theta_1$$
+$$x_2 = l_1\cos\theta_1 + l_2\cos(\theta_1 + \theta_2), \quad y_2 = l_1\sin\theta_1 + l_2\sin(\theta_1 + \theta_2)$$
+$$x_{c2} = l_1\cos\theta_1 + l_{c2}\cos(\theta_1 + \theta_2), \quad y_{c2} = l_1\sin\theta_1 + l_{c2}\sin(\theta_1 + \theta_2)$$
+$$V = m_1 g y_{c1} + m_2 g y_{c2}$$
+$$T_1 = \frac{1}{2} m_1 l_{c1}^2 \dot\theta_1^2, \quad T_2 = \frac{1}{2} m_2 v_{c2}^2$$
+"""
+    model = _read(_write(tmp_path, text))
+    rr = """
+name: rr
+parameters: [m1, m2, l1, lc1, lc2, g]
+gravity: [0, -g, 0]
+joints:
+  - {name: theta1, type: revolute, parent: base, child: link1, axis: [0, 0, 1]}
+  - {name: theta2, type: revolute, parent: link1, child: link2, xyz: [l1, 0, 0], axis: [0, 0, 1]}
+links:
+  - {name: link1, mass: m1, com: [lc1, 0, 0], inertia: 0}
+  - {name: link2, mass: m2, com: [lc2, 0, 0], inertia: 0}
+"""
+    _same_dynamics(model, rr)

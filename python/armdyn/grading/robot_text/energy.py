@@ -13,6 +13,7 @@ import re
 import sympy as sp
 
 from .geometry import across, same, vector
+from .statements import POINT
 
 
 def _stated(statements, q: list, conflicts: list) -> dict:
@@ -20,10 +21,13 @@ def _stated(statements, q: list, conflicts: list) -> dict:
     n = len(q)
     found: dict[int, tuple] = {}
     parts: dict[int, dict] = {}
+    centres = {st.index for st in statements if st.what in ("C", "Cx", "Cy", "Cz") and st.frame == 0}
     for st in statements:
         k = st.index
         if st.what not in ("C", "Cx", "Cy", "Cz") or k is None or not 1 <= k <= n:
             continue
+        if st.frame == POINT and k in centres:
+            continue  # x_k beside x_{ck}: the mass centre is the one named so
         if st.what == "C":
             pos = vector(st.value)
             if pos is None:

@@ -19,6 +19,9 @@ from ..reader import Equation, Submission, read_text
 MAX_FRAMES = 24
 #: inline equations read from the prose, at most
 MAX_INLINE = 500
+#: the ``frame`` of a point mass's place written without the ``c`` (``x_1``): a mass centre
+#: written ``x_{c1}`` for the same link wins over it
+POINT = -1
 #: a statement's value longer than this (characters) is not read for the robot
 MAX_STATEMENT = 6000
 _TOL = 1e-9
@@ -234,8 +237,9 @@ def _what(lhs: str):
         return "I", int(m.group(2)), None
     m = _CENTRE.fullmatch(s)  # an energy method's mass centre in the base frame: p_{c2}, x_{c2}
     if m:
-        axis, k = (m.group(1), m.group(2)) if m.group(1) else (m.group(3), m.group(4))
-        return ("C" if axis in "pr" else "C" + axis), int(k), 0
+        if m.group(1):
+            return ("C" if m.group(1) in "pr" else "C" + m.group(1)), int(m.group(2)), 0
+        return "C" + m.group(3), int(m.group(4)), POINT
     m = _SPONG_R.fullmatch(s)  # Spong's r_{i,c_i} (to the mass centre), r_{i,i+1} (to the next joint)
     if m and m.group(2) and m.group(2) == m.group(1):
         return "Pc", int(m.group(1)), int(m.group(1))
