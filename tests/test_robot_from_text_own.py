@@ -276,3 +276,29 @@ $$\omega_2^2 = \begin{{bmatrix}} 0 \\ 0 \\ {omega2} \end{{bmatrix}}$$
     assert found["omega_1"] == "correct"
     # the joint axis is the convention's, not read: a difference is not called wrong
     assert found["omega_2"] == status
+
+
+def test_a_slip_carried_through_keeps_the_model_read(tmp_path):
+    # one slip in T, carried through L and tau: the reading stands (one wrong, then follows)
+    text = r"""---
+method: lagrange
+---
+$$x_1 = l \cos\theta_1, \qquad y_1 = l \sin\theta_1$$
+
+$$T = m_1 l^2 \dot\theta_1^2$$
+
+$$V = m_1 g l \sin\theta_1$$
+
+$$L = T - V$$
+
+$$\frac{\partial L}{\partial \dot\theta_1} = 2 m_1 l^2 \dot\theta_1$$
+
+$$\frac{d}{dt}\frac{\partial L}{\partial \dot\theta_1} = 2 m_1 l^2 \ddot\theta_1$$
+
+$$\tau_1 = 2 m_1 l^2 \ddot\theta_1 + m_1 g l \cos\theta_1$$
+"""
+    report = grade(_write(tmp_path, text))
+    assert report.model_note.startswith("model read from the text")
+    status = {v.name: v.status for v in report.steps}
+    assert status["T"] == "wrong"  # a point mass m1 at l: T = m1 l^2 thd^2 / 2
+    assert status["tau_1"] == "follows-from-earlier-error"

@@ -47,11 +47,16 @@ def _read(report: GradeReport) -> int:
     return sum(v.status != "unrecognised" for v in report.steps)
 
 
+def _wrong(report: GradeReport) -> int:
+    return sum(v.status == "wrong" for v in report.steps)
+
+
 def disagreeing(report: GradeReport) -> bool:
-    """Most of the steps are found wrong against the model read, or use names it does not
-    have (at least 3): the reading is more likely wrong than the text."""
+    """Most of the steps are found wrong against the model read, each on its own (a slip
+    carried through is one ``wrong`` and then ``follows``), or use names it does not have (at
+    least 3): the reading is more likely wrong than the text."""
     steps = [v for v in report.steps if v.key and (v.status != "unrecognised" or _unknown_name(v))]
-    trouble = sum(v.status in _FLAGGED or _unknown_name(v) for v in steps)
+    trouble = sum(v.status == "wrong" or _unknown_name(v) for v in steps)
     return trouble >= 3 and 2 * trouble > len(steps)
 
 
@@ -60,10 +65,10 @@ def own_values_instead(sub, report: GradeReport) -> GradeReport:
     kept when it finds fewer steps wrong (or as many, reading more); else ``report``."""
     from .own_values import grade_without_model
 
-    flagged = _flagged(report)
+    wrong = _wrong(report)
     unknown = sum(_unknown_name(v) for v in report.steps)
-    why = f"{flagged} found wrong" + (f", {unknown} using names it does not have" if unknown else "")
+    why = f"{wrong} found wrong" + (f", {unknown} using names it does not have" if unknown else "")
     own = grade_without_model(sub, f"the model read from the text disagrees with most of its steps ({why})")
-    if _flagged(own) < flagged or (_flagged(own) == flagged and _read(own) > _read(report)):
+    if _wrong(own) < wrong or (_wrong(own) == wrong and _read(own) > _read(report)):
         return own
     return report
