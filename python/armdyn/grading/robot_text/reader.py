@@ -44,6 +44,13 @@ def _gravity_in_words(text: str):
     return "xyz".index(m.group(2).lower()), sign, text.count("\n", 0, m.start()) + 1
 
 
+def _plain(e):
+    """A frame's offset or axis, tidied: it holds no joint variable here (each was set to 0 or
+    differentiated away), so expanding and cancelling is enough (sympy's simplify would cost
+    its first caller 0.7 s of imports)."""
+    return sp.cancel(sp.expand(e))
+
+
 def _energies(statements, what: str) -> list:
     """The kinetic energies stated as a function of the rates (``K = K_1 + K_2`` names others: left out)."""
     return [
@@ -426,8 +433,8 @@ class TextReader:
                 axis = sp.Matrix([S[2, 1], S[0, 2], S[1, 0]]).applyfunc(sp.nsimplify)
                 if not same(axes, A0 * axis_angle(axis, x), self.free):
                     self.fail(f"the rotation of frame {k} ({src}) is not a turn about one axis by {x}")
-                centre = ((rel_k.subs(x, 0) + rel_k.subs(x, sp.pi)) / 2).applyfunc(sp.simplify)
-                fx = (A0.T * (rel_k.subs(x, 0) - centre)).applyfunc(sp.simplify)
+                centre = ((rel_k.subs(x, 0) + rel_k.subs(x, sp.pi)) / 2).applyfunc(_plain)
+                fx = (A0.T * (rel_k.subs(x, 0) - centre)).applyfunc(_plain)
                 if not same(rel_k, centre + A0 * axis_angle(axis, x) * fx, self.free):
                     self.conflicts.append(f"frame {k}'s origin does not turn about joint {k}'s axis")
                 item.insert(1, "    type: revolute")
@@ -440,16 +447,16 @@ class TextReader:
                     item.append(f"    frame_xyz: {yaml_vec(fx)}    # frame {k}'s origin off the axis")
                 params |= axis.free_symbols | centre.free_symbols | fx.free_symbols
             else:
-                slide = rel_k.diff(x).applyfunc(sp.simplify)
+                slide = rel_k.diff(x).applyfunc(_plain)
                 if x not in rel_k.free_symbols:
                     self.fail(
                         f"joint variable {x} moves nothing: it is in no rotation and in no position read "
                         f"(state frame {k}'s origin, P_{k}^{k - 1}, or the heights in V)"
                     )
-                axis = (axes.T * slide).applyfunc(sp.simplify)
+                axis = (axes.T * slide).applyfunc(_plain)
                 if slide.free_symbols or axis.norm() != 1:
                     self.fail(f"joint {k} ({x}) slides along {pretty_vector(slide)}, not a unit direction")
-                at = rel_k.subs(x, 0).applyfunc(sp.simplify)
+                at = rel_k.subs(x, 0).applyfunc(_plain)
                 item.insert(1, "    type: prismatic")
                 if axes != sp.eye(3):
                     item.append(f"    rotation: {yaml_matrix(axes)}    # {src}")
@@ -461,7 +468,7 @@ class TextReader:
             mass, mline = masses.get(k, (None, None))
             if mass is None:
                 self.fail(f"no mass of link {k} (m_{k}) is stated in V or T")
-            c = com_local[k].subs(zero).applyfunc(sp.simplify)
+            c = com_local[k].subs(zero).applyfunc(_plain)
             inertia, iline = inertias[k][:2]
             links_yaml += [
                 f"  - name: link{k}",
