@@ -584,7 +584,7 @@ def grade(
             raise err.located(source=sub.path) from None
     hint = sub.method if sub.method in ("newton-euler", "lagrange") else None
     report = _Grader(sub, model, symbols).run(hint)
-    if read_model is not None and read_model.alternatives:  # more than one gravity stated
+    if read_model is not None and read_model.alternatives:  # the statements allow other readings
         from .robot_text.support import most_supported
 
         def with_model(other):

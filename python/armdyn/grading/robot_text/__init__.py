@@ -44,9 +44,14 @@ def robot_from_text(sub: Submission) -> TextModel:
     try:
         first = TextReader(sub)
         model = first.read()
-        for choice in range(1, min(first.gravity_options, 3)):  # other gravities stated: read too
-            other = TextReader(sub)
-            other.gravity_choice = choice
+        others = []  # the other readings the statements allow: other gravities, x_k or y_k
+        for choice in range(1, min(first.gravity_options, 3)):
+            others.append(TextReader(sub))
+            others[-1].gravity_choice = choice
+        for k in list(first.pair_choices)[:2]:
+            others.append(TextReader(sub))
+            others[-1].pair_choices = {k: True}
+        for other in others:
             try:
                 model.alternatives.append(other.read())
             except ModelError:

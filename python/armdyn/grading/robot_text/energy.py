@@ -16,7 +16,7 @@ from .geometry import across, same, vector
 from .statements import POINT
 
 
-def _stated(statements, q: list, conflicts: list) -> dict:
+def _stated(statements, q: list, conflicts: list, choices: dict | None = None) -> dict:
     """Link k -> (position in the base frame, None, statement) from p_{ck}, x_{ck}, y_{ck}, z_{ck}."""
     n = len(q)
     found: dict[int, tuple] = {}
@@ -47,7 +47,7 @@ def _stated(statements, q: list, conflicts: list) -> dict:
             continue
         first = min((s for _, s in comps.values()), key=lambda s: s.line)
         found[k] = (sp.Matrix([comps[i][0] if i in comps else 0 for i in range(3)]), None, first)
-    _planar_pairs(found, parts, q, conflicts)
+    _planar_pairs(found, parts, q, conflicts, choices if choices is not None else {})
     for st in statements:  # positions stated win; else the position whose Jacobian is stated
         k = st.index
         if st.what == "CJ" and k is not None and 1 <= k <= n and k not in found:
@@ -59,10 +59,12 @@ def _stated(statements, q: list, conflicts: list) -> dict:
     return found
 
 
-def _planar_pairs(found: dict, parts: dict, q: list, conflicts: list) -> None:
+def _planar_pairs(found: dict, parts: dict, q: list, conflicts: list, choices: dict) -> None:
     """A planar point turning about z has ``x = a cos(phi) - b sin(phi)`` and ``y = a sin(phi) +
     b cos(phi)``: each coordinate alone gives the other. When the two stated disagree (a slip in
-    one), the reading that keeps the arm serial with its neighbours is used, named."""
+    one), the reading that keeps the arm serial with its neighbours is used, named.
+    ``choices``: link k -> True to take the other one (a reading kept as an alternative: the
+    grading keeps the one the text's steps agree with); each link decided is added (False)."""
     turning = {x for v in found.values() for f in v[0].atoms(sp.sin, sp.cos) for x in f.free_symbols} & set(q)
     for k, comps in sorted(parts.items()):
         if 0 not in comps or 1 not in comps or found[k][2] not in (comps[0][1], comps[1][1]):
@@ -82,10 +84,14 @@ def _planar_pairs(found: dict, parts: dict, q: list, conflicts: list) -> None:
         ]
         scores = [_serial_score(found, k, p, q, turning) for p, _, _ in options]
         best = max(range(2), key=lambda j: (scores[j], -options[j][2].line))
+        flipped = choices.setdefault(k, False)
+        best = 1 - best if flipped else best
         pos, name, st = options[best]
         other = options[1 - best]
         why = (
-            "it keeps the arm serial, a mass at the next joint"
+            "the other reading, kept for the text's steps to decide"
+            if flipped
+            else "it keeps the arm serial, a mass at the next joint"
             if scores[best] > scores[1 - best]
             else "the first written"
         )
@@ -137,10 +143,12 @@ def _integrated(J, q: list):
     return p
 
 
-def mass_centres(statements, gravity, q: list, revolute: set, free: set, conflicts: list) -> dict:
+def mass_centres(
+    statements, gravity, q: list, revolute: set, free: set, conflicts: list, choices: dict | None = None
+) -> dict:
     """Link k's mass centre in the base frame -> (position, mass symbol or None, statement)."""
     n = len(q)
-    found = _stated(statements, q, conflicts)
+    found = _stated(statements, q, conflicts, choices)
     for st in statements:
         if st.what not in ("V", "Vl") or isinstance(st.value, sp.MatrixBase):  # V, or one link's V_k
             continue

@@ -93,6 +93,7 @@ class TextReader:
         self.unplaced: dict[int, str] = {}  # frame -> why its only rotation stated was not used
         self.gravity_choice = 0  # which of the gravities stated (most supported first) is read
         self.gravity_options = 1
+        self.pair_choices: dict[int, bool] = {}  # link -> the other of its x_k, y_k readings (energy.py)
 
     def where(self, st: Statement) -> str:
         return f"line {st.line}"
@@ -295,7 +296,7 @@ class TextReader:
 
     def _coms(self, statements, gravity, rot, revolute) -> dict:
         """Link k's mass centre in the base frame -> (position, mass or None, statement)."""
-        return mass_centres(statements, gravity, self.q, revolute, self.free, self.conflicts)
+        return mass_centres(statements, gravity, self.q, revolute, self.free, self.conflicts, self.pair_choices)
 
     # -- the model
     def _build(self, statements, rot, revolute, gravity, g_line, coms) -> TextModel:

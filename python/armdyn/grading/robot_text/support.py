@@ -1,6 +1,7 @@
 """Which reading of a text's robot its own steps support: when the text states more than one
-gravity (a case shown in passing, a correction), each reading is graded and the one with the
-fewest steps found wrong is kept, named in the report's first note."""
+gravity (a case shown in passing, a correction), or an x_k and a y_k that are not one point,
+each reading is graded and the one with the fewest steps found wrong is kept, named in the
+report's first note."""
 
 from __future__ import annotations
 
@@ -33,8 +34,8 @@ def most_supported(
             best, best_report = other, other_report
     if best is not model:
         best.conflicts.append(
-            f"the gravity read is the one the text's steps agree with: {_flagged(best_report)} steps "
-            f"found wrong with it, {counts[0]} with the gravity most statements give"
+            f"the reading kept is the one the text's steps agree with: {_flagged(best_report)} steps "
+            f"found wrong with it, {counts[0]} with the reading most statements give"
         )
     return best, best_report
 
