@@ -553,8 +553,14 @@ def grade(
         model = _load_robot(robot or sub.robot or "", sub, trusted=bool(trusted and robot))
     else:
         from .robot_text import robot_from_text
+        from .robot_text.own_values import grade_without_model
 
-        read_model = robot_from_text(sub)  # the robot the text itself describes
+        try:
+            read_model = robot_from_text(sub)  # the robot the text itself describes
+        except ModelError as err:
+            if not sub.equations:
+                raise
+            return grade_without_model(sub, err.message)  # what the text's own values decide
         model = read_model.robot
     if sub.values is not None:
         try:
@@ -564,7 +570,23 @@ def grade(
             raise err.located(source=sub.path) from None
     hint = sub.method if sub.method in ("newton-euler", "lagrange") else None
     report = _Grader(sub, model, symbols).run(hint)
+    if read_model is not None and read_model.alternatives:  # the statements allow other readings
+        from .robot_text.support import most_supported
+
+        def with_model(other):
+            robot = other.robot
+            if sub.values is not None:
+                robot = robot.bind(sub.values if isinstance(sub.values, Mapping) else None)
+            return _Grader(sub, robot, symbols).run(hint)
+
+        read_model, report = most_supported(read_model, report, with_model)
     if read_model is not None:
+        from .robot_text.support import disagreeing, own_values_instead
+
+        if disagreeing(report):  # the reading, not the text, is likely wrong: the text's own values
+            own = own_values_instead(sub, report)
+            if own is not report:
+                return own
         report.model_note = read_model.note()  # the report's first line: what was graded against
         report.notes.insert(0, report.model_note)
     return report

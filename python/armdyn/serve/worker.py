@@ -100,7 +100,7 @@ class Grader:
         model, notes = model_for(sub, assigned, f"exercise {variant}" if variant else None)
         report = grade(sub, robot=model)
         report.notes[:0] = notes
-        return (variant if model is assigned else FROM_TEXT), report
+        return (variant if model is not None and model is assigned else FROM_TEXT), report
 
     def grade(self, markdown: str, exercise: str | None) -> dict:
         from ..errors import ModelError
