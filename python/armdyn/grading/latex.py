@@ -34,6 +34,7 @@ import sympy as sp
 from .equations import side_offsets, sides, split_equations  # noqa: F401
 from .latex_symbols import SymbolReader
 from .latex_tables import (  # noqa: F401  (re-exported: the reader's tables and limits)
+    ELIDED,
     FUNCTIONS,
     GREEK,
     MATRIX_ENVS,
@@ -63,6 +64,8 @@ class _Parser(SymbolReader):
     def parse(self):
         try:
             value = self.expr()
+            while self._closing_bar():  # \left. a \right| + b: the bar closes nothing
+                value = value + self.expr() if self.peek()[0] != "eof" else value
         except LatexError as err:
             if err.pos is None:
                 err.pos = self.at(self.i)
@@ -72,6 +75,19 @@ class _Parser(SymbolReader):
         if self.peek()[0] != "eof":
             raise LatexError(f"unexpected '{self.peek()[1]}'", self.at(self.i))
         return value
+
+    def _closing_bar(self) -> bool:
+        """A ``\\right|`` (``\\right\\vert``) with no ``\\left`` before it (``\\left.`` is dropped): a bar
+        around nothing, taken; with a script it evaluates at a point (``\\right|_{t=0}``): refused."""
+        if self.peek() != ("cmd", "right") or self.peek(1) not in (("char", "|"), ("cmd", "vert"), ("cmd", "rvert")):
+            return False
+        if self.peek(2) in (("char", "_"), ("char", "^")):
+            raise LatexError(
+                "an evaluation bar \\right|_{...} (a value at a point) is not read: write the value there",
+                self.at(self.i),
+            )
+        self.i += 2
+        return True
 
     def expr(self):
         self.enter()
@@ -84,6 +100,8 @@ class _Parser(SymbolReader):
                 value = value + self.term()
                 continue
             op = self.take()[1]
+            while self.peek() in (("char", "+"), ("char", "-")):  # "+ -b" (a row "+" then a row "-b")
+                op = "-" if (op == "-") != (self.take()[1] == "-") else "+"
             nxt = self.term()
             value = value + nxt if op == "+" else value - nxt
         self.leave()
@@ -142,18 +160,16 @@ class _Parser(SymbolReader):
         return base
 
     def _transpose_mark(self) -> bool:
-        """After ``^`` on a matrix: ``T``, ``\\top``, ``{T}``, ``{\\mathrm{T}}`` (consumed)."""
-        marks = (
-            [("char", "T")],
-            [("cmd", "top")],
-            [("char", "{"), ("char", "T"), ("char", "}")],
-            [("char", "{"), ("cmd", "top"), ("char", "}")],
-            [("char", "{"), ("cmd", "mathrm"), ("char", "{"), ("char", "T"), ("char", "}"), ("char", "}")],
-        )
-        for mark in marks:
-            if all(self.peek(k) == tok for k, tok in enumerate(mark)):
-                self.i += len(mark)
-                return True
+        """After ``^`` on a matrix: ``T``, ``\\top``, ``\\intercal``, ``\\mathsf{T}``, in braces or
+        not, in a typeface or not (``{\\mathrm{T}}``, ``{\\mathsf T}``): consumed when it is one."""
+        n = self._script_length(0)
+        if self.peek() != ("char", "{") and self.peek() in (("cmd", w) for w in WRAPPERS):
+            n += self._script_length(1)  # ^\mathsf{T}: the typeface and its argument
+        marks = [t for t in (self.peek(k) for k in range(n)) if t not in (("char", "{"), ("char", "}"))]
+        marks = [t for t in marks if not (t[0] == "cmd" and t[1] in WRAPPERS)]
+        if marks in ([("char", "T")], [("cmd", "top")], [("cmd", "intercal")]):
+            self.i += n
+            return True
         return False
 
     def script_value(self):
@@ -216,7 +232,34 @@ class _Parser(SymbolReader):
                     self.expect("cmd", "right")
                     self.take()
                     return value
+                if opener in ("|", "vert", "lvert"):  # |x|: the absolute value of a scalar
+                    at = self.at(self.i - 2)
+                    value = self.expr()
+                    self.expect("cmd", "right")
+                    self.take()
+                    if isinstance(value, sp.MatrixBase):
+                        raise LatexError(
+                            "\\left| ... \\right| around a matrix (a determinant or a norm) is not read", at
+                        )
+                    return sp.Abs(value)
                 raise LatexError(f"unsupported bracket \\left{opener}")
+            if tok in ("cancel", "bcancel", "xcancel"):  # struck through, still written: read as it stands
+                self.take()
+                return self._braced()
+            if tok in ELIDED:
+                raise LatexError(
+                    f"\\{tok} in a matrix: a general matrix (its entries are not all written), not read as a value"
+                    if self.matrices
+                    else f"\\{tok}: {ELIDED[tok]}",
+                    self.at(self.i),
+                )
+            if tok in ("pmatrix", "bmatrix", "matrix") and self.peek(1) == (
+                "char",
+                "{",
+            ):  # plain TeX: \pmatrix{a \cr b}
+                self.take()
+                self.take()
+                return self.matrix(tok, closer=("char", "}"))
             if tok in ("underbrace", "overbrace", "boxed"):  # a term's label or frame: the term is read
                 self.take()
                 value = self._braced()
@@ -225,6 +268,9 @@ class _Parser(SymbolReader):
                     self.group_text()  # the label, words or a name: not part of the value
                 return value
             if tok in ("frac", "dfrac", "tfrac"):
+                derivative = self._time_derivative()
+                if derivative is not None:
+                    return derivative
                 if self._derivative_fraction():
                     raise LatexError(
                         "a derivative written as a fraction (d/dt, \\partial): a value is read worked out, "
@@ -255,6 +301,49 @@ class _Parser(SymbolReader):
             raise LatexError(f"unsupported command \\{tok}")
         raise LatexError("unexpected end of equation" if kind == "eof" else f"unexpected '{tok}'")
 
+    def _time_derivative(self):
+        """``\\frac{d\\theta_1}{dt}``, ``\\frac{\\mathrm{d}^2 q}{\\mathrm{d}t^2}``: a symbol's time
+        derivative (read as its dots), or None with nothing taken (an operator, a partial)."""
+        saved = self.i
+        try:
+            self.take()  # \frac
+            self.expect("char", "{")
+            order = self._d_mark()
+            value = self._symbol(dots_added=order) if order else None
+            if value is not None and self.take() == ("char", "}") and self.take() == ("char", "{"):
+                if self._d_mark(False) == 1 and self.take() == ("char", "t") and self._d_order() == order:
+                    if self.take() == ("char", "}"):
+                        return value
+        except UnknownSymbol:
+            raise
+        except LatexError:
+            pass
+        self.i = saved
+        return None
+
+    def _d_mark(self, ordered: bool = True) -> int:
+        """Take ``d`` or ``\\mathrm{d}`` (and, when ``ordered``, a power ``^2``): the order, or 0."""
+        if self.peek() == ("char", "d"):
+            self.take()
+        elif [self.peek(k) for k in range(4)] == [("cmd", "mathrm"), ("char", "{"), ("char", "d"), ("char", "}")]:
+            self.i += 4
+        else:
+            return 0
+        return self._d_order() if ordered else 1
+
+    def _d_order(self) -> int:
+        """A derivative's order written as a power after ``d`` or ``dt`` (``^2``, ``^{2}``): 1 if none."""
+        if self.peek() != ("char", "^"):
+            return 1
+        self.take()
+        braced = self.peek() == ("char", "{")
+        if braced:
+            self.take()
+        kind, tok = self.take()
+        if braced and self.take() != ("char", "}") or kind != "num" or not tok.isdigit() or int(tok) > 3:
+            return 0
+        return int(tok)
+
     def _derivative_fraction(self) -> bool:
         """Is the ``\\frac`` next ``\\frac{d}{dt}``, ``\\frac{\\mathrm{d}}{\\mathrm{d}t}`` or
         ``\\frac{\\partial L}{\\partial q}`` (an operator, not a quotient)?"""
@@ -268,7 +357,7 @@ class _Parser(SymbolReader):
             if first == ("cmd", "mathrm"):
                 return self.peek(k + 2) == ("char", "{") and self.peek(k + 3) == ("char", "d")
             after = self.peek(k + 2)  # d then a letter or a command: dt, d\theta (d_2 is a name)
-            letter = after[0] == "cmd" or after[0] == "char" and after[1].isalpha()
+            letter = after[0] == "cmd" or after[0] == "char" and (after[1].isalpha() or after[1] == "^")
             return first == ("char", "d") and (letter or alone and after == ("char", "}"))
 
         return starts_d(1, True) and starts_d(1 + self._script_length(1), False)
@@ -317,15 +406,19 @@ class _Parser(SymbolReader):
         self.calls -= 1
         return _power(value, power, at) if power is not None else value
 
-    def matrix(self):
-        env = self.take()[1]
+    def matrix(self, env: str | None = None, closer: tuple | None = None):
+        """``\\begin{pmatrix} ... \\end{pmatrix}`` (or plain TeX's ``\\pmatrix{...}``, ``closer``
+        its brace, the opener taken): rows by ``\\\\`` (``\\cr``), cells by ``&``."""
+        if env is None:
+            env = self.take()[1]
         if env not in MATRIX_ENVS:
             raise LatexError(f"unsupported environment {env}")
         self.enter()
+        self.matrices += 1
         rows, row = [], []
         while True:
             kind, tok = self.peek()
-            if kind == "end":
+            if kind == "end" or closer is not None and (kind, tok) == closer:
                 self.take()
                 break
             if kind == "eof":
@@ -339,13 +432,14 @@ class _Parser(SymbolReader):
             if (kind, tok) == ("char", "&"):
                 self.take()
                 continue
-            if (kind, tok) == ("cmd", "\\") or kind == "end":
+            if (kind, tok) == ("cmd", "\\") or kind == "end" or closer is not None and (kind, tok) == closer:
                 rows.append(row)
                 row = []
                 continue
             raise LatexError(f"unexpected '{tok}' in a matrix")
         if row:
             rows.append(row)
+        self.matrices -= 1
         self.leave()
         if not rows or len({len(r) for r in rows}) != 1:
             raise LatexError("a matrix whose rows have different lengths")

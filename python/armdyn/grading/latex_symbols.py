@@ -70,10 +70,11 @@ class SymbolReader(Cursor):
         exponent, read by :meth:`factor`."""
         return self._symbol()
 
-    def _symbol(self, pre_sup: str = "", pre_sub: str = "", start: int | None = None):
+    def _symbol(self, pre_sup: str = "", pre_sub: str = "", start: int | None = None, dots_added: int = 0):
         start = self.at(self.i) if start is None else start
         hat = self.peek() == ("cmd", "hat")
         dots, base, sub = self._accented()
+        dots += dots_added  # written d\theta/dt: a time derivative
         if base[0].isdigit() and not (pre_sup or pre_sub):  # \mathbf{0}: a number in bold
             return sp.Rational(base)
         primes = self._primes()
@@ -163,6 +164,10 @@ class SymbolReader(Cursor):
                     raise LatexError(f"unexpected '{t2}' inside \\{tok}{{...}}")
             self.take()
             self.leave()
+            if tok == "operatorname" and len(base) > 1:  # \operatorname{sin} is read by the tokenizer
+                raise LatexError(
+                    f"\\operatorname{{{base}}}: an operator that is not read (read: sin cos tan exp ln log)"
+                )
             return dots + inner, base, sub
         if kind == "cmd" and tok in GREEK:
             return 0, tok, ""

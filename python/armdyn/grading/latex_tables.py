@@ -59,6 +59,10 @@ WRAPPERS = {
     "text",
     "mathcal",
     "tilde",
+    "mathbb",
+    "mathfrak",
+    "mathscr",
+    "mathtt",
 }
 SPACES = {
     ",",
@@ -91,6 +95,17 @@ SIZES = {
     "Biggr",
     "bigm",
     "Bigm",
+}
+#: what elides terms or entries (\cdots), or sums or integrates over an index: a general
+#: formula, not a value; why each is not read
+ELIDED = {
+    **dict.fromkeys(
+        ("cdots", "ldots", "dots", "vdots", "ddots"), "elided terms (not all written), not read as a value"
+    ),
+    "sum": "a sum over an index (its terms not written), not read as a value",
+    "prod": "a product over an index (its factors not written), not read as a value",
+    "int": "an integral, not read as a value (write what it gives)",
+    "cancelto": "a term struck out towards a value, not read (write the expression after cancelling)",
 }
 MATRIX_ENVS = {"pmatrix", "bmatrix", "Bmatrix", "matrix", "vmatrix", "smallmatrix", "array"}
 

@@ -68,6 +68,7 @@ class Cursor:
         self.resolve = resolve
         self.depth = 0
         self.calls = 0  # function calls and square roots open around the current token
+        self.matrices = 0  # matrices open around the current token
         self.positions = positions or []
         self.length = length
 
