@@ -141,6 +141,7 @@ class SymbolReader(Cursor):
         """(number of dots, base name, subscript written inside the braces) of an
         accented or wrapped symbol: ``\\dot{\\theta}``, ``\\dot{\\theta_1}``, ``\\mathbf{v}``."""
         kind, tok = self.take()
+        start = self.at(self.i - 1)
         if kind == "cmd" and (tok in ("dot", "ddot", "dddot") or tok in WRAPPERS):
             self.enter()  # \dot{\dot{...}}: each accent nests one level (left unbalanced on error)
             dots = {"dot": 1, "ddot": 2, "dddot": 3}.get(tok, 0)
@@ -166,7 +167,7 @@ class SymbolReader(Cursor):
             self.leave()
             if tok == "operatorname" and len(base) > 1:  # \operatorname{sin} is read by the tokenizer
                 raise LatexError(
-                    f"\\operatorname{{{base}}}: an operator that is not read (read: sin cos tan exp ln log)"
+                    f"\\operatorname{{{base}}}: an operator that is not read (read: sin cos tan exp ln log)", start
                 )
             return dots + inner, base, sub
         if kind == "cmd" and tok in GREEK:

@@ -303,7 +303,7 @@ def _read_block(sub: Submission, index: LineIndex, block_start: int, block: str)
             eq = " " * arrow.end() + eq[arrow.end() :]
             lead, cuts = _LEAD.match(eq).end(), side_offsets(eq)
             if len(cuts) < 2 and lead < len(eq):  # "\\Rightarrow value": the chain's next member
-                eq, cuts = eq[: lead - 1] + "=" + eq[lead:], [0, lead]
+                eq, cuts, lead = eq[: lead - 1] + "=" + eq[lead:], [0, lead], lead - 1
         if eq.startswith("=", lead) or eq.startswith(("+", "-"), lead) and len(cuts) < 2:
             _continue(sub, index, eq, start, cuts, new_block=n == 0)
             continue
