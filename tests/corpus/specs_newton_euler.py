@@ -211,12 +211,14 @@ CRAIG_SPLIT = [
     Eq(r"$${}^{2}F_{2} =", "F2", m2 * _vc2),
     Eq(r"$${}^{2}N_{2} =", "N2", z(I2 * _a2)),
     Eq(r"$${}^{2}f_{2} =", "f2", m2 * _vc2, span=1),
+    # the formula block and the product block are right; the slip is in the value block
+    Eq(r"$${}^{2}n_{2} =", "n2", z(I2 * _a2 + m2 * lc2 * _vc2[1])),
+    Eq(r"$$= \begin{bmatrix} 0 \\ 0 \\ I_2", "n2", z(I2 * _a2) + vec(lc2, 0, 0).cross(m2 * _vc2)),
     Eq(
-        r"$${}^{2}n_{2} =",
+        r"$$= \begin{bmatrix} 0 \\ 0 \\ I_2",
         "n2",
         z(_n2z_split),
         id="n2",
-        span=4,
         why="the value block has m_2 l_{c2}(q1'' + q2'') where l_{c2} x (m_2 l_{c2}(q1'' + q2'')) gives "
         "m_2 l_{c2}^2(q1'' + q2''); its formula and product blocks are right",
     ),
