@@ -215,3 +215,46 @@ def test_a_general_matrix_in_a_step_is_refused_at_its_line_and_column(tmp_path):
     col = body.split("\n")[2].index("\\cdots") + 1
     assert v.status == "unrecognised"
     assert f"general.md:6:{col}:" in v.message and "a general matrix" in v.message
+
+
+# ---------------------------------------------------------------- 3. relations between steps
+
+CRAIG_2R = (
+    "---\nrobot: planar-2r\nmethod: newton-euler\nsymbols:\n  '\\theta_1': q1\n  '\\theta_2': q2\n"
+    "  'l_1': l1\n  'l_{c2}': lc2\n  'm_2': m2\n  'I_2': I2\n  'g': g\n---\n"
+)
+# {}^2\dot v_{C_2} of the planar 2R (Craig's frames, gravity as a base acceleration g Y_0), by
+# hand: the elbow's acceleration rotated into frame 2 plus the centre's tangential and
+# centripetal parts; SLIP is the same with the sign of the centripetal part flipped
+VC2 = (
+    r"\begin{bmatrix} l_1 s_2\ddot\theta_1 - l_1 c_2\dot\theta_1^2 + g s_{12} - l_{c2}(\dot\theta_1 + \dot\theta_2)^2 \\ "
+    r"l_1 c_2\ddot\theta_1 + l_1 s_2\dot\theta_1^2 + g c_{12} + l_{c2}(\ddot\theta_1 + \ddot\theta_2) \\ 0 \end{bmatrix}"
+)
+VC2_SLIP = VC2.replace(r"- l_{c2}(\dot", r"+ l_{c2}(\dot")
+
+
+def test_a_step_written_as_another_step_alone_is_an_identity_that_holds(tmp_path):
+    body = (
+        f"$${{}}^{{2}}\\dot v_{{C_2}} = {VC2_SLIP}$$\n"
+        "$${}^{2}F_{2} = {}^{2}f_{2}$$\n"  # tip free: the same quantity, whatever its value
+        "$${}^{2}f_{2} = m_2\\,{}^{2}\\dot v_{C_2}$$\n"  # a formula in names: its value carries the slip
+        f"$${{}}^{{2}}F_{{2}} = m_2 {VC2_SLIP}$$\n"  # a worked value: carries the slip
+    )
+    report = grade(write(tmp_path, "relation.md", body, header=CRAIG_2R))
+    assert [(v.name, v.status) for v in report.steps] == [
+        ("vc_dot_2", "wrong"),
+        ("F_2", "correct"),
+        ("f_2", "follows-from-earlier-error"),
+        ("F_2", "follows-from-earlier-error"),
+    ]
+    assert "right as a relation between steps" in report.steps[1].message
+    assert "follows from the error in vc_dot_2" in report.steps[1].message
+
+
+def test_the_right_value_is_not_called_a_relation(tmp_path):
+    body = f"$${{}}^{{2}}\\dot v_{{C_2}} = {VC2}$$\n$${{}}^{{2}}F_{{2}} = m_2\\,{{}}^{{2}}\\dot v_{{C_2}}$$\n"
+    report = grade(write(tmp_path, "relation-right.md", body, header=CRAIG_2R))
+    assert [(v.name, v.status, v.message) for v in report.steps] == [
+        ("vc_dot_2", "correct", ""),
+        ("F_2", "correct", ""),
+    ]

@@ -421,6 +421,31 @@ def reported_at(sub, eq, findings: list) -> tuple[int, int]:
     return sub.locate(eq.offset)
 
 
+def relation_holds(grader, eq, expected) -> bool:
+    """Is ``eq``'s value (just read) another step's name alone (``{}^3\\dot v_{C_3} =
+    {}^3\\dot v_3``, ``{}^3f_3 = {}^3F_3``: the two are the same quantity here), right when
+    that step takes its right value? Then the equation is an identity that holds, whatever
+    the named step carries. A formula in names (``F_2 = m_2 \\dot v_{C_2}``) is not: its
+    value is what it gives. ``expected``: the step's right value as written."""
+    from .engine import equal, to_sympy
+
+    last = grader.last_read
+    if last is None or last[0] is not eq or last[3] or last[1] is last[2] or not isinstance(eq.value, str):
+        return False
+    try:
+        body, found = step_names(grader)._substitute(eq.value)
+    except LatexError:
+        return False
+    if len(found) != 1 or body.strip() != f"\\mathrm{{{PLACEHOLDER}}}_{{0}}":
+        return False
+    right = _shaped(to_sympy(last[2]), expected)
+    try:
+        fingerprint = grader.sampler.fingerprint
+        return bool(equal(fingerprint(right), fingerprint(to_sympy(expected))).all())
+    except (TypeError, ValueError, sp.ShapeError):
+        return False
+
+
 def _at(f: MemberFinding) -> str:
     """A member named in a message: its number, and its line when the chain spans several."""
     return f"member {f.number}" + (f" at line {f.line}" if f.line else "")

@@ -15,7 +15,7 @@ import sympy as sp
 from ..errors import ModelError
 from ..model import Robot
 from ..symbolic.names import latex_symbol_names
-from .chains import check_step, reported_at, with_members
+from .chains import check_step, relation_holds, reported_at, with_members
 from .defined import DefinedNames, after_equation, definition, model_value, read_pair, read_value
 from .diagnose import cannot_read, location
 from .energy_steps import EnergySteps
@@ -499,6 +499,9 @@ class _Grader(EnergySteps, KinematicsSteps):
             message = j.convention or ""
         status = j.status
         line, column = reported_at(self.sub, eq, findings) if eq.latex else (eq.line, eq.column)
+        if status == "follows-from-earlier-error" and ref.key != "tau" and relation_holds(self, eq, exp_shown):
+            status = "correct"  # a relation between steps that holds: what it names carries the error
+            message = f"right as a relation between steps; the value it names {message}"
         if findings:
             status, message, difference, components, caused_by = with_members(
                 findings, (status, message, difference, components, caused_by), _matrix(to_sympy(as_written)), self
