@@ -1,5 +1,5 @@
 """The equations of a display-math block: where it splits into equations (rows at
-``\\\\``, separators ``,`` ``;`` ``\\quad`` ``\\text{and}`` before another ``LHS = ...``),
+``\\\\`` or ``\\cr``, separators ``,`` ``;`` ``\\quad`` ``\\;\\;`` ``\\text{and}`` before another ``LHS = ...``),
 what is blanked out (alignment ``&``, environment wrappers, ``\\tag``, ``\\label``, a
 trailing ``\\text{for ...}``) and where the sides of ``A = B = C`` start. Everything here
 keeps offsets into the block (for line and column in messages) and is linear in its

@@ -11,8 +11,10 @@ display block (``$$``, ``\\[``, ```` ```math ````, a bare ``align``... environme
 ``$ ... $`` lines written as steps: :mod:`.display`) is split into equations (at ``\\\\`` and at
 separators before another ``LHS = ...``: :func:`.equations.split_equations`), each with its
 line, the column where its value starts, and the part of the assignment it is in
-(:mod:`.parts`). A row or block with no left-hand side that starts with ``=``, ``+`` or
-``-`` continues the equation before it (:func:`_continue`). Reading is linear in the file's size and bounded: at most
+(:mod:`.parts`). A row or block with no left-hand side that starts with ``=``, ``+``, ``-``
+or ``\\Rightarrow`` continues the equation before it (:func:`_continue`), and a block that
+is only ``LHS =`` takes the next block as its value; a chain so joined keeps where each of
+its sides was written (:attr:`Equation.sides_at`). Reading is linear in the file's size and bounded: at most
 :data:`MAX_BYTES` bytes and :data:`MAX_EQUATIONS` equations; an equation with an
 unbalanced brace is kept with ``problem`` naming the brace's line and column.
 
