@@ -258,3 +258,20 @@ def test_the_right_value_is_not_called_a_relation(tmp_path):
         ("vc_dot_2", "correct", ""),
         ("F_2", "correct", ""),
     ]
+
+
+@pytest.mark.parametrize(
+    "text",
+    ["\\frac{d" * 3000, "\\frac{d}{dt}" * 3000 + "x", "a" + "\\;\\;" * 20000 + "= b", "\\pmatrix{" * 3000],
+    ids=["open-d-fractions", "d-dt-operators", "thin-space-runs", "plain-tex-matrices"],
+)
+def test_hostile_layouts_end_in_bounded_time(text):
+    import time
+
+    start = time.perf_counter()
+    try:
+        read(text)
+    except LatexError:
+        pass
+    split_equations(text)
+    assert time.perf_counter() - start < 2.0

@@ -304,7 +304,7 @@ class _Parser(SymbolReader):
     def _time_derivative(self):
         """``\\frac{d\\theta_1}{dt}``, ``\\frac{\\mathrm{d}^2 q}{\\mathrm{d}t^2}``: a symbol's time
         derivative (read as its dots), or None with nothing taken (an operator, a partial)."""
-        saved = self.i
+        saved = self.i, self.depth, self.calls  # an accent left open on error is closed again
         try:
             self.take()  # \frac
             self.expect("char", "{")
@@ -318,7 +318,7 @@ class _Parser(SymbolReader):
             raise
         except LatexError:
             pass
-        self.i = saved
+        self.i, self.depth, self.calls = saved
         return None
 
     def _d_mark(self, ordered: bool = True) -> int:
