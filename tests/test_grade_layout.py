@@ -275,3 +275,16 @@ def test_hostile_layouts_end_in_bounded_time(text):
         pass
     split_equations(text)
     assert time.perf_counter() - start < 2.0
+
+
+def test_digits_typed_after_a_letter_are_its_subscript_and_said(tmp_path):
+    body = f"$$\\tau_2 = {TAU_2_OUT.replace('m_2', 'm2')}$$\n"
+    report = grade(write(tmp_path, "glued.md", body))
+    assert only(report).status == "correct"
+    assert "m2 read as m_{2} (digits typed after a letter)" in report.notes
+
+
+def test_a_letter_then_a_space_then_digits_stays_a_product(tmp_path):
+    body = f"$$\\tau_2 = {TAU_2_OUT.replace('m_2', 'm 2')}$$\n"
+    v = only(grade(write(tmp_path, "spaced.md", body)))
+    assert v.status == "unrecognised" and "unknown symbol m " in v.message

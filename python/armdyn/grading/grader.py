@@ -323,6 +323,7 @@ class _Grader(EnergySteps, KinematicsSteps):
         for v in self.verdicts:
             if v.key == "tau" and 1 <= int(v.name.split("_")[1]) <= self.robot.dof:  # tau_3 of 2: unrecognised
                 tau_correct[int(v.name.split("_")[1]) - 1] = v.status in (*PASSING, "correct-but-unsupported")
+        self.notes.extend(n for n in self.symbols.notes if n not in self.notes)  # how names were read
         if self.symbols.used_gravity_magnitude:
             self.notes.append("g read as the magnitude of the model's gravity vector")
         if self.symbols.unit_axes:

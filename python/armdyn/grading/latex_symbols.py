@@ -100,8 +100,30 @@ class SymbolReader(Cursor):
                 ) from None
             if primes:
                 raise UnknownSymbol(f"{err} (a prime ' is read as a time derivative)", err.pos) from None
-            raise
+            value = self._glued_digits(name, start) if exponent is None else None
+            if value is None:
+                raise
         return power(value, exponent, at) if exponent is not None else value
+
+    def _glued_digits(self, name: Name, start: int | None):
+        """``m2`` typed for ``m_2`` (a letter no symbol has, digits right after it): the
+        subscripted name when the resolver knows it (the digits taken, and said), else None."""
+        kind, digits = self.peek()
+        if name.sub or name.dots or len(name.base) != 1 or kind != "num" or not digits.isdigit():
+            return None
+        if start is None or self.at(self.i) != start + 1:  # "m 2": a product, as written
+            return None
+        try:
+            value = self.resolve(Name(name.base, sub=digits))
+        except LatexError:
+            return None
+        self.take()
+        notes = getattr(self.resolve, "notes", None)
+        if isinstance(notes, list):
+            note = f"{name.base}{digits} read as {Name(name.base, sub=digits).latex()} (digits typed after a letter)"
+            if note not in notes:
+                notes.append(note)
+        return value
 
     def _primes(self) -> int:
         """How many primes follow (``\\theta_1''``): each a time derivative."""
