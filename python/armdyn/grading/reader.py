@@ -340,13 +340,17 @@ MAX_ROWS = 200
 _ARROW = re.compile(r"\\(?:Rightarrow|Longrightarrow|implies|therefore)(?![A-Za-z])")
 
 
+_SPACES = re.compile(r"\s*")
+
+
 def _sides_at(eq: str, start: int, cuts: list[int]) -> tuple:
-    """File offsets where each side of ``eq`` (written at ``start``) starts, past its spaces."""
-    return tuple(start + c + len(eq[c:]) - len(eq[c:].lstrip()) for c in cuts)
+    """File offsets where each side of ``eq`` (written at ``start``) starts, past its spaces
+    (each side's spaces looked at once: linear however many sides)."""
+    return tuple(start + _SPACES.match(eq, c).end() for c in cuts)
 
 
 def _awaits_value(sub: Submission) -> bool:
-    """Does the last equation end at its ``=`` (``\tau_1 =`` alone in a block: the value
+    """Does the last equation end at its ``=`` (``\\tau_1 =`` alone in a block: the value
     is in the next one)?"""
     last = sub.equations[-1] if sub.equations else None
     return last is not None and not last.problem and last.value == "" and last.rows == 1
