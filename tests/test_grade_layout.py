@@ -288,3 +288,18 @@ def test_a_letter_then_a_space_then_digits_stays_a_product(tmp_path):
     body = f"$$\\tau_2 = {TAU_2_OUT.replace('m_2', 'm 2')}$$\n"
     v = only(grade(write(tmp_path, "spaced.md", body)))
     assert v.status == "unrecognised" and "unknown symbol m " in v.message
+
+
+def test_the_last_of_a_run_of_math_lines_is_read_though_prose_follows(tmp_path):
+    body = (
+        "The torques, written out:\n"
+        f"$\\tau_2 = {TAU_2}$\n"  # line 5: the line after is math
+        f"$\\tau_2 = {TAU_2_OUT}$\n"  # line 6: the line before is math, prose after
+        "This matches the matrix form.\n"
+        "\n"
+        "A sentence, then\n"
+        f"$\\tau_2 = {TAU_2_OUT}$\n"  # line 10: alone between prose lines: prose
+        "which we keep.\n"
+    )
+    report = grade(write(tmp_path, "run.md", body))
+    assert [(v.name, v.status, v.line) for v in report.steps] == [("tau_2", "correct", 5), ("tau_2", "correct", 6)]
