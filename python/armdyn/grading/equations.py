@@ -1,5 +1,5 @@
 """The equations of a display-math block: where it splits into equations (rows at
-``\\\\``, separators ``,`` ``;`` ``\\quad`` ``\\text{and}`` before another ``LHS = ...``),
+``\\\\`` or ``\\cr``, separators ``,`` ``;`` ``\\quad`` ``\\;\\;`` ``\\text{and}`` before another ``LHS = ...``),
 what is blanked out (alignment ``&``, environment wrappers, ``\\tag``, ``\\label``, a
 trailing ``\\text{for ...}``) and where the sides of ``A = B = C`` start. Everything here
 keeps offsets into the block (for line and column in messages) and is linear in its
@@ -74,6 +74,11 @@ _PROSE = re.compile(r"\\(?:text|textrm|textit|textbf|mbox|mathrm)\s*\{([^{}]*)\}
 _PAREN_PROSE = re.compile(r"\(\s*\\text\s*\{[^{}]*[A-Za-z]{2,}[^{}]*\}\s*\)")
 _JOINER = re.compile(r"\s*(?:and|,|;|und|&)?\s*", re.IGNORECASE)
 _SEPARATORS = (",", ";", "\\quad", "\\qquad")
+#: two or more thin spaces in a row (``\\;\\;``) separate equations as ``\\quad`` does (one alone is
+#: a product's spacing, ``m\\; v``, or an operator's, ``a \\;=\\; b``)
+_SPACE_RUN = re.compile(r"(?:\\[;:>]\s*){2,}")
+#: spacing an equation may start with (``\\;\\tau_2 = ...`` in a box)
+_LEADER = re.compile(r"(?:\s|\\(?:[;:,! ]|quad|qquad)(?![A-Za-z]))*")
 
 
 def _blank(chars: list[str], start: int, end: int) -> None:
@@ -239,7 +244,12 @@ def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str
         text = _unboxed(text)
     if "\\" in text:
         text = _prose_out(text)
-    marks = [(i, c) for i, c in top_level(text, commands=True) if c in ("&", "=", "\\\\", *_SEPARATORS)]
+    runs = {m.start(): m.end() for m in _SPACE_RUN.finditer(text)} if "\\;" in text or "\\:" in text else {}
+    marks = [
+        (i, "\\\\" if c == "\\cr" else c)  # plain TeX's \cr ends a row as \\ does
+        for i, c in top_level(text, commands=True)
+        if c in ("&", "=", "\\\\", "\\cr", *_SEPARATORS) or i in runs
+    ]
     if any(c == "&" for _, c in marks):
         chars = list(text)
         for i, c in marks:
@@ -249,15 +259,16 @@ def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str
     out: list[tuple[int, str]] = []
     start = 0
     pieces = [i for i, c in marks if c == "\\\\"] + [len(text)]
+    ends = {i: 3 if text.startswith("\\cr", i) else 2 for i in pieces}  # the row mark's length
     k = 0  # index into marks
     for cut in pieces:
         # segments of this piece at top-level separators, each flagged: has a top-level '='?
         segments, s0, has_eq = [], start, False
         while k < len(marks) and marks[k][0] < cut:
             i, c = marks[k]
-            if c in _SEPARATORS:
+            if c in _SEPARATORS or i in runs:
                 segments.append((s0, i, has_eq))
-                s0, has_eq = i + (1 if c in ",;" else len(c)), False
+                s0, has_eq = runs.get(i) or i + (1 if c in ",;" else len(c)), False
             elif c == "=":
                 has_eq = True
             k += 1
@@ -271,17 +282,37 @@ def split_equations(block: str, limit: int | None = None) -> list[tuple[int, str
             if limit is not None and len(out) > limit:
                 break
         out.append((cur_start, text[cur_start:cur_end]))
-        start = cut + 2
+        start = cut + ends[cut]
         if limit is not None and len(out) > limit:
             break
     result = []
     for off, t in out:
-        stripped = t.strip().rstrip(".,;").strip()
+        lead = _LEADER.match(t).end()
+        stripped = t[lead : _end(t, lead)]
         if stripped:
-            at = off + (len(t) - len(t.lstrip()))
+            at = off + lead
             rows = _components(at, stripped) if "\\begin" in stripped else None
             result.extend(rows or [(at, stripped)])
     return result
+
+
+def _end(text: str, lead: int) -> int:
+    """Where ``text``'s equation ends: before trailing spaces, spacing commands (``\\;``,
+    ``\\quad``) and the sentence's ``.`` ``,`` ``;`` (not the ``;`` of a ``\\;``). Scanned from
+    the end, each character once."""
+    end = len(text)
+    while end > lead:
+        if text[end - 1].isspace():
+            end -= 1
+        elif text.endswith("\\qquad", lead, end) or text.endswith("\\quad", lead, end):
+            end = text.rindex("\\", lead, end)
+        elif end - 2 >= lead and text[end - 2] == "\\" and text[end - 1] in ";:,! ":
+            end -= 2
+        elif text[end - 1] in ".,;":
+            end -= 1
+        else:
+            break
+    return end
 
 
 def side_offsets(equation: str) -> list[int]:

@@ -15,7 +15,7 @@ import sympy as sp
 from ..errors import ModelError
 from ..model import Robot
 from ..symbolic.names import latex_symbol_names
-from .chains import check_step, with_members
+from .chains import check_step, relation_holds, reported_at, with_members
 from .defined import DefinedNames, after_equation, definition, model_value, read_pair, read_value
 from .diagnose import cannot_read, location
 from .energy_steps import EnergySteps
@@ -212,7 +212,7 @@ class _Grader(EnergySteps, KinematicsSteps):
                 last = self.verdicts[-1].key
                 context = "lagrange" if last in LAGRANGE_KEYS or last in MODEL_KEYS else "newton-euler"
             for v in self.verdicts[done:]:
-                v.part, v.task, v.column = eq.part, eq.task, eq.column
+                v.part, v.task, v.column = eq.part, eq.task, v.column or eq.column  # a chain's: where reported
         self.verdicts = grade_proofs(self.sub, self.verdicts)  # rigid-body proofs: every link checked
         for v in self.verdicts:  # proof links (also bare expressions) carry the part they are in
             if v.part is None and not v.task:
@@ -309,6 +309,7 @@ class _Grader(EnergySteps, KinematicsSteps):
         for v in self.verdicts:
             if v.key == "tau" and 1 <= int(v.name.split("_")[1]) <= self.robot.dof:  # tau_3 of 2: unrecognised
                 tau_correct[int(v.name.split("_")[1]) - 1] = v.status in (*PASSING, "correct-but-unsupported")
+        self.notes.extend(n for n in self.symbols.notes if n not in self.notes)  # how names were read
         if self.symbols.used_gravity_magnitude:
             self.notes.append("g read as the magnitude of the model's gravity vector")
         if self.symbols.unit_axes:
@@ -484,6 +485,10 @@ class _Grader(EnergySteps, KinematicsSteps):
         elif j.status == "correct-by-convention":
             message = j.convention or ""
         status = j.status
+        line, column = reported_at(self.sub, eq, findings) if eq.latex else (eq.line, eq.column)
+        if status == "follows-from-earlier-error" and ref.key != "tau" and relation_holds(self, eq, exp_shown):
+            status = "correct"  # a relation between steps that holds: what it names carries the error
+            message = f"right as a relation between steps; the value it names {message}"
         if findings:
             status, message, difference, components, caused_by = with_members(
                 findings, (status, message, difference, components, caused_by), _matrix(to_sympy(as_written)), self
@@ -496,7 +501,8 @@ class _Grader(EnergySteps, KinematicsSteps):
                 status=status,
                 label=eq.lhs,
                 source=eq.source,
-                line=eq.line,
+                line=line,
+                column=column,
                 expected=exp_shown,
                 got=value,
                 difference=difference,
