@@ -191,7 +191,7 @@ def _encode(mesh) -> dict:
 
 
 def _scene(robot: Robot, times, Q, frames: bool, markers: bool | None, package_dirs) -> dict:
-    from ..show import _floats, view_of
+    from ..show import as_floats, view_of
 
     names = list(robot.links)
     at = {n: i for i, n in enumerate(names)}
@@ -207,12 +207,12 @@ def _scene(robot: Robot, times, Q, frames: bool, markers: bool | None, package_d
     joints, coms = [], []
     if markers:
         for j in robot.movable_joints:
-            joints.append({"link": at[j.child], "type": j.type, "axis": _floats(j.axis).reshape(3).tolist()})
+            joints.append({"link": at[j.child], "type": j.type, "axis": as_floats(j.axis).reshape(3).tolist()})
         masses = {n: float(ln.mass) for n, ln in robot.links.items()}
         heaviest = max(masses.values(), default=0.0)
         for n, m in masses.items():
             if m > 0:
-                com = _floats(robot.links[n].com).reshape(3).tolist()
+                com = as_floats(robot.links[n].com).reshape(3).tolist()
                 coms.append({"link": at[n], "com": com, "r": float(0.05 * size * (m / heaviest) ** (1 / 3))})
     return {
         "name": robot.name,
@@ -235,10 +235,10 @@ def view(robot, q=None, *, frames: bool = False, markers: bool | None = None, pa
     (default zeros). ``frames``: draw each link frame's axes; ``markers``: joint
     cylinders and mass spheres (default: only when the model has no visual geometry);
     ``package_dirs``: folders where ``package://`` meshes are looked up."""
-    from ..show import _coordinates
+    from ..show import joint_values
 
     robot = _coerce(robot)
-    q = _coordinates(robot, q)
+    q = joint_values(robot, q)
     return View(_scene(robot, [0.0], q[None, :], frames, markers, package_dirs))
 
 

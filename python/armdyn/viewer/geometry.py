@@ -100,18 +100,18 @@ def resolve_mesh(filename: str, urdf_dir: Path, package_dirs=()) -> Path:
 
 
 def _floats(text: str | None, count: int, default: list[float], where: str) -> list[float]:
-    from ..io.urdf import _numbers
+    from ..io.urdf import parse_numbers
 
-    return default if text is None else _numbers(text, count, where.split(":")[0], where)
+    return default if text is None else parse_numbers(text, count, where.split(":")[0], where)
 
 
 def _pose(visual, where: str) -> list[float]:
-    from ..io.urdf import _rpy_floats
+    from ..io.urdf import rpy_floats
 
     origin = visual.find("origin")
     xyz = _floats(None if origin is None else origin.get("xyz"), 3, [0.0] * 3, f"<origin> xyz: {where}")
     rpy = _floats(None if origin is None else origin.get("rpy"), 3, [0.0] * 3, f"<origin> rpy: {where}")
-    return [*xyz, *quaternion(_rpy_floats(*rpy))]
+    return [*xyz, *quaternion(rpy_floats(*rpy))]
 
 
 def _colours(root) -> dict[str, list[float]]:
