@@ -24,7 +24,7 @@ from optional import example_robot_data_dir, needs_pinocchio, pin
 from armdyn.cli import main
 from armdyn.errors import ModelError
 from armdyn.io import load
-from armdyn.viewer import MeshWarning, animate, script_json, view
+from armdyn.viewer import MeshWarning, View, animate, script_json, view
 from armdyn.viewer import meshes as meshes_mod
 from armdyn.viewer.meshes import read_mesh
 
@@ -66,10 +66,11 @@ def browse(page_html: str, tmp_path: Path, name: str, shot: bool = True, size=(9
 
 
 def drawn_fraction(img: np.ndarray) -> float:
-    """Share of the view's middle (the arm is centred there) that is not the white background."""
+    """Share of the view's middle (the arm is centred there) drawn darker than the white
+    background and the light floor grid (channels above 190): the arm's shaded surfaces."""
     h, w, _ = img.shape
     middle = img[int(0.2 * h) : int(0.85 * h), int(0.15 * w) : int(0.85 * w)]
-    return float(np.mean(np.abs(middle - 255).sum(axis=2) > 30))
+    return float(np.mean(middle.max(axis=2) < 180))
 
 
 # ------------------------------------------------------------------ the page
@@ -143,7 +144,7 @@ def test_ur5_meshes_render(tmp_path):
     assert attrs["status"] == "ready", attrs
     assert int(attrs["links"]) == len(robot.links) and int(attrs["meshes"]) == 7 and attrs["frames"] == "1"
     assert drawn_fraction(img) > 0.03
-    assert img[-5:, :].min() > 240  # the bottom edge is background: the arm is in view, not cut
+    assert img[-5:, :].max(axis=2).min() >= 180  # the bottom edge is background or grid: the arm is in view
 
 
 def test_rp_arm_simple_shapes_render(tmp_path):
@@ -156,6 +157,10 @@ def test_rp_arm_simple_shapes_render(tmp_path):
     r, g, b = img[..., 0], img[..., 1], img[..., 2]
     assert np.any((r > 180) & (g > 90) & (g < 170) & (b < 80)), "no orange joint"
     assert np.any((b > 150) & (r > 90) & (g < 110)), "no purple joint"
+    # the control: the same page with nothing of the arm drawn has no such pixels
+    empty = View({**v.scene, "segments": [], "joints": [], "coms": [], "axes": False})
+    attrs, img = browse(empty.html(), tmp_path, "empty")
+    assert attrs["status"] == "ready" and drawn_fraction(img) == 0
 
 
 def test_animation_reports_its_frames(tmp_path):

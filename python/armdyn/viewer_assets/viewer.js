@@ -34,6 +34,10 @@
   const sun = new THREE.DirectionalLight(0xffffff, 2.0);
   sun.position.set(1, -2, 3);
   scene.add(sun);
+  // a floor grid in the base's xy plane, for depth (grid lines every 0.25 of the arm's size)
+  const grid = new THREE.GridHelper(3 * S.size, 12, 0xc4ccd5, 0xe1e6eb);
+  grid.rotateX(Math.PI / 2);
+  scene.add(grid);
   const camera = new THREE.PerspectiveCamera(40, 1, 0.001, 1000);
   camera.up.set(0, 0, 1);
 
@@ -121,7 +125,7 @@
 
   // camera on a sphere around the arm: drag turns, wheel zooms
   const centre = new THREE.Vector3(...S.centre);
-  let azimuth = -Math.PI / 3, elevation = 0.45, distance = 2.6 * size;
+  let azimuth = -Math.PI / 3, elevation = 0.45, distance = 2.1 * size;
   function aim() {
     camera.position.set(
       centre.x + distance * Math.cos(elevation) * Math.cos(azimuth),
