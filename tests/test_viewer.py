@@ -287,6 +287,17 @@ def test_dae_units_up_axis_and_nodes(tmp_path):
     assert np.allclose(v[t[0]], expected, atol=1e-7)
 
 
+def test_ur5_collada_matches_its_collision_stl():
+    """The UR5's visual COLLADA meshes (with their node transforms) and its collision
+    STLs are independent files of the same parts: their bounding boxes agree to 3 mm."""
+    folder = example_robot_data_dir() / "ur_description" / "meshes" / "ur5"
+    for part in ("base", "shoulder", "upperarm", "forearm", "wrist1", "wrist2", "wrist3"):
+        v, _ = read_mesh(folder / "visual" / f"{part}.dae")
+        c, _ = read_mesh(folder / "collision" / f"{part}.stl")
+        assert np.allclose(v.min(axis=0), c.min(axis=0), atol=3e-3), part
+        assert np.allclose(v.max(axis=0), c.max(axis=0), atol=3e-3), part
+
+
 def test_mesh_size_cap(tmp_path, monkeypatch):
     big = tmp_path / "big.stl"
     big.write_bytes(b"\0" * 80 + struct.pack("<I", 100) + b"\0" * 5000)
