@@ -176,6 +176,22 @@ def test_animation_reports_its_frames(tmp_path):
     assert 'id="armdyn-play"' in page and 'max="199"' in page and 'id="armdyn-loop"' in page
 
 
+def test_animation_plays(tmp_path):
+    """Opened as ``page.html#play`` the page starts playing: after some (virtual) time it
+    shows a later frame; opened plainly it stays at the first."""
+    chromium = require_chromium()
+    t = np.linspace(0, 2, 201)
+    page = tmp_path / "play.html"
+    animate(rp_arm(), t, np.c_[t, 0.1 * t]).save(page)
+    shown = []
+    for suffix in ("#play", ""):
+        dom = _run(
+            chromium, [*WEBGL[:2], "--virtual-time-budget=3000", "--dump-dom", page.as_uri() + suffix], 120
+        ).stdout
+        shown.append(int(re.search(r'<body[^>]*data-frame="(\d+)"', dom).group(1)))
+    assert shown[0] > 0 and shown[1] == 0, shown
+
+
 # --------------------------------------------------------------- kinematics
 
 

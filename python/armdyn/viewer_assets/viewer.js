@@ -169,6 +169,7 @@
     show(k);
     if (slider) slider.value = String(k);
     if (clock) clock.textContent = "t = " + S.times[k].toFixed(3) + " s";
+    body.dataset.frame = String(k);
     draw();
   }
   function tick(now) {
@@ -198,6 +199,7 @@
     slider.addEventListener("input", () => { go(Number(slider.value)); t0 = performance.now() - (S.times[frame] - S.times[0]) * 1000; });
   }
   go(0);
+  if (play && location.hash === "#play") play.click();  // a link (or a test) that starts playing
   document.title = S.name + " (3-D: " + nL + " links, " + nF + " frames)";
   report("ready");
 })();
