@@ -360,6 +360,15 @@ def test_unusable_mesh_becomes_a_capsule_with_one_warning(tmp_path, filename, wh
     assert scene["visuals"] == [] and scene["segments"] == [[0, 1]]
 
 
+def test_model_file_gone_draws_simple_shapes(tmp_path):
+    urdf = arm_with_mesh(tmp_path, "m.stl")
+    robot = load(urdf)
+    urdf.unlink()
+    with pytest.warns(MeshWarning, match="visual geometry not read: .*no such file"):
+        scene = view(robot).scene
+    assert scene["visuals"] == [] and scene["segments"] == [[0, 1]]
+
+
 def test_package_mesh_resolves_inside_its_package(tmp_path):
     package = tmp_path / "mypkg"
     (package / "meshes").mkdir(parents=True)

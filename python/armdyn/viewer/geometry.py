@@ -137,8 +137,15 @@ def urdf_visuals(robot, package_dirs=()) -> tuple[dict[str, list[dict]], list[tu
     from ..io.urdf import parse_xml
     from .meshes import read_mesh
 
+    if str(file).lower().endswith(".xacro"):  # its visuals hold macros only xacro expands (and runs)
+        warnings.warn(MeshWarning(f"{file}: visual geometry of a .xacro model is not drawn (expand it first)"), 2)
+        return {}, []
     urdf_dir = Path(file).resolve().parent
-    root = parse_xml(read_bytes(file, "model", MODEL_MAX_BYTES))
+    try:  # read again: moved or changed since loading is one warning, the arm still drawn
+        root = parse_xml(read_bytes(file, "model", MODEL_MAX_BYTES))
+    except ModelError as err:
+        warnings.warn(MeshWarning(f"{file}: visual geometry not read: {err}"), stacklevel=2)
+        return {}, []
     colours = _colours(root)
     visuals: dict[str, list[dict]] = {}
     meshes: list = []
