@@ -128,7 +128,7 @@ def script_json(data) -> str:
 
 
 def _asset(name: str) -> str:
-    return resources.files("armdyn").joinpath("viewer_assets", name).read_text(encoding="utf-8")
+    return resources.files("armdyn").joinpath("viewer_assets").joinpath(name).read_text(encoding="utf-8")
 
 
 @lru_cache(maxsize=1)
