@@ -26,6 +26,7 @@ from armdyn.errors import ModelError
 from armdyn.io import load
 from armdyn.viewer import MeshWarning, View, animate, script_json, view
 from armdyn.viewer import meshes as meshes_mod
+from armdyn.viewer.geometry import quaternions
 from armdyn.viewer.meshes import read_mesh
 
 WEBGL = ("--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--virtual-time-budget=6000")
@@ -228,6 +229,16 @@ def test_poses_equal_pinocchio():
             assert np.allclose(poses[k, i, :3], oMf.translation, atol=1e-6), (name, k)
             assert np.allclose(quat_matrix(*poses[k, i, 3:]), oMf.rotation, atol=1e-6), (name, k)
     assert sum(model.existFrame(n, pin.FrameType.BODY) for n in scene["links"]) >= 7
+
+
+def test_quaternions_match_scipy():
+    """Random rotations and the half turns about each axis (where the trace is -1: the
+    other branches of Shepperd's method) against SciPy's conversion."""
+    Rotation = pytest.importorskip("scipy.spatial.transform").Rotation
+    M = np.concatenate([Rotation.random(500, random_state=3).as_matrix(), [np.diag(d) for d in np.eye(3) * 2 - 1]])
+    q = quaternions(M)
+    ref = Rotation.from_matrix(M).as_quat()  # [x, y, z, w], either sign
+    assert np.all(q[:, 3] >= 0) and np.allclose(np.abs(np.einsum("ij,ij->i", q, ref)), 1, atol=1e-12)
 
 
 def test_too_many_frames_are_sampled():

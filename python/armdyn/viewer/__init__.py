@@ -37,7 +37,7 @@ import numpy as np
 
 from ..mathml import escape
 from ..model import Robot
-from .geometry import MeshWarning, quaternion, urdf_visuals
+from .geometry import MeshWarning, quaternions, urdf_visuals
 
 __all__ = ["view", "animate", "View", "MeshWarning", "MAX_FRAMES", "CSP"]
 
@@ -175,11 +175,8 @@ def _poses(robot: Robot, Q: np.ndarray) -> tuple[list[float], np.ndarray]:
     from ..numeric import forward_kinematics
 
     T = np.asarray(forward_kinematics(robot, np.ascontiguousarray(Q, dtype=float))).reshape(len(Q), -1, 4, 4)
-    flat = []
-    for frame in T:
-        for pose in frame:
-            flat += [*pose[:3, 3], *quaternion(pose[:3, :3])]
-    return [round(float(v), 7) for v in flat], T[:, :, :3, 3].reshape(-1, 3)
+    flat = np.concatenate([T[:, :, :3, 3], quaternions(T[:, :, :3, :3])], axis=2).round(7)
+    return flat.reshape(-1).tolist(), T[:, :, :3, 3].reshape(-1, 3)
 
 
 def _encode(mesh) -> dict:

@@ -21,7 +21,6 @@ that cannot be found, is refused or cannot be read becomes the simple shape of i
 
 from __future__ import annotations
 
-import math
 import os
 import warnings
 from pathlib import Path
@@ -30,33 +29,45 @@ import numpy as np
 
 from ..errors import ModelError
 
-__all__ = ["urdf_visuals", "resolve_mesh", "quaternion", "MeshWarning"]
+__all__ = ["urdf_visuals", "resolve_mesh", "quaternion", "quaternions", "MeshWarning"]
 
 
 class MeshWarning(UserWarning):
     """A mesh of the model is not drawn (not found, refused or unreadable); its link gets a simple shape."""
 
 
-def quaternion(R: np.ndarray) -> list[float]:
-    """Unit quaternion ``[x, y, z, w]`` of the rotation matrix ``R`` (3, 3), ``w >= 0``
-    (Shepperd's method: the largest of the four squares first, for accuracy)."""
+def quaternions(R: np.ndarray) -> np.ndarray:
+    """Unit quaternions ``[x, y, z, w]`` (..., 4), ``w >= 0``, of the rotation matrices
+    ``R`` (..., 3, 3) (Shepperd's method: each from the largest of its four squares, for
+    accuracy)."""
     R = np.asarray(R, dtype=float)
-    t = np.trace(R)
-    d = (t, R[0, 0], R[1, 1], R[2, 2])
-    k = int(np.argmax(d))
-    if k == 0:
-        s = 2 * math.sqrt(max(1 + t, 0))
-        q = [(R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s, s / 4]
-    else:
-        i, j, m = k - 1, k % 3, (k + 1) % 3
-        s = 2 * math.sqrt(max(1 + R[i, i] - R[j, j] - R[m, m], 0))
-        q = [0.0] * 4
-        q[i], q[j], q[m] = s / 4, (R[j, i] + R[i, j]) / s, (R[m, i] + R[i, m]) / s
-        q[3] = (R[m, j] - R[j, m]) / s
-    if q[3] < 0:
-        q = [-c for c in q]
-    n = math.sqrt(sum(c * c for c in q))
-    return [c / n for c in q]
+    shape = R.shape[:-2]
+    R = R.reshape(-1, 3, 3)
+    d = np.stack([np.trace(R, axis1=1, axis2=2), R[:, 0, 0], R[:, 1, 1], R[:, 2, 2]], axis=1)
+    k = np.argmax(d, axis=1)
+    q = np.empty((len(R), 4))
+    for case in range(4):
+        m = R[k == case]
+        if case == 0:
+            s = 2 * np.sqrt(np.maximum(1 + d[k == 0, 0], 0))
+            q[k == 0] = np.stack(
+                [(m[:, 2, 1] - m[:, 1, 2]) / s, (m[:, 0, 2] - m[:, 2, 0]) / s, (m[:, 1, 0] - m[:, 0, 1]) / s, s / 4], 1
+            )
+            continue
+        i, j, n = case - 1, case % 3, (case + 1) % 3
+        s = 2 * np.sqrt(np.maximum(1 + m[:, i, i] - m[:, j, j] - m[:, n, n], 0))
+        part = np.empty((len(m), 4))
+        part[:, i], part[:, j], part[:, n] = s / 4, (m[:, j, i] + m[:, i, j]) / s, (m[:, n, i] + m[:, i, n]) / s
+        part[:, 3] = (m[:, n, j] - m[:, j, n]) / s
+        q[k == case] = part
+    q *= np.where(q[:, 3:] < 0, -1.0, 1.0)
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    return q.reshape(*shape, 4)
+
+
+def quaternion(R: np.ndarray) -> list[float]:
+    """The unit quaternion ``[x, y, z, w]`` of one rotation matrix (see :func:`quaternions`)."""
+    return quaternions(R).tolist()
 
 
 def _package_roots(name: str, urdf_dir: Path, package_dirs) -> list[Path]:
