@@ -207,9 +207,14 @@ def _lagrange(sides: list[str], chain: bool) -> LawResult | None:
 
     if len(sides) < 2 or len(sides) > 2 and not chain or not any("\\partial" in s for s in sides[:2]):
         return None  # τ_1 = (the law) = a value: the value is a step, graded as one
+    # τ_1 = (the law) alone is joint 1's torque left unworked: a step refused with its reason
     later = " (the sides after it not checked)" if len(sides) > 2 else ""
     for law_side, torque in ((sides[0], sides[1]), (sides[1], sides[0])):
-        if _RHS_TORQUE.match(normalise(torque)) and "\\partial" in law_side and not re.search(r"\d", torque):
+        if (
+            _RHS_TORQUE.match(normalise(torque))
+            and "\\partial" in law_side
+            and (len(sides) > 2 or not re.search(r"\d", torque))
+        ):
             verdict = lagrange_law(law_side, torque)
             if verdict is not None:
                 ok, message = verdict
