@@ -188,3 +188,20 @@ def test_definitions_pass_and_are_listed(tmp_path):
     data = report.to_dict()
     assert [s["status"] for s in data["steps"]] == statuses
     assert "definition" in report._repr_html_()
+
+
+@pytest.mark.parametrize("name", ["planar-2r-laws-energy", "planar-2r-laws-craig-ne"])
+def test_the_corpus_files_that_state_laws_first(name):
+    # the truth (tests/corpus/specs_laws.py: laws by hand, steps by first principles) is met
+    # exactly: every equation read, the slip in a law found at its line, no false alarm
+    import sys
+    from pathlib import Path
+
+    corpus = Path(__file__).parent / "corpus"
+    sys.path.insert(0, str(Path(__file__).parent.parent / "benchmarks"))
+    import bench_corpus
+
+    fs = bench_corpus.score(corpus / f"{name}.md", corpus / f"{name}.truth.yaml")
+    assert not fs.refused and fs.read == fs.equations
+    assert fs.slips == 1 and fs.slips_found == 1
+    assert not fs.false_alarms and not fs.missed
