@@ -47,6 +47,11 @@ RIGHT = [
     r" - \frac{\partial m_{jk}}{\partial \theta_i}\right)",
     r"C_{kj} = \sum_{i=1}^{n} c_{ijk}\dot q_i",
     r"\phi_k = \frac{\partial P}{\partial q_k}",
+    # the gravity vector from the Jacobians, g along gravity (minus) or against it (Spong)
+    r"G = -J_{v_1}^T m_1 g - J_{v_2}^T m_2 g",
+    r"G(q) = \sum_{i=1}^{n} J_{v_i}^T m_i g",
+    # the inverse rotation
+    r"{}^{i}_{i+1}R = \bigl(\,{}^{i+1}_{i}R\bigr)^T",
     # Craig's outward and inward iterations (revolute and prismatic)
     r"{}^{i+1}\omega_{i+1} = {}^{i+1}_{i}R\,{}^{i}\omega_i + \dot\theta_{i+1}\,{}^{i+1}\hat Z_{i+1}",
     r"{}^{i+1}\omega_{i+1} = {}^{i+1}_{i}R\,{}^{i}\omega_i",
@@ -88,6 +93,8 @@ WRONG = [
     (r"{}^{i+1}\omega_{i+1} = {}^{i}_{i+1}R\,{}^{i}\omega_i + \dot\theta_{i+1}\,{}^{i+1}\hat Z_{i+1}", "transposed"),
     (r"{}^{i}f_{i} = {}^{i+1}_{i}R\,{}^{i+1}f_{i+1} + {}^{i}F_{i}", "transposed"),
     (r"{}^{i}F_{i} = m_i\,{}^{i}v_{C_i}", "velocity"),
+    (r"{}^{i}_{i+1}R = {}^{i+1}_{i}R", "transposed"),
+    (r"\phi_k = -\frac{\partial P}{\partial q_k}", "sign"),
     (r"{}^{i}N_{i} = {}^{C_i}I_i\,{}^{i}\dot\omega_i - {}^{i}\omega_i \times {}^{C_i}I_i\,{}^{i}\omega_i", "sign"),
     (r"K = \frac{1}{2}\dot{q}^T D(q)", None),  # shapes that do not fit: not judged (below)
 ]

@@ -47,7 +47,11 @@ from .law_reading import (
     script_letters,
     strip_arguments,
 )
-from .law_table import HALF, LAWS, Ctx, Form, _add, _native, classify
+from .law_table import HALF, LAGRANGE_LAWS, Ctx, Form, _add, _native, classify
+from .law_table_ne import NE_LAWS
+
+#: every law a statement is judged against
+LAWS = [*LAGRANGE_LAWS, *NE_LAWS]
 
 
 # -- judging a statement
