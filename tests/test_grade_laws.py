@@ -212,3 +212,21 @@ def test_the_corpus_files_that_state_laws_first(name):
     assert not fs.refused and fs.read == fs.equations
     assert fs.slips == 1 and fs.slips_found == 1
     assert not fs.false_alarms and not fs.missed
+
+
+def test_an_identity_is_correct_and_a_non_identity_not_judged(tmp_path):
+    # by hand: c2 c23 + s2 s23 = cos(q2 + q3 - q2) = c3; the planar cross product
+    # (0, 0, w) x (p_x, p_y, 0) = (-w p_y, w p_x, 0); c2 c23 - s2 s23 is cos(q2 + q2 + q3), not c3
+    body = (
+        "---\nrobot: planar-3r\n---\n"
+        "$$c_2 c_{23} + s_2 s_{23} = c_3$$\n\n"
+        "$$\\begin{bmatrix}0\\\\0\\\\w\\end{bmatrix}\\times\\begin{bmatrix}p_x\\\\p_y\\\\0\\end{bmatrix}"
+        " = \\begin{bmatrix}-w p_y\\\\ w p_x\\\\ 0\\end{bmatrix}$$\n\n"
+        "$$c_2 c_{23} - s_2 s_{23} = c_3$$\n\n"
+        "$$\\mathcal{L} = K - P$$\n"
+    )
+    path = tmp_path / "identities.md"
+    path.write_text(body, encoding="utf-8")
+    report = grade(path)
+    got = [(v.line, v.name, v.status) for v in report.steps]
+    assert got[:3] == [(4, "identity", "correct"), (6, "identity", "correct"), (8, "", "unrecognised")]

@@ -23,7 +23,7 @@ from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, tidy
 from .kinematics_steps import KinematicsSteps, confirm_used
 from .latex import LatexError, UnknownSymbol
-from .laws import law_statement
+from .laws import identity, law_statement
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
@@ -276,6 +276,10 @@ class _Grader(EnergySteps, KinematicsSteps):
             if defined:  # a name given a value used later, a setup line: read, not judged
                 self._unrecognised(eq, defined)
                 self.verdicts[-1].status = "definition"
+                return
+            same = identity(self, eq)  # cos a cos b + sin a sin b = cos(a - b)
+            if same is not None:
+                self.verdicts.append(same)
                 return
             self._unrecognised(eq, "not a step of Newton-Euler or Lagrange (skipped)")
             return

@@ -360,3 +360,57 @@ def law_statement(grader, eq, fallback: bool = False):
         line=eq.line,
         message=result.message,
     ), result.method
+
+
+#: sides larger than this (operations) are not compared as an identity (simplify is slow)
+MAX_IDENTITY_OPS = 300
+
+
+def identity(grader, eq):
+    """``cos a cos b + sin a sin b = cos(a - b)``, ``c_2 c_{23} + s_2 s_{23} = c_3``, a cross
+    product written out: a general statement whose sides are equal for every value of
+    their symbols (the model's, and any other name a free symbol). The verdict
+    (``correct``) when every side reads and all are equal; else None (never judged wrong:
+    an equation that is no identity may still be meant as something else)."""
+    from .equations import sides
+    from .latex import UnknownSymbol
+    from .verdict import StepVerdict
+
+    if not eq.latex or eq.problem or isinstance(eq.value, list):
+        return None
+    free: dict = {}
+
+    def resolve(name):
+        try:
+            return grader.symbols(name)
+        except (UnknownSymbol, LatexError):
+            return free.setdefault(name.latex(), sp.Symbol(f"armdyn_free_{len(free)}"))
+
+    try:
+        values = [parse(s, resolve) for s in sides(eq.source)]
+    except (LatexError, TypeError, ValueError, RecursionError, sp.ShapeError, AttributeError):
+        return None
+    if len(values) < 2:
+        return None
+    flat = []
+    for v in values:
+        items = list(v) if isinstance(v, sp.MatrixBase) else [v]
+        if isinstance(v, sp.MatrixBase) and v.shape != getattr(values[0], "shape", None):
+            return None
+        if any(not isinstance(x, sp.Expr) or sp.count_ops(x) > MAX_IDENTITY_OPS for x in items):
+            return None
+        flat.append(items)
+    for other in flat[1:]:
+        for a, b in zip(flat[0], other, strict=True):
+            if sp.simplify(sp.expand_trig(a - b)) != 0:
+                return None
+    return StepVerdict(
+        name="identity",
+        key="law",
+        link="",
+        status="correct",
+        label=eq.lhs,
+        source=eq.source,
+        line=eq.line,
+        message="an identity: its sides are equal for every value of their symbols",
+    )
