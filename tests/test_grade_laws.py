@@ -230,3 +230,22 @@ def test_an_identity_is_correct_and_a_non_identity_not_judged(tmp_path):
     report = grade(path)
     got = [(v.line, v.name, v.status) for v in report.steps]
     assert got[:3] == [(4, "identity", "correct"), (6, "identity", "correct"), (8, "", "unrecognised")]
+
+
+def test_a_rotation_written_in_an_index_is_checked_for_every_frame(tmp_path):
+    # by hand: the planar arm's frame i+1 turns by theta_{i+1} about Z_i, so {}^{i+1}_{i}R is
+    # Rz(theta_{i+1}) transposed: rows (c, s, 0), (-s, c, 0), (0, 0, 1); the other sign is wrong
+    right = r"\begin{bmatrix} c_{i+1} & s_{i+1} & 0 \\ -s_{i+1} & c_{i+1} & 0 \\ 0 & 0 & 1 \end{bmatrix}"
+    wrong = r"\begin{bmatrix} c_{i+1} & -s_{i+1} & 0 \\ s_{i+1} & c_{i+1} & 0 \\ 0 & 0 & 1 \end{bmatrix}"
+    body = (
+        "---\nrobot: planar-2r\n---\n"
+        f"$${{}}^{{i+1}}_{{i}}R = {right}$$\n\n"
+        f"$${{}}^{{i+1}}_{{i}}R = {wrong}$$\n\n"
+        "$$\\mathcal{L} = K - P$$\n"
+    )
+    path = tmp_path / "indexed.md"
+    path.write_text(body, encoding="utf-8")
+    report = grade(path)
+    first, second = report.steps[0], report.steps[1]
+    assert first.status == "correct" and "i = 0, i = 1" in first.message
+    assert second.status == "wrong" and "i = 0, i = 1" in second.message

@@ -23,7 +23,7 @@ from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, tidy
 from .kinematics_steps import KinematicsSteps, confirm_used
 from .latex import LatexError, UnknownSymbol
-from .laws import identity, law_statement
+from .laws import identity, indexed_step, law_statement
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
@@ -246,6 +246,10 @@ class _Grader(EnergySteps, KinematicsSteps):
             )
             return
         if self._law(eq, seen_methods):  # a law stated in general symbols (k_i = ..., \sum, c_{ijk})
+            return
+        indexed = indexed_step(self, eq) if ref is None else None  # {}^{i+1}_{i}R = ...: every i
+        if indexed is not None:
+            self.verdicts.append(indexed)
             return
         if ref is None:
             law = lagrange_law(eq.lhs, str(eq.value)) if eq.latex else None

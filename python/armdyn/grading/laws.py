@@ -414,3 +414,86 @@ def identity(grader, eq):
         line=eq.line,
         message="an identity: its sides are equal for every value of their symbols",
     )
+
+
+# -- a step of one robot written in an index: checked for every value the robot has
+_SCRIPT = re.compile(r"([_^]\s*)(\{(?:[^{}]|\{[^{}]*\})*\}|[A-Za-z0-9])")
+
+
+def substitute(text: str, letter: str, k: int) -> str:
+    """``text`` with the index ``letter`` set to ``k`` in its sub- and superscripts
+    (``c_{i+1}`` -> ``c_{2}`` for k = 1); commands (``\\sin``, ``J_{\\omega_i}``'s ``\\omega``) kept."""
+
+    def one(m):
+        body = re.sub(rf"(?<![A-Za-z\\]){letter}(?![A-Za-z])", str(k), m.group(2))
+        body = re.sub(
+            r"(\d+)\s*([+-])\s*(\d+)", lambda a: str(int(a[1]) + (1 if a[2] == "+" else -1) * int(a[3])), body
+        )
+        return m.group(1) + body
+
+    return _SCRIPT.sub(one, text)
+
+
+def indexed_step(grader, eq):
+    """``{}^{i+1}_{i}R = \\begin{bmatrix} c_{i+1} & s_{i+1} & 0 \\\\ ...``: a rotation or a position
+    of the robot written in an index, checked against the model for every value of the
+    index its frames have. Right for every value: ``correct``; wrong for every one: ``wrong``
+    (the first named); right for some only (a joint of another kind?): not judged."""
+    from .engine import equal
+    from .methods import position, rotation_between
+    from .notation import parse_lhs
+    from .verdict import StepVerdict
+
+    letters = script_letters(eq.lhs)
+    if not eq.latex or eq.problem or isinstance(eq.value, list) or len(letters) != 1:
+        return None
+    letter = letters.pop()
+    ctx = grader.world("newton-euler").ctx
+    fp = grader.sampler.fingerprint
+    right, wrong = [], []
+    for k in range(0, len(grader.robot.links)):
+        try:
+            ref = parse_lhs(substitute(eq.lhs, letter, k), grader.symbols.coordinate_of)
+        except (LatexError, TypeError, ValueError):
+            return None
+        if ref is None or ref.key not in ("R", "P", "Pc"):
+            return None
+        if grader._check_index(ref):
+            continue  # a frame this robot does not have
+        try:
+            value = parse(substitute(str(eq.value), letter, k), grader.symbols)
+            if ref.key == "R":
+                expected = rotation_between(ctx, ref.index, ref.frame)
+            else:
+                expected = sp.Matrix(position(ctx, ref.key, ref.index, ref.frame, ref.origin)[0])
+            value = value if isinstance(value, sp.MatrixBase) else None
+            if value is None or value.shape != expected.shape:
+                return None
+            (right if equal(fp(value), fp(expected)).all() else wrong).append(k)
+        except (LatexError, TypeError, ValueError, RecursionError, sp.ShapeError, AttributeError):
+            return None
+    if not right and not wrong:
+        return None
+    values = lambda ks: ", ".join(f"{letter} = {k}" for k in ks)  # noqa: E731
+    if right and wrong:
+        status, message = (
+            "unrecognised",
+            (
+                f"written in the index {letter}: right for {values(right)}, not for {values(wrong)} "
+                "(a joint of another kind?): not judged"
+            ),
+        )
+    elif wrong:
+        status, message = "wrong", f"written in the index {letter}: not the robot's for {values(wrong)}"
+    else:
+        status, message = "correct", f"written in the index {letter}: the robot's for {values(right)}"
+    return StepVerdict(
+        name=f"{ref.key}_{letter}",
+        key=ref.key,
+        link="",
+        status=status,
+        label=eq.lhs,
+        source=eq.source,
+        line=eq.line,
+        message=message,
+    )
