@@ -249,3 +249,22 @@ def test_a_rotation_written_in_an_index_is_checked_for_every_frame(tmp_path):
     first, second = report.steps[0], report.steps[1]
     assert first.status == "correct" and "i = 0, i = 1" in first.message
     assert second.status == "wrong" and "i = 0, i = 1" in second.message
+
+
+@pytest.mark.parametrize(
+    "statement",
+    [
+        "K = M(" + "q " * 40,  # an argument list that never closes
+        "K = M(" + "\\dot q , " * 40 + "x)",
+        "K = " + "\\sum_{i=1}^{n} " * 400 + "K_i",
+        "K_i = " + " = ".join(["K_i"] * 400),
+        "c_{ijk} = " + " + ".join(["\\frac{\\partial d_{kj}}{\\partial q_i}"] * 200),
+    ],
+)
+def test_hostile_statements_end_in_bounded_time(statement):
+    import time
+
+    start = time.perf_counter()
+    result = judge(sides(statement), n_links=3)
+    assert time.perf_counter() - start < 2.0
+    assert result is None or result.status == "unrecognised"

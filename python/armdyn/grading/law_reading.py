@@ -31,6 +31,8 @@ from .latex import LatexError, Name, UnknownSymbol, parse
 INDEX_LETTERS = "ijkn"
 #: links a sum over ``i = 1..n`` is written out for
 N_LINKS = 3
+#: sums and derivatives beyond which a side is not read as a law (each is read once per index value)
+MAX_SUMS, MAX_PARTIALS = 6, 24
 #: commands that show a pattern, not a value (``m_1 g \\; \\cdots \\; m_n g``)
 PATTERN = re.compile(r"\\(?:cdots|ldots|vdots|ddots|dots)\b")
 
@@ -106,10 +108,15 @@ def script_letters(text: str) -> set[str]:
 
 
 # -- the text before reading: sums, derivatives, argument lists
+#: one argument a quantity depends on: the joint vector or its rates (``\dot\Theta``, ``\mathbf q``)
+_ARG = (
+    r"(?>(?:\\d?dot\s*)?\{?\s*(?:\\mathbf\s*\{\s*q\s*\}|\\boldsymbol\s*\{\s*\\?\w+\s*\}|\\Theta|\\theta|q"
+    r"|\\mathbf\s*q)\s*\}?)"
+)
+#: atomic groups: a long list that does not close is refused in linear time
 _ARGS = re.compile(
     r"(?P<head>(?<![A-Za-z\\])[A-Za-z]|(?<=_)\w|\\Gamma|\\phi|\}|\\mathbf\s*\{[A-Za-z]\})"
-    r"\s*\\?(?:left)?\(\s*(?:(?:\\d?dot\s*)?\{?\s*(?:\\mathbf\s*\{\s*q\s*\}|\\boldsymbol\s*\{\s*\\?\w+\s*\}|"
-    r"\\Theta|\\theta|\\Theta|q|\\mathbf\s*q)\s*\}?\s*,?\s*)+\\?(?:right)?\)"
+    r"\s*(?>\\left)?\(\s*" + _ARG + r"(?>\s*,\s*" + _ARG + r")*\s*(?>\\right)?\)"
 )
 _SUM = re.compile(r"\\sum\s*(?:\\limits|\\nolimits)?\s*")
 
@@ -185,6 +192,8 @@ class Placeholders:
     def prepare(self, text: str, bound: set) -> str:
         """``text`` with its sums and derivative fractions replaced (``bound``: index letters
         the left-hand side binds, which a sum's summand does not take)."""
+        if text.count("\\sum") > MAX_SUMS or text.count("\\partial") > 2 * MAX_PARTIALS:
+            raise NotALaw("too many sums or derivatives to read as a law")
         text = re.sub(r"\\space\b|\\,|\\;|\\!|\\quad", " ", text)
         text = re.sub(r"\{\s*(?=[\^_])", "{{}", text)  # {^i\omega_i}: the prescript of a group's name
         text = re.sub(r"\^\s*\{\s*(?:T|\\top)\s*\}\s*_\s*(\{[^{}]*\}|\w)", r"_\1^{T}", text)  # n^{T}_i: n_i^T
@@ -218,6 +227,8 @@ class Placeholders:
                 if close is None:
                     continue
                 end += close.end()
+            if len(self.partials) >= MAX_PARTIALS:
+                raise NotALaw(f"more than {MAX_PARTIALS} derivatives")
             out.append(text[pos : m.start()])
             out.append(f" \\mathrm{{lawpd}}_{{{len(self.partials)}}} ")
             self.partials.append((bool(m.group("ddt")), text[num_start:num_end].strip(), den[len("\\partial") :]))

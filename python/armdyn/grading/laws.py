@@ -66,6 +66,8 @@ class LawResult:
     method: str = "lagrange"
 
 
+#: sides beyond which an equation is not read as a law (each is read for every index value)
+MAX_SIDES = 8
 #: the values of each index a law is checked for (three letters: every order of 1, 2, 3 and repeats)
 _VALUES = (1, 2, 3)
 _TRIPLES = [*itertools.permutations(_VALUES), (1, 1, 2), (1, 2, 1), (2, 1, 1), (2, 2, 2)]
@@ -235,6 +237,8 @@ def judge(sides: list[str], n_links: int = 3, chain: bool = False) -> LawResult 
     right? None when it states no law (a name in it is no generic quantity, or its
     left-hand side names none); ``n_links``: the links a sum over ``n`` runs over; ``chain``:
     the Lagrange equation may be followed by sides not checked (its value could not be read)."""
+    if len(sides) > MAX_SIDES:
+        return None
     lagrange = _lagrange(sides, chain)
     if lagrange is not None:
         return lagrange
@@ -363,7 +367,7 @@ def law_statement(grader, eq, fallback: bool = False):
 
 
 #: sides larger than this (operations) are not compared as an identity (simplify is slow)
-MAX_IDENTITY_OPS = 300
+MAX_IDENTITY_OPS = 150
 
 
 def identity(grader, eq):
@@ -390,7 +394,7 @@ def identity(grader, eq):
         values = [parse(s, resolve) for s in sides(eq.source)]
     except (LatexError, TypeError, ValueError, RecursionError, sp.ShapeError, AttributeError):
         return None
-    if len(values) < 2:
+    if not 2 <= len(values) <= MAX_SIDES:
         return None
     flat = []
     for v in values:
