@@ -24,7 +24,10 @@ RIGHT = [
     r"T = \frac12 m v^2 + \frac12 I\omega^2",
     r"\mathcal{E}_K = \tfrac{1}{2} m v^2 + \tfrac{1}{2} I \omega^2",
     r"K_i = \frac{1}{2} m_i v_i^2",
-    # total kinetic energy
+    r"K_i = \frac12 m_i v_{c_i} \cdot v_{c_i} + \frac12 \omega_i \cdot I_i \omega_i",
+    r"K_i = \frac{1}{2} m_i \|v_{c_i}\|^2 + \frac12 \omega_i^T I_i \omega_i",
+    # total kinetic energy (also the link's formula summed)
+    r"K = \frac12 \sum_{i=1}^{n} \left(m_i v_{c_i}^T v_{c_i} + \omega_i^T I_i \omega_i\right)",
     r"K = \sum_{i=1}^{n} K_i",
     r"T = \frac{1}{2}\dot{q}^T D(q) \dot{q}",
     r"k = \sum_{i=1}^{n} k_i = k(\Theta, \dot\Theta) = \frac{1}{2}\dot\Theta^T M(\Theta)\dot\Theta",
@@ -33,6 +36,9 @@ RIGHT = [
     r"P_i = m_i g^T r_{c_i}",
     r"P = m g h",
     r"V = \sum_{i=1}^{n} V_i",
+    r"P = \sum_{i=1}^{n} m_i g^T r_{c_i}",
+    r"U_i = m_i g y_{c_i}",
+    r"L = \sum_{i=1}^{n} (K_i - P_i)",
     # the Lagrangian and the Lagrange equation
     r"\mathcal{L} = K - P",
     r"L = T - V",
@@ -258,6 +264,7 @@ def test_a_rotation_written_in_an_index_is_checked_for_every_frame(tmp_path):
         "K = M(" + "\\dot q , " * 40 + "x)",
         "K = " + "\\sum_{i=1}^{n} " * 400 + "K_i",
         "K_i = " + " = ".join(["K_i"] * 400),
+        "K_i = " + "\\|v" * 3000 + "\\|^2",
         "c_{ijk} = " + " + ".join(["\\frac{\\partial d_{kj}}{\\partial q_i}"] * 200),
     ],
 )

@@ -118,6 +118,10 @@ _ARGS = re.compile(
     r"(?P<head>(?<![A-Za-z\\])[A-Za-z]|(?<=_)\w|\\Gamma|\\phi|\}|\\mathbf\s*\{[A-Za-z]\})"
     r"\s*(?>\\left)?\(\s*" + _ARG + r"(?>\s*,\s*" + _ARG + r")*\s*(?>\\right)?\)"
 )
+#: a squared norm, \|v\|^2 or \lVert v \rVert^2 (its content without bars or groups)
+_NORM = re.compile(
+    r"(?:\\\||\\lVert)\s*([^|{}\\]*(?:\\[A-Za-z]+[^|{}\\]*|\{[^{}|]*\}[^|{}\\]*)*?)\s*(?:\\\||\\rVert)\s*\^\s*(?:\{\s*2\s*\}|2)"
+)
 _SUM = re.compile(r"\\sum\s*(?:\\limits|\\nolimits)?\s*")
 
 
@@ -197,6 +201,7 @@ class Placeholders:
         text = re.sub(r"\\space\b|\\,|\\;|\\!|\\quad", " ", text)
         text = re.sub(r"\{\s*(?=[\^_])", "{{}", text)  # {^i\omega_i}: the prescript of a group's name
         text = re.sub(r"\^\s*\{\s*(?:T|\\top)\s*\}\s*_\s*(\{[^{}]*\}|\w)", r"_\1^{T}", text)  # n^{T}_i: n_i^T
+        text = _NORM.sub(lambda m: f"({m[1]})^T({m[1]})", text)  # \|v\|^2 = v^T v
         text = strip_arguments(text)
         text = self._partials(text)
         return self._sums(text, bound)

@@ -146,6 +146,8 @@ def classify(name: Name, family: str, world: str, binding: dict) -> tuple[Quanti
         return q("pc" if centre else "po", dots=0)
     if base == "P" and family == "NE":
         return q("po", dots=0)
+    if base in ("y", "z") and family == "PE":  # the height of a mass centre, y or z up
+        return q("h", frame=None, dots=0, centre=False)
     if base == "h":
         return q("h", frame=None, dots=0)
     if base in ("F", "N", "f", "n") and family in ("lhs", "NE") and sub:
@@ -203,6 +205,10 @@ class Ctx:
         if kind in ("vector", "axis") and frame is not None and _native(quantity) not in (None, frame):
             value = self.values.rotation(frame, _native(quantity)) * value
         return value
+
+    def at(self, link: int) -> Ctx:
+        """The same values, for link ``link`` (a law's term summed over the links)."""
+        return Ctx(self.values, self.world, link, self.entry, self.transpose)
 
     def rot(self, to: int, frm: int):
         return self.values.rotation(frm, to) if self.transpose else self.values.rotation(to, frm)
@@ -326,6 +332,24 @@ _PE = Law(
         ),
     ],
 )
+
+
+def _summed(form: Form) -> Form:
+    """A link's form summed over the links (``K = \\sum_i \\frac12 m_i v_i^T v_i + …``); a
+    reference level is added once."""
+
+    def term(t: Term) -> Term:
+        if "reference" in t.what:
+            return t
+        return Term(f"{t.what}, summed over the links", lambda c: _sum_links(c, lambda i: t.value(c.at(i))), t.optional)
+
+    return Form(f"{form.source}, summed over the links", [term(t) for t in form.terms], form.note)
+
+
+_KE_SUM.forms += [_summed(f) for f in _KE_LINK.forms[:2]]
+_PE.forms += [_summed(f) for f in _PE.forms[:3]]
+
+
 _LAGRANGIAN = Law(
     "L",
     "L",
