@@ -87,6 +87,7 @@ class _Grader(EnergySteps, KinematicsSteps):
         self.verdicts: list[StepVerdict] = []
         self.notes: list[str] = list(sub.notes)  # what the reader set aside comes first
         self.refusals: list[tuple[str, str]] = []  # (file:line:column, why) of equations not graded
+        self._refused_before = 0  # refusals before the current equation
         self._primes_noted = False
         self.written: dict = {}  # (key, index) -> (their value, the right one in their convention), link frame
         # names the student gave values to (d_{11}, X, c_1), read in later values
@@ -237,6 +238,7 @@ class _Grader(EnergySteps, KinematicsSteps):
 
     def _equation(self, eq, seen_methods: list, context: str | None) -> None:
         """Grade one equation: append its verdict."""
+        self._refused_before = len(self.refusals)  # a law read after a refusal takes it back
         ref = parse_lhs(eq.lhs, self.symbols.coordinate_of) if eq.latex or "\\" in eq.lhs else None
         if ref is None:
             ref = _named_ref(eq.lhs) or (parse_lhs(eq.lhs, self.symbols.coordinate_of) if not eq.latex else None)
@@ -338,13 +340,14 @@ class _Grader(EnergySteps, KinematicsSteps):
         if found is None:
             return False
         verdict, method = found
+        del self.refusals[self._refused_before :]
         if method not in seen_methods:
             seen_methods.append(method)
         self.verdicts.append(verdict)
         return True
 
     def _report(self, seen_methods: list, method_hint: str | None) -> GradeReport:
-        if not any(v.key for v in self.verdicts):  # no equation names a step: nothing to grade
+        if not any(v.key or v.name in ("law", "identity") for v in self.verdicts):  # nothing graded
             if self.refusals:  # the reason is the first equation that could not be read
                 where, why = self.refusals[0]
                 raise ModelError(why, source=where)

@@ -31,7 +31,7 @@ def _centre_split(sub: str) -> tuple[bool, str]:
     return False, s
 
 
-def _add(a, b):
+def add_terms(a, b):
     """a + b, None the empty sum (0 + a matrix is no sum in SymPy)."""
     if a is None:
         return b
@@ -202,8 +202,8 @@ class Ctx:
         kind = _kind(role, self.world, entry)
         quantity = Quantity(role, link, frame, dots, centre, entry)
         value = self.values.get((role, link, dots, centre, entry), kind)
-        if kind in ("vector", "axis") and frame is not None and _native(quantity) not in (None, frame):
-            value = self.values.rotation(frame, _native(quantity)) * value
+        if kind in ("vector", "axis") and frame is not None and native_frame(quantity) not in (None, frame):
+            value = self.values.rotation(frame, native_frame(quantity)) * value
         return value
 
     def at(self, link: int) -> Ctx:
@@ -214,7 +214,7 @@ class Ctx:
         return self.values.rotation(frm, to) if self.transpose else self.values.rotation(to, frm)
 
 
-def _native(q: Quantity) -> int | None:
+def native_frame(q: Quantity) -> int | None:
     """The frame a vector's value is drawn in: its link's (an origin: the frame before)."""
     if q.link is None:
         return None
@@ -447,7 +447,7 @@ def _coriolis(order: tuple):
         total = None
         for k in range(1, _n(c) + 1):
             slots = {"r": row, "c": col, "k": k}
-            total = _add(total, c("chr", entry=tuple(slots[s] for s in order)) * c("q", k, dots=1))
+            total = add_terms(total, c("chr", entry=tuple(slots[s] for s in order)) * c("q", k, dots=1))
         return total
 
     return Form("", [Term("Σ_k c q̇_k", value)])

@@ -41,9 +41,9 @@ NOT_A_STEP = "not a step of Newton-Euler or Lagrange (skipped)"
 
 def step_title(v: StepVerdict, ascii_only: bool = False) -> str:
     """``v̇_1`` (Unicode) or the step's name (ASCII)."""
+    if v.name in ("law", "identity") and not v.key:  # a law stated in general symbols, an identity (laws.py)
+        return v.name
     if v.key == "law":
-        if v.name in ("law", "identity"):  # a law stated in general symbols, an identity (laws.py)
-            return v.name
         if v.name == "matrix_form":  # M q̈ + C q̇ + g = τ stated
             return "matrix form" if not ascii_only else v.name
         return "Lagrange eq." if not ascii_only else "lagrange_equation"
