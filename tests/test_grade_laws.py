@@ -275,3 +275,18 @@ def test_hostile_statements_end_in_bounded_time(statement):
     result = judge(sides(statement), n_links=3)
     assert time.perf_counter() - start < 2.0
     assert result is None or result.status == "unrecognised"
+
+
+def test_an_inertia_tensor_as_the_models_is_setup(tmp_path):
+    # planar-2r.yaml states each link's inertia about its mass centre as diag(0, I_i, I_i)
+    body = (
+        "---\nrobot: planar-2r\n---\n"
+        "$${}^{C_1}I_1 = \\begin{bmatrix} 0 & 0 & 0 \\\\ 0 & I_1 & 0 \\\\ 0 & 0 & I_1 \\end{bmatrix}$$\n\n"
+        "$${}^{C_2}I_2 = \\begin{bmatrix} 0 & 0 & 0 \\\\ 0 & 0 & 0 \\\\ 0 & 0 & I_2 \\end{bmatrix}$$\n\n"
+        "$$\\mathcal{L} = K - P$$\n"
+    )
+    path = tmp_path / "inertia.md"
+    path.write_text(body, encoding="utf-8")
+    report = grade(path)
+    assert [v.status for v in report.steps] == ["definition", "unrecognised", "correct"]
+    assert "as the model's" in report.steps[0].message

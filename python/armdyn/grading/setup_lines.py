@@ -1,6 +1,7 @@
 """Equations that set the problem up rather than compute a step: the joint vector
 ``\\mathbf q = (\\theta_1, \\theta_2)^T`` (and its rates), the gravity vector
-``\\mathbf g = (0, -g, 0)^T``, a relation between the model's parameters ``l_{c1} = l_1/2``.
+``\\mathbf g = (0, -g, 0)^T``, a relation between the model's parameters ``l_{c1} = l_1/2``,
+the links' inertia tensors ``{}^{C_1}I_1 = {}^{C_2}I_2 = 0`` (when they are the model's).
 
 They are read (the joint vector must be the model's coordinates, in its order; the gravity
 vector one axis times the gravity magnitude; a relation only the parameters) and given the
@@ -23,10 +24,58 @@ def _value(grader, text: str):
         return None
 
 
+def _one_name(text: str):
+    """The one symbol ``text`` is, its prescripts kept (``{}^{C_1}I_1``), else None."""
+    names: list = []
+    marker = sp.Symbol("armdyn_setup_marker")
+    try:
+        value = parse(text, lambda n: names.append(n) or marker)
+    except (LatexError, TypeError, ValueError, RecursionError):
+        return None
+    return names[0] if value == marker and len(names) == 1 else None
+
+
+def _inertia_link(name) -> int | None:
+    """The link whose inertia tensor about its mass centre ``name`` is (``{}^{C_1}I_1``,
+    ``I_{c1}``, ``I_1``), or None."""
+    if name is None or name.base != "I" or name.dots:
+        return None
+    for text in (name.sub, name.pre_sup.lstrip("Cc_")):
+        digits = text.replace("{", "").replace("}", "").lstrip("Cc_,")
+        if digits.isdigit():
+            return int(digits)
+    return None
+
+
+def _inertias(grader, eq) -> str | None:
+    """``{}^{C_1}I_1 = {}^{C_2}I_2 = 0``: every name an inertia tensor, equal to the model's."""
+    from .equations import sides
+
+    parts = sides(eq.source)
+    links = [_inertia_link(_one_name(p)) for p in parts[:-1]]
+    if not links or None in links:
+        return None
+    value = _value(grader, parts[-1])
+    value = sp.zeros(3, 3) if value == 0 else value
+    named = list(grader.robot.links.values())
+    if not isinstance(value, sp.MatrixBase) or value.shape != (3, 3):
+        return None
+    for k in links:
+        if not 1 <= k < len(named) or any(sp.simplify(x) != 0 for x in value - named[k].inertia):
+            return None
+    if len(links) == 1:
+        return f"the inertia tensor of link {links[0]} about its mass centre, as the model's: setup, read"
+    which = ", ".join(map(str, links))
+    return f"the inertia tensors of links {which} about their mass centres, as the model's: setup, read"
+
+
 def setup_line(grader, eq) -> str | None:
     """The message for ``eq`` when it sets the problem up, else None."""
     if not eq.latex or eq.problem or isinstance(eq.value, list):
         return None
+    inertia = _inertias(grader, eq)
+    if inertia is not None:
+        return inertia
     name = simple_name(eq.lhs)
     if name is None and eq.lhs.replace(" ", "") in ("\\dot{\\mathbf{q}}", "\\ddot{\\mathbf{q}}", "\\dot\\mathbf{q}"):
         name = None  # a dotted bold q: read below
