@@ -192,9 +192,10 @@ def all_specs() -> dict[str, dict]:
     import specs_laws
     import specs_newton_euler
     import specs_proofs
+    import specs_public
 
     out = {}
-    for mod in (specs_newton_euler, specs_lagrange, specs_proofs, specs_laws):
+    for mod in (specs_newton_euler, specs_lagrange, specs_proofs, specs_public, specs_laws):
         out.update(mod.SPECS)
     return out
 
