@@ -75,6 +75,7 @@ CSS = """
 .armdyn .s-wrong { color:var(--bad); background:var(--bad-bg); }
 .armdyn .s-follows-from-earlier-error { color:var(--carry); background:var(--carry-bg); }
 .armdyn .s-correct-but-unsupported { color:var(--unsup); background:var(--unsup-bg); }
+.armdyn .s-definition { color:#3d4a5c; background:#e8eef5; }
 .armdyn .s-unrecognised { color:var(--grey); background:var(--grey-bg); }
 
 /* steps */
@@ -86,6 +87,7 @@ CSS = """
 .armdyn .step.st-wrong { border-left-color:var(--bad); }
 .armdyn .step.st-follows-from-earlier-error { border-left-color:#d4a72c; }
 .armdyn .step.st-correct-but-unsupported { border-left-color:var(--unsup); }
+.armdyn .step.st-definition { border-left-color:#8aa0b8; }
 .armdyn .step.st-unrecognised { border-left-color:var(--rule); background:var(--tint); color:var(--muted); }
 .armdyn .step.first { box-shadow:0 0 0 2px var(--bad-bg); }
 .armdyn .head { display:flex; flex-wrap:wrap; align-items:baseline; gap:4px 12px; }

@@ -64,6 +64,18 @@ class Proof:
     id: str = field(default="")
 
 
+@dataclass
+class Stated:
+    """A law of the method stated before it is used (``k_i = ...``, ``c_{ijk} = ...``): no
+    model quantity, so its truth is decided by hand against the textbook: ``not-a-step``
+    when it is the law as the textbooks state it, ``wrong`` with ``why`` for a slip."""
+
+    anchor: str
+    law: str
+    why: str = ""
+    span: int = 0
+
+
 QS = (q1, q2, q3, q4)
 QDS = (qd1, qd2, qd3, qd4)
 QDDS = (qdd1, qdd2, qdd3, qdd4)

@@ -37,7 +37,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 import truth_models  # noqa: E402
-from specs_common import Eq, Proof  # noqa: E402
+from specs_common import Eq, Proof, Stated  # noqa: E402
 
 TRIALS = 4
 RTOL = 1e-8
@@ -131,6 +131,13 @@ def establish(name: str, spec: dict) -> dict:
             entry["continues"] = prev["line"]
         if e.span:
             entry["last_line"] = i + 1 + e.span
+        if isinstance(e, Stated):  # a law stated in general symbols: decided by hand
+            entry["quantity"] = f"law: {e.law}"
+            entry["truth"] = "wrong" if e.why else "not-a-step"
+            if e.why:
+                entry["why"] = e.why
+            out["equations"].append(entry)
+            continue
         if isinstance(e, Proof):
             forms = e.rhs if isinstance(e.rhs, list | tuple) else [e.rhs]
             ok = all(same(e.lhs(b), f(b)) for b in bodies for f in forms)
@@ -182,12 +189,13 @@ def _at(expr, state):
 def all_specs() -> dict[str, dict]:
     """Every corpus file's spec, by file name."""
     import specs_lagrange
+    import specs_laws
     import specs_newton_euler
     import specs_proofs
     import specs_public
 
     out = {}
-    for mod in (specs_newton_euler, specs_lagrange, specs_proofs, specs_public):
+    for mod in (specs_newton_euler, specs_lagrange, specs_proofs, specs_public, specs_laws):
         out.update(mod.SPECS)
     return out
 

@@ -9,7 +9,8 @@ each equation's left-hand side is mapped to a step of Newton-Euler or Lagrange
 (:mod:`.notation`), and each step gets a verdict (:mod:`.grader` walks the equations,
 :mod:`.engine` decides, statuses in
 :mod:`.verdict`): correct, correct-by-convention, wrong, follows-from-earlier-error,
-correct-but-unsupported, or unrecognised. Bad input (no equation recognised, malformed
+correct-but-unsupported, unrecognised, or definition (a name given a value, a setup line;
+it passes). Bad input (no equation recognised, malformed
 front matter, an unknown symbol, a vector of the wrong length, a link that does not
 exist) raises :class:`armdyn.errors.ModelError` naming the file and line.
 """

@@ -395,7 +395,7 @@ def after_equation(grader, eq, new: list) -> None:
         v.message = "; ".join(x for x in [v.message, *said] if x)
     if v.status in ("wrong", "follows-from-earlier-error") and v.expected is not None and v.got is not None:
         right_value = v.expected
-    elif v.status == "unrecognised":
+    elif v.status in ("unrecognised", "definition"):
         right_value = right
     else:
         right_value = own

@@ -23,10 +23,12 @@ from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, tidy
 from .kinematics_steps import KinematicsSteps, confirm_used
 from .latex import LatexError, UnknownSymbol
+from .laws import identity, indexed_step, law_statement
 from .methods import lagrange_method, newton_euler_method, rotation_between
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
 from .reader import Submission, read
+from .setup_lines import setup_line
 from .statements import FREE_END, lagrange_law, matrix_form
 from .sympy_syntax import parse_sympy_syntax
 from .verdict import PASSING, GradeReport, StepVerdict
@@ -71,6 +73,7 @@ class _Grader(EnergySteps, KinematicsSteps):
         self.verdicts: list[StepVerdict] = []
         self.notes: list[str] = list(sub.notes)  # what the reader set aside comes first
         self.refusals: list[tuple[str, str]] = []  # (file:line:column, why) of equations not graded
+        self._refused_before = 0  # refusals before the current equation
         self._primes_noted = False
         self.written: dict = {}  # (key, index) -> (their value, the right one in their convention), link frame
         # names the student gave values to (d_{11}, X, c_1), read in later values
@@ -221,6 +224,7 @@ class _Grader(EnergySteps, KinematicsSteps):
 
     def _equation(self, eq, seen_methods: list, context: str | None) -> None:
         """Grade one equation: append its verdict."""
+        self._refused_before = len(self.refusals)  # a law read after a refusal takes it back
         ref = parse_lhs(eq.lhs, self.symbols.coordinate_of) if eq.latex or "\\" in eq.lhs else None
         if ref is None:
             ref = _named_ref(eq.lhs) or (parse_lhs(eq.lhs, self.symbols.coordinate_of) if not eq.latex else None)
@@ -228,6 +232,12 @@ class _Grader(EnergySteps, KinematicsSteps):
             self._unrecognised(
                 eq, self._unreadable(eq, eq.problem), name=ref.name if ref else "", key=ref.key if ref else ""
             )
+            return
+        if self._law(eq, seen_methods):  # a law stated in general symbols (k_i = ..., \sum, c_{ijk})
+            return
+        indexed = indexed_step(self, eq) if ref is None else None  # {}^{i+1}_{i}R = ...: every i
+        if indexed is not None:
+            self.verdicts.append(indexed)
             return
         if ref is None:
             law = lagrange_law(eq.lhs, str(eq.value)) if eq.latex else None
@@ -252,13 +262,27 @@ class _Grader(EnergySteps, KinematicsSteps):
             if eq.latex and matrix_form(eq.lhs, str(eq.value)):
                 self._matrix_form(eq)
                 return
-            self._unrecognised(eq, definition(self, eq) or "not a step of Newton-Euler or Lagrange (skipped)")
+            if self._law(eq, seen_methods, fallback=True):  # L = K - P, E_K = ½ m v^2 + ...
+                return
+            defined = definition(self, eq) or setup_line(self, eq)
+            if defined:  # a name given a value used later, a setup line: read, not judged
+                self._unrecognised(eq, defined)
+                self.verdicts[-1].status = "definition"
+                return
+            same = identity(self, eq)  # cos a cos b + sin a sin b = cos(a - b)
+            if same is not None:
+                self.verdicts.append(same)
+                return
+            self._unrecognised(eq, "not a step of Newton-Euler or Lagrange (skipped)")
             return
         if ref.key in ("tau", "tau_vec") and eq.latex and matrix_form(eq.lhs, str(eq.value)):  # τ = M q̈ + C q̇ + g
             self._matrix_form(eq)
             return
         ref, assumed = self._vocabulary(ref, eq, seen_methods)  # energy-method names; by the value's shape
         if ref is None:
+            if self.verdicts and self.verdicts[-1].line == eq.line and self.verdicts[-1].status == "unrecognised":
+                if self._law(eq, seen_methods, fallback=True):  # D = m_1 J_{v_1}^T J_{v_1} + ...: in names
+                    del self.verdicts[-2]
             return
         n_links = len(self.robot.links) - 1
         if ref.key in ("f", "n") and ref.index == n_links + 1:
@@ -279,6 +303,8 @@ class _Grader(EnergySteps, KinematicsSteps):
             return
         value, problem = self.value(eq, ref)
         if value is None:
+            if self._law(eq, seen_methods, fallback=True):  # in generic names: T = ½ m v^2, K = T_1 + T_2
+                return
             self._unrecognised(eq, problem, name=ref.name, key=ref.key)
             return
         own_value = value
@@ -294,8 +320,20 @@ class _Grader(EnergySteps, KinematicsSteps):
             for name in student_names(ref):
                 self.symbols.steps[name] = own_value
 
+    def _law(self, eq, seen_methods: list, fallback: bool = False) -> bool:
+        """Record ``eq`` as the statement of a law (:mod:`.laws`) if it is one."""
+        found = law_statement(self, eq, fallback)
+        if found is None:
+            return False
+        verdict, method = found
+        del self.refusals[self._refused_before :]
+        if method not in seen_methods:
+            seen_methods.append(method)
+        self.verdicts.append(verdict)
+        return True
+
     def _report(self, seen_methods: list, method_hint: str | None) -> GradeReport:
-        if not any(v.key for v in self.verdicts):  # no equation names a step: nothing to grade
+        if not any(v.key or v.name in ("law", "identity") for v in self.verdicts):  # nothing graded
             if self.refusals:  # the reason is the first equation that could not be read
                 where, why = self.refusals[0]
                 raise ModelError(why, source=where)

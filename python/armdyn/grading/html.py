@@ -40,6 +40,7 @@ STATUS_TEXT = {
     "follows-from-earlier-error": "follows from an earlier error",
     "correct-but-unsupported": "correct but unsupported",
     "unrecognised": "unrecognised",
+    "definition": "definition",
 }
 _AXES = "xyz"
 #: a report whose values have more nodes than this in all is printed as SymPy orders

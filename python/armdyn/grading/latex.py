@@ -103,7 +103,7 @@ class _Parser(SymbolReader):
             while self.peek() in (("char", "+"), ("char", "-")):  # "+ -b" (a row "+" then a row "-b")
                 op = "-" if (op == "-") != (self.take()[1] == "-") else "+"
             nxt = self.term()
-            value = value + nxt if op == "+" else value - nxt
+            value = _plus(value, nxt if op == "+" else -nxt)
         self.leave()
         return value
 
@@ -444,6 +444,14 @@ class _Parser(SymbolReader):
         if not rows or len({len(r) for r in rows}) != 1:
             raise LatexError("a matrix whose rows have different lengths")
         return sp.Matrix(rows)
+
+
+def _plus(a, b):
+    """``a + b``; a 1x1 matrix (``v^T v``, ``\\dot q^T M \\dot q``) added to a scalar is its entry."""
+    if isinstance(a, sp.MatrixBase) != isinstance(b, sp.MatrixBase):
+        a = a[0, 0] if isinstance(a, sp.MatrixBase) and a.shape == (1, 1) else a
+        b = b[0, 0] if isinstance(b, sp.MatrixBase) and b.shape == (1, 1) else b
+    return a + b
 
 
 def _cross(a, b):

@@ -24,6 +24,7 @@ _MARK = {
     "follows-from-earlier-error": ("→", "->"),
     "correct-but-unsupported": ("?", "??"),
     "unrecognised": ("·", "--"),
+    "definition": ("=", "=="),
 }
 _KEY_TEXT = {
     **VECTOR_STEP_TEXT,
@@ -40,6 +41,8 @@ NOT_A_STEP = "not a step of Newton-Euler or Lagrange (skipped)"
 
 def step_title(v: StepVerdict, ascii_only: bool = False) -> str:
     """``v̇_1`` (Unicode) or the step's name (ASCII)."""
+    if v.name in ("law", "identity") and not v.key:  # a law stated in general symbols, an identity (laws.py)
+        return v.name
     if v.key == "law":
         if v.name == "matrix_form":  # M q̈ + C q̇ + g = τ stated
             return "matrix form" if not ascii_only else v.name
@@ -107,7 +110,7 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
             what += f": {extra}" if extra else ""
         elif v.status == "correct" and v.message:
             what = f"correct: {v.message}"
-        elif v.status in ("wrong", "correct-but-unsupported", "unrecognised"):
+        elif v.status in ("wrong", "correct-but-unsupported", "unrecognised", "definition"):
             what = f"{v.status.upper() if v.status == 'wrong' else v.status}: {v.message}"
         lines.append(f"  {mark} line {v.line:>4}  {_pad(step_title(v, ascii_only), width)}  {what}")
         if details and v.status == "wrong":

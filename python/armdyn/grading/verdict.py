@@ -19,6 +19,10 @@ Statuses (``StepVerdict.status``):
 * ``correct-but-unsupported``: right, but not what the student's own earlier steps give.
 * ``unrecognised``: the LHS could not be mapped to a step, or the value could not be
   read (the message says where, line and column, and why); it counts against passing.
+* ``definition``: an equation that introduces a name used later (``X = ...``, ``l_{c1} =
+  l_1/2``) or sets the problem up (the joint vector ``\\mathbf q = (\\theta_1, \\theta_2)^T``,
+  the gravity vector): read (its value stands for the name in later steps), not judged;
+  it passes (the steps that use it are judged with it).
 
 Values are SymPy: a (3, 1) ``Matrix`` for vectors, an expression for scalars, in the
 robot model's symbols (``theta1``, ``theta1_dot``, ``l1``...); ``symbol_latex`` maps those
@@ -39,10 +43,13 @@ STATUSES = (
     "follows-from-earlier-error",
     "correct-but-unsupported",
     "unrecognised",
+    "definition",
 )
 
-#: statuses that count as right for the exit status (0 when every equation is one of these)
-PASSING = ("correct", "correct-by-convention")
+#: statuses that count as right for the exit status (0 when every equation is one of these);
+#: a definition introduces a name or sets up the problem: read, nothing to be wrong about
+#: (where it is used, the step using it is judged)
+PASSING = ("correct", "correct-by-convention", "definition")
 
 
 @dataclass
@@ -132,7 +139,8 @@ class GradeReport:
 
     @property
     def passed(self) -> bool:
-        """Every equation read and right (an unread one is not a pass: it was not checked)."""
+        """Every equation read and right or a definition (an unread one is not a pass: it was
+        not checked)."""
         return all(s.status in PASSING for s in self.steps)
 
     # the text, JSON and HTML renderers (text.py, html.py) register with armdyn.dispatch

@@ -121,6 +121,9 @@ def grade_proofs(sub, verdicts: list[StepVerdict]) -> list[StepVerdict]:
     proofs = check_text(text, getattr(sub, "path", "") or "<string>", {v.line for v in verdicts if v.key})
     if not proofs:
         return verdicts
+    # a law stated in general symbols (grading.laws) stays when the proof checker cannot read its line
+    laws = {v.line for v in verdicts if v.name in ("law", "identity") and not v.key}
+    proofs = [p for p in proofs if not (p.line in laws and p.status == "unrecognised")]
     handled = {v.line for v in proofs}
     kept = [v for v in verdicts if v.key or v.line not in handled]
     return sorted(kept + proofs, key=lambda v: v.line)
