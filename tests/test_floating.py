@@ -153,7 +153,11 @@ def test_dynamics_agree_with_pinocchio(name):
         assert close(M[np.ix_(perm, perm)], Mp) < TOL, "crba"
         tau2 = rng.uniform(-10, 10, robot.nv)
         acc = numeric.aba(robot, q, v, tau2)
-        assert close(acc[perm], pin.aba(model, data, qp, vp, tau2[perm])) < TOL * max(1.0, np.linalg.cond(M)), "aba"
+        # 1e-10, loosened only for an ill-conditioned M (icub's reaches cond 5e9): rounding
+        # in either library is amplified by cond(M) in the solve
+        assert close(acc[perm], pin.aba(model, data, qp, vp, tau2[perm])) < TOL * max(1.0, np.linalg.cond(M) / 1e8), (
+            "aba"
+        )
 
 
 @needs_pinocchio
@@ -305,13 +309,15 @@ def test_shapes_are_named():
         numeric.rnea(robot, q, v[6:], a)
 
 
-def test_batches_are_single_calls():
+@pytest.mark.parametrize("threads", [None, 1, 2])
+def test_batches_are_single_calls(threads):
+    """Batches (SIMD lanes, leftover rows alone, threads) equal single calls bit for bit."""
     robot, _, rng = floating_tree(3)
-    states = [floating_state(robot, rng) for _ in range(4)]
+    states = [floating_state(robot, rng) for _ in range(11)]
     Q, V, A = (np.array([s[k] for s in states]) for k in range(3))
-    tau = numeric.rnea(robot, Q, V, A)
-    M = numeric.crba(robot, Q)
-    acc = numeric.aba(robot, Q, V, tau)
+    tau = numeric.rnea(robot, Q, V, A, threads=threads)
+    M = numeric.crba(robot, Q, threads=threads)
+    acc = numeric.aba(robot, Q, V, tau, threads=threads)
     for k, (q, v, a) in enumerate(states):
         assert np.array_equal(tau[k], numeric.rnea(robot, q, v, a))
         assert np.array_equal(M[k], numeric.crba(robot, q))

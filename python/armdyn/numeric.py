@@ -36,8 +36,8 @@ then the joints; ``qd``, ``qdd`` and ``tau`` are ``(robot.nv,) = (6 + dof,)``: t
 linear then angular velocity (acceleration; the force then the moment about the base
 origin applied to the base), all in the base frame, then the joints; ``M`` is
 ``(nv, nv)`` in that order. Gravity is then in the world frame. A quaternion whose length
-differs from 1 by more than 1e-9 is refused (``ValueError``). Batches ``(N, nq)`` work,
-run state by state. :mod:`armdyn.configuration` moves on that configuration space
+differs from 1 by more than 1e-9 is refused (``ValueError``). Batches ``(N, nq)`` run
+as the fixed-base ones (SIMD lanes, ``threads``; bit for bit the single calls). :mod:`armdyn.configuration` moves on that configuration space
 (``integrate``, ``difference``, ``neutral``, ``random_configuration``, re-exported
 here). Every other function here raises :class:`~armdyn.errors.FloatingBaseError` (a
 ``ModelError`` and ``NotImplementedError``) for a floating robot, naming itself.
@@ -282,8 +282,7 @@ def rnea(
     with external wrenches ``f_ext`` (see :func:`rnea_derivatives`), minus sum J^T w.
     A floating base (see the module doc): q (nq,) or (N, nq); qd, qdd (nv,) or (N, nv);
     tau (nv,): the wrench the base needs (base frame, force then moment; zero when the
-    robot flies freely at that acceleration), then the joint torques. ``threads`` is
-    not used there yet (a batch runs state by state).
+    robot flies freely at that acceleration), then the joint torques.
     """
     threads = check_threads(threads)
     if f_ext is not None:

@@ -3,11 +3,13 @@
 //! and aba dispatch here when the model floats, and every other method refuses.
 //!
 //! `q` is `(7 + n,)` or `(N, 7 + n)`, `v` (`qd`), `a` (`qdd`) and `tau` `(6 + n,)` or
-//! `(N, 6 + n)`; a batch is run row by row (no SIMD lanes nor threads yet). The
+//! `(N, 6 + n)`; a batch runs as the fixed-base ones do (SIMD lanes, `threads` threads,
+//! the GIL released; bit for bit the single calls). The
 //! quaternion `q[3:7]` (x, y, z, w) must have unit length to within [`QUATERNION_TOL`]:
 //! anything further from it is refused, never silently used.
 
-use crate::{as_f64, all_finite, guard, new_array, slice, NumericModel, Shape};
+use crate::{all_finite, as_f64, guard, new_array, slice, thread_arg, NumericModel, Shape};
+use armdyn_core::batch;
 use armdyn_core::algo::floating::{aba_floating, crba_floating, rnea_floating, NQ_BASE, NV_BASE};
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyFloatingPointError, PyNotImplementedError, PyValueError};
@@ -78,35 +80,42 @@ impl NumericModel {
         Ok((shape.expect("at least one argument"), arrays))
     }
 
-    /// Run `f(data, inputs, output)` on every state of `args`, into a fresh array of
-    /// shape `out_shape` per state.
+    /// `single(data, inputs, output)` for one state, `batched(model, inputs, output,
+    /// threads)` for a batch (GIL released), into a fresh array of shape `out_shape` per
+    /// state.
     fn floating_op<'py, const K: usize>(
         &self,
         py: Python<'py>,
         args: [(&str, &Bound<'py, PyAny>, usize); K],
         out_shape: &[usize],
-        f: impl Fn(&mut armdyn_core::Data<f64>, [&[f64]; K], &mut [f64]),
+        threads: Option<i64>,
+        single: impl FnOnce(&mut armdyn_core::Data<f64>, [&[f64]; K], &mut [f64]),
+        batched: impl FnOnce(&armdyn_core::Model, [&[f64]; K], &mut [f64], Option<usize>) + Send,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guard(|| {
-            let widths = args.map(|a| a.2);
+            let threads = thread_arg(threads)?;
             let (shape, arrays) = self.floating_states(args)?;
-            let rows = match shape {
-                Shape::Single => None,
-                Shape::Batch(rows) => Some(rows),
-            };
-            let dims: Vec<usize> = rows.into_iter().chain(out_shape.iter().copied()).collect();
-            let out = new_array(py, &dims);
-            // SAFETY: inputs read-only and `out` fresh, GIL held throughout.
-            let ins: [&[f64]; K] = std::array::from_fn(|k| unsafe { slice(&arrays[k]) });
-            let o = unsafe { out.as_slice_mut().expect("fresh array") };
-            let per_row: usize = out_shape.iter().product();
-            self.with_scratch(|s| {
-                for r in 0..rows.unwrap_or(1) {
-                    let row: [&[f64]; K] = std::array::from_fn(|k| &ins[k][r * widths[k]..(r + 1) * widths[k]]);
-                    f(&mut s.data, row, &mut o[r * per_row..(r + 1) * per_row]);
+            match shape {
+                Shape::Single => {
+                    let out = new_array(py, out_shape);
+                    // SAFETY: inputs read-only and `out` fresh, GIL held throughout.
+                    let ins: [&[f64]; K] = std::array::from_fn(|k| unsafe { slice(&arrays[k]) });
+                    let o = unsafe { out.as_slice_mut().expect("fresh array") };
+                    self.with_scratch(|s| single(&mut s.data, ins, o));
+                    Ok(out)
                 }
-            });
-            Ok(out)
+                Shape::Batch(rows) => {
+                    let dims: Vec<usize> = std::iter::once(rows).chain(out_shape.iter().copied()).collect();
+                    let out = new_array(py, &dims);
+                    let readonly: Vec<_> = arrays.iter().map(|a| a.readonly()).collect();
+                    let ins: [&[f64]; K] = std::array::from_fn(|k| readonly[k].as_slice().expect("contiguous"));
+                    // SAFETY: `out` is fresh and not visible to Python until returned.
+                    let o = unsafe { out.as_slice_mut().expect("fresh array") };
+                    let model = &self.model;
+                    py.detach(|| batched(model, ins, o, threads));
+                    Ok(out)
+                }
+            }
         })
     }
 
@@ -117,18 +126,36 @@ impl NumericModel {
         q: &Bound<'py, PyAny>,
         v: &Bound<'py, PyAny>,
         a: &Bound<'py, PyAny>,
+        threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let (nq, nv) = (self.model.nv + NQ_BASE, self.model.nv + NV_BASE);
-        let out = self.floating_op(py, [("q", q, nq), ("qd", v, nv), ("qdd", a, nv)], &[nv], |d, [q, v, a], o| {
-            rnea_floating(&self.model, d, q, v, a, o)
-        })?;
+        let out = self.floating_op(
+            py,
+            [("q", q, nq), ("qd", v, nv), ("qdd", a, nv)],
+            &[nv],
+            threads,
+            |d, [q, v, a], o| rnea_floating(&self.model, d, q, v, a, o),
+            batch::rnea_floating,
+        )?;
         finite(out)
     }
 
     /// Floating-base inertia matrix (6 + n, 6 + n) from q (7 + n).
-    pub(crate) fn crba_floating<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    pub(crate) fn crba_floating<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let (nq, nv) = (self.model.nv + NQ_BASE, self.model.nv + NV_BASE);
-        let out = self.floating_op(py, [("q", q, nq)], &[nv, nv], |d, [q], o| crba_floating(&self.model, d, q, o))?;
+        let out = self.floating_op(
+            py,
+            [("q", q, nq)],
+            &[nv, nv],
+            threads,
+            |d, [q], o| crba_floating(&self.model, d, q, o),
+            batch::crba_floating,
+        )?;
         finite(out)
     }
 
@@ -139,11 +166,17 @@ impl NumericModel {
         q: &Bound<'py, PyAny>,
         v: &Bound<'py, PyAny>,
         tau: &Bound<'py, PyAny>,
+        threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let (nq, nv) = (self.model.nv + NQ_BASE, self.model.nv + NV_BASE);
-        let out = self.floating_op(py, [("q", q, nq), ("qd", v, nv), ("tau", tau, nv)], &[nv], |d, [q, v, tau], o| {
-            aba_floating(&self.model, d, q, v, tau, o)
-        })?;
+        let out = self.floating_op(
+            py,
+            [("q", q, nq), ("qd", v, nv), ("tau", tau, nv)],
+            &[nv],
+            threads,
+            |d, [q, v, tau], o| aba_floating(&self.model, d, q, v, tau, o),
+            batch::aba_floating,
+        )?;
         // SAFETY: `out` is ours and not yet returned.
         if !all_finite(unsafe { slice(&out) }) {
             return Err(PyValueError::new_err(format!(

@@ -553,7 +553,7 @@ impl NumericModel {
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         if self.floating {
-            return self.rnea_floating(py, q, qd, qdd);
+            return self.rnea_floating(py, q, qd, qdd, threads);
         }
         self.vector_op(
             py,
@@ -576,7 +576,7 @@ impl NumericModel {
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         if self.floating {
-            return self.aba_floating(py, q, qd, tau);
+            return self.aba_floating(py, q, qd, tau, threads);
         }
         if !self.inert_joints.is_empty() {
             let names: Vec<String> = self.inert_joints.iter().map(|n| format!("'{n}'")).collect();
@@ -621,7 +621,7 @@ impl NumericModel {
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         if self.floating {
-            return self.crba_floating(py, q);
+            return self.crba_floating(py, q, threads);
         }
         let n = self.model.nv;
         self.vector_op(

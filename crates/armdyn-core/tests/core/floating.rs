@@ -94,3 +94,32 @@ fn floating_lanes_equal_single_states() {
         }
     }
 }
+
+#[test]
+fn floating_batches_equal_single_states() {
+    let mut rng = Rng::new(11);
+    let model = floating_model(&mut rng, 4);
+    let (n, nv) = (model.nv, model.nv + 6);
+    let rows = 13; // groups of lanes and leftover rows
+    let states: Vec<_> = (0..rows).map(|_| state(&mut rng, n)).collect();
+    let flat = |pick: fn(&(Vec<f64>, Vec<f64>, Vec<f64>)) -> &Vec<f64>| -> Vec<f64> { states.iter().flat_map(|s| pick(s).clone()).collect() };
+    let (q, v, a) = (flat(|s| &s.0), flat(|s| &s.1), flat(|s| &s.2));
+    let mut tau = vec![0.0; rows * nv];
+    armdyn_core::batch::rnea_floating(&model, [&q, &v, &a], &mut tau, Some(2));
+    let mut acc = vec![0.0; rows * nv];
+    armdyn_core::batch::aba_floating(&model, [&q, &v, &tau], &mut acc, Some(2));
+    let mut m = vec![0.0; rows * nv * nv];
+    armdyn_core::batch::crba_floating(&model, [&q], &mut m, Some(2));
+    let mut data = Data::new(&model);
+    for (r, (qs, vs, as_)) in states.iter().enumerate() {
+        let mut t = vec![0.0; nv];
+        rnea_floating(&model, &mut data, qs, vs, as_, &mut t);
+        assert_eq!(&tau[r * nv..(r + 1) * nv], &t[..], "rnea row {r}");
+        let mut x = vec![0.0; nv];
+        aba_floating(&model, &mut data, qs, vs, &t, &mut x);
+        assert_eq!(&acc[r * nv..(r + 1) * nv], &x[..], "aba row {r}");
+        let mut mm = vec![0.0; nv * nv];
+        crba_floating(&model, &mut data, qs, &mut mm);
+        assert_eq!(&m[r * nv * nv..(r + 1) * nv * nv], &mm[..], "crba row {r}");
+    }
+}
