@@ -346,6 +346,16 @@ def test_unsupported_functions_say_so(call):
         call(robot, q, v)
 
 
+def test_a_compiled_floating_model_pickles():
+    import pickle
+
+    robot, _, rng = floating_tree(6)
+    q, v, a = floating_state(robot, rng)
+    model = pickle.loads(pickle.dumps(numeric.compile_model(robot)))
+    assert model.floating and model.nq == robot.nq and model.nv == robot.nv
+    assert np.array_equal(model.rnea(q, v, a), numeric.rnea(robot, q, v, a))
+
+
 def test_root_joint_is_checked_and_kept():
     robot, fixed, _ = floating_tree(5)
     with pytest.raises(ModelError, match="root_joint"):
