@@ -20,17 +20,20 @@ from __future__ import annotations
 
 import argparse
 import importlib.metadata
+import os
 import platform
-import statistics
-import timeit
+import sys
 import warnings
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
-import armdyn
-from armdyn import numeric as num
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_numeric import paired_medians, per_call_run  # noqa: E402  (the same timing as the arms')
+
+import armdyn  # noqa: E402
+from armdyn import numeric as num  # noqa: E402
 
 ROBOTS = {
     "solo12": "solo_description/robots/solo12.urdf",
@@ -42,21 +45,6 @@ ROBOTS = {
 def robots_dir() -> Path:
     dist = importlib.metadata.distribution("example-robot-data")
     return Path(dist.locate_file("cmeel.prefix/share/example-robot-data/robots"))
-
-
-def per_call_run(f, args, number: int):
-    names = [f"a{i}" for i in range(len(args))]
-    timer = timeit.Timer(f"f({', '.join(names)})", globals={"f": f, **dict(zip(names, args))})
-    return lambda: timer.timeit(number) / number
-
-
-def paired_medians(run_mine, run_theirs, repeat: int) -> tuple[float, float]:
-    run_mine(), run_theirs()
-    mine, theirs = [], []
-    for _ in range(repeat):
-        mine.append(run_mine())
-        theirs.append(run_theirs())
-    return statistics.median(mine), statistics.median(theirs)
 
 
 def main() -> None:
