@@ -337,6 +337,8 @@ def test_batches_are_single_calls(threads):
         lambda r, q, v: armdyn.derive(r),
         lambda r, q, v: armdyn.codegen(r),
         lambda r, q, v: __import__("armdyn.simulate", fromlist=["simulate"]).simulate(r, q, v, dt=0.01, steps=1),
+        lambda r, q, v: __import__("armdyn.identification", fromlist=["x"]).base_parameters(r),
+        lambda r, q, v: __import__("armdyn.identification", fromlist=["x"]).regressor(r),
     ],
 )
 def test_unsupported_functions_say_so(call):
