@@ -212,8 +212,8 @@ pub(crate) fn articulated_inertias<T: Real, F: AbaFrames<T>>(
 }
 
 /// Pass 3 of RBDA Table 7.1 (root to leaves), after [`articulated_inertias`] with a bias,
-/// in the same coordinates: `a'_i = X a_lambda + c_i` (`a_lambda = a_0 = [0; -g]` at a
-/// root), `qdd_i = (u_i - U_i^T a'_i) / D_i`, `a_i = a'_i + S_i qdd_i`. Writes `qdd` (nv,)
+/// in the same coordinates: `a'_i = X a_lambda + c_i` (`a_lambda = a_root` at a root),
+/// `qdd_i = (u_i - U_i^T a'_i) / D_i`, `a_i = a'_i + S_i qdd_i`. Writes `qdd` (nv,)
 /// and `data.a`. `a_root`: the acceleration of the root bodies' parent (the base), in
 /// its coordinates, gravity's `-g` included (`[0; -g]` for a fixed base).
 #[inline(always)]
