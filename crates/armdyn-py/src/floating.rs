@@ -76,7 +76,7 @@ impl NumericModel {
                 )));
             }
         }
-        let arrays: [Bound<'py, PyArrayDyn<f64>>; K] = arrays.try_into().ok().expect("K arrays");
+        let arrays: [Bound<'py, PyArrayDyn<f64>>; K] = arrays.try_into().expect("K arrays");
         Ok((shape.expect("at least one argument"), arrays))
     }
 

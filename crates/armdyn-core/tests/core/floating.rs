@@ -13,8 +13,11 @@ fn floating_model(rng: &mut Rng, njoints: usize) -> Model {
     model
 }
 
+/// (q, v, a) of one state.
+type State = (Vec<f64>, Vec<f64>, Vec<f64>);
+
 /// Random (q, v, a): any base pose (a unit quaternion), joints in [-3, 3].
-fn state(rng: &mut Rng, n: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+fn state(rng: &mut Rng, n: usize) -> State {
     let mut q = rng.vec(7 + n, -3.0, 3.0);
     let quat = rng.vec(4, -1.0, 1.0);
     let norm = quat.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -65,7 +68,7 @@ fn floating_lanes_equal_single_states() {
     let model = floating_model(&mut rng, 5);
     let (n, nv) = (model.nv, model.nv + 6);
     let states: Vec<_> = (0..4).map(|_| state(&mut rng, n)).collect();
-    let lanes = |pick: fn(&(Vec<f64>, Vec<f64>, Vec<f64>)) -> &Vec<f64>, len: usize| -> Vec<F64x4> {
+    let lanes = |pick: fn(&State) -> &Vec<f64>, len: usize| -> Vec<F64x4> {
         (0..len)
             .map(|k| {
                 let mut x = F64x4::zero();
@@ -102,7 +105,7 @@ fn floating_batches_equal_single_states() {
     let (n, nv) = (model.nv, model.nv + 6);
     let rows = 13; // groups of lanes and leftover rows
     let states: Vec<_> = (0..rows).map(|_| state(&mut rng, n)).collect();
-    let flat = |pick: fn(&(Vec<f64>, Vec<f64>, Vec<f64>)) -> &Vec<f64>| -> Vec<f64> { states.iter().flat_map(|s| pick(s).clone()).collect() };
+    let flat = |pick: fn(&State) -> &Vec<f64>| -> Vec<f64> { states.iter().flat_map(|s| pick(s).clone()).collect() };
     let (q, v, a) = (flat(|s| &s.0), flat(|s| &s.1), flat(|s| &s.2));
     let mut tau = vec![0.0; rows * nv];
     armdyn_core::batch::rnea_floating(&model, [&q, &v, &a], &mut tau, Some(2));
