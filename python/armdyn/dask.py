@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .numeric import check_threads, compiled_model, core_model
+from .numeric import check_threads, compiled_model, core_model, require_fixed_base
 
 __all__ = ["rnea", "aba", "crba", "simulate", "rnea_derivatives", "aba_derivatives", "minverse", "gravity_derivatives"]
 
@@ -68,6 +68,7 @@ def _crba(q, model, threads):
 def rnea(robot, q, qd, qdd, *, chunks=None, threads=1):
     """Lazy inverse dynamics ``tau = M qdd + C qd + g``: (N, dof) Dask arrays in and out.
     NumPy inputs are wrapped with ``chunks`` rows per block (default: Dask's "auto")."""
+    require_fixed_base(robot, "armdyn.dask.rnea")
     model = compiled_model(robot)
     threads = check_threads(threads)  # Rust reads True as 1
     q, qd, qdd = _arrays(model.dof, chunks, q, qd, qdd)
@@ -76,6 +77,7 @@ def rnea(robot, q, qd, qdd, *, chunks=None, threads=1):
 
 def aba(robot, q, qd, tau, *, chunks=None, threads=1):
     """Lazy forward dynamics ``qdd = M^-1 (tau - C qd - g)``: (N, dof) in and out."""
+    require_fixed_base(robot, "armdyn.dask.aba")
     model = compiled_model(robot)
     threads = check_threads(threads)  # Rust reads True as 1
     q, qd, tau = _arrays(model.dof, chunks, q, qd, tau)
@@ -84,6 +86,7 @@ def aba(robot, q, qd, tau, *, chunks=None, threads=1):
 
 def crba(robot, q, *, chunks=None, threads=1):
     """Lazy joint-space inertia matrices: q (N, dof) -> M (N, dof, dof)."""
+    require_fixed_base(robot, "armdyn.dask.crba")
     model = compiled_model(robot)
     threads = check_threads(threads)  # Rust reads True as 1
     (q,) = _arrays(model.dof, chunks, q)
@@ -144,6 +147,7 @@ def simulate(
 
     from .simulate import PD, ComputedTorque, Trajectory, joint_limits, step_count
 
+    require_fixed_base(robot, "armdyn.dask.simulate")
     model = compiled_model(robot)
     threads = check_threads(threads)  # Rust reads True as 1
     dof = model.dof

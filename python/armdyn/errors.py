@@ -36,5 +36,10 @@ class ModelError(ValueError):
         return self
 
 
+class FloatingBaseError(ModelError, NotImplementedError):
+    """A function that handles fixed-base robots only was given one whose base floats
+    (``root_joint="free-flyer"``); the message names the function."""
+
+
 class UnboundParameterError(ValueError):
     """A numeric function was given a robot that still has free symbols."""

@@ -27,6 +27,20 @@ Every function takes a robot and one state or a batch of states:
 
 Conventions (docs/architecture.md): SI units, radians; ``M(q) qdd + C(q, qd) qd + g(q) = tau``;
 gravity is the robot's vector in the base frame; frames as in :mod:`armdyn.model`.
+
+A floating base (``armdyn.load(path, root_joint="free-flyer")``, ``robot.floating``):
+``rnea``, ``crba`` and ``aba`` take Pinocchio's arrays, unchanged: ``q`` is
+``(robot.nq,) = (7 + dof,)``, the base origin in the world frame (3), the base
+orientation as a unit quaternion ``x, y, z, w`` (4; base axes in world coordinates),
+then the joints; ``qd``, ``qdd`` and ``tau`` are ``(robot.nv,) = (6 + dof,)``: the base's
+linear then angular velocity (acceleration; the force then the moment about the base
+origin applied to the base), all in the base frame, then the joints; ``M`` is
+``(nv, nv)`` in that order. Gravity is then in the world frame. A quaternion whose length
+differs from 1 by more than 1e-9 is refused (``ValueError``). Batches ``(N, nq)`` run
+as the fixed-base ones (SIMD lanes, ``threads``; bit for bit the single calls). :mod:`armdyn.configuration` moves on that configuration space
+(``integrate``, ``difference``, ``neutral``, ``random_configuration``, re-exported
+here). Every other function here raises :class:`~armdyn.errors.FloatingBaseError` (a
+``ModelError`` and ``NotImplementedError``) for a floating robot, naming itself.
 """
 
 from __future__ import annotations
@@ -39,7 +53,8 @@ import sympy as sp
 from numpy.typing import ArrayLike
 
 from . import _core
-from .errors import ModelError, UnboundParameterError
+from .configuration import difference, integrate, neutral, random_configuration
+from .errors import FloatingBaseError, ModelError, UnboundParameterError
 from .mimic import MimicModel
 from .model import Link, Robot
 
@@ -62,6 +77,11 @@ __all__ = [
     "gravity_derivatives",
     "jacobian_dot",
     "regressor",
+    "integrate",
+    "difference",
+    "neutral",
+    "random_configuration",
+    "require_fixed_base",
 ]
 
 #: A robot compiled for numeric evaluation (built by :func:`compile_model`). Its
@@ -157,6 +177,12 @@ def compile_model(robot: Robot | NumericModel | MimicModel) -> NumericModel | Mi
     gravity_vec = _floats(robot.gravity, f"robot '{robot.name}'")
     base = robot.links[robot.base]
     where = f"link '{base.name}'"
+    if robot.floating and robot.mimic_joints:
+        raise FloatingBaseError(
+            "mimic joints with a floating base are not supported yet", f"robot '{robot.name}'", robot.meta.get("file")
+        )
+    # a floating base moves: its own inertia counts (a fixed one only adds a constant potential)
+    base_inertia = _field(base, "inertia", where) if robot.floating else None
     try:
         core = NumericModel(
             parents,
@@ -174,6 +200,8 @@ def compile_model(robot: Robot | NumericModel | MimicModel) -> NumericModel | Mi
             _field(base, "mass", where),
             _field(base, "com", where),
             joint_dynamics,
+            base_inertia,
+            robot.floating,
         )
     except ValueError as err:
         raise ModelError(str(err), f"robot '{robot.name}'") from None
@@ -252,9 +280,13 @@ def rnea(
 
     q, qd, qdd: (n,) or (N, n). Returns tau = M(q) qdd + C(q, qd) qd + g(q), same shape;
     with external wrenches ``f_ext`` (see :func:`rnea_derivatives`), minus sum J^T w.
+    A floating base (see the module doc): q (nq,) or (N, nq); qd, qdd (nv,) or (N, nv);
+    tau (nv,): the wrench the base needs (base frame, force then moment; zero when the
+    robot flies freely at that acceleration), then the joint torques.
     """
     threads = check_threads(threads)
     if f_ext is not None:
+        require_fixed_base(robot, "rnea with f_ext")
         f_ext = _canonical_wrenches(robot, f_ext, frame)
         return _finite(
             _core.rnea_ext(core_model(robot, "rnea with f_ext"), q, qd, qdd, f_ext, frame, threads),
@@ -272,7 +304,10 @@ def rnea(
 def crba(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Joint-space inertia matrix M(q) by the composite rigid-body algorithm.
 
-    q: (n,) or (N, n). Returns the full symmetric M: (n, n) or (N, n, n).
+    q: (n,) or (N, n). Returns the full symmetric M: (n, n) or (N, n, n). A floating
+    base (see the module doc): q (nq,) or (N, nq); M (nv, nv) in the order of the
+    velocity (base linear, base angular in the base frame, joints); it does not depend
+    on the base's pose.
     """
     threads = check_threads(threads)
     try:
@@ -294,9 +329,13 @@ def aba(
 
     q, qd, tau: (n,) or (N, n). Returns qdd = M^-1 (tau - C qd - g), same shape; with
     external wrenches ``f_ext`` (see :func:`rnea_derivatives`), M^-1 (tau + sum J^T w - C qd - g).
+    A floating base (see the module doc): q (nq,) or (N, nq); qd, tau, qdd (nv,) or (N, nv),
+    tau's first 6 the wrench applied to the base (base frame, force then moment), qdd's
+    the base's linear then angular acceleration (base frame).
     """
     threads = check_threads(threads)
     if f_ext is not None:
+        require_fixed_base(robot, "aba with f_ext")
         f_ext = _canonical_wrenches(robot, f_ext, frame)
         return _core.aba_ext(core_model(robot, "aba with f_ext"), q, qd, tau, f_ext, frame, threads)
     try:
@@ -773,4 +812,46 @@ def _finite(result, what: str, **arrays):
 
 for _name in ("forward_kinematics", "jacobian", "gravity_derivatives", "jacobian_dot", "regressor"):
     globals()[_name] = _checked(globals()[_name])
+
+
+def require_fixed_base(robot, what: str) -> None:
+    """Raise :class:`~armdyn.errors.FloatingBaseError` naming ``what`` if ``robot`` (a Robot
+    or a compiled model) has a floating base."""
+    if getattr(robot, "floating", False):
+        if isinstance(robot, Robot):
+            robot.require_fixed_base(what)
+        raise FloatingBaseError(
+            f"{what} does not support a floating base (root_joint='free-flyer') yet; rnea, crba and aba do",
+            f"robot '{robot.name}'",
+        )
+
+
+def _fixed_base_only(fn):
+    """``fn`` refusing a floating-base robot with a FloatingBaseError naming ``fn``."""
+
+    @functools.wraps(fn)
+    def call(robot, *args, **kwargs):
+        if getattr(robot, "floating", False):
+            require_fixed_base(robot, f"armdyn.numeric.{fn.__name__}")
+        return fn(robot, *args, **kwargs)
+
+    return call
+
+
+for _name in (
+    "gravity",
+    "bias",
+    "coriolis_matrix",
+    "kinetic_energy",
+    "potential_energy",
+    "forward_kinematics",
+    "jacobian",
+    "rnea_derivatives",
+    "aba_derivatives",
+    "minverse",
+    "gravity_derivatives",
+    "jacobian_dot",
+    "regressor",
+):
+    globals()[_name] = _fixed_base_only(globals()[_name])
 del _name

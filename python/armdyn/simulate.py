@@ -59,7 +59,7 @@ from typing import Callable
 import numpy as np
 
 from . import _core
-from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy
+from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy, require_fixed_base
 
 __all__ = ["simulate", "simulate_adaptive", "Trajectory", "PD", "ComputedTorque", "joint_limits"]
 
@@ -312,6 +312,7 @@ def simulate(
     Bad input (shapes, NaN, a non-positive dt, a duration that is not a whole number of
     steps, a run that would not fit in memory) raises ``ValueError`` naming it.
     """
+    require_fixed_base(robot, "armdyn.simulate")
     model = compiled_model(robot)
     dof = model.dof
     steps = step_count(duration, steps, dt)
@@ -601,6 +602,7 @@ def simulate_adaptive(
     """
     from scipy.integrate import solve_ivp
 
+    require_fixed_base(robot, "armdyn.simulate_adaptive")
     model = compiled_model(robot)
     dof = model.dof
     q0 = _state(q0, "q0", dof)

@@ -260,22 +260,32 @@ pub struct Work<L> {
 impl<L: Real> Work<L> {
     pub fn new(model: &Model) -> Self {
         let n = model.nv;
+        // the longest argument: a floating base's q (7 + n)
+        let arg = n + algo::floating::NQ_BASE;
+        let nv = n + algo::floating::NV_BASE;
         Work {
             d1: Data::new(model),
             dl: Data::new(model),
-            args: [vec![L::zero(); n], vec![L::zero(); n], vec![L::zero(); n]],
-            // the largest per-state output: M (n x n) or the regressor (n x columns)
-            res: vec![L::zero(); n * n.max(algo::regressor_columns(model))],
+            args: [vec![L::zero(); arg], vec![L::zero(); arg], vec![L::zero(); arg]],
+            // the largest per-state output: M (n x n, or nv x nv with a floating base) or
+            // the regressor (n x columns)
+            res: vec![L::zero(); (nv * nv).max(n * algo::regressor_columns(model))],
         }
     }
 }
 
 /// Defines a batched lane kernel `$name` from a call `$call` generic over the lane type
 /// `T` (`f64` for one state, `F64x4`/`F64x8` for a group), and its AVX2/AVX-512
-/// instantiations.
+/// instantiations. Each argument row is `nv` long unless `widths` says otherwise (a
+/// floating base's q and v).
 macro_rules! lanes_kernel {
     ($(#[$doc:meta])* $name:ident, nargs = $nargs:literal, out = |$m:ident| $out:expr,
      |$model:ident, $data:ident, $a:ident, $o:ident| $call:expr) => {
+        lanes_kernel!($(#[$doc])* $name, nargs = $nargs, widths = |m| [m.nv; 3], out = |$m| $out,
+                      |$model, $data, $a, $o| $call);
+    };
+    ($(#[$doc:meta])* $name:ident, nargs = $nargs:literal, widths = |$wm:ident| $widths:expr,
+     out = |$m:ident| $out:expr, |$model:ident, $data:ident, $a:ident, $o:ident| $call:expr) => {
         $(#[$doc])*
         pub fn $name(model: &Model, args: [&[f64]; $nargs], out: &mut [f64], threads: Option<usize>) {
             fn kernel<T: Real>($model: &Model, $data: &mut Data<T>, $a: [&[T]; 3], $o: &mut [T]) {
@@ -285,13 +295,13 @@ macro_rules! lanes_kernel {
             /// The rows `first..first + out.len() / per_row` of the batch.
             #[inline(always)]
             fn rows<L: Real>(model: &Model, w: &mut Work<L>, args: [&[f64]; 3], first: usize, out: &mut [f64]) {
-                let n = model.nv;
+                let widths: [usize; 3] = { let $wm = model; $widths };
                 let per_row = { let $m = model; $out };
                 let rows = out.len() / per_row;
                 let mut r = 0;
                 // Groups of L::LANES rows: transpose into lanes, run, transpose back.
                 while r + L::LANES <= rows {
-                    for (slot, arg) in w.args.iter_mut().zip(args).take($nargs) {
+                    for ((slot, arg), &n) in w.args.iter_mut().zip(args).zip(&widths).take($nargs) {
                         for j in 0..n {
                             for k in 0..L::LANES {
                                 slot[j].set_lane(k, arg[(first + r + k) * n + j]);
@@ -299,7 +309,8 @@ macro_rules! lanes_kernel {
                         }
                     }
                     let [a0, a1, a2] = &w.args;
-                    kernel(model, &mut w.dl, [a0, a1, a2], &mut w.res[..per_row]);
+                    let lanes = [&a0[..widths[0]], &a1[..widths[1]], &a2[..widths[2]]];
+                    kernel(model, &mut w.dl, lanes, &mut w.res[..per_row]);
                     for j in 0..per_row {
                         for k in 0..L::LANES {
                             out[(r + k) * per_row + j] = w.res[j].lane(k);
@@ -309,7 +320,8 @@ macro_rules! lanes_kernel {
                 }
                 // Leftover rows one by one.
                 for r in r..rows {
-                    let a = args.map(|a| if a.is_empty() { a } else { row(a, n, first + r) });
+                    let a: [&[f64]; 3] =
+                        std::array::from_fn(|k| if args[k].is_empty() { args[k] } else { row(args[k], widths[k], first + r) });
                     kernel(model, &mut w.d1, a, &mut out[r * per_row..(r + 1) * per_row]);
                 }
             }
@@ -326,10 +338,10 @@ macro_rules! lanes_kernel {
                 rows(model, w, args, first, out)
             }
 
-            let n = model.nv;
+            let widths: [usize; 3] = { let $wm = model; $widths };
             let per_row = { let $m = model; $out };
             let nrows = if per_row == 0 { 0 } else { out.len() / per_row };
-            for a in &args {
+            for (a, n) in args.iter().zip(widths) {
                 assert_eq!(a.len(), nrows * n, "argument size");
             }
             let mut all: [&[f64]; 3] = [&[], &[], &[]];
@@ -367,6 +379,24 @@ lanes_kernel!(
     /// Batched [`algo::crba`]: `args = [q]` (N, nv), `out` = M (N, nv, nv).
     crba, nargs = 1, out = |m| m.nv * m.nv,
     |model, data, a, o| algo::crba(model, data, a[0], o)
+);
+lanes_kernel!(
+    /// Batched [`algo::rnea_floating`]: `args = [q (N, 7 + nv), v, a (N, 6 + nv)]`, `out` =
+    /// tau (N, 6 + nv) (a floating base, `algo::floating`).
+    rnea_floating, nargs = 3, widths = |m| [m.nv + 7, m.nv + 6, m.nv + 6], out = |m| m.nv + 6,
+    |model, data, a, o| algo::rnea_floating(model, data, a[0], a[1], a[2], o)
+);
+lanes_kernel!(
+    /// Batched [`algo::aba_floating`]: `args = [q (N, 7 + nv), v, tau (N, 6 + nv)]`, `out` =
+    /// the accelerations (N, 6 + nv) (a floating base, `algo::floating`).
+    aba_floating, nargs = 3, widths = |m| [m.nv + 7, m.nv + 6, m.nv + 6], out = |m| m.nv + 6,
+    |model, data, a, o| algo::aba_floating(model, data, a[0], a[1], a[2], o)
+);
+lanes_kernel!(
+    /// Batched [`algo::crba_floating`]: `args = [q (N, 7 + nv)]`, `out` = M (N, 6 + nv, 6 + nv)
+    /// (a floating base, `algo::floating`).
+    crba_floating, nargs = 1, widths = |m| [m.nv + 7, 0, 0], out = |m| (m.nv + 6) * (m.nv + 6),
+    |model, data, a, o| algo::crba_floating(model, data, a[0], o)
 );
 lanes_kernel!(
     /// Batched [`algo::gravity`]: `args = [q]` (N, nv), `out` = g (N, nv).

@@ -6,7 +6,8 @@
 //! * [`Data`] — a per-thread workspace, allocated once per model; the algorithms
 //!   allocate nothing.
 //! * [`algo`] — one algorithm per file: `rnea`, `crba`, `aba`, `gravity`, `bias`,
-//!   `coriolis_matrix`, energies, `jacobian`, `forward_kinematics`.
+//!   `coriolis_matrix`, energies, `jacobian`, `forward_kinematics`; `floating`: the
+//!   RNEA, CRBA and ABA with a floating base (Pinocchio's free-flyer arrays).
 //! * [`batch`] — many states (rows of `(N, n)` arrays), rayon over chunks of rows,
 //!   4 or 8 states per SIMD step for `rnea`, `aba`, `crba`, `gravity`, `bias`.
 //!

@@ -120,6 +120,9 @@ pub struct Model {
     pub joint_body: Vec<Option<usize>>,
     /// Potential energy of the links welded to the base (constant, `-sum m g . p_c`).
     pub welded_potential: f64,
+    /// Spatial inertia of the base link and the links welded to it, base frame: what
+    /// moves with a floating base (`algo::floating`); a fixed base ignores it.
+    pub base_inertia: RigidInertia<f64>,
     /// Joint friction, rotor inertia and offset of body i's joint (zero by default; set
     /// with [`Model::set_joint_dynamics`]).
     pub joint_dynamics: Vec<JointDynamics>,
@@ -180,6 +183,7 @@ impl Model {
             links: vec![],
             joint_body: vec![],
             welded_potential: 0.0,
+            base_inertia: RigidInertia::zero(),
             joint_dynamics: vec![],
             has_joint_dynamics: false,
         };
@@ -250,7 +254,10 @@ impl Model {
             let i_body = i_link.tr_transform(&link_x_body);
             match link.body {
                 Some(b) => m.inertia[b] += i_body,
-                None => m.welded_potential -= m.gravity.dot(i_body.h),
+                None => {
+                    m.welded_potential -= m.gravity.dot(i_body.h);
+                    m.base_inertia += i_body;
+                }
             }
         }
         m.links = links;
@@ -283,6 +290,27 @@ impl Model {
     /// base link itself, in the potential energy (a constant; no other effect).
     pub fn add_base_mass(&mut self, mass: f64, com: [f64; 3]) {
         self.welded_potential -= mass * self.gravity.dot(V3::from_array(com));
+    }
+
+    /// Add the base link's own inertia (mass, centre of mass and inertia tensor about it,
+    /// base frame) to [`Model::base_inertia`]; it also counts in the potential energy,
+    /// as [`Model::add_base_mass`]. Refuses a negative mass, a non-finite number or a
+    /// tensor that is not symmetric.
+    pub fn add_base_inertia(&mut self, mass: f64, com: [f64; 3], inertia: [[f64; 3]; 3]) -> Result<(), ModelError> {
+        let err = |message: &str| Err(ModelError { joint: None, message: format!("base link: {message}") });
+        if !(mass.is_finite() && com.iter().chain(inertia.iter().flatten()).all(|x| x.is_finite())) {
+            return err("a number is NaN or infinite");
+        }
+        if mass < 0.0 {
+            return err("negative mass");
+        }
+        let ic = m3(&inertia);
+        if (0..3).any(|a| (0..3).any(|b| (ic.at(a, b) - ic.at(b, a)).abs() > TOL * (1.0 + ic.at(a, b).abs()))) {
+            return err("inertia tensor is not symmetric");
+        }
+        self.base_inertia += RigidInertia::from_mass_com(mass, V3::from_array(com), Sym3::from_m3(&ic));
+        self.add_base_mass(mass, com);
+        Ok(())
     }
 
     /// Number of link frames (base included): joints + 1.

@@ -144,6 +144,7 @@ fn run<'py, const K: usize, const R: usize>(
     batched: impl FnOnce(&Model, [&[f64]; K], Ext<'_>, [&mut [f64]; R], Option<usize>) + Send,
 ) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; R]> {
     guard(|| {
+        m.fixed_base_only()?;
         let threads = thread_arg(threads)?;
         let frame = parse_frame(frame)?;
         let (shape, arrays) = states(m.model.nv, args)?;

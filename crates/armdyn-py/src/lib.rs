@@ -24,6 +24,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 
 mod derivatives;
+mod floating;
 mod simulate;
 
 /// Run `f`, turning a Rust panic into a Python `RuntimeError`.
@@ -228,6 +229,9 @@ pub struct NumericModel {
     /// Movable joints whose whole subtree has no mass and no inertia: M is singular
     /// and `aba` refuses (it would divide by zero).
     inert_joints: Vec<String>,
+    /// Whether the base floats (a free-flyer root joint, `floating.rs`): rnea, crba and
+    /// aba then take Pinocchio's floating-base arrays, and every other method refuses.
+    floating: bool,
 }
 
 /// Bodies (= movable joints, by coordinate index) whose subtree, themselves included,
@@ -303,6 +307,7 @@ impl NumericModel {
         batched: impl FnOnce(&Model, [&[f64]; K], &mut [f64], Option<usize>) + Send,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guard(|| {
+            self.fixed_base_only()?;
             let threads = thread_arg(threads)?;
             let (shape, arrays) = states(self.model.nv, args)?;
             match shape {
@@ -345,7 +350,7 @@ impl NumericModel {
     /// joint_dynamics: None, or per movable joint `[armature, viscous, coulomb, offset]`
     /// (docs/architecture.md: tau += Ia qdd + Fv qd + Fc sign(qd) + offset).
     #[new]
-    #[pyo3(signature = (parents, types, rotations, translations, axes, masses, coms, inertias, gravity, link_names, coordinate_names, name = String::new(), base_mass = 0.0, base_com = [0.0; 3], joint_dynamics = None))]
+    #[pyo3(signature = (parents, types, rotations, translations, axes, masses, coms, inertias, gravity, link_names, coordinate_names, name = String::new(), base_mass = 0.0, base_com = [0.0; 3], joint_dynamics = None, base_inertia = None, floating = false))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -364,6 +369,8 @@ impl NumericModel {
         base_mass: f64,
         base_com: [f64; 3],
         joint_dynamics: Option<Vec<[f64; 4]>>,
+        base_inertia: Option<[[f64; 3]; 3]>,
+        floating: bool,
     ) -> PyResult<Self> {
         guard(|| {
             let init_args = PyTuple::new(py, [
@@ -383,6 +390,8 @@ impl NumericModel {
                 base_com.into_pyobject(py)?.into_any(),
                 // friction and rotor inertia travel too (a pickled model on a Dask worker)
                 joint_dynamics.clone().into_pyobject(py)?.into_any(),
+                base_inertia.into_pyobject(py)?.into_any(),
+                floating.into_pyobject(py)?.to_owned().into_any(),
             ])?
             .unbind();
             let nj = parents.len();
@@ -427,7 +436,12 @@ impl NumericModel {
                 };
                 PyValueError::new_err(format!("{what}: {}", e.message))
             })?;
-            model.add_base_mass(base_mass, base_com);
+            match base_inertia {
+                Some(inertia) => model
+                    .add_base_inertia(base_mass, base_com, inertia)
+                    .map_err(|e| PyValueError::new_err(format!("link '{}': {}", link_names[0], e.message)))?,
+                None => model.add_base_mass(base_mass, base_com),
+            }
             if coordinate_names.len() != model.nv {
                 return Err(PyValueError::new_err(format!(
                     "{} coordinate names for {} movable joints",
@@ -452,7 +466,17 @@ impl NumericModel {
             let link_index = link_names.iter().enumerate().map(|(k, s)| (s.clone(), k)).collect();
             let scratch = Mutex::new(Scratch::new(&model));
             let inert_joints = inert_bodies(&model).into_iter().map(|i| coordinate_names[i].clone()).collect();
-            Ok(NumericModel { model, scratch, name, link_names, link_index, coordinate_names, init_args, inert_joints })
+            Ok(NumericModel {
+                model,
+                scratch,
+                name,
+                link_names,
+                link_index,
+                coordinate_names,
+                init_args,
+                inert_joints,
+                floating,
+            })
         })
     }
 
@@ -460,6 +484,21 @@ impl NumericModel {
     #[getter]
     fn dof(&self) -> usize {
         self.model.nv
+    }
+    /// Whether the base floats (a free-flyer root joint).
+    #[getter]
+    fn floating(&self) -> bool {
+        self.floating
+    }
+    /// Length of q: 7 + dof for a floating base, dof otherwise.
+    #[getter]
+    fn nq(&self) -> usize {
+        self.model.nv + if self.floating { 7 } else { 0 }
+    }
+    /// Length of v (qd, qdd, tau): 6 + dof for a floating base, dof otherwise.
+    #[getter]
+    fn nv(&self) -> usize {
+        self.model.nv + if self.floating { 6 } else { 0 }
     }
     /// Number of link frames (base included).
     #[getter]
@@ -499,7 +538,8 @@ impl NumericModel {
     }
 
     fn __repr__(&self) -> String {
-        format!("NumericModel({:?}, dof={}, nlinks={})", self.name, self.model.nv, self.model.nlinks())
+        let base = if self.floating { ", floating" } else { "" };
+        format!("NumericModel({:?}, dof={}, nlinks={}{base})", self.name, self.model.nv, self.model.nlinks())
     }
 
     /// Inverse dynamics tau = M qdd + C qd + g. q, qd, qdd: (n,) or (N, n).
@@ -512,6 +552,9 @@ impl NumericModel {
         qdd: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        if self.floating {
+            return self.rnea_floating(py, q, qd, qdd, threads);
+        }
         self.vector_op(
             py,
             [("q", q), ("qd", qd), ("qdd", qdd)],
@@ -532,6 +575,9 @@ impl NumericModel {
         tau: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        if self.floating {
+            return self.aba_floating(py, q, qd, tau, threads);
+        }
         if !self.inert_joints.is_empty() {
             let names: Vec<String> = self.inert_joints.iter().map(|n| format!("'{n}'")).collect();
             return Err(PyValueError::new_err(format!(
@@ -574,6 +620,9 @@ impl NumericModel {
         q: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        if self.floating {
+            return self.crba_floating(py, q, threads);
+        }
         let n = self.model.nv;
         self.vector_op(
             py,

@@ -107,6 +107,7 @@ fn _simulate<'py>(
     threads: Option<i64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
+        model.get().fixed_base_only()?;
         let threads = thread_arg(threads)?;
         let m = &model.get().model;
         let n = m.nv;

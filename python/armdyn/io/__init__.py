@@ -98,11 +98,16 @@ def _published(path: Path) -> Robot:
         robot.base,
         robot.defaults,
         strict=False,
+        root_joint=robot.root_joint,
     )
 
 
 def load(
-    source: str | os.PathLike[str], strict: bool | None = None, trusted: bool = False, floating: str | None = None
+    source: str | os.PathLike[str],
+    strict: bool | None = None,
+    trusted: bool = False,
+    floating: str | None = None,
+    root_joint: str | None = None,
 ) -> Robot:
     """A :class:`~armdyn.Robot` from a bundled model's name or a model file.
 
@@ -121,10 +126,42 @@ def load(
             ``armdyn serve`` never do.
     floating: MJCF only: ``"weld"`` reads a ``free`` joint of a body of the world body as
             a fixed base (see :func:`armdyn.io.mjcf.load_mjcf`).
+    root_joint: None (the model's root link is fixed in the world) or ``"free-flyer"``:
+            the root link floats, as Pinocchio's ``buildModelFromUrdf(path,
+            JointModelFreeFlyer())`` (any model format; see :class:`armdyn.Robot`'s
+            ``floating``, ``nq``, ``nv``, and :mod:`armdyn.numeric` for the arrays).
 
     Raises ModelError (one line naming the file) for an unknown name, a missing file
     or a bad model.
     """
+    robot = _load(source, strict, trusted, floating)
+    if root_joint == robot.root_joint:
+        return robot
+    return with_root_joint(robot, root_joint)
+
+
+def with_root_joint(robot: Robot, root_joint: str | None) -> Robot:
+    """``robot`` with its root link fixed (``root_joint=None``) or floating
+    (``"free-flyer"``); links, joints and parameters unchanged."""
+    import warnings
+
+    with warnings.catch_warnings():  # its links were warned about when it was built
+        warnings.simplefilter("ignore")
+        return Robot(
+            robot.name,
+            robot.links.values(),
+            robot.joints,
+            robot.gravity,
+            robot.parameters,
+            robot.meta,
+            robot.base,
+            robot.defaults,
+            strict=robot.strict,
+            root_joint=root_joint,
+        )
+
+
+def _load(source, strict: bool | None, trusted: bool, floating: str | None) -> Robot:
     text = os.fspath(source)
     path = Path(text)
     if floating is not None and path.suffix.lower() != ".xml":

@@ -10,7 +10,7 @@ import numpy as np
 import sympy as sp
 
 from ..dispatch import call
-from ..errors import ModelError
+from ..errors import FloatingBaseError, ModelError
 from ..inertia import check_physical, physical_violations
 from .frozen import FreezeAfterInit, FrozenDict, FrozenList
 from .joints import JOINT_DYNAMICS, Joint, Link, coordinate_symbols
@@ -19,8 +19,27 @@ from .numbers import Numbers, mat3, vec3
 _CACHES = ("_numeric_model", "_canonical")
 
 
+#: The root joints a robot's base may have: None (the base is fixed in the world) or
+#: ``"free-flyer"`` (the base floats: Pinocchio's JointModelFreeFlyer at the root).
+ROOT_JOINTS = (None, "free-flyer")
+
+
+def _pinocchio_order(base: str, by_parent: dict[str, list[Joint]]) -> list[Joint]:
+    """The joints in the order Pinocchio's URDF parser gives a floating robot's
+    coordinates: depth first from the base, a link's child joints by name (its URDF
+    reader keeps them in a map), so that q and v pass unchanged between the two."""
+    ordered: list[Joint] = []
+    stack = sorted(by_parent.get(base, []), key=lambda j: j.name, reverse=True)
+    while stack:
+        j = stack.pop()
+        ordered.append(j)
+        stack.extend(sorted(by_parent.get(j.child, []), key=lambda b: b.name, reverse=True))
+    return ordered
+
+
 class Robot(metaclass=FreezeAfterInit):
-    """A fixed-base robot: links and joints in tree order, and gravity.
+    """A robot: links and joints in tree order, and gravity; its base fixed in the world,
+    or floating (``root_joint="free-flyer"``).
 
     Immutable once constructed: setting a public attribute raises AttributeError and
     its lists and dicts (``joints``, ``links``, ``parameters``, ...) refuse changes,
@@ -33,7 +52,11 @@ class Robot(metaclass=FreezeAfterInit):
     Attributes
     ----------
     name:        the robot's name.
-    base:        name of the base link (the root, fixed in the world).
+    base:        name of the base link (the root: fixed in the world, or floating).
+    root_joint:  None (a fixed base) or ``"free-flyer"``: the base is a free rigid body
+                 (6 more coordinates, Pinocchio's layout; see :attr:`floating`). The
+                 joints of a floating robot are then in the order Pinocchio's URDF
+                 parser gives them: depth first from the base, siblings by joint name.
     links:       dict name -> :class:`Link`, base first, then each joint's child in order.
     joints:      list of :class:`Joint` in tree order (fixed ones included).
     gravity:     (3, 1) gravity vector in the base frame (m/s^2).
@@ -48,6 +71,12 @@ class Robot(metaclass=FreezeAfterInit):
 
     Derived:
     movable_joints: the non-fixed joints, in order; ``dof`` is their number.
+    floating:       whether the base floats (``root_joint == "free-flyer"``).
+    nq, nv:         the lengths of the numeric configuration and velocity arrays
+                    (:mod:`armdyn.numeric`): ``dof`` and ``dof`` for a fixed base;
+                    ``7 + dof`` (base position, quaternion x y z w, joints) and ``6 + dof``
+                    (base linear and angular velocity in the base frame, joints) for a
+                    floating one.
     q, qd, qdd:     (dof, 1) symbol vectors named after the movable joints.
     """
 
@@ -102,8 +131,15 @@ class Robot(metaclass=FreezeAfterInit):
         base: str | None = None,
         defaults: Mapping[str, float] | None = None,
         strict: bool = True,
+        root_joint: str | None = None,
     ):
         self.name = name
+        if root_joint not in ROOT_JOINTS:
+            raise ModelError(
+                f"root_joint={root_joint!r}: expected None (a fixed base) or 'free-flyer' (a floating base)",
+                f"robot '{name}'",
+            )
+        self.root_joint = root_joint
         links = list(links)
         joints = list(joints)
         self.meta = dict(meta or {})  # "file" (if any) names the model file in messages
@@ -157,6 +193,9 @@ class Robot(metaclass=FreezeAfterInit):
         self.movable_joints = [j for j in self.joints if j.movable and j.mimic is None]
         self.mimic_joints = [j for j in self.joints if j.mimic is not None]
         self.dof = len(self.movable_joints)
+        self.floating = root_joint == "free-flyer"
+        self.nq = self.dof + 7 if self.floating else self.dof
+        self.nv = self.dof + 6 if self.floating else self.dof
         self.coordinate_names = [j.name for j in self.movable_joints]
         self.q, self.qd, self.qdd = coordinate_symbols(self.coordinate_names)
         clash = set(self.coordinate_names) & set(self.parameters)
@@ -235,6 +274,8 @@ class Robot(metaclass=FreezeAfterInit):
             )
         # the given order is a tree order when every joint comes after its parent joint
         # (the joint whose child is its parent link): one dict lookup per joint, O(n)
+        if self.root_joint == "free-flyer":
+            return _pinocchio_order(self.base, by_parent)
         position = {j.name: i for i, j in enumerate(joints)}
         if all(b.parent not in child_of or position[child_of[b.parent].name] < position[b.name] for b in joints):
             return list(joints)
@@ -376,6 +417,7 @@ class Robot(metaclass=FreezeAfterInit):
             self.base,
             self.defaults,
             strict=self.strict,
+            root_joint=self.root_joint,
         )
         self.__dict__["_canonical"] = out  # built once: the numeric engines and codegen share it
         return out
@@ -434,6 +476,7 @@ class Robot(metaclass=FreezeAfterInit):
                 self.base,
                 defaults,
                 strict=self.strict,
+                root_joint=self.root_joint,
             )
         except ModelError as err:  # e.g. a bound value that is not physical: name the model file
             raise err.located(source=self.meta.get("file")) from None
@@ -514,6 +557,7 @@ class Robot(metaclass=FreezeAfterInit):
                 self.base,
                 self.defaults,
                 strict=self.strict,
+                root_joint=self.root_joint,
             )
 
     @property
@@ -551,11 +595,24 @@ class Robot(metaclass=FreezeAfterInit):
                 self.base,
                 self.defaults,
                 strict=self.strict,
+                root_joint=self.root_joint,
+            )
+
+    def require_fixed_base(self, what: str) -> None:
+        """Raise :class:`~armdyn.errors.FloatingBaseError` naming ``what`` if the base
+        floats: for the functions that handle a fixed base only (yet)."""
+        if self.floating:
+            raise FloatingBaseError(
+                f"{what} does not support a floating base (root_joint='free-flyer') yet; "
+                "armdyn.numeric's rnea, crba and aba do",
+                f"robot '{self.name}'",
+                self.meta.get("file"),
             )
 
     def __repr__(self) -> str:
         kinds = "".join({"revolute": "R", "prismatic": "P", "fixed": "F"}[j.type] for j in self.joints)
         extra = f", joint_dynamics={list(self.joint_dynamics)}" if self.joint_dynamics else ""
+        extra += ", root_joint='free-flyer'" if self.floating else ""
         return f"Robot({self.name!r}, dof={self.dof}, joints={kinds}, parameters={sorted(self.parameters)}{extra})"
 
     def _repr_html_(self) -> str:

@@ -32,6 +32,7 @@ def derive(robot: Robot | str, method: str = "newton-euler") -> EquationsOfMotio
         from ..io import load
 
         robot = load(robot)
+    robot.require_fixed_base("armdyn.derive")
     try:
         fn = METHODS[method]
     except KeyError:

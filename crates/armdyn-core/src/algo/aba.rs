@@ -20,15 +20,33 @@ use crate::spatial::{ArticulatedInertia, Force, Motion, RigidInertia, V3};
 pub fn aba<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], tau: &[T], qdd: &mut [T]) {
     let n = model.nv;
     assert!(q.len() == n && qd.len() == n && tau.len() == n && qdd.len() == n, "state length");
-    // Pass 1 (root to leaves): velocities, velocity-product accelerations c_i,
-    // I^A_i = I_i and p^A_i = v_i x* I_i v_i.
-    for i in 0..n {
+    velocities_and_bias(model, data, q, qd, None);
+    let frames = BodyFrames(&model.kind);
+    articulated_inertias(model, data, &frames, Some((qd, tau)));
+    let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
+    joint_accelerations(model, data, &frames, qdd, &a0);
+}
+
+/// Pass 1 of RBDA Table 7.1 (root to leaves), body frames: velocities `v_i`,
+/// velocity-product accelerations `c_i`, `I^A_i = I_i` and `p^A_i = v_i x* I_i v_i`;
+/// the root bodies' parent moves with `base_v` (base frame; None: at rest). Writes
+/// `data.xup`, `data.v`, `data.c`, `data.ia`, `data.pa`. `q`, `qd`: (nv,).
+#[inline(always)]
+pub(crate) fn velocities_and_bias<T: Real>(
+    model: &Model,
+    data: &mut Data<T>,
+    q: &[T],
+    qd: &[T],
+    base_v: Option<&Motion<T>>,
+) {
+    for i in 0..model.nv {
         let kind = model.kind[i];
         let xup = kind.xup(&model.xtree[i], q[i]);
         let vj = kind.s_times(qd[i]);
-        let v = match model.parent[i] {
-            Some(p) => xup.apply_motion(&data.v[p]) + vj,
-            None => vj,
+        let v = match (model.parent[i], base_v) {
+            (Some(p), _) => xup.apply_motion(&data.v[p]) + vj,
+            (None, Some(vb)) => xup.apply_motion(vb) + vj,
+            (None, None) => vj,
         };
         let inertia = RigidInertia::splat(&model.inertia[i]);
         data.c[i] = kind.v_cross_s(&v, qd[i]);
@@ -37,9 +55,16 @@ pub fn aba<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], tau: &
         data.xup[i] = xup;
         data.v[i] = v;
     }
-    let frames = BodyFrames(&model.kind);
-    articulated_inertias(model, data, &frames, Some((qd, tau)));
-    joint_accelerations(model, data, &frames, qdd);
+}
+
+/// What body i hands to its parent in pass 2, in body i's coordinates, after
+/// [`articulated_inertias`] with a bias: `I^a_i = I^A_i - U_i U_i^T / D_i` and
+/// `p^a_i = p^A_i + I^a_i c_i + U_i u_i / D_i`.
+#[inline(always)]
+pub(crate) fn handed_to_parent<T: Real>(data: &Data<T>, i: usize) -> (ArticulatedInertia<T>, Force<T>) {
+    let ia = data.ia[i].sub_outer(&data.u_col[i], data.d_inv[i]);
+    let pa = data.pa[i] + ia.mul_motion(&data.c[i]) + data.u_col[i].scale(data.u[i] * data.d_inv[i]);
+    (ia, pa)
 }
 
 /// The coordinates the articulated-body passes express body i's quantities in: how
@@ -168,16 +193,16 @@ pub(crate) fn articulated_inertias<T: Real, F: AbaFrames<T>>(
             data.u[i] = u;
         }
         if let Some(p) = model.parent[i] {
-            let ia = data.ia[i].sub_outer(&u_col, d_inv);
             match u {
-                Some(u) => {
-                    let pa = data.pa[i] + ia.mul_motion(&data.c[i]) + u_col.scale(u * d_inv);
+                Some(_) => {
+                    let (ia, pa) = handed_to_parent(data, i);
                     let ia_p = frames.inertia_to_parent(data, i, &ia);
                     let pa_p = frames.force_to_parent(data, i, &pa);
                     data.ia[p] += ia_p;
                     data.pa[p] += pa_p;
                 }
                 None => {
+                    let ia = data.ia[i].sub_outer(&u_col, d_inv);
                     let ia_p = frames.inertia_to_parent(data, i, &ia);
                     data.ia[p] += ia_p;
                 }
@@ -187,16 +212,22 @@ pub(crate) fn articulated_inertias<T: Real, F: AbaFrames<T>>(
 }
 
 /// Pass 3 of RBDA Table 7.1 (root to leaves), after [`articulated_inertias`] with a bias,
-/// in the same coordinates: `a'_i = X a_lambda + c_i` (`a_lambda = a_0 = [0; -g]` at a
-/// root), `qdd_i = (u_i - U_i^T a'_i) / D_i`, `a_i = a'_i + S_i qdd_i`. Writes `qdd` (nv,)
-/// and `data.a`.
+/// in the same coordinates: `a'_i = X a_lambda + c_i` (`a_lambda = a_root` at a root),
+/// `qdd_i = (u_i - U_i^T a'_i) / D_i`, `a_i = a'_i + S_i qdd_i`. Writes `qdd` (nv,)
+/// and `data.a`. `a_root`: the acceleration of the root bodies' parent (the base), in
+/// its coordinates, gravity's `-g` included (`[0; -g]` for a fixed base).
 #[inline(always)]
-pub(crate) fn joint_accelerations<T: Real, F: AbaFrames<T>>(model: &Model, data: &mut Data<T>, frames: &F, qdd: &mut [T]) {
-    let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
+pub(crate) fn joint_accelerations<T: Real, F: AbaFrames<T>>(
+    model: &Model,
+    data: &mut Data<T>,
+    frames: &F,
+    qdd: &mut [T],
+    a_root: &Motion<T>,
+) {
     for i in 0..model.nv {
         let ap = match model.parent[i] {
             Some(p) => frames.motion_from_parent(data, i, &data.a[p]),
-            None => frames.motion_from_parent(data, i, &a0),
+            None => frames.motion_from_parent(data, i, a_root),
         };
         let a = ap + data.c[i];
         let qddi = (data.u[i] - a.dot(&data.u_col[i])) * data.d_inv[i];

@@ -23,7 +23,7 @@ use crate::data::Data;
 use crate::deriv_data::DerivData;
 use crate::model::Model;
 use crate::real::Real;
-use crate::spatial::ArticulatedInertia;
+use crate::spatial::{ArticulatedInertia, Motion, V3};
 
 /// Partial derivatives of `qdd = aba(q, qd, tau)` (with external wrenches `ext`, if any:
 /// `M qdd + C qd + g = tau + sum_L J_L^T w_L`).
@@ -95,5 +95,6 @@ fn aba_world<T: Real>(model: &Model, data: &mut Data<T>, dd: &DerivData<T>, qd: 
     }
     let frames = BaseFrame(&dd.s[..]);
     articulated_inertias(model, data, &frames, Some((qd, tau)));
-    joint_accelerations(model, data, &frames, qdd);
+    let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
+    joint_accelerations(model, data, &frames, qdd, &a0);
 }

@@ -3,7 +3,7 @@
 use crate::data::Data;
 use crate::model::Model;
 use crate::real::Real;
-use crate::spatial::{Motion, RigidInertia};
+use crate::spatial::{Force, Motion, RigidInertia};
 
 /// `tau = M(q) qdd + C(q, qd) qd + g(q)`.
 ///
@@ -11,6 +11,24 @@ use crate::spatial::{Motion, RigidInertia};
 /// `a_0 = [0; -g]` (RBDA 5.3). Writes `data.xup`, `data.v`, `data.a`, `data.f`.
 #[inline(always)]
 pub fn rnea<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd: &[T], tau: &mut [T]) {
+    rnea_tree(model, data, q, qd, qdd, tau, None);
+}
+
+/// The RNEA over the movable joints: [`rnea`] when `base` is None (the base at rest, its
+/// acceleration `a_0 = [0; -g]`); with `base = Some((v_B, a_B))` the base moves with
+/// spatial velocity `v_B` and acceleration `a_B` (base frame, gravity's `-g` included),
+/// and the sum of the forces the root bodies exert on the base, `sum ^B X_i^* f_i`
+/// (base frame), is returned (zero without `base`). Slices as in [`rnea`].
+#[inline(always)]
+pub(crate) fn rnea_tree<T: Real>(
+    model: &Model,
+    data: &mut Data<T>,
+    q: &[T],
+    qd: &[T],
+    qdd: &[T],
+    tau: &mut [T],
+    base: Option<(Motion<T>, Motion<T>)>,
+) -> Force<T> {
     let n = model.nv;
     assert!(q.len() == n && qd.len() == n && qdd.len() == n && tau.len() == n, "state length");
     let a0 = Motion::new(crate::spatial::V3::splat(model.a0.w), crate::spatial::V3::splat(model.a0.v));
@@ -20,9 +38,10 @@ pub fn rnea<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd: 
         let kind = model.kind[i];
         let xup = kind.xup(&model.xtree[i], q[i]);
         let vj = kind.s_times(qd[i]);
-        let (v, a) = match model.parent[i] {
-            Some(p) => (xup.apply_motion(&data.v[p]) + vj, xup.apply_motion(&data.a[p])),
-            None => (vj, xup.apply_motion(&a0)),
+        let (v, a) = match (model.parent[i], &base) {
+            (Some(p), _) => (xup.apply_motion(&data.v[p]) + vj, xup.apply_motion(&data.a[p])),
+            (None, Some((vb, ab))) => (xup.apply_motion(vb) + vj, xup.apply_motion(ab)),
+            (None, None) => (vj, xup.apply_motion(&a0)),
         };
         let a = a + kind.s_times(qdd[i]) + kind.v_cross_s(&v, qd[i]);
         let inertia = RigidInertia::splat(&model.inertia[i]);
@@ -32,16 +51,22 @@ pub fn rnea<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd: 
         data.a[i] = a;
     }
     // Backward pass: tau_i = S_i^T f_i; f_lambda += ^i X_lambda^T f_i.
+    let mut on_base = Force::zero();
     for i in (0..n).rev() {
         tau[i] = model.kind[i].s_dot(&data.f[i]);
-        if let Some(p) = model.parent[i] {
-            let fp = data.xup[i].tr_apply_force(&data.f[i]);
-            data.f[p] += fp;
+        match model.parent[i] {
+            Some(p) => {
+                let fp = data.xup[i].tr_apply_force(&data.f[i]);
+                data.f[p] += fp;
+            }
+            None if base.is_some() => on_base += data.xup[i].tr_apply_force(&data.f[i]),
+            None => {}
         }
     }
     if model.has_joint_dynamics {
         add_joint_dynamics(model, qd, qdd, tau);
     }
+    on_base
 }
 
 /// `tau_i += Ia_i qdd_i + Fv_i qd_i + Fc_i sign(qd_i) + offset_i` (docs/architecture.md), all (nv,).

@@ -8,6 +8,7 @@ mod alloc;
 mod assert_close;
 mod batch;
 mod derivatives;
+mod floating;
 mod identities;
 mod integrate;
 mod minverse;

@@ -1,0 +1,88 @@
+"""A floating base: armdyn.numeric vs Pinocchio per call from Python, side by side in one
+process, on example-robot-data's solo12, anymal and talos (free-flyer root).
+
+    python benchmarks/bench_floating.py            # full run
+    python benchmarks/bench_floating.py --quick    # smoke run: fewer repeats
+
+(with armdyn importable: ``PYTHONPATH=python`` after a release build).
+
+``armdyn.numeric.rnea(robot, q, v, a)`` vs ``pin.rnea(model, data, q, v, a)`` on the same
+arrays (Pinocchio's layout: q = base position, quaternion x y z w, joints), likewise
+crba and aba. Each time is the median over ``--repeat`` runs of ``timeit`` with
+``--number`` calls each; the runs of the two libraries alternate, so both see the same
+machine load. Before timing each robot is checked: armdyn == Pinocchio to 1e-10.
+Ratios are armdyn time / Pinocchio time: below 1 means armdyn is faster.
+
+Not a test: timings depend on the machine and its load.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.metadata
+import os
+import platform
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_numeric import paired_medians, per_call_run  # noqa: E402  (the same timing as the arms')
+
+import armdyn  # noqa: E402
+from armdyn import numeric as num  # noqa: E402
+
+ROBOTS = {
+    "solo12": "solo_description/robots/solo12.urdf",
+    "anymal": "anymal_b_simple_description/robots/anymal.urdf",
+    "talos": "talos_data/robots/talos_reduced.urdf",
+}
+
+
+def robots_dir() -> Path:
+    dist = importlib.metadata.distribution("example-robot-data")
+    return Path(dist.locate_file("cmeel.prefix/share/example-robot-data/robots"))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--repeat", type=int, default=15)
+    parser.add_argument("--number", type=int, default=2000)
+    args = parser.parse_args()
+    repeat, number = (5, 300) if args.quick else (args.repeat, args.number)
+    print(f"{platform.processor() or platform.machine()}, Python {platform.python_version()}, pin {pin.__version__}")
+    print(f"median of {repeat} runs x {number} calls; ratio = armdyn / Pinocchio\n")
+    print("| robot | nv | algorithm | armdyn (us) | Pinocchio (us) | ratio |")
+    print("| --- | --- | --- | --- | --- | --- |")
+    rng = np.random.default_rng(0)
+    for name, rel in ROBOTS.items():
+        urdf = robots_dir() / rel
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            robot = armdyn.load(urdf, strict=False, root_joint="free-flyer").without_joint_dynamics()
+        model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+        data = model.createData()
+        assert list(model.names)[2:] == list(robot.coordinate_names), "the same joint order"
+        q = num.random_configuration(robot, rng)
+        v, a = rng.uniform(-1, 1, (2, robot.nv))
+        tau = num.rnea(robot, q, v, a)
+        assert np.max(np.abs(tau - pin.rnea(model, data, q, v, a))) < 1e-10 * max(1, np.max(np.abs(tau)))
+        M = pin.crba(model, data, q)
+        assert np.max(np.abs(num.crba(robot, q) - (np.triu(M) + np.triu(M, 1).T))) < 1e-10 * np.max(np.abs(M))
+        assert np.max(np.abs(num.aba(robot, q, v, tau) - a)) < 1e-8
+        cases = {
+            "rnea": ((num.rnea, (robot, q, v, a)), (pin.rnea, (model, data, q, v, a))),
+            "crba": ((num.crba, (robot, q)), (pin.crba, (model, data, q))),
+            "aba": ((num.aba, (robot, q, v, tau)), (pin.aba, (model, data, q, v, tau))),
+        }
+        for algo, ((f, fa), (g, ga)) in cases.items():
+            mine, theirs = paired_medians(per_call_run(f, fa, number), per_call_run(g, ga, number), repeat)
+            print(f"| {name} | {robot.nv} | {algo} | {mine * 1e6:.2f} | {theirs * 1e6:.2f} | {mine / theirs:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
