@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .latex import MAX_CALL_DEPTH, MAX_SYMBOLIC_EXPONENT, LatexError, Name, UnknownSymbol, parse
+from .named import keep_named
 from .notation import parse_lhs
 from .vocabulary import MODEL_KEYS
 
@@ -54,7 +55,11 @@ class Entry:
 
 
 def simple_name(lhs: str) -> Name | None:
-    """The one undotted symbol ``lhs`` is (``X``, ``c_1``, ``d_{11}``, ``\\phi_3``), else None."""
+    """The one undotted symbol ``lhs`` is (``X``, ``c_1``, ``d_{11}``, ``\\phi_3``; also written
+    with its arguments, ``M_{12}(\\theta_2)``), else None."""
+    from .named import without_arguments
+
+    lhs = without_arguments(lhs)
     names: list[Name] = []
     marker = sp.Symbol("armdyn_lhs_marker")
     try:
@@ -89,6 +94,8 @@ class DefinedNames:
         self._stack: list[str] = []
         self.failed: dict[str, str] = {}  # key -> why its definition cannot be read
         self.active = False
+        self.unknown: list[Name] = []  # names no reading knew, in the equation being read (.named.Waiting)
+        self.aliased: set[str] = set()  # keys given as another name of an energy (.named.keep_named)
 
     # -- what may be defined
     def definable(self, name: Name) -> bool:
@@ -121,8 +128,12 @@ class DefinedNames:
     # -- the SymbolMap hook
     def lookup(self, name: Name):
         """The value of a name given earlier (or defined anywhere), else None."""
-        if not self.active or name.dots or name.pre_sup or name.pre_sub:
+        if not self.active or name.pre_sup or name.pre_sub:
             return None
+        if name.dots:  # \dot M_{11}: the time derivative of the student's M_{11}
+            from .named import differentiated
+
+            return differentiated(self, name)
         key = plain(name)
         if key in self.failed:
             raise LatexError(self.failed[key])
@@ -137,9 +148,12 @@ class DefinedNames:
     def model(self, name: Name):
         """A model quantity not written (``d_{11}``, ``\\phi_3``): the model's value, said."""
         if not self.active or name.dots:
+            if self.active:
+                self.unknown.append(name)
             return None
         entry = self.model_value(name)
         if entry is None:
+            self.unknown.append(name)
             return None
         self.used.append(entry)
         return entry.right if self.right else entry.own
@@ -222,6 +236,7 @@ class DefinedNames:
             return
         self.entries[plain(name)] = Entry(eq.lhs, own, own if right is None else right, eq.line, wrong)
         self.pending.pop(plain(name), None)
+        self.aliased.discard(plain(name))
 
 
 def bounded(value):
@@ -260,6 +275,8 @@ def energy_names(text: str, steps: dict) -> str:
     (a product K·E otherwise)."""
 
     def one(m):
+        if text[m.end() : m.end() + 1] == "_":  # KE_1, PE_{2}: a link's energy by one name
+            return f"\\mathrm{{{m.group(1)}E}}"
         for name in _ENERGY_NAMES[m.group(1)]:
             if name in steps:
                 return f" \\mathrm{{{name}}} "
@@ -274,9 +291,10 @@ def read_pair(grader, text: str):
     with their right ones; step names (``{}^{2}F_2``, ``n_1^{1T}``) through
     :class:`~.chains.StepNames` when the plain reading does not know them."""
     from .chains import step_names
+    from .named import drop_arguments
 
     names = grader.names
-    text = energy_names(text, grader.symbols.steps)
+    text = drop_arguments(grader, energy_names(text, grader.symbols.steps))
     saved = names.right
     start = len(names.used)
     try:
@@ -399,6 +417,8 @@ def after_equation(grader, eq, new: list) -> None:
         right_value = right
     else:
         right_value = own
+    wrong = v.name if v.status == "wrong" else (v.caused_by or "") if v.status == "follows-from-earlier-error" else ""
     name = simple_name(eq.lhs) if eq.latex else None
     if name is not None and grader.names.definable(name):
-        grader.names.record(eq, own, right_value, v.name if v.status in ("wrong",) else "")
+        grader.names.record(eq, own, right_value, wrong)
+    keep_named(grader, eq, v, own, right_value, wrong)

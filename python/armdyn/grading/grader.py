@@ -24,6 +24,7 @@ from .explain import component_name, contract, describe, pretty, tidy
 from .kinematics_steps import KinematicsSteps, confirm_used
 from .latex import LatexError, UnknownSymbol
 from .methods import lagrange_method, newton_euler_method, rotation_between
+from .named import Waiting, derivative_step
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
 from .reader import Submission, read
@@ -218,15 +219,25 @@ class _Grader(EnergySteps, KinematicsSteps):
         context = method_hint if method_hint in ("newton-euler", "lagrange") else None
         seen_methods: list[str] = []
         self.names.collect(self.sub.equations)
-        for eq in self.sub.equations:
+        waiting = Waiting(self)  # equations that use a name given further on
+
+        def one(eq):
             done = len(self.verdicts)
+            self.names.unknown = []
             self._equation(eq, seen_methods, context)
             after_equation(self, eq, self.verdicts[done:])
-            if self.verdicts[done:] and self.verdicts[-1].key not in ("", "R", "P", "Pc", "law", "tau", "shorthand"):
-                last = self.verdicts[-1].key
-                context = "lagrange" if last in LAGRANGE_KEYS or last in MODEL_KEYS else "newton-euler"
             for v in self.verdicts[done:]:
                 v.part, v.task, v.column = eq.part, eq.task, eq.column
+            return self.verdicts[done:]
+
+        for eq in self.sub.equations:
+            new = one(eq)
+            if new and new[-1].key not in ("", "R", "P", "Pc", "law", "tau", "shorthand", "dt"):
+                last = new[-1].key
+                context = "lagrange" if last in LAGRANGE_KEYS or last in MODEL_KEYS else "newton-euler"
+            waiting.hold(eq, new)
+            waiting.retry(one)
+        waiting.finish()
         self.verdicts = grade_proofs(self.sub, self.verdicts)  # rigid-body proofs: every link checked
         for v in self.verdicts:  # proof links (also bare expressions) carry the part they are in
             if v.part is None and not v.task:
@@ -265,6 +276,10 @@ class _Grader(EnergySteps, KinematicsSteps):
                 return
             if eq.latex and matrix_form(eq.lhs, str(eq.value)):
                 self._matrix_form(eq)
+                return
+            derivative = derivative_step(self, eq)
+            if derivative is not None:
+                self.verdicts.append(derivative)
                 return
             self._unrecognised(eq, definition(self, eq) or "not a step of Newton-Euler or Lagrange (skipped)")
             return

@@ -354,11 +354,11 @@ class SymbolMap:
             if undotted in self.explicit:
                 return self._derivative(self.explicit[undotted], name.dots, name)
         plain = name.base + sub
-        if name.dots == 0 and plain in self.steps:
-            return self.steps[plain]
         value = self.defined.lookup(name) if self.defined is not None else None
         if value is not None:  # a name the student gave a value to (.defined)
             return value
+        if name.dots == 0 and plain in self.steps:
+            return self.steps[plain]
         candidate = plain + {0: "", 1: "_dot", 2: "_ddot"}.get(name.dots, "?")
         if candidate in self.names:
             return self.names[candidate]

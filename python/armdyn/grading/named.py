@@ -1,0 +1,368 @@
+"""Quantities used by name across a derivation, as textbooks and exam answers write them.
+
+:mod:`.defined` keeps the values the student gave under plain names; this module reads the
+other ways a derivation uses them:
+
+* a name applied to its arguments, ``M_{11}(\\theta_2)\\ddot\\theta_1``, ``K_1(\\theta,\\dot\\theta)``:
+  the quantity itself, not a product with the joint variable (:func:`drop_arguments`);
+* the time derivative of a named quantity, ``\\dot M_{11}``: the total derivative of the
+  student's own value (:func:`time_derivative`); a step ``\\dot M_{11} = ...`` is checked
+  against it (:func:`derivative_step`);
+* a link's energy under any textbook name, ``\\mathcal L = \\mathcal K_1 + \\mathcal K_2 - ...``
+  after ``\\mathcal E_{K_1} = ...`` (:func:`keep_energy`); a speed given through its square,
+  ``v_2^2 = ...`` then ``\\frac12 m_2 v_2^2`` (:func:`keep_square`);
+* a name used before the step that gives it (``T = T_1 + T_2`` above ``T_1 = ...``): the
+  equation waits for it and is graded, at its own line, once it is given
+  (:class:`Waiting`); a name never given is said so.
+"""
+
+from __future__ import annotations
+
+import re
+
+import sympy as sp
+
+from .latex import LatexError, Name, UnknownSymbol
+
+#: a function's argument list is at most this long (bounds the scan of each "(")
+MAX_ARGS_TEXT = 80
+#: one argument: a joint variable, its rate, or the joint vector (\theta_2, \dot{\theta}_1, q, \dot{\mathbf q}, \Theta)
+_ARG = re.compile(
+    r"(?:\\(?:dot|mathbf|boldsymbol|bm|vec)\s*\{?\s*){0,3}\\?[A-Za-z]+\s*(?:\}\s*){0,3}(?:_\{?\w{1,3}\}?)?"
+)
+#: the joint vector's letters, written without an index as a function's argument
+_JOINT_VECTOR = {"q", "theta", "Theta", "vartheta", "t", "d"}
+#: the name written just before "(": a letter or command, its accent or typeface, a subscript
+_BEFORE = re.compile(
+    r"(?:\\(?:dot|mathcal|mathbf|mathrm|boldsymbol)\s*\{?\s*){0,2}\\?[A-Za-z]+\s*\}{0,2}\s*"
+    r"(?:_\{[^{}]{1,20}\}|_\\?[A-Za-z0-9]+)?\s*$"
+)
+#: a link's kinetic and potential energy under each textbook's name (plain keys, index appended)
+KINETIC_NAMES = ("K", "T", "KE", "k", "EK", "Ek", "Ekin")
+POTENTIAL_NAMES = ("P", "U", "V", "PE", "u", "EP", "Ep", "Epot")
+
+
+def _arguments(text: str, grader) -> bool:
+    """Is ``text`` (between the parentheses) a list of joint variables, rates or the joint vector?"""
+    parts = [p.strip() for p in text.split(",")]
+    if not parts or len(parts) > 6:
+        return False
+    for part in parts:
+        if not _ARG.fullmatch(part) or "ddot" in part:
+            return False
+        if grader.symbols.coordinate_of(part) is not None:
+            continue
+        letters = re.sub(r"\\(?:dot|mathbf|boldsymbol|bm|vec)\b|[{}\s]|_.*$", "", part).lstrip("\\")
+        if letters not in _JOINT_VECTOR:
+            return False
+    return True
+
+
+def _named(grader, text: str) -> Name | None:
+    """The Name ``text`` is when it is a quantity the student (or the method) names: not a
+    symbol of the model (``m_2(\\dot\\theta_1)^2`` stays a product), not the shorthand ``c_1``."""
+    from .defined import _shorthand, simple_name
+
+    name = simple_name(text)
+    if name is None:
+        base = _strip_dots(text)
+        name = simple_name(base) if base != text else None
+        if name is None:
+            return None
+    if _shorthand(name) or not grader.names.definable(name):
+        return None
+    return name
+
+
+def _strip_dots(text: str) -> str:
+    return re.sub(r"\\d?dot\s*", "", text, count=1)
+
+
+def drop_arguments(grader, text: str) -> str:
+    """``text`` with the argument list of each named quantity blanked (``M_{11}(\\theta_2)``
+    -> ``M_{11}``, positions kept), said once in the report's notes."""
+    out = text
+    start = 0
+    while True:
+        i = out.find("(", start)
+        if i < 0:
+            return out
+        start = i + 1
+        j = out.find(")", i, i + MAX_ARGS_TEXT)
+        if j < 0 or "(" in out[i + 1 : j] or not _arguments(out[i + 1 : j], grader):
+            continue
+        if out[j + 1 : j + 2] == "^" or out[j + 1 : j + 3] == "'^":
+            continue  # m_2(\dot\theta_1)^2: a power of the bracket
+        m = _BEFORE.search(out, max(0, i - 60), i)
+        if m is None or not m.group(0).strip():
+            continue
+        name = _named(grader, m.group(0).strip())
+        if name is None:
+            continue
+        out = out[:i] + " " * (j + 1 - i) + out[j + 1 :]
+        note = f"{m.group(0).strip()}{text[i : j + 1]} read as the quantity {name.latex()} (its arguments named)"
+        if note not in grader.notes:
+            grader.notes.append(note)
+
+
+def time_derivative(value, robot, order: int = 1):
+    """The total time derivative of ``value`` along the joint motion: Σ ∂/∂q_k q̇_k + ∂/∂q̇_k q̈_k."""
+    pairs = list(zip(robot.q, robot.qd)) + list(zip(robot.qd, robot.qdd))
+    for _ in range(order):
+        if isinstance(value, sp.MatrixBase):
+            value = value.applyfunc(lambda x: sum((sp.diff(x, a) * b for a, b in pairs), sp.Integer(0)))
+        else:
+            value = sum((sp.diff(value, a) * b for a, b in pairs), sp.Integer(0))
+    return value
+
+
+def differentiated(names, name: Name):
+    """``\\dot X``: the time derivative of the value ``X`` has (the student's, or with
+    :attr:`~.defined.DefinedNames.right` the right one), or None when ``X`` has none."""
+    if name.dots > 2 or name.pre_sup or name.pre_sub:
+        return None
+    base = Name(name.base, 0, name.sub, name.sup)
+    saved, names.active = names.active, True
+    try:
+        value = names.lookup(base)
+        if value is None:
+            value = names.model(base)
+    finally:
+        names.active = saved
+    if value is None or not isinstance(value, (sp.Expr, sp.MatrixBase)):
+        return None
+    return time_derivative(value, names.symbols.robot, name.dots)
+
+
+# -- steps about named quantities
+_DOTTED_LHS = re.compile(r"\s*\\(d?dot)\s*(\{[^{}]*\}|\\?[A-Za-z]+)(.*)$", re.S)
+
+
+def derivative_step(grader, eq):
+    """``\\dot M_{11} = ...`` of a quantity the student named: checked against the time
+    derivative of their own value and of the right one; the verdict, or None."""
+    from .defined import plain, simple_name
+    from .verdict import StepVerdict
+
+    m = _DOTTED_LHS.fullmatch(eq.lhs) if eq.latex else None
+    if m is None:
+        return None
+    inner = m.group(2)[1:-1] if m.group(2).startswith("{") else m.group(2)
+    base = simple_name(inner + m.group(3))
+    if base is None or not grader.names.definable(base):
+        return None
+    dots = 2 if m.group(1) == "ddot" else 1
+    dotted = Name(base.base, dots, base.sub, base.sup)
+    names = grader.names
+    names.used = []
+    try:
+        names.right = False
+        own_expected = differentiated(names, dotted)
+        names.right = True
+        right_expected = differentiated(names, dotted)
+    finally:
+        names.right = False
+    if own_expected is None:
+        return None
+    used = [e for e in names.used if e.line or e.wrong]
+    from .defined import read_pair
+
+    label = f"{base.base}{'dot' * dots}" + (f"_{plain(base)[len(base.base) :]}" if base.sub else "")
+    try:
+        got, _ = read_pair(grader, str(eq.value))
+    except (LatexError, TypeError, ValueError, RecursionError) as err:
+        why = f"{label}: {str(err).splitlines()[0][:200]}"
+        return StepVerdict(
+            name=label,
+            key="",
+            link="",
+            status="unrecognised",
+            label=eq.lhs,
+            source=eq.source,
+            line=eq.line,
+            message=why,
+        )
+    fp = grader.sampler.fingerprint
+    from .engine import equal
+
+    def same(a, b):
+        try:
+            return bool(equal(fp(a), fp(b)).all())
+        except (TypeError, ValueError, sp.ShapeError):
+            return False
+
+    right, own = same(got, right_expected), same(got, own_expected)
+    wrong_entry = next((e for e in used if e.wrong), None)
+    what = f"the time derivative of {base.latex()}"
+    where = f" (line {used[-1].line})" if used and used[-1].line else ""
+    caused_by, difference = None, None
+    if right and (own or wrong_entry is None):
+        status, message = "correct", f"{what}{where}"
+    elif right:
+        status = "correct-but-unsupported"
+        message = f"right, but not {what} as you gave it{where}"
+    elif own and wrong_entry is not None:
+        status, caused_by = "follows-from-earlier-error", wrong_entry.wrong
+        message = f"follows from the error in {wrong_entry.wrong} (line {wrong_entry.line}): {what} as you gave it"
+    else:
+        from .explain import describe
+
+        status = "wrong"
+        message = f"{describe(got, own_expected, grader.robot, grader.sampler)} ({what}{where})"
+        difference = sp.simplify(got - own_expected) if not isinstance(got, sp.MatrixBase) else got - own_expected
+    return StepVerdict(
+        name=label,
+        key="dt",
+        link="",
+        status=status,
+        label=eq.lhs,
+        source=eq.source,
+        line=eq.line,
+        expected=right_expected,
+        got=got,
+        difference=difference,
+        caused_by=caused_by,
+        message=message,
+    )
+
+
+_TRAILING_ARGS = re.compile(r"\(([^()]{0,%d})\)\s*$" % MAX_ARGS_TEXT)
+
+
+def without_arguments(lhs: str) -> str:
+    """A left-hand side without the argument list written after its name (``M_{12}(\\theta_2)``,
+    ``K_1(\\theta,\\dot\\theta)``, ``g(q)``): the name it gives a value to."""
+    m = _TRAILING_ARGS.search(lhs)
+    if m is None or m.start() == 0:
+        return lhs
+    parts = [p.strip() for p in m.group(1).split(",")]
+    if all(_ARG.fullmatch(p) and "ddot" not in p for p in parts):
+        return lhs[: m.start()].rstrip()
+    return lhs
+
+
+def _model_symbol(grader, name: Name) -> bool:
+    """Is ``name`` a symbol of the model (a length, a mass, a joint variable), read without the
+    student's names?"""
+    names, symbols = grader.names, grader.symbols
+    saved, names.active = names.active, False
+    steps, symbols.steps = symbols.steps, {}
+    try:
+        symbols(name)
+        return True
+    except (UnknownSymbol, LatexError):
+        return False
+    finally:
+        names.active = saved
+        symbols.steps = steps
+
+
+def _alias_names(v) -> list[Name]:
+    """The textbooks' names of the energy a verdict graded (``K_1``, ``T_1``, ``\\mathcal E_{K_1}``...)."""
+    kinetic = v.key in ("T", "Tl")
+    index = ""
+    if v.key in ("Tl", "Vl"):
+        index = v.name.rpartition("_")[2]
+        if not index.isdigit():
+            return []
+    out = []
+    for base in KINETIC_NAMES if kinetic else POTENTIAL_NAMES:
+        if base.startswith("E") and len(base) > 1:  # E_{K_1}, E_{k,1} (Lynch & Park)
+            out.append(Name("E", sub=base[1:] + index))
+        else:
+            out.append(Name(base, sub=index))
+    return out
+
+
+def keep_named(grader, eq, v, own, right, wrong: str) -> None:
+    """After a step: a link's (or the total) energy kept under every textbook name of it, a
+    speed given through its square (``v_2^2 = ...``) kept as the speed ``v_2``, for later values.
+    A name the student gave a value to themselves is never replaced by another's."""
+    from .defined import Entry, plain, simple_name
+
+    names = grader.names
+    if v.status == "unrecognised" or own is None or isinstance(own, sp.MatrixBase):
+        return
+    if v.key in ("T", "V", "Tl", "Vl"):
+        for alias in _alias_names(v):
+            key = plain(alias)
+            if key in names.entries and key not in names.aliased or _model_symbol(grader, alias):
+                continue
+            names.entries[key] = Entry(alias.latex(), own, right, eq.line, wrong)
+            names.aliased.add(key)
+        return
+    m = re.fullmatch(r"\s*(?:\|(.+)\|\s*|(.+?))\s*\^\s*\{?\s*2\s*\}?\s*", eq.lhs) if eq.latex else None
+    name = simple_name(m.group(1) or m.group(2)) if m else None
+    if name is None or _model_symbol(grader, name) or not isinstance(own, sp.Expr):
+        return
+    # the speed whose square was given: its square gives the value back exactly
+    names.entries[plain(name)] = Entry(name.latex(), sp.sqrt(own), sp.sqrt(right), eq.line, wrong)
+    names.pending.pop(plain(name), None)
+
+
+class Waiting:
+    """Equations that use a name given only further on (``T = T_1 + T_2`` above ``T_1 = ...``):
+    graded again, at their own line, as soon as every name they use is known; a name never
+    given is said so at the end (:meth:`finish`)."""
+
+    def __init__(self, grader):
+        self.grader = grader
+        self.items: list[tuple] = []  # (equation, its unrecognised verdict, the name missing)
+
+    def hold(self, eq, new: list) -> None:
+        """``eq`` could not be read for a name not given (yet): wait for it."""
+        unknown = self.grader.names.unknown
+        if len(new) == 1 and new[0].status == "unrecognised" and unknown and "unknown symbol" in new[0].message:
+            self.items.append((eq, new[0], unknown[-1]))
+
+    def known(self, name: Name) -> bool:
+        names = self.grader.names
+        used, unknown = names.used, names.unknown
+        names.used, names.unknown = [], []
+        try:
+            self.grader.symbols(name)
+            return True
+        except (LatexError, TypeError, ValueError, RecursionError):
+            return False
+        finally:
+            names.used, names.unknown = used, unknown
+
+    def retry(self, grade) -> None:
+        """Grade again each waiting equation whose missing name is now given; ``grade(eq)``
+        grades one equation and returns its new verdicts (appended), which take the old
+        verdict's place."""
+        progress = True
+        while progress:
+            progress = False
+            for item in list(self.items):
+                eq, old, missing = item
+                if not self.known(missing):
+                    continue
+                self.items.remove(item)
+                verdicts = self.grader.verdicts
+                at = next((k for k, x in enumerate(verdicts) if x is old), None)
+                if at is None:
+                    continue
+                del verdicts[at]
+                self.grader.names.unknown = []
+                done = len(verdicts)
+                new = grade(eq)
+                verdicts[at:at] = verdicts[done:]
+                del verdicts[done + len(new) :]
+                self.hold(eq, new)
+                progress = True
+
+    def finish(self) -> None:
+        """The names never given: said in the verdicts of the equations that use them."""
+        from .notation import parse_lhs
+
+        n = len(self.grader.robot.links) - 1
+        for _eq, verdict, missing in self.items:
+            ref = parse_lhs(Name(missing.base, 0, missing.sub).latex(), lambda _: None)
+            indices = [k for k in (ref.index, *ref.entry) if k is not None] if ref is not None else []
+            if ref is None or not all(1 <= k <= n for k in indices):
+                continue  # not a quantity of this arm: "unknown symbol" (map it) says more
+            where, _, rest = verdict.message.partition(": ")
+            step = rest.partition(": ")[0] if ": unknown symbol" in rest else ""
+            said = f"{missing.latex()} is used but never given"
+            verdict.message = ": ".join(x for x in (where, step, said) if x)
