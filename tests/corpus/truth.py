@@ -182,11 +182,12 @@ def _at(expr, state):
 def all_specs() -> dict[str, dict]:
     """Every corpus file's spec, by file name."""
     import specs_lagrange
+    import specs_names
     import specs_newton_euler
     import specs_proofs
 
     out = {}
-    for mod in (specs_newton_euler, specs_lagrange, specs_proofs):
+    for mod in (specs_newton_euler, specs_lagrange, specs_names, specs_proofs):
         out.update(mod.SPECS)
     return out
 
