@@ -242,3 +242,16 @@ def test_many_brackets_are_read_in_bounded_time(tmp_path):
     start = time.perf_counter()
     _grade(tmp_path, body)
     assert time.perf_counter() - start < 60
+
+
+def test_partials_of_entries(tmp_path):
+    # dM_11/dtheta_2 = -2 m_2 l_1 l_c2 sin(theta_2); dM_12/dtheta_2 is half that (written with the l_c2^2 term's slip)
+    assert _same(sp.diff(M11, q2), -2 * m2 * l1 * lc2 * s2)
+    assert not _same(sp.diff(M12, q2), -m2 * (lc2**2 + l1 * lc2) * s2)
+    body = _entries(TEX["M12"]) + (
+        "$$\\frac{\\partial M_{11}}{\\partial \\theta_2} = -2 m_2 l_1 l_{c2} \\sin\\theta_2$$\n\n"
+        "$$\\frac{\\partial M_{12}}{\\partial \\theta_2} = -m_2 (l_{c2}^2 + l_1 l_{c2}) \\sin\\theta_2$$\n"
+    )
+    _, at, lines = _grade(tmp_path, body)
+    assert at[_line(lines, "\\partial M_{11}")].status == "correct"
+    assert at[_line(lines, "\\partial M_{12}")].status == "wrong"

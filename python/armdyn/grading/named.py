@@ -136,38 +136,73 @@ def differentiated(names, name: Name):
 
 # -- steps about named quantities
 _DOTTED_LHS = re.compile(r"\s*\\(d?dot)\s*(\{[^{}]*\}|\\?[A-Za-z]+)(.*)$", re.S)
+#: \frac{\partial M_{11}}{\partial \theta_2}: the partial of a named quantity by one joint variable or rate
+_PARTIAL_LHS = re.compile(r"\s*\\frac\s*\{\s*\\partial\s*([^{}]*(?:\{[^{}]*\}[^{}]*)*)\}\s*\{\s*\\partial\s*(.+)\}\s*")
+
+
+def _derivative_of(grader, lhs: str):
+    """(the quantity's Name, a function value -> its derivative, the step's name, what it is) of a
+    left-hand side ``\\dot X`` / ``\\frac{\\partial X}{\\partial q_k}`` of a named quantity, or None."""
+    from .defined import plain, simple_name
+
+    m = _DOTTED_LHS.fullmatch(lhs)
+    if m is not None:
+        inner = m.group(2)[1:-1] if m.group(2).startswith("{") else m.group(2)
+        base = simple_name(inner + m.group(3))
+        if base is None:
+            return None
+        dots = 2 if m.group(1) == "ddot" else 1
+        label = f"{base.base}{'dot' * dots}" + (f"_{plain(base)[len(base.base) :]}" if base.sub else "")
+        robot = grader.robot
+        return base, lambda v: time_derivative(v, robot, dots), label, f"the time derivative of {base.latex()}"
+    m = _PARTIAL_LHS.fullmatch(lhs)
+    if m is None:
+        return None
+    base = simple_name(m.group(1))
+    found = grader.symbols.coordinate_of(m.group(2).strip())
+    if base is None or found is None:
+        return None
+    k, order = found
+    var = (grader.robot.q if order == 0 else grader.robot.qd)[k - 1]
+    label = f"d{base.base}" + (f"_{plain(base)[len(base.base) :]}" if base.sub else "") + f"_d{var}"
+
+    def partial(v):
+        return v.diff(var) if isinstance(v, sp.MatrixBase) else sp.diff(v, var)
+
+    return base, partial, label, f"the partial of {base.latex()} by {m.group(2).strip()}"
 
 
 def derivative_step(grader, eq):
-    """``\\dot M_{11} = ...`` of a quantity the student named: checked against the time
-    derivative of their own value and of the right one; the verdict, or None."""
-    from .defined import plain, simple_name
+    """``\\dot M_{11} = ...`` or ``\\frac{\\partial M_{11}}{\\partial \\theta_2} = ...`` of a quantity the
+    student named: checked against that derivative of their own value and of the right one; the
+    verdict, or None."""
     from .verdict import StepVerdict
 
-    m = _DOTTED_LHS.fullmatch(eq.lhs) if eq.latex else None
-    if m is None:
+    found = _derivative_of(grader, eq.lhs) if eq.latex else None
+    if found is None:
         return None
-    inner = m.group(2)[1:-1] if m.group(2).startswith("{") else m.group(2)
-    base = simple_name(inner + m.group(3))
-    if base is None or not grader.names.definable(base):
+    base, derive, label, what = found
+    if _model_symbol(grader, base):
         return None
-    dots = 2 if m.group(1) == "ddot" else 1
-    dotted = Name(base.base, dots, base.sub, base.sup)
     names = grader.names
     names.used = []
+    saved = names.active, names.right
+    names.active = True
     try:
         names.right = False
-        own_expected = differentiated(names, dotted)
+        own_value = names.lookup(base)
+        own_value = names.model(base) if own_value is None else own_value
         names.right = True
-        right_expected = differentiated(names, dotted)
+        right_value = names.lookup(base)
+        right_value = names.model(base) if right_value is None else right_value
     finally:
-        names.right = False
-    if own_expected is None:
+        names.active, names.right = saved
+    if own_value is None or right_value is None or not isinstance(own_value, (sp.Expr, sp.MatrixBase)):
         return None
+    own_expected, right_expected = derive(own_value), derive(right_value)
     used = [e for e in names.used if e.line or e.wrong]
     from .defined import read_pair
 
-    label = f"{base.base}{'dot' * dots}" + (f"_{plain(base)[len(base.base) :]}" if base.sub else "")
     try:
         got, _ = read_pair(grader, str(eq.value))
     except (LatexError, TypeError, ValueError, RecursionError) as err:
@@ -193,7 +228,6 @@ def derivative_step(grader, eq):
 
     right, own = same(got, right_expected), same(got, own_expected)
     wrong_entry = next((e for e in used if e.wrong), None)
-    what = f"the time derivative of {base.latex()}"
     where = f" (line {used[-1].line})" if used and used[-1].line else ""
     caused_by, difference = None, None
     if right and (own or wrong_entry is None):
@@ -358,7 +392,8 @@ class Waiting:
 
         n = len(self.grader.robot.links) - 1
         for _eq, verdict, missing in self.items:
-            ref = parse_lhs(Name(missing.base, 0, missing.sub).latex(), lambda _: None)
+            plain = Name(missing.base, 0, missing.sub).latex()
+            ref = parse_lhs(plain, lambda _: None) or parse_lhs(plain + "^2", lambda _: None)  # v_1: a speed
             indices = [k for k in (ref.index, *ref.entry) if k is not None] if ref is not None else []
             if ref is None or not all(1 <= k <= n for k in indices):
                 continue  # not a quantity of this arm: "unknown symbol" (map it) says more
