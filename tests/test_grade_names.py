@@ -255,3 +255,31 @@ def test_partials_of_entries(tmp_path):
     _, at, lines = _grade(tmp_path, body)
     assert at[_line(lines, "\\partial M_{11}")].status == "correct"
     assert at[_line(lines, "\\partial M_{12}")].status == "wrong"
+
+
+def test_a_partial_of_an_entry_inside_a_value(tmp_path):
+    # dL/dtheta_2 = 1/2 dM11/dtheta_2 thd1^2 + dM12/dtheta_2 thd1 thd2 - dP/dtheta_2 (M_22 is constant)
+    dL_dq2 = half * sp.diff(M11, q2) * qd1**2 + sp.diff(M12, q2) * qd1 * qd2 - sp.diff(P2, q2)
+    assert _same(dL_dq2, TRUE["dL_dq2"])
+    body = _entries(TEX["M12"]) + (
+        "$$\\frac{\\partial L}{\\partial\\theta_2} = \\frac{1}{2}\\frac{\\partial M_{11}}{\\partial\\theta_2}\\dot\\theta_1^2"
+        " + \\frac{\\partial M_{12}}{\\partial \\theta_2}\\dot\\theta_1\\dot\\theta_2"
+        " - m_2 g l_{c2}\\cos(\\theta_1 + \\theta_2)$$\n"
+    )
+    _, at, lines = _grade(tmp_path, body)
+    assert at[_line(lines, "\\frac{\\partial L}")].status == "correct"
+
+
+def test_a_point_mass_speed_is_checked_and_used(tmp_path):
+    # v_1 = l_c1 thd1 is link 1's speed; a v_2 without the elbow's cross term is not link 2's
+    speed2_slip = sp.sqrt(l1**2 * qd1**2 + lc2**2 * (qd1 + qd2) ** 2)
+    assert not _same(speed2_slip**2, TRUE["vc2_sq"])
+    body = (
+        "$$v_1 = l_{c1}\\dot\\theta_1$$\n\n"
+        "$$v_2 = \\sqrt{l_1^2\\dot\\theta_1^2 + l_{c2}^2(\\dot\\theta_1 + \\dot\\theta_2)^2}$$\n\n"
+        "$$K_1 = \\frac{1}{2} m_1 v_1^2 + \\frac{1}{2} I_1\\dot\\theta_1^2$$\n"
+    )
+    _, at, lines = _grade(tmp_path, body)
+    assert at[_line(lines, "v_1 =")].status == "correct"
+    assert at[_line(lines, "v_2 =")].status == "wrong"
+    assert at[_line(lines, "K_1 =")].status == "correct"

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .latex import MAX_CALL_DEPTH, MAX_SYMBOLIC_EXPONENT, LatexError, Name, UnknownSymbol, parse
-from .named import keep_named
+from .named import PARTIAL_MARK, keep_named, partial_value
 from .notation import parse_lhs
 from .vocabulary import MODEL_KEYS
 
@@ -95,7 +95,10 @@ class DefinedNames:
         self.failed: dict[str, str] = {}  # key -> why its definition cannot be read
         self.active = False
         self.unknown: list[Name] = []  # names no reading knew, in the equation being read (.named.Waiting)
-        self.aliased: set[str] = set()  # keys given as another name of an energy (.named.keep_named)
+        self.aliased: set[str] = set()
+        self.partials: dict[
+            str, tuple
+        ] = {}  # placeholder -> (Name, variable): .named.partials_as_names  # keys given as another name of an energy (.named.keep_named)
 
     # -- what may be defined
     def definable(self, name: Name) -> bool:
@@ -134,6 +137,8 @@ class DefinedNames:
             from .named import differentiated
 
             return differentiated(self, name)
+        if name.base == PARTIAL_MARK:  # \frac{\partial M_{11}}{\partial q_2}
+            return partial_value(self, name)
         key = plain(name)
         if key in self.failed:
             raise LatexError(self.failed[key])
@@ -291,10 +296,10 @@ def read_pair(grader, text: str):
     with their right ones; step names (``{}^{2}F_2``, ``n_1^{1T}``) through
     :class:`~.chains.StepNames` when the plain reading does not know them."""
     from .chains import step_names
-    from .named import drop_arguments
+    from .named import drop_arguments, partials_as_names
 
     names = grader.names
-    text = drop_arguments(grader, energy_names(text, grader.symbols.steps))
+    text = partials_as_names(grader, drop_arguments(grader, energy_names(text, grader.symbols.steps)))
     saved = names.right
     start = len(names.used)
     try:

@@ -154,7 +154,9 @@ def expected_of(terms: ModelTerms, ref):
         return p if axis is None else p[axis]
     if key == "vc":
         v = terms.velocity(i)
-        return (v.T * v)[0, 0] if ref.part == "sq" else v if axis is None else v[axis]
+        if ref.part in ("sq", "speed"):
+            return (v.T * v)[0, 0] if ref.part == "sq" else sp.sqrt((v.T * v)[0, 0])
+        return v if axis is None else v[axis]
     if key == "w":
         return terms.angular_velocity(i)
     if key in ("Jv", "Jw"):

@@ -401,3 +401,65 @@ class Waiting:
             step = rest.partition(": ")[0] if ": unknown symbol" in rest else ""
             said = f"{missing.latex()} is used but never given"
             verdict.message = ": ".join(x for x in (where, step, said) if x)
+
+
+#: the placeholder a partial of a named quantity is read as (a letter no derivation writes)
+PARTIAL_MARK = "ð"
+_PARTIAL_VALUE = re.compile(
+    r"\\frac\s*\{\s*\\partial\s*((?:[^{}]|\{[^{}]{0,30}\}){1,40})\}\s*\{\s*\\partial\s*((?:[^{}]|\{[^{}]{0,30}\}){1,40})\}"
+)
+
+
+def partials_as_names(grader, text: str) -> str:
+    """``text`` with each ``\\frac{\\partial X}{\\partial q_k}`` of a quantity ``X`` the student gave
+    (``M_{11}``, ``d_{12}``, ``V``) by a joint variable or rate replaced, positions kept, by a
+    placeholder name read as that partial of their value (:func:`partial_value`)."""
+    out, start = text, 0
+    names = grader.names
+    while True:
+        i = out.find("\\frac", start)
+        if i < 0:
+            return out
+        start = i + 5
+        m = _PARTIAL_VALUE.match(out, i)
+        if m is None:
+            continue
+        name = _quantity(grader, m.group(1).strip())
+        found = grader.symbols.coordinate_of(m.group(2).strip()) if name is not None else None
+        if found is None:
+            continue
+        k, order = found
+        var = (grader.robot.q if order == 0 else grader.robot.qd)[k - 1]
+        key = next((s for s, v in names.partials.items() if v == (name, var)), None)
+        if key is None:
+            key = str(len(names.partials))
+            names.partials[key] = (name, var)
+        mark = f"{PARTIAL_MARK}_{{{key}}}"
+        out = out[:i] + mark + " " * (m.end() - i - len(mark)) + out[m.end() :]
+
+
+def _quantity(grader, text: str) -> Name | None:
+    """The Name ``text`` is when it names a quantity with a value now (not a model symbol)."""
+    from .defined import simple_name
+
+    name = simple_name(text)
+    if name is None or _model_symbol(grader, name):
+        return None
+    names = grader.names
+    used, unknown = list(names.used), list(names.unknown)
+    try:
+        grader.symbols(name)
+        return name
+    except (LatexError, TypeError, ValueError, RecursionError):
+        return None
+    finally:
+        names.used, names.unknown = used, unknown
+
+
+def partial_value(names, name: Name):
+    """The value of a placeholder of :func:`partials_as_names` (own or right, as being read), or None."""
+    if name.base != PARTIAL_MARK or name.sub not in names.partials:
+        return None
+    base, var = names.partials[name.sub]
+    value = names.symbols(base)
+    return value.diff(var) if isinstance(value, sp.MatrixBase) else sp.diff(value, var)
