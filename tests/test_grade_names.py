@@ -283,3 +283,17 @@ def test_a_point_mass_speed_is_checked_and_used(tmp_path):
     assert at[_line(lines, "v_1 =")].status == "correct"
     assert at[_line(lines, "v_2 =")].status == "wrong"
     assert at[_line(lines, "K_1 =")].status == "correct"
+
+
+def test_the_joint_vector_in_a_quadratic_form(tmp_path):
+    # K = 1/2 qdot^T D(q) qdot with the D(q) given: the total kinetic energy (checked by hand above)
+    assert _same(half * (M11 * qd1**2 + 2 * M12 * qd1 * qd2 + M22 * qd2**2), TRUE["K"])
+    body = (
+        f"$$D(q) = \\begin{{bmatrix}} {TEX['M11']} & {TEX['M12']} \\\\ {TEX['M12']} & {TEX['M22']} \\end{{bmatrix}}$$\n\n"
+        "$$K = \\frac{1}{2}\\dot\\theta^T D(\\theta)\\dot\\theta$$\n\n"
+        "$$\\tau = D(\\theta)\\ddot\\theta$$\n"
+    )
+    _, at, lines = _grade(tmp_path, body)
+    assert at[_line(lines, "K =")].status == "correct"
+    form = at[_line(lines, "\\tau =")]  # written to say what D does: not the equations of motion
+    assert form.status == "unrecognised" and "names of whole quantities only" in form.message

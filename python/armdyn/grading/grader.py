@@ -24,7 +24,7 @@ from .explain import component_name, contract, describe, pretty, tidy
 from .kinematics_steps import KinematicsSteps, confirm_used
 from .latex import LatexError, UnknownSymbol
 from .methods import lagrange_method, newton_euler_method, rotation_between
-from .named import Waiting, derivative_step
+from .named import Waiting, derivative_step, form_only
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
 from .reader import Submission, read
@@ -277,14 +277,14 @@ class _Grader(EnergySteps, KinematicsSteps):
             if eq.latex and matrix_form(eq.lhs, str(eq.value)):
                 self._matrix_form(eq)
                 return
-            derivative = derivative_step(self, eq)
-            if derivative is not None:
-                self.verdicts.append(derivative)
+            if derivative_step(self, eq):  # \dot M_{12} = ..., \frac{\partial M_{11}}{\partial q_2} = ...
                 return
             self._unrecognised(eq, definition(self, eq) or "not a step of Newton-Euler or Lagrange (skipped)")
             return
         if ref.key in ("tau", "tau_vec") and eq.latex and matrix_form(eq.lhs, str(eq.value)):  # τ = M q̈ + C q̇ + g
             self._matrix_form(eq)
+            return
+        if ref.key == "tau_vec" and form_only(self, eq):  # τ = M(q) q̈, to say what M does
             return
         ref, assumed = self._vocabulary(ref, eq, seen_methods)  # energy-method names; by the value's shape
         if ref is None:

@@ -22,7 +22,7 @@ import re
 
 import sympy as sp
 
-from .latex import LatexError, Name, UnknownSymbol
+from .latex import LatexError, Name, UnknownSymbol, parse
 
 #: a function's argument list is at most this long (bounds the scan of each "(")
 MAX_ARGS_TEXT = 80
@@ -172,7 +172,15 @@ def _derivative_of(grader, lhs: str):
     return base, partial, label, f"the partial of {base.latex()} by {m.group(2).strip()}"
 
 
-def derivative_step(grader, eq):
+def derivative_step(grader, eq) -> bool:
+    """Grade ``eq`` when it states a derivative of a named quantity (:func:`derivative_verdict`)."""
+    verdict = derivative_verdict(grader, eq)
+    if verdict is not None:
+        grader.verdicts.append(verdict)
+    return verdict is not None
+
+
+def derivative_verdict(grader, eq):
     """``\\dot M_{11} = ...`` or ``\\frac{\\partial M_{11}}{\\partial \\theta_2} = ...`` of a quantity the
     student named: checked against that derivative of their own value and of the right one; the
     verdict, or None."""
@@ -463,3 +471,38 @@ def partial_value(names, name: Name):
     base, var = names.partials[name.sub]
     value = names.symbols(base)
     return value.diff(var) if isinstance(value, sp.MatrixBase) else sp.diff(value, var)
+
+
+#: why a torque column written through names only is not graded
+NAMES_ONLY = (
+    "the torques written through names of whole quantities only ({}): a statement of the form, "
+    "not graded (the equations of motion in matrix form are M q̈ + C q̇ + g)"
+)
+
+
+def names_only(grader, text: str) -> str:
+    """The names of a value written only through the joint vector and whole quantities the
+    student named (``M(q)\\ddot q``), no parameter or joint variable of its own; else ""."""
+    from .notation import JOINT_VECTOR
+
+    found: list[Name] = []
+    try:
+        parse(drop_arguments(grader, text), lambda n: found.append(n) or sp.Symbol(f"x{len(found)}"))
+    except (LatexError, TypeError, ValueError, RecursionError, sp.ShapeError):
+        return ""
+    if not found or not any(n.base in JOINT_VECTOR and not n.sub for n in found):
+        return ""
+    for n in found:
+        if n.base in JOINT_VECTOR and not n.sub:
+            continue
+        if n.sub or _model_symbol(grader, n):
+            return ""
+    return ", ".join(dict.fromkeys(n.latex() for n in found))
+
+
+def form_only(grader, eq) -> bool:
+    """``τ = M(q)\\ddot q`` (names only): recorded as not graded, said why; False for other values."""
+    names = names_only(grader, str(eq.value)) if eq.latex else ""
+    if names:
+        grader._unrecognised(eq, NAMES_ONLY.format(names))
+    return bool(names)
