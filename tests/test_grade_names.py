@@ -297,3 +297,19 @@ def test_the_joint_vector_in_a_quadratic_form(tmp_path):
     assert at[_line(lines, "K =")].status == "correct"
     form = at[_line(lines, "\\tau =")]  # written to say what D does: not the equations of motion
     assert form.status == "unrecognised" and "names of whole quantities only" in form.message
+
+
+@pytest.mark.parametrize("restated", [False, True])
+def test_a_symmetric_entry_given_by_name(tmp_path, restated):
+    # M_21 = M_12 states the symmetry; M_21 then stands for the student's latest M_12
+    assert _same(TRUE["dL_dqd2"], M12 * qd1 + M22 * qd2)
+    slip = r"m_2 (l_{c2}^2 + 2 l_1 l_{c2} \cos\theta_2) + I_2"
+    body = _entries(slip) + "$$M_{21} = M_{12}$$\n\n"
+    if restated:
+        body += f"$$M_{{12}} = {TEX['M12']}$$\n\n"
+    body += "$$\\frac{\\partial L}{\\partial\\dot\\theta_2} = M_{21}\\dot\\theta_1 + M_{22}\\dot\\theta_2$$\n"
+    _, at, lines = _grade(tmp_path, body)
+    symmetry = at[_line(lines, "M_{21} = M_{12}")]
+    assert symmetry.status == "correct" and "symmetric" in symmetry.message
+    step = at[_line(lines, "\\frac{\\partial L}")]
+    assert step.status == ("correct" if restated else "follows-from-earlier-error")

@@ -95,10 +95,9 @@ class DefinedNames:
         self.failed: dict[str, str] = {}  # key -> why its definition cannot be read
         self.active = False
         self.unknown: list[Name] = []  # names no reading knew, in the equation being read (.named.Waiting)
-        self.aliased: set[str] = set()
-        self.partials: dict[
-            str, tuple
-        ] = {}  # placeholder -> (Name, variable): .named.partials_as_names  # keys given as another name of an energy (.named.keep_named)
+        self.aliased: set[str] = set()  # keys given as another name of an energy (.named.keep_named)
+        self.partials: dict[str, tuple] = {}  # placeholder -> (Name, variable): .named.partials_as_names
+        self.links: dict[str, str] = {}  # key -> the key it was given as (M_{21} = M_{12}): .named.symmetric_entry
 
     # -- what may be defined
     def definable(self, name: Name) -> bool:
@@ -140,6 +139,7 @@ class DefinedNames:
         if name.base == PARTIAL_MARK:  # \frac{\partial M_{11}}{\partial q_2}
             return partial_value(self, name)
         key = plain(name)
+        key = self.links.get(key, key) if key not in self.entries else key
         if key in self.failed:
             raise LatexError(self.failed[key])
         entry = self.entries.get(key)
@@ -241,6 +241,7 @@ class DefinedNames:
             return
         self.entries[plain(name)] = Entry(eq.lhs, own, own if right is None else right, eq.line, wrong)
         self.pending.pop(plain(name), None)
+        self.links.pop(plain(name), None)
         self.aliased.discard(plain(name))
 
 

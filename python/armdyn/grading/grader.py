@@ -24,7 +24,7 @@ from .explain import component_name, contract, describe, pretty, tidy
 from .kinematics_steps import KinematicsSteps, confirm_used
 from .latex import LatexError, UnknownSymbol
 from .methods import lagrange_method, newton_euler_method, rotation_between
-from .named import Waiting, derivative_step, form_only
+from .named import Waiting, derivative_step, form_only, symmetric_entry
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
 from .reader import Submission, read
@@ -284,7 +284,7 @@ class _Grader(EnergySteps, KinematicsSteps):
         if ref.key in ("tau", "tau_vec") and eq.latex and matrix_form(eq.lhs, str(eq.value)):  # τ = M q̈ + C q̇ + g
             self._matrix_form(eq)
             return
-        if ref.key == "tau_vec" and form_only(self, eq):  # τ = M(q) q̈, to say what M does
+        if ref.key == "tau_vec" and form_only(self, eq) or symmetric_entry(self, eq, ref):  # τ = M q̈; M_21 = M_12
             return
         ref, assumed = self._vocabulary(ref, eq, seen_methods)  # energy-method names; by the value's shape
         if ref is None:

@@ -506,3 +506,41 @@ def form_only(grader, eq) -> bool:
     if names:
         grader._unrecognised(eq, NAMES_ONLY.format(names))
     return bool(names)
+
+
+def symmetric_entry(grader, eq, ref) -> bool:
+    """``M_{21} = M_{12}``: the inertia matrix's symmetry, right whatever the value of ``M_{12}``;
+    from here ``M_{21}`` stands for the student's ``M_{12}`` (its latest value). False for other
+    equations."""
+    from .defined import plain, simple_name
+    from .notation import parse_lhs
+    from .verdict import StepVerdict
+
+    if ref.key != "M" or len(ref.entry) != 2 or ref.entry[0] == ref.entry[1] or not eq.latex:
+        return False
+    other = simple_name(str(eq.value))
+    mine = simple_name(eq.lhs)
+    if other is None or mine is None or other.base != mine.base:
+        return False
+    ref2 = parse_lhs(other.latex(), lambda _: None)
+    if ref2 is None or ref2.key != "M" or ref2.entry != ref.entry[::-1]:
+        return False
+    names = grader.names
+    names.links[plain(mine)] = plain(other)
+    names.entries.pop(plain(mine), None)
+    given = names.entries.get(plain(other))
+    where = f" (line {given.line})" if given is not None and given.line else ""
+    grader.verdicts.append(
+        StepVerdict(
+            name=ref.name,
+            key=ref.key,
+            link="",
+            status="correct",
+            label=eq.lhs,
+            source=eq.source,
+            line=eq.line,
+            message=f"the inertia matrix is symmetric: {mine.latex()} is {other.latex()}{where}, "
+            f"whatever its value (used by name from here)",
+        )
+    )
+    return True
