@@ -131,12 +131,21 @@ def test_a_total_written_before_its_parts_is_graded_at_its_own_line(tmp_path):
     assert [s.line for s in report.steps] == sorted(s.line for s in report.steps)  # in the text's order
 
 
-def test_a_total_before_a_wrong_part_follows_from_it(tmp_path):
+def test_a_total_above_a_wrong_part_is_right_in_its_names(tmp_path):
+    # the slip is the part's, further on; written above it, the total is right as a formula
     wrong_k2 = TEX["K2"].replace(r"\frac{1}{2} I_2", "I_2")  # the rotation term without its 1/2
     assert not _same(K2 - half * I2 * (qd1 + qd2) ** 2 + I2 * (qd1 + qd2) ** 2, TRUE["K2"])
-    body = f"$$K = K_1 + K_2$$\n\n$$K_1 = {TEX['K1']}$$\n\n$$K_2 = {wrong_k2}$$\n"
+    body = f"$$K = K_1 + K_2$$\n\n$$K_1 = {TEX['K1']}$$\n\n$$K_2 = {wrong_k2}$$\n\n$$L = K - P_1$$\n"
     _, at, lines = _grade(tmp_path, body)
     assert at[_line(lines, "K_2 =")].status == "wrong"
+    total = at[_line(lines, "K = K_1")]
+    assert total.status == "correct" and "wrong further on" in total.message
+
+
+def test_a_total_below_a_wrong_part_follows_from_it(tmp_path):
+    wrong_k2 = TEX["K2"].replace(r"\frac{1}{2} I_2", "I_2")
+    body = f"$$K_1 = {TEX['K1']}$$\n\n$$K_2 = {wrong_k2}$$\n\n$$K = K_1 + K_2$$\n"
+    _, at, lines = _grade(tmp_path, body)
     total = at[_line(lines, "K = K_1")]
     assert total.status == "follows-from-earlier-error" and total.caused_by == "T_2"
 

@@ -410,7 +410,10 @@ def after_equation(grader, eq, new: list) -> None:
     said = list(dict.fromkeys([*(e.note for e in used if e.note), *assumed]))
     wrong = next((e for e in used if e.wrong), None)
     if v.status == "wrong" and used and v.expected is not None and _fingerprints_equal(grader, right, v.expected):
-        if wrong is not None:  # right with the right value of the step it names: the error is carried
+        if wrong is not None and wrong.line > eq.line:  # a formula above the wrong step it names
+            v.status, v.difference, v.components = "correct", None, []
+            v.message = f"right in its names; {wrong.name} is wrong further on (line {wrong.line})"
+        elif wrong is not None:  # right with the right value of the step it names: the error is carried
             v.status, v.caused_by = "follows-from-earlier-error", wrong.wrong
             v.message = f"follows from the error in {wrong.wrong} (line {wrong.line}), used by name"
         elif said:
