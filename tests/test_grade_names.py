@@ -322,3 +322,11 @@ def test_a_symmetric_entry_given_by_name(tmp_path, restated):
     assert symmetry.status == "correct" and "symmetric" in symmetry.message
     step = at[_line(lines, "\\frac{\\partial L}")]
     assert step.status == ("correct" if restated else "follows-from-earlier-error")
+
+
+def test_many_names_never_given_end_in_bounded_time(tmp_path):
+    body = "".join(f"$$L = X_{{{k}}} + \\dot\\theta_1$$\n\n" for k in range(300))
+    start = time.perf_counter()
+    report, _, _ = _grade(tmp_path, body + f"$$K_1 = {TEX['K1']}$$\n")
+    assert time.perf_counter() - start < 60
+    assert sum(s.status == "unrecognised" for s in report.steps) == 300

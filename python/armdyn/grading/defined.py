@@ -20,12 +20,11 @@ carries an earlier error (:meth:`DefinedNames.carry`).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 
 import sympy as sp
 
 from .latex import MAX_CALL_DEPTH, MAX_SYMBOLIC_EXPONENT, LatexError, Name, UnknownSymbol, parse
-from .named import PARTIAL_MARK, keep_named, partial_value
+from .named import PARTIAL_MARK, Entry, keep_named, partial_value, plain, shorthand_name, simple_name
 from .notation import parse_lhs
 from .vocabulary import MODEL_KEYS
 
@@ -39,41 +38,6 @@ _ENERGY = re.compile(
     r"(?<![A-Za-z\\])(?:\\(?:mathrm|text|mathit|rm)\s*\{\s*)?([KP])(?:E|\.\s*E\.?)(?:\s*\})?(?![A-Za-z])"
 )
 _ENERGY_NAMES = {"K": ("KE", "K", "T"), "P": ("PE", "P", "V", "U")}
-
-
-@dataclass
-class Entry:
-    """A name with a value: ``own`` (the student's), ``right`` (the model's, when it names a
-    model quantity; else the definition read with right values), where it was given."""
-
-    name: str
-    own: object
-    right: object
-    line: int = 0
-    wrong: str = ""  # the verdict name of a wrong step, or "" (a definition: never wrong itself)
-    note: str = ""  # said in the verdicts of steps that use it
-
-
-def simple_name(lhs: str) -> Name | None:
-    """The one undotted symbol ``lhs`` is (``X``, ``c_1``, ``d_{11}``, ``\\phi_3``; also written
-    with its arguments, ``M_{12}(\\theta_2)``), else None."""
-    from .named import without_arguments
-
-    lhs = without_arguments(lhs)
-    names: list[Name] = []
-    marker = sp.Symbol("armdyn_lhs_marker")
-    try:
-        value = parse(lhs, lambda n: names.append(n) or marker)
-    except (LatexError, TypeError, ValueError, RecursionError):
-        return None
-    if value != marker or len(names) != 1 or names[0].dots or names[0].pre_sup or names[0].pre_sub:
-        return None
-    return names[0]
-
-
-def plain(name: Name) -> str:
-    """The key a name is kept under (as :class:`~.notation.SymbolMap` looks names up)."""
-    return name.base + re.sub(r"[{}\s,_]|\\mathrm|\\text", "", name.sub or "")
 
 
 class DefinedNames:
@@ -103,7 +67,7 @@ class DefinedNames:
     def definable(self, name: Name) -> bool:
         """Not a symbol of the model (a length, a joint variable): those keep their meaning.
         The shorthand ``c_1``, ``s_{12}`` may be defined (and is checked)."""
-        if _shorthand(name):
+        if shorthand_name(name):
             return True
         saved, self.active = self.active, False
         try:
@@ -122,7 +86,7 @@ class DefinedNames:
             name = simple_name(eq.lhs)
             if name is None or parse_lhs(eq.lhs, lambda _: None) is not None or not self.definable(name):
                 continue
-            if _shorthand(name):  # c_1 means cos q_1 until the student defines it otherwise
+            if shorthand_name(name):  # c_1 means cos q_1 until the student defines it otherwise
                 continue
             self.pending.setdefault(plain(name), eq)
         self.active = True
@@ -188,7 +152,7 @@ class DefinedNames:
         """``c_1 = \\sin\\theta_1``: not the model's ``c_1``; later steps use it, said. A value
         that is no sine or cosine (Lynch & Park's ``c_1``, a velocity-product entry) is another
         quantity of that name: only said in its own line."""
-        if name is None or not _shorthand(name):
+        if name is None or not shorthand_name(name):
             return
         saved, self.active = self.active, False
         try:
@@ -265,11 +229,6 @@ def bounded(value):
             raise LatexError(f"an exponent over {MAX_SYMBOLIC_EXPONENT} (through its names)")
         stack.extend((a, calls) for a in x.args)
     return value
-
-
-def _shorthand(name: Name) -> bool:
-    """``c_1``, ``s_{12}``, ``C_2``: a name the grader reads as the sine or cosine of joint angles."""
-    return name.base in ("s", "c", "S", "C") and (name.sub or "").strip("{} ").isdigit()
 
 
 def _inner_note(used: list) -> str:

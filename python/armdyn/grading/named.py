@@ -19,6 +19,7 @@ other ways a derivation uses them:
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 
 import sympy as sp
 
@@ -37,9 +38,49 @@ _BEFORE = re.compile(
     r"(?:\\(?:dot|mathcal|mathbf|mathrm|boldsymbol)\s*\{?\s*){0,2}\\?[A-Za-z]+\s*\}{0,2}\s*"
     r"(?:_\{[^{}]{1,20}\}|_\\?[A-Za-z0-9]+)?\s*$"
 )
+#: equations waiting for a name given further on at most (each is looked at after every equation)
+MAX_WAITING = 200
 #: a link's kinetic and potential energy under each textbook's name (plain keys, index appended)
 KINETIC_NAMES = ("K", "T", "KE", "k", "EK", "Ek", "Ekin")
 POTENTIAL_NAMES = ("P", "U", "V", "PE", "u", "EP", "Ep", "Epot")
+
+
+@dataclass
+class Entry:
+    """A name with a value: ``own`` (the student's), ``right`` (the model's, when it names a
+    model quantity; else the definition read with right values), where it was given."""
+
+    name: str
+    own: object
+    right: object
+    line: int = 0
+    wrong: str = ""  # the verdict name of a wrong step, or "" (a definition: never wrong itself)
+    note: str = ""  # said in the verdicts of steps that use it
+
+
+def simple_name(lhs: str) -> Name | None:
+    """The one undotted symbol ``lhs`` is (``X``, ``c_1``, ``d_{11}``, ``\\phi_3``; also written
+    with its arguments, ``M_{12}(\\theta_2)``), else None."""
+    lhs = without_arguments(lhs)
+    names: list[Name] = []
+    marker = sp.Symbol("armdyn_lhs_marker")
+    try:
+        value = parse(lhs, lambda n: names.append(n) or marker)
+    except (LatexError, TypeError, ValueError, RecursionError):
+        return None
+    if value != marker or len(names) != 1 or names[0].dots or names[0].pre_sup or names[0].pre_sub:
+        return None
+    return names[0]
+
+
+def plain(name: Name) -> str:
+    """The key a name is kept under (as :class:`~.notation.SymbolMap` looks names up)."""
+    return name.base + re.sub(r"[{}\s,_]|\\mathrm|\\text", "", name.sub or "")
+
+
+def shorthand_name(name: Name) -> bool:
+    """``c_1``, ``s_{12}``, ``C_2``: a name the grader reads as the sine or cosine of joint angles."""
+    return name.base in ("s", "c", "S", "C") and (name.sub or "").strip("{} ").isdigit()
 
 
 def _arguments(text: str, grader) -> bool:
@@ -61,7 +102,6 @@ def _arguments(text: str, grader) -> bool:
 def _named(grader, text: str) -> Name | None:
     """The Name ``text`` is when it is a quantity the student (or the method) names: not a
     symbol of the model (``m_2(\\dot\\theta_1)^2`` stays a product), not the shorthand ``c_1``."""
-    from .defined import _shorthand, simple_name
 
     name = simple_name(text)
     if name is None:
@@ -69,7 +109,7 @@ def _named(grader, text: str) -> Name | None:
         name = simple_name(base) if base != text else None
         if name is None:
             return None
-    if _shorthand(name) or not grader.names.definable(name):
+    if shorthand_name(name) or not grader.names.definable(name):
         return None
     return name
 
@@ -143,7 +183,6 @@ _PARTIAL_LHS = re.compile(r"\s*\\frac\s*\{\s*\\partial\s*([^{}]*(?:\{[^{}]*\}[^{
 def _derivative_of(grader, lhs: str):
     """(the quantity's Name, a function value -> its derivative, the step's name, what it is) of a
     left-hand side ``\\dot X`` / ``\\frac{\\partial X}{\\partial q_k}`` of a named quantity, or None."""
-    from .defined import plain, simple_name
 
     m = _DOTTED_LHS.fullmatch(lhs)
     if m is not None:
@@ -209,10 +248,9 @@ def derivative_verdict(grader, eq):
         return None
     own_expected, right_expected = derive(own_value), derive(right_value)
     used = [e for e in names.used if e.line or e.wrong]
-    from .defined import read_pair
 
     try:
-        got, _ = read_pair(grader, str(eq.value))
+        got, _ = grader.names.read(str(eq.value))
     except (LatexError, TypeError, ValueError, RecursionError) as err:
         why = f"{label}: {str(err).splitlines()[0][:200]}"
         return StepVerdict(
@@ -320,7 +358,6 @@ def keep_named(grader, eq, v, own, right, wrong: str) -> None:
     """After a step: a link's (or the total) energy kept under every textbook name of it, a
     speed given through its square (``v_2^2 = ...``) kept as the speed ``v_2``, for later values.
     A name the student gave a value to themselves is never replaced by another's."""
-    from .defined import Entry, plain, simple_name
 
     names = grader.names
     if v.status == "unrecognised" or own is None or isinstance(own, sp.MatrixBase):
@@ -355,7 +392,8 @@ class Waiting:
         """``eq`` could not be read for a name not given (yet): wait for it."""
         unknown = self.grader.names.unknown
         if len(new) == 1 and new[0].status == "unrecognised" and unknown and "unknown symbol" in new[0].message:
-            self.items.append((eq, new[0], unknown[-1]))
+            if len(self.items) < MAX_WAITING:
+                self.items.append((eq, new[0], unknown[-1]))
 
     def known(self, name: Name) -> bool:
         names = self.grader.names
@@ -374,11 +412,12 @@ class Waiting:
         grades one equation and returns its new verdicts (appended), which take the old
         verdict's place."""
         progress = True
-        while progress:
+        while progress and self.items:
             progress = False
+            known = {m: self.known(m) for m in {item[2] for item in self.items}}  # each name looked up once
             for item in list(self.items):
                 eq, old, missing = item
-                if not self.known(missing):
+                if not known[missing]:
                     continue
                 self.items.remove(item)
                 verdicts = self.grader.verdicts
@@ -448,7 +487,6 @@ def partials_as_names(grader, text: str) -> str:
 
 def _quantity(grader, text: str) -> Name | None:
     """The Name ``text`` is when it names a quantity with a value now (not a model symbol)."""
-    from .defined import simple_name
 
     name = simple_name(text)
     if name is None or _model_symbol(grader, name):
@@ -512,7 +550,6 @@ def symmetric_entry(grader, eq, ref) -> bool:
     """``M_{21} = M_{12}``: the inertia matrix's symmetry, right whatever the value of ``M_{12}``;
     from here ``M_{21}`` stands for the student's ``M_{12}`` (its latest value). False for other
     equations."""
-    from .defined import plain, simple_name
     from .notation import parse_lhs
     from .verdict import StepVerdict
 
