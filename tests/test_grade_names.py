@@ -330,3 +330,11 @@ def test_many_names_never_given_end_in_bounded_time(tmp_path):
     report, _, _ = _grade(tmp_path, body + f"$$K_1 = {TEX['K1']}$$\n")
     assert time.perf_counter() - start < 60
     assert sum(s.status == "unrecognised" for s in report.steps) == 300
+
+
+def test_a_speed_of_a_joint_is_said_so(tmp_path):
+    # the elbow joint (frame 2's origin) moves at l_1 |thd1|: not link 2's mass centre, right for that point
+    body = "$$v_2 = l_1\\dot\\theta_1$$\n"
+    _, at, lines = _grade(tmp_path, body)
+    step = at[_line(lines, "v_2 =")]
+    assert step.status == "correct" and "frame 2's origin" in step.message

@@ -147,12 +147,10 @@ def drop_arguments(grader, text: str) -> str:
 
 def time_derivative(value, robot, order: int = 1):
     """The total time derivative of ``value`` along the joint motion: Σ ∂/∂q_k q̇_k + ∂/∂q̇_k q̈_k."""
-    pairs = list(zip(robot.q, robot.qd)) + list(zip(robot.qd, robot.qdd))
+    from ..symbolic.terms import time_derivative as chain_rule
+
     for _ in range(order):
-        if isinstance(value, sp.MatrixBase):
-            value = value.applyfunc(lambda x: sum((sp.diff(x, a) * b for a, b in pairs), sp.Integer(0)))
-        else:
-            value = sum((sp.diff(value, a) * b for a, b in pairs), sp.Integer(0))
+        value = chain_rule(value, robot.q, robot.qd, robot.qdd)
     return value
 
 
