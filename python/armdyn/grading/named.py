@@ -1,19 +1,23 @@
 """Quantities used by name across a derivation, as textbooks and exam answers write them.
 
-:mod:`.defined` keeps the values the student gave under plain names; this module reads the
-other ways a derivation uses them:
+:mod:`.defined` keeps the values the student gave under plain names (:class:`Entry`, keyed by
+:func:`plain`); this module reads the other ways a derivation uses them:
 
 * a name applied to its arguments, ``M_{11}(\\theta_2)\\ddot\\theta_1``, ``K_1(\\theta,\\dot\\theta)``:
   the quantity itself, not a product with the joint variable (:func:`drop_arguments`);
-* the time derivative of a named quantity, ``\\dot M_{11}``: the total derivative of the
-  student's own value (:func:`time_derivative`); a step ``\\dot M_{11} = ...`` is checked
+* the time derivative of a named quantity, ``\\dot M_{11}``, and its partial by a joint variable,
+  ``\\frac{\\partial M_{11}}{\\partial \\theta_2}``: that derivative of the student's own value
+  (:func:`differentiated`, :func:`partials_as_names`); a step ``\\dot M_{11} = ...`` is checked
   against it (:func:`derivative_step`);
 * a link's energy under any textbook name, ``\\mathcal L = \\mathcal K_1 + \\mathcal K_2 - ...``
-  after ``\\mathcal E_{K_1} = ...`` (:func:`keep_energy`); a speed given through its square,
-  ``v_2^2 = ...`` then ``\\frac12 m_2 v_2^2`` (:func:`keep_square`);
+  after ``\\mathcal E_{K_1} = ...``, and a speed given through its square, ``v_2^2 = ...`` then
+  ``\\frac12 m_2 v_2^2`` (:func:`keep_named`);
 * a name used before the step that gives it (``T = T_1 + T_2`` above ``T_1 = ...``): the
   equation waits for it and is graded, at its own line, once it is given
-  (:class:`Waiting`); a name never given is said so.
+  (:class:`Waiting`); a name never given is said so;
+* ``M_{21} = M_{12}``: the symmetry, after which ``M_{21}`` stands for ``M_{12}``
+  (:func:`symmetric_entry`); ``\\tau = M(q)\\ddot q`` in names only: a statement of the form
+  (:func:`form_only`).
 """
 
 from __future__ import annotations
@@ -102,14 +106,13 @@ def _arguments(text: str, grader) -> bool:
 def _named(grader, text: str) -> Name | None:
     """The Name ``text`` is when it is a quantity the student (or the method) names: not a
     symbol of the model (``m_2(\\dot\\theta_1)^2`` stays a product), not the shorthand ``c_1``."""
-
     name = simple_name(text)
     if name is None:
         base = _strip_dots(text)
         name = simple_name(base) if base != text else None
         if name is None:
             return None
-    if shorthand_name(name) or not grader.names.definable(name):
+    if shorthand_name(name) or _model_symbol(grader, name):
         return None
     return name
 
