@@ -39,7 +39,12 @@ def _drop_postgres_tables(url: str) -> None:
 
     engine = _engine(url)
     with engine.begin() as conn:
-        conn.execute(sa.text("DROP TABLE IF EXISTS submissions, armdyn_schema"))
+        conn.execute(
+            sa.text(
+                "DROP TABLE IF EXISTS submissions, armdyn_schema, student_links, student_sessions, "
+                "lti_states, lti_nonces, lti_users, lti_lineitems"
+            )
+        )
     engine.dispose()
 
 

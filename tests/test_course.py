@@ -130,7 +130,7 @@ def test_same_seed_same_bytes_and_seed_matters(tmp_path):
     make_exercise("rp", b, seed=4, count=2)
     make_exercise("rp", c, seed=5, count=2)
     files = sorted(p.relative_to(a) for p in a.rglob("*") if p.is_file())
-    assert len(files) == 9  # 4 files per variant + rubric.yaml
+    assert len(files) == 13  # 6 files per variant + rubric-rp.yaml
     for f in files:
         assert (a / f).read_bytes() == (b / f).read_bytes(), f
     assert any((a / f).read_bytes() != (c / f).read_bytes() for f in files if f.name == "model.yaml")
@@ -147,6 +147,10 @@ def test_variant_folder_contents(tmp_path):
     assert "$\\alpha_{i-1}$" in md  # Craig's table
     sol = (folder / "solution.md").read_text()
     assert sol.startswith("---\n") and "robot: model.yaml" in sol and "student: v001" in sol
+    assert "kind: rr" in (folder / "variant.yaml").read_text()
+    page = (folder / "solution.html").read_text()
+    assert 'http-equiv="Content-Security-Policy"' in page and "<script" not in page
+    assert page.count("<math") >= 30 and "<pre>" not in page  # every step as MathML
     report = armdyn.grade(str(folder / "solution.md"))
     assert report.passed and report.first_wrong is None
 
@@ -244,19 +248,24 @@ def test_gradebook_points_by_hand():
         [("bob", "v1", report, None), ("amy", None, None, "timeout: more than 60 s")], rubric=rubric
     )
     amy, bob = gb.rows
+    assert bob["kind"] == "arm-2"  # no exercise kind given: an arm of as many joints as torques
     # Newton-Euler: omega 1 + v_dot 0 + F_1 0.5 + F_2 3 + tau_1 4*0.5 + tau_2 0, of 1+1+1+3+4+4 (+ n_1 required: 1)
     assert bob["points_newton-euler"] == 6.5
     # Lagrange: T 1 + tau_1 4, of 1 + 4 (+ V required: 1)
     assert bob["points_lagrange"] == 5
     assert bob["total"] == 11.5 and bob["max"] == 15 + 6
     assert bob["first_wrong"] == "v_dot_1" and bob["first_wrong_kind"] == "missing term"
-    assert bob["tau_correct"] == "1/2" and bob["n_wrong"] == 2 and bob["n_unrecognised"] == 1
+    # the final torques per method: NE tau_1 unsupported (right), tau_2 wrong; Lagrange tau_1 right
+    assert bob["tau_newton-euler"] == "1/2" and bob["tau_lagrange"] == "1/2"
+    assert bob["n_wrong"] == 2 and bob["n_unrecognised"] == 1
     assert amy["status"] == "timeout" and amy["total"] == 0 and amy["error"].startswith("timeout")
     assert gb.kind_counts() == {"missing term": 1, "derivative mixed up": 1}
     assert gb.first_wrong_counts() == {"v_dot_1": 1}
     lines = gb.to_csv().splitlines()
-    assert lines[0].startswith("student,variant,status,error,points_lagrange,points_newton-euler,total,max")
-    assert lines[2].startswith("bob,v1,graded,,5,6.5,11.5,21,v_dot_1,missing term,1/2")
+    assert lines[0].startswith(
+        "student,variant,kind,status,error,submissions,policy,points_newton-euler,points_lagrange,total,max"
+    )
+    assert lines[2].startswith("bob,v1,arm-2,graded,,1,latest,6.5,5,11.5,21,v_dot_1,missing term,1/2,1/2")
     data = json.loads(gb.to_json())
     assert data["rows"][1]["total"] == 11.5 and data["columns"] == gb.columns
 
@@ -272,8 +281,11 @@ def test_gradebook_part_totals_scale_and_csv_formulas_are_quoted():
         [("=HYPERLINK(1)", None, report, None)], rubric=Rubric.from_text("parts:\n  newton-euler: 10\n  lagrange: 5\n")
     )
     row = gb.rows[0]
-    assert row["points_newton-euler"] == pytest.approx(10 * (1 + 1) / 3, abs=0.01)  # (1 + 2*0.5) of 3
-    assert row["points_lagrange"] == 0 and row["max"] == 15
+    # a one-joint arm graded by Newton-Euler only asks 12 steps (base 3, outward 6, inward 3):
+    # 11 points + tau's 2; written: omega_1 1 + tau_1 2*0.5, scaled to the part's 10
+    assert row["kind"] == "arm-1"
+    assert row["points_newton-euler"] == pytest.approx(10 * (1 + 1) / 13, abs=0.01)
+    assert "points_lagrange" not in row and row["max"] == 10  # no Lagrange part: not counted
     assert "\n'=HYPERLINK(1)," in gb.to_csv()
 
 

@@ -141,16 +141,21 @@ def test_class_of_60_against_the_injected_truth(course, tmp_path, capsys):
         assert r["n_wrong"] == (1 if slip else 0)
     # the CSV says the same as the JSON
     lines = book.read_text().splitlines()
-    assert len(lines) == 61 and lines[0].split(",")[:4] == ["student", "variant", "status", "error"]
+    assert len(lines) == 61 and lines[0].split(",")[:5] == ["student", "variant", "kind", "status", "error"]
     # the summary's counts: first wrong steps and kinds, from the injection list
     firsts = collections.Counter(s.name for _, s, _, _ in truth.values() if s)
     kinds = collections.Counter(KIND_OF_SLIP[s.how] for _, s, _, _ in truth.values() if s)
     page = (tmp_path / "out" / "summary.html").read_text()
-    shown = {k: int(n) for k, n in re.findall(r'<tr><td><code>([^<]+)</code></td><td class="num">(\d+)</td>', page)}
-    assert shown == dict(firsts)
-    shown_kinds = {k: int(n) for k, n in re.findall(r'<tr><td>([a-z ]+)</td><td class="num">(\d+)</td>', page)}
-    assert shown_kinds == dict(kinds)
-    assert f"<b>{sum(1 for (*_x,) in truth.values())}</b> submissions" in page
+    shown, shown_kinds = collections.Counter(), collections.Counter()  # summed over the kinds' sections
+    for k, n in re.findall(r'<tr><td><code>([^<]+)</code></td><td class="num">(\d+)</td>', page):
+        shown[k] += int(n)
+    for k, n in re.findall(r'<tr><td>([a-z ]+)</td><td class="num">(\d+)</td>', page):
+        shown_kinds[k] += int(n)
+    assert shown == firsts and shown_kinds == kinds
+    # each kind its own section: read from model.yaml's description (no variant.yaml here)
+    assert {r["kind"] for r in rows.values()} == {k for k, _ in VARIANTS}
+    assert all(f"<h2>{k}</h2>" in page for k, _ in VARIANTS)
+    assert f"<b>{len(truth)}</b> students, <b>{len(truth)}</b> submissions" in page
     assert len(list((tmp_path / "reports").glob("*.html"))) == 60
     print(f"60 submissions graded in {seconds:.1f} s with --jobs 2")
 
@@ -186,9 +191,9 @@ def test_bad_files_are_reported_alone(small_class, tmp_path, capsys):
     code, book = _run(root, subs, tmp_path)
     err = capsys.readouterr().err
     assert code == 1
-    rows = {
-        r["student"]: r for r in json.loads(book.with_suffix(".json").read_text())["rows"] if r["status"] != "duplicate"
-    }
+    data = json.loads(book.with_suffix(".json").read_text())
+    rows = {r["student"]: r for r in data["rows"]}
+    assert len(rows) == len(data["rows"])  # one row per student
     assert [rows[f"s{k}"]["status"] for k in range(3)] == ["graded"] * 3
     assert all(rows[f"s{k}"]["first_wrong"] is None for k in range(3))
     # a file that is not UTF-8 cannot say who handed it in: the file's stem stands for the student
@@ -196,8 +201,11 @@ def test_bad_files_are_reported_alone(small_class, tmp_path, capsys):
     assert f"{subs / 'corrupt.md'}:5: not UTF-8" in rows["corrupt"]["error"]
     assert rows["lost"]["status"] == "no-variant" and "w99" in rows["lost"]["error"]
     assert rows["nameless"]["status"] == "no-variant"
-    dup = [r for r in json.loads(book.with_suffix(".json").read_text())["rows"] if r["status"] == "duplicate"]
-    assert len(dup) == 1 and dup[0]["student"] == "s1" and "s1.yaml" in dup[0]["error"] and "s1.md" in dup[0]["error"]
+    # s1 handed in twice: one row (the graded file), the other set aside with its reason
+    assert rows["s1"]["submissions"] == 2 and rows["s1"]["policy"] == "latest"
+    dup = data["set_aside"]
+    assert len(dup) == 1 and dup[0]["student"] == "s1" and dup[0]["status"] == "duplicate"
+    assert "s1.yaml" in dup[0]["error"] and "s1.md" in dup[0]["error"]
     assert rows["twice"]["status"] == "graded" and rows["twice"]["variant"] == "w1"
     assert f"armdyn: note: {subs / 'twice.md'}: the front matter says student 's1'" in err
     not_graded = [line for line in err.splitlines() if line.startswith("armdyn: not graded: ")]

@@ -119,9 +119,10 @@ def test_serve_worker_grades_the_texts_robot():
     # an exercise chosen in the request names the model: graded against it, as before
     chosen = g.grade(_text("planar-2r-lagrange.md"), "planar-2r")
     assert chosen["graded_as"] == "planar-2r" and "read from the text" not in chosen["report_json"]
-    # a text that cannot be read and no variant: the reading's error, one line
+    # a text whose robot cannot be read and no variant: graded on its own values, saying why
     bad = g.grade(_text("scara-lagrange.md"), None)
-    assert bad["report_json"] is None and "cannot read the robot from the text" in bad["error"]
+    assert bad["error"] is None and bad["graded_as"] == FROM_TEXT
+    assert "no model: the robot could not be read from the text" in bad["report_json"]
     # an unknown variant is not a path to open: the text's robot, nothing loaded
     odd = g.grade(_text("planar-2r-lagrange.md", "variant: ../../etc/passwd"), None)
     assert odd["graded_as"] == FROM_TEXT and odd["error"] is None

@@ -179,7 +179,8 @@ def test_continuation_blocks_join_the_equation_before(tmp_path):
     )
     report = grade(write(tmp_path, "blocks.md", body))
     assert statuses(report) == [("tau_2", "correct"), ("tau_1", "correct")]
-    assert [v.line for v in report.steps] == [4, 7]
+    # a chain split over blocks is reported where its value is written (tau_1's: line 8)
+    assert [v.line for v in report.steps] == [4, 8]
 
 
 def test_a_continued_value_reports_the_column_of_its_second_piece(tmp_path):

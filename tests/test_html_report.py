@@ -549,7 +549,15 @@ def test_grouped_unrecognised_and_inherited_rows():
     assert card.count('<mtd class="hl">') == 3  # row 1 (y) on yours, expected and the difference
     assert "difference: yours \u2212 expected" in card
     card = page[page.index('id="step-4"') :]
-    assert "difference: yours \u2212 what your own earlier steps give" in card
+    # the expected value shown and the difference name one reference: the student's own
+    # chain gives 2x - x = x in the first row; the exercise's value is shown apart, named
+    assert "difference: yours \u2212 expected from your own earlier steps" in card
+    assert "expected from your own earlier steps</span>" in card and "from the exercise&#x27;s model" in card
+    from armdyn.grading.html import OWN_REFERENCE, reference
+
+    value, name = reference(own)
+    assert name == OWN_REFERENCE and value == V([x, 0, 0])
+    assert reference(carried)[0] == V([x, y, 0])
 
 
 def test_exercise_grade_report_renders_in_chromium(tmp_path):

@@ -59,8 +59,14 @@ def test_same_verdicts_as_the_named_model(name, tmp_path):
 def test_geometry_stated_only_in_words_is_not_read(tmp_path):
     # the SCARA text states its gravity (along -z0), its rotations and the heights only in
     # words; its horizontal p_{ck} leave the quill's slider d_3 moving nothing: it says so
+    path = _unnamed("scara-lagrange.md", tmp_path)
     with pytest.raises(ModelError, match="cannot read the robot from the text: joint variable q3 moves nothing"):
-        grade(_unnamed("scara-lagrange.md", tmp_path))
+        robot_from_text(read(path))
+    # graded all the same, against the text's own earlier values, the reason first
+    report = grade(path)
+    assert report.model_note.startswith("no model: the robot could not be read from the text")
+    assert "joint variable q3 moves nothing" in report.model_note
+    assert report.notes[0] == report.model_note
 
 
 def _tau_at(robot, values: dict):

@@ -144,7 +144,7 @@ def test_headers_preview_and_openapi(tmp_path):
         assert not tags & {"script", "img", "iframe", "a"} and not any("=" in t for t in tags), tags
         assert "&lt;script&gt;" in html  # the student's markup shown as text
         spec = c.get("/openapi.json").json()
-        assert spec["openapi"].startswith("3.") and {"/api/grade", "/api/submissions/{id}", "/api/health"} <= set(
+        assert spec["openapi"].startswith("3.") and {"/api/grade", "/api/submissions/{sid}", "/api/health"} <= set(
             spec["paths"]
         )
 

@@ -9,7 +9,7 @@ driven over the DevTools protocol (tests/cdp.py), against a real server process.
 - the instructor logs in with the token and downloads the gradebook.
 
 With ``ARMDYN_SERVE_SCREENSHOT=path.png`` the student's page is also saved there
-(docs/serve.png is made this way).
+(tests/test_serve_pages.py makes the screenshots of docs/img).
 """
 
 from __future__ import annotations

@@ -7,11 +7,12 @@
     armdyn grade SUBMISSION [--robot MODEL] [--json] [--html OUT.html] [--ascii] [--to-yaml] [--show-model]
     armdyn grade DIR --gradebook grades.csv [--rubric R.yaml] [--html-dir DIR] [--variants DIR] [--jobs N]
     armdyn exercise make KIND (--count N | --roster roster.csv) --seed S --out DIR
+    armdyn links --roster roster.csv --base-url URL [--db URL] [--renew ID...]
     armdyn serve [--host H] [--port P] [--db URL] [--workers N] [--exercises DIR] [--instructor-token T]
     armdyn codegen ROBOT [--what tau,M,C,g,regressor] [--base] [--lang c|python|numpy] [--bind] [--out DIR]
     armdyn simulate ROBOT --duration T --dt DT [--q0 ...] [--controller pd --target ...] [--plot run.png] [--animate run.gif]
 
-ROBOT is a bundled model's name (see ``armdyn robots``) or a model file (.yaml, .urdf).
+ROBOT is a bundled model's name (see ``armdyn robots``) or a model file (.yaml, .urdf, MJCF .xml).
 Bad input prints one line ``armdyn: error: ...`` and exits with status 2, no traceback.
 Ctrl-C prints ``armdyn: interrupted`` and exits with status 130, writing nothing.
 ``simulate`` exits with status 4 when the state became NaN/inf (see armdyn.simulate_cli).
@@ -148,6 +149,22 @@ def cmd_serve(args) -> int:
     return run(args)
 
 
+def cmd_links(args) -> int:
+    """``armdyn links``: the roster's personal links, as CSV (docs/serve.md)."""
+    from .serve.exercises import catalogue
+    from .serve.identity import make_links
+    from .serve.server import db_url
+
+    text = make_links(args.roster, db_url(args.db), args.base_url, catalogue(args.exercises), args.renew)
+    if args.out:
+        fd = os.open(args.out, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)  # secrets: owner only
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+    else:
+        print(text, end="")
+    return 0
+
+
 def cmd_codegen(args) -> int:
     from .printing import codegen, write_files
 
@@ -196,7 +213,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
 
     def robot_arg(sp_):
-        sp_.add_argument("robot", help="bundled model name (armdyn robots) or a .yaml/.urdf file")
+        sp_.add_argument("robot", help="bundled model name (armdyn robots) or a .yaml/.urdf/.xml (MJCF) file")
         sp_.add_argument(
             "--allow-nonphysical",
             action="store_true",
@@ -298,7 +315,28 @@ def build_parser() -> argparse.ArgumentParser:
         default="127.0.0.1",
         help="proxies whose X-Forwarded-* headers are trusted (default 127.0.0.1)",
     )
+    sv.add_argument("--roster", metavar="CSV", help="the class: students come by personal link or LTI (docs/serve.md)")
+    sv.add_argument(
+        "--deadline",
+        action="append",
+        metavar="[EXERCISE=]WHEN",
+        help="ISO 8601 deadline of an exercise (or of all); later submissions are marked late (repeatable)",
+    )
+    sv.add_argument("--policy", choices=("latest", "best"), default="latest", help="submission the gradebook counts")
+    sv.add_argument("--lti", metavar="YAML", help="LTI 1.3: the tool's key and the platforms (docs/serve.md)")
     sv.set_defaults(func=cmd_serve)
+    ln = sub.add_parser(
+        "links",
+        help="print the roster's secret personal links for armdyn serve",
+        description="Issue each roster student's personal link for `armdyn serve --roster` (docs/serve.md).",
+    )
+    ln.add_argument("--roster", required=True, metavar="CSV")
+    ln.add_argument("--db", help="the server's database (default sqlite:///armdyn-serve.db)")
+    ln.add_argument("--exercises", metavar="DIR", help="the variants the server serves")
+    ln.add_argument("--base-url", required=True, help="the server's address as students reach it, https://...")
+    ln.add_argument("--renew", nargs="+", metavar="ID", help="replace these students' links ('*': all)")
+    ln.add_argument("--out", help="write the CSV here (mode 600) instead of printing it")
+    ln.set_defaults(func=cmd_links)
     cg = sub.add_parser("codegen", help="generate C, Python or NumPy code for tau, M, C, g, the regressor")
     robot_arg(cg)
     cg.add_argument("--what", default="tau,M,C,g", help="comma-separated: tau,M,C,g,regressor (default tau,M,C,g)")

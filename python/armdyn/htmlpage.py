@@ -43,8 +43,8 @@ CSS = """
   font-size:0.86em; }
 .armdyn pre { white-space:pre-wrap; word-break:break-word; margin:6px 0 0; padding:8px 10px;
   background:var(--tint); border-radius:6px; color:var(--muted); }
-.armdyn a { color:var(--conv); text-decoration:none; }
-.armdyn a:hover { text-decoration:underline; }
+.armdyn a { color:var(--conv); text-decoration:underline; text-underline-offset:2px; }
+.armdyn a:hover { text-decoration-thickness:2px; }
 
 /* summary */
 .armdyn .summary { display:grid; grid-template-columns:1fr auto; gap:14px 28px; align-items:start;

@@ -128,17 +128,110 @@ _DELIMITED = re.compile(r"(?<!\\)\$(?!\$)(.+?)(?<!\\)\$|\\\((.+?)\\\)", re.S)
 
 
 def text_with_math(text: str) -> str:
-    """HTML of running text (a grader's message) whose delimited math (``$...$``,
-    ``\\(...\\)``) becomes inline MathML, through the whitelist sanitizer like all
-    math here; the rest, and math that does not convert, is escaped text."""
+    """HTML of running text (a grader's message) with its math as inline MathML, through
+    the whitelist sanitizer like all math here: delimited math (``$...$``, ``\\(...\\)``),
+    a formula quoted in backticks, and LaTeX written bare in the text (a run of words
+    holding a command such as ``\\dot{v}_{1}`` or a group ``E_{rot}``, with the short
+    symbols, numbers and operators around it, see :func:`_bare_math`). Math cut short
+    (``\\frac{1}{2}\\omega...``) is closed and shown followed by an ellipsis. The rest is
+    escaped text; math that does not convert is shown in ``<code>``."""
     out, at = [], 0
     for m in _DELIMITED.finditer(text):
         inner = latex_to_mathml(m.group(1) if m.group(1) is not None else m.group(2))
-        out.append(escape(text[at : m.start()]))
+        out.append(_with_bare_math(text[at : m.start()]))
         out.append(math_element(inner) if inner is not None else escape(m.group(0)))
         at = m.end()
+    out.append(_with_bare_math(text[at:]))
+    return "".join(out)
+
+
+_QUOTED = re.compile(r"`([^`\n]{1,400})`")
+_COMMAND = re.compile(r"\\[A-Za-z]+|[_^]\{")  # a TeX command or a braced script
+_GLUE = re.compile(r"^[A-Za-z0-9_^{}()\[\]|=+\-*/<>'\u2212\u00d7\u00b7]{1,16}$")
+_WORDS = {"a", "an", "as", "at", "be", "by", "if", "in", "is", "it", "no", "of", "on", "or", "so", "to", "we"}
+_CUT = ("\\...", "...", "\u2026")
+
+
+def _glue(word: str) -> bool:
+    """A short symbol, number or operator that belongs to the formula beside it (not an
+    English word, not a step name such as ``v_dot_1``)."""
+    if not _GLUE.match(word) or word.lower() in _WORDS or word.count("_") > 1:
+        return False
+    if re.search(r"[A-Za-z]{3,}", word) or word.count("(") != word.count(")") or word.count("[") != word.count("]"):
+        return False  # a word, or half of a parenthesis of the text around
+    return len(word) == 1 or not word.isalpha() or bool(re.fullmatch(r"d[A-Za-z]", word))
+
+
+def _bare_math(tex: str) -> str | None:
+    """Inline MathML of bare LaTeX (closed first if it was cut short), or None."""
+    tex = tex.replace("$", "")  # a delimiter left unpaired by a cut (a title shortened)
+    cut = tex.endswith(_CUT)
+    if cut:
+        for end in _CUT:
+            tex = tex.removesuffix(end)
+        tex += "}" * max(0, tex.count("{") - tex.count("}"))
+    inner = latex_to_mathml(tex)
+    if inner is None:
+        return None
+    return math_element(inner) + ("\u2026" if cut else "")
+
+
+def _with_bare_math(text: str) -> str:
+    """Escaped ``text`` with its backtick-quoted and bare LaTeX as MathML."""
+    out, at = [], 0
+    for m in _QUOTED.finditer(text):
+        out.append(_bare_runs(text[at : m.start()]))
+        quoted = m.group(1)
+        shown = _bare_math(quoted) if any(c in quoted for c in "\\_^{") else None
+        out.append(shown if shown is not None else f"<code>{escape(quoted)}</code>")
+        at = m.end()
+    out.append(_bare_runs(text[at:]))
+    return "".join(out)
+
+
+def _bare_runs(text: str) -> str:
+    """Escaped ``text`` with each run of words that holds a TeX command as MathML (a run
+    ends at a word that is neither TeX nor :func:`_glue`, or at a word's trailing , ; : .)."""
+    spans, run = [], []  # run: (start, end, is_tex) of its words
+
+    def flush():
+        while run and not run[-1][2] and not _glue_end(text[run[-1][0] : run[-1][1]]):
+            run.pop()
+        while run and not run[0][2]:
+            run.pop(0)
+        if run:
+            spans.append((run[0][0], run[-1][1]))
+        run.clear()
+
+    for m in re.finditer(r"\S+", text):
+        word, start = m.group(0), m.start()
+        core = word.rstrip(",;:")
+        if core.endswith(".") and not core.endswith(_CUT):
+            core = core[:-1]
+        if not core:
+            flush()
+            continue
+        tex = bool(_COMMAND.search(core))
+        if tex or _glue(core):
+            run.append((start, start + len(core), tex))
+            if core != word:  # trailing punctuation: the formula ends here
+                flush()
+        else:
+            flush()
+    flush()
+    out, at = [], 0
+    for start, end in spans:
+        shown = _bare_math(text[start:end])
+        out.append(escape(text[at:start]))
+        out.append(shown if shown is not None else f"<code>{escape(text[start:end])}</code>")
+        at = end
     out.append(escape(text[at:]))
     return "".join(out)
+
+
+def _glue_end(word: str) -> bool:
+    """May a formula end with this glue word? (a number or a symbol: not an operator)"""
+    return not re.fullmatch(r"[=+\-*/<>\u2212\u00d7\u00b7]+", word)
 
 
 class _Printer(MathMLPresentationPrinter):

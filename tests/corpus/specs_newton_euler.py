@@ -193,3 +193,59 @@ SPONG_SUPERSCRIPTS = [
     Eq(r"$$g_2^2 =", "g2", vec(-g * s12, -g * c12, 0)),
 ]
 SPECS["planar-3r-spong-superscripts.md"] = {"robot": "planar-3r", "eqs": SPONG_SUPERSCRIPTS}
+
+# ---------------------------------------------------------------- planar-2r-craig-split-blocks.md
+_n2z_split = I2 * _a2 + m2 * l1 * lc2 * c2 * qdd1 + m2 * l1 * lc2 * s2 * qd1**2 + m2 * lc2 * _a2 + m2 * g * lc2 * c12
+_inward1 = m2 * l1 * (l1 * qdd1 - lc2 * s2 * _w2**2 + lc2 * c2 * _a2 + g * c1)  # P_2 x R f_2, its z
+CRAIG_SPLIT = [
+    Eq(r"$${}^{1}\omega_{1} =", "omega1", z(qd1), span=1),
+    Eq(r"$${}^{1}\dot\omega_{1} =", "omegadot1", z(qdd1)),
+    Eq(r"$${}^{1}\dot v_{1} =", "vdot1", vec(g * s1, g * c1, 0), span=6),
+    Eq(r"$${}^{1}\dot v_{C_1} =", "vcdot1", vec(-lc1 * qd1**2 + g * s1, lc1 * qdd1 + g * c1, 0), span=1),
+    Eq(r"$${}^{1}F_{1} =", "F1", vec(-m1 * lc1 * qd1**2 + m1 * g * s1, m1 * lc1 * qdd1 + m1 * g * c1, 0), span=1),
+    Eq(r"$${}^{1}N_{1} =", "N1", z(I1 * qdd1)),
+    Eq(r"$${}^{2}\omega_{2} =", "omega2", z(_w2), span=1),
+    Eq(r"$${}^{2}\dot\omega_{2} =", "omegadot2", z(_a2)),
+    Eq(r"$${}^{2}\dot v_{2} =", "vdot2", _vd2, span=4),
+    Eq(r"$${}^{2}\dot v_{C_2} =", "vcdot2", _vc2, span=1),
+    Eq(r"$${}^{2}F_{2} =", "F2", m2 * _vc2),
+    Eq(r"$${}^{2}N_{2} =", "N2", z(I2 * _a2)),
+    Eq(r"$${}^{2}f_{2} =", "f2", m2 * _vc2, span=1),
+    # the formula block and the product block are right; the slip is in the value block
+    Eq(r"$${}^{2}n_{2} =", "n2", z(I2 * _a2 + m2 * lc2 * _vc2[1])),
+    Eq(r"$$= \begin{bmatrix} 0 \\ 0 \\ I_2", "n2", z(I2 * _a2) + vec(lc2, 0, 0).cross(m2 * _vc2)),
+    Eq(
+        r"$$= \begin{bmatrix} 0 \\ 0 \\ I_2",
+        "n2",
+        z(_n2z_split),
+        id="n2",
+        why="the value block has m_2 l_{c2}(q1'' + q2'') where l_{c2} x (m_2 l_{c2}(q1'' + q2'')) gives "
+        "m_2 l_{c2}^2(q1'' + q2''); its formula and product blocks are right",
+    ),
+    Eq(r"$${}^{1}f_{1} =", "f1", _f1, span=2),
+    Eq(
+        r"$${}^{1}n_{1} =",
+        "n1",
+        z(I1 * qdd1 + m1 * lc1**2 * qdd1 + m1 * g * lc1 * c1 + _n2z_split + _inward1),
+        id="n1",
+        span=3,
+        after="n2",
+        carried=lambda v: z(I1 * qdd1 + m1 * lc1 * (lc1 * qdd1 + g * c1) + v["n2"][2] + _inward1),
+    ),
+    Eq(r"$$\tau_2 =", "tau2", _n2z_split, span=1, after="n2", carried=lambda v: v["n2"][2]),
+    Eq(
+        r"$$\tau_1 =",
+        "tau1",
+        (I1 + m1 * lc1**2 + m2 * l1**2) * qdd1
+        + I2 * _a2
+        + m2 * lc2 * _a2
+        + m2 * l1 * lc2 * c2 * (2 * qdd1 + qdd2)
+        - m2 * l1 * lc2 * s2 * (2 * qd1 * qd2 + qd2**2)
+        + (m1 * lc1 + m2 * l1) * g * c1
+        + m2 * g * lc2 * c12,
+        span=2,
+        after="n2",
+        carried=lambda v: v["n1"][2],
+    ),
+]
+SPECS["planar-2r-craig-split-blocks.md"] = {"robot": "planar-2r", "eqs": CRAIG_SPLIT}

@@ -185,9 +185,10 @@ def all_specs() -> dict[str, dict]:
     import specs_names
     import specs_newton_euler
     import specs_proofs
+    import specs_public
 
     out = {}
-    for mod in (specs_newton_euler, specs_lagrange, specs_names, specs_proofs):
+    for mod in (specs_newton_euler, specs_lagrange, specs_names, specs_proofs, specs_public):
         out.update(mod.SPECS)
     return out
 

@@ -181,6 +181,8 @@ class Arm:
             for j in range(n):
                 for k in range(n):
                     Q.later(f"c{i + 1}{j + 1}{k + 1}", lambda i=i, j=j, k=k: self._christoffel(D, i, j, k))
+                    # Asada & Slotine's h_ijk = dD_ij/dq_k - 1/2 dD_jk/dq_i (i the equation; not symmetric)
+                    Q.later(f"h{i + 1}{j + 1}{k + 1}", lambda i=i, j=j, k=k: self._asada(D, i, j, k))
         Q.later("Cqd", lambda: Q["C"] * sp.Matrix(self.qd))
         Q["G"] = sp.Matrix([Q[f"phi{k + 1}"] for k in range(n)])
         Q["dL_dqd"] = sp.Matrix([Q[f"dL_dqd{k + 1}"] for k in range(n)])
@@ -207,6 +209,10 @@ class Arm:
         """Spong's c_ijk (k names the equation), from D(q)."""
         q = self.q
         return (sp.diff(D[k, j], q[i]) + sp.diff(D[k, i], q[j]) - sp.diff(D[i, j], q[k])) / 2
+
+    def _asada(self, D, i, j, k):
+        """Asada & Slotine's h_ijk (i names the equation), from D(q)."""
+        return sp.diff(D[i, j], self.q[k]) - sp.diff(D[j, k], self.q[i]) / 2
 
     def _coriolis(self, D):
         """C(q, qd) with C_kj = sum_i c_ijk qd_i."""

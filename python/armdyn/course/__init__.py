@@ -13,8 +13,10 @@
 One concept per module: :mod:`.kinds` (the arms), :mod:`.variants` (one drawn variant
 and its model file), :mod:`.statement` (problem.md / problem.html), :mod:`.solution`
 (the worked solution, injected slips), :mod:`.exercise` (the folders, the roster),
-:mod:`.rubric` (points per step and part), :mod:`.gradebook` (rows, CSV, JSON),
-:mod:`.errorkinds` (the kind of a wrong step), :mod:`.summary` (the class page),
+:mod:`.drawing` (the statement's drawing), :mod:`.expected` (the parts and steps a kind
+asks), :mod:`.rubric` (points per step and part), :mod:`.gradebook` (one row per student,
+CSV, JSON), :mod:`.slipkinds` (the kind of a wrong step, from its values),
+:mod:`.errorkinds` (from its message), :mod:`.summary` (the class page, per kind),
 :mod:`.chart` (reproducible SVG charts), :mod:`.page` (the HTML frame), :mod:`.isolate`
 (a forked child per submission, with limits), :mod:`.batch` (the class graded),
 :mod:`.cli` (the command line).

@@ -13,11 +13,14 @@ submission is graded against ``variants/<variant>/model.yaml``; a submission who
 variant is not there is not graded (status ``no-variant``); one whose front matter names
 no ``robot:`` is graded against the robot its text describes, with a warning in its
 report when that differs from the variant's (:mod:`armdyn.grading.robot_text.assigned`;
-the variant's when the text's cannot be read). Without ``variants``, against the
+the variant's when the text's cannot be read); its exercise kind is the variant folder's
+``variant.yaml`` (:func:`.exercise.variant_kind`), and without a ``rubric`` it is scored
+with that kind's ``rubric-<kind>.yaml``. Without ``variants``, against the
 front matter's ``robot:``: a bundled name or a file directly in the folder (never a
 ``.xacro`` file: models are loaded untrusted). A second file for the same student, or
 one whose report would have the same file name (``a b`` and ``a_b``), is not graded
-(``duplicate``, naming both files).
+(``duplicate``, naming both files; the student keeps one row, :mod:`.gradebook`). An empty
+file, or one with nothing after its front matter, is not graded (``error``, saying so).
 
 Each submission is graded in its own forked child (:mod:`.isolate`) with a time and
 memory limit; one that times out, runs out of memory or crashes is reported as such
@@ -42,6 +45,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import ModelError
+from .exercise import rubric_path, variant_kind
 from .gradebook import Gradebook
 from .rubric import Rubric
 
@@ -59,6 +63,7 @@ class Task:
     robot: str | None
     want_html: bool
     from_text: bool = False  # names no model: graded against its text's, robot the assigned one to compare
+    kind: str | None = None  # the exercise kind (variant.yaml of its variant folder), None when not known
 
 
 @dataclass
@@ -77,7 +82,8 @@ class BatchResult:
 # ------------------------------------------------------------------ one submission
 def grade_task(task: dict) -> dict:
     """Grade one submission (runs in the child): ``{"report": grade JSON, "html": page}``
-    or ``{"error": "error: file:line: what"}`` for a submission the grader refuses."""
+    or ``{"error": "error: file:line: what"}`` for a submission the grader refuses. Each
+    wrong step whose kind :mod:`.slipkinds` reads from its values gets ``slip_kind``."""
     from ..grading import grade
 
     try:
@@ -88,6 +94,10 @@ def grade_task(task: dict) -> dict:
     except (ModelError, ValueError, OSError) as exc:
         return {"error": "error: " + " ".join(str(exc).split())}
     out = {"report": json.loads(report.to_json())}
+    from .slipkinds import slip_kinds
+
+    for k, kind in slip_kinds(report).items():  # read from the values, where the message is vague
+        out["report"]["steps"][k]["slip_kind"] = kind
     if task["want_html"]:
         from ..grading.html import report_html
 
@@ -130,12 +140,16 @@ def _front_matter(path: str) -> tuple[dict, str | None]:
         text = read_text(path)
     except ModelError as exc:
         return {}, str(exc)
+    if not text.strip():
+        return {}, f"{path}: the file is empty"
     if path.lower().endswith(".md"):
         from ..grading.display import front_matter
 
         front = front_matter(text)  # after blank lines or comments too, as the grader reads it
         if front is None or front[1] < 0:
             return {}, None
+        if not text[front[1] :].lstrip("-").strip():
+            return {}, f"{path}: the file is empty after its front matter (no derivation)"
         text = text[front[0] : front[1]]
     try:
         data = safe_yaml(text, path)
@@ -195,7 +209,7 @@ def discover(folder, variants=None, want_html: bool = False) -> Found:
         if unreadable:
             refused.append((student, variant, f"error: {unreadable}"))
             continue
-        robot, from_text = None, False
+        robot, from_text, kind = None, False, None
         if variants is not None:
             own = student if os.path.isdir(os.path.join(variants, student)) else None
             if own is not None and variant not in (None, own):
@@ -214,6 +228,7 @@ def discover(folder, variants=None, want_html: bool = False) -> Found:
                 continue
             robot = model
             from_text = _name(meta.get("robot")) is None
+            kind = variant_kind(os.path.join(variants, variant))
         else:
             robot, why = _class_model(folder, _name(meta.get("robot")))
             if why:
@@ -232,7 +247,7 @@ def discover(folder, variants=None, want_html: bool = False) -> Found:
             refused.append((student, variant, why))
             continue
         owner[student], reports[report] = path, path
-        tasks.append(Task(path, student, variant, robot, want_html, from_text))
+        tasks.append(Task(path, student, variant, robot, want_html, from_text, kind))
     return Found(tasks, refused, notes)
 
 
@@ -255,7 +270,8 @@ def _class_model(folder: str, name: str | None) -> tuple[str | None, str | None]
 
 # ------------------------------------------------------------------ cache
 def _grader_fingerprint() -> str:
-    """armdyn's version and a hash of the grader's source (a changed grader re-grades)."""
+    """armdyn's version and a hash of the grader's source and of :mod:`.slipkinds` (a
+    changed grader re-grades)."""
     from .. import __version__
 
     h = hashlib.sha256(__version__.encode())
@@ -263,6 +279,7 @@ def _grader_fingerprint() -> str:
     for p in sorted(root.rglob("*.py")):
         h.update(p.relative_to(root).as_posix().encode())
         h.update(p.read_bytes())
+    h.update((Path(__file__).resolve().parent / "slipkinds.py").read_bytes())  # its kinds are in the result
     return h.hexdigest()
 
 
@@ -303,22 +320,32 @@ def grade_class(
     use_cache: bool = True,
     dask: str | None = None,
     progress: bool | None = None,
+    policy: str = "latest",
 ) -> BatchResult:
-    """Grade every submission in ``folder`` and write the gradebook (see the module docstring)."""
+    """Grade every submission in ``folder`` and write the gradebook (see the module docstring).
+    ``rubric``: one rubric for every student; None: with ``variants`` each student's
+    kind's ``rubric-<kind>.yaml`` there (:func:`.exercise.rubric_path`), else the default.
+    ``policy``: which submission a student who handed in twice is graded on
+    (:data:`.gradebook.POLICIES`)."""
     from .._io_atomic import atomic_writes
     from .summary import summary_html
 
     t0 = time.perf_counter()
-    rubric = rubric or Rubric.default()
     gradebook = os.fspath(gradebook)
     if variants is not None and not os.path.isdir(variants):
         raise ModelError("not a folder of variants (the output of armdyn exercise make)", source=os.fspath(variants))
     found = discover(folder, variants, want_html=html_dir is not None)
     tasks, refused, notes = found.tasks, found.refused, list(found.notes)
+    rubrics = {}
+    if rubric is None and variants is not None:  # each kind its own rubric, when exercise make wrote it
+        for kind in sorted({t.kind for t in tasks if t.kind}):
+            if os.path.isfile(rubric_path(variants, kind)):
+                rubrics[kind] = Rubric.load(rubric_path(variants, kind))
+    rubric = rubric or Rubric.default()
     out_dir = os.path.dirname(os.path.abspath(gradebook))
     cache_dir = os.path.join(out_dir, CACHE_DIR)
     grader = _grader_fingerprint()
-    keys = {t.path: cache_key(t, rubric, grader) for t in tasks}
+    keys = {t.path: cache_key(t, rubrics.get(t.kind, rubric), grader) for t in tasks}
     results: dict[str, dict] = {}
     todo = []
     for t in tasks:
@@ -345,13 +372,15 @@ def grade_class(
     items, not_graded = [], []
     for t in tasks:
         r = results[t.path]
-        items.append((t.student, t.variant, r.get("report"), r.get("error")))
+        items.append((t.student, t.variant, r.get("report"), r.get("error"), t.kind))
         if "report" not in r:
             not_graded.append(_why(t.path, r.get("error") or "crashed: no result"))
     for student, variant, error in refused:
-        items.append((student, variant, None, error))
+        ok = variants and variant and "/" not in variant and not variant.startswith(".")
+        kind = variant_kind(os.path.join(variants, variant)) if ok else None
+        items.append((student, variant, None, error, kind))
         not_graded.append(_why(None, error))
-    book = Gradebook.from_results(items, rubric=rubric)
+    book = Gradebook.from_results(items, rubric=rubric, policy=policy, rubrics=rubrics)
 
     outputs = [
         (gradebook, book.to_csv()),

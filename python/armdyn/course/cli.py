@@ -26,7 +26,18 @@ def add_batch_arguments(parser) -> None:
         help="write the gradebook here (and grades.json, "
         "summary.html beside it); default grades.csv in the folder's parent",
     )
-    b.add_argument("--rubric", metavar="rubric.yaml", help="points per step or part (default: docs/course.md)")
+    b.add_argument(
+        "--rubric",
+        metavar="rubric.yaml",
+        help="points per step or part, for every student (default: with --variants each student's kind's "
+        "rubric-<kind>.yaml there, else the default of docs/course.md)",
+    )
+    b.add_argument(
+        "--policy",
+        choices=("latest", "best"),
+        default="latest",
+        help="a student who handed in twice: the latest graded submission (default) or the best",
+    )
     b.add_argument("--html-dir", metavar="DIR", help="write one HTML report per student here")
     b.add_argument(
         "--variants",
@@ -54,7 +65,7 @@ def cmd_grade_class(args) -> int:
         raise ValueError(f"--jobs must be at least 1, got {args.jobs}")
     if args.timeout <= 0:
         raise ValueError(f"--timeout must be positive, got {args.timeout}")
-    rubric = Rubric.load(args.rubric) if args.rubric else Rubric.default()
+    rubric = Rubric.load(args.rubric) if args.rubric else None
     gradebook = args.gradebook or os.path.join(os.path.dirname(os.path.abspath(folder)), "grades.csv")
     result = grade_class(
         folder,
@@ -67,6 +78,7 @@ def cmd_grade_class(args) -> int:
         memory_mb=args.memory_mb,
         use_cache=not args.no_cache,
         dask=args.dask,
+        policy=args.policy,
     )
     for line in result.notes:
         print(f"armdyn: note: {line}", file=sys.stderr)
@@ -74,13 +86,14 @@ def cmd_grade_class(args) -> int:
         print(f"armdyn: not graded: {line}", file=sys.stderr)
     rows = result.gradebook.rows
     graded = sum(1 for r in rows if r["status"] == "graded")
+    handed = sum(r["submissions"] for r in rows)
     print(
-        f"graded {graded} of {len(rows)} submissions ({result.cached} unchanged, from the cache) in "
+        f"graded {graded} of {len(rows)} students ({handed} submissions) ({result.cached} unchanged, from the cache) in "
         f"{result.seconds:.1f} s; wrote {gradebook}, {os.path.splitext(gradebook)[0]}.json, "
         f"{os.path.join(os.path.dirname(os.path.abspath(gradebook)), 'summary.html')}"
         + (f" and reports in {args.html_dir}" if args.html_dir else "")
     )
-    return 0 if graded == len(rows) else 1
+    return 0 if not result.not_graded else 1
 
 
 def add_exercise_parser(sub) -> None:
@@ -102,6 +115,9 @@ def add_exercise_parser(sub) -> None:
     m.add_argument("--seed", type=int, default=0, help="the same seed and roster give the same files")
     m.add_argument("--convention", choices=CONVENTIONS, help="use these frames for every variant (default: drawn)")
     m.add_argument("--out", required=True, help="the folder to write into (one sub-folder per id)")
+    m.add_argument(
+        "--force", action="store_true", help="overwrite variant folders (and the kind's rubric) already there"
+    )
     m.set_defaults(func=cmd_exercise_make)
 
 
@@ -109,9 +125,20 @@ def cmd_exercise_make(args) -> int:
     from .exercise import make_exercise
 
     result = make_exercise(
-        args.kind, args.out, seed=args.seed, count=args.count, roster=args.roster, convention=args.convention
+        args.kind,
+        args.out,
+        seed=args.seed,
+        count=args.count,
+        roster=args.roster,
+        convention=args.convention,
+        force=args.force,
     )
     for line in result.problems:
         print(f"armdyn: error: {line}", file=sys.stderr)
-    print(f"wrote {len(result.written)} variant(s) of '{args.kind}' into {args.out}")
+    from .exercise import rubric_path
+
+    print(
+        f"wrote {len(result.written)} variant(s) of '{args.kind}' into {args.out} "
+        f"(rubric: {rubric_path(args.out, args.kind)})"
+    )
     return 1 if result.problems else 0

@@ -1,4 +1,5 @@
-"""The kind of a wrong step, read from the grader's message (``armdyn.grading.explain``).
+"""The kind of a wrong step, read from the grader's message (``armdyn.grading.explain``),
+when :mod:`.slipkinds` (the values themselves) cannot tell.
 
 ``describe`` writes one sentence per wrong component; its opening words name the slip:
 
@@ -28,7 +29,14 @@ KINDS = (
     "derivative mixed up",
     "factor missing",
     "extra factor",
+    "inertia about the wrong point",
+    "transposed rotation",
     "wrong shape",
+    "proof: sign",
+    "proof: transpose",
+    "proof: mass-centre fact about the wrong point",
+    "proof: factor",
+    "proof: dropped term",
     "other",
 )
 

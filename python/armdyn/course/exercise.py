@@ -7,9 +7,13 @@ model and the worked solution.
 Each ``out/<id>/`` holds ``problem.md``, ``problem.html`` (with a drawing),
 ``model.yaml`` and ``solution.md`` (front matter ``robot: model.yaml``, ``student``,
 ``variant``; grading it gives every step correct). The same seed and roster give
-byte-identical files. ``out/rubric.yaml`` is the default rubric with every step of
-the solution required (for ``armdyn grade DIR --rubric``). A roster is a CSV file with a header naming an ``id`` (or
-``student``) column; other columns are ignored. Ids are folder names: letters, digits,
+byte-identical files. Each folder also holds ``variant.yaml`` (the exercise kind and
+what was drawn: what ``armdyn grade DIR --variants`` reads the student's kind from), and
+``out/rubric-<kind>.yaml`` is the kind's rubric, every step of its worked solution
+required per part: exercises of several kinds made into one folder (a mixed class) each
+get their own, side by side. A folder that already holds a variant (or the kind's rubric)
+is refused, naming it, unless ``force``: nothing is then written. A roster is a CSV file
+with a header naming an ``id`` (or ``student``) column; other columns are ignored. Ids are folder names: letters, digits,
 ``.``, ``_``, ``-`` (not first), at most 64 characters.
 """
 
@@ -83,7 +87,7 @@ def read_roster(path) -> tuple[list[str], list[str]]:
 def proof_files(kind: str, ident: str, seed: int) -> dict[str, str]:
     """The four files of one variant of a proof exercise: name -> text."""
     from .proofkinds import PROOF_MODEL, proof_blocks, proof_markdown
-    from .statement import statement_html, statement_markdown
+    from .statement import markdown_blocks, statement_html, statement_markdown
     from .variants import rng_for
 
     title, blocks = proof_blocks(kind, rng_for(seed, ident))
@@ -103,7 +107,7 @@ def proof_files(kind: str, ident: str, seed: int) -> dict[str, str]:
     front = {"robot": "model.yaml", "student": ident, "variant": ident}
     text, _ = proof_markdown(blocks, front, f"Solution of exercise {ident}: {title}")
     return {
-        "steps.txt": "",
+        "solution.html": statement_html(markdown_blocks(text), None),
         "model.yaml": PROOF_MODEL,
         "problem.md": statement_markdown(statement),
         "problem.html": statement_html(statement, None),
@@ -116,9 +120,10 @@ def variant_files(kind: str, ident: str, seed: int, convention: str | None = Non
     if kind in PROOF_KINDS:
         return proof_files(kind, ident, seed)
     from ..io.yaml import load_yaml_string
+    from .drawing import drawing_uri
     from .solution import solution_markdown, solution_steps
     from .statement import (
-        drawing_uri,
+        markdown_blocks,
         statement_blocks,
         statement_html,
         statement_markdown,
@@ -139,13 +144,66 @@ def variant_files(kind: str, ident: str, seed: int, convention: str | None = Non
         "$N_i = I_i \\dot\\omega_i + \\omega_i \\times I_i \\omega_i$; gravity as an upward acceleration of "
         "the base). `armdyn grade solution.md` grades every step correct."
     )
+    solution = solution_markdown(robot, steps, front, f"Solution of exercise {ident}", intro)
     return {
-        "steps.txt": "".join(f"    - {s.name}\n" for s in steps),
         "model.yaml": model_text,
         "problem.md": statement_markdown(blocks),
         "problem.html": statement_html(blocks, drawing_uri(v, robot)),
-        "solution.md": solution_markdown(robot, steps, front, f"Solution of exercise {ident}", intro),
+        "solution.md": solution,
+        "solution.html": statement_html(markdown_blocks(solution), None),
     }
+
+
+def rubric_text(kind: str) -> str:
+    """The rubric of an exercise kind: the default points and credit, and every step its
+    worked solution has, required per part (a proof: its links are counted, see
+    :mod:`.expected`)."""
+    from .expected import expected_for
+
+    exp = expected_for(kind)
+    lines = [
+        f"# armdyn exercise make {kind}: the rubric of this kind, every step of the worked solution",
+        "# required (a step not handed in scores 0 of its points). See docs/course.md.",
+        "points:\n  tau: 2\ndefault: 1\ncredit:\n  correct: 1\n  correct-by-convention: 1",
+        "  follows-from-earlier-error: 0.5\n  correct-but-unsupported: 0.5\n  wrong: 0",
+    ]
+    if exp.steps:
+        lines.append("required:")
+        for part in exp.parts:
+            lines.append(f"  {part}:")
+            lines += [f"    - {n}" for p, n in exp.steps if p == part]
+    else:
+        lines.append(f"# a proof: its {exp.links} links (each = of the worked proof) are required")
+    return "\n".join(lines) + "\n"
+
+
+def rubric_path(out, kind: str) -> str:
+    """Where ``exercise make`` writes the rubric of ``kind``: ``out/rubric-<kind>.yaml``."""
+    return os.path.join(os.fspath(out), f"rubric-{kind}.yaml")
+
+
+def variant_kind(folder) -> str | None:
+    """The exercise kind of a variant folder: its ``variant.yaml``, else (a folder made
+    before it was written) the arm its ``model.yaml`` description names
+    (``exercise variant ada: rp, ...``); None when neither says."""
+    folder = os.fspath(folder)
+    path = os.path.join(folder, "variant.yaml")
+    if os.path.isfile(path) and not os.path.islink(path):
+        try:
+            data = yaml.safe_load(read_text(path, "variant", 1 << 16))
+        except (ModelError, yaml.YAMLError):
+            data = None
+        kind = data.get("kind") if isinstance(data, dict) else None
+        return kind if kind in KINDS or kind in PROOF_KINDS else None
+    model = os.path.join(folder, "model.yaml")
+    if not os.path.isfile(model) or os.path.islink(model):
+        return None
+    try:
+        head = read_text(model, "model", MAX_ROSTER_BYTES)[:4000]
+    except ModelError:
+        return None
+    m = re.search(r"^description: ['\"]?exercise variant \S+: ([a-z]+), ", head, re.MULTILINE)
+    return m.group(1) if m and m.group(1) in KINDS else None
 
 
 def _writer(text: str):
@@ -157,10 +215,19 @@ def _writer(text: str):
 
 
 def make_exercise(
-    kind: str, out, seed: int = 0, count: int | None = None, roster=None, convention: str | None = None, progress=None
+    kind: str,
+    out,
+    seed: int = 0,
+    count: int | None = None,
+    roster=None,
+    convention: str | None = None,
+    progress=None,
+    force: bool = False,
 ) -> MakeResult:
     """Write one folder per id into ``out`` (see the module docstring). Each folder is
-    written all or nothing. ``progress(ident)`` is called after each one."""
+    written all or nothing. ``progress(ident)`` is called after each one. A variant
+    folder that is not empty, or the kind's rubric, already there: :class:`ModelError`
+    naming them (nothing written) unless ``force``."""
     from .._io_atomic import atomic_writes
 
     if kind not in KINDS and kind not in PROOF_KINDS:
@@ -175,27 +242,33 @@ def make_exercise(
             raise ModelError(f"--count must be in 1..100000, got {count}")
         ids = [f"v{k:03d}" for k in range(1, count + 1)]
     out = os.fspath(out)
-    required: list[str] = []
+    if not force:
+        taken = [i for i in ids if os.path.isdir(os.path.join(out, i)) and os.listdir(os.path.join(out, i))]
+        if os.path.exists(rubric_path(out, kind)):
+            taken.append(os.path.basename(rubric_path(out, kind)))
+        if taken:
+            shown = ", ".join(taken[:5]) + (f" and {len(taken) - 5} more" if len(taken) > 5 else "")
+            raise ModelError(
+                f"already there: {shown}; nothing written (--force to overwrite, or another --out)", source=out
+            )
     for ident in ids:
         files = variant_files(kind, ident, seed, convention)
+        files["variant.yaml"] = _variant_yaml(kind, ident, seed, convention)
         folder = os.path.join(out, ident)
         os.makedirs(folder, exist_ok=True)
-
-        steps_list = files.pop("steps.txt")
         atomic_writes([(os.path.join(folder, name), _writer(text)) for name, text in sorted(files.items())])
-        for name in re.findall(r"^    - (\S+)$", steps_list, re.MULTILINE):
-            if name not in required:
-                required.append(name)
         result.written.append(ident)
         if progress is not None:
             progress(ident)
-    if required:
-        rubric = (
-            f"# armdyn exercise make {kind}: the default rubric, with every step of the worked\n"
-            "# solution required (a step not handed in scores 0 of its points). See docs/course.md.\n"
-            "points:\n  tau: 2\ndefault: 1\ncredit:\n  correct: 1\n  correct-by-convention: 1\n"
-            "  follows-from-earlier-error: 0.5\n  correct-but-unsupported: 0.5\n  wrong: 0\n"
-            "required:\n" + "".join(f"  - {n}\n" for n in required)
-        )
-        atomic_writes([(os.path.join(out, "rubric.yaml"), _writer(rubric))])
+    if ids:
+        atomic_writes([(rubric_path(out, kind), _writer(rubric_text(kind)))])
     return result
+
+
+def _variant_yaml(kind: str, ident: str, seed: int, convention: str | None) -> str:
+    """``variant.yaml``: the exercise kind of the folder and what it was drawn from."""
+    data = {"kind": kind, "id": ident, "seed": int(seed)}
+    if kind not in PROOF_KINDS:
+        v = draw_variant(kind, ident, seed=seed, convention=convention)
+        data.update(convention=v.convention, masses=v.masses, lengths=dict(v.lengths) or "symbolic")
+    return "# armdyn exercise make: the exercise kind of this folder\n" + yaml.safe_dump(data, sort_keys=False)

@@ -8,9 +8,12 @@ A rubric is a small YAML file (every key optional; this is :meth:`Rubric.default
     parts:                       # optional: scale each part's steps to this many points
       newton-euler: 10           #   (parts: newton-euler, lagrange, proof)
       lagrange: 5
-    required: [tau_1, tau_2]     # optional: steps every submission must write; one that
-                                 #   is missing scores 0 of its points (steps not written
-                                 #   and not required are simply not counted)
+    required: [tau_1, tau_2]     # optional: the steps every submission must write (a tau
+                                 #   in both methods), or per part: {lagrange: [tau_1]}; one
+                                 #   missing scores 0 of its points. Without it every step
+                                 #   of the student's exercise kind is required
+                                 #   (armdyn.course.expected); a required step the kind does
+                                 #   not have is not asked of it
     credit:                      # fraction of a step's points, by verdict status
       correct: 1
       correct-by-convention: 1
@@ -22,7 +25,8 @@ A step's part is the ``part`` field of the grade JSON when it has one, else read
 key: Lagrange's steps (T, V, L, the derivatives of L, and a tau after them) are part
 ``lagrange``, the links of a proof (``proof_<line>``) ``proof``, the others
 ``newton-euler``. Unrecognised equations score nothing and are
-not counted. Points are rounded to 2 decimals.
+not counted. Points are rounded to 2 decimals. ``parts`` totals count only the parts the
+student's exercise kind has (a proof has no Newton-Euler part).
 """
 
 from __future__ import annotations
@@ -58,6 +62,7 @@ class Rubric:
     default_points: float = 1.0
     parts: dict[str, float] = field(default_factory=dict)
     required: list[str] = field(default_factory=list)
+    required_by_part: dict[str, list[str]] = field(default_factory=dict)
     credit: dict[str, float] = field(default_factory=lambda: dict(DEFAULT_CREDIT))
     source: str = "<default rubric>"
 
@@ -127,12 +132,24 @@ class Rubric:
                 rubric.parts = table
         if "required" in data:
             req = data["required"]
-            if not isinstance(req, list) or not all(isinstance(x, str) for x in req):
+            where = _line_of(text, source, "required", top)
+            if isinstance(req, dict):
+                from .expected import PARTS
+
+                for part, names in req.items():
+                    if part not in PARTS or not isinstance(names, list) or not all(isinstance(x, str) for x in names):
+                        raise ModelError(
+                            f"required.{part}: a part ({', '.join(PARTS)}) with a list of step names",
+                            source=_line_of(text, source, str(part), where),
+                        )
+                    rubric.required_by_part[str(part)] = list(names)
+            elif not isinstance(req, list) or not all(isinstance(x, str) for x in req):
                 raise ModelError(
-                    "required must be a list of step names (tau_1, v_dot_2, ...)",
-                    source=_line_of(text, source, "required", top),
+                    "required must be a list of step names (tau_1, v_dot_2, ...) or one such list per part",
+                    source=where,
                 )
-            rubric.required = list(req)
+            else:
+                rubric.required = list(req)
         return rubric
 
     # -- scoring
@@ -142,12 +159,29 @@ class Rubric:
             return self.points[name]
         return self.points.get(key, self.default_points)
 
+    def required_steps(self, expected) -> set[tuple[str, str]] | None:
+        """``(part, name)`` of the steps a submission of the kind ``expected`` (an
+        :class:`~.expected.Expected`) must write: the rubric's ``required`` that the kind
+        has, else every step of the kind; None when neither says (only the steps written
+        count)."""
+        from .expected import parts_of_name
+
+        if not self.required and not self.required_by_part:
+            return set(expected.steps) if expected is not None and expected.steps else None
+        asked = {(p, n) for n in self.required for p in parts_of_name(n)}
+        asked |= {(p, n) for p, names in self.required_by_part.items() for n in names}
+        if expected is None:
+            return {(p, n) for p, n in asked if not n.startswith("proof_")}
+        return asked & set(expected.steps)
+
     def to_dict(self) -> dict:
         return {
             "points": dict(sorted(self.points.items())),
             "default": self.default_points,
             "parts": dict(sorted(self.parts.items())),
-            "required": list(self.required),
+            "required": list(self.required)
+            if not self.required_by_part
+            else {**({"any": list(self.required)} if self.required else {}), **self.required_by_part},
             "credit": dict(sorted(self.credit.items())),
         }
 

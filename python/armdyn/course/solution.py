@@ -15,9 +15,11 @@ derivative, ∂L/∂q and τ. The LaTeX of each value is armdyn's report rendere
 from __future__ import annotations
 
 import functools
+import re
 from dataclasses import dataclass, replace
 
 import sympy as sp
+from sympy.printing.latex import LatexPrinter
 
 from ..model import Robot
 from ..symbolic.agreement import trig_reduce
@@ -174,23 +176,49 @@ def inject_slip(steps: list[SolutionStep], rng, q, index: int | None = None, how
     return out, Slip(index=index, part=s.part, name=s.name, how=how, component=component, term=sp.sstr(t))
 
 
-def _latex_names(robot: Robot) -> dict:
+def _teacher_names(robot: Robot) -> dict:
+    """Symbol -> LaTeX as a teacher writes it: ``\\theta_1``, ``\\dot\\theta_1``, ``\\ddot d_2``,
+    ``l_1``, ``m_2`` (one-character indices without braces)."""
+    from ..symbolic.names import latex_symbol_names
+
     names = {}
-    for q, qd, qdd in zip(robot.q, robot.qd, robot.qdd):
-        base = sp.latex(q)
-        names[qd] = rf"\dot{{{base}}}"
-        names[qdd] = rf"\ddot{{{base}}}"
+    for sym, tex in latex_symbol_names(robot).items():
+        tex = re.sub(r"\\(dot|ddot)\{(\\?[A-Za-z]+)\}", r"\\\1\2", tex)  # \dot{\theta} -> \dot\theta
+        tex = re.sub(r"_\{(\w)\}", r"_\1", tex)  # _{1} -> _1
+        names[sym] = re.sub(r"(\\d?dot)([A-Za-z])", r"\1 \2", tex)  # \dot d_2 stays two tokens
     return names
 
 
-def render_value(value, names: dict, q=()) -> str:
-    """LaTeX of a step's value (a pmatrix column for vectors); small expressions
-    expanded with sin^2 + cos^2 = 1 applied in the coordinates ``q``."""
+class TeacherPrinter(LatexPrinter):
+    """SymPy's LaTeX with a teacher's notation: ``\\sin\\theta_1`` (no parentheses around
+    one symbol), ``\\sin(\\theta_1 + \\theta_2)``, the model's symbols as :func:`_teacher_names`."""
+
+    def __init__(self, names: dict):
+        super().__init__({"symbol_names": names, "mul_symbol": None})
+
+    def _print_Function(self, expr, exp=None):
+        fn = expr.func.__name__
+        if fn in ("sin", "cos", "tan") and len(expr.args) == 1:
+            arg = expr.args[0]
+            inner = self._print(arg)
+            power = f"^{{{exp}}}" if exp is not None else ""
+            return f"\\{fn}{power} {inner}" if arg.is_Symbol else f"\\{fn}{power}\\left({inner}\\right)"
+        return super()._print_Function(expr, exp)
+
+
+def teacher_latex(value, names: dict, q=(), qd=(), qdd=()) -> str:
+    """LaTeX of a value as a teacher writes it: expanded with ``sin^2 + cos^2 = 1``, its
+    terms collected on the joint accelerations, then the rates, then ``g``, and each
+    coefficient on the masses; a vector as a ``pmatrix`` column."""
+    printer = TeacherPrinter(names)
+    order = [*qdd, *qd, sp.Symbol("g")]
 
     def one(x):
         if sp.count_ops(x) < 400:
             x = sp.expand(trig_reduce(x, q, keep_trig=True)) if len(q) else sp.expand(x)
-        return sp.latex(x, symbol_names=names)
+            masses = sorted((s for s in x.free_symbols if re.fullmatch(r"m\d+", s.name)), key=str)
+            x = sp.collect(x, [s for s in order if x.has(s)], func=lambda c: sp.collect(c, masses))
+        return printer.doprint(x)
 
     if isinstance(value, sp.MatrixBase):
         return r"\begin{pmatrix}" + r" \\ ".join(one(v) for v in value) + r"\end{pmatrix}"
@@ -203,7 +231,7 @@ def solution_markdown(robot: Robot, steps: list[SolutionStep], front: dict, titl
     its part's and stage's headings."""
     import yaml
 
-    names = _latex_names(robot)
+    names = _teacher_names(robot)
     lines = [
         "---",
         yaml.safe_dump(front, sort_keys=True, default_flow_style=False, allow_unicode=True).rstrip(),
@@ -221,5 +249,6 @@ def solution_markdown(robot: Robot, steps: list[SolutionStep], front: dict, titl
         if s.stage != stage:
             stage = s.stage
             lines += [f"**{stage}**", ""]
-        lines += [f"$${s.label} = {render_value(s.value, names, robot.q)}$$", ""]
+        value = teacher_latex(s.value, names, robot.q, robot.qd, robot.qdd)
+        lines += [f"$${s.label} = {value}$$", ""]
     return "\n".join(lines).rstrip() + "\n"

@@ -192,20 +192,80 @@ def inline_html(text: str) -> str:
     return "".join(out)
 
 
-def statement_html(blocks: list[tuple], drawing_uri: str | None) -> str:
+def markdown_blocks(text: str) -> list[tuple]:
+    """The blocks of a Markdown file as ``exercise make`` writes it (a statement or a
+    solution: headings, paragraphs, display math, code, numbered lists, tables, ``**stage**``
+    lines), the front matter skipped; :func:`statement_blocks` makes the same blocks."""
+    blocks: list[tuple] = []
+    lines = text.splitlines()
+    if lines and lines[0] == "---" and "---" in lines[1:]:
+        lines = lines[lines.index("---", 1) + 1 :]
+    i = 0
+    while i < len(lines):
+        line = lines[i]
+        if not line.strip():
+            i += 1
+        elif line.startswith("```"):
+            j = i + 1
+            while j < len(lines) and not lines[j].startswith("```"):
+                j += 1
+            blocks.append(("code", "\n".join(lines[i + 1 : j])))
+            i = j + 1
+        elif line.startswith("## "):
+            blocks.append(("h2", line[3:].strip()))
+            i += 1
+        elif line.startswith("# "):
+            blocks.append(("h1", line[2:].strip()))
+            i += 1
+        elif line.startswith("|"):
+            rows = []
+            while i < len(lines) and lines[i].startswith("|"):
+                cells = [c.strip() for c in lines[i].strip().strip("|").split("|")]
+                if not all(re.fullmatch(r"-+", c) for c in cells):
+                    rows.append(cells)
+                i += 1
+            blocks.append(("table", rows[0], rows[1:]))
+        elif re.match(r"\d+\. ", line):
+            items = []
+            while i < len(lines) and re.match(r"\d+\. ", lines[i]):
+                items.append(lines[i].split(". ", 1)[1])
+                i += 1
+            blocks.append(("list", items))
+        elif line.startswith("**") and line.rstrip().endswith("**") and len(line.strip()) > 4:
+            blocks.append(("p", line.strip().strip("*")))
+            i += 1
+        elif line.startswith("$$") and line.rstrip().endswith("$$") and len(line.strip()) > 4:
+            blocks.append(("math", line.strip()[2:-2]))
+            i += 1
+        else:
+            para = []
+            while i < len(lines) and lines[i].strip() and not lines[i].startswith(("#", "|", "```", "$$")):
+                para.append(lines[i].strip())
+                i += 1
+            if not para:  # a line no rule above takes: shown as text
+                para.append(lines[i].strip())
+                i += 1
+            blocks.append(("p", " ".join(para)))
+    return blocks
+
+
+def statement_body(blocks: list[tuple], drawing_uri: str | None, level: int = 1) -> tuple[str, str]:
+    """(title, HTML) of the blocks, headings from ``<h{level}>`` down (a page: 1; a
+    statement inside another page, as ``armdyn serve``'s, deeper)."""
     body = []
     title = "Exercise"
     for b in blocks:
         if b[0] == "h1":
             title = b[1]
-            body.append(f"<h1>{inline_html(b[1])}</h1>")
+            body.append(f"<h{level}>{inline_html(b[1])}</h{level}>")
             if drawing_uri:
                 body.append(
-                    f'<img class="chart" alt="the arm and its frames (x red, y green, z blue)" '
+                    f'<img class="chart" alt="the arm at a sample pose: its joints, angles, slides, lengths and frames '
+                    f'(x red, y green, z blue)" '
                     f'src="{escape(drawing_uri)}">'
                 )
         elif b[0] == "h2":
-            body.append(f"<h2>{inline_html(b[1])}</h2>")
+            body.append(f"<h{level + 1}>{inline_html(b[1])}</h{level + 1}>")
         elif b[0] == "p":
             body.append(f"<p>{inline_html(b[1])}</p>")
         elif b[0] == "math":
@@ -219,12 +279,17 @@ def statement_html(blocks: list[tuple], drawing_uri: str | None) -> str:
             head = "".join(f"<th>{inline_html(h)}</th>" for h in b[1])
             rows = "".join("<tr>" + "".join(f"<td>{inline_html(c)}</td>" for c in r) + "</tr>" for r in b[2])
             body.append(f'<table class="grid"><tr>{head}</tr>{rows}</table>')
-    return course_page(title, "\n".join(body))
+    return title, "\n".join(body)
+
+
+def statement_html(blocks: list[tuple], drawing_uri: str | None) -> str:
+    return course_page(*statement_body(blocks, drawing_uri))
 
 
 def drawing_uri(variant: Variant, robot) -> str:
-    """The arm at a sample pose, its frames and joint axes (armdyn.show's picture), as an
-    SVG ``data:`` URI. Symbolic lengths are drawn at nominal values."""
+    """The arm at a sample pose, its frames and joint axes in 3-D (armdyn.show's picture),
+    as an SVG ``data:`` URI: the spatial arm's drawing (:mod:`.drawing` draws the planar
+    ones). Symbolic lengths are drawn at nominal values."""
     import matplotlib
 
     matplotlib.use("Agg", force=False)

@@ -320,6 +320,8 @@ class MemberFinding:
     why: str = ""
     components: list = field(default_factory=list)
     member: object = None
+    line: int = 0  # where it was written, when the chain spans several rows or blocks (0: not said)
+    column: int = 0
 
 
 def quoted(text: str) -> str:
@@ -337,39 +339,48 @@ def members(source: str) -> list[str]:
     return sides("".join(chars))[1:-1]
 
 
-def check(source: str, value, expected, names: StepNames, fingerprint, equal, value_wrong=False) -> list:
+def check(source: str, value, expected, names: StepNames, fingerprint, equal, value_wrong=False, at=()) -> list:
     """Each member of the equation ``source`` against the step's ``value`` (as written:
     its frame, its convention) and, when it differs, against ``expected`` (the right value
     in the same frame and convention): a member right in itself is "right" when the value
-    is wrong on its own (``value_wrong``), else "inherited"."""
+    is wrong on its own (``value_wrong``), else "inherited". ``at``: (line, column) of each
+    member, when the chain spans several rows or blocks (each finding then says where)."""
     out = []
     value = _matrixish(value)
-    for number, text in enumerate(members(source), start=1):
-        try:
-            reading = names.read(text)
-            own, right = _shaped(reading.own, value), _shaped(reading.right, value)
-            ok = equal(fingerprint(own), fingerprint(value))
-        except UnknownSymbol as err:
-            out.append(MemberFinding(number, quoted(text), "skipped", str(err).split(" (")[0][:QUOTE]))
+    texts = members(source)
+    at = at if len(at) == len(texts) else [(0, 0)] * len(texts)
+    for number, text in enumerate(texts, start=1):
+        if not text.strip():  # "a =" closing a block, "= b" opening the next: no member between
             continue
-        except (LatexError, TypeError, ValueError, AttributeError, sp.ShapeError, RecursionError) as err:
-            why = str(err).split("\n")[0][:120] or type(err).__name__
-            out.append(MemberFinding(number, quoted(text), "skipped", f"cannot read it ({why})"))
-            continue
-        assumed = "; ".join(reading.assumed)
-        if ok.all():
-            if value_wrong and not equal(fingerprint(right), fingerprint(expected)).all():
-                out.append(MemberFinding(number, quoted(text), "source", assumed))  # the slip is already here
-            elif assumed:
-                out.append(MemberFinding(number, quoted(text), "assumed", assumed))
-            continue
-        bad = [int(i) for i in range(ok.size) if not ok.ravel()[i]]
-        if not equal(fingerprint(right), fingerprint(expected)).all():
-            kind = "wrong"
-        else:
-            kind = "right" if value_wrong else "inherited"
-        out.append(MemberFinding(number, quoted(text), kind, assumed, bad, own))
+        finding = _member(number, text, value, expected, names, fingerprint, equal, value_wrong)
+        if finding is not None:
+            finding.line, finding.column = at[number - 1]
+            out.append(finding)
     return out
+
+
+def _member(number, text, value, expected, names, fingerprint, equal, value_wrong) -> MemberFinding | None:
+    """One member checked (see :func:`check`): a finding, or None (equal, nothing to say)."""
+    try:
+        reading = names.read(text)
+        own, right = _shaped(reading.own, value), _shaped(reading.right, value)
+        ok = equal(fingerprint(own), fingerprint(value))
+    except UnknownSymbol as err:
+        return MemberFinding(number, quoted(text), "skipped", str(err).split(" (")[0][:QUOTE])
+    except (LatexError, TypeError, ValueError, AttributeError, sp.ShapeError, RecursionError) as err:
+        why = str(err).split("\n")[0][:120] or type(err).__name__
+        return MemberFinding(number, quoted(text), "skipped", f"cannot read it ({why})")
+    assumed = "; ".join(reading.assumed)
+    if ok.all():
+        if value_wrong and not equal(fingerprint(right), fingerprint(expected)).all():
+            return MemberFinding(number, quoted(text), "source", assumed)  # the slip is already here
+        return MemberFinding(number, quoted(text), "assumed", assumed) if assumed else None
+    bad = [int(i) for i in range(ok.size) if not ok.ravel()[i]]
+    if not equal(fingerprint(right), fingerprint(expected)).all():
+        kind = "wrong"
+    else:
+        kind = "right" if value_wrong else "inherited"
+    return MemberFinding(number, quoted(text), kind, assumed, bad, own)
 
 
 def _matrixish(value):
@@ -384,7 +395,60 @@ def check_step(grader, eq, value, expected, value_wrong: bool) -> list:
     grader's symbols, its student's steps so far and its worlds."""
     from .engine import equal
 
-    return check(eq.source, value, expected, step_names(grader), grader.sampler.fingerprint, equal, value_wrong)
+    names, fingerprint = step_names(grader), grader.sampler.fingerprint
+    return check(eq.source, value, expected, names, fingerprint, equal, value_wrong, member_places(grader.sub, eq))
+
+
+def member_places(sub, eq) -> list:
+    """(line, column) of each member of a chain joined from rows or blocks written on
+    several lines (:attr:`~.reader.Equation.sides_at`), else [] (a chain on one line)."""
+    if eq.rows < 2 or len(eq.sides_at) < 3:
+        return []
+    places = [sub.locate(offset) for offset in eq.sides_at]
+    return places[1:-1] if len({line for line, _ in places}) > 1 else []
+
+
+def reported_at(sub, eq, findings: list) -> tuple[int, int]:
+    """(line, column) a step's verdict is reported at: for a chain split over display blocks,
+    the member holding its slip (one wrong on its own, or the first already holding the
+    value's slip), else where its value is written; else the equation's (a chain in one
+    block: at its left-hand side)."""
+    if eq.blocks < 2 or eq.offset < 0 or len(eq.sides_at) < 2:
+        return eq.line, eq.column
+    for f in findings:
+        if f.kind in ("wrong", "source") and f.line:
+            return f.line, f.column
+    return sub.locate(eq.offset)
+
+
+def relation_holds(grader, eq, expected) -> bool:
+    """Is ``eq``'s value (just read) another step's name alone (``{}^3\\dot v_{C_3} =
+    {}^3\\dot v_3``, ``{}^3f_3 = {}^3F_3``: the two are the same quantity here), right when
+    that step takes its right value? Then the equation is an identity that holds, whatever
+    the named step carries. A formula in names (``F_2 = m_2 \\dot v_{C_2}``) is not: its
+    value is what it gives. ``expected``: the step's right value as written."""
+    from .engine import equal, to_sympy
+
+    last = grader.last_read
+    if last is None or last[0] is not eq or last[3] or last[1] is last[2] or not isinstance(eq.value, str):
+        return False
+    try:
+        body, found = step_names(grader)._substitute(eq.value)
+    except LatexError:
+        return False
+    if len(found) != 1 or body.strip() != f"\\mathrm{{{PLACEHOLDER}}}_{{0}}":
+        return False
+    right = _shaped(to_sympy(last[2]), expected)
+    try:
+        fingerprint = grader.sampler.fingerprint
+        return bool(equal(fingerprint(right), fingerprint(to_sympy(expected))).all())
+    except (TypeError, ValueError, sp.ShapeError):
+        return False
+
+
+def _at(f: MemberFinding) -> str:
+    """A member named in a message: its number, and its line when the chain spans several."""
+    return f"member {f.number}" + (f" at line {f.line}" if f.line else "")
 
 
 def step_names(grader) -> StepNames:
@@ -408,17 +472,17 @@ def with_members(findings: list, verdict: tuple, value, grader) -> tuple:
     said = []
     for f in findings:
         if f.kind == "skipped":
-            said.append(f"member {f.number} not checked: {f.why}")
+            said.append(f"{_at(f)} not checked: {f.why}")
             continue
         if f.why:  # read with an assumption
-            said.append(f"member {f.number}: {f.why}")
+            said.append(f"{_at(f)}: {f.why}")
         if f.kind == "assumed":
             continue
         if f.kind == "source":
-            said.append(f"the slip is already in its formula member `{f.text}` (member {f.number})")
+            said.append(f"the slip is already in its formula member `{f.text}` ({_at(f)})")
             continue
         if f.kind == "right":
-            said.append(f"its formula member `{f.text}` (member {f.number}) is right: the slip is in the value")
+            said.append(f"its formula member `{f.text}` ({_at(f)}) is right: the slip is in the value")
             continue
         member = f.member if isinstance(f.member, sp.MatrixBase) else sp.Matrix([[f.member]])
         where = [component_name(i, value.shape) for i in f.components[:3]]
@@ -428,9 +492,9 @@ def with_members(findings: list, verdict: tuple, value, grader) -> tuple:
         if len(what) > 160:  # a long difference: where, not what
             what = "a long difference" + (f" in {', '.join(w for w in where if w)}" if any(where) else "")
         if f.kind == "inherited":
-            said.append(f"member {f.number} `{f.text}` differs from the value only through earlier errors: {what}")
+            said.append(f"{_at(f)} `{f.text}` differs from the value only through earlier errors: {what}")
             continue
-        said.append(f"the formula member `{f.text}` (member {f.number}) differs from the value: {what}")
+        said.append(f"the formula member `{f.text}` ({_at(f)}) differs from the value: {what}")
         if status != "wrong":
             status, caused_by, components, message = "wrong", None, list(f.components), ""
             difference = sp.Matrix([tidy(member[i] - value[i], grader.robot) for i in range(len(value))])

@@ -123,6 +123,15 @@ def _alone(text: str, at: int, step: int) -> bool:
     return intro is not None and (intro.group("short") is None or _words(intro.group("short")) <= MAX_LEAD_WORDS)
 
 
+def _after_math(text: str, at: int) -> bool:
+    """Is the line before (``at`` its newline) a math line, not blank (``$ ... $`` only, or a
+    display block's edge)? The last line of a run of math lines is read whatever follows."""
+    if at <= 0:
+        return False
+    start = text.rfind("\n", 0, at) + 1
+    return bool(text[start:at].strip()) and _MATH_LINE.fullmatch(text, start, at) is not None
+
+
 def _is_equation(body: str) -> bool:
     """Does ``body`` hold a top-level ``=`` with something on its left?"""
     from .equations import side_offsets
@@ -144,7 +153,8 @@ def _inline(text: str, m: re.Match, last_end: int):
     prose = lead[marker:]
     if _words(prose) > MAX_LEAD_WORDS:
         return
-    if not lead[:marker].strip() and not (_alone(text, m.start() - 1, -1) and _alone(text, m.end() + 1, 1)):
+    after = _alone(text, m.end() + 1, 1) or _after_math(text, m.start() - 1)  # a run of math lines may end in prose
+    if not lead[:marker].strip() and not (_alone(text, m.start() - 1, -1) and after):
         return  # a sentence's math, on a line of the paragraph: prose
     pieces = [(p.start(), p.end()) for p in _ONE_MATH.finditer(text, m.start("inline"), m.end("inline"))]
     if len(pieces) == 1 and not prose.strip():

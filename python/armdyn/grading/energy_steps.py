@@ -94,6 +94,17 @@ class EnergySteps:
             return new, assumed
         rates = {*self.robot.q, *self.robot.qd}
         moves = bool(rates & value.free_symbols) if isinstance(value, sp.Basic) else True
+        if (
+            ref.key == "Vl"
+            and ref.alias == "u"
+            and isinstance(value, sp.Expr)
+            and set(self.robot.qdd) & value.free_symbols
+        ):
+            # u_k holding joint accelerations: the commanded torque of the Rome course (De Luca), not an energy
+            return StepRef("tau", ref.index), (
+                f"u_{ref.index} read as joint {ref.index}'s input torque or force τ_{ref.index} "
+                "(its value holds joint accelerations; a potential energy u_i does not)"
+            )
         new, assumed = by_shape(
             ref, value, lambda key, index=None, **kw: StepRef(key, index, **kw), prismatic, self.robot.dof, moves
         )

@@ -15,7 +15,7 @@ import sympy as sp
 from ..errors import ModelError
 from ..model import Robot
 from ..symbolic.names import latex_symbol_names
-from .chains import check_step, with_members
+from .chains import check_step, relation_holds, reported_at, with_members
 from .defined import DefinedNames, after_equation, definition, model_value, read_pair, read_value
 from .diagnose import cannot_read, location
 from .energy_steps import EnergySteps
@@ -33,22 +33,8 @@ from .sympy_syntax import parse_sympy_syntax
 from .verdict import PASSING, GradeReport, StepVerdict
 from .vocabulary import MODEL_KEYS, student_names
 
-_NAMED = {  # step names as armdyn reports them, accepted as left-hand sides in YAML
-    "omega": "omega",
-    "omega_dot": "omega_dot",
-    "v_dot": "v_dot",
-    "vc_dot": "vc_dot",
-    "F": "F",
-    "N": "N",
-    "f": "f",
-    "n": "n",
-    "tau": "tau",
-    "dL_dqd": "dL_dqd",
-    "dL_dq": "dL_dq",
-    "ddt_dL_dqd": "ddt_dL_dqd",
-    "dT_dq": "dT_dq",
-    "dV_dq": "dV_dq",
-}
+#: step names as armdyn reports them (``v_dot_1``, ``tau_2``), accepted as left-hand sides in YAML
+_NAMED = frozenset(VECTOR_KEYS) | frozenset(LAGRANGE_KEYS) - {"T", "V", "L"} | {"tau"}
 
 
 def _named_ref(text: str) -> StepRef | None:
@@ -57,7 +43,7 @@ def _named_ref(text: str) -> StepRef | None:
         return StepRef(text)
     head, _, tail = text.rpartition("_")
     if head in _NAMED and tail.isdigit():
-        return StepRef(_NAMED[head], int(tail))
+        return StepRef(head, int(tail))
     return None
 
 
@@ -227,7 +213,7 @@ class _Grader(EnergySteps, KinematicsSteps):
             self._equation(eq, seen_methods, context)
             after_equation(self, eq, self.verdicts[done:])
             for v in self.verdicts[done:]:
-                v.part, v.task, v.column = eq.part, eq.task, eq.column
+                v.part, v.task, v.column = eq.part, eq.task, v.column or eq.column  # a chain's: where reported
             return self.verdicts[done:]
 
         for eq in self.sub.equations:
@@ -338,6 +324,7 @@ class _Grader(EnergySteps, KinematicsSteps):
         for v in self.verdicts:
             if v.key == "tau" and 1 <= int(v.name.split("_")[1]) <= self.robot.dof:  # tau_3 of 2: unrecognised
                 tau_correct[int(v.name.split("_")[1]) - 1] = v.status in (*PASSING, "correct-but-unsupported")
+        self.notes.extend(n for n in self.symbols.notes if n not in self.notes)  # how names were read
         if self.symbols.used_gravity_magnitude:
             self.notes.append("g read as the magnitude of the model's gravity vector")
         if self.symbols.unit_axes:
@@ -513,6 +500,10 @@ class _Grader(EnergySteps, KinematicsSteps):
         elif j.status == "correct-by-convention":
             message = j.convention or ""
         status = j.status
+        line, column = reported_at(self.sub, eq, findings) if eq.latex else (eq.line, eq.column)
+        if status == "follows-from-earlier-error" and ref.key != "tau" and relation_holds(self, eq, exp_shown):
+            status = "correct"  # a relation between steps that holds: what it names carries the error
+            message = f"right as a relation between steps; the value it names {message}"
         if findings:
             status, message, difference, components, caused_by = with_members(
                 findings, (status, message, difference, components, caused_by), _matrix(to_sympy(as_written)), self
@@ -525,7 +516,8 @@ class _Grader(EnergySteps, KinematicsSteps):
                 status=status,
                 label=eq.lhs,
                 source=eq.source,
-                line=eq.line,
+                line=line,
+                column=column,
                 expected=exp_shown,
                 got=value,
                 difference=difference,
@@ -582,8 +574,14 @@ def grade(
         model = _load_robot(robot or sub.robot or "", sub, trusted=bool(trusted and robot))
     else:
         from .robot_text import robot_from_text
+        from .robot_text.own_values import grade_without_model
 
-        read_model = robot_from_text(sub)  # the robot the text itself describes
+        try:
+            read_model = robot_from_text(sub)  # the robot the text itself describes
+        except ModelError as err:
+            if not sub.equations:
+                raise
+            return grade_without_model(sub, err.message)  # what the text's own values decide
         model = read_model.robot
     if sub.values is not None:
         try:
@@ -593,7 +591,23 @@ def grade(
             raise err.located(source=sub.path) from None
     hint = sub.method if sub.method in ("newton-euler", "lagrange") else None
     report = _Grader(sub, model, symbols).run(hint)
+    if read_model is not None and read_model.alternatives:  # the statements allow other readings
+        from .robot_text.support import most_supported
+
+        def with_model(other):
+            robot = other.robot
+            if sub.values is not None:
+                robot = robot.bind(sub.values if isinstance(sub.values, Mapping) else None)
+            return _Grader(sub, robot, symbols).run(hint)
+
+        read_model, report = most_supported(read_model, report, with_model)
     if read_model is not None:
+        from .robot_text.support import disagreeing, own_values_instead
+
+        if disagreeing(report):  # the reading, not the text, is likely wrong: the text's own values
+            own = own_values_instead(sub, report)
+            if own is not report:
+                return own
         report.model_note = read_model.note()  # the report's first line: what was graded against
         report.notes.insert(0, report.model_note)
     return report

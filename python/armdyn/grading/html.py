@@ -184,13 +184,32 @@ def _against_expected(step: StepVerdict) -> bool:
         return "own earlier steps" not in step.message
 
 
+#: the two references a step is compared with, as the report names them
+EXERCISE_REFERENCE = "expected (from the exercise's model)"
+OWN_REFERENCE = "expected from your own earlier steps"
+
+
+def reference(step: StepVerdict) -> tuple[object, str]:
+    """(value, name) of what ``step.difference`` was taken against: the exercise's value
+    (``step.expected``), or, after an earlier slip, what the student's own earlier steps
+    give (``got - difference``: the grader compared with that), so the expected value
+    shown and the difference always name one reference."""
+    if step.got is None or step.difference is None or _against_expected(step):
+        return step.expected, EXERCISE_REFERENCE
+    if isinstance(step.got, sp.MatrixBase):
+        own = (sp.Matrix(step.got) - sp.Matrix(step.difference)).applyfunc(sp.expand)
+    else:
+        own = sp.expand(sp.sympify(step.got) - sp.sympify(step.difference))
+    return own, OWN_REFERENCE
+
+
 def _step_card(i: int, step: StepVerdict, w: _Writer, anchors: dict, first: int | None) -> str:
     cls = f"step st-{escape(step.status)}" + (" first" if i == first else "")
     where = [f"line {step.line}"] if step.line else []
     if step.frame:
         where.append(f"in frame {escape(step.frame)}")
     if step.part or step.task:  # the assignment's part (or the unnumbered task's title)
-        where.append(f"part {escape(step.part)}" if step.part else escape(step.task[:40]))
+        where.append(f"part {escape(step.part)}" if step.part else text_with_math(step.task))
     head = (
         f'<div class="head"><span class="label">{math_element(_label(step))}</span>'
         f'{_badge(step.status)}<span class="where">{" · ".join(where)}</span></div>'
@@ -223,12 +242,17 @@ def _step_card(i: int, step: StepVerdict, w: _Writer, anchors: dict, first: int 
     if step.got is not None:
         caption = "yours = expected" if step.status == "correct" else "yours"
         sides.append(_side("left side, on the counterexample" if proof else caption, label, w.value(step.got, hl)))
+    shown_diff = step.difference is not None and step.status in ("wrong", "follows-from-earlier-error")
+    value, than = reference(step) if shown_diff and not proof else (step.expected, EXERCISE_REFERENCE)
     if step.expected is not None and (step.status != "correct" or step.got is None):
-        sides.append(
-            _side("right side, on the counterexample" if proof else "expected", label, w.value(step.expected, hl))
-        )
-    if step.difference is not None and step.status in ("wrong", "follows-from-earlier-error"):
-        than = "expected" if _against_expected(step) else "what your own earlier steps give"
+        if proof:
+            sides.append(_side("right side, on the counterexample", label, w.value(step.expected, hl)))
+        else:
+            sides.append(_side(than, label, w.value(value, hl)))
+            if than == OWN_REFERENCE:  # the exercise's value too, named as such
+                sides.append(_side(EXERCISE_REFERENCE, label, w.value(step.expected, hl), "textbook"))
+    if shown_diff:
+        than = "the right side" if proof else than.split(" (")[0]
         sides.append(
             _side(f"difference: yours \u2212 {than}", "<mi>\u0394</mi>", w.difference(step.difference, hl), "diff")
         )
@@ -298,10 +322,11 @@ def _summary(report: GradeReport, anchors: dict, labels: dict) -> str:
         step = report.steps[k] if k is not None else None
         shown = math_element(labels[k]) if k is not None else escape(report.first_wrong)
         line = f" (line {step.line})" if step is not None and step.line else ""
-        link = f'<a href="#step-{k}">{shown}</a>' if k is not None else shown
+        name = f"go to the step {report.first_wrong}" + line  # its math alone names no link for a screen reader
+        link = f'<a href="#step-{k}" aria-label="{escape(name)}">{shown}</a>' if k is not None else shown
         verdict = (
             f'<div class="verdict fail">First wrong step: {link}{line}'
-            f'<span class="sub">{escape(step.message) if step is not None and step.message else ""}</span></div>'
+            f'<span class="sub">{text_with_math(step.message) if step is not None and step.message else ""}</span></div>'
         )
     elif not graded:
         verdict = (

@@ -12,8 +12,8 @@ Conventions accepted, each named in the verdict:
 
 * a potential energy (per link or total) that differs from the model's by a constant
   (no dependence on q): another reference level;
-* a Christoffel symbol with the free index first (Murray, Li & Sastry's ``Γ_ijk``), or
-  LaValle's unsymmetrised ``h_ijk = ∂m_ij/∂q_k − ½ ∂m_jk/∂q_i``, when it is not Spong's
+* a Christoffel symbol with the free index first (Murray, Li & Sastry's ``Γ_ijk``), or Asada
+  & Slotine's (Siciliano's, LaValle's) unsymmetrised ``h_ijk = ∂m_ij/∂q_k − ½ ∂m_jk/∂q_i``, when it is not Spong's
   ``c_ijk = ½(∂d_kj/∂q_i + ∂d_ki/∂q_j − ∂d_ij/∂q_k)``;
 * a centrifugal/Coriolis vector with gravity added (Lynch & Park's ``h(θ, θ̇)``);
 * a Coriolis matrix that is not the Christoffel one but gives the same ``C q̇`` (any
@@ -35,7 +35,10 @@ from .explain import describe, pretty, tidy
 from .verdict import StepVerdict
 
 SPONG = "Spong's c_ijk = ½(∂d_kj/∂q_i + ∂d_ki/∂q_j − ∂d_ij/∂q_k)"
-LAVALLE = "LaValle's h_ijk = ∂m_ij/∂q_k − ½ ∂m_jk/∂q_i (free index first, not symmetric in j, k)"
+LAVALLE = (
+    "Asada & Slotine's (Siciliano's, LaValle's) h_ijk = ∂m_ij/∂q_k − ½ ∂m_jk/∂q_i"
+    " (free index first, not symmetric in j, k)"
+)
 FREE_FIRST = "the free index first (Murray, Li & Sastry's Γ_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_kj/∂q_i))"
 
 

@@ -24,18 +24,7 @@ import sympy as sp
 
 from ..model import Robot
 from ..symbolic.lagrange import link_energies
-from ..symbolic.newton_euler import (
-    inertial_force,
-    inertial_moment,
-    joint_force,
-    joint_moment,
-    joint_torque,
-    moment_about,
-    omega,
-    omega_dot,
-    v_dot,
-    vc_dot,
-)
+from ..symbolic.newton_euler import INWARD_STEPS, OUTWARD_STEPS, joint_torque, moment_about
 from ..symbolic.terms import time_derivative
 
 Ref = tuple  # (key, index)
@@ -148,6 +137,18 @@ def evaluate_context(ctx, point: dict):
     return out
 
 
+def _inward(step, i: int, own: int) -> Callable:
+    """An inward step's formula on flat inputs: its own, then each child's ``step.children``."""
+    width = len(step.children)
+
+    def fn(c, *values):
+        rest = values[own:]
+        kids = [(c[k]["R"], c[k]["P"], *rest[j * width : (j + 1) * width]) for j, k in enumerate(c[i]["children"])]
+        return step.formula(c[i], *values[:own], kids)
+
+    return fn
+
+
 def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
     """The Newton-Euler steps of ``robot`` and its symbolic context."""
     ctx = _link_context(robot)
@@ -164,32 +165,10 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
 
     for i in range(1, n + 1):
         p = ctx[i]["parent"]
-        m.formulas[("omega", i)] = [
-            Formula((("omega", p),), lambda c, w, i=i: omega(c[i]["R"], w, c[i]["z"], c[i]["qd"], c[i]["kind"]))
-        ]
-        m.formulas[("omega_dot", i)] = [
-            Formula(
-                (("omega", p), ("omega_dot", p)),
-                lambda c, w, wd, i=i: omega_dot(c[i]["R"], w, wd, c[i]["z"], c[i]["qd"], c[i]["qdd"], c[i]["kind"]),
-            )
-        ]
-        m.formulas[("v_dot", i)] = [
-            Formula(
-                (("omega", p), ("omega_dot", p), ("v_dot", p)),
-                lambda c, w, wd, vd, i=i: v_dot(c[i]["R"], w, wd, vd, c[i]["P"], c[i]["V"], c[i]["Vd"]),
-            )
-        ]
-        m.formulas[("vc_dot", i)] = [
-            Formula(
-                (("omega", i), ("omega_dot", i), ("v_dot", i)),
-                lambda c, w, wd, vd, i=i: vc_dot(w, wd, vd, c[i]["c"]),
-            )
-        ]
-        m.formulas[("F", i)] = [Formula((("vc_dot", i),), lambda c, a, i=i: inertial_force(c[i]["m"], a))]
-        m.formulas[("N", i)] = [
-            Formula((("omega", i), ("omega_dot", i)), lambda c, w, wd, i=i: inertial_moment(c[i]["I"], w, wd))
-        ]
-        m.refs += [("omega", i), ("omega_dot", i), ("v_dot", i), ("vc_dot", i), ("F", i), ("N", i)]
+        for step in OUTWARD_STEPS:  # derive's own formulas, on the student's values
+            inputs = tuple((key, p if where == "parent" else i) for key, where in step.inputs)
+            m.formulas[(step.key, i)] = [Formula(inputs, lambda c, *v, i=i, step=step: step.formula(c[i], *v))]
+            m.refs.append((step.key, i))
 
         gravity_free = Convention(
             "gravity as a force (no base acceleration in the accelerations)",
@@ -221,20 +200,12 @@ def newton_euler_method(robot: Robot) -> tuple[Method, dict]:
     # inward: children first
     for i in range(n, 0, -1):
         kids = ctx[i]["children"]
-        f_inputs = (("F", i),) + tuple(("f", k) for k in kids)
-        n_inputs = (("N", i), ("F", i)) + tuple(r for k in kids for r in (("n", k), ("f", k)))
-
-        def f_fn(c, F, *fs, i=i):
-            return joint_force(F, [(c[k]["R"], fk) for k, fk in zip(c[i]["children"], fs)])
-
-        def n_fn(c, N, F, *nfs, i=i):
-            kids = c[i]["children"]
-            pairs = [(c[k]["R"], c[k]["P"], nfs[2 * j], nfs[2 * j + 1]) for j, k in enumerate(kids)]
-            return joint_moment(N, c[i]["c"], F, pairs)
-
-        m.formulas[("f", i)] = [Formula(f_inputs, f_fn)]
-        m.formulas[("n", i)] = [Formula(n_inputs, n_fn)]
-        m.refs += [("f", i), ("n", i)]
+        for step in INWARD_STEPS:
+            own = tuple((key, i) for key, _ in step.inputs)
+            m.formulas[(step.key, i)] = [
+                Formula(own + tuple((key, k) for k in kids for key in step.children), _inward(step, i, len(own)))
+            ]
+            m.refs.append((step.key, i))
         m.conventions[("f", i)] = [
             USUAL,
             Convention(f"the reaction: force exerted by link {i} on link {i - 1}", lambda v, c: -v, lambda v, c: -v),

@@ -43,10 +43,11 @@ from typing import Any
 import sympy as sp
 
 from ..model import Robot
+from ..symbolic.newton_euler import VECTOR_STEP_TEXT
 from .latex import LatexError, Name, UnknownSymbol, parse
 from .vocabulary import MODEL_KEYS, energy_lhs, mass_centre, model_name, scripts
 
-VECTOR_KEYS = ("omega", "omega_dot", "v_dot", "vc_dot", "F", "N", "f", "n")
+VECTOR_KEYS = tuple(VECTOR_STEP_TEXT)  # the Newton-Euler steps, from derive's table
 LAGRANGE_KEYS = ("T", "V", "L", "dL_dqd", "ddt_dL_dqd", "dL_dq", "dT_dq", "dV_dq")
 
 

@@ -11,8 +11,10 @@ display block (``$$``, ``\\[``, ```` ```math ````, a bare ``align``... environme
 ``$ ... $`` lines written as steps: :mod:`.display`) is split into equations (at ``\\\\`` and at
 separators before another ``LHS = ...``: :func:`.equations.split_equations`), each with its
 line, the column where its value starts, and the part of the assignment it is in
-(:mod:`.parts`). A row or block with no left-hand side that starts with ``=``, ``+`` or
-``-`` continues the equation before it (:func:`_continue`). Reading is linear in the file's size and bounded: at most
+(:mod:`.parts`). A row or block with no left-hand side that starts with ``=``, ``+``, ``-``
+or ``\\Rightarrow`` continues the equation before it (:func:`_continue`), and a block that
+is only ``LHS =`` takes the next block as its value; a chain so joined keeps where each of
+its sides was written (:attr:`Equation.sides_at`). Reading is linear in the file's size and bounded: at most
 :data:`MAX_BYTES` bytes and :data:`MAX_EQUATIONS` equations; an equation with an
 unbalanced brace is kept with ``problem`` naming the brace's line and column.
 
@@ -71,6 +73,10 @@ class Equation:
     task: str = ""
     spans: tuple = ()  # (offset in value, offset in the file) of each piece of a joined value
     rows: int = 1  # rows or blocks joined into this equation (see _continue)
+    blocks: int = 1  # display blocks joined into this equation (a chain split over $$ blocks)
+    #: file offsets where each side of ``LHS = A = ... = value`` starts, the left-hand side's
+    #: first (a chain joined from rows or blocks: each member is located where it was written)
+    sides_at: tuple = ()
 
     def offset_of(self, pos: int) -> int:
         """The file offset of character ``pos`` of ``value`` (a value joined from rows
@@ -276,7 +282,7 @@ def _read_block(sub: Submission, index: LineIndex, block_start: int, block: str)
             f"display math too long ({len(block)} characters, at most {MAX_LENGTH})",
         )
         return
-    for offset, eq in split_equations(block, limit=MAX_EQUATIONS):
+    for n, (offset, eq) in enumerate(split_equations(block, limit=MAX_EQUATIONS)):
         start = block_start + offset
         if len(eq) > MAX_LENGTH:
             unreadable(eq[:40], eq[:200], start, f"equation too long ({len(eq)} characters, at most {MAX_LENGTH})")
@@ -294,10 +300,18 @@ def _read_block(sub: Submission, index: LineIndex, block_start: int, block: str)
             continue
         cuts = side_offsets(eq)
         lead = _LEAD.match(eq).end()
+        arrow = _ARROW.match(eq, lead)
+        if arrow is not None:  # "\\Rightarrow ...": implied by the equation before; the arrow set aside
+            eq = " " * arrow.end() + eq[arrow.end() :]
+            lead, cuts = _LEAD.match(eq).end(), side_offsets(eq)
+            if len(cuts) < 2 and lead < len(eq):  # "\\Rightarrow value": the chain's next member
+                eq, cuts, lead = eq[: lead - 1] + "=" + eq[lead:], [0, lead], lead - 1
         if eq.startswith("=", lead) or eq.startswith(("+", "-"), lead) and len(cuts) < 2:
-            _continue(sub, index, eq, start, cuts)
+            _continue(sub, index, eq, start, cuts, new_block=n == 0)
             continue
         if len(cuts) < 2:
+            if _awaits_value(sub):  # "\tau_1 =" closed a block: this one is its value
+                _continue(sub, index, eq, start, [0], new_block=n == 0)
             continue
         value = eq[cuts[-1] :]
         skip = len(value) - len(value.lstrip())
@@ -310,6 +324,7 @@ def _read_block(sub: Submission, index: LineIndex, block_start: int, block: str)
                 " ".join(eq.split()),
                 column=col,
                 offset=start + cuts[-1] + skip,
+                sides_at=_sides_at(eq, start, cuts),
             )
         )
         if len(sub.equations) > MAX_EQUATIONS:
@@ -321,9 +336,27 @@ def _read_block(sub: Submission, index: LineIndex, block_start: int, block: str)
 
 #: rows (or blocks) continuing one equation beyond which it is refused (bounds the joining)
 MAX_ROWS = 200
+#: an implication arrow starting a row or block (``\Rightarrow = ...``, ``\implies ...``)
+_ARROW = re.compile(r"\\(?:Rightarrow|Longrightarrow|implies|therefore)(?![A-Za-z])")
 
 
-def _continue(sub: Submission, index: LineIndex, eq: str, start: int, cuts: list[int]) -> None:
+_SPACES = re.compile(r"\s*")
+
+
+def _sides_at(eq: str, start: int, cuts: list[int]) -> tuple:
+    """File offsets where each side of ``eq`` (written at ``start``) starts, past its spaces
+    (each side's spaces looked at once: linear however many sides)."""
+    return tuple(start + _SPACES.match(eq, c).end() for c in cuts)
+
+
+def _awaits_value(sub: Submission) -> bool:
+    """Does the last equation end at its ``=`` (``\\tau_1 =`` alone in a block: the value
+    is in the next one)?"""
+    last = sub.equations[-1] if sub.equations else None
+    return last is not None and not last.problem and last.value == "" and last.rows == 1
+
+
+def _continue(sub: Submission, index: LineIndex, eq: str, start: int, cuts: list[int], new_block=False) -> None:
     """Join a row or block with no left-hand side (``= ...``, ``+ ...``) to the equation
     before it: the value becomes its last right-hand side (``= ...``) or grows by it
     (``+ ...``). Nothing before it to continue: not an equation (skipped). More than
@@ -334,15 +367,20 @@ def _continue(sub: Submission, index: LineIndex, eq: str, start: int, cuts: list
         return
     prev = sub.equations[-1]
     prev.rows += 1
+    prev.blocks += new_block
     if prev.rows > MAX_ROWS or max(len(prev.value), len(prev.source)) + len(eq) > MAX_LENGTH:
         prev.problem = f"more than {MAX_ROWS} rows or {MAX_LENGTH} characters continue this equation"
         return
     prev.source = f"{prev.source} {' '.join(eq.split())}"
-    if len(cuts) >= 2:  # "= b" or "= b = c": the last side is the value now
+    if len(cuts) >= 2 or prev.value == "":  # "= b", "= b = c", the value of "a =": the last side is the value now
         value = eq[cuts[-1] :]
         skip = len(value) - len(value.lstrip())
         prev.value, prev.offset, prev.spans = value.strip(), start + cuts[-1] + skip, ()
         prev.column = index.locate(prev.offset)[1]
+        if len(cuts) >= 2:
+            prev.sides_at = (*prev.sides_at, *_sides_at(eq, start, cuts)[1:])
+        elif prev.sides_at:  # the value of "a =": its side starts here
+            prev.sides_at = (*prev.sides_at[:-1], prev.offset)
         return
     prev.spans = (*(prev.spans or ((0, prev.offset),)), (len(prev.value) + 1, start))
     prev.value = f"{prev.value} {eq}"

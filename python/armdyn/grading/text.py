@@ -13,7 +13,7 @@ import symengine as se
 import sympy as sp
 
 from ..dispatch import register
-from ..symbolic.names import VECTOR_STEP_TEXT
+from ..symbolic.newton_euler import VECTOR_STEP_TEXT
 from .explain import display_name, pretty, to_ascii
 from .verdict import GradeReport, StepVerdict
 

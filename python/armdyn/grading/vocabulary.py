@@ -13,7 +13,7 @@ V (total)      ``U``, ``V``, ``P``, ``PE``, ``u``, ``E_p``, ``\\mathcal{U}``, ``
 Tl, Vl         the same with a link index: ``K_1``, ``T_2``, ``KE_1``, ``PE_1``, ``u_2``, ``P_1``,
                ``\\mathcal{E}_{K_1}`` (Lynch & Park)
 pc             ``p_{c1}``, ``r_{c_2}``, ``x_{c1}`` / ``y_{c1}`` / ``z_{c1}`` (one component);
-               ``x_1``, ``y_2`` without the c when the value moves with the joints
+               ``x_1``, ``y_2``, ``P_{1,x}`` without the c when the value moves with the joints
 vc             ``v_{c1}``, ``\\dot p_{c1}``, ``\\dot x_{c1}``, ``\\dot x_1``; squared: ``v_{c1}^2``,
                ``|v_{c1}|^2``, ``v_{c1}^T v_{c1}``, ``v_{c1} \\cdot v_{c1}``, a scalar ``v_2^2``; a
                scalar ``v_2``: the speed (a point mass's, by shape)
@@ -24,7 +24,7 @@ christoffel    ``c_{ijk}``, ``\\Gamma_{ijk}``, ``h_{ijk}`` (three indices)
 C              ``C``, ``C(q,\\dot q)`` (the Coriolis matrix)
 h              ``V(\\theta,\\dot\\theta)`` (Craig), ``c(\\theta,\\dot\\theta)`` (Lynch & Park), ``h``,
                ``b(q,\\dot q)``, ``C(q,\\dot q)\\dot q``; entries ``h_i``
-G              ``g(q)``, ``G(\\theta)``, ``G``; entries ``g_k``, ``G_k``, ``\\phi_k``
+G              ``g(q)``, ``G(\\theta)``, ``G``, ``N(\\theta,\\dot\\theta)`` (Murray, Li & Sastry); entries ``g_k``, ``G_k``, ``\\phi_k``
                (``g`` alone is the gravity constant, not a step)
 =============  ==================================================================
 
@@ -109,7 +109,7 @@ def energy_lhs(s: str, ref_type):
         return ref_type("h", alias=s, by_shape=not had_args)
     if re.fullmatch(r"C(?:\([^()]*\))?\\dot\{(?:q|\\theta|\\boldsymbol\{q\})\}", s):  # C(q, q̇) q̇
         return ref_type("h", alias="C q̇")
-    if s in ("G",) or (s == "g" and had_args):
+    if s in ("G",) or (s in ("g", "N") and had_args):  # N(θ, θ̇): Murray, Li & Sastry (N alone: a moment)
         return ref_type("G", alias=s, by_shape=not had_args)
     # |v|^2, v^T v, v . v
     sq = re.fullmatch(r"(?:\||\\\||\\lVert|\\vert|\\Vert)(.+?)(?:\||\\\||\\rVert|\\vert|\\Vert)\^\{?2\}?", s)
@@ -146,6 +146,9 @@ def _indexed(s: str, ref_type):
     # link i's mass centre only when the value moves with the joints (decided in the grader)
     if base in ("x", "y", "z") and _index(sub) is not None and sup is None and dots < 2:
         return ref_type("vc" if dots else "pc", _index(sub), part=base, alias=POINT, by_shape=True)
+    comp = re.fullmatch(r"\{?(\d+)\s*,\s*([xyz])\}?", sub or "")
+    if base in ("P", "p", "r") and comp and sup is None and dots < 2:  # P_{1,x}: one component of a point
+        return ref_type("vc" if dots else "pc", int(comp.group(1)), part=comp.group(2), alias=POINT, by_shape=True)
     if base == "v" and _index(sub) is not None and sup == "2" and not dots:
         return ref_type("vc", _index(sub), part="sq", alias=POINT, by_shape=True)
     if base == "v" and _index(sub) is not None and sup is None and not dots:  # a point mass's speed
@@ -164,7 +167,7 @@ def _indexed(s: str, ref_type):
         return ref_type("shorthand", entry=digits, alias=base, by_shape=True)  # c_1 = \cos\theta_1: by the value
     if base in ("c", "\\Gamma", "h") and _digits(sub, 3):
         return ref_type("christoffel", entry=_digits(sub, 3), alias=base)
-    if base in ("d", "m", "M", "D", "b", "B") and _digits(sub, 2):
+    if base in ("d", "m", "M", "D", "b", "B", "H") and _digits(sub, 2):  # H_{12}: Asada & Slotine
         return ref_type("M", entry=_digits(sub, 2), alias=base)
     if base in ("h", "b") and _index(sub) is not None:
         return ref_type("h", entry=(_index(sub),), alias=base)
@@ -179,7 +182,7 @@ def _indexed(s: str, ref_type):
     if re.fullmatch(_KINETIC, base):
         return ref_type("Tl", i, alias=base)
     if re.fullmatch(_POTENTIAL, base):
-        return ref_type("Vl", i, alias=base, by_shape=base == "P")
+        return ref_type("Vl", i, alias=base, by_shape=base in ("P", "u"))  # u_1: an energy, or De Luca's torque
     if base in ("L", "H"):
         return ref_type("Lang", i, alias=base)
     return None

@@ -2,7 +2,7 @@
 
 ``load(source)`` takes a bundled model's name (``armdyn.load("rp-arm")``; the files
 live in ``armdyn/robots/``) or a file path (``.yaml``/``.yml``: :mod:`armdyn.io.yaml`;
-``.urdf``: :mod:`armdyn.io.urdf`; ``.xacro``: :mod:`armdyn.io.xacro`, needs the ``xacro``
+``.urdf``: :mod:`armdyn.io.urdf`; ``.xml``: MuJoCo's MJCF, :mod:`armdyn.io.mjcf`; ``.xacro``: :mod:`armdyn.io.xacro`, needs the ``xacro``
 package and ``trusted=True``: xacro runs Python code from the file). ``bundled_robots()``
 lists the bundled models.
 
@@ -26,7 +26,7 @@ from . import urdf  # registers Robot.from_urdf with armdyn.dispatch
 #: Directory of the bundled models.
 ROBOTS_DIR = Path(__file__).resolve().parent.parent / "robots"
 
-_SUFFIXES = (".yaml", ".yml", ".urdf", ".xacro")
+_SUFFIXES = (".yaml", ".yml", ".urdf", ".xml", ".xacro")
 
 
 def bundled_files() -> dict[str, Path]:
@@ -39,7 +39,7 @@ def bundled_files() -> dict[str, Path]:
     return dict(sorted(out.items()))
 
 
-def _load_file(path: Path, strict: bool, source: str, trusted: bool = False) -> Robot:
+def _load_file(path: Path, strict: bool, source: str, trusted: bool = False, floating: str | None = None) -> Robot:
     suffix = path.suffix.lower()
     if suffix in (".yaml", ".yml"):
         from .yaml import load_yaml
@@ -47,11 +47,15 @@ def _load_file(path: Path, strict: bool, source: str, trusted: bool = False) -> 
         return load_yaml(path, strict=strict, source=source)
     if suffix == ".urdf":
         return urdf.load_urdf(path, strict=strict)
+    if suffix == ".xml":
+        from .mjcf import load_mjcf
+
+        return load_mjcf(path, strict=strict, floating=floating)
     if suffix == ".xacro":
         from .xacro import load_xacro
 
         return load_xacro(path, strict=strict, trusted=trusted)
-    raise ModelError(f"unknown model file type '{suffix}' (expected .yaml, .yml, .urdf or .xacro)", None, source)
+    raise ModelError(f"unknown model file type '{suffix}' (expected .yaml, .yml, .urdf, .xml or .xacro)", None, source)
 
 
 def _published(path: Path) -> Robot:
@@ -97,11 +101,13 @@ def _published(path: Path) -> Robot:
     )
 
 
-def load(source: str | os.PathLike[str], strict: bool | None = None, trusted: bool = False) -> Robot:
+def load(
+    source: str | os.PathLike[str], strict: bool | None = None, trusted: bool = False, floating: str | None = None
+) -> Robot:
     """A :class:`~armdyn.Robot` from a bundled model's name or a model file.
 
     source: a bundled name (see :func:`bundled_robots`, e.g. ``"rp-arm"``, ``"puma560"``)
-            or a path (str or PathLike) to a ``.yaml``/``.yml``/``.urdf`` file. A string
+            or a path (str or PathLike) to a ``.yaml``/``.yml``/``.urdf``/``.xml`` (MJCF) file. A string
             with a path separator or one of those suffixes is always taken as a path; a
             bare bundled name wins over a file of that name in the working directory.
     strict: check each link's physical validity (mass >= 0, inertia PSD, triangle
@@ -113,12 +119,16 @@ def load(source: str | os.PathLike[str], strict: bool | None = None, trusted: bo
             default: a ``.xacro`` file is then a ModelError naming it and this option.
             Pass True only for a file you would run as a program; class grading and
             ``armdyn serve`` never do.
+    floating: MJCF only: ``"weld"`` reads a ``free`` joint of a body of the world body as
+            a fixed base (see :func:`armdyn.io.mjcf.load_mjcf`).
 
     Raises ModelError (one line naming the file) for an unknown name, a missing file
     or a bad model.
     """
     text = os.fspath(source)
     path = Path(text)
+    if floating is not None and path.suffix.lower() != ".xml":
+        raise ModelError("floating= applies to MJCF (.xml) files only", None, text)
     looks_like_path = path.suffix.lower() in _SUFFIXES or os.sep in text or "/" in text
     bundled = bundled_files()
     if not looks_like_path and text in bundled:
@@ -130,7 +140,7 @@ def load(source: str | os.PathLike[str], strict: bool | None = None, trusted: bo
         if not path.is_file():
             what = "cannot read the model (not a regular file)" if path.exists() else "no such file"
             raise ModelError(what, None, text)
-        return _load_file(path, strict, text, trusted)
+        return _load_file(path, strict, text, trusted, floating)
     names = ", ".join(bundled) or "none"
     raise ModelError(f"unknown robot '{text}': not a file, and not a bundled model ({names})")
 

@@ -123,7 +123,7 @@ def _read(path_or_xml) -> tuple[bytes, str]:
 
 def parse_xml(text: bytes) -> ET.Element:
     """The ``<robot>`` root of URDF bytes (no DTD, no entities); ModelError with line and column."""
-    _refuse_dtd(text)
+    refuse_dtd(text)
     try:
         root = ET.fromstring(text)
     except ET.ParseError as err:
@@ -139,13 +139,13 @@ class _DTD(Exception):
     pass
 
 
-def _refuse_dtd(text: bytes) -> None:
+def refuse_dtd(text: bytes, fmt: str = "URDF") -> None:
     """ModelError if the document has a DTD (``<!DOCTYPE ...>``, with or without entity
     or ``<!ATTLIST>`` declarations), in whatever encoding it is written.
 
     Entity declarations are the one XML feature that can make a small file huge ("billion
     laughs"); they and ATTLIST defaults also change what the file says (a robot name, a
-    mass) invisibly; URDF needs none of it. Looking for the bytes ``<!ENTITY`` misses a
+    mass) invisibly; URDF (and MJCF, ``fmt``) needs none of it. Looking for the bytes ``<!ENTITY`` misses a
     UTF-16 file, so expat itself (which decodes any encoding it accepts) reads the
     document up to its DTD and stops there, before anything is declared or expanded."""
     import xml.parsers.expat
@@ -162,7 +162,7 @@ def _refuse_dtd(text: bytes) -> None:
     except _DTD:
         where = f"<!DOCTYPE> on line {parser.CurrentLineNumber}"
         raise ModelError(
-            "a DTD is not allowed in URDF (entity declarations are not allowed, nor ATTLIST defaults)", where
+            f"a DTD is not allowed in {fmt} (entity declarations are not allowed, nor ATTLIST defaults)", where
         ) from None
     except xml.parsers.expat.ExpatError:
         return  # malformed: ElementTree reports it with its own wording

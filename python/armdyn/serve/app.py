@@ -2,7 +2,8 @@
 
 Routes (the JSON API is described in :mod:`.openapi`, served at ``/openapi.json``):
 
-    GET  /                               student page: exercise, text, live preview, Grade, earlier ones
+    GET  /                               student page: exercise, its statement, text, live preview, Grade, earlier ones
+    GET  /exercises/{eid}/statement      an exercise's statement (HTML fragment, for the student page)
     POST /grade                          the student's form (CSRF) -> /submissions/{id}?t=TOKEN
     GET  /submissions/{id}               the submission and its report (link token, owner or instructor)
     GET  /submissions/{id}/report.html   the self-contained report (``armdyn grade --html``)
@@ -11,6 +12,8 @@ Routes (the JSON API is described in :mod:`.openapi`, served at ``/openapi.json`
     GET  /instructor/gradebook.csv       the gradebook (armdyn.course)
     GET  /instructor/summary             the class summary page (armdyn.course)
     GET  /api/health, POST /api/grade, GET /api/submissions/{id}, POST /api/preview
+    GET  /link/{token}, /me, /me/statement; POST /me/logout             (--roster: :mod:`.identity`)
+    GET|POST /lti/login, POST /lti/launch, /lti/deep-link, GET /lti/jwks     (--lti: :mod:`.lti_web`)
 
 The web process stores and serves; it never reads a student's LaTeX itself: grading
 and previews go to worker processes (:mod:`.pool`).
@@ -26,6 +29,7 @@ import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import jinja2
 import sqlalchemy as sa
@@ -37,10 +41,12 @@ from starlette.responses import HTMLResponse, JSONResponse, RedirectResponse, Re
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
-from . import security
+from . import identity, lti_web, security
 from .exercises import DEFAULT, Exercise, ordered
 from .openapi import schema
+from .pages import INSTRUCTOR_LINKS, report_links, with_nav
 from .pool import Pool
+from .statement import statements
 from .storage import DONE, FAILED, Repository
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -69,6 +75,10 @@ class Settings:
     grace: float = 10.0
     login_per_client: int = 10  # failed instructor logins per client in 5 min
     login_overall: int = 100  # failed instructor logins from everyone in 5 min
+    roster: dict | None = None  # id -> identity.Student (``--roster``): students come by link or LTI
+    deadlines: dict[str, float] = field(default_factory=dict)  # exercise id (or "*") -> Unix seconds
+    policy: str = "latest"  # which submission the gradebook counts (grades.POLICIES)
+    lti: object = None  # lti.Tool (``--lti``)
 
 
 _templates = jinja2.Environment(
@@ -106,12 +116,15 @@ class Server:
         self.pool: Pool | None = None
         self.loop: asyncio.AbstractEventLoop | None = None
         self.waiters: dict[str, asyncio.Event] = {}
+        self.people: identity.Store | None = None
+        self.done_hooks: list = []  # called in the event loop with the ids just graded (LTI score passback)
 
     # -- life cycle (the app's lifespan)
     async def startup(self) -> None:
         self.loop = asyncio.get_running_loop()
         s = self.settings
         self.repo = await run_in_threadpool(Repository, s.db, s.max_attempts)
+        self.people = identity.Store(self.repo.engine)
         sources = {k: e.source for k, e in s.exercises.items()}
         self.pool = Pool(
             self.repo,
@@ -140,6 +153,8 @@ class Server:
             ev = self.waiters.pop(sid, None)
             if ev is not None:
                 ev.set()
+        for hook in self.done_hooks:
+            hook(ids)
 
     async def wait(self, sid: str, seconds: float) -> dict:
         """The submission's summary once done/failed, or after ``seconds``."""
@@ -161,14 +176,16 @@ class Server:
             except asyncio.TimeoutError:
                 pass
 
-    async def accept(self, markdown: str, exercise: str | None, student: str, owner_key: str | None) -> tuple:
-        """Store a submission; returns (summary row, secret link token)."""
+    async def accept(self, markdown: str, who: dict, owner_key: str | None) -> tuple:
+        """Store a submission of ``who`` (:func:`.identity.submitter`'s exercise, student,
+        student_id, late); returns (summary row, secret link token)."""
         _no_nul(markdown, "the derivation")
-        _no_nul(student, "the student name")
+        _no_nul(who["student"], "the student name")
         token = security.new_token()
         owner = security.digest(owner_key) if owner_key else None
+        fields = {**who, "student": who["student"].strip(), "owner_hash": owner}
         row = await run_in_threadpool(
-            self.repo.add, security.new_id(), security.digest(token), markdown, exercise, student.strip(), owner
+            lambda: self.repo.add(security.new_id(), security.digest(token), markdown, **fields)
         )
         if row["status"] != DONE:
             self.pool.wake()
@@ -201,7 +218,7 @@ class Server:
         key = request.cookies.get(security.STUDENT_COOKIE)
         if key and row.get("owner_hash") and security.token_matches(key, row["owner_hash"]):
             return True
-        return self.is_instructor(request)
+        return identity.owns(request, row) or self.is_instructor(request)
 
     def exercise_of(self, value: str | None) -> str | None:
         """A requested exercise id, checked against the whitelist (None: the front matter's)."""
@@ -281,6 +298,7 @@ def _api_view(row: dict, full: dict | None = None) -> dict:
                 "created_at",
                 "started_at",
                 "finished_at",
+                "late",
             )
         }
     )
@@ -301,6 +319,9 @@ def build_app(settings: Settings) -> Starlette:
     """The ASGI app for ``settings`` (workers start with the app's lifespan)."""
     srv = Server(settings)
     menu = ordered(settings.exercises)
+    # what identity's and LTI's pages share with these (passed: they do not import this module)
+    web = SimpleNamespace(page=_page, student_key=_student_key, with_key=_with_key)
+    statement_of = statements(settings.exercises)
 
     async def health(request: Request):
         """ok (200); starting, or degraded with its ``problems`` (503): a grading thread
@@ -330,7 +351,8 @@ def build_app(settings: Settings) -> Starlette:
             wait = min(120.0, max(0.0, float(q.get("wait", API_WAIT))))
         except ValueError:
             raise _BadRequest("wait must be a number of seconds") from None
-        row, token = await srv.accept(markdown, exercise, q.get("student", ""), None)
+        who = identity.submitter(srv, request, markdown, exercise, q.get("student", ""), form=False)
+        row, token = await srv.accept(markdown, who, None)
         row = await srv.wait(row["id"], wait) if row["status"] not in (DONE, FAILED) else row
         full = await run_in_threadpool(srv.repo.get, row["id"])
         body = _api_view(row, full)
@@ -356,7 +378,7 @@ def build_app(settings: Settings) -> Starlette:
             markdown = await _text_body(request)
             if len(markdown.encode()) > MAX_PREVIEW:
                 return _error(413, f"a preview reads at most {MAX_PREVIEW} bytes")
-            exercise = srv.exercise_of(request.query_params.get("exercise"))
+            exercise = identity.may_preview(srv, request, srv.exercise_of(request.query_params.get("exercise")))
             async with srv.preview_lock:
                 if await request.is_disconnected():
                     return Response(status_code=204)  # nobody reads it: do not make it
@@ -369,21 +391,32 @@ def build_app(settings: Settings) -> Starlette:
         return JSONResponse({"html": reply["html"]})
 
     async def openapi(request: Request):
-        return JSONResponse(schema())
+        return JSONResponse(schema(request.app.router.routes))
 
     # -- the student's pages
     async def student_page(request: Request):
+        if settings.roster is not None:  # students are known: each has a page of their own
+            return RedirectResponse("/me", status_code=303)
         key, new = _student_key(request)
         mine = await run_in_threadpool(srv.repo.by_owner, security.digest(key)) if not new else []
         response = _page(
             "student.html",
             exercises=menu,
             default=DEFAULT,
+            statement=statement_of.get(DEFAULT, "<p>Choose an exercise to see its statement.</p>"),
             csrf=srv.secrets.csrf_token(key),
             mine=mine,
             instructor=False,
         )
         return _with_key(response, key, new, request)
+
+    async def statement_part(request: Request):
+        """An exercise's statement (HTML fragment: text escaped, math sanitized MathML)."""
+        identity.check_statement(srv, request, request.path_params["eid"])
+        html = statement_of.get(request.path_params["eid"])
+        if html is None:
+            return HTMLResponse("No such exercise.", status_code=404)
+        return HTMLResponse(html, headers={"cache-control": "private, max-age=300"})
 
     async def grade_form(request: Request):
         key = request.cookies.get(security.STUDENT_COOKIE)
@@ -402,9 +435,12 @@ def build_app(settings: Settings) -> Starlette:
         if not markdown.strip():
             return HTMLResponse("Paste or upload your derivation first.", status_code=400)
         exercise = srv.exercise_of(str(form.get("exercise") or "") or None)
-        row, token = await srv.accept(markdown, exercise, str(form.get("student") or ""), key)
+        who = identity.submitter(srv, request, markdown, exercise, str(form.get("student") or ""), form=True)
+        owner = key if who["student_id"] is None else None  # a known student's are theirs, not the browser's
+        row, token = await srv.accept(markdown, who, owner)
         await srv.wait(row["id"], FORM_WAIT)
-        return RedirectResponse(f"/submissions/{row['id']}?t={token}", status_code=303)
+        key_in_url = "" if who["student_id"] else f"?t={token}"  # a known student's session opens it
+        return RedirectResponse(f"/submissions/{row['id']}{key_in_url}", status_code=303)
 
     async def submission_page(request: Request):
         full = await run_in_threadpool(srv.repo.get, _sid(request))
@@ -424,7 +460,8 @@ def build_app(settings: Settings) -> Starlette:
         full = await run_in_threadpool(srv.repo.get, _sid(request))
         if full is None or not srv.may_see(request, full) or not full.get("report_html"):
             return HTMLResponse("No report (yet) for this submission.", status_code=404)
-        return HTMLResponse(full["report_html"])
+        links = report_links(full["id"], request.query_params.get("t"), srv.is_instructor(request))
+        return HTMLResponse(with_nav(full["report_html"], links))
 
     # -- the instructor's pages
     async def instructor_page(request: Request):
@@ -512,21 +549,11 @@ def build_app(settings: Settings) -> Starlette:
         return RedirectResponse(back, status_code=303)
 
     async def _gradebook():
-        from ..course import Gradebook
+        """One row per student and exercise, by the policy of ``--policy`` (:mod:`.grades`)."""
+        from .grades import gradebook
 
         rows = await run_in_threadpool(srv.repo.graded)
-        items = [
-            (
-                r["student"] or "(no name)",
-                r["graded_as"] or r["exercise"],
-                json.loads(r["report_json"]) if r["report_json"] else None,
-                None
-                if r["report_json"]
-                else (("failed: " if r["status"] == FAILED else "") + (r["error"] or "no verdict")),
-            )
-            for r in rows
-        ]
-        return Gradebook.from_results(items)
+        return gradebook(rows, settings.policy, settings.roster)
 
     async def gradebook_csv(request: Request):
         if not srv.is_instructor(request):
@@ -543,7 +570,7 @@ def build_app(settings: Settings) -> Starlette:
             return RedirectResponse("/instructor", status_code=303)
         from ..course import summary_html
 
-        return HTMLResponse(summary_html(await _gradebook()))
+        return HTMLResponse(with_nav(summary_html(await _gradebook()), INSTRUCTOR_LINKS))
 
     async def bad_request(request: Request, exc: _BadRequest):
         if request.url.path.startswith("/api/"):
@@ -566,6 +593,11 @@ def build_app(settings: Settings) -> Starlette:
         response.headers["Retry-After"] = "2"
         return response
 
+    async def refused(request: Request, exc: identity.Refused):
+        if request.url.path.startswith("/api/"):
+            return _error(exc.status, exc.message)
+        return HTMLResponse(jinja2.utils.markupsafe.escape(exc.message), status_code=exc.status)
+
     async def too_large(request: Request, exc: security.BodyTooLarge):
         return _error(413, f"request body larger than {MAX_BODY} bytes")
 
@@ -585,6 +617,7 @@ def build_app(settings: Settings) -> Starlette:
 
     routes = [
         Route("/", student_page),
+        Route("/exercises/{eid}/statement", statement_part),
         Route("/grade", grade_form, methods=["POST"]),
         Route("/submissions/{sid}", submission_page),
         Route("/submissions/{sid}/report.html", report_page),
@@ -599,6 +632,8 @@ def build_app(settings: Settings) -> Starlette:
         Route("/api/submissions/{sid}", api_submission),
         Route("/api/preview", api_preview, methods=["POST"]),
         Route("/openapi.json", openapi),
+        *identity.routes(srv, web),
+        *lti_web.routes(srv, web),
         Mount("/static", StaticFiles(directory=os.path.join(HERE, "static")), name="static"),
     ]
 
@@ -618,12 +653,14 @@ def build_app(settings: Settings) -> Starlette:
         exception_handlers={
             _BadRequest: bad_request,
             security.BodyTooLarge: too_large,
+            identity.Refused: refused,
             HTTPException: not_found,
             sa.exc.OperationalError: database_down,
         },
     )
     app.router.redirect_slashes = False  # Starlette's would build an absolute URL from Host
     app.state.server = srv
+    app.add_middleware(identity.Sessions, server=srv)
     app.add_middleware(security.SecurityHeaders)
     app.add_middleware(security.BodyLimit, max_bytes=MAX_BODY)
     return app

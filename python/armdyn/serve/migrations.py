@@ -46,8 +46,60 @@ def _v1_submissions(op: Operations) -> None:
     op.create_index("ix_submissions_owner", "submissions", ["owner_hash"])
 
 
+def _v2_identity(op: Operations) -> None:
+    """Who submitted (the roster's student id, from a personal link or an LTI launch),
+    whether after the deadline; personal links, student sessions and LTI 1.3's state
+    (see :mod:`.identity` and :mod:`.lti`)."""
+    with op.batch_alter_table("submissions") as batch:
+        batch.add_column(sa.Column("student_id", sa.String(64), nullable=True))  # None: anonymous
+        batch.add_column(sa.Column("late", sa.Boolean, nullable=True))  # None: no deadline
+    op.create_index("ix_submissions_student", "submissions", ["student_id", "created_at"])
+    op.create_table(
+        "student_links",  # one secret personal link per roster student (sha256 of its token)
+        sa.Column("student_id", sa.String(64), primary_key=True),
+        sa.Column("link_hash", sa.String(64), nullable=False, unique=True),
+        sa.Column("created_at", sa.Float, nullable=False),
+    )
+    op.create_table(
+        "student_sessions",  # a student's login (personal link or LTI launch): sha256 of the cookie
+        sa.Column("token_hash", sa.String(64), primary_key=True),
+        sa.Column("student_id", sa.String(64), nullable=False),
+        sa.Column("exercise", sa.String(100), nullable=False),
+        sa.Column("expires_at", sa.Float, nullable=False),
+    )
+    op.create_table(
+        "lti_states",  # OIDC login initiations waiting for their launch (single use)
+        sa.Column("state_hash", sa.String(64), primary_key=True),
+        sa.Column("nonce", sa.String(100), nullable=False),
+        sa.Column("issuer", sa.String(500), nullable=False),
+        sa.Column("client_id", sa.String(200), nullable=False),
+        sa.Column("expires_at", sa.Float, nullable=False),
+    )
+    op.create_table(
+        "lti_nonces",  # nonces of accepted launches: a replayed id_token is refused
+        sa.Column("nonce", sa.String(100), primary_key=True),
+        sa.Column("expires_at", sa.Float, nullable=False),
+    )
+    op.create_table(
+        "lti_users",  # an LMS user bound to a roster student (by the roster's sub or email)
+        sa.Column("issuer", sa.String(500), primary_key=True),
+        sa.Column("sub", sa.String(255), primary_key=True),
+        sa.Column("student_id", sa.String(64), nullable=False),
+    )
+    op.create_table(
+        "lti_lineitems",  # where a student's score for an exercise goes (AGS)
+        sa.Column("issuer", sa.String(500), primary_key=True),
+        sa.Column("resource_link", sa.String(255), primary_key=True),
+        sa.Column("student_id", sa.String(64), primary_key=True),
+        sa.Column("client_id", sa.String(200), nullable=False),
+        sa.Column("sub", sa.String(255), nullable=False),
+        sa.Column("exercise", sa.String(100), nullable=False),
+        sa.Column("lineitem", sa.String(1000), nullable=False),
+    )
+
+
 #: in order; version n is MIGRATIONS[n - 1]
-MIGRATIONS = [_v1_submissions]
+MIGRATIONS = [_v1_submissions, _v2_identity]
 
 
 def current_version(conn: sa.Connection) -> int:

@@ -11,12 +11,23 @@ ones (kept below the open-file limit), or past a quarter of them from one addres
 is not a trusted proxy, a new connection is closed at once. So half-open connections
 can neither pile up nor starve the server of file descriptors, and one client cannot
 take every connection.
+
+What it says (on stderr): one ready line with its address once the workers are up
+(``armdyn serve: listening on http://127.0.0.1:8000/``) and one when the grading workers
+are up, one line per request
+(:mod:`.accesslog`: no query secrets, no cookies, no tokens), and on Ctrl-C or SIGTERM
+that it is stopping and then that it stopped. A port already taken is one sentence and
+exit status 2, before any worker starts. The grading workers ignore SIGINT: a Ctrl-C in
+the terminal reaches the whole process group, and it is the server that stops them.
 """
 
 from __future__ import annotations
 
+import asyncio
+import errno
 import os
 import resource
+import socket
 import sys
 
 from ..errors import ModelError
@@ -125,6 +136,7 @@ def config(app, host: str, port: int, forwarded_allow_ips: str = "127.0.0.1", **
         port=port,
         http=guarded_protocol(header_seconds, max_connections, forwarded_allow_ips),
         log_level="warning",
+        access_log=False,  # ours (.accesslog) leaves the query's secrets out
         proxy_headers=True,
         forwarded_allow_ips=forwarded_allow_ips,
         timeout_graceful_shutdown=GRACEFUL_SECONDS,
@@ -133,9 +145,98 @@ def config(app, host: str, port: int, forwarded_allow_ips: str = "127.0.0.1", **
     )
 
 
+def course_settings(settings, args) -> None:
+    """``--roster``, ``--deadline``, ``--policy``, ``--lti`` into ``settings``."""
+    from .grades import POLICIES
+    from .identity import load_roster, parse_deadlines
+
+    if getattr(args, "roster", None):
+        settings.roster = load_roster(args.roster, settings.exercises)
+    settings.deadlines = parse_deadlines(getattr(args, "deadline", None))
+    settings.policy = getattr(args, "policy", None) or "latest"
+    if settings.policy not in POLICIES:
+        raise ModelError(f"--policy must be one of {', '.join(POLICIES)}")
+    if getattr(args, "lti", None):
+        from .lti import Tool
+
+        if settings.roster is None:
+            raise ModelError("--lti needs --roster: a launch is mapped to a roster student (by email or LTI sub)")
+        settings.lti = Tool.load(args.lti)
+
+
+def url_of(sock: socket.socket) -> str:
+    """``http://HOST:PORT/`` of a listening socket (an IPv6 address in brackets; the
+    wildcard addresses as the loopback one a browser on this machine can open)."""
+    host, port = sock.getsockname()[:2]
+    host = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(host, host)
+    return f"http://[{host}]:{port}/" if ":" in host else f"http://{host}:{port}/"
+
+
+def listen(host: str, port: int) -> socket.socket:
+    """A socket bound to ``host:port`` (``port`` 0: a free one), or a :class:`ModelError`
+    that says what to do when the port is taken or the address is not this machine's."""
+    try:
+        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+    except socket.gaierror as err:
+        raise ModelError(f"--host {host!r} is not an address of this machine ({err.strerror})") from None
+    family, kind, proto, _, address = infos[0]
+    sock = socket.socket(family, kind, proto)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        sock.bind(address)
+    except OSError as err:
+        sock.close()
+        if err.errno == errno.EADDRINUSE:
+            raise ModelError(
+                f"port {port} on {host} is already in use (another armdyn serve, or another program): "
+                f"stop it, or choose another port with --port"
+            ) from None
+        if err.errno in (errno.EACCES, errno.EPERM):
+            raise ModelError(f"not allowed to listen on port {port} of {host} (ports below 1024 need root)") from None
+        if err.errno == errno.EADDRNOTAVAIL:
+            raise ModelError(f"--host {host!r} is not an address of this machine") from None
+        raise ModelError(f"cannot listen on {host}:{port}: {err.strerror}") from None
+    sock.listen(2048)
+    sock.set_inheritable(False)
+    return sock
+
+
+def _say(message: str) -> None:
+    print(f"armdyn serve: {message}", file=sys.stderr, flush=True)
+
+
+def _server_class():
+    """uvicorn's Server that says when it is ready and when it stops."""
+    import uvicorn
+
+    class Server(uvicorn.Server):
+        url = ""
+        state = None  # the app's Server (armdyn.serve.app): its pool says when workers are up
+
+        async def startup(self, sockets=None) -> None:
+            await super().startup(sockets=sockets)
+            if not self.should_exit:
+                _say(f"listening on {self.url}")
+                self._announce = asyncio.ensure_future(self._workers_ready())
+
+        async def _workers_ready(self) -> None:
+            while not self.should_exit:
+                pool = getattr(self.state, "pool", None)
+                if pool is not None and pool.ready:
+                    _say(f"{self.state.settings.workers} grading worker(s) ready")
+                    return
+                await asyncio.sleep(0.2)
+
+        async def shutdown(self, sockets=None) -> None:
+            _say("stopping: no new requests; open ones and running gradings may finish")
+            await super().shutdown(sockets=sockets)
+
+    return Server
+
+
 def run(args) -> int:
     try:
-        import uvicorn
+        import uvicorn  # noqa: F401 - the extra is there
     except ImportError:
         raise ModelError("armdyn serve needs its extra: pip install 'armdyn[serve]'") from None
     from .app import Settings, build_app
@@ -159,11 +260,24 @@ def run(args) -> int:
         instructor_token=token,
         secret=os.environ.get("ARMDYN_SECRET"),
     )
+    course_settings(settings, args)
     if token is None:
         print(
             "armdyn serve: no --instructor-token (or ARMDYN_INSTRUCTOR_TOKEN): the instructor page is closed",
             file=sys.stderr,
         )
-    app = build_app(settings)
-    uvicorn.Server(config(app, args.host, args.port, args.forwarded_allow_ips)).run()
+    sock = listen(args.host, args.port)  # before the workers start: a busy port fails at once
+    from .accesslog import AccessLog
+
+    inner = build_app(settings)
+    server = _server_class()(config(AccessLog(inner), args.host, args.port, args.forwarded_allow_ips))
+    server.url, server.state = url_of(sock), inner.state.server
+    try:
+        server.run(sockets=[sock])
+    except KeyboardInterrupt:  # uvicorn raises the Ctrl-C again once it has shut down
+        _say("stopped")
+        return 0
+    finally:
+        sock.close()
+    _say("stopped")
     return 0

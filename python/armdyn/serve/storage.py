@@ -58,6 +58,8 @@ class Submission(Base):
     created_at: Mapped[float] = mapped_column(sa.Float)
     started_at: Mapped[float | None] = mapped_column(sa.Float)
     finished_at: Mapped[float | None] = mapped_column(sa.Float)
+    student_id: Mapped[str | None] = mapped_column(sa.String(64))  # the roster's id (migration 2)
+    late: Mapped[bool | None] = mapped_column(sa.Boolean)
 
 
 T = Submission.__table__
@@ -78,6 +80,8 @@ SUMMARY = (
     "created_at",
     "started_at",
     "finished_at",
+    "student_id",
+    "late",
 )
 
 
@@ -137,6 +141,8 @@ class Repository:
         exercise: str | None = None,
         student: str = "",
         owner_hash: str | None = None,
+        student_id: str | None = None,
+        late: bool | None = None,
     ) -> dict:
         """Accept a submission: stored ``queued``, or ``done`` at once when the same
         exercise and text were graded before. Returns its summary row."""
@@ -154,6 +160,8 @@ class Repository:
             "attempts": 0,
             "cached": False,
             "created_at": now,
+            "student_id": student_id,
+            "late": late,
         }
         with self.engine.begin() as conn:
             twin = (
@@ -291,6 +299,21 @@ class Repository:
             )
         return [dict(r) for r in rows]
 
+    def by_student(self, student_id: str, limit: int = 200) -> list[dict]:
+        """A roster student's submissions, newest first."""
+        with self.engine.connect() as conn:
+            rows = (
+                conn.execute(
+                    sa.select(*(T.c[k] for k in SUMMARY))
+                    .where(T.c.student_id == student_id)
+                    .order_by(T.c.created_at.desc())
+                    .limit(limit)
+                )
+                .mappings()
+                .all()
+            )
+        return [dict(r) for r in rows]
+
     def listing(self) -> list[dict]:
         """Every submission's summary, by student then time (the instructor's table)."""
         with self.engine.connect() as conn:
@@ -312,6 +335,8 @@ class Repository:
             T.c.report_json,
             T.c.error,
             T.c.created_at,
+            T.c.student_id,
+            T.c.late,
         )
         with self.engine.connect() as conn:
             rows = (

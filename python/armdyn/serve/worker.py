@@ -26,6 +26,7 @@ from __future__ import annotations
 import json
 import os
 import resource
+import signal
 import sys
 
 SUBMISSION = "submission.md"  # the name reports show; nothing is read from or written to it
@@ -99,7 +100,7 @@ class Grader:
         model, notes = model_for(sub, assigned, f"exercise {variant}" if variant else None)
         report = grade(sub, robot=model)
         report.notes[:0] = notes
-        return (variant if model is assigned else FROM_TEXT), report
+        return (variant if model is not None and model is assigned else FROM_TEXT), report
 
     def grade(self, markdown: str, exercise: str | None) -> dict:
         from ..errors import ModelError
@@ -204,6 +205,9 @@ def serve(stdin, out) -> None:
 
 
 def main() -> None:
+    # a Ctrl-C in the terminal reaches the whole process group: the server stops its
+    # workers (closing their pipes), a worker does not die of it with a traceback
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     # the protocol owns the real stdout; anything a library prints goes to stderr
     out = os.fdopen(os.dup(1), "w", encoding="utf-8")
     os.dup2(2, 1)

@@ -13,19 +13,6 @@ from sympy.printing.precedence import precedence
 
 SUBSCRIPT_DIGITS = str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉")
 
-#: the Newton-Euler vector steps as written in text (ω̇, v̇_C, ...): the derivation
-#: report and the grade report each add their own steps to these
-VECTOR_STEP_TEXT = {
-    "omega": "ω",
-    "omega_dot": "ω̇",
-    "v_dot": "v̇",
-    "vc_dot": "v̇_C",
-    "F": "F",
-    "N": "N",
-    "f": "f",
-    "n": "n",
-}
-
 #: the one table of Greek letters: LaTeX name -> Unicode letter (the grader's reader, its
 #: messages and every printed name use it)
 GREEK = {

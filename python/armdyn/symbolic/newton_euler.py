@@ -36,14 +36,15 @@ frames); the step ``n`` is reported about that point (the moment whose z compone
 the joint torque), ``n_i - o_i x f_i``. ``F_i``/``N_i`` are the rates of change of
 momentum (Craig's sign; the exercise writes the d'Alembert inertial force ``-m vcd``).
 
-The per-step formulas are the functions ``omega`` ... ``joint_torque`` below; the
-derivation and :mod:`armdyn.grading` (which re-applies them to a student's own values)
-share them.
+The per-step formulas are the functions ``omega`` ... ``joint_torque`` below, wired into
+the recursion by one table, ``NEWTON_EULER_STEPS``, which the derivation and
+:mod:`armdyn.grading.methods` (re-applying it to a student's own values) share.
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
+from typing import Callable
 
 import sympy as sp
 
@@ -138,72 +139,168 @@ def joint_torque(kind, z, n_axis, f):
     return (n_axis if kind == "revolute" else f).dot(z)
 
 
+# ------------------------------------------------------------------ the steps, one table
+# derive computes and reports them from this table; the grader (grading/methods.py)
+# re-applies the same entries to a student's own values; the reports name them by `symbol`.
+
+
+@dataclass(frozen=True)
+class NewtonEulerStep:
+    """One step of the recursion for link i.
+
+    key:      armdyn's name of the step ("omega", "vc_dot", "f", ...)
+    sweep:    "outward" (base to tips) or "inward" (tips to base)
+    symbol:   the text symbol ("ω̇", "v̇_C")
+    latex:    Craig's left-hand side, ``#`` standing for i (``{}^{#}\\dot\\omega_{#}``)
+    meaning:  what the value is, as the derivation report says it
+    inputs:   the steps it takes, each ``(key, "parent" | "self")``
+    children: the steps it takes from each child c (inward sweep)
+    formula:  ``formula(link, *inputs)`` for an outward step, ``formula(link, *inputs,
+              kids)`` for an inward one, ``kids = [(R_c, P_c, *children values)]``; ``link``
+              maps "R", "P", "V", "Vd" (placement of frame i in its parent's frame, and the
+              origin's relative motion), "z", "qd", "qdd", "kind" (the joint) and "m", "c", "I"
+              (the link) to their values.
+    """
+
+    key: str
+    sweep: str
+    symbol: str
+    latex: str
+    meaning: str
+    inputs: tuple
+    formula: Callable
+    children: tuple = ()
+
+
+NEWTON_EULER_STEPS = (
+    NewtonEulerStep(
+        "omega",
+        "outward",
+        "ω",
+        r"{}^{#}\omega_{#}",
+        "angular velocity",
+        (("omega", "parent"),),
+        lambda c, w: omega(c["R"], w, c["z"], c["qd"], c["kind"]),
+    ),
+    NewtonEulerStep(
+        "omega_dot",
+        "outward",
+        "ω̇",
+        r"{}^{#}\dot\omega_{#}",
+        "angular acceleration",
+        (("omega", "parent"), ("omega_dot", "parent")),
+        lambda c, w, wd: omega_dot(c["R"], w, wd, c["z"], c["qd"], c["qdd"], c["kind"]),
+    ),
+    NewtonEulerStep(
+        "v_dot",
+        "outward",
+        "v̇",
+        r"{}^{#}\dot v_{#}",
+        "linear acceleration of the frame origin (gravity included as base acceleration)",
+        (("omega", "parent"), ("omega_dot", "parent"), ("v_dot", "parent")),
+        lambda c, w, wd, vd: v_dot(c["R"], w, wd, vd, c["P"], c["V"], c["Vd"]),
+    ),
+    NewtonEulerStep(
+        "vc_dot",
+        "outward",
+        "v̇_C",
+        r"{}^{#}\dot v_{C_#}",
+        "linear acceleration of the centre of mass",
+        (("omega", "self"), ("omega_dot", "self"), ("v_dot", "self")),
+        lambda c, w, wd, vd: vc_dot(w, wd, vd, c["c"]),
+    ),
+    NewtonEulerStep(
+        "F",
+        "outward",
+        "F",
+        r"{}^{#}F_{#}",
+        "inertial force m vcd",
+        (("vc_dot", "self"),),
+        lambda c, a: inertial_force(c["m"], a),
+    ),
+    NewtonEulerStep(
+        "N",
+        "outward",
+        "N",
+        r"{}^{#}N_{#}",
+        "inertial moment I wd + w x I w",
+        (("omega", "self"), ("omega_dot", "self")),
+        lambda c, w, wd: inertial_moment(c["I"], w, wd),
+    ),
+    NewtonEulerStep(
+        "f",
+        "inward",
+        "f",
+        r"{}^{#}f_{#}",
+        "force exerted on the link by its parent",
+        (("F", "self"),),
+        lambda c, F, kids: joint_force(F, [(Rc, fc) for Rc, _, fc in kids]),
+        children=("f",),
+    ),
+    NewtonEulerStep(
+        "n",
+        "inward",
+        "n",
+        r"{}^{#}n_{#}",
+        "moment exerted on the link by its parent",
+        (("N", "self"), ("F", "self")),
+        lambda c, N, F, kids: joint_moment(N, c["c"], F, kids),
+        children=("n", "f"),
+    ),
+)
+OUTWARD_STEPS = tuple(s for s in NEWTON_EULER_STEPS if s.sweep == "outward")
+INWARD_STEPS = tuple(s for s in NEWTON_EULER_STEPS if s.sweep == "inward")
+#: the vector steps' text symbols, for every report
+VECTOR_STEP_TEXT = {s.key: s.symbol for s in NEWTON_EULER_STEPS}
+
+
+def step_latex(step: NewtonEulerStep, i: int) -> str:
+    """Craig's left-hand side of ``step`` for link ``i``."""
+    return step.latex.replace("#", str(i))
+
+
 def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | None = None) -> sp.Matrix:
     """tau (n x 1) for joint velocities ``qd`` and accelerations ``qdd`` (sequences of
     length n, symbols or numbers) with the base accelerating at ``base_acceleration``
     (3 x 1; ``-gravity`` for the equations of motion). Appends the steps if given."""
     zero = sp.zeros(3, 1)
-    w = {robot.base: zero}
-    wd = {robot.base: zero}
-    vd = {robot.base: base_acceleration}
-    F, N, placement = {}, {}, {}
+    value = {s.key: {} for s in NEWTON_EULER_STEPS}  # key -> link name -> value
+    value["omega"][robot.base], value["omega_dot"][robot.base] = zero, zero
+    value["v_dot"][robot.base] = base_acceleration
+    placement, context = {}, {}  # link name -> (R, P); link name -> the formulas' link quantities
     record = steps is not None
     outward: list[Step] = []
 
     for joint in robot.joints:
         link = robot.links[joint.child]
-        parent, i = joint.parent, robot.link_index(joint.child)
+        name, parent, i = joint.child, joint.parent, robot.link_index(joint.child)
         follow = robot.follows(joint)  # (k, c, o): this joint's coordinate is c q_k + o
         qd_j, qdd_j = (follow[1] * qd[follow[0]], follow[1] * qdd[follow[0]]) if follow is not None else (0, 0)
         R, P = joint.transform(robot.joint_coordinate(joint))
         V, Vd = joint.origin_motion(qd_j, qdd_j)
-        placement[joint.child] = (R, P)
-        z = joint.child_axis
-
-        w_i = omega(R, w[parent], z, qd_j, joint.type)
-        wd_i = omega_dot(R, w[parent], wd[parent], z, qd_j, qdd_j, joint.type)
-        vd_i = v_dot(R, w[parent], wd[parent], vd[parent], P, V, Vd)
-        vcd = vc_dot(w_i, wd_i, vd_i, link.com)
-        w[joint.child], wd[joint.child], vd[joint.child] = w_i, wd_i, vd_i
-        F[joint.child] = inertial_force(link.mass, vcd)
-        N[joint.child] = inertial_moment(link.inertia, w_i, wd_i)
-
+        placement[name] = (R, P)
+        ctx = {"R": R, "P": P, "V": V, "Vd": Vd, "z": joint.child_axis, "qd": qd_j, "qdd": qdd_j, "kind": joint.type}
+        ctx.update(m=link.mass, c=link.com, I=link.inertia)
+        context[name] = ctx
+        for step in OUTWARD_STEPS:
+            args = [value[key][parent if where == "parent" else name] for key, where in step.inputs]
+            value[step.key][name] = step.formula(ctx, *args)
         if record:
-            name = joint.child
             outward += [
-                Step("outward", name, "omega", rf"{{}}^{{{i}}}\omega_{{{i}}}", w_i, "angular velocity"),
-                Step("outward", name, "omega_dot", rf"{{}}^{{{i}}}\dot\omega_{{{i}}}", wd_i, "angular acceleration"),
-                Step(
-                    "outward",
-                    name,
-                    "v_dot",
-                    rf"{{}}^{{{i}}}\dot v_{{{i}}}",
-                    vd_i,
-                    "linear acceleration of the frame origin (gravity included as base acceleration)",
-                ),
-                Step(
-                    "outward",
-                    name,
-                    "vc_dot",
-                    rf"{{}}^{{{i}}}\dot v_{{C_{i}}}",
-                    vcd,
-                    "linear acceleration of the centre of mass",
-                ),
-                Step("outward", name, "F", rf"{{}}^{{{i}}}F_{{{i}}}", F[name], "inertial force m vcd"),
-                Step("outward", name, "N", rf"{{}}^{{{i}}}N_{{{i}}}", N[name], "inertial moment I wd + w x I w"),
+                Step("outward", name, s.key, step_latex(s, i), value[s.key][name], s.meaning) for s in OUTWARD_STEPS
             ]
 
-    f, n = {}, {}
     tau = [sp.Integer(0)] * robot.dof
     inward: list[Step] = []
     tau_steps = []  # (position in inward, k): filled in with the final tau_k at the end
     for joint in reversed(robot.joints):
         name, i = joint.child, robot.link_index(joint.child)
-        link = robot.links[name]
-        children = [(*placement[c.child], n[c.child], f[c.child]) for c in robot.children(name)]
-        f_i = joint_force(F[name], [(Rc, fc) for Rc, _, _, fc in children])
-        n_i = joint_moment(N[name], link.com, F[name], children)
-        f[name], n[name] = f_i, n_i
+        kids = [c.child for c in robot.children(name)]
+        for step in INWARD_STEPS:
+            args = [value[key][name] for key, _ in step.inputs]
+            kid_values = [(*placement[c], *(value[key][c] for key in step.children)) for c in kids]
+            value[step.key][name] = step.formula(context[name], *args, kid_values)
+        f_i, n_i = value["f"][name], value["n"][name]
         follow = robot.follows(joint)
         point = joint.joint_point(robot.joint_coordinate(joint)) if joint.type == "revolute" else sp.zeros(3, 1)
         n_axis = moment_about(n_i, f_i, point)
@@ -213,16 +310,17 @@ def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | Non
             tau[k] = tau[k] + mult * tau_j  # a mimic joint's torque is carried to its leader
         if record:
             about = "" if point == sp.zeros(3, 1) else f", about joint {i}'s axis point {list(point)} (frame {i})"
+            reported = {"f": f_i, "n": n_axis}  # n about the axis point: its z component is the torque
             inward += [
-                Step("inward", name, "f", rf"{{}}^{{{i}}}f_{{{i}}}", f_i, "force exerted on the link by its parent"),
                 Step(
                     "inward",
                     name,
-                    "n",
-                    rf"{{}}^{{{i}}}n_{{{i}}}",
-                    n_axis,
-                    "moment exerted on the link by its parent" + about,
-                ),
+                    s.key,
+                    step_latex(s, i),
+                    reported[s.key],
+                    s.meaning + (about if s.key == "n" else ""),
+                )
+                for s in INWARD_STEPS
             ]
             kind = "torque" if joint.type == "revolute" else "force"
             if joint.mimic is not None:

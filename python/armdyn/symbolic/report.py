@@ -17,7 +17,8 @@ import sympy as sp
 
 from ..dispatch import register
 from . import dag
-from .names import SUBSCRIPT_DIGITS, VECTOR_STEP_TEXT, UnicodeTextPrinter, latex_symbol_names, unicode_name
+from .names import SUBSCRIPT_DIGITS, UnicodeTextPrinter, latex_symbol_names, unicode_name
+from .newton_euler import VECTOR_STEP_TEXT
 from .notes import note_text
 from .report_html import derivation_html
 from .terms import EquationsOfMotion, Step

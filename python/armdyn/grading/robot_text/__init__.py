@@ -10,16 +10,20 @@ armdyn's YAML format (docs/model-format.md) is built from them:
 - positions: ``P_i^j`` (frame i's origin from frame i-1's, in frame j) and ``P_{C_i}^j``
   (link i's mass centre from frame i's origin, in frame j);
 - gravity: the base acceleration ``\\dot v_0^0 = (0, g, 0)`` of Newton-Euler means gravity
-  ``(0, -g, 0)``; else a sentence "gravity acts along -y0" (:mod:`.reader`);
-- mass centres in the base frame: ``p_{ck}``, ``x_{ck}``, Craig's ``{}^{0}P_{C_k}``, or
-  Spong's velocity Jacobians ``J_{v_{ck}}`` (:mod:`.energy`); DH tables in Markdown or LaTeX
-  (:mod:`.dh`);
+  ``(0, -g, 0)``; a stated ``g = (-g, 0, 0)^T`` is gravity itself; else a sentence "gravity
+  acts along -y0" (:mod:`.gravity`); several stated: each is read, the grading keeps the
+  reading the text's steps agree with (:mod:`.support`);
+- mass centres in the base frame: ``p_{ck}``, ``x_{ck}`` (``x_k``: a point mass), Craig's
+  ``{}^{0}P_{C_k}``, or Spong's velocity Jacobians ``J_{v_{ck}}`` (:mod:`.energy`); DH
+  tables in Markdown or LaTeX (:mod:`.dh`);
 - the potential energy ``V = m_1 g h_1 + ...`` (each mass's height) of an energy-method
   derivation; for a planar arm whose joints turn about z, a height ``a sin(phi) + b cos(phi)``
   is the point ``Rz(phi) (a, b)`` (``a cos(phi) - b sin(phi)`` across);
 - the kinetic energy ``T`` (and each link's ``T_k``/``K_k``): its ``I_k`` terms are link k's
   moment of inertia about z; the whole ``T`` is checked against the positions read;
 - a text with proofs and no joint variable: an arm of no joints (its proofs need none).
+
+A text whose robot cannot be read is graded on its own earlier values (:mod:`.own_values`).
 
 Symbols keep the text's names (``l_1`` -> ``l1``, ``l_{c1}`` -> ``lc1``, ``\\theta_1`` ->
 ``theta1``). Nothing from the text is evaluated as code: the LaTeX is parsed by
@@ -42,7 +46,21 @@ def robot_from_text(sub: Submission) -> TextModel:
     """The robot ``sub``'s own statements describe (see the module's docstring); a
     :class:`ModelError` naming the file when they do not fix one."""
     try:
-        return TextReader(sub).read()
+        first = TextReader(sub)
+        model = first.read()
+        others = []  # the other readings the statements allow: other gravities, x_k or y_k
+        for choice in range(1, min(first.gravity_options, 3)):
+            others.append(TextReader(sub))
+            others[-1].gravity_choice = choice
+        for k in list(first.pair_choices)[:2]:
+            others.append(TextReader(sub))
+            others[-1].pair_choices = {k: True}
+        for other in others:
+            try:
+                model.alternatives.append(other.read())
+            except ModelError:
+                continue
+        return model
     except ModelError:
         raise
     except (ArithmeticError, TypeError, ValueError, AttributeError, IndexError, KeyError, RecursionError) as err:

@@ -7,8 +7,8 @@ none: the robot the text describes, checked against the variant the course assig
 The text's model is compared with the assigned one as dynamics (the mass matrix M, the
 Coriolis matrix C and the gravity torques g at random states, each parameter given one
 random value by its name); a difference is a warning note, never a refusal. A text whose
-robot cannot be read is graded against the assigned model (noted), or refused when the
-course assigns none. Only the caller's models are loaded here: nothing the text names.
+robot cannot be read is graded against the assigned model (noted), or, when the course
+assigns none, on its own values (``model`` None: :func:`~armdyn.grading.grade` does that). Only the caller's models are loaded here: nothing the text names.
 """
 
 from __future__ import annotations
@@ -71,10 +71,13 @@ def model_for(sub: Submission, assigned: Robot | None = None, assigned_name: str
     """``(model, notes)`` for a submission that names no model: the robot its text describes
     (the note that says so first), with a warning when its dynamics differ from the
     assigned model's; the assigned model when the text's cannot be read (noted). Without
-    an assigned model an unreadable text is the :class:`ModelError` the reading gives."""
+    an assigned model an unreadable text gives ``(None, [])`` (graded on its own values by
+    :func:`~armdyn.grading.grade`), or the :class:`ModelError` when it has no equation."""
     try:
         read = robot_from_text(sub)
     except ModelError as err:
+        if assigned is None and sub.equations:
+            return None, []  # grade(sub, robot=None) grades the text on its own values, saying why
         if assigned is None:
             raise
         why = " ".join(str(err).split())[:300]

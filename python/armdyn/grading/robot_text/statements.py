@@ -19,6 +19,11 @@ from ..reader import Equation, Submission, read_text
 MAX_FRAMES = 24
 #: inline equations read from the prose, at most
 MAX_INLINE = 500
+#: the ``frame`` of a point mass's place written without the ``c`` (``x_1``): a mass centre
+#: written ``x_{c1}`` for the same link wins over it
+POINT = -1
+#: a statement's value longer than this (characters) is not read for the robot
+MAX_STATEMENT = 6000
 _TOL = 1e-9
 _JOINT_BASES = ("theta", "vartheta", "q", "d")
 
@@ -74,6 +79,9 @@ class Names:
         base = "theta" if name.base == "vartheta" else name.base
         if base == "pi" and not sub:
             return sp.pi
+        if name.hat and base in ("X", "Y", "Z", "x", "y", "z") and not name.dots:
+            # Craig's \hat X_1: the unit vector along frame 1's x axis, written in frame 1
+            return sp.Matrix([1 if base.lower() == a else 0 for a in "xyz"])
         if base in ("s", "c", "S", "C") and not name.dots and sub.isdigit() and all(int(k) in self.joints for k in sub):
             angle = sum((sp.Symbol(self.joints[int(k)]) for k in sub), sp.Integer(0))
             return (sp.sin if base in "sS" else sp.cos)(angle)
@@ -149,9 +157,15 @@ def _inline_equations(text: str) -> list[Equation]:
 _GENERIC = re.compile(r"(?<![A-Za-z\\])i(?![A-Za-z])")
 _GENERIC_SUB = re.compile(r"(?<![A-Za-z\\])i(?![A-Za-z])|(?<=\{[cC])i(?=\})")
 _SPONG_R = re.compile(r"r_\{(\d+),\s*(?:[cC]_?\{?(\d+)\}?|(\d+))\}")
-_CENTRE = re.compile(r"([prxyz])_\{?[cC]_?\{?(\d+)\}?\}?")
+_CENTRE = re.compile(r"([prxyz])_\{?[cC]_?\{?(\d+)\}?\}?|([xyz])_\{?(\d)\}?")  # x_1: a point mass's place
 _DIAG = re.compile(r"\\(?:mathrm|operatorname|text)\{diag\}\s*\((.*)\)", re.S)
 _ELEMENTARY = re.compile(r"R_\{?([xyz])\}?\s*\((.*)\)", re.S)
+#: ``g``, ``\mathbf{g}``, ``\vec g``, ``\boldsymbol{g}``, ``\vec{g}_0``: the gravity vector stated
+_GRAVITY_LHS = re.compile(
+    r"(?:\\(?:mathbf|vec|boldsymbol|bm|underline)\s*\{?\s*g\s*\}?|g)(?:\s*_\s*\{?\s*0\s*\}?)?(?:\^\{?\s*0\s*\}?)?"
+)
+#: ``m2d_2``: a mass written without its underscore before another factor (m_2 d_2)
+_GLUED_MASS = re.compile(r"(?<![A-Za-z\\_^{])m(\d)(?=[A-Za-z\\])")
 _SPACED = re.compile(r"\[(.*)\]\s*\^\s*\{?(?:T|\\top|\\mathrm\{T\})\}?", re.S)
 
 
@@ -181,7 +195,7 @@ def _split_top(text: str, seps: str) -> list[str]:
 def _value(text: str, names: Names):
     """A statement's value: LaTeX, also ``\\mathrm{diag}(a, b, c)``, an elementary rotation
     ``R_z(\\theta_1)`` and a row ``[a\\ b\\ c]^T`` (each entry parsed on its own)."""
-    text = text.strip()
+    text = _GLUED_MASS.sub(r"m_\1 ", text.strip())
     m = _DIAG.fullmatch(text)
     if m:
         items = [parse(p, names) for p in _split_top(m.group(1), ",")]
@@ -215,13 +229,17 @@ def _what(lhs: str):
         return "CJ", ref.index, 0  # Spong's J_{v_{ck}}: link k's mass centre's velocity Jacobian
     if ref is not None and ref.key == "v_dot" and ref.index == 0:
         return "g", 0, ref.frame
+    if _GRAVITY_LHS.fullmatch(lhs.strip()):
+        return "gv", 0, 0  # the gravity vector itself, in the base frame
     s = normalise(lhs)
     m = _INERTIA_LHS.fullmatch(s)
     if m:
         return "I", int(m.group(2)), None
     m = _CENTRE.fullmatch(s)  # an energy method's mass centre in the base frame: p_{c2}, x_{c2}
     if m:
-        return ("C" if m.group(1) in "pr" else "C" + m.group(1)), int(m.group(2)), 0
+        if m.group(1):
+            return ("C" if m.group(1) in "pr" else "C" + m.group(1)), int(m.group(2)), 0
+        return "C" + m.group(3), int(m.group(4)), POINT
     m = _SPONG_R.fullmatch(s)  # Spong's r_{i,c_i} (to the mass centre), r_{i,i+1} (to the next joint)
     if m and m.group(2) and m.group(2) == m.group(1):
         return "Pc", int(m.group(1)), int(m.group(1))
@@ -238,7 +256,7 @@ def read_statements(equations: list[Equation], names: Names, n: int) -> list[Sta
             continue
         for lhs, text, note in _instances(eq, n):
             found = _what(lhs)
-            if found is None:
+            if found is None or len(text) > MAX_STATEMENT:  # longer than any arm's geometry by hand
                 continue
             try:
                 value = _value(text, names)

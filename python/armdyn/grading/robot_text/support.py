@@ -1,0 +1,75 @@
+"""Which reading of a text's robot its own steps support: when the text states more than one
+gravity (a case shown in passing, a correction), or an x_k and a y_k that are not one point,
+each reading is graded and the one with the fewest steps found wrong is kept, named in the
+report's first note."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from ...errors import ModelError
+from ..verdict import GradeReport
+from .reader import TextModel
+
+_FLAGGED = ("wrong", "follows-from-earlier-error")
+
+
+def _flagged(report: GradeReport) -> int:
+    return sum(v.status in _FLAGGED for v in report.steps)
+
+
+def most_supported(
+    model: TextModel, report: GradeReport, grade_with: Callable[[TextModel], GradeReport]
+) -> tuple[TextModel, GradeReport]:
+    """``(model, report)`` of the reading (``model`` or one of its alternatives) whose grading
+    finds the fewest steps wrong; a tie keeps the reading most statements give (``model``)."""
+    best, best_report, counts = model, report, [_flagged(report)]
+    for other in model.alternatives:
+        try:
+            other_report = grade_with(other)
+        except ModelError:
+            continue
+        counts.append(_flagged(other_report))
+        if counts[-1] < _flagged(best_report):
+            best, best_report = other, other_report
+    if best is not model:
+        best.conflicts.append(
+            f"the reading kept is the one the text's steps agree with: {_flagged(best_report)} steps "
+            f"found wrong with it, {counts[0]} with the reading most statements give"
+        )
+    return best, best_report
+
+
+def _unknown_name(v) -> bool:
+    return v.status == "unrecognised" and bool(v.key) and "unknown symbol" in v.message
+
+
+def _read(report: GradeReport) -> int:
+    return sum(v.status != "unrecognised" for v in report.steps)
+
+
+def _wrong(report: GradeReport) -> int:
+    return sum(v.status == "wrong" for v in report.steps)
+
+
+def disagreeing(report: GradeReport) -> bool:
+    """Most of the steps are found wrong against the model read, each on its own (a slip
+    carried through is one ``wrong`` and then ``follows``), or use names it does not have (at
+    least 3): the reading is more likely wrong than the text."""
+    steps = [v for v in report.steps if v.key and (v.status != "unrecognised" or _unknown_name(v))]
+    trouble = sum(v.status == "wrong" or _unknown_name(v) for v in steps)
+    return trouble >= 3 and 2 * trouble > len(steps)
+
+
+def own_values_instead(sub, report: GradeReport) -> GradeReport:
+    """The text graded on its own values when the model read disagrees with most of its steps,
+    kept when it finds fewer steps wrong (or as many, reading more); else ``report``."""
+    from .own_values import grade_without_model
+
+    wrong = _wrong(report)
+    unknown = sum(_unknown_name(v) for v in report.steps)
+    why = f"{wrong} found wrong" + (f", {unknown} using names it does not have" if unknown else "")
+    own = grade_without_model(sub, f"the model read from the text disagrees with most of its steps ({why})")
+    if _wrong(own) < wrong or (_wrong(own) == wrong and _read(own) > _read(report)):
+        return own
+    return report
