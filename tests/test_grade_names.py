@@ -338,3 +338,14 @@ def test_a_speed_of_a_joint_is_said_so(tmp_path):
     _, at, lines = _grade(tmp_path, body)
     step = at[_line(lines, "v_2 =")]
     assert step.status == "correct" and "frame 2's origin" in step.message
+
+
+def test_a_chain_member_with_arguments(tmp_path):
+    # K = K(theta, thetadot) = 1/2 thetadot^T D thetadot: every member is the total kinetic energy
+    body = (
+        f"$$D(\\theta) = \\begin{{bmatrix}} {TEX['M11']} & {TEX['M12']} \\\\ {TEX['M12']} & {TEX['M22']} \\end{{bmatrix}}$$\n\n"
+        f"$$K_1 = {TEX['K1']}$$\n\n$$K_2 = {TEX['K2']}$$\n\n"
+        "$$K = K_1(\\theta, \\dot\\theta) + K_2(\\theta, \\dot\\theta) = \\frac{1}{2}\\dot\\theta^T D(\\theta)\\dot\\theta$$\n"
+    )
+    _, at, lines = _grade(tmp_path, body)
+    assert at[_line(lines, "K = K_1")].status == "correct"
