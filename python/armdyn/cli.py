@@ -3,14 +3,14 @@
     armdyn derive ROBOT [--method newton-euler|lagrange|both] [--steps] [--format text|latex|markdown|html]
     armdyn check ROBOT [--exact | --numeric] [--samples N]
     armdyn robots
-    armdyn show ROBOT [--q Q1,Q2,...] [--out arm.png]
+    armdyn show ROBOT [--q Q1,Q2,...] [--out arm.png] [--3d [--frames] --out arm.html]
     armdyn grade SUBMISSION [--robot MODEL] [--json] [--html OUT.html] [--ascii] [--to-yaml] [--show-model]
     armdyn grade DIR --gradebook grades.csv [--rubric R.yaml] [--html-dir DIR] [--variants DIR] [--jobs N]
     armdyn exercise make KIND (--count N | --roster roster.csv) --seed S --out DIR
     armdyn links --roster roster.csv --base-url URL [--db URL] [--renew ID...]
     armdyn serve [--host H] [--port P] [--db URL] [--workers N] [--exercises DIR] [--instructor-token T]
     armdyn codegen ROBOT [--what tau,M,C,g,regressor] [--base] [--lang c|python|numpy] [--bind] [--out DIR]
-    armdyn simulate ROBOT --duration T --dt DT [--q0 ...] [--controller pd --target ...] [--plot run.png] [--animate run.gif]
+    armdyn simulate ROBOT --duration T --dt DT [--q0 ...] [--controller pd --target ...] [--plot run.png] [--animate run.gif] [--3d run.html]
 
 ROBOT is a bundled model's name (see ``armdyn robots``) or a model file (.yaml, .urdf, MJCF .xml).
 Bad input prints one line ``armdyn: error: ...`` and exits with status 2, no traceback.
@@ -95,6 +95,21 @@ def cmd_show(args) -> int:
             q = [float(x) for x in args.q.split(",")]
         except ValueError:
             raise ValueError(f"--q must be comma-separated numbers, got {args.q!r}") from None
+    if args.three_d:  # a 3-D page (armdyn.viewer) instead of the matplotlib picture
+        from ._io_atomic import destination
+        from .show import numeric_robot, table
+        from .viewer import view
+
+        out = args.out or "arm.html"
+        if not out.lower().endswith((".html", ".htm")):
+            raise ValueError(f"{out}: --3d writes an HTML page (give a .html name)")
+        destination(out)
+        robot = numeric_robot(robot)
+        page = view(robot, q, frames=args.frames)
+        print(table(robot))
+        page.save(out)
+        print(f"wrote {out}")
+        return 0
     print(show(robot, q=q, out=args.out))
     if args.out is not None:
         print(f"wrote {args.out}")
@@ -190,7 +205,7 @@ def cmd_simulate(args) -> int:
     from ._io_atomic import destination
     from .simulate_cli import run
 
-    for path, ext in ((args.plot, (".png", ".svg", ".pdf")), (args.animate, (".gif",))):
+    for path, ext in ((args.plot, (".png", ".svg", ".pdf")), (args.animate, (".gif",)), (args.three_d, (".html",))):
         if path is not None:
             destination(path)  # refused before the run: not a regular file, read-only, ""
             if not path.lower().endswith(ext):
@@ -267,7 +282,16 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("show", help="table of joints and links, and a picture of the arm")
     robot_arg(s)
     s.add_argument("--q", help="joint values, comma-separated (default: zeros)")
-    s.add_argument("--out", help="write a PNG picture of the arm here")
+    s.add_argument(
+        "--out", "-o", help="write a PNG picture of the arm here (with --3d: an HTML page, default arm.html)"
+    )
+    s.add_argument(
+        "--3d",
+        dest="three_d",
+        action="store_true",
+        help="write a 3-D view (HTML page, three.js inlined: opens offline in a browser) instead of a picture",
+    )
+    s.add_argument("--frames", action="store_true", help="with --3d: draw each link frame's axes")
     s.set_defaults(func=cmd_show)
 
     gr = sub.add_parser(
@@ -369,6 +393,12 @@ def build_parser() -> argparse.ArgumentParser:
     m.add_argument("--stride", type=int, help="store every k-th step (default: about 2000 samples)")
     m.add_argument("--plot", help="write q, qd, tau and energy plots here (.png/.svg/.pdf)")
     m.add_argument("--animate", help="write an animation of the arm here (.gif)")
+    m.add_argument(
+        "--3d",
+        dest="three_d",
+        metavar="RUN.html",
+        help="write a 3-D animation (HTML page: play/pause, time slider; at most 500 frames) here",
+    )
     m.add_argument(
         "--fps",
         type=float,

@@ -53,7 +53,8 @@ def numeric_robot(robot: Robot) -> Robot:
     return robot
 
 
-def _coordinates(robot: Robot, q) -> np.ndarray:
+def joint_values(robot: Robot, q) -> np.ndarray:
+    """``q`` as a float array of one finite value per coordinate (zeros for None), else a ValueError."""
     if q is None:
         return np.zeros(robot.dof)
     q = np.asarray(q, dtype=float).reshape(-1)
@@ -64,7 +65,8 @@ def _coordinates(robot: Robot, q) -> np.ndarray:
     return q
 
 
-def _floats(m: sp.Matrix) -> np.ndarray:
+def as_floats(m: sp.Matrix) -> np.ndarray:
+    """A numeric SymPy matrix as a float array."""
     return np.array(m.evalf(), dtype=float)
 
 
@@ -75,13 +77,13 @@ def frame_poses(robot: Robot, q=None) -> dict[str, np.ndarray]:
     ``robot`` must be numeric (see :func:`numeric_robot`). Each pose is the parent's
     pose times the joint's ``Joint.transform(q_i)``.
     """
-    q = _coordinates(robot, q)
+    q = joint_values(robot, q)
     poses = {robot.base: np.eye(4)}
     for joint in robot.joints:
         f = robot.follows(joint)  # (coordinate, multiplier, offset); mimic joints follow a leader
         R, p = joint.transform(0 if f is None else float(f[1]) * q[f[0]] + float(f[2]))
         local = np.eye(4)
-        local[:3, :3], local[:3, 3] = _floats(R), _floats(p).reshape(3)
+        local[:3, :3], local[:3, 3] = as_floats(R), as_floats(p).reshape(3)
         poses[joint.child] = poses[joint.parent] @ local
     return poses
 
@@ -103,7 +105,7 @@ def _vec(v) -> str:
 
 def rpy(R: sp.Matrix) -> tuple:
     """URDF roll, pitch, yaw of a numeric rotation (inverse of ``rpy_matrix``)."""
-    r = _floats(R)
+    r = as_floats(R)
     pitch = math.atan2(-r[2, 0], math.hypot(r[2, 1], r[2, 2]))
     if math.hypot(r[2, 1], r[2, 2]) < 1e-12:  # gimbal lock: put it all in yaw
         return 0.0, pitch, math.atan2(-r[0, 1], r[1, 1])
@@ -169,7 +171,7 @@ def draw(robot: Robot, q=None, out=None, title: str | None = None):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    q = _coordinates(robot, q)
+    q = joint_values(robot, q)
     poses = frame_poses(robot, q)
     origins = np.array([T[:3, 3] for T in poses.values()])
     fig = plt.figure(figsize=(7, 7))
@@ -298,7 +300,7 @@ def draw_on(ax, robot: Robot, poses: dict[str, np.ndarray], title: str, view: tu
     labels = []
     for j in robot.movable_joints:
         T = poses[j.child]
-        axis = T[:3, :3] @ _floats(j.axis).reshape(3)
+        axis = T[:3, :3] @ as_floats(j.axis).reshape(3)
         ax.quiver(*T[:3, 3], *(arrow * axis), color=AXIS_COLOURS[j.type], linewidth=2.5, arrow_length_ratio=0.3)
         labels.append((j.name, T[:3, 3] + arrow * axis, AXIS_COLOURS[j.type]))
         drawn.append(T[:3, 3] + np.linspace(0.3, 1, 3)[:, None] * arrow * axis)
@@ -307,7 +309,7 @@ def draw_on(ax, robot: Robot, poses: dict[str, np.ndarray], title: str, view: tu
     heaviest = max(masses.values(), default=0.0)
     for name, m in masses.items():
         if m > 0:
-            c = poses[name][:3, :3] @ _floats(robot.links[name].com).reshape(3) + poses[name][:3, 3]
+            c = poses[name][:3, :3] @ as_floats(robot.links[name].com).reshape(3) + poses[name][:3, 3]
             ax.scatter(*c, color="black", s=10 + 80 * m / heaviest, alpha=0.6, depthshade=False)
 
     # equal scales on the three axes (box sides proportional to the ranges): not distorted

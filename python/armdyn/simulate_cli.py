@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -174,6 +175,12 @@ def run(args, robot) -> int:
                     gif_bar.close()
 
         outputs.append((args.animate, write_gif))
+    if getattr(args, "three_d", None):
+        from .viewer import animate as animate_3d
+
+        page = animate_3d(robot, result.t, result.q)
+        notes.append(f"3-D: {page.frames} frames, real time")
+        outputs.append((args.three_d, lambda tmp: Path(tmp).write_text(page.html(), encoding="utf-8")))
     atomic_writes(outputs)
 
     names = robot.coordinate_names
@@ -189,7 +196,7 @@ def run(args, robot) -> int:
         )
     for note in notes:
         print(note)
-    for path in (args.plot, args.animate):
+    for path in (args.plot, args.animate, getattr(args, "three_d", None)):
         if path:
             print(f"wrote {path}")
     if result.nonfinite_step >= 0:

@@ -206,7 +206,7 @@ def _number(text: str, what: str, where: str) -> float:
     return value
 
 
-def _numbers(text: str, count: int, what: str, where: str) -> list[float]:
+def parse_numbers(text: str, count: int, what: str, where: str) -> list[float]:
     parts = text.split()
     if len(parts) != count:
         raise ModelError(f"{what} is {_clip(text)!r}: expected {count} numbers", where)
@@ -230,7 +230,7 @@ def _angle(value: float) -> sp.Expr:
     return _sym(value)
 
 
-def _rpy_floats(roll: float, pitch: float, yaw: float) -> np.ndarray:
+def rpy_floats(roll: float, pitch: float, yaw: float) -> np.ndarray:
     """URDF roll-pitch-yaw in floats: ``Rz(yaw) Ry(pitch) Rx(roll)`` (3, 3)."""
     cr, sr, cp, sp_, cy, sy = (
         math.cos(roll),
@@ -284,14 +284,14 @@ def _origin(parent: ET.Element, where: str) -> tuple[Numbers, Numbers, tuple]:
     xyz, rpy = [0.0] * 3, [0.0] * 3
     if origin is not None:
         if origin.get("xyz") is not None:
-            xyz = _numbers(origin.get("xyz"), 3, "<origin> xyz", where)
+            xyz = parse_numbers(origin.get("xyz"), 3, "<origin> xyz", where)
         if origin.get("rpy") is not None:
-            rpy = _numbers(origin.get("rpy"), 3, "<origin> rpy", where)
+            rpy = parse_numbers(origin.get("rpy"), 3, "<origin> rpy", where)
     rpy = tuple(rpy)
     if not any(rpy):
         rotation = Numbers(np.eye(3))
     else:
-        rotation = Numbers(_rpy_floats(*rpy), partial(_rpy_exact, rpy))
+        rotation = Numbers(rpy_floats(*rpy), partial(_rpy_exact, rpy))
     return Numbers(xyz), rotation, rpy
 
 
@@ -346,7 +346,7 @@ def _joint(elem: ET.Element, index: int) -> Joint:
     axis = Numbers([1.0, 0.0, 0.0])
     axis_elem = _single(elem, "axis", where)
     if kind != "fixed" and axis_elem is not None:
-        values = _numbers(_attr(axis_elem, "xyz", where), 3, "<axis> xyz", where)
+        values = parse_numbers(_attr(axis_elem, "xyz", where), 3, "<axis> xyz", where)
         norm = math.sqrt(sum(v * v for v in values))
         if norm == 0:
             raise ModelError("axis is zero", where)
