@@ -190,12 +190,13 @@ def all_specs() -> dict[str, dict]:
     """Every corpus file's spec, by file name."""
     import specs_lagrange
     import specs_laws
+    import specs_names
     import specs_newton_euler
     import specs_proofs
     import specs_public
 
     out = {}
-    for mod in (specs_newton_euler, specs_lagrange, specs_proofs, specs_public, specs_laws):
+    for mod in (specs_newton_euler, specs_lagrange, specs_names, specs_proofs, specs_public, specs_laws):
         out.update(mod.SPECS)
     return out
 

@@ -173,6 +173,8 @@ class Arm:
         for i in range(n):
             for j in range(n):
                 Q[f"d{i + 1}{j + 1}"] = D[i, j]
+                # its time derivative along the motion (the chain rule through each joint angle)
+                Q[f"d{i + 1}{j + 1}dot"] = sum(sp.diff(D[i, j], self.q[k]) * self.qd[k] for k in range(n))
         Q["D"] = D
         Q.later("C", lambda: self._coriolis(D))
         for i in range(n):

@@ -128,9 +128,10 @@ class StepNames:
     """Reads members: step names resolve through ``values(meaning, own) -> value or None``
     (None: a step this robot does not have), every other symbol through ``symbols``."""
 
-    def __init__(self, symbols, values):
+    def __init__(self, symbols, values, prepare=None):
         self.symbols = symbols
         self.values = values
+        self.prepare = prepare  # (text) -> text: names with arguments, partials (.named), before reading
         robot = symbols.robot
         #: joint indices (1-based) of prismatic joints: their angle, if written, is a constant
         self.prismatic = {
@@ -185,7 +186,7 @@ class StepNames:
 
     def read(self, text: str) -> Reading:
         """The member ``text`` read; raises LatexError (UnknownSymbol) when it cannot be."""
-        body, found = self._substitute(text)
+        body, found = self._substitute(self.prepare(text) if self.prepare else text)
 
         def resolver(own: bool):
             def resolve(name: Name):
@@ -456,7 +457,9 @@ def step_names(grader) -> StepNames:
     values = Values(
         lambda: grader.world("newton-euler"), grader.written, grader.verdicts, lambda: grader.world("lagrange")
     )
-    return StepNames(grader.symbols, values)
+    from .named import drop_arguments, partials_as_names
+
+    return StepNames(grader.symbols, values, lambda t: partials_as_names(grader, drop_arguments(grader, t)))
 
 
 def with_members(findings: list, verdict: tuple, value, grader) -> tuple:
@@ -485,9 +488,10 @@ def with_members(findings: list, verdict: tuple, value, grader) -> tuple:
             said.append(f"its formula member `{f.text}` ({_at(f)}) is right: the slip is in the value")
             continue
         member = f.member if isinstance(f.member, sp.MatrixBase) else sp.Matrix([[f.member]])
-        where = [component_name(i, value.shape) for i in f.components[:3]]
+        shared = [i for i in f.components if i < min(len(member), len(value))]  # a member of another shape
+        where = [component_name(i, value.shape) for i in shared[:3]]
         what = "; ".join(
-            grader._describe(member[i], value[i]) + (f" in {w}" if w else "") for i, w in zip(f.components, where)
+            grader._describe(member[i], value[i]) + (f" in {w}" if w else "") for i, w in zip(shared, where)
         )
         if len(what) > 160:  # a long difference: where, not what
             what = "a long difference" + (f" in {', '.join(w for w in where if w)}" if any(where) else "")

@@ -20,11 +20,11 @@ carries an earlier error (:meth:`DefinedNames.carry`).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 
 import sympy as sp
 
 from .latex import MAX_CALL_DEPTH, MAX_SYMBOLIC_EXPONENT, LatexError, Name, UnknownSymbol, parse
+from .named import PARTIAL_MARK, Entry, keep_named, partial_value, plain, shorthand_name, simple_name
 from .notation import parse_lhs
 from .vocabulary import MODEL_KEYS
 
@@ -38,37 +38,6 @@ _ENERGY = re.compile(
     r"(?<![A-Za-z\\])(?:\\(?:mathrm|text|mathit|rm)\s*\{\s*)?([KP])(?:E|\.\s*E\.?)(?:\s*\})?(?![A-Za-z])"
 )
 _ENERGY_NAMES = {"K": ("KE", "K", "T"), "P": ("PE", "P", "V", "U")}
-
-
-@dataclass
-class Entry:
-    """A name with a value: ``own`` (the student's), ``right`` (the model's, when it names a
-    model quantity; else the definition read with right values), where it was given."""
-
-    name: str
-    own: object
-    right: object
-    line: int = 0
-    wrong: str = ""  # the verdict name of a wrong step, or "" (a definition: never wrong itself)
-    note: str = ""  # said in the verdicts of steps that use it
-
-
-def simple_name(lhs: str) -> Name | None:
-    """The one undotted symbol ``lhs`` is (``X``, ``c_1``, ``d_{11}``, ``\\phi_3``), else None."""
-    names: list[Name] = []
-    marker = sp.Symbol("armdyn_lhs_marker")
-    try:
-        value = parse(lhs, lambda n: names.append(n) or marker)
-    except (LatexError, TypeError, ValueError, RecursionError):
-        return None
-    if value != marker or len(names) != 1 or names[0].dots or names[0].pre_sup or names[0].pre_sub:
-        return None
-    return names[0]
-
-
-def plain(name: Name) -> str:
-    """The key a name is kept under (as :class:`~.notation.SymbolMap` looks names up)."""
-    return name.base + re.sub(r"[{}\s,_]|\\mathrm|\\text", "", name.sub or "")
 
 
 class DefinedNames:
@@ -89,12 +58,16 @@ class DefinedNames:
         self._stack: list[str] = []
         self.failed: dict[str, str] = {}  # key -> why its definition cannot be read
         self.active = False
+        self.unknown: list[Name] = []  # names no reading knew, in the equation being read (.named.Waiting)
+        self.aliased: set[str] = set()  # keys given as another name of an energy (.named.keep_named)
+        self.partials: dict[str, tuple] = {}  # placeholder -> (Name, variable): .named.partials_as_names
+        self.links: dict[str, str] = {}  # key -> the key it was given as (M_{21} = M_{12}): .named.symmetric_entry
 
     # -- what may be defined
     def definable(self, name: Name) -> bool:
         """Not a symbol of the model (a length, a joint variable): those keep their meaning.
         The shorthand ``c_1``, ``s_{12}`` may be defined (and is checked)."""
-        if _shorthand(name):
+        if shorthand_name(name):
             return True
         saved, self.active = self.active, False
         try:
@@ -113,7 +86,7 @@ class DefinedNames:
             name = simple_name(eq.lhs)
             if name is None or parse_lhs(eq.lhs, lambda _: None) is not None or not self.definable(name):
                 continue
-            if _shorthand(name):  # c_1 means cos q_1 until the student defines it otherwise
+            if shorthand_name(name):  # c_1 means cos q_1 until the student defines it otherwise
                 continue
             self.pending.setdefault(plain(name), eq)
         self.active = True
@@ -121,9 +94,16 @@ class DefinedNames:
     # -- the SymbolMap hook
     def lookup(self, name: Name):
         """The value of a name given earlier (or defined anywhere), else None."""
-        if not self.active or name.dots or name.pre_sup or name.pre_sub:
+        if not self.active or name.pre_sup or name.pre_sub:
             return None
+        if name.dots:  # \dot M_{11}: the time derivative of the student's M_{11}
+            from .named import differentiated
+
+            return differentiated(self, name)
+        if name.base == PARTIAL_MARK:  # \frac{\partial M_{11}}{\partial q_2}
+            return partial_value(self, name)
         key = plain(name)
+        key = self.links.get(key, key) if key not in self.entries else key
         if key in self.failed:
             raise LatexError(self.failed[key])
         entry = self.entries.get(key)
@@ -137,9 +117,12 @@ class DefinedNames:
     def model(self, name: Name):
         """A model quantity not written (``d_{11}``, ``\\phi_3``): the model's value, said."""
         if not self.active or name.dots:
+            if self.active:
+                self.unknown.append(name)
             return None
         entry = self.model_value(name)
         if entry is None:
+            self.unknown.append(name)
             return None
         self.used.append(entry)
         return entry.right if self.right else entry.own
@@ -169,7 +152,7 @@ class DefinedNames:
         """``c_1 = \\sin\\theta_1``: not the model's ``c_1``; later steps use it, said. A value
         that is no sine or cosine (Lynch & Park's ``c_1``, a velocity-product entry) is another
         quantity of that name: only said in its own line."""
-        if name is None or not _shorthand(name):
+        if name is None or not shorthand_name(name):
             return
         saved, self.active = self.active, False
         try:
@@ -222,6 +205,8 @@ class DefinedNames:
             return
         self.entries[plain(name)] = Entry(eq.lhs, own, own if right is None else right, eq.line, wrong)
         self.pending.pop(plain(name), None)
+        self.links.pop(plain(name), None)
+        self.aliased.discard(plain(name))
 
 
 def bounded(value):
@@ -246,11 +231,6 @@ def bounded(value):
     return value
 
 
-def _shorthand(name: Name) -> bool:
-    """``c_1``, ``s_{12}``, ``C_2``: a name the grader reads as the sine or cosine of joint angles."""
-    return name.base in ("s", "c", "S", "C") and (name.sub or "").strip("{} ").isdigit()
-
-
 def _inner_note(used: list) -> str:
     return "; ".join(dict.fromkeys(e.note for e in used if e.note))
 
@@ -260,6 +240,8 @@ def energy_names(text: str, steps: dict) -> str:
     (a product K·E otherwise)."""
 
     def one(m):
+        if text[m.end() : m.end() + 1] == "_":  # KE_1, PE_{2}: a link's energy by one name
+            return f"\\mathrm{{{m.group(1)}E}}"
         for name in _ENERGY_NAMES[m.group(1)]:
             if name in steps:
                 return f" \\mathrm{{{name}}} "
@@ -274,9 +256,10 @@ def read_pair(grader, text: str):
     with their right ones; step names (``{}^{2}F_2``, ``n_1^{1T}``) through
     :class:`~.chains.StepNames` when the plain reading does not know them."""
     from .chains import step_names
+    from .named import drop_arguments, partials_as_names
 
     names = grader.names
-    text = energy_names(text, grader.symbols.steps)
+    text = partials_as_names(grader, drop_arguments(grader, energy_names(text, grader.symbols.steps)))
     saved = names.right
     start = len(names.used)
     try:
@@ -386,7 +369,10 @@ def after_equation(grader, eq, new: list) -> None:
     said = list(dict.fromkeys([*(e.note for e in used if e.note), *assumed]))
     wrong = next((e for e in used if e.wrong), None)
     if v.status == "wrong" and used and v.expected is not None and _fingerprints_equal(grader, right, v.expected):
-        if wrong is not None:  # right with the right value of the step it names: the error is carried
+        if wrong is not None and wrong.line > eq.line:  # a formula above the wrong step it names
+            v.status, v.difference, v.components = "correct", None, []
+            v.message = f"right in its names; {wrong.name} is wrong further on (line {wrong.line})"
+        elif wrong is not None:  # right with the right value of the step it names: the error is carried
             v.status, v.caused_by = "follows-from-earlier-error", wrong.wrong
             v.message = f"follows from the error in {wrong.wrong} (line {wrong.line}), used by name"
         elif said:
@@ -399,6 +385,8 @@ def after_equation(grader, eq, new: list) -> None:
         right_value = right
     else:
         right_value = own
+    wrong = v.name if v.status == "wrong" else (v.caused_by or "") if v.status == "follows-from-earlier-error" else ""
     name = simple_name(eq.lhs) if eq.latex else None
     if name is not None and grader.names.definable(name):
-        grader.names.record(eq, own, right_value, v.name if v.status in ("wrong",) else "")
+        grader.names.record(eq, own, right_value, wrong)
+    keep_named(grader, eq, v, own, right_value, wrong)

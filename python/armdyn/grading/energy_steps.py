@@ -128,6 +128,8 @@ class EnergySteps:
         verdict = grade_model_step(self, ref, eq, value)
         if verdict.status == "wrong" and ref.alias == POINT and ref.key == "pc":
             self._end_of_link(ref, value, verdict)
+        if verdict.status == "wrong" and ref.alias == POINT and ref.part == "speed":
+            self._speed_of_joint(ref, value, verdict)
         if assumed:
             verdict.message = assumed + ("; " + verdict.message if verdict.message else "")
         self.verdicts.append(verdict)
@@ -168,6 +170,23 @@ class EnergySteps:
                 f"{ref.part}_{i} read as the end of link {i} (frame {i + 1}'s origin, joint {i + 1}), "
                 f"not its mass centre: right for that point"
             )
+
+    def _speed_of_joint(self, ref: StepRef, value, verdict) -> None:
+        """``v_i`` that is not link i's mass-centre speed but that of frame i's or i+1's origin (a
+        joint: Craig's v_i): right for that point, and said so."""
+        from .named import time_derivative
+
+        origins, fp = self.model_terms().origins, self.sampler.fingerprint
+        for k in (ref.index, ref.index + 1):
+            if k in origins and isinstance(value, sp.Basic):
+                v = time_derivative(origins[k], self.robot)
+                if equal(fp(value**2), fp((v.T * v)[0, 0])).all():
+                    verdict.status, verdict.difference, verdict.components = "correct", None, []
+                    verdict.message = (
+                        f"v_{ref.index} read as the speed of frame {k}'s origin (joint {k}), "
+                        f"not link {ref.index}'s mass centre: right for that point"
+                    )
+                    return
 
     def _end_of_link_frame(self, ref: StepRef, eq):
         """(Spong's ``a_{e,i}`` as the model's step, what was assumed): the end of link i is

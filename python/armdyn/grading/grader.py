@@ -25,6 +25,7 @@ from .kinematics_steps import KinematicsSteps, confirm_used
 from .latex import LatexError, UnknownSymbol
 from .laws import identity, indexed_step, law_statement
 from .methods import lagrange_method, newton_euler_method, rotation_between
+from .named import Waiting, derivative_step, form_only, symmetric_entry
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
 from .reader import Submission, read
@@ -207,15 +208,25 @@ class _Grader(EnergySteps, KinematicsSteps):
         context = method_hint if method_hint in ("newton-euler", "lagrange") else None
         seen_methods: list[str] = []
         self.names.collect(self.sub.equations)
-        for eq in self.sub.equations:
+        waiting = Waiting(self)  # equations that use a name given further on
+
+        def one(eq):
             done = len(self.verdicts)
+            self.names.unknown = []
             self._equation(eq, seen_methods, context)
             after_equation(self, eq, self.verdicts[done:])
-            if self.verdicts[done:] and self.verdicts[-1].key not in ("", "R", "P", "Pc", "law", "tau", "shorthand"):
-                last = self.verdicts[-1].key
-                context = "lagrange" if last in LAGRANGE_KEYS or last in MODEL_KEYS else "newton-euler"
             for v in self.verdicts[done:]:
                 v.part, v.task, v.column = eq.part, eq.task, v.column or eq.column  # a chain's: where reported
+            return self.verdicts[done:]
+
+        for eq in self.sub.equations:
+            new = one(eq)
+            if new and new[-1].key not in ("", "R", "P", "Pc", "law", "tau", "shorthand", "dt"):
+                last = new[-1].key
+                context = "lagrange" if last in LAGRANGE_KEYS or last in MODEL_KEYS else "newton-euler"
+            waiting.hold(eq, new)
+            waiting.retry(one)
+        waiting.finish()
         self.verdicts = grade_proofs(self.sub, self.verdicts)  # rigid-body proofs: every link checked
         for v in self.verdicts:  # proof links (also bare expressions) carry the part they are in
             if v.part is None and not v.task:
@@ -262,6 +273,8 @@ class _Grader(EnergySteps, KinematicsSteps):
             if eq.latex and matrix_form(eq.lhs, str(eq.value)):
                 self._matrix_form(eq)
                 return
+            if derivative_step(self, eq):  # \dot M_{12} = ..., \frac{\partial M_{11}}{\partial q_2} = ...
+                return
             if self._law(eq, seen_methods, fallback=True):  # L = K - P, E_K = ½ m v^2 + ...
                 return
             defined = definition(self, eq) or setup_line(self, eq)
@@ -277,6 +290,8 @@ class _Grader(EnergySteps, KinematicsSteps):
             return
         if ref.key in ("tau", "tau_vec") and eq.latex and matrix_form(eq.lhs, str(eq.value)):  # τ = M q̈ + C q̇ + g
             self._matrix_form(eq)
+            return
+        if ref.key == "tau_vec" and form_only(self, eq) or symmetric_entry(self, eq, ref):  # τ = M q̈; M_21 = M_12
             return
         ref, assumed = self._vocabulary(ref, eq, seen_methods)  # energy-method names; by the value's shape
         if ref is None:

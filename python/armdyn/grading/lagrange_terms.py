@@ -31,7 +31,7 @@ from ..model import Robot
 from ..symbolic.lagrange import lagrange, link_energies
 from ..symbolic.terms import time_derivative
 from .engine import equal
-from .explain import describe, tidy
+from .explain import describe, pretty, tidy
 from .verdict import StepVerdict
 
 SPONG = "Spong's c_ijk = ½(∂d_kj/∂q_i + ∂d_ki/∂q_j − ∂d_ij/∂q_k)"
@@ -58,6 +58,13 @@ class ModelTerms:
     def _energies(self):
         T_trans, T_rot, V, _ = link_energies(self.robot)
         return T_trans, T_rot, V
+
+    def speed_squared(self, i: int, build):
+        """Link i's squared speed as shown (``build()``, tidied once: a text may give the speed often)."""
+        cache = self.__dict__.setdefault("_speed_squared", {})
+        if i not in cache:
+            cache[i] = build()
+        return cache[i]
 
     def kinetic(self, i: int):
         T_trans, T_rot, _ = self._energies
@@ -157,7 +164,9 @@ def expected_of(terms: ModelTerms, ref):
         return p if axis is None else p[axis]
     if key == "vc":
         v = terms.velocity(i)
-        return (v.T * v)[0, 0] if ref.part == "sq" else v if axis is None else v[axis]
+        if ref.part in ("sq", "speed"):
+            return (v.T * v)[0, 0] if ref.part == "sq" else sp.sqrt((v.T * v)[0, 0])
+        return v if axis is None else v[axis]
     if key == "w":
         return terms.angular_velocity(i)
     if key in ("Jv", "Jw"):
@@ -204,7 +213,11 @@ def grade_model_step(grader, ref, eq, value) -> StepVerdict:
         if convention:
             status, message = "correct-by-convention", convention
     components = [int(k) for k in range(len(ok)) if not ok[k]] if status == "wrong" else []
-    if status == "wrong":
+    speed = ref.key == "vc" and ref.part == "speed"  # a speed: its square is shown (no roots to expand)
+    squared = terms.speed_squared(ref.index, lambda: tidy(expected**2, robot)) if speed else None
+    if status == "wrong" and speed:
+        message = f"squared, it is not the squared speed {pretty(squared)} ({what})"
+    elif status == "wrong":
         g_m, e_m = _matrix(got), _matrix(expected)
         message = (
             "; ".join(
@@ -216,11 +229,13 @@ def grade_model_step(grader, ref, eq, value) -> StepVerdict:
         if ref.key == "C":
             message = _coriolis_wrong(got, terms, sampler) + f" ({what})"
     diff = None
-    if status == "wrong":
-        d = _matrix(got) - _matrix(expected)
+    if status == "wrong" and not speed:
+        d = g_m - e_m
         diff = d.applyfunc(lambda x: tidy(x, robot)) if d.shape != (1, 1) else tidy(d[0], robot)
     shown = (
-        expected.applyfunc(lambda x: tidy(x, robot)) if isinstance(expected, sp.MatrixBase) else tidy(expected, robot)
+        (expected.applyfunc(lambda x: tidy(x, robot)) if isinstance(expected, sp.MatrixBase) else tidy(expected, robot))
+        if not speed
+        else sp.sqrt(squared)
     )
     return StepVerdict(
         link=link,

@@ -355,11 +355,11 @@ class SymbolMap:
             if undotted in self.explicit:
                 return self._derivative(self.explicit[undotted], name.dots, name)
         plain = name.base + sub
-        if name.dots == 0 and plain in self.steps:
-            return self.steps[plain]
         value = self.defined.lookup(name) if self.defined is not None else None
         if value is not None:  # a name the student gave a value to (.defined)
             return value
+        if name.dots == 0 and plain in self.steps:
+            return self.steps[plain]
         candidate = plain + {0: "", 1: "_dot", 2: "_ddot"}.get(name.dots, "?")
         if candidate in self.names:
             return self.names[candidate]
@@ -383,6 +383,9 @@ class SymbolMap:
                 return sp.nsimplify(magnitude) if magnitude.is_Float else magnitude
         if name.base == "pi" and not sub:
             return sp.pi
+        if name.base in JOINT_VECTOR and not sub and not name.sup and name.dots <= 2 and self.robot.dof > 1:
+            # \dot q^T D(q) \dot q: the joint variables (their rates) as one column
+            return sp.Matrix([self.robot.q, self.robot.qd, self.robot.qdd][name.dots])
         value = self.defined.model(name) if self.defined is not None else None
         if value is not None:  # a model quantity the student did not write (d_{11}): the model's
             return value
@@ -410,6 +413,8 @@ class SymbolMap:
         return None
 
 
+#: the joint vector's letters, written without an index (``\dot q``, ``\ddot\theta``, ``\Theta``)
+JOINT_VECTOR = ("q", "theta", "Theta", "vartheta")
 #: the letters that under \hat are a frame's unit axes (Craig's X̂, Ŷ, Ẑ; x̂; î, ĵ, k̂) -> the axis
 UNIT_AXES = {"X": 0, "Y": 1, "Z": 2, "x": 0, "y": 1, "z": 2, "i": 0, "j": 1, "k": 2}
 

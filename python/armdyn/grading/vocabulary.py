@@ -15,7 +15,8 @@ Tl, Vl         the same with a link index: ``K_1``, ``T_2``, ``KE_1``, ``PE_1``,
 pc             ``p_{c1}``, ``r_{c_2}``, ``x_{c1}`` / ``y_{c1}`` / ``z_{c1}`` (one component);
                ``x_1``, ``y_2``, ``P_{1,x}`` without the c when the value moves with the joints
 vc             ``v_{c1}``, ``\\dot p_{c1}``, ``\\dot x_{c1}``, ``\\dot x_1``; squared: ``v_{c1}^2``,
-               ``|v_{c1}|^2``, ``v_{c1}^T v_{c1}``, ``v_{c1} \\cdot v_{c1}``, a scalar ``v_2^2``
+               ``|v_{c1}|^2``, ``v_{c1}^T v_{c1}``, ``v_{c1} \\cdot v_{c1}``, a scalar ``v_2^2``; a
+               scalar ``v_2``: the speed (a point mass's, by shape)
 Jv, Jw         ``J_{v_1}``, ``J_{v_{c1}}``, ``J_{\\omega_1}``
 M              ``M``, ``D``, ``H``, ``B``, ``M(q)``, ``D(q)``, ``M(\\theta)``, ``H(q)``, ``B(q)``;
                entries ``d_{11}``, ``m_{12}``, ``M_{11}``, ``D_{21}``, ``b_{12}``
@@ -150,6 +151,8 @@ def _indexed(s: str, ref_type):
         return ref_type("vc" if dots else "pc", int(comp.group(1)), part=comp.group(2), alias=POINT, by_shape=True)
     if base == "v" and _index(sub) is not None and sup == "2" and not dots:
         return ref_type("vc", _index(sub), part="sq", alias=POINT, by_shape=True)
+    if base == "v" and _index(sub) is not None and sup is None and not dots:  # a point mass's speed
+        return ref_type("vc", _index(sub), part="speed", alias=POINT, by_shape=True)
     if dots:
         return None
     if base == "J" and sub is not None and sup is None:
@@ -228,7 +231,8 @@ def model_name(ref) -> str:
     if ref.key == "pc":
         return f"{ref.part or 'p'}_c{ref.index}"
     if ref.key == "vc":
-        return {"sq": f"v_c{ref.index}^2", "": f"v_c{ref.index}"}.get(ref.part, f"{ref.part}dot_c{ref.index}")
+        names = {"sq": f"v_c{ref.index}^2", "": f"v_c{ref.index}", "speed": f"|v_c{ref.index}|"}
+        return names.get(ref.part, f"{ref.part}dot_c{ref.index}")
     if ref.key == "w":
         return f"omega_{ref.index}"
     if ref.key in ("Jv", "Jw"):
@@ -344,6 +348,8 @@ def _point(ref, scalar: bool, moves: bool):
         return None, NOT_A_STEP  # a constant, a length, a vector: the student's own name
     if ref.part == "sq":
         return ref, f"v_{i}^2 read as the squared speed of link {i}'s mass centre (a scalar)"
+    if ref.part == "speed":
+        return ref, f"v_{i} read as the speed of link {i}'s mass centre (a scalar, |v_c{i}|)"
     what = "position" if ref.key == "pc" else "velocity"
     name = {"x": "ẋ", "y": "ẏ", "z": "ż"}[ref.part] if ref.key == "vc" else ref.part
     return ref, f"{name}_{i} read as link {i}'s mass centre ({ref.part} of its {what} in the base frame)"
