@@ -142,7 +142,8 @@ def simulate(
     """
     import dask.array as da
 
-    from .simulate import PD, ComputedTorque, Trajectory, joint_limits, step_count
+    from .simulate import step_count
+    from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
     model = compiled_model(robot)
     threads = check_threads(threads)  # Rust reads True as 1
