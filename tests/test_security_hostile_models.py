@@ -8,11 +8,9 @@ plain floats."""
 
 from __future__ import annotations
 
-import contextlib
 import math
 import os
 import re
-import signal
 import subprocess
 import sys
 import time
@@ -21,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy
-from security_support import two_link_yaml
+from security_support import deadline, two_link_yaml
 
 import armdyn
 from armdyn.errors import ModelError
@@ -49,22 +47,6 @@ def _model_with(field_lines: list[str], field: str = "mass") -> str:
         else:
             out.append(ln)
     return "\n".join(out) + "\n"
-
-
-@contextlib.contextmanager
-def deadline(seconds: int):
-    """A hang becomes a failure (SIGALRM interrupts the Python-level loader)."""
-
-    def expired(*_):
-        raise TimeoutError(f"still running after {seconds} s")
-
-    old = signal.signal(signal.SIGALRM, expired)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
 
 
 def _cli_in_subprocess(args, timeout=60):
