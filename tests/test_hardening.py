@@ -178,8 +178,8 @@ def test_concurrent_single_calls_agree():
 
 # ------------------------------------------------------------ hostile model files
 
-import signal  # noqa: E402
-from contextlib import contextmanager  # noqa: E402
+
+from security_support import deadline  # noqa: E402
 
 from armdyn.cli import main  # noqa: E402
 from armdyn.errors import ModelError  # noqa: E402
@@ -187,22 +187,6 @@ from armdyn.io.expressions import parse_expression  # noqa: E402
 from armdyn.io.yaml import load_yaml_string  # noqa: E402
 
 PLANAR = (TESTS.parent / "python" / "armdyn" / "robots" / "planar-2r.yaml").read_text()
-
-
-@contextmanager
-def deadline(seconds: int):
-    """Turn a hang into a failure (the bound is generous: these take milliseconds)."""
-
-    def expired(*_):
-        raise TimeoutError(f"still running after {seconds} s")
-
-    old = signal.signal(signal.SIGALRM, expired)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
 
 
 HOSTILE_EXPRESSIONS = {

@@ -145,7 +145,8 @@ def simulate(
     """
     import dask.array as da
 
-    from .simulate import PD, ComputedTorque, Trajectory, joint_limits, step_count
+    from .simulate import step_count
+    from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
     require_fixed_base(robot, "armdyn.dask.simulate")
     model = compiled_model(robot)

@@ -54,23 +54,30 @@ coefficients. When those change with the geometry (two random geometries are tri
 e.g. a SCARA's prismatic joint parallel to its revolute ones, ZZ2R = ZZ2 + ZZ3 + 2 a2 MX3),
 the few columns involved are evaluated with the geometry kept symbolic and the small
 system solved exactly. By the Schwartz-Zippel lemma a polynomial identity that holds at
-random points holds everywhere with probability 1 - O(degree / range).
+random points holds everywhere with probability 1 - O(degree / range). The exact
+evaluation, ranks and reconstruction are in :mod:`armdyn.exact_evaluation`.
 """
 
 from __future__ import annotations
 
-import math
 import random
 from dataclasses import dataclass, field, replace
-from fractions import Fraction
 
 import symengine as se
 import sympy as sp
 
+from .exact_evaluation import (
+    PRIME,
+    angles_and_scalars,
+    exact_rank,
+    nonzero_fraction,
+    rational,
+    rref,
+    stacked_exact,
+)
 from .model import Robot
 from .programs.grouping import moved_to_parent
 from .programs.vectors import rows
-from .symbolic import dag
 
 #: standard inertial parameter names per link, the architecture's (Pinocchio's) order
 INERTIAL = ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")
@@ -257,163 +264,6 @@ def regressor(robot: Robot) -> Regressor:
     return Regressor(robot, Y, sp.Matrix(values), names)
 
 
-# ------------------------------------------------------------------ exact evaluation
-
-
-def _exact_point(symbols_sin_cos, scalars, rng: random.Random):
-    """Random exact values: rational points of the unit circle for each angle, small
-    rationals for everything else."""
-    values = {}
-    for x in symbols_sin_cos:
-        t = Fraction(rng.randint(-20, 20), rng.randint(1, 20))
-        values[sp.sin(x)] = 2 * t / (1 + t * t)
-        values[sp.cos(x)] = (1 - t * t) / (1 + t * t)
-    for s in scalars:
-        values[s] = Fraction(rng.randint(-30, 30), rng.randint(1, 12))
-    return values
-
-
-#: the Mersenne prime 2^127 - 1: ranks and dependencies are computed modulo it (exact
-#: integer arithmetic, fast), coefficients recovered by rational reconstruction and checked
-#: in exact rational arithmetic at a further random point
-PRIME = 2**127 - 1
-
-
-def _exact_evaluate(matrix: sp.Matrix, values: dict, modulus: int | None = None) -> list[list]:
-    """Entries of ``matrix`` at exact rational ``values`` (keys: symbols, sin(x), cos(x);
-    values: Fractions), shared subexpressions visited once. With ``modulus``, the
-    entries modulo that prime (ints), which is much faster."""
-    memo: dict = {}
-    p = modulus
-
-    def num(x: Fraction):
-        return x if p is None else x.numerator * pow(x.denominator, -1, p) % p
-
-    def node(e, args):
-        if e in values:
-            return num(values[e])
-        if e.is_Rational:
-            return num(Fraction(int(e.p), int(e.q)))
-        if e.is_Float:  # the decimal as written (0.4318 -> 2159/5000): small exact numbers
-            return num(Fraction(repr(float(e))))
-        if e.is_Add:
-            r = sum(args[1:], args[0])
-            return r if p is None else r % p
-        if e.is_Mul:
-            r = args[0]
-            for a in args[1:]:
-                r = r * a if p is None else r * a % p
-            return r
-        if e.is_Pow and e.exp.is_Integer:
-            return args[0] ** int(e.exp) if p is None else pow(args[0], int(e.exp), p)
-        if isinstance(e, sp.sign):
-            if p is not None:  # the sign of the rational value, not of its residue
-                x = values[e.args[0]]
-            else:
-                x = args[0]
-            return num(Fraction((x > 0) - (x < 0)))
-        if e.is_Symbol:
-            raise KeyError(f"no value for symbol {e}")
-        raise ValueError(f"cannot evaluate {e} exactly (only polynomials in parameters, sin/cos of symbols and sign)")
-
-    def ev(entry):
-        return dag.fold(sp.sympify(entry), node, memo, leaf=values.__contains__)
-
-    return [[ev(matrix[i, j]) for j in range(matrix.shape[1])] for i in range(matrix.shape[0])]
-
-
-def _rational(a: int, p: int = PRIME) -> Fraction:
-    """The fraction n/d with |n|, d <= sqrt(p/2) congruent to ``a`` mod p (rational
-    reconstruction by the extended Euclidean algorithm, Wang 1981)."""
-    bound = math.isqrt(p // 2)
-    r0, r1, s0, s1 = p, a % p, 0, 1
-    while r1 > bound:
-        q = r0 // r1
-        r0, r1, s0, s1 = r1, r0 - q * r1, s1, s0 - q * s1
-    if s1 == 0 or abs(s1) > bound:
-        raise ArithmeticError("rational reconstruction failed")
-    return Fraction(r1, s1)
-
-
-def _angles_and_scalars(Y: sp.Matrix):
-    """Symbols that appear inside sin/cos (angles) and the others."""
-    angles, scalars, seen = set(), set(), set()
-    stack = list(set(Y))
-    while stack:  # one visit per distinct subexpression
-        e = stack.pop()
-        if e in seen:
-            continue
-        seen.add(e)
-        if isinstance(e, (sp.sin, sp.cos)):
-            if not e.args[0].is_Symbol:
-                raise ValueError(f"cannot evaluate {e} exactly: only sin/cos of a single symbol are handled")
-            angles.add(e.args[0])
-        elif e.is_Symbol:
-            scalars.add(e)
-        stack.extend(e.args)
-    return sorted(angles, key=str), sorted(scalars - angles, key=str)
-
-
-def stacked_exact(Y: sp.Matrix, states: int, seed: int = 0, fixed: dict | None = None, modulus: int | None = None):
-    """Y evaluated exactly at ``states`` random rational points, stacked: a list of rows
-    (states * dof rows of Fractions, or of ints modulo ``modulus``). Symbols in ``fixed``
-    (symbol -> Fraction) keep those values at every point (the geometry), the others
-    change from point to point."""
-    rng = random.Random(seed)
-    angles, scalars = _angles_and_scalars(Y)
-    fixed = dict(fixed or {})
-    rows = []
-    for _ in range(states):
-        values = _exact_point([a for a in angles if a not in fixed], [s for s in scalars if s not in fixed], rng)
-        for s, v in fixed.items():
-            if s in angles:
-                t = v
-                values[sp.sin(s)], values[sp.cos(s)] = 2 * t / (1 + t * t), (1 - t * t) / (1 + t * t)
-            else:
-                values[s] = v
-        rows += _exact_evaluate(Y, values, modulus)
-    return rows
-
-
-def _rref(rows: list[list], ncols: int, modulus: int | None = None):
-    """Reduced row echelon form, in exact rational arithmetic (Fractions) or modulo a
-    prime (ints): ``(R, pivots)``."""
-    p = modulus
-    A = [list(r) for r in rows]
-    pivots, r = [], 0
-    for c in range(ncols):
-        piv = next((i for i in range(r, len(A)) if A[i][c] != 0), None)
-        if piv is None:
-            continue
-        A[r], A[piv] = A[piv], A[r]
-        inv = 1 / A[r][c] if p is None else pow(A[r][c], -1, p)
-        A[r] = [x * inv for x in A[r]] if p is None else [x * inv % p for x in A[r]]
-        for i in range(len(A)):
-            if i != r and A[i][c] != 0:
-                f = A[i][c]
-                if p is None:
-                    A[i] = [x - f * y for x, y in zip(A[i], A[r])]
-                else:
-                    A[i] = [(x - f * y) % p for x, y in zip(A[i], A[r])]
-        pivots.append(c)
-        r += 1
-        if r == len(A):
-            break
-    return A[:r], pivots
-
-
-def exact_rank(Y: sp.Matrix, states: int | None = None, seed: int = 0, state_symbols=()) -> int:
-    """Rank of Y stacked over random rational states, in exact arithmetic modulo
-    :data:`PRIME` (equal to the rank over the rationals but with probability ~1e-38 per
-    pivot). Symbols other
-    than ``state_symbols`` (the geometry, gravity) get one random value for all states."""
-    states = states or (Y.shape[1] // max(Y.shape[0], 1) + 3)
-    angles, scalars = _angles_and_scalars(Y)
-    rng = random.Random(seed + 1)
-    fixed = {s: _nonzero_fraction(rng) for s in angles + scalars if s not in set(state_symbols)}
-    return len(_rref(stacked_exact(Y, states, seed, fixed, PRIME), Y.shape[1], PRIME)[1])
-
-
 # ------------------------------------------------------------------ base parameters
 
 
@@ -506,12 +356,12 @@ def _symbolic_coefficients(Yk, d, pivots, Rs, geometry, robot, seed):
     cols = [pivots[r] for r in support] + [d]
     sub = Yk[:, cols]
     rng = random.Random(seed + 55)
-    state = [s for s in _angles_and_scalars(sub)[0] + _angles_and_scalars(sub)[1] if s not in set(geometry)]
+    state = [s for s in angles_and_scalars(sub)[0] + angles_and_scalars(sub)[1] if s not in set(geometry)]
     rows = []
     for _ in range(len(support) // max(robot.dof, 1) + 3):
         values = {}
         for x in state:
-            t = _nonzero_fraction(rng)
+            t = nonzero_fraction(rng)
             if any(x in (a.args[0],) for a in sub.atoms(sp.sin, sp.cos)):
                 values[sp.sin(x)] = sp.Rational(2 * t.numerator * t.denominator, t.denominator**2 + t.numerator**2)
                 values[sp.cos(x)] = sp.Rational(t.denominator**2 - t.numerator**2, t.denominator**2 + t.numerator**2)
@@ -532,17 +382,12 @@ def _symbolic_coefficients(Yk, d, pivots, Rs, geometry, robot, seed):
         rng_g = random.Random(seed + 1)
         fixed = None
         for t in range(trial + 1):
-            fixed = {s: _nonzero_fraction(rng_g) for s in geometry}
+            fixed = {s: nonzero_fraction(rng_g) for s in geometry}
         for r in range(len(pivots)):
             value = sp.sympify(k[r]).xreplace({s: sp.Rational(v.numerator, v.denominator) for s, v in fixed.items()})
             if value != sp.Rational(R[r][d].numerator, R[r][d].denominator):
                 raise ArithmeticError("base_parameters: geometry-dependent grouping not confirmed")
     return k
-
-
-def _nonzero_fraction(rng: random.Random) -> Fraction:
-    """A random nonzero small rational (a zero length would make the geometry special)."""
-    return Fraction(rng.choice([-1, 1]) * rng.randint(1, 30), rng.randint(1, 12))
 
 
 def rationalized(robot: Robot) -> Robot:
@@ -592,16 +437,16 @@ def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
     states = P // max(robot.dof, 1) + 3
     # exact rank tests on the kept columns at random rational points
     Yk = Y[:, keep] if keep else sp.zeros(robot.dof, 0)
-    angles, scalars = _angles_and_scalars(Y)
+    angles, scalars = angles_and_scalars(Y)
     state_syms = set(robot.q) | set(robot.qd) | set(robot.qdd)
     geometry = [s for s in angles + scalars if s not in state_syms]
     rng = random.Random(seed + 1)
     coefficient_sets = []
     for trial in range(2 if geometry else 1):
-        fixed = {s: _nonzero_fraction(rng) for s in geometry}
+        fixed = {s: nonzero_fraction(rng) for s in geometry}
         rows = stacked_exact(Yk, states, seed + trial, fixed, PRIME)
-        R, pivots = _rref(rows, len(keep), PRIME)
-        R = [[_rational(x) for x in row] for row in R]
+        R, pivots = rref(rows, len(keep), PRIME)
+        R = [[rational(x) for x in row] for row in R]
         coefficient_sets.append((R, pivots))
         # the dependencies, checked in exact rational arithmetic at a fresh random state
         check = stacked_exact(Yk, 1, seed + 100 + trial, fixed)

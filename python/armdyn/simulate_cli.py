@@ -95,7 +95,8 @@ def run(args, robot) -> int:
     """The ``simulate`` subcommand on the loaded ``robot`` (see the module docstring)."""
     from ._io_atomic import atomic_writes
     from .show import numeric_robot
-    from .simulate import PD, ComputedTorque, simulate
+    from .simulate import simulate
+    from .trajectory import PD, ComputedTorque
 
     robot = numeric_robot(robot)
     dof = robot.dof

@@ -239,9 +239,10 @@ def run(args) -> int:
         import uvicorn  # noqa: F401 - the extra is there
     except ImportError:
         raise ModelError("armdyn serve needs its extra: pip install 'armdyn[serve]'") from None
-    from .app import Settings, build_app
+    from .app import build_app
     from .exercises import catalogue
     from .security import MIN_TOKEN_CHARS
+    from .state import Settings
 
     token = args.instructor_token or os.environ.get("ARMDYN_INSTRUCTOR_TOKEN")
     if args.workers < 1:
