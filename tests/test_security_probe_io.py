@@ -292,7 +292,10 @@ def test_the_roster_variant_wins_over_the_text(tmp_path):
         (variants / vid / "model.yaml").write_text("name: x\n")
     subs = _class(
         tmp_path / "subs",
-        {"alice.md": "---\nvariant: bob\n---\n", "carol.md": "---\nvariant: v001\n---\n"},
+        {
+            "alice.md": "---\nvariant: bob\n---\n$$\\tau_1 = 0$$\n",
+            "carol.md": "---\nvariant: v001\n---\n$$\\tau_1 = 0$$\n",
+        },
     )
     found = discover(subs, variants)
     assert {t.student: t.variant for t in found.tasks} == {"alice": "alice", "carol": "v001"}

@@ -209,7 +209,7 @@ def _judge_side(side_values, ctxs, laws, transposed_ctxs):
 
 def _lagrange(sides: list[str], chain: bool) -> LawResult | None:
     from .notation import normalise
-    from .statements import _RHS_TORQUE, LAW, lagrange_law
+    from .statements import LAW, RHS_TORQUE, lagrange_law
 
     if len(sides) < 2 or len(sides) > 2 and not chain or not any("\\partial" in s for s in sides[:2]):
         return None  # τ_1 = (the law) = a value: the value is a step, graded as one
@@ -217,7 +217,7 @@ def _lagrange(sides: list[str], chain: bool) -> LawResult | None:
     later = " (the sides after it not checked)" if len(sides) > 2 else ""
     for law_side, torque in ((sides[0], sides[1]), (sides[1], sides[0])):
         if (
-            _RHS_TORQUE.match(normalise(torque))
+            RHS_TORQUE.match(normalise(torque))
             and "\\partial" in law_side
             and (len(sides) > 2 or not re.search(r"\d", torque))
         ):

@@ -23,7 +23,7 @@ FREE_END = "nothing acts on the free end: the iteration starts from f_{n+1} = 0 
 
 _DDT = (r"\frac{d}{dt}", r"\frac{\mathrm{d}}{\mathrm{d}t}", r"\dfrac{d}{dt}", "d/dt", r"\frac{\mathrm{d}}{dt}")
 _PARTIAL_L = re.compile(r"\\partial(?:L|\\mathcal\{?L\}?)")
-_RHS_TORQUE = re.compile(r"^(?:\\tau|Q|u)(?:_\{?[^{}]*\}?)?(?:\^\{?T\}?)?$")
+RHS_TORQUE = re.compile(r"^(?:\\tau|Q|u)(?:_\{?[^{}]*\}?)?(?:\^\{?T\}?)?$")
 
 
 def _signed_terms(s: str) -> list[tuple[int, str]]:
@@ -68,7 +68,7 @@ def lagrange_law(lhs: str, rhs: str) -> tuple[bool, str] | None:
     if any(k is None for _, k in terms) or len(terms) != 2:
         return False, f"not the Lagrange equation {LAW}"
     kinds = {k: sign for sign, k in terms}
-    torque = bool(_RHS_TORQUE.match(right))
+    torque = bool(RHS_TORQUE.match(right))
     if "dqd" in kinds and "ddt" not in kinds:
         return False, f"d/dt missing before ∂L/∂q̇: the Lagrange equation is {LAW}"
     if set(kinds) != {"ddt", "dq"}:
@@ -103,12 +103,12 @@ def matrix_form(lhs: str, rhs: str) -> bool:
     matrix times an un-indexed joint vector (``τ = [M]q̈ + [C]q̇ + [G]``), so that one
     joint's torque written out with entries (``τ_1 = M_{11} q̈_1 + …``) stays a step."""
     left, right = normalise(lhs), normalise(rhs)
-    if _RHS_TORQUE.match(left) and not _RHS_TORQUE.match(right):
+    if RHS_TORQUE.match(left) and not RHS_TORQUE.match(right):
         terms = [t for _, t in _signed_terms(right)]
         if not all(_VECTOR_TERM.match(t) for t in terms) or not left.startswith("\\tau"):
             return False
         left, right = "+".join(re.sub(r"^\[(\w)\]", r"\1", t) for t in terms), left
-    if not _RHS_TORQUE.match(right):
+    if not RHS_TORQUE.match(right):
         return False
     terms = [t for _, t in _signed_terms(left)]
     if not 2 <= len(terms) <= 5 or not all(_MATRIX_LETTER.match(t) for t in terms):
