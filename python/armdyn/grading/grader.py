@@ -22,6 +22,7 @@ from .energy_steps import EnergySteps
 from .engine import Sampler, Value, World, canonical, equal, judge, to_sympy
 from .explain import component_name, contract, describe, pretty, tidy
 from .kinematics_steps import KinematicsSteps, confirm_used
+from .lagrange_terms import coriolis_entries_as_matrix
 from .latex import LatexError, UnknownSymbol
 from .laws import identity, indexed_step, law_statement
 from .methods import lagrange_method, newton_euler_method, rotation_between
@@ -357,6 +358,8 @@ class _Grader(EnergySteps, KinematicsSteps):
                 "\\omega_1^1 = ..., F_2^2 = ..., \\tau_1 = ..., T = ...)",
                 source=self.sub.path,
             )
+        if any(v.key == "C" for v in self.verdicts):
+            coriolis_entries_as_matrix(self.verdicts, self.model_terms(), self.sampler)
         first_wrong = next((v.name for v in self.verdicts if v.status == "wrong"), None)
         tau_correct = [False] * self.robot.dof
         for v in self.verdicts:

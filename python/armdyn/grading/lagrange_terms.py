@@ -345,3 +345,30 @@ def potential_shift(value, expected, q, sampler):
     if all(np.allclose(fp(sp.diff(d, x)), 0) for x in q):
         return d
     return None
+
+
+def coriolis_entries_as_matrix(verdicts: list, terms: "ModelTerms", sampler) -> None:
+    """Every entry ``C_{ij}`` written one by one and the matrix they make gives ``C q̇ = h``:
+    a Coriolis matrix other than the Christoffel one (C is not unique; ``C q̇`` is), so an
+    entry that differs from the Christoffel entry is right by that convention, not wrong.
+    Changes ``verdicts`` in place; nothing when an entry is missing or the product differs."""
+    n = terms.M.shape[0]
+    entries = {}
+    for v in verdicts:  # the latest value of each entry, as the student restates it
+        if v.key == "C" and v.got is not None and not isinstance(v.got, sp.MatrixBase):
+            parts = v.name.split("_")[-1]
+            if len(parts) == 2 and parts.isdigit() and all(1 <= int(k) <= n for k in parts):
+                entries[(int(parts[0]) - 1, int(parts[1]) - 1)] = v
+    if len(entries) != n * n or not any(v.status == "wrong" for v in entries.values()):
+        return
+    C = sp.Matrix(n, n, lambda i, j: entries[(i, j)].got)
+    fp = sampler.fingerprint
+    if not equal(fp(C * terms.qd), fp(terms.h)).all():
+        return
+    for v in entries.values():
+        if v.status == "wrong":
+            v.status, v.convention = "correct-by-convention", "a Coriolis matrix other than the Christoffel one"
+            v.message = (
+                "your entries make a Coriolis matrix whose C q̇ is the centrifugal and Coriolis vector: not the "
+                "Christoffel factorisation, which this entry's expected value is (C is not unique; C q̇ is)"
+            )

@@ -44,9 +44,27 @@ def shorthand_reading(ref, value, robot, step_ref):
                 "(the value holds joint rates)"
             )
         return None, NOT_A_STEP
+    if ref.alias in ("c", "C") and len(ref.entry) == 2 and _coriolis_like(value, symbols, robot):
+        # C_{11} = 0, C_{12} = -m_2 l_1 l_{c2} sin(theta_2): no shorthand (a sum's cosine is in the
+        # angles alone, never 0), so the Coriolis entry, judged (its missing rates are the slip)
+        name = f"{ref.alias}_{''.join(map(str, ref.entry))}"
+        return step_ref("C", entry=ref.entry, alias=ref.alias), (
+            f"{name} read as entry ({ref.entry[0]}, {ref.entry[1]}) of the Coriolis matrix C(q, q̇) (the value is "
+            "not the sine or cosine shorthand's: zero, or the joint angles with the model's parameters)"
+        )
     if not symbols or not symbols <= set(robot.q):
         return None, NOT_A_STEP  # a length, a constant: the student's own name
     return ref, ""
+
+
+def _coriolis_like(value, symbols, robot) -> bool:
+    """Zero, or a value in the joint angles and the model's other parameters (masses,
+    lengths): what a Coriolis entry written without its rates looks like; a shorthand's
+    value is in the angles alone."""
+    if value == 0:
+        return True
+    angles = symbols & set(robot.q)
+    return bool(angles) and bool(symbols - set(robot.q))
 
 
 def grade_shorthand(ref, eq, value, robot, sampler) -> StepVerdict:
