@@ -42,9 +42,6 @@ NOT_SAME: dict[str, str | set[int]] = {
     "planar-2r-spong-christoffel.md": _NO_POSITION,
     "planar-2r-mls-constants.md": _NO_POSITION,  # M, C, N in lumped constants only
     "planar-2r-asada-slotine.md": _NO_POSITION,  # H_ij, h_ijk, G_i only
-    # the mass centres as one column equation per link (bmatrix = bmatrix): the reading does
-    # not place link 2 from them yet, a gap left documented
-    "planar-2r-jekyll-array.md": "moves with other joints than joint 2",
     # the forward recursion of link 2 only: links 1 and 3 are placed in words
     "planar-3r-spong-superscripts.md": _NO_POSITION,
     # links 1 and 3 are placed (x_{c1}, y_{c3}, P_1, P_3); link 2 only in words

@@ -93,7 +93,15 @@ class OwnValues:
                 return ""
             return m.group(0)
 
-        return parse(_ARGS.sub(strip, text), self._resolve)
+        text = _ARGS.sub(strip, text)
+        try:
+            return parse(text, self._resolve)
+        except TypeError:  # g(\theta) given a vector, g the constant a factor: the vector only where it fits
+            return parse(text, self._scalar_resolve)
+
+    def _scalar_resolve(self, name):
+        value = self._resolve(name)
+        return self.names(name) if isinstance(value, sp.MatrixBase) else value
 
     def _coordinate_of(self, latex: str):
         try:
