@@ -106,3 +106,39 @@ def test_a_gravity_vector_named_g_beside_the_constant_g(tmp_path):
     status = {v.name: v.status for v in report.steps}
     assert status["tau_1"] == "correct"
     assert status["tau_2"] == "wrong"
+
+
+_CRAIG_ROTATIONS = r"""---
+method: newton-euler
+---
+Frame 2 sits at the elbow (its place is in the figure). The rotations between the frames:
+
+$${}^{1}_{0}R = \begin{bmatrix} c_1 & s_1 & 0 \\ -s_1 & c_1 & 0 \\ 0 & 0 & 1 \end{bmatrix}$$
+
+$${}^{2}_{1}R = \begin{bmatrix} c_2 & -s_2 & 0 \\ s_2 & c_2 & 0 \\ 0 & 0 & 1 \end{bmatrix}$$
+
+$${}^{1}_{2}R = \begin{bmatrix} c_2 & -s_2 & 0 \\ s_2 & c_2 & 0 \\ 0 & 0 & 1 \end{bmatrix}$$
+
+$${}^{2}F_2 = m_2 \begin{bmatrix} a \ddot\theta_2 \\ b \dot\theta_1 \\ 0 \end{bmatrix}$$
+"""
+
+
+def test_a_rotation_between_successive_frames_is_checked_against_its_joint(tmp_path):
+    # {}^{b}_{a}R maps frame-a coordinates to frame b; joint k turns theta_k about z, so frame k's
+    # axes in frame k-1 are the columns of Rz(theta_k) and {}^{k}_{k-1}R is its transpose
+    t1, t2 = sp.symbols("theta1 theta2")
+
+    def rz(t):
+        return sp.Matrix([[sp.cos(t), -sp.sin(t), 0], [sp.sin(t), sp.cos(t), 0], [0, 0, 1]])
+
+    written = rz(t2)  # lines 8 and 10 write the same matrix
+    assert sp.simplify(
+        rz(t1).T - sp.Matrix([[sp.cos(t1), sp.sin(t1), 0], [-sp.sin(t1), sp.cos(t1), 0], [0, 0, 1]])
+    ) == sp.zeros(3)
+    assert sp.simplify(written - rz(t2).T) != sp.zeros(3)  # {}^{2}_{1}R written transposed
+    report = grade(_write(tmp_path, _CRAIG_ROTATIONS))
+    assert report.model_note.startswith("no model:")
+    by_line = {v.line: v for v in report.steps}
+    assert by_line[6].status == "correct"  # {}^{1}_{0}R = Rz(theta_1)^T
+    assert by_line[8].status == "wrong" and "Rz(" in by_line[8].message  # {}^{2}_{1}R = Rz(theta_2): transposed
+    assert by_line[10].status == "correct"  # {}^{1}_{2}R = Rz(theta_2)
