@@ -31,10 +31,9 @@ _NO_POSITION = "frame 2's origin is not stated"
 NOT_SAME: dict[str, str | set[int]] = {
     # the quill's height is stated (z_{c3}), not where links 1 and 2 put it in the plane
     "scara-lagrange.md": "joint variable q3 moves nothing",
-    # Newton-Euler in Craig's frames: P_1, P_2, {}^{i}P_{C_i} are used but given no value
-    "planar-2r-craig-align.md": _NO_POSITION,
+    # Craig's P_2, {}^{i}P_{C_i} used only in products, and no ω_1, ω̇_1 to solve them from
+    # (its transposed rotation is found at its line on the text's own values)
     "planar-2r-craig-transposed.md": _NO_POSITION,
-    "planar-2r-craig-split-blocks.md": _NO_POSITION,
     # the closed-form M, c, g only: the geometry is in words
     "planar-2r-lynch-park.md": _NO_POSITION,
     "planar-2r-lynch-park-gamma.md": _NO_POSITION,
@@ -46,9 +45,6 @@ NOT_SAME: dict[str, str | set[int]] = {
     # the laws stated first, then D's entries, Christoffel symbols and phi_k: the geometry in words
     "planar-2r-laws-energy.md": "joint variable q1 moves nothing",  # M, C, N in lumped constants only
     "planar-2r-asada-slotine.md": _NO_POSITION,  # H_ij, h_ijk, G_i only
-    # the mass centres as one column equation per link (bmatrix = bmatrix): the reading does
-    # not place link 2 from them yet, a gap left documented
-    "planar-2r-jekyll-array.md": "moves with other joints than joint 2",
     # the forward recursion of link 2 only: links 1 and 3 are placed in words
     "planar-3r-spong-superscripts.md": _NO_POSITION,
     # links 1 and 3 are placed (x_{c1}, y_{c3}, P_1, P_3); link 2 only in words

@@ -16,6 +16,9 @@ armdyn's YAML format (docs/model-format.md) is built from them:
 - mass centres in the base frame: ``p_{ck}``, ``x_{ck}`` (``x_k``: a point mass), Craig's
   ``{}^{0}P_{C_k}``, or Spong's velocity Jacobians ``J_{v_{ck}}`` (:mod:`.energy`); DH
   tables in Markdown or LaTeX (:mod:`.dh`);
+- Craig's ``{}^{i}P_{C_i}``, ``{}^{i}P_{i+1}`` and inertias used only in products: the
+  constant vectors (and diagonal tensor) that give the text's own accelerations and ``N_i``
+  (:mod:`.recursion`);
 - the potential energy ``V = m_1 g h_1 + ...`` (each mass's height) of an energy-method
   derivation; for a planar arm whose joints turn about z, a height ``a sin(phi) + b cos(phi)``
   is the point ``Rz(phi) (a, b)`` (``a cos(phi) - b sin(phi)`` across);

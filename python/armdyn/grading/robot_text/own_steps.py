@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import sympy as sp
 
+from .geometry import same
+
 _START = {
     "pc": "a position: a starting value, nothing earlier to check it against",
     "Jv": "a Jacobian: needs the positions it differentiates",
@@ -358,3 +360,27 @@ def _pick(m, entry):
         return m[entry[0], entry[1]] if len(entry) == 2 and m.shape[1] > 1 else m[entry[0]]
     except IndexError:
         return None
+
+
+def rotation(ov, ref, got) -> tuple[list, str]:
+    """(candidates, why none) for a rotation between successive frames written as the joint's
+    elementary turn about z: ``R_a^b`` maps frame-a coordinates to frame b, so for a joint k
+    turning θ_k about z, ``R_{k-1}^{k} = Rz(θ_k)ᵀ`` and ``R_k^{k-1} = Rz(θ_k)`` (the
+    convention the grader checks with a model). A rotation of another shape (a twist, an
+    offset) stays a starting value: the frames' axes are not fixed without a model."""
+    a, b = ref.index, ref.frame
+    if a is None or b is None or abs(a - b) != 1 or not isinstance(got, sp.MatrixBase) or got.shape != (3, 3):
+        return [], _NEWTON_EULER["R"]
+    k = max(a, b)
+    if not 1 <= k <= ov.n or str(ov.q[k - 1]).startswith("d"):
+        return [], _NEWTON_EULER["R"]
+    c, s_ = sp.cos(ov.q[k - 1]), sp.sin(ov.q[k - 1])
+    rz = sp.Matrix([[c, -s_, 0], [s_, c, 0], [0, 0, 1]])
+    value = rz.T if b == k else rz
+    if not any(same(got, m) for m in (rz, rz.T)):
+        return [], _NEWTON_EULER["R"]
+    how = (
+        f"the turn of joint {k} by q{k} about z: R_{a}^{b} maps frame-{a} coordinates to frame {b}, "
+        f"Rz(q{k}){'ᵀ' if b == k else ''} (the convention a model is graded by)"
+    )
+    return [(value, [_Base()], how, True)], _NEWTON_EULER["R"]

@@ -33,7 +33,7 @@ from ..reader import Submission
 from ..statements import lagrange_law
 from ..verdict import GradeReport, StepVerdict
 from .geometry import same
-from .own_steps import candidates
+from .own_steps import candidates, rotation
 from .statements import MAX_FRAMES, Names, joint_candidates
 
 #: equations looked at, at most; a value longer than this (characters) is not checked
@@ -93,7 +93,15 @@ class OwnValues:
                 return ""
             return m.group(0)
 
-        return parse(_ARGS.sub(strip, text), self._resolve)
+        text = _ARGS.sub(strip, text)
+        try:
+            return parse(text, self._resolve)
+        except TypeError:  # g(\theta) given a vector, g the constant a factor: the vector only where it fits
+            return parse(text, self._scalar_resolve)
+
+    def _scalar_resolve(self, name):
+        value = self._resolve(name)
+        return self.names(name) if isinstance(value, sp.MatrixBase) else value
 
     def _coordinate_of(self, latex: str):
         try:
@@ -259,7 +267,7 @@ class OwnValues:
     def _judge(self, eq, ref: StepRef, got) -> None:
         name, key = ref.name, self._key(ref)
         try:
-            cands, starting = candidates(self, ref, key)
+            cands, starting = rotation(self, ref, got) if ref.key == "R" else candidates(self, ref, key)
         except (ArithmeticError, TypeError, ValueError, AttributeError, IndexError, RecursionError) as err:
             cands, starting = [], f"could not be derived from the earlier values ({str(err)[:80]})"
         status, message, expected, caused = "unrecognised", "", None, None

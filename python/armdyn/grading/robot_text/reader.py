@@ -27,6 +27,7 @@ from .geometry import (
     yaml_vec,
 )
 from .gravity import read_gravity
+from .recursion import positions_from_accelerations
 from .statements import MAX_FRAMES, Names, Statement, all_equations, joint_candidates, read_statements
 
 
@@ -124,6 +125,12 @@ class TextReader:
             qs[k - 1] for k in range(1, n + 1) if rot.get(k) is not None and qs[k - 1] in rot[k][0].free_symbols
         }
         gravity, g_line = self._gravity(statements)
+        stated = {
+            ("Pc" if st.what == "C" else st.what, st.index) for st in statements if st.what in ("P", "Pc", "C", "I")
+        }
+        solved, notes = positions_from_accelerations(equations, names, qs, rot, stated)
+        statements = statements + solved  # Craig's P used only in products: from the accelerations they give
+        self.assumptions += notes
         coms = self._coms(statements, gravity, rot, revolute)
         revolute |= {x for p in coms.values() for x in self._in_trig(p[0])}
         lengths = {x for p in coms.values() for x in self._outside_trig(p[0])} - revolute

@@ -236,6 +236,8 @@ def _what(lhs: str):
     if m:
         return "I", int(m.group(2)), None
     m = _CENTRE.fullmatch(s)  # an energy method's mass centre in the base frame: p_{c2}, x_{c2}
+    if m is None and ref is not None and ref.key == "pc" and ref.part in ("x", "y", "z") and ref.index:
+        return "C" + ref.part, ref.index, POINT  # P_{2,x}: a component of a point's place, named by its link
     if m:
         if m.group(1):
             return ("C" if m.group(1) in "pr" else "C" + m.group(1)), int(m.group(2)), 0
@@ -251,6 +253,7 @@ def _what(lhs: str):
 def read_statements(equations: list[Equation], names: Names, n: int) -> list[Statement]:
     """What the equations state about the robot of ``n`` joints, in the order written."""
     out: list[Statement] = []
+    named: dict = {}  # the symbol of a stated coordinate (x_{c1}, P_{1,y}) -> its value
     for eq in equations:
         if not eq.latex or eq.problem:
             continue
@@ -265,8 +268,23 @@ def read_statements(equations: list[Equation], names: Names, n: int) -> list[Sta
             if value is None:
                 continue
             what, index, frame = found
+            if what in ("V", "Vl", "T", "Tl") and named:  # PE = m_1 g P_{1,y}: the heights stated before
+                value = value.subs(named) if not isinstance(value, sp.MatrixBase) else value
+            elif what in ("Cx", "Cy", "Cz") and not isinstance(value, sp.MatrixBase):
+                name = _name_of(lhs, names)
+                if name is not None:
+                    named[name] = value
             out.append(Statement(what, eq.line, " ".join(eq.source.split()) + note, value, index, frame))
     return out
+
+
+def _name_of(lhs: str, names: Names):
+    """The symbol a left-hand side is parsed to (``P_{1,y}`` -> ``P1y``), or None."""
+    try:
+        sym = parse(lhs, names)
+    except (LatexError, RecursionError, ValueError, TypeError):
+        return None
+    return sym if isinstance(sym, sp.Symbol) else None
 
 
 # ------------------------------------------------------------------ numeric checks
