@@ -45,7 +45,10 @@ def _unknown_name(v) -> bool:
 
 
 def _read(report: GradeReport) -> int:
-    return sum(v.status != "unrecognised" for v in report.steps)
+    """Steps about this arm read: the laws stated and definitions, the same whatever the arm, left out."""
+    return sum(
+        v.status not in ("unrecognised", "definition") and v.name not in ("law", "identity") for v in report.steps
+    )
 
 
 def _wrong(report: GradeReport) -> int:
@@ -56,7 +59,14 @@ def disagreeing(report: GradeReport) -> bool:
     """Most of the steps are found wrong against the model read, each on its own (a slip
     carried through is one ``wrong`` and then ``follows``), or use names it does not have (at
     least 3): the reading is more likely wrong than the text."""
-    steps = [v for v in report.steps if v.key and (v.status != "unrecognised" or _unknown_name(v))]
+    steps = [  # the laws stated (L = T - V) and definitions say nothing of this arm: left out
+        v
+        for v in report.steps
+        if v.key
+        and v.name not in ("law", "identity")
+        and v.status != "definition"
+        and (v.status != "unrecognised" or _unknown_name(v))
+    ]
     trouble = sum(v.status == "wrong" or _unknown_name(v) for v in steps)
     return trouble >= 3 and 2 * trouble > len(steps)
 
