@@ -302,3 +302,48 @@ $$\tau_1 = 2 m_1 l^2 \ddot\theta_1 + m_1 g l \cos\theta_1$$
     status = {v.name: v.status for v in report.steps}
     assert status["T"] == "wrong"  # a point mass m1 at l: T = m1 l^2 thd^2 / 2
     assert status["tau_1"] == "follows-from-earlier-error"
+
+
+_SPONG_OWN = r"""---
+method: lagrange
+---
+$$K = \frac{1}{2}\dot q^T D(q)\dot q$$
+
+$$\mathcal{L} = K - P$$
+
+$$d_{11} = a + 2b\cos q_2$$
+
+$$d_{12} = c + b\cos q_2$$
+
+$$d_{22} = c$$
+
+$$c_{121} = -b\sin q_2$$
+
+$$c_{221} = -b\sin q_2$$
+
+$$c_{112} = b\sin q_2$$
+
+$$\phi_1 = e\cos q_1$$
+
+$$\phi_2 = f\cos(q_1 + q_2)$$
+
+$$\tau_1 = d_{11}\ddot q_1 + d_{12}\ddot q_2 + 2c_{121}\dot q_1\dot q_2 + c_{221}\dot q_2^2 + \phi_1$$
+
+$$\tau_2 = d_{12}\ddot q_1 + d_{22}\ddot q_2 + SIGN c_{112}\dot q_1^2 + \phi_2$$
+"""
+
+
+def test_laws_stated_first_and_named_christoffel_symbols_on_own_values(tmp_path):
+    """No arm is stated (a, b, c lump it): the laws (K, L) are judged as laws, never taken for
+    this arm's values, and c_{121} in tau_1 is the text's own symbol, not the cosine shorthand.
+    By hand, for d = [[a + 2b cos q2, c + b cos q2], [., c]]: c_121 = c_211 = -b sin q2,
+    c_221 = -b sin q2, c_112 = b sin q2, so tau_2 = d_12 q1'' + d_22 q2'' + c_112 q1'^2 + phi_2."""
+    right = _write(tmp_path, _SPONG_OWN.replace("SIGN ", ""))
+    got = {v.line: (v.name, v.status) for v in grade(right).steps}
+    assert got[4] == ("law", "correct") and got[6][1] != "wrong"
+    assert got[24] == ("tau_1", "correct") and got[26] == ("tau_2", "correct")
+    slip = tmp_path / "slip"
+    slip.mkdir()
+    wrong = _write(slip, _SPONG_OWN.replace("SIGN ", "- "))
+    got = {v.line: (v.name, v.status) for v in grade(wrong).steps}
+    assert got[24] == ("tau_1", "correct") and got[26] == ("tau_2", "wrong")

@@ -341,6 +341,12 @@ def law_statement(grader, eq, fallback: bool = False):
     statement marked general (an index letter, a sum, a pattern, a derivative) is tried;
     with it (the equation named no step, or its value could not be read) any, and only a
     judged one (correct or wrong) is returned."""
+    return law_verdict(eq, max(grader.robot.dof, 1), fallback)
+
+
+def law_verdict(eq, n_links: int, fallback: bool = False):
+    """:func:`law_statement` for an arm of ``n_links`` links, with no model (the text graded on
+    its own values: a law stated is judged, never taken for a value of this arm)."""
     from .equations import sides
     from .verdict import StepVerdict
 
@@ -351,7 +357,7 @@ def law_statement(grader, eq, fallback: bool = False):
     if not general and not fallback:
         return None
     try:
-        result = judge(sides(text), n_links=max(grader.robot.dof, 1), chain=fallback)
+        result = judge(sides(text), n_links=n_links, chain=fallback)
     except (LatexError, TypeError, ValueError, RecursionError, sp.ShapeError):
         return None
     if result is None or fallback and result.status == "unrecognised":

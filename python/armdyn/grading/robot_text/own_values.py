@@ -28,6 +28,8 @@ import re
 import sympy as sp
 
 from ..latex import LatexError, parse
+from ..laws import law_verdict
+from ..named import plain
 from ..notation import StepRef, parse_lhs
 from ..reader import Submission
 from ..statements import lagrange_law
@@ -79,6 +81,9 @@ class OwnValues:
 
     # -- reading
     def _resolve(self, name):
+        key = self.aliases.get(plain(name))  # c_{121} the text gave a value: that, not the cosine shorthand
+        if key in self.own:
+            return self.own[key].value
         value = self.names(name)
         if isinstance(value, sp.Symbol):
             key = self.aliases.get(value.name)
@@ -229,6 +234,11 @@ class OwnValues:
         if eq.problem or not eq.latex:
             self._add(eq, "", "", "unrecognised", eq.problem or "not LaTeX: no model to read it against")
             return
+        stated = law_verdict(eq, max(self.n, 1))  # K_i = ..., L = K - P: the method's law, not a value
+        if stated is not None:
+            self._method(stated[1] or "lagrange")
+            self.verdicts.append(stated[0])
+            return
         value_text = str(eq.value)
         try:
             ref = parse_lhs(eq.lhs, self._coordinate_of)
@@ -251,6 +261,12 @@ class OwnValues:
         except (LatexError, RecursionError, ValueError, TypeError, ArithmeticError) as err:
             self._add(eq, name, ref.key, "unrecognised", f"{name}: cannot be read: {str(err)[:160]}")
             return
+        if self._unknown(got, []):  # K = 1/2 q'^T D(q) q' with D never given: the law, if it is one
+            stated = law_verdict(eq, max(self.n, 1), fallback=True)
+            if stated is not None:
+                self._method(stated[1] or "lagrange")
+                self.verdicts.append(stated[0])
+                return
         if ref.key in _VECTORS:
             self._method("newton-euler")
             self._judge(eq, ref, got)
@@ -302,6 +318,9 @@ class OwnValues:
             else:
                 message = f"{name}: {starting or 'no earlier value of the text decides it'} (no model)"
         self._add(eq, name, ref.key, status, message, expected=expected, got=got, caused_by=caused)
+        joints = {*self.q, *self.qd, *self.qdd}
+        if status == "unrecognised" and not _symbols(got) & joints and self._unknown(got, []):
+            return  # L = K - P in names never given: a relation, no value of this arm to build on
         tainted = name if status == "wrong" else caused
         self.own[key] = _Own(got, eq.line, name, tainted)
         for alias in _aliases(eq.lhs, self.names):
@@ -344,8 +363,8 @@ def _aliases(lhs: str, names: Names) -> list[str]:
     try:
         value = names(found[0])
     except LatexError:
-        return []
-    return [value.name] if isinstance(value, sp.Symbol) else []
+        return [plain(found[0])]
+    return [value.name] if isinstance(value, sp.Symbol) else [plain(found[0])]
 
 
 def _difference(got, expected):
