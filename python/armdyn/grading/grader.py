@@ -7,6 +7,7 @@ point every path uses (``armdyn.grade``, ``armdyn grade``, the class batch, the 
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Mapping
 
 import symengine as se
@@ -26,7 +27,7 @@ from .lagrange_terms import coriolis_entries_as_matrix
 from .latex import LatexError, UnknownSymbol
 from .laws import identity, indexed_step, law_statement
 from .methods import lagrange_method, newton_euler_method, rotation_between
-from .named import Waiting, derivative_step, form_only, symmetric_entry
+from .named import Waiting, derivative_step, form_only, plain, simple_name, symmetric_entry
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
 from .reader import Submission, read
@@ -297,7 +298,7 @@ class _Grader(EnergySteps, KinematicsSteps):
         ref, assumed = self._vocabulary(ref, eq, seen_methods)  # energy-method names; by the value's shape
         if ref is None:
             if self.verdicts and self.verdicts[-1].line == eq.line and self.verdicts[-1].status == "unrecognised":
-                if self._law(eq, seen_methods, fallback=True):  # D = m_1 J_{v_1}^T J_{v_1} + ...: in names
+                if not self._this_arms_names(eq) and self._law(eq, seen_methods, fallback=True):  # D = m J^T J
                     del self.verdicts[-2]
             return
         n_links = len(self.robot.links) - 1
@@ -319,7 +320,7 @@ class _Grader(EnergySteps, KinematicsSteps):
             return
         value, problem = self.value(eq, ref)
         if value is None:
-            if self._law(eq, seen_methods, fallback=True):  # in generic names: T = ½ m v^2, K = T_1 + T_2
+            if not self._this_arms_names(eq) and self._law(eq, seen_methods, fallback=True):  # T = ½ m v^2
                 return
             self._unrecognised(eq, problem, name=ref.name, key=ref.key)
             return
@@ -335,6 +336,18 @@ class _Grader(EnergySteps, KinematicsSteps):
         if ref.key in ("T", "V", "L"):
             for name in student_names(ref):
                 self.symbols.steps[name] = own_value
+
+    def _this_arms_names(self, eq) -> bool:
+        """Does the value use names of this arm's links (``K_2``: a link number) or a name a later
+        equation gives (``K = K_1 + K_2`` before ``K_1 = ...``)? Then it is this arm's step, waiting
+        for them (:class:`.named.Waiting`) or saying which is never given, not a law stated in
+        generic names (``T = ½ m v^2``)."""
+        if any(re.search(r"\d", n.sub or "") for n in self.names.unknown):
+            return True
+        later = {
+            plain(n) for e in self.sub.equations if e.line > eq.line and e.latex for n in [simple_name(e.lhs)] if n
+        }
+        return any(plain(n) in later for n in self.names.unknown)
 
     def _law(self, eq, seen_methods: list, fallback: bool = False) -> bool:
         """Record ``eq`` as the statement of a law (:mod:`.laws`) if it is one."""
