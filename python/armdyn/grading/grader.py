@@ -338,12 +338,16 @@ class _Grader(EnergySteps, KinematicsSteps):
                 self.symbols.steps[name] = own_value
 
     def _this_arms_names(self, eq) -> bool:
-        """Does the value use names of this arm's links (``K_2``: a link number) or a name a later
-        equation gives (``K = K_1 + K_2`` before ``K_1 = ...``)? Then it is this arm's step, waiting
-        for them (:class:`.named.Waiting`) or saying which is never given, not a law stated in
-        generic names (``T = ½ m v^2``)."""
-        if any(re.search(r"\d", n.sub or "") for n in self.names.unknown):
-            return True
+        """Does the value use a name a later equation gives (``K = K_1 + K_2`` before ``K_1 = ...``),
+        or names the text gave beside a link's name it never gives (``L = K_1 + K_2 - ...``, K_1
+        given)? Then it is this arm's step, waiting for them (:class:`.named.Waiting`) or saying
+        which is never given, not a law stated in generic names (``T = ½ m v^2``, ``D = m_1 J_{v_1}^T
+        J_{v_1} + ...`` with no Jacobian given)."""
+        given = {
+            re.match(r"\\?[A-Za-z]+", e.name).group(0) for e in self.names.used if re.match(r"\\?[A-Za-z]+", e.name)
+        }
+        if any(n.base in given and parse_lhs(n.latex(), lambda _: None) is not None for n in self.names.unknown):
+            return True  # K_1 given, K_2 not: this arm's Lagrangian missing a part
         later = {
             plain(n) for e in self.sub.equations if e.line > eq.line and e.latex for n in [simple_name(e.lhs)] if n
         }
