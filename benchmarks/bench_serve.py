@@ -216,7 +216,15 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--postgres", action="store_true", help="store in a throwaway PostgreSQL cluster")
     ap.add_argument("--restart-db-at", type=float, metavar="S", help="stop PostgreSQL S s into a run, for 3 s")
+    ap.add_argument("--roster", type=int, metavar="N", help="the deadline rush: N students, personal links, variants")
+    ap.add_argument("--window", type=float, default=600.0, help="--roster: seconds the class hands in over")
+    ap.add_argument("--concurrency", type=int, default=32, help="--roster: requests open at a time")
+    ap.add_argument("--seed", type=int, default=2026, help="--roster: the variants' and the hand-in times' seed")
     args = ap.parse_args()
+    if args.roster is not None:
+        from serve_rush import run_rush
+
+        return run_rush(args, Postgres)
     if args.restart_db_at is not None and not args.postgres:
         ap.error("--restart-db-at needs --postgres")
     from armdyn.grading import grade
