@@ -162,12 +162,22 @@ def test_five_students_around_a_deadline(tmp_path):
             server.base + "/instructor/gradebook.csv", headers={"authorization": f"Bearer {TOKEN}"}
         )
         with urllib.request.urlopen(req, timeout=60) as r:
-            rows = {row["student"]: row for row in csv.DictReader(io.StringIO(r.read().decode()))}
+            book = r.read().decode()
+        header = book.splitlines()[0].split(",")
+        assert len(header) == len(set(header)), header  # each column once
+        rows = {row["student"]: row for row in csv.DictReader(io.StringIO(book))}
         assert sorted(rows) == IDS
         for k, sid in enumerate(IDS):
             assert rows[sid]["late"] == ("yes" if k >= 3 else "no")
             assert float(rows[sid]["max"]) == 36
             assert (float(rows[sid]["total"]) == 36) is (k % 2 == 0)
+
+        from armdyn.serve.handedin import write_handed_in
+
+        written = write_handed_in(db, str(tmp_path / "handed-in"))  # for armdyn grade DIR --regrade
+        assert [p.rsplit("/", 1)[1] for p in written] == [f"{sid}.md" for sid in IDS]
+        for sid in IDS:
+            assert (tmp_path / "handed-in" / f"{sid}.md").read_text(encoding="utf-8") == texts[sid]
     finally:
         server.stop()
 
@@ -218,3 +228,68 @@ def test_regrade_after_the_rubric_changed(tmp_path, capsys):
         ("alan", "23.0", "25.0", "40.0"),
     ]
     assert changed[1]["steps_changed"].count(";") == 3
+
+
+def test_course_pages_as_a_class_sees_them(tmp_path):
+    """The pages of a roster course in headless Chromium: a student's /me (their own
+    variant, a late mark after their deadline), their statement and report; the
+    instructor's class and summary. With ``ARMDYN_SERVE_SCREENSHOTS=DIR`` the
+    screenshots go to DIR (docs/img is made this way)."""
+    from browser import require_chromium
+    from test_serve_pages import login, shoot, viewport
+
+    from armdyn.serve.exercises import catalogue
+    from armdyn.serve.identity import make_links
+
+    chromium = require_chromium()
+    pytest.importorskip("websocket")
+    import test_serve_pages
+    from cdp import Browser as Chromium
+
+    test_serve_pages.TOKEN = TOKEN  # its login() types this token
+    make_course(tmp_path, ["ada", "alan"], seed=5)
+    roster = tmp_path / "roster.csv"  # alan's own deadline has passed: his submission is late
+    roster.write_text("id,name,deadline\nada,Ada L.,\nalan,Alan T.,2026-01-05T12:00Z\n", encoding="utf-8")
+    db = f"sqlite:///{tmp_path}/course.db"
+    extra = ["--roster", str(roster), "--exercises", str(tmp_path / "v"), "--deadline", "2100-01-01T12:00Z"]
+    server = start_server(tmp_path, db, workers=1, token=TOKEN, extra=extra)
+    browser = Chromium(chromium)
+    try:
+        text = make_links(str(roster), db, server.base, catalogue(str(tmp_path / "v")))
+        link = {r["id"]: r["link"] for r in csv.DictReader(io.StringIO(text))}
+        alan = Browser(server.base)
+        alan.get(link["alan"])
+        late = alan.submit((tmp_path / "v" / "alan" / "solution.md").read_text())
+        assert late["late"] is True
+
+        page = browser.page()
+        viewport(page, 1280, 900)
+        page.b.call("Page.navigate", {"url": link["ada"]}, page.session)  # redirected to /me
+        page.wait_for("location.pathname === '/me' && document.readyState === 'complete'", 60, "/me")
+        page.eval(
+            "(function () { var t = document.getElementById('markdown'); t.focus(); t.value = "
+            + json.dumps(slipped(tmp_path, "ada", 3))
+            + "; t.dispatchEvent(new Event('input')); return true; })()"
+        )
+        page.wait_for("document.querySelectorAll('#preview math').length > 10", 60, "the preview")
+        shoot(page, "course-me-editor.png", tmp_path, full=False)
+        page.eval("document.getElementById('grade-button').click(); true")
+        page.wait_for("!!document.querySelector('.report .step.first')", 120, "the report")
+        shoot(page, "course-report.png", tmp_path, full=False)
+        page.goto(server.base + "/me")
+        mine = page.eval("document.getElementById('mine').textContent")
+        assert "first wrong" in mine and "late" not in mine  # ada's deadline is the course's, far ahead
+        shoot(page, "course-me.png", tmp_path)
+        page.goto(server.base + "/me/statement")
+        assert "ada" in page.eval("document.body.textContent")
+        shoot(page, "course-statement.png", tmp_path, full=False)
+
+        login(page, server)
+        assert page.eval("document.body.textContent.includes('Alan T.')")
+        viewport(page, 1280, 420)
+        shoot(page, "course-class.png", tmp_path, full=False)
+        page.goto(server.base + "/instructor/summary")
+        shoot(page, "course-summary.png", tmp_path, full=False)
+    finally:
+        browser.close()
+        server.stop()
