@@ -24,6 +24,14 @@ row). Two workloads:
 a temporary folder, as .ci/run does); ``--restart-db-at S`` stops it S seconds into the
 run and starts it again 3 s later: every submission must still get its verdict.
 
+``--roster N`` is the deadline rush instead (``serve_rush.py``): N students, each with
+their own variant and personal link, hand in around ``--deadline`` within ``--window``
+seconds (600 for the reported run; less for a quick one), ``--concurrency`` requests at a
+time; it reports lost submissions, verdicts that differ from ``armdyn.grade``, late marks
+against the deadline, latencies and the queue positions students were shown.
+
+    python benchmarks/bench_serve.py --roster 200 --window 600 [--postgres]
+
 Not a test (pytest does not collect it); the numbers depend on the machine's load.
 """
 

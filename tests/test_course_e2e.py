@@ -289,7 +289,7 @@ def test_course_pages_as_a_class_sees_them(tmp_path):
         viewport(page, 1280, 420)
         shoot(page, "course-class.png", tmp_path, full=False)
         page.goto(server.base + "/instructor/summary")
-        shoot(page, "course-summary.png", tmp_path, full=False)
+        shoot(page, "course-summary.png", tmp_path)
     finally:
         browser.close()
         server.stop()
