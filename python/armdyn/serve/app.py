@@ -41,7 +41,7 @@ from starlette.responses import HTMLResponse, JSONResponse, RedirectResponse, Re
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
-from . import identity, lti_web, queue, security
+from . import identity, lti_web, security, waiting
 from .exercises import DEFAULT, Exercise, ordered
 from .openapi import schema
 from .pages import INSTRUCTOR_LINKS, report_links, with_nav
@@ -363,7 +363,7 @@ def build_app(settings: Settings) -> Starlette:
         full = await run_in_threadpool(srv.repo.get, _sid(request))
         if full is None or not srv.may_see(request, full):
             return _error(404, "no such submission (or not yours: give its token as ?t=)")
-        return JSONResponse(await run_in_threadpool(queue.with_position, srv.repo, full, _api_view(full, full)))
+        return JSONResponse(await run_in_threadpool(waiting.with_position, srv.repo, full, _api_view(full, full)))
 
     async def api_preview(request: Request):
         """One preview worker, at most :data:`PREVIEW_SLOTS` previews running or waiting
@@ -450,7 +450,7 @@ def build_app(settings: Settings) -> Starlette:
         response = _page(
             "submission.html",
             s=full,
-            position=await run_in_threadpool(queue.position, srv.repo, full),
+            position=await run_in_threadpool(waiting.position, srv.repo, full),
             token=request.query_params.get("t", ""),
             csrf=srv.secrets.csrf_token(key),
             instructor=srv.is_instructor(request),
