@@ -227,6 +227,12 @@ def main() -> None:
     ap.add_argument("--roster", type=int, metavar="N", help="the deadline rush: N students, personal links, variants")
     ap.add_argument("--window", type=float, default=600.0, help="--roster: seconds the class hands in over")
     ap.add_argument("--concurrency", type=int, default=32, help="--roster: requests open at a time")
+    ap.add_argument(
+        "--arrivals",
+        choices=["uniform", "rush"],
+        default="rush",
+        help="--roster: hand-in times spread evenly, or densest at the deadline (Beta(5, 2) over the window)",
+    )
     ap.add_argument("--seed", type=int, default=2026, help="--roster: the variants' and the hand-in times' seed")
     args = ap.parse_args()
     if args.roster is not None:

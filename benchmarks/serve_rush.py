@@ -209,7 +209,10 @@ def run_rush(args, start_postgres) -> None:
         load0 = os.getloadavg()[0]
         start = max(time.time() + 1, deadline - (1 - LATE_SHARE) * args.window)
         rnd = random.Random(args.seed)
-        at = {sid: start + rnd.uniform(0, deadline + LATE_SHARE * args.window - start) for sid in ids}
+        span = deadline + LATE_SHARE * args.window - start
+        # uniform, or a rush: Beta(5, 2), densest at the deadline (80% of the window), a third after it
+        draw = (lambda: rnd.uniform(0, 1)) if args.arrivals == "uniform" else (lambda: rnd.betavariate(5, 2))
+        at = {sid: start + draw() * span for sid in ids}
         t0 = start
         try:
             results, errors = rush(base, link_of, text_of, at, args.concurrency)
@@ -230,7 +233,8 @@ def run_rush(args, start_postgres) -> None:
     slips = sum(text_of[s][1] for s in results)
     print(
         f"{args.roster} students, each their own 'rp' variant (exercise make: {make_s:.0f} s), {slips} with a slip; "
-        f"window {args.window:g} s, deadline at {1 - LATE_SHARE:.0%} of it; {args.concurrency} requests at a time; "
+        f"window {args.window:g} s, deadline at {1 - LATE_SHARE:.0%} of it, arrivals {args.arrivals}; "
+        f"{args.concurrency} requests at a time; "
         f"{args.workers} workers, {os.cpu_count()} CPUs, load average {load0:.1f} at the start, {load1:.1f} at the end; "
         + ("PostgreSQL" if args.postgres else "SQLite")
     )
