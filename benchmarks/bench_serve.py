@@ -24,6 +24,14 @@ row). Two workloads:
 a temporary folder, as .ci/run does); ``--restart-db-at S`` stops it S seconds into the
 run and starts it again 3 s later: every submission must still get its verdict.
 
+``--roster N`` is the deadline rush instead (``serve_rush.py``): N students, each with
+their own variant and personal link, hand in around ``--deadline`` within ``--window``
+seconds (600 for the reported run; less for a quick one), ``--concurrency`` requests at a
+time; it reports lost submissions, verdicts that differ from ``armdyn.grade``, late marks
+against the deadline, latencies and the queue positions students were shown.
+
+    python benchmarks/bench_serve.py --roster 200 --window 600 [--postgres]
+
 Not a test (pytest does not collect it); the numbers depend on the machine's load.
 """
 
@@ -216,7 +224,21 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--postgres", action="store_true", help="store in a throwaway PostgreSQL cluster")
     ap.add_argument("--restart-db-at", type=float, metavar="S", help="stop PostgreSQL S s into a run, for 3 s")
+    ap.add_argument("--roster", type=int, metavar="N", help="the deadline rush: N students, personal links, variants")
+    ap.add_argument("--window", type=float, default=600.0, help="--roster: seconds the class hands in over")
+    ap.add_argument("--concurrency", type=int, default=32, help="--roster: requests open at a time")
+    ap.add_argument(
+        "--arrivals",
+        choices=["uniform", "rush"],
+        default="rush",
+        help="--roster: hand-in times spread evenly, or densest at the deadline (Beta(5, 2) over the window)",
+    )
+    ap.add_argument("--seed", type=int, default=2026, help="--roster: the variants' and the hand-in times' seed")
     args = ap.parse_args()
+    if args.roster is not None:
+        from serve_rush import run_rush
+
+        return run_rush(args, Postgres)
     if args.restart_db_at is not None and not args.postgres:
         ap.error("--restart-db-at needs --postgres")
     from armdyn.grading import grade

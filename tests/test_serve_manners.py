@@ -182,6 +182,7 @@ def test_access_log_redaction_alone():
     from armdyn.serve.accesslog import redacted_target
 
     assert redacted_target("/a", b"") == "/a"
+    assert redacted_target("/link/GudeB8fVKN37FL0_sdbtp6vQnvSe", b"") == "/link/*"  # a student's key
     assert redacted_target("/a", b"t=xyz&wait=5&robot=rp-arm") == "/a?t=*&wait=5&robot=rp-arm"
     assert redacted_target("/a", "student=Bob&token=abc") == "/a?student=*&token=*"
     assert redacted_target("/a b\n", b"") == "/a%20b%0A"  # a line of the log stays one line

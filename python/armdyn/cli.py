@@ -164,6 +164,16 @@ def cmd_serve(args) -> int:
     return run(args)
 
 
+def cmd_submissions(args) -> int:
+    """``armdyn submissions``: the counted submissions as files (docs/serve.md)."""
+    from .serve.handedin import write_handed_in
+    from .serve.server import db_url
+
+    written = write_handed_in(db_url(args.db), args.out, args.policy)
+    print(f"wrote {len(written)} submission(s) into {args.out}")
+    return 0
+
+
 def cmd_links(args) -> int:
     """``armdyn links``: the roster's personal links, as CSV (docs/serve.md)."""
     from .serve.exercises import catalogue
@@ -361,6 +371,15 @@ def build_parser() -> argparse.ArgumentParser:
     ln.add_argument("--renew", nargs="+", metavar="ID", help="replace these students' links ('*': all)")
     ln.add_argument("--out", help="write the CSV here (mode 600) instead of printing it")
     ln.set_defaults(func=cmd_links)
+    hi = sub.add_parser(
+        "submissions",
+        help="write each student's counted submission of armdyn serve as a file, for armdyn grade DIR",
+        description="One OUT/<student>.md per student: the submission the gradebook counts (docs/serve.md).",
+    )
+    hi.add_argument("--db", help="the server's database (default sqlite:///armdyn-serve.db)")
+    hi.add_argument("--policy", choices=("latest", "best"), default="latest", help="which submission to write")
+    hi.add_argument("--out", required=True, help="the folder to write into")
+    hi.set_defaults(func=cmd_submissions)
     cg = sub.add_parser("codegen", help="generate C, Python or NumPy code for tau, M, C, g, the regressor")
     robot_arg(cg)
     cg.add_argument("--what", default="tau,M,C,g", help="comma-separated: tau,M,C,g,regressor (default tau,M,C,g)")

@@ -54,6 +54,12 @@ def add_batch_arguments(parser) -> None:
     )
     b.add_argument("--no-cache", action="store_true", help="grade everything again (ignore .armdyn-cache)")
     b.add_argument("--dask", metavar="SCHEDULER", help="grade on this Dask scheduler (address)")
+    b.add_argument(
+        "--regrade",
+        action="store_true",
+        help="after the key or the rubric changed: print, per student, the old and new score and the steps "
+        "that changed (against the gradebook's previous JSON), and write regrade.csv beside the gradebook",
+    )
 
 
 def cmd_grade_class(args) -> int:
@@ -67,6 +73,11 @@ def cmd_grade_class(args) -> int:
         raise ValueError(f"--timeout must be positive, got {args.timeout}")
     rubric = Rubric.load(args.rubric) if args.rubric else None
     gradebook = args.gradebook or os.path.join(os.path.dirname(os.path.abspath(folder)), "grades.csv")
+    before = None
+    if getattr(args, "regrade", False):
+        from .regrade import load_previous
+
+        before = load_previous(os.path.splitext(gradebook)[0] + ".json")  # before this run overwrites it
     result = grade_class(
         folder,
         gradebook,
@@ -93,6 +104,14 @@ def cmd_grade_class(args) -> int:
         f"{os.path.join(os.path.dirname(os.path.abspath(gradebook)), 'summary.html')}"
         + (f" and reports in {args.html_dir}" if args.html_dir else "")
     )
+    if before is not None:
+        from .regrade import compare, report_lines, to_csv
+
+        changes = compare(before, result.gradebook)
+        path = os.path.join(os.path.dirname(os.path.abspath(gradebook)), "regrade.csv")
+        with open(path, "w", encoding="utf-8", newline="") as fh:
+            fh.write(to_csv(changes))
+        print("\n".join(report_lines(changes, len(rows))) + f"\nwrote {path}")
     return 0 if not result.not_graded else 1
 
 

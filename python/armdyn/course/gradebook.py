@@ -5,6 +5,7 @@ exercise kind, as CSV and JSON.
     gb.rows          # list of dicts, one per student, sorted by student
     gb.to_csv()      # str: the columns of :attr:`Gradebook.columns`
     gb.to_json()     # str: {"columns", "rows", "slips", "steps", "set_aside", "policy", "rubric"}
+    gb.steps         # student -> the counted submission's steps: part, step, status, points, max
 
 ``items`` yields ``(student, variant, grade_json, error)`` or ``(student, variant,
 grade_json, error, kind)`` in the order the submissions were handed in: ``grade_json``
@@ -88,6 +89,7 @@ class Gradebook:
     rubric: Rubric = field(default_factory=Rubric.default)
     policy: str = "latest"
     set_aside: list[dict] = field(default_factory=list)
+    steps: dict[str, list[dict]] = field(default_factory=dict)
 
     @classmethod
     def from_results(cls, items, rubric: Rubric | None = None, policy: str = "latest", rubrics=None) -> Gradebook:
@@ -110,9 +112,12 @@ class Gradebook:
             )
             row["_order"] = order
             by_student.setdefault(student, []).append((row, row_slips))
-        rows, slips, set_aside = [], [], []
+        rows, slips, set_aside, steps = [], [], [], {}
         for student, tried in by_student.items():
             chosen = _choose(tried, policy)
+            steps[student] = chosen[0]["_steps"]
+            for r, _ in tried:
+                r.pop("_steps")
             for r, _ in tried:
                 if r is not chosen[0]:
                     set_aside.append({k: r[k] for k in ("student", "variant", "kind", "status", "error", "total")})
@@ -129,7 +134,7 @@ class Gradebook:
         rows.sort(key=lambda r: (r["student"], r["variant"] or ""))
         slips.sort(key=lambda s: (s.student, s.step))
         set_aside.sort(key=lambda r: (r["student"], r["variant"] or ""))
-        return cls(rows=rows, parts=parts, slips=slips, rubric=rubric, policy=policy, set_aside=set_aside)
+        return cls(rows=rows, parts=parts, slips=slips, rubric=rubric, policy=policy, set_aside=set_aside, steps=steps)
 
     @property
     def columns(self) -> list[str]:
@@ -152,6 +157,7 @@ class Gradebook:
             "rows": [{c: r[c] for c in self.columns} for r in self.rows],
             "slips": [s.__dict__ for s in self.slips],
             "set_aside": self.set_aside,
+            "steps": self.steps,
             "policy": self.policy,
             "rubric": self.rubric.to_dict(),
         }
@@ -286,7 +292,7 @@ def _row(student: str, variant: str | None, report: dict | None, error: str | No
     steps = [s for s in (report or {}).get("steps", []) if isinstance(s, dict)]
     parts_of = part_of_steps(steps, (report or {}).get("method"))
     earned: dict[str, list[float]] = {p: [0.0, 0.0] for p in (expected.parts if expected else ())}
-    seen, slips, links = set(), [], 0
+    seen, slips, links, counted = set(), [], 0, []
     first = (report or {}).get("first_wrong")
     exercise = row["kind"] or ""
     for s, part in zip(steps, parts_of):
@@ -304,6 +310,9 @@ def _row(student: str, variant: str | None, report: dict | None, error: str | No
         acc = earned.setdefault(part, [0.0, 0.0])
         acc[0] += pts * rubric.credit.get(status, 0.0)
         acc[1] += pts
+        counted.append(
+            {"part": part, "step": name, "status": status, "points": pts * rubric.credit.get(status, 0.0), "max": pts}
+        )
         if status == "wrong":
             message = s.get("message") or ""
             slips.append(
@@ -319,6 +328,15 @@ def _row(student: str, variant: str | None, report: dict | None, error: str | No
     for part, name in sorted(rubric.required_steps(expected) or ()):
         if (part, name) not in seen:
             earned.setdefault(part, [0.0, 0.0])[1] += rubric.step_points(name, key_of(name))
+            counted.append(
+                {
+                    "part": part,
+                    "step": name,
+                    "status": "missing",
+                    "points": 0.0,
+                    "max": rubric.step_points(name, key_of(name)),
+                }
+            )
     if expected is not None and expected.links > links:  # a proof that stops early: its missing links
         earned.setdefault(PROOF, [0.0, 0.0])[1] += (expected.links - links) * rubric.step_points("proof", "proof")
     for part, total in rubric.parts.items():  # scaled to the rubric's part totals
@@ -326,7 +344,11 @@ def _row(student: str, variant: str | None, report: dict | None, error: str | No
             continue
         got, most = earned.get(part, [0.0, 0.0])
         earned[part] = [total * got / most if most else 0.0, total]
+        for c in counted:  # each step scaled as its part is
+            if c["part"] == part:
+                c["points"], c["max"] = (c["points"] * total / most, c["max"] * total / most) if most else (0.0, 0.0)
     row["_parts"] = {p: (round(a, 2), round(b, 2)) for p, (a, b) in earned.items()}
+    row["_steps"] = [dict(c, points=round(c["points"], 2), max=round(c["max"], 2)) for c in counted]
     row["total"] = round(sum(a for a, _ in row["_parts"].values()), 2)
     row["max"] = round(sum(b for _, b in row["_parts"].values()), 2)
     chosen = next((x for x in slips if x.first), None)

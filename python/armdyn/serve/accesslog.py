@@ -4,7 +4,8 @@
 
 The client's address, the method, the path, the status and the time to the end of the
 response. The query keeps its parameter names, but only the values of :data:`SHOWN`
-(exercise ids and a wait): a submission's link token (``?t=``), a student's name or
+(exercise ids and a wait): a submission's link token (``?t=``), a personal link's token
+(``/link/*``), a student's name or
 anything else a client put there is logged as ``*``. No header is logged: no cookie,
 no ``Authorization``. A request whose client left before an answer is logged with
 status 499 (nginx's "client closed request"); one the app failed on, 500.
@@ -23,7 +24,8 @@ _MAX_PATH = 300  # characters of a path logged (a longer one is cut, with "...")
 
 def redacted_target(path: str, query: bytes | str) -> str:
     """``path?query`` as logged: only :data:`SHOWN` values, every other value ``*``."""
-    path = quote(path, safe="/-_.~%")
+    # a personal link's token is a student's key: never logged
+    path = "/link/*" if path.startswith("/link/") else quote(path, safe="/-_.~%")
     if len(path) > _MAX_PATH:
         path = path[:_MAX_PATH] + "..."
     if isinstance(query, bytes):

@@ -13,7 +13,7 @@ from starlette.concurrency import run_in_threadpool
 from starlette.requests import Request
 from starlette.responses import JSONResponse, Response
 
-from . import identity
+from . import identity, waiting
 from .helpers import BadRequest, api_view, json_error, submission_id, text_body
 from .openapi import schema
 from .state import Server
@@ -72,7 +72,7 @@ class ApiHandlers:
         full = await run_in_threadpool(self.srv.repo.get, submission_id(request))
         if full is None or not self.srv.may_see(request, full):
             return json_error(404, "no such submission (or not yours: give its token as ?t=)")
-        return JSONResponse(api_view(full, full))
+        return JSONResponse(await run_in_threadpool(waiting.with_position, self.srv.repo, full, api_view(full, full)))
 
     async def api_preview(self, request: Request):
         """One preview worker, at most :data:`PREVIEW_SLOTS` previews running or waiting

@@ -28,7 +28,8 @@ class ServedGradebook(Gradebook):
 
     @property
     def columns(self) -> list[str]:
-        return [*super().columns, *EXTRA]
+        base = super().columns  # the course's columns have policy and submissions too: once each
+        return [*base, *(c for c in EXTRA if c not in base)]
 
 
 def _item(row: dict) -> tuple:

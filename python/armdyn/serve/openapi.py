@@ -59,6 +59,10 @@ _SUBMISSION = {
         "tau_correct": {"type": "array", "items": {"type": "boolean"}},
         "token": {"type": "string", "description": "POST only: the secret that opens this submission"},
         "url": {"type": "string", "description": "POST only: its page, token included"},
+        "position": {
+            "type": "integer",
+            "description": "GET only, while queued: its place in the grading queue (1: graded next)",
+        },
     },
 }
 

@@ -10,7 +10,7 @@ from starlette.concurrency import run_in_threadpool
 from starlette.requests import Request
 from starlette.responses import HTMLResponse, RedirectResponse
 
-from . import identity, security
+from . import identity, security, waiting
 from .exercises import DEFAULT, ordered
 from .helpers import page, student_key, submission_id, with_key
 from .pages import report_links, with_nav
@@ -85,6 +85,7 @@ class StudentPages:
         response = page(
             "submission.html",
             s=full,
+            position=await run_in_threadpool(waiting.position, self.srv.repo, full),
             token=request.query_params.get("t", ""),
             csrf=self.srv.secrets.csrf_token(key),
             instructor=self.srv.is_instructor(request),

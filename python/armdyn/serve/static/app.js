@@ -93,14 +93,19 @@
   if (sub && (sub.dataset.status === "queued" || sub.dataset.status === "running")) {
     var url = "/api/submissions/" + encodeURIComponent(sub.dataset.id)
       + (sub.dataset.token ? "?t=" + encodeURIComponent(sub.dataset.token) : "");
-    var pending = $("pending"), shown = sub.dataset.status;
+    var pending = $("pending"), shown = pending ? pending.textContent : "";
+    var waiting = function (position) {
+      return position ? "Waiting in the queue: number " + position + " (1 is graded next)… this page updates by itself."
+        : "Waiting in the queue… this page updates by itself.";
+    };
     var poll = function () {
       fetch(url, {credentials: "same-origin"}).then(function (r) { return r.json(); }).then(function (j) {
         if (j.status === "done" || j.status === "failed") { window.location.reload(); return; }
-        if (pending && j.status !== shown) {  // the live region says when grading starts
-          shown = j.status;
-          pending.textContent = j.status === "running" ? "Grading now… this page updates by itself."
-            : "Waiting in the queue… this page updates by itself.";
+        var said = j.status === "running" ? "Grading now… this page updates by itself."
+          : waiting(j.position);
+        if (pending && said !== shown) {  // the live region says when grading starts, or the queue moves
+          shown = said;
+          pending.textContent = said;
         }
         setTimeout(poll, 1000);
       }).catch(function () { setTimeout(poll, 3000); });
