@@ -142,13 +142,13 @@ class Gradebook:
 
     def to_csv(self) -> str:
         """One header line and one line per row (``\\n`` line ends); a cell a spreadsheet
-        would run as a formula, split on ``,`` or on ``;``, is quoted with ``'`` (:func:`_cell`)."""
+        would run as a formula, split on ``,`` or on ``;``, is quoted with ``'`` (:func:`cell_text`)."""
         out = io.StringIO()
         w = csv.writer(out, lineterminator="\n")
         cols = self.columns
         w.writerow(cols)
         for r in self.rows:
-            w.writerow([_cell(r[c]) for c in cols])
+            w.writerow([cell_text(r[c]) for c in cols])
         return out.getvalue()
 
     def to_json(self) -> str:
@@ -200,7 +200,7 @@ def _choose(tried: list, policy: str):
 _FORMULA_START = re.compile(r"(^|[,;\r\n])([ ]*)(?=[=+\-@\t\r])")
 
 
-def _cell(value) -> str:
+def cell_text(value) -> str:
     """A CSV cell no spreadsheet opens as a formula, whichever separator it splits on:
     ``'`` before every ``= + - @ TAB CR`` that starts the cell or follows ``,``, ``;``
     or a line break (``Ada;=cmd|...`` -> ``'Ada;'=cmd|...``; the text after a quote is

@@ -18,7 +18,7 @@ import json
 from dataclasses import dataclass, field
 
 from ..errors import ModelError
-from .gradebook import _cell
+from .gradebook import cell_text
 
 
 @dataclass
@@ -119,5 +119,5 @@ def to_csv(changes: list[Change]) -> str:
     for c in changes:
         old, new = c.old or ("", ""), c.new or ("", "")
         steps = "; ".join(s.text() for s in c.steps)
-        w.writerow([_cell(c.student), *old, *new, c.status[0] or "", c.status[1] or "", _cell(steps)])
+        w.writerow([cell_text(c.student), *old, *new, c.status[0] or "", c.status[1] or "", cell_text(steps)])
     return out.getvalue()

@@ -343,9 +343,7 @@ class _Grader(EnergySteps, KinematicsSteps):
         given)? Then it is this arm's step, waiting for them (:class:`.named.Waiting`) or saying
         which is never given, not a law stated in generic names (``T = ½ m v^2``, ``D = m_1 J_{v_1}^T
         J_{v_1} + ...`` with no Jacobian given)."""
-        given = {
-            re.match(r"\\?[A-Za-z]+", e.name).group(0) for e in self.names.used if re.match(r"\\?[A-Za-z]+", e.name)
-        }
+        given = {m.group(0) for e in self.names.used for m in [re.match(r"\\?[A-Za-z]+", e.name)] if m}
         if any(n.base in given and parse_lhs(n.latex(), lambda _: None) is not None for n in self.names.unknown):
             return True  # K_1 given, K_2 not: this arm's Lagrangian missing a part
         later = {

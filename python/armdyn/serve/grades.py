@@ -38,10 +38,10 @@ def _item(row: dict) -> tuple:
     error = None
     if report is None:
         error = ("failed: " if row["status"] == "failed" else "") + (row.get("error") or "no verdict")
-    return (_who(row), row.get("graded_as") or row.get("exercise"), report, error)
+    return (who_of(row), row.get("graded_as") or row.get("exercise"), report, error)
 
 
-def _who(row: dict) -> str:
+def who_of(row: dict) -> str:
     return row.get("student_id") or row.get("student") or "(no name)"
 
 
@@ -66,7 +66,7 @@ def gradebook(rows: list[dict], policy: str = "latest", roster: dict | None = No
         raise ValueError(f"gradebook policy must be one of {', '.join(POLICIES)}, not {policy!r}")
     groups: dict[tuple, list[dict]] = {}
     for r in rows:
-        groups.setdefault((_who(r), r.get("graded_as") or r.get("exercise")), []).append(r)
+        groups.setdefault((who_of(r), r.get("graded_as") or r.get("exercise")), []).append(r)
     chosen = {key: choose(group, policy) for key, group in groups.items()}
     items = [_item(r) for r in chosen.values()]
     seen = {who for who, _ in groups}

@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 
 from ..course.batch import safe_file_name
-from .grades import _who, choose
+from .grades import choose, who_of
 from .storage import Repository
 
 
@@ -22,7 +22,7 @@ def write_handed_in(db: str, out: str, policy: str = "latest") -> list[str]:
     try:
         groups: dict[str, list[dict]] = {}
         for row in repo.graded():
-            groups.setdefault(_who(row), []).append(row)
+            groups.setdefault(who_of(row), []).append(row)
         os.makedirs(out, exist_ok=True)
         written = []
         for student, rows in sorted(groups.items()):
