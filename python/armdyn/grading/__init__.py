@@ -21,7 +21,7 @@ from __future__ import annotations
 # _repr_html_ with armdyn.dispatch when imported
 from . import html as _html_report  # noqa: F401
 from . import text as _text_report  # noqa: F401
-from .grader import grade
+from .entry import grade
 from .verdict import STATUSES, GradeReport, StepVerdict
 
 __all__ = ["grade", "GradeReport", "StepVerdict", "STATUSES"]

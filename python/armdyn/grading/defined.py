@@ -250,7 +250,7 @@ def energy_names(text: str, steps: dict) -> str:
     return _ENERGY.sub(one, text)
 
 
-# -- the grader's side (functions of armdyn.grading.grader._Grader, as chains.check_step)
+# -- the grader's side (functions of armdyn.grading.grader.Grader, as chains.check_step)
 def read_pair(grader, text: str):
     """(own, right) values of one LaTeX value: its names read with the student's values and
     with their right ones; step names (``{}^{2}F_2``, ``n_1^{1T}``) through

@@ -1,5 +1,5 @@
 """The grader's handling of the textbooks' energy-method vocabulary (a mixin of
-:class:`armdyn.grading.grader._Grader`): names whose step depends on the value's shape
+:class:`armdyn.grading.grader.Grader`): names whose step depends on the value's shape
 (:func:`.vocabulary.by_shape`), the quantities checked directly against the model
 (:mod:`.lagrange_terms`), the joint torques given as one column, and the equations of
 motion stated in matrix form."""

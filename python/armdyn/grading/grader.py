@@ -6,9 +6,7 @@ point every path uses (``armdyn.grade``, ``armdyn grade``, the class batch, the 
 
 from __future__ import annotations
 
-import os
 import re
-from collections.abc import Mapping
 
 import symengine as se
 import sympy as sp
@@ -30,7 +28,7 @@ from .methods import lagrange_method, newton_euler_method, rotation_between
 from .named import Waiting, derivative_step, form_only, plain, simple_name, symmetric_entry
 from .notation import LAGRANGE_KEYS, VECTOR_KEYS, StepRef, SymbolMap, parse_lhs
 from .proofs import grade_proofs
-from .reader import Submission, read
+from .reader import Submission
 from .setup_lines import setup_line
 from .statements import FREE_END, lagrange_law, matrix_form
 from .sympy_syntax import parse_sympy_syntax
@@ -51,18 +49,7 @@ def _named_ref(text: str) -> StepRef | None:
     return None
 
 
-def _load_robot(name: str, sub: Submission, trusted: bool = False) -> Robot:
-    from ..io import load
-
-    candidate = os.path.join(sub.base_dir, name)
-    source = candidate if os.path.isfile(candidate) else name
-    try:
-        return load(source, strict=False, trusted=trusted)
-    except ModelError as err:
-        raise err.located(source=sub.path) from None
-
-
-class _Grader(EnergySteps, KinematicsSteps):
+class Grader(EnergySteps, KinematicsSteps):
     def __init__(self, sub: Submission, robot: Robot, symbols: dict | None):
         self.sub = sub
         self.robot = robot
@@ -603,67 +590,3 @@ def _tidied(value, robot):
 
 def _matrix(value) -> sp.Matrix:
     return value if isinstance(value, sp.MatrixBase) else sp.Matrix([[value]])
-
-
-def grade(
-    submission: str | os.PathLike[str] | Submission,
-    robot: str | Robot | None = None,
-    symbols: dict | None = None,
-    trusted: bool = False,
-) -> GradeReport:
-    """Grade a derivation.
-
-    submission: path of a Markdown (.md) or YAML (.yaml) file, or a :class:`Submission`.
-    robot:      the model whose frames the student used (bundled name, model file or
-                Robot); default: the submission's front matter ``robot``.
-    symbols:    extra mapping of the student's symbols to model names.
-    trusted:    the model named by ``robot`` may be a ``.xacro`` file (expanding one runs
-                its Python code); never applies to a model the front matter names.
-    """
-    sub = submission if isinstance(submission, Submission) else read(os.fspath(submission))
-    read_model = None
-    if isinstance(robot, Robot):
-        model = robot
-    elif robot or sub.robot:
-        # a stated model wins: the text's statements are only checked; only a model given
-        # by the caller (never the front matter's) may be a trusted .xacro
-        model = _load_robot(robot or sub.robot or "", sub, trusted=bool(trusted and robot))
-    else:
-        from .robot_text import robot_from_text
-        from .robot_text.own_values import grade_without_model
-
-        try:
-            read_model = robot_from_text(sub)  # the robot the text itself describes
-        except ModelError as err:
-            if not sub.equations:
-                raise
-            return grade_without_model(sub, err.message)  # what the text's own values decide
-        model = read_model.robot
-    if sub.values is not None:
-        try:
-            # the reader admits "published" or a mapping parameter -> number
-            model = model.bind(sub.values if isinstance(sub.values, Mapping) else None)
-        except ModelError as err:
-            raise err.located(source=sub.path) from None
-    hint = sub.method if sub.method in ("newton-euler", "lagrange") else None
-    report = _Grader(sub, model, symbols).run(hint)
-    if read_model is not None and read_model.alternatives:  # the statements allow other readings
-        from .robot_text.support import most_supported
-
-        def with_model(other):
-            robot = other.robot
-            if sub.values is not None:
-                robot = robot.bind(sub.values if isinstance(sub.values, Mapping) else None)
-            return _Grader(sub, robot, symbols).run(hint)
-
-        read_model, report = most_supported(read_model, report, with_model)
-    if read_model is not None:
-        from .robot_text.support import disagreeing, own_values_instead
-
-        if disagreeing(report):  # the reading, not the text, is likely wrong: the text's own values
-            own = own_values_instead(sub, report)
-            if own is not report:
-                return own
-        report.model_note = read_model.note()  # the report's first line: what was graded against
-        report.notes.insert(0, report.model_note)
-    return report

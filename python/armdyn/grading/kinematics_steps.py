@@ -1,4 +1,4 @@
-"""Kinematics steps (a mixin of :class:`armdyn.grading.grader._Grader`): rotations
+"""Kinematics steps (a mixin of :class:`armdyn.grading.grader.Grader`): rotations
 ``R_a^b`` and positions ``P_i^j``, ``P_{C_i}^j``, checked against the model's frames
 directly, and a rotation decided by how it is used.
 

@@ -335,7 +335,7 @@ def _side(side: str, laws: list, bindings: list, letters: set, n_links: int, lhs
     return None
 
 
-# -- the grader's side (a function of armdyn.grading.grader._Grader, as defined.definition)
+# -- the grader's side (a function of armdyn.grading.grader.Grader, as defined.definition)
 def law_statement(grader, eq, fallback: bool = False):
     """(The verdict, the method) on ``eq`` when it states a law, else None. Without ``fallback`` only a
     statement marked general (an index letter, a sum, a pattern, a derivative) is tried;
