@@ -293,3 +293,51 @@ def test_course_pages_as_a_class_sees_them(tmp_path):
     finally:
         browser.close()
         server.stop()
+
+
+def test_the_served_gradebook_scores_each_kind_by_its_rubric(tmp_path):
+    """A mixed class (an RP arm and an RR arm: different kinds, each with the rubric ``exercise
+    make`` wrote for it) scored by the server's gradebook exactly as ``armdyn grade DIR
+    --variants`` scores the same files: the batch is the independent second opinion."""
+    import csv
+    import json
+
+    import armdyn
+    from armdyn.cli import main
+    from armdyn.serve.exercises import catalogue
+    from armdyn.serve.grades import gradebook
+
+    for kind, sid in (("rp", "ada"), ("rr", "bob")):
+        roster = tmp_path / f"{kind}.csv"
+        roster.write_text(f"id,name\n{sid},{sid}\n", encoding="utf-8")
+        args = ["exercise", "make", kind, "--roster", str(roster), "--seed", "5", "--out", str(tmp_path / "v")]
+        assert main(args) == 0
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    rows = []
+    for k, sid in enumerate(("ada", "bob")):
+        text = (tmp_path / "v" / sid / "solution.md").read_text(encoding="utf-8")
+        (subs / f"{sid}.md").write_text(text, encoding="utf-8")
+        report = armdyn.grade(str(subs / f"{sid}.md"), robot=str(tmp_path / "v" / sid / "model.yaml"))
+        rows.append(
+            {
+                "id": f"s{k}",
+                "student_id": sid,
+                "graded_as": sid,
+                "exercise": sid,
+                "status": "done",
+                "report_json": json.dumps(json.loads(report.to_json())),
+                "created_at": 1000.0 + k,
+                "late": False,
+            }
+        )
+    served = {
+        r["student"]: (float(r["total"]), float(r["max"]))
+        for r in gradebook(rows, exercises=catalogue(str(tmp_path / "v"))).rows
+    }
+    assert grade_dir(tmp_path) in (0, 1)
+    with open(tmp_path / "out" / "grades.csv", newline="", encoding="utf-8") as fh:
+        batch = {r["student"]: (float(r["total"]), float(r["max"])) for r in csv.DictReader(fh)}
+    assert served == batch
+    assert served["ada"][1] != served["bob"][1]  # two kinds, two rubrics
+    assert all(total == most for total, most in served.values())  # the worked solutions: full marks

@@ -427,8 +427,6 @@ def routes(srv, web) -> list:
     from starlette.responses import FileResponse, HTMLResponse, RedirectResponse
     from starlette.routing import Route
 
-    from .grades import total_of
-
     failed_links = security.Throttle(per_client=20, overall=200)
 
     async def open_link(request):
@@ -462,11 +460,11 @@ def routes(srv, web) -> list:
         finished = [r for r in mine if r["status"] == "done" and r["graded_as"] == exercise]
         counted = None
         if finished:
-            from .grades import choose
+            from .grades import counted as counted_of
 
             full = [await run_in_threadpool(srv.repo.get, r["id"]) for r in finished]
-            pick = choose(full, srv.settings.policy)
-            counted = {"id": pick["id"], "score": total_of(pick)}
+            pick, points, out_of = counted_of(full, srv.settings.policy, srv.settings.exercises, exercise)
+            counted = {"id": pick["id"], "score": (points, out_of)}
         response = web.page(
             "me.html",
             student=student,

@@ -113,7 +113,7 @@ class InstructorPages:
         from .grades import gradebook
 
         rows = await run_in_threadpool(self.srv.repo.graded)
-        return gradebook(rows, self.settings.policy, self.settings.roster)
+        return gradebook(rows, self.settings.policy, self.settings.roster, self.settings.exercises)
 
     async def gradebook_csv(self, request: Request):
         if not self.srv.is_instructor(request):

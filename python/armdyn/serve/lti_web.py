@@ -46,7 +46,7 @@ def _client_id(claims: dict) -> str:
 def passback(srv, tool, ledger: Ledger, sid: str) -> None:
     """Send the score the gradebook counts for the student of submission ``sid`` to
     every line item of their launches of that exercise (a failure is logged)."""
-    from .grades import choose, total_of
+    from .grades import counted
 
     row = srv.repo.get(sid)
     if row is None or not row.get("student_id") or row["status"] != "done":
@@ -57,8 +57,7 @@ def passback(srv, tool, ledger: Ledger, sid: str) -> None:
         return
     mine = [srv.repo.get(r["id"]) for r in srv.repo.by_student(row["student_id"])]
     mine = [r for r in mine if r["status"] == "done" and (r.get("graded_as") or r.get("exercise")) == exercise]
-    pick = choose(mine, srv.settings.policy)
-    given, maximum = total_of(pick)
+    pick, given, maximum = counted(mine, srv.settings.policy, srv.settings.exercises, exercise)
     if maximum <= 0:
         return  # nothing gradable (an input error): nothing to send
     verdict = "every step right" if pick.get("passed") else f"first wrong step: {pick.get('first_wrong') or '-'}"
