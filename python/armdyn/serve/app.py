@@ -113,8 +113,8 @@ def build_app(settings: Settings) -> Starlette:
     """The ASGI app for ``settings`` (workers start with the app's lifespan)."""
     srv = Server(settings)
     # what identity's and LTI's pages share with these (passed: they do not import this module)
-    web = SimpleNamespace(page=page, student_key=student_key, with_key=with_key)
     api, student, instructor = ApiHandlers(srv), StudentPages(srv), InstructorPages(srv)
+    web = SimpleNamespace(page=page, student_key=student_key, with_key=with_key, statement_of=student.statement_of)
 
     routes = [
         Route("/", student.student_page),

@@ -470,6 +470,7 @@ def routes(srv, web) -> list:
             student=student,
             exercise=srv.settings.exercises.get(exercise),
             statement=statement_path(srv.settings.exercises.get(exercise)) is not None,
+            statement_html=web.statement_of.get(exercise, ""),
             deadline=deadline,
             past_deadline=deadline is not None and time.time() > deadline,
             policy=srv.settings.policy,
