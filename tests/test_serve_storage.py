@@ -60,9 +60,12 @@ def test_fifo_claim_finish_and_cache(db_url):  # noqa: F811
     assert later["status"] == DONE and later["cached"] and later["first_wrong"] == "v_dot_1"
     other = repo.add("s5", "tok5", "$$x = 1$$", "planar-2r")  # another exercise: not the same work
     assert other["status"] == QUEUED
+    # the same exercise and text, but its model corrected since (another grading key): graded again
+    corrected = repo.add("s6", "tok6", "$$x = 1$$", "rp-arm", "eve", key="0.1.0:model digest after the fix")
+    assert corrected["status"] == QUEUED and not corrected["cached"]
     assert repo.claim().id == "s2"
     assert [r["id"] for r in repo.by_owner("owner-a")] == ["s1"]
-    assert repo.counts() == {QUEUED: 1, RUNNING: 1, DONE: 3, FAILED: 0}
+    assert repo.counts() == {QUEUED: 2, RUNNING: 1, DONE: 3, FAILED: 0}
     repo.dispose()
 
 

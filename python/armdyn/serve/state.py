@@ -8,6 +8,7 @@ session or token, a submission's link token, its owner).
 from __future__ import annotations
 
 import asyncio
+import hashlib
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -127,12 +128,30 @@ class Server:
         token = security.new_token()
         owner = security.digest(owner_key) if owner_key else None
         fields = {**who, "student": who["student"].strip(), "owner_hash": owner}
+        key = await run_in_threadpool(self.grading_key, who.get("exercise"))
         row = await run_in_threadpool(
-            lambda: self.repo.add(security.new_id(), security.digest(token), markdown, **fields)
+            lambda: self.repo.add(security.new_id(), security.digest(token), markdown, key=key, **fields)
         )
         if row["status"] != DONE:
             self.pool.wake()
         return row, token
+
+    def grading_key(self, exercise: str | None) -> str:
+        """What a verdict depends on besides the text: the grader's version and, for a
+        variant, its model file as it is now (an instructor who corrects a variant's model
+        gets identical texts graded again, not the old verdict back)."""
+        from .. import __version__
+        from ..errors import ModelError
+        from ..io.textfile import read_bytes
+
+        ex = self.settings.exercises.get(exercise or "")
+        model = ""
+        if ex is not None and ex.variant:
+            try:
+                model = hashlib.sha256(read_bytes(ex.source, "model", 4_000_000)).hexdigest()
+            except ModelError:
+                model = "unreadable"
+        return f"{__version__}:{model}"
 
     # -- who may see what
     def is_instructor(self, request: Request) -> bool:

@@ -95,9 +95,10 @@ class Job:
     attempts: int
 
 
-def content_hash(exercise: str | None, markdown: str) -> str:
-    """sha256 of the exercise asked for and the text: equal hashes grade alike."""
-    return hashlib.sha256(f"{exercise or ''}\0{markdown}".encode()).hexdigest()
+def content_hash(exercise: str | None, markdown: str, key: str = "") -> str:
+    """sha256 of the exercise asked for, the text and ``key`` (what the exercise is graded
+    against: its model file's digest and the grader's version): equal hashes grade alike."""
+    return hashlib.sha256(f"{exercise or ''}\0{key}\0{markdown}".encode()).hexdigest()
 
 
 def _engine(url: str) -> sa.Engine:
@@ -143,10 +144,12 @@ class Repository:
         owner_hash: str | None = None,
         student_id: str | None = None,
         late: bool | None = None,
+        key: str = "",
     ) -> dict:
         """Accept a submission: stored ``queued``, or ``done`` at once when the same
-        exercise and text were graded before. Returns its summary row."""
-        digest = content_hash(exercise, markdown)
+        exercise (graded against the same ``key``: :func:`content_hash`) and text were
+        graded before. Returns its summary row."""
+        digest = content_hash(exercise, markdown, key)
         now = time.time()
         row = {
             "id": sid,
