@@ -121,14 +121,14 @@ def load_core(path: str):
 def compiled_with(core, robot):
     """``robot`` compiled by the extension module ``core`` (armdyn.numeric's compile_model
     with that module's NumericModel)."""
-    import armdyn.numeric as numeric
+    from armdyn.numeric import compiled
 
-    saved = numeric.NumericModel, numeric._core
-    numeric.NumericModel, numeric._core = core.NumericModel, core
+    saved = compiled.NumericModel
+    compiled.NumericModel = core.NumericModel
     try:
-        return numeric.compile_model(armdyn.load(robot.meta["file"]) if robot.meta.get("file") else robot)
+        return compiled.compile_model(armdyn.load(robot.meta["file"]) if robot.meta.get("file") else robot)
     finally:
-        numeric.NumericModel, numeric._core = saved
+        compiled.NumericModel = saved
 
 
 def median_time(f, repeat: int) -> float:

@@ -1,6 +1,6 @@
 //! Bindings of the derivative algorithms, M^-1, jacobian_dot and the external-force
 //! variants of rnea/aba: module-level functions taking the NumericModel first (called by
-//! `python/armdyn/numeric.py`, which documents them). Same rules as the methods in
+//! `python/armdyn/numeric/`, which documents them). Same rules as the methods in
 //! `lib.rs`: one state `(n,)` or a batch `(N, n)`, ValueError naming the argument.
 
 use crate::{as_f64, guard, is_c_contiguous_aligned, new_array, slice, states, thread_arg, NumericModel, Scratch, Shape};

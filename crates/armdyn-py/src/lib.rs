@@ -1,7 +1,7 @@
 //! `armdyn._core`: thin Python bindings of armdyn-core.
 //!
 //! One class, `NumericModel`: built once from a robot's numeric description (see
-//! `python/armdyn/numeric.py`, which is the user-facing API and documents every
+//! `python/armdyn/numeric/`, which is the user-facing API and documents every
 //! function), holding the immutable model and a workspace for single calls.
 //!
 //! Every method takes one state `(n,)` or a batch `(N, n)` of float64 (anything else is

@@ -1,0 +1,82 @@
+"""Argument checks shared by :mod:`armdyn.numeric`'s functions: ``threads``, a floating
+base where it is not supported, and the core's overflow told in the caller's words."""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from ..errors import FloatingBaseError
+from ..model import Robot
+
+MAX_THREADS = 256
+
+
+def check_threads(threads):
+    """Checked ``threads``: ``threads`` if it is None or an integer from 1 to MAX_THREADS;
+    TypeError naming it for anything but an integer (``True`` is an int to Python and to
+    PyO3), ValueError for an integer out of range (2**64 would be PyO3's OverflowError,
+    naming nothing)."""
+    if threads is None or type(threads) is int and 1 <= threads <= MAX_THREADS:
+        return threads
+    shown = repr(threads) if len(repr(threads)) <= 40 else f"{type(threads).__name__} {repr(threads)[:30]}..."
+    message = f"threads: expected None or an integer from 1 to {MAX_THREADS}, got {shown}"
+    if isinstance(threads, (bool, np.bool_)) or not isinstance(threads, (int, np.integer)):
+        raise TypeError(message)
+    if not 1 <= threads <= MAX_THREADS:
+        raise ValueError(message)
+    return int(threads)
+
+
+def overflow_error(what: str, arrays: dict) -> ValueError:
+    sizes = []
+    for name, a in arrays.items():
+        try:
+            sizes.append(f"max |{name}| = {float(np.max(np.abs(np.asarray(a, dtype=float)))):.3g}")
+        except (TypeError, ValueError):
+            pass
+    return ValueError(
+        f"{what}: the result overflows float64 (not finite) for finite inputs ({', '.join(sizes)}); "
+        "the state or torque is too large for this arm"
+    )
+
+
+def checked(fn):
+    """``fn`` with ``threads`` checked first (for the functions whose bodies do not), and the
+    core's overflow error told as :func:`overflow_error` does."""
+
+    @functools.wraps(fn)
+    def call(robot, *args, threads=None, **kwargs):
+        if threads is not None:
+            threads = check_threads(threads)
+        try:
+            return fn(robot, *args, threads=threads, **kwargs)
+        except FloatingPointError:
+            raise overflow_error(fn.__name__, dict(zip(("q", "qd", "qdd"), args))) from None
+
+    return call
+
+
+def require_fixed_base(robot, what: str) -> None:
+    """Raise :class:`~armdyn.errors.FloatingBaseError` naming ``what`` if ``robot`` (a Robot
+    or a compiled model) has a floating base."""
+    if getattr(robot, "floating", False):
+        if isinstance(robot, Robot):
+            robot.require_fixed_base(what)
+        raise FloatingBaseError(
+            f"{what} does not support a floating base (root_joint='free-flyer') yet; rnea, crba and aba do",
+            f"robot '{robot.name}'",
+        )
+
+
+def fixed_base_only(fn):
+    """``fn`` refusing a floating-base robot with a FloatingBaseError naming ``fn``."""
+
+    @functools.wraps(fn)
+    def call(robot, *args, **kwargs):
+        if getattr(robot, "floating", False):
+            require_fixed_base(robot, f"armdyn.numeric.{fn.__name__}")
+        return fn(robot, *args, **kwargs)
+
+    return call
