@@ -14,14 +14,14 @@ use armdyn_core::algo::coriolis::CoriolisWork;
 use armdyn_core::{algo, batch, Data, JointDynamics, JointSpec, JointType, Model};
 
 mod regressor;
-use numpy::{PyArray, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{npyffi, Element, PyArray, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyFloatingPointError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyFloat, PyString, PyTuple};
 use std::collections::HashMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 mod derivatives;
 mod floating;
@@ -104,6 +104,58 @@ unsafe fn slice<'a>(a: &'a Bound<'_, PyArrayDyn<f64>>) -> &'a [f64] {
     unsafe { a.as_slice().expect("C-contiguous") }
 }
 
+/// The ndarray type and the native float64 descriptor, read once: what a single state
+/// usually is, recognised by two pointer comparisons.
+fn ndarray_and_f64(py: Python<'_>) -> (*mut pyo3::ffi::PyTypeObject, *mut npyffi::PyArray_Descr) {
+    static POINTERS: OnceLock<(usize, usize)> = OnceLock::new();
+    let &(array_type, f64_descr) = POINTERS.get_or_init(|| {
+        // SAFETY: NumPy's C API, loaded by rust-numpy on first use, with the GIL held.
+        let array_type = unsafe { npyffi::get_type_object(py, npyffi::NpyTypes::PyArray_Type) } as usize;
+        // the builtin descriptor is a singleton NumPy keeps for its lifetime (`get_dtype`
+        // holds a reference only for this call)
+        (array_type, f64::get_dtype(py).as_dtype_ptr() as usize)
+    });
+    (array_type as *mut _, f64_descr as *mut _)
+}
+
+/// The values of `obj` in place when it is the plain case of one state: exactly a
+/// `numpy.ndarray` (no subclass) of native float64, C-contiguous and aligned, of shape
+/// `(n,)`, every value finite. None for anything else, which the general path
+/// ([`states`]) converts or refuses with a message naming what is wrong.
+///
+/// SAFETY (callers): the GIL is held and the array is not written while the slice lives.
+unsafe fn plain_state<'a>(py: Python<'_>, obj: &'a Bound<'_, PyAny>, n: usize) -> Option<&'a [f64]> {
+    let (array_type, f64_descr) = ndarray_and_f64(py);
+    let p = obj.as_ptr();
+    unsafe {
+        if pyo3::ffi::Py_TYPE(p) != array_type {
+            return None;
+        }
+        let a = &(*(p as *const npyffi::PyArrayObject)).fields;
+        let wanted = npyffi::NPY_ARRAY_C_CONTIGUOUS | npyffi::NPY_ARRAY_ALIGNED;
+        if a.nd != 1 || *a.dimensions != n as npyffi::npy_intp || a.descr != f64_descr || a.flags & wanted != wanted {
+            return None;
+        }
+        let values = std::slice::from_raw_parts(a.data as *const f64, n);
+        all_finite(values).then_some(values)
+    }
+}
+
+/// [`plain_state`] for every argument, or None if any is not plain.
+///
+/// SAFETY: as [`plain_state`].
+unsafe fn plain_states<'a, 'py, const K: usize>(
+    py: Python<'py>,
+    n: usize,
+    args: &'a [(&str, &Bound<'py, PyAny>); K],
+) -> Option<[&'a [f64]; K]> {
+    let mut out: [&[f64]; K] = [&[]; K];
+    for (slot, (_, obj)) in out.iter_mut().zip(args) {
+        *slot = unsafe { plain_state(py, obj, n) }?;
+    }
+    Some(out)
+}
+
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum Shape {
     /// One state, `(n,)`.
@@ -180,6 +232,13 @@ fn all_finite(values: &[f64]) -> bool {
 fn new_array<'py>(py: Python<'py>, dims: &[usize]) -> Bound<'py, PyArrayDyn<f64>> {
     // SAFETY: every element is written before the array is returned to Python.
     unsafe { PyArray::<f64, _>::new(py, dims, false) }
+}
+
+/// The data of an array [`new_array`] just made (C-contiguous, not yet seen by Python).
+///
+/// SAFETY (callers): `a` is such an array and nothing else refers to its data.
+unsafe fn fresh_slice<'a>(a: &'a Bound<'_, PyArrayDyn<f64>>) -> &'a mut [f64] {
+    unsafe { std::slice::from_raw_parts_mut(a.data(), a.len()) }
 }
 
 /// `threads` as given from Python: None (all cores) or a count in `1..=MAX_THREADS`.
@@ -309,6 +368,14 @@ impl NumericModel {
         guard(|| {
             self.fixed_base_only()?;
             let threads = thread_arg(threads)?;
+            // the common call, one plain float64 state: read in place, no conversion objects
+            // SAFETY: inputs read-only and `out` fresh, GIL held throughout.
+            if let Some(ins) = unsafe { plain_states(py, self.model.nv, &args) } {
+                let out = new_array(py, out_shape);
+                let o = unsafe { fresh_slice(&out) };
+                self.with_scratch(|s| single(&self.model, s, ins, o));
+                return Ok(out);
+            }
             let (shape, arrays) = states(self.model.nv, args)?;
             match shape {
                 Shape::Single => {
