@@ -3,8 +3,6 @@ base where it is not supported, and the core's overflow told in the caller's wor
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from ..errors import FloatingBaseError
@@ -42,22 +40,6 @@ def overflow_error(what: str, arrays: dict) -> ValueError:
     )
 
 
-def checked(fn):
-    """``fn`` with ``threads`` checked first (for the functions whose bodies do not), and the
-    core's overflow error told as :func:`overflow_error` does."""
-
-    @functools.wraps(fn)
-    def call(robot, *args, threads=None, **kwargs):
-        if threads is not None:
-            threads = check_threads(threads)
-        try:
-            return fn(robot, *args, threads=threads, **kwargs)
-        except FloatingPointError:
-            raise overflow_error(fn.__name__, dict(zip(("q", "qd", "qdd"), args))) from None
-
-    return call
-
-
 def require_fixed_base(robot, what: str) -> None:
     """Raise :class:`~armdyn.errors.FloatingBaseError` naming ``what`` if ``robot`` (a Robot
     or a compiled model) has a floating base."""
@@ -70,13 +52,10 @@ def require_fixed_base(robot, what: str) -> None:
         )
 
 
-def fixed_base_only(fn):
-    """``fn`` refusing a floating-base robot with a FloatingBaseError naming ``fn``."""
-
-    @functools.wraps(fn)
-    def call(robot, *args, **kwargs):
-        if getattr(robot, "floating", False):
-            require_fixed_base(robot, f"armdyn.numeric.{fn.__name__}")
-        return fn(robot, *args, **kwargs)
-
-    return call
+def fixed_base_threads(robot, threads, what: str):
+    """The first lines of every function that has no floating-base form: refuse a floating
+    ``robot`` (:func:`require_fixed_base`, naming ``armdyn.numeric.<what>``), then return
+    ``threads`` checked by :func:`check_threads`."""
+    if getattr(robot, "floating", False):
+        require_fixed_base(robot, f"armdyn.numeric.{what}")
+    return threads if threads is None else check_threads(threads)

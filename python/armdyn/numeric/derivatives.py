@@ -7,7 +7,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .. import _core
-from .checks import check_threads, checked, fixed_base_only
+from .checks import fixed_base_threads, overflow_error
 from .compiled import NumericModel, RobotLike, canonical_wrenches, compiled_model, core_model, mimic_model
 
 # rnea_derivatives, aba_derivatives and minverse decide here which path a call takes: the
@@ -22,7 +22,6 @@ from .compiled import NumericModel, RobotLike, canonical_wrenches, compiled_mode
 # keyword-only parameters (about 30 ns more per call).
 
 
-@fixed_base_only
 def rnea_derivatives(
     robot: RobotLike,
     q: ArrayLike,
@@ -59,8 +58,7 @@ def rnea_derivatives(
     batches then allocates nothing, and a large batch is spared the first-touch page
     faults of fresh arrays.
     """
-    if threads is not None:  # the common call (None) skips the check's frame
-        threads = check_threads(threads)  # Rust reads True as 1
+    threads = fixed_base_threads(robot, threads, "rnea_derivatives")  # (Rust would read True as 1)
     if f_ext is None:
         try:  # the core takes a NumericModel only: a Robot's cached one, or the model itself
             return _core.rnea_derivatives(robot._numeric_model, q, qd, qdd, None, frame, threads, out)  # type: ignore[union-attr]
@@ -69,7 +67,6 @@ def rnea_derivatives(
     return _rnea_derivatives_path(robot, q, qd, qdd, f_ext, frame, threads, out)
 
 
-@fixed_base_only
 def aba_derivatives(
     robot: RobotLike,
     q: ArrayLike,
@@ -87,8 +84,7 @@ def aba_derivatives(
     f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
     joints as there (``Minv`` is that of ``M + diag(Ia)``). out: as there.
     """
-    if threads is not None:  # the common call (None) skips the check's frame
-        threads = check_threads(threads)  # Rust reads True as 1
+    threads = fixed_base_threads(robot, threads, "aba_derivatives")  # (Rust would read True as 1)
     if f_ext is None:
         try:  # as in rnea_derivatives
             return _core.aba_derivatives(robot._numeric_model, q, qd, tau, None, frame, threads, out)  # type: ignore[union-attr]
@@ -97,7 +93,6 @@ def aba_derivatives(
     return _aba_derivatives_path(robot, q, qd, tau, f_ext, frame, threads, out)
 
 
-@fixed_base_only
 def minverse(robot: RobotLike, q: ArrayLike, threads: int | None = None, out=None) -> np.ndarray:
     """The inverse of the joint-space inertia matrix, by the articulated-body recursion
     (without forming or factorising M; Carpentier 2018). q: (n,) or (N, n). Returns (n, n)
@@ -106,8 +101,7 @@ def minverse(robot: RobotLike, q: ArrayLike, threads: int | None = None, out=Non
     positive definite). out: optionally, the array to write M^-1 into and return (float64,
     C-contiguous, the result's shape, not sharing memory with q).
     """
-    if threads is not None:  # the common call (None) skips the check's frame
-        threads = check_threads(threads)  # Rust reads True as 1
+    threads = fixed_base_threads(robot, threads, "minverse")  # (Rust would read True as 1)
     try:  # as in rnea_derivatives
         return _core.minverse(robot._numeric_model, q, threads, out)  # type: ignore[union-attr]
     except (AttributeError, TypeError):
@@ -169,11 +163,13 @@ def _minverse_path(robot, q, threads, out):
     return _into(out, mimic_model(robot, "minverse").minverse(q, threads))
 
 
-@fixed_base_only
-@checked
 def gravity_derivatives(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """``dg/dq`` of the gravity torques: (n, n) or (N, n, n), ``[i, j] = d g_i / d q_j``."""
-    mimic = mimic_model(robot, "gravity_derivatives")
-    if mimic is not None:
-        return mimic.gravity_derivatives(q, threads)
-    return _core.gravity_derivatives(core_model(robot, "gravity_derivatives"), q, threads)
+    threads = fixed_base_threads(robot, threads, "gravity_derivatives")
+    try:
+        mimic = mimic_model(robot, "gravity_derivatives")
+        if mimic is not None:
+            return mimic.gravity_derivatives(q, threads)
+        return _core.gravity_derivatives(core_model(robot, "gravity_derivatives"), q, threads)
+    except FloatingPointError:  # the core checks its result: an overflow from finite inputs
+        raise overflow_error("gravity_derivatives", {"q": q}) from None

@@ -10,7 +10,7 @@ from numpy.typing import ArrayLike
 
 from .. import _core
 from ..model import Robot
-from .checks import check_threads, checked, fixed_base_only, overflow_error, require_fixed_base
+from .checks import check_threads, fixed_base_threads, overflow_error, require_fixed_base
 from .compiled import RobotLike, canonical_wrenches, compile_model, compiled_model, core_model
 
 
@@ -114,54 +114,49 @@ def aba(
     return _core.aba_ext(core_model(robot, "aba with f_ext"), q, qd, tau, f_ext, frame, threads)
 
 
-@fixed_base_only
 def gravity(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Gravity torques g(q) = rnea(q, 0, 0). q: (n,) or (N, n); same shape out."""
-    threads = check_threads(threads)
+    threads = fixed_base_threads(robot, threads, "gravity")
     try:
         return compiled_model(robot).gravity_torques(q, threads)
     except FloatingPointError:
         raise overflow_error("gravity", {"q": q}) from None
 
 
-@fixed_base_only
 def bias(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Nonlinear effects h(q, qd) = C(q, qd) qd + g(q) = rnea(q, qd, 0).
 
     q, qd: (n,) or (N, n); same shape out.
     """
-    threads = check_threads(threads)
+    threads = fixed_base_threads(robot, threads, "bias")
     try:
         return compiled_model(robot).bias(q, qd, threads)
     except FloatingPointError:
         raise overflow_error("bias", {"q": q, "qd": qd}) from None
 
 
-@fixed_base_only
 def coriolis_matrix(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """The Coriolis matrix C(q, qd) built from the Christoffel symbols of M.
 
     C qd = h - g, and Mdot - 2C is skew-symmetric. q, qd: (n,) or (N, n).
     Returns (n, n) or (N, n, n).
     """
-    threads = check_threads(threads)
+    threads = fixed_base_threads(robot, threads, "coriolis_matrix")
     try:
         return compiled_model(robot).coriolis_matrix(q, qd, threads)
     except FloatingPointError:
         raise overflow_error("coriolis_matrix", {"q": q, "qd": qd}) from None
 
 
-@fixed_base_only
 def kinetic_energy(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None = None) -> float | np.ndarray:
     """Kinetic energy T = 1/2 qd^T M(q) qd. q, qd: (n,) -> float, or (N, n) -> (N,)."""
-    threads = check_threads(threads)
+    threads = fixed_base_threads(robot, threads, "kinetic_energy")
     try:
         return compiled_model(robot).kinetic_energy(q, qd, threads)
     except FloatingPointError:
         raise overflow_error("kinetic_energy", {"q": q, "qd": qd}) from None
 
 
-@fixed_base_only
 def potential_energy(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> float | np.ndarray:
     """Potential energy V = -sum_i m_i gravity . p_ci over every link (the base and links
     welded to it included, a constant), zero with every centre of mass at the base
@@ -169,15 +164,13 @@ def potential_energy(robot: RobotLike, q: ArrayLike, *, threads: int | None = No
 
     q: (n,) -> float, or (N, n) -> (N,).
     """
-    threads = check_threads(threads)
+    threads = fixed_base_threads(robot, threads, "potential_energy")
     try:
         return compiled_model(robot).potential_energy(q, threads)
     except FloatingPointError:
         raise overflow_error("potential_energy", {"q": q}) from None
 
 
-@fixed_base_only
-@checked
 def regressor(
     robot: RobotLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, *, threads: int | None = None, columns: str = "model"
 ) -> np.ndarray:
@@ -194,12 +187,16 @@ def regressor(
       :func:`armdyn.identification.regressor`'s ``pi``;
     * ``columns="all"``: every movable joint's four columns ``[qdd, qd, sign(qd), 1]``.
     """
+    threads = fixed_base_threads(robot, threads, "regressor")
     if columns not in ("model", "all"):
         raise ValueError(f"columns must be 'model' or 'all', got {columns!r}")
     # parameters about each link's frame on its joint (Robot.canonical), as the symbolic
     # armdyn.identification.regressor defines them
     model = core_model(robot, "regressor")
-    Y = _core.regressor(model, q, qd, qdd, threads)
+    try:
+        Y = _core.regressor(model, q, qd, qdd, threads)
+    except FloatingPointError:
+        raise overflow_error("regressor", {"q": q, "qd": qd, "qdd": qdd}) from None
     if columns == "all":
         return Y
     keep = robot.__dict__.get("_regressor_columns") if isinstance(robot, Robot) else None

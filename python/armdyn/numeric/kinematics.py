@@ -7,12 +7,10 @@ from numpy.typing import ArrayLike
 
 from .. import _core
 from ..model import Link, Robot
-from .checks import checked, fixed_base_only
+from .checks import fixed_base_threads, overflow_error
 from .compiled import RobotLike, compiled_model, core_model, frame_offsets, mimic_model
 
 
-@fixed_base_only
-@checked
 def forward_kinematics(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Homogeneous pose of every link frame in the base frame.
 
@@ -20,17 +18,19 @@ def forward_kinematics(robot: RobotLike, q: ArrayLike, *, threads: int | None = 
     ``list(robot.links)`` order (base first); each ``[[R, p], [0, 0, 0, 1]]`` with R the
     link's axes in base coordinates and p its origin.
     """
-    poses = compiled_model(robot).forward_kinematics(q, threads)
-    offsets = frame_offsets(robot)
-    return poses if offsets is None else poses @ offsets
+    threads = fixed_base_threads(robot, threads, "forward_kinematics")
+    try:
+        poses = compiled_model(robot).forward_kinematics(q, threads)
+        offsets = frame_offsets(robot)
+        return poses if offsets is None else poses @ offsets
+    except FloatingPointError:  # the core checks its result: an overflow from finite inputs
+        raise overflow_error("forward_kinematics", {"q": q}) from None
 
 
 #: the reference frames of :func:`jacobian`, named as Pinocchio names them
 REFERENCE_FRAMES = ("local_world_aligned", "local", "world")
 
 
-@fixed_base_only
-@checked
 def jacobian(
     robot: RobotLike,
     q: ArrayLike,
@@ -51,22 +51,26 @@ def jacobian(
     * ``"world"``: the spatial velocity in the base frame: v the velocity of the body
       point passing through the base origin, ``v_p - w x p``; w in base axes.
     """
-    frame = str(getattr(reference_frame, "name", reference_frame)).lower()
-    if frame not in REFERENCE_FRAMES:
-        raise ValueError(f"reference_frame must be one of {', '.join(REFERENCE_FRAMES)}, got {reference_frame!r}")
-    J = _aligned_jacobian(robot, q, link, threads)
-    if frame == "local_world_aligned":
-        return J
-    name = link.name if isinstance(link, Link) else link
-    k = name if isinstance(name, (int, np.integer)) else list(compiled_model(robot).link_names).index(name)
-    pose = forward_kinematics(robot, q, threads=threads)[..., k, :, :]
-    R, p = pose[..., :3, :3], pose[..., :3, 3]
-    Jv, Jw = J[..., :3, :], J[..., 3:, :]
-    if frame == "local":
-        Rt = R.swapaxes(-1, -2)
-        return np.concatenate([Rt @ Jv, Rt @ Jw], axis=-2)
-    # world: v_O = v_p + w x (0 - p) = v_p + p x w, column by column
-    return np.concatenate([Jv + np.cross(p[..., None, :], Jw.swapaxes(-1, -2)).swapaxes(-1, -2), Jw], axis=-2)
+    threads = fixed_base_threads(robot, threads, "jacobian")
+    try:
+        frame = str(getattr(reference_frame, "name", reference_frame)).lower()
+        if frame not in REFERENCE_FRAMES:
+            raise ValueError(f"reference_frame must be one of {', '.join(REFERENCE_FRAMES)}, got {reference_frame!r}")
+        J = _aligned_jacobian(robot, q, link, threads)
+        if frame == "local_world_aligned":
+            return J
+        name = link.name if isinstance(link, Link) else link
+        k = name if isinstance(name, (int, np.integer)) else list(compiled_model(robot).link_names).index(name)
+        pose = forward_kinematics(robot, q, threads=threads)[..., k, :, :]
+        R, p = pose[..., :3, :3], pose[..., :3, 3]
+        Jv, Jw = J[..., :3, :], J[..., 3:, :]
+        if frame == "local":
+            Rt = R.swapaxes(-1, -2)
+            return np.concatenate([Rt @ Jv, Rt @ Jw], axis=-2)
+        # world: v_O = v_p + w x (0 - p) = v_p + p x w, column by column
+        return np.concatenate([Jv + np.cross(p[..., None, :], Jw.swapaxes(-1, -2)).swapaxes(-1, -2), Jw], axis=-2)
+    except FloatingPointError:  # the core checks its result: an overflow from finite inputs
+        raise overflow_error("jacobian", {"q": q}) from None
 
 
 def _aligned_jacobian(robot, q, link, threads):
@@ -86,8 +90,6 @@ def _aligned_jacobian(robot, q, link, threads):
     return np.concatenate([Jv - np.cross(r[..., None, :], Jw.swapaxes(-1, -2)).swapaxes(-1, -2), Jw], axis=-2)
 
 
-@fixed_base_only
-@checked
 def jacobian_dot(
     robot: RobotLike, q: ArrayLike, qd: ArrayLike, link: str | int | Link, *, threads: int | None = None
 ) -> np.ndarray:
@@ -95,27 +97,31 @@ def jacobian_dot(
     ``[v; w]`` in base-frame axes (Pinocchio's LOCAL_WORLD_ALIGNED), so that the link
     origin's acceleration and the link's angular acceleration are ``J qdd + Jdot qd``.
     link: a link name, index in ``list(robot.links)``, or Link."""
-    if isinstance(link, Link):
-        link = link.name
-    mimic = mimic_model(robot, "jacobian_dot")
-    if mimic is not None:
-        Jd = mimic.jacobian_dot(q, qd, link, threads)
-    else:
-        Jd = _core.jacobian_dot(core_model(robot, "jacobian_dot"), q, qd, link, threads)
-    offsets = frame_offsets(robot)
-    if offsets is None or not isinstance(robot, Robot):  # offsets: only a Robot has them
-        return Jd
-    # the point at r = R pf from the compiled (on-joint) frame's origin: J_v' = J_v - [r]x J_w,
-    # so Jdot_v' = Jdot_v - [w x r]x J_w - [r]x Jdot_w, with w = J_w qd
-    model = compiled_model(robot)
-    k = link if isinstance(link, (int, np.integer)) else robot.link_index(link)
-    r = model.forward_kinematics(q, threads)[..., k, :3, :3] @ offsets[k, :3, 3]
-    Jw = model.jacobian(q, link, threads)[..., 3:, :]
-    w = np.einsum("...ij,...j->...i", Jw, np.asarray(qd, dtype=float))
-    rd = np.cross(w, r)
+    threads = fixed_base_threads(robot, threads, "jacobian_dot")
+    try:
+        if isinstance(link, Link):
+            link = link.name
+        mimic = mimic_model(robot, "jacobian_dot")
+        if mimic is not None:
+            Jd = mimic.jacobian_dot(q, qd, link, threads)
+        else:
+            Jd = _core.jacobian_dot(core_model(robot, "jacobian_dot"), q, qd, link, threads)
+        offsets = frame_offsets(robot)
+        if offsets is None or not isinstance(robot, Robot):  # offsets: only a Robot has them
+            return Jd
+        # the point at r = R pf from the compiled (on-joint) frame's origin: J_v' = J_v - [r]x J_w,
+        # so Jdot_v' = Jdot_v - [w x r]x J_w - [r]x Jdot_w, with w = J_w qd
+        model = compiled_model(robot)
+        k = link if isinstance(link, (int, np.integer)) else robot.link_index(link)
+        r = model.forward_kinematics(q, threads)[..., k, :3, :3] @ offsets[k, :3, 3]
+        Jw = model.jacobian(q, link, threads)[..., 3:, :]
+        w = np.einsum("...ij,...j->...i", Jw, np.asarray(qd, dtype=float))
+        rd = np.cross(w, r)
 
-    def cross_cols(v, A):  # [v]x A, column by column
-        return np.cross(v[..., None, :], A.swapaxes(-1, -2)).swapaxes(-1, -2)
+        def cross_cols(v, A):  # [v]x A, column by column
+            return np.cross(v[..., None, :], A.swapaxes(-1, -2)).swapaxes(-1, -2)
 
-    Jdv = Jd[..., :3, :] - cross_cols(rd, Jw) - cross_cols(r, Jd[..., 3:, :])
-    return np.concatenate([Jdv, Jd[..., 3:, :]], axis=-2)
+        Jdv = Jd[..., :3, :] - cross_cols(rd, Jw) - cross_cols(r, Jd[..., 3:, :])
+        return np.concatenate([Jdv, Jd[..., 3:, :]], axis=-2)
+    except FloatingPointError:  # the core checks its result: an overflow from finite inputs
+        raise overflow_error("jacobian_dot", {"q": q, "qd": qd}) from None
