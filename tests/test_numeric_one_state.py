@@ -149,3 +149,78 @@ def test_a_state_that_overflows_is_an_error_not_inf(arm):
     huge = np.full(robot.dof, 1e300)
     with pytest.raises(ValueError, match="overflows"):
         num.rnea(robot, state["q"], huge, state["qdd"])
+
+
+# ------------------------------------------------------------------ results reused once dropped
+# The core keeps a few small single-state results and writes a new result into one only
+# when nothing else refers to it (lib.rs, OutputPool): a result the caller holds, or
+# anything seen through it, never changes.
+
+
+def _fresh(fn, robot, *args):
+    """The result computed on lists (the general path, a newly made array every time)."""
+    return fn(robot, *(np.asarray(a).tolist() for a in args))
+
+
+def test_held_results_never_change(arm):
+    robot, state = arm
+    rng = np.random.default_rng(5)
+    held = []
+    for _ in range(12):  # more calls than the pool has slots, each result kept
+        q, qd, qdd = (random_state(rng, robot.dof) for _ in range(3))
+        held.append(((q, qd, qdd), num.rnea(robot, q, qd, qdd), num.crba(robot, q)))
+    for (q, qd, qdd), tau, M in held:
+        assert np.array_equal(tau, _fresh(num.rnea, robot, q, qd, qdd))
+        assert np.array_equal(M, _fresh(num.crba, robot, q))
+    arrays = [a for _, tau, M in held for a in (tau, M)]
+    assert len({id(a) for a in arrays}) == len(arrays)
+    assert not any(np.shares_memory(a, b) for i, a in enumerate(arrays) for b in arrays[i + 1 :])
+
+
+def test_a_dropped_result_is_written_whole_when_reused(arm):
+    robot, state = arm
+    rng = np.random.default_rng(6)
+    for _ in range(6):
+        q = random_state(rng, robot.dof)
+        M = num.crba(robot, q)
+        M[...] = np.nan  # scribbled on, then dropped: the next result must not show it
+        del M
+        q2 = random_state(rng, robot.dof)
+        assert np.array_equal(num.crba(robot, q2), _fresh(num.crba, robot, q2))
+
+
+def test_views_weak_references_and_changed_arrays_are_not_reused(arm):
+    import weakref
+
+    robot, state = arm
+    q, qd = state["q"], state["qd"]
+    rng = np.random.default_rng(7)
+    row = num.crba(robot, q)[0]  # the result is dropped, its first row (a view) kept
+    tau = num.gravity(robot, q)
+    ref = weakref.ref(tau)
+    expected_tau = tau.copy()
+    del tau
+    frozen = num.bias(robot, q, qd)
+    frozen.flags.writeable = False
+    del frozen
+    flat = num.crba(robot, q)
+    flat.shape = (robot.dof * robot.dof,)
+    del flat
+    for _ in range(8):
+        q2 = random_state(rng, robot.dof)
+        M2, g2, h2 = num.crba(robot, q2), num.gravity(robot, q2), num.bias(robot, q2, qd)
+        assert M2.shape == (robot.dof, robot.dof) and M2.flags.writeable and h2.flags.writeable
+        assert np.array_equal(M2, _fresh(num.crba, robot, q2))
+        assert np.array_equal(g2, _fresh(num.gravity, robot, q2))
+        assert np.array_equal(h2, _fresh(num.bias, robot, q2, qd))
+    assert np.array_equal(row, _fresh(num.crba, robot, q)[0])
+    alive = ref()
+    assert alive is None or np.array_equal(alive, expected_tau)
+
+
+def test_a_result_resizes_in_place_without_the_reference_check(arm):
+    robot, state = arm
+    M = num.crba(robot, state["q"])
+    M.resize((robot.dof * robot.dof + 1,), refcheck=False)  # the pool's reference is not a view
+    assert M.shape == (robot.dof * robot.dof + 1,)
+    assert num.crba(robot, state["q"]).shape == (robot.dof, robot.dof)

@@ -21,6 +21,11 @@ Every function takes a robot and one state or a batch of states:
   Batched results equal single calls bit for bit.
 * Arrays must hold real numbers: complex, boolean, string or other non-real arrays
   are refused with a ``ValueError`` (not converted).
+* Every result belongs to the caller alone. For one state armdyn may write the result
+  into a small array it made for an earlier call once nothing refers to that array any
+  more (no name, view or weak reference; it spares the allocation, a fifth of a
+  6-joint crba): a result held is never changed. The one visible trace is that
+  ``result.resize(...)`` in place needs ``refcheck=False``.
 * ``aba`` raises ``ValueError`` when the joint-space inertia matrix is singular: a
   movable joint whose subtree has no mass and no inertia (named in the message), or
   a state where the result is not finite.
