@@ -2,6 +2,7 @@
 
     python benchmarks/bench_numeric.py            # full run (a few minutes)
     python benchmarks/bench_numeric.py --quick    # smoke run: fewer repeats, N = 2e4
+    python benchmarks/bench_numeric.py --cpu-time # single calls timed in on-CPU time (shared machines)
 
 (with armdyn importable: ``maturin develop --release`` or ``pip install .``, or
 ``PYTHONPATH=python`` after a release build).
@@ -52,11 +53,12 @@ from pinocchio_bridge import PinocchioRobot  # noqa: E402
 from armdyn import numeric as num  # noqa: E402
 
 
-def per_call_run(f, args, number: int):
-    """A function timing one run of ``number`` calls ``f(*args)``; returns seconds per call."""
+def per_call_run(f, args, number: int, clock=time.perf_counter):
+    """A function timing one run of ``number`` calls ``f(*args)`` by ``clock``; returns seconds
+    per call."""
     names = [f"a{i}" for i in range(len(args))]
     stmt = f"f({', '.join(names)})"  # a direct call, no lambda or *args layer
-    timer = timeit.Timer(stmt, globals={"f": f, **dict(zip(names, args))})
+    timer = timeit.Timer(stmt, globals={"f": f, **dict(zip(names, args))}, timer=clock)
     return lambda: timer.timeit(number) / number
 
 
@@ -97,6 +99,11 @@ def main(argv=None) -> int:
     parser.add_argument("--batch", type=float, default=1e5, help="N, states per batch")
     parser.add_argument("--batch-repeat", type=int, default=7, help="runs per batch measurement (median)")
     parser.add_argument("--threads", default="1,2", help="thread counts for batches")
+    parser.add_argument(
+        "--cpu-time",
+        action="store_true",
+        help="time single calls in this thread's CPU time (time.thread_time), not wall time: steadier on a shared machine",
+    )
     args = parser.parse_args(argv)
     if args.quick:
         args.number, args.repeat, args.batch, args.batch_repeat = 2000, 5, 2e4, 3
@@ -110,6 +117,7 @@ def main(argv=None) -> int:
     print(
         f"per call: median of {args.repeat} x {args.number} calls; batch: N = {N}, median of {args.batch_repeat}; "
         f"OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY')}; load average {os.getloadavg()[0]:.2f}"
+        + ("; single calls in CPU time" if args.cpu_time else "")
     )
     print("ratio = armdyn time / Pinocchio time (< 1: armdyn faster)\n")
 
@@ -129,8 +137,9 @@ def main(argv=None) -> int:
             ("crba", (num.crba, (robot, q)), (pin.crba, (model, data, q))),
             ("aba", (num.aba, (robot, q, v, tau)), (pin.aba, (model, data, q, v, tau))),
         ):
+            clock = time.thread_time if args.cpu_time else time.perf_counter
             t_mine, t_pin = paired_medians(
-                per_call_run(*mine, args.number), per_call_run(*theirs, args.number), args.repeat
+                per_call_run(*mine, args.number, clock), per_call_run(*theirs, args.number, clock), args.repeat
             )
             rows.append((name, fn, "1 state", t_mine, t_pin))
 
