@@ -9,6 +9,10 @@
 //! errors and NaN/inf raise `ValueError` naming the argument. Batches run on `threads`
 //! threads (None = all cores) with the GIL released. A Rust panic becomes a
 //! `RuntimeError`, never a crash.
+//!
+//! One state is the latency-bound case (a 6-joint rnea is 300 ns of arithmetic): a plain
+//! float64 `(n,)` ndarray is read in place (`plain_state`), the GIL is kept, and the
+//! result goes into an array of an earlier call that nobody holds any more (`OutputPool`).
 
 use armdyn_core::algo::coriolis::CoriolisWork;
 use armdyn_core::{algo, batch, Data, JointDynamics, JointSpec, JointType, Model};
