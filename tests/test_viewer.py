@@ -148,6 +148,20 @@ def test_ur5_meshes_render(tmp_path):
     assert img[-5:, :].max(axis=2).min() >= 180  # the bottom edge is background or grid: the arm is in view
 
 
+def test_the_floor_is_under_a_legged_robots_feet(tmp_path):
+    """Solo-12 with its base fixed hangs its legs below the base: the floor grid goes under
+    its feet, not through its legs. At q = 0 no joint turns anything, so each foot frame
+    sits at the sum of its chain's joint origins in the URDF, z = -0.16 - 0.16 m; the
+    foot's ball reaches a little below that. An arm's floor stays at its base plane (the
+    UR5's base mesh reaches 1.6 cm below it)."""
+    solo = load(example_robot_data_dir() / "solo_description" / "robots" / "solo12.urdf")
+    attrs, img = browse(view(solo).html(), tmp_path, "solo12")
+    assert attrs["status"] == "ready" and drawn_fraction(img) > 0.03
+    assert -0.32 - 0.03 < float(attrs["floor"]) < -0.32
+    attrs, _ = browse(view(load(ur5_urdf()), [0.3, -1.0, 1.2, -0.5, 0.8, 0.2]).html(), tmp_path, "ur5", shot=False)
+    assert -0.03 < float(attrs["floor"]) <= 0
+
+
 def test_rp_arm_simple_shapes_render(tmp_path):
     v = view(rp_arm(), [0.4, 0.3], frames=True)
     assert v.scene["meshes"] == [] and len(v.scene["segments"]) == 2 and len(v.scene["coms"]) == 2
