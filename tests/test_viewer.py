@@ -245,6 +245,31 @@ def test_poses_equal_pinocchio():
     assert sum(model.existFrame(n, pin.FrameType.BODY) for n in scene["links"]) >= 7
 
 
+@needs_pinocchio
+def test_floating_poses_equal_pinocchio():
+    """A floating robot's configurations (base position, quaternion, joints) place its
+    links where Pinocchio's free flyer does; Solo-12's arrays are Pinocchio's as they are."""
+    path = example_robot_data_dir() / "solo_description" / "robots" / "solo12.urdf"
+    robot = load(path, root_joint="free-flyer")
+    model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    data = model.createData()
+    np.random.seed(11)  # pin.randomConfiguration draws from NumPy's global generator
+    Q = np.array([pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq)) for _ in range(4)])
+    scene = animate(robot, np.arange(4.0), Q).scene
+    L = len(scene["links"])
+    poses = np.array(scene["poses"]).reshape(4, L, 7)
+    for k, q in enumerate(Q):
+        pin.framesForwardKinematics(model, data, q)
+        for i, name in enumerate(scene["links"]):
+            oMf = data.oMf[model.getFrameId(name, pin.FrameType.BODY)]
+            assert np.allclose(poses[k, i, :3], oMf.translation, atol=1e-6), (name, k)
+            assert np.allclose(quat_matrix(*poses[k, i, 3:]), oMf.rotation, atol=1e-6), (name, k)
+    bad = Q[:1].copy()
+    bad[0, 3:7] *= 1.1
+    with pytest.raises(ValueError, match="unit length"):
+        view(robot, bad[0])
+
+
 def test_quaternions_match_scipy():
     """Random rotations and the half turns about each axis (where the trace is -1: the
     other branches of Shepperd's method) against SciPy's conversion."""

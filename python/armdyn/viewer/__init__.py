@@ -1,6 +1,7 @@
 """A 3-D view of an arm in the browser or in Jupyter (three.js, WebGL).
 
-``view(robot, q=None)`` shows the arm at the joint coordinates ``q``;
+``view(robot, q=None)`` shows the arm at the joint coordinates ``q`` (a floating robot's
+``q`` places its base too);
 ``animate(robot, times, Q)`` plays a trajectory (play/pause, a time slider, loop), at
 most ``max_frames`` frames of it (evenly spread samples of the rows of ``Q``). Both
 return a :class:`View`: ``.html()`` is a self-contained page (three.js inlined, nothing
