@@ -148,6 +148,20 @@ def test_ur5_meshes_render(tmp_path):
     assert img[-5:, :].max(axis=2).min() >= 180  # the bottom edge is background or grid: the arm is in view
 
 
+def test_the_floor_is_under_a_legged_robots_feet(tmp_path):
+    """Solo-12 with its base fixed hangs its legs below the base: the floor grid goes under
+    its feet, not through its legs. At q = 0 no joint turns anything, so each foot frame
+    sits at the sum of its chain's joint origins in the URDF, z = -0.16 - 0.16 m; the
+    foot's ball reaches a little below that. An arm's floor stays at its base plane (the
+    UR5's base mesh reaches 1.6 cm below it)."""
+    solo = load(example_robot_data_dir() / "solo_description" / "robots" / "solo12.urdf")
+    attrs, img = browse(view(solo).html(), tmp_path, "solo12")
+    assert attrs["status"] == "ready" and drawn_fraction(img) > 0.03
+    assert -0.32 - 0.03 < float(attrs["floor"]) < -0.32
+    attrs, _ = browse(view(load(ur5_urdf()), [0.3, -1.0, 1.2, -0.5, 0.8, 0.2]).html(), tmp_path, "ur5", shot=False)
+    assert -0.03 < float(attrs["floor"]) <= 0
+
+
 def test_rp_arm_simple_shapes_render(tmp_path):
     v = view(rp_arm(), [0.4, 0.3], frames=True)
     assert v.scene["meshes"] == [] and len(v.scene["segments"]) == 2 and len(v.scene["coms"]) == 2
@@ -229,6 +243,31 @@ def test_poses_equal_pinocchio():
             assert np.allclose(poses[k, i, :3], oMf.translation, atol=1e-6), (name, k)
             assert np.allclose(quat_matrix(*poses[k, i, 3:]), oMf.rotation, atol=1e-6), (name, k)
     assert sum(model.existFrame(n, pin.FrameType.BODY) for n in scene["links"]) >= 7
+
+
+@needs_pinocchio
+def test_floating_poses_equal_pinocchio():
+    """A floating robot's configurations (base position, quaternion, joints) place its
+    links where Pinocchio's free flyer does; Solo-12's arrays are Pinocchio's as they are."""
+    path = example_robot_data_dir() / "solo_description" / "robots" / "solo12.urdf"
+    robot = load(path, root_joint="free-flyer")
+    model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    data = model.createData()
+    np.random.seed(11)  # pin.randomConfiguration draws from NumPy's global generator
+    Q = np.array([pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq)) for _ in range(4)])
+    scene = animate(robot, np.arange(4.0), Q).scene
+    L = len(scene["links"])
+    poses = np.array(scene["poses"]).reshape(4, L, 7)
+    for k, q in enumerate(Q):
+        pin.framesForwardKinematics(model, data, q)
+        for i, name in enumerate(scene["links"]):
+            oMf = data.oMf[model.getFrameId(name, pin.FrameType.BODY)]
+            assert np.allclose(poses[k, i, :3], oMf.translation, atol=1e-6), (name, k)
+            assert np.allclose(quat_matrix(*poses[k, i, 3:]), oMf.rotation, atol=1e-6), (name, k)
+    bad = Q[:1].copy()
+    bad[0, 3:7] *= 1.1
+    with pytest.raises(ValueError, match="unit length"):
+        view(robot, bad[0])
 
 
 def test_quaternions_match_scipy():
