@@ -69,7 +69,7 @@ from typing import Callable
 import numpy as np
 
 from . import _core
-from .configuration import _rotate
+from .configuration import rotate_vector
 from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy, require_fixed_base
 from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
@@ -316,7 +316,7 @@ def floating_energies(model, q: np.ndarray, v: np.ndarray, threads=None, rows: i
         M = model.crba(qs, threads)
         kinetic[at : at + rows] = 0.5 * np.einsum("ni,nij,nj->n", vs, M, vs)
         h = np.stack([M[:, 5, 1], M[:, 3, 2], M[:, 4, 0]], axis=-1)
-        com_moment = M[:, 0, 0, None] * qs[:, :3] + _rotate(qs[:, 3:7], h)
+        com_moment = M[:, 0, 0, None] * qs[:, :3] + rotate_vector(qs[:, 3:7], h)
         potential[at : at + rows] = -com_moment @ g
     return kinetic, potential
 
