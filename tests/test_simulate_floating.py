@@ -229,3 +229,38 @@ def test_limits_and_refusals():
         simulate(robot, q0[7:], v0, dt=1e-3, steps=3)
     with pytest.raises(ValueError, match="torque"):
         simulate(robot, q0, v0, dt=1e-3, steps=3, torque=np.zeros(robot.dof))
+
+
+FREE_MJCF = """<mujoco model="bug"><worldbody><body name="torso" pos="0 0 1" euler="0 0 90"><freejoint/>
+<inertial pos="0 0 0" mass="4" diaginertia="0.1 0.2 0.25"/>
+<body name="leg" pos="0.3 0 0"><joint name="hip" axis="0 1 0"/>
+<inertial pos="0.1 0 0" mass="0.5" diaginertia="0.01 0.01 0.01"/></body></body></worldbody></mujoco>"""
+
+
+def test_cli_simulates_a_floating_mjcf(capsys, tmp_path):
+    """``armdyn simulate`` on an MJCF with a free body: it starts at the pose the file
+    writes (turned 90 degrees about z, 1 m up), --qd0 gives the whole velocity, the
+    energy line reports the drift; a controller is refused with exit status 2."""
+    from armdyn.cli import main
+
+    path = tmp_path / "bug.xml"
+    path.write_text(FREE_MJCF)
+    plot = tmp_path / "run.png"
+    common = ["simulate", str(path), "--duration", "0.2", "--dt", "0.001"]
+    assert main([*common, "--qd0", "0,0,0,1,2,0.5,3", "--plot", str(plot)]) == 0
+    out = capsys.readouterr().out
+    q_final = np.array(out.split("q_final  = [")[1].split("]")[0].split(","), dtype=float)
+    assert len(q_final) == 8 and plot.stat().st_size > 0
+    assert "relative drift" in out and float(out.split("relative drift ")[1].split()[0]) < 1e-10
+    # from the written pose (1 m up, turned 90 degrees about z): the centre of mass on
+    # its parabola (6 printed digits)
+    robot = armdyn.load(path)
+    q0 = np.array([0, 0, 1, 0, 0, np.sqrt(0.5), np.sqrt(0.5), 0])
+    v0 = np.array([0, 0, 0, 1, 2, 0.5, 3.0])
+    p0, _ = momenta(robot, q0[None], v0[None])
+    mass = num.crba(robot, q0)[0, 0]
+    q_final[3:7] /= np.linalg.norm(q_final[3:7])
+    expected = com(robot, q0[None])[0] + 0.2 * p0[0] / mass + 0.5 * G * 0.04
+    assert robot.floating and np.abs(com(robot, q_final[None])[0] - expected).max() < 1e-5
+    assert main([*common, "--controller", "pd", "--target", "0"]) == 2
+    assert "floating base" in capsys.readouterr().err
