@@ -20,9 +20,7 @@
 
 from __future__ import annotations
 
-import re
 import warnings
-import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
@@ -32,7 +30,13 @@ import armdyn
 import armdyn.numeric as numeric
 from armdyn.errors import ModelError
 from armdyn.io.mjcf import MjcfIgnoredWarning, load_mjcf
-from armdyn.io.mjcf_state import from_mujoco_force, from_mujoco_state, to_mujoco_force, to_mujoco_state
+from armdyn.io.mjcf_state import (
+    from_mujoco_force,
+    from_mujoco_state,
+    to_mujoco_force,
+    to_mujoco_state,
+    urdf_for_mujoco,
+)
 from armdyn.simulate import simulate
 
 mujoco = pytest.importorskip("mujoco")
@@ -210,18 +214,8 @@ ERD = {
 
 
 def floating_urdf(urdf, out):
-    """``urdf`` with the base on a ``floating`` joint from a ``world`` link (MuJoCo's URDF
-    reader makes that joint a free joint) and no meshes (not installed where the URDF
-    points; they only make contacts)."""
-    text = re.sub(r"<(visual|collision)>.*?</\1>", "", urdf.read_text(), flags=re.S)
-    root = ET.fromstring(text.encode())
-    children = {j.find("child").get("link") for j in root.findall("joint")}
-    (base,) = [link.get("name") for link in root.findall("link") if link.get("name") not in children]
-    head = re.search(r"<robot[^>]*>", text).end()
-    joint = (
-        f'<link name="world"/><joint name="root" type="floating"><parent link="world"/><child link="{base}"/></joint>'
-    )
-    out.write_text(text[:head] + joint + text[head:])
+    """``urdf`` for MuJoCo's compiler, floating (:func:`urdf_for_mujoco`), written to ``out``."""
+    out.write_text(urdf_for_mujoco(urdf.read_text()))
     return out
 
 

@@ -26,15 +26,23 @@ armdyn's floating robots as Pinocchio (siblings by name), so they are permuted b
 ``robot.meta["mujoco_joints"]`` (an MJCF read by armdyn), else armdyn's own order.
 Fixed-base robots: the permutation alone. Arrays are one state ``(n,)`` or a batch
 ``(N, n)``; the functions only rearrange and rotate (a quaternion is not normalised).
+
+:func:`urdf_for_mujoco` prepares a URDF for MuJoCo's compiler: its root link on a
+``floating`` joint from a ``world`` link (which MuJoCo makes a free joint) and without
+meshes, so that ``mujoco.MjModel.from_xml_string`` then ``mujoco.mj_saveLastXML`` write
+the floating robot's MJCF.
 """
 
 from __future__ import annotations
+
+import re
+import xml.etree.ElementTree as ET
 
 import numpy as np
 
 from ..configuration import quaternion_conjugate, rotate_vector
 
-__all__ = ["from_mujoco_state", "to_mujoco_state", "from_mujoco_force", "to_mujoco_force"]
+__all__ = ["from_mujoco_state", "to_mujoco_state", "from_mujoco_force", "to_mujoco_force", "urdf_for_mujoco"]
 
 
 def _order(robot, joint_names) -> np.ndarray:
@@ -145,3 +153,28 @@ def to_mujoco_force(robot, q, tau, *, joint_names=None) -> np.ndarray:
     tau = got["tau"]
     f = rotate_vector(got["q"][..., 3:7], tau[..., :3])
     return np.concatenate([f, tau[..., 3:6], _joints(tau, 6, order, False)], axis=-1)
+
+
+def urdf_for_mujoco(text: str, floating: bool = True) -> str:
+    """The URDF ``text`` for MuJoCo's compiler: ``<visual>`` and ``<collision>`` dropped
+    (their meshes are rarely where MuJoCo looks, and they only make contacts) and, with
+    ``floating``, the root link on a ``floating`` joint named ``root`` from a new
+    ``world`` link (MuJoCo's URDF reader makes it a free joint; without it, it welds the
+    root to the world). ModelError for a DTD (see :func:`armdyn.io.urdf.refuse_dtd`) or
+    not exactly one root link."""
+    from ..errors import ModelError
+    from .urdf import refuse_dtd
+
+    refuse_dtd(text.encode("utf-8"))
+    text = re.sub(r"<(visual|collision)\b.*?</\1>", "", text, flags=re.S)
+    if not floating:
+        return text
+    root = ET.fromstring(text.encode("utf-8"))
+    children = {j.find("child").get("link") for j in root.findall("joint") if j.find("child") is not None}
+    roots = [link.get("name") for link in root.findall("link") if link.get("name") not in children]
+    if len(roots) != 1:
+        raise ModelError(f"expected one root link, found {roots}", "<robot>")
+    head = re.search(r"<robot\b[^>]*>", text)
+    assert head is not None  # ET parsed a <robot>
+    joint = f'<link name="world"/><joint name="root" type="floating"><parent link="world"/><child link="{roots[0]}"/></joint>'
+    return text[: head.end()] + joint + text[head.end() :]
