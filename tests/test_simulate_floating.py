@@ -197,10 +197,11 @@ def test_rk4_converges_at_fourth_order():
 
 
 def test_torques_batches_and_threads():
-    """A constant base wrench and joint torques; a batch equals its single runs, and
-    the threads do not change a bit; the work is the wrench's and torques'."""
+    """A constant base wrench and joint torques; a batch (SIMD lane groups of 4 or 8,
+    the leftover rows alone) equals its single runs, and the threads do not change a
+    bit; the work is the wrench's and torques'."""
     robot, rng = floating_tree(22)
-    states = [start(robot, rng) for _ in range(5)]
+    states = [start(robot, rng) for _ in range(11)]
     Q, V = np.array([s[0] for s in states]), np.array([s[1] for s in states])
     tau = rng.uniform(-1, 1, robot.nv)
     one = simulate(robot, Q, V, dt=2e-3, steps=50, torque=tau, threads=1, stride=3)
@@ -209,10 +210,16 @@ def test_torques_batches_and_threads():
     for k, (q, v) in enumerate(states):
         single = simulate(robot, q, v, dt=2e-3, steps=50, torque=tau, stride=3)
         assert np.array_equal(single.q, one.q[k]) and np.array_equal(single.qdd, one.qdd[k])
-    assert one.q.shape == (5, 17, robot.nq) and one.qd.shape == (5, 17, robot.nv)
+    assert one.q.shape == (11, 17, robot.nq) and one.qd.shape == (11, 17, robot.nv)
     assert one.energy_balance().max() < 1e-8
     series = np.broadcast_to(tau, (50, robot.nv))
     assert np.array_equal(simulate(robot, Q, V, dt=2e-3, steps=50, torque=series, stride=3).q, one.q)
+    # one series per state, Euler: each lane its own torques
+    per_state = rng.uniform(-1, 1, (11, 20, robot.nv))
+    batch = simulate(robot, Q, V, dt=2e-3, steps=20, torque=per_state, method="euler")
+    for k in (0, 7, 8, 10):
+        single = simulate(robot, Q[k], V[k], dt=2e-3, steps=20, torque=per_state[k], method="euler")
+        assert np.array_equal(single.q, batch.q[k]) and np.array_equal(single.work, batch.work[k])
 
 
 def test_limits_and_refusals():
@@ -264,3 +271,20 @@ def test_cli_simulates_a_floating_mjcf(capsys, tmp_path):
     assert robot.floating and np.abs(com(robot, q_final[None])[0] - expected).max() < 1e-5
     assert main([*common, "--controller", "pd", "--target", "0"]) == 2
     assert "floating base" in capsys.readouterr().err
+
+
+def test_a_diverging_state_stops_alone():
+    """A huge torque on one state of a lane group: that state is reported not finite at
+    the step it overflows and its later samples are NaN; its lane neighbours go on; alone
+    it stops at the same step."""
+    robot, rng = floating_tree(24)
+    Q = np.array([start(robot, rng)[0] for _ in range(9)])
+    V = np.zeros((9, robot.nv))
+    tau = np.zeros((9, 30, robot.nv))
+    tau[2, 5:, -1] = 1e306  # on the last joint
+    run = simulate(robot, Q, V, dt=1e-2, steps=30, torque=tau)
+    assert run.nonfinite_step[2] > 5 and (np.delete(run.nonfinite_step, 2) == -1).all()
+    assert np.isnan(run.q[2, run.nonfinite_step[2] :]).all() and np.isfinite(run.q[3]).all()
+    alone = simulate(robot, Q[2], V[2], dt=1e-2, steps=30, torque=tau[2])
+    assert alone.nonfinite_step == run.nonfinite_step[2] and len(alone.t) == alone.nonfinite_step
+    assert alone.coordinate_names[alone.nonfinite_joint] in alone.coordinate_names

@@ -22,14 +22,18 @@
 //! base's six first), `lower`, `upper` are the joints' (nv). The work is of the whole
 //! wrench, `tau . v` (the base wrench's power included).
 //!
-//! One state per thread task, in `f64` (the exponential needs square roots and sines
-//! the lane types do not have); results do not depend on the number of threads.
+//! States run in SIMD lanes (4 or 8 per group, as [`crate::algo::integrate`]; the
+//! leftover rows one by one), groups spread over rayon threads. The dynamics run on the
+//! lanes; the base's exponential (square roots and sines, which the lane types do not
+//! have) lane by lane in `f64`. Every lane performs exactly the operations of a single
+//! state, so results do not depend on the kernels, threads or grouping.
 
 use crate::algo::floating::{aba_floating, NQ_BASE, NV_BASE};
 use crate::algo::integrate::{Input, Method, Outputs, Settings, STOP_POLL};
-use crate::batch::{install, thread_count};
+use crate::batch::{install, kernels, thread_count, Kernels};
 use crate::data::Data;
 use crate::model::Model;
+use crate::real::{F64x4, F64x8, Real};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -66,6 +70,36 @@ fn rotate(quat: [f64; 4], x: V3) -> V3 {
 /// `out = q (+) xi`: the base pose (`q[..7]`) times `exp(xi[..6])`, the joints plus
 /// `xi[6..]`. The quaternion is renormalised and kept on the side of `q`'s.
 pub fn integrate_configuration(q: &[f64], xi: &[f64], out: &mut [f64]) {
+    integrate_base(q, xi, out);
+    for (o, (x, dx)) in out[NQ_BASE..].iter_mut().zip(q[NQ_BASE..].iter().zip(&xi[NV_BASE..])) {
+        *o = x + dx;
+    }
+}
+
+/// [`integrate_configuration`] lane by lane: the base in `f64`, the joints on the lanes.
+#[inline(always)]
+fn integrate_lanes<T: Real>(q: &[T], xi: &[T], out: &mut [T]) {
+    let (mut qa, mut xa, mut oa) = ([0.0; NQ_BASE], [0.0; NV_BASE], [0.0; NQ_BASE]);
+    for l in 0..T::LANES {
+        for k in 0..NQ_BASE {
+            qa[k] = T::lane_of(&q[k], l);
+        }
+        for k in 0..NV_BASE {
+            xa[k] = T::lane_of(&xi[k], l);
+        }
+        integrate_base(&qa, &xa, &mut oa);
+        for k in 0..NQ_BASE {
+            out[k].set_lane(l, oa[k]);
+        }
+    }
+    for (o, (x, dx)) in out[NQ_BASE..].iter_mut().zip(q[NQ_BASE..].iter().zip(&xi[NV_BASE..])) {
+        *o = *x + *dx;
+    }
+}
+
+/// The base part of [`integrate_configuration`]: `out[..7]` from `q[..7]`, `xi[..6]`.
+#[inline(always)]
+fn integrate_base(q: &[f64], xi: &[f64], out: &mut [f64]) {
     let lin = [xi[0], xi[1], xi[2]];
     let w = [xi[3], xi[4], xi[5]];
     let theta = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
@@ -91,25 +125,31 @@ pub fn integrate_configuration(q: &[f64], xi: &[f64], out: &mut [f64]) {
         out[k] = q[k] + d[k];
     }
     out[3..NQ_BASE].copy_from_slice(&quat);
-    for (o, (x, dx)) in out[NQ_BASE..].iter_mut().zip(q[NQ_BASE..].iter().zip(&xi[NV_BASE..])) {
-        *o = x + dx;
-    }
+}
+
+/// `a x b` on lanes.
+#[inline(always)]
+fn cross_lanes<T: Real>(a: [T; 3], b: [T; 3]) -> [T; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 /// `[x, y]` in se(3), twists as (linear, angular).
-fn bracket(x: &[f64], y: &[f64]) -> [f64; 6] {
+#[inline(always)]
+fn bracket<T: Real>(x: &[T], y: &[T]) -> [T; 6] {
     let (rho, om) = ([x[0], x[1], x[2]], [x[3], x[4], x[5]]);
     let (u, w) = ([y[0], y[1], y[2]], [y[3], y[4], y[5]]);
-    let (a, b, c) = (cross(om, u), cross(rho, w), cross(om, w));
+    let (a, b, c) = (cross_lanes(om, u), cross_lanes(rho, w), cross_lanes(om, w));
     [a[0] + b[0], a[1] + b[1], a[2] + b[2], c[0], c[1], c[2]]
 }
 
 /// The base part of `k = dexp^-1_{-theta}(v)` (see the module doc), into `k[..6]`.
-fn local_rate(theta: &[f64], v: &[f64], k: &mut [f64]) {
+#[inline(always)]
+fn local_rate<T: Real>(theta: &[T], v: &[T], k: &mut [T]) {
     let b1 = bracket(theta, v);
     let b2 = bracket(theta, &b1);
+    let (half, twelfth) = (T::splat(0.5), T::splat(1.0 / 12.0));
     for i in 0..NV_BASE {
-        k[i] = v[i] + 0.5 * b1[i] + b2[i] / 12.0;
+        k[i] = v[i] + half * b1[i] + b2[i] * twelfth;
     }
 }
 
@@ -165,24 +205,22 @@ pub fn simulate_floating_until(
             assert!(settings.steps >= 1, "a torque series needs at least one step");
             assert_eq!(tau.len(), if shared { 1 } else { rows } * settings.steps * nv, "torque series size")
         }
-        Input::Pd { .. } | Input::ComputedTorque { .. } => {
-            panic!("controllers are fixed-base only")
-        }
+        Input::Pd { .. } | Input::ComputedTorque { .. } => panic!("controllers are fixed-base only"),
     }
     let Outputs { q, work, qd, qdd, tau, q_final, qd_final, limit_step, limit_joint, nonfinite_step, nonfinite_joint } =
         out;
-    let mut tasks: Vec<(usize, Row)> = Vec::with_capacity(rows);
+    let mut all: Vec<Row> = Vec::with_capacity(rows);
     let mut ints =
         limit_step.iter_mut().zip(limit_joint.iter_mut()).zip(nonfinite_step.iter_mut().zip(nonfinite_joint));
     let mut q_rows = q.chunks_mut(s * nq).zip(q_final.chunks_mut(nq));
     let mut v_rows = qd.chunks_mut(s * nv).zip(qdd.chunks_mut(s * nv)).zip(tau.chunks_mut(s * nv));
     let mut w_rows = work.chunks_mut(s).zip(qd_final.chunks_mut(nv));
-    for r in 0..rows {
+    for _ in 0..rows {
         let ((ls, lj), (ns, nj)) = ints.next().expect("rows");
         let (q, q_final) = q_rows.next().expect("rows");
         let ((qd, qdd), tau) = v_rows.next().expect("rows");
         let (work, qd_final) = w_rows.next().expect("rows");
-        let row = Row {
+        all.push(Row {
             q,
             work,
             qd,
@@ -194,18 +232,35 @@ pub fn simulate_floating_until(
             limit_joint: lj,
             nonfinite_step: ns,
             nonfinite_joint: nj,
-        };
-        tasks.push((r, row));
+        });
+    }
+    // groups of the widest kernel's lanes, then the leftover rows one by one
+    let lanes = match kernels() {
+        #[cfg(target_arch = "x86_64")]
+        Kernels::Avx512 => 8,
+        #[cfg(target_arch = "x86_64")]
+        Kernels::Avx2 => 4,
+        #[cfg(target_arch = "x86_64")]
+        _ => 1,
+        #[cfg(not(target_arch = "x86_64"))]
+        _ => 4,
+    };
+    let mut groups: Vec<(usize, Vec<Row>)> = Vec::new();
+    let mut rest = all.into_iter();
+    let mut first = 0;
+    while first < rows {
+        let width = if rows - first >= lanes { lanes } else { 1 };
+        groups.push((first, rest.by_ref().take(width).collect()));
+        first += width;
     }
     let job = Job { model, q0, v0, input, settings, lower, upper, stop };
-    let mut tasks = Some(tasks);
+    let mut groups = Some(groups);
     let mut run = || {
-        let tasks = tasks.take().expect("runs once");
-        if thread_count(threads) == 1 || rows < 2 {
-            let mut data = Data::new(model);
-            tasks.into_iter().for_each(|(r, mut row)| job.row(&mut data, r, &mut row));
+        let groups = groups.take().expect("runs once");
+        if thread_count(threads) == 1 || groups.len() < 2 {
+            groups.into_iter().for_each(|(first, mut rows)| job.dispatch(first, &mut rows));
         } else {
-            tasks.into_par_iter().for_each_init(|| Data::new(model), |data, (r, mut row)| job.row(data, r, &mut row));
+            groups.into_par_iter().for_each(|(first, mut rows)| job.dispatch(first, &mut rows));
         }
     };
     match threads {
@@ -227,127 +282,236 @@ struct Job<'a> {
     stop: &'a AtomicBool,
 }
 
+/// Per-group workspace: lane vectors (q: 7 + nv, the others 6 + nv).
+struct Work<T> {
+    data: Data<T>,
+    q: Vec<T>,
+    v: Vec<T>,
+    qs: Vec<T>,
+    vs: Vec<T>,
+    tau: Vec<T>,
+    a: Vec<T>,
+    /// RK4: the stage's local coordinate, its rate, and the weighted sums.
+    theta: Vec<T>,
+    rate: Vec<T>,
+    sum_rate: Vec<T>,
+    sum_a: Vec<T>,
+}
+
+impl<T: Real> Work<T> {
+    fn new(model: &Model) -> Self {
+        let z = |k: usize| vec![T::zero(); model.nv + k];
+        Work {
+            data: Data::new(model),
+            q: z(NQ_BASE),
+            v: z(NV_BASE),
+            qs: z(NQ_BASE),
+            vs: z(NV_BASE),
+            tau: z(NV_BASE),
+            a: z(NV_BASE),
+            theta: z(NV_BASE),
+            rate: z(NV_BASE),
+            sum_rate: z(NV_BASE),
+            sum_a: z(NV_BASE),
+        }
+    }
+}
+
+/// Lanes of `dst` from rows `first..first + LANES` of the (rows, width) array `src`.
+#[inline(always)]
+fn load<T: Real>(dst: &mut [T], src: &[f64], first: usize) {
+    let width = dst.len();
+    for (j, d) in dst.iter_mut().enumerate() {
+        for l in 0..T::LANES {
+            d.set_lane(l, src[(first + l) * width + j]);
+        }
+    }
+}
+
+/// Lane `l` of `src` into `dst`.
+#[inline(always)]
+fn put<T: Real>(dst: &mut [f64], src: &[T], l: usize) {
+    for (d, x) in dst.iter_mut().zip(src) {
+        *d = T::lane_of(x, l);
+    }
+}
+
 impl Job<'_> {
-    /// The torque during step `k` of state `r`.
-    fn torque(&self, r: usize, k: usize, tau: &mut [f64]) {
+    /// Integrate the rows of one group: in SIMD lanes if it is a whole group of the
+    /// widest kernel's, else one by one.
+    fn dispatch(&self, first: usize, rows: &mut [Row]) {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx512f")]
+        unsafe fn avx512(job: &Job, first: usize, rows: &mut [Row]) {
+            job.group(&mut Work::<F64x8>::new(job.model), first, rows)
+        }
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2")]
+        unsafe fn avx2(job: &Job, first: usize, rows: &mut [Row]) {
+            job.group(&mut Work::<F64x4>::new(job.model), first, rows)
+        }
+        match (kernels(), rows.len()) {
+            // SAFETY: the CPU supports the features (checked by `kernels`).
+            #[cfg(target_arch = "x86_64")]
+            (Kernels::Avx512, 8) => unsafe { avx512(self, first, rows) },
+            #[cfg(target_arch = "x86_64")]
+            (Kernels::Avx2, 4) => unsafe { avx2(self, first, rows) },
+            #[cfg(not(target_arch = "x86_64"))]
+            (_, 4) => self.group(&mut Work::<F64x4>::new(self.model), first, rows),
+            _ => {
+                let mut w = Work::<f64>::new(self.model);
+                for (k, row) in rows.iter_mut().enumerate() {
+                    self.group(&mut w, first + k, std::slice::from_mut(row));
+                }
+            }
+        }
+    }
+
+    /// The torque during step `k` of the lanes' rows `r..`.
+    #[inline(always)]
+    fn torque<T: Real>(&self, r: usize, k: usize, tau: &mut [T]) {
         let nv = tau.len();
         match self.input {
-            Input::Constant(t) => tau.copy_from_slice(&t[r * nv..(r + 1) * nv]),
+            Input::Constant(t) => load(tau, t, r),
             Input::Series { tau: t, shared } => {
                 let k = k.min(self.settings.steps - 1);
-                let at = if shared { k } else { r * self.settings.steps + k } * nv;
-                tau.copy_from_slice(&t[at..at + nv]);
+                for (j, x) in tau.iter_mut().enumerate() {
+                    if shared {
+                        *x = T::splat(t[k * nv + j]);
+                    } else {
+                        for l in 0..T::LANES {
+                            x.set_lane(l, t[((r + l) * self.settings.steps + k) * nv + j]);
+                        }
+                    }
+                }
             }
-            _ => tau.fill(0.0),
+            _ => tau.fill(T::zero()),
         }
     }
 
-    /// Record limit crossings and non-finite coordinates of `(q, v)` at step `k`; true
-    /// once the state is not finite.
-    fn check(&self, q: &[f64], v: &[f64], row: &mut Row, k: usize) -> bool {
-        if *row.limit_step < 0 {
-            let mut joints = q[NQ_BASE..].iter().enumerate();
-            if let Some((j, _)) = joints.find(|&(j, &x)| x < self.lower[j] || x > self.upper[j]) {
-                *row.limit_step = k as i64;
-                *row.limit_joint = (NV_BASE + j) as i64;
+    /// Record limit crossings and non-finite coordinates of the lanes' `(q, v)` at step
+    /// `k`; true once every lane is not finite.
+    #[inline(always)]
+    fn check<T: Real>(&self, q: &[T], v: &[T], rows: &mut [Row], k: usize) -> bool {
+        let mut diverged = 0;
+        for (l, row) in rows.iter_mut().enumerate() {
+            let x = |j: usize| T::lane_of(&q[j], l);
+            if *row.limit_step < 0 {
+                if let Some(j) = (0..self.lower.len()).find(|&j| {
+                    let y = x(NQ_BASE + j);
+                    y < self.lower[j] || y > self.upper[j]
+                }) {
+                    *row.limit_step = k as i64;
+                    *row.limit_joint = (NV_BASE + j) as i64;
+                }
             }
-        }
-        if *row.nonfinite_step < 0 {
-            // q's coordinates in v's layout: the base position (0..3), its orientation (3..6)
-            let q_finite = |j: usize| match j {
-                0..=2 => q[j].is_finite(),
-                3..=5 => q[3..NQ_BASE].iter().all(|x| x.is_finite()),
-                _ => q[j + 1].is_finite(),
-            };
-            if let Some(j) = (0..v.len()).find(|&j| !(v[j].is_finite() && q_finite(j))) {
-                *row.nonfinite_step = k as i64;
-                *row.nonfinite_joint = j as i64;
+            if *row.nonfinite_step < 0 {
+                // q's coordinates in v's layout: the base position (0..3), its orientation (3..6)
+                let q_finite = |j: usize| match j {
+                    0..=2 => x(j).is_finite(),
+                    3..=5 => (3..NQ_BASE).all(|i| x(i).is_finite()),
+                    _ => x(j + 1).is_finite(),
+                };
+                if let Some(j) = (0..v.len()).find(|&j| !(T::lane_of(&v[j], l).is_finite() && q_finite(j))) {
+                    *row.nonfinite_step = k as i64;
+                    *row.nonfinite_joint = j as i64;
+                }
             }
+            diverged += (*row.nonfinite_step >= 0) as usize;
         }
-        *row.nonfinite_step >= 0
+        diverged == T::LANES
     }
 
-    /// Integrate state `r` into `row`.
-    fn row(&self, data: &mut Data<f64>, r: usize, row: &mut Row) {
-        let n = self.model.nv;
-        let (nq, nv) = (n + NQ_BASE, n + NV_BASE);
-        let Settings { method, dt: h, steps, stride } = self.settings;
-        let mut q = self.q0[r * nq..(r + 1) * nq].to_vec();
-        let mut v = self.v0[r * nv..(r + 1) * nv].to_vec();
-        let (mut qs, mut vs) = (q.clone(), v.clone());
-        let (mut tau, mut a) = (vec![0.0; nv], vec![0.0; nv]);
-        // RK4: the stage's local coordinate theta, its rate, and the weighted sums
-        let (mut theta, mut rate) = (vec![0.0; nv], vec![0.0; nv]);
-        let (mut sum_rate, mut sum_a) = (vec![0.0; nv], vec![0.0; nv]);
-        let (mut work, mut sum_work) = (0.0, 0.0);
-        *row.limit_step = -1;
-        *row.limit_joint = -1;
-        *row.nonfinite_step = -1;
-        *row.nonfinite_joint = -1;
-        self.check(&q, &v, row, 0);
+    /// Store sample `s` of the lanes: the state `w.q`, `w.v` with `w.a`, `w.tau`.
+    #[inline(always)]
+    fn store<T: Real>(&self, w: &Work<T>, work: T, rows: &mut [Row], s: usize) {
+        let (nq, nv) = (w.q.len(), w.v.len());
+        for (l, row) in rows.iter_mut().enumerate() {
+            put(&mut row.q[s * nq..(s + 1) * nq], &w.q, l);
+            put(&mut row.qd[s * nv..(s + 1) * nv], &w.v, l);
+            put(&mut row.qdd[s * nv..(s + 1) * nv], &w.a, l);
+            put(&mut row.tau[s * nv..(s + 1) * nv], &w.tau, l);
+            row.work[s] = work.lane(l);
+        }
+    }
+
+    /// Integrate the lanes of rows `r..r + LANES` into `rows`.
+    #[inline(always)]
+    fn group<T: Real>(&self, w: &mut Work<T>, r: usize, rows: &mut [Row]) {
+        let nv = w.v.len();
+        let Settings { method, dt, steps, stride } = self.settings;
+        let (h, h2, h6, two) = (T::splat(dt), T::splat(0.5 * dt), T::splat(dt / 6.0), T::splat(2.0));
+        load(&mut w.q, self.q0, r);
+        load(&mut w.v, self.v0, r);
+        w.qs.copy_from_slice(&w.q);
+        w.vs.copy_from_slice(&w.v);
+        let (mut work, mut sum_work) = (T::zero(), T::zero());
+        for row in rows.iter_mut() {
+            *row.limit_step = -1;
+            *row.limit_joint = -1;
+            *row.nonfinite_step = -1;
+            *row.nonfinite_joint = -1;
+        }
+        self.check(&w.q, &w.v, rows, 0);
         let stages = if method == Method::Rk4 { 4 } else { 1 };
         let (mut k, mut st) = (0, 0);
         loop {
-            self.torque(r, k, &mut tau);
-            aba_floating(self.model, data, &qs, &vs, &tau, &mut a);
-            let power: f64 = tau.iter().zip(&vs).map(|(t, x)| t * x).sum();
+            self.torque(r, k, &mut w.tau);
+            aba_floating(self.model, &mut w.data, &w.qs, &w.vs, &w.tau, &mut w.a);
+            let mut power = T::zero();
+            for j in 0..nv {
+                power += w.tau[j] * w.vs[j];
+            }
             if st == 0 {
                 if k % stride == 0 {
-                    let s = k / stride;
-                    row.q[s * nq..(s + 1) * nq].copy_from_slice(&q);
-                    row.qd[s * nv..(s + 1) * nv].copy_from_slice(&v);
-                    row.qdd[s * nv..(s + 1) * nv].copy_from_slice(&a);
-                    row.tau[s * nv..(s + 1) * nv].copy_from_slice(&tau);
-                    row.work[s] = work;
+                    self.store(w, work, rows, k / stride);
                 }
                 if k == steps {
                     break;
                 }
             }
-            match (method, st) {
-                (Method::SemiImplicitEuler, _) => {
+            match method {
+                Method::SemiImplicitEuler => {
                     work += h * power;
                     for j in 0..nv {
-                        v[j] += h * a[j];
-                        rate[j] = h * v[j];
+                        w.v[j] += h * w.a[j];
+                        w.rate[j] = h * w.v[j];
                     }
-                    integrate_configuration(&q, &rate, &mut qs);
-                    q.copy_from_slice(&qs);
+                    integrate_lanes(&w.q, &w.rate, &mut w.qs);
+                    w.q.copy_from_slice(&w.qs);
                 }
-                (Method::Rk4, _) => {
+                Method::Rk4 => {
                     // the stage's rate of theta: v_i at theta_i (theta_1 = 0: v itself)
                     if st == 0 {
-                        rate.copy_from_slice(&vs);
+                        w.rate.copy_from_slice(&w.vs);
+                        w.sum_rate.fill(T::zero());
+                        w.sum_a.fill(T::zero());
+                        sum_work = T::zero();
                     } else {
-                        local_rate(&theta, &vs, &mut rate);
-                        rate[NV_BASE..].copy_from_slice(&vs[NV_BASE..]);
+                        local_rate(&w.theta, &w.vs, &mut w.rate);
+                        w.rate[NV_BASE..].copy_from_slice(&w.vs[NV_BASE..]);
                     }
-                    let weight = if st == 0 || st == 3 { 1.0 } else { 2.0 };
-                    if st == 0 {
-                        sum_rate.fill(0.0);
-                        sum_a.fill(0.0);
-                        sum_work = 0.0;
-                    }
+                    let weight = if st == 0 || st == 3 { T::splat(1.0) } else { two };
                     sum_work += weight * power;
                     for j in 0..nv {
-                        sum_rate[j] += weight * rate[j];
-                        sum_a[j] += weight * a[j];
+                        w.sum_rate[j] += weight * w.rate[j];
+                        w.sum_a[j] += weight * w.a[j];
                     }
                     if st < 3 {
-                        let c = if st == 2 { h } else { 0.5 * h };
+                        let c = if st == 2 { h } else { h2 };
                         for j in 0..nv {
-                            theta[j] = c * rate[j];
-                            vs[j] = v[j] + c * a[j];
+                            w.theta[j] = c * w.rate[j];
+                            w.vs[j] = w.v[j] + c * w.a[j];
                         }
-                        integrate_configuration(&q, &theta, &mut qs);
+                        integrate_lanes(&w.q, &w.theta, &mut w.qs);
                     } else {
-                        work += h / 6.0 * sum_work;
+                        work += h6 * sum_work;
                         for j in 0..nv {
-                            theta[j] = h / 6.0 * sum_rate[j];
-                            v[j] += h / 6.0 * sum_a[j];
+                            w.theta[j] = h6 * w.sum_rate[j];
+                            w.v[j] += h6 * w.sum_a[j];
                         }
-                        integrate_configuration(&q, &theta, &mut qs);
-                        q.copy_from_slice(&qs);
+                        integrate_lanes(&w.q, &w.theta, &mut w.qs);
+                        w.q.copy_from_slice(&w.qs);
                     }
                 }
             }
@@ -355,17 +519,19 @@ impl Job<'_> {
             if st == stages {
                 st = 0;
                 k += 1;
-                if self.check(&q, &v, row, k) || (k == steps && steps % stride != 0) {
+                if self.check(&w.q, &w.v, rows, k) || (k == steps && steps % stride != 0) {
                     break;
                 }
                 if k % STOP_POLL == 0 && self.stop.load(Ordering::Relaxed) {
                     break;
                 }
-                qs.copy_from_slice(&q);
-                vs.copy_from_slice(&v);
+                w.qs.copy_from_slice(&w.q);
+                w.vs.copy_from_slice(&w.v);
             }
         }
-        row.q_final.copy_from_slice(&q);
-        row.qd_final.copy_from_slice(&v);
+        for (l, row) in rows.iter_mut().enumerate() {
+            put(row.q_final, &w.q, l);
+            put(row.qd_final, &w.v, l);
+        }
     }
 }
