@@ -201,6 +201,9 @@ def test_weld_and_root_joint_options(tmp_path):
     assert load_quiet(path, root_joint="free-flyer").floating
     welded = load_quiet(path, floating="weld")
     assert not welded.floating and welded.dof == floating.dof and welded.base == "world"
+    from armdyn.show import table
+
+    assert "base (floating)" in table(floating) and "base (fixed)" in table(welded)
 
 
 # ------------------------------------------------------------ example-robot-data
