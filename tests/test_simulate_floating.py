@@ -288,3 +288,20 @@ def test_a_diverging_state_stops_alone():
     alone = simulate(robot, Q[2], V[2], dt=1e-2, steps=30, torque=tau[2])
     assert alone.nonfinite_step == run.nonfinite_step[2] and len(alone.t) == alone.nonfinite_step
     assert alone.coordinate_names[alone.nonfinite_joint] in alone.coordinate_names
+
+
+def test_progress_pieces_are_one_call():
+    """With a progress callback the run is cut into pieces, each continuing from the
+    last one's end: the same states, bit for bit, as one call (q of 7 + dof, the others
+    of 6 + dof); the work, summed piece by piece, to rounding."""
+    robot, rng = floating_tree(25)
+    Q = np.array([start(robot, rng)[0] for _ in range(3)])
+    V = rng.uniform(-1, 1, (3, robot.nv))
+    tau = rng.uniform(-1, 1, (3, 300, robot.nv))
+    seen = []
+    pieces = simulate(robot, Q, V, dt=1e-3, steps=300, stride=2, torque=tau, progress=lambda k, n: seen.append(k))
+    whole = simulate(robot, Q, V, dt=1e-3, steps=300, stride=2, torque=tau)
+    assert len(seen) > 2 and seen[-1] == 300
+    for name in ("q", "qd", "qdd", "tau", "q_final", "qd_final"):
+        assert np.array_equal(getattr(pieces, name), getattr(whole, name)), name
+    assert np.abs(pieces.work - whole.work).max() < 1e-15 * max(1.0, np.abs(whole.work).max()) * 300

@@ -345,7 +345,7 @@ def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower,
     # In pieces of whole strides: each piece continues from the last one's final state,
     # its first sample replaces the last one's final sample (same state, and the torque
     # of the next step, as in one call).
-    rows, dof = q0.shape
+    rows = q0.shape[0]
     samples = steps // stride + 1
     piece = max(1, steps // stride // 100) * stride
     out = None
@@ -359,8 +359,8 @@ def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower,
         elif kind == "series-per-state":
             tau = _c(tau[:, done : done + k])
         part = call(q, qd, k, tau)
-        if out is None:
-            out = {name: np.empty((rows, samples, dof)) for name in ("q", "qd", "qdd", "tau")}
+        if out is None:  # q's width may differ from the others' (a floating base: 7 + dof, 6 + dof)
+            out = {name: np.empty((rows, samples, part[name].shape[2])) for name in ("q", "qd", "qdd", "tau")}
             out["work"] = np.empty((rows, samples))
             for name in ("limit_step", "limit_joint", "nonfinite_step", "nonfinite_joint"):
                 out[name] = np.full(rows, -1, dtype=np.int64)

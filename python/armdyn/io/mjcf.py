@@ -113,7 +113,8 @@ def load_mjcf(path_or_xml, strict: bool = True, floating: str | None = None) -> 
     Returns a numeric :class:`Robot` whose base is the world body (link ``"world"``),
     its coordinates in MuJoCo's order (depth-first through the bodies as written): q is
     MuJoCo's ``qpos``. With a free root body the robot floats, its base that body, its
-    arrays in Pinocchio's layout (:mod:`armdyn.io.mjcf_state` converts). Unnamed joints and bodies are called ``joint_<n>``, ``body_<n>``.
+    arrays in Pinocchio's layout (:mod:`armdyn.io.mjcf_state` converts). Unnamed joints
+    and bodies are called ``joint_<n>``, ``body_<n>``.
     ``strict=False`` loads physically invalid inertias with a warning instead of an error.
     ``floating="weld"``: a ``free`` joint of a body of the world body is read as a fixed
     base (the body welded at its pose); without it that body floats.
