@@ -13,6 +13,7 @@ pub mod external;
 pub mod floating;
 pub mod gravity_derivatives;
 pub mod integrate;
+pub mod integrate_floating;
 pub mod jacobian;
 pub mod jacobian_dot;
 pub mod kinematics;
