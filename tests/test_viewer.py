@@ -445,3 +445,36 @@ def test_cli_show_and_simulate_3d(tmp_path, capsys):
     assert 2 <= len(scene["times"]) <= 500 and scene["times"][-1] == pytest.approx(1.0)
     assert main(["show", "planar-3r", "--3d", "-o", str(tmp_path / "a.png")]) == 2
     assert "HTML page" in capsys.readouterr().err
+
+
+def test_show_3d_of_a_floating_robot_takes_its_joints_or_its_whole_configuration(tmp_path, capsys):
+    """``armdyn show --root-joint free-flyer``: the joints alone put the base at the origin,
+    unturned; a whole configuration places it (its quaternion, typed to 7 digits, normalised
+    and said); anything else is one clear error."""
+    path = str(example_robot_data_dir() / "solo_description" / "robots" / "solo12.urdf")
+    legs = [0.1, 0.8, -1.6, -0.1, 0.8, -1.6, 0.1, -0.8, 1.6, -0.1, -0.8, 1.6]
+    s, c = np.sin(np.pi / 8), np.cos(np.pi / 8)  # a turn of 45 degrees about z
+    whole = [0.0, 0.0, 0.3, 0.0, 0.0, round(s, 7), round(c, 7), *legs]
+    robot = load(path, root_joint="free-flyer")
+    for q, name in ((legs, "legs"), (whole, "whole")):
+        out = tmp_path / f"{name}.html"
+        args = ["show", path, "--root-joint", "free-flyer", "--3d", "--q", ",".join(map(str, q)), "-o", str(out)]
+        assert main(args) == 0
+        full = [0, 0, 0, 0, 0, 0, 1, *legs] if name == "legs" else [*whole[:3], 0, 0, s, c, *legs]
+        written = re.search(r'"poses":(\[[^\]]*\])', out.read_text()).group(1)
+        assert np.allclose(json.loads(written), view(robot, np.array(full)).scene["poses"], atol=1e-7)
+    assert "quaternion normalised" in capsys.readouterr().err
+    for q, said in (([1, 2, 3], "3 values for a floating robot with 12 joints"), ([*whole[:6], 1.01, *legs], "not 1")):
+        args = [
+            "show",
+            path,
+            "--root-joint",
+            "free-flyer",
+            "--3d",
+            "--q",
+            ",".join(map(str, q)),
+            "-o",
+            str(tmp_path / "x.html"),
+        ]
+        assert main(args) == 2
+        assert said in capsys.readouterr().err
