@@ -32,11 +32,15 @@ impl NumericModel {
     }
 
     /// Check the arguments `(name, object, width)`: each `(width,)` or `(N, width)`, the
-    /// same N for all, finite; the first is `q`, whose quaternions must be unit.
+    /// same N for all, finite; the first is `q`, whose quaternions must be unit. A fixed
+    /// base's arguments are checked by [`crate::states`] (every width is then dof).
     fn floating_states<'py, const K: usize>(
         &self,
         args: [(&str, &Bound<'py, PyAny>, usize); K],
     ) -> PyResult<(Shape, [Bound<'py, PyArrayDyn<f64>>; K])> {
+        if !self.floating {
+            return crate::states(self.model.nv, args.map(|(name, obj, _)| (name, obj)));
+        }
         let mut shape = None;
         let mut arrays = Vec::with_capacity(K);
         for (name, obj, width) in args {
@@ -82,8 +86,8 @@ impl NumericModel {
 
     /// `single(data, inputs, output)` for one state, `batched(model, inputs, output,
     /// threads)` for a batch (GIL released), into a fresh array of shape `out_shape` per
-    /// state.
-    fn floating_op<'py, const K: usize>(
+    /// state. Also for a fixed base (the centroidal quantities, `centroidal.rs`).
+    pub(crate) fn floating_op<'py, const K: usize>(
         &self,
         py: Python<'py>,
         args: [(&str, &Bound<'py, PyAny>, usize); K],
@@ -190,7 +194,7 @@ impl NumericModel {
 }
 
 /// `out`, or a `FloatingPointError` if it holds NaN or inf (inputs were checked finite).
-fn finite(out: Bound<'_, PyArrayDyn<f64>>) -> PyResult<Bound<'_, PyArrayDyn<f64>>> {
+pub(crate) fn finite(out: Bound<'_, PyArrayDyn<f64>>) -> PyResult<Bound<'_, PyArrayDyn<f64>>> {
     // SAFETY: `out` is ours and not yet returned.
     if all_finite(unsafe { slice(&out) }) {
         Ok(out)

@@ -1,0 +1,84 @@
+"""Centre of mass and centroidal momentum, for a floating base or a fixed one (the Rust
+core's ``algo/centroidal.rs``; Pinocchio's ``centerOfMass``, ``jacobianCenterOfMass``,
+``computeCentroidalMap``, ``computeCentroidalMomentum`` and
+``computeCentroidalMomentumTimeVariation``, with the same results).
+
+Arguments as in :mod:`armdyn.numeric`: ``robot`` a bound Robot or a compiled model; ``q``
+``(nq,)`` or ``(N, nq)``, ``v`` and ``a`` ``(nv,)`` or ``(N, nv)`` (a floating base:
+Pinocchio's free-flyer layout, ``nq = 7 + dof``, ``nv = 6 + dof``, the quaternion checked
+unit; a fixed base: ``nq = nv = dof``); ``threads`` for batches. A wrong shape, NaN or inf
+raises ``ValueError`` naming the argument.
+
+* The world frame: the frame ``q``'s base pose is given in (a fixed base: the base frame).
+* The mass is that of the bodies that move: every link a joint moves, and for a floating
+  base the base link with the links welded to it. A fixed base and the links welded to it
+  are left out (as Pinocchio leaves out its universe). A robot with none of that mass has
+  no centre of mass (``ValueError``).
+* The centroidal momentum ``h_G = [p; k_G]`` (6,): the linear momentum ``p = m c'``, then
+  the angular momentum about the centre of mass ``c``, both in world axes.
+
+Robots with mimic joints are not supported yet (``ValueError``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import _core
+from .numeric import RobotLike, check_threads, core_model
+
+__all__ = [
+    "center_of_mass",
+    "com_jacobian",
+    "centroidal_momentum_matrix",
+    "centroidal_momentum",
+    "centroidal_momentum_rate",
+]
+
+
+def _call(what: str, entry, robot, arrays: dict, threads):
+    """``entry(model, *arrays, threads)`` with ``threads`` checked; a result the core finds
+    not finite from finite inputs (an overflow) is a ValueError, as in :mod:`armdyn.numeric`."""
+    threads = check_threads(threads)
+    try:
+        return entry(core_model(robot, what), *arrays.values(), threads)
+    except FloatingPointError as err:
+        raise ValueError(f"{what}: {err}; the state is too large for this robot") from None
+
+
+def center_of_mass(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
+    """Centre of mass ``c`` of the bodies that move, in the world frame: (3,) or (N, 3)."""
+    return _call("center_of_mass", _core.center_of_mass, robot, {"q": q}, threads)
+
+
+def com_jacobian(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
+    """Jacobian ``J_c`` of the centre of mass, ``c' = J_c v`` (world axes): (3, nv) or
+    (N, 3, nv). It is the first three rows of :func:`centroidal_momentum_matrix` over the
+    mass."""
+    return _call("com_jacobian", _core.com_jacobian, robot, {"q": q}, threads)
+
+
+def centroidal_momentum_matrix(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
+    """Centroidal momentum matrix ``A_G`` (6, nv) or (N, 6, nv): ``h_G = A_G v``, rows the
+    linear momentum then the angular momentum about the centre of mass, world axes
+    (Orin and Goswami's; Pinocchio's ``computeCentroidalMap``). Column k is the momentum
+    of the robot moving at a unit rate of velocity coordinate k."""
+    return _call("centroidal_momentum_matrix", _core.centroidal_map, robot, {"q": q}, threads)
+
+
+def centroidal_momentum(robot: RobotLike, q: ArrayLike, v: ArrayLike, *, threads: int | None = None) -> np.ndarray:
+    """Centroidal momentum ``h_G = A_G(q) v`` (6,) or (N, 6): linear momentum, then the
+    angular momentum about the centre of mass, world axes (by one pass over the bodies,
+    without forming ``A_G``)."""
+    return _call("centroidal_momentum", _core.centroidal_momentum, robot, {"q": q, "v": v}, threads)
+
+
+def centroidal_momentum_rate(
+    robot: RobotLike, q: ArrayLike, v: ArrayLike, a: ArrayLike, *, threads: int | None = None
+) -> np.ndarray:
+    """Time derivative of the centroidal momentum, ``h_G' = A_G a + A_G' v`` (6,) or (N, 6)
+    for the acceleration ``a`` (Pinocchio's ``computeCentroidalMomentumTimeVariation``);
+    ``a = 0`` gives ``A_G' v``. Equal to the net external wrench on the robot, gravity
+    included, about the centre of mass (world axes) when ``a`` is the motion it causes."""
+    return _call("centroidal_momentum_rate", _core.centroidal_momentum_rate, robot, {"q": q, "v": v, "a": a}, threads)
