@@ -347,3 +347,13 @@ def test_unknown_frame_and_link_are_named():
         numeric.jacobian(robot, q, 1, reference_frame="body")
     with pytest.raises(ValueError, match="no link named 'nope'"):
         numeric.jacobian(robot, q, "nope")
+
+
+def test_an_overflow_is_a_value_error():
+    """Finite inputs whose products overflow: refused, never inf or NaN handed back."""
+    robot, _, rng = floating_tree(8)
+    q, v, a = floating_state(robot, rng)
+    with pytest.raises(ValueError, match="too large"):
+        centroidal.centroidal_momentum_rate(robot, q, v * 1e200, a)
+    with pytest.raises(ValueError, match="overflow"):
+        numeric.kinetic_energy(robot, q, v * 1e200)
