@@ -37,26 +37,37 @@ __all__ = [
 ]
 
 
-def _call(what: str, entry, robot, arrays: dict, threads):
-    """``entry(model, *arrays, threads)`` with ``threads`` checked; a result the core finds
-    not finite from finite inputs (an overflow) is a ValueError, as in :mod:`armdyn.numeric`."""
-    threads = check_threads(threads)
-    try:
-        return entry(core_model(robot, what), *arrays.values(), threads)
-    except FloatingPointError as err:
-        raise ValueError(f"{what}: {err}; the state is too large for this robot") from None
+def _model(robot, what: str):
+    """The compiled model (:func:`armdyn.numeric.core_model`), by its cache when it has one
+    (these functions are timed per call)."""
+    model = getattr(robot, "_numeric_model", None)
+    return model if type(model) is _core.NumericModel else core_model(robot, what)
+
+
+def _too_large(what: str, err: FloatingPointError) -> ValueError:
+    """The core found the result not finite from finite inputs: an overflow, a ValueError
+    as in :mod:`armdyn.numeric`."""
+    return ValueError(f"{what}: {err}; the state is too large for this robot")
 
 
 def center_of_mass(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Centre of mass ``c`` of the bodies that move, in the world frame: (3,) or (N, 3)."""
-    return _call("center_of_mass", _core.center_of_mass, robot, {"q": q}, threads)
+    what = "center_of_mass"
+    try:
+        return _core.center_of_mass(_model(robot, what), q, threads and check_threads(threads))
+    except FloatingPointError as err:
+        raise _too_large(what, err) from None
 
 
 def com_jacobian(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Jacobian ``J_c`` of the centre of mass, ``c' = J_c v`` (world axes): (3, nv) or
     (N, 3, nv). It is the first three rows of :func:`centroidal_momentum_matrix` over the
     mass."""
-    return _call("com_jacobian", _core.com_jacobian, robot, {"q": q}, threads)
+    what = "com_jacobian"
+    try:
+        return _core.com_jacobian(_model(robot, what), q, threads and check_threads(threads))
+    except FloatingPointError as err:
+        raise _too_large(what, err) from None
 
 
 def centroidal_momentum_matrix(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
@@ -64,14 +75,22 @@ def centroidal_momentum_matrix(robot: RobotLike, q: ArrayLike, *, threads: int |
     linear momentum then the angular momentum about the centre of mass, world axes
     (Orin and Goswami's; Pinocchio's ``computeCentroidalMap``). Column k is the momentum
     of the robot moving at a unit rate of velocity coordinate k."""
-    return _call("centroidal_momentum_matrix", _core.centroidal_map, robot, {"q": q}, threads)
+    what = "centroidal_momentum_matrix"
+    try:
+        return _core.centroidal_map(_model(robot, what), q, threads and check_threads(threads))
+    except FloatingPointError as err:
+        raise _too_large(what, err) from None
 
 
 def centroidal_momentum(robot: RobotLike, q: ArrayLike, v: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Centroidal momentum ``h_G = A_G(q) v`` (6,) or (N, 6): linear momentum, then the
     angular momentum about the centre of mass, world axes (by one pass over the bodies,
     without forming ``A_G``)."""
-    return _call("centroidal_momentum", _core.centroidal_momentum, robot, {"q": q, "v": v}, threads)
+    what = "centroidal_momentum"
+    try:
+        return _core.centroidal_momentum(_model(robot, what), q, v, threads and check_threads(threads))
+    except FloatingPointError as err:
+        raise _too_large(what, err) from None
 
 
 def centroidal_momentum_rate(
@@ -81,4 +100,8 @@ def centroidal_momentum_rate(
     for the acceleration ``a`` (Pinocchio's ``computeCentroidalMomentumTimeVariation``);
     ``a = 0`` gives ``A_G' v``. Equal to the net external wrench on the robot, gravity
     included, about the centre of mass (world axes) when ``a`` is the motion it causes."""
-    return _call("centroidal_momentum_rate", _core.centroidal_momentum_rate, robot, {"q": q, "v": v, "a": a}, threads)
+    what = "centroidal_momentum_rate"
+    try:
+        return _core.centroidal_momentum_rate(_model(robot, what), q, v, a, threads and check_threads(threads))
+    except FloatingPointError as err:
+        raise _too_large(what, err) from None
