@@ -2,7 +2,7 @@
 (armdyn.centroidal; armdyn.numeric's forward_kinematics, jacobian, kinetic_energy and
 potential_energy on a floating base) against Pinocchio (buildModelFromUrdf, with
 JointModelFreeFlyer for the floating robots of example-robot-data that test_floating.py
-loads, without for UR5 and Kinova), and against identities that need no second library:
+loads, without for UR5, Kinova and Panda, whose fingers are a mimic pair), and against identities that need no second library:
 
 * h_G = A_G v is the sum of the links' momenta (each from its pose, Jacobian and inertia
   as the URDF gives them), moved to the centre of mass, itself the links' mean position;
@@ -46,11 +46,12 @@ def pin_configuration(model, robot, q):
     return qp, perm
 
 
-def fixed_pin_configuration(model, robot, q):
-    """:func:`pin_configuration` for a fixed base (a continuous joint is cos, sin there)."""
+def fixed_pin_configuration(model, names, q):
+    """:func:`pin_configuration` for a fixed base whose coordinates are ``names`` (a
+    continuous joint is cos, sin in Pinocchio)."""
     qp, perm = np.zeros(model.nq), np.zeros(model.nv, dtype=int)
     for j in range(1, model.njoints):
-        k = robot.coordinate_names.index(model.names[j])
+        k = list(names).index(model.names[j])
         iq, perm[model.idx_vs[j]] = model.idx_qs[j], k
         qp[iq : iq + model.joints[j].nq] = [np.cos(q[k]), np.sin(q[k])] if model.joints[j].nq == 2 else q[k]
     return qp, perm
@@ -62,7 +63,7 @@ def compare_with_pinocchio(robot, model, states, floating: bool):
         if floating:
             qp, perm = pin_configuration(model, robot, q)
         else:
-            qp, perm = fixed_pin_configuration(model, robot, q)
+            qp, perm = fixed_pin_configuration(model, robot.coordinate_names, q)
         vp, ap = v[perm], a[perm]
         assert close(centroidal.center_of_mass(robot, q), pin.centerOfMass(model, data, qp)) < TOL, "com"
         Jc = centroidal.com_jacobian(robot, q)
@@ -131,15 +132,40 @@ def test_fixed_base_agrees_with_pinocchio(name):
     compare_with_pinocchio(robot, model, states, floating=False)
 
 
-def test_mimic_joints_are_refused():
-    """panda's fingers are a mimic pair: not supported here yet, said by name."""
+@needs_pinocchio
+def test_mimic_joints_agree_with_pinocchio():
+    """panda's fingers are a mimic pair: armdyn's quantities in its 8 coordinates are the
+    full tree's (Pinocchio's 9 joints, the follower free) at q_full = G q + o, the matrices
+    times G."""
     urdf = example_robot_data_dir() / "panda_description/urdf/panda.urdf"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        robot = armdyn.load(urdf, strict=False)
+        robot = armdyn.load(urdf, strict=False).without_joint_dynamics()
     robot = robot.bind() if robot.defaults else robot
-    with pytest.raises(ValueError, match="mimic"):
-        centroidal.center_of_mass(robot, np.zeros(robot.dof))
+    mimic = numeric.compile_model(robot)
+    model = pin.buildModelFromUrdf(str(urdf))
+    data = model.createData()
+    assert model.nv == len(mimic.offset) == robot.dof + 1
+    rng = np.random.default_rng(9)
+    for _ in range(3):
+        q, v, a = rng.uniform(-1, 1, (3, robot.dof))
+        qp, perm = fixed_pin_configuration(model, mimic.full.coordinate_names, mimic.G @ q + mimic.offset)
+        vp, ap = (mimic.G @ v)[perm], (mimic.G @ a)[perm]
+        assert close(centroidal.center_of_mass(robot, q), pin.centerOfMass(model, data, qp)) < TOL
+        for ours, theirs in (
+            (centroidal.com_jacobian(robot, q), pin.jacobianCenterOfMass(model, data, qp)),
+            (centroidal.centroidal_momentum_matrix(robot, q), pin.computeCentroidalMap(model, data, qp)),
+        ):
+            full = np.zeros_like(theirs)
+            full[:, perm] = theirs
+            assert close(ours, full @ mimic.G) < TOL
+        hg = pin.computeCentroidalMomentum(model, data, qp, vp).vector
+        assert close(centroidal.centroidal_momentum(robot, q, v), hg) < TOL
+        pin.computeCentroidalMomentumTimeVariation(model, data, qp, vp, ap)
+        assert close(centroidal.centroidal_momentum_rate(robot, q, v, a), data.dhg.vector) < TOL
+    Q = rng.uniform(-1, 1, (4, robot.dof))
+    batch = centroidal.centroidal_momentum_matrix(robot, Q)
+    assert all(np.array_equal(batch[k], centroidal.centroidal_momentum_matrix(robot, Q[k])) for k in range(4))
 
 
 # ------------------------------------------------------------------ identities

@@ -17,7 +17,8 @@ raises ``ValueError`` naming the argument.
 * The centroidal momentum ``h_G = [p; k_G]`` (6,): the linear momentum ``p = m c'``, then
   the angular momentum about the centre of mass ``c``, both in world axes.
 
-Robots with mimic joints are not supported yet (``ValueError``).
+A robot with mimic joints (a fixed base) is computed on its full tree, the matrices
+mapped to the independent coordinates (:class:`armdyn.mimic.MimicModel`).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
-from .numeric import RobotLike, check_threads, core_model
+from .numeric import RobotLike, check_threads, compiled_model
 
 __all__ = [
     "center_of_mass",
@@ -37,11 +38,19 @@ __all__ = [
 ]
 
 
-def _model(robot, what: str):
-    """The compiled model (:func:`armdyn.numeric.core_model`), by its cache when it has one
-    (these functions are timed per call)."""
-    model = getattr(robot, "_numeric_model", None)
-    return model if type(model) is _core.NumericModel else core_model(robot, what)
+def _call(what: str, entry: str, robot, *args):
+    """``_core.<entry>(model, *args)`` for a compiled model, ``model.<entry>(*args)`` for a
+    :class:`~armdyn.mimic.MimicModel` (the full tree's quantities in the independent
+    coordinates); an overflow as :func:`_too_large` says."""
+    model = getattr(robot, "_numeric_model", None)  # the cache first: these are timed per call
+    if model is None:
+        model = compiled_model(robot)
+    try:
+        if type(model) is _core.NumericModel:
+            return getattr(_core, entry)(model, *args)
+        return getattr(model, entry)(*args)
+    except FloatingPointError as err:
+        raise _too_large(what, err) from None
 
 
 def _too_large(what: str, err: FloatingPointError) -> ValueError:
@@ -52,22 +61,14 @@ def _too_large(what: str, err: FloatingPointError) -> ValueError:
 
 def center_of_mass(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Centre of mass ``c`` of the bodies that move, in the world frame: (3,) or (N, 3)."""
-    what = "center_of_mass"
-    try:
-        return _core.center_of_mass(_model(robot, what), q, threads and check_threads(threads))
-    except FloatingPointError as err:
-        raise _too_large(what, err) from None
+    return _call("center_of_mass", "center_of_mass", robot, q, threads and check_threads(threads))
 
 
 def com_jacobian(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Jacobian ``J_c`` of the centre of mass, ``c' = J_c v`` (world axes): (3, nv) or
     (N, 3, nv). It is the first three rows of :func:`centroidal_momentum_matrix` over the
     mass."""
-    what = "com_jacobian"
-    try:
-        return _core.com_jacobian(_model(robot, what), q, threads and check_threads(threads))
-    except FloatingPointError as err:
-        raise _too_large(what, err) from None
+    return _call("com_jacobian", "com_jacobian", robot, q, threads and check_threads(threads))
 
 
 def centroidal_momentum_matrix(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
@@ -75,22 +76,14 @@ def centroidal_momentum_matrix(robot: RobotLike, q: ArrayLike, *, threads: int |
     linear momentum then the angular momentum about the centre of mass, world axes
     (Orin and Goswami's; Pinocchio's ``computeCentroidalMap``). Column k is the momentum
     of the robot moving at a unit rate of velocity coordinate k."""
-    what = "centroidal_momentum_matrix"
-    try:
-        return _core.centroidal_map(_model(robot, what), q, threads and check_threads(threads))
-    except FloatingPointError as err:
-        raise _too_large(what, err) from None
+    return _call("centroidal_momentum_matrix", "centroidal_map", robot, q, threads and check_threads(threads))
 
 
 def centroidal_momentum(robot: RobotLike, q: ArrayLike, v: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Centroidal momentum ``h_G = A_G(q) v`` (6,) or (N, 6): linear momentum, then the
     angular momentum about the centre of mass, world axes (by one pass over the bodies,
     without forming ``A_G``)."""
-    what = "centroidal_momentum"
-    try:
-        return _core.centroidal_momentum(_model(robot, what), q, v, threads and check_threads(threads))
-    except FloatingPointError as err:
-        raise _too_large(what, err) from None
+    return _call("centroidal_momentum", "centroidal_momentum", robot, q, v, threads and check_threads(threads))
 
 
 def centroidal_momentum_rate(
@@ -100,8 +93,6 @@ def centroidal_momentum_rate(
     for the acceleration ``a`` (Pinocchio's ``computeCentroidalMomentumTimeVariation``);
     ``a = 0`` gives ``A_G' v``. Equal to the net external wrench on the robot, gravity
     included, about the centre of mass (world axes) when ``a`` is the motion it causes."""
-    what = "centroidal_momentum_rate"
-    try:
-        return _core.centroidal_momentum_rate(_model(robot, what), q, v, a, threads and check_threads(threads))
-    except FloatingPointError as err:
-        raise _too_large(what, err) from None
+    return _call(
+        "centroidal_momentum_rate", "centroidal_momentum_rate", robot, q, v, a, threads and check_threads(threads)
+    )
