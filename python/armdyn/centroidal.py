@@ -38,17 +38,17 @@ __all__ = [
 ]
 
 
-def _call(what: str, entry: str, robot, *args):
-    """``_core.<entry>(model, *args)`` for a compiled model, ``model.<entry>(*args)`` for a
-    :class:`~armdyn.mimic.MimicModel` (the full tree's quantities in the independent
-    coordinates); an overflow as :func:`_too_large` says."""
+def _call(what: str, entry, robot, *args):
+    """``entry(model, *args)`` (a function of ``_core``) for a compiled model; for a
+    :class:`~armdyn.mimic.MimicModel` its method of the same name (the full tree's
+    quantities in the independent coordinates); an overflow as :func:`_too_large` says."""
     model = getattr(robot, "_numeric_model", None)  # the cache first: these are timed per call
     if model is None:
         model = compiled_model(robot)
     try:
         if type(model) is _core.NumericModel:
-            return getattr(_core, entry)(model, *args)
-        return getattr(model, entry)(*args)
+            return entry(model, *args)
+        return getattr(model, entry.__name__)(*args)
     except FloatingPointError as err:
         raise _too_large(what, err) from None
 
@@ -61,14 +61,14 @@ def _too_large(what: str, err: FloatingPointError) -> ValueError:
 
 def center_of_mass(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Centre of mass ``c`` of the bodies that move, in the world frame: (3,) or (N, 3)."""
-    return _call("center_of_mass", "center_of_mass", robot, q, threads and check_threads(threads))
+    return _call("center_of_mass", _core.center_of_mass, robot, q, threads and check_threads(threads))
 
 
 def com_jacobian(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Jacobian ``J_c`` of the centre of mass, ``c' = J_c v`` (world axes): (3, nv) or
     (N, 3, nv). It is the first three rows of :func:`centroidal_momentum_matrix` over the
     mass."""
-    return _call("com_jacobian", "com_jacobian", robot, q, threads and check_threads(threads))
+    return _call("com_jacobian", _core.com_jacobian, robot, q, threads and check_threads(threads))
 
 
 def centroidal_momentum_matrix(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
@@ -76,14 +76,14 @@ def centroidal_momentum_matrix(robot: RobotLike, q: ArrayLike, *, threads: int |
     linear momentum then the angular momentum about the centre of mass, world axes
     (Orin and Goswami's; Pinocchio's ``computeCentroidalMap``). Column k is the momentum
     of the robot moving at a unit rate of velocity coordinate k."""
-    return _call("centroidal_momentum_matrix", "centroidal_map", robot, q, threads and check_threads(threads))
+    return _call("centroidal_momentum_matrix", _core.centroidal_map, robot, q, threads and check_threads(threads))
 
 
 def centroidal_momentum(robot: RobotLike, q: ArrayLike, v: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Centroidal momentum ``h_G = A_G(q) v`` (6,) or (N, 6): linear momentum, then the
     angular momentum about the centre of mass, world axes (by one pass over the bodies,
     without forming ``A_G``)."""
-    return _call("centroidal_momentum", "centroidal_momentum", robot, q, v, threads and check_threads(threads))
+    return _call("centroidal_momentum", _core.centroidal_momentum, robot, q, v, threads and check_threads(threads))
 
 
 def centroidal_momentum_rate(
@@ -94,5 +94,5 @@ def centroidal_momentum_rate(
     ``a = 0`` gives ``A_G' v``. Equal to the net external wrench on the robot, gravity
     included, about the centre of mass (world axes) when ``a`` is the motion it causes."""
     return _call(
-        "centroidal_momentum_rate", "centroidal_momentum_rate", robot, q, v, a, threads and check_threads(threads)
+        "centroidal_momentum_rate", _core.centroidal_momentum_rate, robot, q, v, a, threads and check_threads(threads)
     )
