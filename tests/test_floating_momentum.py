@@ -6,7 +6,7 @@ loads, without for UR5, Kinova and Panda, whose fingers are a mimic pair), and a
 
 * h_G = A_G v is the sum of the links' momenta (each from its pose, Jacobian and inertia
   as the URDF gives them), moved to the centre of mass, itself the links' mean position;
-* c' = J_c v and h_G' = (A_G v)' by central differences along ``integrate(q, t v)``
+* c' = J_c v, A_G' and h_G' = (A_G v)' by central differences along ``integrate(q, t v)``
   (a constant velocity: the base twist is constant in the base frame);
 * a robot flying freely (no base wrench, any joint torques) changes its centroidal
   momentum by gravity alone: h_G' = [m g; 0];
@@ -57,6 +57,14 @@ def fixed_pin_configuration(model, names, q):
     return qp, perm
 
 
+def pinocchio_dag(dA, robot, q, v):
+    """Pinocchio's ``dAg`` from the time derivative of A_G: ``c' x`` the linear rows added
+    to the angular ones (it moves the moments to a centre of mass standing still)."""
+    A = centroidal.centroidal_momentum_matrix(robot, q)
+    cdot = centroidal.com_jacobian(robot, q) @ v
+    return np.concatenate([dA[:3], dA[3:] + np.cross(cdot, A[:3].T).T])
+
+
 def compare_with_pinocchio(robot, model, states, floating: bool):
     data = model.createData()
     for q, v, a in states:
@@ -74,6 +82,10 @@ def compare_with_pinocchio(robot, model, states, floating: bool):
         assert close(centroidal.centroidal_momentum(robot, q, v), hg) < TOL, "h_G"
         pin.computeCentroidalMomentumTimeVariation(model, data, qp, vp, ap)
         assert close(centroidal.centroidal_momentum_rate(robot, q, v, a), data.dhg.vector) < TOL, "h_G'"
+        dA = pinocchio_dag(centroidal.centroidal_momentum_matrix_rate(robot, q, v), robot, q, v)
+        # (a fresh Data: after computeCentroidalMomentumTimeVariation Pinocchio 4.1's dAg
+        # differs, a stale workspace)
+        assert close(dA[:, perm], pin.computeCentroidalMapTimeVariation(model, model.createData(), qp, vp)) < TOL
         assert close(numeric.kinetic_energy(robot, q, v), pin.computeKineticEnergy(model, data, qp, vp)) < TOL
         if floating:  # (a fixed base's potential counts its base link; Pinocchio's does not)
             assert close(numeric.potential_energy(robot, q), pin.computePotentialEnergy(model, data, qp)) < TOL
@@ -163,6 +175,10 @@ def test_mimic_joints_agree_with_pinocchio():
         assert close(centroidal.centroidal_momentum(robot, q, v), hg) < TOL
         pin.computeCentroidalMomentumTimeVariation(model, data, qp, vp, ap)
         assert close(centroidal.centroidal_momentum_rate(robot, q, v, a), data.dhg.vector) < TOL
+        full = np.zeros((6, model.nv))
+        full[:, perm] = pin.computeCentroidalMapTimeVariation(model, model.createData(), qp, vp)
+        dA = pinocchio_dag(centroidal.centroidal_momentum_matrix_rate(robot, q, v), robot, q, v)
+        assert close(dA, full @ mimic.G) < TOL
     Q = rng.uniform(-1, 1, (4, robot.dof))
     batch = centroidal.centroidal_momentum_matrix(robot, Q)
     assert all(np.array_equal(batch[k], centroidal.centroidal_momentum_matrix(robot, Q[k])) for k in range(4))
@@ -251,8 +267,9 @@ def test_rates_by_central_differences(index):
     q, v, _ = state(robot, rng)
     Jc = centroidal.com_jacobian(robot, q)
     assert close(Jc @ v, derivative(lambda x: centroidal.center_of_mass(robot, x), robot, q, v)) < 1e-7
-    dh = derivative(lambda x: centroidal.centroidal_momentum_matrix(robot, x) @ v, robot, q, v)
-    assert close(centroidal.centroidal_momentum_rate(robot, q, v, np.zeros(robot.nv)), dh) < 1e-7
+    dA = derivative(lambda x: centroidal.centroidal_momentum_matrix(robot, x), robot, q, v)
+    assert close(centroidal.centroidal_momentum_matrix_rate(robot, q, v), dA) < 1e-7
+    assert close(centroidal.centroidal_momentum_rate(robot, q, v, np.zeros(robot.nv)), dA @ v) < 1e-7
     # the link Jacobians (world axes): the velocity of the origin and the angular velocity
     for k, link in enumerate(robot.links):
         J = numeric.jacobian(robot, q, link)
@@ -309,6 +326,9 @@ CALLS = {
     "centroidal_momentum_matrix": lambda r, q, v, a, t: centroidal.centroidal_momentum_matrix(r, q, threads=t),
     "centroidal_momentum": lambda r, q, v, a, t: centroidal.centroidal_momentum(r, q, v, threads=t),
     "centroidal_momentum_rate": lambda r, q, v, a, t: centroidal.centroidal_momentum_rate(r, q, v, a, threads=t),
+    "centroidal_momentum_matrix_rate": lambda r, q, v, a, t: centroidal.centroidal_momentum_matrix_rate(
+        r, q, v, threads=t
+    ),
     "forward_kinematics": lambda r, q, v, a, t: numeric.forward_kinematics(r, q, threads=t),
     "jacobian": lambda r, q, v, a, t: numeric.jacobian(r, q, 2, reference_frame="local", threads=t),
     "kinetic_energy": lambda r, q, v, a, t: numeric.kinetic_energy(r, q, v, threads=t),
@@ -345,7 +365,7 @@ def test_bad_input_is_refused_by_name(name):
     bad[-1] = np.nan
     with pytest.raises(ValueError, match="q contains NaN"):
         call(robot, bad, v, a, None)
-    if name in ("centroidal_momentum", "centroidal_momentum_rate", "kinetic_energy"):
+    if name in ("centroidal_momentum", "centroidal_momentum_rate", "centroidal_momentum_matrix_rate", "kinetic_energy"):
         bad = v.copy()
         bad[0] = np.inf
         with pytest.raises(ValueError, match="contains NaN or inf"):

@@ -31,6 +31,7 @@ if TYPE_CHECKING:  # what __getattr__ below imports on first use, for type check
         center_of_mass,
         centroidal_momentum,
         centroidal_momentum_matrix,
+        centroidal_momentum_matrix_rate,
         centroidal_momentum_rate,
         com_jacobian,
     )
@@ -82,6 +83,7 @@ _CENTROIDAL = (
     "centroidal_momentum_matrix",
     "centroidal_momentum",
     "centroidal_momentum_rate",
+    "centroidal_momentum_matrix_rate",
 )
 
 

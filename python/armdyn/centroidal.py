@@ -1,7 +1,8 @@
 """Centre of mass and centroidal momentum, for a floating base or a fixed one (the Rust
 core's ``algo/centroidal.rs``; Pinocchio's ``centerOfMass``, ``jacobianCenterOfMass``,
-``computeCentroidalMap``, ``computeCentroidalMomentum`` and
-``computeCentroidalMomentumTimeVariation``, with the same results).
+``computeCentroidalMap``, ``computeCentroidalMomentum``,
+``computeCentroidalMomentumTimeVariation`` and ``computeCentroidalMapTimeVariation``,
+with the same results).
 
 Arguments as in :mod:`armdyn.numeric`: ``robot`` a bound Robot or a compiled model; ``q``
 ``(nq,)`` or ``(N, nq)``, ``v`` and ``a`` ``(nv,)`` or ``(N, nv)`` (a floating base:
@@ -35,6 +36,7 @@ __all__ = [
     "centroidal_momentum_matrix",
     "centroidal_momentum",
     "centroidal_momentum_rate",
+    "centroidal_momentum_matrix_rate",
 ]
 
 
@@ -95,4 +97,20 @@ def centroidal_momentum_rate(
     included, about the centre of mass (world axes) when ``a`` is the motion it causes."""
     return _call(
         "centroidal_momentum_rate", _core.centroidal_momentum_rate, robot, q, v, a, threads and check_threads(threads)
+    )
+
+
+def centroidal_momentum_matrix_rate(
+    robot: RobotLike, q: ArrayLike, v: ArrayLike, *, threads: int | None = None
+) -> np.ndarray:
+    """Time derivative ``A_G'(q, v)`` of the centroidal momentum matrix (6, nv) or
+    (N, 6, nv) when the robot moves at ``v``; ``A_G' v`` is
+    ``centroidal_momentum_rate(robot, q, v, 0)``.
+
+    Pinocchio's ``computeCentroidalMapTimeVariation`` moves the moments to the centre of
+    mass as if it stood still: its ``dAg`` is this plus ``c' x`` (the centre of mass's
+    velocity crossed with) the linear rows of ``A_G`` in the angular rows, a difference
+    that ``dAg v`` does not see (``c' x m c' = 0``)."""
+    return _call(
+        "centroidal_momentum_matrix_rate", _core.centroidal_map_rate, robot, q, v, threads and check_threads(threads)
     )

@@ -250,6 +250,11 @@ class MimicModel:
         (q,) = self._states(("q", q))
         return self._reduce(self._call_core("centroidal_map", {"q": q}, self._position(q), threads))
 
+    def centroidal_map_rate(self, q, v, threads=None):
+        q, v = self._states(("q", q), ("v", v))
+        named = {"q": q, "v": v}
+        return self._reduce(self._call_core("centroidal_map_rate", named, self._position(q), self._rate(v), threads))
+
     def centroidal_momentum(self, q, v, threads=None):
         q, v = self._states(("q", q), ("v", v))
         named = {"q": q, "v": v}

@@ -144,6 +144,36 @@ fn centroidal_momentum<'py>(
     finite(out)
 }
 
+/// Time derivative of the centroidal momentum matrix (6, nv) or (N, 6, nv).
+#[pyfunction]
+#[pyo3(signature = (model, q, v, threads = None))]
+fn centroidal_map_rate<'py>(
+    py: Python<'py>,
+    model: &NumericModel,
+    q: &Bound<'py, PyAny>,
+    v: &Bound<'py, PyAny>,
+    threads: Option<i64>,
+) -> Out<'py> {
+    model.require_mass("centroidal_momentum_matrix_rate")?;
+    let (nq, nv) = model.widths();
+    let fl = model.floating;
+    let out = model.floating_op(
+        py,
+        [("q", q, nq), ("v", v, nv)],
+        &[6, nv],
+        threads,
+        |d, [q, v], o| {
+            centroidal::centroidal_map_rate(&model.model, d, q, v, fl, o);
+        },
+        |m, [q, v], o, t| {
+            rows(m, [q, v], [nq, nv], o, 6 * nv, t, |d, [q, v], o| {
+                centroidal::centroidal_map_rate(m, d, q, v, fl, o);
+            })
+        },
+    )?;
+    finite(out)
+}
+
 /// Rate of change of the centroidal momentum (6,) or (N, 6).
 #[pyfunction]
 #[pyo3(signature = (model, q, v, a, threads = None))]
@@ -266,5 +296,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(centroidal_map, m)?)?;
     m.add_function(wrap_pyfunction!(centroidal_momentum, m)?)?;
     m.add_function(wrap_pyfunction!(centroidal_momentum_rate, m)?)?;
+    m.add_function(wrap_pyfunction!(centroidal_map_rate, m)?)?;
     Ok(())
 }

@@ -214,3 +214,112 @@ pub fn centroidal_momentum_rate(
     to_centroidal(&base, m, h, &rate, out);
     m
 }
+
+/// Column `k` of a (6, nv) row-major matrix as a force `[n; f]` (rows `[f; n]`).
+fn column(out: &[f64], nv: usize, k: usize) -> Force<f64> {
+    let at = |r: usize| out[r * nv + k];
+    Force::new(V3::new(at(3), at(4), at(5)), V3::new(at(0), at(1), at(2)))
+}
+
+/// Write the force `[n; f]` as column `k` (rows `[f; n]`) of a (6, nv) row-major matrix.
+fn put_column(out: &mut [f64], nv: usize, k: usize, f: &Force<f64>) {
+    for (r, x) in f.f.to_array().into_iter().chain(f.n.to_array()).enumerate() {
+        out[r * nv + k] = x;
+    }
+}
+
+/// The time derivative of the centroidal momentum matrix, `A_G'(q, v)` (6, nv) (row-major;
+/// Pinocchio's `computeCentroidalMapTimeVariation`), with `A_G' v` the velocity term of
+/// [`centroidal_momentum_rate`]. Returns the mass.
+///
+/// In the world frame about its origin the column of coordinate j is `I^c_j S_j` (world
+/// inertias and motion subspaces, [`centroidal_map`]), whose rate is
+/// `sum_{i in subtree(j)} (v_i x* I_i S_j - I_i (v_i x S_j)) + I^c_j (v_j x S_j)` (each
+/// body's inertia turns with it: `I_i' = v_i x* I_i - I_i v_i x`; `S_j' = v_j x S_j`), the
+/// base a body whose subtree is the robot with six axes `^0 X_B e_k`; moving the moment
+/// to the centre of mass `c` (`n_G = n - c x f`) adds `-c' x f - c x f'`.
+pub fn centroidal_map_rate(
+    model: &Model,
+    data: &mut Data<f64>,
+    q: &[f64],
+    v: &[f64],
+    floating: bool,
+    out: &mut [f64],
+) -> f64 {
+    let (_, nvb) = base_widths(floating);
+    let nv = model.nv + nvb;
+    assert_eq!(out.len(), 6 * nv, "output length");
+    let (base, qj) = split_configuration(model, q, floating);
+    let (vb, vj) = split_velocity(model, v, floating);
+    update_xup(model, data, qj);
+    update_x0(model, data);
+    // world quantities about the world origin: data.x0 = ^i X_0, data.c = S_i, data.v = v_i,
+    // data.ic = I_i; the momentum summed on the way
+    let xb = base.xform();
+    let vb0 = xb.inv_apply_motion(&vb);
+    let ib0 = if floating { model.base_inertia.tr_transform(&xb) } else { RigidInertia::zero() };
+    let mut momentum = ib0.mul_motion(&vb0);
+    for i in 0..model.nv {
+        data.x0[i] = data.x0[i].compose(&xb);
+        data.c[i] = data.x0[i].inv_apply_motion(&model.kind[i].s_times(1.0));
+        let parent = model.parent[i].map_or(vb0, |p| data.v[p]);
+        data.v[i] = parent + data.c[i].scale(vj[i]);
+        data.ic[i] = model.inertia[i].tr_transform(&data.x0[i]);
+        momentum += data.ic[i].mul_motion(&data.v[i]);
+    }
+    let base_axes: [Motion<f64>; 6] = std::array::from_fn(|k| {
+        let mut unit = [0.0; 6];
+        unit[k] = 1.0;
+        xb.inv_apply_motion(&Motion::new(V3::new(unit[3], unit[4], unit[5]), V3::new(unit[0], unit[1], unit[2])))
+    });
+    // sum over the bodies i of the turning of I_i, on each column j at or above i
+    let turning = |i: &RigidInertia<f64>, vi: &Motion<f64>, s: &Motion<f64>| {
+        vi.cross_force(&i.mul_motion(s)) - i.mul_motion(&vi.cross_motion(s))
+    };
+    out.fill(0.0);
+    for i in 0..model.nv {
+        let (inertia, vi) = (data.ic[i], data.v[i]);
+        let mut j = Some(i);
+        while let Some(b) = j {
+            let sum = column(out, nv, nvb + b) + turning(&inertia, &vi, &data.c[b]);
+            put_column(out, nv, nvb + b, &sum);
+            j = model.parent[b];
+        }
+        if floating {
+            for (k, s) in base_axes.iter().enumerate() {
+                let sum = column(out, nv, k) + turning(&inertia, &vi, s);
+                put_column(out, nv, k, &sum);
+            }
+        }
+    }
+    // composite inertias (world), and each column's own term and shift
+    let mut total = ib0;
+    for i in (0..model.nv).rev() {
+        let ic = data.ic[i];
+        match model.parent[i] {
+            Some(p) => data.ic[p] += ic,
+            None => total += ic,
+        }
+    }
+    let c = total.h.scale(1.0 / total.m);
+    let cdot = momentum.f.scale(1.0 / total.m);
+    let finish = |out: &mut [f64], k: usize, ic: &RigidInertia<f64>, vj: &Motion<f64>, s: &Motion<f64>| {
+        let a = ic.mul_motion(s);
+        let da = column(out, nv, k) + ic.mul_motion(&vj.cross_motion(s));
+        let n = da.n - cdot.cross(a.f) - c.cross(da.f);
+        put_column(out, nv, k, &Force::new(n, da.f));
+    };
+    if floating {
+        for (k, s) in base_axes.iter().enumerate() {
+            // the base body's own turning, then the whole robot's composite
+            let sum = column(out, nv, k) + turning(&ib0, &vb0, s);
+            put_column(out, nv, k, &sum);
+            finish(out, k, &total, &vb0, s);
+        }
+    }
+    for i in 0..model.nv {
+        let (ic, vi, s) = (data.ic[i], data.v[i], data.c[i]);
+        finish(out, nvb + i, &ic, &vi, &s);
+    }
+    total.m
+}

@@ -7,7 +7,7 @@
 use crate::common::*;
 use crate::floating::{floating_model, state};
 use armdyn_core::algo::centroidal::{
-    center_of_mass, centroidal_map, centroidal_momentum, centroidal_momentum_rate, com_jacobian,
+    center_of_mass, centroidal_map, centroidal_map_rate, centroidal_momentum, centroidal_momentum_rate, com_jacobian,
 };
 use armdyn_core::algo::floating::{aba_floating, crba_floating, quaternion_rotation};
 use armdyn_core::algo::floating_kinematics::{jacobian_world, kinetic_energy_world};
@@ -99,4 +99,25 @@ fn the_base_links_jacobian_is_the_base_rotation() {
         }
     }
     assert_close(&j, &want, 1e-15, "[R_B 0; 0 R_B], joint columns 0");
+}
+
+#[test]
+fn the_map_rate_times_v_is_the_momentum_rate_at_rest() {
+    let mut rng = Rng::new(13);
+    for (njoints, floating) in [(5, true), (7, false)] {
+        let model = floating_model(&mut rng, njoints);
+        let (mut q, mut v, _) = state(&mut rng, model.nv);
+        if !floating {
+            q.drain(..7);
+            v.drain(..6);
+        }
+        let nv = v.len();
+        let mut data = Data::new(&model);
+        let mut da = vec![0.0; 6 * nv];
+        centroidal_map_rate(&model, &mut data, &q, &v, floating, &mut da);
+        let mut rate = [0.0; 6];
+        centroidal_momentum_rate(&model, &mut data, &q, &v, &vec![0.0; nv], floating, &mut rate);
+        let dav: Vec<f64> = (0..6).map(|i| (0..nv).map(|k| da[i * nv + k] * v[k]).sum()).collect();
+        assert_close(&dav, &rate, 1e-12, "A_G' v = h_G'(a = 0)");
+    }
 }
