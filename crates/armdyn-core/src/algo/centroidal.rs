@@ -1,7 +1,8 @@
 //! Centre of mass and centroidal momentum (Orin and Goswami's centroidal momentum
 //! matrix; Pinocchio's `centerOfMass`, `jacobianCenterOfMass`, `computeCentroidalMap`,
-//! `computeCentroidalMomentum`, `computeCentroidalMomentumTimeVariation`), for a floating
-//! base or a fixed one (`floating`; arrays as in `algo::floating_kinematics`).
+//! `computeCentroidalMomentum`, `computeCentroidalMomentumTimeVariation`, and the time
+//! derivative of the matrix), for a floating base or a fixed one (`floating`; arrays as in
+//! `algo::floating_kinematics`).
 //!
 //! The mass is that of the bodies that move: every movable body, and the base (with the
 //! links welded to it, [`Model::base_inertia`]) when it floats. A fixed base and the links
@@ -13,6 +14,7 @@
 //! `k_G = R_B (n_B - c_B x f_B)` ([`to_centroidal`]). Outputs are ordered linear first,
 //! as Pinocchio's.
 
+use crate::algo::floating::base_motion;
 use crate::algo::floating_kinematics::{base_widths, mass_and_moment, split_configuration, split_velocity, BasePose};
 use crate::algo::kinematics::{update_x0, update_xup};
 use crate::algo::rnea::rnea_tree;
@@ -21,8 +23,8 @@ use crate::joint::JointKind;
 use crate::model::Model;
 use crate::spatial::{Force, Motion, RigidInertia, V3};
 
-/// `(m, c)`: the mass and the centre of mass in the world frame (`c` is NaN without
-/// mass). `out`: (3,).
+/// The centre of mass `c` in the world frame into `out` (3,) (NaN without mass); returns
+/// the mass.
 pub fn center_of_mass(model: &Model, data: &mut Data<f64>, q: &[f64], floating: bool, out: &mut [f64]) -> f64 {
     assert_eq!(out.len(), 3, "output length");
     let (base, qj) = split_configuration(model, q, floating);
@@ -31,6 +33,13 @@ pub fn center_of_mass(model: &Model, data: &mut Data<f64>, q: &[f64], floating: 
     let (m, h) = mass_and_moment(model, data, floating);
     out.copy_from_slice(&(base.p + base.r.mul_v(h.scale(1.0 / m))).to_array());
     m
+}
+
+/// The unit velocity of the base's coordinate k (`[v; w]` order) as a motion `[w; v]`.
+fn base_axis(k: usize) -> Motion<f64> {
+    let mut unit = [0.0; 6];
+    unit[k] = 1.0;
+    base_motion(&unit)
 }
 
 /// Write the spatial momentum (or its rate) `f` (base frame, about the base origin) as
@@ -81,10 +90,7 @@ pub fn centroidal_map(model: &Model, data: &mut Data<f64>, q: &[f64], floating: 
     };
     if floating {
         for k in 0..6 {
-            let mut unit = [0.0; 6];
-            unit[k] = 1.0;
-            let axis = Motion::new(V3::new(unit[3], unit[4], unit[5]), V3::new(unit[0], unit[1], unit[2]));
-            put(k, &total.mul_motion(&axis));
+            put(k, &total.mul_motion(&base_axis(k)));
         }
     }
     for i in 0..model.nv {
@@ -135,12 +141,9 @@ pub fn com_jacobian(model: &Model, data: &mut Data<f64>, q: &[f64], floating: bo
     };
     if floating {
         for k in 0..3 {
-            let mut e = V3::zero();
-            match k {
-                0 => e.x = 1.0,
-                1 => e.y = 1.0,
-                _ => e.z = 1.0,
-            }
+            let mut unit = [0.0; 3];
+            unit[k] = 1.0;
+            let e = V3::from_array(unit);
             put(k, e.scale(m));
             put(3 + k, e.cross(h));
         }
@@ -228,9 +231,10 @@ fn put_column(out: &mut [f64], nv: usize, k: usize, f: &Force<f64>) {
     }
 }
 
-/// The time derivative of the centroidal momentum matrix, `A_G'(q, v)` (6, nv) (row-major;
-/// Pinocchio's `computeCentroidalMapTimeVariation`), with `A_G' v` the velocity term of
-/// [`centroidal_momentum_rate`]. Returns the mass.
+/// The time derivative of the centroidal momentum matrix, `A_G'(q, v)` (6, nv) (row-major),
+/// with `A_G' v` the velocity term of [`centroidal_momentum_rate`]. Returns the mass.
+/// (Pinocchio's `computeCentroidalMapTimeVariation` moves the moments to a centre of mass
+/// standing still: its `dAg` adds `c' x` the linear rows to the angular ones.)
 ///
 /// In the world frame about its origin the column of coordinate j is `I^c_j S_j` (world
 /// inertias and motion subspaces, [`centroidal_map`]), whose rate is
@@ -267,11 +271,7 @@ pub fn centroidal_map_rate(
         data.ic[i] = model.inertia[i].tr_transform(&data.x0[i]);
         momentum += data.ic[i].mul_motion(&data.v[i]);
     }
-    let base_axes: [Motion<f64>; 6] = std::array::from_fn(|k| {
-        let mut unit = [0.0; 6];
-        unit[k] = 1.0;
-        xb.inv_apply_motion(&Motion::new(V3::new(unit[3], unit[4], unit[5]), V3::new(unit[0], unit[1], unit[2])))
-    });
+    let base_axes: [Motion<f64>; 6] = std::array::from_fn(|k| xb.inv_apply_motion(&base_axis(k)));
     // sum over the bodies i of the turning of I_i, on each column j at or above i
     let turning = |i: &RigidInertia<f64>, vi: &Motion<f64>, s: &Motion<f64>| {
         vi.cross_force(&i.mul_motion(s)) - i.mul_motion(&vi.cross_motion(s))
