@@ -10,6 +10,7 @@ use crate::{scalar_if_0d, NumericModel};
 use armdyn_core::algo::centroidal;
 use armdyn_core::algo::floating_kinematics as fk;
 use armdyn_core::batch_centroidal::rows;
+use armdyn_core::{Data, Model};
 use numpy::PyArrayDyn;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -40,6 +41,30 @@ impl NumericModel {
             }
         )))
     }
+
+    /// `f(model, data, row args, row out)` on one state or each state of a batch (the
+    /// arguments `(name, object, width)` checked as `floating_op` checks them), into a
+    /// fresh array of shape `out_shape` per state; a result not finite is an error.
+    fn world_op<'py, const K: usize>(
+        &self,
+        py: Python<'py>,
+        args: [(&str, &Bound<'py, PyAny>, usize); K],
+        out_shape: &[usize],
+        threads: Option<i64>,
+        f: impl Fn(&Model, &mut Data<f64>, [&[f64]; K], &mut [f64]) + Sync + Send + Copy,
+    ) -> Out<'py> {
+        let widths = args.map(|(_, _, w)| w);
+        let per_row = out_shape.iter().product::<usize>();
+        let out = self.floating_op(
+            py,
+            args,
+            out_shape,
+            threads,
+            |d, ins, o| f(&self.model, d, ins, o),
+            move |m, ins, o, t| rows(m, ins, widths, o, per_row, t, move |d, a, o| f(m, d, a, o)),
+        )?;
+        finite(out)
+    }
 }
 
 /// Centre of mass (3,) or (N, 3), world frame.
@@ -47,23 +72,10 @@ impl NumericModel {
 #[pyo3(signature = (model, q, threads = None))]
 fn center_of_mass<'py>(py: Python<'py>, model: &NumericModel, q: &Bound<'py, PyAny>, threads: Option<i64>) -> Out<'py> {
     model.require_mass("center_of_mass")?;
-    let (nq, _) = model.widths();
-    let fl = model.floating;
-    let out = model.floating_op(
-        py,
-        [("q", q, nq)],
-        &[3],
-        threads,
-        |d, [q], o| {
-            centroidal::center_of_mass(&model.model, d, q, fl, o);
-        },
-        |m, [q], o, t| {
-            rows(m, [q], [nq], o, 3, t, |d, [q], o| {
-                centroidal::center_of_mass(m, d, q, fl, o);
-            })
-        },
-    )?;
-    finite(out)
+    let (nq, fl) = (model.widths().0, model.floating);
+    model.world_op(py, [("q", q, nq)], &[3], threads, move |m, d, [q], o| {
+        centroidal::center_of_mass(m, d, q, fl, o);
+    })
 }
 
 /// Jacobian of the centre of mass (3, nv) or (N, 3, nv), world axes.
@@ -71,23 +83,10 @@ fn center_of_mass<'py>(py: Python<'py>, model: &NumericModel, q: &Bound<'py, PyA
 #[pyo3(signature = (model, q, threads = None))]
 fn com_jacobian<'py>(py: Python<'py>, model: &NumericModel, q: &Bound<'py, PyAny>, threads: Option<i64>) -> Out<'py> {
     model.require_mass("com_jacobian")?;
-    let (nq, nv) = model.widths();
-    let fl = model.floating;
-    let out = model.floating_op(
-        py,
-        [("q", q, nq)],
-        &[3, nv],
-        threads,
-        |d, [q], o| {
-            centroidal::com_jacobian(&model.model, d, q, fl, o);
-        },
-        |m, [q], o, t| {
-            rows(m, [q], [nq], o, 3 * nv, t, |d, [q], o| {
-                centroidal::com_jacobian(m, d, q, fl, o);
-            })
-        },
-    )?;
-    finite(out)
+    let ((nq, nv), fl) = (model.widths(), model.floating);
+    model.world_op(py, [("q", q, nq)], &[3, nv], threads, move |m, d, [q], o| {
+        centroidal::com_jacobian(m, d, q, fl, o);
+    })
 }
 
 /// Centroidal momentum matrix A_G (6, nv) or (N, 6, nv).
@@ -95,53 +94,10 @@ fn com_jacobian<'py>(py: Python<'py>, model: &NumericModel, q: &Bound<'py, PyAny
 #[pyo3(signature = (model, q, threads = None))]
 fn centroidal_map<'py>(py: Python<'py>, model: &NumericModel, q: &Bound<'py, PyAny>, threads: Option<i64>) -> Out<'py> {
     model.require_mass("centroidal_momentum_matrix")?;
-    let (nq, nv) = model.widths();
-    let fl = model.floating;
-    let out = model.floating_op(
-        py,
-        [("q", q, nq)],
-        &[6, nv],
-        threads,
-        |d, [q], o| {
-            centroidal::centroidal_map(&model.model, d, q, fl, o);
-        },
-        |m, [q], o, t| {
-            rows(m, [q], [nq], o, 6 * nv, t, |d, [q], o| {
-                centroidal::centroidal_map(m, d, q, fl, o);
-            })
-        },
-    )?;
-    finite(out)
-}
-
-/// Centroidal momentum h_G (6,) or (N, 6).
-#[pyfunction]
-#[pyo3(signature = (model, q, v, threads = None))]
-fn centroidal_momentum<'py>(
-    py: Python<'py>,
-    model: &NumericModel,
-    q: &Bound<'py, PyAny>,
-    v: &Bound<'py, PyAny>,
-    threads: Option<i64>,
-) -> Out<'py> {
-    model.require_mass("centroidal_momentum")?;
-    let (nq, nv) = model.widths();
-    let fl = model.floating;
-    let out = model.floating_op(
-        py,
-        [("q", q, nq), ("v", v, nv)],
-        &[6],
-        threads,
-        |d, [q, v], o| {
-            centroidal::centroidal_momentum(&model.model, d, q, v, fl, o);
-        },
-        |m, [q, v], o, t| {
-            rows(m, [q, v], [nq, nv], o, 6, t, |d, [q, v], o| {
-                centroidal::centroidal_momentum(m, d, q, v, fl, o);
-            })
-        },
-    )?;
-    finite(out)
+    let ((nq, nv), fl) = (model.widths(), model.floating);
+    model.world_op(py, [("q", q, nq)], &[6, nv], threads, move |m, d, [q], o| {
+        centroidal::centroidal_map(m, d, q, fl, o);
+    })
 }
 
 /// Time derivative of the centroidal momentum matrix (6, nv) or (N, 6, nv).
@@ -155,23 +111,27 @@ fn centroidal_map_rate<'py>(
     threads: Option<i64>,
 ) -> Out<'py> {
     model.require_mass("centroidal_momentum_matrix_rate")?;
-    let (nq, nv) = model.widths();
-    let fl = model.floating;
-    let out = model.floating_op(
-        py,
-        [("q", q, nq), ("v", v, nv)],
-        &[6, nv],
-        threads,
-        |d, [q, v], o| {
-            centroidal::centroidal_map_rate(&model.model, d, q, v, fl, o);
-        },
-        |m, [q, v], o, t| {
-            rows(m, [q, v], [nq, nv], o, 6 * nv, t, |d, [q, v], o| {
-                centroidal::centroidal_map_rate(m, d, q, v, fl, o);
-            })
-        },
-    )?;
-    finite(out)
+    let ((nq, nv), fl) = (model.widths(), model.floating);
+    model.world_op(py, [("q", q, nq), ("v", v, nv)], &[6, nv], threads, move |m, d, [q, v], o| {
+        centroidal::centroidal_map_rate(m, d, q, v, fl, o);
+    })
+}
+
+/// Centroidal momentum h_G (6,) or (N, 6).
+#[pyfunction]
+#[pyo3(signature = (model, q, v, threads = None))]
+fn centroidal_momentum<'py>(
+    py: Python<'py>,
+    model: &NumericModel,
+    q: &Bound<'py, PyAny>,
+    v: &Bound<'py, PyAny>,
+    threads: Option<i64>,
+) -> Out<'py> {
+    model.require_mass("centroidal_momentum")?;
+    let ((nq, nv), fl) = (model.widths(), model.floating);
+    model.world_op(py, [("q", q, nq), ("v", v, nv)], &[6], threads, move |m, d, [q, v], o| {
+        centroidal::centroidal_momentum(m, d, q, v, fl, o);
+    })
 }
 
 /// Rate of change of the centroidal momentum (6,) or (N, 6).
@@ -186,23 +146,11 @@ fn centroidal_momentum_rate<'py>(
     threads: Option<i64>,
 ) -> Out<'py> {
     model.require_mass("centroidal_momentum_rate")?;
-    let (nq, nv) = model.widths();
-    let fl = model.floating;
-    let out = model.floating_op(
-        py,
-        [("q", q, nq), ("v", v, nv), ("a", a, nv)],
-        &[6],
-        threads,
-        |d, [q, v, a], o| {
-            centroidal::centroidal_momentum_rate(&model.model, d, q, v, a, fl, o);
-        },
-        |m, [q, v, a], o, t| {
-            rows(m, [q, v, a], [nq, nv, nv], o, 6, t, |d, [q, v, a], o| {
-                centroidal::centroidal_momentum_rate(m, d, q, v, a, fl, o);
-            })
-        },
-    )?;
-    finite(out)
+    let ((nq, nv), fl) = (model.widths(), model.floating);
+    let args = [("q", q, nq), ("v", v, nv), ("a", a, nv)];
+    model.world_op(py, args, &[6], threads, move |m, d, [q, v, a], o| {
+        centroidal::centroidal_momentum_rate(m, d, q, v, a, fl, o);
+    })
 }
 
 impl NumericModel {
@@ -214,17 +162,10 @@ impl NumericModel {
         q: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> Out<'py> {
-        let (nq, _) = self.widths();
-        let per = self.model.nlinks() * 16;
-        let out = self.floating_op(
-            py,
-            [("q", q, nq)],
-            &[self.model.nlinks(), 4, 4],
-            threads,
-            |d, [q], o| fk::forward_kinematics_world(&self.model, d, q, true, o),
-            |m, [q], o, t| rows(m, [q], [nq], o, per, t, |d, [q], o| fk::forward_kinematics_world(m, d, q, true, o)),
-        )?;
-        finite(out)
+        let shape = [self.model.nlinks(), 4, 4];
+        self.world_op(py, [("q", q, self.widths().0)], &shape, threads, |m, d, [q], o| {
+            fk::forward_kinematics_world(m, d, q, true, o)
+        })
     }
 
     /// Jacobian (6, nv) or (N, 6, nv) of link `index`, world axes: `jacobian` of a
@@ -237,15 +178,9 @@ impl NumericModel {
         threads: Option<i64>,
     ) -> Out<'py> {
         let (nq, nv) = self.widths();
-        let out = self.floating_op(
-            py,
-            [("q", q, nq)],
-            &[6, nv],
-            threads,
-            |d, [q], o| fk::jacobian_world(&self.model, d, q, true, index, o),
-            |m, [q], o, t| rows(m, [q], [nq], o, 6 * nv, t, |d, [q], o| fk::jacobian_world(m, d, q, true, index, o)),
-        )?;
-        finite(out)
+        self.world_op(py, [("q", q, nq)], &[6, nv], threads, move |m, d, [q], o| {
+            fk::jacobian_world(m, d, q, true, index, o)
+        })
     }
 
     /// Kinetic energy 1/2 v^T M v, a float or (N,): `kinetic_energy` of a floating model.
@@ -257,17 +192,10 @@ impl NumericModel {
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (nq, nv) = self.widths();
-        let out = self.floating_op(
-            py,
-            [("q", q, nq), ("qd", v, nv)],
-            &[],
-            threads,
-            |d, [q, v], o| o[0] = fk::kinetic_energy_world(&self.model, d, q, v, true),
-            |m, [q, v], o, t| {
-                rows(m, [q, v], [nq, nv], o, 1, t, |d, [q, v], o| o[0] = fk::kinetic_energy_world(m, d, q, v, true))
-            },
-        )?;
-        scalar_if_0d(finite(out)?)
+        let out = self.world_op(py, [("q", q, nq), ("qd", v, nv)], &[], threads, |m, d, [q, v], o| {
+            o[0] = fk::kinetic_energy_world(m, d, q, v, true)
+        })?;
+        scalar_if_0d(out)
     }
 
     /// Potential energy, a float or (N,): `potential_energy` of a floating model.
@@ -277,16 +205,10 @@ impl NumericModel {
         q: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (nq, _) = self.widths();
-        let out = self.floating_op(
-            py,
-            [("q", q, nq)],
-            &[],
-            threads,
-            |d, [q], o| o[0] = fk::potential_energy_floating(&self.model, d, q),
-            |m, [q], o, t| rows(m, [q], [nq], o, 1, t, |d, [q], o| o[0] = fk::potential_energy_floating(m, d, q)),
-        )?;
-        scalar_if_0d(finite(out)?)
+        let out = self.world_op(py, [("q", q, self.widths().0)], &[], threads, |m, d, [q], o| {
+            o[0] = fk::potential_energy_floating(m, d, q)
+        })?;
+        scalar_if_0d(out)
     }
 }
 
