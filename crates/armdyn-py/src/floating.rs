@@ -1,6 +1,7 @@
 //! The floating-base methods of `NumericModel` (a free-flyer root joint; see
 //! `armdyn_core::algo::floating` for the layout of the arrays, Pinocchio's): rnea, crba
-//! and aba dispatch here when the model floats, and every other method refuses.
+//! and aba dispatch here when the model floats (the kinematics and energies to
+//! `centroidal.rs`), and every other method refuses.
 //!
 //! `q` is `(7 + n,)` or `(N, 7 + n)`, `v` (`qd`), `a` (`qdd`) and `tau` `(6 + n,)` or
 //! `(N, 6 + n)`; a batch runs as the fixed-base ones do (SIMD lanes, `threads` threads,
@@ -24,7 +25,7 @@ impl NumericModel {
     pub(crate) fn fixed_base_only(&self) -> PyResult<()> {
         if self.floating {
             return Err(PyNotImplementedError::new_err(format!(
-                "'{}' has a floating base (free-flyer root joint): only rnea, crba and aba support it yet",
+                "'{}' has a floating base (free-flyer root joint): only rnea, crba, aba, forward_kinematics, jacobian and the energies support it yet",
                 self.name
             )));
         }

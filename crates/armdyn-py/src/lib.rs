@@ -231,7 +231,8 @@ pub struct NumericModel {
     /// and `aba` refuses (it would divide by zero).
     inert_joints: Vec<String>,
     /// Whether the base floats (a free-flyer root joint, `floating.rs`): rnea, crba and
-    /// aba then take Pinocchio's floating-base arrays, and every other method refuses.
+    /// aba (and the kinematics and energies) then take Pinocchio's floating-base arrays, and
+    /// every other method refuses.
     floating: bool,
 }
 
