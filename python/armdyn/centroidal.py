@@ -40,19 +40,11 @@ __all__ = [
 ]
 
 
-def _call(what: str, entry, robot, *args):
-    """``entry(model, *args)`` (a function of ``_core``) for a compiled model; for a
-    :class:`~armdyn.mimic.MimicModel` its method of the same name (the full tree's
-    quantities in the independent coordinates); an overflow as :func:`_too_large` says."""
-    model = getattr(robot, "_numeric_model", None)  # the cache first: these are timed per call
-    if model is None:
-        model = compiled_model(robot)
-    try:
-        if type(model) is _core.NumericModel:
-            return entry(model, *args)
-        return getattr(model, entry.__name__)(*args)
-    except FloatingPointError as err:
-        raise _too_large(what, err) from None
+# Each function below runs the core's function on a compiled model, a MimicModel's method
+# of the same name otherwise (the full tree's quantities in the independent coordinates),
+# written out in each (no shared helper): a call costs 1 to 3 us, and a helper's frame and
+# argument packing were a fifth of that.
+_NumericModel = _core.NumericModel
 
 
 def _too_large(what: str, err: FloatingPointError) -> ValueError:
@@ -63,14 +55,26 @@ def _too_large(what: str, err: FloatingPointError) -> ValueError:
 
 def center_of_mass(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Centre of mass ``c`` of the bodies that move, in the world frame: (3,) or (N, 3)."""
-    return _call("center_of_mass", _core.center_of_mass, robot, q, threads and check_threads(threads))
+    model = getattr(robot, "_numeric_model", None) or compiled_model(robot)
+    try:
+        if type(model) is _NumericModel:
+            return _core.center_of_mass(model, q, threads if threads is None else check_threads(threads))
+        return model.center_of_mass(q, threads if threads is None else check_threads(threads))
+    except FloatingPointError as err:
+        raise _too_large("center_of_mass", err) from None
 
 
 def com_jacobian(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Jacobian ``J_c`` of the centre of mass, ``c' = J_c v`` (world axes): (3, nv) or
     (N, 3, nv). It is the first three rows of :func:`centroidal_momentum_matrix` over the
     mass."""
-    return _call("com_jacobian", _core.com_jacobian, robot, q, threads and check_threads(threads))
+    model = getattr(robot, "_numeric_model", None) or compiled_model(robot)
+    try:
+        if type(model) is _NumericModel:
+            return _core.com_jacobian(model, q, threads if threads is None else check_threads(threads))
+        return model.com_jacobian(q, threads if threads is None else check_threads(threads))
+    except FloatingPointError as err:
+        raise _too_large("com_jacobian", err) from None
 
 
 def centroidal_momentum_matrix(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
@@ -78,14 +82,26 @@ def centroidal_momentum_matrix(robot: RobotLike, q: ArrayLike, *, threads: int |
     linear momentum then the angular momentum about the centre of mass, world axes
     (Orin and Goswami's; Pinocchio's ``computeCentroidalMap``). Column k is the momentum
     of the robot moving at a unit rate of velocity coordinate k."""
-    return _call("centroidal_momentum_matrix", _core.centroidal_map, robot, q, threads and check_threads(threads))
+    model = getattr(robot, "_numeric_model", None) or compiled_model(robot)
+    try:
+        if type(model) is _NumericModel:
+            return _core.centroidal_map(model, q, threads if threads is None else check_threads(threads))
+        return model.centroidal_map(q, threads if threads is None else check_threads(threads))
+    except FloatingPointError as err:
+        raise _too_large("centroidal_momentum_matrix", err) from None
 
 
 def centroidal_momentum(robot: RobotLike, q: ArrayLike, v: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Centroidal momentum ``h_G = A_G(q) v`` (6,) or (N, 6): linear momentum, then the
     angular momentum about the centre of mass, world axes (by one pass over the bodies,
     without forming ``A_G``)."""
-    return _call("centroidal_momentum", _core.centroidal_momentum, robot, q, v, threads and check_threads(threads))
+    model = getattr(robot, "_numeric_model", None) or compiled_model(robot)
+    try:
+        if type(model) is _NumericModel:
+            return _core.centroidal_momentum(model, q, v, threads if threads is None else check_threads(threads))
+        return model.centroidal_momentum(q, v, threads if threads is None else check_threads(threads))
+    except FloatingPointError as err:
+        raise _too_large("centroidal_momentum", err) from None
 
 
 def centroidal_momentum_rate(
@@ -95,9 +111,15 @@ def centroidal_momentum_rate(
     for the acceleration ``a`` (Pinocchio's ``computeCentroidalMomentumTimeVariation``);
     ``a = 0`` gives ``A_G' v``. Equal to the net external wrench on the robot, gravity
     included, about the centre of mass (world axes) when ``a`` is the motion it causes."""
-    return _call(
-        "centroidal_momentum_rate", _core.centroidal_momentum_rate, robot, q, v, a, threads and check_threads(threads)
-    )
+    model = getattr(robot, "_numeric_model", None) or compiled_model(robot)
+    try:
+        if type(model) is _NumericModel:
+            return _core.centroidal_momentum_rate(
+                model, q, v, a, threads if threads is None else check_threads(threads)
+            )
+        return model.centroidal_momentum_rate(q, v, a, threads if threads is None else check_threads(threads))
+    except FloatingPointError as err:
+        raise _too_large("centroidal_momentum_rate", err) from None
 
 
 def centroidal_momentum_matrix_rate(
@@ -111,6 +133,10 @@ def centroidal_momentum_matrix_rate(
     mass as if it stood still: its ``dAg`` is this plus ``c' x`` (the centre of mass's
     velocity crossed with) the linear rows of ``A_G`` in the angular rows, a difference
     that ``dAg v`` does not see (``c' x m c' = 0``)."""
-    return _call(
-        "centroidal_momentum_matrix_rate", _core.centroidal_map_rate, robot, q, v, threads and check_threads(threads)
-    )
+    model = getattr(robot, "_numeric_model", None) or compiled_model(robot)
+    try:
+        if type(model) is _NumericModel:
+            return _core.centroidal_map_rate(model, q, v, threads if threads is None else check_threads(threads))
+        return model.centroidal_map_rate(q, v, threads if threads is None else check_threads(threads))
+    except FloatingPointError as err:
+        raise _too_large("centroidal_momentum_matrix_rate", err) from None
