@@ -403,3 +403,14 @@ def test_an_overflow_is_a_value_error():
         centroidal.centroidal_momentum_rate(robot, q, v * 1e200, a)
     with pytest.raises(ValueError, match="overflow"):
         numeric.kinetic_energy(robot, q, v * 1e200)
+
+
+def test_a_compiled_model_and_the_top_level_names():
+    """The functions take a compiled model as they take the Robot; armdyn exports them."""
+    robot, _, rng = floating_tree(9)
+    q, v, _ = floating_state(robot, rng)
+    model = numeric.compile_model(robot)
+    assert np.array_equal(armdyn.center_of_mass(model, q), centroidal.center_of_mass(robot, q))
+    assert np.array_equal(armdyn.centroidal_momentum(model, q, v), centroidal.centroidal_momentum(robot, q, v))
+    assert np.array_equal(numeric.jacobian(model, q, 2), numeric.jacobian(robot, q, 2))
+    assert set(centroidal.__all__) <= set(armdyn.__all__)
