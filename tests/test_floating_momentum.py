@@ -2,7 +2,8 @@
 (armdyn.centroidal; armdyn.numeric's forward_kinematics, jacobian, kinetic_energy and
 potential_energy on a floating base) against Pinocchio (buildModelFromUrdf, with
 JointModelFreeFlyer for the floating robots of example-robot-data that test_floating.py
-loads, without for UR5, Kinova and Panda, whose fingers are a mimic pair), and against identities that need no second library:
+loads, without for UR5, Kinova and Panda, whose fingers are a mimic pair), and against
+identities that need no second library:
 
 * h_G = A_G v is the sum of the links' momenta (each from its pose, Jacobian and inertia
   as the URDF gives them), moved to the centre of mass, itself the links' mean position;
@@ -306,7 +307,8 @@ def test_energies(index):
 
 def test_jacobian_frames_relate():
     """LOCAL = R^T LOCAL_WORLD_ALIGNED; WORLD's linear rows are v - w x p."""
-    robot = robots()[4]  # link frames off the joints
+    robot = robots()[4]
+    assert any(j.has_frame_offset for j in robot.joints), "link frames off the joints"
     q, _, _ = floating_state(robot, np.random.default_rng(1))
     poses = numeric.forward_kinematics(robot, q)
     for k, link in enumerate(robot.links):
