@@ -39,8 +39,12 @@ origin applied to the base), all in the base frame, then the joints; ``M`` is
 differs from 1 by more than 1e-9 is refused (``ValueError``). Batches ``(N, nq)`` run
 as the fixed-base ones (SIMD lanes, ``threads``; bit for bit the single calls). :mod:`armdyn.configuration` moves on that configuration space
 (``integrate``, ``difference``, ``neutral``, ``random_configuration``, re-exported
-here). Every other function here raises :class:`~armdyn.errors.FloatingBaseError` (a
-``ModelError`` and ``NotImplementedError``) for a floating robot, naming itself.
+here). ``forward_kinematics`` (poses in the world frame), ``jacobian`` (``(6, nv)``, its
+frames in the world frame), ``kinetic_energy`` and ``potential_energy`` (of the whole
+robot, the base's too) take them as well, and :mod:`armdyn.centroidal` gives the centre
+of mass and the centroidal momentum. Every other function here raises
+:class:`~armdyn.errors.FloatingBaseError` (a ``ModelError`` and ``NotImplementedError``)
+for a floating robot, naming itself.
 """
 
 from __future__ import annotations
@@ -821,7 +825,8 @@ def require_fixed_base(robot, what: str) -> None:
         if isinstance(robot, Robot):
             robot.require_fixed_base(what)
         raise FloatingBaseError(
-            f"{what} does not support a floating base (root_joint='free-flyer') yet; rnea, crba and aba do",
+            f"{what} does not support a floating base (root_joint='free-flyer') yet; rnea, crba, aba, "
+            "forward_kinematics, jacobian, the energies and armdyn.centroidal do",
             f"robot '{robot.name}'",
         )
 
@@ -842,10 +847,6 @@ for _name in (
     "gravity",
     "bias",
     "coriolis_matrix",
-    "kinetic_energy",
-    "potential_energy",
-    "forward_kinematics",
-    "jacobian",
     "rnea_derivatives",
     "aba_derivatives",
     "minverse",

@@ -6,11 +6,13 @@
 
 pub mod aba;
 pub mod aba_derivatives;
+pub mod centroidal;
 pub mod coriolis;
 pub mod crba;
 pub mod energy;
 pub mod external;
 pub mod floating;
+pub mod floating_kinematics;
 pub mod gravity_derivatives;
 pub mod integrate;
 pub mod integrate_floating;

@@ -5,7 +5,7 @@ use crate::common::*;
 use armdyn_core::algo::floating::{aba_floating, crba_floating, rnea_floating};
 use armdyn_core::{algo, Data, F64x4, Model, Real};
 
-fn floating_model(rng: &mut Rng, njoints: usize) -> Model {
+pub(crate) fn floating_model(rng: &mut Rng, njoints: usize) -> Model {
     let mut model = random_model(rng, njoints, true);
     let inertia = random_inertia(rng);
     let com = [rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2)];
@@ -14,10 +14,10 @@ fn floating_model(rng: &mut Rng, njoints: usize) -> Model {
 }
 
 /// (q, v, a) of one state.
-type State = (Vec<f64>, Vec<f64>, Vec<f64>);
+pub(crate) type State = (Vec<f64>, Vec<f64>, Vec<f64>);
 
 /// Random (q, v, a): any base pose (a unit quaternion), joints in [-3, 3].
-fn state(rng: &mut Rng, n: usize) -> State {
+pub(crate) fn state(rng: &mut Rng, n: usize) -> State {
     let mut q = rng.vec(7 + n, -3.0, 3.0);
     let quat = rng.vec(4, -1.0, 1.0);
     let norm = quat.iter().map(|x| x * x).sum::<f64>().sqrt();
