@@ -8,7 +8,10 @@ process, on example-robot-data's solo12, anymal and talos (free-flyer root).
 
 ``armdyn.numeric.rnea(robot, q, v, a)`` vs ``pin.rnea(model, data, q, v, a)`` on the same
 arrays (Pinocchio's layout: q = base position, quaternion x y z w, joints), likewise
-crba and aba. Each time is the median over ``--repeat`` runs of ``timeit`` with
+crba and aba, and the centroidal momentum matrix (``armdyn.centroidal_momentum_matrix`` vs
+``pin.computeCentroidalMap``), the centre of mass Jacobian (``com_jacobian`` vs
+``pin.jacobianCenterOfMass``) and the centroidal momentum (``centroidal_momentum`` vs
+``pin.computeCentroidalMomentum``). Each time is the median over ``--repeat`` runs of ``timeit`` with
 ``--number`` calls each; the runs of the two libraries alternate, so both see the same
 machine load. Before timing each robot is checked: armdyn == Pinocchio to 1e-10.
 Ratios are armdyn time / Pinocchio time: below 1 means armdyn is faster.
@@ -33,6 +36,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_numeric import paired_medians, per_call_run  # noqa: E402  (the same timing as the arms')
 
 import armdyn  # noqa: E402
+from armdyn import centroidal as cen  # noqa: E402
 from armdyn import numeric as num  # noqa: E402
 
 ROBOTS = {
@@ -74,10 +78,25 @@ def main() -> None:
         M = pin.crba(model, data, q)
         assert np.max(np.abs(num.crba(robot, q) - (np.triu(M) + np.triu(M, 1).T))) < 1e-10 * np.max(np.abs(M))
         assert np.max(np.abs(num.aba(robot, q, v, tau) - a)) < 1e-8
+        A = pin.computeCentroidalMap(model, data, q)
+        assert np.max(np.abs(cen.centroidal_momentum_matrix(robot, q) - A)) < 1e-10 * np.max(np.abs(A))
+        Jc = pin.jacobianCenterOfMass(model, data, q)
+        assert np.max(np.abs(cen.com_jacobian(robot, q) - Jc)) < 1e-10 * max(1, np.max(np.abs(Jc)))
+        h = pin.computeCentroidalMomentum(model, data, q, v).vector
+        assert np.max(np.abs(cen.centroidal_momentum(robot, q, v) - h)) < 1e-10 * max(1, np.max(np.abs(h)))
         cases = {
             "rnea": ((num.rnea, (robot, q, v, a)), (pin.rnea, (model, data, q, v, a))),
             "crba": ((num.crba, (robot, q)), (pin.crba, (model, data, q))),
             "aba": ((num.aba, (robot, q, v, tau)), (pin.aba, (model, data, q, v, tau))),
+            "centroidal map": (
+                (cen.centroidal_momentum_matrix, (robot, q)),
+                (pin.computeCentroidalMap, (model, data, q)),
+            ),
+            "com jacobian": ((cen.com_jacobian, (robot, q)), (pin.jacobianCenterOfMass, (model, data, q))),
+            "centroidal momentum": (
+                (cen.centroidal_momentum, (robot, q, v)),
+                (pin.computeCentroidalMomentum, (model, data, q, v)),
+            ),
         }
         for algo, ((f, fa), (g, ga)) in cases.items():
             mine, theirs = paired_medians(per_call_run(f, fa, number), per_call_run(g, ga, number), repeat)

@@ -1,8 +1,9 @@
 """armdyn.simulate vs MuJoCo's mujoco.rollout and Robotics Toolbox's fdyn, side by side in
-one process, on the UR5.
+one process, on the UR5; and a floating robot (solo12) against MuJoCo's rollout.
 
     PYTHONPATH=python python3 benchmarks/bench_simulate.py            # N = 1e4 states x 1000 steps
     PYTHONPATH=python python3 benchmarks/bench_simulate.py --quick    # N = 1e3
+    PYTHONPATH=python python3 benchmarks/bench_simulate.py --case floating --quick
 
 The model: example-robot-data's ``ur5_robot.urdf``, loaded by armdyn (``armdyn.load``) and
 by MuJoCo (``mujoco.MjModel.from_xml_path``, which compiles URDF), no actuators, zero
@@ -31,6 +32,14 @@ one, on the same compiled model description: "armdyn before (...)" rows and the 
 Reported: median seconds over ``--repeat`` runs (runs alternate between libraries),
 simulated steps per second (states x steps / time), and ratios armdyn / other.
 Also the peak memory (tracemalloc) of armdyn with stride = steps vs stride = 1.
+
+The floating case (``--case floating``): example-robot-data's solo12 (12 joints and a
+free base) given to MuJoCo's compiler as a floating URDF
+(:func:`armdyn.io.mjcf_state.urdf_for_mujoco`), the MJCF it writes loaded by both;
+``--floating-states`` random states (base anywhere, any orientation, joints in [-pi, pi],
+velocities in [-1, 1]) passed to MuJoCo through :func:`armdyn.io.mjcf_state.to_mujoco_state`;
+RK4, contacts off; the final states of the first 8 must agree to 1e-9 (both fourth order).
+armdyn runs the floating integrator (one state per task, f64) with stride = steps.
 
 Not a test: timings depend on the machine and its load.
 """
@@ -151,9 +160,16 @@ def main() -> None:
     p.add_argument("--rtb-trajectories", type=int, default=3)
     p.add_argument("--quick", action="store_true")
     p.add_argument("--core-before", help="another build of armdyn's _core*.so to time alongside")
+    p.add_argument("--case", choices=("ur5", "floating", "all"), default="all")
+    p.add_argument("--floating-states", type=int, default=2000)
     args = p.parse_args()
     if args.quick:
         args.states, args.repeat, args.rtb_trajectories = 1000, 2, 1
+        args.floating_states = min(args.floating_states, 200)
+    if args.case in ("floating", "all"):
+        floating_case(args)
+    if args.case == "floating":
+        return
     n, steps, dt, threads = args.states, args.steps, args.dt, args.threads
 
     import re
@@ -317,6 +333,75 @@ def main() -> None:
         print(
             f"memory, 1000 states, stride {stride:4d}: peak {peak / 2**20:8.1f} MiB, stored arrays {stored / 2**20:8.1f} MiB"
         )
+
+
+def floating_case(args) -> None:
+    """solo12 floating: armdyn's simulate vs MuJoCo's rollout (see the module doc)."""
+    import tempfile
+    import warnings
+
+    import mujoco
+    from mujoco import rollout
+
+    from armdyn.io.mjcf_state import from_mujoco_state, to_mujoco_state, urdf_for_mujoco
+
+    urdf = urdf_path().replace(URDF, "solo_description/robots/solo12.urdf")
+    folder = tempfile.mkdtemp()
+    compiled = mujoco.MjModel.from_xml_string(urdf_for_mujoco(open(urdf).read()))
+    path = os.path.join(folder, "solo12.xml")
+    mujoco.mj_saveLastXML(path, compiled)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = armdyn.load(path, strict=False)
+    n, steps, dt, threads = args.floating_states, args.steps, args.dt, args.threads
+    rng = np.random.default_rng(1)
+    q0 = np.array([armdyn.numeric.random_configuration(robot, rng) for _ in range(n)])
+    v0 = rng.uniform(-1, 1, (n, robot.nv))
+    mj = mujoco.MjModel.from_xml_path(path)
+    mj.opt.timestep = dt
+    mj.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    mj.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_CONTACT
+    datas = [mujoco.MjData(mj) for _ in range(threads)]
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    x0 = np.zeros((n, mujoco.mj_stateSize(mj, spec)))
+    qpos, qvel = to_mujoco_state(robot, q0, v0)
+    for i in range(n):
+        datas[0].qpos[:], datas[0].qvel[:], datas[0].time = qpos[i], qvel[i], 0.0
+        mujoco.mj_getState(mj, datas[0], x0[i], spec)
+    block = min(args.block, n)
+    buf = np.empty((block, steps, x0.shape[1]))
+
+    def run_mujoco():
+        for b in range(0, n, block):
+            k = min(block, n - b)
+            rollout.rollout(mj, datas, x0[b : b + k], nstep=steps, state=buf[:k], persistent_pool=True)
+
+    def run_armdyn():
+        return simulate(robot, q0, v0, dt=dt, steps=steps, stride=steps, threads=threads, energies=False)
+
+    last = rollout.rollout(mj, datas, x0[:8], nstep=steps)[0][:, -1]
+    q_mj, v_mj = from_mujoco_state(robot, last[:, 1 : 1 + mj.nq], last[:, 1 + mj.nq : 1 + mj.nq + mj.nv])
+    ours = run_armdyn()
+    gap = max(
+        np.abs(armdyn.numeric.difference(robot, ours.q_final[:8], q_mj)).max(),
+        np.abs(ours.qd_final[:8] - v_mj).max(),
+    )
+    print(f"# solo12 floating (MJCF written by MuJoCo), {n} states x {steps} steps, dt = {dt}, {threads} threads")
+    print(f"# check: MuJoCo vs armdyn final q, v, 8 states: max |diff| = {gap:.2e}")
+    assert gap < 1e-9, gap
+    times = {"armdyn floating (stride = steps)": [], "MuJoCo rollout (floating)": []}
+    for _ in range(args.repeat):
+        times["armdyn floating (stride = steps)"].append(median_time(run_armdyn, 1))
+        times["MuJoCo rollout (floating)"].append(median_time(run_mujoco, 1))
+    print(f"{'':34s} {'time (s)':>10s} {'steps/s':>12s} {'per trajectory':>15s}")
+    for k, ts in times.items():
+        t = statistics.median(ts)
+        print(f"{k:34s} {t:10.3f} {n * steps / t:12.3e} {t / n * 1e6:12.1f} us")
+    ratio = statistics.median(times["MuJoCo rollout (floating)"]) / statistics.median(
+        times["armdyn floating (stride = steps)"]
+    )
+    print(f"throughput armdyn floating / MuJoCo rollout: {ratio:.2f}x")
+    print()
 
 
 if __name__ == "__main__":

@@ -71,6 +71,17 @@ def test_grader_agrees_with_truth(md):
     assert not fs.missed, f"{md.name}: missed slips / carried errors at lines {fs.missed}"
 
 
+@pytest.mark.parametrize("md", FILES, ids=[p.name for p in FILES])
+def test_grader_agrees_with_truth_without_the_robot(md):
+    # the robot read from the text (or, failing that, the text's own values): what is read is
+    # never called wrong when the truth says right, nor right when it carries a slip
+    truth_file = md.with_name(md.name[: -len(".md")] + ".truth.yaml")
+    fs = bench_corpus.score(md, truth_file, no_robot=True)
+    assert not fs.refused, f"{md.name} refused: {fs.refused}"
+    assert not fs.false_alarms, f"{md.name}: false alarms at lines {fs.false_alarms}"
+    assert not fs.missed, f"{md.name}: missed slips / carried errors at lines {fs.missed}"
+
+
 def test_truth_refuses_an_unexplained_wrong_transcription():
     # a right equation transcribed wrong (theta1-ddot for theta1-dot in omega_1) with no
     # 'why' must stop truth.py: a wrong equation is never silently accepted

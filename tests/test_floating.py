@@ -343,11 +343,14 @@ def test_batches_are_single_calls(threads):
         lambda r, q, v: numeric.rnea_derivatives(r, q, v, v),
         lambda r, q, v: numeric.aba_derivatives(r, q, v, v),
         lambda r, q, v: numeric.minverse(r, q),
-        lambda r, q, v: numeric.kinetic_energy(r, q, v),
-        lambda r, q, v: numeric.jacobian(r, q, "link1"),
+        lambda r, q, v: numeric.coriolis_matrix(r, q, v),
+        lambda r, q, v: numeric.jacobian_dot(r, q, v, "link1"),
         lambda r, q, v: armdyn.derive(r),
         lambda r, q, v: armdyn.codegen(r),
-        lambda r, q, v: __import__("armdyn.simulate", fromlist=["simulate"]).simulate(r, q, v, dt=0.01, steps=1),
+        lambda r, q, v: __import__("armdyn.simulate", fromlist=["x"]).simulate_adaptive(r, q, v, duration=0.01),
+        lambda r, q, v: __import__("armdyn.simulate", fromlist=["x"]).simulate(
+            r, q, v, dt=0.01, steps=1, torque=lambda t, q, qd: 0 * qd
+        ),
         lambda r, q, v: __import__("armdyn.identification", fromlist=["x"]).base_parameters(r),
         lambda r, q, v: __import__("armdyn.identification", fromlist=["x"]).regressor(r),
     ],

@@ -407,8 +407,11 @@ def one_body(joint: str = "<joint/>", inertial: str = '<inertial pos="0 0 0" mas
     "text, words",
     [
         (one_body("<joint name='s' type='ball'/>"), r"<joint name='s'>: ball joint: armdyn has no ball \(spherical\)"),
-        (one_body("<joint name='f' type='free'/>"), "free joint: armdyn has no free-flyer.*floating='weld'"),
-        (one_body("<freejoint name='f'/>"), "<freejoint name='f'>: free joint"),
+        (
+            "<mujoco><worldbody><body><body name='b'><freejoint name='f'/></body></body></worldbody></mujoco>",
+            "<freejoint name='f'>: free joint in a body that is not a child of the world body",
+        ),
+        (one_body("<freejoint name='f'/><joint/>"), "<freejoint name='f'>: a free joint must be its body's only"),
         (one_body("<joint type='screw'/>"), "unknown joint type 'screw'"),
         (one_body("<joint axis='0 0 0'/>"), "axis is zero"),
         (one_body("<joint axis='0 1'/>"), "'axis' is '0 1': expected 3 numbers"),
@@ -463,14 +466,13 @@ def test_errors_name_file_and_line(tmp_path):
     assert str(err.value).startswith(f"{path}:4: <joint name='s'>: ball joint")
 
 
-def test_free_joint_is_welded_only_on_request(tmp_path):
+def test_free_joint_is_welded_on_request(tmp_path):
     text = """<mujoco><worldbody><body name="base" pos="0 0 1" euler="0 0 90"><freejoint name="float"/>
       <inertial pos="0 0 0" mass="5" diaginertia="1 1 1"/>
       <body name="arm" pos="0.5 0 0"><joint name="j" axis="0 1 0"/><inertial pos="0.2 0 0" mass="1" diaginertia="0.1 0.1 0.1"/>
       </body></body></worldbody></mujoco>"""
     path = write(tmp_path, text)
-    with pytest.raises(ModelError, match="floating='weld'"):
-        armdyn.load(path)
+    assert armdyn.load(path).floating  # the free body floats unless welded
     with pytest.warns(MjcfIgnoredWarning, match="fixed base"):
         robot = armdyn.load(path, floating="weld")
     assert robot.dof == 1 and robot.joints[0].type == "fixed"

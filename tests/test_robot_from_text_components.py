@@ -104,7 +104,7 @@ def test_a_gravity_vector_named_g_beside_the_constant_g(tmp_path):
     report = grade(_write(tmp_path, _CLOSED))
     assert report.model_note.startswith("no model:")
     status = {v.name: v.status for v in report.steps}
-    assert status["tau_1"] == "correct"
+    assert status["tau_1"] == "consistent"
     assert status["tau_2"] == "wrong"
 
 

@@ -54,9 +54,6 @@ NOT_SAME: dict[str, str | set[int]] = {
     # the planar links' geometry in words; only the quill's height and energies stated
     "scara-inertia-matrix-slip.md": "no variable of joint 3 is written",
     "scara-mathfence-slip.md": "moves with other joints than joint 3",
-    # link 3's height is stated only by P_3, with its slip (a dropped l_2 sin(q1+q2)): the arm
-    # read hangs link 3 from joint 2, and P_3, P, phi_1, phi_2, g(q) agree with it
-    "planar-3r-gravity-slip.md": {30, 35, 39, 41, 45},
 }
 
 

@@ -148,6 +148,20 @@ def test_ur5_meshes_render(tmp_path):
     assert img[-5:, :].max(axis=2).min() >= 180  # the bottom edge is background or grid: the arm is in view
 
 
+def test_the_floor_is_under_a_legged_robots_feet(tmp_path):
+    """Solo-12 with its base fixed hangs its legs below the base: the floor grid goes under
+    its feet, not through its legs. At q = 0 no joint turns anything, so each foot frame
+    sits at the sum of its chain's joint origins in the URDF, z = -0.16 - 0.16 m; the
+    foot's ball reaches a little below that. An arm's floor stays at its base plane (the
+    UR5's base mesh reaches 1.6 cm below it)."""
+    solo = load(example_robot_data_dir() / "solo_description" / "robots" / "solo12.urdf")
+    attrs, img = browse(view(solo).html(), tmp_path, "solo12")
+    assert attrs["status"] == "ready" and drawn_fraction(img) > 0.03
+    assert -0.32 - 0.03 < float(attrs["floor"]) < -0.32
+    attrs, _ = browse(view(load(ur5_urdf()), [0.3, -1.0, 1.2, -0.5, 0.8, 0.2]).html(), tmp_path, "ur5", shot=False)
+    assert -0.03 < float(attrs["floor"]) <= 0
+
+
 def test_rp_arm_simple_shapes_render(tmp_path):
     v = view(rp_arm(), [0.4, 0.3], frames=True)
     assert v.scene["meshes"] == [] and len(v.scene["segments"]) == 2 and len(v.scene["coms"]) == 2
@@ -229,6 +243,31 @@ def test_poses_equal_pinocchio():
             assert np.allclose(poses[k, i, :3], oMf.translation, atol=1e-6), (name, k)
             assert np.allclose(quat_matrix(*poses[k, i, 3:]), oMf.rotation, atol=1e-6), (name, k)
     assert sum(model.existFrame(n, pin.FrameType.BODY) for n in scene["links"]) >= 7
+
+
+@needs_pinocchio
+def test_floating_poses_equal_pinocchio():
+    """A floating robot's configurations (base position, quaternion, joints) place its
+    links where Pinocchio's free flyer does; Solo-12's arrays are Pinocchio's as they are."""
+    path = example_robot_data_dir() / "solo_description" / "robots" / "solo12.urdf"
+    robot = load(path, root_joint="free-flyer")
+    model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    data = model.createData()
+    np.random.seed(11)  # pin.randomConfiguration draws from NumPy's global generator
+    Q = np.array([pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq)) for _ in range(4)])
+    scene = animate(robot, np.arange(4.0), Q).scene
+    L = len(scene["links"])
+    poses = np.array(scene["poses"]).reshape(4, L, 7)
+    for k, q in enumerate(Q):
+        pin.framesForwardKinematics(model, data, q)
+        for i, name in enumerate(scene["links"]):
+            oMf = data.oMf[model.getFrameId(name, pin.FrameType.BODY)]
+            assert np.allclose(poses[k, i, :3], oMf.translation, atol=1e-6), (name, k)
+            assert np.allclose(quat_matrix(*poses[k, i, 3:]), oMf.rotation, atol=1e-6), (name, k)
+    bad = Q[:1].copy()
+    bad[0, 3:7] *= 1.1
+    with pytest.raises(ValueError, match="unit length"):
+        view(robot, bad[0])
 
 
 def test_quaternions_match_scipy():
@@ -406,3 +445,36 @@ def test_cli_show_and_simulate_3d(tmp_path, capsys):
     assert 2 <= len(scene["times"]) <= 500 and scene["times"][-1] == pytest.approx(1.0)
     assert main(["show", "planar-3r", "--3d", "-o", str(tmp_path / "a.png")]) == 2
     assert "HTML page" in capsys.readouterr().err
+
+
+def test_show_3d_of_a_floating_robot_takes_its_joints_or_its_whole_configuration(tmp_path, capsys):
+    """``armdyn show --root-joint free-flyer``: the joints alone put the base at the origin,
+    unturned; a whole configuration places it (its quaternion, typed to 7 digits, normalised
+    and said); anything else is one clear error."""
+    path = str(example_robot_data_dir() / "solo_description" / "robots" / "solo12.urdf")
+    legs = [0.1, 0.8, -1.6, -0.1, 0.8, -1.6, 0.1, -0.8, 1.6, -0.1, -0.8, 1.6]
+    s, c = np.sin(np.pi / 8), np.cos(np.pi / 8)  # a turn of 45 degrees about z
+    whole = [0.0, 0.0, 0.3, 0.0, 0.0, round(s, 7), round(c, 7), *legs]
+    robot = load(path, root_joint="free-flyer")
+    for q, name in ((legs, "legs"), (whole, "whole")):
+        out = tmp_path / f"{name}.html"
+        args = ["show", path, "--root-joint", "free-flyer", "--3d", "--q", ",".join(map(str, q)), "-o", str(out)]
+        assert main(args) == 0
+        full = [0, 0, 0, 0, 0, 0, 1, *legs] if name == "legs" else [*whole[:3], 0, 0, s, c, *legs]
+        written = re.search(r'"poses":(\[[^\]]*\])', out.read_text()).group(1)
+        assert np.allclose(json.loads(written), view(robot, np.array(full)).scene["poses"], atol=1e-7)
+    assert "quaternion normalised" in capsys.readouterr().err
+    for q, said in (([1, 2, 3], "3 values for a floating robot with 12 joints"), ([*whole[:6], 1.01, *legs], "not 1")):
+        args = [
+            "show",
+            path,
+            "--root-joint",
+            "free-flyer",
+            "--3d",
+            "--q",
+            ",".join(map(str, q)),
+            "-o",
+            str(tmp_path / "x.html"),
+        ]
+        assert main(args) == 2
+        assert said in capsys.readouterr().err

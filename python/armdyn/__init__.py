@@ -27,6 +27,14 @@ from .printing import codegen  # noqa: E402  (armdyn.printing.compile builds the
 from .symbolic import EquationsOfMotion, check, derive, prove_agreement  # noqa: E402
 
 if TYPE_CHECKING:  # what __getattr__ below imports on first use, for type checkers (py.typed)
+    from .centroidal import (  # noqa: F401
+        center_of_mass,
+        centroidal_momentum,
+        centroidal_momentum_matrix,
+        centroidal_momentum_matrix_rate,
+        centroidal_momentum_rate,
+        com_jacobian,
+    )
     from .grading import grade  # noqa: F401
     from .identification import base_parameters, regressor  # noqa: F401
     from .numeric import (  # noqa: F401  # noqa: F401  # noqa: F401
@@ -69,6 +77,14 @@ _NUMERIC = (
     "jacobian_dot",
 )
 _IDENTIFICATION = ("regressor", "base_parameters")
+_CENTROIDAL = (
+    "center_of_mass",
+    "com_jacobian",
+    "centroidal_momentum_matrix",
+    "centroidal_momentum",
+    "centroidal_momentum_rate",
+    "centroidal_momentum_matrix_rate",
+)
 
 
 def __getattr__(name):
@@ -91,6 +107,12 @@ def __getattr__(name):
         value = getattr(identification, name)
         globals()[name] = value
         return value
+    if name in _CENTROIDAL:  # centre of mass and centroidal momentum (armdyn.centroidal)
+        from . import centroidal
+
+        value = getattr(centroidal, name)
+        globals()[name] = value
+        return value
     raise AttributeError(f"module 'armdyn' has no attribute {name!r}")
 
 
@@ -98,6 +120,7 @@ __all__ = [
     "__version__",
     *_NUMERIC,
     *_IDENTIFICATION,
+    *_CENTROIDAL,
     "inertia",
     "io",
     "ModelError",

@@ -30,13 +30,15 @@ from ._interrupt import raise_from_now_on
 from .errors import ModelError
 
 
-def _load(source: str, allow_nonphysical: bool = False, strict: bool = False, trusted: bool = False):
+def _load(source: str, allow_nonphysical: bool = False, strict: bool = False, trusted: bool = False, root_joint=None):
     """A model file (strict unless --allow-nonphysical) or a bundled model (as published,
     one warning if it is not physical, unless --strict); a .xacro file only with
-    --trust-xacro (``trusted``: expanding one runs its Python code)."""
+    --trust-xacro (``trusted``: expanding one runs its Python code); ``root_joint``
+    "free-flyer": the root link floats (``armdyn.load``'s option)."""
     from .io import load
 
-    return load(source, strict=True if strict else (False if allow_nonphysical else None), trusted=trusted)
+    strict_ = True if strict else (False if allow_nonphysical else None)
+    return load(source, strict=strict_, trusted=trusted, root_joint=root_joint)
 
 
 def cmd_derive(args) -> int:
@@ -88,13 +90,15 @@ def cmd_robots(args) -> int:
 def cmd_show(args) -> int:
     from .show import show
 
-    robot = _load(args.robot, args.allow_nonphysical, args.strict, args.trust_xacro)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict, args.trust_xacro, args.root_joint)
     q = None
     if args.q is not None:
         try:
             q = [float(x) for x in args.q.split(",")]
         except ValueError:
             raise ValueError(f"--q must be comma-separated numbers, got {args.q!r}") from None
+        if robot.floating:
+            q = _floating_q(robot, q)
     if args.three_d:  # a 3-D page (armdyn.viewer) instead of the matplotlib picture
         from ._io_atomic import destination
         from .show import numeric_robot, table
@@ -114,6 +118,26 @@ def cmd_show(args) -> int:
     if args.out is not None:
         print(f"wrote {args.out}")
     return 0
+
+
+def _floating_q(robot, q: list[float]) -> list[float]:
+    """A floating robot's ``--q``: its joints alone (the base at the origin, unturned) or its
+    whole configuration, whose quaternion, typed to a few digits, is normalised when within
+    1e-4 of unit length (said on stderr); further off it is refused."""
+    dof = robot.nv - 6
+    if len(q) == dof:
+        return [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, *q]
+    if len(q) != dof + 7:
+        raise ValueError(
+            f"--q: {len(q)} values for a floating robot with {dof} joints: give the {dof} joints, or "
+            f"{dof + 7} (base position, quaternion x y z w, joints)"
+        )
+    norm = sum(x * x for x in q[3:7]) ** 0.5
+    if abs(norm - 1.0) > 1e-4:
+        raise ValueError(f"--q: the base quaternion {q[3:7]} has length {norm:.6g}, not 1")
+    if norm != 1.0:
+        print(f"note: the base quaternion normalised (its length was {norm:.9g})", file=sys.stderr)
+    return [*q[:3], *(x / norm for x in q[3:7]), *q[7:]]
 
 
 def cmd_grade(args) -> int:
@@ -291,7 +315,16 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("show", help="table of joints and links, and a picture of the arm")
     robot_arg(s)
-    s.add_argument("--q", help="joint values, comma-separated (default: zeros)")
+    s.add_argument(
+        "--q",
+        help="joint values, comma-separated (default: zeros); a floating robot's whole configuration "
+        "(base position, quaternion x y z w, joints) or its joints alone (the base at the origin)",
+    )
+    s.add_argument(
+        "--root-joint",
+        choices=["free-flyer"],
+        help="the root link floats (a free-flyer base, as armdyn.load(path, root_joint=...))",
+    )
     s.add_argument(
         "--out", "-o", help="write a PNG picture of the arm here (with --3d: an HTML page, default arm.html)"
     )

@@ -61,12 +61,13 @@ def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.concatenate([v, w], axis=-1)
 
 
-def _quat_conj(a: np.ndarray) -> np.ndarray:
+def quaternion_conjugate(a: np.ndarray) -> np.ndarray:
+    """The conjugate (inverse rotation) of quaternions ``x, y, z, w`` (last axis)."""
     return np.concatenate([-a[..., :3], a[..., 3:]], axis=-1)
 
 
-def _rotate(quat: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """``R(quat) x`` (last axis), for unit quaternions."""
+def rotate_vector(quat: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``R(quat) x`` (last axis), for unit quaternions ``x, y, z, w``."""
     v, w = quat[..., :3], quat[..., 3:]
     t = 2.0 * np.cross(v, x)
     return x + w * t + np.cross(v, t)
@@ -122,7 +123,7 @@ def integrate(robot: Robot, q, v) -> np.ndarray:
     quat = _quat_mul(quat0, _exp_quaternion(w))
     quat = np.where(np.sum(quat * quat0, axis=-1, keepdims=True) < 0, -quat, quat)
     quat = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
-    base = np.concatenate([q[..., :3] + _rotate(quat0, p), quat], axis=-1)
+    base = np.concatenate([q[..., :3] + rotate_vector(quat0, p), quat], axis=-1)
     return np.concatenate([base, q[..., 7:] + v[..., 6:]], axis=-1)
 
 
@@ -136,8 +137,8 @@ def difference(robot: Robot, q0, q1) -> np.ndarray:
     if not robot.floating:
         return q1 - q0
     quat0, quat1 = _quaternions(q0, "q0"), _quaternions(q1, "q1")
-    inv0 = _quat_conj(quat0)
-    p = _rotate(inv0, q1[..., :3] - q0[..., :3])  # M0^-1 M1's translation
+    inv0 = quaternion_conjugate(quat0)
+    p = rotate_vector(inv0, q1[..., :3] - q0[..., :3])  # M0^-1 M1's translation
     w = _log_quaternion(_quat_mul(inv0, quat1))
     theta = np.linalg.norm(w, axis=-1, keepdims=True)
     # V(w)^-1 = 1 - [w]x / 2 + c [w]x^2, c = (1 - t sin t / (2 (1 - cos t))) / t^2

@@ -12,7 +12,8 @@ student or model text ever get through as markup. A Jupyter fragment cannot carr
 
 Colours of the statuses (text on a pale background, readable in print):
 correct green, correct-by-convention blue, wrong red, follows-from-earlier-error amber,
-correct-but-unsupported violet, unrecognised grey.
+correct-but-unsupported violet, consistent (not checked) grey on blue with a dashed rule,
+unrecognised grey.
 """
 
 from __future__ import annotations
@@ -75,6 +76,7 @@ CSS = """
 .armdyn .s-wrong { color:var(--bad); background:var(--bad-bg); }
 .armdyn .s-follows-from-earlier-error { color:var(--carry); background:var(--carry-bg); }
 .armdyn .s-correct-but-unsupported { color:var(--unsup); background:var(--unsup-bg); }
+.armdyn .s-consistent { color:var(--grey); background:var(--conv-bg); }
 .armdyn .s-definition { color:#3d4a5c; background:#e8eef5; }
 .armdyn .s-unrecognised { color:var(--grey); background:var(--grey-bg); }
 
@@ -87,6 +89,7 @@ CSS = """
 .armdyn .step.st-wrong { border-left-color:var(--bad); }
 .armdyn .step.st-follows-from-earlier-error { border-left-color:#d4a72c; }
 .armdyn .step.st-correct-but-unsupported { border-left-color:var(--unsup); }
+.armdyn .step.st-consistent { border-left-color:var(--conv); border-left-style:dashed; }
 .armdyn .step.st-definition { border-left-color:#8aa0b8; }
 .armdyn .step.st-unrecognised { border-left-color:var(--rule); background:var(--tint); color:var(--muted); }
 .armdyn .step.first { box-shadow:0 0 0 2px var(--bad-bg); }

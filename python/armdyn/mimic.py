@@ -235,6 +235,37 @@ class MimicModel:
         (q,) = self._states(("q", q))
         return self._reduce(self._call("jacobian", {"q": q}, self._position(q), link, threads))
 
+    # ---------------------------------------------------------------- centre of mass
+    # armdyn.centroidal's quantities: the full tree's at (G q + o, G v, G a); a matrix over
+    # the velocities times G (h_G = A_full G v).
+    def center_of_mass(self, q, threads=None):
+        (q,) = self._states(("q", q))
+        return self._call_core("center_of_mass", {"q": q}, self._position(q), threads)
+
+    def com_jacobian(self, q, threads=None):
+        (q,) = self._states(("q", q))
+        return self._reduce(self._call_core("com_jacobian", {"q": q}, self._position(q), threads))
+
+    def centroidal_map(self, q, threads=None):
+        (q,) = self._states(("q", q))
+        return self._reduce(self._call_core("centroidal_map", {"q": q}, self._position(q), threads))
+
+    def centroidal_map_rate(self, q, v, threads=None):
+        q, v = self._states(("q", q), ("v", v))
+        named = {"q": q, "v": v}
+        return self._reduce(self._call_core("centroidal_map_rate", named, self._position(q), self._rate(v), threads))
+
+    def centroidal_momentum(self, q, v, threads=None):
+        q, v = self._states(("q", q), ("v", v))
+        named = {"q": q, "v": v}
+        return self._call_core("centroidal_momentum", named, self._position(q), self._rate(v), threads)
+
+    def centroidal_momentum_rate(self, q, v, a, threads=None):
+        q, v, a = self._states(("q", q), ("v", v), ("a", a))
+        named = {"q": q, "v": v, "a": a}
+        full = (self._position(q), self._rate(v), self._rate(a))
+        return self._call_core("centroidal_momentum_rate", named, *full, threads)
+
     # ---------------------------------------------------------------- derivatives
     # With q_full = G q + o (G constant), tau(q, qd, qdd) = G^T tau_full(G q + o, G qd, G qdd),
     # so by the chain rule every derivative is the full tree's, reduced on both sides:

@@ -15,6 +15,9 @@ import numpy as np
 
 __all__ = ["plot_trajectory"]
 
+#: a floating base's configuration coordinates (position, quaternion x y z w)
+FLOATING_Q_NAMES = ("base_x", "base_y", "base_z", "base_qx", "base_qy", "base_qz", "base_qw")
+
 
 def plot_trajectory(run, out=None, *, state: int = 0, title: str | None = None):
     """Figure of ``run`` (one state of a batch: row ``state``); saved to ``out`` (PNG, SVG,
@@ -40,8 +43,10 @@ def plot_trajectory(run, out=None, *, state: int = 0, title: str | None = None):
     names = run.coordinate_names or [f"q{i}" for i in range(q.shape[1])]
     panels = 5 if kinetic is not None else 3
     fig, axes = plt.subplots(panels, 1, figsize=(8, 2.1 * panels), sharex=True)
+    # a floating base: q has its position and quaternion, the velocities its twist (names)
+    q_names = names if q.shape[1] == len(names) else [*FLOATING_Q_NAMES, *names[6:]]
     for ax, values, label in zip(axes, (q, qd, tau), ("q (rad, m)", "qd (rad/s, m/s)", "tau (N m, N)")):
-        for i, name in enumerate(names):
+        for i, name in enumerate(q_names if values is q else names):
             ax.plot(t, values[:, i], label=name, linewidth=1.2)
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)

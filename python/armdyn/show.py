@@ -148,7 +148,7 @@ def table(robot: Robot) -> str:
     for link in robot.links.values():
         note = "no <inertial>" if link.name in massless else ""
         if link.name == robot.base:
-            note = (note + ", " if note else "") + "base (fixed)"
+            note = (note + ", " if note else "") + ("base (floating)" if robot.floating else "base (fixed)")
         diag = _vec([link.inertia[0, 0], link.inertia[1, 1], link.inertia[2, 2]])
         rows.append([link.name, _num(link.mass), _vec(link.com), diag, note])
     lines += ["", "links"] + _rows(["name", "mass", "com", "inertia (ixx, iyy, izz)", ""], rows)

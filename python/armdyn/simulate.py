@@ -31,6 +31,17 @@ a controller run in Rust at every integrator stage (:class:`PD`,
 :class:`ComputedTorque`); or a callable ``torque(t, q, qd) -> tau`` with ``q``, ``qd``
 ``(N, dof)`` and ``tau`` ``(dof,)`` or ``(N, dof)``.
 
+A floating base (``robot.floating``, Pinocchio's layout: ``q0`` (7 + dof,) base position,
+quaternion x y z w, joints; ``qd0`` and torques (6 + dof,) base linear and angular
+velocity (wrench) in the base frame, joints): the same two methods with the base moved
+on SE(3) as :func:`armdyn.configuration.integrate` moves it (semi-implicit Euler
+``q' = q (+) h v'``; RK4 as Runge-Kutta-Munthe-Kaas, fourth order on the manifold; see
+``crates/armdyn-core/src/algo/integrate_floating.rs``). Stored ``q`` rows are (7 + dof,),
+the others (6 + dof,); ``limit_joint`` and ``nonfinite_joint`` index
+``Trajectory.coordinate_names``, the velocity's (``base_vx`` ... ``base_wz``, then the
+joints). Energies include the base: ``T = 1/2 v^T M v``, ``V = -g . (m c)`` with ``c``
+the world centre of mass. Controllers and torque callables are fixed-base only.
+
 Joint limits (from the robot's joints, or ``limits=(lower, upper)``) are reported, never
 enforced: :attr:`Trajectory.limit_step` / :attr:`Trajectory.limit_joint` give, per state,
 the first step at which a joint is outside its range and which joint.
@@ -58,6 +69,7 @@ from typing import Callable
 import numpy as np
 
 from . import _core
+from .configuration import rotate_vector
 from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy, require_fixed_base
 from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
@@ -170,9 +182,10 @@ def simulate(
     Bad input (shapes, NaN, a non-positive dt, a duration that is not a whole number of
     steps, a run that would not fit in memory) raises ``ValueError`` naming it.
     """
-    require_fixed_base(robot, "armdyn.simulate")
     model = compiled_model(robot)
-    dof = model.dof
+    floating = bool(getattr(model, "floating", False))
+    # the widths of q and of qd (qdd, tau): dof each, or 7 + dof and 6 + dof with a floating base
+    dof, nv = (model.nq, model.nv) if floating else (model.dof, model.dof)
     steps = step_count(duration, steps, dt)
     dt = float(dt)
     if method not in ("rk4", "euler"):
@@ -185,18 +198,21 @@ def simulate(
     q0a = _c(np.atleast_2d(q0a))
     rows = q0a.shape[0]
     threads = check_threads(threads)  # Rust reads True as 1
-    qd0a = np.zeros_like(q0a) if qd0 is None else _state(qd0, "qd0", dof)
-    if qd0a.shape not in ((dof,), (rows, dof)):
+    qd0a = np.zeros((rows, nv)) if qd0 is None else _state(qd0, "qd0", nv)
+    if qd0a.shape not in ((nv,), (rows, nv)):
         raise ValueError(f"qd0: shape {qd0a.shape} does not match q0's {q0a.shape}")
-    qd0a = _c(np.broadcast_to(qd0a, (rows, dof)))
+    qd0a = _c(np.broadcast_to(qd0a, (rows, nv)))
     lower, upper = (
         joint_limits(robot)
         if limits is None
-        else (_per_joint(limits[0], "limits[0] (lower)", dof), _per_joint(limits[1], "limits[1] (upper)", dof))
+        else (
+            _per_joint(limits[0], "limits[0] (lower)", model.dof),
+            _per_joint(limits[1], "limits[1] (upper)", model.dof),
+        )
     )
 
     samples = steps // stride + 1
-    need = (4 * samples * dof + (3 * samples if energies else 0)) * rows * 8
+    need = ((dof + 3 * nv) * samples + (3 * samples if energies else 0)) * rows * 8
     budget = _available_bytes() if max_bytes is None else max_bytes
     if need > budget:
         raise ValueError(
@@ -206,6 +222,8 @@ def simulate(
 
     if torque is not None and controller is not None:
         raise ValueError("give torque or controller, not both")
+    if floating and (controller is not None or callable(torque)):
+        require_fixed_base(robot, "armdyn.simulate with a controller or a torque callable")
     empty = np.zeros(0)
     args = dict(torque=empty, kp=empty, kd=empty, target=empty, target_qd=empty)
     if callable(torque):
@@ -232,22 +250,25 @@ def simulate(
             tau = np.asarray(torque, dtype=float)
             if not np.all(np.isfinite(tau)):
                 raise ValueError("torque contains NaN or inf")
-            if tau.shape == (dof,):
-                kind, tau = "constant", np.broadcast_to(tau, (rows, dof))
-            elif tau.shape == (steps, dof):
+            if tau.shape == (nv,):
+                kind, tau = "constant", np.broadcast_to(tau, (rows, nv))
+            elif tau.shape == (steps, nv):
                 kind = "series"
-            elif tau.shape == (rows, steps, dof):
+            elif tau.shape == (rows, steps, nv):
                 kind = "series-per-state"
             else:
                 raise ValueError(
-                    f"torque: shape {tau.shape}; expected ({dof},) constant, ({steps}, {dof}) one row per step, "
-                    f"or ({rows}, {steps}, {dof}) one series per state"
+                    f"torque: shape {tau.shape}; expected ({nv},) constant, ({steps}, {nv}) one row per step, "
+                    f"or ({rows}, {steps}, {nv}) one series per state"
                 )
             args["torque"] = _c(tau)
         out = _simulate_rust(model, q0a, qd0a, kind, args, dt, steps, stride, method, lower, upper, threads, progress)
 
     t = np.arange(samples) * (stride * dt)
-    run = Trajectory(t=t, dt=dt, stride=stride, method=method, coordinate_names=list(model.coordinate_names), **out)
+    names = list(model.coordinate_names)
+    if floating:  # limit_joint and nonfinite_joint index the velocity's coordinates
+        names = [*BASE_VELOCITY_NAMES, *names]
+    run = Trajectory(t=t, dt=dt, stride=stride, method=method, coordinate_names=names, **out)
     # a diverged state stopped at its nonfinite_step: its later samples were never written
     diverged = run.nonfinite_step >= 0
     kept = np.ones((rows, samples), dtype=bool)
@@ -259,7 +280,9 @@ def simulate(
     if energies:
         run.kinetic, run.potential = np.full((rows, samples), np.nan), np.full((rows, samples), np.nan)
         flat_q, flat_qd = run.q[kept], run.qd[kept]
-        if len(flat_q):
+        if len(flat_q) and floating:
+            run.kinetic[kept], run.potential[kept] = floating_energies(model, flat_q, flat_qd, threads)
+        elif len(flat_q):
             run.kinetic[kept] = kinetic_energy(model, _c(flat_q), _c(flat_qd), threads=threads)
             run.potential[kept] = potential_energy(model, _c(flat_q), threads=threads)
     if single:
@@ -273,6 +296,29 @@ def simulate(
         for name in ("limit_step", "limit_joint", "nonfinite_step", "nonfinite_joint"):
             setattr(run, name, int(getattr(run, name)[0]))
     return run
+
+
+#: the names of a floating base's six velocity coordinates (base frame)
+BASE_VELOCITY_NAMES = ("base_vx", "base_vy", "base_vz", "base_wx", "base_wy", "base_wz")
+
+
+def floating_energies(model, q: np.ndarray, v: np.ndarray, threads=None, rows: int = 2048):
+    """``(kinetic, potential)`` (N,) of a floating-base robot at the states ``q`` (N, 7 +
+    dof), ``v`` (N, 6 + dof): ``T = 1/2 v^T M(q) v`` and ``V = -g . (m p_B + R_B h)``
+    over every link, the base included, with ``m`` the total mass and ``h = m c`` the
+    first moment of the whole robot in the base frame, both read from the CRBA's base
+    block (``M[:3, :3] = m 1``, ``M[3:6, :3] = [h]x``). ``rows`` at a time (M is
+    (6 + dof)^2 per state)."""
+    kinetic, potential = np.empty(len(q)), np.empty(len(q))
+    g = np.asarray(model.gravity, dtype=float).ravel()
+    for at in range(0, len(q), rows):
+        qs, vs = _c(q[at : at + rows]), _c(v[at : at + rows])
+        M = model.crba(qs, threads)
+        kinetic[at : at + rows] = 0.5 * np.einsum("ni,nij,nj->n", vs, M, vs)
+        h = np.stack([M[:, 5, 1], M[:, 3, 2], M[:, 4, 0]], axis=-1)
+        com_moment = M[:, 0, 0, None] * qs[:, :3] + rotate_vector(qs[:, 3:7], h)
+        potential[at : at + rows] = -com_moment @ g
+    return kinetic, potential
 
 
 def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower, upper, threads, progress):
@@ -299,7 +345,7 @@ def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower,
     # In pieces of whole strides: each piece continues from the last one's final state,
     # its first sample replaces the last one's final sample (same state, and the torque
     # of the next step, as in one call).
-    rows, dof = q0.shape
+    rows = q0.shape[0]
     samples = steps // stride + 1
     piece = max(1, steps // stride // 100) * stride
     out = None
@@ -313,8 +359,8 @@ def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower,
         elif kind == "series-per-state":
             tau = _c(tau[:, done : done + k])
         part = call(q, qd, k, tau)
-        if out is None:
-            out = {name: np.empty((rows, samples, dof)) for name in ("q", "qd", "qdd", "tau")}
+        if out is None:  # q's width may differ from the others' (a floating base: 7 + dof, 6 + dof)
+            out = {name: np.empty((rows, samples, part[name].shape[2])) for name in ("q", "qd", "qdd", "tau")}
             out["work"] = np.empty((rows, samples))
             for name in ("limit_step", "limit_joint", "nonfinite_step", "nonfinite_joint"):
                 out[name] = np.full(rows, -1, dtype=np.int64)

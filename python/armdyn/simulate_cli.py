@@ -100,8 +100,16 @@ def run(args, robot) -> int:
 
     robot = numeric_robot(robot)
     dof = robot.dof
-    q0 = np.broadcast_to(_numbers(args.q0, "--q0", dof) or [0.0], (dof,))
-    qd0 = np.broadcast_to(_numbers(args.qd0, "--qd0", dof) or [0.0], (dof,))
+    if robot.floating:
+        q0, qd0 = floating_start(robot, args)
+    else:
+        q0 = np.broadcast_to(_numbers(args.q0, "--q0", dof) or [0.0], (dof,))
+        qd0 = np.broadcast_to(_numbers(args.qd0, "--qd0", dof) or [0.0], (dof,))
+    if robot.floating and (args.controller or args.animate or getattr(args, "three_d", None)):
+        raise ValueError(
+            f"'{robot.name}' has a floating base: --controller, --animate and --3d are for fixed-base robots "
+            "(a passive run, --plot and the energy report work)"
+        )
     controller = None
     if args.controller is not None:
         if args.target is None:
@@ -184,7 +192,7 @@ def run(args, robot) -> int:
         outputs.append((args.three_d, lambda tmp: Path(tmp).write_text(page.html(), encoding="utf-8")))
     atomic_writes(outputs)
 
-    names = robot.coordinate_names
+    names = result.coordinate_names  # a floating base's first: base_vx ... base_wz
     print(f"{robot.name}: {steps} steps of {args.dt:g} s ({args.method}), {len(result.t)} samples stored")
     print("q_final  = [" + ", ".join(f"{v:.6g}" for v in result.q_final) + "]")
     print("qd_final = [" + ", ".join(f"{v:.6g}" for v in result.qd_final) + "]")
@@ -210,6 +218,33 @@ def run(args, robot) -> int:
         )
         return EXIT_DIVERGED
     return 0
+
+
+def floating_start(robot, args) -> tuple[np.ndarray, np.ndarray]:
+    """``(q0, qd0)`` of a floating robot: ``--q0`` gives the joints (1 or dof values; the
+    base at the pose an MJCF file wrote, else at the origin) or the whole q (7 + dof:
+    position, quaternion x y z w, joints); ``--qd0`` the joints (the base at rest) or the
+    whole v (6 + dof: base linear and angular velocity in the base frame, joints)."""
+    from .configuration import neutral
+
+    q0, qd0 = neutral(robot), np.zeros(robot.nv)
+    if robot.meta.get("base_pose"):  # MuJoCo's qpos0: position, quaternion w x y z
+        position, (w, x, y, z) = robot.meta["base_pose"]
+        q0[:7] = [*position, x, y, z, w]
+    for values, out, option, base in ((args.q0, q0, "--q0", 7), (args.qd0, qd0, "--qd0", 6)):
+        given = _numbers(values, option)
+        if given is None:
+            continue
+        if len(given) == robot.nv + base - 6:
+            out[:] = given
+        elif len(given) in (1, robot.dof):
+            out[base:] = given
+        else:
+            raise ValueError(
+                f"{option} needs 1 or {robot.dof} joint values, or {robot.nv + base - 6} for the floating base "
+                f"and the joints, got {len(given)}"
+            )
+    return q0, qd0
 
 
 def _numbers(text: str | None, option: str, dof: int | None = None):

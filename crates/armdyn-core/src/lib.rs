@@ -7,9 +7,12 @@
 //!   allocate nothing.
 //! * [`algo`] — one algorithm per file: `rnea`, `crba`, `aba`, `gravity`, `bias`,
 //!   `coriolis_matrix`, energies, `jacobian`, `forward_kinematics`; `floating`: the
-//!   RNEA, CRBA and ABA with a floating base (Pinocchio's free-flyer arrays).
+//!   RNEA, CRBA and ABA with a floating base (Pinocchio's free-flyer arrays);
+//!   `floating_kinematics` and `centroidal`: world-frame poses, Jacobians, energies,
+//!   centre of mass and centroidal momentum, for a floating base or a fixed one.
 //! * [`batch`] — many states (rows of `(N, n)` arrays), rayon over chunks of rows,
-//!   4 or 8 states per SIMD step for `rnea`, `aba`, `crba`, `gravity`, `bias`.
+//!   4 or 8 states per SIMD step for `rnea`, `aba`, `crba`, `gravity`, `bias`;
+//!   [`batch_centroidal`] for the world-frame and centroidal quantities.
 //!
 //! Conventions: SI units; `M(q) qdd + C(q, qd) qd + g(q) = tau`; spatial vectors
 //! `[angular; linear]`; matrices row-major.
@@ -19,6 +22,7 @@
 
 pub mod algo;
 pub mod batch;
+pub mod batch_centroidal;
 pub mod batch_derivatives;
 pub mod data;
 pub mod deriv_data;

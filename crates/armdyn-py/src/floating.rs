@@ -1,6 +1,7 @@
 //! The floating-base methods of `NumericModel` (a free-flyer root joint; see
 //! `armdyn_core::algo::floating` for the layout of the arrays, Pinocchio's): rnea, crba
-//! and aba dispatch here when the model floats, and every other method refuses.
+//! and aba dispatch here when the model floats (the kinematics and energies to
+//! `centroidal.rs`), and every other method refuses.
 //!
 //! `q` is `(7 + n,)` or `(N, 7 + n)`, `v` (`qd`), `a` (`qdd`) and `tau` `(6 + n,)` or
 //! `(N, 6 + n)`; a batch runs as the fixed-base ones do (SIMD lanes, `threads` threads,
@@ -24,7 +25,7 @@ impl NumericModel {
     pub(crate) fn fixed_base_only(&self) -> PyResult<()> {
         if self.floating {
             return Err(PyNotImplementedError::new_err(format!(
-                "'{}' has a floating base (free-flyer root joint): only rnea, crba and aba support it yet",
+                "'{}' has a floating base (free-flyer root joint): only rnea, crba, aba, forward_kinematics, jacobian and the energies support it yet",
                 self.name
             )));
         }
@@ -32,11 +33,15 @@ impl NumericModel {
     }
 
     /// Check the arguments `(name, object, width)`: each `(width,)` or `(N, width)`, the
-    /// same N for all, finite; the first is `q`, whose quaternions must be unit.
+    /// same N for all, finite; the first is `q`, whose quaternions must be unit. A fixed
+    /// base's arguments are checked by [`crate::states`] (every width is then dof).
     fn floating_states<'py, const K: usize>(
         &self,
         args: [(&str, &Bound<'py, PyAny>, usize); K],
     ) -> PyResult<(Shape, [Bound<'py, PyArrayDyn<f64>>; K])> {
+        if !self.floating {
+            return crate::states(self.model.nv, args.map(|(name, obj, _)| (name, obj)));
+        }
         let mut shape = None;
         let mut arrays = Vec::with_capacity(K);
         for (name, obj, width) in args {
@@ -82,8 +87,8 @@ impl NumericModel {
 
     /// `single(data, inputs, output)` for one state, `batched(model, inputs, output,
     /// threads)` for a batch (GIL released), into a fresh array of shape `out_shape` per
-    /// state.
-    fn floating_op<'py, const K: usize>(
+    /// state. Also for a fixed base (the centroidal quantities, `centroidal.rs`).
+    pub(crate) fn floating_op<'py, const K: usize>(
         &self,
         py: Python<'py>,
         args: [(&str, &Bound<'py, PyAny>, usize); K],
@@ -190,7 +195,7 @@ impl NumericModel {
 }
 
 /// `out`, or a `FloatingPointError` if it holds NaN or inf (inputs were checked finite).
-fn finite(out: Bound<'_, PyArrayDyn<f64>>) -> PyResult<Bound<'_, PyArrayDyn<f64>>> {
+pub(crate) fn finite(out: Bound<'_, PyArrayDyn<f64>>) -> PyResult<Bound<'_, PyArrayDyn<f64>>> {
     // SAFETY: `out` is ours and not yet returned.
     if all_finite(unsafe { slice(&out) }) {
         Ok(out)

@@ -27,6 +27,7 @@ use std::collections::HashMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::{Mutex, OnceLock};
 
+mod centroidal;
 mod derivatives;
 mod floating;
 mod simulate;
@@ -353,7 +354,8 @@ pub struct NumericModel {
     /// and `aba` refuses (it would divide by zero).
     inert_joints: Vec<String>,
     /// Whether the base floats (a free-flyer root joint, `floating.rs`): rnea, crba and
-    /// aba then take Pinocchio's floating-base arrays, and every other method refuses.
+    /// aba (and the kinematics and energies) then take Pinocchio's floating-base arrays, and
+    /// every other method refuses.
     floating: bool,
 }
 
@@ -835,6 +837,9 @@ impl NumericModel {
         qd: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        if self.floating {
+            return self.kinetic_energy_floating(py, q, qd, threads);
+        }
         let out = self.vector_op(
             py,
             [("q", q), ("qd", qd)],
@@ -854,6 +859,9 @@ impl NumericModel {
         q: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        if self.floating {
+            return self.potential_energy_floating(py, q, threads);
+        }
         let out = self.vector_op(
             py,
             [("q", q)],
@@ -873,6 +881,9 @@ impl NumericModel {
         q: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        if self.floating {
+            return self.forward_kinematics_floating(py, q, threads);
+        }
         self.vector_op(
             py,
             [("q", q)],
@@ -894,6 +905,9 @@ impl NumericModel {
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         let index = self.link_arg(link)?;
+        if self.floating {
+            return self.jacobian_floating(py, q, index, threads);
+        }
         self.vector_op(
             py,
             [("q", q)],
@@ -954,5 +968,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(regressor::regressor_columns, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     simulate::register(m)?;
+    centroidal::register(m)?;
     Ok(())
 }

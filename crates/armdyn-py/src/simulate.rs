@@ -12,6 +12,7 @@
 
 use super::{guard, thread_arg, NumericModel};
 use armdyn_core::algo::integrate::{self, Input, Method, Outputs, Settings};
+use armdyn_core::algo::integrate_floating;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::Duration;
@@ -77,6 +78,10 @@ fn data<'a>(a: &'a PyReadonlyArrayDyn<'_, f64>, name: &str, shape: &[usize]) -> 
 
 /// Integrate `q0`, `qd0` (N, nv) for `steps` steps of `dt`; see armdyn.simulate.
 ///
+/// A floating-base model (`algo::integrate_floating`): `q0`, `q`, `q_final` have 7 + nv
+/// columns, `qd0`, the torques and the other outputs 6 + nv; lower, upper stay (nv,);
+/// only the torque kinds "zero", "constant", "series" and "series-per-state".
+///
 /// torque_kind: "zero", "constant" (torque (N, nv)), "series" (torque (steps, nv)),
 /// "series-per-state" (torque (N, steps, nv)), "pd", "pd-gravity", "computed-torque"
 /// (kp, kd (nv,), target, target_qd (N, nv)). lower, upper: (nv,). Returns a dict of
@@ -107,10 +112,12 @@ fn _simulate<'py>(
     threads: Option<i64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
-        model.get().fixed_base_only()?;
         let threads = thread_arg(threads)?;
         let m = &model.get().model;
+        let floating = model.get().floating;
         let n = m.nv;
+        // the widths of q and of v (qd, qdd, tau): a floating base adds its 7 and 6
+        let (nq, nv) = if floating { (n + 7, n + 6) } else { (n, n) };
         let rows = q0.shape().first().copied().unwrap_or(0);
         let method = match method {
             "rk4" => Method::Rk4,
@@ -121,8 +128,8 @@ fn _simulate<'py>(
             return Err(PyValueError::new_err(format!("dt = {dt}, stride = {stride}: need dt > 0 finite, stride >= 1")));
         }
         let settings = Settings { method, dt, steps, stride };
-        let q0 = data(&q0, "q0", &[rows, n])?;
-        let qd0 = data(&qd0, "qd0", &[rows, n])?;
+        let q0 = data(&q0, "q0", &[rows, nq])?;
+        let qd0 = data(&qd0, "qd0", &[rows, nv])?;
         let lower = data(&lower, "lower", &[n])?;
         let upper = data(&upper, "upper", &[n])?;
         let gains = || -> PyResult<_> {
@@ -130,9 +137,9 @@ fn _simulate<'py>(
         };
         let input = match torque_kind {
             "zero" => Input::Zero,
-            "constant" => Input::Constant(data(&torque, "torque", &[rows, n])?),
-            "series" => Input::Series { tau: data(&torque, "torque", &[steps, n])?, shared: true },
-            "series-per-state" => Input::Series { tau: data(&torque, "torque", &[rows, steps, n])?, shared: false },
+            "constant" => Input::Constant(data(&torque, "torque", &[rows, nv])?),
+            "series" => Input::Series { tau: data(&torque, "torque", &[steps, nv])?, shared: true },
+            "series-per-state" => Input::Series { tau: data(&torque, "torque", &[rows, steps, nv])?, shared: false },
             "pd" | "pd-gravity" => {
                 let (kp, kd, target, target_qd) = gains()?;
                 Input::Pd { kp, kd, target, target_qd, gravity_compensation: torque_kind == "pd-gravity" }
@@ -143,14 +150,20 @@ fn _simulate<'py>(
             }
             other => return Err(PyValueError::new_err(format!("torque_kind: unknown '{other}'"))),
         };
+        if floating && matches!(input, Input::Pd { .. } | Input::ComputedTorque { .. }) {
+            let name = &model.get().name;
+            return Err(PyValueError::new_err(format!(
+                "torque_kind '{torque_kind}': controllers are fixed-base only ('{name}' floats)"
+            )));
+        }
         if matches!(input, Input::Series { .. }) && steps == 0 {
             return Err(PyValueError::new_err("a torque series needs at least one step"));
         }
         let s = settings.samples();
         let f = |dims: &[usize]| PyArrayDyn::<f64>::zeros(py, dims, false);
         let i = |dims: &[usize]| PyArrayDyn::<i64>::zeros(py, dims, false);
-        let (q, qd, qdd, tau) = (f(&[rows, s, n]), f(&[rows, s, n]), f(&[rows, s, n]), f(&[rows, s, n]));
-        let (q_final, qd_final) = (f(&[rows, n]), f(&[rows, n]));
+        let (q, qd, qdd, tau) = (f(&[rows, s, nq]), f(&[rows, s, nv]), f(&[rows, s, nv]), f(&[rows, s, nv]));
+        let (q_final, qd_final) = (f(&[rows, nq]), f(&[rows, nv]));
         let work = f(&[rows, s]);
         let (limit_step, limit_joint, nonfinite_step, nonfinite_joint) = (i(&[rows]), i(&[rows]), i(&[rows]), i(&[rows]));
         {
@@ -171,9 +184,14 @@ fn _simulate<'py>(
                 }
             };
             let run = |stop: &AtomicBool| {
-                integrate::simulate_until(m, q0, qd0, input, settings, lower, upper, out, threads, stop);
+                if floating {
+                    let f = integrate_floating::simulate_floating_until;
+                    f(m, q0, qd0, input, settings, lower, upper, out, threads, stop);
+                } else {
+                    integrate::simulate_until(m, q0, qd0, input, settings, lower, upper, out, threads, stop);
+                }
             };
-            if rows.saturating_mul(steps).saturating_mul(n.max(1)) < INLINE_WORK {
+            if rows.saturating_mul(steps).saturating_mul(nv.max(1)) < INLINE_WORK {
                 py.detach(|| run(&AtomicBool::new(false)));
             } else {
                 interruptible(py, run)?;

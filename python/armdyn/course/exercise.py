@@ -165,7 +165,7 @@ def rubric_text(kind: str) -> str:
         f"# armdyn exercise make {kind}: the rubric of this kind, every step of the worked solution",
         "# required (a step not handed in scores 0 of its points). See docs/course.md.",
         "points:\n  tau: 2\ndefault: 1\ncredit:\n  correct: 1\n  correct-by-convention: 1",
-        "  follows-from-earlier-error: 0.5\n  correct-but-unsupported: 0.5\n  wrong: 0",
+        "  follows-from-earlier-error: 0.5\n  correct-but-unsupported: 0.5\n  consistent: 0.5\n  wrong: 0",
     ]
     if exp.steps:
         lines.append("required:")

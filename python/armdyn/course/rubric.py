@@ -19,6 +19,7 @@ A rubric is a small YAML file (every key optional; this is :meth:`Rubric.default
       correct-by-convention: 1
       follows-from-earlier-error: 0.5
       correct-but-unsupported: 0.5
+      consistent: 0.5            # no model: agrees with the text's own unchecked values
       wrong: 0
 
 A step's part is the ``part`` field of the grade JSON when it has one, else read from its
@@ -44,6 +45,7 @@ DEFAULT_CREDIT = {
     "correct-by-convention": 1.0,
     "follows-from-earlier-error": 0.5,
     "correct-but-unsupported": 0.5,
+    "consistent": 0.5,
     "wrong": 0.0,
     "unrecognised": 0.0,
 }

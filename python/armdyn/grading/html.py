@@ -39,6 +39,7 @@ STATUS_TEXT = {
     "wrong": "wrong",
     "follows-from-earlier-error": "follows from an earlier error",
     "correct-but-unsupported": "correct but unsupported",
+    "consistent": "consistent, not checked",
     "unrecognised": "unrecognised",
     "definition": "definition",
 }
@@ -89,6 +90,8 @@ class _Writer:
 
     def __init__(self, report: GradeReport):
         self.w = MathWriter(report.symbol_latex)
+        # no model (the text graded on its own values): every expected value is the text's own
+        self.own_only = report.model_note.startswith("no model")
         values = []
         for s in report.steps:
             for v in (s.expected, s.got, s.difference):
@@ -245,12 +248,14 @@ def _step_card(i: int, step: StepVerdict, w: _Writer, anchors: dict, first: int 
         sides.append(_side("left side, on the counterexample" if proof else caption, label, w.value(step.got, hl)))
     shown_diff = step.difference is not None and step.status in ("wrong", "follows-from-earlier-error")
     value, than = reference(step) if shown_diff and not proof else (step.expected, EXERCISE_REFERENCE)
+    if w.own_only:
+        value, than = step.expected, OWN_REFERENCE + " (no model)"
     if step.expected is not None and (step.status != "correct" or step.got is None):
         if proof:
             sides.append(_side("right side, on the counterexample", label, w.value(step.expected, hl)))
         else:
             sides.append(_side(than, label, w.value(value, hl)))
-            if than == OWN_REFERENCE:  # the exercise's value too, named as such
+            if than == OWN_REFERENCE and not w.own_only:  # the exercise's value too, named as such
                 sides.append(_side(EXERCISE_REFERENCE, label, w.value(step.expected, hl), "textbook"))
     if shown_diff:
         than = "the right side" if proof else than.split(" (")[0]
@@ -341,6 +346,12 @@ def _summary(report: GradeReport, anchors: dict, labels: dict) -> str:
             '<div class="verdict fail">No step is wrong, but not every one follows from the ones before'
             f'<span class="sub">{n} correct but unsupported</span></div>'
         )
+    elif any(s.status == "consistent" for s in graded):
+        n = sum(s.status == "consistent" for s in graded)
+        verdict = (
+            '<div class="verdict fail">No step is wrong, but not every one could be checked'
+            f'<span class="sub">{n} consistent with your own values, which no model could check</span></div>'
+        )
     else:  # every step read is right, but some equations were not read: not checked, not a pass
         n = len(report.steps) - len(graded)
         verdict = (
@@ -355,6 +366,10 @@ def _summary(report: GradeReport, anchors: dict, labels: dict) -> str:
             word, cls = "right", "right"
             if step is not None and step.status == "correct-but-unsupported":
                 word, cls = "right, but not from your steps", "right unsupported"
+        elif step is not None and step.status == "consistent":
+            word, cls = "not checked: no model", "unsupported"
+        elif step is not None and step.status == "unrecognised":
+            word, cls = "not read", "unsupported"
         else:
             word, cls = ("not given" if step is None else "not right"), "notright"
         taus.append(

@@ -23,6 +23,7 @@ _MARK = {
     "wrong": ("✗", "XX"),
     "follows-from-earlier-error": ("→", "->"),
     "correct-but-unsupported": ("?", "??"),
+    "consistent": ("~", "~~"),
     "unrecognised": ("·", "--"),
     "definition": ("=", "=="),
 }
@@ -110,7 +111,7 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
             what += f": {extra}" if extra else ""
         elif v.status == "correct" and v.message:
             what = f"correct: {v.message}"
-        elif v.status in ("wrong", "correct-but-unsupported", "unrecognised", "definition"):
+        elif v.status in ("wrong", "correct-but-unsupported", "consistent", "unrecognised", "definition"):
             what = f"{v.status.upper() if v.status == 'wrong' else v.status}: {v.message}"
         lines.append(f"  {mark} line {v.line:>4}  {_pad(step_title(v, ascii_only), width)}  {what}")
         if details and v.status == "wrong":
@@ -144,6 +145,8 @@ def text(report: GradeReport, ascii_only: bool = False, details: bool = True) ->
             taus.append(f"tau_{k} not read (line {last[-1].line})")
         elif ok and last[-1].status == "correct-but-unsupported":
             taus.append(f"tau_{k} right, but not supported by the steps before it")
+        elif last[-1].status == "consistent":
+            taus.append(f"tau_{k} not checked (agrees with your own values; no model)")
         else:
             taus.append(f"tau_{k} {'right' if ok else 'wrong'}")
     lines.append("final torques: " + "; ".join(taus))

@@ -17,6 +17,9 @@ Statuses (``StepVerdict.status``):
 * ``follows-from-earlier-error``: wrong, but exactly what the method gives from the
   student's own earlier values (``caused_by`` names the earliest wrong step it inherits).
 * ``correct-but-unsupported``: right, but not what the student's own earlier steps give.
+* ``consistent``: with no model (the robot could not be read from the text), what the
+  student's own earlier values give, one of which could not be checked: right only if that
+  one is, which nothing can say; it does not pass.
 * ``unrecognised``: the LHS could not be mapped to a step, or the value could not be
   read (the message says where, line and column, and why); it counts against passing.
 * ``definition``: an equation that introduces a name used later (``X = ...``, ``l_{c1} =
@@ -42,6 +45,7 @@ STATUSES = (
     "wrong",
     "follows-from-earlier-error",
     "correct-but-unsupported",
+    "consistent",
     "unrecognised",
     "definition",
 )

@@ -125,7 +125,8 @@ def load(
             Pass True only for a file you would run as a program; class grading and
             ``armdyn serve`` never do.
     floating: MJCF only: ``"weld"`` reads a ``free`` joint of a body of the world body as
-            a fixed base (see :func:`armdyn.io.mjcf.load_mjcf`).
+            a fixed base (see :func:`armdyn.io.mjcf.load_mjcf`); without it that body
+            is a floating base, whatever ``root_joint`` says.
     root_joint: None (the model's root link is fixed in the world) or ``"free-flyer"``:
             the root link floats, as Pinocchio's ``buildModelFromUrdf(path,
             JointModelFreeFlyer())`` (any model format; see :class:`armdyn.Robot`'s
@@ -135,8 +136,8 @@ def load(
     or a bad model.
     """
     robot = _load(source, strict, trusted, floating)
-    if root_joint == robot.root_joint:
-        return robot
+    if root_joint == robot.root_joint or root_joint is None and robot.meta.get("base_pose"):
+        return robot  # an MJCF free body floats as written (floating="weld" fixes it)
     return with_root_joint(robot, root_joint)
 
 

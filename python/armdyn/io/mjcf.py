@@ -20,9 +20,12 @@ What is read (the part of MJCF that fixes a fixed-base arm's rigid-body dynamics
   previous ones moved: they become a chain through massless intermediate links named
   ``<body>_<joint>``, listed in ``robot.meta["intermediate_links"]``. A body without a
   joint is welded to its parent (a fixed joint ``<body>_fixed``).
-* ``ball`` and ``free`` joints are refused (armdyn has no spherical or free-flyer joint
-  yet); ``floating="weld"`` reads a free joint of a body of the world body as a fixed
-  base at the body's pose.
+* A ``free`` joint (``<freejoint/>`` or ``<joint type="free"/>``) of a body of the world
+  body makes that body the floating base (``root_joint="free-flyer"``; one such body,
+  its only joint; see :mod:`armdyn.io.mjcf_free` for what is checked and
+  :mod:`armdyn.io.mjcf_state` for MuJoCo's ``qpos``/``qvel`` layout against armdyn's);
+  ``floating="weld"`` reads it as a fixed base at the body's pose instead. A free joint
+  anywhere else, and ``ball`` joints, are refused (no spherical joint yet).
 * ``<inertial pos mass diaginertia|fullinertia>`` (with an orientation for
   ``diaginertia``). A body without one gets MuJoCo's inertia from its geoms
   (``<compiler inertiafromgeom>``: ``auto`` by default; ``true`` always; ``false``
@@ -66,6 +69,7 @@ import numpy as np
 from ..errors import ModelError
 from ..model import Joint, Link, Numbers, Robot, exact_number
 from .expressions import check_name
+from .mjcf_free import base_pose, floating_tree, free_joint
 from .mjcf_math import (
     GEOM_SIZES,
     axis_angle_quat,
@@ -108,12 +112,16 @@ def load_mjcf(path_or_xml, strict: bool = True, floating: str | None = None) -> 
 
     Returns a numeric :class:`Robot` whose base is the world body (link ``"world"``),
     its coordinates in MuJoCo's order (depth-first through the bodies as written): q is
-    MuJoCo's ``qpos``. Unnamed joints and bodies are called ``joint_<n>``, ``body_<n>``.
+    MuJoCo's ``qpos``. With a free root body the robot floats, its base that body, its
+    arrays in Pinocchio's layout (:mod:`armdyn.io.mjcf_state` converts). Unnamed joints
+    and bodies are called ``joint_<n>``, ``body_<n>``.
     ``strict=False`` loads physically invalid inertias with a warning instead of an error.
     ``floating="weld"``: a ``free`` joint of a body of the world body is read as a fixed
-    base (the body welded at its pose); without it a free joint is an error.
+    base (the body welded at its pose); without it that body floats.
     ``robot.meta``: ``convention`` ("mjcf"), ``file``, ``ignored`` (what was not used),
-    ``massless_links``, ``intermediate_links``.
+    ``massless_links``, ``intermediate_links``, ``mujoco_joints`` (the coordinates in
+    MuJoCo's order) and, floating, ``base_pose`` (the body's pose as written, MuJoCo's
+    ``qpos0``: position and quaternion ``w x y z``).
     """
     if floating not in (None, "weld"):
         raise ModelError(f"floating={floating!r}: the one option is floating='weld'")
@@ -143,6 +151,8 @@ class _Reader(MjcfDocument):
         self.joints: list[Joint] = []
         self.massless: list[str] = []
         self.intermediate: list[str] = []
+        self.base: str | None = None  # the floating base's body, once read
+        self.base_pose: tuple = ()
 
     def rotation(self, elem, attrs) -> np.ndarray:
         """The orientation ``attrs`` give (identity when none)."""
@@ -315,6 +325,8 @@ class _Reader(MjcfDocument):
         bodies: list = []
         for world in root.findall("worldbody"):
             bodies += self.contents(world, WORLD, np.eye(3), np.zeros(3), "main", world=True)[2]
+        if self.floating is None:
+            bodies = floating_tree(self, root, bodies)
         stack = list(reversed(bodies))
         count = 0
         while stack:
@@ -327,7 +339,11 @@ class _Reader(MjcfDocument):
             "ignored": tuple(f"{k} x{n}" if n > 1 else k for k, n in sorted(self.ignored.items())),
             "massless_links": self.massless,
             "intermediate_links": self.intermediate,
+            "mujoco_joints": [j.name for j in self.joints if j.type != "fixed"],
         }
+        if self.base is not None:
+            del self.links[0]  # the world: the floating base's joint is the free-flyer
+            meta["base_pose"] = self.base_pose
         if self.directory is not None:
             meta["file"] = self.source
         name = root.get("model") or (Path(self.source).stem if self.directory is not None else "mjcf")
@@ -339,8 +355,9 @@ class _Reader(MjcfDocument):
                 self.joints,
                 [exact_number(g) for g in gravity],
                 meta=meta,
-                base=WORLD,
+                base=self.base or WORLD,
                 strict=self.strict,
+                root_joint=None if self.base is None else "free-flyer",
             )
         except ModelError as err:
             raise err.located(source=self.source)
@@ -405,26 +422,27 @@ class _Reader(MjcfDocument):
         joints, geoms, bodies, inertials = self.contents(elem, name, np.eye(3), np.zeros(3), cls)
         if len(inertials) > 1:
             raise self.error(inertials[1][0], "more than one <inertial> in the body")
-        self.joints += self.body_joints(elem, name, parent, Rb, pb, joints)
+        read = self.body_joints(elem, name, parent, Rb, pb, joints)
+        if read is None:  # the floating base: its pose is its free joint's coordinates
+            self.base, self.base_pose = name, base_pose(Rb, pb)
+        self.joints += read or []
         self.links.append(self.link(elem, name, inertials, geoms))
         return bodies
 
-    def body_joints(self, elem, name, parent, Rb, pb, joints) -> list[Joint]:
-        """The joints from ``parent`` to body ``name`` at pose ``(Rb, pb)``."""
+    def body_joints(self, elem, name, parent, Rb, pb, joints) -> list[Joint] | None:
+        """The joints from ``parent`` to body ``name`` at pose ``(Rb, pb)``; None for the
+        floating base (a free joint, see :func:`floating_tree`)."""
         read = [(j, self.attrs(j, cls) if j.tag == "joint" else self.free_attrs(j), R, p) for j, cls, R, p in joints]
         for j, attrs, _, _ in read:
             kind = "free" if j.tag == "freejoint" else attrs.get("type", "hinge")
-            if kind == "free" and self.floating == "weld" and parent == WORLD and len(read) == 1:
+            if kind == "free":
+                free_joint(self, j, attrs, parent == WORLD, len(read))
+                if self.floating != "weld":
+                    return None
                 self.ignored["free joint read as a fixed base (floating='weld')"] += 1
                 read = []
-            elif kind in ("free", "ball"):
-                what = "free-flyer (6-DOF)" if kind == "free" else "ball (spherical)"
-                extra = (
-                    "; a free joint of a body of the world body can be read as a fixed base with floating='weld'"
-                    if kind == "free"
-                    else ""
-                )
-                raise self.error(j, f"{kind} joint: armdyn has no {what} joint yet{extra}")
+            elif kind == "ball":
+                raise self.error(j, "ball joint: armdyn has no ball (spherical) joint yet")
             elif kind not in ("hinge", "slide"):
                 raise self.error(j, f"unknown joint type '{clip(kind)}' (expected hinge, slide, ball or free)")
         if not read:

@@ -44,8 +44,12 @@ origin applied to the base), all in the base frame, then the joints; ``M`` is
 differs from 1 by more than 1e-9 is refused (``ValueError``). Batches ``(N, nq)`` run
 as the fixed-base ones (SIMD lanes, ``threads``; bit for bit the single calls). :mod:`armdyn.configuration` moves on that configuration space
 (``integrate``, ``difference``, ``neutral``, ``random_configuration``, re-exported
-here). Every other function here raises :class:`~armdyn.errors.FloatingBaseError` (a
-``ModelError`` and ``NotImplementedError``) for a floating robot, naming itself.
+here). ``forward_kinematics`` (poses in the world frame), ``jacobian`` (``(6, nv)``, its
+frames in the world frame), ``kinetic_energy`` and ``potential_energy`` (of the whole
+robot, the base's too) take them as well, and :mod:`armdyn.centroidal` gives the centre
+of mass and the centroidal momentum. Every other function here raises
+:class:`~armdyn.errors.FloatingBaseError` (a ``ModelError`` and ``NotImplementedError``)
+for a floating robot, naming itself.
 """
 
 from __future__ import annotations

@@ -47,7 +47,8 @@ def require_fixed_base(robot, what: str) -> None:
         if isinstance(robot, Robot):
             robot.require_fixed_base(what)
         raise FloatingBaseError(
-            f"{what} does not support a floating base (root_joint='free-flyer') yet; rnea, crba and aba do",
+            f"{what} does not support a floating base (root_joint='free-flyer') yet; rnea, crba, aba, "
+            "forward_kinematics, jacobian, the energies and armdyn.centroidal do",
             f"robot '{robot.name}'",
         )
 

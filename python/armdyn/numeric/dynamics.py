@@ -150,7 +150,8 @@ def coriolis_matrix(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: i
 
 def kinetic_energy(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None = None) -> float | np.ndarray:
     """Kinetic energy T = 1/2 qd^T M(q) qd. q, qd: (n,) -> float, or (N, n) -> (N,)."""
-    threads = fixed_base_threads(robot, threads, "kinetic_energy")
+    if threads is not None:  # (a floating base too)
+        threads = check_threads(threads)
     try:
         return compiled_model(robot).kinetic_energy(q, qd, threads)
     except FloatingPointError:
@@ -164,7 +165,8 @@ def potential_energy(robot: RobotLike, q: ArrayLike, *, threads: int | None = No
 
     q: (n,) -> float, or (N, n) -> (N,).
     """
-    threads = fixed_base_threads(robot, threads, "potential_energy")
+    if threads is not None:  # (a floating base too)
+        threads = check_threads(threads)
     try:
         return compiled_model(robot).potential_energy(q, threads)
     except FloatingPointError:

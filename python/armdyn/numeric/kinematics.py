@@ -7,7 +7,7 @@ from numpy.typing import ArrayLike
 
 from .. import _core
 from ..model import Link, Robot
-from .checks import fixed_base_threads, overflow_error
+from .checks import check_threads, fixed_base_threads, overflow_error
 from .compiled import RobotLike, compiled_model, core_model, frame_offsets, mimic_model
 
 
@@ -18,7 +18,8 @@ def forward_kinematics(robot: RobotLike, q: ArrayLike, *, threads: int | None = 
     ``list(robot.links)`` order (base first); each ``[[R, p], [0, 0, 0, 1]]`` with R the
     link's axes in base coordinates and p its origin.
     """
-    threads = fixed_base_threads(robot, threads, "forward_kinematics")
+    if threads is not None:  # (a floating base too)
+        threads = check_threads(threads)
     try:
         poses = compiled_model(robot).forward_kinematics(q, threads)
         offsets = frame_offsets(robot)
@@ -51,7 +52,8 @@ def jacobian(
     * ``"world"``: the spatial velocity in the base frame: v the velocity of the body
       point passing through the base origin, ``v_p - w x p``; w in base axes.
     """
-    threads = fixed_base_threads(robot, threads, "jacobian")
+    if threads is not None:  # (a floating base too)
+        threads = check_threads(threads)
     try:
         frame = str(getattr(reference_frame, "name", reference_frame)).lower()
         if frame not in REFERENCE_FRAMES:

@@ -1,6 +1,7 @@
 """A 3-D view of an arm in the browser or in Jupyter (three.js, WebGL).
 
-``view(robot, q=None)`` shows the arm at the joint coordinates ``q``;
+``view(robot, q=None)`` shows the arm at the joint coordinates ``q`` (a floating robot's
+``q`` places its base too);
 ``animate(robot, times, Q)`` plays a trajectory (play/pause, a time slider, loop), at
 most ``max_frames`` frames of it (evenly spread samples of the rows of ``Q``). Both
 return a :class:`View`: ``.html()`` is a self-contained page (three.js inlined, nothing
@@ -13,7 +14,9 @@ every YAML/DH model) a grey capsule from its joint's parent frame origin to its 
 frame origin. Movable joints are short cylinders along their axes (orange revolute,
 purple prismatic) and centres of mass dark spheres whose volume grows with the mass:
 always for a model without visual geometry, with ``markers=True`` for one with it.
-``frames=True`` adds each link frame's axes (x red, y green, z blue).
+``frames=True`` adds each link frame's axes (x red, y green, z blue). The camera is
+fitted to what the first frame draws; the floor grid lies in the base's xy plane, or
+under the lowest point drawn when that is below the base (a legged robot's feet).
 
 The link poses are computed here, by armdyn's forward kinematics
 (:func:`armdyn.numeric.forward_kinematics`), and sent as JSON: per frame and link

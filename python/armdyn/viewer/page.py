@@ -147,11 +147,53 @@ def _coerce(robot) -> Robot:
     return numeric_robot(robot)
 
 
-def _poses(robot: Robot, Q: np.ndarray) -> tuple[list[float], np.ndarray]:
-    """Flat ``x, y, z, qx, qy, qz, qw`` per frame and link, and every link origin (k, 3)."""
+def _link_poses(robot: Robot, Q: np.ndarray) -> np.ndarray:
+    """(N, links, 4, 4) world poses of ``list(robot.links)`` at the rows of ``Q``. A
+    floating robot's rows are its ``q`` (base position, quaternion ``x, y, z, w``,
+    joints): the same tree with its base fixed gives the poses in the base frame, which
+    the base pose carries into the world."""
     from ..numeric import forward_kinematics
 
-    T = np.asarray(forward_kinematics(robot, np.ascontiguousarray(Q, dtype=float))).reshape(len(Q), -1, 4, 4)
+    if not robot.floating:
+        return np.asarray(forward_kinematics(robot, np.ascontiguousarray(Q))).reshape(len(Q), -1, 4, 4)
+    from ..io import with_root_joint
+
+    fixed = with_root_joint(robot, None)
+    column = {n: 7 + i for i, n in enumerate(robot.coordinate_names)}
+    joints = np.ascontiguousarray(Q[:, [column[n] for n in fixed.coordinate_names]])
+    local = np.asarray(forward_kinematics(fixed, joints)).reshape(len(Q), -1, 4, 4)
+    at = {n: i for i, n in enumerate(fixed.links)}
+    local = local[:, [at[n] for n in robot.links]]
+    base = np.tile(np.eye(4), (len(Q), 1, 1))
+    x, y, z, w = Q[:, 3:7].T
+    base[:, :3, :3] = np.stack(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    ).transpose(2, 0, 1)
+    base[:, :3, 3] = Q[:, :3]
+    return base[:, None] @ local
+
+
+def _configurations(robot: Robot, Q) -> np.ndarray:
+    """``Q`` (N, nq) as finite floats; a floating base's quaternions checked unit."""
+    Q = np.asarray(Q, dtype=float)
+    if Q.ndim != 2 or Q.shape[1] != robot.nq or len(Q) == 0:
+        raise ValueError(f"Q: shape {Q.shape}, expected (frames, {robot.nq}) with at least one frame")
+    if not np.all(np.isfinite(Q)):
+        raise ValueError("times or Q contain NaN or inf")
+    if robot.floating:
+        from ..configuration import difference
+
+        difference(robot, Q, Q)  # refuses a quaternion off unit length, naming it
+    return Q
+
+
+def _poses(robot: Robot, Q: np.ndarray) -> tuple[list[float], np.ndarray]:
+    """Flat ``x, y, z, qx, qy, qz, qw`` per frame and link, and every link origin (k, 3)."""
+    T = _link_poses(robot, Q)
     flat = np.concatenate([T[:, :, :3, 3], quaternions(T[:, :, :3, :3])], axis=2).round(7)
     return flat.reshape(-1).tolist(), T[:, :, :3, 3].reshape(-1, 3)
 
@@ -206,13 +248,19 @@ def _scene(robot: Robot, times, Q, frames: bool, markers: bool | None, package_d
 
 def view(robot, q=None, *, frames: bool = False, markers: bool | None = None, package_dirs=()) -> View:
     """The arm ``robot`` (a :class:`Robot`, model file or bundled name) at ``q`` (dof,)
-    (default zeros). ``frames``: draw each link frame's axes; ``markers``: joint
+    (default zeros; a floating robot's ``q`` is (nq,), default its neutral
+    configuration). ``frames``: draw each link frame's axes; ``markers``: joint
     cylinders and mass spheres (default: only when the model has no visual geometry);
     ``package_dirs``: folders where ``package://`` meshes are looked up."""
     from ..show import joint_values
 
     robot = _coerce(robot)
-    q = joint_values(robot, q)
+    if robot.floating:
+        from ..configuration import neutral
+
+        q = _configurations(robot, [neutral(robot) if q is None else np.asarray(q, dtype=float).reshape(-1)])[0]
+    else:
+        q = joint_values(robot, q)
     return View(_scene(robot, [0.0], q[None, :], frames, markers, package_dirs))
 
 
@@ -226,17 +274,16 @@ def sample(times, count: int, max_frames: int = MAX_FRAMES) -> np.ndarray:
 def animate(
     robot, times, Q, *, max_frames: int = MAX_FRAMES, frames: bool = False, markers: bool | None = None, package_dirs=()
 ) -> View:
-    """The arm moving through the joint coordinates ``Q`` (N, dof) at the increasing
-    ``times`` (N,) in seconds, played in real time; at most ``max_frames`` of the rows
-    are kept (evenly spread, first and last included). Other options as :func:`view`."""
+    """The arm moving through the joint coordinates ``Q`` (N, dof), or a floating robot's
+    configurations (N, nq), at the increasing ``times`` (N,) in seconds, played in real
+    time; at most ``max_frames`` of the rows are kept (evenly spread, first and last
+    included). Other options as :func:`view`."""
     robot = _coerce(robot)
     times = np.asarray(times, dtype=float).reshape(-1)
-    Q = np.asarray(Q, dtype=float)
-    if Q.ndim != 2 or Q.shape[1] != robot.dof or len(Q) == 0:
-        raise ValueError(f"Q: shape {Q.shape}, expected (frames, {robot.dof}) with at least one frame")
+    Q = _configurations(robot, Q)
     if times.shape != (len(Q),):
         raise ValueError(f"times: {times.size} values for {len(Q)} rows of Q")
-    if not (np.all(np.isfinite(Q)) and np.all(np.isfinite(times))):
+    if not np.all(np.isfinite(times)):
         raise ValueError("times or Q contain NaN or inf")
     if np.any(np.diff(times) < 0):
         raise ValueError("times must not decrease")

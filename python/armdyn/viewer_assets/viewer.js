@@ -2,7 +2,7 @@
 // the scene script element. Runs after three.js (inlined before it as `THREE`).
 // Link poses come precomputed per frame (x, y, z, qx, qy, qz, qw per link): no
 // kinematics here. Reports what it loaded on <body data-status data-links data-frames
-// data-meshes> (tests read it) and in the title.
+// data-meshes data-floor> (tests read it) and in the title.
 (function () {
   "use strict";
   const S = JSON.parse(document.getElementById("armdyn-scene").textContent);
@@ -125,7 +125,34 @@
 
   // camera on a sphere around the arm: drag turns, wheel zooms
   const centre = new THREE.Vector3(...S.centre);
-  let azimuth = -Math.PI / 3, elevation = 0.45, distance = 2.1 * size;
+  let azimuth = -Math.PI / 3, elevation = 0.45, distance = 2.1 * size, zoom = 1;
+  // what the first frame draws (meshes included, not only the joint origins): the view is
+  // fitted to it, and the floor put under it when it reaches below the base (a legged
+  // robot's feet stand on the floor instead of hanging through it)
+  show(0);
+  const box = new THREE.Box3();
+  for (const g of links) box.expandByObject(g);
+  for (const c of capsules) box.expandByObject(c.tube.parent);
+  if (!box.isEmpty()) {
+    box.getCenter(centre);
+    grid.position.z = Math.min(0, box.min.z);
+  }
+  body.dataset.floor = String(grid.position.z);
+  // the least distance at which every corner of the box is inside the view, with a margin
+  function fit(aspect) {
+    if (box.isEmpty()) return 2.1 * size;
+    const ty = Math.tan(THREE.MathUtils.degToRad(camera.fov) / 2), tx = ty * aspect;
+    const back = new THREE.Vector3(Math.cos(elevation) * Math.cos(azimuth),
+      Math.cos(elevation) * Math.sin(azimuth), Math.sin(elevation));
+    const right = new THREE.Vector3(0, 0, 1).cross(back).normalize(), up = new THREE.Vector3().crossVectors(back, right);
+    let d = 0;
+    for (let i = 0; i < 8; i++) {
+      const p = new THREE.Vector3(i & 1 ? box.max.x : box.min.x, i & 2 ? box.max.y : box.min.y,
+        i & 4 ? box.max.z : box.min.z).sub(centre);
+      d = Math.max(d, p.dot(back) + Math.abs(p.dot(right)) / tx, p.dot(back) + Math.abs(p.dot(up)) / ty);
+    }
+    return 1.1 * d;
+  }
   function aim() {
     camera.position.set(
       centre.x + distance * Math.cos(elevation) * Math.cos(azimuth),
@@ -143,7 +170,7 @@
     drag = [e.clientX, e.clientY];
     draw();
   });
-  view.addEventListener("wheel", (e) => { e.preventDefault(); distance *= Math.exp(e.deltaY * 0.001); draw(); },
+  view.addEventListener("wheel", (e) => { e.preventDefault(); zoom *= Math.exp(e.deltaY * 0.001); draw(); },
     { passive: false });
 
   function draw() {
@@ -153,6 +180,7 @@
     renderer.domElement.style.height = "100%";
     camera.aspect = w / h;
     camera.updateProjectionMatrix();
+    distance = zoom * fit(camera.aspect);
     aim();
     renderer.render(scene, camera);
   }

@@ -52,7 +52,7 @@ pub fn quaternion_rotation<T: Real>(x: T, y: T, z: T, w: T) -> M3<T> {
 
 /// A base velocity or acceleration `[linear (3); angular (3)]` as a motion `[w; v]`.
 #[inline(always)]
-fn base_motion<T: Real>(x: &[T]) -> Motion<T> {
+pub(crate) fn base_motion<T: Real>(x: &[T]) -> Motion<T> {
     Motion::new(V3::new(x[3], x[4], x[5]), V3::new(x[0], x[1], x[2]))
 }
 

@@ -6,13 +6,16 @@
 
 pub mod aba;
 pub mod aba_derivatives;
+pub mod centroidal;
 pub mod coriolis;
 pub mod crba;
 pub mod energy;
 pub mod external;
 pub mod floating;
+pub mod floating_kinematics;
 pub mod gravity_derivatives;
 pub mod integrate;
+pub mod integrate_floating;
 pub mod jacobian;
 pub mod jacobian_dot;
 pub mod kinematics;

@@ -134,3 +134,30 @@ fn derivative_batch_allocations_do_not_grow_with_the_number_of_states() {
     let (small, large) = (run(5), run(5000));
     assert_eq!(small, large, "allocations: {small} for 5 states, {large} for 5000");
 }
+
+#[test]
+fn world_and_centroidal_algorithms_do_not_allocate() {
+    use algo::{centroidal, floating_kinematics as fk};
+    let model = crate::floating::floating_model(&mut Rng::new(4), 7);
+    let (q, v, a) = crate::floating::state(&mut Rng::new(5), model.nv);
+    let nv = v.len();
+    let mut d = Data::new(&model);
+    let (mut x, mut j, mut c) = (vec![0.0; 16 * model.nlinks()], vec![0.0; 6 * nv], [0.0; 6]);
+    let allocs = count(|| {
+        for floating in [true, false] {
+            let (q, v, a) = if floating { (&q[..], &v[..], &a[..]) } else { (&q[7..], &v[6..], &a[6..]) };
+            let j = &mut j[..6 * v.len()];
+            fk::forward_kinematics_world(&model, &mut d, q, floating, &mut x);
+            fk::jacobian_world(&model, &mut d, q, floating, model.nlinks() - 1, j);
+            std::hint::black_box(fk::kinetic_energy_world(&model, &mut d, q, v, floating));
+            centroidal::center_of_mass(&model, &mut d, q, floating, &mut c[..3]);
+            centroidal::com_jacobian(&model, &mut d, q, floating, &mut j[..3 * v.len()]);
+            centroidal::centroidal_map(&model, &mut d, q, floating, j);
+            centroidal::centroidal_map_rate(&model, &mut d, q, v, floating, j);
+            centroidal::centroidal_momentum(&model, &mut d, q, v, floating, &mut c);
+            centroidal::centroidal_momentum_rate(&model, &mut d, q, v, a, floating, &mut c);
+        }
+        std::hint::black_box(fk::potential_energy_floating(&model, &mut d, &q));
+    });
+    assert_eq!(allocs, 0, "the world-frame and centroidal algorithms allocate");
+}

@@ -5,7 +5,7 @@ use crate::common::*;
 use armdyn_core::algo::floating::{aba_floating, crba_floating, rnea_floating};
 use armdyn_core::{algo, Data, F64x4, Model, Real};
 
-fn floating_model(rng: &mut Rng, njoints: usize) -> Model {
+pub(crate) fn floating_model(rng: &mut Rng, njoints: usize) -> Model {
     let mut model = random_model(rng, njoints, true);
     let inertia = random_inertia(rng);
     let com = [rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2)];
@@ -14,10 +14,10 @@ fn floating_model(rng: &mut Rng, njoints: usize) -> Model {
 }
 
 /// (q, v, a) of one state.
-type State = (Vec<f64>, Vec<f64>, Vec<f64>);
+pub(crate) type State = (Vec<f64>, Vec<f64>, Vec<f64>);
 
 /// Random (q, v, a): any base pose (a unit quaternion), joints in [-3, 3].
-fn state(rng: &mut Rng, n: usize) -> State {
+pub(crate) fn state(rng: &mut Rng, n: usize) -> State {
     let mut q = rng.vec(7 + n, -3.0, 3.0);
     let quat = rng.vec(4, -1.0, 1.0);
     let norm = quat.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -125,4 +125,70 @@ fn floating_batches_equal_single_states() {
         crba_floating(&model, &mut data, qs, &mut mm);
         assert_eq!(&m[r * nv * nv..(r + 1) * nv * nv], &mm[..], "crba row {r}");
     }
+}
+
+/// The end states (q, v) of `rows` floating states integrated by RK4 for `steps` steps.
+fn integrate_floating(model: &Model, q0: &[f64], v0: &[f64], steps: usize, threads: Option<usize>) -> Vec<f64> {
+    use armdyn_core::algo::integrate::{Input, Method, Outputs, Settings};
+    use armdyn_core::algo::integrate_floating::simulate_floating_until;
+    let (n, rows) = (model.nv, q0.len() / (model.nv + 7));
+    let s = Settings { method: Method::Rk4, dt: 1e-3, steps, stride: steps };
+    let (nq, nv, k) = (n + 7, n + 6, s.samples());
+    let mut q = vec![0.0; rows * k * nq];
+    let (mut qd, mut qdd, mut tau) = (vec![0.0; rows * k * nv], vec![0.0; rows * k * nv], vec![0.0; rows * k * nv]);
+    let mut work = vec![0.0; rows * k];
+    let (mut qf, mut qdf) = (vec![0.0; rows * nq], vec![0.0; rows * nv]);
+    let (mut ls, mut lj, mut nf, mut nj) = (vec![0; rows], vec![0; rows], vec![0; rows], vec![0; rows]);
+    let (inf, ninf) = (vec![f64::INFINITY; n], vec![f64::NEG_INFINITY; n]);
+    let out = Outputs {
+        q: &mut q, work: &mut work, qd: &mut qd, qdd: &mut qdd, tau: &mut tau, q_final: &mut qf, qd_final: &mut qdf,
+        limit_step: &mut ls, limit_joint: &mut lj, nonfinite_step: &mut nf, nonfinite_joint: &mut nj,
+    };
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    assert!(simulate_floating_until(model, q0, v0, Input::Zero, s, &ninf, &inf, out, threads, &stop));
+    assert!(nf.iter().all(|&k| k == -1));
+    qf.into_iter().chain(qdf).collect()
+}
+
+#[test]
+fn integrate_floating_lanes_equal_single_states() {
+    // 11 states: a group of 8 (or two of 4) in SIMD lanes and leftovers alone, on 1 and 2
+    // threads: every state ends where it ends integrated alone, bit for bit
+    let mut rng = Rng::new(43);
+    let model = floating_model(&mut rng, 5);
+    let (n, rows) = (model.nv, 11);
+    let (mut q0, mut v0) = (vec![], vec![]);
+    for _ in 0..rows {
+        let (q, v, _) = state(&mut rng, n);
+        q0.extend(q);
+        v0.extend(v);
+    }
+    let (nq, nv) = (n + 7, n + 6);
+    for threads in [Some(1), Some(2)] {
+        let all = integrate_floating(&model, &q0, &v0, 40, threads);
+        for r in 0..rows {
+            let one = integrate_floating(&model, &q0[r * nq..(r + 1) * nq], &v0[r * nv..(r + 1) * nv], 40, Some(1));
+            assert_eq!(&all[r * nq..(r + 1) * nq], &one[..nq], "q of state {r}");
+            assert_eq!(&all[rows * nq + r * nv..rows * nq + (r + 1) * nv], &one[nq..], "v of state {r}");
+        }
+    }
+}
+
+#[test]
+fn integrate_configuration_is_the_se3_exponential() {
+    use armdyn_core::algo::integrate_floating::integrate_configuration;
+    // a turn by pi/2 about z with a linear twist (1, 0, 0): the screw motion's closed
+    // form, from a base at (1, 2, 3) turned pi/2 about x
+    let s = 0.5f64.sqrt();
+    let q = [1.0, 2.0, 3.0, s, 0.0, 0.0, s, 0.5];
+    let xi = [1.0, 0.0, 0.0, 0.0, 0.0, std::f64::consts::FRAC_PI_2, 0.25];
+    let mut out = [0.0; 8];
+    integrate_configuration(&q, &xi, &mut out);
+    // exp: R_z(pi/2), p = V lin = (sin t / t, (1 - cos t) / t, 0) with t = pi/2; then
+    // turned by R_x(pi/2): (x, y, z) -> (x, -z, y); the orientation q_x(pi/2) q_z(pi/2)
+    // = (s, 0, 0, s)(0, 0, s, s) = (1/2, -1/2, 1/2, 1/2) (x y z w)
+    let t = std::f64::consts::FRAC_PI_2;
+    let p = [t.sin() / t, (1.0 - t.cos()) / t, 0.0];
+    let expected = [1.0 + p[0], 2.0 - p[2], 3.0 + p[1], 0.5, -0.5, 0.5, 0.5, 0.75];
+    assert_close(&out, &expected, 1e-15, "q (+) xi");
 }

@@ -7,6 +7,7 @@ mod common;
 mod alloc;
 mod assert_close;
 mod batch;
+mod centroidal;
 mod derivatives;
 mod floating;
 mod identities;

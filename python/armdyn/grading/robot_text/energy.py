@@ -3,7 +3,9 @@ functions of q (``p_{c2} = l_1(\\cos q_1, \\sin q_1) + ...``, ``x_{c2} = l_1 c_1
 or their velocity Jacobians (Spong's ``J_{v_{ck}}``, integrated joint by joint and checked),
 or, failing those, the heights in the potential energy ``V = m_1 g h_1 + ...``: for a planar
 arm turning about z with gravity in its plane, the height ``a sin(phi) + b cos(phi)`` is the
-point ``Rz(phi) (a, b)``. Positions and V stated both are checked against each other.
+point ``Rz(phi) (a, b)``. Positions and V stated both are checked against each other, and
+against the arm's own geometry: a uniform link with its centre halfway along it (``l_2/2``)
+ends at ``l_2``, so every later link hangs from that end (:func:`uniform_links`).
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ import re
 
 import sympy as sp
 
-from .geometry import across, same, vector
+from .geometry import across, rz, same, vector
 from .statements import POINT
 
 
@@ -199,4 +201,58 @@ def mass_centres(
         rest = sum((t for t in sp.Add.make_args(rest) if t.free_symbols & set(q)), sp.Integer(0))  # V's zero aside
         if rest != 0 and found and not same(rest, sp.Integer(0), free):
             conflicts.append(f"line {st.line}: V has a term not of one mass's height: {rest}")
+    uniform_links(found, q, revolute, conflicts)
     return found
+
+
+def _along(p: sp.Matrix, phi) -> tuple | None:
+    """The constant ``(a, b)`` with ``Rz(phi) (a, b)`` the part of the planar point ``p`` that
+    turns with the angle ``phi`` (None when that part is not such a rotation)."""
+    x, y = sp.expand(p[0]), sp.expand(p[1])
+    c, s = sp.cos(phi), sp.sin(phi)
+    a, b = x.coeff(c), -x.coeff(s)
+    if (a, b) == (0, 0):
+        return (0, 0) if y.coeff(c) == 0 and y.coeff(s) == 0 else None
+    if sp.expand(y.coeff(s) - a) != 0 or sp.expand(y.coeff(c) - b) != 0:
+        return None
+    return a, b
+
+
+def uniform_links(found: dict, q: list, revolute: set, conflicts: list) -> None:
+    """A planar arm of uniform links: link k's centre at ``S/2`` along it (``S`` one symbol,
+    its length) puts joint k+1, and so every later link, at ``S`` along it. A later centre
+    placed without that reach, or with half of it, drops a term of the chain (the slip of a
+    position written link by link, which every step after it carries): the chain's reading
+    is used, and the conflict named with the lines."""
+    trig = {x for v in found.values() for f in v[0].atoms(sp.sin, sp.cos) for x in f.free_symbols}
+    turning = (trig & set(q)) | revolute
+    angles, total = [], sp.Integer(0)
+    for x in q:
+        total = total + x if x in turning else total
+        angles.append(total)
+    for k in sorted(found):
+        if not 1 <= k <= len(q) or angles[k - 1] == 0:
+            continue
+        phi = angles[k - 1]
+        mine = _along(found[k][0], phi)
+        if mine is None or mine[1] != 0:
+            continue
+        half = sp.nsimplify(mine[0]) * 2
+        if not isinstance(half, sp.Symbol):
+            continue
+        for j in sorted(found):
+            if j <= k or j > len(q) or angles[j - 1] == phi:  # a slider on link k moves along it
+                continue
+            theirs = _along(found[j][0], phi)
+            if theirs is None or theirs[1] != 0 or theirs[0] == half:
+                continue
+            if theirs[0] != 0 and sp.simplify(theirs[0] / half).free_symbols:
+                continue  # some other length along link k: not this slip
+            pos, mass, st = found[j]
+            found[j] = (pos + rz(phi) * sp.Matrix([half - theirs[0], 0, 0]), mass, st)
+            reach = "nothing" if theirs[0] == 0 else str(theirs[0])
+            conflicts.append(
+                f"line {st.line} places link {j}'s mass centre with {reach} along link {k}, where line "
+                f"{found[k][2].line} makes link {k} uniform and {half} long (its centre at {half}/2): "
+                f"read with {half} along link {k}, where link {k} ends"
+            )

@@ -83,6 +83,10 @@ def candidates(ov, ref, key: str) -> tuple[list, str]:
             if ov.christoffel_order != "last":
                 first = ov.christoffel(M, b, c, a)
                 out.append((first, used, "the Christoffel symbol of your M (free index first)", True))
+            if ref.alias == "h":  # Asada & Slotine's unsymmetrised h_ijk = dM_ij/dq_k - dM_jk/dq_i / 2
+                q = ov.q
+                asada = M[a, b].diff(q[c]) - M[b, c].diff(q[a]) / 2
+                out.append((asada, used, "Asada & Slotine's h_ijk of your M", True))
         return out, "needs M stated before it"
     if k in ("C", "h"):
         return _coriolis(ov, k, entry), "needs M or τ stated before it"
@@ -184,7 +188,7 @@ def _turning(ov, i: int, k: str, col) -> list:
 class _Base:
     """The base at rest, as a value 'used' (no line of the text)."""
 
-    line, name, tainted = 0, "the base at rest", None
+    line, name, tainted, unchecked = 0, "the base at rest", None, None
 
 
 def _joint_torque(ov, i: int) -> list:

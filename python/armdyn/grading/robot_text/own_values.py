@@ -16,7 +16,10 @@ checked against the values the text itself gave before it:
 
 A step no earlier value decides (a starting value, a Newton-Euler vector needing the
 frames) is ``unrecognised`` with that reason, never guessed. A step agreeing with earlier
-values that were themselves found wrong is ``follows-from-earlier-error``. Nothing from the
+values that were themselves found wrong is ``follows-from-earlier-error``; one agreeing with
+earlier values of which one could not be checked (a step read but undecided, so perhaps
+wrong) is ``consistent``: it is right only if that one is, which nothing here can say.
+Nothing from the
 text is evaluated as code: values are parsed by :mod:`..latex`.
 """
 
@@ -51,10 +54,13 @@ _NAME_BEFORE = re.compile(r"(?<![\\A-Za-z])([A-Za-z])(_\{[^{}]{0,20}\}|_\w)?$")
 
 
 class _Own:
-    """One value the text gave: the value, its line, its step name, and whether it carries a slip."""
+    """One value the text gave: the value, its line, its step name, whether it carries a slip
+    (``tainted``: the wrong step's name) and whether it rests on a value nothing could check
+    (``unchecked``: ``"line N"`` of that step)."""
 
-    def __init__(self, value, line: int, name: str, tainted: str | None):
-        self.value, self.line, self.name, self.tainted = value, line, name, tainted
+    def __init__(self, value, line: int, name: str, tainted: str | None, unchecked: str | None = None):
+        self.value, self.line, self.name, self.tainted, self.unchecked = value, line, name, tainted, unchecked
+        self.corrected = None  # a wrong value: what the text's earlier values give instead
 
 
 class OwnValues:
@@ -72,6 +78,9 @@ class OwnValues:
         self.qd = [sp.Symbol(f"{x}_dot") for x in self.q]
         self.qdd = [sp.Symbol(f"{x}_ddot") for x in self.q]
         self.own: dict[str, _Own] = {}  # canonical step name -> the text's value
+        self.read_own = False  # whether the value being read used one of the text's earlier values
+        #: line -> (the lines of the earlier values it fits, how): what each step follows from
+        self.fits: dict[int, tuple[list[int], str]] = {}
         self.aliases: dict[str, str] = {}  # the symbol the text wrote (K1) -> canonical name (T_1)
         self.verdicts: list[StepVerdict] = []
         self.methods: list[str] = []
@@ -83,11 +92,13 @@ class OwnValues:
     def _resolve(self, name):
         key = self.aliases.get(plain(name))  # c_{121} the text gave a value: that, not the cosine shorthand
         if key in self.own:
+            self.read_own = True
             return self.own[key].value
         value = self.names(name)
         if isinstance(value, sp.Symbol):
             key = self.aliases.get(value.name)
             if key in self.own:
+                self.read_own = True
                 return self.own[key].value
         return value
 
@@ -256,12 +267,15 @@ class OwnValues:
         if len(value_text) > MAX_VALUE:
             self._add(eq, name, ref.key, "unrecognised", f"{name}: too long to check ({len(value_text)} characters)")
             return
+        self.read_own = False
         try:
             got = self._read(value_text)
         except (LatexError, RecursionError, ValueError, TypeError, ArithmeticError) as err:
             self._add(eq, name, ref.key, "unrecognised", f"{name}: cannot be read: {str(err)[:160]}")
             return
-        if self._unknown(got, []):  # K = 1/2 q'^T D(q) q' with D never given: the law, if it is one
+        # K = 1/2 q'^T D(q) q' with D never given: the law, if it is one; F_2 = m_2 v_{C_2} after
+        # the text's v_{C_2}: a step of this arm built on that value, judged as one
+        if self._unknown(got, []) and not self.read_own:
             stated = law_verdict(eq, max(self.n, 1), fallback=True)
             if stated is not None:
                 self._method(stated[1] or "lagrange")
@@ -286,7 +300,9 @@ class OwnValues:
             cands, starting = rotation(self, ref, got) if ref.key == "R" else candidates(self, ref, key)
         except (ArithmeticError, TypeError, ValueError, AttributeError, IndexError, RecursionError) as err:
             cands, starting = [], f"could not be derived from the earlier values ({str(err)[:80]})"
-        status, message, expected, caused = "unrecognised", "", None, None
+        if self._scalar_name(eq, ref, got, cands):
+            return
+        status, message, expected, caused, unchecked = "unrecognised", "", None, None, None
         fitting = [c for c in cands if _fits(got, c[0])]
         orders = {o for c in fitting for o in ("first", "last") if f"(free index {o})" in c[2]}
         if ref.key == "christoffel" and len(orders) == 1:  # the text's index order, kept from here on
@@ -294,10 +310,19 @@ class OwnValues:
         if fitting:
             value, used, how, complete = fitting[0]
             tainted = next((u.tainted for u in used if u.tainted), None)
+            unchecked = next((u.unchecked for u in used if u.unchecked), None)
             lines = _lines(used)
+            self.fits[eq.line] = (sorted({u.line for u in used if u.line}), f"{how}{lines}")
+            if tainted and self._untouched(got, ref, key, [u for u in used if u.tainted]):
+                tainted = None  # the slip is in a part of that value this step does not use
             if tainted:
                 status, caused = "follows-from-earlier-error", tainted
                 message = f"follows from the error in {tainted}: {how}{lines}"
+            elif unchecked:
+                status = "consistent"
+                message = (
+                    f"agrees with {how}{lines}; your {unchecked} could not be checked (no model), so neither can this"
+                )
             else:
                 status = "correct"
                 message = f"{how}{lines}; no model to check those against"
@@ -322,7 +347,11 @@ class OwnValues:
         if status == "unrecognised" and not _symbols(got) & joints and self._unknown(got, []):
             return  # L = K - P in names never given: a relation, no value of this arm to build on
         tainted = name if status == "wrong" else caused
-        self.own[key] = _Own(got, eq.line, name, tainted)
+        if status == "unrecognised":
+            unchecked = f"line {eq.line}"
+        self.own[key] = _Own(got, eq.line, name, tainted, unchecked)
+        if status == "wrong":
+            self.own[key].corrected = expected
         for alias in _aliases(eq.lhs, self.names):
             self.aliases.setdefault(alias, key)
             m = re.fullmatch(r"([A-Za-z]+)(\d)(\d)", alias)
@@ -330,6 +359,44 @@ class OwnValues:
                 self.aliases.setdefault(m.group(1) + m.group(3) + m.group(2), key)
         self.seen |= _symbols(got)
         self.aliases.setdefault(key.replace("_", ""), key)
+
+    def _untouched(self, got, ref: StepRef, key: str, tainted: list) -> bool:
+        """Whether ``got`` is also what the wrong values it used give once corrected (``τ_1``
+        from a C whose slip is in row 2 only): then it does not carry that slip."""
+        if not all(u.tainted == u.name and u.corrected is not None for u in tainted):
+            return False  # a value carrying a slip from further back: its right value is not known
+        saved = [(u, u.value) for u in tainted]
+        try:
+            for u in tainted:
+                u.value = u.corrected
+            cands, _ = candidates(self, ref, key)
+            return any(_fits(got, c[0]) for c in cands)
+        except (ArithmeticError, TypeError, ValueError, AttributeError, IndexError, RecursionError):
+            return False
+        finally:
+            for u, value in saved:
+                u.value = value
+
+    def _scalar_name(self, eq, ref: StepRef, got, cands) -> bool:
+        """``h = m_2 l_1 l_{c2} \\sin q_2`` where h, the velocity products, has n entries: a
+        shorthand the text defines, read as its value where used, not judged."""
+        if not cands or isinstance(got, sp.MatrixBase):
+            return False
+        if not all(isinstance(c[0], sp.MatrixBase) and len(c[0]) > 1 for c in cands):
+            return False
+        key = f"defined_{ref.name}"
+        self._add(
+            eq,
+            "",
+            "",
+            "definition",
+            f"{ref.name} read as a name for a scalar the text uses later ({ref.name} has {len(cands[0][0])} entries)",
+        )
+        self.own[key] = _Own(got, eq.line, ref.name, None)
+        for alias in _aliases(eq.lhs, self.names):
+            self.aliases[alias] = key
+        self.seen |= _symbols(got)
+        return True
 
     def _unknown(self, got, candidates) -> list[str]:
         """Names in ``got`` that no earlier value and no candidate holds (b_{21} never given)."""

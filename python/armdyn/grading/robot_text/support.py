@@ -71,6 +71,31 @@ def disagreeing(report: GradeReport) -> bool:
     return trouble >= 3 and 2 * trouble > len(steps)
 
 
+def carry_own_values(sub, report: GradeReport) -> None:
+    """A step found wrong that is exactly what the text's own earlier values give, one of them
+    found wrong (``V = V_1 + V_2 + V_3`` after a wrong ``V_3``, ``G_k = \\partial V/\\partial q_k``
+    after it): ``follows-from-earlier-error``, as the method's own formulas mark the steps they
+    compute. The text's values are read as :mod:`.own_values` reads them; only with two steps
+    wrong or more (one alone inherits nothing)."""
+    if sum(v.status == "wrong" for v in report.steps) < 2:
+        return
+    from .own_values import OwnValues
+
+    own = OwnValues(sub, "")
+    own.run()
+    by_line: dict[int, list] = {}
+    for v in report.steps:
+        if v.status == "wrong" and v.line in own.fits:
+            lines, how = own.fits[v.line]
+            earlier = [u for ln in lines for u in by_line.get(ln, []) if u.status in _FLAGGED]
+            if earlier:
+                cause = earlier[0].caused_by or earlier[0].name
+                v.status, v.caused_by = "follows-from-earlier-error", cause
+                v.message = f"follows from the error in {cause}: {how}"
+        by_line.setdefault(v.line, []).append(v)
+    report.first_wrong = next((v.name for v in report.steps if v.status == "wrong"), None)
+
+
 def own_values_instead(sub, report: GradeReport) -> GradeReport:
     """The text graded on its own values when the model read disagrees with most of its steps,
     kept when it finds fewer steps wrong (or as many, reading more); else ``report``."""
