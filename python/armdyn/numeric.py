@@ -29,13 +29,15 @@ Conventions (docs/architecture.md): SI units, radians; ``M(q) qdd + C(q, qd) qd 
 gravity is the robot's vector in the base frame; frames as in :mod:`armdyn.model`.
 
 A floating base (``armdyn.load(path, root_joint="free-flyer")``, ``robot.floating``):
-``rnea``, ``crba`` and ``aba`` take Pinocchio's arrays, unchanged: ``q`` is
+``rnea``, ``crba``, ``aba``, ``rnea_derivatives``, ``aba_derivatives`` and ``minverse`` take
+Pinocchio's arrays, unchanged: ``q`` is
 ``(robot.nq,) = (7 + dof,)``, the base origin in the world frame (3), the base
 orientation as a unit quaternion ``x, y, z, w`` (4; base axes in world coordinates),
 then the joints; ``qd``, ``qdd`` and ``tau`` are ``(robot.nv,) = (6 + dof,)``: the base's
 linear then angular velocity (acceleration; the force then the moment about the base
-origin applied to the base), all in the base frame, then the joints; ``M`` is
-``(nv, nv)`` in that order. Gravity is then in the world frame. A quaternion whose length
+origin applied to the base), all in the base frame, then the joints; ``M`` and the
+derivatives are ``(nv, nv)`` in that order, ``d/dq`` on the tangent space: along
+``integrate(q, dq)`` at ``dq = 0`` (Pinocchio's ``computeRNEADerivatives``). Gravity is then in the world frame. A quaternion whose length
 differs from 1 by more than 1e-9 is refused (``ValueError``). Batches ``(N, nq)`` run
 as the fixed-base ones (SIMD lanes, ``threads``; bit for bit the single calls). :mod:`armdyn.configuration` moves on that configuration space
 (``integrate``, ``difference``, ``neutral``, ``random_configuration``, re-exported
@@ -535,6 +537,8 @@ def rnea_derivatives(
     piecewise constant: it adds nothing, also at ``qd_k = 0`` where rnea's term jumps
     (``sign(0) = 0``) and has no derivative; the value given there is that of either side.
     Robots with mimic joints: ``G^T D_full G`` (chain rule, see :mod:`armdyn.mimic`); no f_ext.
+    A floating base (module doc): q (nq,), qd, qdd (nv,) (or with a leading N); every
+    result (nv, nv), ``dtau_dq`` on the tangent space; no f_ext (NotImplementedError).
 
     out: optionally, the three arrays to write the results into and return (float64,
     C-contiguous, the results' shapes, sharing no memory with the inputs): a loop over
@@ -821,7 +825,8 @@ def require_fixed_base(robot, what: str) -> None:
         if isinstance(robot, Robot):
             robot.require_fixed_base(what)
         raise FloatingBaseError(
-            f"{what} does not support a floating base (root_joint='free-flyer') yet; rnea, crba and aba do",
+            f"{what} does not support a floating base (root_joint='free-flyer') yet; rnea, crba, aba and "
+            "rnea_derivatives, aba_derivatives, minverse do",
             f"robot '{robot.name}'",
         )
 
@@ -846,9 +851,6 @@ for _name in (
     "potential_energy",
     "forward_kinematics",
     "jacobian",
-    "rnea_derivatives",
-    "aba_derivatives",
-    "minverse",
     "gravity_derivatives",
     "jacobian_dot",
     "regressor",

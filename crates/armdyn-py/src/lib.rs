@@ -25,6 +25,7 @@ use std::sync::Mutex;
 
 mod derivatives;
 mod floating;
+mod floating_derivatives;
 mod simulate;
 
 /// Run `f`, turning a Rust panic into a Python `RuntimeError`.
