@@ -570,7 +570,7 @@ def aba_derivatives(
     q, qd, tau: (n,) or (N, n). Returns ``(dqdd_dq, dqdd_dqd, Minv)``, each (n, n) or
     (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
     f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
-    joints as there (``Minv`` is that of ``M + diag(Ia)``). out: as there.
+    joints as there (``Minv`` is that of ``M + diag(Ia)``). out: as there. A floating base: as there.
     """
     if threads is not None:  # the common call (None) skips the check's frame
         threads = check_threads(threads)  # Rust reads True as 1
@@ -588,7 +588,8 @@ def minverse(robot: RobotLike, q: ArrayLike, threads: int | None = None, out=Non
     or (N, n, n). M includes the rotor inertias, ``diag(Ia)``, as :func:`crba`. Robots
     with mimic joints: ``(G^T M_full G)^-1`` by Cholesky (ValueError when M is not
     positive definite). out: optionally, the array to write M^-1 into and return (float64,
-    C-contiguous, the result's shape, not sharing memory with q).
+    C-contiguous, the result's shape, not sharing memory with q). A floating base: q (nq,), M^-1
+    (nv, nv), from the CRBA and M's sparse factors.
     """
     if threads is not None:  # the common call (None) skips the check's frame
         threads = check_threads(threads)  # Rust reads True as 1
