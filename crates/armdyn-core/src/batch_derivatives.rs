@@ -1,7 +1,8 @@
 //! Batches of the derivative algorithms, M^-1 and the external-force variants: row `k`
 //! of each `(N, nv)` input is one state; each output is its own array with `N` rows
 //! (`(N, nv, nv)` matrices, `(N, nv)` vectors, `(N, 6, nv)` Jacobians). External
-//! wrenches are `(N, nlinks, 6)`.
+//! wrenches are `(N, nlinks, 6)`. A floating base's rows are wider (`algo::floating`):
+//! `q` `(N, 7 + nv)`, velocities `(N, 6 + nv)`, matrices `(N, 6 + nv, 6 + nv)`.
 //!
 //! As in `batch.rs`: rayon over chunks of rows, one workspace per chunk (never per
 //! state), and inside a chunk groups of 4 or 8 states in SIMD lanes (the algorithms are
