@@ -9,8 +9,9 @@ is the derivative along ``configuration.integrate(q, dq)`` at dq = 0 (every matr
 * against central finite differences of armdyn.rnea and armdyn.aba along
   configuration.integrate (and along v), on those robots with their joint friction and
   on random floating trees; dtau/da is crba, dqdd/dtau = M^-1 = inv(crba);
-* batches (SIMD lanes, leftover rows, threads, out=) equal single calls bit for bit;
-  external wrenches and bad quaternions are refused.
+* wrenches in the link frames (f_ext) against Pinocchio's fext; those fixed in space and
+  bad quaternions are refused; batches (SIMD lanes, leftover rows, threads, out=) equal
+  single calls bit for bit.
 """
 
 from __future__ import annotations
@@ -204,13 +205,51 @@ def test_out_arrays_and_compiled_models():
         numeric.aba_derivatives(robot, q, v, a, out=tuple(np.empty((robot.dof, robot.dof)) for _ in range(3)))
 
 
-def test_external_wrenches_are_refused():
+def pin_wrenches(model, robot, W):
+    """armdyn's (nlinks, 6) link-frame wrenches as Pinocchio's per-joint forces: each moved
+    from its link's frame to its joint's by the frame placement (the free flyer, joint 1,
+    takes the base link's and those welded to it)."""
+    fext = [pin.Force.Zero() for _ in range(model.njoints)]
+    for k, link in enumerate(robot.links):
+        frame = model.frames[model.getFrameId(link)]
+        fext[frame.parentJoint] = fext[frame.parentJoint] + frame.placement.act(pin.Force(W[k, :3], W[k, 3:]))
+    return fext
+
+
+@needs_pinocchio
+@pytest.mark.parametrize("name", MUST_LOAD)
+def test_link_frame_wrenches_agree_with_pinocchio(name):
+    """f_ext in the link frames (Pinocchio's fext): tau = rnea - sum J^T w; batches too."""
+    robot, model = _load_pair(name)
+    data = model.createData()
+    rng = np.random.default_rng(21)
+    states = [floating_state(robot, rng) for _ in range(5)]
+    W = rng.uniform(-20, 20, (5, len(robot.links), 6))
+    for k, (q, v, a) in enumerate(states):
+        fext = pin_wrenches(model, robot, W[k])
+        dq, dv, M = numeric.rnea_derivatives(robot, q, v, a, W[k])
+        pdq, pdv, pda = pin.computeRNEADerivatives(model, data, q, v, a, fext)
+        assert close(dq, pdq) < TOL and close(dv, pdv) < TOL and close(M, sym(pda)) < TOL
+        Adq, Adv, Minv = numeric.aba_derivatives(robot, q, v, a, W[k])
+        qdq, qdv, qmi = pin.computeABADerivatives(model, data, q, v, a, fext)
+        tol = TOL * max(1.0, np.linalg.cond(M) / 1e6)
+        assert close(Adq, qdq) < tol and close(Adv, qdv) < tol and close(Minv, sym(qmi)) < tol
+    Q, V, A = (np.array([s[j] for s in states]) for j in range(3))
+    batch = numeric.aba_derivatives(robot, Q, V, A, W, threads=2)
+    for k in range(5):
+        single = numeric.aba_derivatives(robot, Q[k], V[k], A[k], W[k])
+        assert all(np.array_equal(b[k], x) for b, x in zip(batch, single))
+
+
+def test_wrenches_fixed_in_space_are_refused():
     robot, _, rng = floating_tree(8)
     q, v, a = floating_state(robot, rng)
     f_ext = np.zeros((len(robot.links), 6))
     for call in (numeric.rnea_derivatives, numeric.aba_derivatives):
-        with pytest.raises(NotImplementedError, match="floating base"):
-            call(robot, q, v, a, f_ext)
+        with pytest.raises(NotImplementedError, match="frame='local'"):
+            call(robot, q, v, a, f_ext, "world")
+        with pytest.raises(ValueError, match="f_ext"):
+            call(robot, q, v, a, f_ext[1:])
 
 
 def test_bad_states_are_refused():

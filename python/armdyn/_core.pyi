@@ -33,7 +33,8 @@ class NumericModel:
 # array as (n,) or (N, n) and returns (n, n) or (N, n, n) matrices; a floating base
 # (``model.floating``) takes q in the configuration space, (nq,) = (7 + n,), qd and the
 # third array in the velocity space, (nv,) = (6 + n,), or (N, nq) and (N, nv), and returns
-# (nv, nv) or (N, nv, nv) matrices, d/dq on the tangent space (along integrate(q, dq)).
+# (nv, nv) or (N, nv, nv) matrices, d/dq on the tangent space (along integrate(q, dq)),
+# and takes f_ext (nlinks, 6) (or (N, nlinks, 6)) in the link frames only (frame="local").
 # ``model`` must be a NumericModel: anything else is a TypeError (armdyn.numeric relies on it).
 
 def rnea_derivatives(

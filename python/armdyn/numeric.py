@@ -538,7 +538,8 @@ def rnea_derivatives(
     (``sign(0) = 0``) and has no derivative; the value given there is that of either side.
     Robots with mimic joints: ``G^T D_full G`` (chain rule, see :mod:`armdyn.mimic`); no f_ext.
     A floating base (module doc): q (nq,), qd, qdd (nv,) (or with a leading N); every
-    result (nv, nv), ``dtau_dq`` on the tangent space; no f_ext (NotImplementedError).
+    result (nv, nv), ``dtau_dq`` on the tangent space; f_ext in the link frames only (the
+    base link's row acts on the base; ``frame="world"`` is a NotImplementedError).
 
     out: optionally, the three arrays to write the results into and return (float64,
     C-contiguous, the results' shapes, sharing no memory with the inputs): a loop over

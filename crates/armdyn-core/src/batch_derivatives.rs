@@ -389,12 +389,12 @@ kernel!(AbaExt, nargs = 3, nout = 1, out_len = |m| m.nv, |m, d, dd, a, e, [o0, _
 });
 
 kernel!(RneaDerivativesFloating, nargs = 3, nout = 3, out_len = |m| (m.nv + 6) * (m.nv + 6),
-    widths = |m| [m.nv + 7, m.nv + 6, m.nv + 6], |m, d, dd, a, _, [o0, o1, o2]| {
-    algo::rnea_derivatives_floating(m, d, dd, a[0], a[1], a[2], o0, o1, o2)
+    widths = |m| [m.nv + 7, m.nv + 6, m.nv + 6], |m, d, dd, a, e, [o0, o1, o2]| {
+    algo::rnea_derivatives_floating(m, d, dd, a[0], a[1], a[2], e, o0, o1, o2)
 });
 kernel!(AbaDerivativesFloating, nargs = 3, nout = 3, out_len = |m| (m.nv + 6) * (m.nv + 6),
-    widths = |m| [m.nv + 7, m.nv + 6, m.nv + 6], |m, d, dd, a, _, [o0, o1, o2]| {
-    algo::aba_derivatives_floating(m, d, dd, a[0], a[1], a[2], o0, o1, o2)
+    widths = |m| [m.nv + 7, m.nv + 6, m.nv + 6], |m, d, dd, a, e, [o0, o1, o2]| {
+    algo::aba_derivatives_floating(m, d, dd, a[0], a[1], a[2], e, o0, o1, o2)
 });
 kernel!(MinverseFloating, nargs = 1, nout = 1, out_len = |m| (m.nv + 6) * (m.nv + 6),
     widths = |m| [m.nv + 7, 0, 0], |m, d, dd, a, _, [o0, _, _]| {
@@ -447,15 +447,28 @@ pub fn jacobian_dot(model: &Model, q: &[f64], qd: &[f64], link: usize, out: &mut
 }
 
 /// Batched [`algo::rnea_derivatives_floating`] (a floating base, `algo::floating`):
-/// `args = [q (N, 7 + nv), v, a (N, 6 + nv)]`; `outs = [dtau_dq, dtau_dv, M]` (N, 6 + nv, 6 + nv) each.
-pub fn rnea_derivatives_floating(model: &Model, args: [&[f64]; 3], outs: [&mut [f64]; 3], threads: Option<usize>) {
-    drive(&RneaDerivativesFloating, model, &args, None, outs, threads)
+/// `args = [q (N, 7 + nv), v, a (N, 6 + nv)]`; `ext` as for `rnea_derivatives` (link
+/// frames only); `outs = [dtau_dq, dtau_dv, M]` (N, 6 + nv, 6 + nv) each.
+pub fn rnea_derivatives_floating(
+    model: &Model,
+    args: [&[f64]; 3],
+    ext: Option<(&[f64], ForceFrame)>,
+    outs: [&mut [f64]; 3],
+    threads: Option<usize>,
+) {
+    drive(&RneaDerivativesFloating, model, &args, ext, outs, threads)
 }
 
 /// Batched [`algo::aba_derivatives_floating`]: `args = [q (N, 7 + nv), v, tau (N, 6 + nv)]`;
-/// `outs = [da_dq, da_dv, Minv]` (N, 6 + nv, 6 + nv) each.
-pub fn aba_derivatives_floating(model: &Model, args: [&[f64]; 3], outs: [&mut [f64]; 3], threads: Option<usize>) {
-    drive(&AbaDerivativesFloating, model, &args, None, outs, threads)
+/// `ext` as for `rnea_derivatives_floating`; `outs = [da_dq, da_dv, Minv]` (N, 6 + nv, 6 + nv) each.
+pub fn aba_derivatives_floating(
+    model: &Model,
+    args: [&[f64]; 3],
+    ext: Option<(&[f64], ForceFrame)>,
+    outs: [&mut [f64]; 3],
+    threads: Option<usize>,
+) {
+    drive(&AbaDerivativesFloating, model, &args, ext, outs, threads)
 }
 
 /// Batched [`algo::minverse_floating`]: `q` (N, 7 + nv), `out` = M^-1 (N, 6 + nv, 6 + nv).

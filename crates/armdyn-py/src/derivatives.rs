@@ -21,7 +21,7 @@ fn parse_frame(frame: &str) -> PyResult<ForceFrame> {
 
 /// `f_ext` converted and checked against the states' shape: (nlinks, 6) for one state,
 /// (N, nlinks, 6) for N states, finite.
-fn check_f_ext<'py>(m: &NumericModel, obj: &Bound<'py, PyAny>, shape: Shape) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+pub(crate) fn check_f_ext<'py>(m: &NumericModel, obj: &Bound<'py, PyAny>, shape: Shape) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let a = as_f64(obj, "f_ext")?;
     let nl = m.model.nlinks();
     let ok = match (shape, a.shape()) {
@@ -266,7 +266,7 @@ macro_rules! derivatives_entry {
         ) -> PyResult<Bound<'py, PyTuple>> {
             let m = model.get();
             if m.floating {
-                return $floating(m, py, q, qd, $third, f_ext, threads, out);
+                return $floating(m, py, q, qd, $third, f_ext, frame, threads, out);
             }
             let n = m.model.nv;
             let o = run(

@@ -5,35 +5,48 @@
 //! output is `(6 + n, 6 + n)` (or `(N, 6 + n, 6 + n)`), in the order of `v`; `d/dq` is
 //! on the tangent space (Pinocchio's). `out=` as for a fixed base. A batch runs in the
 //! lane kernels of `batch_derivatives` (`threads` threads, the GIL released; bit for bit
-//! the single calls). External wrenches are refused.
+//! the single calls). External wrenches: in the link frames only (`frame="local"`).
 
-use crate::derivatives::outputs_given;
+use crate::derivatives::{check_f_ext, outputs_given};
 use crate::{all_finite, guard, new_array, slice, thread_arg, NumericModel, Scratch, Shape};
 use armdyn_core::algo::floating::{NQ_BASE, NV_BASE};
+use armdyn_core::algo::{ExternalForces, ForceFrame};
 use armdyn_core::{algo, batch_derivatives as bd, Model};
 use numpy::{PyArrayDyn, PyArrayMethods};
 use pyo3::exceptions::{PyNotImplementedError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
-/// Check the states (`floating_states`), then run `single` on the model's workspace or
-/// `batched` with the GIL released, into `R` (6 + n)^2 outputs per state: fresh arrays
-/// or the caller's `out`. A result that is not finite (a singular M) is an error naming
-/// `what`.
+/// External wrenches in the link frames, `(nlinks, 6)` per state, or none.
+type Ext<'a> = Option<&'a [f64]>;
+
+/// Check the states (`floating_states`) and `f_ext` (link frames only), then run
+/// `single` on the model's workspace or `batched` with the GIL released, into `R`
+/// (6 + n)^2 outputs per state: fresh arrays or the caller's `out`. A result that is not
+/// finite (a singular M) is an error naming `what`.
 #[allow(clippy::too_many_arguments)]
 fn run<'py, const K: usize, const R: usize>(
     m: &NumericModel,
     py: Python<'py>,
     what: &str,
     args: [(&str, &Bound<'py, PyAny>, usize); K],
+    f_ext: Option<&Bound<'py, PyAny>>,
+    frame: &str,
     threads: Option<i64>,
     out: Option<&Bound<'py, PyAny>>,
-    single: impl FnOnce(&Model, &mut Scratch, [&[f64]; K], [&mut [f64]; R]),
-    batched: impl FnOnce(&Model, [&[f64]; K], [&mut [f64]; R], Option<usize>) + Send,
+    single: impl FnOnce(&Model, &mut Scratch, [&[f64]; K], Ext<'_>, [&mut [f64]; R]),
+    batched: impl FnOnce(&Model, [&[f64]; K], Ext<'_>, [&mut [f64]; R], Option<usize>) + Send,
 ) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; R]> {
     guard(|| {
         let threads = thread_arg(threads)?;
+        if f_ext.is_some() && frame != "local" {
+            return Err(PyNotImplementedError::new_err(format!(
+                "{what}: f_ext with frame='{frame}' is not available for a floating base (root_joint='free-flyer'); \
+                 give the wrenches in the link frames (frame='local')"
+            )));
+        }
         let (shape, arrays) = m.floating_states(args)?;
+        let ext_arr = f_ext.map(|f| check_f_ext(m, f, shape)).transpose()?;
         let s = m.model.nv + NV_BASE;
         let dims: Vec<usize> = match shape {
             Shape::Single => vec![s, s],
@@ -42,8 +55,11 @@ fn run<'py, const K: usize, const R: usize>(
         let outs: [Bound<'py, PyArrayDyn<f64>>; R] = match out {
             None => std::array::from_fn(|_| new_array(py, &dims)),
             Some(o) => {
-                let inputs: Vec<(&str, &Bound<'py, PyArrayDyn<f64>>)> =
+                let mut inputs: Vec<(&str, &Bound<'py, PyArrayDyn<f64>>)> =
                     args.iter().map(|(name, _, _)| *name).zip(arrays.iter()).collect();
+                if let Some(e) = ext_arr.as_ref() {
+                    inputs.push(("f_ext", e));
+                }
                 outputs_given(o, &dims, &inputs)?
             }
         };
@@ -57,13 +73,16 @@ fn run<'py, const K: usize, const R: usize>(
             Shape::Single => {
                 // SAFETY: inputs read-only, GIL held throughout.
                 let ins: [&[f64]; K] = std::array::from_fn(|k| unsafe { slice(&arrays[k]) });
-                m.with_scratch(|sc| single(&m.model, sc, ins, os));
+                let ext = ext_arr.as_ref().map(|a| unsafe { slice(a) });
+                m.with_scratch(|sc| single(&m.model, sc, ins, ext, os));
             }
             Shape::Batch(_) => {
                 let readonly: Vec<_> = arrays.iter().map(|a| a.readonly()).collect();
                 let ins: [&[f64]; K] = std::array::from_fn(|k| readonly[k].as_slice().expect("contiguous"));
+                let ext_ro = ext_arr.as_ref().map(|a| a.readonly());
+                let ext = ext_ro.as_ref().map(|a| a.as_slice().expect("contiguous"));
                 let model = &m.model;
-                py.detach(|| batched(model, ins, os, threads));
+                py.detach(|| batched(model, ins, ext, os, threads));
             }
         }
         // SAFETY: the outputs are ours (or the caller's, checked above), GIL held.
@@ -78,14 +97,9 @@ fn run<'py, const K: usize, const R: usize>(
     })
 }
 
-/// Refuse external wrenches on a floating base.
-fn no_wrenches(what: &str, f_ext: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
-    match f_ext {
-        Some(_) => Err(PyNotImplementedError::new_err(format!(
-            "{what} with f_ext is not available for a floating base (root_joint='free-flyer') yet"
-        ))),
-        None => Ok(()),
-    }
+/// The core's wrenches in the link frames.
+fn local(e: Ext<'_>) -> Option<ExternalForces<'_, f64>> {
+    e.map(|wrenches| ExternalForces { wrenches, frame: ForceFrame::Local })
 }
 
 /// ``(dtau_dq, dtau_dv, M)`` of a floating-base model from q (7 + n), v, a (6 + n).
@@ -97,23 +111,25 @@ pub(crate) fn rnea_derivatives<'py>(
     v: &Bound<'py, PyAny>,
     a: &Bound<'py, PyAny>,
     f_ext: Option<&Bound<'py, PyAny>>,
+    frame: &str,
     threads: Option<i64>,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    no_wrenches("rnea_derivatives", f_ext)?;
     let (nq, nv) = (m.model.nv + NQ_BASE, m.model.nv + NV_BASE);
     let o = run(
         m,
         py,
         "rnea_derivatives",
         [("q", q, nq), ("qd", v, nv), ("qdd", a, nv)],
+        f_ext,
+        frame,
         threads,
         out,
-        |md, sc, [q, v, a], [o0, o1, o2]| {
+        |md, sc, [q, v, a], e, [o0, o1, o2]| {
             let (data, deriv) = sc.deriv(md);
-            algo::rnea_derivatives_floating(md, data, deriv, q, v, a, o0, o1, o2)
+            algo::rnea_derivatives_floating(md, data, deriv, q, v, a, local(e).as_ref(), o0, o1, o2)
         },
-        bd::rnea_derivatives_floating,
+        |md, args, e, outs, t| bd::rnea_derivatives_floating(md, args, e.map(|w| (w, ForceFrame::Local)), outs, t),
     )?;
     PyTuple::new(py, o)
 }
@@ -127,23 +143,25 @@ pub(crate) fn aba_derivatives<'py>(
     v: &Bound<'py, PyAny>,
     tau: &Bound<'py, PyAny>,
     f_ext: Option<&Bound<'py, PyAny>>,
+    frame: &str,
     threads: Option<i64>,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    no_wrenches("aba_derivatives", f_ext)?;
     let (nq, nv) = (m.model.nv + NQ_BASE, m.model.nv + NV_BASE);
     let o = run(
         m,
         py,
         "aba_derivatives",
         [("q", q, nq), ("qd", v, nv), ("tau", tau, nv)],
+        f_ext,
+        frame,
         threads,
         out,
-        |md, sc, [q, v, tau], [o0, o1, o2]| {
+        |md, sc, [q, v, tau], e, [o0, o1, o2]| {
             let (data, deriv) = sc.deriv(md);
-            algo::aba_derivatives_floating(md, data, deriv, q, v, tau, o0, o1, o2)
+            algo::aba_derivatives_floating(md, data, deriv, q, v, tau, local(e).as_ref(), o0, o1, o2)
         },
-        bd::aba_derivatives_floating,
+        |md, args, e, outs, t| bd::aba_derivatives_floating(md, args, e.map(|w| (w, ForceFrame::Local)), outs, t),
     )?;
     PyTuple::new(py, o)
 }
@@ -162,13 +180,15 @@ pub(crate) fn minverse<'py>(
         py,
         "minverse",
         [("q", q, nq)],
+        None,
+        "local",
         threads,
         out,
-        |md, sc, [q], [o]| {
+        |md, sc, [q], _, [o]| {
             let (data, deriv) = sc.deriv(md);
             algo::minverse_floating(md, data, deriv, q, o)
         },
-        |md, [q], [o], t| bd::minverse_floating(md, q, o, t),
+        |md, [q], _, [o], t| bd::minverse_floating(md, q, o, t),
     )?;
     Ok(o)
 }

@@ -32,7 +32,12 @@
 //! at `qdd = aba(q, v, tau)`; M^-1 here from M's sparse `L^T D L` factors (RBDA 6.5, the
 //! tree's sparsity, the base's six velocities a chain above the root joints), which
 //! also solve for the two products row by row instead of forming them.
+//!
+//! External wrenches: in the link frames only (they move with their links; wrenches
+//! fixed in space would need their own terms, as `ForceFrame::World` has for a fixed
+//! base, and a world frame that is not the base's).
 
+use crate::algo::external::{generalized_forces, local_in_body, ExternalForces, ForceFrame};
 use crate::algo::floating::{
     aba_floating, base_motion, crba_floating, gravity_acceleration, put_base_block, NQ_BASE, NV_BASE,
 };
@@ -50,6 +55,12 @@ use crate::spatial::{Force, Motion, RigidInertia, V3};
 /// space, see the module), `dtau_dv` and `m` = `dtau/da` = M(q), each (6 + nv)^2
 /// row-major, `[i * (6 + nv) + j] = d tau_i / d x_j`. Joint friction and rotor inertia
 /// as for a fixed base. Uses `data.xup`, `data.x0`.
+///
+/// `ext`: external wrenches given in the link frames ([`ForceFrame::Local`]; Pinocchio's
+/// `fext`), then `tau = rnea_floating(q, v, a) - sum_L J_L^T w_L`. They move with their
+/// links like the bodies' inertial forces, so they enter through the bodies' bias forces
+/// alone (`velocity_pass_on`); those on links welded to the base only shift the base's
+/// wrench by a constant of the base frame, which has no derivative.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn rnea_derivatives_floating<T: Real>(
@@ -59,6 +70,7 @@ pub fn rnea_derivatives_floating<T: Real>(
     q: &[T],
     v: &[T],
     a: &[T],
+    ext: Option<&ExternalForces<T>>,
     dtau_dq: &mut [T],
     dtau_dv: &mut [T],
     m: &mut [T],
@@ -66,15 +78,16 @@ pub fn rnea_derivatives_floating<T: Real>(
     let (n, s) = (model.nv, model.nv + NV_BASE);
     assert!(q.len() == n + NQ_BASE && v.len() == s && a.len() == s, "state length");
     assert!(dtau_dq.len() == s * s && dtau_dv.len() == s * s && m.len() == s * s, "output size");
+    assert!(ext.is_none_or(|e| e.frame == ForceFrame::Local), "floating base: wrenches in link frames only");
     let g = gravity_acceleration(model, q);
     let vb = base_motion(&v[..NV_BASE]);
     let ab = base_motion(&a[..NV_BASE]) + g;
     let (qj, vj, aj) = (&q[NQ_BASE..], &v[NV_BASE..], &a[NV_BASE..]);
-    velocity_pass_on(model, data, dd, qj, vj, None, Some(vb));
+    velocity_pass_on(model, data, dd, qj, vj, ext, Some(vb));
     acceleration_pass_on(model, dd, vj, aj, Some((vb, ab)));
-    subtree_sums(model, dd, None);
+    subtree_sums(model, dd, ext);
     let at = Placement { stride: s, base: Some((g.v, vb)) };
-    derivative_terms_in(model, dd, None, dtau_dq, dtau_dv, Some(&mut *m), at);
+    derivative_terms_in(model, dd, ext, dtau_dq, dtau_dv, Some(&mut *m), at);
     base_block(model, dd, &vb, g.v, dtau_dq, dtau_dv, m);
 }
 
@@ -130,6 +143,9 @@ fn base_block<T: Real>(
 /// each (6 + nv)^2 row-major, `[i * (6 + nv) + j] = d a_i / d x_j`: `aba_floating`, then
 /// [`rnea_derivatives_floating`] at its acceleration, then `-M^-1` of its results from
 /// M's sparse factors (module docs). Uses `dd.qdd_floating` and `dd.factor`.
+///
+/// `ext`: wrenches in the link frames, as for [`rnea_derivatives_floating`]; then
+/// `a = aba_floating(q, v, tau + sum_L J_L^T w_L)` ([`generalized_forces_floating`]).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn aba_derivatives_floating<T: Real>(
@@ -139,6 +155,7 @@ pub fn aba_derivatives_floating<T: Real>(
     q: &[T],
     v: &[T],
     tau: &[T],
+    ext: Option<&ExternalForces<T>>,
     da_dq: &mut [T],
     da_dv: &mut [T],
     minv: &mut [T],
@@ -146,14 +163,50 @@ pub fn aba_derivatives_floating<T: Real>(
     let s = model.nv + NV_BASE;
     assert!(tau.len() == s && minv.len() == s * s, "state length");
     let (mut qdd, mut h) = (std::mem::take(&mut dd.qdd_floating), std::mem::take(&mut dd.factor));
-    aba_floating(model, data, q, v, tau, &mut qdd);
-    rnea_derivatives_floating(model, data, dd, q, v, &qdd, da_dq, da_dv, &mut h);
+    match ext {
+        Some(e) => {
+            // tau + tau_ext, in the factors' buffer until M overwrites it
+            let total = &mut h[..s];
+            generalized_forces_floating(model, data, dd, q, e, total);
+            total.iter_mut().zip(tau).for_each(|(t, u)| *t += *u);
+            aba_floating(model, data, q, v, &h[..s], &mut qdd);
+        }
+        None => aba_floating(model, data, q, v, tau, &mut qdd),
+    }
+    rnea_derivatives_floating(model, data, dd, q, v, &qdd, ext, da_dq, da_dv, &mut h);
     factorize(model, &mut h);
     identity(minv, s);
     let (one, minus) = (T::splat(1.0), T::splat(-1.0));
     solve(model, &h, [minv, da_dq, da_dv], [one, minus, minus]);
     dd.qdd_floating = qdd;
     dd.factor = h;
+}
+
+/// `tau_ext = sum_L J_L^T w_L` (6 + nv) of wrenches given in the link frames on a
+/// floating base: the joints' part by the fixed-base backward pass
+/// ([`generalized_forces`], which leaves the root bodies' subtree forces in `dd.f`), the
+/// base's the wrench those exert on it plus the wrenches on links welded to it, in the
+/// base frame, force then moment. `q`: (7 + nv).
+pub fn generalized_forces_floating<T: Real>(
+    model: &Model,
+    data: &mut Data<T>,
+    dd: &mut DerivData<T>,
+    q: &[T],
+    ext: &ExternalForces<T>,
+    tau_ext: &mut [T],
+) {
+    assert!(ext.frame == ForceFrame::Local, "floating base: wrenches in link frames only");
+    let (head, tail) = tau_ext.split_at_mut(NV_BASE);
+    generalized_forces(model, data, dd, &q[NQ_BASE..], ext, tail);
+    let mut fb = Force::zero();
+    for i in (0..model.nv).filter(|&i| model.parent[i].is_none()) {
+        fb += data.xup[i].tr_apply_force(&dd.f[i]);
+    }
+    for k in (0..model.nlinks()).filter(|&k| model.links[k].body.is_none()) {
+        fb += local_in_body(model, k, &ext.raw(k));
+    }
+    head[..3].copy_from_slice(&fb.f.to_array());
+    head[3..].copy_from_slice(&fb.n.to_array());
 }
 
 /// M(q)^-1 of the floating-base tree, (6 + nv)^2 row-major, from `crba_floating` and

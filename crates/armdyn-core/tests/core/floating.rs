@@ -149,15 +149,15 @@ fn floating_derivatives_identities_and_batches() {
     let mut batch: Vec<Vec<f64>> = vec![vec![0.0; rows * s * s]; 7];
     {
         let [b0, b1, b2, b3, b4, b5, b6] = &mut batch[..] else { unreachable!() };
-        bd::rnea_derivatives_floating(&model, [&q, &v, &a], [b0, b1, b2], Some(2));
-        bd::aba_derivatives_floating(&model, [&q, &v, &a], [b3, b4, b5], Some(2));
+        bd::rnea_derivatives_floating(&model, [&q, &v, &a], None, [b0, b1, b2], Some(2));
+        bd::aba_derivatives_floating(&model, [&q, &v, &a], None, [b3, b4, b5], Some(2));
         bd::minverse_floating(&model, &q, b6, Some(2));
     }
     for (r, (qs, vs, as_)) in states.iter().enumerate() {
         {
             let [o0, o1, o2, o3, o4, o5, o6] = &mut single[..] else { unreachable!() };
-            algo::rnea_derivatives_floating(&model, &mut data, &mut dd, qs, vs, as_, o0, o1, o2);
-            algo::aba_derivatives_floating(&model, &mut data, &mut dd, qs, vs, as_, o3, o4, o5);
+            algo::rnea_derivatives_floating(&model, &mut data, &mut dd, qs, vs, as_, None, o0, o1, o2);
+            algo::aba_derivatives_floating(&model, &mut data, &mut dd, qs, vs, as_, None, o3, o4, o5);
             algo::minverse_floating(&model, &mut data, &mut dd, qs, o6);
         }
         for (k, (b, x)) in batch.iter().zip(&single).enumerate() {
