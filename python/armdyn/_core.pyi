@@ -35,4 +35,41 @@ def centroidal_map(model: NumericModel, q: Any, threads: int | None = None) -> A
 def centroidal_momentum(model: NumericModel, q: Any, v: Any, threads: int | None = None) -> Any: ...
 def centroidal_momentum_rate(model: NumericModel, q: Any, v: Any, a: Any, threads: int | None = None) -> Any: ...
 def centroidal_map_rate(model: NumericModel, q: Any, v: Any, threads: int | None = None) -> Any: ...
+
+# The derivative entries (crates/armdyn-py/src/derivatives.rs; a floating model's in
+# floating_derivatives.rs). With ``n = model.dof``: a fixed base takes q, qd and the third
+# array as (n,) or (N, n) and returns (n, n) or (N, n, n) matrices; a floating base
+# (``model.floating``) takes q in the configuration space, (nq,) = (7 + n,), qd and the
+# third array in the velocity space, (nv,) = (6 + n,), or (N, nq) and (N, nv), and returns
+# (nv, nv) or (N, nv, nv) matrices, d/dq on the tangent space (along integrate(q, dq)),
+# and takes f_ext (nlinks, 6) (or (N, nlinks, 6)) in the link frames only (frame="local").
+# ``model`` must be a NumericModel: anything else is a TypeError (armdyn.numeric relies on it).
+
+def rnea_derivatives(
+    model: Any,
+    q: Any,
+    qd: Any,
+    qdd: Any,
+    f_ext: Any = None,
+    frame: str = "local",
+    threads: int | None = None,
+    out: Any = None,
+) -> tuple[Any, Any, Any]:
+    """``(dtau_dq, dtau_dqd, M)`` (see above; armdyn.numeric.rnea_derivatives)."""
+
+def aba_derivatives(
+    model: Any,
+    q: Any,
+    qd: Any,
+    tau: Any,
+    f_ext: Any = None,
+    frame: str = "local",
+    threads: int | None = None,
+    out: Any = None,
+) -> tuple[Any, Any, Any]:
+    """``(dqdd_dq, dqdd_dqd, Minv)`` (see above; armdyn.numeric.aba_derivatives)."""
+
+def minverse(model: Any, q: Any, threads: int | None = None, out: Any = None) -> Any:
+    """M^-1, (n, n) or, floating, (nv, nv), with a leading N for a batch."""
+
 def __getattr__(name: str) -> Any: ...

@@ -1,7 +1,8 @@
 //! Batches of the derivative algorithms, M^-1 and the external-force variants: row `k`
 //! of each `(N, nv)` input is one state; each output is its own array with `N` rows
 //! (`(N, nv, nv)` matrices, `(N, nv)` vectors, `(N, 6, nv)` Jacobians). External
-//! wrenches are `(N, nlinks, 6)`.
+//! wrenches are `(N, nlinks, 6)`. A floating base's rows are wider (`algo::floating`):
+//! `q` `(N, 7 + nv)`, velocities `(N, 6 + nv)`, matrices `(N, 6 + nv, 6 + nv)`.
 //!
 //! As in `batch.rs`: rayon over chunks of rows, one workspace per chunk (never per
 //! state), and inside a chunk groups of 4 or 8 states in SIMD lanes (the algorithms are
@@ -23,6 +24,10 @@ trait Kernel: Sync {
     /// Number of outputs and their sizes per state.
     const NOUT: usize;
     fn out_len(model: &Model) -> usize;
+    /// Values per state of each argument: `nv`, or a floating base's `7 + nv`, `6 + nv`.
+    fn widths(model: &Model) -> [usize; 3] {
+        [model.nv; 3]
+    }
     #[allow(clippy::too_many_arguments)]
     fn run<T: Real>(
         &self,
@@ -60,13 +65,12 @@ struct Work<L> {
 }
 
 impl<L: Real> Work<L> {
-    fn new(model: &Model, out_len: usize) -> Self {
-        let n = model.nv;
+    fn new(model: &Model, out_len: usize, widths: [usize; 3]) -> Self {
         Work {
             one: One::new(model, out_len),
             dl: Data::new(model),
             ddl: DerivData::new(model),
-            args: std::array::from_fn(|_| vec![L::zero(); n]),
+            args: std::array::from_fn(|k| vec![L::zero(); widths[k]]),
             ext: vec![L::zero(); 6 * model.nlinks()],
             res: std::array::from_fn(|_| vec![L::zero(); out_len]),
         }
@@ -199,14 +203,14 @@ fn rows<L: Real, K: Kernel>(
     first: usize,
     mut outs: [&mut [f64]; 3],
 ) {
-    let n = model.nv;
+    let widths = K::widths(model);
     let per = K::out_len(model);
     let ne = 6 * model.nlinks();
     let rows = if per == 0 { 0 } else { outs[0].len() / per };
     let mut r = 0;
     while r + L::LANES <= rows {
         let group = first + r..first + r + L::LANES;
-        for (slot, arg) in w.args.iter_mut().zip(args).take(K::NARGS) {
+        for ((slot, arg), n) in w.args.iter_mut().zip(args).zip(widths).take(K::NARGS) {
             rows_to_lanes(&arg[group.start * n..group.end * n], slot, n);
         }
         if let Some((e, _)) = ext {
@@ -242,12 +246,15 @@ fn one_by_one<K: Kernel>(
     from: usize,
     mut outs: [&mut [f64]; 3],
 ) {
-    let n = model.nv;
+    let widths = K::widths(model);
     let per = K::out_len(model);
     let ne = 6 * model.nlinks();
     let rows = if per == 0 { 0 } else { outs[0].len() / per };
     for r in from..rows {
-        let a = args.map(|a| if a.is_empty() { a } else { &a[(first + r) * n..(first + r + 1) * n] });
+        let a: [&[f64]; 3] = std::array::from_fn(|j| {
+            let (a, n) = (args[j], widths[j]);
+            if a.is_empty() { a } else { &a[(first + r) * n..(first + r + 1) * n] }
+        });
         let e = ext.map(|(e, frame)| ExternalForces { wrenches: &e[(first + r) * ne..(first + r + 1) * ne], frame });
         let [r0, r1, r2] = &mut w.res;
         k.run(model, &mut w.d, &mut w.dd, a, e.as_ref(), [r0, r1, r2]);
@@ -295,9 +302,9 @@ fn drive<K: Kernel>(
     threads: Option<usize>,
 ) {
     assert_eq!(args.len(), K::NARGS, "argument count");
-    let (n, per) = (model.nv, K::out_len(model));
+    let (widths, per) = (K::widths(model), K::out_len(model));
     let nrows = if per == 0 { 0 } else { outs[0].len() / per };
-    for a in args {
+    for (a, n) in args.iter().zip(widths) {
         assert_eq!(a.len(), nrows * n, "argument size");
     }
     if let Some((e, _)) = ext {
@@ -309,12 +316,12 @@ fn drive<K: Kernel>(
     let per_row: [usize; 3] = std::array::from_fn(|j| if j < K::NOUT { per } else { 0 });
     match kernels() {
         #[cfg(target_arch = "x86_64")]
-        Kernels::Avx512 => par_rows(nrows, outs, per_row, threads, || Work::<F64x8>::new(model, per), |w, first, o| {
+        Kernels::Avx512 => par_rows(nrows, outs, per_row, threads, || Work::<F64x8>::new(model, per, widths), |w, first, o| {
             // SAFETY: the CPU supports AVX-512F (checked by `kernels`).
             unsafe { rows_avx512(k, model, w, all, ext, first, o) }
         }),
         #[cfg(target_arch = "x86_64")]
-        Kernels::Avx2 => par_rows(nrows, outs, per_row, threads, || Work::<F64x4>::new(model, per), |w, first, o| {
+        Kernels::Avx2 => par_rows(nrows, outs, per_row, threads, || Work::<F64x4>::new(model, per, widths), |w, first, o| {
             // SAFETY: the CPU supports AVX2 (checked by `kernels`).
             unsafe { rows_avx2(k, model, w, all, ext, first, o) }
         }),
@@ -324,7 +331,7 @@ fn drive<K: Kernel>(
             one_by_one(k, model, w, all, ext, first, 0, o)
         }),
         #[cfg(not(target_arch = "x86_64"))]
-        _ => par_rows(nrows, outs, per_row, threads, || Work::<F64x4>::new(model, per), |w, first, o| {
+        _ => par_rows(nrows, outs, per_row, threads, || Work::<F64x4>::new(model, per, widths), |w, first, o| {
             rows(k, model, w, all, ext, first, o)
         }),
     }
@@ -334,6 +341,7 @@ fn drive<K: Kernel>(
 /// `$out_len` values per state, running `$call` (generic over the lane type `T`).
 macro_rules! kernel {
     ($name:ident, nargs = $nargs:literal, nout = $nout:literal, out_len = |$m:ident| $out_len:expr,
+     $(widths = |$wm:ident| $widths:expr,)?
      |$model:ident, $d:ident, $dd:ident, $a:ident, $e:pat_param, $o:pat_param| $call:expr) => {
         struct $name;
         impl Kernel for $name {
@@ -342,6 +350,9 @@ macro_rules! kernel {
             fn out_len($m: &Model) -> usize {
                 $out_len
             }
+            $(fn widths($wm: &Model) -> [usize; 3] {
+                $widths
+            })?
             #[inline(always)]
             fn run<T: Real>(
                 &self,
@@ -375,6 +386,19 @@ kernel!(RneaExt, nargs = 3, nout = 1, out_len = |m| m.nv, |m, d, dd, a, e, [o0, 
 });
 kernel!(AbaExt, nargs = 3, nout = 1, out_len = |m| m.nv, |m, d, dd, a, e, [o0, _, _]| {
     algo::aba_ext(m, d, dd, a[0], a[1], a[2], e.expect("external forces"), o0)
+});
+
+kernel!(RneaDerivativesFloating, nargs = 3, nout = 3, out_len = |m| (m.nv + 6) * (m.nv + 6),
+    widths = |m| [m.nv + 7, m.nv + 6, m.nv + 6], |m, d, dd, a, e, [o0, o1, o2]| {
+    algo::rnea_derivatives_floating(m, d, dd, a[0], a[1], a[2], e, o0, o1, o2)
+});
+kernel!(AbaDerivativesFloating, nargs = 3, nout = 3, out_len = |m| (m.nv + 6) * (m.nv + 6),
+    widths = |m| [m.nv + 7, m.nv + 6, m.nv + 6], |m, d, dd, a, e, [o0, o1, o2]| {
+    algo::aba_derivatives_floating(m, d, dd, a[0], a[1], a[2], e, o0, o1, o2)
+});
+kernel!(MinverseFloating, nargs = 1, nout = 1, out_len = |m| (m.nv + 6) * (m.nv + 6),
+    widths = |m| [m.nv + 7, 0, 0], |m, d, dd, a, _, [o0, _, _]| {
+    algo::minverse_floating(m, d, dd, a[0], o0)
 });
 
 /// Batched [`algo::rnea_derivatives`]: `args = [q, qd, qdd]` (N, nv) each; `ext`:
@@ -420,4 +444,34 @@ pub fn jacobian_dot(model: &Model, q: &[f64], qd: &[f64], link: usize, out: &mut
             algo::jacobian_dot(model, d, &q[r * n..(r + 1) * n], &qd[r * n..(r + 1) * n], link, o);
         }
     });
+}
+
+/// Batched [`algo::rnea_derivatives_floating`] (a floating base, `algo::floating`):
+/// `args = [q (N, 7 + nv), v, a (N, 6 + nv)]`; `ext` as for `rnea_derivatives` (link
+/// frames only); `outs = [dtau_dq, dtau_dv, M]` (N, 6 + nv, 6 + nv) each.
+pub fn rnea_derivatives_floating(
+    model: &Model,
+    args: [&[f64]; 3],
+    ext: Option<(&[f64], ForceFrame)>,
+    outs: [&mut [f64]; 3],
+    threads: Option<usize>,
+) {
+    drive(&RneaDerivativesFloating, model, &args, ext, outs, threads)
+}
+
+/// Batched [`algo::aba_derivatives_floating`]: `args = [q (N, 7 + nv), v, tau (N, 6 + nv)]`;
+/// `ext` as for `rnea_derivatives_floating`; `outs = [da_dq, da_dv, Minv]` (N, 6 + nv, 6 + nv) each.
+pub fn aba_derivatives_floating(
+    model: &Model,
+    args: [&[f64]; 3],
+    ext: Option<(&[f64], ForceFrame)>,
+    outs: [&mut [f64]; 3],
+    threads: Option<usize>,
+) {
+    drive(&AbaDerivativesFloating, model, &args, ext, outs, threads)
+}
+
+/// Batched [`algo::minverse_floating`]: `q` (N, 7 + nv), `out` = M^-1 (N, 6 + nv, 6 + nv).
+pub fn minverse_floating(model: &Model, q: &[f64], out: &mut [f64], threads: Option<usize>) {
+    drive(&MinverseFloating, model, &[q], None, [out, &mut [], &mut []], threads)
 }

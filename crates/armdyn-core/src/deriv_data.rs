@@ -2,6 +2,7 @@
 //! `minverse`, `gravity_derivatives`) and of the external-force wrappers, beside
 //! [`crate::Data`]: allocated once for a model, reused by every call.
 
+use crate::algo::floating::NV_BASE;
 use crate::model::Model;
 use crate::real::Real;
 use crate::spatial::{Force, Motion, RigidInertia, Sym3, V3};
@@ -51,6 +52,10 @@ pub struct DerivData<T> {
     pub tau: Vec<T>,
     pub dq: Vec<T>,
     pub dqd: Vec<T>,
+    /// A floating base's velocity-space scratch (`floating_derivatives.rs`): the
+    /// accelerations (6 + nv) and the factors of M ((6 + nv)^2).
+    pub qdd_floating: Vec<T>,
+    pub factor: Vec<T>,
 }
 
 impl<T: Real> DerivData<T> {
@@ -88,6 +93,8 @@ impl<T: Real> DerivData<T> {
             tau: vec![T::zero(); n],
             dq: vec![T::zero(); n * n],
             dqd: vec![T::zero(); n * n],
+            qdd_floating: vec![T::zero(); n + NV_BASE],
+            factor: vec![T::zero(); (n + NV_BASE) * (n + NV_BASE)],
         }
     }
 

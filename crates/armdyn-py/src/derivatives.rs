@@ -21,7 +21,7 @@ fn parse_frame(frame: &str) -> PyResult<ForceFrame> {
 
 /// `f_ext` converted and checked against the states' shape: (nlinks, 6) for one state,
 /// (N, nlinks, 6) for N states, finite.
-fn check_f_ext<'py>(m: &NumericModel, obj: &Bound<'py, PyAny>, shape: Shape) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+pub(crate) fn check_f_ext<'py>(m: &NumericModel, obj: &Bound<'py, PyAny>, shape: Shape) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let a = as_f64(obj, "f_ext")?;
     let nl = m.model.nlinks();
     let ok = match (shape, a.shape()) {
@@ -68,7 +68,7 @@ fn memory(a: &Bound<'_, PyArrayDyn<f64>>) -> std::ops::Range<usize> {
 /// `out=`: the caller's `R` arrays (one array when `R` is 1, else a tuple or list of `R`),
 /// checked: float64, C-contiguous, aligned, writeable, of shape `dims`, sharing no
 /// memory with `inputs` (name, array) nor with each other. Nothing is written here.
-fn outputs_given<'py, const R: usize>(
+pub(crate) fn outputs_given<'py, const R: usize>(
     out: &Bound<'py, PyAny>,
     dims: &[usize],
     inputs: &[(&str, &Bound<'py, PyArrayDyn<f64>>)],
@@ -207,7 +207,7 @@ fn ext_forces(e: Ext<'_>) -> Option<ExternalForces<'_, f64>> {
 /// output of `$algo` / `$batch` on a compiled model; the attributes given first (e.g.
 /// `#[pyfunction]`) are passed on.
 macro_rules! matrix_of_q {
-    ($(#[$attr:meta])* $name:ident, $algo:path, $batch:path) => {
+    ($(#[$attr:meta])* $name:ident, $algo:path, $batch:path $(, floating = $floating:path)?) => {
         $(#[$attr])*
         fn $name<'py>(
             py: Python<'py>,
@@ -217,6 +217,9 @@ macro_rules! matrix_of_q {
             out: Option<&Bound<'py, PyAny>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             let m = model.get();
+            $(if m.floating {
+                return $floating(m, py, q, threads, out);
+            })?
             let n = m.model.nv;
             let [o] = run(
                 m,
@@ -245,7 +248,7 @@ macro_rules! matrix_of_q {
 /// Robot's cached NumericModel; mimic joints and a Robot's f_ext are handled there): its
 /// common call, no f_ext, passes every argument by position.
 macro_rules! derivatives_entry {
-    ($(#[$doc:meta])* $name:ident, $third:ident, $algo:path, $batch:path) => {
+    ($(#[$doc:meta])* $name:ident, $third:ident, $algo:path, $batch:path, floating = $floating:path) => {
         $(#[$doc])*
         #[pyfunction]
         #[pyo3(signature = (model, q, qd, $third, f_ext = None, frame = "local", threads = None, out = None))]
@@ -262,6 +265,9 @@ macro_rules! derivatives_entry {
             out: Option<&Bound<'py, PyAny>>,
         ) -> PyResult<Bound<'py, PyTuple>> {
             let m = model.get();
+            if m.floating {
+                return $floating(m, py, q, qd, $third, f_ext, frame, threads, out);
+            }
             let n = m.model.nv;
             let o = run(
                 m,
@@ -286,12 +292,14 @@ macro_rules! derivatives_entry {
 derivatives_entry!(
     /// ``(dtau_dq, dtau_dqd, M)`` of a NumericModel, each (n, n) or (N, n, n): the entry
     /// of ``armdyn.numeric.rnea_derivatives`` (documented there).
-    rnea_derivatives, qdd, algo::rnea_derivatives, bd::rnea_derivatives
+    rnea_derivatives, qdd, algo::rnea_derivatives, bd::rnea_derivatives,
+    floating = crate::floating_derivatives::rnea_derivatives
 );
 derivatives_entry!(
     /// ``(dqdd_dq, dqdd_dqd, Minv)`` of a NumericModel, each (n, n) or (N, n, n): the entry
     /// of ``armdyn.numeric.aba_derivatives`` (documented there).
-    aba_derivatives, tau, algo::aba_derivatives, bd::aba_derivatives
+    aba_derivatives, tau, algo::aba_derivatives, bd::aba_derivatives,
+    floating = crate::floating_derivatives::aba_derivatives
 );
 
 matrix_of_q!(
@@ -299,7 +307,7 @@ matrix_of_q!(
     /// ``armdyn.numeric.minverse`` (documented there).
     #[pyfunction]
     #[pyo3(signature = (model, q, threads = None, out = None))]
-    minverse, algo::minverse, bd::minverse
+    minverse, algo::minverse, bd::minverse, floating = crate::floating_derivatives::minverse
 );
 
 matrix_of_q!(

@@ -25,7 +25,7 @@ impl NumericModel {
     pub(crate) fn fixed_base_only(&self) -> PyResult<()> {
         if self.floating {
             return Err(PyNotImplementedError::new_err(format!(
-                "'{}' has a floating base (free-flyer root joint): only rnea, crba, aba, forward_kinematics, jacobian and the energies support it yet",
+                "'{}' has a floating base (free-flyer root joint): only rnea, crba, aba, rnea_derivatives, aba_derivatives, minverse, forward_kinematics, jacobian and the energies support it yet",
                 self.name
             )));
         }
@@ -35,7 +35,7 @@ impl NumericModel {
     /// Check the arguments `(name, object, width)`: each `(width,)` or `(N, width)`, the
     /// same N for all, finite; the first is `q`, whose quaternions must be unit. A fixed
     /// base's arguments are checked by [`crate::states`] (every width is then dof).
-    fn floating_states<'py, const K: usize>(
+    pub(crate) fn floating_states<'py, const K: usize>(
         &self,
         args: [(&str, &Bound<'py, PyAny>, usize); K],
     ) -> PyResult<(Shape, [Bound<'py, PyArrayDyn<f64>>; K])> {

@@ -30,6 +30,7 @@ use std::sync::{Mutex, OnceLock};
 mod centroidal;
 mod derivatives;
 mod floating;
+mod floating_derivatives;
 mod simulate;
 
 /// Run `f`, turning a Rust panic into a Python `RuntimeError`.

@@ -34,13 +34,15 @@ Conventions (docs/architecture.md): SI units, radians; ``M(q) qdd + C(q, qd) qd 
 gravity is the robot's vector in the base frame; frames as in :mod:`armdyn.model`.
 
 A floating base (``armdyn.load(path, root_joint="free-flyer")``, ``robot.floating``):
-``rnea``, ``crba`` and ``aba`` take Pinocchio's arrays, unchanged: ``q`` is
+``rnea``, ``crba``, ``aba``, ``rnea_derivatives``, ``aba_derivatives`` and ``minverse``
+take Pinocchio's arrays, unchanged: ``q`` is
 ``(robot.nq,) = (7 + dof,)``, the base origin in the world frame (3), the base
 orientation as a unit quaternion ``x, y, z, w`` (4; base axes in world coordinates),
 then the joints; ``qd``, ``qdd`` and ``tau`` are ``(robot.nv,) = (6 + dof,)``: the base's
 linear then angular velocity (acceleration; the force then the moment about the base
-origin applied to the base), all in the base frame, then the joints; ``M`` is
-``(nv, nv)`` in that order. Gravity is then in the world frame. A quaternion whose length
+origin applied to the base), all in the base frame, then the joints; ``M`` and the
+derivatives are ``(nv, nv)`` in that order, ``d/dq`` on the tangent space: along
+``integrate(q, dq)`` at ``dq = 0`` (Pinocchio's ``computeRNEADerivatives``). Gravity is then in the world frame. A quaternion whose length
 differs from 1 by more than 1e-9 is refused (``ValueError``). Batches ``(N, nq)`` run
 as the fixed-base ones (SIMD lanes, ``threads``; bit for bit the single calls). :mod:`armdyn.configuration` moves on that configuration space
 (``integrate``, ``difference``, ``neutral``, ``random_configuration``, re-exported

@@ -7,7 +7,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .. import _core
-from .checks import fixed_base_threads, overflow_error
+from .checks import check_threads, fixed_base_threads, overflow_error
 from .compiled import NumericModel, RobotLike, canonical_wrenches, compiled_model, core_model, mimic_model
 
 # rnea_derivatives, aba_derivatives and minverse decide here which path a call takes: the
@@ -52,13 +52,16 @@ def rnea_derivatives(
     piecewise constant: it adds nothing, also at ``qd_k = 0`` where rnea's term jumps
     (``sign(0) = 0``) and has no derivative; the value given there is that of either side.
     Robots with mimic joints: ``G^T D_full G`` (chain rule, see :mod:`armdyn.mimic`); no f_ext.
+    A floating base (module doc): q (nq,), qd, qdd (nv,) (or with a leading N); every
+    result (nv, nv), ``dtau_dq`` on the tangent space; f_ext in the link frames only (the
+    base link's row acts on the base; ``frame="world"`` is a NotImplementedError).
 
     out: optionally, the three arrays to write the results into and return (float64,
     C-contiguous, the results' shapes, sharing no memory with the inputs): a loop over
     batches then allocates nothing, and a large batch is spared the first-touch page
     faults of fresh arrays.
     """
-    threads = fixed_base_threads(robot, threads, "rnea_derivatives")  # (Rust would read True as 1)
+    threads = threads if threads is None else check_threads(threads)  # (Rust would read True as 1)
     if f_ext is None:
         try:  # the core takes a NumericModel only: a Robot's cached one, or the model itself
             return _core.rnea_derivatives(robot._numeric_model, q, qd, qdd, None, frame, threads, out)  # type: ignore[union-attr]
@@ -82,9 +85,10 @@ def aba_derivatives(
     q, qd, tau: (n,) or (N, n). Returns ``(dqdd_dq, dqdd_dqd, Minv)``, each (n, n) or
     (N, n, n): ``dqdd_dq[i, j] = d qdd_i / d q_j`` and ``Minv = d qdd / d tau = M^-1``.
     f_ext, frame: as in :func:`rnea_derivatives`; joint friction, rotor inertia and mimic
-    joints as there (``Minv`` is that of ``M + diag(Ia)``). out: as there.
+    joints as there (``Minv`` is that of ``M + diag(Ia)``). out: as there. A floating base:
+    as there.
     """
-    threads = fixed_base_threads(robot, threads, "aba_derivatives")  # (Rust would read True as 1)
+    threads = threads if threads is None else check_threads(threads)  # (Rust would read True as 1)
     if f_ext is None:
         try:  # as in rnea_derivatives
             return _core.aba_derivatives(robot._numeric_model, q, qd, tau, None, frame, threads, out)  # type: ignore[union-attr]
@@ -99,9 +103,10 @@ def minverse(robot: RobotLike, q: ArrayLike, threads: int | None = None, out=Non
     or (N, n, n). M includes the rotor inertias, ``diag(Ia)``, as :func:`crba`. Robots
     with mimic joints: ``(G^T M_full G)^-1`` by Cholesky (ValueError when M is not
     positive definite). out: optionally, the array to write M^-1 into and return (float64,
-    C-contiguous, the result's shape, not sharing memory with q).
+    C-contiguous, the result's shape, not sharing memory with q). A floating base: q (nq,),
+    M^-1 (nv, nv), from the CRBA and M's sparse factors.
     """
-    threads = fixed_base_threads(robot, threads, "minverse")  # (Rust would read True as 1)
+    threads = threads if threads is None else check_threads(threads)  # (Rust would read True as 1)
     try:  # as in rnea_derivatives
         return _core.minverse(robot._numeric_model, q, threads, out)  # type: ignore[union-attr]
     except (AttributeError, TypeError):

@@ -43,7 +43,7 @@ pub struct ExternalForces<'a, T> {
 impl<'a, T: Real> ExternalForces<'a, T> {
     /// Link `k`'s wrench as a spatial force `[n; f]` in its given frame.
     #[inline(always)]
-    fn raw(&self, k: usize) -> Force<T> {
+    pub(crate) fn raw(&self, k: usize) -> Force<T> {
         let w = &self.wrenches[6 * k..6 * k + 6];
         Force::new(V3::new(w[3], w[4], w[5]), V3::new(w[0], w[1], w[2]))
     }
@@ -52,7 +52,7 @@ impl<'a, T: Real> ExternalForces<'a, T> {
 /// Link `k`'s wrench (given in its own frame) in the frame of the body carrying it:
 /// `f_b = R f`, `n_b = R n + p x f_b` with `(R, p)` the link's constant pose in the body.
 #[inline(always)]
-fn local_in_body<T: Real>(model: &Model, k: usize, w: &Force<T>) -> Force<T> {
+pub(crate) fn local_in_body<T: Real>(model: &Model, k: usize, w: &Force<T>) -> Force<T> {
     let lf = &model.links[k];
     let r = M3::<T>::splat(lf.rotation);
     let f = r.mul_v(w.f);

@@ -66,7 +66,7 @@ fn put_wrench<T: Real>(f: &Force<T>, out: &mut [T]) {
 /// `[0; -R^T g]`: gravity as a fictitious acceleration of the base, base frame
 /// (RBDA 5.3), for the base orientation `q[3..7]`.
 #[inline(always)]
-fn gravity_acceleration<T: Real>(model: &Model, q: &[T]) -> Motion<T> {
+pub(crate) fn gravity_acceleration<T: Real>(model: &Model, q: &[T]) -> Motion<T> {
     let r = quaternion_rotation(q[3], q[4], q[5], q[6]);
     Motion::new(V3::zero(), -r.tr_mul_v(V3::splat(model.gravity)))
 }
@@ -103,6 +103,13 @@ pub fn crba_floating<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], m: &mu
     let s = n + NV_BASE;
     assert!(q.len() == n + NQ_BASE && m.len() == s * s, "state length");
     let ic = RigidInertia::splat(&model.base_inertia) + crba_tree(model, data, &q[NQ_BASE..], m, NV_BASE);
+    put_base_block(&ic, m, s);
+}
+
+/// M's base block (rows and columns 0..6 of `m`, `s` wide): the whole robot's composite
+/// inertia `ic` (base frame) in the `[v; w]` order of the base's velocities.
+#[inline(always)]
+pub(crate) fn put_base_block<T: Real>(ic: &RigidInertia<T>, m: &mut [T], s: usize) {
     for k in 0..NV_BASE {
         // column k: the composite inertia times the unit base motion k ([v; w] order)
         let mut unit = [T::zero(); NV_BASE];

@@ -37,6 +37,7 @@
 //! so the subtree sums are one symmetric 3x3 and two 3-vectors per body.
 
 use crate::algo::external::{body_forces, Coordinates, ExternalForces, ForceFrame};
+use crate::algo::floating::NV_BASE;
 use crate::algo::kinematics::{update_x0, update_xup};
 use crate::data::Data;
 use crate::deriv_data::DerivData;
@@ -58,7 +59,7 @@ fn b_apply<T: Real>(dd: &DerivData<T>, i: usize, p2: V3<T>, m: &Motion<T>) -> Fo
 /// outer products and `v . h` partly cancel: `S_xx = 2 K_xx + 2 (v_y h_y + v_z h_z)`, and
 /// so on.
 #[inline(always)]
-fn b_sym<T: Real>(i: &RigidInertia<T>, v: &Motion<T>) -> Sym3<T> {
+pub(crate) fn b_sym<T: Real>(i: &RigidInertia<T>, v: &Motion<T>) -> Sym3<T> {
     let (w, vv, h) = (v.w, v.v, i.h);
     // columns of w^x Ibar
     let (k0, k1, k2) = (w.cross(i.ibar.col(0)), w.cross(i.ibar.col(1)), w.cross(i.ibar.col(2)));
@@ -93,6 +94,22 @@ pub(crate) fn velocity_pass<T: Real>(
     qd: &[T],
     ext: Option<&ExternalForces<T>>,
 ) {
+    velocity_pass_on(model, data, dd, q, qd, ext, None);
+}
+
+/// [`velocity_pass`] on a base moving with velocity `base = Some(v_B)` (base
+/// coordinates): the root bodies' parent is then the base, `v_lambda = v_B` (a floating
+/// base, `floating_derivatives.rs`); `None` is the fixed base at rest.
+#[inline(always)]
+pub(crate) fn velocity_pass_on<T: Real>(
+    model: &Model,
+    data: &mut Data<T>,
+    dd: &mut DerivData<T>,
+    q: &[T],
+    qd: &[T],
+    ext: Option<&ExternalForces<T>>,
+    base: Option<Motion<T>>,
+) {
     update_xup(model, data, q);
     update_x0(model, data);
     // without external forces nothing reads dd.fx
@@ -102,12 +119,13 @@ pub(crate) fn velocity_pass<T: Real>(
     for i in 0..model.nv {
         let x0 = data.x0[i];
         let s = model.kind[i].s_in(&x0);
-        let (v, dvdq) = match model.parent[i] {
-            Some(p) => {
+        let (v, dvdq) = match (model.parent[i], base) {
+            (Some(p), _) => {
                 let vp = dd.v[p];
                 (vp + s.scale(qd[i]), vp.cross_motion(&s))
             }
-            None => (s.scale(qd[i]), Motion::zero()),
+            (None, Some(vb)) => (vb + s.scale(qd[i]), vb.cross_motion(&s)),
+            (None, None) => (s.scale(qd[i]), Motion::zero()),
         };
         let inertia = RigidInertia::splat(&model.inertia[i]).tr_transform(&x0);
         let h = inertia.mul_motion(&v);
@@ -136,13 +154,31 @@ pub(crate) fn velocity_pass<T: Real>(
 /// `dA_i = a_0 x J_i`, which for `a_0 = [0; -g]` is `[0; -g x J_i^w]`.
 #[inline(always)]
 pub(crate) fn acceleration_pass<T: Real>(model: &Model, dd: &mut DerivData<T>, qd: &[T], qdd: &[T]) {
+    acceleration_pass_on(model, dd, qd, qdd, None);
+}
+
+/// [`acceleration_pass`] on a base moving with `base = Some((v_B, a_B))` (base
+/// coordinates, `a_B` with gravity's `-g`), after [`velocity_pass_on`] with `v_B`: the
+/// root bodies' parent is then the base (`v_lambda = v_B`, `a_lambda = a_B`).
+#[inline(always)]
+pub(crate) fn acceleration_pass_on<T: Real>(
+    model: &Model,
+    dd: &mut DerivData<T>,
+    qd: &[T],
+    qdd: &[T],
+    base: Option<(Motion<T>, Motion<T>)>,
+) {
     let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
     let a0_linear = model.a0.w == V3::zero();
     for i in 0..model.nv {
         let s = dd.s[i];
-        let (a, dadq) = match model.parent[i] {
-            Some(p) => {
-                let (vp, ap, dvdq) = (dd.v[p], dd.a[p], dd.dvdq[i]);
+        let parent = match (model.parent[i], base) {
+            (Some(p), _) => Some((dd.v[p], dd.a[p])),
+            (None, b) => b,
+        };
+        let (a, dadq) = match parent {
+            Some((vp, ap)) => {
+                let dvdq = dd.dvdq[i];
                 (ap + s.scale(qdd[i]) + dvdq.scale(qd[i]), ap.cross_motion(&s) + vp.cross_motion(&dvdq))
             }
             None if a0_linear => (a0 + s.scale(qdd[i]), Motion::new(V3::zero(), a0.v.cross(s.w))),
@@ -223,9 +259,50 @@ pub(crate) fn derivative_terms<T: Real>(
     ext: Option<&ExternalForces<T>>,
     dtau_dq: &mut [T],
     dtau_dqd: &mut [T],
+    m: Option<&mut [T]>,
+) {
+    derivative_terms_in(model, dd, ext, dtau_dq, dtau_dqd, m, Placement { stride: model.nv, base: None });
+}
+
+/// Where [`derivative_terms_in`] writes: the matrices are `stride` wide (row-major).
+/// `base: None`: a fixed base, the joints' block is the whole matrix (`stride = nv`).
+/// `base: Some((g, v_B))`: a floating base (`floating_derivatives.rs`), after the `_on`
+/// passes with the base's motion: `stride = 6 + nv`, the base's six velocities (linear,
+/// angular) first, then the joints; `g` is gravity's fictitious acceleration `-R^T g`,
+/// `v_B` the base's velocity (base frame).
+#[derive(Clone, Copy)]
+pub(crate) struct Placement<T> {
+    pub stride: usize,
+    pub base: Option<(V3<T>, Motion<T>)>,
+}
+
+/// [`derivative_terms`] written where `at` says. With a floating base the root bodies'
+/// parent (the base) moves, so their `dV` is not zero, and each body i also fills the
+/// base's rows and columns: the base is an ancestor of every body whose axes `e_b` (unit
+/// motions, base frame) do not move with `q_i`, so `dtau_b/dx_i` is `e_b^T` of the
+/// forces of row i (`dtau/dq`, `dtau/dqd`, `M`); and `dtau_i/dq_b = J_i^T I^c_i dA_b`
+/// with `dA_b = a_0 x e_b` (`dV_b = 0`: the base's parent, the world, is at rest):
+/// 0 for the linear `e_b`, `(I^c_i J_i)^f x g` for the angular; and
+/// `dtau_i/dqd_b = J_i^T (I^c_i (v_B x e_b) + B^c_i e_b)`, where `v_B x e_b` is the
+/// once-counted `2 dV` of a 1-dof joint: the free flyer's `dJ/dt v = v_B x v_B` is 0 for
+/// every `v`, so only the descendants' `(v_k x J_k) qd_k` depend on `v_b`, by
+/// `e_b x (v_k - v_B)`. As `(m x e_b) . f = -e_b . (m x* f)`, that row is
+/// `-(v_B x* I^c_i J_i)` plus the angular part of `B^c_i^T J_i` at the angular `e_b`.
+#[inline(always)]
+pub(crate) fn derivative_terms_in<T: Real>(
+    model: &Model,
+    dd: &DerivData<T>,
+    ext: Option<&ExternalForces<T>>,
+    dtau_dq: &mut [T],
+    dtau_dqd: &mut [T],
     mut m: Option<&mut [T]>,
+    at: Placement<T>,
 ) {
     let n = model.nv;
+    let floating = at.base.is_some();
+    let (w, off) = (at.stride, if floating { NV_BASE } else { 0 });
+    // row r, column c of the joints' block
+    let ix = |r: usize, c: usize| (off + r) * w + off + c;
     let world_ext = matches!(ext, Some(e) if e.frame == ForceFrame::World);
     // On a chain every (row, column) pair is a body and itself or one of its ancestors,
     // so the loop below writes every entry; elsewhere the unrelated pairs stay 0.
@@ -247,48 +324,86 @@ pub(crate) fn derivative_terms<T: Real>(
         let (sw, nw) = (dd.bs[i].mul_v(s.w), dd.bn[i].cross(s.w));
         let bj = Force::new(sw - nw, s.w.cross(p2));
         let bt = sw + nw + p2.cross(s.v);
-        let (fq, fv) = match model.parent[i] {
-            Some(_) => {
-                let dvdq = dd.dvdq[i];
-                let fq = s.cross_force(&ft) + ic.mul_motion(&dd.dadq[i]) + b_apply(dd, i, p2, &dvdq);
-                (fq, ic.mul_motion(&(dvdq + dvdq)) + bj)
-            }
-            None => (s.cross_force(&ft) + ic.mul_motion(&dd.dadq[i]), bj),
+        let (fq, fv) = if model.parent[i].is_some() || floating {
+            let dvdq = dd.dvdq[i];
+            let fq = s.cross_force(&ft) + ic.mul_motion(&dd.dadq[i]) + b_apply(dd, i, p2, &dvdq);
+            (fq, ic.mul_motion(&(dvdq + dvdq)) + bj)
+        } else {
+            (s.cross_force(&ft) + ic.mul_motion(&dd.dadq[i]), bj)
         };
         // row i: the columns of i and its ancestors j (the motion of j moves body i's subtree)
         if let Some(m) = m.as_deref_mut() {
-            m[i * n + i] = s.dot(&fa);
+            m[ix(i, i)] = s.dot(&fa);
         }
-        dtau_dq[i * n + i] = s.dot(&fq);
-        dtau_dqd[i * n + i] = s.dot(&fv);
+        dtau_dq[ix(i, i)] = s.dot(&fq);
+        dtau_dqd[ix(i, i)] = s.dot(&fv);
         let mut a = model.parent[i];
         while let Some(j) = a {
             let (sj, daj) = (dd.s[j], dd.dadq[j]);
             if let Some(m) = m.as_deref_mut() {
                 let mji = sj.dot(&fa);
-                m[j * n + i] = mji;
-                m[i * n + j] = mji;
+                m[ix(j, i)] = mji;
+                m[ix(i, j)] = mji;
             }
-            dtau_dq[j * n + i] = sj.dot(&fq);
-            dtau_dqd[j * n + i] = sj.dot(&fv);
+            dtau_dq[ix(j, i)] = sj.dot(&fq);
+            dtau_dqd[ix(j, i)] = sj.dot(&fv);
             a = model.parent[j];
-            if a.is_some() {
+            if a.is_some() || floating {
                 let dvj = dd.dvdq[j];
-                dtau_dq[i * n + j] = daj.dot(&fa) + bt.dot(dvj.w);
-                dtau_dqd[i * n + j] = dvj.dot(&fa2) + bt.dot(sj.w);
+                dtau_dq[ix(i, j)] = daj.dot(&fa) + bt.dot(dvj.w);
+                dtau_dqd[ix(i, j)] = dvj.dot(&fa2) + bt.dot(sj.w);
             } else {
-                dtau_dq[i * n + j] = daj.dot(&fa);
-                dtau_dqd[i * n + j] = bt.dot(sj.w);
+                dtau_dq[ix(i, j)] = daj.dot(&fa);
+                dtau_dqd[ix(i, j)] = bt.dot(sj.w);
             }
             if world_ext {
                 // forces fixed in space do not turn with joint j: J_i^T (J_j x* FX_i)
-                dtau_dq[i * n + j] += s.dot(&sj.cross_force(&dd.fx[i]));
+                dtau_dq[ix(i, j)] += s.dot(&sj.cross_force(&dd.fx[i]));
             }
+        }
+        if let Some((g, vb)) = at.base {
+            base_entries(dtau_dq, dtau_dqd, m.as_deref_mut(), w, off + i, [fq, fv, fa], bt, g, vb);
         }
     }
     if model.has_joint_dynamics {
-        add_joint_dynamics_derivatives(model, dtau_dqd, m);
+        add_joint_dynamics_at(model, dtau_dqd, m, w, off);
     }
+}
+
+/// Body i's entries in a floating base's rows and columns (see [`derivative_terms_in`]),
+/// `c = 6 + i` its row and column in matrices `w` wide: `[fq, fv, fa]` are its forces
+/// `dtau/dq`, `dtau/dqd` and `I^c_i J_i`, `bt` the angular part of `B^c_i^T J_i`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn base_entries<T: Real>(
+    dtau_dq: &mut [T],
+    dtau_dqd: &mut [T],
+    m: Option<&mut [T]>,
+    w: usize,
+    c: usize,
+    [fq, fv, fa]: [Force<T>; 3],
+    bt: V3<T>,
+    g: V3<T>,
+    vb: Motion<T>,
+) {
+    let fv_ = |f: &Force<T>| f.f.to_array().into_iter().chain(f.n.to_array());
+    for (b, (xq, xv)) in fv_(&fq).zip(fv_(&fv)).enumerate() {
+        dtau_dq[b * w + c] = xq;
+        dtau_dqd[b * w + c] = xv;
+    }
+    if let Some(m) = m {
+        for (b, x) in fv_(&fa).enumerate() {
+            m[b * w + c] = x;
+            m[c * w + b] = x;
+        }
+    }
+    let row_q = &mut dtau_dq[c * w..c * w + NV_BASE];
+    row_q[..3].fill(T::zero());
+    row_q[3..].copy_from_slice(&fa.f.cross(g).to_array());
+    let t = vb.cross_force(&fa);
+    let row_v = &mut dtau_dqd[c * w..c * w + NV_BASE];
+    row_v[..3].copy_from_slice(&(-t.f).to_array());
+    row_v[3..].copy_from_slice(&(bt - t.n).to_array());
 }
 
 /// Whether body i's parent is body i - 1 for every i (a serial chain in tree order).
@@ -303,13 +418,20 @@ fn is_chain(model: &Model) -> bool {
 /// derivative) we report the same 0, the one-sided derivative of either side, consistent with
 /// rnea's `sign(0) = 0`. The offset is constant: nothing. `dtau/dq` is unchanged.
 #[inline(always)]
-pub fn add_joint_dynamics_derivatives<T: Real>(model: &Model, dtau_dqd: &mut [T], mut m: Option<&mut [T]>) {
-    let n = model.nv;
-    for i in 0..n {
+pub fn add_joint_dynamics_derivatives<T: Real>(model: &Model, dtau_dqd: &mut [T], m: Option<&mut [T]>) {
+    add_joint_dynamics_at(model, dtau_dqd, m, model.nv, 0);
+}
+
+/// [`add_joint_dynamics_derivatives`] into matrices `stride` wide whose joints' block
+/// starts at row and column `off`.
+#[inline(always)]
+fn add_joint_dynamics_at<T: Real>(model: &Model, dtau_dqd: &mut [T], mut m: Option<&mut [T]>, stride: usize, off: usize) {
+    for i in 0..model.nv {
         let jd = &model.joint_dynamics[i];
+        let k = (off + i) * stride + off + i;
         if let Some(m) = m.as_deref_mut() {
-            m[i * n + i] += T::splat(jd.armature);
+            m[k] += T::splat(jd.armature);
         }
-        dtau_dqd[i * n + i] += T::splat(jd.viscous);
+        dtau_dqd[k] += T::splat(jd.viscous);
     }
 }

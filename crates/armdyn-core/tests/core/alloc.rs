@@ -109,6 +109,24 @@ fn derivative_algorithms_do_not_allocate() {
         }
     });
     assert_eq!(allocs, 0);
+    // a floating base: q (7 + nv), v, a (6 + nv), (6 + nv)^2 outputs
+    let s = n + 6;
+    let mut qf = rng.vec(7 + n, -1.0, 1.0);
+    qf[3..7].copy_from_slice(&[0.0, 0.6, 0.0, 0.8]);
+    let (vf, af) = (rng.vec(s, -1.0, 1.0), rng.vec(s, -1.0, 1.0));
+    let (mut a, mut b, mut c) = (vec![0.0; s * s], vec![0.0; s * s], vec![0.0; s * s]);
+    let local = algo::ExternalForces { wrenches: &w, frame: algo::ForceFrame::Local };
+    let allocs = count(|| {
+        for _ in 0..50 {
+            algo::rnea_derivatives_floating(&model, &mut d, &mut dd, &qf, &vf, &af, None, &mut a, &mut b, &mut c);
+            algo::aba_derivatives_floating(&model, &mut d, &mut dd, &qf, &vf, &af, None, &mut a, &mut b, &mut c);
+            let e = Some(&local);
+            algo::rnea_derivatives_floating(&model, &mut d, &mut dd, &qf, &vf, &af, e, &mut a, &mut b, &mut c);
+            algo::aba_derivatives_floating(&model, &mut d, &mut dd, &qf, &vf, &af, e, &mut a, &mut b, &mut c);
+            algo::minverse_floating(&model, &mut d, &mut dd, &qf, &mut a);
+        }
+    });
+    assert_eq!(allocs, 0, "floating base");
 }
 
 #[test]

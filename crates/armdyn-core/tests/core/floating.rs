@@ -3,7 +3,7 @@
 
 use crate::common::*;
 use armdyn_core::algo::floating::{aba_floating, crba_floating, rnea_floating};
-use armdyn_core::{algo, Data, F64x4, Model, Real};
+use armdyn_core::{algo, batch_derivatives as bd, Data, F64x4, Model, Real};
 
 pub(crate) fn floating_model(rng: &mut Rng, njoints: usize) -> Model {
     let mut model = random_model(rng, njoints, true);
@@ -191,4 +191,48 @@ fn integrate_configuration_is_the_se3_exponential() {
     let p = [t.sin() / t, (1.0 - t.cos()) / t, 0.0];
     let expected = [1.0 + p[0], 2.0 - p[2], 3.0 + p[1], 0.5, -0.5, 0.5, 0.5, 0.75];
     assert_close(&out, &expected, 1e-15, "q (+) xi");
+}
+
+/// The floating-base derivatives (`algo::floating_derivatives`), with rotor inertia and
+/// viscous friction on one joint: `dtau/da` is `crba_floating`, `M^-1 M = 1`, the `M^-1`
+/// of `aba_derivatives_floating` is `minverse_floating`'s, and batches (lanes, leftover
+/// rows, threads) equal single states bit for bit. (Pinocchio and finite differences:
+/// `tests/test_floating_derivatives.py`.)
+#[test]
+fn floating_derivatives_identities_and_batches() {
+    let mut rng = Rng::new(13);
+    let mut model = floating_model(&mut rng, 6);
+    let jd = armdyn_core::JointDynamics { armature: 0.3, viscous: 0.7, coulomb: 0.0, offset: 0.0 };
+    model.set_joint_dynamics(0, jd).expect("a movable joint");
+    let (n, s) = (model.nv, model.nv + 6);
+    let mut data = Data::new(&model);
+    let mut dd = armdyn_core::DerivData::new(&model);
+    let rows = 13;
+    let states: Vec<_> = (0..rows).map(|_| state(&mut rng, n)).collect();
+    let mut single = vec![vec![0.0; s * s]; 7];
+    let flat = |pick: fn(&State) -> &Vec<f64>| -> Vec<f64> { states.iter().flat_map(|x| pick(x).clone()).collect() };
+    let (q, v, a) = (flat(|x| &x.0), flat(|x| &x.1), flat(|x| &x.2));
+    let mut batch: Vec<Vec<f64>> = vec![vec![0.0; rows * s * s]; 7];
+    {
+        let [b0, b1, b2, b3, b4, b5, b6] = &mut batch[..] else { unreachable!() };
+        bd::rnea_derivatives_floating(&model, [&q, &v, &a], None, [b0, b1, b2], Some(2));
+        bd::aba_derivatives_floating(&model, [&q, &v, &a], None, [b3, b4, b5], Some(2));
+        bd::minverse_floating(&model, &q, b6, Some(2));
+    }
+    for (r, (qs, vs, as_)) in states.iter().enumerate() {
+        {
+            let [o0, o1, o2, o3, o4, o5, o6] = &mut single[..] else { unreachable!() };
+            algo::rnea_derivatives_floating(&model, &mut data, &mut dd, qs, vs, as_, None, o0, o1, o2);
+            algo::aba_derivatives_floating(&model, &mut data, &mut dd, qs, vs, as_, None, o3, o4, o5);
+            algo::minverse_floating(&model, &mut data, &mut dd, qs, o6);
+        }
+        for (k, (b, x)) in batch.iter().zip(&single).enumerate() {
+            assert_eq!(&b[r * s * s..(r + 1) * s * s], &x[..], "output {k}, row {r}");
+        }
+        let mut m = vec![0.0; s * s];
+        crba_floating(&model, &mut data, qs, &mut m);
+        assert_close(&single[2], &m, 1e-12, "dtau/da = crba");
+        assert_close(&single[5], &single[6], 1e-12, "aba_derivatives' M^-1 = minverse");
+        assert_inverse(&m, &single[6], s, 1e-10, "M M^-1 = 1");
+    }
 }
