@@ -234,9 +234,6 @@ FIXED_BASE_ONLY = {
     "bias": lambda r, q, v: num.bias(r, q, v),
     "coriolis_matrix": lambda r, q, v: num.coriolis_matrix(r, q, v),
     "jacobian_dot": lambda r, q, v: num.jacobian_dot(r, q, v, 1),
-    "rnea_derivatives": lambda r, q, v: num.rnea_derivatives(r, q, v, v),
-    "aba_derivatives": lambda r, q, v: num.aba_derivatives(r, q, v, v),
-    "minverse": lambda r, q, v: num.minverse(r, q),
     "gravity_derivatives": lambda r, q, v: num.gravity_derivatives(r, q),
     "regressor": lambda r, q, v: num.regressor(r, q, v, v, columns="all"),
 }
