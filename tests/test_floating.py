@@ -345,7 +345,8 @@ def test_batches_are_single_calls(threads):
         lambda r, q, v: numeric.minverse(r, q),
         lambda r, q, v: numeric.kinetic_energy(r, q, v),
         lambda r, q, v: numeric.jacobian(r, q, "link1"),
-        lambda r, q, v: armdyn.derive(r),
+        lambda r, q, v: armdyn.derive(r, "lagrange"),
+        lambda r, q, v: armdyn.prove_agreement(r),
         lambda r, q, v: armdyn.codegen(r),
         lambda r, q, v: __import__("armdyn.simulate", fromlist=["x"]).simulate_adaptive(r, q, v, duration=0.01),
         lambda r, q, v: __import__("armdyn.simulate", fromlist=["x"]).simulate(
