@@ -237,3 +237,19 @@ def test_cli_derives_the_steps_with_root_joint(tmp_path, capsys):
     code = main(["derive", str(path), "--root-joint", "free-flyer", "--method", "lagrange"])
     err = capsys.readouterr().err
     assert code == 2 and "armdyn: error:" in err and "'newton-euler' derives it" in err
+
+
+def test_reports_name_the_base_rows_and_symbols(tmp_path):
+    from armdyn.symbolic.report import derivation_report
+
+    robot, _ = load(tmp_path, ONE_BODY.replace("</robot>", ARM))
+    eom = derive(robot)
+    latex = derivation_report([eom], "latex")
+    for row in (r"f_{b,x} &=", r"n_{b,z} &=", r"\tau_{1} &="):
+        assert row in latex, row
+    assert r"\dot{v}_{b,x}" in latex and r"\omega_{b,y}" in latex and r"g_{b,z}" in latex
+    html = derivation_report([eom], "html")
+    assert "wrench on the base" in html and "moment about the base origin on the base" in html
+    # the base's symbols typeset with their LaTeX names: g_{b,z}, omega_{b,y}
+    assert "<msub><mi>g</mi><mrow><mi>b</mi><mo>,</mo><mi>z</mi></mrow></msub>" in html
+    assert "<msub><mi>&#969;</mi><mrow><mi>b</mi><mo>,</mo><mi>y</mi></mrow></msub>" in html
