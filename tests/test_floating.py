@@ -343,7 +343,8 @@ def test_batches_are_single_calls(threads):
         lambda r, q, v: numeric.coriolis_matrix(r, q, v),
         lambda r, q, v: numeric.jacobian_dot(r, q, v, "link1"),
         lambda r, q, v: numeric.gravity_derivatives(r, q),
-        lambda r, q, v: armdyn.derive(r),
+        lambda r, q, v: armdyn.derive(r, "lagrange"),
+        lambda r, q, v: armdyn.prove_agreement(r),
         lambda r, q, v: armdyn.codegen(r),
         lambda r, q, v: __import__("armdyn.simulate", fromlist=["x"]).simulate_adaptive(r, q, v, duration=0.01),
         lambda r, q, v: __import__("armdyn.simulate", fromlist=["x"]).simulate(

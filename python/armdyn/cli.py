@@ -1,6 +1,7 @@
 """The ``armdyn`` command line.
 
     armdyn derive ROBOT [--method newton-euler|lagrange|both] [--steps] [--format text|latex|markdown|html]
+                        [--root-joint free-flyer]
     armdyn check ROBOT [--exact | --numeric] [--samples N]
     armdyn robots
     armdyn show ROBOT [--q Q1,Q2,...] [--out arm.png] [--3d [--frames] --out arm.html]
@@ -45,8 +46,14 @@ def cmd_derive(args) -> int:
     from .symbolic import check, derive
     from .symbolic.report import derivation_report, unicode_supported
 
-    robot = _load(args.robot, args.allow_nonphysical, args.strict, args.trust_xacro)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict, args.trust_xacro, args.root_joint)
     methods = ["newton-euler", "lagrange"] if args.method == "both" else [args.method]
+    if robot.floating and args.method == "both":
+        methods = ["newton-euler"]
+        print(
+            "armdyn derive: a floating base is derived by Newton-Euler only (no Lagrange, no agreement check)",
+            file=sys.stderr,
+        )
     eoms = []
     for m in methods:
         t0 = time.perf_counter()
@@ -289,6 +296,12 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--steps", action="store_true", help="show every intermediate step")
     d.add_argument("--format", choices=["text", "latex", "markdown", "html"], default="text")
     d.add_argument("--timing", action="store_true", help="print derivation times to stderr")
+    d.add_argument(
+        "--root-joint",
+        choices=["free-flyer"],
+        help="the root link floats (a free-flyer base, as armdyn.load(path, root_joint=...)): "
+        "Newton-Euler from the base twist, tau = wrench on the base then the joints",
+    )
     d.add_argument(
         "--ascii",
         action="store_true",

@@ -3,10 +3,14 @@
 eom = derive(robot, method="newton-euler")   # or "lagrange"
 eom.tau, eom.M, eom.C, eom.g, eom.steps
 check(derive(robot), derive(robot, "lagrange")).text()
+
+A floating base (``root_joint="free-flyer"``): Newton-Euler only, parametrised by the
+base twist (newton_euler_floating.py); tau, M, g and bias have 6 + n rows.
 """
 
 from __future__ import annotations
 
+from ..errors import FloatingBaseError
 from ..model import Robot
 
 # the LaTeX and HTML renderers register EquationsOfMotion._repr_latex_, the _repr_html_ of
@@ -15,6 +19,7 @@ from . import report, report_html  # noqa: F401
 from .agreement import AgreementReport, check
 from .lagrange import lagrange
 from .newton_euler import newton_euler
+from .newton_euler_floating import FloatingEquationsOfMotion, newton_euler_floating
 from .terms import EquationsOfMotion, Step
 
 METHODS = {"newton-euler": newton_euler, "lagrange": lagrange}
@@ -27,16 +32,29 @@ def derive(robot: Robot | str, method: str = "newton-euler") -> EquationsOfMotio
             "lagrange" (Euler-Lagrange equations from T and V).
     Returns an :class:`EquationsOfMotion` with q, qd, qdd, tau (n x 1), M, C, g,
     parameters and steps.
+
+    A floating base (``robot.floating``): Newton-Euler from the base's twist, a
+    :class:`FloatingEquationsOfMotion` whose qd, qdd, tau have 6 + n rows (base twist,
+    joints: Pinocchio's order) and that carries ``bias`` instead of ``C``; "lagrange"
+    raises :class:`~armdyn.errors.FloatingBaseError`.
     """
     if isinstance(robot, str):
         from ..io import load
 
         robot = load(robot)
-    robot.require_fixed_base("armdyn.derive")
     try:
         fn = METHODS[method]
     except KeyError:
         raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}") from None
+    if robot.floating:
+        if method != "newton-euler":
+            raise FloatingBaseError(
+                f"method {method!r} does not support a floating base (root_joint='free-flyer'): "
+                "method 'newton-euler' derives it (a Lagrangian of the base's quaternion is another exercise)",
+                f"robot '{robot.name}'",
+                robot.meta.get("file"),
+            )
+        return newton_euler_floating(robot)
     return fn(robot)
 
 
@@ -52,6 +70,7 @@ __all__ = [
     "newton_euler",
     "lagrange",
     "EquationsOfMotion",
+    "FloatingEquationsOfMotion",
     "Step",
     "AgreementReport",
     "METHODS",

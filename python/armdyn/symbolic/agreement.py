@@ -178,6 +178,15 @@ def check(
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
         raise ValueError(f"samples must be a positive integer (random points for numeric checks), got {samples!r}")
     robot = a.robot
+    if robot.floating:
+        from ..errors import FloatingBaseError
+
+        raise FloatingBaseError(
+            "armdyn.check does not support a floating base (root_joint='free-flyer'): it is derived by "
+            "Newton-Euler alone, and C is no Christoffel matrix of M for a base twist",
+            f"robot '{robot.name}'",
+            robot.meta.get("file"),
+        )
     report = AgreementReport(robot.name)
     cache = {}
     if exact is None and _mimic_angles(robot):

@@ -64,7 +64,7 @@ def _mul(A, v):
     return sp.Matrix([sp.Add(*[a * x for a, x in zip(A.row(r), v) if a != 0 and x != 0]) for r in range(A.rows)])
 
 
-def _cross(a, b):
+def cross(a, b):
     """``a x b`` (3-vectors), skipping zero factors as :func:`_mul`."""
     if not (isinstance(a, sp.MatrixBase) and isinstance(b, sp.MatrixBase)):
         return a.cross(b)
@@ -88,7 +88,7 @@ def omega_dot(R, w_p, wd_p, z, qd, qdd, kind):
     """Angular acceleration of link i in frame i."""
     if kind != "revolute":
         return _mul(R.T, wd_p)
-    return _mul(R.T, wd_p) + _cross(_mul(R.T, w_p), _mul(qd, z)) + _mul(qdd, z)
+    return _mul(R.T, wd_p) + cross(_mul(R.T, w_p), _mul(qd, z)) + _mul(qdd, z)
 
 
 def v_dot(R, w_p, wd_p, vd_p, P, V, Vd):
@@ -96,12 +96,12 @@ def v_dot(R, w_p, wd_p, vd_p, P, V, Vd):
     ``R^T (wd_p x P + w_p x (w_p x P) + vd_p) + 2 w x V + Vd`` with ``w = R^T w_p`` and the
     origin's velocity ``V`` and acceleration ``Vd`` relative to the parent frame, in
     frame i (:meth:`armdyn.model.Joint.origin_motion`)."""
-    return _mul(R.T, _cross(wd_p, P) + _cross(w_p, _cross(w_p, P)) + vd_p) + 2 * _cross(_mul(R.T, w_p), V) + Vd
+    return _mul(R.T, cross(wd_p, P) + cross(w_p, cross(w_p, P)) + vd_p) + 2 * cross(_mul(R.T, w_p), V) + Vd
 
 
 def vc_dot(w, wd, vd, c):
     """Linear acceleration of link i's centre of mass ``c`` (frame i)."""
-    return _cross(wd, c) + _cross(w, _cross(w, c)) + vd
+    return cross(wd, c) + cross(w, cross(w, c)) + vd
 
 
 def inertial_force(m, vcd):
@@ -109,7 +109,7 @@ def inertial_force(m, vcd):
 
 
 def inertial_moment(I, w, wd):
-    return _mul(I, wd) + _cross(w, _mul(I, w))
+    return _mul(I, wd) + cross(w, _mul(I, w))
 
 
 def joint_force(F, children):
@@ -123,15 +123,15 @@ def joint_force(F, children):
 def joint_moment(N, c, F, children):
     """n_i about frame i's origin from N_i, F_i (at ``c``) and the children's
     ``(R_c, P_c, n_c, f_c)``."""
-    out = N + _cross(c, F)
+    out = N + cross(c, F)
     for Rc, Pc, nc, fc in children:
-        out = out + _mul(Rc, nc) + _cross(Pc, _mul(Rc, fc))
+        out = out + _mul(Rc, nc) + cross(Pc, _mul(Rc, fc))
     return out
 
 
 def moment_about(n, f, point):
     """The moment ``n`` (about frame i's origin) taken about ``point`` (frame i)."""
-    return n - _cross(point, f)
+    return n - cross(point, f)
 
 
 def joint_torque(kind, z, n_axis, f):
@@ -259,15 +259,30 @@ def step_latex(step: NewtonEulerStep, i: int) -> str:
     return step.latex.replace("#", str(i))
 
 
-def _recursion(robot: Robot, qd, qdd, base_acceleration, steps: list[Step] | None = None) -> sp.Matrix:
+def recursion(
+    robot: Robot,
+    qd,
+    qdd,
+    base_acceleration,
+    steps: list[Step] | None = None,
+    base_rotation=None,
+    values: dict | None = None,
+) -> sp.Matrix:
     """tau (n x 1) for joint velocities ``qd`` and accelerations ``qdd`` (sequences of
     length n, symbols or numbers) with the base accelerating at ``base_acceleration``
-    (3 x 1; ``-gravity`` for the equations of motion). Appends the steps if given."""
+    (3 x 1; ``-gravity`` for the equations of motion). Appends the steps if given.
+
+    base_rotation: the base's ``(omega, omega_dot)`` (frame 0) when it turns (a floating
+    base, newton_euler_floating.py); None: at rest. values: a dict that receives the
+    steps' values (``"value"``: key -> link -> value), the children's placements
+    (``"placement"``) and the links' formula quantities (``"context"``)."""
     zero = sp.zeros(3, 1)
     value = {s.key: {} for s in NEWTON_EULER_STEPS}  # key -> link name -> value
-    value["omega"][robot.base], value["omega_dot"][robot.base] = zero, zero
+    value["omega"][robot.base], value["omega_dot"][robot.base] = base_rotation or (zero, zero)
     value["v_dot"][robot.base] = base_acceleration
     placement, context = {}, {}  # link name -> (R, P); link name -> the formulas' link quantities
+    if values is not None:
+        values.update(value=value, placement=placement, context=context)
     record = steps is not None
     outward: list[Step] = []
 
@@ -356,14 +371,14 @@ def mass_matrix(robot: Robot) -> sp.Matrix:
     zeros = [0] * n
     for j in range(n):
         unit = [int(i == j) for i in range(n)]
-        M[:, j] = _recursion(robot, zeros, unit, sp.zeros(3, 1))
+        M[:, j] = recursion(robot, zeros, unit, sp.zeros(3, 1))
     return M + sp.diag(*armature(robot))  # rotor inertias on the diagonal
 
 
 def newton_euler(robot: Robot) -> EquationsOfMotion:
     """Derive ``tau`` by iterated Newton-Euler; steps as in Craig's outward/inward passes."""
     steps: list[Step] = []
-    tau = _recursion(robot, list(robot.qd), list(robot.qdd), -robot.gravity, steps)
+    tau = recursion(robot, list(robot.qd), list(robot.qdd), -robot.gravity, steps)
     if has_joint_terms(robot):
         # docs/architecture.md: tau += Ia qdd + Fv qd + Fc sign(qd) + offset, joint by joint
         extra = joint_torques(robot, robot.qd, robot.qdd)

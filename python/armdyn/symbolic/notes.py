@@ -12,6 +12,7 @@ from __future__ import annotations
 #: (ASCII, Unicode for the text report, LaTeX for HTML/MathML captions)
 NOTE_FORMULAS = (
     ("m vcd", "m v̇_C", r"m \dot{v}_C"),
+    ("vbd + wb x vb - gb", "v̇_b + ω_b × v_b − g_b", r"\dot{v}_b + \omega_b \times v_b - g_b"),
     ("I wd + w x I w", "I ω̇ + ω × I ω", r"I \dot{\omega} + \omega \times I \omega"),
     ("1/2 m vc.vc", "½ m v_Cᵀ v_C", r"\tfrac{1}{2} m \, v_C^{\mathsf{T}} v_C"),
     ("1/2 w^T I w", "½ ωᵀ I ω", r"\tfrac{1}{2} \omega^{\mathsf{T}} I \omega"),

@@ -19,6 +19,7 @@ from ..dispatch import register
 from . import dag
 from .names import SUBSCRIPT_DIGITS, UnicodeTextPrinter, latex_symbol_names, unicode_name
 from .newton_euler import VECTOR_STEP_TEXT
+from .newton_euler_floating import BASE_ROWS, FLOATING_NOTE
 from .notes import note_text
 from .report_html import derivation_html
 from .terms import EquationsOfMotion, Step
@@ -40,8 +41,8 @@ _TEXT_NAMES = {
 def _text_names(eom: EquationsOfMotion) -> dict:
     """Symbol -> Unicode name for the coordinates, their derivatives and parameters
     whose names have the letters+digits form."""
-    names = {}
-    for q, qd, qdd in zip(eom.q, eom.qd, eom.qdd):
+    names = eom.symbol_names("text")
+    for q, qd, qdd in zip(eom.robot.q, eom.robot.qd, eom.robot.qdd):
         for sym, dots in ((q, ""), (qd, "_dot"), (qdd, "_ddot")):
             u = unicode_name(q.name, dots)
             if u:
@@ -104,7 +105,7 @@ class Renderer:
         self.eom, self.fmt, self.ascii = eom, fmt, ascii
         # text: θ̇₁, d̈₂, m₂ (Unicode), or SymPy's own names with ascii (theta1_dot)
         self._text = str if ascii else UnicodeTextPrinter(_text_names(eom)).doprint
-        self._latex_names = latex_symbol_names(eom.robot)
+        self._latex_names = {**latex_symbol_names(eom.robot), **eom.symbol_names("latex")}
 
     def atom(self, expr) -> str:
         if self.fmt == "text":
@@ -201,9 +202,15 @@ def tau_lines(eom: EquationsOfMotion, fmt: str = "text", ascii: bool = False) ->
     else:
         exprs = list(eom.tau)
         render = r.scalar
+    base = 6 if eom.robot.floating else 0  # a floating base's wrench rows first
     for k, t in enumerate(exprs):
-        coord = r.atom(eom.q[k]) if fmt == "text" else eom.robot.coordinate_names[k]
-        eq = r.equation(tau_name(k), render(t))
+        if k < base:
+            tex, text, what = BASE_ROWS[k]
+            name, coord = (text if fmt == "text" else tex), what
+        else:
+            name = tau_name(k - base)
+            coord = r.atom(eom.robot.q[k - base]) if fmt == "text" else eom.robot.coordinate_names[k - base]
+        eq = r.equation(name, render(t))
         lines.append(f"{eq}    ({coord})" if fmt == "text" else eq)
     return lines
 
@@ -253,6 +260,8 @@ def derivation_report(
     joints = ", ".join(f"{j.name} {j.type}" for j in robot.movable_joints)
     params = ", ".join(sorted(robot.parameters)) or "none"
     head = f"{robot.name}: {robot.dof} dof ({joints}); parameters: {params}"
+    if robot.floating:
+        head += f"; {FLOATING_NOTE}"
     out = [head if fmt == "text" else (f"% {head}" if fmt == "latex" else f"# {robot.name}\n\n{head}")]
     for eom in eoms:
         title = {"newton-euler": "Newton-Euler", "lagrange": "Lagrange"}[eom.method]

@@ -26,6 +26,7 @@ from ..model import Robot
 from . import dag
 from .agreement import AgreementReport
 from .names import latex_symbol_names
+from .newton_euler_floating import BASE_ROWS, FLOATING_NOTE
 from .notes import NOTE_FORMULAS, note_parts
 from .terms import EquationsOfMotion
 from .tidy import TIDY_NODE_LIMIT, tidy_terms, too_big_to_tidy
@@ -53,7 +54,8 @@ _METHODS = {"newton-euler": "Newton\u2013Euler", "lagrange": "Lagrange"}
 class _Writer:
     def __init__(self, eom):
         # the robot's symbols as the LaTeX report and the grade report name them (l_{c1})
-        self.eom, self.w, self.limit = eom, MathWriter(latex_symbol_names(eom.robot)), TIDY_NODE_LIMIT
+        names = {**latex_symbol_names(eom.robot), **eom.symbol_names("latex")}
+        self.eom, self.w, self.limit = eom, MathWriter(names), TIDY_NODE_LIMIT
 
     def scalar(self, expr) -> str:
         expr = sp.sympify(expr)
@@ -115,8 +117,12 @@ def _tau_block(eom, wr: _Writer) -> str:
         values = [wr.w.expr(sp.sympify(e)) for e in reduced]
     else:
         values = [wr.scalar(t) for t in eom.tau]
+    base = 6 if eom.robot.floating else 0  # a floating base's wrench rows first
     for k, v in enumerate(values):
-        out.append(_equation(_tau(k), v, f"({eom.robot.coordinate_names[k]})"))
+        if k < base:
+            out.append(_equation(_label(BASE_ROWS[k][0]), v, f"({BASE_ROWS[k][2]})"))
+        else:
+            out.append(_equation(_tau(k - base), v, f"({eom.robot.coordinate_names[k - base]})"))
     return "".join(out)
 
 
@@ -271,7 +277,9 @@ def derivation_html(eoms, steps: bool = False, agreement=None) -> str:
             body.append(_steps_block(eom, wr))
             body.append("<h3>Result</h3>")
         body.append(_tau_block(eom, wr))
-    if robot.dof <= TERMS_MAX_DOF and not too_big_to_tidy(eoms[0]):
+    if robot.floating:
+        body.append(f'<p class="meta">{escape(FLOATING_NOTE)}</p>')  # no C: see newton_euler_floating.py
+    elif robot.dof <= TERMS_MAX_DOF and not too_big_to_tidy(eoms[0]):
         body.append(_terms_block(eoms[0], _Writer(eoms[0])))
     if agreement is not None:
         body.append("<h2>Agreement</h2>" + agreement_body(agreement))

@@ -146,6 +146,11 @@ class EquationsOfMotion:
         """Coriolis/centrifugal matrix (n x n) from the Christoffel symbols of M."""
         return christoffel_coriolis(self.M, self.q, self.qd)
 
+    def symbol_names(self, fmt: str) -> dict:
+        """Symbol -> name ("text" or "latex" ``fmt``) of the symbols beyond the robot's q,
+        qd, qdd and parameters (a floating base's twist: newton_euler_floating.py)."""
+        return {}
+
     def steps_of(self, name: str) -> dict[str, object]:
         """The values of one kind of step by link, e.g. ``eom.steps_of("omega")``."""
         return {s.link: s.value for s in self.steps if s.name == name}
