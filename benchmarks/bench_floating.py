@@ -16,24 +16,34 @@ crba and aba, and the centroidal momentum matrix (``armdyn.centroidal_momentum_m
 machine load. Before timing each robot is checked: armdyn == Pinocchio to 1e-10.
 Ratios are armdyn time / Pinocchio time: below 1 means armdyn is faster.
 
+Batches (``--batch N``, default 20000; 0 skips them): ``armdyn.numeric.rnea(robot, Q, V, A,
+threads=t)`` and ``aba`` on (N, nq) / (N, nv) C-contiguous arrays, its output allocated by
+each call, vs ``pin.rneaInParallel(t, pool, q, v, a, out)`` / ``abaInParallel`` on the
+column-major transposes into a preallocated output (Pinocchio's fastest form), t = 1 and 2,
+median of ``--batch-repeat`` runs, alternating.
+
 Not a test: timings depend on the machine and its load.
 """
 
 from __future__ import annotations
 
-import argparse
-import importlib.metadata
 import os
-import platform
-import sys
-import warnings
-from pathlib import Path
 
-import numpy as np
-import pinocchio as pin
+# as bench_numeric: OpenMP's idle workers must not spin on the cores after a Pinocchio batch
+os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+
+import argparse  # noqa: E402
+import importlib.metadata  # noqa: E402
+import platform  # noqa: E402
+import sys  # noqa: E402
+import warnings  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+import pinocchio as pin  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_numeric import paired_medians, per_call_run  # noqa: E402  (the same timing as the arms')
+from bench_numeric import batch_run, paired_medians, per_call_run  # noqa: E402  (the same timing as the arms')
 
 import armdyn  # noqa: E402
 from armdyn import centroidal as cen  # noqa: E402
@@ -56,6 +66,8 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--repeat", type=int, default=15)
     parser.add_argument("--number", type=int, default=2000)
+    parser.add_argument("--batch", type=int, default=20000, help="states per batch (0: no batches)")
+    parser.add_argument("--batch-repeat", type=int, default=7)
     args = parser.parse_args()
     repeat, number = (5, 300) if args.quick else (args.repeat, args.number)
     print(f"{platform.processor() or platform.machine()}, Python {platform.python_version()}, pin {pin.__version__}")
@@ -63,6 +75,7 @@ def main() -> None:
     print("| robot | nv | algorithm | armdyn (us) | Pinocchio (us) | ratio |")
     print("| --- | --- | --- | --- | --- | --- |")
     rng = np.random.default_rng(0)
+    batches: list[tuple] = []
     for name, rel in ROBOTS.items():
         urdf = robots_dir() / rel
         with warnings.catch_warnings():
@@ -101,6 +114,42 @@ def main() -> None:
         for algo, ((f, fa), (g, ga)) in cases.items():
             mine, theirs = paired_medians(per_call_run(f, fa, number), per_call_run(g, ga, number), repeat)
             print(f"| {name} | {robot.nv} | {algo} | {mine * 1e6:.2f} | {theirs * 1e6:.2f} | {mine / theirs:.2f} |")
+        if args.batch:
+            batches.append((name, robot, model))
+    if batches:
+        n_states = 2000 if args.quick else args.batch
+        print(f"\nbatches of {n_states} states; ratio = armdyn / Pinocchio's *InParallel (out preallocated)\n")
+        print("| robot | algorithm | threads | armdyn (ms) | Pinocchio (ms) | ratio | Pinocchio / armdyn |")
+        print("| --- | --- | --- | --- | --- | --- | --- |")
+    for name, robot, model in batches:
+        batch_rows(name, robot, model, n_states, 3 if args.quick else args.batch_repeat, rng)
+
+
+def batch_rows(name: str, robot, model, n: int, repeat: int, rng) -> None:
+    """The batch table's rows of one robot (see the module doc), checked equal first."""
+    Q = np.ascontiguousarray([num.random_configuration(robot, rng) for _ in range(n)])
+    V, A = (np.ascontiguousarray(rng.uniform(-1, 1, (n, robot.nv))) for _ in range(2))
+    TAU = num.rnea(robot, Q, V, A)
+    q_p, v_p, a_p, tau_p = Q.T, V.T, A.T, np.asfortranarray(TAU.T)  # Pinocchio's (n, N) column-major views
+    out = np.zeros((robot.nv, n), order="F")
+    pin.rneaInParallel(1, pin.ModelPool(model, 1), q_p, v_p, a_p, out)
+    assert np.max(np.abs(out - tau_p)) <= 1e-9 * max(1.0, np.max(np.abs(tau_p)))
+    for t in (1, 2):
+        pool = pin.ModelPool(model, t)
+        for algo, mine, theirs in (
+            (
+                "rnea",
+                lambda: num.rnea(robot, Q, V, A, threads=t),
+                lambda: pin.rneaInParallel(t, pool, q_p, v_p, a_p, out),
+            ),
+            (
+                "aba",
+                lambda: num.aba(robot, Q, V, TAU, threads=t),
+                lambda: pin.abaInParallel(t, pool, q_p, v_p, tau_p, out),
+            ),
+        ):
+            m, p = paired_medians(batch_run(mine), batch_run(theirs), repeat)
+            print(f"| {name} | {algo} | {t} | {m * 1e3:.2f} | {p * 1e3:.2f} | {m / p:.2f} | {p / m:.1f}x |")
 
 
 if __name__ == "__main__":
