@@ -191,7 +191,14 @@
   const play = document.getElementById("armdyn-play");
   const loop = document.getElementById("armdyn-loop");
   const clock = document.getElementById("armdyn-time");
-  let frame = 0, playing = false, t0 = 0, last = 0;
+  let frame = 0, playing = false, t0 = 0, last = 0, token = 0;
+  // the next tick on the next animation frame, or after 40 ms if no frame comes first (a
+  // headless or throttled page may paint no frames): whichever fires first runs it
+  function schedule() {
+    const id = ++token;
+    requestAnimationFrame((now) => { if (id === token) tick(now); });
+    setTimeout(() => { if (id === token) tick(performance.now()); }, 40);
+  }
   function go(k) {
     frame = k;
     show(k);
@@ -212,7 +219,7 @@
       if (k !== last) go(k);
       last = k;
     }
-    requestAnimationFrame(tick);
+    schedule();
   }
   if (play) {
     play.addEventListener("click", () => {
@@ -221,7 +228,7 @@
       if (playing) {
         if (frame === nF - 1) go(0);
         t0 = performance.now() - (S.times[frame] - S.times[0]) * 1000;
-        requestAnimationFrame(tick);
+        schedule();
       }
     });
     slider.addEventListener("input", () => { go(Number(slider.value)); t0 = performance.now() - (S.times[frame] - S.times[0]) * 1000; });
