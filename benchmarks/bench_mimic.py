@@ -84,8 +84,11 @@ def main() -> None:
     print(f"Pinocchio {pin.__version__}; N = {N} for batches; times are medians, ratio = armdyn / Pinocchio")
     for label, rel in ROBOTS.items():
         path = root / rel
-        robot = load(path)
-        free = load(path, "\n".join(line for line in path.read_text().splitlines() if "<mimic" not in line))
+        # Pinocchio's rnea has no joint friction or damping: the URDF's <dynamics> left out
+        robot = load(path).without_joint_dynamics()
+        free = load(
+            path, "\n".join(line for line in path.read_text().splitlines() if "<mimic" not in line)
+        ).without_joint_dynamics()
         model = pin.buildModelFromUrdf(str(path), mimic=True)
         data = model.createData()
         n = robot.dof
