@@ -153,7 +153,7 @@ def test_a_state_that_overflows_is_an_error_not_inf(arm):
 
 # ------------------------------------------------------------------ results reused once dropped
 # The core keeps a few small single-state results and writes a new result into one only
-# when nothing else refers to it (lib.rs, OutputPool): a result the caller holds, or
+# when nothing else refers to it (scratch.rs, OutputPool): a result the caller holds, or
 # anything seen through it, never changes.
 
 
