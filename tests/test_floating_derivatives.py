@@ -79,6 +79,32 @@ def test_derivatives_agree_with_pinocchio(name):
 
 @needs_pinocchio
 @pytest.mark.parametrize("name", MUST_LOAD)
+def test_gravity_bias_and_gravity_derivatives_agree_with_pinocchio(name):
+    """g(q), h(q, v) and dg/dq on the tangent space against computeGeneralizedGravity,
+    nonLinearEffects and computeGeneralizedGravityDerivatives; one state and a batch."""
+    robot, model = _load_pair(name)
+    data = model.createData()
+    rng = np.random.default_rng(21)
+    Q, V = [], []
+    for _ in range(3):
+        q, v, _ = floating_state(robot, rng)
+        qp, vp, _, perm = pin_state(model, robot, q, v, v)
+        P = np.ix_(perm, perm)
+        g = numeric.gravity(robot, q)
+        assert g.shape == (robot.nv,) and close(g[perm], pin.computeGeneralizedGravity(model, data, qp)) < TOL
+        assert close(numeric.bias(robot, q, v)[perm], pin.nonLinearEffects(model, data, qp, vp)) < TOL
+        dg = numeric.gravity_derivatives(robot, q)
+        assert close(dg[P], pin.computeGeneralizedGravityDerivatives(model, data, qp)) < TOL
+        Q.append(q)
+        V.append(v)
+    Q, V = np.array(Q), np.array(V)
+    assert np.array_equal(numeric.gravity(robot, Q)[1], numeric.gravity(robot, Q[1]))
+    assert np.array_equal(numeric.bias(robot, Q, V)[2], numeric.bias(robot, Q[2], V[2]))
+    assert np.array_equal(numeric.gravity_derivatives(robot, Q)[0], numeric.gravity_derivatives(robot, Q[0]))
+
+
+@needs_pinocchio
+@pytest.mark.parametrize("name", MUST_LOAD)
 def test_arrays_pass_unchanged(name):
     """solo12, anymal, talos: Pinocchio's arrays as they are, large velocities."""
     robot, model = _load_pair(name)

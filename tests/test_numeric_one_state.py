@@ -230,11 +230,8 @@ def test_a_result_resizes_in_place_without_the_reference_check(arm):
 
 
 FIXED_BASE_ONLY = {
-    "gravity": lambda r, q, v: num.gravity(r, q),
-    "bias": lambda r, q, v: num.bias(r, q, v),
     "coriolis_matrix": lambda r, q, v: num.coriolis_matrix(r, q, v),
     "jacobian_dot": lambda r, q, v: num.jacobian_dot(r, q, v, 1),
-    "gravity_derivatives": lambda r, q, v: num.gravity_derivatives(r, q),
     "regressor": lambda r, q, v: num.regressor(r, q, v, v, columns="all"),
 }
 

@@ -604,7 +604,8 @@ class Robot(metaclass=FreezeAfterInit):
         if self.floating:
             raise FloatingBaseError(
                 f"{what} does not support a floating base (root_joint='free-flyer') yet; "
-                "armdyn.numeric's rnea, crba, aba, rnea_derivatives, aba_derivatives, minverse, forward_kinematics, jacobian and energies, "
+                "armdyn.numeric's rnea, crba, aba, gravity, bias, their derivatives, minverse, forward_kinematics, "
+                "jacobian and energies, "
                 "and armdyn.centroidal, do",
                 f"robot '{self.name}'",
                 self.meta.get("file"),

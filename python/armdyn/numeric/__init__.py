@@ -34,8 +34,8 @@ Conventions (docs/architecture.md): SI units, radians; ``M(q) qdd + C(q, qd) qd 
 gravity is the robot's vector in the base frame; frames as in :mod:`armdyn.model`.
 
 A floating base (``armdyn.load(path, root_joint="free-flyer")``, ``robot.floating``):
-``rnea``, ``crba``, ``aba``, ``rnea_derivatives``, ``aba_derivatives`` and ``minverse``
-take Pinocchio's arrays, unchanged: ``q`` is
+``rnea``, ``crba``, ``aba``, ``rnea_derivatives``, ``aba_derivatives`` and ``minverse`` (and
+``gravity``, ``bias``, ``gravity_derivatives``: theirs at rest) take Pinocchio's arrays, unchanged: ``q`` is
 ``(robot.nq,) = (7 + dof,)``, the base origin in the world frame (3), the base
 orientation as a unit quaternion ``x, y, z, w`` (4; base axes in world coordinates),
 then the joints; ``qd``, ``qdd`` and ``tau`` are ``(robot.nv,) = (6 + dof,)``: the base's

@@ -48,7 +48,8 @@ def require_fixed_base(robot, what: str) -> None:
             robot.require_fixed_base(what)
         raise FloatingBaseError(
             f"{what} does not support a floating base (root_joint='free-flyer') yet; rnea, crba, aba, "
-            "rnea_derivatives, aba_derivatives, minverse, forward_kinematics, jacobian, the energies and "
+            "gravity, bias, the rnea, aba and gravity derivatives, minverse, forward_kinematics, jacobian, "
+            "the energies and "
             "armdyn.centroidal do",
             f"robot '{robot.name}'",
         )

@@ -9,6 +9,7 @@ from numpy.typing import ArrayLike
 from .. import _core
 from .checks import check_threads, fixed_base_threads, overflow_error
 from .compiled import NumericModel, RobotLike, canonical_wrenches, compiled_model, core_model, mimic_model
+from .dynamics import at_rest
 
 # rnea_derivatives, aba_derivatives and minverse decide here which path a call takes: the
 # common one (a Robot already compiled to a plain NumericModel, or that model itself, and
@@ -169,7 +170,12 @@ def _minverse_path(robot, q, threads, out):
 
 
 def gravity_derivatives(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
-    """``dg/dq`` of the gravity torques: (n, n) or (N, n, n), ``[i, j] = d g_i / d q_j``."""
+    """``dg/dq`` of the gravity torques: (n, n) or (N, n, n), ``[i, j] = d g_i / d q_j``. A
+    floating base: (nv, nv), on the tangent space (``rnea_derivatives`` at rest, as
+    Pinocchio's ``computeGeneralizedGravityDerivatives``)."""
+    if getattr(robot, "floating", False):
+        zero = at_rest(robot, q)
+        return rnea_derivatives(robot, q, zero, zero, threads=threads)[0]
     threads = fixed_base_threads(robot, threads, "gravity_derivatives")
     try:
         mimic = mimic_model(robot, "gravity_derivatives")

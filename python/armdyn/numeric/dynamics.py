@@ -114,8 +114,20 @@ def aba(
     return _core.aba_ext(core_model(robot, "aba with f_ext"), q, qd, tau, f_ext, frame, threads)
 
 
+def at_rest(robot: RobotLike, q: ArrayLike) -> np.ndarray:
+    """Zeros of ``robot.nv`` per state of ``q`` (one state or a batch): a floating robot's
+    velocities or accelerations at rest, for the quantities that are rnea's at them."""
+    nv: int = robot.nv  # type: ignore[union-attr]  # only floating robots come here: a Robot or its model
+    shape = np.shape(q)
+    return np.zeros((*shape[:-1], nv) if len(shape) in (1, 2) else (nv,))
+
+
 def gravity(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
-    """Gravity torques g(q) = rnea(q, 0, 0). q: (n,) or (N, n); same shape out."""
+    """Gravity torques g(q) = rnea(q, 0, 0). q: (n,) or (N, n); same shape out. A floating
+    base: q (nq,) or (N, nq), g (nv,) or (N, nv) (the base's wrench first)."""
+    if getattr(robot, "floating", False):
+        zero = at_rest(robot, q)
+        return rnea(robot, q, zero, zero, threads=threads)
     threads = fixed_base_threads(robot, threads, "gravity")
     try:
         return compiled_model(robot).gravity_torques(q, threads)
@@ -126,8 +138,11 @@ def gravity(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np
 def bias(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """Nonlinear effects h(q, qd) = C(q, qd) qd + g(q) = rnea(q, qd, 0).
 
-    q, qd: (n,) or (N, n); same shape out.
+    q, qd: (n,) or (N, n); same shape out. A floating base: q (nq,), qd and h (nv,) (or
+    with a leading N).
     """
+    if getattr(robot, "floating", False):
+        return rnea(robot, q, qd, at_rest(robot, q), threads=threads)
     threads = fixed_base_threads(robot, threads, "bias")
     try:
         return compiled_model(robot).bias(q, qd, threads)
