@@ -80,12 +80,12 @@ def grade(
         read_model, report = most_supported(read_model, report, with_model)
     from .robot_text.support import carry_own_values
 
-    carry_own_values(sub, report)  # a step the method has no formula for, on a wrong earlier one
+    reading = carry_own_values(sub, report)  # a step the method has no formula for, on a wrong earlier one
     if read_model is not None:
         from .robot_text.support import disagreeing, own_values_instead
 
         if disagreeing(report):  # the reading, not the text, is likely wrong: the text's own values
-            own = own_values_instead(sub, report)
+            own = own_values_instead(sub, report, reading)
             if own is not report:
                 return own
         report.model_note = read_model.note()  # the report's first line: what was graded against

@@ -68,6 +68,7 @@ class OwnValues:
 
     def __init__(self, sub: Submission, why: str):
         self.sub, self.why = sub, why
+        self.passed = False  # whether run() has been over the equations
         eqs = [e for e in sub.equations[:MAX_EQUATIONS]]
         joints, _ = joint_candidates(eqs, sub.symbols)
         # joints past a hand derivation's count are not read (n^3 Christoffel symbols stay small)
@@ -198,8 +199,12 @@ class OwnValues:
 
     # -- the pass
     def run(self) -> GradeReport:
-        for eq in self.sub.equations[:MAX_EQUATIONS]:
-            self._equation(eq)
+        """The report, ``why`` its first note. The pass over the equations is made once: a
+        second call (``why`` changed) reports the same verdicts."""
+        if not self.passed:
+            for eq in self.sub.equations[:MAX_EQUATIONS]:
+                self._equation(eq)
+            self.passed = True
         first_wrong = next((v.name for v in self.verdicts if v.status == "wrong"), None)
         tau_ok = [False] * self.n
         for v in self.verdicts:

@@ -71,14 +71,15 @@ def disagreeing(report: GradeReport) -> bool:
     return trouble >= 3 and 2 * trouble > len(steps)
 
 
-def carry_own_values(sub, report: GradeReport) -> None:
+def carry_own_values(sub, report: GradeReport):
     """A step found wrong that is exactly what the text's own earlier values give, one of them
     found wrong (``V = V_1 + V_2 + V_3`` after a wrong ``V_3``, ``G_k = \\partial V/\\partial q_k``
     after it): ``follows-from-earlier-error``, as the method's own formulas mark the steps they
     compute. The text's values are read as :mod:`.own_values` reads them; only with two steps
-    wrong or more (one alone inherits nothing)."""
+    wrong or more (one alone inherits nothing). Returns that reading (an :class:`OwnValues`
+    already run, for :func:`own_values_instead`), or None when there was none to make."""
     if sum(v.status == "wrong" for v in report.steps) < 2:
-        return
+        return None
     from .own_values import OwnValues
 
     own = OwnValues(sub, "")
@@ -94,17 +95,21 @@ def carry_own_values(sub, report: GradeReport) -> None:
                 v.message = f"follows from the error in {cause}: {how}"
         by_line.setdefault(v.line, []).append(v)
     report.first_wrong = next((v.name for v in report.steps if v.status == "wrong"), None)
+    return own
 
 
-def own_values_instead(sub, report: GradeReport) -> GradeReport:
+def own_values_instead(sub, report: GradeReport, reading=None) -> GradeReport:
     """The text graded on its own values when the model read disagrees with most of its steps,
-    kept when it finds fewer steps wrong (or as many, reading more); else ``report``."""
-    from .own_values import grade_without_model
+    kept when it finds fewer steps wrong (or as many, reading more); else ``report``.
+    ``reading``: the :class:`OwnValues` :func:`carry_own_values` already ran, if any."""
+    from .own_values import OwnValues
 
     wrong = _wrong(report)
     unknown = sum(_unknown_name(v) for v in report.steps)
     why = f"{wrong} found wrong" + (f", {unknown} using names it does not have" if unknown else "")
-    own = grade_without_model(sub, f"the model read from the text disagrees with most of its steps ({why})")
+    reading = reading if reading is not None else OwnValues(sub, "")
+    reading.why = f"the model read from the text disagrees with most of its steps ({why})"
+    own = reading.run()
     if _wrong(own) < wrong or (_wrong(own) == wrong and _read(own) > _read(report)):
         return own
     return report
