@@ -43,7 +43,7 @@ import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_numeric import batch_run, paired_medians, per_call_run  # noqa: E402  (the same timing as the arms')
+from bench_numeric import batch_pairs, paired_medians, per_call_run  # noqa: E402  (the same timing as the arms')
 
 import armdyn  # noqa: E402
 from armdyn import centroidal as cen  # noqa: E402
@@ -54,6 +54,18 @@ ROBOTS = {
     "anymal": "anymal_b_simple_description/robots/anymal.urdf",
     "talos": "talos_data/robots/talos_reduced.urdf",
 }
+
+
+def load_pair(name: str):
+    """(armdyn robot, Pinocchio model) of ``ROBOTS[name]`` with a free-flyer root, the URDF's
+    joint friction left out (Pinocchio's algorithms have none); their joints in one order."""
+    urdf = robots_dir() / ROBOTS[name]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = armdyn.load(urdf, strict=False, root_joint="free-flyer").without_joint_dynamics()
+    model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+    assert list(model.names)[2:] == list(robot.coordinate_names), "the same joint order"
+    return robot, model
 
 
 def robots_dir() -> Path:
@@ -76,14 +88,9 @@ def main() -> None:
     print("| --- | --- | --- | --- | --- | --- |")
     rng = np.random.default_rng(0)
     batches: list[tuple] = []
-    for name, rel in ROBOTS.items():
-        urdf = robots_dir() / rel
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            robot = armdyn.load(urdf, strict=False, root_joint="free-flyer").without_joint_dynamics()
-        model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+    for name in ROBOTS:
+        robot, model = load_pair(name)
         data = model.createData()
-        assert list(model.names)[2:] == list(robot.coordinate_names), "the same joint order"
         q = num.random_configuration(robot, rng)
         v, a = rng.uniform(-1, 1, (2, robot.nv))
         tau = num.rnea(robot, q, v, a)
@@ -129,27 +136,8 @@ def batch_rows(name: str, robot, model, n: int, repeat: int, rng) -> None:
     """The batch table's rows of one robot (see the module doc), checked equal first."""
     Q = np.ascontiguousarray([num.random_configuration(robot, rng) for _ in range(n)])
     V, A = (np.ascontiguousarray(rng.uniform(-1, 1, (n, robot.nv))) for _ in range(2))
-    TAU = num.rnea(robot, Q, V, A)
-    q_p, v_p, a_p, tau_p = Q.T, V.T, A.T, np.asfortranarray(TAU.T)  # Pinocchio's (n, N) column-major views
-    out = np.zeros((robot.nv, n), order="F")
-    pin.rneaInParallel(1, pin.ModelPool(model, 1), q_p, v_p, a_p, out)
-    assert np.max(np.abs(out - tau_p)) <= 1e-9 * max(1.0, np.max(np.abs(tau_p)))
-    for t in (1, 2):
-        pool = pin.ModelPool(model, t)
-        for algo, mine, theirs in (
-            (
-                "rnea",
-                lambda: num.rnea(robot, Q, V, A, threads=t),
-                lambda: pin.rneaInParallel(t, pool, q_p, v_p, a_p, out),
-            ),
-            (
-                "aba",
-                lambda: num.aba(robot, Q, V, TAU, threads=t),
-                lambda: pin.abaInParallel(t, pool, q_p, v_p, tau_p, out),
-            ),
-        ):
-            m, p = paired_medians(batch_run(mine), batch_run(theirs), repeat)
-            print(f"| {name} | {algo} | {t} | {m * 1e3:.2f} | {p * 1e3:.2f} | {m / p:.2f} | {p / m:.1f}x |")
+    for algo, t, m, p in batch_pairs(robot, model, Q, V, A, (1, 2), repeat, relative=True):
+        print(f"| {name} | {algo} | {t} | {m * 1e3:.2f} | {p * 1e3:.2f} | {m / p:.2f} | {p / m:.1f}x |")
 
 
 if __name__ == "__main__":

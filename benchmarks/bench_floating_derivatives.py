@@ -25,16 +25,14 @@ import argparse
 import os
 import platform
 import sys
-import warnings
 
 import numpy as np
 import pinocchio as pin
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_floating import ROBOTS, robots_dir  # noqa: E402
+from bench_floating import ROBOTS, load_pair  # noqa: E402
 from bench_numeric import paired_medians, per_call_run  # noqa: E402
 
-import armdyn  # noqa: E402
 from armdyn import numeric as num  # noqa: E402
 
 
@@ -81,14 +79,9 @@ def main() -> None:
     print("| robot | nv | algorithm | armdyn (us) | Pinocchio (us) | ratio |")
     print("| --- | --- | --- | --- | --- | --- |")
     rng = np.random.default_rng(0)
-    for name, rel in ROBOTS.items():
-        urdf = robots_dir() / rel
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            robot = armdyn.load(urdf, strict=False, root_joint="free-flyer").without_joint_dynamics()
-        model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+    for name in ROBOTS:
+        robot, model = load_pair(name)
         data = model.createData()
-        assert list(model.names)[2:] == list(robot.coordinate_names), "the same joint order"
         q = num.random_configuration(robot, rng)
         v, a = rng.uniform(-1, 1, (2, robot.nv))
         tau = num.rnea(robot, q, v, a)

@@ -62,6 +62,37 @@ def per_call_run(f, args, number: int, clock=time.perf_counter):
     return lambda: timer.timeit(number) / number
 
 
+def batch_pairs(robot, model, Q, V, A, threads, repeat: int, relative: bool = False) -> list:
+    """``(fn, t, armdyn s, Pinocchio s)`` for rnea and aba on the batch ``Q, V, A`` ((N, nq),
+    (N, nv) C-contiguous) on ``t`` threads each: ``armdyn.rnea/aba(..., threads=t)`` against
+    ``pin.rneaInParallel/abaInParallel`` into a preallocated output, medians of ``repeat``
+    alternating runs. Pinocchio's batch is first checked equal to armdyn's to 1e-9 (``relative``:
+    times the largest torque, at least 1)."""
+    TAU = num.rnea(robot, Q, V, A)
+    # Pinocchio's batches are (n, N) column-major: the transposes are views, no copy
+    q_p, v_p, a_p, tau_p = Q.T, V.T, A.T, np.asfortranarray(TAU.T)
+    out = np.zeros(tau_p.shape, order="F")
+    scale = max(1.0, float(np.max(np.abs(TAU)))) if relative else 1.0
+    assert np.max(np.abs(pin.rneaInParallel(1, pin.ModelPool(model, 1), q_p, v_p, a_p) - tau_p)) <= 1e-9 * scale
+    found = []
+    for t in threads:
+        pool = pin.ModelPool(model, t)
+        for fn, mine, theirs in (
+            (
+                "rnea",
+                lambda: num.rnea(robot, Q, V, A, threads=t),
+                lambda: pin.rneaInParallel(t, pool, q_p, v_p, a_p, out),
+            ),
+            (
+                "aba",
+                lambda: num.aba(robot, Q, V, TAU, threads=t),
+                lambda: pin.abaInParallel(t, pool, q_p, v_p, tau_p, out),
+            ),
+        ):
+            found.append((fn, t, *paired_medians(batch_run(mine), batch_run(theirs), repeat)))
+    return found
+
+
 def batch_run(f):
     """A function timing one call ``f()``; returns seconds."""
 
@@ -144,27 +175,8 @@ def main(argv=None) -> int:
             rows.append((name, fn, "1 state", t_mine, t_pin))
 
         Q, V, A = (np.ascontiguousarray(rng.uniform(-np.pi, np.pi, (N, robot.dof))) for _ in range(3))
-        TAU = num.rnea(robot, Q, V, A)
-        # Pinocchio's batches are (n, N) column-major: the transposes are views, no copy
-        q_p, v_p, a_p, tau_p = Q.T, V.T, A.T, np.asfortranarray(TAU.T)
-        out = np.zeros((robot.dof, N), order="F")
-        assert np.max(np.abs(pin.rneaInParallel(1, pin.ModelPool(model, 1), q_p, v_p, a_p) - tau_p)) <= 1e-9
-        for t in threads:
-            pool = pin.ModelPool(model, t)
-            for fn, mine, theirs in (
-                (
-                    "rnea",
-                    lambda: num.rnea(robot, Q, V, A, threads=t),
-                    lambda: pin.rneaInParallel(t, pool, q_p, v_p, a_p, out),
-                ),
-                (
-                    "aba",
-                    lambda: num.aba(robot, Q, V, TAU, threads=t),
-                    lambda: pin.abaInParallel(t, pool, q_p, v_p, tau_p, out),
-                ),
-            ):
-                t_mine, t_pin = paired_medians(batch_run(mine), batch_run(theirs), args.batch_repeat)
-                rows.append((name, fn, f"N={N}, {t} thr", t_mine, t_pin))
+        for fn, t, t_mine, t_pin in batch_pairs(robot, model, Q, V, A, threads, args.batch_repeat):
+            rows.append((name, fn, f"N={N}, {t} thr", t_mine, t_pin))
         for t in threads:  # no crbaInParallel in Pinocchio: armdyn's throughput alone
             run = batch_run(lambda: num.crba(robot, Q, threads=t))
             t_mine, _ = paired_medians(run, lambda: 0.0, args.batch_repeat)
