@@ -131,9 +131,11 @@ def _floating_q(robot, q: list[float]) -> list[float]:
     """A floating robot's ``--q``: its joints alone (the base at the origin, unturned) or its
     whole configuration, whose quaternion, typed to a few digits, is normalised when within
     1e-4 of unit length (said on stderr); further off it is refused."""
-    dof = robot.nv - 6
+    from .configuration import neutral
+
+    dof = robot.dof
     if len(q) == dof:
-        return [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, *q]
+        return [*neutral(robot)[:7], *q]
     if len(q) != dof + 7:
         raise ValueError(
             f"--q: {len(q)} values for a floating robot with {dof} joints: give the {dof} joints, or "
