@@ -27,7 +27,21 @@ from .numbers import (
 )
 from .rotations import axis_angle_matrix
 
-JOINT_TYPES = ("revolute", "prismatic", "fixed")
+JOINT_TYPES = ("revolute", "prismatic", "fixed", "spherical", "planar", "floating")
+#: The joints of several coordinates, in Pinocchio's layouts (docs/architecture.md,
+#: "Joint kinds"): type -> (nq, nv, the names of the velocity coordinates). Velocities
+#: are the child frame's motion relative to the parent, in child-frame axes.
+#:
+#: * spherical: q = the rotation's unit quaternion x, y, z, w; v = the angular velocity;
+#: * planar: q = x, y (in the placement frame), cos, sin of the turn about z; v = the
+#:   linear velocity along the moved x and y axes, then the turn's rate;
+#: * floating: q = the position (placement frame) then the unit quaternion x, y, z, w;
+#:   v = the linear velocity of the child frame's origin, then the angular velocity.
+MULTI_DOF = {
+    "spherical": (4, 3, ("wx", "wy", "wz")),
+    "planar": (4, 3, ("vx", "vy", "wz")),
+    "floating": (7, 6, ("vx", "vy", "vz", "wx", "wy", "wz")),
+}
 #: Joint fields that add to tau (docs/architecture.md: Fv, Fc, Ia, offset), in that naming.
 JOINT_DYNAMICS = ("damping", "friction", "armature", "torque_offset")
 
@@ -116,7 +130,9 @@ class Mimic:
 class Joint:
     """A joint between ``parent`` and ``child`` links.
 
-    type:     "revolute", "prismatic" or "fixed".
+    type:     "revolute", "prismatic", "fixed", or one of several coordinates
+              (:data:`MULTI_DOF`): "spherical", "planar" (in the placement frame's x-y
+              plane) or "floating"; those take no axis, mimic, limits or joint dynamics.
     xyz:      (3, 1) placement translation in the parent link frame (m).
     rotation: (3, 3) placement rotation: placement-frame axes in the parent frame.
     axis:     (3, 1) unit axis of motion in the placement frame (ignored when fixed).
@@ -181,6 +197,13 @@ class Joint:
                 raise ModelError(f"mimic must be a Mimic, got {type(self.mimic).__name__}", where)
             if self.type == "fixed":
                 raise ModelError("a fixed joint cannot mimic another joint", where)
+        if self.type in MULTI_DOF:
+            given = [k for k in ("lower", "upper", "velocity") + JOINT_DYNAMICS if self.__dict__[k] is not None]
+            if self.mimic is not None or given:
+                what = "mimic" if self.mimic is not None else ", ".join(given)
+                raise ModelError(
+                    f"a {self.type} joint takes no {what} (not modelled for joints of several coordinates)", where
+                )
         _check_joint_dynamics(self, where)
         for key in ("rotation", "frame_rotation"):
             if self.__dict__[key] is EYE3:  # the default: a rotation, no check needed
@@ -193,6 +216,8 @@ class Joint:
                 if not (np.all(np.abs(R.T @ R - I3) <= 1e-9 + 1e-5 * I3) and det > 0):
                     raise ModelError(f"{key} {R.tolist()} is not a proper rotation matrix", where)
         axis = self.__dict__["axis"]
+        if self.type in MULTI_DOF:
+            return  # no axis: the motion is in the placement frame's own axes
         if self.type != "fixed" and isinstance(axis, Numbers):  # numbers: checked without SymPy
             norm = float(np.linalg.norm(axis.floats))
             if norm == 0:
@@ -214,6 +239,25 @@ class Joint:
     def movable(self) -> bool:
         return self.type != "fixed"
 
+    @property
+    def nq(self) -> int:
+        """Configuration coordinates of the joint: 0 fixed, 1 revolute or prismatic, 4
+        spherical or planar, 7 floating (a mimic joint's are its leader's)."""
+        return MULTI_DOF[self.type][0] if self.type in MULTI_DOF else int(self.movable)
+
+    @property
+    def nv(self) -> int:
+        """Velocity coordinates of the joint: 0, 1, 3 (spherical, planar) or 6 (floating)."""
+        return MULTI_DOF[self.type][1] if self.type in MULTI_DOF else int(self.movable)
+
+    @property
+    def coordinate_names(self) -> tuple[str, ...]:
+        """The names of its velocity coordinates: the joint's own name for a joint of one,
+        ``<name>.wx`` and so on for the others (:data:`MULTI_DOF`), none when fixed."""
+        if self.type in MULTI_DOF:
+            return tuple(f"{self.name}.{c}" for c in MULTI_DOF[self.type][2])
+        return (self.name,) if self.movable else ()
+
     def floats(self, name: str):
         """``xyz``, ``axis``, ``frame_xyz`` (shape ``(3,)``), ``rotation`` or
         ``frame_rotation`` (``(3, 3)``) as a float array without building SymPy
@@ -231,7 +275,9 @@ class Joint:
     def motion(self, q=0) -> tuple[sp.Matrix, sp.Matrix]:
         """The child frame in the placement frame at coordinate ``q``: ``(R, p)``, the
         joint's motion followed by the fixed ``frame`` offset."""
-        if self.type == "revolute":
+        if self.type in MULTI_DOF:
+            Rm, pm = multi_dof_motion(self.type, q)
+        elif self.type == "revolute":
             # at exactly 0 (the grouping's placements), Rodrigues' rotation is the identity
             at_zero = q is sp.S.Zero or (type(q) is int and q == 0)
             Rm, pm = sp.eye(3) if at_zero else axis_angle_matrix(self.axis, q), sp.zeros(3, 1)
@@ -278,6 +324,31 @@ class Joint:
         if self.type == "fixed" or r == zero:
             return zero, zero
         return qd * z.cross(r), qdd * z.cross(r) + qd**2 * z.cross(z.cross(r))
+
+
+def multi_dof_motion(kind: str, q) -> tuple[sp.Matrix, sp.Matrix]:
+    """``(R, p)`` of a joint of several coordinates (:data:`MULTI_DOF`) at its
+    configuration ``q`` ((nq,) numbers or SymPy expressions; ``0``: the neutral one, no
+    motion). Quaternions are used as given (unit length is the caller's to check)."""
+    if isinstance(q, (int, sp.Integer)) and q == 0:
+        return sp.eye(3), sp.zeros(3, 1)
+    q = list(q)
+    nq = MULTI_DOF[kind][0]
+    if len(q) != nq:
+        raise ModelError(f"a {kind} joint's configuration has {nq} coordinates, got {len(q)}")
+    if kind == "planar":
+        x, y, c, s = q
+        return sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]]), sp.Matrix([x, y, 0])
+    p = sp.Matrix(q[:3]) if kind == "floating" else sp.zeros(3, 1)
+    x, y, z, w = q[-4:]
+    R = sp.Matrix(
+        [
+            [1 - 2 * (y**2 + z**2), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x**2 + z**2), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x**2 + y**2)],
+        ]
+    )
+    return R, p
 
 
 def coordinate_symbols(names: Iterable[str]) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:

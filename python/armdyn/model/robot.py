@@ -13,7 +13,7 @@ from ..dispatch import call
 from ..errors import FloatingBaseError, ModelError
 from ..inertia import check_physical, physical_violations
 from .frozen import FreezeAfterInit, FrozenDict, FrozenList
-from .joints import JOINT_DYNAMICS, Joint, Link, coordinate_symbols
+from .joints import JOINT_DYNAMICS, MULTI_DOF, Joint, Link, coordinate_symbols
 from .numbers import Numbers, mat3, vec3
 
 _CACHES = ("_numeric_model", "_canonical")
@@ -192,11 +192,20 @@ class Robot(metaclass=FreezeAfterInit):
         # joints with a coordinate of their own; mimic joints move but follow a leader
         self.movable_joints = [j for j in self.joints if j.movable and j.mimic is None]
         self.mimic_joints = [j for j in self.joints if j.mimic is not None]
-        self.dof = len(self.movable_joints)
+        # joints of several coordinates (spherical, planar, floating; Pinocchio's layouts)
+        self.multi_dof_joints = [j for j in self.movable_joints if j.type in MULTI_DOF]
+        self.dof = sum(j.nv for j in self.movable_joints)
         self.floating = root_joint == "free-flyer"
-        self.nq = self.dof + 7 if self.floating else self.dof
-        self.nv = self.dof + 6 if self.floating else self.dof
-        self.coordinate_names = [j.name for j in self.movable_joints]
+        base_q, base_v = (7, 6) if self.floating else (0, 0)
+        self.nq = base_q + sum(j.nq for j in self.movable_joints)
+        self.nv = base_v + self.dof
+        self.coordinate_names = [c for j in self.movable_joints for c in j.coordinate_names]
+        # (joint name, type, first index in q, first index in v) per movable joint
+        layout, iq, iv = [], base_q, base_v
+        for j in self.movable_joints:
+            layout.append((j.name, j.type, iq, iv))
+            iq, iv = iq + j.nq, iv + j.nv
+        self.configuration_layout = tuple(layout)
         self.q, self.qd, self.qdd = coordinate_symbols(self.coordinate_names)
         clash = set(self.coordinate_names) & set(self.parameters)
         if clash:
@@ -204,6 +213,7 @@ class Robot(metaclass=FreezeAfterInit):
         self._link_index = {name: i for i, name in enumerate(self.links)}
         # index of each movable joint's coordinate, None for fixed joints
         coordinate = {n: i for i, n in enumerate(self.coordinate_names)}
+        coordinate.update({j.name: coordinate[j.coordinate_names[0]] for j in self.multi_dof_joints})
         self._coord_index = {j.name: coordinate.get(j.name) if j.movable else None for j in self.joints}
         self._parent_joint = {j.child: j for j in self.joints}
         self._children: dict[str, list[Joint]] = {}
@@ -215,6 +225,7 @@ class Robot(metaclass=FreezeAfterInit):
         self.joints = FrozenList(self.joints)
         self.movable_joints = FrozenList(self.movable_joints)
         self.mimic_joints = FrozenList(self.mimic_joints)
+        self.multi_dof_joints = FrozenList(self.multi_dof_joints)
         self.coordinate_names = FrozenList(self.coordinate_names)
         self.links = FrozenDict(self.links)
         self.parameters = FrozenDict(self.parameters)
@@ -611,8 +622,24 @@ class Robot(metaclass=FreezeAfterInit):
                 self.meta.get("file"),
             )
 
+    def require_one_dof_joints(self, what: str) -> None:
+        """Raise :class:`~armdyn.errors.ModelError` naming ``what`` if a joint has several
+        coordinates (spherical, planar, floating): for what handles revolute and
+        prismatic joints only (yet)."""
+        if self.multi_dof_joints:
+            named = ", ".join(f"'{j.name}' ({j.type})" for j in self.multi_dof_joints[:3])
+            more = f" and {len(self.multi_dof_joints) - 3} more" if len(self.multi_dof_joints) > 3 else ""
+            raise ModelError(
+                f"{what} handles revolute and prismatic joints only (yet); this robot has joints of "
+                f"several coordinates: {named}{more}. armdyn.numeric's rnea, crba, aba, gravity, bias, "
+                "minverse, forward_kinematics, jacobian and energies, and armdyn.centroidal, take them",
+                f"robot '{self.name}'",
+                self.meta.get("file"),
+            )
+
     def __repr__(self) -> str:
-        kinds = "".join({"revolute": "R", "prismatic": "P", "fixed": "F"}[j.type] for j in self.joints)
+        letters = {"revolute": "R", "prismatic": "P", "fixed": "F", "spherical": "S", "planar": "L", "floating": "X"}
+        kinds = "".join(letters[j.type] for j in self.joints)
         extra = f", joint_dynamics={list(self.joint_dynamics)}" if self.joint_dynamics else ""
         extra += ", root_joint='free-flyer'" if self.floating else ""
         return f"Robot({self.name!r}, dof={self.dof}, joints={kinds}, parameters={sorted(self.parameters)}{extra})"
