@@ -199,10 +199,10 @@ def test_planar_drive_along_an_arc():
 @pytest.mark.parametrize(
     "slot, bad, message",
     [
-        (slice(8, 12), [0, 0, 0, 1.1], r"q\[8:12\] \(x, y, z, w\) of joint 'ball' \(spherical\)"),
-        (slice(15, 17), [1.0, 0.2], r"q\[15:17\] \(cos th, sin th\) of joint 'table' \(planar\)"),
-        (slice(20, 24), [0, 0, 0, 0.5], r"q\[20:24\] \(x, y, z, w\) of joint 'free' \(floating\)"),
-        (slice(3, 7), [0, 0, 0, 2.0], r"q\[3:7\] \(x, y, z, w\) of the base"),
+        (slice(8, 12), [0, 0, 0, 1.1], r"quaternion \(x, y, z, w\) q\[8:12\] of joint 'ball' \(spherical\)"),
+        (slice(15, 17), [1.0, 0.2], r"\(cos th, sin th\) pair q\[15:17\] of joint 'table' \(planar\)"),
+        (slice(20, 24), [0, 0, 0, 0.5], r"quaternion \(x, y, z, w\) q\[20:24\] of joint 'free' \(floating\)"),
+        (slice(3, 7), [0, 0, 0, 2.0], r"quaternion \(x, y, z, w\) q\[3:7\] of the base"),
     ],
 )
 def test_off_unit_length_is_refused_naming_joint_and_slice(slot, bad, message):
@@ -211,7 +211,7 @@ def test_off_unit_length_is_refused_naming_joint_and_slice(slot, bad, message):
     q[slot] = bad
     with pytest.raises(ValueError, match=message):
         integrate(robot, q, np.zeros(robot.nv))
-    with pytest.raises(ValueError, match=message.replace("q", "q1", 1)):
+    with pytest.raises(ValueError, match=message.replace(" q", " q1", 1)):
         difference(robot, neutral(robot), q)
     batch = np.array([neutral(robot)] * 3)
     batch[1] = q

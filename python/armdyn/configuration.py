@@ -98,29 +98,41 @@ def _layout(robot: Robot) -> _Layout:
     )
 
 
+def require_unit_length(x: np.ndarray, index: np.ndarray, labels, what: str, name: str) -> None:
+    """ValueError naming the first of the slices ``x[..., index[k]]`` (``index`` (k, w),
+    one row a slice; ``labels[k]`` what it belongs to) whose length is off 1 by more than
+    :data:`QUATERNION_TOL`, with the slice (``name[a:b]``) and, for a batch, how many rows.
+    ``what``: the slice's kind and parts, e.g. ``"quaternion (x, y, z, w)"``."""
+    if not len(labels):
+        return
+    err = np.abs(np.linalg.norm(x[..., index], axis=-1) - 1.0)  # (..., k)
+    bad = (err > QUATERNION_TOL).reshape(-1, len(labels)).any(axis=0)
+    if bad.any():
+        k = int(np.argmax(bad))
+        rows = ""
+        if x.ndim == 2:
+            rows = f" in {int(np.count_nonzero(err[:, k] > QUATERNION_TOL))} of {x.shape[0]} rows"
+        raise ValueError(
+            f"{name}: the {what} {name}[{index[k, 0]}:{index[k, -1] + 1}] of {labels[k]} does not have unit "
+            f"length{rows} (off by {float(np.max(err[..., k])):.3g}; tolerance {QUATERNION_TOL:g}): normalise it first"
+        )
+
+
 def _check_unit(layout: _Layout, q: np.ndarray, name: str) -> None:
     """ValueError naming the first joint whose quaternion (or planar (cos, sin) pair) in
-    ``q`` is off unit length by more than :data:`QUATERNION_TOL`."""
-    checks = (
-        (layout.se3_q[:, 3:7], layout.se3_names, "quaternion", "(x, y, z, w)"),
-        (layout.so3_q, layout.so3_names, "quaternion", "(x, y, z, w)"),
-        (layout.se2_q[:, 2:4], layout.se2_names, "(cos, sin) pair", "(cos th, sin th)"),
-    )
-    for index, labels, what, parts in checks:
-        if not len(labels):
-            continue
-        err = np.abs(np.linalg.norm(q[..., index], axis=-1) - 1.0)  # (..., k)
-        bad = (err > QUATERNION_TOL).reshape(-1, len(labels)).any(axis=0)
-        if bad.any():
-            k = int(np.argmax(bad))
-            where = f"{name}[{index[k, 0]}:{index[k, -1] + 1}]"
-            rows = ""
-            if q.ndim == 2:
-                rows = f" in {int(np.count_nonzero(err[:, k] > QUATERNION_TOL))} of {q.shape[0]} rows"
-            raise ValueError(
-                f"{name}: the {what} {where} {parts} of {labels[k]} does not have unit length{rows} "
-                f"(off by {float(np.max(err[..., k])):.3g}; tolerance {QUATERNION_TOL:g}): normalise it first"
-            )
+    ``q`` is off unit length (:func:`require_unit_length`)."""
+    require_unit_length(q, layout.se3_q[:, 3:7], layout.se3_names, "quaternion (x, y, z, w)", name)
+    require_unit_length(q, layout.so3_q, layout.so3_names, "quaternion (x, y, z, w)", name)
+    require_unit_length(q, layout.se2_q[:, 2:4], layout.se2_names, "(cos th, sin th) pair", name)
+
+
+def check_configuration(robot: Robot, q, name: str = "q") -> np.ndarray:
+    """``q`` as a float array (nq,) or (N, nq), checked: finite, every quaternion and
+    planar (cos, sin) pair of unit length (ValueError naming the joint and the slice)."""
+    q = _array(robot, q, robot.nq, name)
+    if robot.nq != robot.nv:
+        _check_unit(_layout(robot), q, name)
+    return q
 
 
 def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -375,4 +387,4 @@ def random_configuration(robot: Robot, rng: np.random.Generator, base_position: 
     return q
 
 
-__all__ = ["QUATERNION_TOL", "integrate", "difference", "neutral", "random_configuration"]
+__all__ = ["QUATERNION_TOL", "integrate", "difference", "neutral", "random_configuration", "check_configuration"]
