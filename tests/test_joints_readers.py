@@ -103,6 +103,20 @@ def test_urdf_layout_is_pinocchios():
     assert [model.joints[i].shortname() for i in (2, 4)] == ["JointModelPlanar", "JointModelFreeFlyer"]
 
 
+@needs_pinocchio
+def test_urdf_kinematics_agree_with_pinocchio():
+    """Each link's pose from the read model's joint transforms (not the numeric core) is
+    Pinocchio's, at armdyn's random configurations (the layouts are one)."""
+    robot, model = load_urdf(TREE), pin.buildModelFromXML(TREE)
+    data, rng = model.createData(), np.random.default_rng(6)
+    for _ in range(5):
+        q = numeric.random_configuration(robot, rng)
+        pin.framesForwardKinematics(model, data, q)
+        for link, (R, p) in link_poses(robot, q).items():
+            pose = data.oMf[model.getFrameId(link, pin.BODY)]
+            assert np.abs(R - pose.rotation).max() <= 1e-12 and np.abs(p - pose.translation).max() <= 1e-12, link
+
+
 def pinocchio_dynamics(model, q, v, a, tau):
     data = model.createData()
     M = pin.crba(model, data, q)
