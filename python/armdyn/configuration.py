@@ -30,6 +30,7 @@ them on the side of ``q``'s, as Pinocchio's).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -73,10 +74,16 @@ class _Layout:
 
 def _layout(robot: Robot) -> _Layout:
     """The robot's configuration space as groups of joints of one kind."""
+    return _grouped(robot.configuration_layout, robot.floating)
+
+
+@lru_cache(maxsize=64)
+def _grouped(configuration_layout: tuple, floating: bool) -> _Layout:
+    """:func:`_layout` of a layout (built once per layout: integrate runs in loops)."""
     groups: dict[str, tuple[list, list, list]] = {k: ([], [], []) for k in ("flat", "se3", "so3", "se2")}
     kinds = {"floating": ("se3", 7, 6), "spherical": ("so3", 4, 3), "planar": ("se2", 4, 3)}
-    entries = [("the base", "floating", 0, 0)] if robot.floating else []
-    entries += [(f"joint '{name}' ({kind})", kind, iq, iv) for name, kind, iq, iv in robot.configuration_layout]
+    entries = [("the base", "floating", 0, 0)] if floating else []
+    entries += [(f"joint '{name}' ({kind})", kind, iq, iv) for name, kind, iq, iv in configuration_layout]
     for label, kind, iq, iv in entries:
         group, nq, nv = kinds.get(kind, ("flat", 1, 1))
         qs, vs, names = groups[group]
