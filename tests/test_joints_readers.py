@@ -64,16 +64,6 @@ def tree(planar: str = '<axis xyz="0 0 1"/>', free: str = "") -> str:
 TREE = tree()
 
 
-def core_takes_several_coordinates() -> None:
-    """Skip until the numeric core takes joints of several coordinates (it lands in a
-    separate change; this guard goes with it)."""
-    robot = load_urdf(TREE)
-    try:
-        numeric.rnea(robot, numeric.neutral(robot), np.zeros(robot.nv), np.zeros(robot.nv))
-    except (KeyError, ModelError) as err:
-        pytest.skip(f"the numeric core does not take joints of several coordinates yet ({err})")
-
-
 # ------------------------------------------------------------------------ URDF
 
 
@@ -142,14 +132,12 @@ def compare_dynamics(robot, model, seed: int, states: int = 6) -> None:
 
 @needs_pinocchio
 def test_urdf_dynamics_agree_with_pinocchio():
-    core_takes_several_coordinates()
     compare_dynamics(load_urdf(TREE), pin.buildModelFromXML(TREE), seed=1)
 
 
 @needs_pinocchio
 def test_urdf_free_flyer_root_with_floating_and_planar_joints(tmp_path):
     """``root_joint="free-flyer"`` as before: the root floats too (Pinocchio's root joint)."""
-    core_takes_several_coordinates()
     path = tmp_path / "mixed.urdf"
     path.write_text(TREE)
     robot = load(path, root_joint="free-flyer")
@@ -386,7 +374,6 @@ def test_mjcf_kinematics_agree_with_mujoco(name):
 def test_mjcf_dynamics_agree_with_mujoco(name):
     """mj_fullM and mj_inverse's qfrc_inverse against armdyn's crba and rnea: ``M_mujoco
     = T^T M T`` and ``qfrc = T^T tau`` (T by hand), the state through from_mujoco_state."""
-    core_takes_several_coordinates()
     robot, model = read(MODELS[name]), mujoco_model(MODELS[name])
     data, rng = mujoco.MjData(model), np.random.default_rng(4)
     for _ in range(6):
