@@ -4,6 +4,8 @@ own compiler on the same text) at random states."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from optional import mujoco, needs_mujoco, needs_pinocchio, pin
@@ -324,10 +326,12 @@ def velocity_map(robot, model, qpos) -> np.ndarray:
     """``T`` with armdyn's ``v = T qvel``, by hand: the rotation's transpose on a free
     joint's linear velocity (MuJoCo: world axes, armdyn: body axes), 1 elsewhere."""
     layout = {name: iv for name, _, _, iv in robot.configuration_layout}
+    names = robot.meta["mujoco_joints"]  # MuJoCo's joints in order, unnamed ones named by armdyn
     T = np.zeros((robot.nv, model.nv))
     for j in range(model.njnt):
         mv, kind = model.jnt_dofadr[j], model.jnt_type[j]
-        iv = layout[model.joint(j).name]
+        assert model.joint(j).name in ("", names[j])
+        iv = layout[names[j]]
         if kind == FREE:
             a = model.jnt_qposadr[j]
             T[iv : iv + 3, mv : mv + 3] = rotation_wxyz(qpos[a + 3 : a + 7]).T
@@ -454,3 +458,42 @@ def test_mjcf_ball_range_and_stiffness_are_reported():
     with pytest.warns(MjcfIgnoredWarning, match="ball joint range.*joint stiffness|joint stiffness.*ball joint range"):
         robot = load_mjcf(text)
     assert robot.movable_joints[0].type == "spherical"
+
+
+@needs_mujoco
+def test_mujoco_test_model_with_its_ball_joint_and_free_bodies(tmp_path):
+    """MuJoCo's own test model (shipped in its wheel) with its ball joint and its five
+    free bodies (one of them carrying legs), so each free body hangs on a floating joint;
+    changed: its mesh made a sphere, the gravity compensation dropped, the ball's
+    damping and armature (inherited from its classes) set to 0; MuJoCo's springs and fluid
+    forces switched off (armdyn lists them as ignored)."""
+    source = Path(mujoco.__file__).parent / "testdata" / "model.xml"
+    if not source.is_file():
+        pytest.skip(f"mujoco {mujoco.__version__} ships no testdata/model.xml")
+    text = source.read_text().replace('type="mesh" mesh="icosahedron"', 'type="sphere"')
+    text = text.replace(' gravcomp="0.5"', "").replace(
+        'type="ball" class="wheel"', 'type="ball" damping="0" armature="0"'
+    )
+    path = tmp_path / "model.xml"
+    path.write_text(text)
+    with pytest.warns(MjcfIgnoredWarning, match="joint stiffness"):
+        robot = load_mjcf(path)
+    kinds = [k for _, k, _, _ in robot.configuration_layout]
+    assert (kinds.count("floating"), kinds.count("spherical")) == (5, 1) and not robot.floating
+    model = mujoco.MjModel.from_xml_path(str(path))
+    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_SPRING
+    model.opt.density = model.opt.viscosity = 0
+    model.opt.wind[:] = 0
+    data, rng = mujoco.MjData(model), np.random.default_rng(9)
+    for _ in range(4):
+        data.qpos[:] = random_qpos(model, rng)
+        data.qvel[:], data.qacc[:] = rng.uniform(-1.5, 1.5, (2, model.nv))
+        mujoco.mj_forward(model, data)
+        M = np.zeros((model.nv, model.nv))
+        mujoco.mj_fullM(model, data, M)
+        mujoco.mj_inverse(model, data)
+        q, v, a = from_mujoco_state(robot, data.qpos, data.qvel, data.qacc)
+        T = velocity_map(robot, model, data.qpos)
+        scale = max(1.0, np.abs(M).max(), np.abs(data.qfrc_inverse).max())
+        assert np.abs(T.T @ numeric.crba(robot, q) @ T - M).max() / scale <= TOL
+        assert np.abs(T.T @ numeric.rnea(robot, q, v, a) - data.qfrc_inverse).max() / scale <= TOL
