@@ -112,15 +112,16 @@ def load_mjcf(path_or_xml, strict: bool = True, floating: str | None = None) -> 
     """Read an MJCF file (a path) or MJCF text (a string holding ``<`` or a line break).
 
     Returns a numeric :class:`Robot` whose base is the world body (link ``"world"``),
-    its coordinates in MuJoCo's order (depth-first through the bodies as written): q is
-    MuJoCo's ``qpos``. With a free root body the robot floats, its base that body, its
+    its coordinates in MuJoCo's order (depth-first through the bodies as written): with
+    hinge and slide joints only, q is MuJoCo's ``qpos``. With a free root body the robot
+    floats, its base that body; floating base, free bodies and ball joints have their
     arrays in Pinocchio's layout (:mod:`armdyn.io.mjcf_state` converts). Unnamed joints
     and bodies are called ``joint_<n>``, ``body_<n>``.
     ``strict=False`` loads physically invalid inertias with a warning instead of an error.
     ``floating="weld"``: a ``free`` joint of a body of the world body is read as a fixed
     base (the body welded at its pose); without it that body floats.
     ``robot.meta``: ``convention`` ("mjcf"), ``file``, ``ignored`` (what was not used),
-    ``massless_links``, ``intermediate_links``, ``mujoco_joints`` (the coordinates in
+    ``massless_links``, ``intermediate_links``, ``mujoco_joints`` (the movable joints in
     MuJoCo's order) and, floating, ``base_pose`` (the body's pose as written, MuJoCo's
     ``qpos0``: position and quaternion ``w x y z``); with free bodies on floating joints,
     ``free_poses`` (the same, per floating joint's name).
