@@ -497,3 +497,26 @@ def test_mujoco_test_model_with_its_ball_joint_and_free_bodies(tmp_path):
         scale = max(1.0, np.abs(M).max(), np.abs(data.qfrc_inverse).max())
         assert np.abs(T.T @ numeric.crba(robot, q) @ T - M).max() / scale <= TOL
         assert np.abs(T.T @ numeric.rnea(robot, q, v, a) - data.qfrc_inverse).max() / scale <= TOL
+
+
+@needs_mujoco
+def test_readme_ball_joint_block_runs(tmp_path):
+    """README's "Ball, planar and floating joints" Python block, run as written: armdyn's
+    inverse dynamics of a ball-jointed pendulum equal MuJoCo's mj_inverse."""
+    import os
+    import subprocess
+    import sys
+
+    import armdyn
+
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    section = readme.split("### Ball, planar and floating joints", 1)[1]
+    code = section.split("```python\n", 1)[1].split("```", 1)[0]
+    env = {**os.environ, "PYTHONPATH": str(Path(armdyn.__file__).parent.parent)}
+    done = subprocess.run(
+        [sys.executable, "-W", "ignore", "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 0, done.stderr
+    names, gap = done.stdout.strip().splitlines()
+    assert names == "['ball.wx', 'ball.wy', 'ball.wz', 'hinge']"
+    assert float(gap) < 1e-12
