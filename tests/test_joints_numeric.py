@@ -3,8 +3,8 @@
 Second opinions: Pinocchio (JointModelSpherical / Planar / FreeFlyer, the same layouts) on
 hand-built and random trees, fixed and floating bases; and physical identities on random
 trees mixing every joint kind: ``aba(rnea(a)) = a``, M symmetric positive definite,
-``M e_k = rnea(q, 0, e_k) - rnea(q, 0, 0)``, ``T = 1/2 v^T M v``, batches equal to single
-calls bit for bit.
+``M e_k = rnea(q, 0, e_k) - rnea(q, 0, 0)``, ``T = 1/2 v^T M v``,
+``integrate(q, difference(q, q')) = q'``, batches equal to single calls bit for bit.
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ def mixed_tree(rng: np.random.Generator, n: int) -> Robot:
 
 def test_random_trees_identities():
     rng = np.random.default_rng(7)
-    worst = dict(aba=0.0, sym=0.0, col=0.0, energy=0.0)
+    worst = dict(aba=0.0, sym=0.0, col=0.0, energy=0.0, manifold=0.0)
     for _ in range(1000):
         robot = mixed_tree(rng, int(rng.integers(1, 6)))
         q = random_configuration(robot, rng)
@@ -69,8 +69,15 @@ def test_random_trees_identities():
         worst["col"] = max(worst["col"], np.abs(col - M[:, k]).max())
         T = an.kinetic_energy(robot, q, v)
         worst["energy"] = max(worst["energy"], abs(T - 0.5 * v @ M @ v) / (1 + T))
+        # integrate(q, difference(q, q')) = q': the same link poses (a quaternion and its
+        # negative are one rotation)
+        q2 = random_configuration(robot, rng)
+        back = an.integrate(robot, q, an.difference(robot, q, q2))
+        poses = an.forward_kinematics(robot, back) - an.forward_kinematics(robot, q2)
+        worst["manifold"] = max(worst["manifold"], np.abs(poses).max())
     assert all(np.isfinite(x) for x in worst.values())
     assert worst["aba"] < 1e-8 and worst["sym"] < 1e-12 and worst["col"] < 1e-10 and worst["energy"] < 1e-12, worst
+    assert worst["manifold"] < 1e-10, worst
 
 
 def test_batches_equal_single_calls():
