@@ -34,6 +34,8 @@ from .model import Robot
 __all__ = ["show", "table", "frame_poses", "numeric_robot", "draw_on", "animate"]
 
 AXIS_COLOURS = {"revolute": "tab:orange", "prismatic": "tab:purple"}
+#: joints of several coordinates have no axis: a ring at the joint instead
+JOINT_MARKS = {"spherical": "tab:green", "planar": "tab:cyan", "floating": "tab:gray"}
 
 
 # ----------------------------------------------------------------- kinematics
@@ -54,12 +56,22 @@ def numeric_robot(robot: Robot) -> Robot:
 
 
 def joint_values(robot: Robot, q) -> np.ndarray:
-    """``q`` as a float array of one finite value per coordinate (zeros for None), else a ValueError."""
+    """The joints' configuration (a floating base's left out: drawn in the base frame) as a
+    float array of finite values (None: zeros, or the neutral configuration of joints of
+    several coordinates), else a ValueError. A floating robot's whole ``q`` is taken too."""
+    base = 7 if robot.floating else 0
     if q is None:
+        if robot.multi_dof_joints:
+            from .configuration import neutral
+
+            return neutral(robot)[base:]
         return np.zeros(robot.dof)
     q = np.asarray(q, dtype=float).reshape(-1)
-    if q.shape != (robot.dof,):
-        raise ValueError(f"q must have {robot.dof} values (one per movable joint), got {q.size}")
+    if base and q.shape == (robot.nq,):
+        q = q[base:]
+    if q.shape != (robot.nq - base,):
+        each = "one per movable joint" if robot.nq - base == robot.dof else "quaternions x y z w, planar x y cos sin"
+        raise ValueError(f"q must have {robot.nq - base} values ({each}), got {q.size}")
     if not np.all(np.isfinite(q)):
         raise ValueError("q contains NaN or inf")
     return q
@@ -79,9 +91,18 @@ def frame_poses(robot: Robot, q=None) -> dict[str, np.ndarray]:
     """
     q = joint_values(robot, q)
     poses = {robot.base: np.eye(4)}
+    # each joint's place in q: its velocity coordinate's index -> its configuration block
+    base = (7, 6) if robot.floating else (0, 0)
+    block = {iv - base[1]: (iq - base[0], kind) for _, kind, iq, iv in robot.configuration_layout}
     for joint in robot.joints:
         f = robot.follows(joint)  # (coordinate, multiplier, offset); mimic joints follow a leader
-        R, p = joint.transform(0 if f is None else float(f[1]) * q[f[0]] + float(f[2]))
+        if f is None:
+            R, p = joint.transform(0)
+        elif joint.nq > 1:
+            iq, _ = block[f[0]]
+            R, p = joint.transform(q[iq : iq + joint.nq].tolist())
+        else:
+            R, p = joint.transform(float(f[1]) * q[block[f[0]][0]] + float(f[2]))
         local = np.eye(4)
         local[:3, :3], local[:3, 3] = as_floats(R), as_floats(p).reshape(3)
         poses[joint.child] = poses[joint.parent] @ local
@@ -300,6 +321,10 @@ def draw_on(ax, robot: Robot, poses: dict[str, np.ndarray], title: str, view: tu
     labels = []
     for j in robot.movable_joints:
         T = poses[j.child]
+        if j.type in JOINT_MARKS:
+            ax.scatter(*T[:3, 3], s=140, facecolors="none", edgecolors=JOINT_MARKS[j.type], linewidths=2.5)
+            labels.append((f"{j.name} ({j.type})", T[:3, 3] + 0.5 * arrow * T[:3, 2], JOINT_MARKS[j.type]))
+            continue
         axis = T[:3, :3] @ as_floats(j.axis).reshape(3)
         ax.quiver(*T[:3, 3], *(arrow * axis), color=AXIS_COLOURS[j.type], linewidth=2.5, arrow_length_ratio=0.3)
         labels.append((j.name, T[:3, 3] + arrow * axis, AXIS_COLOURS[j.type]))

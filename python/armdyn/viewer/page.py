@@ -184,7 +184,7 @@ def _configurations(robot: Robot, Q) -> np.ndarray:
         raise ValueError(f"Q: shape {Q.shape}, expected (frames, {robot.nq}) with at least one frame")
     if not np.all(np.isfinite(Q)):
         raise ValueError("times or Q contain NaN or inf")
-    if robot.floating:
+    if robot.floating or robot.multi_dof_joints:
         from ..configuration import difference
 
         difference(robot, Q, Q)  # refuses a quaternion off unit length, naming it
@@ -255,7 +255,7 @@ def view(robot, q=None, *, frames: bool = False, markers: bool | None = None, pa
     from ..show import joint_values
 
     robot = _coerce(robot)
-    if robot.floating:
+    if robot.floating or robot.multi_dof_joints:
         from ..configuration import neutral
 
         q = _configurations(robot, [neutral(robot) if q is None else np.asarray(q, dtype=float).reshape(-1)])[0]
