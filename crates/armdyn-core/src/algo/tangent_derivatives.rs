@@ -23,7 +23,7 @@ use crate::model::Model;
 use crate::spatial::V3;
 
 /// Directions carried by one dual-number pass.
-pub const DIRECTIONS: usize = 8;
+pub const DIRECTIONS: usize = 4;
 type D = Dual<DIRECTIONS>;
 
 /// The workspaces of one derivative call: dual-number RNEA, the f64 CRBA / M^-1, and
