@@ -65,7 +65,9 @@ fn local_rate_is_so3_dexp_inverse_to_fourth_order() {
         let v = [1.0, 2.0, -0.5, 0.0, 0.0, 0.0, 0.7];
         let mut k = [0.0; 7];
         m.local_rate(&theta, &v, &mut k);
-        let cross = |a: [f64; 3], b: [f64; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+        };
         let (th, w) = ([theta[0], theta[1], theta[2]], [v[0], v[1], v[2]]);
         let t = th.iter().map(|x| x * x).sum::<f64>().sqrt();
         let c = (1.0 - 0.5 * t / (0.5 * t).tan()) / (t * t);
