@@ -300,3 +300,16 @@ def test_limits_report_the_hinge_in_velocity_coordinates():
     run = simulate(robot, q0, v0, dt=1e-3, steps=200, limits=(np.full(robot.dof, -0.1), np.full(robot.dof, 0.1)))
     assert run.coordinate_names[run.limit_joint] == "hinge"
     assert 40 < run.limit_step < 60  # about 0.1 rad / 2 rad/s
+
+
+def test_progress_pieces_equal_one_run():
+    """A run cut into pieces (``progress``) continues each from the last one's q_final
+    (nq wide): the same bits as one call."""
+    robot = chain(True)
+    q0, v0 = start(robot, 12)
+    seen = []
+    one = simulate(robot, q0, v0, dt=2e-3, steps=300, stride=3)
+    cut = simulate(robot, q0, v0, dt=2e-3, steps=300, stride=3, progress=lambda k, n: seen.append(k))
+    assert len(seen) > 10 and seen[-1] == 300
+    for name in ("q", "qd", "qdd", "tau", "work", "q_final", "qd_final"):
+        np.testing.assert_array_equal(getattr(cut, name), getattr(one, name), err_msg=name)
