@@ -42,6 +42,14 @@ the others (6 + dof,); ``limit_joint`` and ``nonfinite_joint`` index
 joints). Energies include the base: ``T = 1/2 v^T M v``, ``V = -g . (m c)`` with ``c``
 the world centre of mass. Controllers and torque callables are fixed-base only.
 
+Joints of several coordinates (spherical, planar, free; ``robot.nq`` > ``robot.nv``),
+fixed or floating base: the same two methods with each joint's block moved on its group
+as :func:`armdyn.configuration.integrate` moves it (spherical on SO(3), free on SE(3),
+planar on SE(2); the quaternions and planar ``(cos, sin)`` kept unit). ``q0`` and the
+stored ``q`` rows are (nq,), the others (nv,) (``Trajectory.coordinate_names``);
+limits are checked on the 1-dof joints only; energies as for a floating base.
+Controllers and torque callables take 1-dof joints only.
+
 Joint limits (from the robot's joints, or ``limits=(lower, upper)``) are reported, never
 enforced: :attr:`Trajectory.limit_step` / :attr:`Trajectory.limit_joint` give, per state,
 the first step at which a joint is outside its range and which joint.
@@ -70,10 +78,23 @@ import numpy as np
 
 from . import _core
 from .configuration import rotate_vector
+from .errors import ModelError
 from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy, require_fixed_base
 from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
 __all__ = ["simulate", "simulate_adaptive", "Trajectory", "PD", "ComputedTorque", "joint_limits"]
+
+
+def _require_one_dof_joints(robot, model, what: str) -> None:
+    """Raise naming ``what`` if the robot has joints of several coordinates (``q`` longer
+    than the velocity beyond a floating base's quaternion)."""
+    if hasattr(model, "nq") and model.nq - model.nv != (1 if model.floating else 0):
+        if hasattr(robot, "require_one_dof_joints"):
+            robot.require_one_dof_joints(what)
+        raise ModelError(
+            f"{what} handles revolute and prismatic joints only (yet); this robot has joints of several coordinates",
+            f"robot '{model.name}'",
+        )
 
 
 def _c(a):
@@ -184,8 +205,9 @@ def simulate(
     """
     model = compiled_model(robot)
     floating = bool(getattr(model, "floating", False))
-    # the widths of q and of qd (qdd, tau): dof each, or 7 + dof and 6 + dof with a floating base
-    dof, nv = (model.nq, model.nv) if floating else (model.dof, model.dof)
+    # the widths of q and of qd (qdd, tau): dof each, 7 + dof and 6 + dof with a floating base, nq and nv
+    # with joints of several coordinates (whose q blocks are longer than their v blocks)
+    dof, nv = getattr(model, "nq", model.dof), getattr(model, "nv", model.dof)
     steps = step_count(duration, steps, dt)
     dt = float(dt)
     if method not in ("rk4", "euler"):
@@ -224,6 +246,8 @@ def simulate(
         raise ValueError("give torque or controller, not both")
     if floating and (controller is not None or callable(torque)):
         require_fixed_base(robot, "armdyn.simulate with a controller or a torque callable")
+    if controller is not None or callable(torque):
+        _require_one_dof_joints(robot, model, "armdyn.simulate with a controller or a torque callable")
     empty = np.zeros(0)
     args = dict(torque=empty, kp=empty, kd=empty, target=empty, target_qd=empty)
     if callable(torque):
@@ -266,7 +290,7 @@ def simulate(
 
     t = np.arange(samples) * (stride * dt)
     names = list(model.coordinate_names)
-    if floating:  # limit_joint and nonfinite_joint index the velocity's coordinates
+    if floating:  # limit_joint and nonfinite_joint index the velocity's coordinates (the joints' are already)
         names = [*BASE_VELOCITY_NAMES, *names]
     run = Trajectory(t=t, dt=dt, stride=stride, method=method, coordinate_names=names, **out)
     # a diverged state stopped at its nonfinite_step: its later samples were never written
@@ -508,6 +532,7 @@ def simulate_adaptive(
 
     require_fixed_base(robot, "armdyn.simulate_adaptive")
     model = compiled_model(robot)
+    _require_one_dof_joints(robot, model, "armdyn.simulate_adaptive")
     dof = model.dof
     q0 = _state(q0, "q0", dof)
     qd0 = np.zeros(dof) if qd0 is None else _state(qd0, "qd0", dof)

@@ -124,7 +124,7 @@ impl NumericModel {
     /// Every quaternion of the configurations `q` (rows of `nq`: the base's `q[3:7]`, each
     /// spherical or free joint's) and every planar joint's `(cos, sin)` must have unit
     /// length to within [`QUATERNION_TOL`]: anything else is refused, never used.
-    fn check_unit_blocks(&self, q: &[f64]) -> PyResult<()> {
+    pub(crate) fn check_unit_blocks(&self, q: &[f64]) -> PyResult<()> {
         let qb = if self.floating { NQ_BASE } else { 0 };
         let nq = self.model.nq + qb;
         let base = self.floating.then_some((3, 4, "the base quaternion", "x, y, z, w"));

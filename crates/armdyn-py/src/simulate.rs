@@ -78,9 +78,11 @@ fn data<'a>(a: &'a PyReadonlyArrayDyn<'_, f64>, name: &str, shape: &[usize]) -> 
 
 /// Integrate `q0`, `qd0` (N, nv) for `steps` steps of `dt`; see armdyn.simulate.
 ///
-/// A floating-base model (`algo::integrate_floating`): `q0`, `q`, `q_final` have 7 + nv
-/// columns, `qd0`, the torques and the other outputs 6 + nv; lower, upper stay (nv,);
-/// only the torque kinds "zero", "constant", "series" and "series-per-state".
+/// A floating-base model or one with joints of several coordinates
+/// (`algo::integrate_floating`): `q0`, `q`, `q_final` have the model's `nq` columns
+/// (7 more with a floating base), `qd0`, the torques and the other outputs `nv` (6
+/// more); lower, upper stay (dof,); only the torque kinds "zero", "constant", "series"
+/// and "series-per-state".
 ///
 /// torque_kind: "zero", "constant" (torque (N, nv)), "series" (torque (steps, nv)),
 /// "series-per-state" (torque (N, steps, nv)), "pd", "pd-gravity", "computed-torque"
@@ -113,12 +115,13 @@ fn _simulate<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         let threads = thread_arg(threads)?;
-        model.get().one_dof_only("simulate")?;
         let m = &model.get().model;
         let floating = model.get().floating;
+        // a configuration that is not flat: a floating base or joints of several coordinates
+        let manifold = floating || m.has_multi();
         let n = m.nv;
         // the widths of q and of v (qd, qdd, tau): a floating base adds its 7 and 6
-        let (nq, nv) = if floating { (n + 7, n + 6) } else { (n, n) };
+        let (nq, nv) = if floating { (m.nq + 7, n + 6) } else { (m.nq, n) };
         let rows = q0.shape().first().copied().unwrap_or(0);
         let method = match method {
             "rk4" => Method::Rk4,
@@ -131,6 +134,9 @@ fn _simulate<'py>(
         let settings = Settings { method, dt, steps, stride };
         let q0 = data(&q0, "q0", &[rows, nq])?;
         let qd0 = data(&qd0, "qd0", &[rows, nv])?;
+        if manifold {
+            model.get().check_unit_blocks(q0)?;
+        }
         let lower = data(&lower, "lower", &[n])?;
         let upper = data(&upper, "upper", &[n])?;
         let gains = || -> PyResult<_> {
@@ -151,11 +157,14 @@ fn _simulate<'py>(
             }
             other => return Err(PyValueError::new_err(format!("torque_kind: unknown '{other}'"))),
         };
-        if floating && matches!(input, Input::Pd { .. } | Input::ComputedTorque { .. }) {
+        if manifold && matches!(input, Input::Pd { .. } | Input::ComputedTorque { .. }) {
             let name = &model.get().name;
-            return Err(PyValueError::new_err(format!(
-                "torque_kind '{torque_kind}': controllers are fixed-base only ('{name}' floats)"
-            )));
+            if floating {
+                return Err(PyValueError::new_err(format!(
+                    "torque_kind '{torque_kind}': controllers are fixed-base only ('{name}' floats)"
+                )));
+            }
+            model.get().one_dof_only(&format!("simulate with the controller '{torque_kind}'"))?;
         }
         if matches!(input, Input::Series { .. }) && steps == 0 {
             return Err(PyValueError::new_err("a torque series needs at least one step"));
@@ -185,9 +194,9 @@ fn _simulate<'py>(
                 }
             };
             let run = |stop: &AtomicBool| {
-                if floating {
-                    let f = integrate_floating::simulate_floating_until;
-                    f(m, q0, qd0, input, settings, lower, upper, out, threads, stop);
+                if manifold {
+                    let f = integrate_floating::simulate_manifold_until;
+                    f(m, floating, q0, qd0, input, settings, lower, upper, out, threads, stop);
                 } else {
                     integrate::simulate_until(m, q0, qd0, input, settings, lower, upper, out, threads, stop);
                 }

@@ -1,35 +1,39 @@
-//! Time integration of a floating-base robot (`algo::floating`, Pinocchio's layout:
-//! `q` (7 + nv), `v` (6 + nv)) for many initial states at once: the fixed-base
-//! integrator's methods ([`crate::algo::integrate`]) with the base moved on SE(3).
-//!
-//! The configuration space is not flat: the base pose moves as `M' = M exp(xi)` for a
-//! base twist `xi` (base frame, linear then angular; the exponential of SE(3), as
-//! `armdyn.configuration.integrate` and Pinocchio's `integrate`), the joints add.
+//! Time integration of a model whose configuration is not flat, for many initial
+//! states at once: an optional floating base (`algo::floating`, Pinocchio's layout: `q`
+//! (7 + nq), `v` (6 + nv)) and joints of several coordinates anywhere in the tree
+//! (`joint_multi.rs`). The fixed-base integrator's methods ([`crate::algo::integrate`])
+//! with every block of `q` moved on its group ([`crate::algo::manifold`]): the base and
+//! free joints on SE(3), spherical joints on SO(3), planar joints on SE(2), as
+//! `armdyn.configuration.integrate` and Pinocchio's `integrate`; the 1-dof joints add.
 //! Written `q (+) xi`:
 //!
 //! * [`Method::SemiImplicitEuler`]: `v' = v + h a(q, v)`, `q' = q (+) h v'`.
 //! * [`Method::Rk4`]: Runge-Kutta-Munthe-Kaas (Hairer, Lubich, Wanner, *Geometric
 //!   Numerical Integration*, IV.8.2) with the classical tableau: the stages live in the
 //!   tangent space at the step's start, `q_i = q (+) theta_i`, and the local coordinate
-//!   obeys `theta' = dexp^-1_{-theta}(v)`, the Bernoulli series `v + [theta, v] / 2 +
-//!   [theta, [theta, v]] / 12 + O(theta^4)` (its `theta^3` term is zero, so the
-//!   truncation keeps fourth order). Velocities are a vector space: plain RK4.
+//!   obeys `theta' = dexp^-1_{-theta}(v)`, on each block the Bernoulli series `v +
+//!   [theta, v] / 2 + [theta, [theta, v]] / 12 + O(theta^4)` with the block's bracket
+//!   (its `theta^3` term is zero, so the truncation keeps fourth order). Velocities are
+//!   a vector space: plain RK4.
 //!
-//! Torques ([`Input`]): zero, constant, or a series, of width 6 + nv (the base wrench
-//! in the base frame, then the joints); controllers are fixed-base only. Outputs as
-//! [`crate::algo::integrate::Outputs`], `q` of width 7 + nv and `qd`, `qdd`, `tau` of
-//! width 6 + nv; `limit_joint` and `nonfinite_joint` index `v`'s coordinates (the
-//! base's six first), `lower`, `upper` are the joints' (nv). The work is of the whole
-//! wrench, `tau . v` (the base wrench's power included).
+//! Torques ([`Input`]): zero, constant, or a series, of width `v`'s (a floating base's
+//! wrench in the base frame first, then the joints); controllers are for fixed-base
+//! 1-dof models only. Outputs as [`crate::algo::integrate::Outputs`], `q` of width
+//! `q`'s and `qd`, `qdd`, `tau` of width `v`'s; `limit_joint` and `nonfinite_joint`
+//! index `v`'s coordinates (a floating base's six first); `lower`, `upper` are the
+//! joints' (`model.nv`), checked on the 1-dof joints only. The work is of the whole
+//! torque, `tau . v` (the base wrench's power included).
 //!
 //! States run in SIMD lanes (4 or 8 per group, as [`crate::algo::integrate`]; the
 //! leftover rows one by one), groups spread over rayon threads. The dynamics run on the
-//! lanes; the base's exponential (square roots and sines, which the lane types do not
+//! lanes; the blocks' exponentials (square roots and sines, which the lane types do not
 //! have) lane by lane in `f64`. Every lane performs exactly the operations of a single
 //! state, so results do not depend on the kernels, threads or grouping.
 
+use crate::algo::aba;
 use crate::algo::floating::{aba_floating, NQ_BASE, NV_BASE};
 use crate::algo::integrate::{Input, Method, Outputs, Settings, STOP_POLL};
+use crate::algo::manifold::Manifold;
 use crate::batch::{install, kernels, thread_count, Kernels};
 use crate::data::Data;
 use crate::model::Model;
@@ -37,119 +41,12 @@ use crate::real::{F64x4, F64x8, Real};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Below this rotation angle (rad) the series of the SE(3) maps are used (their closed
-/// forms divide 0 by 0 at 0), as in `armdyn.configuration`.
-const SMALL: f64 = 1e-4;
-
-type V3 = [f64; 3];
-
-fn cross(a: V3, b: V3) -> V3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-/// Hamilton product of quaternions `x, y, z, w`.
-fn quat_mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
-    let c = cross([a[0], a[1], a[2]], [b[0], b[1], b[2]]);
-    let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    [
-        a[3] * b[0] + b[3] * a[0] + c[0],
-        a[3] * b[1] + b[3] * a[1] + c[1],
-        a[3] * b[2] + b[3] * a[2] + c[2],
-        a[3] * b[3] - dot,
-    ]
-}
-
-/// `R(quat) x` for a unit quaternion `x, y, z, w`.
-fn rotate(quat: [f64; 4], x: V3) -> V3 {
-    let v = [quat[0], quat[1], quat[2]];
-    let t = cross(v, x).map(|c| 2.0 * c);
-    let vt = cross(v, t);
-    [0, 1, 2].map(|k| x[k] + quat[3] * t[k] + vt[k])
-}
-
-/// `out = q (+) xi`: the base pose (`q[..7]`) times `exp(xi[..6])`, the joints plus
-/// `xi[6..]`. The quaternion is renormalised and kept on the side of `q`'s.
+/// `out = q (+) xi` for a floating base with 1-dof joints: the base pose (`q[..7]`)
+/// times `exp(xi[..6])`, the joints plus `xi[6..]`.
 pub fn integrate_configuration(q: &[f64], xi: &[f64], out: &mut [f64]) {
-    integrate_base(q, xi, out);
+    crate::algo::manifold::se3_exp(q, xi, out);
     for (o, (x, dx)) in out[NQ_BASE..].iter_mut().zip(q[NQ_BASE..].iter().zip(&xi[NV_BASE..])) {
         *o = x + dx;
-    }
-}
-
-/// [`integrate_configuration`] lane by lane: the base in `f64`, the joints on the lanes.
-#[inline(always)]
-fn integrate_lanes<T: Real>(q: &[T], xi: &[T], out: &mut [T]) {
-    let (mut qa, mut xa, mut oa) = ([0.0; NQ_BASE], [0.0; NV_BASE], [0.0; NQ_BASE]);
-    for l in 0..T::LANES {
-        for k in 0..NQ_BASE {
-            qa[k] = T::lane_of(&q[k], l);
-        }
-        for k in 0..NV_BASE {
-            xa[k] = T::lane_of(&xi[k], l);
-        }
-        integrate_base(&qa, &xa, &mut oa);
-        for k in 0..NQ_BASE {
-            out[k].set_lane(l, oa[k]);
-        }
-    }
-    for (o, (x, dx)) in out[NQ_BASE..].iter_mut().zip(q[NQ_BASE..].iter().zip(&xi[NV_BASE..])) {
-        *o = *x + *dx;
-    }
-}
-
-/// The base part of [`integrate_configuration`]: `out[..7]` from `q[..7]`, `xi[..6]`.
-#[inline(always)]
-fn integrate_base(q: &[f64], xi: &[f64], out: &mut [f64]) {
-    let lin = [xi[0], xi[1], xi[2]];
-    let w = [xi[3], xi[4], xi[5]];
-    let theta = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
-    let t2 = theta * theta;
-    // V(w) = 1 + a [w]x + b [w]x^2: the translation of exp(xi) is V(w) lin
-    let (a, b, s) = if theta < SMALL {
-        (0.5 - t2 / 24.0 + t2 * t2 / 720.0, 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0, 0.5 - t2 / 48.0)
-    } else {
-        ((1.0 - theta.cos()) / t2, (theta - theta.sin()) / (t2 * theta), (0.5 * theta).sin() / theta)
-    };
-    let wl = cross(w, lin);
-    let wwl = cross(w, wl);
-    let p = [0, 1, 2].map(|k| lin[k] + a * wl[k] + b * wwl[k]);
-    let quat0 = [q[3], q[4], q[5], q[6]];
-    let e = [w[0] * s, w[1] * s, w[2] * s, (0.5 * theta).cos()];
-    let mut quat = quat_mul(quat0, e);
-    let side: f64 = (0..4).map(|k| quat[k] * quat0[k]).sum();
-    let norm = (0..4).map(|k| quat[k] * quat[k]).sum::<f64>().sqrt();
-    let scale = if side < 0.0 { -1.0 / norm } else { 1.0 / norm };
-    quat = quat.map(|c| c * scale);
-    let d = rotate(quat0, p);
-    for k in 0..3 {
-        out[k] = q[k] + d[k];
-    }
-    out[3..NQ_BASE].copy_from_slice(&quat);
-}
-
-/// `a x b` on lanes.
-#[inline(always)]
-fn cross_lanes<T: Real>(a: [T; 3], b: [T; 3]) -> [T; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-/// `[x, y]` in se(3), twists as (linear, angular).
-#[inline(always)]
-fn bracket<T: Real>(x: &[T], y: &[T]) -> [T; 6] {
-    let (rho, om) = ([x[0], x[1], x[2]], [x[3], x[4], x[5]]);
-    let (u, w) = ([y[0], y[1], y[2]], [y[3], y[4], y[5]]);
-    let (a, b, c) = (cross_lanes(om, u), cross_lanes(rho, w), cross_lanes(om, w));
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2], c[0], c[1], c[2]]
-}
-
-/// The base part of `k = dexp^-1_{-theta}(v)` (see the module doc), into `k[..6]`.
-#[inline(always)]
-fn local_rate<T: Real>(theta: &[T], v: &[T], k: &mut [T]) {
-    let b1 = bracket(theta, v);
-    let b2 = bracket(theta, &b1);
-    let (half, twelfth) = (T::splat(0.5), T::splat(1.0 / 12.0));
-    for i in 0..NV_BASE {
-        k[i] = v[i] + half * b1[i] + b2[i] * twelfth;
     }
 }
 
@@ -168,9 +65,7 @@ struct Row<'a> {
     nonfinite_joint: &'a mut i64,
 }
 
-/// Integrate `N` floating-base states `q0` (N, 7 + nv), `v0` (N, 6 + nv) as the module
-/// says, ending early once `stop` is set (read every [`STOP_POLL`] steps). Returns false
-/// if it was stopped. Panics on a controller input or on mis-sized arrays.
+/// [`simulate_manifold_until`] with a floating base: `q0` (N, 7 + nq), `v0` (N, 6 + nv).
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_floating_until(
     model: &Model,
@@ -184,8 +79,30 @@ pub fn simulate_floating_until(
     threads: Option<usize>,
     stop: &AtomicBool,
 ) -> bool {
+    simulate_manifold_until(model, true, q0, v0, input, settings, lower, upper, out, threads, stop)
+}
+
+/// Integrate `N` states `q0` (N, nq), `v0` (N, nv) of `model` (`floating`: with a
+/// floating base, widths 7 + `model.nq` and 6 + `model.nv`) as the module says, ending
+/// early once `stop` is set (read every [`STOP_POLL`] steps). Returns false if it was
+/// stopped. Panics on a controller input or on mis-sized arrays.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_manifold_until(
+    model: &Model,
+    floating: bool,
+    q0: &[f64],
+    v0: &[f64],
+    input: Input,
+    settings: Settings,
+    lower: &[f64],
+    upper: &[f64],
+    out: Outputs,
+    threads: Option<usize>,
+    stop: &AtomicBool,
+) -> bool {
     let n = model.nv;
-    let (nq, nv) = (n + NQ_BASE, n + NV_BASE);
+    let manifold = Manifold::new(model, floating);
+    let (nq, nv) = (manifold.nq, manifold.nv);
     assert!(settings.stride >= 1 && settings.dt.is_finite(), "settings");
     assert!(lower.len() == n && upper.len() == n, "limits length");
     let rows = q0.len() / nq;
@@ -205,7 +122,9 @@ pub fn simulate_floating_until(
             assert!(settings.steps >= 1, "a torque series needs at least one step");
             assert_eq!(tau.len(), if shared { 1 } else { rows } * settings.steps * nv, "torque series size")
         }
-        Input::Pd { .. } | Input::ComputedTorque { .. } => panic!("controllers are fixed-base only"),
+        Input::Pd { .. } | Input::ComputedTorque { .. } => {
+            panic!("controllers are for fixed-base 1-dof models only")
+        }
     }
     let Outputs { q, work, qd, qdd, tau, q_final, qd_final, limit_step, limit_joint, nonfinite_step, nonfinite_joint } =
         out;
@@ -253,7 +172,7 @@ pub fn simulate_floating_until(
         groups.push((first, rest.by_ref().take(width).collect()));
         first += width;
     }
-    let job = Job { model, q0, v0, input, settings, lower, upper, stop };
+    let job = Job { model, manifold, floating, q0, v0, input, settings, lower, upper, stop };
     let mut groups = Some(groups);
     let mut run = || {
         let groups = groups.take().expect("runs once");
@@ -273,6 +192,8 @@ pub fn simulate_floating_until(
 /// The shared read-only inputs of one call.
 struct Job<'a> {
     model: &'a Model,
+    manifold: Manifold,
+    floating: bool,
     q0: &'a [f64],
     v0: &'a [f64],
     input: Input<'a>,
@@ -282,7 +203,7 @@ struct Job<'a> {
     stop: &'a AtomicBool,
 }
 
-/// Per-group workspace: lane vectors (q: 7 + nv, the others 6 + nv).
+/// Per-group workspace: lane vectors (q: nq, the others nv, the manifold's).
 struct Work<T> {
     data: Data<T>,
     q: Vec<T>,
@@ -299,20 +220,21 @@ struct Work<T> {
 }
 
 impl<T: Real> Work<T> {
-    fn new(model: &Model) -> Self {
-        let z = |k: usize| vec![T::zero(); model.nv + k];
+    fn new(model: &Model, manifold: &Manifold) -> Self {
+        let z = |k: usize| vec![T::zero(); k];
+        let (nq, nv) = (manifold.nq, manifold.nv);
         Work {
             data: Data::new(model),
-            q: z(NQ_BASE),
-            v: z(NV_BASE),
-            qs: z(NQ_BASE),
-            vs: z(NV_BASE),
-            tau: z(NV_BASE),
-            a: z(NV_BASE),
-            theta: z(NV_BASE),
-            rate: z(NV_BASE),
-            sum_rate: z(NV_BASE),
-            sum_a: z(NV_BASE),
+            q: z(nq),
+            v: z(nv),
+            qs: z(nq),
+            vs: z(nv),
+            tau: z(nv),
+            a: z(nv),
+            theta: z(nv),
+            rate: z(nv),
+            sum_rate: z(nv),
+            sum_a: z(nv),
         }
     }
 }
@@ -343,12 +265,12 @@ impl Job<'_> {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = "avx512f")]
         unsafe fn avx512(job: &Job, first: usize, rows: &mut [Row]) {
-            job.group(&mut Work::<F64x8>::new(job.model), first, rows)
+            job.group(&mut Work::<F64x8>::new(job.model, &job.manifold), first, rows)
         }
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = "avx2")]
         unsafe fn avx2(job: &Job, first: usize, rows: &mut [Row]) {
-            job.group(&mut Work::<F64x4>::new(job.model), first, rows)
+            job.group(&mut Work::<F64x4>::new(job.model, &job.manifold), first, rows)
         }
         match (kernels(), rows.len()) {
             // SAFETY: the CPU supports the features (checked by `kernels`).
@@ -357,9 +279,9 @@ impl Job<'_> {
             #[cfg(target_arch = "x86_64")]
             (Kernels::Avx2, 4) => unsafe { avx2(self, first, rows) },
             #[cfg(not(target_arch = "x86_64"))]
-            (_, 4) => self.group(&mut Work::<F64x4>::new(self.model), first, rows),
+            (_, 4) => self.group(&mut Work::<F64x4>::new(self.model, &self.manifold), first, rows),
             _ => {
-                let mut w = Work::<f64>::new(self.model);
+                let mut w = Work::<f64>::new(self.model, &self.manifold);
                 for (k, row) in rows.iter_mut().enumerate() {
                     self.group(&mut w, first + k, std::slice::from_mut(row));
                 }
@@ -397,21 +319,18 @@ impl Job<'_> {
         for (l, row) in rows.iter_mut().enumerate() {
             let x = |j: usize| T::lane_of(&q[j], l);
             if *row.limit_step < 0 {
-                if let Some(j) = (0..self.lower.len()).find(|&j| {
-                    let y = x(NQ_BASE + j);
-                    y < self.lower[j] || y > self.upper[j]
+                // the 1-dof joints' coordinates (the limits are the joints', v's less a base's)
+                let base = if self.floating { NV_BASE } else { 0 };
+                if let Some(&(_, iv)) = self.manifold.flat().iter().find(|&&(iq, iv)| {
+                    let y = x(iq);
+                    y < self.lower[iv - base] || y > self.upper[iv - base]
                 }) {
                     *row.limit_step = k as i64;
-                    *row.limit_joint = (NV_BASE + j) as i64;
+                    *row.limit_joint = iv as i64;
                 }
             }
             if *row.nonfinite_step < 0 {
-                // q's coordinates in v's layout: the base position (0..3), its orientation (3..6)
-                let q_finite = |j: usize| match j {
-                    0..=2 => x(j).is_finite(),
-                    3..=5 => (3..NQ_BASE).all(|i| x(i).is_finite()),
-                    _ => x(j + 1).is_finite(),
-                };
+                let q_finite = |j: usize| self.manifold.q_of_v(j).all(|i| x(i).is_finite());
                 if let Some(j) = (0..v.len()).find(|&j| !(T::lane_of(&v[j], l).is_finite() && q_finite(j))) {
                     *row.nonfinite_step = k as i64;
                     *row.nonfinite_joint = j as i64;
@@ -457,7 +376,11 @@ impl Job<'_> {
         let (mut k, mut st) = (0, 0);
         loop {
             self.torque(r, k, &mut w.tau);
-            aba_floating(self.model, &mut w.data, &w.qs, &w.vs, &w.tau, &mut w.a);
+            if self.floating {
+                aba_floating(self.model, &mut w.data, &w.qs, &w.vs, &w.tau, &mut w.a);
+            } else {
+                aba(self.model, &mut w.data, &w.qs, &w.vs, &w.tau, &mut w.a);
+            }
             let mut power = T::zero();
             for j in 0..nv {
                 power += w.tau[j] * w.vs[j];
@@ -477,7 +400,7 @@ impl Job<'_> {
                         w.v[j] += h * w.a[j];
                         w.rate[j] = h * w.v[j];
                     }
-                    integrate_lanes(&w.q, &w.rate, &mut w.qs);
+                    self.manifold.integrate_lanes(&w.q, &w.rate, &mut w.qs);
                     w.q.copy_from_slice(&w.qs);
                 }
                 Method::Rk4 => {
@@ -488,8 +411,7 @@ impl Job<'_> {
                         w.sum_a.fill(T::zero());
                         sum_work = T::zero();
                     } else {
-                        local_rate(&w.theta, &w.vs, &mut w.rate);
-                        w.rate[NV_BASE..].copy_from_slice(&w.vs[NV_BASE..]);
+                        self.manifold.local_rate(&w.theta, &w.vs, &mut w.rate);
                     }
                     let weight = if st == 0 || st == 3 { T::splat(1.0) } else { two };
                     sum_work += weight * power;
@@ -503,14 +425,14 @@ impl Job<'_> {
                             w.theta[j] = c * w.rate[j];
                             w.vs[j] = w.v[j] + c * w.a[j];
                         }
-                        integrate_lanes(&w.q, &w.theta, &mut w.qs);
+                        self.manifold.integrate_lanes(&w.q, &w.theta, &mut w.qs);
                     } else {
                         work += h6 * sum_work;
                         for j in 0..nv {
                             w.theta[j] = h6 * w.sum_rate[j];
                             w.v[j] += h6 * w.sum_a[j];
                         }
-                        integrate_lanes(&w.q, &w.theta, &mut w.qs);
+                        self.manifold.integrate_lanes(&w.q, &w.theta, &mut w.qs);
                         w.q.copy_from_slice(&w.qs);
                     }
                 }

@@ -12,6 +12,7 @@ mod derivatives;
 mod floating;
 mod identities;
 mod integrate;
+mod manifold;
 mod minverse;
 mod regressor;
 mod sin_cos;
