@@ -30,6 +30,7 @@ import sympy as sp
 
 from .errors import ModelError
 from .model import Robot
+from .model.joints import MULTI_DOF
 
 __all__ = ["show", "table", "frame_poses", "numeric_robot", "draw_on", "animate"]
 
@@ -54,7 +55,9 @@ def numeric_robot(robot: Robot) -> Robot:
 
 
 def joint_values(robot: Robot, q) -> np.ndarray:
-    """``q`` as a float array of one finite value per coordinate (zeros for None), else a ValueError."""
+    """``q`` as a float array of one finite value per coordinate (zeros for None), else a ValueError.
+    A joint of several coordinates is a ModelError: the pictures place joints of one coordinate."""
+    robot.require_one_dof_joints("the arm's picture (armdyn show --out, --3d; armdyn.viewer)")
     if q is None:
         return np.zeros(robot.dof)
     q = np.asarray(q, dtype=float).reshape(-1)
@@ -137,7 +140,7 @@ def table(robot: Robot) -> str:
             limits = f"[{bounds[0]}, {bounds[1]}]"
         else:
             limits = ""
-        axis = _vec(j.axis) if j.movable else ""
+        axis = _vec(j.axis) if j.movable and j.type not in MULTI_DOF else ""  # a ball or planar joint has none
         rows.append([j.name, j.type, j.parent, j.child, _vec(j.xyz), angles, axis, limits])
     lines += ["", "joints"] + _rows(["name", "type", "parent", "child", "xyz", "rpy", "axis", "limits"], rows)
     for j in robot.mimic_joints:  # no coordinate of their own: say whom they follow
@@ -376,6 +379,7 @@ def animate(
     if not isinstance(robot, Robot):
         robot = load(robot)
     robot = numeric_robot(robot)
+    robot.require_one_dof_joints("the arm's picture (armdyn show --out, --3d; armdyn.viewer)")
     q = np.asarray(q, dtype=float)
     if q.ndim != 2 or q.shape[1] != robot.dof or len(q) == 0:
         raise ValueError(f"q: shape {q.shape}, expected (frames, {robot.dof}) with at least one frame")

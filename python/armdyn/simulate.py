@@ -71,6 +71,7 @@ import numpy as np
 from . import _core
 from .configuration import rotate_vector
 from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy, require_fixed_base
+from .numeric.checks import require_one_dof_joints
 from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
 __all__ = ["simulate", "simulate_adaptive", "Trajectory", "PD", "ComputedTorque", "joint_limits"]
@@ -182,6 +183,8 @@ def simulate(
     Bad input (shapes, NaN, a non-positive dt, a duration that is not a whole number of
     steps, a run that would not fit in memory) raises ``ValueError`` naming it.
     """
+    if controller is not None or callable(torque):  # before the states' shapes are read
+        require_one_dof_joints(robot, "armdyn.simulate with a controller or a torque callable")
     model = compiled_model(robot)
     floating = bool(getattr(model, "floating", False))
     # the widths of q and of qd (qdd, tau): dof each, or 7 + dof and 6 + dof with a floating base
@@ -507,6 +510,7 @@ def simulate_adaptive(
     from scipy.integrate import solve_ivp
 
     require_fixed_base(robot, "armdyn.simulate_adaptive")
+    require_one_dof_joints(robot, "armdyn.simulate_adaptive")
     model = compiled_model(robot)
     dof = model.dof
     q0 = _state(q0, "q0", dof)

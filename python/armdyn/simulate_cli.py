@@ -99,6 +99,8 @@ def run(args, robot) -> int:
     from .trajectory import PD, ComputedTorque
 
     robot = numeric_robot(robot)
+    # its --q0 and --qd0 are one value per joint coordinate
+    robot.require_one_dof_joints("armdyn simulate")
     dof = robot.dof
     if robot.floating:
         q0, qd0 = floating_start(robot, args)

@@ -179,6 +179,7 @@ def _link_poses(robot: Robot, Q: np.ndarray) -> np.ndarray:
 
 def _configurations(robot: Robot, Q) -> np.ndarray:
     """``Q`` (N, nq) as finite floats; a floating base's quaternions checked unit."""
+    robot.require_one_dof_joints("the arm's picture (armdyn show --out, --3d; armdyn.viewer)")
     Q = np.asarray(Q, dtype=float)
     if Q.ndim != 2 or Q.shape[1] != robot.nq or len(Q) == 0:
         raise ValueError(f"Q: shape {Q.shape}, expected (frames, {robot.nq}) with at least one frame")

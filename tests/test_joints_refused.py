@@ -1,0 +1,154 @@
+"""What handles revolute and prismatic joints only refuses a joint of several coordinates
+(spherical, planar, floating) with one ModelError that names what refused and the joint,
+before any work: never a wrong answer, never a traceback from deep inside."""
+
+from __future__ import annotations
+
+import argparse
+import types
+
+import numpy as np
+import pytest
+
+import armdyn
+from armdyn.errors import ModelError
+from armdyn.model import Joint, Link, Robot
+
+
+def arm(kind: str = "spherical", root_joint=None) -> Robot:
+    """A joint of several coordinates ``kind`` named 'hip', then a revolute joint 'knee'."""
+    inertia = np.diag([0.02, 0.03, 0.04]).tolist()
+    links = [Link("base", 1.0, [0, 0, 0], inertia), Link("thigh", 2.0, [0.1, 0, -0.3], inertia)]
+    links.append(Link("shin", 1.5, [0, 0.05, -0.2], inertia))
+    joints = [
+        Joint("hip", kind, "base", "thigh", [0, 0, 0.8]),
+        Joint("knee", "revolute", "thigh", "shin", [0, 0, -0.5], axis=[0, 1, 0]),
+    ]
+    return Robot("leg", links, joints, root_joint=root_joint)
+
+
+def refused(call, what: str, joint: str = "hip"):
+    with pytest.raises(ModelError) as err:
+        call()
+    text = str(err.value)
+    assert what in text and f"'{joint}'" in text, text
+    return text
+
+
+@pytest.mark.parametrize("kind", ["spherical", "planar", "floating"])
+def test_lagrange_and_check_refuse(kind):
+    robot = arm(kind)
+    refused(lambda: armdyn.derive(robot, "lagrange"), "Lagrange's method")
+    refused(lambda: armdyn.prove_agreement(robot), "armdyn.prove_agreement")
+
+
+@pytest.mark.parametrize("kind", ["planar", "floating"])
+def test_newton_euler_refuses_what_it_does_not_derive(kind):
+    text = refused(lambda: armdyn.derive(arm(kind)), "Newton-Euler derivation")
+    assert kind in text and "spherical" in text  # what it takes instead
+
+
+def test_check_refuses_a_derivation_with_a_ball_joint():
+    robot = arm()
+    ne = armdyn.derive(robot)
+    refused(lambda: armdyn.check(ne, ne), "armdyn.check")
+
+
+def test_floating_base_derivation_refuses():
+    refused(lambda: armdyn.derive(arm(root_joint="free-flyer")), "floating-base Newton-Euler")
+
+
+@pytest.mark.parametrize("kind", ["spherical", "planar"])
+def test_codegen_and_identification_refuse(kind):
+    robot = arm(kind)
+    refused(lambda: armdyn.codegen(robot), "armdyn.codegen")
+    refused(lambda: armdyn.regressor(robot), "armdyn.identification.regressor")
+    refused(lambda: armdyn.base_parameters(robot), "armdyn.identification.base_parameters")
+
+
+def test_grade_refuses_the_model(tmp_path):
+    path = tmp_path / "derivation.md"
+    path.write_text("# Newton-Euler\n\n$$\\tau_1 = 0$$\n", encoding="utf-8")
+    refused(lambda: armdyn.grade(str(path), robot=arm()), "armdyn.grade")
+
+
+def test_course_solution_refuses():
+    from armdyn.course.solution import solution_steps
+
+    refused(lambda: solution_steps(arm()), "course")
+
+
+def test_simulate_with_a_controller_refuses():
+    from armdyn.simulate import PD, simulate, simulate_adaptive
+
+    robot = arm()
+    q0 = np.zeros(robot.nq)
+    pd = PD(np.ones(robot.nv), np.ones(robot.nv), np.zeros(robot.nv))
+    what = "armdyn.simulate with a controller"
+    refused(lambda: simulate(robot, q0, dt=0.01, steps=2, controller=pd), what)
+    refused(lambda: simulate(robot, q0, dt=0.01, steps=2, torque=lambda t, q, qd: qd), what)
+    refused(lambda: simulate_adaptive(robot, q0, duration=0.1), "armdyn.simulate_adaptive")
+
+
+def test_simulate_command_refuses():
+    from armdyn.simulate_cli import run
+
+    refused(lambda: run(argparse.Namespace(), arm()), "armdyn simulate")
+
+
+def test_dask_refuses():
+    pytest.importorskip("dask")
+    from armdyn import dask as ad
+
+    robot = arm()
+    q = np.zeros((2, robot.nq))
+    v = np.zeros((2, robot.nv))
+    refused(lambda: ad.rnea(robot, q, v, v), "armdyn.dask.rnea")
+    refused(lambda: ad.aba(robot, q, v, v), "armdyn.dask.aba")
+    refused(lambda: ad.crba(robot, q), "armdyn.dask.crba")
+    refused(lambda: ad.simulate(robot, q, v, dt=0.01, steps=2), "armdyn.dask.simulate")
+
+
+def test_reference_oracle_refuses():
+    from armdyn import reference
+
+    robot = arm()
+    refused(
+        lambda: reference.rnea(robot, np.zeros(robot.nq), np.zeros(robot.nv), np.zeros(robot.nv)), "armdyn.reference"
+    )
+
+
+def test_compiled_model_refused_by_its_widths():
+    from armdyn.numeric.checks import require_one_dof_joints
+
+    model = types.SimpleNamespace(nq=5, nv=4, floating=False, name="leg")  # one joint of several coordinates
+    with pytest.raises(ModelError, match="nq 5, nv 4"):
+        require_one_dof_joints(model, "armdyn.dask.rnea")
+    require_one_dof_joints(types.SimpleNamespace(nq=9, nv=8, floating=True, name="f"), "x")  # a free-flyer alone
+
+
+def test_pictures_refuse_but_the_table_works(tmp_path):
+    from armdyn.show import animate, show
+    from armdyn.viewer import animate as animate_3d
+    from armdyn.viewer import view
+
+    robot = arm()
+    what = "the arm's picture"
+    refused(lambda: show(robot, out=str(tmp_path / "leg.png")), what)
+    refused(lambda: view(robot), what)
+    refused(lambda: animate(robot, np.zeros((2, robot.nq)), str(tmp_path / "leg.gif")), what)
+    refused(lambda: animate_3d(robot, [0.0, 1.0], np.zeros((2, robot.nq))), what)
+    table = show(robot)  # the joint and link table needs no coordinates
+    hip = next(line for line in table.splitlines() if line.startswith("hip"))
+    assert "spherical" in hip and "(0, 0, 1)" not in hip  # no axis shown for a ball joint
+
+
+def test_derive_command_says_newton_euler_only(monkeypatch, capsys):
+    from armdyn import cli
+
+    monkeypatch.setattr(cli, "_load", lambda *args: arm())
+    args = cli.build_parser().parse_args(["derive", "leg.yaml", "--method", "both"])
+    assert cli.cmd_derive(args) == 0
+    out, err = capsys.readouterr()
+    assert "spherical joint is derived by Newton-Euler only" in err
+    assert "Lagrange" not in out and "τ₁..₃" not in out  # the result rows: one per coordinate
