@@ -59,16 +59,53 @@ def pendulum() -> Robot:
     return Robot("ball", links, [Joint("ball", "spherical", "base", "bob", [0, 0, 1], PLACEMENT.tolist())])
 
 
-def leg(offset: bool) -> Robot:
-    """A ball joint (with a frame offset when ``offset``), then a knee about KNEE_AXIS."""
-    extra = {"frame_xyz": OFFSET_P.tolist(), "frame_rotation": OFFSET_R.tolist()} if offset else {}
-    links = [Link("base"), Link("thigh", MASS, COM.tolist(), I_COM.tolist())]
-    links.append(Link("shin", 1.5, [0.0, 0.05, -0.2], np.diag([0.03, 0.02, 0.02]).tolist()))
-    joints = [
-        Joint("hip", "spherical", "base", "thigh", [0, 0, 1], PLACEMENT.tolist(), **extra),
-        Joint("knee", "revolute", "thigh", "shin", [0, 0, -0.5], axis=KNEE_AXIS.tolist()),
-    ]
-    return Robot("leg", links, joints)
+#: serial chains: (joint name, type, xyz, placement rotation, axis, (mass, com, inertia about it))
+UPPER = (1.2, np.array([0.15, 0.0, 0.0]), np.diag([0.01, 0.02, 0.02]))
+SHIN = (1.5, np.array([0.0, 0.05, -0.2]), np.diag([0.03, 0.02, 0.02]))
+HAND = (0.5, np.array([0.0, 0.02, -0.05]), np.diag([0.002, 0.003, 0.002]))
+BOB = (MASS, COM, I_COM)
+CHAINS = {
+    "leg": [  # a ball joint at the root, then a knee
+        ("hip", "spherical", [0, 0, 1], PLACEMENT, None, BOB),
+        ("knee", "revolute", [0, 0, -0.5], np.eye(3), KNEE_AXIS, SHIN),
+    ],
+    "arm": [  # a ball joint on a turning link: its parent's w and wd enter
+        ("shoulder", "revolute", [0, 0, 0.4], np.eye(3), np.array([0.0, 0.0, 1.0]), UPPER),
+        ("elbow", "spherical", [0.3, 0, 0.1], rot_x(0.3) @ rot_z(-0.4), None, BOB),
+        ("wrist", "revolute", [0, 0, -0.25], np.eye(3), KNEE_AXIS, HAND),
+    ],
+    "two-balls": [
+        ("ball1", "spherical", [0, 0, 1], PLACEMENT, None, BOB),
+        ("ball2", "spherical", [0, 0.1, -0.5], rot_z(0.5), None, SHIN),
+    ],
+}
+
+
+def chain(name: str, offset: bool) -> Robot:
+    """The chain ``name`` in armdyn; ``offset``: each ball joint's child frame placed at
+    (OFFSET_R, OFFSET_P) in its moved joint frame."""
+    links, joints, parent = [Link("base")], [], "base"
+    for k, (joint, kind, xyz, R, axis, (m, c, inertia)) in enumerate(CHAINS[name]):
+        child = f"link{k + 1}"
+        links.append(Link(child, m, c.tolist(), inertia.tolist()))
+        extra = {"axis": axis.tolist()} if axis is not None else {}
+        if offset and kind == "spherical":
+            extra.update(frame_xyz=OFFSET_P.tolist(), frame_rotation=OFFSET_R.tolist())
+        joints.append(Joint(joint, kind, parent, child, xyz, R.tolist(), **extra))
+        parent = child
+    return Robot(name, links, joints)
+
+
+def pinocchio_chain(name: str, offset: bool):
+    """The chain ``name`` built in Pinocchio by hand: a frame offset ``Xf`` moves the body's
+    inertia and the next joint's placement into the moved joint frame."""
+    model, parent, Xf = pin.Model(), 0, pin.SE3.Identity()
+    for joint, kind, xyz, R, axis, (m, c, inertia) in CHAINS[name]:
+        jmodel = pin.JointModelSpherical() if kind == "spherical" else pin.JointModelRevoluteUnaligned(axis)
+        parent = model.addJoint(parent, jmodel, Xf * pin.SE3(R, np.array(xyz, dtype=float)), joint)
+        Xf = pin.SE3(OFFSET_R, OFFSET_P) if offset and kind == "spherical" else pin.SE3.Identity()
+        model.appendBodyToJoint(parent, Xf.act(pin.Inertia(m, c, inertia)), pin.SE3.Identity())
+    return model
 
 
 def states(robot: Robot, count: int, seed: int):
@@ -112,26 +149,13 @@ def test_terms_of_the_pendulum():
         eom.C
 
 
-def pinocchio_leg(offset: bool):
-    """The leg built in Pinocchio by hand: a frame offset moves the thigh's inertia and the
-    knee's placement into the moved joint frame."""
-    model = pin.Model()
-    hip = model.addJoint(0, pin.JointModelSpherical(), pin.SE3(PLACEMENT, np.array([0.0, 0.0, 1.0])), "hip")
-    Xf = pin.SE3(OFFSET_R, OFFSET_P) if offset else pin.SE3.Identity()
-    model.appendBodyToJoint(hip, Xf.act(pin.Inertia(MASS, COM, I_COM)), pin.SE3.Identity())
-    knee_at = Xf * pin.SE3(np.eye(3), np.array([0.0, 0.0, -0.5]))
-    knee = model.addJoint(hip, pin.JointModelRevoluteUnaligned(KNEE_AXIS), knee_at, "knee")
-    inertia = pin.Inertia(1.5, np.array([0.0, 0.05, -0.2]), np.diag([0.03, 0.02, 0.02]))
-    model.appendBodyToJoint(knee, inertia, pin.SE3.Identity())
-    return model
-
-
 @needs_pinocchio
-@pytest.mark.parametrize("offset", [False, True])
-def test_against_pinocchio(offset):
-    robot = leg(offset)
+@pytest.mark.parametrize("offset", [False, True], ids=["on-joint", "frame-offset"])
+@pytest.mark.parametrize("name", list(CHAINS))
+def test_against_pinocchio(name, offset):
+    robot = chain(name, offset)
     eom = armdyn.derive(robot)
-    model = pinocchio_leg(offset)
+    model = pinocchio_chain(name, offset)
     data = model.createData()
     assert (model.nq, model.nv) == (robot.nq, robot.nv)
     for q, v, a in states(robot, 4, 3):
@@ -141,7 +165,7 @@ def test_against_pinocchio(offset):
 
 
 def test_report_prints_the_steps():
-    eom = armdyn.derive(leg(False))
+    eom = armdyn.derive(chain("leg", False))
     text = derivation_report([eom], "text", steps=True)
     assert "spherical joint 'hip'" in text  # the head says what the symbols are
     assert "τ₁..₃ = [" in text and "τ₄ = " in text  # the ball's moment, the knee's torque
