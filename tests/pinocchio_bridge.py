@@ -27,7 +27,13 @@ def _floats(matrix) -> np.ndarray:
     return np.array([[float(x) for x in row] for row in matrix.tolist()])
 
 
+#: joints of several coordinates: the same layouts as armdyn's (armdyn.model.joints.MULTI_DOF)
+_MULTI_DOF = {"spherical": pin.JointModelSpherical, "planar": pin.JointModelPlanar, "floating": pin.JointModelFreeFlyer}
+
+
 def _joint_model(kind: str, axis: np.ndarray):
+    if kind in _MULTI_DOF:
+        return _MULTI_DOF[kind]()
     aligned = {
         "revolute": (pin.JointModelRX, pin.JointModelRY, pin.JointModelRZ),
         "prismatic": (pin.JointModelPX, pin.JointModelPY, pin.JointModelPZ),
@@ -60,8 +66,10 @@ def depth_first(robot: Robot) -> list:
 
 def to_pinocchio(robot: Robot) -> tuple[pin.Model, dict[str, int], np.ndarray]:
     """Return ``(model, frames, perm)``: the Pinocchio model; for each armdyn link name, the id
-    of the BODY frame placed at that link's frame; and ``perm`` (n,) such that Pinocchio's
-    coordinate i is armdyn's coordinate ``perm[i]`` (``q_pin = q[perm]``)."""
+    of the BODY frame placed at that link's frame; and ``perm`` (nv,) such that Pinocchio's
+    velocity coordinate i is armdyn's ``perm[i]`` (``v_pin = v[perm]``). The configuration's
+    permutation is :func:`configuration_permutation` (the same when every joint has one
+    coordinate)."""
     if getattr(robot, "mimic_joints", None):  # the bridge builds free joints only
         raise NotImplementedError(
             f"robot '{robot.name}' has mimic joints: use pin.buildModelFromUrdf(path, mimic=True)"
@@ -82,7 +90,8 @@ def to_pinocchio(robot: Robot) -> tuple[pin.Model, dict[str, int], np.ndarray]:
             axis = _floats(joint.axis).ravel()
             jid = model.addJoint(parent_id, _joint_model(joint.type, axis), placement, joint.name)
             where[joint.child] = (jid, offset)
-            perm.append(robot.coordinate_index(joint))
+            first = robot.coordinate_index(joint)
+            perm.extend(range(first, first + joint.nv))
         else:
             where[joint.child] = (parent_id, placement * offset)
     frames = {}
@@ -95,6 +104,15 @@ def to_pinocchio(robot: Robot) -> tuple[pin.Model, dict[str, int], np.ndarray]:
     return model, frames, np.array(perm, dtype=int)
 
 
+def configuration_permutation(robot: Robot) -> np.ndarray:
+    """(nq,) such that Pinocchio's configuration coordinate i is armdyn's ``[i]``, for the
+    model :func:`to_pinocchio` builds (joints depth first, each joint's block whole)."""
+    first_q = {name: iq for name, _, iq, _ in robot.configuration_layout}
+    return np.array(
+        [k for j in depth_first(robot) if j.movable for k in range(first_q[j.name], first_q[j.name] + j.nq)]
+    )
+
+
 class PinocchioRobot:
     """Pinocchio's answers for an armdyn.Robot, in armdyn's coordinate order and output
     conventions (full symmetric M, poses in list(robot.links) order, Jacobian rows [v; w]
@@ -105,10 +123,12 @@ class PinocchioRobot:
         self.model, self.frames, self.perm = to_pinocchio(robot)
         self.data = self.model.createData()
         self.inv = np.argsort(self.perm)  # armdyn index -> pinocchio index
+        self.qperm = configuration_permutation(robot)
         self.welded = welded_potential_energy(robot)
 
-    def _p(self, x):  # armdyn order -> pinocchio order
-        return np.asarray(x, dtype=float)[self.perm]
+    def _p(self, x):  # armdyn order -> pinocchio order (a configuration by its own permutation)
+        x = np.asarray(x, dtype=float)
+        return x[self.qperm] if len(x) != len(self.perm) else x[self.perm]
 
     def _a(self, y):  # pinocchio order -> armdyn order
         return np.asarray(y)[self.inv]

@@ -62,13 +62,13 @@ def random_robot(
 
     tree:  False -> a serial chain; True -> each joint's parent is a random earlier link
            (the base included), so the robot branches.
-    kinds: letters R, P, F drawn uniformly for each joint's type (at least one joint is
-           made movable).
+    kinds: letters R, P, F (and S spherical, L planar, X floating) drawn uniformly for each
+           joint's type (at least one joint is made movable).
     random_gravity: gravity of norm 9.81 in a random direction (default: at random).
     frame_offsets: give the first joint and about half the others a child frame off the joint's axis
            (random ``frame_xyz`` and ``frame_rotation``).
     """
-    types = {"R": "revolute", "P": "prismatic", "F": "fixed"}
+    types = {"R": "revolute", "P": "prismatic", "F": "fixed", "S": "spherical", "L": "planar", "X": "floating"}
     links = [random_link(rng, "base")]
     joints = []
     drawn = [types[rng.choice(list(kinds))] for _ in range(n_joints)]

@@ -260,8 +260,8 @@ pub struct Work<L> {
 impl<L: Real> Work<L> {
     pub fn new(model: &Model) -> Self {
         let n = model.nv;
-        // the longest argument: a floating base's q (7 + n)
-        let arg = n + algo::floating::NQ_BASE;
+        // the longest argument: a floating base's q (7 + nq)
+        let arg = model.nq.max(n) + algo::floating::NQ_BASE;
         let nv = n + algo::floating::NV_BASE;
         Work {
             d1: Data::new(model),
@@ -281,7 +281,7 @@ impl<L: Real> Work<L> {
 macro_rules! lanes_kernel {
     ($(#[$doc:meta])* $name:ident, nargs = $nargs:literal, out = |$m:ident| $out:expr,
      |$model:ident, $data:ident, $a:ident, $o:ident| $call:expr) => {
-        lanes_kernel!($(#[$doc])* $name, nargs = $nargs, widths = |m| [m.nv; 3], out = |$m| $out,
+        lanes_kernel!($(#[$doc])* $name, nargs = $nargs, widths = |m| [m.nq, m.nv, m.nv], out = |$m| $out,
                       |$model, $data, $a, $o| $call);
     };
     ($(#[$doc:meta])* $name:ident, nargs = $nargs:literal, widths = |$wm:ident| $widths:expr,
@@ -383,19 +383,19 @@ lanes_kernel!(
 lanes_kernel!(
     /// Batched [`algo::rnea_floating`]: `args = [q (N, 7 + nv), v, a (N, 6 + nv)]`, `out` =
     /// tau (N, 6 + nv) (a floating base, `algo::floating`).
-    rnea_floating, nargs = 3, widths = |m| [m.nv + 7, m.nv + 6, m.nv + 6], out = |m| m.nv + 6,
+    rnea_floating, nargs = 3, widths = |m| [m.nq + 7, m.nv + 6, m.nv + 6], out = |m| m.nv + 6,
     |model, data, a, o| algo::rnea_floating(model, data, a[0], a[1], a[2], o)
 );
 lanes_kernel!(
     /// Batched [`algo::aba_floating`]: `args = [q (N, 7 + nv), v, tau (N, 6 + nv)]`, `out` =
     /// the accelerations (N, 6 + nv) (a floating base, `algo::floating`).
-    aba_floating, nargs = 3, widths = |m| [m.nv + 7, m.nv + 6, m.nv + 6], out = |m| m.nv + 6,
+    aba_floating, nargs = 3, widths = |m| [m.nq + 7, m.nv + 6, m.nv + 6], out = |m| m.nv + 6,
     |model, data, a, o| algo::aba_floating(model, data, a[0], a[1], a[2], o)
 );
 lanes_kernel!(
     /// Batched [`algo::crba_floating`]: `args = [q (N, 7 + nv)]`, `out` = M (N, 6 + nv, 6 + nv)
     /// (a floating base, `algo::floating`).
-    crba_floating, nargs = 1, widths = |m| [m.nv + 7, 0, 0], out = |m| (m.nv + 6) * (m.nv + 6),
+    crba_floating, nargs = 1, widths = |m| [m.nq + 7, 0, 0], out = |m| (m.nv + 6) * (m.nv + 6),
     |model, data, a, o| algo::crba_floating(model, data, a[0], o)
 );
 lanes_kernel!(
@@ -423,56 +423,84 @@ fn row(a: &[f64], n: usize, r: usize) -> &[f64] {
 
 /// Batched [`algo::coriolis_matrix`]: `q`, `qd` (N, nv), `out` = C (N, nv, nv).
 pub fn coriolis_matrix(model: &Model, q: &[f64], qd: &[f64], out: &mut [f64], threads: Option<usize>) {
-    let n = model.nv;
+    let (n, nq) = (model.nv, model.nq);
     let make = || (Data::new(model), CoriolisWork::new(model));
-    par_rows(q.len() / n.max(1), [out], [n * n], threads, make, |(d, cw), first, [chunk]| {
+    par_rows(q.len() / nq.max(1), [out], [n * n], threads, make, |(d, cw), first, [chunk]| {
         for (k, o) in chunk.chunks_exact_mut(n * n).enumerate() {
             let r = first + k;
-            algo::coriolis_matrix(model, d, cw, row(q, n, r), row(qd, n, r), o);
+            algo::coriolis_matrix(model, d, cw, row(q, nq, r), row(qd, n, r), o);
         }
     });
 }
 
 /// Batched [`algo::kinetic_energy`]: `q`, `qd` (N, nv), `out` (N,).
 pub fn kinetic_energy(model: &Model, q: &[f64], qd: &[f64], out: &mut [f64], threads: Option<usize>) {
-    let n = model.nv;
-    assert!(q.len() == out.len() * n && qd.len() == q.len(), "argument size");
-    par_rows(out.len(), [out], [1], threads, || Data::new(model), |d, first, [chunk]| {
-        for (k, o) in chunk.iter_mut().enumerate() {
-            *o = algo::kinetic_energy(model, d, row(q, n, first + k), row(qd, n, first + k));
-        }
-    });
+    let (n, nq) = (model.nv, model.nq);
+    assert!(q.len() == out.len() * nq && qd.len() == out.len() * n, "argument size");
+    par_rows(
+        out.len(),
+        [out],
+        [1],
+        threads,
+        || Data::new(model),
+        |d, first, [chunk]| {
+            for (k, o) in chunk.iter_mut().enumerate() {
+                *o = algo::kinetic_energy(model, d, row(q, nq, first + k), row(qd, n, first + k));
+            }
+        },
+    );
 }
 
 /// Batched [`algo::potential_energy`]: `q` (N, nv), `out` (N,).
 pub fn potential_energy(model: &Model, q: &[f64], out: &mut [f64], threads: Option<usize>) {
-    let n = model.nv;
-    assert!(q.len() == out.len() * n, "argument size");
-    par_rows(out.len(), [out], [1], threads, || Data::new(model), |d, first, [chunk]| {
-        for (k, o) in chunk.iter_mut().enumerate() {
-            *o = algo::potential_energy(model, d, row(q, n, first + k));
-        }
-    });
+    let nq = model.nq;
+    assert!(q.len() == out.len() * nq, "argument size");
+    par_rows(
+        out.len(),
+        [out],
+        [1],
+        threads,
+        || Data::new(model),
+        |d, first, [chunk]| {
+            for (k, o) in chunk.iter_mut().enumerate() {
+                *o = algo::potential_energy(model, d, row(q, nq, first + k));
+            }
+        },
+    );
 }
 
 /// Batched [`algo::forward_kinematics`]: `q` (N, nv), `out` (N, nlinks, 4, 4).
 pub fn forward_kinematics(model: &Model, q: &[f64], out: &mut [f64], threads: Option<usize>) {
-    let (n, per) = (model.nv, model.nlinks() * 16);
+    let (n, per) = (model.nq, model.nlinks() * 16);
     assert!(q.len() * per == out.len() * n || n == 0, "argument size");
-    par_rows(out.len() / per, [out], [per], threads, || Data::new(model), |d, first, [chunk]| {
-        for (k, o) in chunk.chunks_exact_mut(per).enumerate() {
-            algo::forward_kinematics(model, d, row(q, n, first + k), o);
-        }
-    });
+    par_rows(
+        out.len() / per,
+        [out],
+        [per],
+        threads,
+        || Data::new(model),
+        |d, first, [chunk]| {
+            for (k, o) in chunk.chunks_exact_mut(per).enumerate() {
+                algo::forward_kinematics(model, d, row(q, n, first + k), o);
+            }
+        },
+    );
 }
 
 /// Batched [`algo::jacobian`] of link `link`: `q` (N, nv), `out` (N, 6, nv).
 pub fn jacobian(model: &Model, q: &[f64], link: usize, out: &mut [f64], threads: Option<usize>) {
-    let n = model.nv;
+    let (n, nq) = (model.nv, model.nq);
     let per = 6 * n;
-    par_rows(q.len() / n.max(1), [out], [per], threads, || Data::new(model), |d, first, [chunk]| {
-        for (k, o) in chunk.chunks_exact_mut(per).enumerate() {
-            algo::jacobian(model, d, row(q, n, first + k), link, o);
-        }
-    });
+    par_rows(
+        q.len() / nq.max(1),
+        [out],
+        [per],
+        threads,
+        || Data::new(model),
+        |d, first, [chunk]| {
+            for (k, o) in chunk.chunks_exact_mut(per).enumerate() {
+                algo::jacobian(model, d, row(q, nq, first + k), link, o);
+            }
+        },
+    );
 }

@@ -26,7 +26,7 @@ trait Kernel: Sync {
     fn out_len(model: &Model) -> usize;
     /// Values per state of each argument: `nv`, or a floating base's `7 + nv`, `6 + nv`.
     fn widths(model: &Model) -> [usize; 3] {
-        [model.nv; 3]
+        [model.nq, model.nv, model.nv]
     }
     #[allow(clippy::too_many_arguments)]
     fn run<T: Real>(
@@ -389,15 +389,15 @@ kernel!(AbaExt, nargs = 3, nout = 1, out_len = |m| m.nv, |m, d, dd, a, e, [o0, _
 });
 
 kernel!(RneaDerivativesFloating, nargs = 3, nout = 3, out_len = |m| (m.nv + 6) * (m.nv + 6),
-    widths = |m| [m.nv + 7, m.nv + 6, m.nv + 6], |m, d, dd, a, e, [o0, o1, o2]| {
+    widths = |m| [m.nq + 7, m.nv + 6, m.nv + 6], |m, d, dd, a, e, [o0, o1, o2]| {
     algo::rnea_derivatives_floating(m, d, dd, a[0], a[1], a[2], e, o0, o1, o2)
 });
 kernel!(AbaDerivativesFloating, nargs = 3, nout = 3, out_len = |m| (m.nv + 6) * (m.nv + 6),
-    widths = |m| [m.nv + 7, m.nv + 6, m.nv + 6], |m, d, dd, a, e, [o0, o1, o2]| {
+    widths = |m| [m.nq + 7, m.nv + 6, m.nv + 6], |m, d, dd, a, e, [o0, o1, o2]| {
     algo::aba_derivatives_floating(m, d, dd, a[0], a[1], a[2], e, o0, o1, o2)
 });
 kernel!(MinverseFloating, nargs = 1, nout = 1, out_len = |m| (m.nv + 6) * (m.nv + 6),
-    widths = |m| [m.nv + 7, 0, 0], |m, d, dd, a, _, [o0, _, _]| {
+    widths = |m| [m.nq + 7, 0, 0], |m, d, dd, a, _, [o0, _, _]| {
     algo::minverse_floating(m, d, dd, a[0], o0)
 });
 
@@ -435,13 +435,13 @@ pub fn aba_ext(model: &Model, args: [&[f64]; 3], ext: (&[f64], ForceFrame), out:
 
 /// Batched [`algo::jacobian_dot`] of link `link`: `q`, `qd` (N, nv), `out` (N, 6, nv).
 pub fn jacobian_dot(model: &Model, q: &[f64], qd: &[f64], link: usize, out: &mut [f64], threads: Option<usize>) {
-    let (n, per) = (model.nv, 6 * model.nv);
+    let (n, nq, per) = (model.nv, model.nq, 6 * model.nv);
     let rows = if per == 0 { 0 } else { out.len() / per };
-    assert!(q.len() == rows * n && qd.len() == rows * n, "argument size");
+    assert!(q.len() == rows * nq && qd.len() == rows * n, "argument size");
     par_rows(rows, [out], [per], threads, || Data::new(model), |d, first, [o]| {
         for (k, o) in o.chunks_exact_mut(per).enumerate() {
             let r = first + k;
-            algo::jacobian_dot(model, d, &q[r * n..(r + 1) * n], &qd[r * n..(r + 1) * n], link, o);
+            algo::jacobian_dot(model, d, &q[r * nq..(r + 1) * nq], &qd[r * n..(r + 1) * n], link, o);
         }
     });
 }

@@ -18,6 +18,9 @@ pub struct Data<T> {
     pub a: Vec<Motion<T>>,
     /// Velocity-product acceleration `c_i = v_i x S_i qd_i` (ABA).
     pub c: Vec<Motion<T>>,
+    /// The velocity of body i's joint's parent, in body i's frame (the velocity product's
+    /// left factor, `Model::joint_parent_velocity`).
+    pub vjp: Vec<Motion<T>>,
     /// RNEA: net force transmitted across joint i, body frame.
     pub f: Vec<Force<T>>,
     /// CRBA: composite rigid-body inertia of the subtree at i, body frame.
@@ -44,6 +47,7 @@ impl<T: Real> Data<T> {
             v: vec![Motion::zero(); n],
             a: vec![Motion::zero(); n],
             c: vec![Motion::zero(); n],
+            vjp: vec![Motion::zero(); n],
             f: vec![Force::zero(); n],
             ic: vec![RigidInertia::zero(); n],
             ia: vec![ArticulatedInertia::from_rigid(&RigidInertia::zero()); n],

@@ -27,6 +27,7 @@ pub mod batch_derivatives;
 pub mod data;
 pub mod deriv_data;
 pub mod joint;
+pub mod joint_multi;
 pub mod model;
 pub mod real;
 pub mod spatial;

@@ -1,8 +1,9 @@
 //! The immutable model: built once from a robot description, then shared (read-only)
 //! by any number of threads, each with its own [`crate::Data`] workspace.
 
-use crate::real::Real;
 use crate::joint::JointKind;
+use crate::joint_multi::MultiKind;
+use crate::real::Real;
 use crate::spatial::{Motion, RigidInertia, Sym3, Xform, M3, V3};
 use std::fmt;
 
@@ -12,6 +13,30 @@ pub enum JointType {
     Revolute,
     Prismatic,
     Fixed,
+    /// Joints of several coordinates (`joint_multi.rs`); their `axis` is ignored.
+    Spherical,
+    Planar,
+    Free,
+}
+
+/// How a body's transform from its parent follows from `q` (`joint_multi.rs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BodyMotion {
+    /// A 1-dof joint's body: `kind.xup(xtree, q[idx_q])`.
+    Axis,
+    /// The first part of a joint of several coordinates: its whole motion, from
+    /// `q[idx_q..idx_q + nq]`.
+    Head(MultiKind),
+    /// A later part: a constant re-framing `xtree` of the part before it.
+    Tail,
+}
+
+/// A joint of several coordinates: its kind, its first body and its block of `q`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MultiJoint {
+    pub kind: MultiKind,
+    pub body: usize,
+    pub idx_q: usize,
 }
 
 /// One joint of the description, with its child link's inertia (the convention of
@@ -99,8 +124,19 @@ pub struct LinkFrame {
 /// added to it and keep their frames in `links` for kinematics.
 #[derive(Clone, Debug)]
 pub struct Model {
-    /// Number of movable joints (= dof = bodies).
+    /// Number of velocity coordinates (= bodies: a joint of several coordinates has one
+    /// body per velocity coordinate, `joint_multi.rs`).
     pub nv: usize,
+    /// Number of configuration coordinates (`nv` plus one per quaternion or planar turn).
+    pub nq: usize,
+    /// Where body i's coordinate (or, for a head, its joint's block) starts in `q`.
+    pub idx_q: Vec<usize>,
+    /// How body i's transform follows from `q`.
+    pub motion: Vec<BodyMotion>,
+    /// A head's re-framing `Ra^T` (z to its first part's axis); identity elsewhere.
+    pub head_frame: Vec<M3<f64>>,
+    /// The joints of several coordinates, in tree order (empty for an arm of 1-dof joints).
+    pub multi: Vec<MultiJoint>,
     /// `lambda(i)`: the parent body, `None` for the base. Always `< i`.
     pub parent: Vec<Option<usize>>,
     /// Joint type of body i, after re-framing (`S` along z).
@@ -174,6 +210,11 @@ impl Model {
         let mut links = vec![LinkFrame { body: None, rotation: M3::identity(), translation: V3::zero() }];
         let mut m = Model {
             nv: 0,
+            nq: 0,
+            idx_q: vec![],
+            motion: vec![],
+            head_frame: vec![],
+            multi: vec![],
             parent: vec![],
             kind: vec![],
             xtree: vec![],
@@ -236,12 +277,56 @@ impl Model {
                     let b = m.nv;
                     m.nv += 1;
                     m.parent.push(parent_link.body);
-                    m.kind.push(if j.jtype == JointType::Revolute { JointKind::RevoluteZ } else { JointKind::PrismaticZ });
+                    m.kind.push(if j.jtype == JointType::Revolute {
+                        JointKind::RevoluteZ
+                    } else {
+                        JointKind::PrismaticZ
+                    });
                     m.xtree.push(Xform::from_pose(&r_place.mul_m(&ra), p_place));
                     m.inertia.push(RigidInertia::zero());
                     m.joint_body.push(Some(b));
+                    m.idx_q.push(m.nq);
+                    m.nq += 1;
+                    m.motion.push(BodyMotion::Axis);
+                    m.head_frame.push(M3::identity());
                     // child link frame = body frame * Ra^T (Rot(axis, q) = Ra Rz(q) Ra^T)
                     LinkFrame { body: Some(b), rotation: ra.transpose(), translation: V3::zero() }
+                }
+                JointType::Spherical | JointType::Planar | JointType::Free => {
+                    let kind = match j.jtype {
+                        JointType::Spherical => MultiKind::Spherical,
+                        JointType::Planar => MultiKind::Planar,
+                        _ => MultiKind::Free,
+                    };
+                    m.joint_body.push(Some(m.nv));
+                    m.multi.push(MultiJoint { kind, body: m.nv, idx_q: m.nq });
+                    let mut previous: Option<M3<f64>> = None;
+                    for &(part, axis) in kind.parts() {
+                        let ra = frame_with_z(V3::from_array(axis));
+                        let b = m.nv;
+                        m.nv += 1;
+                        m.kind.push(part);
+                        m.inertia.push(RigidInertia::zero());
+                        m.idx_q.push(m.nq);
+                        match previous {
+                            None => {
+                                m.parent.push(parent_link.body);
+                                m.motion.push(BodyMotion::Head(kind));
+                                m.head_frame.push(ra.transpose());
+                                m.xtree.push(Xform::from_pose(&r_place, p_place));
+                            }
+                            Some(ra_before) => {
+                                m.parent.push(Some(b - 1));
+                                m.motion.push(BodyMotion::Tail);
+                                m.head_frame.push(M3::identity());
+                                m.xtree.push(Xform::from_pose(&ra_before.transpose().mul_m(&ra), V3::zero()));
+                            }
+                        }
+                        previous = Some(ra);
+                    }
+                    m.nq += kind.nq();
+                    let ra_last = previous.expect("a joint has parts");
+                    LinkFrame { body: Some(m.nv - 1), rotation: ra_last.transpose(), translation: V3::zero() }
                 }
             };
             links.push(link);
@@ -272,7 +357,8 @@ impl Model {
         if body >= self.nv {
             return err(format!("no such body (the model has {})", self.nv));
         }
-        let values = [("armature", jd.armature), ("viscous", jd.viscous), ("coulomb", jd.coulomb), ("offset", jd.offset)];
+        let values =
+            [("armature", jd.armature), ("viscous", jd.viscous), ("coulomb", jd.coulomb), ("offset", jd.offset)];
         for (name, x) in values {
             if !x.is_finite() {
                 return err(format!("{name} {x} is not finite"));
@@ -311,6 +397,41 @@ impl Model {
         self.base_inertia += RigidInertia::from_mass_com(mass, V3::from_array(com), Sym3::from_m3(&ic));
         self.add_base_mass(mass, com);
         Ok(())
+    }
+
+    /// `^i X_lambda(i)` at configuration `q` (nq,): what every algorithm's first loop
+    /// computes (RBDA Table 5.1 `jcalc`), for 1-dof bodies and joint parts alike.
+    #[inline(always)]
+    pub fn xup<T: Real>(&self, i: usize, q: &[T]) -> Xform<T> {
+        match self.motion[i] {
+            BodyMotion::Axis => self.kind[i].xup(&self.xtree[i], q[self.idx_q[i]]),
+            BodyMotion::Head(kind) => kind.head_xup(&self.xtree[i], &self.head_frame[i], &q[self.idx_q[i]..]),
+            BodyMotion::Tail => Xform::splat(&self.xtree[i]),
+        }
+    }
+
+    /// The velocity body i's velocity product is taken with (`joint_multi.rs`):
+    /// `xup v_lambda` (the parent's velocity in body i's frame) for a 1-dof body or a
+    /// head, `xup vjp_lambda` for a tail, where `vjp` holds this value for every body.
+    /// For a 1-dof body `v_i x S_i qd_i` is the same with either velocity, bit for bit
+    /// (`S_i qd_i` only changes the component the cross product with `S_i` drops).
+    #[inline(always)]
+    pub fn joint_parent_velocity<T: Real>(
+        &self,
+        i: usize,
+        xup: &Xform<T>,
+        vp: Motion<T>,
+        vjp: &[Motion<T>],
+    ) -> Motion<T> {
+        match (self.motion[i], self.parent[i]) {
+            (BodyMotion::Tail, Some(p)) => xup.apply_motion(&vjp[p]),
+            _ => vp,
+        }
+    }
+
+    /// Whether a joint has several coordinates (nq != nv, joint parts in the tree).
+    pub fn has_multi(&self) -> bool {
+        !self.multi.is_empty()
     }
 
     /// Number of link frames (base included): joints + 1.

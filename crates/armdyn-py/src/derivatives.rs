@@ -3,7 +3,7 @@
 //! `python/armdyn/numeric/`, which documents them). Same rules as the methods in
 //! `lib.rs`: one state `(n,)` or a batch `(N, n)`, ValueError naming the argument.
 
-use crate::{as_f64, guard, is_c_contiguous_aligned, new_array, slice, states, thread_arg, NumericModel, Scratch, Shape};
+use crate::{as_f64, guard, is_c_contiguous_aligned, new_array, slice, thread_arg, NumericModel, Scratch, Shape};
 use armdyn_core::algo::{self, ExternalForces, ForceFrame};
 use armdyn_core::{batch_derivatives as bd, Model};
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
@@ -21,7 +21,11 @@ fn parse_frame(frame: &str) -> PyResult<ForceFrame> {
 
 /// `f_ext` converted and checked against the states' shape: (nlinks, 6) for one state,
 /// (N, nlinks, 6) for N states, finite.
-pub(crate) fn check_f_ext<'py>(m: &NumericModel, obj: &Bound<'py, PyAny>, shape: Shape) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+pub(crate) fn check_f_ext<'py>(
+    m: &NumericModel,
+    obj: &Bound<'py, PyAny>,
+    shape: Shape,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let a = as_f64(obj, "f_ext")?;
     let nl = m.model.nlinks();
     let ok = match (shape, a.shape()) {
@@ -87,7 +91,13 @@ pub(crate) fn outputs_given<'py, const R: usize>(
     if items.len() != R {
         return Err(PyValueError::new_err(format!("out: expected {R} arrays, got {}", items.len())));
     }
-    let name = |k: usize| if R == 1 { "out".to_string() } else { format!("out[{k}]") };
+    let name = |k: usize| {
+        if R == 1 {
+            "out".to_string()
+        } else {
+            format!("out[{k}]")
+        }
+    };
     let mut arrays = Vec::with_capacity(R);
     for (k, item) in items.iter().enumerate() {
         let a = item.cast::<PyArrayDyn<f64>>().map_err(|_| {
@@ -104,7 +114,8 @@ pub(crate) fn outputs_given<'py, const R: usize>(
             return Err(PyValueError::new_err(format!("{}: is read-only", name(k))));
         }
         let r = memory(a);
-        let overlaps = |o: &std::ops::Range<usize>| !r.is_empty() && !o.is_empty() && r.start < o.end && o.start < r.end;
+        let overlaps =
+            |o: &std::ops::Range<usize>| !r.is_empty() && !o.is_empty() && r.start < o.end && o.start < r.end;
         if let Some((what, _)) = inputs.iter().find(|(_, i)| overlaps(&memory(i))) {
             return Err(PyValueError::new_err(format!("{}: shares memory with {what}", name(k))));
         }
@@ -147,7 +158,7 @@ fn run<'py, const K: usize, const R: usize>(
         m.fixed_base_only()?;
         let threads = thread_arg(threads)?;
         let frame = parse_frame(frame)?;
-        let (shape, arrays) = states(m.model.nv, args)?;
+        let (shape, arrays) = m.joint_states(args)?;
         let ext_arr = f_ext.map(|f| check_f_ext(m, f, shape)).transpose()?;
         // the output shape, with a leading N for a batch (a stack buffer: no allocation per call)
         let mut buf = [0usize; 4];
@@ -207,7 +218,7 @@ fn ext_forces(e: Ext<'_>) -> Option<ExternalForces<'_, f64>> {
 /// output of `$algo` / `$batch` on a compiled model; the attributes given first (e.g.
 /// `#[pyfunction]`) are passed on.
 macro_rules! matrix_of_q {
-    ($(#[$attr:meta])* $name:ident, $algo:path, $batch:path $(, floating = $floating:path)?) => {
+    ($(#[$attr:meta])* $name:ident, $algo:path, $batch:path $(, floating = $floating:path)? $(, one_dof = $one:literal)?) => {
         $(#[$attr])*
         fn $name<'py>(
             py: Python<'py>,
@@ -217,6 +228,9 @@ macro_rules! matrix_of_q {
             out: Option<&Bound<'py, PyAny>>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             let m = model.get();
+            $(if $one {
+                m.one_dof_only(stringify!($name))?;
+            })?
             $(if m.floating {
                 return $floating(m, py, q, threads, out);
             })?
@@ -265,6 +279,7 @@ macro_rules! derivatives_entry {
             out: Option<&Bound<'py, PyAny>>,
         ) -> PyResult<Bound<'py, PyTuple>> {
             let m = model.get();
+            m.one_dof_only(stringify!($name))?;
             if m.floating {
                 return $floating(m, py, q, qd, $third, f_ext, frame, threads, out);
             }
@@ -314,7 +329,7 @@ matrix_of_q!(
     /// dg/dq, (n, n) or (N, n, n).
     #[pyfunction]
     #[pyo3(signature = (model, q, threads = None, out = None))]
-    gravity_derivatives, algo::gravity_derivatives, bd::gravity_derivatives
+    gravity_derivatives, algo::gravity_derivatives, bd::gravity_derivatives, one_dof = true
 );
 
 /// dJ/dt of link `link`'s Jacobian, (6, n) or (N, 6, n).
@@ -329,6 +344,7 @@ fn jacobian_dot<'py>(
     threads: Option<i64>,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let m = model.get();
+    m.one_dof_only("jacobian_dot")?;
     let index = m.link_arg(link)?;
     let [o] = run(
         m,

@@ -10,8 +10,9 @@
 //! anything further from it is refused, never silently used.
 
 use crate::{all_finite, as_f64, guard, new_array, slice, thread_arg, NumericModel, Shape};
-use armdyn_core::batch;
 use armdyn_core::algo::floating::{aba_floating, crba_floating, rnea_floating, NQ_BASE, NV_BASE};
+use armdyn_core::batch;
+use armdyn_core::model::BodyMotion;
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyFloatingPointError, PyNotImplementedError, PyValueError};
 use pyo3::prelude::*;
@@ -32,14 +33,58 @@ impl NumericModel {
         Ok(())
     }
 
+    /// `Err(ValueError)` naming `what` for a model with joints of several coordinates
+    /// (spherical, planar, free): for the methods whose algorithms take 1-dof joints
+    /// only (their velocity products and derivatives are written for one axis per body).
+    pub(crate) fn one_dof_only(&self, what: &str) -> PyResult<()> {
+        if let Some(j) = self.model.multi.first() {
+            return Err(PyValueError::new_err(format!(
+                "{what}: '{}' has joints of several coordinates (the first: '{}'): {what} takes revolute and \
+                 prismatic joints only (yet); rnea, crba, aba, gravity, bias, minverse, forward_kinematics, \
+                 jacobian, the energies and the centroidal map take them",
+                self.name,
+                self.joint_name(j.body)
+            )));
+        }
+        Ok(())
+    }
+
+    /// The name of the joint of body `b` (a coordinate name without its `.wx`-style suffix
+    /// for the parts of a joint of several coordinates).
+    fn joint_name(&self, b: usize) -> &str {
+        let c = &self.coordinate_names[b];
+        match self.model.motion[b] {
+            BodyMotion::Axis => c,
+            _ => c.rsplit_once('.').map_or(c.as_str(), |(j, _)| j),
+        }
+    }
+
+    /// The state arguments `(name, object)` of a method whose first argument is `q`:
+    /// [`crate::states`] when `q` and the velocities have the same length (1-dof joints),
+    /// else [`Self::floating_states`] with `q` `nq` long.
+    pub(crate) fn joint_states<'py, const K: usize>(
+        &self,
+        args: [(&str, &Bound<'py, PyAny>); K],
+    ) -> PyResult<(Shape, [Bound<'py, PyArrayDyn<f64>>; K])> {
+        if !self.model.has_multi() {
+            return crate::states(self.model.nv, args);
+        }
+        let mut k = 0;
+        self.floating_states(args.map(|(name, obj)| {
+            k += 1;
+            (name, obj, if k == 1 { self.model.nq } else { self.model.nv })
+        }))
+    }
+
     /// Check the arguments `(name, object, width)`: each `(width,)` or `(N, width)`, the
-    /// same N for all, finite; the first is `q`, whose quaternions must be unit. A fixed
-    /// base's arguments are checked by [`crate::states`] (every width is then dof).
+    /// same N for all, finite; the first is `q`, whose quaternions (and planar joints'
+    /// `cos, sin`) must be unit. A model without a floating base or joints of several
+    /// coordinates has its arguments checked by [`crate::states`] (every width is dof).
     pub(crate) fn floating_states<'py, const K: usize>(
         &self,
         args: [(&str, &Bound<'py, PyAny>, usize); K],
     ) -> PyResult<(Shape, [Bound<'py, PyArrayDyn<f64>>; K])> {
-        if !self.floating {
+        if !self.floating && !self.model.has_multi() {
             return crate::states(self.model.nv, args.map(|(name, obj, _)| (name, obj)));
         }
         let mut shape = None;
@@ -52,9 +97,10 @@ impl NumericModel {
                 other => {
                     return Err(PyValueError::new_err(format!(
                         "{name}: expected shape ({width},) for one state or (N, {width}) for a batch of '{}' \
-                         (floating base: q has 7 + {n} entries, velocities and torques 6 + {n}), got {other:?}",
+                         (q has {nq} entries, velocities and torques {nv}), got {other:?}",
                         self.name,
-                        n = self.model.nv
+                        nq = self.model.nq + if self.floating { NQ_BASE } else { 0 },
+                        nv = self.model.nv + if self.floating { NV_BASE } else { 0 },
                     )))
                 }
             };
@@ -70,19 +116,41 @@ impl NumericModel {
         }
         // SAFETY: read-only, GIL held.
         let q = unsafe { slice(&arrays[0]) };
-        let nq = self.model.nv + NQ_BASE;
-        for (row, state) in q.chunks_exact(nq).enumerate() {
-            let norm = state[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
-            if (norm - 1.0).abs() > QUATERNION_TOL {
-                let at = if q.len() > nq { format!(" (row {row})") } else { String::new() };
-                return Err(PyValueError::new_err(format!(
-                    "q{at}: the base quaternion q[3:7] (x, y, z, w) has length {norm}, not 1 \
-                     (to within {QUATERNION_TOL:e}): normalise it first"
-                )));
-            }
-        }
+        self.check_unit_blocks(q)?;
         let arrays: [Bound<'py, PyArrayDyn<f64>>; K] = arrays.try_into().expect("K arrays");
         Ok((shape.expect("at least one argument"), arrays))
+    }
+
+    /// Every quaternion of the configurations `q` (rows of `nq`: the base's `q[3:7]`, each
+    /// spherical or free joint's) and every planar joint's `(cos, sin)` must have unit
+    /// length to within [`QUATERNION_TOL`]: anything else is refused, never used.
+    fn check_unit_blocks(&self, q: &[f64]) -> PyResult<()> {
+        let qb = if self.floating { NQ_BASE } else { 0 };
+        let nq = self.model.nq + qb;
+        let base = self.floating.then_some((3, 4, "the base quaternion", "x, y, z, w"));
+        let joints = self.model.multi.iter().map(|j| {
+            let (off, len) = j.kind.unit_block();
+            let what = if len == 4 { "the quaternion" } else { "the (cos, sin) pair" };
+            (qb + j.idx_q + off, len, what, if len == 4 { "x, y, z, w" } else { "cos, sin" })
+        });
+        for (row, state) in q.chunks_exact(nq.max(1)).enumerate() {
+            for (k, (start, len, what, layout)) in base.into_iter().chain(joints.clone()).enumerate() {
+                let norm = state[start..start + len].iter().map(|x| x * x).sum::<f64>().sqrt();
+                if (norm - 1.0).abs() > QUATERNION_TOL {
+                    let at = if q.len() > nq { format!(" (row {row})") } else { String::new() };
+                    let of = match (base.is_some(), k) {
+                        (true, 0) => String::new(),
+                        (b, k) => format!(" of joint '{}'", self.joint_name(self.model.multi[k - b as usize].body)),
+                    };
+                    return Err(PyValueError::new_err(format!(
+                        "q{at}: {what}{of} q[{start}:{}] ({layout}) has length {norm}, not 1 \
+                         (to within {QUATERNION_TOL:e}): normalise it first",
+                        start + len
+                    )));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// `single(data, inputs, output)` for one state, `batched(model, inputs, output,
@@ -133,7 +201,7 @@ impl NumericModel {
         a: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let (nq, nv) = (self.model.nv + NQ_BASE, self.model.nv + NV_BASE);
+        let (nq, nv) = (self.model.nq + NQ_BASE, self.model.nv + NV_BASE);
         let out = self.floating_op(
             py,
             [("q", q, nq), ("qd", v, nv), ("qdd", a, nv)],
@@ -152,7 +220,7 @@ impl NumericModel {
         q: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let (nq, nv) = (self.model.nv + NQ_BASE, self.model.nv + NV_BASE);
+        let (nq, nv) = (self.model.nq + NQ_BASE, self.model.nv + NV_BASE);
         let out = self.floating_op(
             py,
             [("q", q, nq)],
@@ -173,7 +241,7 @@ impl NumericModel {
         tau: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let (nq, nv) = (self.model.nv + NQ_BASE, self.model.nv + NV_BASE);
+        let (nq, nv) = (self.model.nq + NQ_BASE, self.model.nv + NV_BASE);
         let out = self.floating_op(
             py,
             [("q", q, nq), ("qd", v, nv), ("tau", tau, nv)],

@@ -115,7 +115,7 @@ pub(crate) fn rnea_derivatives<'py>(
     threads: Option<i64>,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let (nq, nv) = (m.model.nv + NQ_BASE, m.model.nv + NV_BASE);
+    let (nq, nv) = (m.model.nq + NQ_BASE, m.model.nv + NV_BASE);
     let o = run(
         m,
         py,
@@ -147,7 +147,7 @@ pub(crate) fn aba_derivatives<'py>(
     threads: Option<i64>,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let (nq, nv) = (m.model.nv + NQ_BASE, m.model.nv + NV_BASE);
+    let (nq, nv) = (m.model.nq + NQ_BASE, m.model.nv + NV_BASE);
     let o = run(
         m,
         py,
@@ -174,7 +174,7 @@ pub(crate) fn minverse<'py>(
     threads: Option<i64>,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    let nq = m.model.nv + NQ_BASE;
+    let nq = m.model.nq + NQ_BASE;
     let [o] = run(
         m,
         py,

@@ -101,9 +101,7 @@ impl NumericModel {
         match self.scratch.try_lock() {
             Ok(mut s) => f(&mut s),
             Err(std::sync::TryLockError::Poisoned(p)) => f(&mut p.into_inner()),
-            Err(std::sync::TryLockError::WouldBlock) => {
-                f(&mut Scratch::new(&self.model))
-            }
+            Err(std::sync::TryLockError::WouldBlock) => f(&mut Scratch::new(&self.model)),
         }
     }
 
@@ -145,7 +143,8 @@ impl NumericModel {
             let threads = thread_arg(threads)?;
             // the common call, one plain float64 state: read in place, no conversion objects
             // SAFETY: inputs read-only and `out` fresh, GIL held throughout.
-            if let Some(ins) = unsafe { plain_states(py, self.model.nv, &args) } {
+            let plain = !self.model.has_multi();
+            if let Some(ins) = plain.then(|| unsafe { plain_states(py, self.model.nv, &args) }).flatten() {
                 return Ok(self.with_scratch(|s| {
                     let out = s.output(py, out_shape);
                     // SAFETY: `out` (C-contiguous, of `out_shape`) is fresh or pooled and free:
@@ -155,7 +154,7 @@ impl NumericModel {
                     out
                 }));
             }
-            let (shape, arrays) = states(self.model.nv, args)?;
+            let (shape, arrays) = self.joint_states(args)?;
             match shape {
                 Shape::Single => {
                     let out = new_array(py, out_shape);
@@ -219,29 +218,40 @@ impl NumericModel {
         floating: bool,
     ) -> PyResult<Self> {
         guard(|| {
-            let init_args = PyTuple::new(py, [
-                parents.clone().into_pyobject(py)?.into_any(),
-                types.clone().into_pyobject(py)?.into_any(),
-                rotations.clone().into_pyobject(py)?.into_any(),
-                translations.clone().into_pyobject(py)?.into_any(),
-                axes.clone().into_pyobject(py)?.into_any(),
-                masses.clone().into_pyobject(py)?.into_any(),
-                coms.clone().into_pyobject(py)?.into_any(),
-                inertias.clone().into_pyobject(py)?.into_any(),
-                gravity.into_pyobject(py)?.into_any(),
-                link_names.clone().into_pyobject(py)?.into_any(),
-                coordinate_names.clone().into_pyobject(py)?.into_any(),
-                name.clone().into_pyobject(py)?.into_any(),
-                base_mass.into_pyobject(py)?.into_any(),
-                base_com.into_pyobject(py)?.into_any(),
-                // friction and rotor inertia travel too (a pickled model on a Dask worker)
-                joint_dynamics.clone().into_pyobject(py)?.into_any(),
-                base_inertia.into_pyobject(py)?.into_any(),
-                floating.into_pyobject(py)?.to_owned().into_any(),
-            ])?
+            let init_args = PyTuple::new(
+                py,
+                [
+                    parents.clone().into_pyobject(py)?.into_any(),
+                    types.clone().into_pyobject(py)?.into_any(),
+                    rotations.clone().into_pyobject(py)?.into_any(),
+                    translations.clone().into_pyobject(py)?.into_any(),
+                    axes.clone().into_pyobject(py)?.into_any(),
+                    masses.clone().into_pyobject(py)?.into_any(),
+                    coms.clone().into_pyobject(py)?.into_any(),
+                    inertias.clone().into_pyobject(py)?.into_any(),
+                    gravity.into_pyobject(py)?.into_any(),
+                    link_names.clone().into_pyobject(py)?.into_any(),
+                    coordinate_names.clone().into_pyobject(py)?.into_any(),
+                    name.clone().into_pyobject(py)?.into_any(),
+                    base_mass.into_pyobject(py)?.into_any(),
+                    base_com.into_pyobject(py)?.into_any(),
+                    // friction and rotor inertia travel too (a pickled model on a Dask worker)
+                    joint_dynamics.clone().into_pyobject(py)?.into_any(),
+                    base_inertia.into_pyobject(py)?.into_any(),
+                    floating.into_pyobject(py)?.to_owned().into_any(),
+                ],
+            )?
             .unbind();
             let nj = parents.len();
-            let lens = [types.len(), rotations.len(), translations.len(), axes.len(), masses.len(), coms.len(), inertias.len()];
+            let lens = [
+                types.len(),
+                rotations.len(),
+                translations.len(),
+                axes.len(),
+                masses.len(),
+                coms.len(),
+                inertias.len(),
+            ];
             if lens.iter().any(|&l| l != nj) || link_names.len() != nj + 1 {
                 return Err(PyValueError::new_err(format!(
                     "inconsistent lengths: {nj} parents, {lens:?} per-joint arrays, {} link names",
@@ -254,6 +264,9 @@ impl NumericModel {
                     0 => JointType::Revolute,
                     1 => JointType::Prismatic,
                     2 => JointType::Fixed,
+                    3 => JointType::Spherical,
+                    4 => JointType::Planar,
+                    5 => JointType::Free,
                     t => return Err(PyValueError::new_err(format!("joint {k}: unknown joint type code {t}"))),
                 };
                 let parent = match parents[k] {
@@ -304,9 +317,9 @@ impl NumericModel {
                     )));
                 }
                 for (b, [armature, viscous, coulomb, offset]) in jd.into_iter().enumerate() {
-                    model
-                        .set_joint_dynamics(b, JointDynamics { armature, viscous, coulomb, offset })
-                        .map_err(|e| PyValueError::new_err(format!("joint '{}': {}", coordinate_names[b], e.message)))?;
+                    model.set_joint_dynamics(b, JointDynamics { armature, viscous, coulomb, offset }).map_err(|e| {
+                        PyValueError::new_err(format!("joint '{}': {}", coordinate_names[b], e.message))
+                    })?;
                 }
             }
             let link_index = link_names.iter().enumerate().map(|(k, s)| (s.clone(), k)).collect();
@@ -339,7 +352,7 @@ impl NumericModel {
     /// Length of q: 7 + dof for a floating base, dof otherwise.
     #[getter]
     fn nq(&self) -> usize {
-        self.model.nv + if self.floating { 7 } else { 0 }
+        self.model.nq + if self.floating { 7 } else { 0 }
     }
     /// Length of v (qd, qdd, tau): 6 + dof for a floating base, dof otherwise.
     #[getter]
@@ -470,14 +483,7 @@ impl NumericModel {
             return self.crba_floating(py, q, threads);
         }
         let n = self.model.nv;
-        self.vector_op(
-            py,
-            [("q", q)],
-            &[n, n],
-            threads,
-            |m, s, [q], o| algo::crba(m, &mut s.data, q, o),
-            batch::crba,
-        )
+        self.vector_op(py, [("q", q)], &[n, n], threads, |m, s, [q], o| algo::crba(m, &mut s.data, q, o), batch::crba)
     }
 
     /// Gravity torques g(q) = rnea(q, 0, 0).
@@ -526,6 +532,7 @@ impl NumericModel {
         qd: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        self.one_dof_only("coriolis_matrix")?;
         let n = self.model.nv;
         self.vector_op(
             py,

@@ -20,6 +20,7 @@ pub fn regressor<'py>(
     qdd: &Bound<'py, PyAny>,
     threads: Option<i64>,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    model.one_dof_only("regressor")?;
     let n = model.model.nv;
     let cols = algo::regressor_columns(&model.model);
     model.vector_op(

@@ -113,6 +113,7 @@ fn _simulate<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         let threads = thread_arg(threads)?;
+        model.get().one_dof_only("simulate")?;
         let m = &model.get().model;
         let floating = model.get().floating;
         let n = m.nv;

@@ -21,7 +21,7 @@ NumericModel = _core.NumericModel
 #: then cached on it) or an already compiled model
 RobotLike = Robot | NumericModel | MimicModel
 
-_TYPE_CODES = {"revolute": 0, "prismatic": 1, "fixed": 2}
+_TYPE_CODES = {"revolute": 0, "prismatic": 1, "fixed": 2, "spherical": 3, "planar": 4, "floating": 5}
 
 
 def _floats(values, where: str) -> list[float]:
@@ -83,7 +83,7 @@ def compile_model(robot: Robot | NumericModel | MimicModel) -> NumericModel | Mi
         types.append(_TYPE_CODES[j.type])
         rotations.append(_field(j, "rotation", where))
         translations.append(_field(j, "xyz", where))
-        axes.append(_field(j, "axis", where) if j.movable else [0.0, 0.0, 1.0])
+        axes.append(_field(j, "axis", where) if j.nv == 1 else [0.0, 0.0, 1.0])
         link = robot.links[j.child]
         where = f"link '{link.name}'"
         masses.append(_field(link, "mass", where))
@@ -92,6 +92,7 @@ def compile_model(robot: Robot | NumericModel | MimicModel) -> NumericModel | Mi
     # per movable joint [armature, viscous, coulomb, offset] (absent = 0); None when all zero
     # one row per joint the compiled model frees (mimic joints too); a mimic joint's own
     # friction and armature are not modelled (yet): zeros, as in the reference
+    # (a joint of several coordinates has none: a row of zeros per velocity coordinate)
     rows = [
         [
             0.0 if j.mimic is not None or j.floats(k) is None else float(j.floats(k))
@@ -99,6 +100,7 @@ def compile_model(robot: Robot | NumericModel | MimicModel) -> NumericModel | Mi
         ]
         for j in robot.joints
         if j.movable
+        for _ in range(j.nv)
     ]
     joint_dynamics = rows if any(any(row) for row in rows) else None
     gravity_vec = _floats(robot.gravity, f"robot '{robot.name}'")
@@ -122,7 +124,7 @@ def compile_model(robot: Robot | NumericModel | MimicModel) -> NumericModel | Mi
             inertias,
             gravity_vec,
             list(robot.links),
-            [j.name for j in robot.joints if j.movable],
+            [c for j in robot.joints for c in j.coordinate_names],
             robot.name,
             _field(base, "mass", where),
             _field(base, "com", where),

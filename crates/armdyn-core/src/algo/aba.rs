@@ -19,7 +19,7 @@ use crate::spatial::{ArticulatedInertia, Force, Motion, RigidInertia, V3};
 #[inline(always)]
 pub fn aba<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], tau: &[T], qdd: &mut [T]) {
     let n = model.nv;
-    assert!(q.len() == n && qd.len() == n && tau.len() == n && qdd.len() == n, "state length");
+    assert!(q.len() == model.nq && qd.len() == n && tau.len() == n && qdd.len() == n, "state length");
     velocities_and_bias(model, data, q, qd, None);
     let frames = BodyFrames(&model.kind);
     articulated_inertias(model, data, &frames, Some((qd, tau)));
@@ -41,15 +41,18 @@ pub(crate) fn velocities_and_bias<T: Real>(
 ) {
     for i in 0..model.nv {
         let kind = model.kind[i];
-        let xup = kind.xup(&model.xtree[i], q[i]);
-        let vj = kind.s_times(qd[i]);
-        let v = match (model.parent[i], base_v) {
-            (Some(p), _) => xup.apply_motion(&data.v[p]) + vj,
-            (None, Some(vb)) => xup.apply_motion(vb) + vj,
-            (None, None) => vj,
+        let xup = model.xup(i, q);
+        let vp = match (model.parent[i], base_v) {
+            (Some(p), _) => xup.apply_motion(&data.v[p]),
+            (None, Some(vb)) => xup.apply_motion(vb),
+            (None, None) => Motion::zero(),
         };
+        let v = vp + kind.s_times(qd[i]);
         let inertia = RigidInertia::splat(&model.inertia[i]);
-        data.c[i] = kind.v_cross_s(&v, qd[i]);
+        // the velocity product with the joint's parent velocity (joint_multi.rs)
+        let vjp = model.joint_parent_velocity(i, &xup, vp, &data.vjp);
+        data.vjp[i] = vjp;
+        data.c[i] = kind.v_cross_s(&vjp, qd[i]);
         data.ia[i] = ArticulatedInertia::from_rigid(&inertia);
         data.pa[i] = v.cross_force(&inertia.mul_motion(&v));
         data.xup[i] = xup;

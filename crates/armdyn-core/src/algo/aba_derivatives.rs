@@ -51,7 +51,7 @@ pub fn aba_derivatives<T: Real>(
     minv: &mut [T],
 ) {
     let n = model.nv;
-    assert!(q.len() == n && qd.len() == n && tau.len() == n, "state length");
+    assert!(q.len() == model.nq && qd.len() == n && tau.len() == n, "state length");
     assert!(dqdd_dq.len() == n * n && dqdd_dqd.len() == n * n && minv.len() == n * n, "output size");
     velocity_pass(model, data, dd, q, qd, ext);
     let mut qdd = std::mem::take(&mut dd.qdd);

@@ -123,7 +123,7 @@ pub fn coriolis_matrix(
     c: &mut [f64],
 ) {
     let n = model.nv;
-    assert!(q.len() == n && qd.len() == n && c.len() == n * n, "state length");
+    assert!(q.len() == model.nq && qd.len() == n && c.len() == n * n, "state length");
     update_xup(model, data, q);
     update_x0(model, data);
     for i in 0..n {

@@ -27,7 +27,7 @@ pub fn crba<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], m: &mut [T]) {
 pub(crate) fn crba_tree<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], m: &mut [T], off: usize) -> RigidInertia<T> {
     let n = model.nv;
     let stride = n + off;
-    assert!(q.len() == n && m.len() == stride * stride && (off == 0 || off == 6), "state length");
+    assert!(q.len() == model.nq && m.len() == stride * stride && (off == 0 || off == 6), "state length");
     update_xup(model, data, q);
     for i in 0..n {
         data.ic[i] = RigidInertia::splat(&model.inertia[i]);

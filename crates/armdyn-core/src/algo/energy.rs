@@ -8,7 +8,7 @@ use crate::model::Model;
 /// RBDA Table 5.1 (independent of the CRBA's `M`, so `T = 1/2 qd^T M qd` is a check).
 /// `q`, `qd`: (nv,).
 pub fn kinetic_energy(model: &Model, data: &mut Data<f64>, q: &[f64], qd: &[f64]) -> f64 {
-    assert!(q.len() == model.nv && qd.len() == model.nv, "state length");
+    assert!(q.len() == model.nq && qd.len() == model.nv, "state length");
     update_xup(model, data, q);
     let mut t = 0.0;
     for i in 0..model.nv {
@@ -31,7 +31,7 @@ pub fn kinetic_energy(model: &Model, data: &mut Data<f64>, q: &[f64], qd: &[f64]
 /// `Model::add_base_mass`) add a constant.
 /// `q`: (nv,).
 pub fn potential_energy(model: &Model, data: &mut Data<f64>, q: &[f64]) -> f64 {
-    assert!(q.len() == model.nv, "state length");
+    assert!(q.len() == model.nq, "state length");
     update_xup(model, data, q);
     update_x0(model, data);
     let mut v = model.welded_potential;

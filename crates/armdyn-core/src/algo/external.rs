@@ -109,7 +109,7 @@ pub fn generalized_forces<T: Real>(
     tau_ext: &mut [T],
 ) {
     let n = model.nv;
-    assert!(q.len() == n && tau_ext.len() == n && ext.wrenches.len() == 6 * model.nlinks(), "argument size");
+    assert!(q.len() == model.nq && tau_ext.len() == n && ext.wrenches.len() == 6 * model.nlinks(), "argument size");
     update_xup(model, data, q);
     if ext.frame == ForceFrame::World {
         update_x0(model, data);

@@ -73,7 +73,7 @@ pub(crate) fn gravity_acceleration<T: Real>(model: &Model, q: &[T]) -> Motion<T>
 
 fn check_lengths(model: &Model, q: usize, v: usize, w: usize, out: usize) {
     let n = model.nv;
-    assert!(q == n + NQ_BASE && v == n + NV_BASE && w == n + NV_BASE && out == n + NV_BASE, "state length");
+    assert!(q == model.nq + NQ_BASE && v == n + NV_BASE && w == n + NV_BASE && out == n + NV_BASE, "state length");
 }
 
 /// Inverse dynamics of the floating-base tree: `tau = M(q) a + C(q, v) v + g(q)`, the
@@ -101,7 +101,7 @@ pub fn rnea_floating<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], v: &[T
 pub fn crba_floating<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], m: &mut [T]) {
     let n = model.nv;
     let s = n + NV_BASE;
-    assert!(q.len() == n + NQ_BASE && m.len() == s * s, "state length");
+    assert!(q.len() == model.nq + NQ_BASE && m.len() == s * s, "state length");
     let ic = RigidInertia::splat(&model.base_inertia) + crba_tree(model, data, &q[NQ_BASE..], m, NV_BASE);
     put_base_block(&ic, m, s);
 }

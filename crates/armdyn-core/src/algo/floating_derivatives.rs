@@ -75,8 +75,8 @@ pub fn rnea_derivatives_floating<T: Real>(
     dtau_dv: &mut [T],
     m: &mut [T],
 ) {
-    let (n, s) = (model.nv, model.nv + NV_BASE);
-    assert!(q.len() == n + NQ_BASE && v.len() == s && a.len() == s, "state length");
+    let s = model.nv + NV_BASE;
+    assert!(q.len() == model.nq + NQ_BASE && v.len() == s && a.len() == s, "state length");
     assert!(dtau_dq.len() == s * s && dtau_dv.len() == s * s && m.len() == s * s, "output size");
     assert!(ext.is_none_or(|e| e.frame == ForceFrame::Local), "floating base: wrenches in link frames only");
     let g = gravity_acceleration(model, q);

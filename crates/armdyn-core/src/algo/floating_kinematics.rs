@@ -39,7 +39,7 @@ pub fn base_widths(floating: bool) -> (usize, usize) {
 /// The base pose and the joint coordinates of the whole configuration `q`.
 pub fn split_configuration<'a>(model: &Model, q: &'a [f64], floating: bool) -> (BasePose, &'a [f64]) {
     let (nqb, _) = base_widths(floating);
-    assert_eq!(q.len(), model.nv + nqb, "q length");
+    assert_eq!(q.len(), model.nq + nqb, "q length");
     let pose = if floating {
         BasePose { r: quaternion_rotation(q[3], q[4], q[5], q[6]), p: V3::new(q[0], q[1], q[2]) }
     } else {

@@ -19,7 +19,7 @@ use crate::spatial::{Motion, RigidInertia, V3};
 #[inline(always)]
 pub fn gravity_derivatives<T: Real>(model: &Model, data: &mut Data<T>, dd: &mut DerivData<T>, q: &[T], dg_dq: &mut [T]) {
     let n = model.nv;
-    assert!(q.len() == n && dg_dq.len() == n * n, "argument size");
+    assert!(q.len() == model.nq && dg_dq.len() == n * n, "argument size");
     update_xup(model, data, q);
     update_x0(model, data);
     let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));

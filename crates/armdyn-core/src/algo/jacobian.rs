@@ -14,7 +14,7 @@ use crate::model::Model;
 /// revolute `[z_j x (p - o_j); z_j]`, prismatic `[z_j; 0]`; other columns are 0.
 pub fn jacobian(model: &Model, data: &mut Data<f64>, q: &[f64], link: usize, out: &mut [f64]) {
     let n = model.nv;
-    assert!(q.len() == n && out.len() == 6 * n && link < model.nlinks(), "argument size");
+    assert!(q.len() == model.nq && out.len() == 6 * n && link < model.nlinks(), "argument size");
     update_xup(model, data, q);
     update_x0(model, data);
     out.fill(0.0);

@@ -18,7 +18,7 @@ use crate::spatial::V3;
 /// (`v_i = v_lambda + J_i qd_i`); a point `x` on body i moves at `v_i.v + v_i.w x x`.
 pub fn jacobian_dot(model: &Model, data: &mut Data<f64>, q: &[f64], qd: &[f64], link: usize, out: &mut [f64]) {
     let n = model.nv;
-    assert!(q.len() == n && qd.len() == n && out.len() == 6 * n && link < model.nlinks(), "argument size");
+    assert!(q.len() == model.nq && qd.len() == n && out.len() == 6 * n && link < model.nlinks(), "argument size");
     update_xup(model, data, q);
     update_x0(model, data);
     // base-frame body velocities, in data.v

@@ -9,7 +9,7 @@ use crate::spatial::{M3, V3};
 #[inline(always)]
 pub fn update_xup<T: Real>(model: &Model, data: &mut Data<T>, q: &[T]) {
     for i in 0..model.nv {
-        data.xup[i] = model.kind[i].xup(&model.xtree[i], q[i]);
+        data.xup[i] = model.xup(i, q);
     }
 }
 
@@ -43,7 +43,7 @@ pub fn link_pose(model: &Model, data: &Data<f64>, link: usize) -> (M3<f64>, V3<f
 /// first, then each joint's child), `[R p; 0 0 0 1]` with `R` the link's axes in base
 /// coordinates and `p` its origin.
 pub fn forward_kinematics(model: &Model, data: &mut Data<f64>, q: &[f64], out: &mut [f64]) {
-    assert_eq!(q.len(), model.nv, "q length");
+    assert_eq!(q.len(), model.nq, "q length");
     assert_eq!(out.len(), model.nlinks() * 16, "output length");
     update_xup(model, data, q);
     update_x0(model, data);

@@ -48,7 +48,7 @@ use crate::spatial::{ArticulatedInertia, RigidInertia, Sym3, V3};
 #[inline(always)]
 pub fn minverse<T: Real>(model: &Model, data: &mut Data<T>, dd: &mut DerivData<T>, q: &[T], minv: &mut [T]) {
     let n = model.nv;
-    assert!(q.len() == n && minv.len() == n * n, "argument size");
+    assert!(q.len() == model.nq && minv.len() == n * n, "argument size");
     update_xup(model, data, q);
     update_x0(model, data);
     for i in 0..n {

@@ -56,18 +56,20 @@ fn unit_inertia(k: usize) -> RigidInertia<f64> {
 pub fn regressor<T: Real>(model: &Model, data: &mut Data<T>, q: &[T], qd: &[T], qdd: &[T], y: &mut [T]) {
     let n = model.nv;
     let cols = regressor_columns(model);
-    assert!(q.len() == n && qd.len() == n && qdd.len() == n && y.len() == n * cols, "state length");
+    assert!(q.len() == model.nq && qd.len() == n && qdd.len() == n && y.len() == n * cols, "state length");
     // Forward pass of RBDA Table 5.1: v_i, a_i (gravity included).
     let a0 = Motion::new(V3::splat(model.a0.w), V3::splat(model.a0.v));
     for i in 0..n {
         let kind = model.kind[i];
-        let xup = kind.xup(&model.xtree[i], q[i]);
-        let vj = kind.s_times(qd[i]);
-        let (v, a) = match model.parent[i] {
-            Some(p) => (xup.apply_motion(&data.v[p]) + vj, xup.apply_motion(&data.a[p])),
-            None => (vj, xup.apply_motion(&a0)),
+        let xup = model.xup(i, q);
+        let (vp, a) = match model.parent[i] {
+            Some(p) => (xup.apply_motion(&data.v[p]), xup.apply_motion(&data.a[p])),
+            None => (Motion::zero(), xup.apply_motion(&a0)),
         };
-        data.a[i] = a + kind.s_times(qdd[i]) + kind.v_cross_s(&v, qd[i]);
+        let v = vp + kind.s_times(qd[i]);
+        let vjp = model.joint_parent_velocity(i, &xup, vp, &data.vjp);
+        data.vjp[i] = vjp;
+        data.a[i] = a + kind.s_times(qdd[i]) + kind.v_cross_s(&vjp, qd[i]);
         data.v[i] = v;
         data.xup[i] = xup;
     }

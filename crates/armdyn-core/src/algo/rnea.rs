@@ -30,20 +30,23 @@ pub(crate) fn rnea_tree<T: Real>(
     base: Option<(Motion<T>, Motion<T>)>,
 ) -> Force<T> {
     let n = model.nv;
-    assert!(q.len() == n && qd.len() == n && qdd.len() == n && tau.len() == n, "state length");
+    assert!(q.len() == model.nq && qd.len() == n && qdd.len() == n && tau.len() == n, "state length");
     let a0 = Motion::new(crate::spatial::V3::splat(model.a0.w), crate::spatial::V3::splat(model.a0.v));
     // Forward pass: velocities, accelerations, and the net force on each body
     // f_i = I_i a_i + v_i x* I_i v_i (RBDA eq. 5.9).
     for i in 0..n {
         let kind = model.kind[i];
-        let xup = kind.xup(&model.xtree[i], q[i]);
-        let vj = kind.s_times(qd[i]);
-        let (v, a) = match (model.parent[i], &base) {
-            (Some(p), _) => (xup.apply_motion(&data.v[p]) + vj, xup.apply_motion(&data.a[p])),
-            (None, Some((vb, ab))) => (xup.apply_motion(vb) + vj, xup.apply_motion(ab)),
-            (None, None) => (vj, xup.apply_motion(&a0)),
+        let xup = model.xup(i, q);
+        let (vp, a) = match (model.parent[i], &base) {
+            (Some(p), _) => (xup.apply_motion(&data.v[p]), xup.apply_motion(&data.a[p])),
+            (None, Some((vb, ab))) => (xup.apply_motion(vb), xup.apply_motion(ab)),
+            (None, None) => (Motion::zero(), xup.apply_motion(&a0)),
         };
-        let a = a + kind.s_times(qdd[i]) + kind.v_cross_s(&v, qd[i]);
+        let v = vp + kind.s_times(qd[i]);
+        // the velocity product with the joint's parent velocity (joint_multi.rs)
+        let vjp = model.joint_parent_velocity(i, &xup, vp, &data.vjp);
+        data.vjp[i] = vjp;
+        let a = a + kind.s_times(qdd[i]) + kind.v_cross_s(&vjp, qd[i]);
         let inertia = RigidInertia::splat(&model.inertia[i]);
         data.f[i] = inertia.mul_motion(&a) + v.cross_force(&inertia.mul_motion(&v));
         data.xup[i] = xup;

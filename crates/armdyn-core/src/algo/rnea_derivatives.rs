@@ -237,7 +237,7 @@ pub fn rnea_derivatives<T: Real>(
     m: &mut [T],
 ) {
     let n = model.nv;
-    assert!(q.len() == n && qd.len() == n && qdd.len() == n, "state length");
+    assert!(q.len() == model.nq && qd.len() == n && qdd.len() == n, "state length");
     assert!(dtau_dq.len() == n * n && dtau_dqd.len() == n * n && m.len() == n * n, "output size");
     velocity_pass(model, data, dd, q, qd, ext);
     acceleration_pass(model, dd, qd, qdd);

@@ -79,7 +79,8 @@ fn batch_allocations_do_not_grow_with_the_number_of_states() {
     };
     let (small, large) = (run(5), run(5000));
     assert_eq!(small, large, "allocations: {small} for 5 states, {large} for 5000");
-    assert!(small <= 3 * 30, "{small} allocations (workspaces only)");
+    // per batch call: two Data workspaces (15 vectors each) and the argument/result buffers
+    assert!(small <= 3 * 32, "{small} allocations (workspaces only)");
 }
 
 #[test]
