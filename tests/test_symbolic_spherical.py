@@ -149,6 +149,18 @@ def test_terms_of_the_pendulum():
         eom.C
 
 
+@pytest.mark.parametrize(
+    "name, offset", [("pendulum", False), *((n, o) for n in CHAINS for o in (False, True))], ids=str
+)
+def test_symbolic_equals_numeric(name, offset):
+    robot = pendulum() if name == "pendulum" else chain(name, offset)
+    eom = armdyn.derive(robot)
+    for q, v, a in states(robot, 4, 2):
+        expected = np.asarray(armdyn.rnea(robot, q, v, a), dtype=float)
+        got = evaluate(eom, q, v, a)
+        assert np.max(np.abs(got - expected)) <= TOL * max(1.0, np.max(np.abs(expected)))
+
+
 @needs_pinocchio
 @pytest.mark.parametrize("offset", [False, True], ids=["on-joint", "frame-offset"])
 @pytest.mark.parametrize("name", list(CHAINS))
