@@ -78,15 +78,15 @@ def test_course_solution_refuses():
     refused(lambda: solution_steps(arm()), "course")
 
 
-def test_simulate_with_a_controller_refuses():
+def test_simulate_refuses():
     from armdyn.simulate import PD, simulate, simulate_adaptive
 
     robot = arm()
     q0 = np.zeros(robot.nq)
     pd = PD(np.ones(robot.nv), np.ones(robot.nv), np.zeros(robot.nv))
-    what = "armdyn.simulate with a controller"
-    refused(lambda: simulate(robot, q0, dt=0.01, steps=2, controller=pd), what)
-    refused(lambda: simulate(robot, q0, dt=0.01, steps=2, torque=lambda t, q, qd: qd), what)
+    refused(lambda: simulate(robot, q0, dt=0.01, steps=2), "armdyn.simulate")
+    refused(lambda: simulate(robot, q0, dt=0.01, steps=2, controller=pd), "armdyn.simulate")
+    refused(lambda: simulate(robot, q0, dt=0.01, steps=2, torque=lambda t, q, qd: qd), "armdyn.simulate")
     refused(lambda: simulate_adaptive(robot, q0, duration=0.1), "armdyn.simulate_adaptive")
 
 
@@ -127,20 +127,18 @@ def test_compiled_model_refused_by_its_widths():
     require_one_dof_joints(types.SimpleNamespace(nq=9, nv=8, floating=True, name="f"), "x")  # a free-flyer alone
 
 
-def test_pictures_refuse_but_the_table_works(tmp_path):
-    from armdyn.show import animate, show
-    from armdyn.viewer import animate as animate_3d
+def test_floating_pictures_and_configuration_moves_refuse():
+    from armdyn.configuration import difference, integrate
+    from armdyn.show import frame_poses
     from armdyn.viewer import view
 
+    floating = arm(root_joint="free-flyer")
+    refused(lambda: view(floating), "the 3-D view of a floating robot")
+    refused(lambda: frame_poses(floating), "the picture of a floating robot")
     robot = arm()
-    what = "the arm's picture"
-    refused(lambda: show(robot, out=str(tmp_path / "leg.png")), what)
-    refused(lambda: view(robot), what)
-    refused(lambda: animate(robot, np.zeros((2, robot.nq)), str(tmp_path / "leg.gif")), what)
-    refused(lambda: animate_3d(robot, [0.0, 1.0], np.zeros((2, robot.nq))), what)
-    table = show(robot)  # the joint and link table needs no coordinates
-    hip = next(line for line in table.splitlines() if line.startswith("hip"))
-    assert "spherical" in hip and "(0, 0, 1)" not in hip  # no axis shown for a ball joint
+    q = np.array([0.0, 0.0, 0.0, 1.0, 0.2])
+    refused(lambda: integrate(robot, q, np.zeros(robot.nv)), "armdyn.configuration.integrate")
+    refused(lambda: difference(robot, q, q), "armdyn.configuration.difference")
 
 
 def test_derive_command_says_newton_euler_only(monkeypatch, capsys):

@@ -12,6 +12,11 @@ pose with the exponential of the base twist, ``M1 = M0 exp(v)`` (a constant twis
 the base frame for unit time, not R3 x SO(3)), and ``difference`` is its inverse,
 ``log(M0^-1 M1)``. Joint coordinates add.
 
+Joints of several coordinates (spherical, planar, floating: :data:`armdyn.model.joints.MULTI_DOF`)
+have their blocks of ``q`` in :attr:`~armdyn.model.Robot.configuration_layout`: ``neutral``
+and ``random_configuration`` take them; ``integrate`` and ``difference`` do not yet (a
+ModelError names the joint).
+
 Arrays are one state (1-d) or a batch (one state per row). A quaternion whose length
 differs from 1 by more than :data:`QUATERNION_TOL` is refused (ValueError); the
 quaternions ``integrate`` returns are unit to rounding, with the sign that keeps them on
@@ -23,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from .model import Robot
+from .model.joints import MULTI_DOF
 
 #: How far a quaternion's length may be from 1 (the numeric core's tolerance too).
 QUATERNION_TOL = 1e-9
@@ -110,6 +116,7 @@ def integrate(robot: Robot, q, v) -> np.ndarray:
     time (Pinocchio's ``integrate``). Fixed base: ``q + v``. Floating base: the base pose
     ``M1 = M0 exp(v_base)`` (SE(3), ``v_base`` the twist in the base frame), the joints
     ``q + v``. ``q`` (nq,) or (N, nq), ``v`` (nv,) or (N, nv); returns q's shape."""
+    robot.require_one_dof_joints("armdyn.configuration.integrate")
     q = _array(robot, q, robot.nq, "q")
     v = _array(robot, v, robot.nv, "v")
     if not robot.floating:
@@ -132,6 +139,7 @@ def difference(robot: Robot, q0, q1) -> np.ndarray:
     ``difference``). Fixed base: ``q1 - q0``. Floating base: ``log(M0^-1 M1)``, the base
     twist in ``q0``'s base frame (linear, angular; rotation angle at most pi), then the
     joints ``q1 - q0``. ``q0``, ``q1`` (nq,) or (N, nq); returns (nv,) or (N, nv)."""
+    robot.require_one_dof_joints("armdyn.configuration.difference")
     q0 = _array(robot, q0, robot.nq, "q0")
     q1 = _array(robot, q1, robot.nq, "q1")
     if not robot.floating:
@@ -156,10 +164,14 @@ def difference(robot: Robot, q0, q1) -> np.ndarray:
 
 def neutral(robot: Robot) -> np.ndarray:
     """The neutral configuration (nq,): joints at 0; a floating base at the world origin
-    with the identity orientation (quaternion ``0, 0, 0, 1``)."""
+    with the identity orientation (quaternion ``0, 0, 0, 1``); a joint of several
+    coordinates unmoved (its quaternion ``0, 0, 0, 1``, a planar joint's ``0, 0, 1, 0``)."""
     q = np.zeros(robot.nq)
     if robot.floating:
         q[6] = 1.0
+    for _, kind, iq, _ in robot.configuration_layout:
+        if kind in MULTI_DOF:  # w = 1 ends each quaternion; a planar joint's cos comes third
+            q[iq + (2 if kind == "planar" else MULTI_DOF[kind][0] - 1)] = 1.0
     return q
 
 
@@ -178,9 +190,13 @@ def random_configuration(robot: Robot, rng: np.random.Generator, base_position: 
     joint uniform between its limits where both are given and finite, else in
     [-pi, pi] (revolute) or [-1, 1] (prismatic); a floating base's position uniform in
     [-base_position, base_position]^3 and its orientation uniform on SO(3) (a normalised
-    Gaussian quaternion)."""
-    joints = []
+    Gaussian quaternion), and so a floating joint's and a spherical joint's; a planar
+    joint's x, y as a base's, its angle uniform in [-pi, pi]."""
+    joints: list[float] = []
     for j in robot.movable_joints:
+        if j.type in MULTI_DOF:
+            joints += _random_block(j.type, rng, base_position)
+            continue
         lo, hi = _limit(j, "lower"), _limit(j, "upper")
         if lo is not None and hi is not None and np.isfinite(lo) and np.isfinite(hi) and lo <= hi:
             joints.append(rng.uniform(lo, hi))
@@ -192,6 +208,17 @@ def random_configuration(robot: Robot, rng: np.random.Generator, base_position: 
     quat = rng.standard_normal(4)
     quat /= np.linalg.norm(quat)
     return np.concatenate([rng.uniform(-base_position, base_position, 3), quat, joints])
+
+
+def _random_block(kind: str, rng: np.random.Generator, base_position: float) -> list[float]:
+    """A random configuration of a joint of several coordinates (:func:`random_configuration`)."""
+    if kind == "planar":
+        x, y = rng.uniform(-base_position, base_position, 2)
+        angle = rng.uniform(-np.pi, np.pi)
+        return [x, y, np.cos(angle), np.sin(angle)]
+    position = list(rng.uniform(-base_position, base_position, 3)) if kind == "floating" else []
+    quat = rng.standard_normal(4)
+    return position + list(quat / np.linalg.norm(quat))
 
 
 __all__ = ["QUATERNION_TOL", "integrate", "difference", "neutral", "random_configuration"]

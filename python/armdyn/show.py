@@ -28,13 +28,14 @@ import math
 import numpy as np
 import sympy as sp
 
+from .configuration import QUATERNION_TOL
 from .errors import ModelError
 from .model import Robot
 from .model.joints import MULTI_DOF
 
 __all__ = ["show", "table", "frame_poses", "numeric_robot", "draw_on", "animate"]
 
-AXIS_COLOURS = {"revolute": "tab:orange", "prismatic": "tab:purple"}
+AXIS_COLOURS = {"revolute": "tab:orange", "prismatic": "tab:purple", "spherical": "tab:green"}
 
 
 # ----------------------------------------------------------------- kinematics
@@ -55,16 +56,30 @@ def numeric_robot(robot: Robot) -> Robot:
 
 
 def joint_values(robot: Robot, q) -> np.ndarray:
-    """``q`` as a float array of one finite value per coordinate (zeros for None), else a ValueError.
-    A joint of several coordinates is a ModelError: the pictures place joints of one coordinate."""
-    robot.require_one_dof_joints("the arm's picture (armdyn show --out, --3d; armdyn.viewer)")
+    """``q`` as a float array of one finite value per coordinate (the joints' neutral
+    configuration for None: zeros, a joint of several coordinates unmoved), else a
+    ValueError; a joint of several coordinates takes its block of ``q`` (Pinocchio's layout,
+    :attr:`Robot.configuration_layout`), its quaternion of unit length."""
+    from .configuration import neutral
+
+    if robot.floating:  # the joints alone: a floating base is placed by its caller
+        robot.require_one_dof_joints("the picture of a floating robot")
     if q is None:
-        return np.zeros(robot.dof)
+        return neutral(robot)[7 if robot.floating else 0 :]
+    width = robot.dof if robot.floating else robot.nq
     q = np.asarray(q, dtype=float).reshape(-1)
-    if q.shape != (robot.dof,):
-        raise ValueError(f"q must have {robot.dof} values (one per movable joint), got {q.size}")
+    if q.shape != (width,):
+        blocks = "; a joint of several coordinates its configuration block" if robot.multi_dof_joints else ""
+        raise ValueError(f"q must have {width} values (one per movable joint{blocks}), got {q.size}")
     if not np.all(np.isfinite(q)):
         raise ValueError("q contains NaN or inf")
+    for name, kind, iq, _ in robot.configuration_layout:
+        if kind in ("spherical", "floating"):
+            norm = float(np.linalg.norm(q[iq + MULTI_DOF[kind][0] - 4 : iq + MULTI_DOF[kind][0]]))
+            if abs(norm - 1) > QUATERNION_TOL:
+                raise ValueError(f"q: joint '{name}''s quaternion (x, y, z, w) has length {norm:.9g}: normalise it")
+        elif kind == "planar" and abs(float(np.hypot(q[iq + 2], q[iq + 3])) - 1) > QUATERNION_TOL:
+            raise ValueError(f"q: joint '{name}''s cos, sin are not of unit length: normalise them")
     return q
 
 
@@ -81,10 +96,17 @@ def frame_poses(robot: Robot, q=None) -> dict[str, np.ndarray]:
     pose times the joint's ``Joint.transform(q_i)``.
     """
     q = joint_values(robot, q)
+    layout = robot.configuration_layout
+    blocks = {name: (iq, iq + MULTI_DOF[kind][0]) for name, kind, iq, _ in layout if kind in MULTI_DOF}
+    at = {iv: iq for _, kind, iq, iv in layout if kind not in MULTI_DOF}  # a coordinate's place in q
     poses = {robot.base: np.eye(4)}
     for joint in robot.joints:
         f = robot.follows(joint)  # (coordinate, multiplier, offset); mimic joints follow a leader
-        R, p = joint.transform(0 if f is None else float(f[1]) * q[f[0]] + float(f[2]))
+        if joint.name in blocks:  # a joint of several coordinates: its block of q
+            start, end = blocks[joint.name]
+            R, p = joint.transform([float(x) for x in q[start:end]])
+        else:
+            R, p = joint.transform(0 if f is None else float(f[1]) * q[at[f[0]]] + float(f[2]))
         local = np.eye(4)
         local[:3, :3], local[:3, 3] = as_floats(R), as_floats(p).reshape(3)
         poses[joint.child] = poses[joint.parent] @ local
@@ -302,6 +324,12 @@ def draw_on(ax, robot: Robot, poses: dict[str, np.ndarray], title: str, view: tu
 
     labels = []
     for j in robot.movable_joints:
+        if j.nv > 1:  # no axis: a ball at the joint's centre (the placement frame's origin)
+            Tp = poses[j.parent]
+            centre = Tp[:3, :3] @ as_floats(j.xyz).reshape(3) + Tp[:3, 3]
+            ax.scatter(*centre, color=AXIS_COLOURS["spherical"], s=90, depthshade=False)
+            labels.append((j.name, centre, AXIS_COLOURS["spherical"]))
+            continue
         T = poses[j.child]
         axis = T[:3, :3] @ as_floats(j.axis).reshape(3)
         ax.quiver(*T[:3, 3], *(arrow * axis), color=AXIS_COLOURS[j.type], linewidth=2.5, arrow_length_ratio=0.3)
@@ -379,10 +407,10 @@ def animate(
     if not isinstance(robot, Robot):
         robot = load(robot)
     robot = numeric_robot(robot)
-    robot.require_one_dof_joints("the arm's picture (armdyn show --out, --3d; armdyn.viewer)")
+    width = robot.nq if not robot.floating else robot.dof  # a joint of several coordinates: its block of q
     q = np.asarray(q, dtype=float)
-    if q.ndim != 2 or q.shape[1] != robot.dof or len(q) == 0:
-        raise ValueError(f"q: shape {q.shape}, expected (frames, {robot.dof}) with at least one frame")
+    if q.ndim != 2 or q.shape[1] != width or len(q) == 0:
+        raise ValueError(f"q: shape {q.shape}, expected (frames, {width}) with at least one frame")
     if not np.all(np.isfinite(q)):
         raise ValueError("q contains NaN or inf")
     if not (np.isfinite(fps) and fps > 0):

@@ -183,8 +183,8 @@ def simulate(
     Bad input (shapes, NaN, a non-positive dt, a duration that is not a whole number of
     steps, a run that would not fit in memory) raises ``ValueError`` naming it.
     """
-    if controller is not None or callable(torque):  # before the states' shapes are read
-        require_one_dof_joints(robot, "armdyn.simulate with a controller or a torque callable")
+    # before the states' shapes are read (q0 is nq long); the core integrates 1-dof joints only
+    require_one_dof_joints(robot, "armdyn.simulate")
     model = compiled_model(robot)
     floating = bool(getattr(model, "floating", False))
     # the widths of q and of qd (qdd, tau): dof each, or 7 + dof and 6 + dof with a floating base

@@ -178,8 +178,8 @@ def _link_poses(robot: Robot, Q: np.ndarray) -> np.ndarray:
 
 
 def _configurations(robot: Robot, Q) -> np.ndarray:
-    """``Q`` (N, nq) as finite floats; a floating base's quaternions checked unit."""
-    robot.require_one_dof_joints("the arm's picture (armdyn show --out, --3d; armdyn.viewer)")
+    """``Q`` (N, nq) as finite floats; a floating base's quaternions checked unit (a
+    joint's of several coordinates: by the numeric core)."""
     Q = np.asarray(Q, dtype=float)
     if Q.ndim != 2 or Q.shape[1] != robot.nq or len(Q) == 0:
         raise ValueError(f"Q: shape {Q.shape}, expected (frames, {robot.nq}) with at least one frame")
@@ -188,6 +188,7 @@ def _configurations(robot: Robot, Q) -> np.ndarray:
     if robot.floating:
         from ..configuration import difference
 
+        robot.require_one_dof_joints("the 3-D view of a floating robot")  # _link_poses places 1-dof joints
         difference(robot, Q, Q)  # refuses a quaternion off unit length, naming it
     return Q
 
@@ -224,6 +225,8 @@ def _scene(robot: Robot, times, Q, frames: bool, markers: bool | None, package_d
     joints, coms = [], []
     if markers:
         for j in robot.movable_joints:
+            if j.nv > 1:  # a ball or planar joint has no axis to draw
+                continue
             joints.append({"link": at[j.child], "type": j.type, "axis": as_floats(j.axis).reshape(3).tolist()})
         masses = {n: float(ln.mass) for n, ln in robot.links.items()}
         heaviest = max(masses.values(), default=0.0)
