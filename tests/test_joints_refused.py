@@ -150,3 +150,9 @@ def test_derive_command_says_newton_euler_only(monkeypatch, capsys):
     out, err = capsys.readouterr()
     assert "spherical joint is derived by Newton-Euler only" in err
     assert "Lagrange" not in out and "τ₁..₃" not in out  # the result rows: one per coordinate
+    args = cli.build_parser().parse_args(["derive", "leg.yaml", "--steps"])
+    assert cli.cmd_derive(args) == 0
+    out = capsys.readouterr().out
+    assert "outward pass" in out and "τ₁..₃ = [" in out and "τ₄ = " in out  # the steps, as for an arm
+    args = cli.build_parser().parse_args(["derive", "leg.yaml", "--method", "lagrange"])
+    refused(lambda: cli.cmd_derive(args), "Lagrange's method")
