@@ -1,6 +1,6 @@
-"""Optional test dependencies (the ``test`` extra: pin, example-robot-data).
+"""Optional test dependencies (the ``test`` extra: pin, example-robot-data, mujoco).
 
-A test that needs one of them is marked ``@needs_pinocchio`` (or calls
+A test that needs one of them is marked ``@needs_pinocchio``, ``@needs_mujoco`` (or calls
 :func:`example_robot_data_dir`) and skips alone; its neighbours still run. With the
 environment variable ``ARMDYN_REQUIRE_OPTIONAL=1`` (CI, where the test extra is
 installed) every skip is a failure instead (see conftest.py).
@@ -19,6 +19,13 @@ except ImportError:  # the comparisons with Pinocchio skip, nothing else
     pin = None
 
 needs_pinocchio = pytest.mark.skipif(pin is None, reason="pinocchio is not installed (pip install pin)")
+
+try:
+    import mujoco
+except ImportError:  # the comparisons with MuJoCo skip, nothing else
+    mujoco = None
+
+needs_mujoco = pytest.mark.skipif(mujoco is None, reason="mujoco is not installed (pip install mujoco)")
 
 #: where the example-robot-data wheel puts its robots, relative to the distribution
 ERD_ROBOTS = "cmeel.prefix/share/example-robot-data/robots"

@@ -53,7 +53,7 @@ EXPECTED = {
     "unknown-link.urdf": ("joint 'j1'", "'link9' does not exist"),
     "mimic-missing-leader.urdf": ("joint 'j2'", "mimics joint 'j9', which does not exist"),
     "mimic-loop.urdf": ("joint 'j1'", "mimic joints form a loop (j1 -> j2 -> j1)"),
-    "floating.urdf": ("joint 'free'", "floating joints are not supported yet"),
+    "planar-axis.urdf": ("joint 'table'", "a planar joint moves in its joint frame's x-y plane"),
     "billion-laughs.urdf": ("<!DOCTYPE> on line 2", "entity declarations are not allowed"),
     "not-a-robot.urdf": ("<sdf>", "expected <robot>"),
     "empty.urdf": ("line 1, column 1", "malformed XML"),

@@ -233,3 +233,9 @@ def test_one_dof_only_functions_refuse(call):
     robot = _ball_pendulum()
     with pytest.raises(ValueError, match="joints of several coordinates.*'ball'"):
         call(robot, np.array([0.0, 0.0, 0.0, 1.0]), np.zeros(3))
+
+
+def test_external_wrenches_refused():
+    robot = _ball_pendulum()
+    with pytest.raises(ValueError, match="rnea with f_ext: 'ball' has joints of several coordinates"):
+        an.rnea(robot, np.array([0.0, 0.0, 0.0, 1.0]), np.zeros(3), np.zeros(3), f_ext=np.zeros((2, 6)))

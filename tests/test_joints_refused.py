@@ -127,32 +127,34 @@ def test_compiled_model_refused_by_its_widths():
     require_one_dof_joints(types.SimpleNamespace(nq=9, nv=8, floating=True, name="f"), "x")  # a free-flyer alone
 
 
-def test_floating_pictures_and_configuration_moves_refuse():
-    from armdyn.configuration import difference, integrate
-    from armdyn.show import frame_poses
-    from armdyn.viewer import view
-
-    floating = arm(root_joint="free-flyer")
-    refused(lambda: view(floating), "the 3-D view of a floating robot")
-    refused(lambda: frame_poses(floating), "the picture of a floating robot")
-    robot = arm()
-    q = np.array([0.0, 0.0, 0.0, 1.0, 0.2])
-    refused(lambda: integrate(robot, q, np.zeros(robot.nv)), "armdyn.configuration.integrate")
-    refused(lambda: difference(robot, q, q), "armdyn.configuration.difference")
+BALL_MJCF = """<mujoco model="ballpend">
+  <worldbody>
+    <body name="bob" pos="0 0 1">
+      <joint name="ball" type="ball"/>
+      <inertial pos="0.1 0 -0.5" mass="2" diaginertia="0.1 0.2 0.3"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
 
 
-def test_derive_command_says_newton_euler_only(monkeypatch, capsys):
-    from armdyn import cli
+def test_commands_on_a_ball_joint_model(tmp_path, capsys):
+    """armdyn derive prints a ball joint's steps (Newton-Euler only); what takes 1-dof
+    joints only says so on one line, naming the file and the joint, status 2."""
+    from armdyn.cli import main
 
-    monkeypatch.setattr(cli, "_load", lambda *args: arm())
-    args = cli.build_parser().parse_args(["derive", "leg.yaml", "--method", "both"])
-    assert cli.cmd_derive(args) == 0
+    model = tmp_path / "ball.xml"
+    model.write_text(BALL_MJCF, encoding="utf-8")
+    assert main(["derive", str(model), "--steps", "--method", "both"]) == 0
     out, err = capsys.readouterr()
     assert "spherical joint is derived by Newton-Euler only" in err
-    assert "Lagrange" not in out and "τ₁..₃" not in out  # the result rows: one per coordinate
-    args = cli.build_parser().parse_args(["derive", "leg.yaml", "--steps"])
-    assert cli.cmd_derive(args) == 0
-    out = capsys.readouterr().out
-    assert "outward pass" in out and "τ₁..₃ = [" in out and "τ₄ = " in out  # the steps, as for an arm
-    args = cli.build_parser().parse_args(["derive", "leg.yaml", "--method", "lagrange"])
-    refused(lambda: cli.cmd_derive(args), "Lagrange's method")
+    assert "outward pass" in out and "τ₁..₃ = [" in out and "τ₃ = " in out and "Lagrange" not in out
+    for argv, what in (
+        (["derive", str(model), "--method", "lagrange"], "Lagrange's method"),
+        (["check", str(model)], "armdyn.prove_agreement"),
+        (["codegen", str(model)], "armdyn.codegen"),
+        (["simulate", str(model), "--duration", "0.1", "--dt", "0.01"], "armdyn simulate"),
+    ):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err.strip()
+        assert err.count("\n") == 0 and str(model) in err and what in err and "'ball'" in err, err

@@ -342,8 +342,16 @@ def test_slightly_unnormalised_axis_is_normalised():
 @pytest.mark.parametrize(
     "change, element, words",
     [
-        (('type="continuous"', 'type="floating"'), "joint 'spin'", "floating joints are not supported yet"),
-        (('type="continuous"', 'type="planar"'), "joint 'spin'", "planar joints are not supported yet"),
+        (
+            ('type="continuous"', 'type="floating"'),
+            "joint 'spin'",
+            "a floating joint takes no lower, upper, velocity, damping",
+        ),
+        (
+            ('type="continuous"', 'type="planar"'),
+            "joint 'spin'",
+            "a planar joint takes no lower, upper, velocity, damping",
+        ),
         (
             ('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="slide"/>'),
             "joint 'spin'",

@@ -1,40 +1,47 @@
 """Moving on a robot's configuration space: ``integrate``, ``difference``, ``neutral``,
 ``random_configuration`` (Pinocchio's names and results), for a fixed base or a floating
-one (re-exported by :mod:`armdyn.numeric`).
+one and for joints of one or several coordinates (re-exported by :mod:`armdyn.numeric`).
 
-A fixed base: q and v are both ``(dof,)`` and the space is flat (``q + v``, ``q1 - q0``).
-A floating base (``robot.floating``, Pinocchio's free-flyer layout, see
-:mod:`armdyn.numeric`): ``q`` is ``(7 + dof,)``, the base origin in the world frame, the
-base orientation as a unit quaternion ``x, y, z, w``, the joints; ``v`` is ``(6 + dof,)``,
-the base's linear then angular velocity in the base frame, the joint rates. The base
-moves on SE(3) as Pinocchio's ``JointModelFreeFlyer``: ``integrate`` composes the base
-pose with the exponential of the base twist, ``M1 = M0 exp(v)`` (a constant twist in
-the base frame for unit time, not R3 x SO(3)), and ``difference`` is its inverse,
-``log(M0^-1 M1)``. Joint coordinates add.
+The space is a product, walked along ``robot.configuration_layout`` (each joint's first
+index in q and in v; a floating base first, at q[0:7], v[0:6]):
 
-Joints of several coordinates (spherical, planar, floating: :data:`armdyn.model.joints.MULTI_DOF`)
-have their blocks of ``q`` in :attr:`~armdyn.model.Robot.configuration_layout`: ``neutral``
-and ``random_configuration`` take them; ``integrate`` and ``difference`` do not yet (a
-ModelError names the joint).
+* revolute and prismatic joints are flat: ``q + v``, ``q1 - q0``;
+* a floating base (``robot.floating``, Pinocchio's free-flyer layout, see
+  :mod:`armdyn.numeric`: the origin in the world frame, the orientation as a unit
+  quaternion ``x, y, z, w``; v the linear then angular velocity in the base frame) and a
+  ``floating`` joint (the same in its placement frame) move on SE(3) as Pinocchio's
+  ``JointModelFreeFlyer``: ``integrate`` composes the pose with the exponential of the
+  twist, ``M1 = M0 exp(v)`` (a constant twist in the moving frame for unit time, not
+  R3 x SO(3)), and ``difference`` is its inverse, ``log(M0^-1 M1)``;
+* a ``spherical`` joint (quaternion ``x, y, z, w``; v the angular velocity in the child
+  frame) moves on SO(3) as ``JointModelSpherical``: ``quat1 = quat0 exp(v)``,
+  ``difference`` ``log(quat0^-1 quat1)`` (the rotation angle at most pi);
+* a ``planar`` joint (``x, y, cos th, sin th``; v the velocity along the moved x and y
+  axes, then the turn rate) moves on SE(2) as ``JointModelPlanar``: ``M1 = M0 exp(v)``
+  and ``log(M0^-1 M1)`` in the plane.
 
-Arrays are one state (1-d) or a batch (one state per row). A quaternion whose length
-differs from 1 by more than :data:`QUATERNION_TOL` is refused (ValueError); the
-quaternions ``integrate`` returns are unit to rounding, with the sign that keeps them on
-the side of ``q``'s (as Pinocchio's).
+Arrays are one state (1-d) or a batch (one state per row). A quaternion, or a planar
+joint's ``(cos, sin)`` pair, whose length differs from 1 by more than
+:data:`QUATERNION_TOL` is refused (ValueError naming the joint and the slice of q); the
+quaternions ``integrate`` returns are unit to rounding (on SE(3) with the sign that keeps
+them on the side of ``q``'s, as Pinocchio's).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from functools import lru_cache
+
 import numpy as np
 
 from .model import Robot
-from .model.joints import MULTI_DOF
 
-#: How far a quaternion's length may be from 1 (the numeric core's tolerance too).
+#: How far a quaternion's (or a planar (cos, sin) pair's) length may be from 1 (the
+#: numeric core's tolerance too).
 QUATERNION_TOL = 1e-9
 
-# Below this rotation angle (rad) the series of the SE(3) maps are used: their closed
-# forms divide 0 by 0 at 0 and lose digits near it.
+# Below this rotation angle (rad) the series of the SE(3), SO(3) and SE(2) maps are used:
+# their closed forms divide 0 by 0 at 0 and lose digits near it.
 _SMALL = 1e-4
 
 
@@ -47,15 +54,92 @@ def _array(robot: Robot, x, width: int, name: str) -> np.ndarray:
     return a
 
 
-def _quaternions(q: np.ndarray, name: str) -> np.ndarray:
-    quat = q[..., 3:7]
-    err = np.abs(np.linalg.norm(quat, axis=-1) - 1.0)
-    if (err > QUATERNION_TOL).any():
+@dataclass(frozen=True)
+class _Layout:
+    """Where each group of the configuration space sits: index arrays into q and v
+    (one row per joint of the group) and, per row, what to call it in a message."""
+
+    flat_q: np.ndarray  # (n,) revolute and prismatic coordinates
+    flat_v: np.ndarray
+    se3_q: np.ndarray  # (k, 7) floating base and floating joints
+    se3_v: np.ndarray  # (k, 6)
+    so3_q: np.ndarray  # (k, 4) spherical joints
+    so3_v: np.ndarray  # (k, 3)
+    se2_q: np.ndarray  # (k, 4) planar joints
+    se2_v: np.ndarray  # (k, 3)
+    se3_names: tuple[str, ...]
+    so3_names: tuple[str, ...]
+    se2_names: tuple[str, ...]
+
+
+def _layout(robot: Robot) -> _Layout:
+    """The robot's configuration space as groups of joints of one kind."""
+    return _grouped(robot.configuration_layout, robot.floating)
+
+
+@lru_cache(maxsize=64)
+def _grouped(configuration_layout: tuple, floating: bool) -> _Layout:
+    """:func:`_layout` of a layout (built once per layout: integrate runs in loops)."""
+    groups: dict[str, tuple[list, list, list]] = {k: ([], [], []) for k in ("flat", "se3", "so3", "se2")}
+    kinds = {"floating": ("se3", 7, 6), "spherical": ("so3", 4, 3), "planar": ("se2", 4, 3)}
+    entries = [("the base", "floating", 0, 0)] if floating else []
+    entries += [(f"joint '{name}' ({kind})", kind, iq, iv) for name, kind, iq, iv in configuration_layout]
+    for label, kind, iq, iv in entries:
+        group, nq, nv = kinds.get(kind, ("flat", 1, 1))
+        qs, vs, names = groups[group]
+        qs.append(np.arange(iq, iq + nq))
+        vs.append(np.arange(iv, iv + nv))
+        names.append(label)
+
+    def rows(group: str, nq: int, nv: int):
+        qs, vs, names = groups[group]
+        shape_q, shape_v = (len(qs), nq), (len(vs), nv)
+        return np.array(qs, dtype=int).reshape(shape_q), np.array(vs, dtype=int).reshape(shape_v), tuple(names)
+
+    flat_q, flat_v, _ = rows("flat", 1, 1)
+    se3_q, se3_v, se3_names = rows("se3", 7, 6)
+    so3_q, so3_v, so3_names = rows("so3", 4, 3)
+    se2_q, se2_v, se2_names = rows("se2", 4, 3)
+    return _Layout(
+        flat_q[:, 0], flat_v[:, 0], se3_q, se3_v, so3_q, so3_v, se2_q, se2_v, se3_names, so3_names, se2_names
+    )
+
+
+def require_unit_length(x: np.ndarray, index: np.ndarray, labels, what: str, name: str) -> None:
+    """ValueError naming the first of the slices ``x[..., index[k]]`` (``index`` (k, w),
+    one row a slice; ``labels[k]`` what it belongs to) whose length is off 1 by more than
+    :data:`QUATERNION_TOL`, with the slice (``name[a:b]``) and, for a batch, how many rows.
+    ``what``: the slice's kind and parts, e.g. ``"quaternion (x, y, z, w)"``."""
+    if not len(labels):
+        return
+    err = np.abs(np.linalg.norm(x[..., index], axis=-1) - 1.0)  # (..., k)
+    bad = (err > QUATERNION_TOL).reshape(-1, len(labels)).any(axis=0)
+    if bad.any():
+        k = int(np.argmax(bad))
+        rows = ""
+        if x.ndim == 2:
+            rows = f" in {int(np.count_nonzero(err[:, k] > QUATERNION_TOL))} of {x.shape[0]} rows"
         raise ValueError(
-            f"{name}: the base quaternion {name}[3:7] (x, y, z, w) does not have unit length "
-            f"(off by {float(np.max(err)):.3g}; tolerance {QUATERNION_TOL:g}): normalise it first"
+            f"{name}: the {what} {name}[{index[k, 0]}:{index[k, -1] + 1}] of {labels[k]} does not have unit "
+            f"length{rows} (off by {float(np.max(err[..., k])):.3g}; tolerance {QUATERNION_TOL:g}): normalise it first"
         )
-    return quat
+
+
+def _check_unit(layout: _Layout, q: np.ndarray, name: str) -> None:
+    """ValueError naming the first joint whose quaternion (or planar (cos, sin) pair) in
+    ``q`` is off unit length (:func:`require_unit_length`)."""
+    require_unit_length(q, layout.se3_q[:, 3:7], layout.se3_names, "quaternion (x, y, z, w)", name)
+    require_unit_length(q, layout.so3_q, layout.so3_names, "quaternion (x, y, z, w)", name)
+    require_unit_length(q, layout.se2_q[:, 2:4], layout.se2_names, "(cos th, sin th) pair", name)
+
+
+def check_configuration(robot: Robot, q, name: str = "q") -> np.ndarray:
+    """``q`` as a float array (nq,) or (N, nq), checked: finite, every quaternion and
+    planar (cos, sin) pair of unit length (ValueError naming the joint and the slice)."""
+    q = _array(robot, q, robot.nq, name)
+    if robot.nq != robot.nv:
+        _check_unit(_layout(robot), q, name)
+    return q
 
 
 def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -85,7 +169,7 @@ def _se3_coefficients(theta: np.ndarray):
     small = theta < _SMALL
     t = np.where(small, 1.0, theta)
     t2 = theta * theta
-    a = np.where(small, 0.5 - t2 / 24.0 + t2 * t2 / 720.0, (1.0 - np.cos(t)) / (t * t))
+    a = np.where(small, 0.5 - t2 / 24.0 + t2 * t2 / 720.0, 2.0 * np.sin(0.5 * t) ** 2 / (t * t))
     b = np.where(small, 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0, (t - np.sin(t)) / (t * t * t))
     return a, b
 
@@ -111,67 +195,153 @@ def _log_quaternion(quat: np.ndarray) -> np.ndarray:
     return v * scale
 
 
-def integrate(robot: Robot, q, v) -> np.ndarray:
-    """``q (+) v``: where the configuration ``q`` goes moving with velocity ``v`` for unit
-    time (Pinocchio's ``integrate``). Fixed base: ``q + v``. Floating base: the base pose
-    ``M1 = M0 exp(v_base)`` (SE(3), ``v_base`` the twist in the base frame), the joints
-    ``q + v``. ``q`` (nq,) or (N, nq), ``v`` (nv,) or (N, nv); returns q's shape."""
-    robot.require_one_dof_joints("armdyn.configuration.integrate")
-    q = _array(robot, q, robot.nq, "q")
-    v = _array(robot, v, robot.nv, "v")
-    if not robot.floating:
-        return q + v
-    quat0 = _quaternions(q, "q")
+def _se3_integrate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """SE(3) poses ``q`` (..., 7: position, quaternion x y z w) moved by the twists ``v``
+    (..., 6: linear, angular, in the moving frame): ``M0 exp(v)``."""
+    quat0 = q[..., 3:7]
     lin, w = v[..., :3], v[..., 3:6]
     theta = np.linalg.norm(w, axis=-1, keepdims=True)
     a, b = _se3_coefficients(theta)
     wxl = np.cross(w, lin)
-    p = lin + a * wxl + b * np.cross(w, wxl)  # V(w) lin: the translation of exp(v), base frame
+    p = lin + a * wxl + b * np.cross(w, wxl)  # V(w) lin: the translation of exp(v), moving frame
     quat = _quat_mul(quat0, _exp_quaternion(w))
     quat = np.where(np.sum(quat * quat0, axis=-1, keepdims=True) < 0, -quat, quat)
     quat = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
-    base = np.concatenate([q[..., :3] + rotate_vector(quat0, p), quat], axis=-1)
-    return np.concatenate([base, q[..., 7:] + v[..., 6:]], axis=-1)
+    return np.concatenate([q[..., :3] + rotate_vector(quat0, p), quat], axis=-1)
+
+
+def _se3_difference(q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
+    """The twists (..., 6) ``log(M0^-1 M1)`` between SE(3) poses (..., 7)."""
+    inv0 = quaternion_conjugate(q0[..., 3:7])
+    p = rotate_vector(inv0, q1[..., :3] - q0[..., :3])  # M0^-1 M1's translation
+    w = _log_quaternion(_quat_mul(inv0, q1[..., 3:7]))
+    theta = np.linalg.norm(w, axis=-1, keepdims=True)
+    # V(w)^-1 = 1 - [w]x / 2 + c [w]x^2, c = (1 - t sin t / (2 (1 - cos t))) / t^2,
+    # written with t sin t / (2 (1 - cos t)) = (t/2) cot(t/2): no 1 - cos t to lose digits
+    small = theta < _SMALL
+    t = np.where(small, 1.0, theta)
+    c = np.where(small, 1.0 / 12.0 + theta * theta / 720.0, (1.0 - 0.5 * t / np.tan(0.5 * t)) / (t * t))
+    wxp = np.cross(w, p)
+    return np.concatenate([p - 0.5 * wxp + c * np.cross(w, wxp), w], axis=-1)
+
+
+def _so3_integrate(quat0: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Unit quaternions (..., 4) turned by the angular velocities ``w`` (..., 3, in the
+    moving frame) for unit time: ``quat0 exp(w)``, normalised."""
+    quat = _quat_mul(quat0, _exp_quaternion(w))
+    return quat / np.linalg.norm(quat, axis=-1, keepdims=True)
+
+
+def _so3_difference(quat0: np.ndarray, quat1: np.ndarray) -> np.ndarray:
+    """``log(quat0^-1 quat1)`` (..., 3), the rotation angle at most pi."""
+    return _log_quaternion(_quat_mul(quaternion_conjugate(quat0), quat1))
+
+
+def _se2_coefficients(theta: np.ndarray):
+    """``sin t / t`` and ``(1 - cos t) / t``: SE(2)'s ``V(t) = [[a, -b], [b, a]]``
+    (series below _SMALL)."""
+    small = np.abs(theta) < _SMALL
+    t = np.where(small, 1.0, theta)
+    t2 = theta * theta
+    a = np.where(small, 1.0 - t2 / 6.0 + t2 * t2 / 120.0, np.sin(t) / t)
+    b = np.where(small, theta * (0.5 - t2 / 24.0 + t2 * t2 / 720.0), 2.0 * np.sin(0.5 * t) ** 2 / t)
+    return a, b
+
+
+def _se2_integrate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Planar poses ``q`` (..., 4: x, y, cos, sin) moved by ``v`` (..., 3: vx, vy along
+    the moving axes, turn rate) for unit time: ``M0 exp(v)`` in SE(2)."""
+    c0, s0 = q[..., 2:3], q[..., 3:4]
+    vx, vy, th = v[..., 0:1], v[..., 1:2], v[..., 2:3]
+    a, b = _se2_coefficients(th)
+    tx, ty = a * vx - b * vy, b * vx + a * vy  # V(th) (vx, vy), moving frame
+    c, s = np.cos(th), np.sin(th)
+    return np.concatenate(
+        [q[..., 0:1] + c0 * tx - s0 * ty, q[..., 1:2] + s0 * tx + c0 * ty, c0 * c - s0 * s, s0 * c + c0 * s],
+        axis=-1,
+    )
+
+
+def _se2_difference(q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
+    """``log(M0^-1 M1)`` (..., 3) between planar poses (..., 4); the turn in (-pi, pi]."""
+    c0, s0, c1, s1 = q0[..., 2:3], q0[..., 3:4], q1[..., 2:3], q1[..., 3:4]
+    th = np.arctan2(c0 * s1 - s0 * c1, c0 * c1 + s0 * s1)
+    dx, dy = q1[..., 0:1] - q0[..., 0:1], q1[..., 1:2] - q0[..., 1:2]
+    tx, ty = c0 * dx + s0 * dy, c0 * dy - s0 * dx  # R0^T (p1 - p0)
+    # V(th)^-1 = [[e, th / 2], [-th / 2, e]], e = (th / 2) sin th / (1 - cos th) = (th / 2) cot(th / 2)
+    small = np.abs(th) < _SMALL
+    t = np.where(small, 1.0, th)
+    e = np.where(small, 1.0 - th * th / 12.0 - th**4 / 720.0, 0.5 * t / np.tan(0.5 * t))
+    return np.concatenate([e * tx + 0.5 * th * ty, e * ty - 0.5 * th * tx, th], axis=-1)
+
+
+def _batch(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``a`` and ``b`` with the same number of rows (one state against a batch)."""
+    rows = np.broadcast_shapes(a.shape[:-1], b.shape[:-1])
+    return np.broadcast_to(a, rows + a.shape[-1:]), np.broadcast_to(b, rows + b.shape[-1:])
+
+
+def integrate(robot: Robot, q, v) -> np.ndarray:
+    """``q (+) v``: where the configuration ``q`` goes moving with velocity ``v`` for unit
+    time (Pinocchio's ``integrate``): revolute and prismatic joints ``q + v``; a floating
+    base or joint ``M1 = M0 exp(v)`` on SE(3) (``v`` its twist in its own frame); a
+    spherical joint ``quat0 exp(w)``; a planar joint ``M0 exp(v)`` on SE(2) (see the
+    module doc). ``q`` (nq,) or (N, nq), ``v`` (nv,) or (N, nv); returns (nq,) or (N, nq)."""
+    q = _array(robot, q, robot.nq, "q")
+    v = _array(robot, v, robot.nv, "v")
+    if robot.nq == robot.nv:  # revolute and prismatic joints only
+        return q + v
+    layout = _layout(robot)
+    _check_unit(layout, q, "q")
+    q, v = _batch(q, v)
+    out = np.array(q)
+    out[..., layout.flat_q] = q[..., layout.flat_q] + v[..., layout.flat_v]
+    for step, iq, iv in (
+        (_se3_integrate, layout.se3_q, layout.se3_v),
+        (_so3_integrate, layout.so3_q, layout.so3_v),
+        (_se2_integrate, layout.se2_q, layout.se2_v),
+    ):
+        if len(iq):
+            out[..., iq] = step(q[..., iq], v[..., iv])
+    return out
 
 
 def difference(robot: Robot, q0, q1) -> np.ndarray:
     """The velocity ``v`` with ``integrate(robot, q0, v) = q1`` (Pinocchio's
-    ``difference``). Fixed base: ``q1 - q0``. Floating base: ``log(M0^-1 M1)``, the base
-    twist in ``q0``'s base frame (linear, angular; rotation angle at most pi), then the
-    joints ``q1 - q0``. ``q0``, ``q1`` (nq,) or (N, nq); returns (nv,) or (N, nv)."""
-    robot.require_one_dof_joints("armdyn.configuration.difference")
+    ``difference``): revolute and prismatic joints ``q1 - q0``; a floating base or joint
+    ``log(M0^-1 M1)``, its twist in ``q0``'s frame (linear, angular; rotation angle at most
+    pi); a spherical joint ``log(quat0^-1 quat1)``; a planar joint ``log(M0^-1 M1)`` on
+    SE(2). ``q0``, ``q1`` (nq,) or (N, nq); returns (nv,) or (N, nv)."""
     q0 = _array(robot, q0, robot.nq, "q0")
     q1 = _array(robot, q1, robot.nq, "q1")
-    if not robot.floating:
+    if robot.nq == robot.nv:
         return q1 - q0
-    quat0, quat1 = _quaternions(q0, "q0"), _quaternions(q1, "q1")
-    inv0 = quaternion_conjugate(quat0)
-    p = rotate_vector(inv0, q1[..., :3] - q0[..., :3])  # M0^-1 M1's translation
-    w = _log_quaternion(_quat_mul(inv0, quat1))
-    theta = np.linalg.norm(w, axis=-1, keepdims=True)
-    # V(w)^-1 = 1 - [w]x / 2 + c [w]x^2, c = (1 - t sin t / (2 (1 - cos t))) / t^2
-    small = theta < _SMALL
-    t = np.where(small, 1.0, theta)
-    c = np.where(
-        small,
-        1.0 / 12.0 + theta * theta / 720.0,
-        (1.0 - t * np.sin(t) / (2.0 * (1.0 - np.cos(t)))) / (t * t),
-    )
-    wxp = np.cross(w, p)
-    lin = p - 0.5 * wxp + c * np.cross(w, wxp)
-    return np.concatenate([lin, w, q1[..., 7:] - q0[..., 7:]], axis=-1)
+    layout = _layout(robot)
+    _check_unit(layout, q0, "q0")
+    _check_unit(layout, q1, "q1")
+    q0, q1 = _batch(q0, q1)
+    out = np.empty(q0.shape[:-1] + (robot.nv,))
+    out[..., layout.flat_v] = q1[..., layout.flat_q] - q0[..., layout.flat_q]
+    for step, iq, iv in (
+        (_se3_difference, layout.se3_q, layout.se3_v),
+        (_so3_difference, layout.so3_q, layout.so3_v),
+        (_se2_difference, layout.se2_q, layout.se2_v),
+    ):
+        if len(iq):
+            out[..., iv] = step(q0[..., iq], q1[..., iq])
+    return out
 
 
 def neutral(robot: Robot) -> np.ndarray:
-    """The neutral configuration (nq,): joints at 0; a floating base at the world origin
-    with the identity orientation (quaternion ``0, 0, 0, 1``); a joint of several
-    coordinates unmoved (its quaternion ``0, 0, 0, 1``, a planar joint's ``0, 0, 1, 0``)."""
+    """The neutral configuration (nq,): revolute and prismatic joints at 0; a floating
+    base or joint at its placement's origin with the identity orientation (quaternion
+    ``0, 0, 0, 1``); a spherical joint at the identity (``0, 0, 0, 1``); a planar joint
+    at ``0, 0, 1, 0`` (x, y, cos 0, sin 0)."""
+    layout = _layout(robot)
     q = np.zeros(robot.nq)
-    if robot.floating:
-        q[6] = 1.0
-    for _, kind, iq, _ in robot.configuration_layout:
-        if kind in MULTI_DOF:  # w = 1 ends each quaternion; a planar joint's cos comes third
-            q[iq + (2 if kind == "planar" else MULTI_DOF[kind][0] - 1)] = 1.0
+    q[layout.se3_q[:, 6]] = 1.0
+    q[layout.so3_q[:, 3]] = 1.0
+    q[layout.se2_q[:, 2]] = 1.0
     return q
 
 
@@ -185,40 +355,43 @@ def _limit(joint, name: str) -> float | None:
     return float(value)
 
 
+def _unit_quaternion(rng: np.random.Generator) -> np.ndarray:
+    """A quaternion uniform on SO(3) (a normalised Gaussian)."""
+    quat = rng.standard_normal(4)
+    return quat / np.linalg.norm(quat)
+
+
 def random_configuration(robot: Robot, rng: np.random.Generator, base_position: float = 1.0) -> np.ndarray:
-    """A random configuration (nq,) from ``rng`` (a ``numpy.random.Generator``): each
-    joint uniform between its limits where both are given and finite, else in
-    [-pi, pi] (revolute) or [-1, 1] (prismatic); a floating base's position uniform in
-    [-base_position, base_position]^3 and its orientation uniform on SO(3) (a normalised
-    Gaussian quaternion), and so a floating joint's and a spherical joint's; a planar
-    joint's x, y as a base's, its angle uniform in [-pi, pi]."""
-    joints: list[float] = []
-    for j in robot.movable_joints:
-        if j.type in MULTI_DOF:
-            joints += _random_block(j.type, rng, base_position)
-            continue
-        lo, hi = _limit(j, "lower"), _limit(j, "upper")
-        if lo is not None and hi is not None and np.isfinite(lo) and np.isfinite(hi) and lo <= hi:
-            joints.append(rng.uniform(lo, hi))
+    """A random configuration (nq,) from ``rng`` (a ``numpy.random.Generator``): a
+    revolute or prismatic joint uniform between its limits where both are given and
+    finite, else in [-pi, pi] (revolute) or [-1, 1] (prismatic); orientations (a floating
+    base's or joint's, a spherical joint's) uniform on SO(3) (a normalised Gaussian
+    quaternion); a floating base's or joint's position uniform in
+    [-base_position, base_position]^3; a planar joint's x, y uniform in
+    [-base_position, base_position] and its turn uniform in [-pi, pi]."""
+    q = np.zeros(robot.nq)
+    by_name = {j.name: j for j in robot.movable_joints}
+    for name, kind, iq, _ in robot.configuration_layout:
+        if kind == "spherical":
+            q[iq : iq + 4] = _unit_quaternion(rng)
+        elif kind == "planar":
+            th = rng.uniform(-np.pi, np.pi)
+            q[iq : iq + 4] = [*rng.uniform(-base_position, base_position, 2), np.cos(th), np.sin(th)]
+        elif kind == "floating":
+            quat = _unit_quaternion(rng)
+            q[iq : iq + 7] = np.concatenate([rng.uniform(-base_position, base_position, 3), quat])
         else:
-            half = np.pi if j.type == "revolute" else 1.0
-            joints.append(rng.uniform(-half, half))
-    if not robot.floating:
-        return np.array(joints, dtype=float)
-    quat = rng.standard_normal(4)
-    quat /= np.linalg.norm(quat)
-    return np.concatenate([rng.uniform(-base_position, base_position, 3), quat, joints])
+            j = by_name[name]
+            lo, hi = _limit(j, "lower"), _limit(j, "upper")
+            if lo is not None and hi is not None and np.isfinite(lo) and np.isfinite(hi) and lo <= hi:
+                q[iq] = rng.uniform(lo, hi)
+            else:
+                half = np.pi if kind == "revolute" else 1.0
+                q[iq] = rng.uniform(-half, half)
+    if robot.floating:  # drawn after the joints (as before joints of several coordinates)
+        quat = _unit_quaternion(rng)
+        q[:7] = np.concatenate([rng.uniform(-base_position, base_position, 3), quat])
+    return q
 
 
-def _random_block(kind: str, rng: np.random.Generator, base_position: float) -> list[float]:
-    """A random configuration of a joint of several coordinates (:func:`random_configuration`)."""
-    if kind == "planar":
-        x, y = rng.uniform(-base_position, base_position, 2)
-        angle = rng.uniform(-np.pi, np.pi)
-        return [x, y, np.cos(angle), np.sin(angle)]
-    position = list(rng.uniform(-base_position, base_position, 3)) if kind == "floating" else []
-    quat = rng.standard_normal(4)
-    return position + list(quat / np.linalg.norm(quat))
-
-
-__all__ = ["QUATERNION_TOL", "integrate", "difference", "neutral", "random_configuration"]
+__all__ = ["QUATERNION_TOL", "integrate", "difference", "neutral", "random_configuration", "check_configuration"]

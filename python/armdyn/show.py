@@ -28,7 +28,6 @@ import math
 import numpy as np
 import sympy as sp
 
-from .configuration import QUATERNION_TOL
 from .errors import ModelError
 from .model import Robot
 from .model.joints import MULTI_DOF
@@ -56,30 +55,25 @@ def numeric_robot(robot: Robot) -> Robot:
 
 
 def joint_values(robot: Robot, q) -> np.ndarray:
-    """``q`` as a float array of one finite value per coordinate (the joints' neutral
-    configuration for None: zeros, a joint of several coordinates unmoved), else a
-    ValueError; a joint of several coordinates takes its block of ``q`` (Pinocchio's layout,
-    :attr:`Robot.configuration_layout`), its quaternion of unit length."""
-    from .configuration import neutral
+    """``q`` as a float array of the joints' configuration (a floating robot's ``q[7:]``;
+    Pinocchio's layout, :attr:`Robot.configuration_layout`: one value per revolute or
+    prismatic joint, a joint of several coordinates its block), finite, every quaternion
+    and (cos, sin) pair of unit length; the joints' neutral configuration for None. Else
+    a ValueError."""
+    from .configuration import check_configuration, neutral
 
-    if robot.floating:  # the joints alone: a floating base is placed by its caller
-        robot.require_one_dof_joints("the picture of a floating robot")
+    base = 7 if robot.floating else 0
     if q is None:
-        return neutral(robot)[7 if robot.floating else 0 :]
-    width = robot.dof if robot.floating else robot.nq
+        return neutral(robot)[base:]
+    width = robot.nq - base
     q = np.asarray(q, dtype=float).reshape(-1)
     if q.shape != (width,):
         blocks = "; a joint of several coordinates its configuration block" if robot.multi_dof_joints else ""
         raise ValueError(f"q must have {width} values (one per movable joint{blocks}), got {q.size}")
     if not np.all(np.isfinite(q)):
         raise ValueError("q contains NaN or inf")
-    for name, kind, iq, _ in robot.configuration_layout:
-        if kind in ("spherical", "floating"):
-            norm = float(np.linalg.norm(q[iq + MULTI_DOF[kind][0] - 4 : iq + MULTI_DOF[kind][0]]))
-            if abs(norm - 1) > QUATERNION_TOL:
-                raise ValueError(f"q: joint '{name}''s quaternion (x, y, z, w) has length {norm:.9g}: normalise it")
-        elif kind == "planar" and abs(float(np.hypot(q[iq + 2], q[iq + 3])) - 1) > QUATERNION_TOL:
-            raise ValueError(f"q: joint '{name}''s cos, sin are not of unit length: normalise them")
+    if robot.multi_dof_joints:  # unit quaternions and (cos, sin) pairs, naming the joint
+        check_configuration(robot, np.concatenate([neutral(robot)[:base], q]))
     return q
 
 
@@ -89,16 +83,18 @@ def as_floats(m: sp.Matrix) -> np.ndarray:
 
 
 def frame_poses(robot: Robot, q=None) -> dict[str, np.ndarray]:
-    """Pose of every link frame in the base frame at ``q`` (dof,): dict link name ->
+    """Pose of every link frame in the base frame at the joints' configuration ``q``
+    (:func:`joint_values`): dict link name ->
     (4, 4) homogeneous transform, base first, then in joint (tree) order.
 
     ``robot`` must be numeric (see :func:`numeric_robot`). Each pose is the parent's
     pose times the joint's ``Joint.transform(q_i)``.
     """
     q = joint_values(robot, q)
+    bq, bv = (7, 6) if robot.floating else (0, 0)  # the layout counts a floating base's q and v first
     layout = robot.configuration_layout
-    blocks = {name: (iq, iq + MULTI_DOF[kind][0]) for name, kind, iq, _ in layout if kind in MULTI_DOF}
-    at = {iv: iq for _, kind, iq, iv in layout if kind not in MULTI_DOF}  # a coordinate's place in q
+    blocks = {name: (iq - bq, iq - bq + MULTI_DOF[kind][0]) for name, kind, iq, _ in layout if kind in MULTI_DOF}
+    at = {iv - bv: iq - bq for _, kind, iq, iv in layout if kind not in MULTI_DOF}  # a coordinate's place in q
     poses = {robot.base: np.eye(4)}
     for joint in robot.joints:
         f = robot.follows(joint)  # (coordinate, multiplier, offset); mimic joints follow a leader

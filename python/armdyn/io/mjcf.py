@@ -21,11 +21,14 @@ What is read (the part of MJCF that fixes a fixed-base arm's rigid-body dynamics
   ``<body>_<joint>``, listed in ``robot.meta["intermediate_links"]``. A body without a
   joint is welded to its parent (a fixed joint ``<body>_fixed``).
 * A ``free`` joint (``<freejoint/>`` or ``<joint type="free"/>``) of a body of the world
-  body makes that body the floating base (``root_joint="free-flyer"``; one such body,
-  its only joint; see :mod:`armdyn.io.mjcf_free` for what is checked and
-  :mod:`armdyn.io.mjcf_state` for MuJoCo's ``qpos``/``qvel`` layout against armdyn's);
-  ``floating="weld"`` reads it as a fixed base at the body's pose instead. A free joint
-  anywhere else, and ``ball`` joints, are refused (no spherical joint yet).
+  body makes that body the floating base (``root_joint="free-flyer"``) when it is the one
+  free body and no other body of the world body has a joint; otherwise (several free
+  bodies, a free object beside a fixed arm) each free body hangs from the world on a
+  ``floating`` joint. A ``ball`` joint is a ``spherical`` joint. See
+  :mod:`armdyn.io.mjcf_free` for both (what is checked, refused or ignored) and
+  :mod:`armdyn.io.mjcf_state` for MuJoCo's ``qpos``/``qvel`` layout against armdyn's.
+  ``floating="weld"`` reads every free body as welded at its pose instead. A free joint
+  anywhere else is refused (MuJoCo refuses it too).
 * ``<inertial pos mass diaginertia|fullinertia>`` (with an orientation for
   ``diaginertia``). A body without one gets MuJoCo's inertia from its geoms
   (``<compiler inertiafromgeom>``: ``auto`` by default; ``true`` always; ``false``
@@ -69,13 +72,12 @@ import numpy as np
 from ..errors import ModelError
 from ..model import Joint, Link, Numbers, Robot, exact_number
 from .expressions import check_name
-from .mjcf_free import base_pose, floating_tree, free_joint
+from .mjcf_free import ball_joint_dynamics, base_pose, floating_tree, free_joint
+from .mjcf_inertia import ORIENTATIONS, geom, inertial
 from .mjcf_math import (
-    GEOM_SIZES,
     axis_angle_quat,
     combine,
     euler_quat,
-    geom_volume_inertia,
     quat_matrix,
     xyaxes_matrix,
     zaxis_quat,
@@ -86,7 +88,6 @@ from .textfile import MODEL_MAX_BYTES, read_bytes
 __all__ = ["load_mjcf", "MjcfIgnoredWarning"]
 
 MAX_DEFAULT_DEPTH = 100
-ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
 WORLD = "world"
 
 #: top-level sections that hold no rigid-body dynamics
@@ -111,17 +112,19 @@ def load_mjcf(path_or_xml, strict: bool = True, floating: str | None = None) -> 
     """Read an MJCF file (a path) or MJCF text (a string holding ``<`` or a line break).
 
     Returns a numeric :class:`Robot` whose base is the world body (link ``"world"``),
-    its coordinates in MuJoCo's order (depth-first through the bodies as written): q is
-    MuJoCo's ``qpos``. With a free root body the robot floats, its base that body, its
+    its coordinates in MuJoCo's order (depth-first through the bodies as written): with
+    hinge and slide joints only, q is MuJoCo's ``qpos``. With a free root body the robot
+    floats, its base that body; floating base, free bodies and ball joints have their
     arrays in Pinocchio's layout (:mod:`armdyn.io.mjcf_state` converts). Unnamed joints
     and bodies are called ``joint_<n>``, ``body_<n>``.
     ``strict=False`` loads physically invalid inertias with a warning instead of an error.
     ``floating="weld"``: a ``free`` joint of a body of the world body is read as a fixed
     base (the body welded at its pose); without it that body floats.
     ``robot.meta``: ``convention`` ("mjcf"), ``file``, ``ignored`` (what was not used),
-    ``massless_links``, ``intermediate_links``, ``mujoco_joints`` (the coordinates in
+    ``massless_links``, ``intermediate_links``, ``mujoco_joints`` (the movable joints in
     MuJoCo's order) and, floating, ``base_pose`` (the body's pose as written, MuJoCo's
-    ``qpos0``: position and quaternion ``w x y z``).
+    ``qpos0``: position and quaternion ``w x y z``); with free bodies on floating joints,
+    ``free_poses`` (the same, per floating joint's name).
     """
     if floating not in (None, "weld"):
         raise ModelError(f"floating={floating!r}: the one option is floating='weld'")
@@ -153,6 +156,8 @@ class _Reader(MjcfDocument):
         self.intermediate: list[str] = []
         self.base: str | None = None  # the floating base's body, once read
         self.base_pose: tuple = ()
+        self.free_joints = False  # free bodies on floating joints from the world (mjcf_free)
+        self.free_poses: dict[str, tuple] = {}
 
     def rotation(self, elem, attrs) -> np.ndarray:
         """The orientation ``attrs`` give (identity when none)."""
@@ -344,6 +349,8 @@ class _Reader(MjcfDocument):
         if self.base is not None:
             del self.links[0]  # the world: the floating base's joint is the free-flyer
             meta["base_pose"] = self.base_pose
+        if self.free_poses:
+            meta["free_poses"] = self.free_poses
         if self.directory is not None:
             meta["file"] = self.source
         name = root.get("model") or (Path(self.source).stem if self.directory is not None else "mjcf")
@@ -437,13 +444,15 @@ class _Reader(MjcfDocument):
             kind = "free" if j.tag == "freejoint" else attrs.get("type", "hinge")
             if kind == "free":
                 free_joint(self, j, attrs, parent == WORLD, len(read))
-                if self.floating != "weld":
+                if self.floating != "weld" and not self.free_joints:
                     return None
+                if self.floating != "weld":  # a free body beside others: a floating joint from the world
+                    jname = self.name(j, self.joint_names, f"joint_{len(self.joint_names) + 1}")
+                    self.free_poses[jname] = base_pose(Rb, pb)
+                    return [self.joint(j, jname, "floating", parent, name, np.zeros(3), np.eye(3), {})]
                 self.ignored["free joint read as a fixed base (floating='weld')"] += 1
                 read = []
-            elif kind == "ball":
-                raise self.error(j, "ball joint: armdyn has no ball (spherical) joint yet")
-            elif kind not in ("hinge", "slide"):
+            elif kind not in ("hinge", "slide", "ball"):
                 raise self.error(j, f"unknown joint type '{clip(kind)}' (expected hinge, slide, ball or free)")
         if not read:
             fixed = self.unique(f"{name}_fixed", self.joint_names)
@@ -451,26 +460,36 @@ class _Reader(MjcfDocument):
         out, previous = [], parent
         for k, (j, attrs, Rf, pf) in enumerate(read):
             jname = self.name(j, self.joint_names, f"joint_{len(self.joint_names) + 1}")
-            hinge = attrs.get("type", "hinge") == "hinge"
-            axis = self.numbers(j, attrs, "axis", 3, [0, 0, 1])
-            if np.linalg.norm(axis) < 1e-10:
-                raise self.error(j, "axis is zero")
-            axis = Rf @ axis / np.linalg.norm(axis)
+            kind = attrs.get("type", "hinge")
             point = pf + Rf @ self.numbers(j, attrs, "pos", 3, [0, 0, 0])
-            ref = self.number(j, attrs, "ref", 0.0) * (self.unit if hinge else 1.0)
-            # the body is drawn at q = ref: fold the turn (shift) by -ref into the placement
-            R = quat_matrix(axis_angle_quat(axis, -ref)) if hinge else np.eye(3)
-            shift = point if hinge else point - axis * ref
+            if kind == "ball":  # turns the body frame about the point (see mjcf_free)
+                ball_joint_dynamics(self, j, attrs)
+                R, shift, extra, kind = np.eye(3), point, {}, "spherical"
+            else:
+                R, shift, extra = self.axis_joint(j, attrs, kind == "hinge", Rf, point)
+                kind = "revolute" if kind == "hinge" else "prismatic"
             R, xyz = (Rb @ R, pb + Rb @ shift) if k == 0 else (R, shift)
             child = name if k == len(read) - 1 else self.unique(f"{name}_{jname}", self.names)
             if child != name:
                 self.links.append(Link(child))
                 self.intermediate.append(child)
-            extra = {"axis": Numbers(axis), "frame_xyz": Numbers(-point)}
-            extra.update(self.joint_dynamics(j, attrs, hinge))
-            out.append(self.joint(j, jname, "revolute" if hinge else "prismatic", previous, child, xyz, R, extra))
+            extra["frame_xyz"] = Numbers(-point)
+            out.append(self.joint(j, jname, kind, previous, child, xyz, R, extra))
             previous = child
         return out
+
+    def axis_joint(self, j, attrs, hinge: bool, Rf, point) -> tuple[np.ndarray, np.ndarray, dict]:
+        """A hinge's or slide's ``(R, shift, extra)``: the placement's turn and origin in
+        the body frame, its axis and joint dynamics."""
+        axis = self.numbers(j, attrs, "axis", 3, [0, 0, 1])
+        if np.linalg.norm(axis) < 1e-10:
+            raise self.error(j, "axis is zero")
+        axis = Rf @ axis / np.linalg.norm(axis)
+        ref = self.number(j, attrs, "ref", 0.0) * (self.unit if hinge else 1.0)
+        # the body is drawn at q = ref: fold the turn (shift) by -ref into the placement
+        R = quat_matrix(axis_angle_quat(axis, -ref)) if hinge else np.eye(3)
+        shift = point if hinge else point - axis * ref
+        return R, shift, {"axis": Numbers(axis), **self.joint_dynamics(j, attrs, hinge)}
 
     def free_attrs(self, elem) -> dict[str, str]:
         self.check_attributes(elem)
@@ -508,12 +527,12 @@ class _Reader(MjcfDocument):
 
     def link(self, elem, name, inertials, geoms) -> Link:
         if inertials and self.fromgeom != "true":
-            mass, com, inertia = self.inertial(*inertials[0])
+            mass, com, inertia = inertial(self, *inertials[0])
             self.ignored["<geom> (contact and visual shapes)"] += len(geoms)
         elif self.fromgeom != "false" and geoms:
             if inertials:
                 self.ignored["<inertial> (inertiafromgeom='true')"] += 1
-            parts = [self.geom(g, R, p, cls, name) for g, R, p, cls in geoms]
+            parts = [geom(self, g, R, p, cls, name) for g, R, p, cls in geoms]
             mass, com, inertia = combine([part for part in parts if part is not None])
         else:
             mass, com, inertia = 0.0, np.zeros(3), np.zeros((3, 3))
@@ -526,74 +545,3 @@ class _Reader(MjcfDocument):
             return Link(name, Numbers(mass), Numbers(com), Numbers((inertia + inertia.T) / 2))
         except ModelError as err:
             raise self.error(elem, err.message) from None
-
-    def inertial(self, elem, cls, Rf, pf) -> tuple[float, np.ndarray, np.ndarray]:
-        """``(mass, com, inertia about com)`` in the body frame (``Rf, pf``: the pose of
-        the frame the <inertial> sits in)."""
-        self.check_attributes(elem)
-        attrs = elem.attrib
-        for key in ("pos", "mass"):
-            if key not in attrs:
-                raise self.error(elem, f"<inertial> has no '{key}'")
-        mass = self.number(elem, attrs, "mass", 0.0)
-        if mass < 0:
-            raise self.error(elem, f"mass {mass} is negative")
-        com = self.numbers(elem, attrs, "pos", 3)
-        if ("diaginertia" in attrs) == ("fullinertia" in attrs):
-            raise self.error(elem, "<inertial> needs one of 'diaginertia' and 'fullinertia'")
-        if "fullinertia" in attrs:
-            if set(attrs) & set(ORIENTATIONS):
-                raise self.error(elem, "fullinertia cannot be given with an orientation (it is in the body's axes)")
-            xx, yy, zz, xy, xz, yz = self.numbers(elem, attrs, "fullinertia", 6)
-            return mass, pf + Rf @ com, Rf @ np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]) @ Rf.T
-        R = Rf @ self.rotation(elem, attrs)
-        return mass, pf + Rf @ com, R @ np.diag(self.numbers(elem, attrs, "diaginertia", 3)) @ R.T
-
-    def geom(self, elem, R0, p0, cls, body) -> tuple | None:
-        """``(mass, com, inertia about com)`` of a geom in the body frame, or None when its
-        group is outside ``inertiagrouprange``."""
-        attrs = self.attrs(elem, cls)
-        group = self.number(elem, attrs, "group", 0.0)
-        if not self.groups[0] <= group <= self.groups[1]:
-            self.ignored["<geom> outside inertiagrouprange"] += 1
-            return None
-        kind = attrs.get("type", "sphere")
-        if kind not in GEOM_SIZES:
-            raise self.error(
-                elem,
-                f"body '{clip(body)}' has no <inertial> and MuJoCo would infer it from this {clip(kind)} geom: "
-                "armdyn infers it from sphere, capsule, cylinder, box and ellipsoid geoms only; "
-                "give the body an <inertial>",
-            )
-        if attrs.get("shellinertia", "false") != "false":
-            raise self.error(elem, "shellinertia is not supported: give the body an <inertial>")
-        size = np.zeros(3)
-        given = self.numbers(elem, attrs, "size", 3, [], at_least=0)
-        size[: len(given)] = given
-        if "fromto" in attrs:
-            if kind == "sphere":
-                raise self.error(elem, "fromto cannot be used with a sphere")
-            ends = self.numbers(elem, attrs, "fromto", 6)
-            length = np.linalg.norm(ends[3:] - ends[:3])
-            if length < 1e-10:
-                raise self.error(elem, "fromto has zero length")
-            R, p = quat_matrix(zaxis_quat(ends[3:] - ends[:3])), (ends[:3] + ends[3:]) / 2
-            if kind in ("capsule", "cylinder"):
-                size[1] = length / 2
-            else:  # a box or an ellipsoid: MuJoCo takes size[0] for both half-widths
-                size[1:] = size[0], length / 2
-        else:
-            R, p = self.pose(elem, attrs)
-        if np.any(size[: GEOM_SIZES[kind]] <= 0):
-            raise self.error(elem, f"a {kind} needs {GEOM_SIZES[kind]} positive size numbers, got {size.tolist()}")
-        volume, unit_inertia = geom_volume_inertia(kind, size)
-        if "mass" in attrs:
-            mass = self.number(elem, attrs, "mass", 0.0)
-            density = mass / volume
-        else:
-            density = self.number(elem, attrs, "density", 1000.0)
-            mass = density * volume
-        if mass < 0:
-            raise self.error(elem, "mass (or density) is negative")
-        R, p = R0 @ R, p0 + R0 @ p
-        return mass, p, R @ (density * unit_inertia) @ R.T

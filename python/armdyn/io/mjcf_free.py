@@ -1,24 +1,41 @@
-"""The floating base of an MJCF model (for :mod:`armdyn.io.mjcf`): a body of the world
-body with a ``free`` joint (``<freejoint/>`` or ``<joint type="free"/>``) is the base of a
-floating robot (``root_joint="free-flyer"``; its frame, the body frame, is the base
-frame, and its pose as written is MuJoCo's ``qpos0``, kept in ``robot.meta["base_pose"]``).
+"""Free and ball joints of an MJCF model (for :mod:`armdyn.io.mjcf`).
 
-What is checked, each a :class:`~armdyn.errors.ModelError` naming the file, line and
-element: one free body (armdyn reads one robot; the world body's other bodies must hold
-no joint: they are fixed to the world, not carried by the robot, and listed as
-ignored); the free joint is its body's only joint and its body is a child of the world
-body (as MuJoCo requires); no ``align`` (MuJoCo would move the body frame to the centre
-of mass); no damping, armature, friction loss or stiffness on it (MuJoCo applies them to
-the base's six velocities, which armdyn's floating base does not model: a ``<joint
-type="free">`` takes them from its default class, a ``<freejoint/>`` never does). A
-free joint's ``pos`` is ignored, as MuJoCo ignores it.
+Free bodies (a body of the world body with a ``free`` joint: ``<freejoint/>`` or
+``<joint type="free"/>``; MuJoCo allows them there only):
+
+* one free body, and no joint in the world body's other bodies: it is the base of a
+  floating robot (``root_joint="free-flyer"``; its frame, the body frame, is the base
+  frame, and its pose as written is MuJoCo's ``qpos0``, kept in
+  ``robot.meta["base_pose"]``). The other bodies of the world body are fixed to the
+  world, not carried by the robot: listed as ignored;
+* several free bodies, or free bodies beside bodies with joints (a free object next to a
+  fixed arm): the robot's base is the world and each free body hangs from it on a
+  ``floating`` joint named after the free joint, placed at the world origin, so that its
+  q is MuJoCo's qpos (the quaternion reordered, see :mod:`armdyn.io.mjcf_state`); each
+  pose as written (its ``qpos0``) is kept in ``robot.meta["free_poses"]``.
+
+Either way the free joint must be its body's only joint; no ``align`` (MuJoCo would move
+the body frame to the centre of mass); no damping, armature, friction loss or stiffness
+on it (MuJoCo applies them to the body's six velocities, which armdyn's floating joints
+do not model: a ``<joint type="free">`` takes them from its default class, a
+``<freejoint/>`` never does). A free joint's ``pos`` is ignored, as MuJoCo ignores it.
+
+A ``ball`` joint is a ``spherical`` joint rotating the body about the joint's ``pos``
+(its axes the body's; MuJoCo ignores a ball's ``axis`` and ``ref``): MuJoCo's qpos
+quaternion ``w x y z`` is armdyn's ``x y z w`` and its qvel, the angular velocity in the
+body frame, is armdyn's v. Its ``damping``, ``armature`` and ``frictionloss`` (MuJoCo
+applies them to the three velocities; armdyn's spherical joint has no joint dynamics)
+and ``springdamper`` are refused; ``stiffness`` and a ``range`` (a cone limit; limits do
+not enter the dynamics) are listed as ignored.
+
+Each problem is a :class:`~armdyn.errors.ModelError` naming the file, line and element.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["floating_tree", "free_joint", "base_pose"]
+__all__ = ["floating_tree", "free_joint", "base_pose", "ball_joint_dynamics"]
 
 
 def _has_free_joint(reader, body, cls: str) -> bool:
@@ -38,27 +55,19 @@ def _has_free_joint(reader, body, cls: str) -> bool:
 
 def floating_tree(reader, root, bodies: list) -> list:
     """The bodies of the world body to read (``(element, parent, R, p, class)`` as the
-    reader collects them): all of them without a free joint; with one, its body alone
-    (the floating base), the others ignored if they hold no joint."""
+    reader collects them). Sets ``reader.free_joints``: False when one free body is the
+    floating base (then it alone is returned, the others ignored if they hold no joint),
+    True when free bodies hang from the world on floating joints (all are returned)."""
     free = [b for b in bodies if _has_free_joint(reader, b[0], b[4])]
-    if not free:
-        return bodies
-    if len(free) > 1:
-        raise reader.error(
-            free[1][0],
-            "a second body with a free joint: armdyn reads one floating robot "
-            "(floating='weld' welds each free body at its pose instead)",
-        )
-    for elem, *_ in bodies:
-        if elem is free[0][0]:
-            continue
-        joint = next((e for e in elem.iter() if e.tag in ("joint", "freejoint")), None)
-        if joint is not None:
-            raise reader.error(
-                joint, "a joint in a body fixed to the world beside the floating base: armdyn reads one robot"
-            )
-        reader.ignored["bodies fixed to the world beside the floating base"] += 1
     reader.alignfree = any(c.get("alignfree", "false") == "true" for c in root.findall("compiler"))
+    others = [b for b in bodies if not any(b is f for f in free)]
+    jointed = [b for b in others if any(e.tag in ("joint", "freejoint") for e in b[0].iter())]
+    reader.free_joints = len(free) > 1 or bool(free and jointed)
+    if not free or reader.free_joints:
+        return bodies
+    reader.ignored["bodies fixed to the world beside the floating base"] += len(others)
+    if not others:
+        del reader.ignored["bodies fixed to the world beside the floating base"]
     return free
 
 
@@ -68,8 +77,7 @@ def free_joint(reader, elem, attrs: dict, at_root: bool, count: int) -> None:
     if not at_root:
         raise reader.error(
             elem,
-            "free joint in a body that is not a child of the world body: MuJoCo allows it on a "
-            "top-level body only, which armdyn reads as the floating base",
+            "free joint in a body that is not a child of the world body: MuJoCo allows it on a top-level body only",
         )
     if count > 1:
         raise reader.error(elem, "a free joint must be its body's only joint (at most 6 degrees of freedom a body)")
@@ -86,8 +94,8 @@ def free_joint(reader, elem, attrs: dict, at_root: bool, count: int) -> None:
         if np.any(reader.numbers(elem, attrs, key, 3, [0], at_least=1)):
             raise reader.error(
                 elem,
-                f"{key} on the free joint (MuJoCo applies it to the base's six velocities, armdyn's floating "
-                "base has none): not supported; <freejoint/> takes no defaults",
+                f"{key} on the free joint (MuJoCo applies it to the body's six velocities, armdyn's floating "
+                "joints have none): not supported; <freejoint/> takes no defaults",
             )
     if np.any(reader.numbers(elem, attrs, "pos", 3, [0, 0, 0])):
         reader.ignored["free joint pos (MuJoCo ignores it)"] += 1
@@ -112,3 +120,20 @@ def base_pose(R: np.ndarray, p: np.ndarray) -> tuple[tuple[float, ...], tuple[fl
         quat[1 + m] = (R[m, i] + R[i, m]) / s
     quat = np.array(quat) * (1 if quat[0] >= 0 else -1)
     return tuple(float(x) for x in p), tuple(float(x) for x in quat / np.linalg.norm(quat))
+
+
+def ball_joint_dynamics(reader, elem, attrs: dict) -> None:
+    """Check a ball joint's attributes (defaults applied): what MuJoCo would apply to its
+    three velocities is refused, a stiffness or a range listed as ignored."""
+    for key in ("damping", "armature", "frictionloss", "springdamper"):
+        if np.any(reader.numbers(elem, attrs, key, 3, [0], at_least=1)):
+            raise reader.error(
+                elem,
+                f"{key} on a ball joint (MuJoCo applies it to the joint's three velocities; armdyn's spherical "
+                "joint has no joint dynamics): not supported",
+            )
+    if np.any(reader.numbers(elem, attrs, "stiffness", 3, [0], at_least=1)):
+        reader.ignored["joint stiffness (springs are not modelled)"] += 1
+    limits = reader.numbers(elem, attrs, "range", 2)
+    if limits is not None and np.any(limits) and attrs.get("limited", "auto") != "false":
+        reader.ignored["ball joint range (a cone limit; limits do not enter the dynamics)"] += 1

@@ -7,15 +7,24 @@ What is read (the URDF 1.0 subset that describes a fixed-base arm's dynamics):
   ``<visual>``/``<collision>`` are ignored.
 * Joints ``revolute``, ``continuous`` (read as revolute, without position limits),
   ``prismatic`` and ``fixed``. Fixed joints stay fixed joints in the :class:`Robot`;
-  the engines handle them. ``floating`` and ``planar`` joints are rejected with a
-  :class:`ModelError` saying they are not supported yet.
+  the engines handle them.
+* Joints of several coordinates, read as Pinocchio's URDF parser reads them (layouts:
+  :data:`armdyn.model.joints.MULTI_DOF`): ``floating`` becomes a ``floating`` joint (a
+  free-flyer anywhere in the tree; its ``<axis>`` is unused, as the URDF spec says) and
+  ``planar`` a ``planar`` joint moving in its joint frame's x-y plane. Pinocchio ignores
+  a planar joint's ``<axis>`` (the plane's normal in the URDF spec) and always moves in
+  that x-y plane; so that both read the file alike, ``<axis xyz="0 0 1"/>`` is required
+  here and any other axis, or none (URDF's default ``1 0 0``), is refused (turn the plane
+  with the joint's ``<origin rpy>`` instead). Limits other than ``effort``, ``<dynamics>``
+  and ``<mimic>`` are refused on them (not modelled; Pinocchio drops them).
 * ``<mimic joint multiplier offset>`` (defaults 1 and 0): the joint follows its leader,
   ``q = multiplier * q_leader + offset``, and has no coordinate of its own (see
   :class:`armdyn.model.Mimic`). The leader must exist and be of the same type; a chain
   is composed, a loop is an error. On a fixed joint ``<mimic>`` is ignored (a fixed
   joint does not move; ``talos_reduced.urdf`` has such joints).
 * ``<origin xyz rpy>`` (default zero, ``rpy`` is URDF's fixed-axis roll-pitch-yaw),
-  ``<axis xyz>`` (default ``1 0 0``, as the URDF spec says; ignored on fixed joints).
+  ``<axis xyz>`` (default ``1 0 0``, as the URDF spec says; ignored on fixed and floating
+  joints).
   An axis within 1e-6 of unit length is normalised (files often write ``0.7071``);
   a zero axis, or one further from unit length, is an error.
 * ``<limit lower upper effort velocity>`` and ``<dynamics damping friction>`` are
@@ -68,9 +77,16 @@ from .expressions import check_name
 __all__ = ["load_urdf", "MasslessWarning"]
 
 #: URDF joint types read, and what they become in the model.
-JOINT_TYPES = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic", "fixed": "fixed"}
-#: URDF joint types that exist but are not supported yet.
-UNSUPPORTED_TYPES = ("floating", "planar")
+JOINT_TYPES = {
+    "revolute": "revolute",
+    "continuous": "revolute",
+    "prismatic": "prismatic",
+    "fixed": "fixed",
+    "floating": "floating",
+    "planar": "planar",
+}
+#: The one ``<axis>`` a planar joint may have: Pinocchio moves it in its frame's x-y plane.
+PLANAR_NORMAL = (0.0, 0.0, 1.0)
 
 # A plain decimal number, as URDF writes them (no "nan", "inf", "1_000" or hex).
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
@@ -335,8 +351,6 @@ def _joint(elem: ET.Element, index: int) -> Joint:
     name = _name(elem, f"joint #{index + 1}")
     where = f"joint '{_clip(name)}'"
     kind = _attr(elem, "type", where)
-    if kind in UNSUPPORTED_TYPES:
-        raise ModelError(f"{kind} joints are not supported yet", where)
     if kind not in JOINT_TYPES:
         raise ModelError(f"unknown joint type '{kind}' (expected one of {', '.join(JOINT_TYPES)})", where)
     parent = _attr(_single(elem, "parent", where, required=True), "link", where)
@@ -345,7 +359,7 @@ def _joint(elem: ET.Element, index: int) -> Joint:
 
     axis = Numbers([1.0, 0.0, 0.0])
     axis_elem = _single(elem, "axis", where)
-    if kind != "fixed" and axis_elem is not None:
+    if kind not in ("fixed", "floating") and axis_elem is not None:
         values = parse_numbers(_attr(axis_elem, "xyz", where), 3, "<axis> xyz", where)
         norm = math.sqrt(sum(v * v for v in values))
         if norm == 0:
@@ -353,6 +367,8 @@ def _joint(elem: ET.Element, index: int) -> Joint:
         if abs(norm - 1) > AXIS_TOLERANCE:
             raise ModelError(f"axis {values} is not a unit vector (norm {norm:.6g})", where)
         axis = Numbers([v / norm for v in values])
+    if kind == "planar":
+        _check_planar_axis(None if axis_elem is None else axis.floats, where)
 
     limit = _single(elem, "limit", where)
     dynamics = _single(elem, "dynamics", where)
@@ -372,6 +388,19 @@ def _joint(elem: ET.Element, index: int) -> Joint:
         friction=_optional_numbers(dynamics, "friction", where),
         mimic=None if kind == "fixed" else mimic,
         **limits,
+    )
+
+
+def _check_planar_axis(axis, where: str) -> None:
+    """ModelError unless a planar joint's ``<axis>`` (None: absent) is +z, the one plane
+    normal Pinocchio's parser honours (it ignores the axis and moves in the x-y plane)."""
+    if axis is not None and np.abs(axis - PLANAR_NORMAL).max() <= AXIS_TOLERANCE:
+        return
+    got = "no <axis> (URDF's default normal 1 0 0)" if axis is None else f"<axis> {axis.tolist()}"
+    raise ModelError(
+        f"a planar joint moves in its joint frame's x-y plane (as Pinocchio reads every planar joint, "
+        f'ignoring <axis>): give <axis xyz="0 0 1"/> and turn the plane with <origin rpy>; got {got}',
+        where,
     )
 
 
@@ -437,7 +466,7 @@ def _warn_inert_joints(robot: Robot, source: str) -> None:
     moves = [False] * robot.dof
     for joint in robot.movable_joints + robot.mimic_joints:
         moves[robot.follows(joint)[0]] |= not inert[joint.child]
-    idle = [j.name for j, moving in zip(robot.movable_joints, moves) if not moving]
+    idle = [j.name for j in robot.movable_joints if not moves[robot.follows(j)[0]]]
     if idle:
         warnings.warn(
             f"{source}: joints {idle} move no mass or inertia (links without <inertial>?): the mass matrix is singular",

@@ -158,9 +158,11 @@ def _link_poses(robot: Robot, Q: np.ndarray) -> np.ndarray:
         return np.asarray(forward_kinematics(robot, np.ascontiguousarray(Q))).reshape(len(Q), -1, 4, 4)
     from ..io import with_root_joint
 
-    fixed = with_root_joint(robot, None)
-    column = {n: 7 + i for i, n in enumerate(robot.coordinate_names)}
-    joints = np.ascontiguousarray(Q[:, [column[n] for n in fixed.coordinate_names]])
+    fixed = with_root_joint(robot, None)  # its joints in tree order: their blocks of q, moved
+    place = {name: iq for name, _, iq, _ in robot.configuration_layout}
+    width = {j.name: j.nq for j in robot.movable_joints}
+    columns = [place[name] + k for name, _, _, _ in fixed.configuration_layout for k in range(width[name])]
+    joints = np.ascontiguousarray(Q[:, columns])
     local = np.asarray(forward_kinematics(fixed, joints)).reshape(len(Q), -1, 4, 4)
     at = {n: i for i, n in enumerate(fixed.links)}
     local = local[:, [at[n] for n in robot.links]]
@@ -178,18 +180,16 @@ def _link_poses(robot: Robot, Q: np.ndarray) -> np.ndarray:
 
 
 def _configurations(robot: Robot, Q) -> np.ndarray:
-    """``Q`` (N, nq) as finite floats; a floating base's quaternions checked unit (a
-    joint's of several coordinates: by the numeric core)."""
+    """``Q`` (N, nq) as finite floats, every quaternion (a floating base's, a joint's) and
+    planar (cos, sin) pair checked unit."""
     Q = np.asarray(Q, dtype=float)
     if Q.ndim != 2 or Q.shape[1] != robot.nq or len(Q) == 0:
         raise ValueError(f"Q: shape {Q.shape}, expected (frames, {robot.nq}) with at least one frame")
     if not np.all(np.isfinite(Q)):
         raise ValueError("times or Q contain NaN or inf")
-    if robot.floating:
-        from ..configuration import difference
+    from ..configuration import check_configuration
 
-        robot.require_one_dof_joints("the 3-D view of a floating robot")  # _link_poses places 1-dof joints
-        difference(robot, Q, Q)  # refuses a quaternion off unit length, naming it
+    check_configuration(robot, Q)  # refuses a quaternion off unit length, naming the joint
     return Q
 
 
@@ -251,9 +251,9 @@ def _scene(robot: Robot, times, Q, frames: bool, markers: bool | None, package_d
 
 
 def view(robot, q=None, *, frames: bool = False, markers: bool | None = None, package_dirs=()) -> View:
-    """The arm ``robot`` (a :class:`Robot`, model file or bundled name) at ``q`` (dof,)
-    (default zeros; a floating robot's ``q`` is (nq,), default its neutral
-    configuration). ``frames``: draw each link frame's axes; ``markers``: joint
+    """The arm ``robot`` (a :class:`Robot`, model file or bundled name) at ``q`` (nq,:
+    one value per revolute or prismatic joint, a joint of several coordinates its block,
+    a floating robot's base first; default the neutral configuration). ``frames``: draw each link frame's axes; ``markers``: joint
     cylinders and mass spheres (default: only when the model has no visual geometry);
     ``package_dirs``: folders where ``package://`` meshes are looked up."""
     from ..show import joint_values
