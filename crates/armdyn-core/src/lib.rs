@@ -26,6 +26,7 @@ pub mod batch_centroidal;
 pub mod batch_derivatives;
 pub mod data;
 pub mod deriv_data;
+pub mod dual;
 pub mod joint;
 pub mod joint_multi;
 pub mod model;

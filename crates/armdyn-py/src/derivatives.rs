@@ -279,7 +279,10 @@ macro_rules! derivatives_entry {
             out: Option<&Bound<'py, PyAny>>,
         ) -> PyResult<Bound<'py, PyTuple>> {
             let m = model.get();
-            m.one_dof_only(stringify!($name))?;
+            if m.model.has_multi() {
+                let rnea = stringify!($name) == "rnea_derivatives";
+                return crate::floating_derivatives::tangent(m, py, rnea, q, qd, $third, f_ext, threads, out);
+            }
             if m.floating {
                 return $floating(m, py, q, qd, $third, f_ext, frame, threads, out);
             }

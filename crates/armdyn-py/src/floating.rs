@@ -40,8 +40,8 @@ impl NumericModel {
         if let Some(j) = self.model.multi.first() {
             return Err(PyValueError::new_err(format!(
                 "{what}: '{}' has joints of several coordinates (the first: '{}'): {what} takes revolute and \
-                 prismatic joints only (yet); rnea, crba, aba, gravity, bias, minverse, forward_kinematics, \
-                 jacobian, the energies and the centroidal map take them",
+                 prismatic joints only (yet); rnea, crba, aba, gravity, bias, their derivatives, minverse, \
+                 forward_kinematics, jacobian, the energies and the centroidal map take them",
                 self.name,
                 self.joint_name(j.body)
             )));

@@ -10,6 +10,7 @@
 use crate::derivatives::{check_f_ext, outputs_given};
 use crate::{all_finite, guard, new_array, slice, thread_arg, NumericModel, Scratch, Shape};
 use armdyn_core::algo::floating::{NQ_BASE, NV_BASE};
+use armdyn_core::algo::tangent_derivatives::{self as td, TangentWork};
 use armdyn_core::algo::{ExternalForces, ForceFrame};
 use armdyn_core::{algo, batch_derivatives as bd, Model};
 use numpy::{PyArrayDyn, PyArrayMethods};
@@ -47,7 +48,7 @@ fn run<'py, const K: usize, const R: usize>(
         }
         let (shape, arrays) = m.floating_states(args)?;
         let ext_arr = f_ext.map(|f| check_f_ext(m, f, shape)).transpose()?;
-        let s = m.model.nv + NV_BASE;
+        let s = m.model.nv + if m.floating { NV_BASE } else { 0 };
         let dims: Vec<usize> = match shape {
             Shape::Single => vec![s, s],
             Shape::Batch(rows) => vec![rows, s, s],
@@ -191,4 +192,60 @@ pub(crate) fn minverse<'py>(
         |md, [q], _, [o], t| bd::minverse_floating(md, q, o, t),
     )?;
     Ok(o)
+}
+
+/// The derivatives of a model with joints of several coordinates, fixed or floating base
+/// (`algo::tangent_derivatives`: dual-number RNEA passes on the tangent space): the
+/// RNEA's (`rnea = true`: `(dtau_dq, dtau_dv, M)` from `qdd`) or the ABA's
+/// (`(dqdd_dq, dqdd_dv, Minv)` from `tau`). No external wrenches yet; a batch runs row
+/// by row on one thread (the GIL released).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn tangent<'py>(
+    m: &NumericModel,
+    py: Python<'py>,
+    rnea: bool,
+    q: &Bound<'py, PyAny>,
+    v: &Bound<'py, PyAny>,
+    third: &Bound<'py, PyAny>,
+    f_ext: Option<&Bound<'py, PyAny>>,
+    threads: Option<i64>,
+    out: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let what = if rnea { "rnea_derivatives" } else { "aba_derivatives" };
+    if f_ext.is_some() {
+        return Err(PyNotImplementedError::new_err(format!(
+            "{what}: f_ext is not available yet for joints of several coordinates"
+        )));
+    }
+    let floating = m.floating;
+    let (nq, nv) = td::widths(&m.model, floating);
+    let each = move |md: &Model, w: &mut TangentWork, [q, v, x]: [&[f64]; 3], [o0, o1, o2]: [&mut [f64]; 3]| {
+        if rnea {
+            td::rnea_derivatives_tangent(md, floating, w, q, v, x, o0, o1, o2)
+        } else {
+            td::aba_derivatives_tangent(md, floating, w, q, v, x, o0, o1, o2)
+        }
+    };
+    let args = [("q", q, nq), ("qd", v, nv), (if rnea { "qdd" } else { "tau" }, third, nv)];
+    let o = run(
+        m,
+        py,
+        what,
+        args,
+        None,
+        "local",
+        threads,
+        out,
+        |md, _, ins, _, outs| each(md, &mut TangentWork::new(md, floating), ins, outs),
+        |md, ins, _, [o0, o1, o2], _| {
+            let mut w = TangentWork::new(md, floating);
+            let per = nv * nv;
+            let outs = o0.chunks_exact_mut(per).zip(o1.chunks_exact_mut(per)).zip(o2.chunks_exact_mut(per));
+            for (r, ((a, b), c)) in outs.enumerate() {
+                let row: [&[f64]; 3] = [&ins[0][r * nq..(r + 1) * nq], &ins[1][r * nv..(r + 1) * nv], &ins[2][r * nv..(r + 1) * nv]];
+                each(md, &mut w, row, [a, b, c]);
+            }
+        },
+    )?;
+    PyTuple::new(py, o)
 }

@@ -632,7 +632,8 @@ class Robot(metaclass=FreezeAfterInit):
             raise ModelError(
                 f"{what} handles revolute and prismatic joints only (yet); this robot has joints of "
                 f"several coordinates: {named}{more}. armdyn.numeric's rnea, crba, aba, gravity, bias, "
-                "minverse, forward_kinematics, jacobian and energies, and armdyn.centroidal, take them",
+                "their derivatives, minverse, forward_kinematics, jacobian and energies, and "
+                "armdyn.centroidal's momentum matrix, take them",
                 f"robot '{self.name}'",
                 self.meta.get("file"),
             )

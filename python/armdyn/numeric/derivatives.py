@@ -172,8 +172,9 @@ def _minverse_path(robot, q, threads, out):
 def gravity_derivatives(robot: RobotLike, q: ArrayLike, *, threads: int | None = None) -> np.ndarray:
     """``dg/dq`` of the gravity torques: (n, n) or (N, n, n), ``[i, j] = d g_i / d q_j``. A
     floating base: (nv, nv), on the tangent space (``rnea_derivatives`` at rest, as
-    Pinocchio's ``computeGeneralizedGravityDerivatives``)."""
-    if getattr(robot, "floating", False):
+    Pinocchio's ``computeGeneralizedGravityDerivatives``), and so with joints of several
+    coordinates (``nq != nv``)."""
+    if getattr(robot, "nq", 0) != getattr(robot, "nv", 0):
         zero = at_rest(robot, q)
         return rnea_derivatives(robot, q, zero, zero, threads=threads)[0]
     threads = fixed_base_threads(robot, threads, "gravity_derivatives")

@@ -24,6 +24,7 @@ pub mod minverse;
 pub mod regressor;
 pub mod rnea;
 pub mod rnea_derivatives;
+pub mod tangent_derivatives;
 
 pub use aba::aba;
 pub use coriolis::coriolis_matrix;

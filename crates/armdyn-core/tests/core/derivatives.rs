@@ -228,3 +228,27 @@ fn every_entry_written_and_unrelated_pairs_zero() {
     }
     assert!(chains > 0 && trees > 0, "chains {chains}, trees {trees}");
 }
+
+/// The dual-number derivatives (`tangent_derivatives`, written for joints of several
+/// coordinates) against the analytical ones on 1-dof trees, where both apply: two
+/// different algorithms, the same numbers to rounding.
+#[test]
+fn dual_number_derivatives_equal_the_analytical_ones() {
+    use armdyn_core::algo::tangent_derivatives::{aba_derivatives_tangent, rnea_derivatives_tangent, TangentWork};
+    for (model, q, qd, x, _) in cases() {
+        let n = model.nv;
+        let (mut data, mut dd) = (Data::new(&model), DerivData::new(&model));
+        let mut w = TangentWork::new(&model, false);
+        let [mut a0, mut a1, mut a2, mut b0, mut b1, mut b2] = std::array::from_fn(|_| vec![0.0; n * n]);
+        algo::rnea_derivatives(&model, &mut data, &mut dd, &q, &qd, &x, None, &mut a0, &mut a1, &mut a2);
+        rnea_derivatives_tangent(&model, false, &mut w, &q, &qd, &x, &mut b0, &mut b1, &mut b2);
+        for (a, b, what) in [(&a0, &b0, "dtau_dq"), (&a1, &b1, "dtau_dqd"), (&a2, &b2, "M")] {
+            assert_close(a, b, 1e-9, what);
+        }
+        algo::aba_derivatives(&model, &mut data, &mut dd, &q, &qd, &x, None, &mut a0, &mut a1, &mut a2);
+        aba_derivatives_tangent(&model, false, &mut w, &q, &qd, &x, &mut b0, &mut b1, &mut b2);
+        for (a, b, what) in [(&a0, &b0, "dqdd_dq"), (&a1, &b1, "dqdd_dqd"), (&a2, &b2, "Minv")] {
+            assert_close(a, b, 1e-7, what);
+        }
+    }
+}

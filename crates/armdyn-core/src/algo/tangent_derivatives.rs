@@ -1,0 +1,218 @@
+//! The derivatives of the RNEA and the ABA on the tangent space for models with joints
+//! of several coordinates (`joint_multi.rs`), fixed or floating base, by forward-mode
+//! automatic differentiation: the RNEA runs on [`Dual`] numbers once per velocity
+//! coordinate for `d tau / dq` (the configuration moved along the tangent direction,
+//! `q ⊕ ε e_m`, as Pinocchio's `integrate`) and once per coordinate for `d tau / dv`.
+//! The results are exact to rounding, as the analytical derivatives of the 1-dof
+//! algorithms (`rnea_derivatives.rs`), at `2 nv` RNEA passes instead of one sweep.
+//!
+//! The ABA's follow from the RNEA's at `a = aba(q, v, tau)`:
+//! `da/dq = -M^-1 dtau/dq`, `da/dv = -M^-1 dtau/dv` (differentiate `M a + h = tau`).
+//!
+//! Arrays: `q` (nq,) with a floating base's 7 first; `v`, `a`, `tau` (nv,); outputs
+//! (nv, nv) row-major, `[r * nv + m] = d out_r / d x_m` (nq, nv include the base's).
+
+use crate::algo::floating::{quaternion_rotation, NQ_BASE, NV_BASE};
+use crate::algo::{aba, aba_floating, crba, crba_floating, minverse, minverse_floating, rnea, rnea_floating};
+use crate::data::Data;
+use crate::deriv_data::DerivData;
+use crate::dual::Dual;
+use crate::joint_multi::MultiKind;
+use crate::model::Model;
+use crate::spatial::V3;
+
+/// The workspaces of one derivative call: dual-number RNEA, the f64 CRBA / M^-1, and
+/// the argument buffers. Allocated once per thread.
+pub struct TangentWork {
+    data: Data<Dual>,
+    data64: Data<f64>,
+    deriv: DerivData<f64>,
+    q: Vec<Dual>,
+    v: Vec<Dual>,
+    a: Vec<Dual>,
+    tau: Vec<Dual>,
+    acc: Vec<f64>,
+    product: Vec<f64>,
+}
+
+impl TangentWork {
+    pub fn new(model: &Model, floating: bool) -> Self {
+        let (nq, nv) = widths(model, floating);
+        TangentWork {
+            data: Data::new(model),
+            data64: Data::new(model),
+            deriv: DerivData::new(model),
+            q: vec![Dual::default(); nq],
+            v: vec![Dual::default(); nv],
+            a: vec![Dual::default(); nv],
+            tau: vec![Dual::default(); nv],
+            acc: vec![0.0; nv],
+            product: vec![0.0; nv * nv],
+        }
+    }
+}
+
+/// `(nq, nv)` of the whole configuration and velocity.
+pub fn widths(model: &Model, floating: bool) -> (usize, usize) {
+    if floating {
+        (model.nq + NQ_BASE, model.nv + NV_BASE)
+    } else {
+        (model.nq, model.nv)
+    }
+}
+
+/// `d quat` for the unit quaternion `x, y, z, w` at `q[0..4]` turned by `ε e_k` in its
+/// own frame: `1/2 quat ⊗ (e_k, 0)`.
+fn quaternion_turn(q: &[f64], k: usize, out: &mut [Dual]) {
+    let (qv, w) = (V3::new(q[0], q[1], q[2]), q[3]);
+    let mut e = [0.0; 3];
+    e[k] = 1.0;
+    let e = V3::from_array(e);
+    let dv = (e.scale(w) + qv.cross(e)).scale(0.5);
+    for (o, d) in out.iter_mut().zip(dv.to_array().into_iter().chain([-0.5 * qv.dot(e)])) {
+        o.du = d;
+    }
+}
+
+/// `ε`-move of the origin at `p` (3) by `ε R(quat) e_k`: a free body's translation
+/// along its own axis `k`.
+fn slide(quat: &[f64], k: usize, out: &mut [Dual]) {
+    let r = quaternion_rotation(quat[0], quat[1], quat[2], quat[3]);
+    for (o, d) in out.iter_mut().zip(r.col(k).to_array()) {
+        o.du = d;
+    }
+}
+
+/// `out = q ⊕ ε e_m`: the configuration moved (to first order, exactly in dual numbers)
+/// along velocity coordinate `m`, as Pinocchio's `integrate(q, ε e_m)`.
+pub fn tangent_direction(model: &Model, floating: bool, q: &[f64], m: usize, out: &mut [Dual]) {
+    for (o, &x) in out.iter_mut().zip(q) {
+        *o = Dual::new(x, 0.0);
+    }
+    let (qb, vb) = if floating { (NQ_BASE, NV_BASE) } else { (0, 0) };
+    if m < vb {
+        match m {
+            0..=2 => slide(&q[3..7], m, &mut out[0..3]),
+            _ => quaternion_turn(&q[3..7], m - 3, &mut out[3..7]),
+        }
+        return;
+    }
+    let b = m - vb;
+    let Some(j) = model.multi.iter().rev().find(|j| j.body <= b) else {
+        out[qb + model.idx_q[b]].du = 1.0;
+        return;
+    };
+    let part = b - j.body;
+    if part >= j.kind.parts().len() {
+        out[qb + model.idx_q[b]].du = 1.0; // a 1-dof body after the joint
+        return;
+    }
+    let at = qb + j.idx_q;
+    match j.kind {
+        MultiKind::Spherical => quaternion_turn(&q[at..at + 4], part, &mut out[at..at + 4]),
+        MultiKind::Free if part < 3 => slide(&q[at + 3..at + 7], part, &mut out[at..at + 3]),
+        MultiKind::Free => quaternion_turn(&q[at + 3..at + 7], part - 3, &mut out[at + 3..at + 7]),
+        MultiKind::Planar => {
+            let (c, s) = (q[at + 2], q[at + 3]);
+            let d = match part {
+                0 => [c, s, 0.0, 0.0],
+                1 => [-s, c, 0.0, 0.0],
+                _ => [0.0, 0.0, -s, c],
+            };
+            for (o, d) in out[at..at + 4].iter_mut().zip(d) {
+                o.du = d;
+            }
+        }
+    }
+}
+
+fn rnea_dual(model: &Model, floating: bool, w: &mut TangentWork) {
+    if floating {
+        rnea_floating(model, &mut w.data, &w.q, &w.v, &w.a, &mut w.tau);
+    } else {
+        rnea(model, &mut w.data, &w.q, &w.v, &w.a, &mut w.tau);
+    }
+}
+
+/// `dtau/dq` and `dtau/dv` (nv, nv) at `(q, v, a)`, column by column.
+fn rnea_partials(model: &Model, floating: bool, w: &mut TangentWork, q: &[f64], v: &[f64], a: &[f64], dq: &mut [f64], dv: &mut [f64]) {
+    let (_, nv) = widths(model, floating);
+    let plain = |x: &[f64], out: &mut [Dual]| out.iter_mut().zip(x).for_each(|(o, &x)| *o = Dual::new(x, 0.0));
+    plain(a, &mut w.a);
+    plain(v, &mut w.v);
+    for m in 0..nv {
+        tangent_direction(model, floating, q, m, &mut w.q);
+        rnea_dual(model, floating, w);
+        for r in 0..nv {
+            dq[r * nv + m] = w.tau[r].du;
+        }
+    }
+    plain(q, &mut w.q);
+    for m in 0..nv {
+        w.v[m].du = 1.0;
+        rnea_dual(model, floating, w);
+        w.v[m].du = 0.0;
+        for r in 0..nv {
+            dv[r * nv + m] = w.tau[r].du;
+        }
+    }
+}
+
+/// `(dtau/dq, dtau/dv, M)` at `(q, v, a)`: the tangent-space derivatives of the RNEA (see
+/// the module) and the joint-space inertia matrix. Joint friction and rotor inertia are
+/// included, as in `rnea` (`sign(qd)` has derivative 0).
+#[allow(clippy::too_many_arguments)]
+pub fn rnea_derivatives_tangent(
+    model: &Model,
+    floating: bool,
+    w: &mut TangentWork,
+    q: &[f64],
+    v: &[f64],
+    a: &[f64],
+    dtau_dq: &mut [f64],
+    dtau_dv: &mut [f64],
+    m: &mut [f64],
+) {
+    rnea_partials(model, floating, w, q, v, a, dtau_dq, dtau_dv);
+    if floating {
+        crba_floating(model, &mut w.data64, q, m);
+    } else {
+        crba(model, &mut w.data64, q, m);
+    }
+}
+
+/// `(da/dq, da/dv, M^-1)` at `(q, v, tau)`: with `a = aba(q, v, tau)`,
+/// `da/dx = -M^-1 dtau/dx` (see the module).
+#[allow(clippy::too_many_arguments)]
+pub fn aba_derivatives_tangent(
+    model: &Model,
+    floating: bool,
+    w: &mut TangentWork,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    da_dq: &mut [f64],
+    da_dv: &mut [f64],
+    minv: &mut [f64],
+) {
+    let (_, nv) = widths(model, floating);
+    let mut acc = std::mem::take(&mut w.acc);
+    if floating {
+        aba_floating(model, &mut w.data64, q, v, tau, &mut acc);
+        minverse_floating(model, &mut w.data64, &mut w.deriv, q, minv);
+    } else {
+        aba(model, &mut w.data64, q, v, tau, &mut acc);
+        minverse(model, &mut w.data64, &mut w.deriv, q, minv);
+    }
+    // dtau/dq and dtau/dv into the outputs, then -M^-1 times each (through `product`)
+    rnea_partials(model, floating, w, q, v, &acc, da_dq, da_dv);
+    w.acc = acc;
+    for d in [da_dq, da_dv] {
+        for r in 0..nv {
+            for c in 0..nv {
+                w.product[r * nv + c] = -(0..nv).map(|k| minv[r * nv + k] * d[k * nv + c]).sum::<f64>();
+            }
+        }
+        d.copy_from_slice(&w.product);
+    }
+}
