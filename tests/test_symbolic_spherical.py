@@ -208,3 +208,23 @@ def test_random_trees_symbolic_equals_numeric(seed):
         expected = np.asarray(armdyn.rnea(robot, q, v, a), dtype=float)
         got = evaluate(eom, q, v, a)
         assert np.max(np.abs(got - expected)) <= 1e-9 * max(1.0, np.max(np.abs(expected)))
+
+
+def test_joint_terms_beside_a_ball_joint():
+    """Damping, Coulomb friction, rotor inertia and offsets on the revolute joints around a
+    ball joint land on their own rows (the ball's three rows carry none): the derivation
+    equals the core's rnea, and the friction rows are the revolute joints'."""
+    from dataclasses import replace
+
+    robot = chain("arm", True)
+    terms = dict(damping=0.3, armature=0.05, friction=0.2, torque_offset=0.1)
+    joints = [replace(j, **terms) if j.type == "revolute" else j for j in robot.joints]
+    robot = Robot(robot.name, robot.links.values(), joints)
+    eom = armdyn.derive(robot)
+    shoulder, wrist = sp.Symbol("shoulder_dot"), sp.Symbol("wrist_dot")
+    friction = [0.3 * shoulder + 0.2 * sp.sign(shoulder), 0, 0, 0, 0.3 * wrist + 0.2 * sp.sign(wrist)]
+    assert list(eom.friction) == friction
+    for q, v, a in states(robot, 3, 7):
+        expected = np.asarray(armdyn.rnea(robot, q, v, a), dtype=float)
+        got = evaluate(eom, q, v, a)
+        assert np.max(np.abs(got - expected)) <= TOL * max(1.0, np.max(np.abs(expected)))
