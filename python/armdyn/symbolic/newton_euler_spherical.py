@@ -89,7 +89,7 @@ def rates(robot: Robot) -> tuple[list, list]:
     return v, a
 
 
-def configuration(robot: Robot) -> list:
+def pose_symbols(robot: Robot) -> list:
     """The symbols the equations' pose dependence is written in: the joints of one
     coordinate's ``q``, then each spherical joint's rotation entries (row by row)."""
     own = [robot.q[robot.coordinate_index(j)] for j in robot.movable_joints if j.type not in DERIVED]
@@ -116,20 +116,22 @@ def motion(joint: Joint, w, wd) -> dict:
 
 def state_values(robot: Robot, q, v=None, a=None) -> dict:
     """Symbol -> value of the equations' symbols at the numeric state ``q`` (nq,),
-    ``v``, ``a`` (nv,) in armdyn.numeric's layout (:attr:`Robot.configuration_layout`):
-    a spherical joint's rotation entries from its quaternion (x, y, z, w, normalised
-    here), its angular velocity and acceleration; the other joints' q, qd, qdd."""
+    ``v``, ``a`` (nv,) in armdyn.numeric's layout (:attr:`Robot.configuration_layout`;
+    a fixed base): a spherical joint's rotation entries from its quaternion (x, y, z, w,
+    of unit length: :func:`armdyn.configuration.check_configuration`), its angular
+    velocity and acceleration; the other joints' q, qd, qdd."""
+    from ..configuration import check_configuration
     from ..model.joints import multi_dof_motion
 
-    q = np.asarray(q, dtype=float).reshape(-1)
+    robot.require_fixed_base("armdyn.symbolic.newton_euler_spherical.state_values")
+    q = check_configuration(robot, np.asarray(q, dtype=float).reshape(-1))
     vel, acc = rates(robot)
+    joints = {j.name: j for j in robot.movable_joints}
     out: dict = {}
     for name, kind, iq, iv in robot.configuration_layout:
-        joint = next(j for j in robot.movable_joints if j.name == name)
         if kind == "spherical":
-            quaternion = q[iq : iq + 4] / np.linalg.norm(q[iq : iq + 4])
-            R, _ = multi_dof_motion(kind, [float(x) for x in quaternion])
-            out.update(zip(rotation_symbols(joint), (float(x) for x in R)))
+            R, _ = multi_dof_motion(kind, [float(x) for x in q[iq : iq + 4]])
+            out.update(zip(rotation_symbols(joints[name]), (float(x) for x in R)))
         else:
             out[robot.q[iv]] = float(q[iq])
     for given, symbols in ((v, vel), (a, acc)):
@@ -146,7 +148,7 @@ class SphericalEquationsOfMotion(EquationsOfMotion):
 
     @property
     def q(self) -> sp.Matrix:
-        return sp.Matrix(configuration(self.robot))
+        return sp.Matrix(pose_symbols(self.robot))
 
     @property
     def qd(self) -> sp.Matrix:
