@@ -520,3 +520,39 @@ def test_readme_ball_joint_block_runs(tmp_path):
     names, gap = done.stdout.strip().splitlines()
     assert names == "['ball.wx', 'ball.wy', 'ball.wz', 'hinge']"
     assert float(gap) < 1e-12
+
+
+def test_show_and_view_a_ball_joint(tmp_path):
+    """`armdyn show` draws a robot with a ball joint (2-D and 3-D) at its neutral
+    configuration or at a typed --q, whose quaternion (few digits) is normalised; a
+    quaternion far from unit length is refused, naming the joint."""
+    import os
+    import subprocess
+    import sys
+
+    import armdyn
+
+    (tmp_path / "pendulum.xml").write_text(
+        "<mujoco><worldbody><body name='rod' pos='0 0 1'><joint name='ball' type='ball'/>"
+        "<geom type='capsule' fromto='0 0 0 0 0 -0.6' size='0.03' mass='2'/></body></worldbody></mujoco>"
+    )
+    env = {**os.environ, "PYTHONPATH": str(Path(armdyn.__file__).parent.parent)}
+
+    def show(*args):
+        cmd = [sys.executable, "-m", "armdyn", "show", "pendulum.xml", *args]
+        return subprocess.run(cmd, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+
+    for args in (["-o", "a.png"], ["--3d", "-o", "a.html"], ["--q", "0,0.7071068,0,0.7071068", "-o", "b.png"]):
+        done = show(*args)
+        assert done.returncode == 0, done.stderr
+    assert "joint 'ball''s quaternion normalised" in done.stderr
+    done = show("--q", "0,0,0,2", "-o", "c.png")
+    assert done.returncode == 2 and "joint 'ball''s quaternion [0.0, 0.0, 0.0, 2.0] has length 2" in done.stderr
+    assert "Traceback" not in done.stderr
+    # the 2-D picture's poses are the numeric core's at that configuration
+    from armdyn.show import frame_poses
+
+    robot = load(tmp_path / "pendulum.xml")
+    q = np.array([0.0, np.sqrt(0.5), 0.0, np.sqrt(0.5)])
+    got = frame_poses(robot, q)
+    np.testing.assert_allclose(np.array(list(got.values())), numeric.forward_kinematics(robot, q), atol=1e-12)

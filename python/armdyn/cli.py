@@ -105,8 +105,8 @@ def cmd_show(args) -> int:
             q = [float(x) for x in args.q.split(",")]
         except ValueError:
             raise ValueError(f"--q must be comma-separated numbers, got {args.q!r}") from None
-        if robot.floating:
-            q = _floating_q(robot, q)
+        if robot.floating or robot.multi_dof_joints:
+            q = _configuration_q(robot, q)
     if args.three_d:  # a 3-D page (armdyn.viewer) instead of the matplotlib picture
         from ._io_atomic import destination
         from .show import numeric_robot, table
@@ -128,26 +128,42 @@ def cmd_show(args) -> int:
     return 0
 
 
-def _floating_q(robot, q: list[float]) -> list[float]:
-    """A floating robot's ``--q``: its joints alone (the base at the origin, unturned) or its
-    whole configuration, whose quaternion, typed to a few digits, is normalised when within
-    1e-4 of unit length (said on stderr); further off it is refused."""
+def _configuration_q(robot, q: list[float]) -> list[float]:
+    """``--q`` of a robot whose configuration holds quaternions (a floating base, spherical or
+    floating joints) or a planar joint's (cos, sin): a floating robot's joints alone (the base
+    at the origin, unturned) or its whole configuration. A quaternion or pair typed to a few
+    digits is normalised when within 1e-4 of unit length (said on stderr); further off it is
+    refused, naming it."""
     from .configuration import neutral
 
-    dof = robot.dof
-    if len(q) == dof:
-        return [*neutral(robot)[:7], *q]
-    if len(q) != dof + 7:
+    joints = robot.nq - 7 if robot.floating else robot.nq
+    if robot.floating and len(q) == joints:
+        q = [*neutral(robot)[:7], *q]
+    if len(q) != robot.nq:
+        if robot.floating:
+            raise ValueError(
+                f"--q: {len(q)} values for a floating robot with {len(robot.movable_joints)} joints: give the "
+                f"{joints} joint coordinates, or {robot.nq} (base position, quaternion x y z w, joints)"
+            )
         raise ValueError(
-            f"--q: {len(q)} values for a floating robot with {dof} joints: give the {dof} joints, or "
-            f"{dof + 7} (base position, quaternion x y z w, joints)"
+            f"--q: {len(q)} values for '{robot.name}': give {robot.nq} (quaternions x y z w, planar x y cos sin)"
         )
-    norm = sum(x * x for x in q[3:7]) ** 0.5
-    if abs(norm - 1.0) > 1e-4:
-        raise ValueError(f"--q: the base quaternion {q[3:7]} has length {norm:.6g}, not 1")
-    if norm != 1.0:
-        print(f"note: the base quaternion normalised (its length was {norm:.9g})", file=sys.stderr)
-    return [*q[:3], *(x / norm for x in q[3:7]), *q[7:]]
+    blocks = [("the base quaternion", 3, 4)] if robot.floating else []
+    at = {"spherical": (0, 4), "floating": (3, 4), "planar": (2, 2)}
+    for name, kind, iq, _ in robot.configuration_layout:
+        if kind in at:
+            what = "(cos, sin)" if kind == "planar" else "quaternion"
+            blocks.append((f"joint '{name}''s {what}", iq + at[kind][0], at[kind][1]))
+    q = list(q)
+    for what, start, n in blocks:
+        part = q[start : start + n]
+        norm = sum(x * x for x in part) ** 0.5
+        if abs(norm - 1.0) > 1e-4:
+            raise ValueError(f"--q: {what} {part} has length {norm:.6g}, not 1")
+        if norm != 1.0:
+            print(f"note: {what} normalised (its length was {norm:.9g})", file=sys.stderr)
+            q[start : start + n] = [x / norm for x in part]
+    return q
 
 
 def cmd_grade(args) -> int:

@@ -30,11 +30,12 @@ import sympy as sp
 
 from .errors import ModelError
 from .model import Robot
-from .model.joints import MULTI_DOF
 
 __all__ = ["show", "table", "frame_poses", "numeric_robot", "draw_on", "animate"]
 
-AXIS_COLOURS = {"revolute": "tab:orange", "prismatic": "tab:purple", "spherical": "tab:green"}
+AXIS_COLOURS = {"revolute": "tab:orange", "prismatic": "tab:purple"}
+#: joints of several coordinates have no axis: a ring at the joint instead
+JOINT_MARKS = {"spherical": "tab:green", "planar": "tab:cyan", "floating": "tab:gray"}
 
 
 # ----------------------------------------------------------------- kinematics
@@ -55,24 +56,27 @@ def numeric_robot(robot: Robot) -> Robot:
 
 
 def joint_values(robot: Robot, q) -> np.ndarray:
-    """``q`` as a float array of the joints' configuration (a floating robot's ``q[7:]``;
-    Pinocchio's layout, :attr:`Robot.configuration_layout`: one value per revolute or
-    prismatic joint, a joint of several coordinates its block), finite, every quaternion
-    and (cos, sin) pair of unit length; the joints' neutral configuration for None. Else
-    a ValueError."""
-    from .configuration import check_configuration, neutral
-
+    """The joints' configuration (a floating base's left out: drawn in the base frame) as a
+    float array of finite values (None: zeros, or the neutral configuration of joints of
+    several coordinates), else a ValueError. A floating robot's whole ``q`` is taken too."""
     base = 7 if robot.floating else 0
     if q is None:
-        return neutral(robot)[base:]
-    width = robot.nq - base
+        if robot.multi_dof_joints:
+            from .configuration import neutral
+
+            return neutral(robot)[base:]
+        return np.zeros(robot.dof)
     q = np.asarray(q, dtype=float).reshape(-1)
-    if q.shape != (width,):
-        blocks = "; a joint of several coordinates its configuration block" if robot.multi_dof_joints else ""
-        raise ValueError(f"q must have {width} values (one per movable joint{blocks}), got {q.size}")
+    if base and q.shape == (robot.nq,):
+        q = q[base:]
+    if q.shape != (robot.nq - base,):
+        each = "one per movable joint" if robot.nq - base == robot.dof else "quaternions x y z w, planar x y cos sin"
+        raise ValueError(f"q must have {robot.nq - base} values ({each}), got {q.size}")
     if not np.all(np.isfinite(q)):
         raise ValueError("q contains NaN or inf")
-    if robot.multi_dof_joints:  # unit quaternions and (cos, sin) pairs, naming the joint
+    if robot.multi_dof_joints:  # a quaternion or (cos, sin) pair off unit length: refused, naming the joint
+        from .configuration import check_configuration, neutral
+
         check_configuration(robot, np.concatenate([neutral(robot)[:base], q]))
     return q
 
@@ -83,26 +87,26 @@ def as_floats(m: sp.Matrix) -> np.ndarray:
 
 
 def frame_poses(robot: Robot, q=None) -> dict[str, np.ndarray]:
-    """Pose of every link frame in the base frame at the joints' configuration ``q``
-    (:func:`joint_values`): dict link name ->
+    """Pose of every link frame in the base frame at ``q`` (dof,): dict link name ->
     (4, 4) homogeneous transform, base first, then in joint (tree) order.
 
     ``robot`` must be numeric (see :func:`numeric_robot`). Each pose is the parent's
     pose times the joint's ``Joint.transform(q_i)``.
     """
     q = joint_values(robot, q)
-    bq, bv = (7, 6) if robot.floating else (0, 0)  # the layout counts a floating base's q and v first
-    layout = robot.configuration_layout
-    blocks = {name: (iq - bq, iq - bq + MULTI_DOF[kind][0]) for name, kind, iq, _ in layout if kind in MULTI_DOF}
-    at = {iv - bv: iq - bq for _, kind, iq, iv in layout if kind not in MULTI_DOF}  # a coordinate's place in q
     poses = {robot.base: np.eye(4)}
+    # each joint's place in q: its velocity coordinate's index -> its configuration block
+    base = (7, 6) if robot.floating else (0, 0)
+    block = {iv - base[1]: (iq - base[0], kind) for _, kind, iq, iv in robot.configuration_layout}
     for joint in robot.joints:
         f = robot.follows(joint)  # (coordinate, multiplier, offset); mimic joints follow a leader
-        if joint.name in blocks:  # a joint of several coordinates: its block of q
-            start, end = blocks[joint.name]
-            R, p = joint.transform([float(x) for x in q[start:end]])
+        if f is None:
+            R, p = joint.transform(0)
+        elif joint.nq > 1:
+            iq, _ = block[f[0]]
+            R, p = joint.transform(q[iq : iq + joint.nq].tolist())
         else:
-            R, p = joint.transform(0 if f is None else float(f[1]) * q[at[f[0]]] + float(f[2]))
+            R, p = joint.transform(float(f[1]) * q[block[f[0]][0]] + float(f[2]))
         local = np.eye(4)
         local[:3, :3], local[:3, 3] = as_floats(R), as_floats(p).reshape(3)
         poses[joint.child] = poses[joint.parent] @ local
@@ -158,7 +162,7 @@ def table(robot: Robot) -> str:
             limits = f"[{bounds[0]}, {bounds[1]}]"
         else:
             limits = ""
-        axis = _vec(j.axis) if j.movable and j.type not in MULTI_DOF else ""  # a ball or planar joint has none
+        axis = _vec(j.axis) if j.movable and j.nv == 1 else ""  # a ball or planar joint has none
         rows.append([j.name, j.type, j.parent, j.child, _vec(j.xyz), angles, axis, limits])
     lines += ["", "joints"] + _rows(["name", "type", "parent", "child", "xyz", "rpy", "axis", "limits"], rows)
     for j in robot.mimic_joints:  # no coordinate of their own: say whom they follow
@@ -320,13 +324,11 @@ def draw_on(ax, robot: Robot, poses: dict[str, np.ndarray], title: str, view: tu
 
     labels = []
     for j in robot.movable_joints:
-        if j.nv > 1:  # no axis: a ball at the joint's centre (the placement frame's origin)
-            Tp = poses[j.parent]
-            centre = Tp[:3, :3] @ as_floats(j.xyz).reshape(3) + Tp[:3, 3]
-            ax.scatter(*centre, color=AXIS_COLOURS["spherical"], s=90, depthshade=False)
-            labels.append((j.name, centre, AXIS_COLOURS["spherical"]))
-            continue
         T = poses[j.child]
+        if j.type in JOINT_MARKS:
+            ax.scatter(*T[:3, 3], s=140, facecolors="none", edgecolors=JOINT_MARKS[j.type], linewidths=2.5)
+            labels.append((f"{j.name} ({j.type})", T[:3, 3] + 0.5 * arrow * T[:3, 2], JOINT_MARKS[j.type]))
+            continue
         axis = T[:3, :3] @ as_floats(j.axis).reshape(3)
         ax.quiver(*T[:3, 3], *(arrow * axis), color=AXIS_COLOURS[j.type], linewidth=2.5, arrow_length_ratio=0.3)
         labels.append((j.name, T[:3, 3] + arrow * axis, AXIS_COLOURS[j.type]))
@@ -403,7 +405,7 @@ def animate(
     if not isinstance(robot, Robot):
         robot = load(robot)
     robot = numeric_robot(robot)
-    width = robot.nq if not robot.floating else robot.dof  # a joint of several coordinates: its block of q
+    width = robot.dof if robot.floating else robot.nq  # a joint of several coordinates: its block of q
     q = np.asarray(q, dtype=float)
     if q.ndim != 2 or q.shape[1] != width or len(q) == 0:
         raise ValueError(f"q: shape {q.shape}, expected (frames, {width}) with at least one frame")

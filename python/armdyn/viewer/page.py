@@ -180,16 +180,16 @@ def _link_poses(robot: Robot, Q: np.ndarray) -> np.ndarray:
 
 
 def _configurations(robot: Robot, Q) -> np.ndarray:
-    """``Q`` (N, nq) as finite floats, every quaternion (a floating base's, a joint's) and
-    planar (cos, sin) pair checked unit."""
+    """``Q`` (N, nq) as finite floats; a floating base's quaternions checked unit."""
     Q = np.asarray(Q, dtype=float)
     if Q.ndim != 2 or Q.shape[1] != robot.nq or len(Q) == 0:
         raise ValueError(f"Q: shape {Q.shape}, expected (frames, {robot.nq}) with at least one frame")
     if not np.all(np.isfinite(Q)):
         raise ValueError("times or Q contain NaN or inf")
-    from ..configuration import check_configuration
+    if robot.floating or robot.multi_dof_joints:
+        from ..configuration import difference
 
-    check_configuration(robot, Q)  # refuses a quaternion off unit length, naming the joint
+        difference(robot, Q, Q)  # refuses a quaternion off unit length, naming it
     return Q
 
 
@@ -251,15 +251,15 @@ def _scene(robot: Robot, times, Q, frames: bool, markers: bool | None, package_d
 
 
 def view(robot, q=None, *, frames: bool = False, markers: bool | None = None, package_dirs=()) -> View:
-    """The arm ``robot`` (a :class:`Robot`, model file or bundled name) at ``q`` (nq,:
-    one value per revolute or prismatic joint, a joint of several coordinates its block,
-    a floating robot's base first; default the neutral configuration). ``frames``: draw each link frame's axes; ``markers``: joint
+    """The arm ``robot`` (a :class:`Robot`, model file or bundled name) at ``q`` (dof,)
+    (default zeros; a floating robot's ``q`` is (nq,), default its neutral
+    configuration). ``frames``: draw each link frame's axes; ``markers``: joint
     cylinders and mass spheres (default: only when the model has no visual geometry);
     ``package_dirs``: folders where ``package://`` meshes are looked up."""
     from ..show import joint_values
 
     robot = _coerce(robot)
-    if robot.floating:
+    if robot.floating or robot.multi_dof_joints:
         from ..configuration import neutral
 
         q = _configurations(robot, [neutral(robot) if q is None else np.asarray(q, dtype=float).reshape(-1)])[0]
