@@ -1,92 +1,105 @@
-//! Dual numbers `re + du ε` (`ε² = 0`): the algorithms, generic over [`Real`], run on
-//! them to give exact first derivatives along one direction (forward-mode automatic
-//! differentiation) where no analytical derivative is written yet: the joints of
-//! several coordinates (`algo/tangent_derivatives.rs`). Each operation carries the
-//! derivative by the chain rule, so the result's `du` is the directional derivative to
-//! rounding, not a finite difference.
+//! Dual numbers `re + sum_k du_k ε_k` (`ε_j ε_k = 0`): the algorithms, generic over
+//! [`Real`], run on them to give exact first derivatives along `N` directions at once
+//! (forward-mode automatic differentiation) where no analytical derivative is written
+//! yet: the joints of several coordinates (`algo/tangent_derivatives.rs`). Each operation
+//! carries the derivatives by the chain rule, so `du[k]` is the derivative along
+//! direction `k` to rounding, not a finite difference; the value is computed once for
+//! all `N` (loops over `du` that LLVM vectorises).
 
 use crate::real::{sin_cos, Real};
 use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 
-/// `re + du ε`.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Dual {
+/// `re + sum_k du[k] ε_k`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Dual<const N: usize> {
     pub re: f64,
-    pub du: f64,
+    pub du: [f64; N],
 }
 
-impl Dual {
-    pub fn new(re: f64, du: f64) -> Self {
-        Dual { re, du }
+impl<const N: usize> Default for Dual<N> {
+    fn default() -> Self {
+        Dual { re: 0.0, du: [0.0; N] }
     }
 }
 
-impl Add for Dual {
-    type Output = Dual;
+impl<const N: usize> Dual<N> {
+    /// A constant: every derivative zero.
     #[inline(always)]
-    fn add(self, o: Dual) -> Dual {
-        Dual::new(self.re + o.re, self.du + o.du)
+    pub fn constant(re: f64) -> Self {
+        Dual { re, du: [0.0; N] }
+    }
+    #[inline(always)]
+    fn map(self, re: f64, f: impl Fn(f64) -> f64) -> Self {
+        Dual { re, du: self.du.map(f) }
     }
 }
-impl Sub for Dual {
-    type Output = Dual;
+
+impl<const N: usize> Add for Dual<N> {
+    type Output = Self;
     #[inline(always)]
-    fn sub(self, o: Dual) -> Dual {
-        Dual::new(self.re - o.re, self.du - o.du)
+    fn add(self, o: Self) -> Self {
+        Dual { re: self.re + o.re, du: std::array::from_fn(|k| self.du[k] + o.du[k]) }
     }
 }
-impl Mul for Dual {
-    type Output = Dual;
+impl<const N: usize> Sub for Dual<N> {
+    type Output = Self;
     #[inline(always)]
-    fn mul(self, o: Dual) -> Dual {
-        Dual::new(self.re * o.re, self.du * o.re + self.re * o.du)
+    fn sub(self, o: Self) -> Self {
+        Dual { re: self.re - o.re, du: std::array::from_fn(|k| self.du[k] - o.du[k]) }
     }
 }
-impl Div for Dual {
-    type Output = Dual;
+impl<const N: usize> Mul for Dual<N> {
+    type Output = Self;
     #[inline(always)]
-    fn div(self, o: Dual) -> Dual {
+    fn mul(self, o: Self) -> Self {
+        Dual { re: self.re * o.re, du: std::array::from_fn(|k| self.du[k] * o.re + self.re * o.du[k]) }
+    }
+}
+impl<const N: usize> Div for Dual<N> {
+    type Output = Self;
+    #[inline(always)]
+    fn div(self, o: Self) -> Self {
         let q = self.re / o.re;
-        Dual::new(q, (self.du - q * o.du) / o.re)
+        Dual { re: q, du: std::array::from_fn(|k| (self.du[k] - q * o.du[k]) / o.re) }
     }
 }
-impl Neg for Dual {
-    type Output = Dual;
+impl<const N: usize> Neg for Dual<N> {
+    type Output = Self;
     #[inline(always)]
-    fn neg(self) -> Dual {
-        Dual::new(-self.re, -self.du)
+    fn neg(self) -> Self {
+        self.map(-self.re, |d| -d)
     }
 }
-impl AddAssign for Dual {
+impl<const N: usize> AddAssign for Dual<N> {
     #[inline(always)]
-    fn add_assign(&mut self, o: Dual) {
+    fn add_assign(&mut self, o: Self) {
         *self = *self + o;
     }
 }
-impl SubAssign for Dual {
+impl<const N: usize> SubAssign for Dual<N> {
     #[inline(always)]
-    fn sub_assign(&mut self, o: Dual) {
+    fn sub_assign(&mut self, o: Self) {
         *self = *self - o;
     }
 }
-impl MulAssign for Dual {
+impl<const N: usize> MulAssign for Dual<N> {
     #[inline(always)]
-    fn mul_assign(&mut self, o: Dual) {
+    fn mul_assign(&mut self, o: Self) {
         *self = *self * o;
     }
 }
 
-impl Real for Dual {
-    /// One state: the lanes are the value (the derivative travels alongside).
+impl<const N: usize> Real for Dual<N> {
+    /// One state: the lanes are the value (the derivatives travel alongside).
     const LANES: usize = 1;
     #[inline(always)]
     fn splat(x: f64) -> Self {
-        Dual::new(x, 0.0)
+        Dual::constant(x)
     }
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
         let (s, c) = sin_cos(self.re);
-        (Dual::new(s, c * self.du), Dual::new(c, -s * self.du))
+        (self.map(s, |d| c * d), self.map(c, |d| -s * d))
     }
     #[inline(always)]
     fn lane(self, _k: usize) -> f64 {
@@ -94,12 +107,12 @@ impl Real for Dual {
     }
     #[inline(always)]
     fn set_lane(&mut self, _k: usize, x: f64) {
-        *self = Dual::new(x, 0.0);
+        *self = Dual::constant(x);
     }
     /// Coulomb friction's sign: constant away from 0, so its derivative is 0 (as the
     /// analytical derivatives take it).
     #[inline(always)]
     fn sign0(self) -> Self {
-        Dual::new(f64::sign0(self.re), 0.0)
+        Dual::constant(f64::sign0(self.re))
     }
 }

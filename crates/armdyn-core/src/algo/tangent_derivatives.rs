@@ -1,10 +1,11 @@
 //! The derivatives of the RNEA and the ABA on the tangent space for models with joints
 //! of several coordinates (`joint_multi.rs`), fixed or floating base, by forward-mode
-//! automatic differentiation: the RNEA runs on [`Dual`] numbers once per velocity
-//! coordinate for `d tau / dq` (the configuration moved along the tangent direction,
-//! `q ⊕ ε e_m`, as Pinocchio's `integrate`) and once per coordinate for `d tau / dv`.
-//! The results are exact to rounding, as the analytical derivatives of the 1-dof
-//! algorithms (`rnea_derivatives.rs`), at `2 nv` RNEA passes instead of one sweep.
+//! automatic differentiation: the RNEA runs on [`Dual`] numbers carrying [`DIRECTIONS`]
+//! directions at a time, the velocity coordinates' for `d tau / dq` (the configuration
+//! moved along the tangent direction, `q ⊕ ε e_m`, as Pinocchio's `integrate`), then for
+//! `d tau / dv`. The results are exact to rounding, as the analytical derivatives of the
+//! 1-dof algorithms (`rnea_derivatives.rs`), at `2 nv / DIRECTIONS` dual-number passes
+//! instead of one sweep.
 //!
 //! The ABA's follow from the RNEA's at `a = aba(q, v, tau)`:
 //! `da/dq = -M^-1 dtau/dq`, `da/dv = -M^-1 dtau/dv` (differentiate `M a + h = tau`).
@@ -21,16 +22,20 @@ use crate::joint_multi::MultiKind;
 use crate::model::Model;
 use crate::spatial::V3;
 
+/// Directions carried by one dual-number pass.
+pub const DIRECTIONS: usize = 8;
+type D = Dual<DIRECTIONS>;
+
 /// The workspaces of one derivative call: dual-number RNEA, the f64 CRBA / M^-1, and
 /// the argument buffers. Allocated once per thread.
 pub struct TangentWork {
-    data: Data<Dual>,
+    data: Data<D>,
     data64: Data<f64>,
     deriv: DerivData<f64>,
-    q: Vec<Dual>,
-    v: Vec<Dual>,
-    a: Vec<Dual>,
-    tau: Vec<Dual>,
+    q: Vec<D>,
+    v: Vec<D>,
+    a: Vec<D>,
+    tau: Vec<D>,
     acc: Vec<f64>,
     product: Vec<f64>,
 }
@@ -42,10 +47,10 @@ impl TangentWork {
             data: Data::new(model),
             data64: Data::new(model),
             deriv: DerivData::new(model),
-            q: vec![Dual::default(); nq],
-            v: vec![Dual::default(); nv],
-            a: vec![Dual::default(); nv],
-            tau: vec![Dual::default(); nv],
+            q: vec![D::default(); nq],
+            v: vec![D::default(); nv],
+            a: vec![D::default(); nv],
+            tau: vec![D::default(); nv],
             acc: vec![0.0; nv],
             product: vec![0.0; nv * nv],
         }
@@ -62,56 +67,54 @@ pub fn widths(model: &Model, floating: bool) -> (usize, usize) {
 }
 
 /// `d quat` for the unit quaternion `x, y, z, w` at `q[0..4]` turned by `ε e_k` in its
-/// own frame: `1/2 quat ⊗ (e_k, 0)`.
-fn quaternion_turn(q: &[f64], k: usize, out: &mut [Dual]) {
+/// own frame, `1/2 quat ⊗ (e_k, 0)`, into direction `lane` of `out`.
+fn quaternion_turn(q: &[f64], k: usize, out: &mut [D], lane: usize) {
     let (qv, w) = (V3::new(q[0], q[1], q[2]), q[3]);
     let mut e = [0.0; 3];
     e[k] = 1.0;
     let e = V3::from_array(e);
     let dv = (e.scale(w) + qv.cross(e)).scale(0.5);
     for (o, d) in out.iter_mut().zip(dv.to_array().into_iter().chain([-0.5 * qv.dot(e)])) {
-        o.du = d;
+        o.du[lane] = d;
     }
 }
 
 /// `ε`-move of the origin at `p` (3) by `ε R(quat) e_k`: a free body's translation
-/// along its own axis `k`.
-fn slide(quat: &[f64], k: usize, out: &mut [Dual]) {
+/// along its own axis `k`, into direction `lane` of `out`.
+fn slide(quat: &[f64], k: usize, out: &mut [D], lane: usize) {
     let r = quaternion_rotation(quat[0], quat[1], quat[2], quat[3]);
     for (o, d) in out.iter_mut().zip(r.col(k).to_array()) {
-        o.du = d;
+        o.du[lane] = d;
     }
 }
 
-/// `out = q ⊕ ε e_m`: the configuration moved (to first order, exactly in dual numbers)
-/// along velocity coordinate `m`, as Pinocchio's `integrate(q, ε e_m)`.
-pub fn tangent_direction(model: &Model, floating: bool, q: &[f64], m: usize, out: &mut [Dual]) {
-    for (o, &x) in out.iter_mut().zip(q) {
-        *o = Dual::new(x, 0.0);
-    }
+/// Direction `lane` of `out` (holding `q`'s values) set to `d q / dε` for `q ⊕ ε e_m`:
+/// the configuration moved along velocity coordinate `m`, as Pinocchio's
+/// `integrate(q, ε e_m)`, to first order (exactly, in dual numbers).
+pub fn tangent_direction(model: &Model, floating: bool, q: &[f64], m: usize, out: &mut [D], lane: usize) {
     let (qb, vb) = if floating { (NQ_BASE, NV_BASE) } else { (0, 0) };
     if m < vb {
         match m {
-            0..=2 => slide(&q[3..7], m, &mut out[0..3]),
-            _ => quaternion_turn(&q[3..7], m - 3, &mut out[3..7]),
+            0..=2 => slide(&q[3..7], m, &mut out[0..3], lane),
+            _ => quaternion_turn(&q[3..7], m - 3, &mut out[3..7], lane),
         }
         return;
     }
     let b = m - vb;
     let Some(j) = model.multi.iter().rev().find(|j| j.body <= b) else {
-        out[qb + model.idx_q[b]].du = 1.0;
+        out[qb + model.idx_q[b]].du[lane] = 1.0;
         return;
     };
     let part = b - j.body;
     if part >= j.kind.parts().len() {
-        out[qb + model.idx_q[b]].du = 1.0; // a 1-dof body after the joint
+        out[qb + model.idx_q[b]].du[lane] = 1.0; // a 1-dof body after the joint
         return;
     }
     let at = qb + j.idx_q;
     match j.kind {
-        MultiKind::Spherical => quaternion_turn(&q[at..at + 4], part, &mut out[at..at + 4]),
-        MultiKind::Free if part < 3 => slide(&q[at + 3..at + 7], part, &mut out[at..at + 3]),
-        MultiKind::Free => quaternion_turn(&q[at + 3..at + 7], part - 3, &mut out[at + 3..at + 7]),
+        MultiKind::Spherical => quaternion_turn(&q[at..at + 4], part, &mut out[at..at + 4], lane),
+        MultiKind::Free if part < 3 => slide(&q[at + 3..at + 7], part, &mut out[at..at + 3], lane),
+        MultiKind::Free => quaternion_turn(&q[at + 3..at + 7], part - 3, &mut out[at + 3..at + 7], lane),
         MultiKind::Planar => {
             let (c, s) = (q[at + 2], q[at + 3]);
             let d = match part {
@@ -120,7 +123,7 @@ pub fn tangent_direction(model: &Model, floating: bool, q: &[f64], m: usize, out
                 _ => [0.0, 0.0, -s, c],
             };
             for (o, d) in out[at..at + 4].iter_mut().zip(d) {
-                o.du = d;
+                o.du[lane] = d;
             }
         }
     }
@@ -134,26 +137,38 @@ fn rnea_dual(model: &Model, floating: bool, w: &mut TangentWork) {
     }
 }
 
-/// `dtau/dq` and `dtau/dv` (nv, nv) at `(q, v, a)`, column by column.
+/// `dtau/dq` and `dtau/dv` (nv, nv) at `(q, v, a)`, [`DIRECTIONS`] columns per pass.
+#[allow(clippy::too_many_arguments)]
 fn rnea_partials(model: &Model, floating: bool, w: &mut TangentWork, q: &[f64], v: &[f64], a: &[f64], dq: &mut [f64], dv: &mut [f64]) {
     let (_, nv) = widths(model, floating);
-    let plain = |x: &[f64], out: &mut [Dual]| out.iter_mut().zip(x).for_each(|(o, &x)| *o = Dual::new(x, 0.0));
-    plain(a, &mut w.a);
-    plain(v, &mut w.v);
-    for m in 0..nv {
-        tangent_direction(model, floating, q, m, &mut w.q);
+    let constant = |x: &[f64], out: &mut [D]| out.iter_mut().zip(x).for_each(|(o, &x)| *o = D::constant(x));
+    constant(a, &mut w.a);
+    constant(v, &mut w.v);
+    for first in (0..nv).step_by(DIRECTIONS) {
+        let columns = first..nv.min(first + DIRECTIONS);
+        constant(q, &mut w.q);
+        for (lane, m) in columns.clone().enumerate() {
+            tangent_direction(model, floating, q, m, &mut w.q, lane);
+        }
         rnea_dual(model, floating, w);
-        for r in 0..nv {
-            dq[r * nv + m] = w.tau[r].du;
+        for (lane, m) in columns.enumerate() {
+            for r in 0..nv {
+                dq[r * nv + m] = w.tau[r].du[lane];
+            }
         }
     }
-    plain(q, &mut w.q);
-    for m in 0..nv {
-        w.v[m].du = 1.0;
+    constant(q, &mut w.q);
+    for first in (0..nv).step_by(DIRECTIONS) {
+        let columns = first..nv.min(first + DIRECTIONS);
+        constant(v, &mut w.v);
+        for (lane, m) in columns.clone().enumerate() {
+            w.v[m].du[lane] = 1.0;
+        }
         rnea_dual(model, floating, w);
-        w.v[m].du = 0.0;
-        for r in 0..nv {
-            dv[r * nv + m] = w.tau[r].du;
+        for (lane, m) in columns.enumerate() {
+            for r in 0..nv {
+                dv[r * nv + m] = w.tau[r].du[lane];
+            }
         }
     }
 }
