@@ -48,10 +48,11 @@ def cmd_derive(args) -> int:
 
     robot = _load(args.robot, args.allow_nonphysical, args.strict, args.trust_xacro, args.root_joint)
     methods = ["newton-euler", "lagrange"] if args.method == "both" else [args.method]
-    if robot.floating and args.method == "both":
+    if (robot.floating or robot.multi_dof_joints) and args.method == "both":
         methods = ["newton-euler"]
+        what = "a floating base" if robot.floating else f"a {robot.multi_dof_joints[0].type} joint"
         print(
-            "armdyn derive: a floating base is derived by Newton-Euler only (no Lagrange, no agreement check)",
+            f"armdyn derive: {what} is derived by Newton-Euler only (no Lagrange, no agreement check)",
             file=sys.stderr,
         )
     eoms = []

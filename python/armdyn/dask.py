@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from .numeric import check_threads, compiled_model, core_model, require_fixed_base
+from .numeric.checks import require_one_dof_joints
 
 __all__ = ["rnea", "aba", "crba", "simulate", "rnea_derivatives", "aba_derivatives", "minverse", "gravity_derivatives"]
 
@@ -69,6 +70,7 @@ def rnea(robot, q, qd, qdd, *, chunks=None, threads=1):
     """Lazy inverse dynamics ``tau = M qdd + C qd + g``: (N, dof) Dask arrays in and out.
     NumPy inputs are wrapped with ``chunks`` rows per block (default: Dask's "auto")."""
     require_fixed_base(robot, "armdyn.dask.rnea")
+    require_one_dof_joints(robot, "armdyn.dask.rnea")
     model = compiled_model(robot)
     threads = check_threads(threads)  # Rust reads True as 1
     q, qd, qdd = _arrays(model.dof, chunks, q, qd, qdd)
@@ -78,6 +80,7 @@ def rnea(robot, q, qd, qdd, *, chunks=None, threads=1):
 def aba(robot, q, qd, tau, *, chunks=None, threads=1):
     """Lazy forward dynamics ``qdd = M^-1 (tau - C qd - g)``: (N, dof) in and out."""
     require_fixed_base(robot, "armdyn.dask.aba")
+    require_one_dof_joints(robot, "armdyn.dask.aba")
     model = compiled_model(robot)
     threads = check_threads(threads)  # Rust reads True as 1
     q, qd, tau = _arrays(model.dof, chunks, q, qd, tau)
@@ -87,6 +90,7 @@ def aba(robot, q, qd, tau, *, chunks=None, threads=1):
 def crba(robot, q, *, chunks=None, threads=1):
     """Lazy joint-space inertia matrices: q (N, dof) -> M (N, dof, dof)."""
     require_fixed_base(robot, "armdyn.dask.crba")
+    require_one_dof_joints(robot, "armdyn.dask.crba")
     model = compiled_model(robot)
     threads = check_threads(threads)  # Rust reads True as 1
     (q,) = _arrays(model.dof, chunks, q)
@@ -149,6 +153,7 @@ def simulate(
     from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
     require_fixed_base(robot, "armdyn.dask.simulate")
+    require_one_dof_joints(robot, "armdyn.dask.simulate")
     model = compiled_model(robot)
     threads = check_threads(threads)  # Rust reads True as 1
     dof = model.dof

@@ -226,6 +226,7 @@ def regressor(robot: Robot) -> Regressor:
     link's frame on its joint (:meth:`armdyn.model.Robot.canonical`: the same as the
     link frame unless the model places a link frame off its joint's axis)."""
     robot.require_fixed_base("armdyn.identification.regressor")
+    robot.require_one_dof_joints("armdyn.identification.regressor")
     robot = robot.canonical()
     names, values = standard_parameters(robot)
     n = robot.dof
@@ -429,6 +430,7 @@ def base_parameters(robot: Robot, seed: int = 0) -> BaseParameters:
     random geometries (not met on the bundled arms; bind the geometry then).
     """
     robot.require_fixed_base("armdyn.identification.base_parameters")
+    robot.require_one_dof_joints("armdyn.identification.base_parameters")
     robot = rationalized(robot.canonical())  # parameters about the frames on the joints
     reg = regressor(robot)
     Y = reg.Y

@@ -100,6 +100,7 @@ def tree_of(robot: Robot) -> Tree:
     """Convert (once per robot) to arrays; refuse a robot with free symbols."""
     if robot in _trees:
         return _trees[robot]
+    robot.require_one_dof_joints("armdyn.reference (the NumPy oracle)")
     free = robot.free_symbols()
     if free:
         names = ", ".join(sorted(str(s) for s in free))

@@ -74,6 +74,10 @@ def joint_values(robot: Robot, q) -> np.ndarray:
         raise ValueError(f"q must have {robot.nq - base} values ({each}), got {q.size}")
     if not np.all(np.isfinite(q)):
         raise ValueError("q contains NaN or inf")
+    if robot.multi_dof_joints:  # a quaternion or (cos, sin) pair off unit length: refused, naming the joint
+        from .configuration import check_configuration, neutral
+
+        check_configuration(robot, np.concatenate([neutral(robot)[:base], q]))
     return q
 
 
@@ -158,7 +162,7 @@ def table(robot: Robot) -> str:
             limits = f"[{bounds[0]}, {bounds[1]}]"
         else:
             limits = ""
-        axis = _vec(j.axis) if j.movable else ""
+        axis = _vec(j.axis) if j.movable and j.nv == 1 else ""  # a ball or planar joint has none
         rows.append([j.name, j.type, j.parent, j.child, _vec(j.xyz), angles, axis, limits])
     lines += ["", "joints"] + _rows(["name", "type", "parent", "child", "xyz", "rpy", "axis", "limits"], rows)
     for j in robot.mimic_joints:  # no coordinate of their own: say whom they follow
@@ -401,9 +405,10 @@ def animate(
     if not isinstance(robot, Robot):
         robot = load(robot)
     robot = numeric_robot(robot)
+    width = robot.dof if robot.floating else robot.nq  # a joint of several coordinates: its block of q
     q = np.asarray(q, dtype=float)
-    if q.ndim != 2 or q.shape[1] != robot.dof or len(q) == 0:
-        raise ValueError(f"q: shape {q.shape}, expected (frames, {robot.dof}) with at least one frame")
+    if q.ndim != 2 or q.shape[1] != width or len(q) == 0:
+        raise ValueError(f"q: shape {q.shape}, expected (frames, {width}) with at least one frame")
     if not np.all(np.isfinite(q)):
         raise ValueError("q contains NaN or inf")
     if not (np.isfinite(fps) and fps > 0):

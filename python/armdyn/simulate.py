@@ -78,23 +78,11 @@ import numpy as np
 
 from . import _core
 from .configuration import rotate_vector
-from .errors import ModelError
 from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy, require_fixed_base
+from .numeric.checks import require_one_dof_joints
 from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
 __all__ = ["simulate", "simulate_adaptive", "Trajectory", "PD", "ComputedTorque", "joint_limits"]
-
-
-def _require_one_dof_joints(robot, model, what: str) -> None:
-    """Raise naming ``what`` if the robot has joints of several coordinates (``q`` longer
-    than the velocity beyond a floating base's quaternion)."""
-    if hasattr(model, "nq") and model.nq - model.nv != (1 if model.floating else 0):
-        if hasattr(robot, "require_one_dof_joints"):
-            robot.require_one_dof_joints(what)
-        raise ModelError(
-            f"{what} handles revolute and prismatic joints only (yet); this robot has joints of several coordinates",
-            f"robot '{model.name}'",
-        )
 
 
 def _c(a):
@@ -247,7 +235,7 @@ def simulate(
     if floating and (controller is not None or callable(torque)):
         require_fixed_base(robot, "armdyn.simulate with a controller or a torque callable")
     if controller is not None or callable(torque):
-        _require_one_dof_joints(robot, model, "armdyn.simulate with a controller or a torque callable")
+        require_one_dof_joints(robot, "armdyn.simulate with a controller or a torque callable")
     empty = np.zeros(0)
     args = dict(torque=empty, kp=empty, kd=empty, target=empty, target_qd=empty)
     if callable(torque):
@@ -531,8 +519,8 @@ def simulate_adaptive(
     from scipy.integrate import solve_ivp
 
     require_fixed_base(robot, "armdyn.simulate_adaptive")
+    require_one_dof_joints(robot, "armdyn.simulate_adaptive")
     model = compiled_model(robot)
-    _require_one_dof_joints(robot, model, "armdyn.simulate_adaptive")
     dof = model.dof
     q0 = _state(q0, "q0", dof)
     qd0 = np.zeros(dof) if qd0 is None else _state(qd0, "qd0", dof)

@@ -100,8 +100,8 @@ def run(args, robot) -> int:
 
     robot = numeric_robot(robot)
     dof = robot.dof
-    if robot.floating:
-        q0, qd0 = floating_start(robot, args)
+    if robot.floating or robot.multi_dof_joints:
+        q0, qd0 = manifold_start(robot, args)
     else:
         q0 = np.broadcast_to(_numbers(args.q0, "--q0", dof) or [0.0], (dof,))
         qd0 = np.broadcast_to(_numbers(args.qd0, "--qd0", dof) or [0.0], (dof,))
@@ -112,6 +112,7 @@ def run(args, robot) -> int:
         )
     controller = None
     if args.controller is not None:
+        robot.require_one_dof_joints("armdyn simulate --controller")  # its target and gains: one per joint
         if args.target is None:
             raise ValueError(f"--controller {args.controller} needs --target (joint values)")
         target = np.broadcast_to(_numbers(args.target, "--target", dof), (dof,))
@@ -220,30 +221,34 @@ def run(args, robot) -> int:
     return 0
 
 
-def floating_start(robot, args) -> tuple[np.ndarray, np.ndarray]:
-    """``(q0, qd0)`` of a floating robot: ``--q0`` gives the joints (1 or dof values; the
-    base at the pose an MJCF file wrote, else at the origin) or the whole q (7 + dof:
-    position, quaternion x y z w, joints); ``--qd0`` the joints (the base at rest) or the
-    whole v (6 + dof: base linear and angular velocity in the base frame, joints)."""
-    from .configuration import neutral
+def manifold_start(robot, args) -> tuple[np.ndarray, np.ndarray]:
+    """``(q0, qd0)`` of a robot whose configuration is not flat (a floating base, ball,
+    planar or floating joints), from its neutral configuration (a floating base at the
+    pose an MJCF file wrote, else at the origin). ``--q0`` gives the joints' configuration
+    (quaternions x y z w, planar x y cos sin; one value when every joint has one
+    coordinate) or, with a floating base, the whole q (position, quaternion x y z w,
+    joints); ``--qd0`` the joints' velocities (the base at rest) or the whole v. A
+    quaternion off unit length is refused, naming it."""
+    from .configuration import difference, neutral
 
     q0, qd0 = neutral(robot), np.zeros(robot.nv)
-    if robot.meta.get("base_pose"):  # MuJoCo's qpos0: position, quaternion w x y z
+    if robot.floating and robot.meta.get("base_pose"):  # MuJoCo's qpos0: position, quaternion w x y z
         position, (w, x, y, z) = robot.meta["base_pose"]
         q0[:7] = [*position, x, y, z, w]
-    for values, out, option, base in ((args.q0, q0, "--q0", 7), (args.qd0, qd0, "--qd0", 6)):
+    qb, vb = (7, 6) if robot.floating else (0, 0)
+    for values, out, option, base in ((args.q0, q0, "--q0", qb), (args.qd0, qd0, "--qd0", vb)):
         given = _numbers(values, option)
         if given is None:
             continue
-        if len(given) == robot.nv + base - 6:
+        joints = len(out) - base
+        if base and len(given) == len(out):
             out[:] = given
-        elif len(given) in (1, robot.dof):
+        elif len(given) == joints or (len(given) == 1 and (option == "--qd0" or robot.nq == robot.nv + qb - vb)):
             out[base:] = given
         else:
-            raise ValueError(
-                f"{option} needs 1 or {robot.dof} joint values, or {robot.nv + base - 6} for the floating base "
-                f"and the joints, got {len(given)}"
-            )
+            whole = f", or {len(out)} for the floating base and the joints" if base else ""
+            raise ValueError(f"{option} needs {joints} joint values{whole}, got {len(given)}")
+    difference(robot, q0, q0)  # refuses a quaternion off unit length, naming it
     return q0, qd0
 
 

@@ -65,6 +65,7 @@ class Slip:
 
 def solution_steps(robot: Robot) -> list[SolutionStep]:
     """Every step of both methods for ``robot`` (in the grader's order)."""
+    robot.require_one_dof_joints("armdyn's course (a worked solution)")
     from ..symbolic import derive
 
     ne = derive(robot, NE)

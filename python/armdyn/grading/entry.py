@@ -60,6 +60,8 @@ def grade(
                 raise
             return grade_without_model(sub, err.message)  # what the text's own values decide
         model = read_model.robot
+    # the grader's steps are those of revolute and prismatic joints (named as the model's)
+    model.require_one_dof_joints("armdyn.grade")
     if sub.values is not None:
         try:
             # the reader admits "published" or a mapping parameter -> number

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import FloatingBaseError
+from ..errors import FloatingBaseError, ModelError
 from ..model import Robot
 
 MAX_THREADS = 256
@@ -62,3 +62,20 @@ def fixed_base_threads(robot, threads, what: str):
     if getattr(robot, "floating", False):
         require_fixed_base(robot, f"armdyn.numeric.{what}")
     return threads if threads is None else check_threads(threads)
+
+
+def require_one_dof_joints(robot, what: str) -> None:
+    """Raise :class:`~armdyn.errors.ModelError` naming ``what`` if ``robot`` (a Robot or a
+    compiled model) has a joint of several coordinates (spherical, planar, floating): for
+    what handles revolute and prismatic joints only. A compiled model tells them by its
+    widths (each such joint has one configuration coordinate more than velocities)."""
+    if isinstance(robot, Robot):
+        robot.require_one_dof_joints(what)
+        return
+    nq, nv = getattr(robot, "nq", None), getattr(robot, "nv", None)
+    if isinstance(nq, int) and isinstance(nv, int) and nq - nv != (1 if getattr(robot, "floating", False) else 0):
+        raise ModelError(
+            f"{what} handles revolute and prismatic joints only (yet); this model has joints of several "
+            f"coordinates (nq {nq}, nv {nv})",
+            f"robot '{robot.name}'",
+        )

@@ -371,6 +371,7 @@ def codegen(robot: Robot | str, what=("tau", "M", "C", "g"), lang: str = "c", ba
     if not isinstance(robot, Robot):
         raise TypeError(f"codegen: expected an armdyn.Robot or a model name, got {type(robot).__name__}")
     robot.require_fixed_base("armdyn.codegen")
+    robot.require_one_dof_joints("armdyn.codegen")
     what = _parse_what(what)
     if lang not in LANGUAGES:
         raise ValueError(f"codegen: unknown language {lang!r}; choose from {', '.join(LANGUAGES)}")

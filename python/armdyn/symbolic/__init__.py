@@ -5,7 +5,8 @@ eom.tau, eom.M, eom.C, eom.g, eom.steps
 check(derive(robot), derive(robot, "lagrange")).text()
 
 A floating base (``root_joint="free-flyer"``): Newton-Euler only, parametrised by the
-base twist (newton_euler_floating.py); tau, M, g and bias have 6 + n rows.
+base twist (newton_euler_floating.py); tau, M, g and bias have 6 + n rows. A spherical
+joint: Newton-Euler only, by its angular velocity (newton_euler_spherical.py).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from .agreement import AgreementReport, check
 from .lagrange import lagrange
 from .newton_euler import newton_euler
 from .newton_euler_floating import FloatingEquationsOfMotion, newton_euler_floating
+from .newton_euler_spherical import SphericalEquationsOfMotion
 from .terms import EquationsOfMotion, Step
 
 METHODS = {"newton-euler": newton_euler, "lagrange": lagrange}
@@ -37,6 +39,10 @@ def derive(robot: Robot | str, method: str = "newton-euler") -> EquationsOfMotio
     :class:`FloatingEquationsOfMotion` whose qd, qdd, tau have 6 + n rows (base twist,
     joints: Pinocchio's order) and that carries ``bias`` instead of ``C``; "lagrange"
     raises :class:`~armdyn.errors.FloatingBaseError`.
+
+    Spherical joints: Newton-Euler by their angular velocity, a
+    :class:`SphericalEquationsOfMotion` (``bias`` instead of ``C``); "lagrange", and a
+    planar or floating joint, raise :class:`~armdyn.errors.ModelError` naming the joint.
     """
     if isinstance(robot, str):
         from ..io import load
@@ -60,6 +66,11 @@ def derive(robot: Robot | str, method: str = "newton-euler") -> EquationsOfMotio
 
 def prove_agreement(robot: Robot | str, **kwargs) -> AgreementReport:
     """Derive by both methods and :func:`check` that they agree (kwargs go to check)."""
+    if isinstance(robot, str):
+        from ..io import load
+
+        robot = load(robot)
+    robot.require_one_dof_joints("armdyn.prove_agreement (Newton-Euler against Lagrange)")
     return check(derive(robot, "newton-euler"), derive(robot, "lagrange"), **kwargs)
 
 
@@ -71,6 +82,7 @@ __all__ = [
     "lagrange",
     "EquationsOfMotion",
     "FloatingEquationsOfMotion",
+    "SphericalEquationsOfMotion",
     "Step",
     "AgreementReport",
     "METHODS",

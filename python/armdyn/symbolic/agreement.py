@@ -178,6 +178,7 @@ def check(
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
         raise ValueError(f"samples must be a positive integer (random points for numeric checks), got {samples!r}")
     robot = a.robot
+    robot.require_one_dof_joints("armdyn.check (Newton-Euler against Lagrange)")
     if robot.floating:
         from ..errors import FloatingBaseError
 

@@ -23,23 +23,28 @@ def _value(joint, name) -> sp.Expr:
     return sp.Integer(0) if value is None else value
 
 
+def _per_coordinate(robot: Robot, name: str) -> list:
+    """The joints' ``name`` value per velocity coordinate (a joint of several coordinates
+    carries none: 0 at each of its rows)."""
+    return [_value(j, name) for j in robot.movable_joints for _ in range(j.nv)]
+
+
 def armature(robot: Robot) -> sp.Matrix:
     """(n, 1) reflected rotor inertias ``Ia`` of the movable joints (0 where absent)."""
-    return sp.Matrix([_value(j, "armature") for j in robot.movable_joints])
+    return sp.Matrix(_per_coordinate(robot, "armature"))
 
 
 def friction_torques(robot: Robot, qd) -> sp.Matrix:
     """(n, 1) ``Fv qd + Fc sign(qd)`` per joint, for velocities ``qd`` (n,)."""
     out = []
-    for k, j in enumerate(robot.movable_joints):
-        fv, fc = _value(j, "damping"), _value(j, "friction")
+    for k, (fv, fc) in enumerate(zip(_per_coordinate(robot, "damping"), _per_coordinate(robot, "friction"))):
         out.append(fv * qd[k] + (fc * sp.sign(qd[k]) if fc != 0 else sp.Integer(0)))
     return sp.Matrix(out)
 
 
 def offsets(robot: Robot) -> sp.Matrix:
     """(n, 1) constant torque offsets (0 where absent)."""
-    return sp.Matrix([_value(j, "torque_offset") for j in robot.movable_joints])
+    return sp.Matrix(_per_coordinate(robot, "torque_offset"))
 
 
 def joint_torques(robot: Robot, qd, qdd) -> sp.Matrix:

@@ -13,6 +13,7 @@ coordinate ``q``::
     revolute:   w_i  = R^T w_p + qd z
                 wd_i = R^T wd_p + (R^T w_p) x qd z + qdd z
     prismatic:  w_i  = R^T w_p,        wd_i = R^T wd_p
+    spherical:  as revolute with the vector S w for qd z (newton_euler_spherical.py)
     vd_i  = R^T (wd_p x P + w_p x (w_p x P) + vd_p) + 2 (R^T w_p) x V + Vd
     vcd_i = wd_i x c_i + w_i x (w_i x c_i) + vd_i
     F_i = m_i vcd_i,   N_i = I_i wd_i + w_i x I_i w_i
@@ -49,8 +50,12 @@ from typing import Callable
 import sympy as sp
 
 from ..model import Robot
+from . import newton_euler_spherical as spherical
 from .joint_terms import armature, has_joint_terms, joint_torques
 from .terms import EquationsOfMotion, Step
+
+#: the joints that turn (their rate adds to the angular velocity)
+TURNING = ("revolute", "spherical")
 
 
 def _mul(A, v):
@@ -79,16 +84,22 @@ def cross(a, b):
 # Vectors are (3, 1) SymPy matrices; each formula names its inputs as Craig does.
 
 
+def joint_rate(z, qd, kind):
+    """The joint's own angular rate in frame i: ``qd z`` (revolute: ``z`` its axis), or
+    ``S w`` (spherical: ``z`` the 3x3 ``S``, ``qd`` its angular velocity ``w``)."""
+    return _mul(z, sp.Matrix(list(qd))) if kind == "spherical" else _mul(qd, z)
+
+
 def omega(R, w_p, z, qd, kind):
     """Angular velocity of link i in frame i."""
-    return _mul(R.T, w_p) + (_mul(qd, z) if kind == "revolute" else sp.zeros(3, 1))
+    return _mul(R.T, w_p) + (joint_rate(z, qd, kind) if kind in TURNING else sp.zeros(3, 1))
 
 
 def omega_dot(R, w_p, wd_p, z, qd, qdd, kind):
     """Angular acceleration of link i in frame i."""
-    if kind != "revolute":
+    if kind not in TURNING:
         return _mul(R.T, wd_p)
-    return _mul(R.T, wd_p) + cross(_mul(R.T, w_p), _mul(qd, z)) + _mul(qdd, z)
+    return _mul(R.T, wd_p) + cross(_mul(R.T, w_p), joint_rate(z, qd, kind)) + joint_rate(z, qdd, kind)
 
 
 def v_dot(R, w_p, wd_p, vd_p, P, V, Vd):
@@ -135,7 +146,10 @@ def moment_about(n, f, point):
 
 
 def joint_torque(kind, z, n_axis, f):
-    """tau_i: ``z . n`` (moment about a point on the axis) or ``z . f`` (prismatic)."""
+    """tau_i: ``z . n`` (moment about a point on the axis) or ``z . f`` (prismatic); a
+    spherical joint's three: ``S^T n`` (``n`` about its centre)."""
+    if kind == "spherical":
+        return _mul(z.T, n_axis)
     return (n_axis if kind == "revolute" else f).dot(z)
 
 
@@ -290,11 +304,18 @@ def recursion(
         link = robot.links[joint.child]
         name, parent, i = joint.child, joint.parent, robot.link_index(joint.child)
         follow = robot.follows(joint)  # (k, c, o): this joint's coordinate is c q_k + o
-        qd_j, qdd_j = (follow[1] * qd[follow[0]], follow[1] * qdd[follow[0]]) if follow is not None else (0, 0)
-        R, P = joint.transform(robot.joint_coordinate(joint))
-        V, Vd = joint.origin_motion(qd_j, qdd_j)
-        placement[name] = (R, P)
-        ctx = {"R": R, "P": P, "V": V, "Vd": Vd, "z": joint.child_axis, "qd": qd_j, "qdd": qdd_j, "kind": joint.type}
+        if joint.type == "spherical":  # three rates: its angular velocity
+            assert follow is not None  # a spherical joint has coordinates of its own
+            k = follow[0]
+            qd_j, qdd_j = qd[k : k + 3], qdd[k : k + 3]
+            ctx = spherical.motion(joint, qd_j, qdd_j)
+        else:
+            qd_j, qdd_j = (follow[1] * qd[follow[0]], follow[1] * qdd[follow[0]]) if follow is not None else (0, 0)
+            R, P = joint.transform(robot.joint_coordinate(joint))
+            V, Vd = joint.origin_motion(qd_j, qdd_j)
+            ctx = {"R": R, "P": P, "V": V, "Vd": Vd, "z": joint.child_axis}
+        placement[name] = (ctx["R"], ctx["P"])
+        ctx.update(qd=qd_j, qdd=qdd_j, kind=joint.type)
         ctx.update(m=link.mass, c=link.com, I=link.inertia)
         context[name] = ctx
         for step in OUTWARD_STEPS:
@@ -317,12 +338,15 @@ def recursion(
             value[step.key][name] = step.formula(context[name], *args, kid_values)
         f_i, n_i = value["f"][name], value["n"][name]
         follow = robot.follows(joint)
-        point = joint.joint_point(robot.joint_coordinate(joint)) if joint.type == "revolute" else sp.zeros(3, 1)
+        point = joint.joint_point(robot.joint_coordinate(joint)) if joint.type in TURNING else sp.zeros(3, 1)
         n_axis = moment_about(n_i, f_i, point)
         if follow is not None:
             k, mult, _ = follow
-            tau_j = joint_torque(joint.type, joint.child_axis, n_axis, f_i)
-            tau[k] = tau[k] + mult * tau_j  # a mimic joint's torque is carried to its leader
+            tau_j = joint_torque(joint.type, context[name]["z"], n_axis, f_i)
+            if joint.type == "spherical":
+                tau[k : k + 3] = list(tau_j)
+            else:
+                tau[k] = tau[k] + mult * tau_j  # a mimic joint's torque is carried to its leader
         if record:
             about = "" if point == sp.zeros(3, 1) else f", about joint {i}'s axis point {list(point)} (frame {i})"
             reported = {"f": f_i, "n": n_axis}  # n about the axis point: its z component is the torque
@@ -350,6 +374,10 @@ def recursion(
                         f"joint {kind} of mimic joint '{joint.name}', added {mult} times to tau{k + 1}",
                     )
                 )
+            elif joint.type == "spherical":  # its three rows, complete now (no mimic follows one)
+                label = rf"\tau_{{{k + 1}..{k + 3}}}"
+                note = f"moment about the centre of joint '{joint.name}', joint frame"
+                inward.append(Step("inward", name, "tau", label, tau_j, note))
             elif follow is not None:
                 tau_steps.append((len(inward), k))
                 inward.append(
@@ -376,12 +404,17 @@ def mass_matrix(robot: Robot) -> sp.Matrix:
 
 
 def newton_euler(robot: Robot) -> EquationsOfMotion:
-    """Derive ``tau`` by iterated Newton-Euler; steps as in Craig's outward/inward passes."""
+    """Derive ``tau`` by iterated Newton-Euler; steps as in Craig's outward/inward passes.
+    Spherical joints by their angular velocity (newton_euler_spherical.py: a
+    :class:`~.newton_euler_spherical.SphericalEquationsOfMotion`); planar and floating
+    joints are a ModelError naming them."""
+    spherical.check_joints(robot)
     steps: list[Step] = []
-    tau = recursion(robot, list(robot.qd), list(robot.qdd), -robot.gravity, steps)
+    velocity, acceleration = spherical.rates(robot)
+    tau = recursion(robot, velocity, acceleration, -robot.gravity, steps)
     if has_joint_terms(robot):
         # docs/architecture.md: tau += Ia qdd + Fv qd + Fc sign(qd) + offset, joint by joint
-        extra = joint_torques(robot, robot.qd, robot.qdd)
+        extra = joint_torques(robot, velocity, acceleration)
         tau = tau + extra
         steps.append(
             Step(
@@ -393,4 +426,5 @@ def newton_euler(robot: Robot) -> EquationsOfMotion:
                 "rotor inertia, viscous and Coulomb friction, offset: Ia qdd + Fv qd + Fc sign(qd) + offset",
             )
         )
-    return EquationsOfMotion(robot, "newton-euler", tau, steps, _M_builder=lambda: mass_matrix(robot))
+    kind = spherical.SphericalEquationsOfMotion if robot.multi_dof_joints else EquationsOfMotion
+    return kind(robot, "newton-euler", tau, steps, _M_builder=lambda: mass_matrix(robot))

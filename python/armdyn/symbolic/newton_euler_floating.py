@@ -236,6 +236,7 @@ def gravity_in_base(robot: Robot, quaternion) -> np.ndarray:
 
 def _check(robot: Robot) -> None:
     where, source = f"robot '{robot.name}'", robot.meta.get("file")
+    robot.require_one_dof_joints("the floating-base Newton-Euler derivation")
     if robot.mimic_joints:
         raise FloatingBaseError("mimic joints with a floating base are not supported yet", where, source)
     taken = {s.name for s in (*BASE_VELOCITY, *BASE_ACCELERATION, *BASE_GRAVITY)}

@@ -20,6 +20,7 @@ from . import dag
 from .names import SUBSCRIPT_DIGITS, UnicodeTextPrinter, latex_symbol_names, unicode_name
 from .newton_euler import VECTOR_STEP_TEXT
 from .newton_euler_floating import BASE_ROWS, FLOATING_NOTE
+from .newton_euler_spherical import note as spherical_note
 from .notes import note_text
 from .report_html import derivation_html
 from .terms import EquationsOfMotion, Step
@@ -144,7 +145,7 @@ class Renderer:
                 step.name
             ]
         if step.name == "tau":
-            return "τ" + str(self._tau_index(step.link) + 1).translate(SUBSCRIPT_DIGITS)
+            return "τ" + self._tau_rows(step.link).translate(SUBSCRIPT_DIGITS)
         return step.name
 
     def _ascii_label(self, step: Step, i: str) -> str:
@@ -154,17 +155,19 @@ class Renderer:
             k = robot.coordinate_names.index(step.link)
             return {"tau": f"tau{k + 1}", "dL_dqd": f"dL/d{self.eom.qd[k]}", "dL_dq": f"dL/d{self.eom.q[k]}"}[step.name]
         if step.name == "tau":
-            return f"tau{self._tau_index(step.link) + 1}"
+            return f"tau{self._tau_rows(step.link)}"
         return f"{step.name}{i}"
 
     def _joint_of(self, link: str):
         return self.eom.robot.parent_joint(link)
 
-    def _tau_index(self, link: str) -> int:
-        """0-based coordinate of the joint moving ``link`` (a tau step's joint has one)."""
-        k = self.eom.robot.coordinate_index(self._joint_of(link))
-        assert k is not None
-        return k
+    def _tau_rows(self, link: str) -> str:
+        """The rows of tau of the joint moving ``link``, from 1: ``2``, or ``1..3`` for a
+        joint of three (a spherical joint's moment)."""
+        joint = self._joint_of(link)
+        k = self.eom.robot.coordinate_index(joint)
+        assert k is not None  # a tau step's joint has a coordinate
+        return f"{k + 1}..{k + joint.nv}" if joint.nv > 1 else str(k + 1)
 
     def equation(self, lhs: str, rhs: str) -> str:
         if self.fmt == "text":
@@ -262,6 +265,8 @@ def derivation_report(
     head = f"{robot.name}: {robot.dof} dof ({joints}); parameters: {params}"
     if robot.floating:
         head += f"; {FLOATING_NOTE}"
+    if robot.multi_dof_joints:
+        head += f"; {spherical_note(robot)}"
     out = [head if fmt == "text" else (f"% {head}" if fmt == "latex" else f"# {robot.name}\n\n{head}")]
     for eom in eoms:
         title = {"newton-euler": "Newton-Euler", "lagrange": "Lagrange"}[eom.method]

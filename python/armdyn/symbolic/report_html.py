@@ -27,6 +27,7 @@ from . import dag
 from .agreement import AgreementReport
 from .names import latex_symbol_names
 from .newton_euler_floating import BASE_ROWS, FLOATING_NOTE
+from .newton_euler_spherical import note as spherical_note
 from .notes import NOTE_FORMULAS, note_parts
 from .terms import EquationsOfMotion
 from .tidy import TIDY_NODE_LIMIT, tidy_terms, too_big_to_tidy
@@ -228,7 +229,7 @@ def robot_body(robot) -> str:
     joints = []
     for j in robot.joints:
         k = robot.coordinate_index(j)
-        q = m(robot.q[k]) if k is not None else ""
+        q = m(robot.q[k]) if k is not None and j.nv == 1 else ""  # a ball joint's q: its quaternion
         frame = (
             (f"<td>{vec(j.frame_xyz) if j.has_frame_offset else ''}</td><td>{rotation(j.frame_rotation)}</td>")
             if offsets
@@ -238,7 +239,7 @@ def robot_body(robot) -> str:
             f"<tr><td>{escape(j.name)}</td><td>{escape(j.type)}</td><td>{q}</td>"
             f"<td>{escape(j.parent)} \u2192 {escape(j.child)}</td><td>{vec(j.xyz)}</td>"
             f"<td>{rotation(j.rotation)}</td>"
-            f"<td>{vec(j.axis) if j.movable else ''}</td>{frame}</tr>"
+            f"<td>{vec(j.axis) if j.movable and j.nv == 1 else ''}</td>{frame}</tr>"
         )
     frame_heads = ("<th>frame_xyz (joint frame)</th><th>frame_rotation</th>") if offsets else ""
     links = []
@@ -279,6 +280,8 @@ def derivation_html(eoms, steps: bool = False, agreement=None) -> str:
         body.append(_tau_block(eom, wr))
     if robot.floating:
         body.append(f'<p class="meta">{escape(FLOATING_NOTE)}</p>')  # no C: see newton_euler_floating.py
+    elif robot.multi_dof_joints:
+        body.append(f'<p class="meta">{escape(spherical_note(robot))}</p>')  # no C: newton_euler_spherical.py
     elif robot.dof <= TERMS_MAX_DOF and not too_big_to_tidy(eoms[0]):
         body.append(_terms_block(eoms[0], _Writer(eoms[0])))
     if agreement is not None:

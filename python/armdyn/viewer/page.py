@@ -158,9 +158,11 @@ def _link_poses(robot: Robot, Q: np.ndarray) -> np.ndarray:
         return np.asarray(forward_kinematics(robot, np.ascontiguousarray(Q))).reshape(len(Q), -1, 4, 4)
     from ..io import with_root_joint
 
-    fixed = with_root_joint(robot, None)
-    column = {n: 7 + i for i, n in enumerate(robot.coordinate_names)}
-    joints = np.ascontiguousarray(Q[:, [column[n] for n in fixed.coordinate_names]])
+    fixed = with_root_joint(robot, None)  # its joints in tree order: their blocks of q, moved
+    place = {name: iq for name, _, iq, _ in robot.configuration_layout}
+    width = {j.name: j.nq for j in robot.movable_joints}
+    columns = [place[name] + k for name, _, _, _ in fixed.configuration_layout for k in range(width[name])]
+    joints = np.ascontiguousarray(Q[:, columns])
     local = np.asarray(forward_kinematics(fixed, joints)).reshape(len(Q), -1, 4, 4)
     at = {n: i for i, n in enumerate(fixed.links)}
     local = local[:, [at[n] for n in robot.links]]
@@ -223,6 +225,8 @@ def _scene(robot: Robot, times, Q, frames: bool, markers: bool | None, package_d
     joints, coms = [], []
     if markers:
         for j in robot.movable_joints:
+            if j.nv > 1:  # a ball or planar joint has no axis to draw
+                continue
             joints.append({"link": at[j.child], "type": j.type, "axis": as_floats(j.axis).reshape(3).tolist()})
         masses = {n: float(ln.mass) for n, ln in robot.links.items()}
         heaviest = max(masses.values(), default=0.0)
