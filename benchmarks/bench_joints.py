@@ -13,9 +13,9 @@ side in one process, on three models built here in both libraries from the same 
   nv 9.
 
 rnea, crba and aba (the same timing as ``bench_floating.py``: medians of ``--repeat``
-alternating ``timeit`` runs of ``--number`` calls), and rnea's derivatives (armdyn's by
-dual numbers, ``algo/tangent_derivatives.rs``, against Pinocchio's analytical
-``computeRNEADerivatives``). Each model is first checked: armdyn == Pinocchio to 1e-10.
+alternating ``timeit`` runs of ``--number`` calls), and the derivatives of rnea and aba
+(``computeRNEADerivatives``, ``computeABADerivatives``; armdyn's from
+``algo/multi_derivatives.rs``). Each model is first checked: armdyn == Pinocchio to 1e-10.
 Ratios are armdyn time / Pinocchio time: below 1 means armdyn is faster.
 
 Not a test: timings depend on the machine and its load.
@@ -126,9 +126,13 @@ def main() -> None:
                 (num.rnea_derivatives, (robot, q, v, a)),
                 (pin.computeRNEADerivatives, (model, data, q, v, a)),
             ),
+            "aba derivatives": (
+                (num.aba_derivatives, (robot, q, v, tau)),
+                (pin.computeABADerivatives, (model, data, q, v, tau)),
+            ),
         }
         for algo, ((f, fa), (g, ga)) in cases.items():
-            n = max(number // 10, 30) if algo == "rnea derivatives" else number
+            n = max(number // 10, 30) if algo.endswith("derivatives") else number
             mine, theirs = paired_medians(per_call_run(f, fa, n), per_call_run(g, ga, n), repeat)
             print(
                 f"| {name} | {robot.nq} | {robot.nv} | {algo} | {mine * 1e6:.2f} | {theirs * 1e6:.2f} | {mine / theirs:.2f} |"

@@ -48,6 +48,8 @@ impl<const N: usize> Sub for Dual<N> {
         Dual { re: self.re - o.re, du: std::array::from_fn(|k| self.du[k] - o.du[k]) }
     }
 }
+// the product and quotient rules use + and - (not a slip: clippy's suspicious_arithmetic_impl)
+#[allow(clippy::suspicious_arithmetic_impl)]
 impl<const N: usize> Mul for Dual<N> {
     type Output = Self;
     #[inline(always)]
@@ -55,6 +57,7 @@ impl<const N: usize> Mul for Dual<N> {
         Dual { re: self.re * o.re, du: std::array::from_fn(|k| self.du[k] * o.re + self.re * o.du[k]) }
     }
 }
+#[allow(clippy::suspicious_arithmetic_impl)]
 impl<const N: usize> Div for Dual<N> {
     type Output = Self;
     #[inline(always)]

@@ -10,7 +10,7 @@
 use crate::derivatives::{check_f_ext, outputs_given};
 use crate::{all_finite, guard, new_array, slice, thread_arg, NumericModel, Scratch, Shape};
 use armdyn_core::algo::floating::{NQ_BASE, NV_BASE};
-use armdyn_core::algo::tangent_derivatives::{self as td, TangentWork};
+use armdyn_core::algo::multi_derivatives::{aba_derivatives_multi, rnea_derivatives_multi, MultiWork};
 use armdyn_core::algo::{ExternalForces, ForceFrame};
 use armdyn_core::{algo, batch_derivatives as bd, Model};
 use numpy::{PyArrayDyn, PyArrayMethods};
@@ -195,7 +195,8 @@ pub(crate) fn minverse<'py>(
 }
 
 /// The derivatives of a model with joints of several coordinates, fixed or floating base
-/// (`algo::tangent_derivatives`: dual-number RNEA passes on the tangent space): the
+/// (`algo::multi_derivatives`: the 1-dof sweep on the joints' parts, corrected to the
+/// tangent space): the
 /// RNEA's (`rnea = true`: `(dtau_dq, dtau_dv, M)` from `qdd`) or the ABA's
 /// (`(dqdd_dq, dqdd_dv, Minv)` from `tau`). No external wrenches yet; a batch runs row
 /// by row on one thread (the GIL released).
@@ -218,12 +219,12 @@ pub(crate) fn tangent<'py>(
         )));
     }
     let floating = m.floating;
-    let (nq, nv) = td::widths(&m.model, floating);
-    let each = move |md: &Model, w: &mut TangentWork, [q, v, x]: [&[f64]; 3], [o0, o1, o2]: [&mut [f64]; 3]| {
+    let (nq, nv) = if floating { (m.model.nq + NQ_BASE, m.model.nv + NV_BASE) } else { (m.model.nq, m.model.nv) };
+    let each = move |md: &Model, w: &mut MultiWork, [q, v, x]: [&[f64]; 3], [o0, o1, o2]: [&mut [f64]; 3]| {
         if rnea {
-            td::rnea_derivatives_tangent(md, floating, w, q, v, x, o0, o1, o2)
+            rnea_derivatives_multi(md, floating, w, q, v, x, o0, o1, o2)
         } else {
-            td::aba_derivatives_tangent(md, floating, w, q, v, x, o0, o1, o2)
+            aba_derivatives_multi(md, floating, w, q, v, x, o0, o1, o2)
         }
     };
     let args = [("q", q, nq), ("qd", v, nv), (if rnea { "qdd" } else { "tau" }, third, nv)];
@@ -236,9 +237,9 @@ pub(crate) fn tangent<'py>(
         "local",
         threads,
         out,
-        |md, _, ins, _, outs| each(md, &mut TangentWork::new(md, floating), ins, outs),
+        |md, sc, ins, _, outs| each(md, sc.multi_work.get_or_insert_with(|| MultiWork::new(md, floating)), ins, outs),
         |md, ins, _, [o0, o1, o2], _| {
-            let mut w = TangentWork::new(md, floating);
+            let mut w = MultiWork::new(md, floating);
             let per = nv * nv;
             let outs = o0.chunks_exact_mut(per).zip(o1.chunks_exact_mut(per)).zip(o2.chunks_exact_mut(per));
             for (r, ((a, b), c)) in outs.enumerate() {

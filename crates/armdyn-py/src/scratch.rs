@@ -14,6 +14,8 @@ pub(crate) struct Scratch {
     /// Built on the first derivative call: it holds nv x nv blocks and subtree lists
     /// (O(nv^2) memory), which a 10^4-joint model must not pay for rnea alone.
     pub(crate) deriv_work: Option<armdyn_core::DerivData<f64>>,
+    /// Built on the first derivative call of a model with joints of several coordinates.
+    pub(crate) multi_work: Option<armdyn_core::algo::multi_derivatives::MultiWork>,
     /// Small single-state results handed out before, for [`Scratch::output`].
     pub(crate) outputs: OutputPool,
 }
@@ -68,6 +70,7 @@ impl Scratch {
             data: Data::new(model),
             coriolis: CoriolisWork::new(model),
             deriv_work: None,
+            multi_work: None,
             outputs: OutputPool { arrays: Default::default(), next: 0 },
         }
     }

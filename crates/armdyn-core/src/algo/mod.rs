@@ -22,6 +22,7 @@ pub mod jacobian_dot;
 pub mod kinematics;
 pub mod manifold;
 pub mod minverse;
+pub mod multi_derivatives;
 pub mod regressor;
 pub mod rnea;
 pub mod rnea_derivatives;

@@ -1,6 +1,8 @@
 //! The derivatives of the RNEA and the ABA on the tangent space for models with joints
 //! of several coordinates (`joint_multi.rs`), fixed or floating base, by forward-mode
-//! automatic differentiation: the RNEA runs on [`Dual`] numbers carrying [`DIRECTIONS`]
+//! automatic differentiation: the second opinion the analytical ones
+//! (`multi_derivatives.rs`, what the bindings call) are tested against, written from the
+//! definition alone: the RNEA runs on [`Dual`] numbers carrying [`DIRECTIONS`]
 //! directions at a time, the velocity coordinates' for `d tau / dq` (the configuration
 //! moved along the tangent direction, `q ⊕ ε e_m`, as Pinocchio's `integrate`), then for
 //! `d tau / dv`. The results are exact to rounding, as the analytical derivatives of the
@@ -139,7 +141,16 @@ fn rnea_dual(model: &Model, floating: bool, w: &mut TangentWork) {
 
 /// `dtau/dq` and `dtau/dv` (nv, nv) at `(q, v, a)`, [`DIRECTIONS`] columns per pass.
 #[allow(clippy::too_many_arguments)]
-fn rnea_partials(model: &Model, floating: bool, w: &mut TangentWork, q: &[f64], v: &[f64], a: &[f64], dq: &mut [f64], dv: &mut [f64]) {
+fn rnea_partials(
+    model: &Model,
+    floating: bool,
+    w: &mut TangentWork,
+    q: &[f64],
+    v: &[f64],
+    a: &[f64],
+    dq: &mut [f64],
+    dv: &mut [f64],
+) {
     let (_, nv) = widths(model, floating);
     let constant = |x: &[f64], out: &mut [D]| out.iter_mut().zip(x).for_each(|(o, &x)| *o = D::constant(x));
     constant(a, &mut w.a);

@@ -252,3 +252,61 @@ fn dual_number_derivatives_equal_the_analytical_ones() {
         }
     }
 }
+
+/// The analytical derivatives of models with joints of several coordinates
+/// (`multi_derivatives`: the 1-dof sweep on the parts, corrected to the tangent space)
+/// against the dual-number ones (`tangent_derivatives`: the RNEA differentiated along
+/// `q ⊕ ε e_m`), on random trees mixing every joint kind, fixed and floating bases.
+#[test]
+fn multi_dof_analytical_derivatives_equal_the_dual_number_ones() {
+    use armdyn_core::algo::multi_derivatives::{aba_derivatives_multi, rnea_derivatives_multi, MultiWork};
+    use armdyn_core::algo::tangent_derivatives::{aba_derivatives_tangent, rnea_derivatives_tangent, TangentWork};
+    use armdyn_core::JointType;
+    let mut rng = Rng::new(29);
+    for trial in 0..60 {
+        let count = 2 + rng.below(6);
+        let mut joints = random_joints(&mut rng, count, trial % 2 == 0);
+        for j in joints.iter_mut() {
+            j.jtype = match rng.below(6) {
+                0 => JointType::Spherical,
+                1 => JointType::Planar,
+                2 => JointType::Free,
+                _ => j.jtype,
+            };
+        }
+        let mut model = Model::new(&joints, [0.3, -0.5, -9.81]).expect("valid model");
+        let floating = trial % 3 == 0;
+        if floating {
+            // a base of its own mass (without it a ball joint at the base turns with it: M singular)
+            let inertia = random_inertia(&mut rng);
+            model.add_base_inertia(2.0, [0.1, 0.0, -0.1], inertia).expect("valid base");
+        }
+        let (qb, vb) = if floating { (7, 6) } else { (0, 0) };
+        let (nq, nv) = (model.nq + qb, model.nv + vb);
+        let mut q = rng.vec(nq, -1.0, 1.0);
+        let unit = |q: &mut [f64]| {
+            let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+            q.iter_mut().for_each(|x| *x /= norm);
+        };
+        if floating {
+            unit(&mut q[3..7]);
+        }
+        for j in &model.multi {
+            let (off, len) = j.kind.unit_block();
+            unit(&mut q[qb + j.idx_q + off..qb + j.idx_q + off + len]);
+        }
+        let (v, x) = (rng.vec(nv, -2.0, 2.0), rng.vec(nv, -2.0, 2.0));
+        let (mut mw, mut tw) = (MultiWork::new(&model, floating), TangentWork::new(&model, floating));
+        let [mut a0, mut a1, mut a2, mut b0, mut b1, mut b2] = std::array::from_fn(|_| vec![0.0; nv * nv]);
+        rnea_derivatives_multi(&model, floating, &mut mw, &q, &v, &x, &mut a0, &mut a1, &mut a2);
+        rnea_derivatives_tangent(&model, floating, &mut tw, &q, &v, &x, &mut b0, &mut b1, &mut b2);
+        for (a, b, what) in [(&a0, &b0, "dtau_dq"), (&a1, &b1, "dtau_dv"), (&a2, &b2, "M")] {
+            assert_close(a, b, 1e-9, what);
+        }
+        aba_derivatives_multi(&model, floating, &mut mw, &q, &v, &x, &mut a0, &mut a1, &mut a2);
+        aba_derivatives_tangent(&model, floating, &mut tw, &q, &v, &x, &mut b0, &mut b1, &mut b2);
+        for (a, b, what) in [(&a0, &b0, "da_dq"), (&a1, &b1, "da_dv"), (&a2, &b2, "Minv")] {
+            assert_close(a, b, 1e-7, what);
+        }
+    }
+}
