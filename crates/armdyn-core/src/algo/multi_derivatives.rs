@@ -243,24 +243,45 @@ pub fn aba_derivatives_multi(
     da_dv: &mut [f64],
     minv: &mut [f64],
 ) {
-    let nv = model.nv + if floating { NV_BASE } else { 0 };
     let (mut acc, mut product) = (std::mem::take(&mut w.acc), std::mem::take(&mut w.product));
-    if floating {
-        crate::algo::aba_floating(model, &mut w.data, q, v, tau, &mut acc);
-        crate::algo::minverse_floating(model, &mut w.data, &mut w.deriv, q, minv);
-    } else {
-        crate::algo::aba(model, &mut w.data, q, v, tau, &mut acc);
-        crate::algo::minverse(model, &mut w.data, &mut w.deriv, q, minv);
-    }
-    // M goes into `product` (not needed), then dtau/dq and dtau/dv are multiplied in place
+    forward_and_inverse(model, floating, &mut w.data, &mut w.deriv, q, v, tau, &mut acc, minv);
+    // M goes into `product` (not needed), then dtau/dq and dtau/dv become -M^-1 times them
     rnea_derivatives_multi(model, floating, w, q, v, &acc, da_dq, da_dv, &mut product);
-    for d in [da_dq, da_dv] {
+    minus_minv_times(minv, [da_dq, da_dv], &mut product);
+    (w.acc, w.product) = (acc, product);
+}
+
+/// `acc = aba(q, v, tau)` and `minv = M^-1(q)`, fixed or floating base.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn forward_and_inverse(
+    model: &Model,
+    floating: bool,
+    data: &mut Data<f64>,
+    deriv: &mut DerivData<f64>,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    acc: &mut [f64],
+    minv: &mut [f64],
+) {
+    if floating {
+        crate::algo::aba_floating(model, data, q, v, tau, acc);
+        crate::algo::minverse_floating(model, data, deriv, q, minv);
+    } else {
+        crate::algo::aba(model, data, q, v, tau, acc);
+        crate::algo::minverse(model, data, deriv, q, minv);
+    }
+}
+
+/// Each `d` (nv, nv) replaced by `-minv d`, through the (nv, nv) scratch `product`.
+pub(crate) fn minus_minv_times<const K: usize>(minv: &[f64], ds: [&mut [f64]; K], product: &mut [f64]) {
+    let nv = product.len().isqrt();
+    for d in ds {
         for r in 0..nv {
             for c in 0..nv {
                 product[r * nv + c] = -(0..nv).map(|k| minv[r * nv + k] * d[k * nv + c]).sum::<f64>();
             }
         }
-        d.copy_from_slice(&product);
+        d.copy_from_slice(product);
     }
-    (w.acc, w.product) = (acc, product);
 }

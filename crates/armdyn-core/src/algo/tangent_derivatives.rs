@@ -16,7 +16,8 @@
 //! (nv, nv) row-major, `[r * nv + m] = d out_r / d x_m` (nq, nv include the base's).
 
 use crate::algo::floating::{quaternion_rotation, NQ_BASE, NV_BASE};
-use crate::algo::{aba, aba_floating, crba, crba_floating, minverse, minverse_floating, rnea, rnea_floating};
+use crate::algo::multi_derivatives::{forward_and_inverse, minus_minv_times};
+use crate::algo::{crba, crba_floating, rnea, rnea_floating};
 use crate::data::Data;
 use crate::deriv_data::DerivData;
 use crate::dual::Dual;
@@ -221,24 +222,10 @@ pub fn aba_derivatives_tangent(
     da_dv: &mut [f64],
     minv: &mut [f64],
 ) {
-    let (_, nv) = widths(model, floating);
     let mut acc = std::mem::take(&mut w.acc);
-    if floating {
-        aba_floating(model, &mut w.data64, q, v, tau, &mut acc);
-        minverse_floating(model, &mut w.data64, &mut w.deriv, q, minv);
-    } else {
-        aba(model, &mut w.data64, q, v, tau, &mut acc);
-        minverse(model, &mut w.data64, &mut w.deriv, q, minv);
-    }
-    // dtau/dq and dtau/dv into the outputs, then -M^-1 times each (through `product`)
+    forward_and_inverse(model, floating, &mut w.data64, &mut w.deriv, q, v, tau, &mut acc, minv);
+    // dtau/dq and dtau/dv into the outputs, then -M^-1 times each
     rnea_partials(model, floating, w, q, v, &acc, da_dq, da_dv);
     w.acc = acc;
-    for d in [da_dq, da_dv] {
-        for r in 0..nv {
-            for c in 0..nv {
-                w.product[r * nv + c] = -(0..nv).map(|k| minv[r * nv + k] * d[k * nv + c]).sum::<f64>();
-            }
-        }
-        d.copy_from_slice(&w.product);
-    }
+    minus_minv_times(minv, [da_dq, da_dv], &mut w.product);
 }
