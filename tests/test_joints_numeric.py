@@ -263,9 +263,16 @@ def test_external_wrenches_refused():
 def test_derivatives_batch_and_finite_differences_along_integrate():
     """A batch equals its rows; d tau / dq along the tangent space equals central
     differences of rnea along ``integrate(q, h e_m)`` (Pinocchio's convention, checked
-    without Pinocchio)."""
+    without Pinocchio), and d tau / dv those along v, joint friction and rotor inertia
+    included."""
+    from dataclasses import replace
+
     rng = np.random.default_rng(21)
     robot = mixed_tree(rng, 5)
+    # rotor inertia and viscous friction on every joint, several coordinates' too
+    terms = dict(armature=0.1, damping=0.2)
+    joints = [replace(j, **terms) if j.movable else j for j in robot.joints]
+    robot = Robot(robot.name, robot.links.values(), joints)
     Q = np.array([random_configuration(robot, rng) for _ in range(3)])
     V, A = rng.normal(size=(2, 3, robot.nv))
     batch = an.rnea_derivatives(robot, Q, V, A)
@@ -282,3 +289,7 @@ def test_derivatives_batch_and_finite_differences_along_integrate():
             an.rnea(robot, an.integrate(robot, q, e), v, a) - an.rnea(robot, an.integrate(robot, q, -e), v, a)
         ) / (2 * h)
     np.testing.assert_allclose(batch[0][0], fd, rtol=0, atol=1e-6 * (1 + np.abs(fd).max()))
+    for m in range(robot.nv):
+        e = np.eye(robot.nv)[m] * h
+        fd[:, m] = (an.rnea(robot, q, v + e, a) - an.rnea(robot, q, v - e, a)) / (2 * h)
+    np.testing.assert_allclose(batch[1][0], fd, rtol=0, atol=1e-6 * (1 + np.abs(fd).max()))

@@ -155,7 +155,6 @@ def test_urdf_free_flyer_root_with_floating_and_planar_joints(tmp_path):
         ('<axis xyz="1 0 0"/>', "got <axis> [1.0, 0.0, 0.0]"),
         ('<axis xyz="0 0 -1"/>', "got <axis> [0.0, 0.0, -1.0]"),
         ('<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>', "takes no lower, upper, velocity"),
-        ('<axis xyz="0 0 1"/><dynamics damping="0.1"/>', "takes no damping"),
         ('<axis xyz="0 0 1"/><mimic joint="a_shoulder"/>', "takes no mimic"),
     ],
 )
@@ -242,7 +241,17 @@ FREE_BODIES = """<mujoco model="free_bodies">
   </worldbody>
 </mujoco>"""
 
-MODELS = {"ball_pendulum": BALL_PENDULUM, "mixed_chain": MIXED_CHAIN, "free_bodies": FREE_BODIES}
+# the mixed chain with damping and rotor inertia on every joint, its ball joint's too (MuJoCo
+# applies them to each of the ball's three velocities, as armdyn to each coordinate)
+DAMPED_CHAIN = MIXED_CHAIN.replace(
+    "<worldbody>", '<default><joint damping="0.3" armature="0.05"/></default><worldbody>', 1
+)
+MODELS = {
+    "ball_pendulum": BALL_PENDULUM,
+    "mixed_chain": MIXED_CHAIN,
+    "free_bodies": FREE_BODIES,
+    "damped_chain": DAMPED_CHAIN,
+}
 
 
 def read(text: str):
@@ -437,20 +446,16 @@ def test_a_state_with_a_non_unit_quaternion_is_refused(where):
             to_mujoco_state(robot, q, np.zeros(robot.nv))
 
 
-@pytest.mark.parametrize(
-    "joint, words",
-    [
-        ('type="ball" damping="0.1"', "damping on a ball joint"),
-        ('type="ball" armature="0.1"', "armature on a ball joint"),
-        ('type="ball" frictionloss="0.1"', "frictionloss on a ball joint"),
-    ],
-)
-def test_mjcf_ball_joint_dynamics_are_refused(tmp_path, joint, words):
-    path = tmp_path / "ball.xml"
-    path.write_text(BALL_PENDULUM.replace('type="ball"', joint))
-    with pytest.raises(ModelError) as info:
-        load_mjcf(path)
-    assert str(info.value).startswith(f"{path}:5: <joint name='ball'>: {words}")
+def test_mjcf_ball_joint_dynamics_are_read():
+    """A ball joint's damping, armature and frictionloss become its joint dynamics on each
+    of its three coordinates (the model's rows; MuJoCo's agreement in
+    test_mjcf_dynamics_agree_with_mujoco["damped_chain"])."""
+    text = BALL_PENDULUM.replace('type="ball"', 'type="ball" damping="0.1" armature="0.2" frictionloss="0.3"')
+    ball = read(text).movable_joints[0]
+    assert ball.type == "spherical"
+    assert (float(ball.damping), float(ball.armature), float(ball.friction)) == (0.1, 0.2, 0.3)
+    with pytest.raises(ModelError, match="damping .*nonlinear damping polynomial"):
+        load_mjcf(BALL_PENDULUM.replace('type="ball"', 'type="ball" damping="0.1 0.2"'))
 
 
 def test_mjcf_ball_range_and_stiffness_are_reported():
@@ -464,16 +469,13 @@ def test_mjcf_ball_range_and_stiffness_are_reported():
 def test_mujoco_test_model_with_its_ball_joint_and_free_bodies(tmp_path):
     """MuJoCo's own test model (shipped in its wheel) with its ball joint and its five
     free bodies (one of them carrying legs), so each free body hangs on a floating joint;
-    changed: its mesh made a sphere, the gravity compensation dropped, the ball's
-    damping and armature (inherited from its classes) set to 0; MuJoCo's springs and fluid
-    forces switched off (armdyn lists them as ignored)."""
+    changed: its mesh made a sphere, the gravity compensation dropped; MuJoCo's springs and
+    fluid forces switched off (armdyn lists them as ignored)."""
     source = Path(mujoco.__file__).parent / "testdata" / "model.xml"
     if not source.is_file():
         pytest.skip(f"mujoco {mujoco.__version__} ships no testdata/model.xml")
     text = source.read_text().replace('type="mesh" mesh="icosahedron"', 'type="sphere"')
-    text = text.replace(' gravcomp="0.5"', "").replace(
-        'type="ball" class="wheel"', 'type="ball" damping="0" armature="0"'
-    )
+    text = text.replace(' gravcomp="0.5"', "")
     path = tmp_path / "model.xml"
     path.write_text(text)
     with pytest.warns(MjcfIgnoredWarning, match="joint stiffness"):

@@ -406,7 +406,10 @@ def one_body(joint: str = "<joint/>", inertial: str = '<inertial pos="0 0 0" mas
 @pytest.mark.parametrize(
     "text, words",
     [
-        (one_body("<joint name='s' type='ball' damping='1'/>"), r"<joint name='s'>: damping on a ball joint"),
+        (
+            one_body("<joint name='s' type='ball' damping='1 2'/>"),
+            r"<joint name='s'>: damping \[1.0, 2.0\]: a nonlinear damping polynomial",
+        ),
         (
             "<mujoco><worldbody><body><body name='b'><freejoint name='f'/></body></body></worldbody></mujoco>",
             "<freejoint name='f'>: free joint in a body that is not a child of the world body",
@@ -459,11 +462,11 @@ def test_bad_input_is_one_clear_error(text, words):
 def test_errors_name_file_and_line(tmp_path):
     path = write(
         tmp_path,
-        "<mujoco>\n<worldbody>\n<body name='b'>\n<joint name='s' type='ball' damping='1'/>\n</body>\n</worldbody>\n</mujoco>",
+        "<mujoco>\n<worldbody>\n<body name='b'>\n<joint name='s' type='ball' damping='1 2'/>\n</body>\n</worldbody>\n</mujoco>",
     )
     with pytest.raises(ModelError) as err:
         armdyn.load(path)
-    assert str(err.value).startswith(f"{path}:4: <joint name='s'>: damping on a ball joint")
+    assert str(err.value).startswith(f"{path}:4: <joint name='s'>: damping [1.0, 2.0]: a nonlinear damping polynomial")
 
 
 def test_free_joint_is_welded_on_request(tmp_path):

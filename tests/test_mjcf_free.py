@@ -338,7 +338,7 @@ LEG = "<body name='leg'><joint name='{}' {}/><inertial pos='0 0 0' mass='1' diag
 @pytest.mark.parametrize(
     "text, element, words",
     [
-        (mjcf(inside=LEG.format("s", "type='ball' armature='0.1'")), "<joint name='s'>", "armature on a ball joint"),
+        (mjcf(inside=LEG.format("s", "type='ball' springdamper='1 1'")), "<joint name='s'>", "springdamper"),
         (
             mjcf("", inside=LEG.format("f", "type='free'")),
             "<joint name='f'>",

@@ -228,3 +228,20 @@ def test_joint_terms_beside_a_ball_joint():
         expected = np.asarray(armdyn.rnea(robot, q, v, a), dtype=float)
         got = evaluate(eom, q, v, a)
         assert np.max(np.abs(got - expected)) <= TOL * max(1.0, np.max(np.abs(expected)))
+
+
+def test_joint_terms_on_a_ball_joint():
+    """Damping, Coulomb friction, rotor inertia and an offset on a ball joint apply to each
+    of its three coordinates (as MuJoCo's on a ball joint): the derivation equals the
+    core's rnea, whose terms are checked against MuJoCo in tests/test_joints_readers.py."""
+    from dataclasses import replace
+
+    robot = chain("arm", True)
+    terms = dict(damping=0.3, armature=0.05, friction=0.2, torque_offset=0.1)
+    joints = [replace(j, **terms) for j in robot.joints if j.movable] + [j for j in robot.joints if not j.movable]
+    robot = Robot(robot.name, robot.links.values(), joints)
+    eom = armdyn.derive(robot)
+    for q, v, a in states(robot, 3, 11):
+        expected = np.asarray(armdyn.rnea(robot, q, v, a), dtype=float)
+        got = evaluate(eom, q, v, a)
+        assert np.max(np.abs(got - expected)) <= TOL * max(1.0, np.max(np.abs(expected)))

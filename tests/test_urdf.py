@@ -345,12 +345,12 @@ def test_slightly_unnormalised_axis_is_normalised():
         (
             ('type="continuous"', 'type="floating"'),
             "joint 'spin'",
-            "a floating joint takes no lower, upper, velocity, damping",
+            "a floating joint takes no lower, upper, velocity",
         ),
         (
             ('type="continuous"', 'type="planar"'),
             "joint 'spin'",
-            "a planar joint takes no lower, upper, velocity, damping",
+            "a planar joint takes no lower, upper, velocity",
         ),
         (
             ('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><mimic joint="slide"/>'),

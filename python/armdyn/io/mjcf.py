@@ -24,7 +24,8 @@ What is read (the part of MJCF that fixes a fixed-base arm's rigid-body dynamics
   body makes that body the floating base (``root_joint="free-flyer"``) when it is the one
   free body and no other body of the world body has a joint; otherwise (several free
   bodies, a free object beside a fixed arm) each free body hangs from the world on a
-  ``floating`` joint. A ``ball`` joint is a ``spherical`` joint. See
+  ``floating`` joint. A ``ball`` joint is a ``spherical`` joint (its damping, armature
+  and frictionloss on each of its three velocities, as MuJoCo's). See
   :mod:`armdyn.io.mjcf_free` for both (what is checked, refused or ignored) and
   :mod:`armdyn.io.mjcf_state` for MuJoCo's ``qpos``/``qvel`` layout against armdyn's.
   ``floating="weld"`` reads every free body as welded at its pose instead. A free joint
@@ -463,8 +464,7 @@ class _Reader(MjcfDocument):
             kind = attrs.get("type", "hinge")
             point = pf + Rf @ self.numbers(j, attrs, "pos", 3, [0, 0, 0])
             if kind == "ball":  # turns the body frame about the point (see mjcf_free)
-                ball_joint_dynamics(self, j, attrs)
-                R, shift, extra, kind = np.eye(3), point, {}, "spherical"
+                R, shift, extra, kind = np.eye(3), point, ball_joint_dynamics(self, j, attrs), "spherical"
             else:
                 R, shift, extra = self.axis_joint(j, attrs, kind == "hinge", Rf, point)
                 kind = "revolute" if kind == "hinge" else "prismatic"

@@ -122,18 +122,13 @@ def base_pose(R: np.ndarray, p: np.ndarray) -> tuple[tuple[float, ...], tuple[fl
     return tuple(float(x) for x in p), tuple(float(x) for x in quat / np.linalg.norm(quat))
 
 
-def ball_joint_dynamics(reader, elem, attrs: dict) -> None:
-    """Check a ball joint's attributes (defaults applied): what MuJoCo would apply to its
-    three velocities is refused, a stiffness or a range listed as ignored."""
-    for key in ("damping", "armature", "frictionloss", "springdamper"):
-        if np.any(reader.numbers(elem, attrs, key, 3, [0], at_least=1)):
-            raise reader.error(
-                elem,
-                f"{key} on a ball joint (MuJoCo applies it to the joint's three velocities; armdyn's spherical "
-                "joint has no joint dynamics): not supported",
-            )
-    if np.any(reader.numbers(elem, attrs, "stiffness", 3, [0], at_least=1)):
-        reader.ignored["joint stiffness (springs are not modelled)"] += 1
+def ball_joint_dynamics(reader, elem, attrs: dict) -> dict:
+    """A ball joint's damping, armature and frictionloss (defaults applied), each applied
+    by MuJoCo to the joint's three velocities as armdyn applies a joint's to each of its
+    coordinates (``damping`` Fv, ``armature`` Ia, ``friction`` Fc); what a hinge refuses
+    is refused the same way, a stiffness or a range (a cone) listed as ignored."""
     limits = reader.numbers(elem, attrs, "range", 2)
     if limits is not None and np.any(limits) and attrs.get("limited", "auto") != "false":
         reader.ignored["ball joint range (a cone limit; limits do not enter the dynamics)"] += 1
+    rest = {k: v for k, v in attrs.items() if k not in ("range", "limited")}
+    return reader.joint_dynamics(elem, rest, hinge=True)

@@ -132,7 +132,8 @@ class Joint:
 
     type:     "revolute", "prismatic", "fixed", or one of several coordinates
               (:data:`MULTI_DOF`): "spherical", "planar" (in the placement frame's x-y
-              plane) or "floating"; those take no axis, mimic, limits or joint dynamics.
+              plane) or "floating"; those take no axis, mimic or limits, and their joint
+              dynamics apply to each of their velocity coordinates.
     xyz:      (3, 1) placement translation in the parent link frame (m).
     rotation: (3, 3) placement rotation: placement-frame axes in the parent frame.
     axis:     (3, 1) unit axis of motion in the placement frame (ignored when fixed).
@@ -198,7 +199,8 @@ class Joint:
             if self.type == "fixed":
                 raise ModelError("a fixed joint cannot mimic another joint", where)
         if self.type in MULTI_DOF:
-            given = [k for k in ("lower", "upper", "velocity") + JOINT_DYNAMICS if self.__dict__[k] is not None]
+            # friction and rotor inertia apply to each of its coordinates, as MuJoCo's on a ball joint
+            given = [k for k in ("lower", "upper", "velocity") if self.__dict__[k] is not None]
             if self.mimic is not None or given:
                 what = "mimic" if self.mimic is not None else ", ".join(given)
                 raise ModelError(

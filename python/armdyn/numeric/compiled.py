@@ -92,7 +92,7 @@ def compile_model(robot: Robot | NumericModel | MimicModel) -> NumericModel | Mi
     # per movable joint [armature, viscous, coulomb, offset] (absent = 0); None when all zero
     # one row per joint the compiled model frees (mimic joints too); a mimic joint's own
     # friction and armature are not modelled (yet): zeros, as in the reference
-    # (a joint of several coordinates has none: a row of zeros per velocity coordinate)
+    # (a joint of several coordinates: its values on each of its velocity coordinates)
     rows = [
         [
             0.0 if j.mimic is not None or j.floats(k) is None else float(j.floats(k))

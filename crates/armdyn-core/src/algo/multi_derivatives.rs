@@ -19,6 +19,11 @@
 //!   `dë/dε_m = -dJ/dε_m (a - Δ(v)) - d(J̇ ė)/dε_m`, whose second derivatives of `J` are
 //!   `[S_m, [S_m, S_k]]` and `[S_hi, [S_lo, S_k]]` (`ε`'s order in the product).
 //!
+//! Joint friction and rotor inertia on a joint's coordinates act on its own velocity and
+//! acceleration (`Ia a + Fv v + ...`, as MuJoCo's armature and damping on a ball joint),
+//! outside the change of coordinates: the sweep's are taken out of `M`, `dtau/dv` and
+//! `tau` where the corrections use the chain's rigid-body terms.
+//!
 //! Arrays as `tangent_derivatives.rs` (a floating base's six first).
 
 use crate::algo::floating::{NQ_BASE, NV_BASE};
@@ -188,6 +193,17 @@ pub fn rnea_derivatives_multi(
         let (o, n) = (vb + j.body, alg.n);
         let vj = &v[o..o + n];
         let d = alg.delta(vj);
+        // the joint's own friction and rotor inertia, out of the rigid-body terms (module doc)
+        let jd = |p: usize| model.joint_dynamics[j.body + p];
+        let ia = |r: usize, p: usize| if r == o + p { jd(p).armature } else { 0.0 };
+        let fv = |r: usize, p: usize| if r == o + p { jd(p).viscous } else { 0.0 };
+        let tau_rb: [f64; MAX_PARTS] = std::array::from_fn(|p| {
+            if p < n {
+                w.tau[o + p] - jd(p).armature * a[o + p] - jd(p).passive_torque(v[o + p])
+            } else {
+                0.0
+            }
+        });
         // dτ/dδ_m first, from the chain's dτ/dė (before its own correction)
         for mcol in 0..n {
             let dj = alg.dj(mcol);
@@ -198,12 +214,12 @@ pub fn rnea_derivatives_multi(
             for r in 0..nv {
                 let mut x = 0.0;
                 for p in 0..n {
-                    x += dtau_dv[r * nv + o + p] * de[p] + m[r * nv + o + p] * dd[p];
+                    x += (dtau_dv[r * nv + o + p] - fv(r, p)) * de[p] + (m[r * nv + o + p] - ia(r, p)) * dd[p];
                 }
                 dtau_dq[r * nv + o + mcol] += x;
             }
             for r in 0..n {
-                dtau_dq[(o + r) * nv + o + mcol] -= (0..n).map(|p| dj[p][r] * w.tau[o + p]).sum::<f64>();
+                dtau_dq[(o + r) * nv + o + mcol] -= (0..n).map(|p| dj[p][r] * tau_rb[p]).sum::<f64>();
             }
         }
         // dτ/dv = dτ_ch/dė - M dΔ/dv
@@ -222,7 +238,7 @@ pub fn rnea_derivatives_multi(
                     .sum()
             });
             for r in 0..nv {
-                dtau_dv[r * nv + o + mcol] -= (0..n).map(|p| m[r * nv + o + p] * dd[p]).sum::<f64>();
+                dtau_dv[r * nv + o + mcol] -= (0..n).map(|p| (m[r * nv + o + p] - ia(r, p)) * dd[p]).sum::<f64>();
             }
         }
     }

@@ -275,6 +275,13 @@ fn multi_dof_analytical_derivatives_equal_the_dual_number_ones() {
             };
         }
         let mut model = Model::new(&joints, [0.3, -0.5, -9.81]).expect("valid model");
+        if trial % 4 == 1 {
+            // rotor inertia and friction on every coordinate, the joints' parts' too
+            for b in 0..model.nv {
+                let jd = JointDynamics { armature: 0.2, viscous: 0.3, coulomb: 0.1, offset: 0.05 };
+                model.set_joint_dynamics(b, jd).expect("valid joint dynamics");
+            }
+        }
         let floating = trial % 3 == 0;
         if floating {
             // a base of its own mass (without it a ball joint at the base turns with it: M singular)
