@@ -25,7 +25,8 @@ Any number may be a SymPy expression of named parameters (``Robot.parameters``).
 with parameters is bound to numbers with :meth:`Robot.bind`.
 
 The package, by concept: ``robot.py`` (:class:`Robot`), ``joints.py`` (:class:`Joint`,
-:class:`Link`, :class:`Mimic`), ``rotations.py``, ``numbers.py`` (exact and lazy numbers) and
+:class:`Link`, :class:`Mimic`), ``tree.py`` (the joints' order, mimic joints' coordinates),
+``rotations.py``, ``numbers.py`` (exact and lazy numbers) and
 ``frozen.py`` (the immutable containers).
 """
 
