@@ -193,6 +193,16 @@ def test_hand_built_tree_against_pinocchio(floating):
             np.testing.assert_allclose(x, want, rtol=0, atol=1e-8)
         dg = pin.computeGeneralizedGravityDerivatives(model, data, q)
         np.testing.assert_allclose(an.gravity_derivatives(robot, q), dg, rtol=0, atol=1e-9)
+        # the momentum's rate, and A_G's (Pinocchio's dAg adds c' x the linear rows to the
+        # angular ones: its moments about a centre of mass standing still)
+        pin.computeCentroidalMomentumTimeVariation(model, data, q, v, a)
+        np.testing.assert_allclose(ac.centroidal_momentum_rate(robot, q, v, a), data.dhg.vector, atol=1e-10)
+        dA = ac.centroidal_momentum_matrix_rate(robot, q, v)
+        cdot = ac.com_jacobian(robot, q) @ v
+        dA[3:] += np.cross(cdot, ac.centroidal_momentum_matrix(robot, q)[:3].T).T
+        np.testing.assert_allclose(
+            dA, pin.computeCentroidalMapTimeVariation(model, model.createData(), q, v), atol=1e-10
+        )
 
 
 def _ball_pendulum() -> Robot:

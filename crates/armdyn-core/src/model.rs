@@ -429,6 +429,20 @@ impl Model {
         }
     }
 
+    /// The body carrying the child of body `i`'s joint: `i` for a 1-dof joint, the last
+    /// part of a joint of several coordinates (whose axes all turn with that child).
+    pub fn joint_child_body(&self, i: usize) -> usize {
+        let mut b = i;
+        while b + 1 < self.nv && self.motion[b + 1] == BodyMotion::Tail {
+            b += 1;
+        }
+        if self.motion[i] == BodyMotion::Axis {
+            i
+        } else {
+            b
+        }
+    }
+
     /// Whether a joint has several coordinates (nq != nv, joint parts in the tree).
     pub fn has_multi(&self) -> bool {
         !self.multi.is_empty()

@@ -111,7 +111,6 @@ fn centroidal_map_rate<'py>(
     threads: Option<i64>,
 ) -> Out<'py> {
     model.require_mass("centroidal_momentum_matrix_rate")?;
-    model.one_dof_only("centroidal_momentum_matrix_rate")?;
     let ((nq, nv), fl) = (model.widths(), model.floating);
     model.world_op(py, [("q", q, nq), ("v", v, nv)], &[6, nv], threads, move |m, d, [q, v], o| {
         centroidal::centroidal_map_rate(m, d, q, v, fl, o);
@@ -147,7 +146,6 @@ fn centroidal_momentum_rate<'py>(
     threads: Option<i64>,
 ) -> Out<'py> {
     model.require_mass("centroidal_momentum_rate")?;
-    model.one_dof_only("centroidal_momentum_rate")?;
     let ((nq, nv), fl) = (model.widths(), model.floating);
     let args = [("q", q, nq), ("v", v, nv), ("a", a, nv)];
     model.world_op(py, args, &[6], threads, move |m, d, [q, v, a], o| {

@@ -239,9 +239,11 @@ fn put_column(out: &mut [f64], nv: usize, k: usize, f: &Force<f64>) {
 /// In the world frame about its origin the column of coordinate j is `I^c_j S_j` (world
 /// inertias and motion subspaces, [`centroidal_map`]), whose rate is
 /// `sum_{i in subtree(j)} (v_i x* I_i S_j - I_i (v_i x S_j)) + I^c_j (v_j x S_j)` (each
-/// body's inertia turns with it: `I_i' = v_i x* I_i - I_i v_i x`; `S_j' = v_j x S_j`), the
-/// base a body whose subtree is the robot with six axes `^0 X_B e_k`; moving the moment
-/// to the centre of mass `c` (`n_G = n - c x f`) adds `-c' x f - c x f'`.
+/// body's inertia turns with it: `I_i' = v_i x* I_i - I_i v_i x`; `S_j' = v_j x S_j`, with
+/// `v_j` the velocity of the body that carries joint j's child, the last part of a joint
+/// of several coordinates), the base a body whose subtree is the robot with six axes
+/// `^0 X_B e_k`; moving the moment to the centre of mass `c` (`n_G = n - c x f`) adds
+/// `-c' x f - c x f'`.
 pub fn centroidal_map_rate(
     model: &Model,
     data: &mut Data<f64>,
@@ -318,7 +320,7 @@ pub fn centroidal_map_rate(
         }
     }
     for i in 0..model.nv {
-        let (ic, vi, s) = (data.ic[i], data.v[i], data.c[i]);
+        let (ic, vi, s) = (data.ic[i], data.v[model.joint_child_body(i)], data.c[i]);
         finish(out, nvb + i, &ic, &vi, &s);
     }
     total.m
