@@ -264,42 +264,27 @@ def test_one_dof_only_functions_refuse(call):
         call(robot, np.array([0.0, 0.0, 0.0, 1.0]), np.zeros(3))
 
 
-def test_external_wrenches_refused():
-    robot = _ball_pendulum()
-    with pytest.raises(ValueError, match="rnea with f_ext: 'ball' has joints of several coordinates"):
-        an.rnea(robot, np.array([0.0, 0.0, 0.0, 1.0]), np.zeros(3), np.zeros(3), f_ext=np.zeros((2, 6)))
-
-
-def test_derivatives_batch_and_finite_differences_along_integrate():
-    """A batch equals its rows; d tau / dq along the tangent space equals central
-    differences of rnea along ``integrate(q, h e_m)`` (Pinocchio's convention, checked
-    without Pinocchio), and d tau / dv those along v, joint friction and rotor inertia
-    included."""
-    from dataclasses import replace
-
-    rng = np.random.default_rng(21)
-    robot = mixed_tree(rng, 5)
-    # rotor inertia and viscous friction on every joint, several coordinates' too
-    terms = dict(armature=0.1, damping=0.2)
-    joints = [replace(j, **terms) if j.movable else j for j in robot.joints]
-    robot = Robot(robot.name, robot.links.values(), joints)
-    Q = np.array([random_configuration(robot, rng) for _ in range(3)])
-    V, A = rng.normal(size=(2, 3, robot.nv))
-    batch = an.rnea_derivatives(robot, Q, V, A)
-    for k in range(3):
-        single = an.rnea_derivatives(robot, Q[k], V[k], A[k])
-        for b, s in zip(batch, single):
-            assert np.array_equal(b[k], s)
-    q, v, a = Q[0], V[0], A[0]
-    h = 1e-6
-    fd = np.empty((robot.nv, robot.nv))
-    for m in range(robot.nv):
-        e = np.eye(robot.nv)[m] * h
-        fd[:, m] = (
-            an.rnea(robot, an.integrate(robot, q, e), v, a) - an.rnea(robot, an.integrate(robot, q, -e), v, a)
-        ) / (2 * h)
-    np.testing.assert_allclose(batch[0][0], fd, rtol=0, atol=1e-6 * (1 + np.abs(fd).max()))
-    for m in range(robot.nv):
-        e = np.eye(robot.nv)[m] * h
-        fd[:, m] = (an.rnea(robot, q, v + e, a) - an.rnea(robot, q, v - e, a)) / (2 * h)
-    np.testing.assert_allclose(batch[1][0], fd, rtol=0, atol=1e-6 * (1 + np.abs(fd).max()))
+@needs_pinocchio
+@pytest.mark.parametrize("frame", ["local", "world"])
+def test_external_wrenches_against_pinocchio(frame):
+    """rnea and aba with a wrench on every link (link frames, or the world frame about
+    its origin) against Pinocchio's rnea and aba with fext (joint frames)."""
+    robot, model = _hand_built(False)
+    data = model.createData()
+    rng = np.random.default_rng(13)
+    links = list(robot.links)
+    joint_of = {j.child: j.name for j in robot.joints}
+    for _ in range(5):
+        q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+        v, a = rng.normal(size=(2, model.nv))
+        W = rng.normal(size=(len(links), 6))
+        W[0] = 0.0  # the base carries none (Pinocchio's universe)
+        pin.forwardKinematics(model, data, q)
+        fext = [pin.Force.Zero() for _ in range(model.njoints)]
+        for k, name in enumerate(links[1:], start=1):
+            jid = model.getJointId(joint_of[name])
+            wrench = pin.Force(W[k, :3], W[k, 3:])
+            fext[jid] = wrench if frame == "local" else data.oMi[jid].actInv(wrench)
+        tau = pin.rnea(model, data, q, v, a, fext)
+        np.testing.assert_allclose(an.rnea(robot, q, v, a, f_ext=W, frame=frame), tau, rtol=0, atol=1e-10)
+        np.testing.assert_allclose(an.aba(robot, q, v, tau, f_ext=W, frame=frame), a, rtol=0, atol=1e-9)

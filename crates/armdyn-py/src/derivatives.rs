@@ -384,7 +384,6 @@ macro_rules! with_wrenches {
             threads: Option<i64>,
         ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
             let m = model.get();
-            m.one_dof_only(&stringify!($name).replace("_ext", " with f_ext"))?;
             let [o] = run(
                 m,
                 py,
