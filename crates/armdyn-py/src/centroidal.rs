@@ -19,7 +19,7 @@ type Out<'py> = PyResult<Bound<'py, PyArrayDyn<f64>>>;
 
 impl NumericModel {
     /// `(nq, nv)`: the lengths of q and v.
-    fn widths(&self) -> (usize, usize) {
+    pub(crate) fn widths(&self) -> (usize, usize) {
         let (qb, vb) = fk::base_widths(self.floating);
         (self.model.nq + qb, self.model.nv + vb)
     }

@@ -99,8 +99,8 @@ impl NumericModel {
                         "{name}: expected shape ({width},) for one state or (N, {width}) for a batch of '{}' \
                          (q has {nq} entries, velocities and torques {nv}), got {other:?}",
                         self.name,
-                        nq = self.model.nq + if self.floating { NQ_BASE } else { 0 },
-                        nv = self.model.nv + if self.floating { NV_BASE } else { 0 },
+                        nq = self.widths().0,
+                        nv = self.widths().1,
                     )))
                 }
             };

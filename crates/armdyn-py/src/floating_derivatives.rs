@@ -48,7 +48,7 @@ fn run<'py, const K: usize, const R: usize>(
         }
         let (shape, arrays) = m.floating_states(args)?;
         let ext_arr = f_ext.map(|f| check_f_ext(m, f, shape)).transpose()?;
-        let s = m.model.nv + if m.floating { NV_BASE } else { 0 };
+        let s = m.widths().1;
         let dims: Vec<usize> = match shape {
             Shape::Single => vec![s, s],
             Shape::Batch(rows) => vec![rows, s, s],
@@ -219,7 +219,7 @@ pub(crate) fn tangent<'py>(
         )));
     }
     let floating = m.floating;
-    let (nq, nv) = if floating { (m.model.nq + NQ_BASE, m.model.nv + NV_BASE) } else { (m.model.nq, m.model.nv) };
+    let (nq, nv) = m.widths();
     let each = move |md: &Model, w: &mut MultiWork, [q, v, x]: [&[f64]; 3], [o0, o1, o2]: [&mut [f64]; 3]| {
         if rnea {
             rnea_derivatives_multi(md, floating, w, q, v, x, o0, o1, o2)

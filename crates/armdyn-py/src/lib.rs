@@ -349,15 +349,17 @@ impl NumericModel {
     fn floating(&self) -> bool {
         self.floating
     }
-    /// Length of q: 7 + dof for a floating base, dof otherwise.
+    /// Length of q: the joints' configuration (a quaternion or planar pair counting 4), 7
+    /// more for a floating base.
     #[getter]
     fn nq(&self) -> usize {
-        self.model.nq + if self.floating { 7 } else { 0 }
+        self.widths().0
     }
-    /// Length of v (qd, qdd, tau): 6 + dof for a floating base, dof otherwise.
+    /// Length of v (qd, qdd, tau): dof (the joints' velocity coordinates), 6 more for a
+    /// floating base.
     #[getter]
     fn nv(&self) -> usize {
-        self.model.nv + if self.floating { 6 } else { 0 }
+        self.widths().1
     }
     /// Number of link frames (base included).
     #[getter]

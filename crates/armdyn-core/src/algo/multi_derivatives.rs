@@ -26,7 +26,7 @@
 //!
 //! Arrays as `tangent_derivatives.rs` (a floating base's six first).
 
-use crate::algo::floating::{NQ_BASE, NV_BASE};
+use crate::algo::floating_kinematics::base_widths;
 use crate::algo::{rnea, rnea_derivatives, rnea_derivatives_floating, rnea_floating};
 use crate::data::Data;
 use crate::deriv_data::DerivData;
@@ -143,7 +143,7 @@ pub struct MultiWork {
 
 impl MultiWork {
     pub fn new(model: &Model, floating: bool) -> Self {
-        let nv = model.nv + if floating { NV_BASE } else { 0 };
+        let nv = model.nv + base_widths(floating).1;
         MultiWork {
             data: Data::new(model),
             deriv: DerivData::new(model),
@@ -170,7 +170,7 @@ pub fn rnea_derivatives_multi(
     dtau_dv: &mut [f64],
     m: &mut [f64],
 ) {
-    let vb = if floating { NV_BASE } else { 0 };
+    let (qb, vb) = base_widths(floating);
     let nv = model.nv + vb;
     // the chain's accelerations, ë = a - Δ(v) on each joint's block, and the torques
     w.a_chain.copy_from_slice(a);
@@ -188,7 +188,7 @@ pub fn rnea_derivatives_multi(
         rnea_derivatives(model, &mut w.data, &mut w.deriv, q, v, &w.a_chain, None, dtau_dq, dtau_dv, m);
         rnea(model, &mut w.data, q, v, a, &mut w.tau);
     }
-    debug_assert_eq!(q.len(), model.nq + if floating { NQ_BASE } else { 0 });
+    debug_assert_eq!(q.len(), model.nq + qb);
     for (j, alg) in model.multi.iter().zip(&w.algebras) {
         let (o, n) = (vb + j.body, alg.n);
         let vj = &v[o..o + n];

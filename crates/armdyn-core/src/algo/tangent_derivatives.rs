@@ -15,7 +15,8 @@
 //! Arrays: `q` (nq,) with a floating base's 7 first; `v`, `a`, `tau` (nv,); outputs
 //! (nv, nv) row-major, `[r * nv + m] = d out_r / d x_m` (nq, nv include the base's).
 
-use crate::algo::floating::{quaternion_rotation, NQ_BASE, NV_BASE};
+use crate::algo::floating::quaternion_rotation;
+use crate::algo::floating_kinematics::base_widths;
 use crate::algo::multi_derivatives::{forward_and_inverse, minus_minv_times};
 use crate::algo::{crba, crba_floating, rnea, rnea_floating};
 use crate::data::Data;
@@ -45,7 +46,8 @@ pub struct TangentWork {
 
 impl TangentWork {
     pub fn new(model: &Model, floating: bool) -> Self {
-        let (nq, nv) = widths(model, floating);
+        let (qb, vb) = base_widths(floating);
+        let (nq, nv) = (model.nq + qb, model.nv + vb);
         TangentWork {
             data: Data::new(model),
             data64: Data::new(model),
@@ -57,15 +59,6 @@ impl TangentWork {
             acc: vec![0.0; nv],
             product: vec![0.0; nv * nv],
         }
-    }
-}
-
-/// `(nq, nv)` of the whole configuration and velocity.
-pub fn widths(model: &Model, floating: bool) -> (usize, usize) {
-    if floating {
-        (model.nq + NQ_BASE, model.nv + NV_BASE)
-    } else {
-        (model.nq, model.nv)
     }
 }
 
@@ -95,7 +88,7 @@ fn slide(quat: &[f64], k: usize, out: &mut [D], lane: usize) {
 /// the configuration moved along velocity coordinate `m`, as Pinocchio's
 /// `integrate(q, ε e_m)`, to first order (exactly, in dual numbers).
 pub fn tangent_direction(model: &Model, floating: bool, q: &[f64], m: usize, out: &mut [D], lane: usize) {
-    let (qb, vb) = if floating { (NQ_BASE, NV_BASE) } else { (0, 0) };
+    let (qb, vb) = base_widths(floating);
     if m < vb {
         match m {
             0..=2 => slide(&q[3..7], m, &mut out[0..3], lane),
@@ -140,6 +133,38 @@ fn rnea_dual(model: &Model, floating: bool, w: &mut TangentWork) {
     }
 }
 
+/// `out[v] = x` with no derivative.
+fn constant(x: &[f64], out: &mut [D]) {
+    out.iter_mut().zip(x).for_each(|(o, &x)| *o = D::constant(x));
+}
+
+/// The (nv, nv) `out`, [`DIRECTIONS`] columns a pass: before each, `reset(w)` clears the
+/// inputs' directions and `seed(w, lane, m)` puts column `m`'s in `lane`; the RNEA's
+/// `du[lane]` is then column `m`.
+fn columns_by_passes(
+    model: &Model,
+    floating: bool,
+    w: &mut TangentWork,
+    out: &mut [f64],
+    reset: impl Fn(&mut TangentWork),
+    seed: impl Fn(&mut TangentWork, usize, usize),
+) {
+    let nv = w.tau.len();
+    for first in (0..nv).step_by(DIRECTIONS) {
+        let columns = first..nv.min(first + DIRECTIONS);
+        reset(w);
+        for (lane, m) in columns.clone().enumerate() {
+            seed(w, lane, m);
+        }
+        rnea_dual(model, floating, w);
+        for (lane, m) in columns.enumerate() {
+            for r in 0..nv {
+                out[r * nv + m] = w.tau[r].du[lane];
+            }
+        }
+    }
+}
+
 /// `dtau/dq` and `dtau/dv` (nv, nv) at `(q, v, a)`, [`DIRECTIONS`] columns per pass.
 #[allow(clippy::too_many_arguments)]
 fn rnea_partials(
@@ -152,37 +177,12 @@ fn rnea_partials(
     dq: &mut [f64],
     dv: &mut [f64],
 ) {
-    let (_, nv) = widths(model, floating);
-    let constant = |x: &[f64], out: &mut [D]| out.iter_mut().zip(x).for_each(|(o, &x)| *o = D::constant(x));
     constant(a, &mut w.a);
     constant(v, &mut w.v);
-    for first in (0..nv).step_by(DIRECTIONS) {
-        let columns = first..nv.min(first + DIRECTIONS);
-        constant(q, &mut w.q);
-        for (lane, m) in columns.clone().enumerate() {
-            tangent_direction(model, floating, q, m, &mut w.q, lane);
-        }
-        rnea_dual(model, floating, w);
-        for (lane, m) in columns.enumerate() {
-            for r in 0..nv {
-                dq[r * nv + m] = w.tau[r].du[lane];
-            }
-        }
-    }
+    let along_q = |w: &mut TangentWork, lane: usize, m: usize| tangent_direction(model, floating, q, m, &mut w.q, lane);
+    columns_by_passes(model, floating, w, dq, |w| constant(q, &mut w.q), along_q);
     constant(q, &mut w.q);
-    for first in (0..nv).step_by(DIRECTIONS) {
-        let columns = first..nv.min(first + DIRECTIONS);
-        constant(v, &mut w.v);
-        for (lane, m) in columns.clone().enumerate() {
-            w.v[m].du[lane] = 1.0;
-        }
-        rnea_dual(model, floating, w);
-        for (lane, m) in columns.enumerate() {
-            for r in 0..nv {
-                dv[r * nv + m] = w.tau[r].du[lane];
-            }
-        }
-    }
+    columns_by_passes(model, floating, w, dv, |w| constant(v, &mut w.v), |w, lane, m| w.v[m].du[lane] = 1.0);
 }
 
 /// `(dtau/dq, dtau/dv, M)` at `(q, v, a)`: the tangent-space derivatives of the RNEA (see
