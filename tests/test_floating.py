@@ -338,8 +338,6 @@ def test_batches_are_single_calls(threads):
 @pytest.mark.parametrize(
     "call",
     [
-        lambda r, q, v: numeric.coriolis_matrix(r, q, v),
-        lambda r, q, v: numeric.jacobian_dot(r, q, v, "link1"),
         lambda r, q, v: armdyn.derive(r, "lagrange"),
         lambda r, q, v: armdyn.prove_agreement(r),
         lambda r, q, v: armdyn.codegen(r),

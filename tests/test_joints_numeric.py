@@ -250,20 +250,6 @@ def test_planar_pair_refused():
         an.crba(robot, np.array([0.0, 0.0, 1.0, 0.5]))
 
 
-@pytest.mark.parametrize(
-    "call",
-    [
-        lambda r, q, v: an.coriolis_matrix(r, q, v),
-        lambda r, q, v: an.jacobian_dot(r, q, v, "rod"),
-    ],
-    ids=["coriolis", "jacobian_dot"],
-)
-def test_one_dof_only_functions_refuse(call):
-    robot = _ball_pendulum()
-    with pytest.raises(ValueError, match="joints of several coordinates.*'ball'"):
-        call(robot, np.array([0.0, 0.0, 0.0, 1.0]), np.zeros(3))
-
-
 @needs_pinocchio
 @pytest.mark.parametrize("frame", ["local", "world"])
 def test_external_wrenches_against_pinocchio(frame):

@@ -224,27 +224,3 @@ def test_a_result_resizes_in_place_without_the_reference_check(arm):
     M.resize((robot.dof * robot.dof + 1,), refcheck=False)  # the pool's reference is not a view
     assert M.shape == (robot.dof * robot.dof + 1,)
     assert num.crba(robot, state["q"]).shape == (robot.dof, robot.dof)
-
-
-# ------------------------------------------------------------------ floating base
-
-
-FIXED_BASE_ONLY = {
-    "coriolis_matrix": lambda r, q, v: num.coriolis_matrix(r, q, v),
-    "jacobian_dot": lambda r, q, v: num.jacobian_dot(r, q, v, 1),
-    "regressor": lambda r, q, v: num.regressor(r, q, v, v, columns="all"),
-}
-
-
-@pytest.mark.parametrize("name", FIXED_BASE_ONLY)
-def test_functions_without_a_floating_form_name_themselves(arm, name):
-    from armdyn.errors import FloatingBaseError
-    from armdyn.io import with_root_joint
-
-    fixed, _ = arm
-    robot = with_root_joint(fixed, "free-flyer")
-    q = np.concatenate([np.zeros(3), [0.0, 0.0, 0.0, 1.0], np.zeros(robot.dof)])
-    v = np.zeros(robot.nv)
-    for target in (robot, num.compile_model(robot)):
-        with pytest.raises(FloatingBaseError, match=rf"armdyn\.numeric\.{name}\b.*floating base"):
-            FIXED_BASE_ONLY[name](target, q, v)

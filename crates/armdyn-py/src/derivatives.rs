@@ -347,8 +347,10 @@ fn jacobian_dot<'py>(
     threads: Option<i64>,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let m = model.get();
-    m.one_dof_only("jacobian_dot")?;
     let index = m.link_arg(link)?;
+    if m.floating {
+        return m.jacobian_dot_free_root(py, q, qd, index, threads);
+    }
     let [o] = run(
         m,
         py,

@@ -26,7 +26,7 @@ impl NumericModel {
     pub(crate) fn fixed_base_only(&self) -> PyResult<()> {
         if self.floating {
             return Err(PyNotImplementedError::new_err(format!(
-                "'{}' has a floating base (free-flyer root joint): only rnea, crba, aba, rnea_derivatives, aba_derivatives, minverse, forward_kinematics, jacobian and the energies support it yet",
+                "'{}' has a floating base (free-flyer root joint): only rnea, crba, aba, their derivatives, minverse, forward_kinematics, jacobian, jacobian_dot, coriolis_matrix, regressor and the energies support it yet",
                 self.name
             )));
         }
@@ -41,7 +41,8 @@ impl NumericModel {
             return Err(PyValueError::new_err(format!(
                 "{what}: '{}' has joints of several coordinates (the first: '{}'): {what} takes revolute and \
                  prismatic joints only (yet); rnea, crba, aba, gravity, bias, their derivatives, minverse, \
-                 forward_kinematics, jacobian, the energies and the centroidal map take them",
+                 forward_kinematics, jacobian, jacobian_dot, coriolis_matrix, regressor, the energies and the \
+                 centroidal map take them",
                 self.name,
                 self.joint_name(j.body)
             )));
@@ -165,6 +166,22 @@ impl NumericModel {
         single: impl FnOnce(&mut armdyn_core::Data<f64>, [&[f64]; K], &mut [f64]),
         batched: impl FnOnce(&armdyn_core::Model, [&[f64]; K], &mut [f64], Option<usize>) + Send,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let single = |ins: [&[f64]; K], o: &mut [f64]| self.with_scratch(|s| single(&mut s.data, ins, o));
+        self.op_on(py, &self.model, args, out_shape, threads, single, batched)
+    }
+
+    /// [`Self::floating_op`] on `model` (this one's, or another of the same widths, e.g.
+    /// `free_root.rs`'s), `single(inputs, output)` bringing its own workspace.
+    pub(crate) fn op_on<'py, const K: usize>(
+        &self,
+        py: Python<'py>,
+        model: &armdyn_core::Model,
+        args: [(&str, &Bound<'py, PyAny>, usize); K],
+        out_shape: &[usize],
+        threads: Option<i64>,
+        single: impl FnOnce([&[f64]; K], &mut [f64]),
+        batched: impl FnOnce(&armdyn_core::Model, [&[f64]; K], &mut [f64], Option<usize>) + Send,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
         guard(|| {
             let threads = thread_arg(threads)?;
             let (shape, arrays) = self.floating_states(args)?;
@@ -174,7 +191,7 @@ impl NumericModel {
                     // SAFETY: inputs read-only and `out` fresh, GIL held throughout.
                     let ins: [&[f64]; K] = std::array::from_fn(|k| unsafe { slice(&arrays[k]) });
                     let o = unsafe { out.as_slice_mut().expect("fresh array") };
-                    self.with_scratch(|s| single(&mut s.data, ins, o));
+                    single(ins, o);
                     Ok(out)
                 }
                 Shape::Batch(rows) => {
@@ -184,7 +201,6 @@ impl NumericModel {
                     let ins: [&[f64]; K] = std::array::from_fn(|k| readonly[k].as_slice().expect("contiguous"));
                     // SAFETY: `out` is fresh and not visible to Python until returned.
                     let o = unsafe { out.as_slice_mut().expect("fresh array") };
-                    let model = &self.model;
                     py.detach(|| batched(model, ins, o, threads));
                     Ok(out)
                 }

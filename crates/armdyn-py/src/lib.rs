@@ -30,6 +30,7 @@ mod centroidal;
 mod derivatives;
 mod floating;
 mod floating_derivatives;
+mod free_root;
 mod scratch;
 mod simulate;
 
@@ -66,6 +67,9 @@ pub struct NumericModel {
     /// aba (and the kinematics and energies) then take Pinocchio's floating-base arrays, and
     /// every other method refuses.
     floating: bool,
+    /// For a floating base, the same robot hung from the world on a free joint
+    /// (`free_root.rs`): what the Coriolis matrix, `jacobian_dot` and the regressor run on.
+    free_root: Option<Model>,
 }
 
 /// Bodies (= movable joints, by coordinate index) whose subtree, themselves included,
@@ -322,6 +326,13 @@ impl NumericModel {
                     })?;
                 }
             }
+            let free_root = match base_inertia.filter(|_| floating) {
+                Some(inertia) => Some(
+                    free_root::free_rooted(&joints, gravity, (base_mass, base_com, inertia), &model.joint_dynamics)
+                        .map_err(|e| PyValueError::new_err(format!("the free-rooted model: {e}")))?,
+                ),
+                None => None,
+            };
             let link_index = link_names.iter().enumerate().map(|(k, s)| (s.clone(), k)).collect();
             let scratch = Mutex::new(Scratch::new(&model));
             let inert_joints = inert_bodies(&model).into_iter().map(|i| coordinate_names[i].clone()).collect();
@@ -335,6 +346,7 @@ impl NumericModel {
                 init_args,
                 inert_joints,
                 floating,
+                free_root,
             })
         })
     }
@@ -534,7 +546,9 @@ impl NumericModel {
         qd: &Bound<'py, PyAny>,
         threads: Option<i64>,
     ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        self.one_dof_only("coriolis_matrix")?;
+        if self.floating {
+            return self.coriolis_free_root(py, q, qd, threads);
+        }
         let n = self.model.nv;
         self.vector_op(
             py,

@@ -20,7 +20,9 @@ pub fn regressor<'py>(
     qdd: &Bound<'py, PyAny>,
     threads: Option<i64>,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    model.one_dof_only("regressor")?;
+    if model.floating {
+        return model.regressor_free_root(py, q, qd, qdd, threads);
+    }
     let n = model.model.nv;
     let cols = algo::regressor_columns(&model.model);
     model.vector_op(
@@ -36,5 +38,6 @@ pub fn regressor<'py>(
 /// The number of regressor columns of `model`.
 #[pyfunction]
 pub fn regressor_columns(model: &NumericModel) -> usize {
-    algo::regressor_columns(&model.model)
+    let dropped = if model.floating { crate::free_root::ROOT_JOINT_COLUMNS } else { 0 };
+    algo::regressor_columns(model.whole()) - dropped
 }

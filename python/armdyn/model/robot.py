@@ -25,6 +25,14 @@ _CACHES = ("_numeric_model", "_canonical")
 ROOT_JOINTS = (None, "free-flyer")
 
 
+#: what runs on a floating base and on joints of several coordinates, named by the refusals
+#: of what does not (yet)
+NUMERIC_EVERYWHERE = (
+    "armdyn.numeric's rnea, crba, aba, gravity, bias, their derivatives, minverse, forward_kinematics, "
+    "jacobian, jacobian_dot, coriolis_matrix, regressor and the energies, and armdyn.centroidal"
+)
+
+
 class Robot(metaclass=FreezeAfterInit):
     """A robot: links and joints in tree order, and gravity; its base fixed in the world,
     or floating (``root_joint="free-flyer"``).
@@ -513,10 +521,7 @@ class Robot(metaclass=FreezeAfterInit):
         floats: for the functions that handle a fixed base only (yet)."""
         if self.floating:
             raise FloatingBaseError(
-                f"{what} does not support a floating base (root_joint='free-flyer') yet; "
-                "armdyn.numeric's rnea, crba, aba, gravity, bias, their derivatives, minverse, forward_kinematics, "
-                "jacobian and energies, "
-                "and armdyn.centroidal, do",
+                f"{what} does not support a floating base (root_joint='free-flyer') yet; {NUMERIC_EVERYWHERE} do",
                 f"robot '{self.name}'",
                 self.meta.get("file"),
             )
@@ -530,9 +535,7 @@ class Robot(metaclass=FreezeAfterInit):
             more = f" and {len(self.multi_dof_joints) - 3} more" if len(self.multi_dof_joints) > 3 else ""
             raise ModelError(
                 f"{what} handles revolute and prismatic joints only (yet); this robot has joints of "
-                f"several coordinates: {named}{more}. armdyn.numeric's rnea, crba, aba, gravity, bias, "
-                "their derivatives, minverse, forward_kinematics, jacobian and energies, and "
-                "armdyn.centroidal's momentum matrix, take them",
+                f"several coordinates: {named}{more}. {NUMERIC_EVERYWHERE} take them",
                 f"robot '{self.name}'",
                 self.meta.get("file"),
             )

@@ -7,6 +7,7 @@ import numpy as np
 
 from ..errors import FloatingBaseError, ModelError
 from ..model import Robot
+from ..model.robot import NUMERIC_EVERYWHERE
 
 MAX_THREADS = 256
 
@@ -47,10 +48,7 @@ def require_fixed_base(robot, what: str) -> None:
         if isinstance(robot, Robot):
             robot.require_fixed_base(what)
         raise FloatingBaseError(
-            f"{what} does not support a floating base (root_joint='free-flyer') yet; rnea, crba, aba, "
-            "gravity, bias, the rnea, aba and gravity derivatives, minverse, forward_kinematics, jacobian, "
-            "the energies and "
-            "armdyn.centroidal do",
+            f"{what} does not support a floating base (root_joint='free-flyer') yet; {NUMERIC_EVERYWHERE} do",
             f"robot '{robot.name}'",
         )
 
@@ -76,6 +74,6 @@ def require_one_dof_joints(robot, what: str) -> None:
     if isinstance(nq, int) and isinstance(nv, int) and nq - nv != (1 if getattr(robot, "floating", False) else 0):
         raise ModelError(
             f"{what} handles revolute and prismatic joints only (yet); this model has joints of several "
-            f"coordinates (nq {nq}, nv {nv})",
+            f"coordinates (nq {nq}, nv {nv}); {NUMERIC_EVERYWHERE} take them",
             f"robot '{robot.name}'",
         )

@@ -156,7 +156,7 @@ def coriolis_matrix(robot: RobotLike, q: ArrayLike, qd: ArrayLike, *, threads: i
     C qd = h - g, and Mdot - 2C is skew-symmetric. q, qd: (n,) or (N, n).
     Returns (n, n) or (N, n, n).
     """
-    threads = fixed_base_threads(robot, threads, "coriolis_matrix")
+    threads = check_threads(threads)  # (a floating base too: free_root.rs)
     try:
         return compiled_model(robot).coriolis_matrix(q, qd, threads)
     except FloatingPointError:
@@ -204,7 +204,7 @@ def regressor(
       :func:`armdyn.identification.regressor`'s ``pi``;
     * ``columns="all"``: every movable joint's four columns ``[qdd, qd, sign(qd), 1]``.
     """
-    threads = fixed_base_threads(robot, threads, "regressor")
+    threads = check_threads(threads)  # (a floating base too: free_root.rs)
     if columns not in ("model", "all"):
         raise ValueError(f"columns must be 'model' or 'all', got {columns!r}")
     # parameters about each link's frame on its joint (Robot.canonical), as the symbolic
@@ -220,10 +220,12 @@ def regressor(
     if keep is None:
         if not isinstance(robot, Robot):
             raise TypeError("columns='model' needs the Robot (a NumericModel does not say which terms a joint has)")
-        first = 10 * len(robot.joints)
+        first = 10 * (len(robot.joints) + robot.floating)  # a floating base link has its ten
+        # one row of four columns per velocity coordinate (a joint of several coordinates has several)
+        rows = [j for j in robot.movable_joints for _ in range(j.nv)]
         extra = [
             first + 4 * i + k
-            for i, j in enumerate(robot.movable_joints)
+            for i, j in enumerate(rows)
             for k, name in enumerate(("armature", "damping", "friction", "torque_offset"))
             if getattr(j, name) is not None
         ]

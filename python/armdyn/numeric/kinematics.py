@@ -7,7 +7,7 @@ from numpy.typing import ArrayLike
 
 from .. import _core
 from ..model import Link, Robot
-from .checks import check_threads, fixed_base_threads, overflow_error
+from .checks import check_threads, overflow_error
 from .compiled import RobotLike, compiled_model, core_model, frame_offsets, mimic_model
 
 
@@ -99,7 +99,7 @@ def jacobian_dot(
     ``[v; w]`` in base-frame axes (Pinocchio's LOCAL_WORLD_ALIGNED), so that the link
     origin's acceleration and the link's angular acceleration are ``J qdd + Jdot qd``.
     link: a link name, index in ``list(robot.links)``, or Link."""
-    threads = fixed_base_threads(robot, threads, "jacobian_dot")
+    threads = check_threads(threads)  # (a floating base too: free_root.rs)
     try:
         if isinstance(link, Link):
             link = link.name

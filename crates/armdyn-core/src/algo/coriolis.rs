@@ -127,19 +127,24 @@ pub fn coriolis_matrix(
     update_xup(model, data, q);
     update_x0(model, data);
     for i in 0..n {
-        let kind = model.kind[i];
-        let vj = kind.s_times(qd[i]);
-        let v = match model.parent[i] {
+        let vj = model.kind[i].s_times(qd[i]);
+        data.v[i] = match model.parent[i] {
             Some(p) => data.xup[i].apply_motion(&data.v[p]) + vj,
             None => vj,
         };
-        data.v[i] = v;
-        // base-frame axis, velocity, axis derivative, inertia
+    }
+    for i in 0..n {
+        // base-frame axis, velocity, axis derivative, inertia. The axis turns with the
+        // body carrying its joint's child (itself for a 1-dof joint, where v_i x S_i =
+        // v_lambda x S_i; the last part for a joint of several coordinates, whose axes are
+        // constant in the child frame: Pinocchio's dJ = v_child x J).
         let x0 = &data.x0[i];
-        let s0 = x0.inv_apply_motion(&kind.s());
-        let v0 = x0.inv_apply_motion(&v);
+        let s0 = x0.inv_apply_motion(&model.kind[i].s());
+        let v0 = x0.inv_apply_motion(&data.v[i]);
+        let child = model.joint_child_body(i);
+        let v_child = data.x0[child].inv_apply_motion(&data.v[child]);
         work.s[i] = s0.to_array();
-        work.sdot[i] = v0.cross_motion(&s0).to_array();
+        work.sdot[i] = v_child.cross_motion(&s0).to_array();
         let i0 = model.inertia[i].tr_transform(x0);
         let i6 = rigid6(&i0);
         let iv = i0.mul_motion(&v0).to_array();

@@ -37,7 +37,9 @@ pub fn jacobian_dot(model: &Model, data: &mut Data<f64>, q: &[f64], qd: &[f64], 
     while let Some(j) = body {
         let (r0j, o) = data.x0[j].to_pose();
         let z = r0j.col(2);
-        let vj = data.v[j];
+        // the axis turns, and the point o moves, with the body carrying the joint's child
+        // (j itself for a 1-dof joint; the last part of a joint of several coordinates)
+        let vj = data.v[model.joint_child_body(j)];
         let zdot = vj.w.cross(z);
         let (top, bottom) = match model.kind[j] {
             JointKind::RevoluteZ => {
