@@ -251,26 +251,78 @@ def test_planar_pair_refused():
 
 
 @needs_pinocchio
-@pytest.mark.parametrize("frame", ["local", "world"])
-def test_external_wrenches_against_pinocchio(frame):
+@pytest.mark.parametrize("floating, frame", [(False, "local"), (False, "world"), (True, "local")])
+def test_external_wrenches_against_pinocchio(floating, frame):
     """rnea and aba with a wrench on every link (link frames, or the world frame about
-    its origin) against Pinocchio's rnea and aba with fext (joint frames)."""
-    robot, model = _hand_built(False)
+    its origin) and their derivatives against Pinocchio's with fext (joint frames). A
+    floating base: the derivatives, wrenches in the link frames (rnea and aba refuse)."""
+    robot, model = _hand_built(floating)
     data = model.createData()
     rng = np.random.default_rng(13)
     links = list(robot.links)
     joint_of = {j.child: j.name for j in robot.joints}
+    joint_of[robot.base] = "root"
+
+    def sym(A):
+        return np.triu(A) + np.triu(A, 1).T
+
     for _ in range(5):
         q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
         v, a = rng.normal(size=(2, model.nv))
         W = rng.normal(size=(len(links), 6))
-        W[0] = 0.0  # the base carries none (Pinocchio's universe)
+        if not floating:
+            W[0] = 0.0  # the base carries none (Pinocchio's universe)
         pin.forwardKinematics(model, data, q)
         fext = [pin.Force.Zero() for _ in range(model.njoints)]
-        for k, name in enumerate(links[1:], start=1):
+        for k, name in enumerate(links):
+            if k == 0 and not floating:
+                continue
             jid = model.getJointId(joint_of[name])
             wrench = pin.Force(W[k, :3], W[k, 3:])
             fext[jid] = wrench if frame == "local" else data.oMi[jid].actInv(wrench)
         tau = pin.rnea(model, data, q, v, a, fext)
-        np.testing.assert_allclose(an.rnea(robot, q, v, a, f_ext=W, frame=frame), tau, rtol=0, atol=1e-10)
-        np.testing.assert_allclose(an.aba(robot, q, v, tau, f_ext=W, frame=frame), a, rtol=0, atol=1e-9)
+        if not floating:
+            np.testing.assert_allclose(an.rnea(robot, q, v, a, f_ext=W, frame=frame), tau, rtol=0, atol=1e-10)
+            np.testing.assert_allclose(an.aba(robot, q, v, tau, f_ext=W, frame=frame), a, rtol=0, atol=1e-9)
+        rnea_d = an.rnea_derivatives(robot, q, v, a, f_ext=W, frame=frame)
+        aba_d = an.aba_derivatives(robot, q, v, tau, f_ext=W, frame=frame)
+        # a batch of two states (the second with twice the wrenches) row by row
+        twice = np.stack([W, 2 * W])
+        batch = an.rnea_derivatives(
+            robot, np.stack([q, q]), np.stack([v, v]), np.stack([a, a]), f_ext=twice, frame=frame
+        )
+        for x, single in zip(batch, rnea_d):
+            np.testing.assert_array_equal(x[0], single)
+        second = an.rnea_derivatives(robot, q, v, a, f_ext=2 * W, frame=frame)
+        for x, single in zip(batch, second):
+            np.testing.assert_array_equal(x[1], single)
+        if frame == "world":  # fixed in space: Pinocchio's fext turn with the joints, so differences
+            _check_by_differences(robot, q, v, a, tau, W, rnea_d, aba_d)
+            continue
+        pin.computeRNEADerivatives(model, data, q, v, a, fext)
+        for x, want in zip(rnea_d, (data.dtau_dq, data.dtau_dv, sym(data.M))):
+            np.testing.assert_allclose(x, want, rtol=0, atol=1e-9)
+        pin.computeABADerivatives(model, data, q, v, tau, fext)
+        for x, want in zip(aba_d, (data.ddq_dq, data.ddq_dv, sym(data.Minv))):
+            np.testing.assert_allclose(x, want, rtol=0, atol=1e-8)
+
+
+def _check_by_differences(robot, q, v, a, tau, W, rnea_d, aba_d):
+    """The derivatives with wrenches fixed in the world against central differences on
+    the tangent space (``q ⊕ h e_m``, armdyn's integrate, checked against Pinocchio's)."""
+    from armdyn.configuration import integrate
+
+    h = 1e-6
+
+    def rnea(q, v):
+        return an.rnea(robot, q, v, a, f_ext=W, frame="world")
+
+    def aba(q, v):
+        return an.aba(robot, q, v, tau, f_ext=W, frame="world")
+
+    for f, (d_dq, d_dv, _) in ((rnea, rnea_d), (aba, aba_d)):
+        for m, e in enumerate(np.eye(robot.nv)):
+            by_q = (f(integrate(robot, q, h * e), v) - f(integrate(robot, q, -h * e), v)) / (2 * h)
+            by_v = (f(q, v + h * e) - f(q, v - h * e)) / (2 * h)
+            np.testing.assert_allclose(d_dq[:, m], by_q, rtol=0, atol=1e-6 * (1 + np.abs(by_q).max()))
+            np.testing.assert_allclose(d_dv[:, m], by_v, rtol=0, atol=1e-6 * (1 + np.abs(by_v).max()))

@@ -11,7 +11,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
-fn parse_frame(frame: &str) -> PyResult<ForceFrame> {
+pub(crate) fn parse_frame(frame: &str) -> PyResult<ForceFrame> {
     match frame {
         "local" => Ok(ForceFrame::Local),
         "world" => Ok(ForceFrame::World),
@@ -281,7 +281,7 @@ macro_rules! derivatives_entry {
             let m = model.get();
             if m.model.has_multi() {
                 let rnea = stringify!($name) == "rnea_derivatives";
-                return crate::floating_derivatives::tangent(m, py, rnea, q, qd, $third, f_ext, threads, out);
+                return crate::floating_derivatives::tangent(m, py, rnea, q, qd, $third, f_ext, frame, threads, out);
             }
             if m.floating {
                 return $floating(m, py, q, qd, $third, f_ext, frame, threads, out);

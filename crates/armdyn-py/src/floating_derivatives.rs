@@ -7,7 +7,7 @@
 //! lane kernels of `batch_derivatives` (`threads` threads, the GIL released; bit for bit
 //! the single calls). External wrenches: in the link frames only (`frame="local"`).
 
-use crate::derivatives::{check_f_ext, outputs_given};
+use crate::derivatives::{check_f_ext, outputs_given, parse_frame};
 use crate::{all_finite, guard, new_array, slice, thread_arg, NumericModel, Scratch, Shape};
 use armdyn_core::algo::floating::{NQ_BASE, NV_BASE};
 use armdyn_core::algo::multi_derivatives::{aba_derivatives_multi, rnea_derivatives_multi, MultiWork};
@@ -40,7 +40,7 @@ fn run<'py, const K: usize, const R: usize>(
 ) -> PyResult<[Bound<'py, PyArrayDyn<f64>>; R]> {
     guard(|| {
         let threads = thread_arg(threads)?;
-        if f_ext.is_some() && frame != "local" {
+        if f_ext.is_some() && frame != "local" && m.floating {
             return Err(PyNotImplementedError::new_err(format!(
                 "{what}: f_ext with frame='{frame}' is not available for a floating base (root_joint='free-flyer'); \
                  give the wrenches in the link frames (frame='local')"
@@ -98,9 +98,14 @@ fn run<'py, const K: usize, const R: usize>(
     })
 }
 
+/// The core's wrenches in `frame`.
+fn with_frame(e: Ext<'_>, frame: ForceFrame) -> Option<ExternalForces<'_, f64>> {
+    e.map(|wrenches| ExternalForces { wrenches, frame })
+}
+
 /// The core's wrenches in the link frames.
 fn local(e: Ext<'_>) -> Option<ExternalForces<'_, f64>> {
-    e.map(|wrenches| ExternalForces { wrenches, frame: ForceFrame::Local })
+    with_frame(e, ForceFrame::Local)
 }
 
 /// ``(dtau_dq, dtau_dv, M)`` of a floating-base model from q (7 + n), v, a (6 + n).
@@ -198,8 +203,9 @@ pub(crate) fn minverse<'py>(
 /// (`algo::multi_derivatives`: the 1-dof sweep on the joints' parts, corrected to the
 /// tangent space): the
 /// RNEA's (`rnea = true`: `(dtau_dq, dtau_dv, M)` from `qdd`) or the ABA's
-/// (`(dqdd_dq, dqdd_dv, Minv)` from `tau`). No external wrenches yet; a batch runs row
-/// by row on one thread (the GIL released).
+/// (`(dqdd_dq, dqdd_dv, Minv)` from `tau`), with external wrenches (in the link frames
+/// on a floating base, as [`run`] checks); a batch runs row by row on one thread (the
+/// GIL released).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn tangent<'py>(
     m: &NumericModel,
@@ -209,42 +215,48 @@ pub(crate) fn tangent<'py>(
     v: &Bound<'py, PyAny>,
     third: &Bound<'py, PyAny>,
     f_ext: Option<&Bound<'py, PyAny>>,
+    frame: &str,
     threads: Option<i64>,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
     let what = if rnea { "rnea_derivatives" } else { "aba_derivatives" };
-    if f_ext.is_some() {
-        return Err(PyNotImplementedError::new_err(format!(
-            "{what}: f_ext is not available yet for joints of several coordinates"
-        )));
-    }
     let floating = m.floating;
     let (nq, nv) = m.widths();
-    let each = move |md: &Model, w: &mut MultiWork, [q, v, x]: [&[f64]; 3], [o0, o1, o2]: [&mut [f64]; 3]| {
+    let each = move |md: &Model,
+                     w: &mut MultiWork,
+                     [q, v, x]: [&[f64]; 3],
+                     e: Option<&ExternalForces<f64>>,
+                     [o0, o1, o2]: [&mut [f64]; 3]| {
         if rnea {
-            rnea_derivatives_multi(md, floating, w, q, v, x, o0, o1, o2)
+            rnea_derivatives_multi(md, floating, w, q, v, x, e, o0, o1, o2)
         } else {
-            aba_derivatives_multi(md, floating, w, q, v, x, o0, o1, o2)
+            aba_derivatives_multi(md, floating, w, q, v, x, e, o0, o1, o2)
         }
     };
     let args = [("q", q, nq), ("qd", v, nv), (if rnea { "qdd" } else { "tau" }, third, nv)];
+    let frame_of = parse_frame(frame)?;
     let o = run(
         m,
         py,
         what,
         args,
-        None,
-        "local",
+        f_ext,
+        frame,
         threads,
         out,
-        |md, sc, ins, _, outs| each(md, sc.multi_work.get_or_insert_with(|| MultiWork::new(md, floating)), ins, outs),
-        |md, ins, _, [o0, o1, o2], _| {
+        |md, sc, ins, e, outs| {
+            let w = sc.multi_work.get_or_insert_with(|| MultiWork::new(md, floating));
+            each(md, w, ins, with_frame(e, frame_of).as_ref(), outs)
+        },
+        |md, ins, e, [o0, o1, o2], _| {
             let mut w = MultiWork::new(md, floating);
-            let per = nv * nv;
+            let (per, width) = (nv * nv, 6 * md.nlinks());
             let outs = o0.chunks_exact_mut(per).zip(o1.chunks_exact_mut(per)).zip(o2.chunks_exact_mut(per));
             for (r, ((a, b), c)) in outs.enumerate() {
-                let row: [&[f64]; 3] = [&ins[0][r * nq..(r + 1) * nq], &ins[1][r * nv..(r + 1) * nv], &ins[2][r * nv..(r + 1) * nv]];
-                each(md, &mut w, row, [a, b, c]);
+                let row: [&[f64]; 3] =
+                    [&ins[0][r * nq..(r + 1) * nq], &ins[1][r * nv..(r + 1) * nv], &ins[2][r * nv..(r + 1) * nv]];
+                let e = e.map(|x| ExternalForces { wrenches: &x[r * width..(r + 1) * width], frame: frame_of });
+                each(md, &mut w, row, e.as_ref(), [a, b, c]);
             }
         },
     )?;

@@ -19,6 +19,10 @@
 //!   `dë/dε_m = -dJ/dε_m (a - Δ(v)) - d(J̇ ė)/dε_m`, whose second derivatives of `J` are
 //!   `[S_m, [S_m, S_k]]` and `[S_hi, [S_lo, S_k]]` (`ε`'s order in the product).
 //!
+//! External wrenches (in the link frames on a floating base) enter the chain's function:
+//! the sweep takes them, and `τ` in the last term is the torque with them (`τ = J^-T τ_ch`,
+//! whatever `τ_ch` holds).
+//!
 //! Joint friction and rotor inertia on a joint's coordinates act on its own velocity and
 //! acceleration (`Ia a + Fv v + ...`, as MuJoCo's armature and damping on a ball joint),
 //! outside the change of coordinates: the sweep's are taken out of `M`, `dtau/dv` and
@@ -26,6 +30,8 @@
 //!
 //! Arrays as `tangent_derivatives.rs` (a floating base's six first).
 
+use crate::algo::external::{generalized_forces, ExternalForces};
+use crate::algo::floating_derivatives::generalized_forces_floating;
 use crate::algo::floating_kinematics::base_widths;
 use crate::algo::{rnea, rnea_derivatives, rnea_derivatives_floating, rnea_floating};
 use crate::data::Data;
@@ -135,6 +141,8 @@ pub struct MultiWork {
     deriv: DerivData<f64>,
     a_chain: Vec<f64>,
     tau: Vec<f64>,
+    /// The external wrenches' generalized forces.
+    tau_ext: Vec<f64>,
     /// The ABA's accelerations and an (nv, nv) scratch ([`aba_derivatives_multi`]).
     acc: Vec<f64>,
     product: Vec<f64>,
@@ -149,6 +157,7 @@ impl MultiWork {
             deriv: DerivData::new(model),
             a_chain: vec![0.0; nv],
             tau: vec![0.0; nv],
+            tau_ext: vec![0.0; nv],
             acc: vec![0.0; nv],
             product: vec![0.0; nv * nv],
             algebras: model.multi.iter().map(|j| Algebra::new(j.kind)).collect(),
@@ -157,7 +166,8 @@ impl MultiWork {
 }
 
 /// `(dtau/dq, dtau/dv, M)` at `(q, v, a)` on the tangent space (see the module), each
-/// (nv, nv) row-major, `nv` with a floating base's six.
+/// (nv, nv) row-major, `nv` with a floating base's six; with the external wrenches `ext`
+/// (a fixed base only).
 #[allow(clippy::too_many_arguments)]
 pub fn rnea_derivatives_multi(
     model: &Model,
@@ -166,6 +176,7 @@ pub fn rnea_derivatives_multi(
     q: &[f64],
     v: &[f64],
     a: &[f64],
+    ext: Option<&ExternalForces<f64>>,
     dtau_dq: &mut [f64],
     dtau_dv: &mut [f64],
     m: &mut [f64],
@@ -182,11 +193,15 @@ pub fn rnea_derivatives_multi(
         }
     }
     if floating {
-        rnea_derivatives_floating(model, &mut w.data, &mut w.deriv, q, v, &w.a_chain, None, dtau_dq, dtau_dv, m);
+        rnea_derivatives_floating(model, &mut w.data, &mut w.deriv, q, v, &w.a_chain, ext, dtau_dq, dtau_dv, m);
         rnea_floating(model, &mut w.data, q, v, a, &mut w.tau);
     } else {
-        rnea_derivatives(model, &mut w.data, &mut w.deriv, q, v, &w.a_chain, None, dtau_dq, dtau_dv, m);
+        rnea_derivatives(model, &mut w.data, &mut w.deriv, q, v, &w.a_chain, ext, dtau_dq, dtau_dv, m);
         rnea(model, &mut w.data, q, v, a, &mut w.tau);
+    }
+    if let Some(e) = ext {
+        external_torques(model, floating, &mut w.data, &mut w.deriv, q, e, &mut w.tau_ext);
+        w.tau.iter_mut().zip(&w.tau_ext).for_each(|(t, x)| *t -= *x);
     }
     debug_assert_eq!(q.len(), model.nq + qb);
     for (j, alg) in model.multi.iter().zip(&w.algebras) {
@@ -244,7 +259,8 @@ pub fn rnea_derivatives_multi(
     }
 }
 
-/// `(da/dq, da/dv, M^-1)` at `(q, v, tau)`: with `a = aba(q, v, tau)`,
+/// `(da/dq, da/dv, M^-1)` at `(q, v, tau)` (and `ext`, as [`rnea_derivatives_multi`]):
+/// with `a = aba(q, v, tau)`,
 /// `da/dx = -M^-1 dtau/dx` (differentiate `M a + h = tau`), `dtau/dx` from
 /// [`rnea_derivatives_multi`].
 #[allow(clippy::too_many_arguments)]
@@ -255,14 +271,25 @@ pub fn aba_derivatives_multi(
     q: &[f64],
     v: &[f64],
     tau: &[f64],
+    ext: Option<&ExternalForces<f64>>,
     da_dq: &mut [f64],
     da_dv: &mut [f64],
     minv: &mut [f64],
 ) {
     let (mut acc, mut product) = (std::mem::take(&mut w.acc), std::mem::take(&mut w.product));
     forward_and_inverse(model, floating, &mut w.data, &mut w.deriv, q, v, tau, &mut acc, minv);
+    if let Some(e) = ext {
+        // a = aba(q, v, tau + tau_ext)
+        external_torques(model, floating, &mut w.data, &mut w.deriv, q, e, &mut w.tau_ext);
+        w.tau_ext.iter_mut().zip(tau).for_each(|(x, t)| *x += *t);
+        if floating {
+            crate::algo::aba_floating(model, &mut w.data, q, v, &w.tau_ext, &mut acc);
+        } else {
+            crate::algo::aba(model, &mut w.data, q, v, &w.tau_ext, &mut acc);
+        }
+    }
     // M goes into `product` (not needed), then dtau/dq and dtau/dv become -M^-1 times them
-    rnea_derivatives_multi(model, floating, w, q, v, &acc, da_dq, da_dv, &mut product);
+    rnea_derivatives_multi(model, floating, w, q, v, &acc, ext, da_dq, da_dv, &mut product);
     minus_minv_times(minv, [da_dq, da_dv], &mut product);
     (w.acc, w.product) = (acc, product);
 }
@@ -286,6 +313,23 @@ pub(crate) fn forward_and_inverse(
     } else {
         crate::algo::aba(model, data, q, v, tau, acc);
         crate::algo::minverse(model, data, deriv, q, minv);
+    }
+}
+
+/// `tau_ext = sum_L J_L^T w_L` (nv, a floating base's six first) of the wrenches `ext`.
+fn external_torques(
+    model: &Model,
+    floating: bool,
+    data: &mut Data<f64>,
+    deriv: &mut DerivData<f64>,
+    q: &[f64],
+    ext: &ExternalForces<f64>,
+    tau_ext: &mut [f64],
+) {
+    if floating {
+        generalized_forces_floating(model, data, deriv, q, ext, tau_ext);
+    } else {
+        generalized_forces(model, data, deriv, q, ext, tau_ext);
     }
 }
 

@@ -305,12 +305,12 @@ fn multi_dof_analytical_derivatives_equal_the_dual_number_ones() {
         let (v, x) = (rng.vec(nv, -2.0, 2.0), rng.vec(nv, -2.0, 2.0));
         let (mut mw, mut tw) = (MultiWork::new(&model, floating), TangentWork::new(&model, floating));
         let [mut a0, mut a1, mut a2, mut b0, mut b1, mut b2] = std::array::from_fn(|_| vec![0.0; nv * nv]);
-        rnea_derivatives_multi(&model, floating, &mut mw, &q, &v, &x, &mut a0, &mut a1, &mut a2);
+        rnea_derivatives_multi(&model, floating, &mut mw, &q, &v, &x, None, &mut a0, &mut a1, &mut a2);
         rnea_derivatives_tangent(&model, floating, &mut tw, &q, &v, &x, &mut b0, &mut b1, &mut b2);
         for (a, b, what) in [(&a0, &b0, "dtau_dq"), (&a1, &b1, "dtau_dv"), (&a2, &b2, "M")] {
             assert_close(a, b, 1e-9, what);
         }
-        aba_derivatives_multi(&model, floating, &mut mw, &q, &v, &x, &mut a0, &mut a1, &mut a2);
+        aba_derivatives_multi(&model, floating, &mut mw, &q, &v, &x, None, &mut a0, &mut a1, &mut a2);
         aba_derivatives_tangent(&model, floating, &mut tw, &q, &v, &x, &mut b0, &mut b1, &mut b2);
         for (a, b, what) in [(&a0, &b0, "da_dq"), (&a1, &b1, "da_dv"), (&a2, &b2, "Minv")] {
             assert_close(a, b, 1e-7, what);
