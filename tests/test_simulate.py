@@ -35,20 +35,10 @@ def pendulum(m=1.3, l=0.7, izz=0.02, gravity=(0.0, 0.0, -9.81), n_extra=0):
     around y."""
     eye = np.eye(3).tolist()
     inertia = np.diag([izz, izz, izz]).tolist()
-    return num.NumericModel(
-        [-1],
-        [0],
-        [eye],
-        [[0.0, 0.0, 0.0]],
-        [[0.0, 1.0, 0.0]],
-        [m],
-        [[0.0, 0.0, -l]],
-        [inertia],
-        list(gravity),
-        ["base", "bob"],
-        ["theta"],
-        "pendulum",
-    )
+    b = num.ModelBuilder("pendulum", list(gravity), "base")
+    k = b.add_joint("theta", "base", "bob", "revolute", eye, [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], ["theta"])
+    b.append_body(k, m, [0.0, 0.0, -l], inertia)
+    return b.build()
 
 
 @pytest.fixture(scope="module")

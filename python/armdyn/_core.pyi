@@ -4,10 +4,30 @@ class and lets everything else through as Any."""
 
 from typing import Any
 
-class NumericModel:
-    """A robot compiled for numeric evaluation (see armdyn.numeric.compile_model)."""
+class ModelBuilder:
+    """Builds a NumericModel joint by joint (crates/armdyn-py/src/builder.rs)."""
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None: ...
+    def __init__(self, name: str, gravity: Any, base: str, floating: bool = False) -> None: ...
+    def set_base_body(self, mass: Any, com: Any, inertia: Any) -> None: ...
+    def add_joint(
+        self,
+        name: str,
+        parent: str,
+        child: str,
+        kind: str,
+        rotation: Any,
+        xyz: Any,
+        axis: Any,
+        coordinates: list[str],
+        dynamics: Any = None,
+    ) -> int: ...
+    def append_body(self, joint: int, mass: Any, com: Any, inertia: Any) -> None: ...
+    def build(self) -> NumericModel: ...
+
+class NumericModel:
+    """A robot compiled for numeric evaluation (see armdyn.numeric.compile_model; built
+    by ModelBuilder)."""
+
     @property
     def dof(self) -> int: ...
     @property

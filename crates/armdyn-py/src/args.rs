@@ -215,4 +215,3 @@ pub(crate) fn thread_arg(threads: Option<i64>) -> PyResult<Option<usize>> {
         ))),
     }
 }
-

@@ -1,8 +1,9 @@
 //! `armdyn._core`: thin Python bindings of armdyn-core.
 //!
-//! One class, `NumericModel`: built once from a robot's numeric description (see
-//! `python/armdyn/numeric/`, which is the user-facing API and documents every
-//! function), holding the immutable model and a workspace for single calls.
+//! One class, `NumericModel`: built once from a robot's numeric description, joint by
+//! joint (`ModelBuilder`, `builder.rs`; `python/armdyn/numeric/` is the user-facing API
+//! and documents every function), holding the immutable model and a workspace for single
+//! calls.
 //!
 //! Every method takes one state `(n,)` or a batch `(N, n)` of float64 (anything else is
 //! converted once with `numpy.ascontiguousarray`) and answers in the same shape. Shape
@@ -14,27 +15,28 @@
 //! float64 `(n,)` ndarray is read in place (`plain_state`), the GIL is kept, and the
 //! result goes into an array of an earlier call that nobody holds any more (`OutputPool`).
 
-use armdyn_core::{algo, batch, JointDynamics, JointSpec, JointType, Model};
-
-mod regressor;
+use armdyn_core::{algo, batch, Model};
 use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyFloatingPointError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyFloat, PyString, PyTuple};
+use pyo3::types::{PyFloat, PyString};
 use std::collections::HashMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 
 mod args;
+mod builder;
 mod centroidal;
 mod derivatives;
 mod floating;
 mod floating_derivatives;
 mod free_root;
+mod regressor;
 mod scratch;
 mod simulate;
 
 pub(crate) use args::*;
+pub(crate) use builder::ModelBuilder;
 pub(crate) use scratch::*;
 
 /// Run `f`, turning a Rust panic into a Python `RuntimeError`.
@@ -58,8 +60,8 @@ pub struct NumericModel {
     link_names: Vec<String>,
     link_index: HashMap<String, usize>,
     coordinate_names: Vec<String>,
-    /// The constructor's arguments, for pickling (`__reduce__`).
-    init_args: Py<PyTuple>,
+    /// What built it, for pickling (`__reduce__`).
+    builder: ModelBuilder,
     /// Movable joints whose whole subtree has no mass and no inertia: M is singular
     /// and `aba` refuses (it would divide by zero).
     inert_joints: Vec<String>,
@@ -74,7 +76,7 @@ pub struct NumericModel {
 
 /// Bodies (= movable joints, by coordinate index) whose subtree, themselves included,
 /// has zero spatial inertia. Parents precede children, so one backward pass suffices.
-fn inert_bodies(model: &Model) -> Vec<usize> {
+pub(crate) fn inert_bodies(model: &Model) -> Vec<usize> {
     let mut inert: Vec<bool> = model.inertia.iter().map(|i| *i == Default::default()).collect();
     for i in (0..model.nv).rev() {
         if let Some(p) = model.parent[i] {
@@ -186,171 +188,6 @@ impl NumericModel {
 
 #[pymethods]
 impl NumericModel {
-    /// Build from the numeric description of a robot, joints in tree order (all of
-    /// them, fixed ones included), lists of length `nj`:
-    ///
-    /// parents[k]: index of the joint whose child link is joint k's parent (-1: base);
-    /// types[k]: 0 revolute, 1 prismatic, 2 fixed; rotations[k] (3x3): placement axes in
-    /// the parent link frame; translations[k] (3); axes[k] (3): unit axis in the placement
-    /// frame; masses[k], coms[k] (3), inertias[k] (3x3 about the com): joint k's child
-    /// link, in its frame; gravity (3) in the base frame. link_names: nj + 1 names (base
-    /// first); coordinate_names: the movable joints' names. base_mass and base_com (3,):
-    /// the base link, which only enters the potential energy (a constant).
-    /// joint_dynamics: None, or per movable joint `[armature, viscous, coulomb, offset]`
-    /// (docs/architecture.md: tau += Ia qdd + Fv qd + Fc sign(qd) + offset).
-    #[new]
-    #[pyo3(signature = (parents, types, rotations, translations, axes, masses, coms, inertias, gravity, link_names, coordinate_names, name = String::new(), base_mass = 0.0, base_com = [0.0; 3], joint_dynamics = None, base_inertia = None, floating = false))]
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        py: Python<'_>,
-        parents: Vec<i64>,
-        types: Vec<i64>,
-        rotations: Vec<[[f64; 3]; 3]>,
-        translations: Vec<[f64; 3]>,
-        axes: Vec<[f64; 3]>,
-        masses: Vec<f64>,
-        coms: Vec<[f64; 3]>,
-        inertias: Vec<[[f64; 3]; 3]>,
-        gravity: [f64; 3],
-        link_names: Vec<String>,
-        coordinate_names: Vec<String>,
-        name: String,
-        base_mass: f64,
-        base_com: [f64; 3],
-        joint_dynamics: Option<Vec<[f64; 4]>>,
-        base_inertia: Option<[[f64; 3]; 3]>,
-        floating: bool,
-    ) -> PyResult<Self> {
-        guard(|| {
-            let init_args = PyTuple::new(
-                py,
-                [
-                    parents.clone().into_pyobject(py)?.into_any(),
-                    types.clone().into_pyobject(py)?.into_any(),
-                    rotations.clone().into_pyobject(py)?.into_any(),
-                    translations.clone().into_pyobject(py)?.into_any(),
-                    axes.clone().into_pyobject(py)?.into_any(),
-                    masses.clone().into_pyobject(py)?.into_any(),
-                    coms.clone().into_pyobject(py)?.into_any(),
-                    inertias.clone().into_pyobject(py)?.into_any(),
-                    gravity.into_pyobject(py)?.into_any(),
-                    link_names.clone().into_pyobject(py)?.into_any(),
-                    coordinate_names.clone().into_pyobject(py)?.into_any(),
-                    name.clone().into_pyobject(py)?.into_any(),
-                    base_mass.into_pyobject(py)?.into_any(),
-                    base_com.into_pyobject(py)?.into_any(),
-                    // friction and rotor inertia travel too (a pickled model on a Dask worker)
-                    joint_dynamics.clone().into_pyobject(py)?.into_any(),
-                    base_inertia.into_pyobject(py)?.into_any(),
-                    floating.into_pyobject(py)?.to_owned().into_any(),
-                ],
-            )?
-            .unbind();
-            let nj = parents.len();
-            let lens = [
-                types.len(),
-                rotations.len(),
-                translations.len(),
-                axes.len(),
-                masses.len(),
-                coms.len(),
-                inertias.len(),
-            ];
-            if lens.iter().any(|&l| l != nj) || link_names.len() != nj + 1 {
-                return Err(PyValueError::new_err(format!(
-                    "inconsistent lengths: {nj} parents, {lens:?} per-joint arrays, {} link names",
-                    link_names.len()
-                )));
-            }
-            let mut joints = Vec::with_capacity(nj);
-            for k in 0..nj {
-                let jtype = match types[k] {
-                    0 => JointType::Revolute,
-                    1 => JointType::Prismatic,
-                    2 => JointType::Fixed,
-                    3 => JointType::Spherical,
-                    4 => JointType::Planar,
-                    5 => JointType::Free,
-                    t => return Err(PyValueError::new_err(format!("joint {k}: unknown joint type code {t}"))),
-                };
-                let parent = match parents[k] {
-                    -1 => None,
-                    p if p >= 0 => Some(p as usize),
-                    p => return Err(PyValueError::new_err(format!("joint {k}: bad parent index {p}"))),
-                };
-                joints.push(JointSpec {
-                    parent,
-                    jtype,
-                    rotation: rotations[k],
-                    translation: translations[k],
-                    axis: axes[k],
-                    mass: masses[k],
-                    com: coms[k],
-                    inertia: inertias[k],
-                });
-            }
-            if !(base_mass.is_finite() && base_com.iter().all(|x| x.is_finite())) {
-                return Err(PyValueError::new_err("base link: mass or com is not finite"));
-            }
-            let mut model = Model::new(&joints, gravity).map_err(|e| {
-                let what = match e.joint {
-                    Some(k) => format!("joint {k} (link '{}')", link_names[k + 1]),
-                    None => "model".into(),
-                };
-                PyValueError::new_err(format!("{what}: {}", e.message))
-            })?;
-            match base_inertia {
-                Some(inertia) => model
-                    .add_base_inertia(base_mass, base_com, inertia)
-                    .map_err(|e| PyValueError::new_err(format!("link '{}': {}", link_names[0], e.message)))?,
-                None => model.add_base_mass(base_mass, base_com),
-            }
-            if coordinate_names.len() != model.nv {
-                return Err(PyValueError::new_err(format!(
-                    "{} coordinate names for {} movable joints",
-                    coordinate_names.len(),
-                    model.nv
-                )));
-            }
-            if let Some(jd) = joint_dynamics {
-                if jd.len() != model.nv {
-                    return Err(PyValueError::new_err(format!(
-                        "joint_dynamics: {} rows for {} movable joints",
-                        jd.len(),
-                        model.nv
-                    )));
-                }
-                for (b, [armature, viscous, coulomb, offset]) in jd.into_iter().enumerate() {
-                    model.set_joint_dynamics(b, JointDynamics { armature, viscous, coulomb, offset }).map_err(|e| {
-                        PyValueError::new_err(format!("joint '{}': {}", coordinate_names[b], e.message))
-                    })?;
-                }
-            }
-            let free_root = match base_inertia.filter(|_| floating) {
-                Some(inertia) => Some(
-                    free_root::free_rooted(&joints, gravity, (base_mass, base_com, inertia), &model.joint_dynamics)
-                        .map_err(|e| PyValueError::new_err(format!("the free-rooted model: {e}")))?,
-                ),
-                None => None,
-            };
-            let link_index = link_names.iter().enumerate().map(|(k, s)| (s.clone(), k)).collect();
-            let scratch = Mutex::new(Scratch::new(&model));
-            let inert_joints = inert_bodies(&model).into_iter().map(|i| coordinate_names[i].clone()).collect();
-            Ok(NumericModel {
-                model,
-                scratch,
-                name,
-                link_names,
-                link_index,
-                coordinate_names,
-                init_args,
-                inert_joints,
-                floating,
-                free_root,
-            })
-        })
-    }
-
     /// Number of movable joints.
     #[getter]
     fn dof(&self) -> usize {
@@ -404,10 +241,11 @@ impl NumericModel {
         slf
     }
 
-    /// Pickling rebuilds the model from its constructor's arguments (so it travels to
-    /// other processes, e.g. Dask workers).
-    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> (Bound<'py, pyo3::types::PyType>, Bound<'py, PyTuple>) {
-        (slf.get_type(), slf.get().init_args.bind(slf.py()).clone())
+    /// Pickling rebuilds the model from its builder (so it travels to other processes,
+    /// e.g. Dask workers: friction and rotor inertia included).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (ModelBuilder,))> {
+        let build = slf.py().import("armdyn._core")?.getattr("_build")?;
+        Ok((build, (slf.get().builder.clone(),)))
     }
 
     fn __repr__(&self) -> String {
@@ -693,6 +531,8 @@ fn simd_kernels() -> &'static str {
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<NumericModel>()?;
+    m.add_class::<ModelBuilder>()?;
+    m.add_function(wrap_pyfunction!(builder::_build, m)?)?;
     m.add_function(wrap_pyfunction!(_test_panic, m)?)?;
     m.add_function(wrap_pyfunction!(simd_kernels, m)?)?;
     derivatives::register(m)?;

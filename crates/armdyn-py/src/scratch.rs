@@ -97,4 +97,3 @@ impl Scratch {
         (&mut self.data, deriv)
     }
 }
-

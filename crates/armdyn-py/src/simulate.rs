@@ -13,13 +13,13 @@
 use super::{guard, thread_arg, NumericModel};
 use armdyn_core::algo::integrate::{self, Input, Method, Outputs, Settings};
 use armdyn_core::algo::integrate_floating;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Condvar, Mutex};
-use std::time::Duration;
 use numpy::{PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Condvar, Mutex};
+use std::time::Duration;
 
 /// How often a waiting run looks at Python's signals.
 const SIGNAL_POLL: Duration = Duration::from_millis(50);
@@ -129,7 +129,9 @@ fn _simulate<'py>(
             other => return Err(PyValueError::new_err(format!("method: unknown '{other}'"))),
         };
         if !(dt.is_finite() && dt > 0.0) || stride == 0 {
-            return Err(PyValueError::new_err(format!("dt = {dt}, stride = {stride}: need dt > 0 finite, stride >= 1")));
+            return Err(PyValueError::new_err(format!(
+                "dt = {dt}, stride = {stride}: need dt > 0 finite, stride >= 1"
+            )));
         }
         let settings = Settings { method, dt, steps, stride };
         let q0 = data(&q0, "q0", &[rows, nq])?;
@@ -140,7 +142,12 @@ fn _simulate<'py>(
         let lower = data(&lower, "lower", &[n])?;
         let upper = data(&upper, "upper", &[n])?;
         let gains = || -> PyResult<_> {
-            Ok((data(&kp, "kp", &[n])?, data(&kd, "kd", &[n])?, data(&target, "target", &[rows, n])?, data(&target_qd, "target_qd", &[rows, n])?))
+            Ok((
+                data(&kp, "kp", &[n])?,
+                data(&kd, "kd", &[n])?,
+                data(&target, "target", &[rows, n])?,
+                data(&target_qd, "target_qd", &[rows, n])?,
+            ))
         };
         let input = match torque_kind {
             "zero" => Input::Zero,
@@ -175,7 +182,8 @@ fn _simulate<'py>(
         let (q, qd, qdd, tau) = (f(&[rows, s, nq]), f(&[rows, s, nv]), f(&[rows, s, nv]), f(&[rows, s, nv]));
         let (q_final, qd_final) = (f(&[rows, nq]), f(&[rows, nv]));
         let work = f(&[rows, s]);
-        let (limit_step, limit_joint, nonfinite_step, nonfinite_joint) = (i(&[rows]), i(&[rows]), i(&[rows]), i(&[rows]));
+        let (limit_step, limit_joint, nonfinite_step, nonfinite_joint) =
+            (i(&[rows]), i(&[rows]), i(&[rows]), i(&[rows]));
         {
             // SAFETY: fresh arrays, not visible to Python until returned.
             let out = unsafe {

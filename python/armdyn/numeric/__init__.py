@@ -59,13 +59,14 @@ from __future__ import annotations
 from .. import _core  # noqa: F401  (armdyn.numeric._core: the extension, for benchmarks comparing builds)
 from ..configuration import difference, integrate, neutral, random_configuration
 from .checks import MAX_THREADS, check_threads, require_fixed_base  # noqa: F401  (shared with simulate, dask)
-from .compiled import NumericModel, RobotLike, compile_model, compiled_model, core_model  # noqa: F401
+from .compiled import ModelBuilder, NumericModel, RobotLike, compile_model, compiled_model, core_model  # noqa: F401
 from .derivatives import aba_derivatives, gravity_derivatives, minverse, rnea_derivatives
 from .dynamics import aba, bias, coriolis_matrix, crba, gravity, kinetic_energy, potential_energy, regressor, rnea
 from .kinematics import REFERENCE_FRAMES, forward_kinematics, jacobian, jacobian_dot  # noqa: F401
 
 __all__ = [
     "NumericModel",
+    "ModelBuilder",
     "compile_model",
     "rnea",
     "crba",

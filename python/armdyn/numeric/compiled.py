@@ -16,12 +16,12 @@ from ..model import Robot
 #: (``gravity`` is ``gravity_torques`` there); attributes ``dof``, ``nlinks``,
 #: ``link_names``, ``coordinate_names``, ``gravity`` (3,), ``name``.
 NumericModel = _core.NumericModel
+#: builds a NumericModel joint by joint (crates/armdyn-py/src/builder.rs)
+ModelBuilder = _core.ModelBuilder
 
 #: what armdyn.numeric's functions accept as ``robot``: a bound Robot (compiled on first use,
 #: then cached on it) or an already compiled model
 RobotLike = Robot | NumericModel | MimicModel
-
-_TYPE_CODES = {"revolute": 0, "prismatic": 1, "fixed": 2, "spherical": 3, "planar": 4, "floating": 5}
 
 
 def _floats(values, where: str) -> list[float]:
@@ -74,66 +74,40 @@ def compile_model(robot: Robot | NumericModel | MimicModel) -> NumericModel | Mi
         )
     source = robot
     robot = robot.canonical()  # link frames on their joints; the dynamics are the same
-    joint_index = {j.child: k for k, j in enumerate(robot.joints)}
-    parents, types, rotations, translations, axes = [], [], [], [], []
-    masses, coms, inertias = [], [], []
-    for j in robot.joints:
-        where = f"joint '{j.name}'"
-        parents.append(joint_index.get(j.parent, -1))
-        types.append(_TYPE_CODES[j.type])
-        rotations.append(_field(j, "rotation", where))
-        translations.append(_field(j, "xyz", where))
-        axes.append(_field(j, "axis", where) if j.nv == 1 else [0.0, 0.0, 1.0])
-        link = robot.links[j.child]
-        where = f"link '{link.name}'"
-        masses.append(_field(link, "mass", where))
-        coms.append(_field(link, "com", where))
-        inertias.append(_field(link, "inertia", where))
-    # per movable joint [armature, viscous, coulomb, offset] (absent = 0); None when all zero
-    # one row per joint the compiled model frees (mimic joints too); a mimic joint's own
-    # friction and armature are not modelled (yet): zeros, as in the reference
-    # (a joint of several coordinates: its values on each of its velocity coordinates)
-    rows = [
-        [
-            0.0 if j.mimic is not None or j.floats(k) is None else float(j.floats(k))
-            for k in ("armature", "damping", "friction", "torque_offset")
-        ]
-        for j in robot.joints
-        if j.movable
-        for _ in range(j.nv)
-    ]
-    joint_dynamics = rows if any(any(row) for row in rows) else None
-    gravity_vec = _floats(robot.gravity, f"robot '{robot.name}'")
-    base = robot.links[robot.base]
-    where = f"link '{base.name}'"
+    where = f"robot '{robot.name}'"
     if robot.floating and robot.mimic_joints:
         raise FloatingBaseError(
-            "mimic joints with a floating base are not supported yet", f"robot '{robot.name}'", robot.meta.get("file")
+            "mimic joints with a floating base are not supported yet", where, robot.meta.get("file")
         )
+    base = robot.links[robot.base]
+    builder = ModelBuilder(robot.name, _floats(robot.gravity, where), base.name, floating=robot.floating)
+    here = f"link '{base.name}'"
     # a floating base moves: its own inertia counts (a fixed one only adds a constant potential)
-    base_inertia = _field(base, "inertia", where) if robot.floating else None
-    try:
-        core = NumericModel(
-            parents,
-            types,
-            rotations,
-            translations,
-            axes,
-            masses,
-            coms,
-            inertias,
-            gravity_vec,
-            list(robot.links),
-            [c for j in robot.joints for c in j.coordinate_names],
-            robot.name,
-            _field(base, "mass", where),
-            _field(base, "com", where),
-            joint_dynamics,
-            base_inertia,
-            robot.floating,
+    inertia = _field(base, "inertia", here) if robot.floating else np.zeros((3, 3)).tolist()
+    builder.set_base_body(_field(base, "mass", here), _field(base, "com", here), inertia)
+    for j in robot.joints:
+        here = f"joint '{j.name}'"
+        # friction, rotor inertia and offset on each of its velocity coordinates (absent = 0);
+        # a mimic joint's own are not modelled (yet): zeros, as in the reference
+        terms = [j.floats(k) if j.mimic is None else None for k in ("armature", "damping", "friction", "torque_offset")]
+        k = builder.add_joint(
+            j.name,
+            j.parent,
+            j.child,
+            j.type,
+            _field(j, "rotation", here),
+            _field(j, "xyz", here),
+            _field(j, "axis", here) if j.nv == 1 else [0.0, 0.0, 1.0],
+            list(j.coordinate_names),
+            [0.0 if t is None else float(t) for t in terms] if any(t is not None for t in terms) else None,
         )
+        link = robot.links[j.child]
+        here = f"link '{link.name}'"
+        builder.append_body(k, _field(link, "mass", here), _field(link, "com", here), _field(link, "inertia", here))
+    try:
+        core = builder.build()
     except ValueError as err:
-        raise ModelError(str(err), f"robot '{robot.name}'") from None
+        raise ModelError(str(err), where) from None
     # every non-fixed joint is free in `core`; see armdyn.mimic
     model = MimicModel(core, robot) if robot.mimic_joints else core
     source._numeric_model = model
