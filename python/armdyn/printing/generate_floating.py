@@ -31,11 +31,14 @@ direction (armdyn.numeric and Pinocchio want unit ones); a zero quaternion has n
 gives NaN or inf (the compiled library refuses it). The base's position does not enter
 the dynamics (the functions do not read it).
 
-The programs come from the symbolic Newton-Euler (:mod:`armdyn.symbolic.newton_euler_floating`,
-:mod:`armdyn.symbolic.newton_euler_spherical`) through SymPy's common-subexpression
-elimination: those derivations keep gravity in the base frame (``gb_x, gb_y, gb_z``) and a
-spherical joint's rotation (``ball.r11`` ... ``ball.r33``) as symbols, which the code
-computes first from the quaternions (the lines each function starts with).
+The programs run the symbolic Newton-Euler recursion (:mod:`armdyn.symbolic.newton_euler_floating`,
+:mod:`armdyn.symbolic.newton_euler_spherical`) with every step's vector a named line (a
+value met twice is one line; each sine and cosine computed once); M is its columns at
+rest under unit accelerations (Walker and Orin), on and above the diagonal. Those derivations
+keep gravity in the base frame (``gb_x, gb_y, gb_z``) and a spherical joint's rotation
+(``ball.r11`` ... ``ball.r33``) as symbols, which the code computes first from the
+quaternions (the lines each function starts with). Joint friction, rotor inertia and
+offsets are added as ``armdyn.derive`` adds them.
 """
 
 from __future__ import annotations
@@ -46,7 +49,7 @@ import sympy as sp
 
 from ..errors import FloatingBaseError, ModelError
 from ..model import Robot
-from ..programs.program import Builder, Program, from_expressions
+from ..programs.program import Builder, Program
 
 #: what codegen generates for these robots when not told
 DEFAULT_WHAT = ("tau", "M", "g", "bias")
@@ -204,29 +207,83 @@ def _conventions(robot: Robot, q, v) -> list[str]:
     return out
 
 
-def programs(robot: Robot, what) -> tuple[dict, dict, Layout]:
-    """The programs of ``what`` (tau, M, g, bias) from the symbolic Newton-Euler, each
-    starting with the preamble's lines it needs; their sources; the layout."""
-    from ..symbolic import derive
+def _named_sines(program: Program, builder: Builder) -> Program:
+    """The program with each sine and cosine a line of its own, read where it is used
+    (``sin_q1 = sin(q1)``: computed once; the C batch code takes them from its kernel)."""
+    exprs = [e for _, e in program.assignments] + [sp.sympify(e) for e in program.outputs]
+    found = sorted(set().union(*(e.atoms(sp.sin, sp.cos) for e in exprs)), key=sp.default_sort_key)
+    if not found:
+        return program
+    named = {f: builder.name(f"{type(f).__name__}_{f.args[0]}") for f in found}
+    lines = [(named[f], f) for f in found]
+    lines += [(t, e.xreplace(named)) for t, e in program.assignments]
+    return Program(lines, [sp.sympify(e).xreplace(named) for e in program.outputs], program.shape)
 
-    eom = derive(robot, "newton-euler")
-    found = layout(robot, eom.qd, eom.qdd)
-    nv = robot.nv
+
+def programs(robot: Robot, what) -> tuple[dict, dict, Layout]:
+    """The programs of ``what`` (tau, M, g, bias): the symbolic Newton-Euler's recursion
+    with every step's vector a named line (:class:`Builder`: a value met twice is one
+    line), joint friction, rotor inertia and offsets added as ``armdyn.derive`` adds them;
+    each program starts with the preamble's lines it needs. Also their sources and the
+    layout."""
+    from ..symbolic import newton_euler_spherical as spherical
+    from ..symbolic.joint_terms import armature, has_joint_terms, joint_torques
+    from ..symbolic.newton_euler import recursion
+    from ..symbolic.newton_euler_floating import (
+        BASE_ACCELERATION,
+        BASE_GRAVITY,
+        BASE_VELOCITY,
+        _check,
+        _floating_recursion,
+    )
+
+    nv, base = robot.nv, (6 if robot.floating else 0)
+    if robot.floating:
+        _check(robot)
+        v, a = [*BASE_VELOCITY, *robot.qd], [*BASE_ACCELERATION, *robot.qdd]
+    else:
+        spherical.check_joints(robot, "armdyn.codegen")
+        v, a = spherical.rates(robot)
+    found = layout(robot, v, a)
     reserved = robot.free_symbols() | {*found.q, *found.v, *found.a} | {s for s, _ in found.preamble}
-    derivation = "floating-base Newton-Euler" if robot.floating else "Newton-Euler with spherical joints"
-    programs, sources = {}, {}
-    for w in what:
-        if w == "M":
-            upper = [(i, j) for i in range(nv) for j in range(i, nv)]  # M is symmetric: half of it
-            prog = from_expressions([eom.M[i, j] for i, j in upper], (len(upper),), reserved=reserved)
-            at = {ij: k for k, ij in enumerate(upper)}
-            outputs = [prog.outputs[at[(min(i, j), max(i, j))]] for i in range(nv) for j in range(nv)]
-            prog, shape = Program(prog.assignments, outputs, (nv, nv)), (nv, nv)
-            sources[w] = f"{derivation}, unit accelerations (Walker-Orin), CSE"
+    builder = Builder(reserved=reserved | set(robot.q) | set(robot.qd) | set(robot.qdd))
+
+    def let(x, hint):
+        return sp.Matrix(builder.vector(x, hint)) if isinstance(x, sp.MatrixBase) and x.shape == (3, 1) else x
+
+    def tau(v, a, gravity: bool) -> list:
+        if robot.floating:
+            out = _floating_recursion(robot, v, a, BASE_GRAVITY if gravity else [0, 0, 0], let=let)
         else:
-            matrix = {"tau": eom.tau, "g": eom.g, "bias": eom.bias}[w]
-            shape = (nv,)
-            prog = from_expressions(list(matrix), shape, reserved=reserved)
-            sources[w] = f"{derivation}" + {"tau": "", "g": " at v = a = 0", "bias": " at a = 0"}[w] + ", CSE"
+            out = recursion(robot, v, a, -robot.gravity if gravity else sp.zeros(3, 1), let=let)
+        return list(out)
+
+    def with_joint_terms(rows, v, a) -> list:
+        if not has_joint_terms(robot):
+            return rows
+        extra = joint_torques(robot, v[base:], a[base:])
+        return rows[:base] + [r + e for r, e in zip(rows[base:], extra)]
+
+    zero = [0] * nv
+    derivation = "floating-base Newton-Euler" if robot.floating else "Newton-Euler with spherical joints"
+    outputs, sources = {}, {}
+    for w in what:
+        if w == "M":  # Walker-Orin: column j is tau at rest, no gravity, a = e_j; symmetric
+            columns = [tau(zero, [int(i == j) for i in range(nv)], False) for j in range(nv)]
+            ia = armature(robot)
+            for k in range(nv - base):
+                columns[base + k][base + k] += ia[k]
+            outputs[w] = [columns[max(i, j)][min(i, j)] for i in range(nv) for j in range(nv)]
+            sources[w] = f"{derivation}, unit accelerations (Walker-Orin)"
+        else:
+            vw, aw = {"tau": (v, a), "g": (zero, zero), "bias": (v, zero)}[w]
+            outputs[w] = with_joint_terms(tau(vw, aw, True), vw, aw)
+            sources[w] = derivation + {"tau": "", "g": " at v = a = 0", "bias": " at a = 0"}[w]
+        sources[w] += ", every step a named vector"
+    programs = {}
+    for w, out in outputs.items():
+        shape = (nv, nv) if w == "M" else (nv,)
+        prog = Program(list(builder.assignments), out, shape).pruned()
+        prog = _named_sines(prog, builder)
         programs[w] = Program(found.preamble + prog.assignments, prog.outputs, shape).pruned()
     return programs, sources, found
