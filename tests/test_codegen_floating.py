@@ -281,6 +281,32 @@ def test_fixed_base_bias_equals_the_core(name, tmp_path):
     assert lib.code.input_names == ("q", "qd", "qdd")
 
 
+@needs_cc
+def test_base_parameter_bias_equals_the_core(tmp_path):
+    """The bias in the base parameters (the customized Newton-Euler at qdd = 0 there), on
+    a planar 2R with every parameter symbolic."""
+    import sympy as sp
+    from test_codegen import _numeric, _random_value, _symbolic_planar_2r
+
+    from armdyn import identification
+
+    robot = _symbolic_planar_2r()
+    code = printing.codegen(robot, what="bias,g", base=True)
+    assert code.sources["bias"].endswith("at the base parameters")
+    rng = np.random.default_rng(7)
+    values = {name: _random_value(name, rng) for name in robot.parameters}
+    reg = identification.regressor(robot)
+    std = {
+        str(s): float(sp.sympify(e).xreplace({sp.Symbol(k): v for k, v in values.items()}))
+        for s, e in zip(reg.symbols, reg.pi)
+    }
+    std.update(values)
+    lib = printing.compile(code, directory=tmp_path)
+    bound = _numeric(robot, values)
+    q, qd = rng.uniform(-np.pi, np.pi, (2, 11, 2))
+    close(lib.bias(q, qd, p=code.parameter_values(std)), an.bias(bound, q, qd))
+
+
 # ----------------------------------------------------------------------- refusals
 def test_planar_and_floating_joints_in_the_tree_are_refused_by_name():
     body = Link("body", 1.0, (0.1, 0, 0), inertia(0.01, 0.01, 0.01))
@@ -295,6 +321,21 @@ def test_a_ball_joint_on_a_floating_base_is_refused():
     robot = Robot("x", list(robot.links.values()), list(robot.joints), root_joint="free-flyer")
     with pytest.raises(FloatingBaseError, match="spherical joint on a floating base yet \\(joint 'ball'\\)"):
         printing.codegen(robot, what="tau")
+
+
+def test_mimic_joints_beside_a_ball_joint_or_a_floating_base_are_refused():
+    from armdyn.model.joints import Mimic
+
+    robot = ball_mid_chain()
+    links = [*robot.links.values(), Link("extra", 0.3, [0.05, 0, 0], inertia(0.001, 0.002, 0.002))]
+    joints = [*robot.joints, Joint("m", "revolute", "tool", "extra", [0.1, 0, 0], mimic=Mimic("q2", 2.0, 0.1))]
+    with pytest.raises(ModelError, match="mimic joints beside spherical joints yet \\(joint 'm'\\)"):
+        printing.codegen(Robot("mimic", links, joints), what="tau")
+    floating = free_body()
+    links = [*floating.links.values(), Link("extra", 0.3, [0.05, 0, 0], inertia(0.001, 0.002, 0.002))]
+    joints = [*floating.joints, Joint("m", "revolute", "arm", "extra", [0.1, 0, 0], mimic=Mimic("q1", 2.0, 0.1))]
+    with pytest.raises(FloatingBaseError, match="mimic joints on a floating base yet \\(joint 'm'\\)"):
+        printing.codegen(Robot("mimic", links, joints, root_joint="free-flyer"), what="tau")
 
 
 def test_c_regressor_and_base_parameters_are_refused():

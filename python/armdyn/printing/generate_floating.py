@@ -21,8 +21,8 @@ and gives, in Pinocchio's order (``M(q) a + bias(q, v) = tau``):
 C is refused: the Christoffel matrix of M does not apply to quasi-velocities; ask for
 the bias. So are the regressor and ``base=True`` (armdyn.identification takes a fixed
 base with joints of one coordinate), planar and floating joints inside the tree, spherical
-joints on a floating base and mimic joints on one (the symbolic derivations do not take
-them yet).
+joints on a floating base (the symbolic derivations do not take them yet) and mimic joints
+with either (armdyn.numeric does not, to check the code against).
 
 Each quaternion is normalised inside the code: the rotation is that of ``q / |q|``,
 written with ``s = 2 / (x^2 + y^2 + z^2 + w^2)`` (``R = [[1 - s (y^2 + z^2), s (x y - w z),
@@ -95,9 +95,10 @@ def check_robot(robot: Robot) -> None:
             where,
             source,
         )
-    if robot.floating and robot.mimic_joints:
-        raise FloatingBaseError(
-            f"armdyn.codegen does not take mimic joints on a floating base yet (joint '{robot.mimic_joints[0].name}')",
+    if robot.mimic_joints:  # nothing to check such code against: armdyn.numeric refuses them too
+        beside = "on a floating base" if robot.floating else "beside spherical joints"
+        raise (FloatingBaseError if robot.floating else ModelError)(
+            f"armdyn.codegen does not take mimic joints {beside} yet (joint '{robot.mimic_joints[0].name}')",
             where,
             source,
         )
