@@ -189,6 +189,36 @@ def test_compiled_quadruped_equals_the_core_and_pinocchio(tmp_path, tmp_path_fac
         close(got["bias"][k], pin.nonLinearEffects(model, data, q, v))
 
 
+def test_one_free_body_is_newton_euler_by_hand():
+    """A rigid body alone, written here by hand (base frame, moment about its origin O,
+    COM at c, inertia I about the COM, gravity R^T g with R the quaternion's rotation):
+    f = m (vd + w x v - R^T g + wd x c + w x (w x c)), n = I wd + w x I w + c x f."""
+    robot = one_body()
+    code = printing.codegen(robot, what="tau,M", lang="numpy")
+    ns = _exec(code.source)
+    m, c = 2.5, np.array([0.1, -0.2, 0.3])
+    I = np.array([[0.3, 0.01, 0.02], [0.01, 0.4, 0.03], [0.02, 0.03, 0.5]])
+    rng = np.random.default_rng(12)
+    for q, v, a in zip(*states(robot, rng, count=5)):
+        x, y, z, w = q[3:7]
+        R = np.array(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+            ]
+        )
+        lin, om, lin_d, om_d = v[:3], v[3:], a[:3], a[3:]
+        f = m * (lin_d + np.cross(om, lin) - R.T @ np.array([0, 0, -9.81]) + np.cross(om_d, c))
+        f += m * np.cross(om, np.cross(om, c))
+        n = I @ om_d + np.cross(om, I @ om) + np.cross(c, f)
+        close(ns["one_body_tau"](q, v, a), np.concatenate([f, n]))
+        # M: the spatial inertia about O in the base frame
+        C = np.array([[0, -c[2], c[1]], [c[2], 0, -c[0]], [-c[1], c[0], 0]])
+        M = np.block([[m * np.eye(3), -m * C], [m * C, I - m * C @ C]])
+        close(ns["one_body_M"](q), M)
+
+
 @pytest.mark.parametrize("name", ["free-body", "ball-chain"])
 def test_python_and_numpy_code_equal_the_core(name):
     robot = ROBOTS[name]()
