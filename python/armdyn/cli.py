@@ -10,7 +10,8 @@
     armdyn exercise make KIND (--count N | --roster roster.csv) --seed S --out DIR
     armdyn links --roster roster.csv --base-url URL [--db URL] [--renew ID...]
     armdyn serve [--host H] [--port P] [--db URL] [--workers N] [--exercises DIR] [--instructor-token T]
-    armdyn codegen ROBOT [--what tau,M,C,g,regressor] [--base] [--lang c|python|numpy] [--bind] [--out DIR]
+    armdyn codegen ROBOT [--what tau,M,C,g,bias,regressor] [--base] [--lang c|python|numpy] [--bind] [--out DIR]
+                   [--root-joint free-flyer]
     armdyn simulate ROBOT --duration T --dt DT [--q0 ...] [--controller pd --target ...] [--plot run.png] [--animate run.gif] [--3d run.html]
 
 ROBOT is a bundled model's name (see ``armdyn robots``) or a model file (.yaml, .urdf, MJCF .xml).
@@ -243,7 +244,7 @@ def cmd_links(args) -> int:
 def cmd_codegen(args) -> int:
     from .printing import codegen, write_files
 
-    robot = _load(args.robot, args.allow_nonphysical, args.strict, args.trust_xacro)
+    robot = _load(args.robot, args.allow_nonphysical, args.strict, args.trust_xacro, args.root_joint)
     if args.bind:
         robot = robot.bind()
     code = codegen(robot, what=args.what, lang=args.lang, base=args.base)
@@ -445,13 +446,23 @@ def build_parser() -> argparse.ArgumentParser:
     hi.add_argument("--policy", choices=("latest", "best"), default="latest", help="which submission to write")
     hi.add_argument("--out", required=True, help="the folder to write into")
     hi.set_defaults(func=cmd_submissions)
-    cg = sub.add_parser("codegen", help="generate C, Python or NumPy code for tau, M, C, g, the regressor")
+    cg = sub.add_parser("codegen", help="generate C, Python or NumPy code for tau, M, C, g, the bias, the regressor")
     robot_arg(cg)
-    cg.add_argument("--what", default="tau,M,C,g", help="comma-separated: tau,M,C,g,regressor (default tau,M,C,g)")
+    cg.add_argument(
+        "--what",
+        help="comma-separated: tau,M,C,g,bias,regressor (default tau,M,C,g; tau,M,g,bias for a floating base "
+        "or spherical joints, where C does not apply)",
+    )
     cg.add_argument("--base", action="store_true", help="in the base parameters (needs armdyn.identification)")
     cg.add_argument("--lang", choices=["c", "python", "numpy"], default="c")
     cg.add_argument("--bind", action="store_true", help="bind the model's published parameter values first")
     cg.add_argument("--out", help="directory to write the source file into (default: print it)")
+    cg.add_argument(
+        "--root-joint",
+        choices=["free-flyer"],
+        help="the root link floats (a free-flyer base, as armdyn.load(path, root_joint=...)): the code takes "
+        "Pinocchio's q (base position, quaternion x y z w, joints), v and a (base twist, joint rates)",
+    )
     cg.set_defaults(func=cmd_codegen)
     m = sub.add_parser(
         "simulate",

@@ -11,7 +11,7 @@ Where each quantity comes from (all with the barycentric / standard inertial par
 of each link, the architecture's order: mass, first moment m c, inertia about the link origin):
 
 * tau: customized Newton-Euler (:mod:`armdyn.programs.customized_ne`);
-* g:   the same recursion with ``qd = qdd = 0``;
+* g:   the same recursion with ``qd = qdd = 0``; bias: with ``qdd = 0``;
 * M:   composite links (:mod:`armdyn.programs.composite_mass_matrix`);
 * C:   the Christoffel symbols of that M, its program differentiated line by line
   (:mod:`armdyn.programs.coriolis_program`);
@@ -40,7 +40,14 @@ vector ``p``, in :attr:`GeneratedCode.parameters` order (the header lists them, 
 definition of each barycentric one in the model's parameters).
 
 Conventions: ``M(q) qdd + C(q, qd) qd + g(q) = tau``, SI units, radians, joints in
-``robot.coordinate_names`` order; batches are ``(N, dof)`` row-major.
+``robot.coordinate_names`` order; batches are ``(N, dof)`` row-major. ``bias`` is
+``C(q, qd) qd + g(q)`` (the same recursion with ``qdd = 0``).
+
+A floating base (``root_joint="free-flyer"``) or spherical joints
+(:mod:`armdyn.printing.generate_floating`): the functions take Pinocchio's ``q`` (nq,),
+``v`` and ``a`` (nv,) (every quaternion x, y, z, w normalised in the code: the rotation of
+``q/|q|``) and give tau, M, g and bias in Pinocchio's order (the default ``what``); C,
+the regressor and ``base=True`` are refused with the reason.
 """
 
 from __future__ import annotations

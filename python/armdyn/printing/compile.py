@@ -21,7 +21,6 @@ import tempfile
 import numpy as np
 
 from .generate import GeneratedCode, codegen, identifier
-from .printers import INPUTS
 
 _DOUBLE_P = ctypes.POINTER(ctypes.c_double)
 
@@ -71,16 +70,20 @@ def build_shared_library(
 
 
 class CompiledFunction:
-    """One generated quantity, callable on (dof,) or (N, dof) float64 arrays.
+    """One generated quantity, callable on (w,) or (N, w) float64 arrays (w: each
+    input's width, ``dof``; for a floating base or spherical joints ``nq`` and ``nv``).
 
-    ``f(q, [qd, [qdd]], p=None)``: the inputs of :data:`~armdyn.printing.printers.INPUTS`;
-    ``p`` (len(parameters),) is required when the code has parameters. Wrong shapes,
-    NaN or inf raise ValueError naming the argument."""
+    ``f(q, [qd, [qdd]], p=None)``: the inputs of :meth:`GeneratedCode.inputs` (``q, v, a``
+    for a floating base or spherical joints); ``p`` (len(parameters),) is required when
+    the code has parameters. Wrong shapes, NaN or inf, and a zero quaternion in ``q``
+    raise ValueError naming the argument."""
 
     def __init__(self, lib, code, what):
         self.what = what
-        self.inputs = INPUTS[what]
-        self.dof = code.dof
+        inputs = code.inputs(what)
+        self.inputs = tuple(a for a, _ in inputs)
+        self.widths = tuple(len(symbols) for _, symbols in inputs)
+        self.quaternions = list(code.quaternions)
         self.shape = code.programs[what].shape
         self.n_parameters = len(code.parameters)
         self._fn = getattr(lib, code.functions[what] + "_batch")
@@ -93,15 +96,19 @@ class CompiledFunction:
                 f"{self.what} takes {', '.join(self.inputs)} ({len(self.inputs)} arrays), got {len(arrays)}"
             )
         checked, shape = [], None
-        for name, a in zip(self.inputs, arrays):
+        for name, width, a in zip(self.inputs, self.widths, arrays):
             a = np.ascontiguousarray(a, dtype=np.float64)
-            if a.ndim not in (1, 2) or a.shape[-1] != self.dof:
-                raise ValueError(f"{name} must have shape ({self.dof},) or (N, {self.dof}), got {a.shape}")
-            if shape is not None and a.shape != shape:
-                raise ValueError(f"{name} has shape {a.shape}, but {self.inputs[0]} has shape {shape}")
+            if a.ndim not in (1, 2) or a.shape[-1] != width:
+                raise ValueError(f"{name} must have shape ({width},) or (N, {width}), got {a.shape}")
+            if shape is not None and a.shape[:-1] != shape:
+                raise ValueError(f"{name} has shape {a.shape}, but {self.inputs[0]} has shape {checked[0].shape}")
             if not np.all(np.isfinite(a)):
                 raise ValueError(f"{name} contains NaN or inf")
-            shape = a.shape
+            if name == "q":
+                for k, whose in self.quaternions:
+                    if np.any(np.all(a[..., k : k + 4] == 0, axis=-1)):
+                        raise ValueError(f"q[{k}:{k + 4}], the quaternion of {whose}, is zero: it is no rotation")
+            shape = a.shape[:-1]
             checked.append(a)
         if self.n_parameters:
             if p is None:
@@ -113,7 +120,7 @@ class CompiledFunction:
                 raise ValueError("p contains NaN or inf")
         else:
             p = np.zeros(1)
-        batch = shape[:-1]
+        batch = shape
         n = int(np.prod(batch)) if batch else 1
         out = np.empty(batch + tuple(self.shape))
         self._fn(
@@ -149,13 +156,12 @@ class CompiledCode:
         return f"CompiledCode({self.code.robot_name!r}, {list(self.functions)}, path={self.path!r})"
 
 
-def compile(
-    code, what=("tau", "M", "C", "g"), *, base: bool = False, directory=None, cc: str | None = None, flags=()
-) -> CompiledCode:
+def compile(code, what=None, *, base: bool = False, directory=None, cc: str | None = None, flags=()) -> CompiledCode:
     """Build C code into a shared library and load it.
 
     code: a :class:`~armdyn.printing.GeneratedCode` in C, or a Robot / model name (then
-          :func:`armdyn.printing.codegen` generates ``what`` in C, with ``base``).
+          :func:`armdyn.printing.codegen` generates ``what`` in C, with ``base``; by default
+          tau, M, C, g, or tau, M, g, bias where C does not apply).
     directory: where the .c and .so go (a new temporary directory if None).
     cc: the compiler (default ``$CC``, then cc, gcc, clang); flags: extra arguments.
     Raises CompilerError when no compiler is found or it fails.

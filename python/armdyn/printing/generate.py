@@ -18,7 +18,10 @@ from ..symbolic import dag
 from .printers import INPUTS, Names, print_c, print_python
 from .safe_names import identifier_base
 
-QUANTITIES = ("tau", "M", "C", "g", "regressor")
+QUANTITIES = ("tau", "M", "C", "g", "bias", "regressor")
+#: what codegen generates when not told: C only where it applies (a fixed base, joints of
+#: one coordinate); elsewhere the bias C v + g (generate_floating.py)
+DEFAULT_WHAT = ("tau", "M", "C", "g")
 LANGUAGES = ("c", "python", "numpy")
 _SUFFIX = {"c": ".c", "python": ".py", "numpy": ".py"}
 
@@ -34,6 +37,12 @@ class GeneratedCode:
     parameters:  Symbols of the parameter vector ``p``, in order (empty for numbers).
     definitions: [(Symbol, expression of the model's parameters)] of the barycentric ones.
     programs:    quantity -> :class:`~armdyn.programs.program.Program`.
+    q, qd, qdd:  the symbols each input array holds, in order (:meth:`inputs`).
+    input_names: what the functions call the three arrays: ``q, qd, qdd``, or ``q, v, a``
+                 for a floating base or spherical joints (``q`` (nq,) in Pinocchio's
+                 layout, ``v`` and ``a`` (nv,): :mod:`.generate_floating`).
+    quaternions: ``[(first index in q, whose)]`` of the quaternions among the inputs.
+    conventions: header lines saying what the arrays hold (the fixed base's when empty).
     """
 
     robot_name: str
@@ -52,13 +61,26 @@ class GeneratedCode:
     functions: dict = field(default_factory=dict)
     op_counts: dict = field(default_factory=dict)
     names: Names | None = None
+    input_names: tuple = ("q", "qd", "qdd")
+    quaternions: list = field(default_factory=list)
+    conventions: list = field(default_factory=list)
+
+    def inputs(self, what: str) -> list[tuple[str, list]]:
+        """``[(argument name, its symbols in order)]`` of the function of ``what``."""
+        arrays = {"q": self.q, "qd": self.qd, "qdd": self.qdd}
+        role = {"q": 0, "qd": 1, "qdd": 2}
+        return [(self.input_names[role[r]], list(arrays[r])) for r in INPUTS[what]]
+
+    def input_widths(self) -> str:
+        """The arrays' widths, e.g. ``"q: 11, v: 10, a: 10"``."""
+        return ", ".join(f"{n}: {len(a)}" for n, a in zip(self.input_names, (self.q, self.qd, self.qdd)))
 
     def output_size(self, what: str) -> int:
         return int(np.prod(self.programs[what].shape))
 
     def describe(self, what: str) -> str:
         shape = " x ".join(str(d) for d in self.programs[what].shape)
-        return f"({shape}) of {', '.join(INPUTS[what])}; {self.sources[what]}"
+        return f"({shape}) of {', '.join(a for a, _ in self.inputs(what))}; {self.sources[what]}"
 
     @property
     def filename(self) -> str:
@@ -140,6 +162,8 @@ def _identification(what: str):
 
 
 def _parse_what(what) -> list[str]:
+    if what is None:
+        what = DEFAULT_WHAT
     if isinstance(what, str):
         what = [w.strip() for w in what.split(",") if w.strip()]
     what = list(what)
@@ -194,6 +218,10 @@ def _standard_programs(robot: Robot, what) -> tuple[dict, dict, list]:
             programs[w], extra = customized_newton_euler(robot, [0] * n, [0] * n, parameters=ne_params, turns=turns)
             definitions += _in_model_parameters(extra, definitions)
             sources[w] = "customized Newton-Euler at qd = qdd = 0"
+        elif w == "bias":
+            programs[w], extra = customized_newton_euler(robot, qdd=[0] * n, parameters=ne_params, turns=turns)
+            definitions += _in_model_parameters(extra, definitions)
+            sources[w] = "customized Newton-Euler at qdd = 0"
         elif w in ("M", "C"):
             if M_prog is None:
                 builder = Builder(reserved=reserved | set(robot.q) | set(robot.qd))
@@ -229,13 +257,18 @@ def _add_joint_terms(robot: Robot, programs: dict) -> None:
     """Joint friction, rotor inertia and torque offsets (docs/architecture.md: ``tau = M qdd + C qd +
     g + Ia qdd + Fv qd + Fc sign(qd) + offset``; :mod:`armdyn.symbolic.joint_terms`) added
     to the rigid-body outputs: all of them to tau, ``Ia`` to M's diagonal, the offset to
-    g (``g = tau(qd = 0, qdd = 0)``); C has none."""
+    g (``g = tau(qd = 0, qdd = 0)``), friction and offset to the bias (``tau(qdd = 0)``);
+    C has none."""
     from ..symbolic import joint_terms
 
     if not joint_terms.has_joint_terms(robot):
         return
     n = robot.dof
-    extra = {"tau": list(joint_terms.joint_torques(robot, robot.qd, robot.qdd)), "g": list(joint_terms.offsets(robot))}
+    extra = {
+        "tau": list(joint_terms.joint_torques(robot, robot.qd, robot.qdd)),
+        "g": list(joint_terms.offsets(robot)),
+        "bias": list(joint_terms.joint_torques(robot, robot.qd, [0] * n)),
+    }
     ia = joint_terms.armature(robot)
     extra["M"] = [ia[k // n] if k // n == k % n else 0 for k in range(n * n)]
     for w, terms in extra.items():
@@ -275,6 +308,8 @@ def _base_programs(robot: Robot, what) -> tuple[dict, dict, list]:
                 expr, shape = list(tau), (n,)
             elif w == "g":
                 expr, shape = list(tau.xreplace({s: 0 for s in list(robot.qd) + list(robot.qdd)})), (n,)
+            elif w == "bias":
+                expr, shape = list(tau.xreplace({s: 0 for s in robot.qdd})), (n,)
             elif w == "M":
                 expr, shape = list(tau.jacobian(robot.qdd)), (n, n)
             else:  # "C"
@@ -332,10 +367,12 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
     for w in what:
         if w == "tau":
             programs[w] = tau_prog
-        elif w == "g":
-            programs[w], _ = customized_newton_euler(robot, [0] * n, [0] * n, parameters=ne_params, turns=turns)
-            g_extra = extra.xreplace({s: 0 for s in states})
-            programs[w].outputs = [o + g_extra[i] for i, o in enumerate(programs[w].outputs)]
+        elif w in ("g", "bias"):
+            rest = states if w == "g" else list(robot.qdd)
+            qd = [0] * n if w == "g" else None
+            programs[w], _ = customized_newton_euler(robot, qd, [0] * n, parameters=ne_params, turns=turns)
+            w_extra = extra.xreplace({s: 0 for s in rest})
+            programs[w].outputs = [o + w_extra[i] for i, o in enumerate(programs[w].outputs)]
         elif w in ("M", "C") and M_prog is None:
             builder = Builder(reserved=reserved | {s for s, _ in defs})
             M_prog, _ = composite_mass_matrix(robot, parameters=params, builder=builder)
@@ -350,19 +387,25 @@ def _customized_base_programs(robot, ident, Yb, beta, definitions, what, reg=Non
         sources[w] = {
             "tau": "customized Newton-Euler",
             "g": "customized Newton-Euler at qd = qdd = 0",
+            "bias": "customized Newton-Euler at qdd = 0",
             "M": "composite links",
             "C": "Christoffel symbols of the composite-link M",
         }[w] + ", at the base parameters"
     return programs, sources, _in_model_parameters(defs, definitions, chained=True)
 
 
-def codegen(robot: Robot | str, what=("tau", "M", "C", "g"), lang: str = "c", base: bool = False) -> GeneratedCode:
+def codegen(robot: Robot | str, what=None, lang: str = "c", base: bool = False) -> GeneratedCode:
     """Generate code for ``what`` (quantities from ``QUANTITIES``, a sequence or a
-    comma-separated string) of ``robot`` (a Robot, bundled name or model file) in
-    ``lang`` ("c", "python", "numpy"). ``base=True``: in the base parameters
-    (needs :mod:`armdyn.identification`). Returns a :class:`GeneratedCode`.
+    comma-separated string; default tau, M, C, g, or tau, M, g, bias where C does not
+    apply) of ``robot`` (a Robot, bundled name or model file) in ``lang`` ("c",
+    "python", "numpy"). ``base=True``: in the base parameters (needs
+    :mod:`armdyn.identification`). Returns a :class:`GeneratedCode`.
 
-    Raises ValueError for an unknown quantity or language, or a robot of 0 dof.
+    A floating base or spherical joints: :mod:`.generate_floating` (inputs ``q, v, a``
+    in Pinocchio's layout; C, the regressor and ``base=True`` refused).
+
+    Raises ValueError for an unknown quantity or language, or a robot that does not move;
+    :class:`~armdyn.errors.ModelError` naming the joint for a joint codegen does not take.
     """
     if isinstance(robot, str):
         from ..io import load
@@ -370,16 +413,29 @@ def codegen(robot: Robot | str, what=("tau", "M", "C", "g"), lang: str = "c", ba
         robot = load(robot)
     if not isinstance(robot, Robot):
         raise TypeError(f"codegen: expected an armdyn.Robot or a model name, got {type(robot).__name__}")
-    robot.require_fixed_base("armdyn.codegen")
-    robot.require_one_dof_joints("armdyn.codegen")
-    what = _parse_what(what)
+    quasi = robot.floating or bool(robot.multi_dof_joints)
+    if quasi:
+        from . import generate_floating
+
+        generate_floating.check_robot(robot)
+        what = _parse_what(generate_floating.DEFAULT_WHAT if what is None else what)
+    else:
+        what = _parse_what(what)
     if lang not in LANGUAGES:
         raise ValueError(f"codegen: unknown language {lang!r}; choose from {', '.join(LANGUAGES)}")
-    if robot.dof == 0:
+    if robot.nv == 0:
         raise ValueError(f"codegen: robot '{robot.name}' has no movable joint")
-    programs, sources, definitions = (_base_programs if base else _standard_programs)(robot, what)
+    layout = None
+    if quasi:
+        generate_floating.check_what(robot, what, base)
+        programs, sources, layout = generate_floating.programs(robot, what)
+        definitions: list = []
+        q, qd, qdd = layout.q, layout.v, layout.a
+    else:
+        programs, sources, definitions = (_base_programs if base else _standard_programs)(robot, what)
+        q, qd, qdd = robot.q, robot.qd, robot.qdd
 
-    states = set(robot.q) | set(robot.qd) | set(robot.qdd)
+    states = set(q) | set(qd) | set(qdd)
     used = set()
     for prog in programs.values():
         for e in [e for _, e in prog.assignments] + list(prog.outputs):
@@ -394,15 +450,15 @@ def codegen(robot: Robot | str, what=("tau", "M", "C", "g"), lang: str = "c", ba
     prefix = identifier(robot.name)
     functions = {w: f"{prefix}_{w}" for w in programs}
     taken = [*functions.values(), *(f + "_batch" for f in functions.values())]
-    names = Names(list(dict.fromkeys([*robot.q, *robot.qd, *robot.qdd, *order, *temps])), taken=taken)
+    names = Names(list(dict.fromkeys([*q, *qd, *qdd, *order, *temps])), taken=taken)
     code = GeneratedCode(
         robot.name,
         lang,
         robot.dof,
         list(robot.coordinate_names),
-        robot.q,
-        robot.qd,
-        robot.qdd,
+        sp.Matrix(list(q)),
+        sp.Matrix(list(qd)),
+        sp.Matrix(list(qdd)),
         programs,
         sources,
         order,
@@ -412,5 +468,7 @@ def codegen(robot: Robot | str, what=("tau", "M", "C", "g"), lang: str = "c", ba
         op_counts={w: p.operation_counts() for w, p in programs.items()},
         names=names,
     )
+    if layout is not None:
+        code.input_names, code.quaternions, code.conventions = ("q", "v", "a"), layout.quaternions, layout.conventions
     code.source = print_c(code) if lang == "c" else print_python(code, numpy=(lang == "numpy"))
     return code

@@ -281,6 +281,7 @@ def recursion(
     steps: list[Step] | None = None,
     base_rotation=None,
     values: dict | None = None,
+    let=None,
 ) -> sp.Matrix:
     """tau (n x 1) for joint velocities ``qd`` and accelerations ``qdd`` (sequences of
     length n, symbols or numbers) with the base accelerating at ``base_acceleration``
@@ -289,7 +290,10 @@ def recursion(
     base_rotation: the base's ``(omega, omega_dot)`` (frame 0) when it turns (a floating
     base, newton_euler_floating.py); None: at rest. values: a dict that receives the
     steps' values (``"value"``: key -> link -> value), the children's placements
-    (``"placement"``) and the links' formula quantities (``"context"``)."""
+    (``"placement"``) and the links' formula quantities (``"context"``). let: ``(value,
+    hint) -> value`` applied to each step's value as computed (generated code names them
+    there: printing/generate_floating.py); None: kept as they are."""
+    let = let or (lambda x, hint: x)
     zero = sp.zeros(3, 1)
     value = {s.key: {} for s in NEWTON_EULER_STEPS}  # key -> link name -> value
     value["omega"][robot.base], value["omega_dot"][robot.base] = base_rotation or (zero, zero)
@@ -320,7 +324,7 @@ def recursion(
         context[name] = ctx
         for step in OUTWARD_STEPS:
             args = [value[key][parent if where == "parent" else name] for key, where in step.inputs]
-            value[step.key][name] = step.formula(ctx, *args)
+            value[step.key][name] = let(step.formula(ctx, *args), f"{step.key}{i}_")
         if record:
             outward += [
                 Step("outward", name, s.key, step_latex(s, i), value[s.key][name], s.meaning) for s in OUTWARD_STEPS
@@ -335,7 +339,7 @@ def recursion(
         for step in INWARD_STEPS:
             args = [value[key][name] for key, _ in step.inputs]
             kid_values = [(*placement[c], *(value[key][c] for key in step.children)) for c in kids]
-            value[step.key][name] = step.formula(context[name], *args, kid_values)
+            value[step.key][name] = let(step.formula(context[name], *args, kid_values), f"{step.key}{i}_")
         f_i, n_i = value["f"][name], value["n"][name]
         follow = robot.follows(joint)
         point = joint.joint_point(robot.joint_coordinate(joint)) if joint.type in TURNING else sp.zeros(3, 1)

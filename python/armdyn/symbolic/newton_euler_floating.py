@@ -117,18 +117,22 @@ def _vec(x) -> sp.Matrix:
     return sp.Matrix(list(x))
 
 
-def _floating_recursion(robot: Robot, v, a, g_b, steps: list[Step] | None = None) -> sp.Matrix:
+def _floating_recursion(robot: Robot, v, a, g_b, steps: list[Step] | None = None, let=None) -> sp.Matrix:
     """tau (6 + n) for the velocity ``v`` and acceleration ``a`` (6 + n each: base twist,
-    then joints) under gravity ``g_b`` (base frame). Appends the steps if given."""
+    then joints) under gravity ``g_b`` (base frame). Appends the steps if given; ``let``
+    as :func:`~.newton_euler.recursion`'s."""
+    let = let or (lambda x, hint: x)
     base = robot.links[robot.base]
     ctx = {"v": _vec(v[:3]), "w": _vec(v[3:6]), "vd": _vec(a[:3]), "wd": _vec(a[3:6]), "g": _vec(g_b)}
     ctx.update(m=base.mass, c=base.com, I=base.inertia)
     own: dict = {}
     for step in BASE_STEPS:
-        own[step.key] = step.formula(ctx, *(own[key] for key, _ in step.inputs))
+        own[step.key] = let(step.formula(ctx, *(own[key] for key, _ in step.inputs)), f"{step.key}0_")
     values: dict = {}
     arm: list[Step] | None = [] if steps is not None else None
-    joint_tau = recursion(robot, list(v[6:]), list(a[6:]), own["v_dot"], arm, (own["omega"], own["omega_dot"]), values)
+    joint_tau = recursion(
+        robot, list(v[6:]), list(a[6:]), own["v_dot"], arm, (own["omega"], own["omega_dot"]), values, let
+    )
     value, placement = values["value"], values["placement"]
     for key, x in own.items():
         value[key][robot.base] = x
@@ -136,7 +140,7 @@ def _floating_recursion(robot: Robot, v, a, g_b, steps: list[Step] | None = None
     for step in INWARD_STEPS:  # the base's inward rows: those of every link
         args = [value[key][robot.base] for key, _ in step.inputs]
         kid_values = [(*placement[k], *(value[key][k] for key in step.children)) for k in kids]
-        value[step.key][robot.base] = step.formula(ctx, *args, kid_values)
+        value[step.key][robot.base] = let(step.formula(ctx, *args, kid_values), f"{step.key}0_")
     f_b, n_b = value["f"][robot.base], value["n"][robot.base]
     if steps is not None and arm is not None:
         name = robot.base
