@@ -475,3 +475,39 @@ pub fn aba_derivatives_floating(
 pub fn minverse_floating(model: &Model, q: &[f64], out: &mut [f64], threads: Option<usize>) {
     drive(&MinverseFloating, model, &[q], None, [out, &mut [], &mut []], threads)
 }
+
+/// Batched [`algo::multi_derivatives`] (joints of several coordinates, fixed or floating
+/// base), one state at a time on each thread (the algorithm is `f64` only): `rnea` picks
+/// the RNEA's derivatives (`args = [q, v, a]`) or the ABA's (`[q, v, tau]`); `q` (N, nq),
+/// the others (N, nv), `nq`/`nv` with a floating base's 7/6; `ext` (N, nlinks, 6) as for
+/// the single call; `outs` (N, nv, nv) each.
+pub fn multi_derivatives(
+    model: &Model,
+    floating: bool,
+    rnea: bool,
+    args: [&[f64]; 3],
+    ext: Option<(&[f64], ForceFrame)>,
+    outs: [&mut [f64]; 3],
+    threads: Option<usize>,
+) {
+    use algo::multi_derivatives::{aba_derivatives_multi, rnea_derivatives_multi, MultiWork};
+    let (qb, vb) = algo::floating_kinematics::base_widths(floating);
+    let (nq, nv, ne) = (model.nq + qb, model.nv + vb, 6 * model.nlinks());
+    let per = nv * nv;
+    let rows = if per == 0 { 0 } else { outs[0].len() / per };
+    assert!(args[0].len() == rows * nq && args[1].len() == rows * nv && args[2].len() == rows * nv, "argument size");
+    let make = || MultiWork::new(model, floating);
+    par_rows(rows, outs, [per; 3], threads, make, |w, first, [o0, o1, o2]| {
+        let outs = o0.chunks_exact_mut(per).zip(o1.chunks_exact_mut(per)).zip(o2.chunks_exact_mut(per));
+        for (k, ((a, b), c)) in outs.enumerate() {
+            let r = first + k;
+            let (q, v, x) = (&args[0][r * nq..][..nq], &args[1][r * nv..][..nv], &args[2][r * nv..][..nv]);
+            let e = ext.map(|(e, frame)| ExternalForces { wrenches: &e[r * ne..][..ne], frame });
+            if rnea {
+                rnea_derivatives_multi(model, floating, w, q, v, x, e.as_ref(), a, b, c);
+            } else {
+                aba_derivatives_multi(model, floating, w, q, v, x, e.as_ref(), a, b, c);
+            }
+        }
+    });
+}

@@ -204,8 +204,8 @@ pub(crate) fn minverse<'py>(
 /// tangent space): the
 /// RNEA's (`rnea = true`: `(dtau_dq, dtau_dv, M)` from `qdd`) or the ABA's
 /// (`(dqdd_dq, dqdd_dv, Minv)` from `tau`), with external wrenches (in the link frames
-/// on a floating base, as [`run`] checks); a batch runs row by row on one thread (the
-/// GIL released).
+/// on a floating base, as [`run`] checks); a batch runs on `threads` threads, one state
+/// at a time on each (the GIL released).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn tangent<'py>(
     m: &NumericModel,
@@ -248,17 +248,7 @@ pub(crate) fn tangent<'py>(
             let w = sc.multi_work.get_or_insert_with(|| MultiWork::new(md, floating));
             each(md, w, ins, with_frame(e, frame_of).as_ref(), outs)
         },
-        |md, ins, e, [o0, o1, o2], _| {
-            let mut w = MultiWork::new(md, floating);
-            let (per, width) = (nv * nv, 6 * md.nlinks());
-            let outs = o0.chunks_exact_mut(per).zip(o1.chunks_exact_mut(per)).zip(o2.chunks_exact_mut(per));
-            for (r, ((a, b), c)) in outs.enumerate() {
-                let row: [&[f64]; 3] =
-                    [&ins[0][r * nq..(r + 1) * nq], &ins[1][r * nv..(r + 1) * nv], &ins[2][r * nv..(r + 1) * nv]];
-                let e = e.map(|x| ExternalForces { wrenches: &x[r * width..(r + 1) * width], frame: frame_of });
-                each(md, &mut w, row, e.as_ref(), [a, b, c]);
-            }
-        },
+        |md, ins, e, outs, t| bd::multi_derivatives(md, floating, rnea, ins, e.map(|e| (e, frame_of)), outs, t),
     )?;
     PyTuple::new(py, o)
 }
