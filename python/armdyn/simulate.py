@@ -80,6 +80,7 @@ from . import _core
 from .configuration import rotate_vector
 from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy, require_fixed_base
 from .numeric.checks import require_one_dof_joints
+from .simulate_control import controller_arrays, simulate_callable
 from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
 __all__ = ["simulate", "simulate_adaptive", "Trajectory", "PD", "ComputedTorque", "joint_limits"]
@@ -116,15 +117,6 @@ def _per_joint(x, name, dof):
     if not np.all(np.isfinite(a)):  # the shape is right: say what is wrong instead
         raise ValueError(f"{name} contains NaN or inf")
     return _c(a)
-
-
-def _per_state(x, name, rows, dof):
-    if x is None:
-        return np.zeros((rows, dof))
-    a = np.asarray(x, dtype=float)
-    if a.shape not in ((dof,), (rows, dof)) or not np.all(np.isfinite(a)):
-        raise ValueError(f"{name}: expected finite ({dof},) or ({rows}, {dof}) values, got shape {a.shape}")
-    return _c(np.broadcast_to(a, (rows, dof)))
 
 
 def step_count(duration, steps, dt) -> int:
@@ -232,30 +224,14 @@ def simulate(
 
     if torque is not None and controller is not None:
         raise ValueError("give torque or controller, not both")
-    if floating and (controller is not None or callable(torque)):
-        require_fixed_base(robot, "armdyn.simulate with a controller or a torque callable")
-    if controller is not None or callable(torque):
-        require_one_dof_joints(robot, "armdyn.simulate with a controller or a torque callable")
     empty = np.zeros(0)
     args = dict(torque=empty, kp=empty, kd=empty, target=empty, target_qd=empty)
     if callable(torque):
-        out = _simulate_python(model, q0a, qd0a, torque, dt, steps, stride, method, lower, upper)
+        out = simulate_callable(robot, model, q0a, qd0a, torque, dt, steps, stride, method, lower, upper)
     else:
         if controller is not None:
-            if isinstance(controller, PD):
-                kind = "pd-gravity" if controller.gravity_compensation else "pd"
-            elif isinstance(controller, ComputedTorque):
-                kind = "computed-torque"
-            else:
-                raise ValueError(
-                    f"controller must be an armdyn.simulate.PD or ComputedTorque, got {type(controller).__name__}"
-                )
-            args.update(
-                kp=_per_joint(controller.kp, "controller.kp", dof),
-                kd=_per_joint(controller.kd, "controller.kd", dof),
-                target=_per_state(controller.target, "controller.target", rows, dof),
-                target_qd=_per_state(controller.target_qd, "controller.target_qd", rows, dof),
-            )
+            kind, gains = controller_arrays(robot, model, controller, q0a)
+            args.update(gains)
         elif torque is None:
             kind = "zero"
         else:
@@ -396,113 +372,6 @@ def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower,
     out["q_final"], out["qd_final"] = q, qd
     if done < steps:
         progress(steps, steps)
-    return out
-
-
-def _simulate_python(model, q0, qd0, torque, dt, steps, stride, method, lower, upper):
-    """The slow path: a NumPy loop calling ``torque(t, q, qd)`` (q, qd (N, dof)) at every
-    stage, ``aba`` batched over the states in Rust."""
-    rows, dof = q0.shape
-    samples = steps // stride + 1
-    out = {name: np.empty((rows, samples, dof)) for name in ("q", "qd", "qdd", "tau")}
-    out["work"] = np.empty((rows, samples))
-    work = np.zeros(rows)  # of the torque, integrated by the same method as the state
-    limit_step = np.full(rows, -1, dtype=np.int64)
-    limit_joint = np.full(rows, -1, dtype=np.int64)
-    nonfinite = np.full(rows, -1, dtype=np.int64)
-    nonfinite_joint = np.full(rows, -1, dtype=np.int64)
-
-    def tau_at(k, t, q, qd):
-        try:
-            tau = torque(t, q.copy(), qd.copy())
-        except Exception as err:  # noqa: BLE001 - the user's error, shown with the step
-            raise ValueError(
-                f"torque callable failed at step {k} (t = {t:.6g} s): {type(err).__name__}: {err}"
-            ) from err
-        if np.iscomplexobj(tau):  # float() would drop the imaginary part with only a warning
-            raise ValueError(f"torque callable returned complex values at step {k} (t = {t:.6g} s); torques are real")
-        try:
-            tau = np.asarray(tau, dtype=float)
-        except (TypeError, ValueError):
-            raise ValueError(f"torque callable returned a non-numeric value at step {k} (t = {t:.6g} s)") from None
-        if tau.shape not in ((dof,), (rows, dof)):
-            raise ValueError(
-                f"torque callable returned shape {tau.shape} at step {k} (t = {t:.6g} s); "
-                f"expected ({dof},) or ({rows}, {dof})"
-            )
-        return _c(np.broadcast_to(tau, (rows, dof)))
-
-    def acc(k, t, q, qd):
-        live = nonfinite < 0
-        if not live.all():  # diverged states stopped: finite stand-ins, their samples are dropped
-            q, qd = np.where(live[:, None], q, 0.0), np.where(live[:, None], qd, 0.0)
-        tau = tau_at(k, t, q, qd)
-        try:
-            return model.aba(_c(q), _c(qd), tau, None), tau
-        except ValueError:
-            pass
-        # no finite acceleration for some state (velocities so large that the dynamics
-        # overflow: a diverging run): that state stops here, the others go on
-        a = np.full_like(q, np.nan)
-        for i in np.flatnonzero(live):
-            try:
-                a[i] = model.aba(q[i], qd[i], tau[i], None)
-            except ValueError:
-                nonfinite[i], nonfinite_joint[i] = k, int(np.argmax(np.abs(qd[i])))
-        return a, tau
-
-    def check(k, q, qd):
-        outside = (q < lower) | (q > upper)
-        new = (limit_step < 0) & outside.any(axis=1)
-        limit_step[new], limit_joint[new] = k, outside[new].argmax(axis=1)
-        finite = np.isfinite(q + qd)
-        bad = (nonfinite < 0) & ~finite.all(axis=1)
-        nonfinite[bad], nonfinite_joint[bad] = k, (~finite[bad]).argmax(axis=1)
-
-    q, qd = q0.copy(), qd0.copy()
-    check(0, q, qd)
-    h = dt
-    with np.errstate(over="ignore", invalid="ignore"):  # a diverging state is reported, not warned about
-        for k in range(steps + 1):
-            t = k * dt
-            if k < steps or k % stride == 0:
-                a1, tau1 = acc(k, t, q, qd)
-            if k % stride == 0:
-                s = k // stride
-                out["q"][:, s], out["qd"][:, s], out["qdd"][:, s], out["tau"][:, s] = q, qd, a1, tau1
-                out["work"][:, s] = work
-            if k == steps:
-                break
-            if method == "euler":
-                work = work + h * (tau1 * qd).sum(axis=1)
-                qd = qd + h * a1
-                q = q + h * qd
-            else:
-                q2, qd2 = q + h / 2 * qd, qd + h / 2 * a1
-                a2, tau2 = acc(k, t + h / 2, q2, qd2)
-                q3, qd3 = q + h / 2 * qd2, qd + h / 2 * a2
-                a3, tau3 = acc(k, t + h / 2, q3, qd3)
-                q4, qd4 = q + h * qd3, qd + h * a3
-                a4, tau4 = acc(k, t + h, q4, qd4)
-                work = work + h / 6 * (
-                    (tau1 * qd).sum(axis=1)
-                    + 2 * (tau2 * qd2).sum(axis=1)
-                    + 2 * (tau3 * qd3).sum(axis=1)
-                    + (tau4 * qd4).sum(axis=1)
-                )
-                q = q + h / 6 * (qd + 2 * qd2 + 2 * qd3 + qd4)
-                qd = qd + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
-            check(k + 1, q, qd)
-            if (nonfinite >= 0).all():
-                break
-    out.update(
-        q_final=q,
-        qd_final=qd,
-        limit_step=limit_step,
-        limit_joint=limit_joint,
-        nonfinite_step=nonfinite,
-        nonfinite_joint=nonfinite_joint,
-    )
     return out
 
 

@@ -13,13 +13,14 @@
 use super::{guard, thread_arg, NumericModel};
 use armdyn_core::algo::integrate::{self, Input, Method, Outputs, Settings};
 use armdyn_core::algo::integrate_floating;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Condvar, Mutex};
-use std::time::Duration;
+use armdyn_core::algo::manifold::Manifold;
 use numpy::{PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Condvar, Mutex};
+use std::time::Duration;
 
 /// How often a waiting run looks at Python's signals.
 const SIGNAL_POLL: Duration = Duration::from_millis(50);
@@ -81,8 +82,9 @@ fn data<'a>(a: &'a PyReadonlyArrayDyn<'_, f64>, name: &str, shape: &[usize]) -> 
 /// A floating-base model or one with joints of several coordinates
 /// (`algo::integrate_floating`): `q0`, `q`, `q_final` have the model's `nq` columns
 /// (7 more with a floating base), `qd0`, the torques and the other outputs `nv` (6
-/// more); lower, upper stay (dof,); only the torque kinds "zero", "constant", "series"
-/// and "series-per-state".
+/// more); lower, upper stay (dof,); the controllers' kp, kd, target_qd are (nv,) and
+/// (N, nv), target (N, nq), at those widths (a floating base's rows are not actuated);
+/// "computed-torque" is refused with a floating base.
 ///
 /// torque_kind: "zero", "constant" (torque (N, nv)), "series" (torque (steps, nv)),
 /// "series-per-state" (torque (N, steps, nv)), "pd", "pd-gravity", "computed-torque"
@@ -129,7 +131,9 @@ fn _simulate<'py>(
             other => return Err(PyValueError::new_err(format!("method: unknown '{other}'"))),
         };
         if !(dt.is_finite() && dt > 0.0) || stride == 0 {
-            return Err(PyValueError::new_err(format!("dt = {dt}, stride = {stride}: need dt > 0 finite, stride >= 1")));
+            return Err(PyValueError::new_err(format!(
+                "dt = {dt}, stride = {stride}: need dt > 0 finite, stride >= 1"
+            )));
         }
         let settings = Settings { method, dt, steps, stride };
         let q0 = data(&q0, "q0", &[rows, nq])?;
@@ -140,7 +144,12 @@ fn _simulate<'py>(
         let lower = data(&lower, "lower", &[n])?;
         let upper = data(&upper, "upper", &[n])?;
         let gains = || -> PyResult<_> {
-            Ok((data(&kp, "kp", &[n])?, data(&kd, "kd", &[n])?, data(&target, "target", &[rows, n])?, data(&target_qd, "target_qd", &[rows, n])?))
+            Ok((
+                data(&kp, "kp", &[nv])?,
+                data(&kd, "kd", &[nv])?,
+                data(&target, "target", &[rows, nq])?,
+                data(&target_qd, "target_qd", &[rows, nv])?,
+            ))
         };
         let input = match torque_kind {
             "zero" => Input::Zero,
@@ -157,14 +166,16 @@ fn _simulate<'py>(
             }
             other => return Err(PyValueError::new_err(format!("torque_kind: unknown '{other}'"))),
         };
-        if manifold && matches!(input, Input::Pd { .. } | Input::ComputedTorque { .. }) {
+        if floating && matches!(input, Input::ComputedTorque { .. }) {
             let name = &model.get().name;
-            if floating {
-                return Err(PyValueError::new_err(format!(
-                    "torque_kind '{torque_kind}': controllers are fixed-base only ('{name}' floats)"
-                )));
+            return Err(PyValueError::new_err(format!(
+                "torque_kind 'computed-torque': '{name}' has a floating base, which no torque actuates"
+            )));
+        }
+        if manifold {
+            if let Input::Pd { target, .. } | Input::ComputedTorque { target, .. } = input {
+                model.get().check_unit_blocks(target)?;
             }
-            model.get().one_dof_only(&format!("simulate with the controller '{torque_kind}'"))?;
         }
         if matches!(input, Input::Series { .. }) && steps == 0 {
             return Err(PyValueError::new_err("a torque series needs at least one step"));
@@ -175,7 +186,8 @@ fn _simulate<'py>(
         let (q, qd, qdd, tau) = (f(&[rows, s, nq]), f(&[rows, s, nv]), f(&[rows, s, nv]), f(&[rows, s, nv]));
         let (q_final, qd_final) = (f(&[rows, nq]), f(&[rows, nv]));
         let work = f(&[rows, s]);
-        let (limit_step, limit_joint, nonfinite_step, nonfinite_joint) = (i(&[rows]), i(&[rows]), i(&[rows]), i(&[rows]));
+        let (limit_step, limit_joint, nonfinite_step, nonfinite_joint) =
+            (i(&[rows]), i(&[rows]), i(&[rows]), i(&[rows]));
         {
             // SAFETY: fresh arrays, not visible to Python until returned.
             let out = unsafe {
@@ -223,7 +235,65 @@ fn _simulate<'py>(
     })
 }
 
+/// The model's manifold (a floating base's first) and `a`, `b` (N, wa), (N, wb) checked.
+fn manifold_rows<'a>(
+    model: &Bound<'_, NumericModel>,
+    a: &'a PyReadonlyArrayDyn<'_, f64>,
+    b: &'a PyReadonlyArrayDyn<'_, f64>,
+    names: [&str; 2],
+    widths: impl Fn(&Manifold) -> (usize, usize),
+) -> PyResult<(Manifold, &'a [f64], &'a [f64])> {
+    let manifold = Manifold::new(&model.get().model, model.get().floating);
+    let (wa, wb) = widths(&manifold);
+    let rows = a.shape().first().copied().unwrap_or(0);
+    Ok((manifold, data(a, names[0], &[rows, wa])?, data(b, names[1], &[rows, wb])?))
+}
+
+/// `q (+) xi` row by row (`q` (N, nq), `xi` (N, nv)): the step of the manifold
+/// integrators (`algo::manifold`), for the Python-callable path of armdyn.simulate.
+#[pyfunction]
+fn _manifold_integrate<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, NumericModel>,
+    q: PyReadonlyArrayDyn<'py, f64>,
+    xi: PyReadonlyArrayDyn<'py, f64>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    guard(|| {
+        let (m, q, xi) = manifold_rows(model, &q, &xi, ["q", "xi"], |m| (m.nq, m.nv))?;
+        let out = PyArrayDyn::<f64>::zeros(py, &[q.len() / m.nq.max(1), m.nq][..], false);
+        // SAFETY: a fresh array, not visible to Python until returned.
+        let o = unsafe { out.as_slice_mut().expect("fresh") };
+        for ((q, xi), o) in q.chunks(m.nq).zip(xi.chunks(m.nv)).zip(o.chunks_mut(m.nq)) {
+            m.integrate(q, xi, o);
+        }
+        Ok(out)
+    })
+}
+
+/// RK-Munthe-Kaas's rate of the local coordinate, `dexp^-1_{-theta}(v)` to fourth order,
+/// row by row (`theta`, `v` (N, nv); `algo::manifold::Manifold::local_rate`).
+#[pyfunction]
+fn _manifold_local_rate<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, NumericModel>,
+    theta: PyReadonlyArrayDyn<'py, f64>,
+    v: PyReadonlyArrayDyn<'py, f64>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    guard(|| {
+        let (m, theta, v) = manifold_rows(model, &theta, &v, ["theta", "v"], |m| (m.nv, m.nv))?;
+        let out = PyArrayDyn::<f64>::zeros(py, &[theta.len() / m.nv.max(1), m.nv][..], false);
+        // SAFETY: a fresh array, not visible to Python until returned.
+        let o = unsafe { out.as_slice_mut().expect("fresh") };
+        for ((t, v), o) in theta.chunks(m.nv).zip(v.chunks(m.nv)).zip(o.chunks_mut(m.nv)) {
+            m.local_rate(t, v, o);
+        }
+        Ok(out)
+    })
+}
+
 /// Register this file's functions in the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(_simulate, m)?)
+    m.add_function(wrap_pyfunction!(_simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(_manifold_integrate, m)?)?;
+    m.add_function(wrap_pyfunction!(_manifold_local_rate, m)?)
 }
