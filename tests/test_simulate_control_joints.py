@@ -266,3 +266,55 @@ def test_batch_of_targets_equals_single_runs():
             single = simulate(robot, q0[r], dt=2e-3, steps=50, stride=25, controller=one)
             np.testing.assert_array_equal(batch.q[r], single.q)
             np.testing.assert_array_equal(batch.tau[r], single.tau)
+
+
+BALL_ARM_MJCF = """<mujoco model="ballarm"><worldbody>
+  <body name="upper" pos="0 0 1"><joint name="shoulder" type="ball"/>
+    <inertial pos="0.05 0 -0.3" mass="1.5" diaginertia="0.02 0.03 0.04"/>
+    <body name="fore" pos="0 0 -0.5"><joint name="elbow" axis="0 1 0"/>
+      <inertial pos="0 0.02 -0.2" mass="0.8" diaginertia="0.01 0.012 0.004"/></body></body>
+</worldbody></mujoco>"""
+
+
+def test_cli_controller_on_a_ball_arm(tmp_path, capsys):
+    """``armdyn simulate --controller pd-gravity --target`` (the joints' blocks, as --q0)
+    drives a ball-and-hinge arm to the target (PD with gravity compensation: no steady
+    error); bad targets and gains end with one line naming them, status 2."""
+    from armdyn.cli import main
+
+    path = tmp_path / "arm.xml"
+    path.write_text(BALL_ARM_MJCF)
+    quat = quaternion([1.0, 1.0, 0.0], 0.6)
+    target = ",".join(f"{x:.17g}" for x in [*quat, 0.4])
+    common = ["simulate", str(path), "--duration", "4", "--dt", "0.001"]
+    assert main([*common, "--controller", "pd-gravity", "--target", target]) == 0
+    out = capsys.readouterr().out
+    q_final = np.array(out.split("q_final  = [")[1].split("]")[0].split(","), dtype=float)
+    q_final[:4] /= np.linalg.norm(q_final[:4])  # 6 printed digits
+    robot = armdyn.load(path)
+    assert np.abs(num.difference(robot, q_final, [*quat, 0.4])).max() < 1e-4
+    for argv, message in (
+        (["--controller", "pd", "--target", "0,0,0,2,0"], "--target[0:4] of joint 'shoulder'"),
+        (["--controller", "pd", "--target", "0,0,1"], "--target needs 5 joint values, got 3"),
+        (["--controller", "pd", "--target", target, "--kp", "1,2"], "--kp needs 1 or 4 values"),
+        (["--controller", "pd", "--target", "0,0,0,1,nan"], "--target must be finite numbers"),
+    ):
+        assert main([*common, *argv]) == 2, argv
+        err = capsys.readouterr().err.strip()
+        assert err.count("\n") == 0 and message in err and "Traceback" not in err, err
+
+
+def test_cli_pd_on_a_floating_robot(tmp_path, capsys):
+    """A floating base: --target is the joints' configuration (the base unactuated, its
+    pose refused), computed torque is refused naming the robot."""
+    from armdyn.cli import main
+
+    path = tmp_path / "free.xml"
+    path.write_text(BALL_ARM_MJCF.replace('<joint name="shoulder" type="ball"/>', "<freejoint/>", 1))
+    common = ["simulate", str(path), "--duration", "0.2", "--dt", "0.001", "--target"]
+    assert main([*common, "0.3", "--controller", "pd"]) == 0
+    assert "work of tau" in capsys.readouterr().out
+    assert main([*common, "0,0,1,0,0,0,1,0.3", "--controller", "pd"]) == 2
+    assert "--target needs 1 joint values (the floating base is not actuated" in capsys.readouterr().err
+    assert main([*common, "0.3", "--controller", "computed-torque"]) == 2
+    assert "'ballarm' has a floating base" in capsys.readouterr().err

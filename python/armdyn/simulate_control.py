@@ -90,7 +90,8 @@ def controller_arrays(robot, model, controller, q0: np.ndarray) -> tuple[str, di
         gains[name] = _c(np.concatenate([np.zeros(bv), a[0]]))
     target = np.array(q0, dtype=float)
     target[:, bq:] = _rows_of(controller.target, f"controller.target ({covers['q']})", rows, nq - bq)
-    if nq != nv:  # a quaternion or (cos, sin) pair off unit length, named
+    if nq != nv and hasattr(robot, "configuration_layout"):  # a quaternion or (cos, sin) pair off unit length,
+        # named (a compiled model's: by the core)
         from .configuration import check_configuration
 
         check_configuration(robot, target, "controller.target")
@@ -131,6 +132,11 @@ def simulate_callable(robot, model, q0, qd0, torque, dt, steps, stride, method, 
     else:
         from .configuration import _layout
 
+        if not hasattr(robot, "configuration_layout"):
+            raise ValueError(
+                f"a torque callable on '{robot.name}' (a floating base or joints of several coordinates) needs the "
+                "robot itself (armdyn.load's), not its compiled model: the Python loop steps along its joints' groups"
+            )
         layout = _layout(robot)
         flat_q, flat_v, v_of_q = layout.flat_q, layout.flat_v, _v_of_q(robot, nq)
         plus = lambda q, xi: _core._manifold_integrate(model, _c(q), _c(xi))  # noqa: E731
