@@ -14,7 +14,12 @@
   its angular momentum about the centre of mass (Pinocchio's
   ``computeCentroidalMomentum``): the base rows of tau are zero; with gravity
   compensation the joints' torques at the target are Pinocchio's generalized gravity;
-* computed torque on a floating base is refused, naming the robot.
+* computed torque on a floating base is refused, naming the robot;
+* simulate_adaptive on the manifold (its embedding): the symmetric top's closed form,
+  a pendulum's energy by hand, a floating robot's momentum (Pinocchio); its kinematics
+  ``q' = Q(q) v`` against the central difference of armdyn.configuration.integrate;
+* ``armdyn simulate --controller --target`` on a ball arm and a floating robot, with
+  one-line errors naming the bad value.
 """
 
 from __future__ import annotations
@@ -32,7 +37,7 @@ from armdyn.errors import FloatingBaseError
 from armdyn.io.mjcf import MjcfIgnoredWarning
 from armdyn.io.mjcf_state import from_mujoco_state, to_mujoco_state
 from armdyn.model import Joint, Link, Robot
-from armdyn.simulate import PD, ComputedTorque, simulate
+from armdyn.simulate import PD, ComputedTorque, simulate, simulate_adaptive
 
 I_O = ROD_INERTIA + ROD_MASS * (ROD_COM @ ROD_COM * np.eye(3) - np.outer(ROD_COM, ROD_COM))
 
@@ -318,3 +323,79 @@ def test_cli_pd_on_a_floating_robot(tmp_path, capsys):
     assert "--target needs 1 joint values (the floating base is not actuated" in capsys.readouterr().err
     assert main([*common, "0.3", "--controller", "computed-torque"]) == 2
     assert "'ballarm' has a floating base" in capsys.readouterr().err
+
+
+def test_adaptive_top_precesses_as_euler_equations():
+    """simulate_adaptive on a ball joint (the quaternion integrated in its embedding): the
+    symmetric top's closed form (as tests/test_simulate_joints.py), a unit quaternion, the
+    world angular momentum kept."""
+    from test_simulate_joints import rotation
+
+    I1, I3 = 0.3, 0.5
+    top = Link("top", 1.0, (0.0, 0.0, 0.0), [[I1, 0, 0], [0, I1, 0], [0, 0, I3]])
+    robot = Robot("top", [Link("base"), top], [Joint("ball", "spherical", "base", "top")], gravity=(0, 0, 0))
+    a, w3 = 1.2, 3.0
+    quat = quaternion([0.2, -0.4, 0.1], 1.0)
+    run = simulate_adaptive(robot, quat, [a, 0.0, w3], duration=3.0)
+    W = (I3 - I1) / I1 * w3
+    want = np.stack([a * np.cos(W * run.t), a * np.sin(W * run.t), np.full_like(run.t, w3)], axis=-1)
+    np.testing.assert_allclose(run.qd, want, rtol=0, atol=1e-8)
+    assert np.abs(np.linalg.norm(run.q, axis=1) - 1).max() < 1e-14
+    L = np.einsum("sij,jk,sk->si", rotation(run.q), np.diag([I1, I1, I3]), run.qd)
+    np.testing.assert_allclose(L, np.tile(L[0], (len(L), 1)), rtol=0, atol=1e-8)
+    assert np.abs(L[0]).max() > 0.3 and np.ptp(run.q[:, 0]) > 0.1  # it turns
+
+
+def test_adaptive_ball_pendulum_energy_and_a_held_pose():
+    """A swinging ball pendulum keeps T + V written by hand; a callable of the gravity
+    torques holds it still."""
+    from test_simulate_joints import rotation
+
+    robot = ball_pendulum()
+    q0 = quaternion([1.0, 0.3, 0.0], 0.8)
+    run = simulate_adaptive(robot, q0, [0.5, -1.0, 2.0], duration=2.0)
+    energy = 0.5 * np.einsum("si,ij,sj->s", run.qd, I_O, run.qd) + ROD_MASS * 9.81 * (rotation(run.q) @ ROD_COM)[:, 2]
+    assert np.ptp(energy) < 1e-8 * abs(energy[0]) and np.ptp(run.potential) > 1.0
+    held = simulate_adaptive(robot, q0, duration=1.0, torque=lambda t, q, qd: num.gravity(robot, q))
+    assert np.abs(held.tau[0]).max() > 5.0
+    assert np.abs(num.difference(robot, held.q, q0)).max() < 1e-10 and np.abs(held.qd).max() < 1e-10
+
+
+@needs_pinocchio
+def test_adaptive_floating_robot_keeps_its_momentum():
+    from pinocchio_bridge import to_pinocchio
+
+    robot = chain(True)
+    robot = Robot(robot.name, list(robot.links.values()), robot.joints, gravity=(0, 0, 0), root_joint="free-flyer")
+    rng = np.random.default_rng(8)
+    q0, v0 = num.random_configuration(robot, rng), rng.uniform(-1, 1, robot.nv)
+    run = simulate_adaptive(robot, q0, v0, duration=1.0, t_eval=np.linspace(0, 1, 21))
+    assert run.q.shape == (21, robot.nq) and run.coordinate_names[:2] == ["base_vx", "base_vy"]
+    model, _, _ = to_pinocchio(world_jointed(robot))
+    data = model.createData()
+    momenta = np.array([pin.computeCentroidalMomentum(model, data, q, v).vector for q, v in zip(run.q, run.qd)])
+    np.testing.assert_allclose(momenta, np.tile(momenta[0], (21, 1)), rtol=0, atol=1e-8)
+    assert np.ptp(run.q[:, 0]) > 0.05  # the base moves
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_configuration_rate_is_the_derivative_of_integrate(seed):
+    """simulate_adaptive's ``q' = Q(q) v`` against the central difference of
+    armdyn.configuration.integrate (the groups' exponentials) on random trees of every
+    joint kind, fixed and floating."""
+    from random_models import random_robot
+
+    from armdyn.configuration import _layout
+    from armdyn.io import with_root_joint
+    from armdyn.simulate_adaptive import configuration_rate
+
+    rng = np.random.default_rng(seed)
+    while True:
+        robot = random_robot(rng, n_joints=5, tree=True, kinds="RPFSLX")
+        if robot.multi_dof_joints:
+            break
+    if seed % 2:
+        robot = with_root_joint(robot, "free-flyer")
+    q, v, h = num.random_configuration(robot, rng), rng.uniform(-2, 2, robot.nv), 1e-5
+    central = (num.integrate(robot, q, h * v) - num.integrate(robot, q, -h * v)) / (2 * h)
+    np.testing.assert_allclose(configuration_rate(_layout(robot), q, v), central, rtol=0, atol=1e-8)

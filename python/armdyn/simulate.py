@@ -78,8 +78,8 @@ import numpy as np
 
 from . import _core
 from .configuration import rotate_vector
-from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy, require_fixed_base
-from .numeric.checks import require_one_dof_joints
+from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy
+from .simulate_adaptive import simulate_adaptive
 from .simulate_control import controller_arrays, simulate_callable
 from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
@@ -373,72 +373,3 @@ def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower,
     if done < steps:
         progress(steps, steps)
     return out
-
-
-def simulate_adaptive(
-    robot, q0, qd0=None, *, duration, torque=None, rtol=1e-10, atol=1e-12, method="DOP853", t_eval=None
-) -> Trajectory:
-    """One trajectory with SciPy's ``solve_ivp`` (adaptive step, error control) on ``aba``.
-
-    q0, qd0: (dof,). torque: None, (dof,) constant, or a callable ``torque(t, q, qd)``
-    with q, qd (dof,) returning (dof,). t_eval: the sample times (default: 101 evenly
-    spaced over ``[0, duration]``). Returns a :class:`Trajectory` of single-state shape
-    (``dt`` is ``nan``: the steps are SciPy's).
-    """
-    from scipy.integrate import solve_ivp
-
-    require_fixed_base(robot, "armdyn.simulate_adaptive")
-    require_one_dof_joints(robot, "armdyn.simulate_adaptive")
-    model = compiled_model(robot)
-    dof = model.dof
-    q0 = _state(q0, "q0", dof)
-    qd0 = np.zeros(dof) if qd0 is None else _state(qd0, "qd0", dof)
-    if q0.ndim != 1 or qd0.ndim != 1:
-        raise ValueError("simulate_adaptive integrates one state: q0, qd0 of shape (dof,)")
-    if not (math.isfinite(duration) and duration > 0):
-        raise ValueError(f"duration must be a positive finite number of seconds, got {duration!r}")
-    if torque is None:
-        tau_of = lambda t, q, qd: np.zeros(dof)  # noqa: E731
-    elif callable(torque):
-        tau_of = torque
-    else:
-        const = _per_joint(torque, "torque", dof)
-        tau_of = lambda t, q, qd: const  # noqa: E731
-    t_eval = np.linspace(0.0, duration, 101) if t_eval is None else np.asarray(t_eval, dtype=float)
-
-    def f(t, x):  # x = (q, qd, W): the torque's work integrated with the state
-        q, qd = x[:dof], x[dof : 2 * dof]
-        tau = np.asarray(tau_of(t, q, qd), dtype=float)
-        return np.concatenate([qd, model.aba(q, qd, tau, None), [tau @ qd]])
-
-    sol = solve_ivp(
-        f, (0.0, duration), np.concatenate([q0, qd0, [0.0]]), method=method, rtol=rtol, atol=atol, t_eval=t_eval
-    )
-    if not sol.success:
-        raise ValueError(f"solve_ivp failed: {sol.message}")
-    q, qd = _c(sol.y[:dof].T), _c(sol.y[dof : 2 * dof].T)
-    tau = np.array([tau_of(t, a, b) for t, a, b in zip(sol.t, q, qd)], dtype=float).reshape(len(sol.t), dof)
-    qdd = model.aba(q, qd, tau, None)
-    lower, upper = joint_limits(robot)
-    outside = (q < lower) | (q > upper)
-    first = int(np.flatnonzero(outside.any(axis=1))[0]) if outside.any() else -1
-    run = Trajectory(
-        t=sol.t,
-        q=q,
-        qd=qd,
-        qdd=qdd,
-        tau=tau,
-        q_final=q[-1],
-        qd_final=qd[-1],
-        limit_step=first,
-        limit_joint=int(outside[first].argmax()) if first >= 0 else -1,
-        nonfinite_step=-1,
-        dt=float("nan"),
-        stride=1,
-        method=method,
-        coordinate_names=list(model.coordinate_names),
-        work=sol.y[2 * dof].copy(),
-    )
-    run.kinetic = kinetic_energy(model, q, qd)
-    run.potential = potential_energy(model, q)
-    return run
