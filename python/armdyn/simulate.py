@@ -29,7 +29,8 @@ Torque: ``None`` (passive); a constant ``(dof,)``; a series ``(steps, dof)`` for
 state or ``(N, steps, dof)`` one per state (row ``k`` acts over ``[t_k, t_k + dt)``);
 a controller run in Rust at every integrator stage (:class:`PD`,
 :class:`ComputedTorque`); or a callable ``torque(t, q, qd) -> tau`` with ``q``, ``qd``
-``(N, dof)`` and ``tau`` ``(dof,)`` or ``(N, dof)``.
+``(N, dof)`` and ``tau`` ``(dof,)`` or ``(N, dof)`` (widths nq and nv where they differ,
+below).
 
 A floating base (``robot.floating``, Pinocchio's layout: ``q0`` (7 + dof,) base position,
 quaternion x y z w, joints; ``qd0`` and torques (6 + dof,) base linear and angular
@@ -40,7 +41,7 @@ on SE(3) as :func:`armdyn.configuration.integrate` moves it (semi-implicit Euler
 the others (6 + dof,); ``limit_joint`` and ``nonfinite_joint`` index
 ``Trajectory.coordinate_names``, the velocity's (``base_vx`` ... ``base_wz``, then the
 joints). Energies include the base: ``T = 1/2 v^T M v``, ``V = -g . (m c)`` with ``c``
-the world centre of mass. Controllers and torque callables are fixed-base only.
+the world centre of mass. The base is not actuated by a controller (below).
 
 Joints of several coordinates (spherical, planar, free; ``robot.nq`` > ``robot.nv``),
 fixed or floating base: the same two methods with each joint's block moved on its group
@@ -48,7 +49,22 @@ as :func:`armdyn.configuration.integrate` moves it (spherical on SO(3), free on 
 planar on SE(2); the quaternions and planar ``(cos, sin)`` kept unit). ``q0`` and the
 stored ``q`` rows are (nq,), the others (nv,) (``Trajectory.coordinate_names``);
 limits are checked on the 1-dof joints only; energies as for a floating base.
-Controllers and torque callables take 1-dof joints only.
+
+Controllers there (:mod:`armdyn.simulate_control`): the error is on the tangent space,
+``e = difference(q, target)`` (:func:`armdyn.configuration.difference`, Pinocchio's
+``difference``: the velocity, in ``q``'s frame, that moves ``q`` to the target in unit
+time, so ``Kp e`` turns a ball joint toward its target), ``target`` a configuration
+(nq,), ``kp``, ``kd``, ``target_qd`` per velocity coordinate (nv,). :class:`PD`: ``tau =
+[g(q)] + Kp e + Kd (qd* - qd)``; :class:`ComputedTorque`: ``tau = rnea(q, qd, Kp e + Kd
+(qd* - qd))``, so that ``qdd = Kp e + Kd (qd* - qd)`` (an error along one axis of a
+ball, or a small one, decays as ``e'' + Kd e' + Kp e = 0``). With a floating base the
+controllers' arrays are the joints' (target ``q[7:]``, gains ``v[6:]``), the base's six
+rows of ``tau`` are zero, PD's gravity compensation is the joints' rows of the
+generalized gravity (what holds the joints while the base is held); computed torque is
+refused (cancelling the dynamics would need a wrench on the base). A torque callable
+gets ``q`` (N, nq) and ``qd`` (N, nv) and returns (nv,) or (N, nv), the steps those of
+the Rust integrators. :func:`simulate_adaptive` integrates ``q`` in its embedding
+(:mod:`armdyn.simulate_adaptive`).
 
 Joint limits (from the robot's joints, or ``limits=(lower, upper)``) are reported, never
 enforced: :attr:`Trajectory.limit_step` / :attr:`Trajectory.limit_joint` give, per state,
