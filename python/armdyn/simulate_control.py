@@ -38,9 +38,9 @@ def _c(a):
     return np.require(a, dtype=float, requirements=["C", "A"])
 
 
-def _rows_of(x, name: str, rows: int, width: int, scalar: bool = False) -> np.ndarray:
+def _rows_of(x, name: str, what: str, rows: int, width: int, scalar: bool = False) -> np.ndarray:
     """``x`` (width,) or (rows, width) (or a scalar, if ``scalar``), finite, as (rows,
-    width); None is zeros."""
+    width); None is zeros. ``what`` it should be, said when its shape is wrong."""
     if x is None:
         return np.zeros((rows, width))
     try:
@@ -50,7 +50,7 @@ def _rows_of(x, name: str, rows: int, width: int, scalar: bool = False) -> np.nd
     if scalar and a.ndim == 0:
         a = np.full(width, float(a))
     if a.shape not in ((width,), (rows, width)):
-        raise ValueError(f"{name}: expected ({width},) or ({rows}, {width}) values, got shape {a.shape}")
+        raise ValueError(f"{name} ({what}): expected ({width},) or ({rows}, {width}) values, got shape {a.shape}")
     if not np.all(np.isfinite(a)):
         raise ValueError(f"{name} contains NaN or inf")
     return np.broadcast_to(a, (rows, width))
@@ -86,17 +86,17 @@ def controller_arrays(robot, model, controller, q0: np.ndarray) -> tuple[str, di
     }
     gains = {}
     for name in ("kp", "kd"):
-        a = _rows_of(getattr(controller, name), f"controller.{name} (a scalar or {covers['v']})", 1, nv - bv, True)
+        a = _rows_of(getattr(controller, name), f"controller.{name}", f"a scalar or {covers['v']}", 1, nv - bv, True)
         gains[name] = _c(np.concatenate([np.zeros(bv), a[0]]))
     target = np.array(q0, dtype=float)
-    target[:, bq:] = _rows_of(controller.target, f"controller.target ({covers['q']})", rows, nq - bq)
+    target[:, bq:] = _rows_of(controller.target, "controller.target", covers["q"], rows, nq - bq)
     if nq != nv and hasattr(robot, "configuration_layout"):  # a quaternion or (cos, sin) pair off unit length,
         # named (a compiled model's: by the core)
         from .configuration import check_configuration
 
         check_configuration(robot, target, "controller.target")
     target_qd = np.zeros((rows, nv))
-    target_qd[:, bv:] = _rows_of(controller.target_qd, f"controller.target_qd ({covers['v']})", rows, nv - bv)
+    target_qd[:, bv:] = _rows_of(controller.target_qd, "controller.target_qd", covers["v"], rows, nv - bv)
     return kind, dict(kp=gains["kp"], kd=gains["kd"], target=_c(target), target_qd=_c(target_qd))
 
 
