@@ -9,7 +9,8 @@
   ball stays on that axis, so each block obeys ``e'' + kd e' + kp e = 0`` exactly; the
   errors follow the critically damped closed form ``e0 (1 + w t) exp(-w t)``;
 * a torque callable returning Pinocchio's ``computeGeneralizedGravity`` holds a ball
-  pendulum still; a callable ``-c qd`` equals MuJoCo's RK4 with the joint damping ``c``;
+  pendulum still; a callable ``-c qd`` equals MuJoCo's RK4 with the joint damping ``c``,
+  a constant one MuJoCo's ``qfrc_applied``;
 * a floating robot with PD on its joints and no gravity keeps its linear momentum and
   its angular momentum about the centre of mass (Pinocchio's
   ``computeCentroidalMomentum``): the base rows of tau are zero; with gravity
@@ -161,32 +162,39 @@ DAMPED = PENDULUM.replace('type="ball"/>', 'type="ball" damping="0.05"/>')
 
 
 @needs_mujoco
-def test_damping_callable_against_mujoco_rk4(tmp_path):
-    """``torque = -c qd`` evaluated at every stage against MuJoCo's RK4 with the ball's
-    joint damping ``c`` (0.05, light: the rod turns easily about its axis; a passive force it also evaluates at every stage): the gap is
-    small and shrinks at least 8-fold when dt halves."""
-    plain, damped = tmp_path / "plain.xml", tmp_path / "damped.xml"
+@pytest.mark.parametrize("force", ["damping", "applied"])
+def test_callable_against_mujoco_rk4(tmp_path, force):
+    """A torque callable on a ball joint against MuJoCo's RK4: ``-c qd`` (evaluated at
+    every stage) against the joint damping ``c`` (0.05, light: the rod turns easily about
+    its axis; MuJoCo evaluates it at every stage too), or a constant torque against
+    ``qfrc_applied`` (in the joint's frame, as qvel). The gap is small and shrinks at
+    least 8-fold when dt halves."""
+    plain, mjcf = tmp_path / "plain.xml", tmp_path / "mujoco.xml"
     plain.write_text(PENDULUM.format(inside=""))
-    damped.write_text(DAMPED.format(inside=""))
+    mjcf.write_text((DAMPED if force == "damping" else PENDULUM).format(inside=""))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", MjcfIgnoredWarning)
         robot = armdyn.load(str(plain))
     q0, v0 = quaternion([0.3, 1.0, 0.2], 1.2), np.array([1.5, -2.0, 3.0])
+    applied = np.array([0.8, -1.5, 0.05])
+    torque = (lambda t, q, qd: -0.05 * qd) if force == "damping" else (lambda t, q, qd: applied)
     gaps = []
     for dt in (4e-3, 2e-3):
-        model = mujoco.MjModel.from_xml_path(str(damped))
+        model = mujoco.MjModel.from_xml_path(str(mjcf))
         model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
         model.opt.timestep = dt
         data = mujoco.MjData(model)
         data.qpos[:], data.qvel[:] = to_mujoco_state(robot, q0, v0)
+        if force == "applied":
+            data.qfrc_applied[:] = applied
         steps = round(1.0 / dt)
         for _ in range(steps):
             mujoco.mj_step(model, data)
-        run = simulate(robot, q0, v0, dt=dt, steps=steps, energies=False, torque=lambda t, q, qd: -0.05 * qd)
+        run = simulate(robot, q0, v0, dt=dt, steps=steps, energies=False, torque=torque)
         q, v = from_mujoco_state(robot, data.qpos.copy(), data.qvel.copy())
         gaps.append(gap(robot, run.q_final, run.qd_final, q, v))
-    undamped = simulate(robot, q0, v0, dt=2e-3, steps=500, energies=False)
-    assert gap(robot, undamped.q_final, undamped.qd_final, q, v) > 1e-2  # the damping matters
+    passive = simulate(robot, q0, v0, dt=2e-3, steps=500, energies=False)
+    assert gap(robot, passive.q_final, passive.qd_final, q, v) > 1e-2  # the torque matters
     assert gaps[0] < 1e-6, gaps
     assert gaps[1] < gaps[0] / 8, gaps
 
