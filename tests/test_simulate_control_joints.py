@@ -15,7 +15,9 @@
   its angular momentum about the centre of mass (Pinocchio's
   ``computeCentroidalMomentum``): the base rows of tau are zero; with gravity
   compensation the joints' torques at the target are Pinocchio's generalized gravity;
-* computed torque on a floating base is refused, naming the robot;
+* computed torque on a floating robot (the base unactuated: collocated partial feedback
+  linearization) gives its joints the closed form too, zero base rows, and keeps the
+  momentum without gravity (Pinocchio);
 * simulate_adaptive on the manifold (its embedding): the symmetric top's closed form,
   a pendulum's energy by hand, a floating robot's momentum (Pinocchio); its kinematics
   ``q' = Q(q) v`` against the central difference of armdyn.configuration.integrate;
@@ -34,7 +36,6 @@ from test_simulate_joints import PENDULUM, ROD_COM, ROD_INERTIA, ROD_MASS, ball_
 
 import armdyn
 from armdyn import numeric as num
-from armdyn.errors import FloatingBaseError
 from armdyn.io.mjcf import MjcfIgnoredWarning
 from armdyn.io.mjcf_state import from_mujoco_state, to_mujoco_state
 from armdyn.model import Joint, Link, Robot
@@ -250,11 +251,34 @@ def test_pd_gravity_on_a_floating_robot_is_pinocchio_generalized_gravity():
     np.testing.assert_allclose(run.tau[0], [0.0] * 6 + list(g[6:]), rtol=0, atol=1e-12)
 
 
+@needs_pinocchio
+def test_computed_torque_on_a_floating_robot():
+    """The joints' errors (any, the robot at rest) decay as the critically damped closed
+    form, as on a fixed base; the base takes no wrench: the base rows of tau are zero and,
+    without gravity, the momentum stays (Pinocchio), while the base moves."""
+    from pinocchio_bridge import to_pinocchio
+
+    robot = chain(True)
+    robot = Robot(robot.name, list(robot.links.values()), robot.joints, gravity=(0, 0, 0), root_joint="free-flyer")
+    rng = np.random.default_rng(3)
+    target = num.random_configuration(robot, rng)
+    e0 = np.concatenate([np.zeros(6), rng.uniform(-0.5, 0.5, robot.nv - 6)])
+    q0 = num.integrate(robot, target, -e0)  # difference(q0, target) = e0 on the joints
+    run = simulate(robot, q0, dt=1e-3, duration=2.0, stride=10, controller=ComputedTorque(25.0, 10.0, target[7:]))
+    t = run.t[:, None]
+    want = e0[6:] * (1 + 5 * t) * np.exp(-5 * t)
+    np.testing.assert_allclose(num.difference(robot, run.q, target)[:, 6:], want, rtol=0, atol=1e-9)
+    assert np.array_equal(run.tau[:, :6], np.zeros((len(run.t), 6))) and np.abs(run.tau[:, 6:]).max() > 0.5
+    model, _, _ = to_pinocchio(world_jointed(robot))
+    data = model.createData()
+    momenta = np.array([pin.computeCentroidalMomentum(model, data, q, v).vector for q, v in zip(run.q, run.qd)])
+    np.testing.assert_allclose(momenta, 0.0, rtol=0, atol=1e-9)  # from rest: zero throughout
+    assert np.abs(num.difference(robot, run.q[0], run.q[-1])[:6]).max() > 0.01  # the base moved
+
+
 def test_pd_widths_and_refusals_on_a_floating_base():
     robot = chain(True)
     q0 = num.neutral(robot)
-    with pytest.raises(FloatingBaseError, match=r"robot 'chain'.*ComputedTorque.*floating base"):
-        simulate(robot, q0, dt=1e-3, steps=2, controller=ComputedTorque(25.0, 10.0, q0[7:]))
     with pytest.raises(ValueError, match=r"controller.kp \(a scalar or the joints' velocity coordinates, v\[6:\]"):
         simulate(robot, q0, dt=1e-3, steps=2, controller=PD(np.ones(robot.nv), 1.0, q0[7:]))
     with pytest.raises(ValueError, match=r"controller.target_qd \(the joints' velocity coordinates"):
@@ -319,7 +343,7 @@ def test_cli_controller_on_a_ball_arm(tmp_path, capsys):
 
 def test_cli_pd_on_a_floating_robot(tmp_path, capsys):
     """A floating base: --target is the joints' configuration (the base unactuated, its
-    pose refused), computed torque is refused naming the robot."""
+    pose refused); PD and computed torque run."""
     from armdyn.cli import main
 
     path = tmp_path / "free.xml"
@@ -329,8 +353,8 @@ def test_cli_pd_on_a_floating_robot(tmp_path, capsys):
     assert "work of tau" in capsys.readouterr().out
     assert main([*common, "0,0,1,0,0,0,1,0.3", "--controller", "pd"]) == 2
     assert "--target needs 1 joint values (the floating base is not actuated" in capsys.readouterr().err
-    assert main([*common, "0.3", "--controller", "computed-torque"]) == 2
-    assert "'ballarm' has a floating base" in capsys.readouterr().err
+    assert main([*common, "0.3", "--controller", "computed-torque"]) == 0
+    assert "work of tau" in capsys.readouterr().out
 
 
 def test_adaptive_top_precesses_as_euler_equations():

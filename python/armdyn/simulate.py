@@ -60,8 +60,10 @@ time, so ``Kp e`` turns a ball joint toward its target), ``target`` a configurat
 ball, or a small one, decays as ``e'' + Kd e' + Kp e = 0``). With a floating base the
 controllers' arrays are the joints' (target ``q[7:]``, gains ``v[6:]``), the base's six
 rows of ``tau`` are zero, PD's gravity compensation is the joints' rows of the
-generalized gravity (what holds the joints while the base is held); computed torque is
-refused (cancelling the dynamics would need a wrench on the base). A torque callable
+generalized gravity (what holds the joints while the base is held); computed torque
+gives the joints ``qdd = Kp e + Kd (qd* - qd)`` and the base the acceleration that
+follows (collocated partial feedback linearization: no wrench on the base, which the
+joints' motion moves). A torque callable
 gets ``q`` (N, nq) and ``qd`` (N, nv) and returns (nv,) or (N, nv), the steps those of
 the Rust integrators. :func:`simulate_adaptive` integrates ``q`` in its embedding
 (:mod:`armdyn.simulate_adaptive`).

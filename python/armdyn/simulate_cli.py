@@ -114,11 +114,6 @@ def run(args, robot) -> int:
     if args.controller is not None:
         if args.target is None:
             raise ValueError(f"--controller {args.controller} needs --target (joint values)")
-        if args.controller == "computed-torque" and robot.floating:  # before any work, as simulate refuses it
-            raise ValueError(
-                f"--controller computed-torque: '{robot.name}' has a floating base, which no joint torque moves "
-                "directly (cancelling its dynamics would take a wrench on the base): use pd or pd-gravity"
-            )
         base_q, base_v = (7, 6) if robot.floating else (0, 0)
         if robot.floating or robot.multi_dof_joints:
             target = manifold_target(robot, args.target)

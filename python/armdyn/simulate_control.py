@@ -17,8 +17,13 @@ A floating base is not actuated: the controllers' arrays cover the joints only
 :class:`~armdyn.trajectory.PD` acts on the joints; with ``gravity_compensation`` it adds
 the joints' rows of the generalized gravity ``g(q)`` (Pinocchio's
 ``computeGeneralizedGravity``: what holds the joints still while the base is held; a
-robot in free fall needs none). :class:`~armdyn.trajectory.ComputedTorque` is refused:
-cancelling the dynamics needs a wrench on the base, which no joint gives.
+robot in free fall needs none). :class:`~armdyn.trajectory.ComputedTorque` gives the
+joints the acceleration ``qdd* = Kp e + Kd (qd* - qd)`` and lets the base take the one
+that follows (collocated partial feedback linearization, Spong 1994): with ``M_bb`` the
+whole robot's composite inertia, ``a_b = -M_bb^-1 (M_bj qdd* + h_b)`` and ``tau_j = M_jb
+a_b + M_jj qdd* + h_j``, so the joints' errors obey ``e'' + Kd e' + Kp e = 0`` as on a
+fixed base while the base moves as the joints' motion drives it (no wrench on it: the
+momentum changes by gravity alone).
 """
 
 from __future__ import annotations
@@ -26,7 +31,6 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
-from .errors import FloatingBaseError
 from .trajectory import PD, ComputedTorque
 
 __all__ = ["controller_arrays", "simulate_callable"]
@@ -69,12 +73,6 @@ def controller_arrays(robot, model, controller, q0: np.ndarray) -> tuple[str, di
         kind = "pd-gravity" if controller.gravity_compensation else "pd"
     elif isinstance(controller, ComputedTorque):
         kind = "computed-torque"
-        if floating:
-            raise FloatingBaseError(
-                "ComputedTorque needs a torque on every coordinate, and a floating base has none (cancelling "
-                "the dynamics would take a wrench on the base): use PD (with gravity_compensation) on its joints",
-                f"robot '{robot.name}'",
-            )
     else:
         raise ValueError(f"controller must be an armdyn.simulate.PD or ComputedTorque, got {type(controller).__name__}")
     # what each array covers: the whole widths, or the joints' (a floating base's rows are not actuated)

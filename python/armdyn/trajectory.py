@@ -46,7 +46,8 @@ class ComputedTorque:
 
     kp, kd: scalars or (dof,) (1/s^2, 1/s); target, target_qd: (dof,) or (N, dof).
     Joints of several coordinates: ``e = difference(q, q*)``, target (nq,), the others
-    (nv,); refused on a floating base, which no joint torque actuates.
+    (nv,); a floating base: the joints' arrays, the joints' closed loop as above and the
+    unactuated base moving as it then must (:mod:`armdyn.simulate_control`).
     """
 
     kp: object

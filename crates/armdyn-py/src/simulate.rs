@@ -83,8 +83,7 @@ fn data<'a>(a: &'a PyReadonlyArrayDyn<'_, f64>, name: &str, shape: &[usize]) -> 
 /// (`algo::integrate_floating`): `q0`, `q`, `q_final` have the model's `nq` columns
 /// (7 more with a floating base), `qd0`, the torques and the other outputs `nv` (6
 /// more); lower, upper stay (dof,); the controllers' kp, kd, target_qd are (nv,) and
-/// (N, nv), target (N, nq), at those widths (a floating base's rows are not actuated);
-/// "computed-torque" is refused with a floating base.
+/// (N, nv), target (N, nq), at those widths (a floating base's rows are not actuated).
 ///
 /// torque_kind: "zero", "constant" (torque (N, nv)), "series" (torque (steps, nv)),
 /// "series-per-state" (torque (N, steps, nv)), "pd", "pd-gravity", "computed-torque"
@@ -166,12 +165,6 @@ fn _simulate<'py>(
             }
             other => return Err(PyValueError::new_err(format!("torque_kind: unknown '{other}'"))),
         };
-        if floating && matches!(input, Input::ComputedTorque { .. }) {
-            let name = &model.get().name;
-            return Err(PyValueError::new_err(format!(
-                "torque_kind 'computed-torque': '{name}' has a floating base, which no torque actuates"
-            )));
-        }
         if manifold {
             if let Input::Pd { target, .. } | Input::ComputedTorque { target, .. } = input {
                 model.get().check_unit_blocks(target)?;

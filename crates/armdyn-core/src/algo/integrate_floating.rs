@@ -26,9 +26,11 @@
 //! * PD: `tau = [g(q)] + Kp e + Kd (qd* - v)`; with a floating base its six rows are set to
 //!   zero (the base is unactuated) and `g(q)` is the generalized gravity with the base not
 //!   accelerating (`rnea_floating(q, 0, 0)`, its joint rows);
-//! * computed torque (fixed base only): `tau = rnea(q, v, Kp e + Kd (qd* - v))`, so that
-//!   `v' = Kp e + Kd (qd* - v)`: with `qd* = 0` and an error along one axis of a block (or
-//!   a small one) `e'' + Kd e' + Kp e = 0`, since then `e' = -v`.
+//! * computed torque: `tau = rnea(q, v, Kp e + Kd (qd* - v))`, so that `v' = Kp e + Kd
+//!   (qd* - v)`: with `qd* = 0` and an error along one axis of a block (or a small one)
+//!   `e'' + Kd e' + Kp e = 0`, since then `e' = -v`. With a floating base (unactuated) the
+//!   joints get that acceleration and the base the one it then has
+//!   ([`unactuated_base`]: collocated partial feedback linearization, Spong 1994).
 //!
 //! Outputs as [`crate::algo::integrate::Outputs`], `q` of width
 //! `q`'s and `qd`, `qdd`, `tau` of width `v`'s; `limit_joint` and `nonfinite_joint`
@@ -43,7 +45,7 @@
 //! state, so results do not depend on the kernels, threads or grouping.
 
 use crate::algo::aba;
-use crate::algo::floating::{aba_floating, rnea_floating, NQ_BASE, NV_BASE};
+use crate::algo::floating::{aba_floating, crba_floating, rnea_floating, NQ_BASE, NV_BASE};
 use crate::algo::integrate::{Input, Method, Outputs, Settings, STOP_POLL};
 use crate::algo::manifold::Manifold;
 use crate::algo::rnea::{gravity, rnea};
@@ -100,7 +102,7 @@ pub fn simulate_floating_until(
 /// early once `stop` is set (read every [`STOP_POLL`] steps). Returns false if it was
 /// stopped. Controllers: `kp`, `kd` (nv), `target` (N, nq), `target_qd` (N, nv), the
 /// manifold's widths (a floating base's included: its rows are not actuated). Panics on
-/// computed torque with a floating base or on mis-sized arrays.
+/// mis-sized arrays.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_manifold_until(
     model: &Model,
@@ -140,8 +142,6 @@ pub fn simulate_manifold_until(
         Input::Pd { kp, kd, target, target_qd, .. } | Input::ComputedTorque { kp, kd, target, target_qd } => {
             assert!(kp.len() == nv && kd.len() == nv, "gain size");
             assert!(target.len() == rows * nq && target_qd.len() == rows * nv, "target size");
-            let ct = matches!(input, Input::ComputedTorque { .. });
-            assert!(!(ct && floating), "computed torque needs every coordinate actuated: not with a floating base");
         }
     }
     let Outputs { q, work, qd, qdd, tau, q_final, qd_final, limit_step, limit_joint, nonfinite_step, nonfinite_joint } =
@@ -230,11 +230,13 @@ struct Work<T> {
     vs: Vec<T>,
     tau: Vec<T>,
     a: Vec<T>,
-    /// A controller's target (nq), target velocity, error (nv), and zeros (nv).
+    /// A controller's target (nq), target velocity, error (nv), zeros (nv), and the mass
+    /// matrix (nv^2, computed torque with a floating base).
     target: Vec<T>,
     target_v: Vec<T>,
     err: Vec<T>,
     zeros: Vec<T>,
+    mass: Vec<T>,
     /// RK4: the stage's local coordinate, its rate, and the weighted sums.
     theta: Vec<T>,
     rate: Vec<T>,
@@ -243,7 +245,8 @@ struct Work<T> {
 }
 
 impl<T: Real> Work<T> {
-    fn new(model: &Model, manifold: &Manifold) -> Self {
+    /// `floating_ct`: computed torque with a floating base (which needs the mass matrix).
+    fn new(model: &Model, manifold: &Manifold, floating_ct: bool) -> Self {
         let z = |k: usize| vec![T::zero(); k];
         let (nq, nv) = (manifold.nq, manifold.nv);
         Work {
@@ -258,12 +261,55 @@ impl<T: Real> Work<T> {
             target_v: z(nv),
             err: z(nv),
             zeros: z(nv),
+            mass: if floating_ct { z(nv * nv) } else { vec![] },
             theta: z(nv),
             rate: z(nv),
             sum_rate: z(nv),
             sum_a: z(nv),
         }
     }
+}
+
+/// Computed torque on a floating base (collocated partial feedback linearization): given
+/// `tau = rnea(q, v, [0; a*])`, whose base rows `f_b = M_bj a* + h_b` are the wrench the
+/// base would need to stay unaccelerated, let the base accelerate instead, `a_b = -M_bb^-1
+/// f_b` (`M_bb` the whole robot's composite inertia, positive definite), and return the
+/// joint torques that give the joints `a*` with it, `tau_j + M_jb a_b`; the base rows zero.
+/// `mass`: M (nv^2, row-major).
+#[inline(always)]
+fn unactuated_base<T: Real>(mass: &[T], tau: &mut [T]) {
+    let nv = tau.len();
+    // Gaussian elimination on M_bb (symmetric positive definite: no pivoting needed)
+    let mut m = [[T::zero(); NV_BASE]; NV_BASE];
+    let mut b = [T::zero(); NV_BASE];
+    for r in 0..NV_BASE {
+        m[r].copy_from_slice(&mass[r * nv..r * nv + NV_BASE]);
+        b[r] = -tau[r];
+    }
+    for k in 0..NV_BASE {
+        for r in k + 1..NV_BASE {
+            let f = m[r][k] / m[k][k];
+            for c in k..NV_BASE {
+                let x = m[k][c];
+                m[r][c] -= f * x;
+            }
+            let x = b[k];
+            b[r] -= f * x;
+        }
+    }
+    for k in (0..NV_BASE).rev() {
+        let mut x = b[k];
+        for c in k + 1..NV_BASE {
+            x -= m[k][c] * b[c];
+        }
+        b[k] = x / m[k][k];
+    }
+    for (j, t) in tau.iter_mut().enumerate().skip(NV_BASE) {
+        for (k, ab) in b.iter().enumerate() {
+            *t += mass[j * nv + k] * *ab;
+        }
+    }
+    tau[..NV_BASE].fill(T::zero());
 }
 
 /// Lanes of `dst` from rows `first..first + LANES` of the (rows, width) array `src`.
@@ -286,18 +332,23 @@ fn put<T: Real>(dst: &mut [f64], src: &[T], l: usize) {
 }
 
 impl Job<'_> {
+    /// Computed torque with a floating base: the stages need the mass matrix.
+    fn floating_ct(&self) -> bool {
+        self.floating && matches!(self.input, Input::ComputedTorque { .. })
+    }
+
     /// Integrate the rows of one group: in SIMD lanes if it is a whole group of the
     /// widest kernel's, else one by one.
     fn dispatch(&self, first: usize, rows: &mut [Row]) {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = "avx512f")]
         unsafe fn avx512(job: &Job, first: usize, rows: &mut [Row]) {
-            job.group(&mut Work::<F64x8>::new(job.model, &job.manifold), first, rows)
+            job.group(&mut Work::<F64x8>::new(job.model, &job.manifold, job.floating_ct()), first, rows)
         }
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = "avx2")]
         unsafe fn avx2(job: &Job, first: usize, rows: &mut [Row]) {
-            job.group(&mut Work::<F64x4>::new(job.model, &job.manifold), first, rows)
+            job.group(&mut Work::<F64x4>::new(job.model, &job.manifold, job.floating_ct()), first, rows)
         }
         match (kernels(), rows.len()) {
             // SAFETY: the CPU supports the features (checked by `kernels`).
@@ -306,9 +357,9 @@ impl Job<'_> {
             #[cfg(target_arch = "x86_64")]
             (Kernels::Avx2, 4) => unsafe { avx2(self, first, rows) },
             #[cfg(not(target_arch = "x86_64"))]
-            (_, 4) => self.group(&mut Work::<F64x4>::new(self.model, &self.manifold), first, rows),
+            (_, 4) => self.group(&mut Work::<F64x4>::new(self.model, &self.manifold, self.floating_ct()), first, rows),
             _ => {
-                let mut w = Work::<f64>::new(self.model, &self.manifold);
+                let mut w = Work::<f64>::new(self.model, &self.manifold, self.floating_ct());
                 for (k, row) in rows.iter_mut().enumerate() {
                     self.group(&mut w, first + k, std::slice::from_mut(row));
                 }
@@ -344,7 +395,14 @@ impl Job<'_> {
                 for j in 0..nv {
                     w.err[j] = T::splat(kp[j]) * w.err[j] + T::splat(kd[j]) * (w.target_v[j] - w.vs[j]);
                 }
-                rnea(self.model, &mut w.data, &w.qs, &w.vs, &w.err, tau);
+                if self.floating {
+                    w.err[..NV_BASE].fill(T::zero());
+                    rnea_floating(self.model, &mut w.data, &w.qs, &w.vs, &w.err, tau);
+                    crba_floating(self.model, &mut w.data, &w.qs, &mut w.mass);
+                    unactuated_base(&w.mass, tau);
+                } else {
+                    rnea(self.model, &mut w.data, &w.qs, &w.vs, &w.err, tau);
+                }
             }
             Input::Constant(t) => load(tau, t, r),
             Input::Series { tau: t, shared } => {
