@@ -78,6 +78,39 @@ def test_simulate_on_cluster_equal_in_process(client, ur5):
     assert np.all(np.isfinite(ref.q))
 
 
+@pytest.mark.parametrize("floating", [False, True], ids=["fixed", "floating"])
+def test_joints_of_several_coordinates_on_cluster_equal_in_process(client, floating):
+    """q nq wide, the others nv (a ball, a hinge, a planar joint, a ball or a free joint;
+    with a floating base 7 and 6 more): rnea, aba, crba and a PD run as in process."""
+    import dask.array as da
+    from test_simulate_joints import chain
+
+    from armdyn import dask as ad
+    from armdyn.simulate import PD
+
+    robot = chain(floating)
+    rng = np.random.default_rng(13)
+    q = np.stack([num.random_configuration(robot, rng) for _ in range(41)])
+    qd, qdd = rng.uniform(-1, 1, (2, 41, robot.nv))
+    dq = da.from_array(q, chunks=(10, robot.nq))
+    tau = ad.rnea(robot, dq, qd, qdd)
+    assert tau.shape == (41, robot.nv) and tau.chunks[1] == (robot.nv,)
+    tau_np = tau.compute()
+    assert np.array_equal(tau_np, num.rnea(robot, q, qd, qdd))
+    assert np.array_equal(ad.aba(robot, dq, qd, tau_np).compute(), num.aba(robot, q, qd, tau_np))
+    assert np.array_equal(ad.crba(robot, q, chunks=15).compute(), num.crba(robot, q))
+    target = num.random_configuration(robot, rng)[7 if floating else 0 :]
+    kw = dict(dt=2e-3, steps=40, stride=10, controller=PD(4.0, 1.0, target))
+    lazy, ref = ad.simulate(robot, q, qd, chunks=9, **kw), simulate(robot, q, qd, **kw)
+    for name in ("q", "qd", "qdd", "tau", "work", "kinetic", "potential", "q_final", "qd_final", "nonfinite_step"):
+        got, want = getattr(lazy, name).compute(), getattr(ref, name)
+        assert got.shape == want.shape and np.array_equal(got, want), name
+    assert lazy.coordinate_names == ref.coordinate_names
+    assert ad.simulate(robot, q[:3], dt=2e-3, steps=2).qd.shape == (3, 3, robot.nv)  # qd0 zero, nv wide
+    with pytest.raises(ValueError, match=rf"expected \(N, {robot.nq}\)"):
+        ad.rnea(robot, qd, qd, qd)
+
+
 def test_bad_input():
     pytest.importorskip("dask.array")
     from armdyn import dask as ad

@@ -341,10 +341,6 @@ def test_batches_are_single_calls(threads):
         lambda r, q, v: armdyn.derive(r, "lagrange"),
         lambda r, q, v: armdyn.prove_agreement(r),
         lambda r, q, v: armdyn.codegen(r, what="C"),  # the rest: test_codegen_floating.py
-        lambda r, q, v: __import__("armdyn.simulate", fromlist=["x"]).simulate_adaptive(r, q, v, duration=0.01),
-        lambda r, q, v: __import__("armdyn.simulate", fromlist=["x"]).simulate(
-            r, q, v, dt=0.01, steps=1, torque=lambda t, q, qd: 0 * qd
-        ),
         lambda r, q, v: __import__("armdyn.identification", fromlist=["x"]).base_parameters(r),
         lambda r, q, v: __import__("armdyn.identification", fromlist=["x"]).regressor(r),
     ],

@@ -79,24 +79,11 @@ def test_course_solution_refuses():
     refused(lambda: solution_steps(arm()), "course")
 
 
-def test_simulate_refuses():
-    from armdyn.configuration import neutral
-    from armdyn.simulate import PD, simulate, simulate_adaptive
-
-    robot = arm()
-    q0 = neutral(robot)
-    pd = PD(np.ones(robot.nv), np.ones(robot.nv), np.zeros(robot.nv))
-    # a passive run integrates (tests/test_simulate_joints.py); controllers do not yet
-    assert simulate(robot, q0, dt=0.01, steps=2).q.shape[-1] == robot.nq
-    refused(lambda: simulate(robot, q0, dt=0.01, steps=2, controller=pd), "armdyn.simulate")
-    refused(lambda: simulate(robot, q0, dt=0.01, steps=2, torque=lambda t, q, qd: qd), "armdyn.simulate")
-    refused(lambda: simulate_adaptive(robot, q0, duration=0.1), "armdyn.simulate_adaptive")
-
-
 def test_simulate_command_runs_and_checks_its_start(tmp_path, capsys):
     """``armdyn simulate`` on a ball joint: from the neutral configuration with a given
     velocity the passive run keeps its energy (E = T + V, the robot's own energies); a
-    typed quaternion off unit length is refused, naming the joint; a controller is refused."""
+    typed quaternion off unit length is refused, naming the joint (controllers:
+    tests/test_simulate_control_joints.py)."""
     from armdyn.simulate_cli import run
 
     def args(**given):
@@ -111,20 +98,6 @@ def test_simulate_command_runs_and_checks_its_start(tmp_path, capsys):
         run(args(q0="0,0,0,2,0"), arm())
     with pytest.raises(ValueError, match="--q0 needs 5 joint values"):
         run(args(q0="0,0,1"), arm())
-    refused(lambda: run(args(controller="pd", target="0,0,0,1,0"), arm()), "armdyn simulate --controller")
-
-
-def test_dask_refuses():
-    pytest.importorskip("dask")
-    from armdyn import dask as ad
-
-    robot = arm()
-    q = np.zeros((2, robot.nq))
-    v = np.zeros((2, robot.nv))
-    refused(lambda: ad.rnea(robot, q, v, v), "armdyn.dask.rnea")
-    refused(lambda: ad.aba(robot, q, v, v), "armdyn.dask.aba")
-    refused(lambda: ad.crba(robot, q), "armdyn.dask.crba")
-    refused(lambda: ad.simulate(robot, q, v, dt=0.01, steps=2), "armdyn.dask.simulate")
 
 
 def test_reference_oracle_refuses():
@@ -172,7 +145,6 @@ def test_commands_on_a_ball_joint_model(tmp_path, capsys):
         (["derive", str(model), "--method", "lagrange"], "Lagrange's method"),
         (["check", str(model)], "armdyn.prove_agreement"),
         (["codegen", str(model), "--what", "tau,C"], "armdyn.codegen"),
-        (["simulate", str(model), "--duration", "0.1", "--dt", "0.01", "--controller", "pd"], "--controller"),
     ):
         assert main(argv) == 2, argv
         err = capsys.readouterr().err.strip()

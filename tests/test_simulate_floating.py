@@ -24,7 +24,6 @@ from random_models import random_robot
 
 import armdyn
 from armdyn import numeric as num
-from armdyn.errors import FloatingBaseError
 from armdyn.io import with_root_joint
 from armdyn.simulate import simulate
 
@@ -230,7 +229,7 @@ def test_limits_and_refusals():
     run = simulate(robot, q0, v0 * 0, dt=1e-3, steps=3, limits=(lower, np.full(robot.dof, 10.0)))
     assert run.limit_step == 0 and run.coordinate_names[run.limit_joint] == robot.coordinate_names[1]
     assert run.coordinate_names[:6] == ["base_vx", "base_vy", "base_vz", "base_wx", "base_wy", "base_wz"]
-    with pytest.raises(FloatingBaseError, match="controller"):
+    with pytest.raises(ValueError, match=r"controller.target \(the joints' configuration, q\[7:\]: the base is not"):
         simulate(robot, q0, v0, dt=1e-3, steps=3, controller=armdyn.simulate.PD(1.0, 1.0, q0))
     with pytest.raises(ValueError, match=rf"\({robot.nq},\)"):
         simulate(robot, q0[7:], v0, dt=1e-3, steps=3)
@@ -269,8 +268,8 @@ def test_cli_simulates_a_floating_mjcf(capsys, tmp_path):
     q_final[3:7] /= np.linalg.norm(q_final[3:7])
     expected = com(robot, q0[None])[0] + 0.2 * p0[0] / mass + 0.5 * G * 0.04
     assert robot.floating and np.abs(com(robot, q_final[None])[0] - expected).max() < 1e-5
-    assert main([*common, "--controller", "pd", "--target", "0"]) == 2
-    assert "floating base" in capsys.readouterr().err
+    assert main([*common, "--controller", "pd", "--target", "0,0,1,0,0,0,1,0"]) == 2
+    assert "the floating base is not actuated" in capsys.readouterr().err
 
 
 def test_a_diverging_state_stops_alone():

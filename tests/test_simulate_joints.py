@@ -16,8 +16,8 @@ fixed or floating base, against second opinions:
   ends where armdyn's does;
 * a puck on a planar joint (gravity along the plane's normal) slides at a constant
   world velocity of its centre of mass and turns at a constant rate;
-* batches equal single runs bit for bit; controllers, callables and non-unit
-  quaternions are refused.
+* batches equal single runs bit for bit; targets and torques of the wrong widths and
+  non-unit quaternions are refused.
 """
 
 from __future__ import annotations
@@ -277,13 +277,17 @@ def test_batches_equal_single_runs(floating):
                 np.testing.assert_array_equal(getattr(batch, name)[r], getattr(one, name), err_msg=name)
 
 
-def test_controllers_callables_and_bad_quaternions_refused():
+def test_bad_targets_torques_and_quaternions_refused():
+    """A controller's target is a configuration (nq), a callable's torque nv wide; a
+    quaternion off unit length is named. (Controllers and callables: test_simulate_control_joints.py.)"""
     robot = ball_pendulum()
     q0 = [0.0, 0.0, 0.0, 1.0]
-    with pytest.raises(ValueError, match="revolute and prismatic joints only.*'ball'"):
+    with pytest.raises(ValueError, match=r"controller.target \(a configuration\): expected \(4,\)"):
         simulate(robot, q0, dt=1e-3, steps=2, controller=PD(kp=1.0, kd=1.0, target=np.zeros(3)))
-    with pytest.raises(ValueError, match="revolute and prismatic joints only.*'ball'"):
-        simulate(robot, q0, dt=1e-3, steps=2, torque=lambda t, q, qd: np.zeros(3))
+    with pytest.raises(ValueError, match=r"controller.target\[0:4\] of joint 'ball'"):
+        simulate(robot, q0, dt=1e-3, steps=2, controller=PD(kp=1.0, kd=1.0, target=[0.0, 0.0, 0.0, 2.0]))
+    with pytest.raises(ValueError, match=r"returned shape \(4,\) at step 0.*expected \(3,\)"):
+        simulate(robot, q0, dt=1e-3, steps=2, torque=lambda t, q, qd: np.zeros(4))
     with pytest.raises(ValueError, match=r"quaternion of joint 'ball' q\[0:4\]"):
         simulate(robot, [0.0, 0.0, 0.0, 1.1], dt=1e-3, steps=2)
     with pytest.raises(ValueError, match=r"shape \(3,\), expected \(4,\)"):

@@ -92,4 +92,12 @@ def aba_derivatives(
 def minverse(model: Any, q: Any, threads: int | None = None, out: Any = None) -> Any:
     """M^-1, (n, n) or, floating, (nv, nv), with a leading N for a batch."""
 
+# The configuration manifold's maps of the integrators (crates/armdyn-py/src/simulate.rs),
+# row by row: q (N, nq), xi, theta, v (N, nv), a floating base's included.
+def _manifold_integrate(model: NumericModel, q: Any, xi: Any) -> Any:
+    """``q (+) xi`` (N, nq), as armdyn.configuration.integrate."""
+
+def _manifold_local_rate(model: NumericModel, theta: Any, v: Any) -> Any:
+    """Runge-Kutta-Munthe-Kaas's ``dexp^-1_{-theta}(v)`` to fourth order (N, nv)."""
+
 def __getattr__(name: str) -> Any: ...

@@ -482,7 +482,11 @@ def build_parser() -> argparse.ArgumentParser:
         choices=["pd", "pd-gravity", "computed-torque"],
         help="joint PD, PD with gravity compensation, or computed torque (default: passive)",
     )
-    m.add_argument("--target", help="controller set point, comma-separated joint values")
+    m.add_argument(
+        "--target",
+        help="controller set point, comma-separated joint values (a ball joint's quaternion x,y,z,w as in --q0; "
+        "with a floating base the joints' only)",
+    )
     m.add_argument("--kp", help="controller gains, comma-separated (pd: 100 M_ii(target), computed-torque: 25)")
     m.add_argument("--kd", help="controller damping, comma-separated (pd: 20 M_ii(target), computed-torque: 10)")
     m.add_argument("--stride", type=int, help="store every k-th step (default: about 2000 samples)")

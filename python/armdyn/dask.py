@@ -25,25 +25,26 @@ from __future__ import annotations
 
 import numpy as np
 
-from .numeric import check_threads, compiled_model, core_model, require_fixed_base
-from .numeric.checks import require_one_dof_joints
+from .numeric import check_threads, compiled_model, core_model
 
 __all__ = ["rnea", "aba", "crba", "simulate", "rnea_derivatives", "aba_derivatives", "minverse", "gravity_derivatives"]
 
 
-def _arrays(dof: int, chunks, *xs):
-    """Dask arrays (N, dof) with the joint axis in one chunk and row chunks aligned to the
-    first argument's."""
+def _arrays(dof, chunks, *xs):
+    """Dask arrays (N, width) with the joint axis in one chunk and row chunks aligned to
+    the first argument's. ``dof``: every argument's width, or one width per argument (q
+    nq wide, the others nv: a floating base or joints of several coordinates)."""
     import dask.array as da
 
+    widths = list(dof) if isinstance(dof, (tuple, list)) else [dof] * len(xs)
     out = []
-    for k, x in enumerate(xs):
+    for k, (x, width) in enumerate(zip(xs, widths)):
         if not isinstance(x, da.Array):
-            x = da.from_array(np.asarray(x, dtype=float), chunks=(chunks, dof) if chunks else "auto")
-        if x.ndim != 2 or x.shape[1] != dof:
-            raise ValueError(f"argument {k}: shape {x.shape}, expected (N, {dof})")
-        if k and x.shape != out[0].shape:
-            raise ValueError(f"argument {k}: shape {x.shape} does not match {out[0].shape}")
+            x = da.from_array(np.asarray(x, dtype=float), chunks=(chunks, width) if chunks else "auto")
+        if x.ndim != 2 or x.shape[1] != width:
+            raise ValueError(f"argument {k}: shape {x.shape}, expected (N, {width})")
+        if k and x.shape[0] != out[0].shape[0]:
+            raise ValueError(f"argument {k}: shape {x.shape} does not match {out[0].shape} (one row per state)")
         x = x.astype(float).rechunk({1: -1} if k == 0 else {0: out[0].chunks[0], 1: -1})
         out.append(x)
     return out
@@ -66,35 +67,45 @@ def _crba(q, model, threads):
     return model.crba(*_c(q), threads)
 
 
+def _widths(model) -> tuple[int, int]:
+    """``(nq, nv)`` of a compiled model: dof each, wider with a floating base (7 + dof, 6 +
+    dof) or joints of several coordinates (Pinocchio's layouts, armdyn.configuration)."""
+    return getattr(model, "nq", model.dof), getattr(model, "nv", model.dof)
+
+
 def rnea(robot, q, qd, qdd, *, chunks=None, threads=1):
-    """Lazy inverse dynamics ``tau = M qdd + C qd + g``: (N, dof) Dask arrays in and out.
-    NumPy inputs are wrapped with ``chunks`` rows per block (default: Dask's "auto")."""
-    require_fixed_base(robot, "armdyn.dask.rnea")
-    require_one_dof_joints(robot, "armdyn.dask.rnea")
+    """Lazy inverse dynamics ``tau = M qdd + C qd + g``: (N, dof) Dask arrays in and out
+    (q (N, nq) and the others (N, nv) for a floating base or joints of several
+    coordinates). NumPy inputs are wrapped with ``chunks`` rows per block (default:
+    Dask's "auto")."""
     model = compiled_model(robot)
     threads = check_threads(threads)  # Rust reads True as 1
-    q, qd, qdd = _arrays(model.dof, chunks, q, qd, qdd)
-    return q.map_blocks(_rnea, qd, qdd, model=model, threads=threads, dtype=float, meta=np.empty((0, 0)))
+    nq, nv = _widths(model)
+    q, qd, qdd = _arrays((nq, nv, nv), chunks, q, qd, qdd)
+    return q.map_blocks(
+        _rnea, qd, qdd, model=model, threads=threads, dtype=float, meta=np.empty((0, 0)), chunks=(q.chunks[0], (nv,))
+    )
 
 
 def aba(robot, q, qd, tau, *, chunks=None, threads=1):
-    """Lazy forward dynamics ``qdd = M^-1 (tau - C qd - g)``: (N, dof) in and out."""
-    require_fixed_base(robot, "armdyn.dask.aba")
-    require_one_dof_joints(robot, "armdyn.dask.aba")
+    """Lazy forward dynamics ``qdd = M^-1 (tau - C qd - g)``: (N, dof) in and out (widths
+    as :func:`rnea`'s)."""
     model = compiled_model(robot)
     threads = check_threads(threads)  # Rust reads True as 1
-    q, qd, tau = _arrays(model.dof, chunks, q, qd, tau)
-    return q.map_blocks(_aba, qd, tau, model=model, threads=threads, dtype=float, meta=np.empty((0, 0)))
+    nq, nv = _widths(model)
+    q, qd, tau = _arrays((nq, nv, nv), chunks, q, qd, tau)
+    return q.map_blocks(
+        _aba, qd, tau, model=model, threads=threads, dtype=float, meta=np.empty((0, 0)), chunks=(q.chunks[0], (nv,))
+    )
 
 
 def crba(robot, q, *, chunks=None, threads=1):
-    """Lazy joint-space inertia matrices: q (N, dof) -> M (N, dof, dof)."""
-    require_fixed_base(robot, "armdyn.dask.crba")
-    require_one_dof_joints(robot, "armdyn.dask.crba")
+    """Lazy joint-space inertia matrices: q (N, nq) -> M (N, nv, nv) (nq = nv = dof for
+    1-dof joints on a fixed base)."""
     model = compiled_model(robot)
     threads = check_threads(threads)  # Rust reads True as 1
-    (q,) = _arrays(model.dof, chunks, q)
-    n = model.dof
+    nq, n = _widths(model)
+    (q,) = _arrays(nq, chunks, q)
     return q.map_blocks(
         _crba,
         model=model,
@@ -115,8 +126,8 @@ def _simulate(q0, qd0, model, options, samples, energies, threads):
 
     q0, qd0 = _c(q0, qd0)
     run = run_simulation(model, q0, qd0, energies=energies, threads=threads, **options)
-    rows, dof = q0.shape
-    parts = [np.stack([run.q, run.qd, run.qdd, run.tau], axis=2).reshape(rows, -1), run.work]
+    rows = q0.shape[0]
+    parts = [run.q.reshape(rows, -1), np.stack([run.qd, run.qdd, run.tau], axis=2).reshape(rows, -1), run.work]
     if energies:
         parts.append(np.stack([run.kinetic, run.potential], axis=2).reshape(rows, -1))
     parts += [run.q_final, run.qd_final] + [np.asarray(getattr(run, f), dtype=float)[:, None] for f in _FLAGS]
@@ -145,33 +156,35 @@ def simulate(
     Dask arrays (``t`` is NumPy): ``q``, ``qd``, ``qdd``, ``tau`` (N, S, dof); ``kinetic``,
     ``potential``, ``work`` (N, S); ``q_final``, ``qd_final`` (N, dof); ``limit_step``,
     ``limit_joint``, ``nonfinite_step``, ``nonfinite_joint`` (N,) int64. ``torque`` may be None, (dof,) or
-    (steps, dof) (shared by all states); a controller's targets are (dof,).
+    (steps, dof) (shared by all states); a controller's targets are one state's.
+    A floating base or joints of several coordinates: ``q0``, ``q``, ``q_final`` are nq
+    wide, the others nv, as :func:`armdyn.simulate.simulate`'s.
     """
     import dask.array as da
 
-    from .simulate import step_count
+    from .simulate import BASE_VELOCITY_NAMES, step_count
     from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
-    require_fixed_base(robot, "armdyn.dask.simulate")
-    require_one_dof_joints(robot, "armdyn.dask.simulate")
     model = compiled_model(robot)
     threads = check_threads(threads)  # Rust reads True as 1
-    dof = model.dof
+    nq, dof = _widths(model)
     steps = step_count(duration, steps, dt)
     if torque is not None and (callable(torque) or np.ndim(torque) > 2):
         raise ValueError("armdyn.dask.simulate: torque must be None, (dof,) or (steps, dof)")
     if isinstance(controller, (PD, ComputedTorque)) and np.ndim(controller.target) > 1:
-        raise ValueError("armdyn.dask.simulate: the controller's target must be (dof,)")
+        raise ValueError("armdyn.dask.simulate: the controller's target must be one state's (1-d)")
     if qd0 is None:
-        qd0 = da.zeros_like(q0) if isinstance(q0, da.Array) else np.zeros(np.shape(q0))
-    q0, qd0 = _arrays(dof, chunks, q0, qd0)
-    if limits is None:
-        limits = joint_limits(robot)
+        rows = np.shape(q0)[0] if np.ndim(q0) == 2 else 0
+        qd0 = da.zeros((rows, dof), chunks=(q0.chunks[0], dof)) if isinstance(q0, da.Array) else np.zeros((rows, dof))
+    q0, qd0 = _arrays((nq, dof), chunks, q0, qd0)
+    if limits is None:  # the robot's own (the workers get the compiled model); a joint without
+        # limits (a ball joint's +-inf) as the largest floats, which simulate takes and no finite q passes
+        limits = tuple(np.nan_to_num(x) for x in joint_limits(robot))
     options = dict(
         dt=dt, steps=steps, method=method, torque=torque, controller=controller, stride=stride, limits=limits
     )
     samples = steps // stride + 1
-    width = samples * dof * 4 + samples + (2 * samples if energies else 0) + 2 * dof + len(_FLAGS)
+    width = samples * (nq + 3 * dof) + samples + (2 * samples if energies else 0) + nq + dof + len(_FLAGS)
     packed = q0.map_blocks(
         _simulate,
         qd0,
@@ -185,9 +198,10 @@ def simulate(
         chunks=(q0.chunks[0], (width,)),
     )
     n = q0.shape[0]
-    at = samples * dof * 4
-    states = packed[:, :at].reshape(n, samples, 4, dof)
-    out = {name: states[:, :, k, :] for k, name in enumerate(("q", "qd", "qdd", "tau"))}
+    out = {"q": packed[:, : samples * nq].reshape(n, samples, nq)}
+    at = samples * (nq + 3 * dof)
+    states = packed[:, samples * nq : at].reshape(n, samples, 3, dof)
+    out.update({name: states[:, :, k, :] for k, name in enumerate(("qd", "qdd", "tau"))})
     out["work"] = packed[:, at : at + samples]
     at += samples
     kinetic = potential = None
@@ -195,8 +209,8 @@ def simulate(
         e = packed[:, at : at + 2 * samples].reshape(n, samples, 2)
         kinetic, potential = e[:, :, 0], e[:, :, 1]
         at += 2 * samples
-    out["q_final"], out["qd_final"] = packed[:, at : at + dof], packed[:, at + dof : at + 2 * dof]
-    at += 2 * dof
+    out["q_final"], out["qd_final"] = packed[:, at : at + nq], packed[:, at + nq : at + nq + dof]
+    at += nq + dof
     for k, name in enumerate(_FLAGS):
         out[name] = packed[:, at + k].astype(np.int64)
     t = np.arange(samples) * (stride * float(dt))
@@ -205,7 +219,7 @@ def simulate(
         dt=float(dt),
         stride=stride,
         method=method,
-        coordinate_names=list(model.coordinate_names),
+        coordinate_names=[*(BASE_VELOCITY_NAMES if getattr(model, "floating", False) else ()), *model.coordinate_names],
         kinetic=kinetic,
         potential=potential,
         **out,

@@ -29,7 +29,8 @@ Torque: ``None`` (passive); a constant ``(dof,)``; a series ``(steps, dof)`` for
 state or ``(N, steps, dof)`` one per state (row ``k`` acts over ``[t_k, t_k + dt)``);
 a controller run in Rust at every integrator stage (:class:`PD`,
 :class:`ComputedTorque`); or a callable ``torque(t, q, qd) -> tau`` with ``q``, ``qd``
-``(N, dof)`` and ``tau`` ``(dof,)`` or ``(N, dof)``.
+``(N, dof)`` and ``tau`` ``(dof,)`` or ``(N, dof)`` (widths nq and nv where they differ,
+below).
 
 A floating base (``robot.floating``, Pinocchio's layout: ``q0`` (7 + dof,) base position,
 quaternion x y z w, joints; ``qd0`` and torques (6 + dof,) base linear and angular
@@ -40,7 +41,7 @@ on SE(3) as :func:`armdyn.configuration.integrate` moves it (semi-implicit Euler
 the others (6 + dof,); ``limit_joint`` and ``nonfinite_joint`` index
 ``Trajectory.coordinate_names``, the velocity's (``base_vx`` ... ``base_wz``, then the
 joints). Energies include the base: ``T = 1/2 v^T M v``, ``V = -g . (m c)`` with ``c``
-the world centre of mass. Controllers and torque callables are fixed-base only.
+the world centre of mass. The base is not actuated by a controller (below).
 
 Joints of several coordinates (spherical, planar, free; ``robot.nq`` > ``robot.nv``),
 fixed or floating base: the same two methods with each joint's block moved on its group
@@ -48,7 +49,24 @@ as :func:`armdyn.configuration.integrate` moves it (spherical on SO(3), free on 
 planar on SE(2); the quaternions and planar ``(cos, sin)`` kept unit). ``q0`` and the
 stored ``q`` rows are (nq,), the others (nv,) (``Trajectory.coordinate_names``);
 limits are checked on the 1-dof joints only; energies as for a floating base.
-Controllers and torque callables take 1-dof joints only.
+
+Controllers there (:mod:`armdyn.simulate_control`): the error is on the tangent space,
+``e = difference(q, target)`` (:func:`armdyn.configuration.difference`, Pinocchio's
+``difference``: the velocity, in ``q``'s frame, that moves ``q`` to the target in unit
+time, so ``Kp e`` turns a ball joint toward its target), ``target`` a configuration
+(nq,), ``kp``, ``kd``, ``target_qd`` per velocity coordinate (nv,). :class:`PD`: ``tau =
+[g(q)] + Kp e + Kd (qd* - qd)``; :class:`ComputedTorque`: ``tau = rnea(q, qd, Kp e + Kd
+(qd* - qd))``, so that ``qdd = Kp e + Kd (qd* - qd)`` (an error along one axis of a
+ball, or a small one, decays as ``e'' + Kd e' + Kp e = 0``). With a floating base the
+controllers' arrays are the joints' (target ``q[7:]``, gains ``v[6:]``), the base's six
+rows of ``tau`` are zero, PD's gravity compensation is the joints' rows of the
+generalized gravity (what holds the joints while the base is held); computed torque
+gives the joints ``qdd = Kp e + Kd (qd* - qd)`` and the base the acceleration that
+follows (collocated partial feedback linearization: no wrench on the base, which the
+joints' motion moves). A torque callable
+gets ``q`` (N, nq) and ``qd`` (N, nv) and returns (nv,) or (N, nv), the steps those of
+the Rust integrators. :func:`simulate_adaptive` integrates ``q`` in its embedding
+(:mod:`armdyn.simulate_adaptive`).
 
 Joint limits (from the robot's joints, or ``limits=(lower, upper)``) are reported, never
 enforced: :attr:`Trajectory.limit_step` / :attr:`Trajectory.limit_joint` give, per state,
@@ -78,8 +96,9 @@ import numpy as np
 
 from . import _core
 from .configuration import rotate_vector
-from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy, require_fixed_base
-from .numeric.checks import require_one_dof_joints
+from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy
+from .simulate_adaptive import simulate_adaptive
+from .simulate_control import controller_arrays, simulate_callable
 from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
 __all__ = ["simulate", "simulate_adaptive", "Trajectory", "PD", "ComputedTorque", "joint_limits"]
@@ -116,15 +135,6 @@ def _per_joint(x, name, dof):
     if not np.all(np.isfinite(a)):  # the shape is right: say what is wrong instead
         raise ValueError(f"{name} contains NaN or inf")
     return _c(a)
-
-
-def _per_state(x, name, rows, dof):
-    if x is None:
-        return np.zeros((rows, dof))
-    a = np.asarray(x, dtype=float)
-    if a.shape not in ((dof,), (rows, dof)) or not np.all(np.isfinite(a)):
-        raise ValueError(f"{name}: expected finite ({dof},) or ({rows}, {dof}) values, got shape {a.shape}")
-    return _c(np.broadcast_to(a, (rows, dof)))
 
 
 def step_count(duration, steps, dt) -> int:
@@ -232,30 +242,14 @@ def simulate(
 
     if torque is not None and controller is not None:
         raise ValueError("give torque or controller, not both")
-    if floating and (controller is not None or callable(torque)):
-        require_fixed_base(robot, "armdyn.simulate with a controller or a torque callable")
-    if controller is not None or callable(torque):
-        require_one_dof_joints(robot, "armdyn.simulate with a controller or a torque callable")
     empty = np.zeros(0)
     args = dict(torque=empty, kp=empty, kd=empty, target=empty, target_qd=empty)
     if callable(torque):
-        out = _simulate_python(model, q0a, qd0a, torque, dt, steps, stride, method, lower, upper)
+        out = simulate_callable(robot, model, q0a, qd0a, torque, dt, steps, stride, method, lower, upper)
     else:
         if controller is not None:
-            if isinstance(controller, PD):
-                kind = "pd-gravity" if controller.gravity_compensation else "pd"
-            elif isinstance(controller, ComputedTorque):
-                kind = "computed-torque"
-            else:
-                raise ValueError(
-                    f"controller must be an armdyn.simulate.PD or ComputedTorque, got {type(controller).__name__}"
-                )
-            args.update(
-                kp=_per_joint(controller.kp, "controller.kp", dof),
-                kd=_per_joint(controller.kd, "controller.kd", dof),
-                target=_per_state(controller.target, "controller.target", rows, dof),
-                target_qd=_per_state(controller.target_qd, "controller.target_qd", rows, dof),
-            )
+            kind, gains = controller_arrays(robot, model, controller, q0a)
+            args.update(gains)
         elif torque is None:
             kind = "zero"
         else:
@@ -397,179 +391,3 @@ def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower,
     if done < steps:
         progress(steps, steps)
     return out
-
-
-def _simulate_python(model, q0, qd0, torque, dt, steps, stride, method, lower, upper):
-    """The slow path: a NumPy loop calling ``torque(t, q, qd)`` (q, qd (N, dof)) at every
-    stage, ``aba`` batched over the states in Rust."""
-    rows, dof = q0.shape
-    samples = steps // stride + 1
-    out = {name: np.empty((rows, samples, dof)) for name in ("q", "qd", "qdd", "tau")}
-    out["work"] = np.empty((rows, samples))
-    work = np.zeros(rows)  # of the torque, integrated by the same method as the state
-    limit_step = np.full(rows, -1, dtype=np.int64)
-    limit_joint = np.full(rows, -1, dtype=np.int64)
-    nonfinite = np.full(rows, -1, dtype=np.int64)
-    nonfinite_joint = np.full(rows, -1, dtype=np.int64)
-
-    def tau_at(k, t, q, qd):
-        try:
-            tau = torque(t, q.copy(), qd.copy())
-        except Exception as err:  # noqa: BLE001 - the user's error, shown with the step
-            raise ValueError(
-                f"torque callable failed at step {k} (t = {t:.6g} s): {type(err).__name__}: {err}"
-            ) from err
-        if np.iscomplexobj(tau):  # float() would drop the imaginary part with only a warning
-            raise ValueError(f"torque callable returned complex values at step {k} (t = {t:.6g} s); torques are real")
-        try:
-            tau = np.asarray(tau, dtype=float)
-        except (TypeError, ValueError):
-            raise ValueError(f"torque callable returned a non-numeric value at step {k} (t = {t:.6g} s)") from None
-        if tau.shape not in ((dof,), (rows, dof)):
-            raise ValueError(
-                f"torque callable returned shape {tau.shape} at step {k} (t = {t:.6g} s); "
-                f"expected ({dof},) or ({rows}, {dof})"
-            )
-        return _c(np.broadcast_to(tau, (rows, dof)))
-
-    def acc(k, t, q, qd):
-        live = nonfinite < 0
-        if not live.all():  # diverged states stopped: finite stand-ins, their samples are dropped
-            q, qd = np.where(live[:, None], q, 0.0), np.where(live[:, None], qd, 0.0)
-        tau = tau_at(k, t, q, qd)
-        try:
-            return model.aba(_c(q), _c(qd), tau, None), tau
-        except ValueError:
-            pass
-        # no finite acceleration for some state (velocities so large that the dynamics
-        # overflow: a diverging run): that state stops here, the others go on
-        a = np.full_like(q, np.nan)
-        for i in np.flatnonzero(live):
-            try:
-                a[i] = model.aba(q[i], qd[i], tau[i], None)
-            except ValueError:
-                nonfinite[i], nonfinite_joint[i] = k, int(np.argmax(np.abs(qd[i])))
-        return a, tau
-
-    def check(k, q, qd):
-        outside = (q < lower) | (q > upper)
-        new = (limit_step < 0) & outside.any(axis=1)
-        limit_step[new], limit_joint[new] = k, outside[new].argmax(axis=1)
-        finite = np.isfinite(q + qd)
-        bad = (nonfinite < 0) & ~finite.all(axis=1)
-        nonfinite[bad], nonfinite_joint[bad] = k, (~finite[bad]).argmax(axis=1)
-
-    q, qd = q0.copy(), qd0.copy()
-    check(0, q, qd)
-    h = dt
-    with np.errstate(over="ignore", invalid="ignore"):  # a diverging state is reported, not warned about
-        for k in range(steps + 1):
-            t = k * dt
-            if k < steps or k % stride == 0:
-                a1, tau1 = acc(k, t, q, qd)
-            if k % stride == 0:
-                s = k // stride
-                out["q"][:, s], out["qd"][:, s], out["qdd"][:, s], out["tau"][:, s] = q, qd, a1, tau1
-                out["work"][:, s] = work
-            if k == steps:
-                break
-            if method == "euler":
-                work = work + h * (tau1 * qd).sum(axis=1)
-                qd = qd + h * a1
-                q = q + h * qd
-            else:
-                q2, qd2 = q + h / 2 * qd, qd + h / 2 * a1
-                a2, tau2 = acc(k, t + h / 2, q2, qd2)
-                q3, qd3 = q + h / 2 * qd2, qd + h / 2 * a2
-                a3, tau3 = acc(k, t + h / 2, q3, qd3)
-                q4, qd4 = q + h * qd3, qd + h * a3
-                a4, tau4 = acc(k, t + h, q4, qd4)
-                work = work + h / 6 * (
-                    (tau1 * qd).sum(axis=1)
-                    + 2 * (tau2 * qd2).sum(axis=1)
-                    + 2 * (tau3 * qd3).sum(axis=1)
-                    + (tau4 * qd4).sum(axis=1)
-                )
-                q = q + h / 6 * (qd + 2 * qd2 + 2 * qd3 + qd4)
-                qd = qd + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
-            check(k + 1, q, qd)
-            if (nonfinite >= 0).all():
-                break
-    out.update(
-        q_final=q,
-        qd_final=qd,
-        limit_step=limit_step,
-        limit_joint=limit_joint,
-        nonfinite_step=nonfinite,
-        nonfinite_joint=nonfinite_joint,
-    )
-    return out
-
-
-def simulate_adaptive(
-    robot, q0, qd0=None, *, duration, torque=None, rtol=1e-10, atol=1e-12, method="DOP853", t_eval=None
-) -> Trajectory:
-    """One trajectory with SciPy's ``solve_ivp`` (adaptive step, error control) on ``aba``.
-
-    q0, qd0: (dof,). torque: None, (dof,) constant, or a callable ``torque(t, q, qd)``
-    with q, qd (dof,) returning (dof,). t_eval: the sample times (default: 101 evenly
-    spaced over ``[0, duration]``). Returns a :class:`Trajectory` of single-state shape
-    (``dt`` is ``nan``: the steps are SciPy's).
-    """
-    from scipy.integrate import solve_ivp
-
-    require_fixed_base(robot, "armdyn.simulate_adaptive")
-    require_one_dof_joints(robot, "armdyn.simulate_adaptive")
-    model = compiled_model(robot)
-    dof = model.dof
-    q0 = _state(q0, "q0", dof)
-    qd0 = np.zeros(dof) if qd0 is None else _state(qd0, "qd0", dof)
-    if q0.ndim != 1 or qd0.ndim != 1:
-        raise ValueError("simulate_adaptive integrates one state: q0, qd0 of shape (dof,)")
-    if not (math.isfinite(duration) and duration > 0):
-        raise ValueError(f"duration must be a positive finite number of seconds, got {duration!r}")
-    if torque is None:
-        tau_of = lambda t, q, qd: np.zeros(dof)  # noqa: E731
-    elif callable(torque):
-        tau_of = torque
-    else:
-        const = _per_joint(torque, "torque", dof)
-        tau_of = lambda t, q, qd: const  # noqa: E731
-    t_eval = np.linspace(0.0, duration, 101) if t_eval is None else np.asarray(t_eval, dtype=float)
-
-    def f(t, x):  # x = (q, qd, W): the torque's work integrated with the state
-        q, qd = x[:dof], x[dof : 2 * dof]
-        tau = np.asarray(tau_of(t, q, qd), dtype=float)
-        return np.concatenate([qd, model.aba(q, qd, tau, None), [tau @ qd]])
-
-    sol = solve_ivp(
-        f, (0.0, duration), np.concatenate([q0, qd0, [0.0]]), method=method, rtol=rtol, atol=atol, t_eval=t_eval
-    )
-    if not sol.success:
-        raise ValueError(f"solve_ivp failed: {sol.message}")
-    q, qd = _c(sol.y[:dof].T), _c(sol.y[dof : 2 * dof].T)
-    tau = np.array([tau_of(t, a, b) for t, a, b in zip(sol.t, q, qd)], dtype=float).reshape(len(sol.t), dof)
-    qdd = model.aba(q, qd, tau, None)
-    lower, upper = joint_limits(robot)
-    outside = (q < lower) | (q > upper)
-    first = int(np.flatnonzero(outside.any(axis=1))[0]) if outside.any() else -1
-    run = Trajectory(
-        t=sol.t,
-        q=q,
-        qd=qd,
-        qdd=qdd,
-        tau=tau,
-        q_final=q[-1],
-        qd_final=qd[-1],
-        limit_step=first,
-        limit_joint=int(outside[first].argmax()) if first >= 0 else -1,
-        nonfinite_step=-1,
-        dt=float("nan"),
-        stride=1,
-        method=method,
-        coordinate_names=list(model.coordinate_names),
-        work=sol.y[2 * dof].copy(),
-    )
-    run.kinetic = kinetic_energy(model, q, qd)
-    run.potential = potential_energy(model, q)
-    return run

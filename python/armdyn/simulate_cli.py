@@ -105,26 +105,32 @@ def run(args, robot) -> int:
     else:
         q0 = np.broadcast_to(_numbers(args.q0, "--q0", dof) or [0.0], (dof,))
         qd0 = np.broadcast_to(_numbers(args.qd0, "--qd0", dof) or [0.0], (dof,))
-    if robot.floating and (args.controller or args.animate or getattr(args, "three_d", None)):
+    if robot.floating and (args.animate or getattr(args, "three_d", None)):
         raise ValueError(
-            f"'{robot.name}' has a floating base: --controller, --animate and --3d are for fixed-base robots "
-            "(a passive run, --plot and the energy report work)"
+            f"'{robot.name}' has a floating base: --animate and --3d are for fixed-base robots "
+            "(a run, --controller on the joints, --plot and the energy report work)"
         )
     controller = None
     if args.controller is not None:
-        robot.require_one_dof_joints("armdyn simulate --controller")  # its target and gains: one per joint
         if args.target is None:
             raise ValueError(f"--controller {args.controller} needs --target (joint values)")
-        target = np.broadcast_to(_numbers(args.target, "--target", dof), (dof,))
+        base_q, base_v = (7, 6) if robot.floating else (0, 0)
+        if robot.floating or robot.multi_dof_joints:
+            target = manifold_target(robot, args.target)
+        else:
+            target = np.broadcast_to(_numbers(args.target, "--target", dof), (dof,))
         if args.controller == "computed-torque":  # gains of the unit-inertia error dynamics
             default = (25.0, 10.0)
-        else:  # 10 rad/s, critically damped, scaled by each joint's inertia M_ii at the target
+        else:  # 10 rad/s, critically damped, scaled by each coordinate's inertia M_ii at the target
             from .numeric import crba
 
-            m_ii = np.diag(crba(robot, np.ascontiguousarray(target)))
+            at = np.array(q0, dtype=float)
+            at[base_q:] = target
+            m_ii = np.diag(crba(robot, at))[base_v:]
             default = (100.0 * m_ii, 20.0 * m_ii)
-        kp = np.broadcast_to(_numbers(args.kp, "--kp", dof) or default[0], (dof,))
-        kd = np.broadcast_to(_numbers(args.kd, "--kd", dof) or default[1], (dof,))
+        # one gain per velocity coordinate of the joints (a ball joint's three)
+        kp = np.broadcast_to(_numbers(args.kp, "--kp", dof, "velocity coordinate") or default[0], (dof,))
+        kd = np.broadcast_to(_numbers(args.kd, "--kd", dof, "velocity coordinate") or default[1], (dof,))
         if args.controller == "computed-torque":
             controller = ComputedTorque(kp, kd, target)
         else:
@@ -252,13 +258,37 @@ def manifold_start(robot, args) -> tuple[np.ndarray, np.ndarray]:
     return q0, qd0
 
 
-def _numbers(text: str | None, option: str, dof: int | None = None):
+def manifold_target(robot, text: str) -> np.ndarray:
+    """``--target`` of a robot whose configuration is not flat: the joints' configuration,
+    read per joint block as ``--q0`` (quaternions x y z w, planar x y cos sin; one value
+    when every joint has one coordinate). A floating base is not actuated: the joints'
+    values only, never its pose. A quaternion off unit length is refused, naming it."""
+    from .configuration import _check_unit, _grouped
+
+    given = _numbers(text, "--target")
+    base_q, base_v = (7, 6) if robot.floating else (0, 0)
+    joints = robot.nq - base_q
+    if len(given) == 1 and joints == robot.nv - base_v:
+        given = given * joints
+    if len(given) != joints:
+        base = " (the floating base is not actuated: no pose for it)" if robot.floating else ""
+        raise ValueError(f"--target needs {joints} joint values{base}, got {len(given)}")
+    # the joints' blocks at their places in the values given (a floating base's 7 off)
+    layout = _grouped(tuple((n, k, iq - base_q, iv - base_v) for n, k, iq, iv in robot.configuration_layout), False)
+    target = np.array(given)
+    _check_unit(layout, target, "--target")
+    return target
+
+
+def _numbers(text: str | None, option: str, dof: int | None = None, each: str = "joint"):
     if text is None:
         return None
     try:
         values = [float(x) for x in text.split(",")]
     except ValueError:
         raise ValueError(f"{option} must be comma-separated numbers, got {text!r}") from None
+    if not all(np.isfinite(values)):
+        raise ValueError(f"{option} must be finite numbers, got {text!r}")
     if dof is not None and len(values) not in (1, dof):
-        raise ValueError(f"{option} needs 1 or {dof} values (one per joint), got {len(values)}")
+        raise ValueError(f"{option} needs 1 or {dof} values (one per {each}), got {len(values)}")
     return values

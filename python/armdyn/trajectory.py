@@ -26,6 +26,9 @@ class PD:
 
     kp, kd: scalars or (dof,) diagonal gains (N m/rad, N m s/rad); target: (dof,) or
     (N, dof); target_qd: same shapes, default zero. Evaluated in Rust at every stage.
+    Joints of several coordinates: ``q* - q`` is ``difference(q, q*)`` on the tangent
+    space, target (nq,), the others per velocity coordinate (nv,); a floating base: the
+    joints' arrays, the base's rows of tau zero (:mod:`armdyn.simulate`).
     """
 
     kp: object
@@ -42,6 +45,9 @@ class ComputedTorque:
     when ``qd* = 0`` and the model is exact (Spong, Hutchinson & Vidyasagar, eq. 8.58).
 
     kp, kd: scalars or (dof,) (1/s^2, 1/s); target, target_qd: (dof,) or (N, dof).
+    Joints of several coordinates: ``e = difference(q, q*)``, target (nq,), the others
+    (nv,); a floating base: the joints' arrays, the joints' closed loop as above and the
+    unactuated base moving as it then must (:mod:`armdyn.simulate_control`).
     """
 
     kp: object

@@ -13,6 +13,7 @@
 use super::{guard, thread_arg, NumericModel};
 use armdyn_core::algo::integrate::{self, Input, Method, Outputs, Settings};
 use armdyn_core::algo::integrate_floating;
+use armdyn_core::algo::manifold::Manifold;
 use numpy::{PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -81,8 +82,8 @@ fn data<'a>(a: &'a PyReadonlyArrayDyn<'_, f64>, name: &str, shape: &[usize]) -> 
 /// A floating-base model or one with joints of several coordinates
 /// (`algo::integrate_floating`): `q0`, `q`, `q_final` have the model's `nq` columns
 /// (7 more with a floating base), `qd0`, the torques and the other outputs `nv` (6
-/// more); lower, upper stay (dof,); only the torque kinds "zero", "constant", "series"
-/// and "series-per-state".
+/// more); lower, upper stay (dof,); the controllers' kp, kd, target_qd are (nv,) and
+/// (N, nv), target (N, nq), at those widths (a floating base's rows are not actuated).
 ///
 /// torque_kind: "zero", "constant" (torque (N, nv)), "series" (torque (steps, nv)),
 /// "series-per-state" (torque (N, steps, nv)), "pd", "pd-gravity", "computed-torque"
@@ -143,10 +144,10 @@ fn _simulate<'py>(
         let upper = data(&upper, "upper", &[n])?;
         let gains = || -> PyResult<_> {
             Ok((
-                data(&kp, "kp", &[n])?,
-                data(&kd, "kd", &[n])?,
-                data(&target, "target", &[rows, n])?,
-                data(&target_qd, "target_qd", &[rows, n])?,
+                data(&kp, "kp", &[nv])?,
+                data(&kd, "kd", &[nv])?,
+                data(&target, "target", &[rows, nq])?,
+                data(&target_qd, "target_qd", &[rows, nv])?,
             ))
         };
         let input = match torque_kind {
@@ -164,14 +165,10 @@ fn _simulate<'py>(
             }
             other => return Err(PyValueError::new_err(format!("torque_kind: unknown '{other}'"))),
         };
-        if manifold && matches!(input, Input::Pd { .. } | Input::ComputedTorque { .. }) {
-            let name = &model.get().name;
-            if floating {
-                return Err(PyValueError::new_err(format!(
-                    "torque_kind '{torque_kind}': controllers are fixed-base only ('{name}' floats)"
-                )));
+        if manifold {
+            if let Input::Pd { target, .. } | Input::ComputedTorque { target, .. } = input {
+                model.get().check_unit_blocks(target)?;
             }
-            model.get().one_dof_only(&format!("simulate with the controller '{torque_kind}'"))?;
         }
         if matches!(input, Input::Series { .. }) && steps == 0 {
             return Err(PyValueError::new_err("a torque series needs at least one step"));
@@ -231,7 +228,65 @@ fn _simulate<'py>(
     })
 }
 
+/// The model's manifold (a floating base's first) and `a`, `b` (N, wa), (N, wb) checked.
+fn manifold_rows<'a>(
+    model: &Bound<'_, NumericModel>,
+    a: &'a PyReadonlyArrayDyn<'_, f64>,
+    b: &'a PyReadonlyArrayDyn<'_, f64>,
+    names: [&str; 2],
+    widths: impl Fn(&Manifold) -> (usize, usize),
+) -> PyResult<(Manifold, &'a [f64], &'a [f64])> {
+    let manifold = Manifold::new(&model.get().model, model.get().floating);
+    let (wa, wb) = widths(&manifold);
+    let rows = a.shape().first().copied().unwrap_or(0);
+    Ok((manifold, data(a, names[0], &[rows, wa])?, data(b, names[1], &[rows, wb])?))
+}
+
+/// `q (+) xi` row by row (`q` (N, nq), `xi` (N, nv)): the step of the manifold
+/// integrators (`algo::manifold`), for the Python-callable path of armdyn.simulate.
+#[pyfunction]
+fn _manifold_integrate<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, NumericModel>,
+    q: PyReadonlyArrayDyn<'py, f64>,
+    xi: PyReadonlyArrayDyn<'py, f64>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    guard(|| {
+        let (m, q, xi) = manifold_rows(model, &q, &xi, ["q", "xi"], |m| (m.nq, m.nv))?;
+        let out = PyArrayDyn::<f64>::zeros(py, &[q.len() / m.nq.max(1), m.nq][..], false);
+        // SAFETY: a fresh array, not visible to Python until returned.
+        let o = unsafe { out.as_slice_mut().expect("fresh") };
+        for ((q, xi), o) in q.chunks(m.nq).zip(xi.chunks(m.nv)).zip(o.chunks_mut(m.nq)) {
+            m.integrate(q, xi, o);
+        }
+        Ok(out)
+    })
+}
+
+/// RK-Munthe-Kaas's rate of the local coordinate, `dexp^-1_{-theta}(v)` to fourth order,
+/// row by row (`theta`, `v` (N, nv); `algo::manifold::Manifold::local_rate`).
+#[pyfunction]
+fn _manifold_local_rate<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, NumericModel>,
+    theta: PyReadonlyArrayDyn<'py, f64>,
+    v: PyReadonlyArrayDyn<'py, f64>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    guard(|| {
+        let (m, theta, v) = manifold_rows(model, &theta, &v, ["theta", "v"], |m| (m.nv, m.nv))?;
+        let out = PyArrayDyn::<f64>::zeros(py, &[theta.len() / m.nv.max(1), m.nv][..], false);
+        // SAFETY: a fresh array, not visible to Python until returned.
+        let o = unsafe { out.as_slice_mut().expect("fresh") };
+        for ((t, v), o) in theta.chunks(m.nv).zip(v.chunks(m.nv)).zip(o.chunks_mut(m.nv)) {
+            m.local_rate(t, v, o);
+        }
+        Ok(out)
+    })
+}
+
 /// Register this file's functions in the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(_simulate, m)?)
+    m.add_function(wrap_pyfunction!(_simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(_manifold_integrate, m)?)?;
+    m.add_function(wrap_pyfunction!(_manifold_local_rate, m)?)
 }

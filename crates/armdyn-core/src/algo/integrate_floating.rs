@@ -17,8 +17,22 @@
 //!   a vector space: plain RK4.
 //!
 //! Torques ([`Input`]): zero, constant, or a series, of width `v`'s (a floating base's
-//! wrench in the base frame first, then the joints); controllers are for fixed-base
-//! 1-dof models only. Outputs as [`crate::algo::integrate::Outputs`], `q` of width
+//! wrench in the base frame first, then the joints); or a controller evaluated at every
+//! stage, its error on the tangent space, `e = q* (-) q = log(q^-1 q*)` (Pinocchio's
+//! `difference(q, q*)`, in `q`'s frame: the velocity that moves `q` to `q*` in unit time;
+//! [`Manifold::difference_lanes`]), gains and `qd*` per coordinate of `v`, `q*` of `q`'s
+//! width:
+//!
+//! * PD: `tau = [g(q)] + Kp e + Kd (qd* - v)`; with a floating base its six rows are set to
+//!   zero (the base is unactuated) and `g(q)` is the generalized gravity with the base not
+//!   accelerating (`rnea_floating(q, 0, 0)`, its joint rows);
+//! * computed torque: `tau = rnea(q, v, Kp e + Kd (qd* - v))`, so that `v' = Kp e + Kd
+//!   (qd* - v)`: with `qd* = 0` and an error along one axis of a block (or a small one)
+//!   `e'' + Kd e' + Kp e = 0`, since then `e' = -v`. With a floating base (unactuated) the
+//!   joints get that acceleration and the base the one it then has
+//!   ([`unactuated_base`]: collocated partial feedback linearization, Spong 1994).
+//!
+//! Outputs as [`crate::algo::integrate::Outputs`], `q` of width
 //! `q`'s and `qd`, `qdd`, `tau` of width `v`'s; `limit_joint` and `nonfinite_joint`
 //! index `v`'s coordinates (a floating base's six first); `lower`, `upper` are the
 //! joints' (`model.nv`), checked on the 1-dof joints only. The work is of the whole
@@ -31,9 +45,10 @@
 //! state, so results do not depend on the kernels, threads or grouping.
 
 use crate::algo::aba;
-use crate::algo::floating::{aba_floating, NQ_BASE, NV_BASE};
+use crate::algo::floating::{aba_floating, crba_floating, rnea_floating, NQ_BASE, NV_BASE};
 use crate::algo::integrate::{Input, Method, Outputs, Settings, STOP_POLL};
 use crate::algo::manifold::Manifold;
+use crate::algo::rnea::{gravity, rnea};
 use crate::batch::{install, kernels, thread_count, Kernels};
 use crate::data::Data;
 use crate::model::Model;
@@ -85,7 +100,9 @@ pub fn simulate_floating_until(
 /// Integrate `N` states `q0` (N, nq), `v0` (N, nv) of `model` (`floating`: with a
 /// floating base, widths 7 + `model.nq` and 6 + `model.nv`) as the module says, ending
 /// early once `stop` is set (read every [`STOP_POLL`] steps). Returns false if it was
-/// stopped. Panics on a controller input or on mis-sized arrays.
+/// stopped. Controllers: `kp`, `kd` (nv), `target` (N, nq), `target_qd` (N, nv), the
+/// manifold's widths (a floating base's included: its rows are not actuated). Panics on
+/// mis-sized arrays.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_manifold_until(
     model: &Model,
@@ -122,8 +139,9 @@ pub fn simulate_manifold_until(
             assert!(settings.steps >= 1, "a torque series needs at least one step");
             assert_eq!(tau.len(), if shared { 1 } else { rows } * settings.steps * nv, "torque series size")
         }
-        Input::Pd { .. } | Input::ComputedTorque { .. } => {
-            panic!("controllers are for fixed-base 1-dof models only")
+        Input::Pd { kp, kd, target, target_qd, .. } | Input::ComputedTorque { kp, kd, target, target_qd } => {
+            assert!(kp.len() == nv && kd.len() == nv, "gain size");
+            assert!(target.len() == rows * nq && target_qd.len() == rows * nv, "target size");
         }
     }
     let Outputs { q, work, qd, qdd, tau, q_final, qd_final, limit_step, limit_joint, nonfinite_step, nonfinite_joint } =
@@ -212,6 +230,13 @@ struct Work<T> {
     vs: Vec<T>,
     tau: Vec<T>,
     a: Vec<T>,
+    /// A controller's target (nq), target velocity, error (nv), zeros (nv), and the mass
+    /// matrix (nv^2, computed torque with a floating base).
+    target: Vec<T>,
+    target_v: Vec<T>,
+    err: Vec<T>,
+    zeros: Vec<T>,
+    mass: Vec<T>,
     /// RK4: the stage's local coordinate, its rate, and the weighted sums.
     theta: Vec<T>,
     rate: Vec<T>,
@@ -220,7 +245,8 @@ struct Work<T> {
 }
 
 impl<T: Real> Work<T> {
-    fn new(model: &Model, manifold: &Manifold) -> Self {
+    /// `floating_ct`: computed torque with a floating base (which needs the mass matrix).
+    fn new(model: &Model, manifold: &Manifold, floating_ct: bool) -> Self {
         let z = |k: usize| vec![T::zero(); k];
         let (nq, nv) = (manifold.nq, manifold.nv);
         Work {
@@ -231,12 +257,59 @@ impl<T: Real> Work<T> {
             vs: z(nv),
             tau: z(nv),
             a: z(nv),
+            target: z(nq),
+            target_v: z(nv),
+            err: z(nv),
+            zeros: z(nv),
+            mass: if floating_ct { z(nv * nv) } else { vec![] },
             theta: z(nv),
             rate: z(nv),
             sum_rate: z(nv),
             sum_a: z(nv),
         }
     }
+}
+
+/// Computed torque on a floating base (collocated partial feedback linearization): given
+/// `tau = rnea(q, v, [0; a*])`, whose base rows `f_b = M_bj a* + h_b` are the wrench the
+/// base would need to stay unaccelerated, let the base accelerate instead, `a_b = -M_bb^-1
+/// f_b` (`M_bb` the whole robot's composite inertia, positive definite), and return the
+/// joint torques that give the joints `a*` with it, `tau_j + M_jb a_b`; the base rows zero.
+/// `mass`: M (nv^2, row-major).
+#[inline(always)]
+fn unactuated_base<T: Real>(mass: &[T], tau: &mut [T]) {
+    let nv = tau.len();
+    // Gaussian elimination on M_bb (symmetric positive definite: no pivoting needed)
+    let mut m = [[T::zero(); NV_BASE]; NV_BASE];
+    let mut b = [T::zero(); NV_BASE];
+    for r in 0..NV_BASE {
+        m[r].copy_from_slice(&mass[r * nv..r * nv + NV_BASE]);
+        b[r] = -tau[r];
+    }
+    for k in 0..NV_BASE {
+        for r in k + 1..NV_BASE {
+            let f = m[r][k] / m[k][k];
+            for c in k..NV_BASE {
+                let x = m[k][c];
+                m[r][c] -= f * x;
+            }
+            let x = b[k];
+            b[r] -= f * x;
+        }
+    }
+    for k in (0..NV_BASE).rev() {
+        let mut x = b[k];
+        for c in k + 1..NV_BASE {
+            x -= m[k][c] * b[c];
+        }
+        b[k] = x / m[k][k];
+    }
+    for (j, t) in tau.iter_mut().enumerate().skip(NV_BASE) {
+        for (k, ab) in b.iter().enumerate() {
+            *t += mass[j * nv + k] * *ab;
+        }
+    }
+    tau[..NV_BASE].fill(T::zero());
 }
 
 /// Lanes of `dst` from rows `first..first + LANES` of the (rows, width) array `src`.
@@ -259,18 +332,23 @@ fn put<T: Real>(dst: &mut [f64], src: &[T], l: usize) {
 }
 
 impl Job<'_> {
+    /// Computed torque with a floating base: the stages need the mass matrix.
+    fn floating_ct(&self) -> bool {
+        self.floating && matches!(self.input, Input::ComputedTorque { .. })
+    }
+
     /// Integrate the rows of one group: in SIMD lanes if it is a whole group of the
     /// widest kernel's, else one by one.
     fn dispatch(&self, first: usize, rows: &mut [Row]) {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = "avx512f")]
         unsafe fn avx512(job: &Job, first: usize, rows: &mut [Row]) {
-            job.group(&mut Work::<F64x8>::new(job.model, &job.manifold), first, rows)
+            job.group(&mut Work::<F64x8>::new(job.model, &job.manifold, job.floating_ct()), first, rows)
         }
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = "avx2")]
         unsafe fn avx2(job: &Job, first: usize, rows: &mut [Row]) {
-            job.group(&mut Work::<F64x4>::new(job.model, &job.manifold), first, rows)
+            job.group(&mut Work::<F64x4>::new(job.model, &job.manifold, job.floating_ct()), first, rows)
         }
         match (kernels(), rows.len()) {
             // SAFETY: the CPU supports the features (checked by `kernels`).
@@ -279,9 +357,9 @@ impl Job<'_> {
             #[cfg(target_arch = "x86_64")]
             (Kernels::Avx2, 4) => unsafe { avx2(self, first, rows) },
             #[cfg(not(target_arch = "x86_64"))]
-            (_, 4) => self.group(&mut Work::<F64x4>::new(self.model, &self.manifold), first, rows),
+            (_, 4) => self.group(&mut Work::<F64x4>::new(self.model, &self.manifold, self.floating_ct()), first, rows),
             _ => {
-                let mut w = Work::<f64>::new(self.model, &self.manifold);
+                let mut w = Work::<f64>::new(self.model, &self.manifold, self.floating_ct());
                 for (k, row) in rows.iter_mut().enumerate() {
                     self.group(&mut w, first + k, std::slice::from_mut(row));
                 }
@@ -289,11 +367,43 @@ impl Job<'_> {
         }
     }
 
-    /// The torque during step `k` of the lanes' rows `r..`.
+    /// The torque during step `k` of the lanes' rows `r..` at the stage state `w.qs`,
+    /// `w.vs`, into `w.tau`.
     #[inline(always)]
-    fn torque<T: Real>(&self, r: usize, k: usize, tau: &mut [T]) {
-        let nv = tau.len();
+    fn torque<T: Real>(&self, w: &mut Work<T>, r: usize, k: usize) {
+        let nv = w.tau.len();
+        let tau = &mut w.tau;
         match self.input {
+            Input::Pd { kp, kd, gravity_compensation, .. } => {
+                if !gravity_compensation {
+                    tau.fill(T::zero());
+                } else if self.floating {
+                    rnea_floating(self.model, &mut w.data, &w.qs, &w.zeros, &w.zeros, tau);
+                } else {
+                    gravity(self.model, &mut w.data, &w.qs, tau);
+                }
+                self.manifold.difference_lanes(&w.qs, &w.target, &mut w.err);
+                for j in 0..nv {
+                    tau[j] += T::splat(kp[j]) * w.err[j] + T::splat(kd[j]) * (w.target_v[j] - w.vs[j]);
+                }
+                if self.floating {
+                    tau[..NV_BASE].fill(T::zero());
+                }
+            }
+            Input::ComputedTorque { kp, kd, .. } => {
+                self.manifold.difference_lanes(&w.qs, &w.target, &mut w.err);
+                for j in 0..nv {
+                    w.err[j] = T::splat(kp[j]) * w.err[j] + T::splat(kd[j]) * (w.target_v[j] - w.vs[j]);
+                }
+                if self.floating {
+                    w.err[..NV_BASE].fill(T::zero());
+                    rnea_floating(self.model, &mut w.data, &w.qs, &w.vs, &w.err, tau);
+                    crba_floating(self.model, &mut w.data, &w.qs, &mut w.mass);
+                    unactuated_base(&w.mass, tau);
+                } else {
+                    rnea(self.model, &mut w.data, &w.qs, &w.vs, &w.err, tau);
+                }
+            }
             Input::Constant(t) => load(tau, t, r),
             Input::Series { tau: t, shared } => {
                 let k = k.min(self.settings.steps - 1);
@@ -362,6 +472,10 @@ impl Job<'_> {
         let (h, h2, h6, two) = (T::splat(dt), T::splat(0.5 * dt), T::splat(dt / 6.0), T::splat(2.0));
         load(&mut w.q, self.q0, r);
         load(&mut w.v, self.v0, r);
+        if let Input::Pd { target, target_qd, .. } | Input::ComputedTorque { target, target_qd, .. } = self.input {
+            load(&mut w.target, target, r);
+            load(&mut w.target_v, target_qd, r);
+        }
         w.qs.copy_from_slice(&w.q);
         w.vs.copy_from_slice(&w.v);
         let (mut work, mut sum_work) = (T::zero(), T::zero());
@@ -375,7 +489,7 @@ impl Job<'_> {
         let stages = if method == Method::Rk4 { 4 } else { 1 };
         let (mut k, mut st) = (0, 0);
         loop {
-            self.torque(r, k, &mut w.tau);
+            self.torque(w, r, k);
             if self.floating {
                 aba_floating(self.model, &mut w.data, &w.qs, &w.vs, &w.tau, &mut w.a);
             } else {

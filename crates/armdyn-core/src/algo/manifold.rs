@@ -1,6 +1,7 @@
 //! The configuration manifold of a model: how `q` moves along a velocity `xi`
-//! (`q (+) xi`, Pinocchio's `integrate`) and the brackets of its Lie algebra, for the
-//! integrators of [`crate::algo::integrate_floating`].
+//! (`q (+) xi`, Pinocchio's `integrate`), the velocity between two configurations
+//! (`q1 (-) q0 = log(q0^-1 q1)`, Pinocchio's `difference`) and the brackets of its Lie
+//! algebra, for the integrators and controllers of [`crate::algo::integrate_floating`].
 //!
 //! `q` is a product of groups, one *block* per non-flat piece, the rest flat:
 //! * a floating base and free joints on SE(3): position then unit quaternion (7),
@@ -121,6 +122,61 @@ fn se2_exp(q: &[f64], xi: &[f64], out: &mut [f64]) {
     out[3] = s / norm;
 }
 
+/// `w` with `exp([w]x) = R(quat)` for a unit quaternion `x, y, z, w`, `|w|` in `[0, pi]`
+/// (the shorter way round).
+fn log_quaternion(quat: [f64; 4]) -> V3 {
+    let quat = if quat[3] < 0.0 { quat.map(|c| -c) } else { quat };
+    let s = (quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2]).sqrt();
+    let scale = if s < 1e-8 { 2.0 / quat[3] } else { 2.0 * s.atan2(quat[3]) / s };
+    [quat[0] * scale, quat[1] * scale, quat[2] * scale]
+}
+
+/// The conjugate (inverse) of a unit quaternion.
+fn conjugate(quat: [f64; 4]) -> [f64; 4] {
+    [-quat[0], -quat[1], -quat[2], quat[3]]
+}
+
+/// SO(3): `out[..3] = log(q0^-1 q1)` for quaternions `q0[..4]`, `q1[..4]`.
+fn so3_log(q0: &[f64], q1: &[f64], out: &mut [f64]) {
+    let rel = quat_mul(conjugate([q0[0], q0[1], q0[2], q0[3]]), [q1[0], q1[1], q1[2], q1[3]]);
+    out[..3].copy_from_slice(&log_quaternion(rel));
+}
+
+/// SE(3): `out[..6] = log(M0^-1 M1)` (linear, angular) for poses `q0[..7]`, `q1[..7]`.
+fn se3_log(q0: &[f64], q1: &[f64], out: &mut [f64]) {
+    let inv0 = conjugate([q0[3], q0[4], q0[5], q0[6]]);
+    let p = rotate(inv0, [q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2]]);
+    let w = log_quaternion(quat_mul(inv0, [q1[3], q1[4], q1[5], q1[6]]));
+    let theta = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+    // V(w)^-1 = 1 - [w]x / 2 + c [w]x^2, c = (1 - (t/2) cot(t/2)) / t^2
+    let c = if theta < SMALL {
+        1.0 / 12.0 + theta * theta / 720.0
+    } else {
+        (1.0 - 0.5 * theta / (0.5 * theta).tan()) / (theta * theta)
+    };
+    let wp = cross(w, p);
+    let wwp = cross(w, wp);
+    for k in 0..3 {
+        out[k] = p[k] - 0.5 * wp[k] + c * wwp[k];
+        out[3 + k] = w[k];
+    }
+}
+
+/// SE(2): `out[..3] = log(M0^-1 M1)` (`vx, vy, wz`) for planar poses `q0[..4]`,
+/// `q1[..4]`; the turn in `(-pi, pi]`.
+fn se2_log(q0: &[f64], q1: &[f64], out: &mut [f64]) {
+    let (c0, s0, c1, s1) = (q0[2], q0[3], q1[2], q1[3]);
+    let th = (c0 * s1 - s0 * c1).atan2(c0 * c1 + s0 * s1);
+    let (dx, dy) = (q1[0] - q0[0], q1[1] - q0[1]);
+    let (tx, ty) = (c0 * dx + s0 * dy, c0 * dy - s0 * dx);
+    // V(th)^-1 = [[e, th / 2], [-th / 2, e]], e = (th / 2) cot(th / 2)
+    let t2 = th * th;
+    let e = if th.abs() < SMALL { 1.0 - t2 / 12.0 - t2 * t2 / 720.0 } else { 0.5 * th / (0.5 * th).tan() };
+    out[0] = e * tx + 0.5 * th * ty;
+    out[1] = e * ty - 0.5 * th * tx;
+    out[2] = th;
+}
+
 /// The group of a block of `q`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Group {
@@ -162,6 +218,16 @@ impl Group {
             Group::Se3 => se3_exp(q, xi, out),
             Group::So3 => so3_exp(q, xi, out),
             Group::Se2 => se2_exp(q, xi, out),
+        }
+    }
+
+    /// `out = log(q0^-1 q1)` on the block (`q0`, `q1` its configurations, `out` its
+    /// velocity).
+    fn log(self, q0: &[f64], q1: &[f64], out: &mut [f64]) {
+        match self {
+            Group::Se3 => se3_log(q0, q1, out),
+            Group::So3 => so3_log(q0, q1, out),
+            Group::Se2 => se2_log(q0, q1, out),
         }
     }
 
@@ -264,6 +330,30 @@ impl Manifold {
         }
         for &(iq, iv) in &self.flat {
             out[iq] = q[iq] + xi[iv];
+        }
+    }
+
+    /// `out = q1 (-) q0`: the velocity that moves `q0` to `q1` in unit time, `q0 (+) out
+    /// = q1` (Pinocchio's `difference(q0, q1)`): `log(q0^-1 q1)` on every block (in
+    /// `q0`'s frame), `q1 - q0` on the flat coordinates. Blocks lane by lane in `f64`.
+    #[inline(always)]
+    pub fn difference_lanes<T: Real>(&self, q0: &[T], q1: &[T], out: &mut [T]) {
+        let (mut a, mut b, mut o) = ([0.0; 7], [0.0; 7], [0.0; 6]);
+        for blk in &self.blocks {
+            let (nq, nv) = blk.group.widths();
+            for l in 0..T::LANES {
+                for k in 0..nq {
+                    a[k] = T::lane_of(&q0[blk.iq + k], l);
+                    b[k] = T::lane_of(&q1[blk.iq + k], l);
+                }
+                blk.group.log(&a, &b, &mut o);
+                for k in 0..nv {
+                    out[blk.iv + k].set_lane(l, o[k]);
+                }
+            }
+        }
+        for &(iq, iv) in &self.flat {
+            out[iv] = q1[iq] - q0[iq];
         }
     }
 

@@ -138,3 +138,33 @@ fn lanes_and_threads_equal_single_states_and_blocks_stay_unit() {
         }
     }
 }
+
+#[test]
+fn difference_inverts_integrate() {
+    // q1 = q0 (+) xi with every block's turn below pi: q1 (-) q0 = xi (the logs invert the
+    // exponentials), on the chain and with a floating base; at the identity, the log of
+    // a quarter turn about z is (0, 0, pi/2)
+    let model = chain();
+    let m = Manifold::new(&model, false);
+    let s = 0.5f64.sqrt();
+    let q0 = [0.1, -0.3, 0.2, (1.0f64 - 0.14).sqrt(), 1.0, 2.0, 0.6, 0.8, 0.25];
+    for scale in [1.0, 1e-6] {
+        let xi: Vec<f64> = [0.4, -1.1, 0.7, 0.3, -0.2, 2.5, 0.9].iter().map(|x| x * scale).collect();
+        let mut q1 = [0.0; 9];
+        m.integrate(&q0, &xi, &mut q1);
+        let mut back = [0.0; 7];
+        m.difference_lanes(&q0, &q1, &mut back);
+        assert_close(&back, &xi, if scale < 1.0 { 1e-15 } else { 1e-13 }, "q1 (-) q0");
+    }
+    let (mut w, id) = ([0.0; 7], [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0]);
+    m.difference_lanes(&id, &[0.0, 0.0, s, s, 0.0, 0.0, 1.0, 0.0, 0.0], &mut w);
+    assert_close(&w[..3], &[0.0, 0.0, std::f64::consts::FRAC_PI_2], 1e-15, "quarter turn");
+    let f = Manifold::new(&model, true);
+    let mut qf = vec![0.3, -0.2, 1.0, 0.5, -0.5, 0.5, 0.5];
+    qf.extend_from_slice(&q0);
+    let xi = [0.5, 0.2, -0.3, 1.2, -0.4, 0.8, 0.4, -1.1, 0.7, 0.3, -0.2, 2.5, 0.9];
+    let (mut q1, mut back) = (vec![0.0; 16], vec![0.0; 13]);
+    f.integrate(&qf, &xi, &mut q1);
+    f.difference_lanes(&qf, &q1, &mut back);
+    assert_close(&back, &xi, 1e-13, "floating q1 (-) q0");
+}
