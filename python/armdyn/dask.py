@@ -162,7 +162,8 @@ def simulate(
     """
     import dask.array as da
 
-    from .simulate import BASE_VELOCITY_NAMES, step_count
+    from .simulate import step_count
+    from .simulate_arrays import BASE_VELOCITY_NAMES
     from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
     model = compiled_model(robot)

@@ -95,18 +95,13 @@ from typing import Callable
 import numpy as np
 
 from . import _core
-from .configuration import rotate_vector
 from .numeric import check_threads, compiled_model, kinetic_energy, potential_energy
 from .simulate_adaptive import simulate_adaptive
+from .simulate_arrays import BASE_VELOCITY_NAMES, checked_state, contiguous, floating_energies, per_joint
 from .simulate_control import controller_arrays, simulate_callable
 from .trajectory import PD, ComputedTorque, Trajectory, joint_limits
 
 __all__ = ["simulate", "simulate_adaptive", "Trajectory", "PD", "ComputedTorque", "joint_limits"]
-
-
-def _c(a):
-    """C-contiguous, aligned float64 (arrays received over a network can be unaligned)."""
-    return np.require(a, dtype=float, requirements=["C", "A"])
 
 
 def _available_bytes() -> int:
@@ -114,27 +109,6 @@ def _available_bytes() -> int:
         return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
     except (ValueError, OSError, AttributeError):
         return 8 << 30
-
-
-def _state(x, name, dof):
-    try:
-        a = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: cannot be read as an array of numbers") from None
-    if a.ndim not in (1, 2) or a.shape[-1] != dof:
-        raise ValueError(f"{name}: shape {a.shape}, expected ({dof},) or (N, {dof})")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"{name} contains NaN or inf")
-    return a
-
-
-def _per_joint(x, name, dof):
-    a = np.broadcast_to(np.asarray(x, dtype=float), (dof,)) if np.ndim(x) == 0 else np.asarray(x, dtype=float)
-    if a.shape != (dof,):
-        raise ValueError(f"{name}: expected a finite scalar or ({dof},) values, got shape {a.shape}")
-    if not np.all(np.isfinite(a)):  # the shape is right: say what is wrong instead
-        raise ValueError(f"{name} contains NaN or inf")
-    return _c(a)
 
 
 def step_count(duration, steps, dt) -> int:
@@ -213,21 +187,21 @@ def simulate(
     if int(stride) != stride or stride < 1:
         raise ValueError(f"stride must be a positive integer, got {stride!r}")
     stride = int(stride)
-    q0a = _state(q0, "q0", dof)
+    q0a = checked_state(q0, "q0", dof)
     single = q0a.ndim == 1
-    q0a = _c(np.atleast_2d(q0a))
+    q0a = contiguous(np.atleast_2d(q0a))
     rows = q0a.shape[0]
     threads = check_threads(threads)  # Rust reads True as 1
-    qd0a = np.zeros((rows, nv)) if qd0 is None else _state(qd0, "qd0", nv)
+    qd0a = np.zeros((rows, nv)) if qd0 is None else checked_state(qd0, "qd0", nv)
     if qd0a.shape not in ((nv,), (rows, nv)):
         raise ValueError(f"qd0: shape {qd0a.shape} does not match q0's {q0a.shape}")
-    qd0a = _c(np.broadcast_to(qd0a, (rows, nv)))
+    qd0a = contiguous(np.broadcast_to(qd0a, (rows, nv)))
     lower, upper = (
         joint_limits(robot)
         if limits is None
         else (
-            _per_joint(limits[0], "limits[0] (lower)", model.dof),
-            _per_joint(limits[1], "limits[1] (upper)", model.dof),
+            per_joint(limits[0], "limits[0] (lower)", model.dof),
+            per_joint(limits[1], "limits[1] (upper)", model.dof),
         )
     )
 
@@ -267,7 +241,7 @@ def simulate(
                     f"torque: shape {tau.shape}; expected ({nv},) constant, ({steps}, {nv}) one row per step, "
                     f"or ({rows}, {steps}, {nv}) one series per state"
                 )
-            args["torque"] = _c(tau)
+            args["torque"] = contiguous(tau)
         out = _simulate_rust(model, q0a, qd0a, kind, args, dt, steps, stride, method, lower, upper, threads, progress)
 
     t = np.arange(samples) * (stride * dt)
@@ -289,8 +263,8 @@ def simulate(
         if len(flat_q) and floating:
             run.kinetic[kept], run.potential[kept] = floating_energies(model, flat_q, flat_qd, threads)
         elif len(flat_q):
-            run.kinetic[kept] = kinetic_energy(model, _c(flat_q), _c(flat_qd), threads=threads)
-            run.potential[kept] = potential_energy(model, _c(flat_q), threads=threads)
+            run.kinetic[kept] = kinetic_energy(model, contiguous(flat_q), contiguous(flat_qd), threads=threads)
+            run.potential[kept] = potential_energy(model, contiguous(flat_q), threads=threads)
     if single:
         last = int(kept[0].sum())  # a single diverged state: only what was computed
         run.t = run.t[:last]
@@ -302,29 +276,6 @@ def simulate(
         for name in ("limit_step", "limit_joint", "nonfinite_step", "nonfinite_joint"):
             setattr(run, name, int(getattr(run, name)[0]))
     return run
-
-
-#: the names of a floating base's six velocity coordinates (base frame)
-BASE_VELOCITY_NAMES = ("base_vx", "base_vy", "base_vz", "base_wx", "base_wy", "base_wz")
-
-
-def floating_energies(model, q: np.ndarray, v: np.ndarray, threads=None, rows: int = 2048):
-    """``(kinetic, potential)`` (N,) of a floating-base robot at the states ``q`` (N, 7 +
-    dof), ``v`` (N, 6 + dof): ``T = 1/2 v^T M(q) v`` and ``V = -g . (m p_B + R_B h)``
-    over every link, the base included, with ``m`` the total mass and ``h = m c`` the
-    first moment of the whole robot in the base frame, both read from the CRBA's base
-    block (``M[:3, :3] = m 1``, ``M[3:6, :3] = [h]x``). ``rows`` at a time (M is
-    (6 + dof)^2 per state)."""
-    kinetic, potential = np.empty(len(q)), np.empty(len(q))
-    g = np.asarray(model.gravity, dtype=float).ravel()
-    for at in range(0, len(q), rows):
-        qs, vs = _c(q[at : at + rows]), _c(v[at : at + rows])
-        M = model.crba(qs, threads)
-        kinetic[at : at + rows] = 0.5 * np.einsum("ni,nij,nj->n", vs, M, vs)
-        h = np.stack([M[:, 5, 1], M[:, 3, 2], M[:, 4, 0]], axis=-1)
-        com_moment = M[:, 0, 0, None] * qs[:, :3] + rotate_vector(qs[:, 3:7], h)
-        potential[at : at + rows] = -com_moment @ g
-    return kinetic, potential
 
 
 def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower, upper, threads, progress):
@@ -363,7 +314,7 @@ def _simulate_rust(model, q0, qd0, kind, args, dt, steps, stride, method, lower,
         if kind == "series":
             tau = tau[done : done + k]
         elif kind == "series-per-state":
-            tau = _c(tau[:, done : done + k])
+            tau = contiguous(tau[:, done : done + k])
         part = call(q, qd, k, tau)
         if out is None:  # q's width may differ from the others' (a floating base: 7 + dof, 6 + dof)
             out = {name: np.empty((rows, samples, part[name].shape[2])) for name in ("q", "qd", "qdd", "tau")}

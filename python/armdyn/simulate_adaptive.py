@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from .numeric import compiled_model, kinetic_energy, potential_energy
+from .simulate_arrays import BASE_VELOCITY_NAMES, checked_state, contiguous, floating_energies, per_joint
 
 __all__ = ["simulate_adaptive", "configuration_rate"]
 
@@ -77,15 +78,14 @@ def simulate_adaptive(
     """
     from scipy.integrate import solve_ivp
 
-    from .simulate import BASE_VELOCITY_NAMES, _c, _per_joint, _state, floating_energies
     from .trajectory import Trajectory, joint_limits
 
     model = compiled_model(robot)
     floating = bool(getattr(model, "floating", False))
     nq, nv = getattr(model, "nq", model.dof), getattr(model, "nv", model.dof)
     flat = nq == nv and not floating
-    q0 = _state(q0, "q0", nq)
-    qd0 = np.zeros(nv) if qd0 is None else _state(qd0, "qd0", nv)
+    q0 = checked_state(q0, "q0", nq)
+    qd0 = np.zeros(nv) if qd0 is None else checked_state(qd0, "qd0", nv)
     if q0.ndim != 1 or qd0.ndim != 1:
         raise ValueError(f"simulate_adaptive integrates one state: q0 ({nq},), qd0 ({nv},)")
     if not (math.isfinite(duration) and duration > 0):
@@ -112,22 +112,24 @@ def simulate_adaptive(
     elif callable(torque):
         tau_of = torque
     else:
-        const = _per_joint(torque, "torque", nv)
+        const = per_joint(torque, "torque", nv)
         tau_of = lambda t, q, qd: const  # noqa: E731
     t_eval = np.linspace(0.0, duration, 101) if t_eval is None else np.asarray(t_eval, dtype=float)
 
     def f(t, x):  # x = (q, qd, W): the torque's work integrated with the state
         q, qd = project(x[:nq]), x[nq : nq + nv]
         tau = np.asarray(tau_of(t, q, qd), dtype=float)
-        return np.concatenate([rate(q, qd), model.aba(_c(q), _c(qd), _c(tau), None), [tau @ qd]])
+        return np.concatenate(
+            [rate(q, qd), model.aba(contiguous(q), contiguous(qd), contiguous(tau), None), [tau @ qd]]
+        )
 
     sol = solve_ivp(
         f, (0.0, duration), np.concatenate([q0, qd0, [0.0]]), method=method, rtol=rtol, atol=atol, t_eval=t_eval
     )
     if not sol.success:
         raise ValueError(f"solve_ivp failed: {sol.message}")
-    q, qd = _c(project(sol.y[:nq].T)), _c(sol.y[nq : nq + nv].T)
-    tau = _c(np.array([tau_of(t, a, b) for t, a, b in zip(sol.t, q, qd)], dtype=float).reshape(len(sol.t), nv))
+    q, qd = contiguous(project(sol.y[:nq].T)), contiguous(sol.y[nq : nq + nv].T)
+    tau = contiguous(np.array([tau_of(t, a, b) for t, a, b in zip(sol.t, q, qd)], dtype=float).reshape(len(sol.t), nv))
     qdd = model.aba(q, qd, tau, None)
     lower, upper = joint_limits(robot)
     base_v = nv - len(lower)  # a floating base's six: the limits are the joints'

@@ -31,15 +31,12 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
+from .simulate_arrays import contiguous
 from .trajectory import PD, ComputedTorque
 
 __all__ = ["controller_arrays", "simulate_callable"]
 
 BASE_Q, BASE_V = 7, 6
-
-
-def _c(a):
-    return np.require(a, dtype=float, requirements=["C", "A"])
 
 
 def _rows_of(x, name: str, what: str, rows: int, width: int, scalar: bool = False) -> np.ndarray:
@@ -85,7 +82,7 @@ def controller_arrays(robot, model, controller, q0: np.ndarray) -> tuple[str, di
     gains = {}
     for name in ("kp", "kd"):
         a = _rows_of(getattr(controller, name), f"controller.{name}", f"a scalar or {covers['v']}", 1, nv - bv, True)
-        gains[name] = _c(np.concatenate([np.zeros(bv), a[0]]))
+        gains[name] = contiguous(np.concatenate([np.zeros(bv), a[0]]))
     target = np.array(q0, dtype=float)
     target[:, bq:] = _rows_of(controller.target, "controller.target", covers["q"], rows, nq - bq)
     if nq != nv and hasattr(robot, "configuration_layout"):  # a quaternion or (cos, sin) pair off unit length,
@@ -95,7 +92,7 @@ def controller_arrays(robot, model, controller, q0: np.ndarray) -> tuple[str, di
         check_configuration(robot, target, "controller.target")
     target_qd = np.zeros((rows, nv))
     target_qd[:, bv:] = _rows_of(controller.target_qd, "controller.target_qd", covers["v"], rows, nv - bv)
-    return kind, dict(kp=gains["kp"], kd=gains["kd"], target=_c(target), target_qd=_c(target_qd))
+    return kind, dict(kp=gains["kp"], kd=gains["kd"], target=contiguous(target), target_qd=contiguous(target_qd))
 
 
 def _v_of_q(robot, nq: int) -> np.ndarray:
@@ -137,8 +134,8 @@ def simulate_callable(robot, model, q0, qd0, torque, dt, steps, stride, method, 
             )
         layout = _layout(robot)
         flat_q, flat_v, v_of_q = layout.flat_q, layout.flat_v, _v_of_q(robot, nq)
-        plus = lambda q, xi: _core._manifold_integrate(model, _c(q), _c(xi))  # noqa: E731
-        rate = lambda theta, v: _core._manifold_local_rate(model, _c(theta), _c(v))  # noqa: E731
+        plus = lambda q, xi: _core._manifold_integrate(model, contiguous(q), contiguous(xi))  # noqa: E731
+        rate = lambda theta, v: _core._manifold_local_rate(model, contiguous(theta), contiguous(v))  # noqa: E731
     base_v = nv - len(lower)  # a floating base's six: the limits are the joints'
     samples = steps // stride + 1
     out = {name: np.empty((rows, samples, nq if name == "q" else nv)) for name in ("q", "qd", "qdd", "tau")}
@@ -167,7 +164,7 @@ def simulate_callable(robot, model, q0, qd0, torque, dt, steps, stride, method, 
                 f"torque callable returned shape {tau.shape} at step {k} (t = {t:.6g} s); "
                 f"expected ({nv},) or ({rows}, {nv}) (one per velocity coordinate)"
             )
-        return _c(np.broadcast_to(tau, (rows, nv)))
+        return contiguous(np.broadcast_to(tau, (rows, nv)))
 
     def acc(k, t, q, qd):
         live = nonfinite < 0
@@ -175,7 +172,7 @@ def simulate_callable(robot, model, q0, qd0, torque, dt, steps, stride, method, 
             q, qd = np.where(live[:, None], q, q0), np.where(live[:, None], qd, 0.0)
         tau = tau_at(k, t, q, qd)
         try:
-            return model.aba(_c(q), _c(qd), tau, None), tau
+            return model.aba(contiguous(q), contiguous(qd), tau, None), tau
         except ValueError:
             pass
         # no finite acceleration for some state (velocities so large that the dynamics
@@ -183,7 +180,7 @@ def simulate_callable(robot, model, q0, qd0, torque, dt, steps, stride, method, 
         a = np.full_like(qd, np.nan)
         for i in np.flatnonzero(live):
             try:
-                a[i] = model.aba(_c(q[i]), _c(qd[i]), tau[i], None)
+                a[i] = model.aba(contiguous(q[i]), contiguous(qd[i]), tau[i], None)
             except ValueError:
                 nonfinite[i], nonfinite_joint[i] = k, int(np.argmax(np.abs(qd[i])))
         return a, tau

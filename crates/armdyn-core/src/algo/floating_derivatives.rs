@@ -41,6 +41,7 @@ use crate::algo::external::{generalized_forces, local_in_body, ExternalForces, F
 use crate::algo::floating::{
     aba_floating, base_motion, crba_floating, gravity_acceleration, put_base_block, NQ_BASE, NV_BASE,
 };
+use crate::algo::ltdl::{factorize, identity, solve};
 use crate::algo::rnea_derivatives::{
     acceleration_pass_on, b_sym, derivative_terms_in, subtree_sums, velocity_pass_on, Placement,
 };
@@ -174,10 +175,10 @@ pub fn aba_derivatives_floating<T: Real>(
         None => aba_floating(model, data, q, v, tau, &mut qdd),
     }
     rnea_derivatives_floating(model, data, dd, q, v, &qdd, ext, da_dq, da_dv, &mut h);
-    factorize(model, &mut h);
+    factorize::<T, NV_BASE>(model, &mut h);
     identity(minv, s);
     let (one, minus) = (T::splat(1.0), T::splat(-1.0));
-    solve(model, &h, [minv, da_dq, da_dv], [one, minus, minus]);
+    solve::<T, 3, NV_BASE>(model, &h, [minv, da_dq, da_dv], [one, minus, minus]);
     dd.qdd_floating = qdd;
     dd.factor = h;
 }
@@ -217,110 +218,8 @@ pub fn minverse_floating<T: Real>(model: &Model, data: &mut Data<T>, dd: &mut De
     assert!(minv.len() == s * s, "output size");
     let mut h = std::mem::take(&mut dd.factor);
     crba_floating(model, data, q, &mut h);
-    factorize(model, &mut h);
+    factorize::<T, NV_BASE>(model, &mut h);
     identity(minv, s);
-    solve(model, &h, [minv], [T::splat(1.0)]);
+    solve::<T, 1, NV_BASE>(model, &h, [minv], [T::splat(1.0)]);
     dd.factor = h;
-}
-
-fn identity<T: Real>(x: &mut [T], s: usize) {
-    x.fill(T::zero());
-    for k in 0..s {
-        x[k * s + k] = T::splat(1.0);
-    }
-}
-
-/// The parent of velocity `k` in M's sparsity tree: the base's six velocities form a
-/// chain (its 6x6 block is dense), the root joints hang from the last of them.
-#[inline(always)]
-fn parent(model: &Model, k: usize) -> Option<usize> {
-    if k < NV_BASE {
-        k.checked_sub(1)
-    } else {
-        Some(model.parent[k - NV_BASE].map_or(NV_BASE - 1, |p| p + NV_BASE))
-    }
-}
-
-/// `M = L^T D L` in place (RBDA Table 6.3, the LTDL factorisation): `L` unit lower
-/// triangular with the tree's sparsity (row k nonzero at k's ancestors only) below the
-/// diagonal of `h`, `D` on it. Reads and writes only the lower triangle of `h`.
-#[inline(always)]
-fn factorize<T: Real>(model: &Model, h: &mut [T]) {
-    let s = model.nv + NV_BASE;
-    for k in (0..s).rev() {
-        let inv = T::splat(1.0) / h[k * s + k];
-        let mut i = parent(model, k);
-        while let Some(ii) = i {
-            let a = h[k * s + ii] * inv;
-            let mut j = Some(ii);
-            while let Some(jj) = j {
-                let x = h[k * s + jj];
-                h[ii * s + jj] -= a * x;
-                j = parent(model, jj);
-            }
-            h[k * s + ii] = a;
-            i = parent(model, ii);
-        }
-    }
-}
-
-/// `x_r <- sign_r * M^-1 x_r` for each of the `R` matrices `x_r`, (6 + nv) x (6 + nv)
-/// row-major, with M's factors `h` from [`factorize`]: `L^T y = x`, `z = D^-1 y`,
-/// `L x = z`, each a sweep of whole-row updates along the tree, all `R` matrices in the
-/// same sweep. For one state (`f64`) the rows are compiled for AVX2 when the CPU has it
-/// (wider vectors on contiguous rows; the same operations, so the same bits).
-#[inline(always)]
-fn solve<T: Real, const R: usize>(model: &Model, h: &[T], xs: [&mut [T]; R], signs: [T; R]) {
-    #[cfg(target_arch = "x86_64")]
-    if std::any::TypeId::of::<T>() == std::any::TypeId::of::<f64>() && std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU has AVX2.
-        return unsafe { solve_avx2(model, h, xs, signs) };
-    }
-    solve_rows(model, h, xs, signs)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn solve_avx2<T: Real, const R: usize>(model: &Model, h: &[T], xs: [&mut [T]; R], signs: [T; R]) {
-    solve_rows(model, h, xs, signs)
-}
-
-#[inline(always)]
-fn solve_rows<T: Real, const R: usize>(model: &Model, h: &[T], mut xs: [&mut [T]; R], signs: [T; R]) {
-    let s = model.nv + NV_BASE;
-    for k in (0..s).rev() {
-        let mut j = parent(model, k);
-        while let Some(jj) = j {
-            // row jj -= L_k,jj row k (jj < k)
-            let l = h[k * s + jj];
-            for x in xs.iter_mut() {
-                let (head, tail) = x.split_at_mut(k * s);
-                for (d, &r) in head[jj * s..(jj + 1) * s].iter_mut().zip(&tail[..s]) {
-                    *d -= l * r;
-                }
-            }
-            j = parent(model, jj);
-        }
-    }
-    for k in 0..s {
-        let d = T::splat(1.0) / h[k * s + k];
-        for (x, &sign) in xs.iter_mut().zip(&signs) {
-            let ds = sign * d;
-            x[k * s..(k + 1) * s].iter_mut().for_each(|e| *e *= ds);
-        }
-    }
-    for k in 0..s {
-        let mut j = parent(model, k);
-        while let Some(jj) = j {
-            // row k -= L_k,jj row jj
-            let l = h[k * s + jj];
-            for x in xs.iter_mut() {
-                let (head, tail) = x.split_at_mut(k * s);
-                for (d, &r) in tail[..s].iter_mut().zip(&head[jj * s..(jj + 1) * s]) {
-                    *d -= l * r;
-                }
-            }
-            j = parent(model, jj);
-        }
-    }
 }

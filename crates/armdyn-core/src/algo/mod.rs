@@ -20,6 +20,7 @@ pub mod integrate_floating;
 pub mod jacobian;
 pub mod jacobian_dot;
 pub mod kinematics;
+pub mod ltdl;
 pub mod manifold;
 pub mod minverse;
 pub mod multi_derivatives;

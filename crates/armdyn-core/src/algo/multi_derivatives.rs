@@ -31,8 +31,10 @@
 //! Arrays as `tangent_derivatives.rs` (a floating base's six first).
 
 use crate::algo::external::{generalized_forces, ExternalForces};
+use crate::algo::floating::NV_BASE;
 use crate::algo::floating_derivatives::generalized_forces_floating;
 use crate::algo::floating_kinematics::base_widths;
+use crate::algo::ltdl::{factorize, identity, solve};
 use crate::algo::{rnea, rnea_derivatives, rnea_derivatives_floating, rnea_floating};
 use crate::data::Data;
 use crate::deriv_data::DerivData;
@@ -143,7 +145,7 @@ pub struct MultiWork {
     tau: Vec<f64>,
     /// The external wrenches' generalized forces.
     tau_ext: Vec<f64>,
-    /// The ABA's accelerations and an (nv, nv) scratch ([`aba_derivatives_multi`]).
+    /// The ABA's accelerations and M's factors ([`aba_derivatives_multi`]).
     acc: Vec<f64>,
     product: Vec<f64>,
     algebras: Vec<Algebra>,
@@ -260,9 +262,9 @@ pub fn rnea_derivatives_multi(
 }
 
 /// `(da/dq, da/dv, M^-1)` at `(q, v, tau)` (and `ext`, as [`rnea_derivatives_multi`]):
-/// with `a = aba(q, v, tau)`,
-/// `da/dx = -M^-1 dtau/dx` (differentiate `M a + h = tau`), `dtau/dx` from
-/// [`rnea_derivatives_multi`].
+/// with `a = aba(q, v, tau)`, `da/dx = -M^-1 dtau/dx` (differentiate `M a + h = tau`),
+/// `dtau/dx` and `M` from [`rnea_derivatives_multi`], `M^-1` applied by M's sparse
+/// factors (`ltdl.rs`: the tree's depth, not nv, sets the cost of each column).
 #[allow(clippy::too_many_arguments)]
 pub fn aba_derivatives_multi(
     model: &Model,
@@ -276,22 +278,32 @@ pub fn aba_derivatives_multi(
     da_dv: &mut [f64],
     minv: &mut [f64],
 ) {
-    let (mut acc, mut product) = (std::mem::take(&mut w.acc), std::mem::take(&mut w.product));
-    forward_and_inverse(model, floating, &mut w.data, &mut w.deriv, q, v, tau, &mut acc, minv);
-    if let Some(e) = ext {
-        // a = aba(q, v, tau + tau_ext)
-        external_torques(model, floating, &mut w.data, &mut w.deriv, q, e, &mut w.tau_ext);
-        w.tau_ext.iter_mut().zip(tau).for_each(|(x, t)| *x += *t);
-        if floating {
-            crate::algo::aba_floating(model, &mut w.data, q, v, &w.tau_ext, &mut acc);
-        } else {
-            crate::algo::aba(model, &mut w.data, q, v, &w.tau_ext, &mut acc);
+    let (mut acc, mut h) = (std::mem::take(&mut w.acc), std::mem::take(&mut w.product));
+    // a = aba(q, v, tau + tau_ext)
+    let total: &[f64] = match ext {
+        Some(e) => {
+            external_torques(model, floating, &mut w.data, &mut w.deriv, q, e, &mut w.tau_ext);
+            w.tau_ext.iter_mut().zip(tau).for_each(|(x, t)| *x += *t);
+            &w.tau_ext
         }
+        None => tau,
+    };
+    if floating {
+        crate::algo::aba_floating(model, &mut w.data, q, v, total, &mut acc);
+    } else {
+        crate::algo::aba(model, &mut w.data, q, v, total, &mut acc);
     }
-    // M goes into `product` (not needed), then dtau/dq and dtau/dv become -M^-1 times them
-    rnea_derivatives_multi(model, floating, w, q, v, &acc, ext, da_dq, da_dv, &mut product);
-    minus_minv_times(minv, [da_dq, da_dv], &mut product);
-    (w.acc, w.product) = (acc, product);
+    // M goes into `h`, then becomes its factors; dtau/dq and dtau/dv become -M^-1 times them
+    rnea_derivatives_multi(model, floating, w, q, v, &acc, ext, da_dq, da_dv, &mut h);
+    identity(minv, acc.len());
+    if floating {
+        factorize::<f64, NV_BASE>(model, &mut h);
+        solve::<f64, 3, NV_BASE>(model, &h, [minv, da_dq, da_dv], [1.0, -1.0, -1.0]);
+    } else {
+        factorize::<f64, 0>(model, &mut h);
+        solve::<f64, 3, 0>(model, &h, [minv, da_dq, da_dv], [1.0, -1.0, -1.0]);
+    }
+    (w.acc, w.product) = (acc, h);
 }
 
 /// `acc = aba(q, v, tau)` and `minv = M^-1(q)`, fixed or floating base.
