@@ -322,23 +322,22 @@ def note(robot: Robot) -> str:
     """What a report says of the joints' symbols (ASCII: the reports' --ascii too)."""
     parts = []
     for j in robot.multi_dof_joints:
-        i, first, last = robot.link_index(j.child), j.coordinate_names[0], j.coordinate_names[-1]
+        i, first, last, name = robot.link_index(j.child), j.coordinate_names[0], j.coordinate_names[-1], j.name
         velocity = {
             "spherical": "its angular velocity",
-            "planar": "its velocity in its x-y plane and turn rate",
+            "planar": "its linear velocity in its x-y plane and turn rate",
             "floating": "its linear, then angular velocity",
         }[j.type]
+        rotation = f"rotation [{name}.r11 ... {name}.r33] (printed r^({i})jk: frame {i}'s axes in its placement frame)"
         pose = {
-            "spherical": f"its rotation the matrix [{j.name}.r11 ... {j.name}.r33] (r^({i})jk: frame {i}'s axes "
-            "in its placement frame)",
-            "planar": f"its position ({j.name}.x, {j.name}.y, printed p^({i})x ...) and turn "
-            f"({j.name}.cos, {j.name}.sin, printed c^({i}), s^({i}))",
-            "floating": f"its position ({j.name}.x ..., printed p^({i})x ...) and rotation the matrix "
-            f"[{j.name}.r11 ... {j.name}.r33] (r^({i})jk)",
+            "spherical": rotation,
+            "planar": f"position {name}.x, {name}.y (printed p^({i})x ...), turn {name}.cos, {name}.sin "
+            f"(printed c^({i}), s^({i}))",
+            "floating": f"position {name}.x ... {name}.z (printed p^({i})x ...), {rotation}",
         }[j.type]
+        printed = f"{'w' if j.type == 'spherical' else 'v'}^({i})x"
         parts.append(
-            f"{j.type} joint '{j.name}': velocity {velocity} relative to its parent in frame {i} axes "
-            f"({first} ... {last}, printed {'w' if first.endswith('wx') else 'v'}^({i})x ...), {pose}, "
-            f"tau its {TAU_MEANING[j.type]}"
+            f"{j.type} joint '{name}': velocity {first} ... {last} (printed {printed} ...), {velocity} relative "
+            f"to its parent in frame {i} axes; {pose}; tau its {TAU_MEANING[j.type]}"
         )
     return "; ".join(parts)
