@@ -293,3 +293,28 @@ def test_cli_derives_a_planar_joint(tmp_path, capsys):
     assert main(["derive", str(path), "--method", "lagrange"]) == 2
     err = capsys.readouterr().err
     assert str(path) in err and "'drive'" in err and "quasi-velocities" in err
+
+
+def test_tidy_groups_the_terms_as_collect_does(derived):
+    """The reports' grouping by joint accelerations and rate products (term by term) is
+    SymPy's ``collect``'s, and the tidied terms add up to the expression (to the float
+    coefficients' rounding)."""
+    from armdyn.symbolic.agreement import trig_reduce
+    from armdyn.symbolic.tidy import _by_motion, tidy_terms
+
+    robot, eom = derived("planar-base arm", True)
+    q, qd, qdd = eom.q, eom.qd, eom.qdd
+    motion = list(qdd) + [qd[i] * qd[j] for i in range(len(qd)) for j in range(i, len(qd))]
+    checked = 0
+    for step in eom.steps:
+        for x in step.value if isinstance(step.value, sp.MatrixBase) else [step.value]:
+            e = trig_reduce(x, q, keep_trig=True)
+            if e == 0:
+                continue
+            ours, collected = _by_motion(e, set(qd) | set(qdd), set(motion)), sp.collect(e, motion, evaluate=False)
+            assert set(ours) == set(collected)
+            assert all(sp.expand(ours[m] - collected[m]) == 0 for m in ours)
+            rest = sp.expand(sum(c * m for c, m in tidy_terms(x, q, qd, qdd)) - e)  # factoring rounds floats
+            assert all(abs(float(t.as_coeff_Mul()[0])) < 1e-12 for t in sp.Add.make_args(rest) if t != 0)
+            checked += 1
+    assert checked > 40
