@@ -318,3 +318,24 @@ def test_tidy_groups_the_terms_as_collect_does(derived):
             assert all(abs(float(t.as_coeff_Mul()[0])) < 1e-12 for t in sp.Add.make_args(rest) if t != 0)
             checked += 1
     assert checked > 40
+
+
+@pytest.mark.parametrize("floating", [False, True], ids=["fixed base", "floating base"])
+@pytest.mark.parametrize("seed", [1, 10, 11, 14])  # a ball and a free joint; planar joints on a ball, ...
+def test_random_trees_of_every_joint_kind_equal_the_core(seed, floating):
+    """Branched random trees of revolute, prismatic, fixed, ball, planar and free joints,
+    child frames off their joints, gravity in any direction, on a fixed or a floating
+    base: tau and M equal the core's rnea and crba."""
+    from random_models import random_robot
+
+    rng = np.random.default_rng(300 + seed)
+    robot = random_robot(rng, n_joints=4, tree=True, kinds="RPFSLX", frame_offsets=True)
+    kinds = {j.type for j in robot.multi_dof_joints}
+    assert kinds, "this seed draws no joint of several coordinates: the test would check nothing new"
+    if floating:
+        robot = Robot(robot.name, robot.links.values(), robot.joints, gravity=robot.gravity, root_joint="free-flyer")
+    eom = armdyn.derive(robot)
+    for q, v, a in states(robot, 2, seed):
+        values = state_values(robot, q, v, a)
+        assert close(evaluate(eom.tau, values).ravel(), numeric.rnea(robot, q, v, a)) <= TOL
+    assert close(evaluate(eom.M, values), numeric.crba(robot, q)) <= TOL
