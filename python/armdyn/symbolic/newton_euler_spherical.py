@@ -80,28 +80,17 @@ TAU_MEANING = {
 
 
 def check_joints(robot: Robot, what: str = "the Newton-Euler derivation (armdyn.derive)") -> None:
-    """A ModelError naming ``what`` and the joint for a joint of several coordinates the
-    derivation does not take (none today: :data:`DERIVED`), or a name of those joints'
-    own symbols (:func:`configuration_symbols`) that the model already uses."""
-    if not robot.multi_dof_joints:
-        return
-    where, source = f"robot '{robot.name}'", robot.meta.get("file")
-    other = [j for j in robot.multi_dof_joints if j.type not in DERIVED]
-    if other:
-        j = other[0]
-        raise ModelError(
-            f"{what} takes revolute, prismatic, {', '.join(DERIVED)} joints; joint '{j.name}' is {j.type}",
-            where,
-            source,
-        )
+    """A ModelError naming ``what`` for a name of the joints of several coordinates' own
+    symbols (:func:`configuration_symbols`) that the model already uses (a parameter, a
+    coordinate), which the derivation would confuse with them."""
     own = {s.name: j for j in robot.multi_dof_joints for s in configuration_symbols(j)}
     clash = set(own) & ({s.name for s in robot.free_symbols()} | set(robot.coordinate_names))
     if clash:
-        named = ", ".join(f"'{own[n].name}'" for n in sorted(clash))
+        named = ", ".join(sorted({f"'{own[n].name}'" for n in clash}))
         raise ModelError(
-            f"names {sorted(clash)} are the own symbols of the {named} joint(s) (their configuration): rename them",
-            where,
-            source,
+            f"{what}: names {sorted(clash)} are the own symbols of joint {named} (its configuration): rename them",
+            f"robot '{robot.name}'",
+            robot.meta.get("file"),
         )
 
 
