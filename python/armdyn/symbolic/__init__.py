@@ -5,8 +5,9 @@ eom.tau, eom.M, eom.C, eom.g, eom.steps
 check(derive(robot), derive(robot, "lagrange")).text()
 
 A floating base (``root_joint="free-flyer"``): Newton-Euler only, parametrised by the
-base twist (newton_euler_floating.py); tau, M, g and bias have 6 + n rows. A spherical
-joint: Newton-Euler only, by its angular velocity (newton_euler_spherical.py).
+base twist (newton_euler_floating.py); tau, M, g and bias have 6 + n rows. A spherical,
+planar or floating joint (under a fixed or a floating base): Newton-Euler only, by its
+velocity (newton_euler_spherical.py).
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from .agreement import AgreementReport, check
 from .lagrange import lagrange
 from .newton_euler import newton_euler
 from .newton_euler_floating import FloatingEquationsOfMotion, newton_euler_floating
-from .newton_euler_spherical import SphericalEquationsOfMotion
+from .newton_euler_spherical import SphericalEquationsOfMotion, refuse_quasi_velocities
 from .terms import EquationsOfMotion, Step
 
 METHODS = {"newton-euler": newton_euler, "lagrange": lagrange}
@@ -40,9 +41,11 @@ def derive(robot: Robot | str, method: str = "newton-euler") -> EquationsOfMotio
     joints: Pinocchio's order) and that carries ``bias`` instead of ``C``; "lagrange"
     raises :class:`~armdyn.errors.FloatingBaseError`.
 
-    Spherical joints: Newton-Euler by their angular velocity, a
-    :class:`SphericalEquationsOfMotion` (``bias`` instead of ``C``); "lagrange", and a
-    planar or floating joint, raise :class:`~armdyn.errors.ModelError` naming the joint.
+    Spherical, planar and floating joints: Newton-Euler by their velocity (a ball joint's
+    angular velocity, a planar or floating joint's twist in its own frame), a
+    :class:`SphericalEquationsOfMotion` (``bias`` instead of ``C``; under a floating base
+    a :class:`FloatingEquationsOfMotion`); "lagrange" raises
+    :class:`~armdyn.errors.ModelError` naming the joint.
     """
     if isinstance(robot, str):
         from ..io import load
@@ -70,7 +73,7 @@ def prove_agreement(robot: Robot | str, **kwargs) -> AgreementReport:
         from ..io import load
 
         robot = load(robot)
-    robot.require_one_dof_joints("armdyn.prove_agreement (Newton-Euler against Lagrange)")
+    refuse_quasi_velocities(robot, "armdyn.prove_agreement (Newton-Euler against Lagrange)")
     return check(derive(robot, "newton-euler"), derive(robot, "lagrange"), **kwargs)
 
 

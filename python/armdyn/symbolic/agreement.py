@@ -25,6 +25,7 @@ import sympy as sp
 
 from ..dispatch import call
 from . import dag
+from .newton_euler_spherical import refuse_quasi_velocities
 from .terms import EquationsOfMotion
 
 #: an expression with more nodes than this is compared at random numeric points
@@ -178,7 +179,7 @@ def check(
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
         raise ValueError(f"samples must be a positive integer (random points for numeric checks), got {samples!r}")
     robot = a.robot
-    robot.require_one_dof_joints("armdyn.check (Newton-Euler against Lagrange)")
+    refuse_quasi_velocities(robot, "armdyn.check (Newton-Euler against Lagrange)")
     if robot.floating:
         from ..errors import FloatingBaseError
 

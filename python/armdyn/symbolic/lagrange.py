@@ -35,6 +35,7 @@ import sympy as sp
 
 from ..model import Robot
 from .joint_terms import armature, friction_torques, offsets
+from .newton_euler_spherical import refuse_quasi_velocities
 from .terms import EquationsOfMotion, Step
 
 
@@ -95,7 +96,7 @@ def link_energies(robot: Robot):
 
 def lagrange(robot: Robot) -> EquationsOfMotion:
     """Derive ``tau`` by the Euler-Lagrange equations; steps show T (trans/rot), V and L."""
-    robot.require_one_dof_joints("Lagrange's method (armdyn.derive(robot, 'lagrange'))")
+    refuse_quasi_velocities(robot, "Lagrange's method (armdyn.derive(robot, 'lagrange'))")
     q, qd, qdd, n = robot.q, robot.qd, robot.qdd, robot.dof
     T_trans, T_rot, V_links, steps = link_energies(robot)
     T = sum(T_trans.values(), sp.Integer(0)) + sum(T_rot.values(), sp.Integer(0))

@@ -13,7 +13,8 @@ coordinate ``q``::
     revolute:   w_i  = R^T w_p + qd z
                 wd_i = R^T wd_p + (R^T w_p) x qd z + qdd z
     prismatic:  w_i  = R^T w_p,        wd_i = R^T wd_p
-    spherical:  as revolute with the vector S w for qd z (newton_euler_spherical.py)
+    spherical, planar, floating: as revolute with the vector s = Z_w v for qd z, and
+                their V, Vd (by their velocity v: newton_euler_spherical.py)
     vd_i  = R^T (wd_p x P + w_p x (w_p x P) + vd_p) + 2 (R^T w_p) x V + Vd
     vcd_i = wd_i x c_i + w_i x (w_i x c_i) + vd_i
     F_i = m_i vcd_i,   N_i = I_i wd_i + w_i x I_i w_i
@@ -55,7 +56,7 @@ from .joint_terms import armature, has_joint_terms, joint_torques
 from .terms import EquationsOfMotion, Step
 
 #: the joints that turn (their rate adds to the angular velocity)
-TURNING = ("revolute", "spherical")
+TURNING = ("revolute", *spherical.DERIVED)
 
 
 def _mul(A, v):
@@ -86,8 +87,9 @@ def cross(a, b):
 
 def joint_rate(z, qd, kind):
     """The joint's own angular rate in frame i: ``qd z`` (revolute: ``z`` its axis), or
-    ``S w`` (spherical: ``z`` the 3x3 ``S``, ``qd`` its angular velocity ``w``)."""
-    return _mul(z, sp.Matrix(list(qd))) if kind == "spherical" else _mul(qd, z)
+    ``Z_w v`` (a joint of several coordinates: ``z`` its 6 x nv ``Z``, ``qd`` its
+    velocity ``v``; newton_euler_spherical.py)."""
+    return _mul(z[3:, :], sp.Matrix(list(qd))) if kind in spherical.DERIVED else _mul(qd, z)
 
 
 def omega(R, w_p, z, qd, kind):
@@ -147,9 +149,10 @@ def moment_about(n, f, point):
 
 def joint_torque(kind, z, n_axis, f):
     """tau_i: ``z . n`` (moment about a point on the axis) or ``z . f`` (prismatic); a
-    spherical joint's three: ``S^T n`` (``n`` about its centre)."""
-    if kind == "spherical":
-        return _mul(z.T, n_axis)
+    joint of several coordinates' nv: ``Z_v^T f + Z_w^T n`` (``n`` about the moved
+    frame's origin; newton_euler_spherical.py)."""
+    if kind in spherical.DERIVED:
+        return _mul(z[:3, :].T, f) + _mul(z[3:, :].T, n_axis)
     return (n_axis if kind == "revolute" else f).dot(z)
 
 
@@ -308,10 +311,10 @@ def recursion(
         link = robot.links[joint.child]
         name, parent, i = joint.child, joint.parent, robot.link_index(joint.child)
         follow = robot.follows(joint)  # (k, c, o): this joint's coordinate is c q_k + o
-        if joint.type == "spherical":  # three rates: its angular velocity
-            assert follow is not None  # a spherical joint has coordinates of its own
+        if joint.type in spherical.DERIVED:  # nv rates: its velocity
+            assert follow is not None  # a joint of several coordinates has coordinates of its own
             k = follow[0]
-            qd_j, qdd_j = qd[k : k + 3], qdd[k : k + 3]
+            qd_j, qdd_j = qd[k : k + joint.nv], qdd[k : k + joint.nv]
             ctx = spherical.motion(joint, qd_j, qdd_j)
         else:
             qd_j, qdd_j = (follow[1] * qd[follow[0]], follow[1] * qdd[follow[0]]) if follow is not None else (0, 0)
@@ -342,17 +345,22 @@ def recursion(
             value[step.key][name] = let(step.formula(context[name], *args, kid_values), f"{step.key}{i}_")
         f_i, n_i = value["f"][name], value["n"][name]
         follow = robot.follows(joint)
-        point = joint.joint_point(robot.joint_coordinate(joint)) if joint.type in TURNING else sp.zeros(3, 1)
+        several = joint.type in spherical.DERIVED
+        if several:
+            point = joint.joint_point()  # the moved frame's origin
+        else:
+            point = joint.joint_point(robot.joint_coordinate(joint)) if joint.type in TURNING else sp.zeros(3, 1)
         n_axis = moment_about(n_i, f_i, point)
         if follow is not None:
             k, mult, _ = follow
             tau_j = joint_torque(joint.type, context[name]["z"], n_axis, f_i)
-            if joint.type == "spherical":
-                tau[k : k + 3] = list(tau_j)
+            if several:
+                tau[k : k + joint.nv] = list(tau_j)
             else:
                 tau[k] = tau[k] + mult * tau_j  # a mimic joint's torque is carried to its leader
         if record:
-            about = "" if point == sp.zeros(3, 1) else f", about joint {i}'s axis point {list(point)} (frame {i})"
+            centre = ("centre" if joint.type == "spherical" else "origin") if several else "axis point"
+            about = "" if point == sp.zeros(3, 1) else f", about joint {i}'s {centre} {list(point)} (frame {i})"
             reported = {"f": f_i, "n": n_axis}  # n about the axis point: its z component is the torque
             inward += [
                 Step(
@@ -378,9 +386,9 @@ def recursion(
                         f"joint {kind} of mimic joint '{joint.name}', added {mult} times to tau{k + 1}",
                     )
                 )
-            elif joint.type == "spherical":  # its three rows, complete now (no mimic follows one)
-                label = rf"\tau_{{{k + 1}..{k + 3}}}"
-                note = f"moment about the centre of joint '{joint.name}', joint frame"
+            elif several:  # its nv rows, complete now (no mimic follows one)
+                label = rf"\tau_{{{k + 1}..{k + joint.nv}}}"
+                note = f"{spherical.TAU_MEANING[joint.type]} of joint '{joint.name}', joint frame"
                 inward.append(Step("inward", name, "tau", label, tau_j, note))
             elif follow is not None:
                 tau_steps.append((len(inward), k))
@@ -409,9 +417,8 @@ def mass_matrix(robot: Robot) -> sp.Matrix:
 
 def newton_euler(robot: Robot) -> EquationsOfMotion:
     """Derive ``tau`` by iterated Newton-Euler; steps as in Craig's outward/inward passes.
-    Spherical joints by their angular velocity (newton_euler_spherical.py: a
-    :class:`~.newton_euler_spherical.SphericalEquationsOfMotion`); planar and floating
-    joints are a ModelError naming them."""
+    Spherical, planar and floating joints by their velocity (newton_euler_spherical.py:
+    a :class:`~.newton_euler_spherical.SphericalEquationsOfMotion`)."""
     spherical.check_joints(robot)
     steps: list[Step] = []
     velocity, acceleration = spherical.rates(robot)

@@ -22,7 +22,9 @@ The recursion is RBDA ch. 9's floating-base RNEA in Craig's form: the base's row
     vcd_0, F_0, N_0                as for every link (NEWTON_EULER_STEPS' rows)
 
 then every joint's rows of :data:`~armdyn.symbolic.newton_euler.NEWTON_EULER_STEPS`,
-unchanged, and the inward pass as for every link, ending on the base::
+unchanged (a spherical, planar or floating joint by its velocity, its pose as symbols:
+newton_euler_spherical.py, whose :func:`~.newton_euler_spherical.state_values` puts in a
+floating robot's values too), and the inward pass as for every link, ending on the base::
 
     f_0 = F_0 + sum_c R_c f_c,    n_0 = N_0 + c_0 x F_0 + sum_c (R_c n_c + P_c x R_c f_c)
 
@@ -46,6 +48,7 @@ import sympy as sp
 from ..errors import FloatingBaseError, ModelError
 from ..model import Robot
 from . import dag
+from . import newton_euler_spherical as spherical
 from .joint_terms import armature, friction_torques, has_joint_terms, joint_torques
 from .newton_euler import (
     INWARD_STEPS,
@@ -172,17 +175,23 @@ def mass_matrix(robot: Robot) -> sp.Matrix:
 
 class FloatingEquationsOfMotion(EquationsOfMotion):
     """The equations of motion of a floating-base robot, ``M(q) a + bias(q, v, g_b) = tau``
-    (see the module doc): ``q`` the joints (the base pose enters through ``gravity``),
-    ``qd`` (6 + n) the base twist then the joint rates, ``qdd`` (6 + n) their time
-    derivatives, ``tau`` (6 + n) the wrench on the base then the joint torques."""
+    (see the module doc): ``q`` the joints (the base pose enters through ``gravity``; a
+    joint of several coordinates by its pose symbols, newton_euler_spherical.py), ``qd``
+    (6 + n) the base twist then the joint rates (a joint of several coordinates' velocity),
+    ``qdd`` (6 + n) their time derivatives, ``tau`` (6 + n) the wrench on the base then
+    the joint torques."""
+
+    @property
+    def q(self) -> sp.Matrix:
+        return sp.Matrix(spherical.pose_symbols(self.robot))  # (0, 0) without joints
 
     @property
     def qd(self) -> sp.Matrix:
-        return sp.Matrix([*BASE_VELOCITY, *self.robot.qd])  # (0, 0) without joints
+        return sp.Matrix([*BASE_VELOCITY, *spherical.rates(self.robot)[0]])
 
     @property
     def qdd(self) -> sp.Matrix:
-        return sp.Matrix([*BASE_ACCELERATION, *self.robot.qdd])
+        return sp.Matrix([*BASE_ACCELERATION, *spherical.rates(self.robot)[1]])
 
     @property
     def gravity(self) -> sp.Matrix:
@@ -197,7 +206,7 @@ class FloatingEquationsOfMotion(EquationsOfMotion):
     @cached_property
     def friction(self) -> sp.Matrix:
         """Joint friction (6 + n; the base has none)."""
-        return sp.Matrix([0] * 6 + list(friction_torques(self.robot, self.robot.qd)))
+        return sp.Matrix([0] * 6 + list(friction_torques(self.robot, self.qd[6:])))
 
     @property
     def C(self) -> sp.Matrix:  # type: ignore[override]
@@ -209,8 +218,9 @@ class FloatingEquationsOfMotion(EquationsOfMotion):
         )
 
     def symbol_names(self, fmt: str) -> dict:
-        """The base's symbols as the reports print them (``v_{b,x}``, ``\\dot{\\omega}_{b,z}``)."""
-        names = {}
+        """The base's symbols as the reports print them (``v_{b,x}``, ``\\dot{\\omega}_{b,z}``),
+        and the joints of several coordinates' (newton_euler_spherical.py)."""
+        names = spherical.joint_symbol_names(self.robot, fmt)
         for k, (v, a) in enumerate(zip(BASE_VELOCITY, BASE_ACCELERATION)):
             letter, axis = ("v", "ω")[k // 3], "xyz"[k % 3]
             if fmt == "latex":
@@ -240,7 +250,7 @@ def gravity_in_base(robot: Robot, quaternion) -> np.ndarray:
 
 def _check(robot: Robot) -> None:
     where, source = f"robot '{robot.name}'", robot.meta.get("file")
-    robot.require_one_dof_joints("the floating-base Newton-Euler derivation")
+    spherical.check_joints(robot, "the floating-base Newton-Euler derivation")
     if robot.mimic_joints:
         raise FloatingBaseError("mimic joints with a floating base are not supported yet", where, source)
     taken = {s.name for s in (*BASE_VELOCITY, *BASE_ACCELERATION, *BASE_GRAVITY)}
@@ -253,10 +263,10 @@ def newton_euler_floating(robot: Robot) -> FloatingEquationsOfMotion:
     """Derive ``tau`` (6 + n) of a floating-base robot by Newton-Euler (module doc)."""
     _check(robot)
     steps: list[Step] = []
-    eom_v, eom_a = list(BASE_VELOCITY) + list(robot.qd), list(BASE_ACCELERATION) + list(robot.qdd)
-    tau = _floating_recursion(robot, eom_v, eom_a, BASE_GRAVITY, steps)
+    v, a = spherical.rates(robot)
+    tau = _floating_recursion(robot, [*BASE_VELOCITY, *v], [*BASE_ACCELERATION, *a], BASE_GRAVITY, steps)
     if has_joint_terms(robot):
-        extra = joint_torques(robot, robot.qd, robot.qdd)
+        extra = joint_torques(robot, v, a)
         tau = tau + sp.Matrix([0] * 6 + list(extra))
         steps.append(
             Step(

@@ -280,9 +280,9 @@ def derivation_html(eoms, steps: bool = False, agreement=None) -> str:
         body.append(_tau_block(eom, wr))
     if robot.floating:
         body.append(f'<p class="meta">{escape(FLOATING_NOTE)}</p>')  # no C: see newton_euler_floating.py
-    elif robot.multi_dof_joints:
+    if robot.multi_dof_joints:
         body.append(f'<p class="meta">{escape(spherical_note(robot))}</p>')  # no C: newton_euler_spherical.py
-    elif robot.dof <= TERMS_MAX_DOF and not too_big_to_tidy(eoms[0]):
+    if not (robot.floating or robot.multi_dof_joints) and robot.dof <= TERMS_MAX_DOF and not too_big_to_tidy(eoms[0]):
         body.append(_terms_block(eoms[0], _Writer(eoms[0])))
     if agreement is not None:
         body.append("<h2>Agreement</h2>" + agreement_body(agreement))
