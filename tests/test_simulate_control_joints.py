@@ -417,7 +417,7 @@ def test_configuration_rate_is_the_derivative_of_integrate(seed):
     joint kind, fixed and floating."""
     from random_models import random_robot
 
-    from armdyn.configuration import _layout
+    from armdyn.configuration import group_layout
     from armdyn.io import with_root_joint
     from armdyn.simulate_adaptive import configuration_rate
 
@@ -430,7 +430,7 @@ def test_configuration_rate_is_the_derivative_of_integrate(seed):
         robot = with_root_joint(robot, "free-flyer")
     q, v, h = num.random_configuration(robot, rng), rng.uniform(-2, 2, robot.nv), 1e-5
     central = (num.integrate(robot, q, h * v) - num.integrate(robot, q, -h * v)) / (2 * h)
-    np.testing.assert_allclose(configuration_rate(_layout(robot), q, v), central, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(configuration_rate(group_layout(robot), q, v), central, rtol=0, atol=1e-8)
 
 
 @pytest.mark.parametrize("method", ["rk4", "euler"])

@@ -72,14 +72,14 @@ class _Layout:
     se2_names: tuple[str, ...]
 
 
-def _layout(robot: Robot) -> _Layout:
+def group_layout(robot: Robot) -> _Layout:
     """The robot's configuration space as groups of joints of one kind."""
-    return _grouped(robot.configuration_layout, robot.floating)
+    return grouped_layout(robot.configuration_layout, robot.floating)
 
 
 @lru_cache(maxsize=64)
-def _grouped(configuration_layout: tuple, floating: bool) -> _Layout:
-    """:func:`_layout` of a layout (built once per layout: integrate runs in loops)."""
+def grouped_layout(configuration_layout: tuple, floating: bool) -> _Layout:
+    """:func:`group_layout` of a layout (built once per layout: integrate runs in loops)."""
     groups: dict[str, tuple[list, list, list]] = {k: ([], [], []) for k in ("flat", "se3", "so3", "se2")}
     kinds = {"floating": ("se3", 7, 6), "spherical": ("so3", 4, 3), "planar": ("se2", 4, 3)}
     entries = [("the base", "floating", 0, 0)] if floating else []
@@ -125,7 +125,7 @@ def require_unit_length(x: np.ndarray, index: np.ndarray, labels, what: str, nam
         )
 
 
-def _check_unit(layout: _Layout, q: np.ndarray, name: str) -> None:
+def check_unit_blocks(layout: _Layout, q: np.ndarray, name: str) -> None:
     """ValueError naming the first joint whose quaternion (or planar (cos, sin) pair) in
     ``q`` is off unit length (:func:`require_unit_length`)."""
     require_unit_length(q, layout.se3_q[:, 3:7], layout.se3_names, "quaternion (x, y, z, w)", name)
@@ -138,7 +138,7 @@ def check_configuration(robot: Robot, q, name: str = "q") -> np.ndarray:
     planar (cos, sin) pair of unit length (ValueError naming the joint and the slice)."""
     q = _array(robot, q, robot.nq, name)
     if robot.nq != robot.nv:
-        _check_unit(_layout(robot), q, name)
+        check_unit_blocks(group_layout(robot), q, name)
     return q
 
 
@@ -291,8 +291,8 @@ def integrate(robot: Robot, q, v) -> np.ndarray:
     v = _array(robot, v, robot.nv, "v")
     if robot.nq == robot.nv:  # revolute and prismatic joints only
         return q + v
-    layout = _layout(robot)
-    _check_unit(layout, q, "q")
+    layout = group_layout(robot)
+    check_unit_blocks(layout, q, "q")
     q, v = _batch(q, v)
     out = np.array(q)
     out[..., layout.flat_q] = q[..., layout.flat_q] + v[..., layout.flat_v]
@@ -316,9 +316,9 @@ def difference(robot: Robot, q0, q1) -> np.ndarray:
     q1 = _array(robot, q1, robot.nq, "q1")
     if robot.nq == robot.nv:
         return q1 - q0
-    layout = _layout(robot)
-    _check_unit(layout, q0, "q0")
-    _check_unit(layout, q1, "q1")
+    layout = group_layout(robot)
+    check_unit_blocks(layout, q0, "q0")
+    check_unit_blocks(layout, q1, "q1")
     q0, q1 = _batch(q0, q1)
     out = np.empty(q0.shape[:-1] + (robot.nv,))
     out[..., layout.flat_v] = q1[..., layout.flat_q] - q0[..., layout.flat_q]
@@ -337,7 +337,7 @@ def neutral(robot: Robot) -> np.ndarray:
     base or joint at its placement's origin with the identity orientation (quaternion
     ``0, 0, 0, 1``); a spherical joint at the identity (``0, 0, 0, 1``); a planar joint
     at ``0, 0, 1, 0`` (x, y, cos 0, sin 0)."""
-    layout = _layout(robot)
+    layout = group_layout(robot)
     q = np.zeros(robot.nq)
     q[layout.se3_q[:, 6]] = 1.0
     q[layout.so3_q[:, 3]] = 1.0

@@ -32,7 +32,7 @@ def _quat_times_vector(quat: np.ndarray, w: np.ndarray) -> np.ndarray:
 
 def configuration_rate(layout, q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """``dq/dt`` (nq,) of the configuration ``q`` (nq,) moving with the velocity ``v``
-    (nv,), ``layout`` the robot's groups (:func:`armdyn.configuration._layout`): 1-dof
+    (nv,), ``layout`` the robot's groups (:func:`armdyn.configuration.group_layout`): 1-dof
     joints ``v``; SE(3) (a floating base, free joints) ``p' = R v_lin``, the quaternion
     turning at ``v_ang``; SO(3) the quaternion turning at ``v``; SE(2) ``(x, y)' = R
     (vx, vy)``, ``(cos, sin)' = wz (-sin, cos)``. The velocities in the moving frame, as
@@ -95,14 +95,14 @@ def simulate_adaptive(
         rate = lambda q, v: v  # noqa: E731
         flat_q = flat_v = np.arange(nq)
     else:
-        from .configuration import _layout, check_configuration
+        from .configuration import check_configuration, group_layout
 
         if not hasattr(robot, "configuration_layout"):
             raise ValueError(
                 f"simulate_adaptive on '{robot.name}' (a floating base or joints of several coordinates) needs the "
                 "robot itself (armdyn.load's), not its compiled model: the kinematics follow its joints' groups"
             )
-        layout = _layout(robot)
+        layout = group_layout(robot)
         check_configuration(robot, q0, "q0")
         project = lambda q: _project(layout, q)  # noqa: E731
         rate = lambda q, v: configuration_rate(layout, q, v)  # noqa: E731

@@ -263,7 +263,7 @@ def manifold_target(robot, text: str) -> np.ndarray:
     read per joint block as ``--q0`` (quaternions x y z w, planar x y cos sin; one value
     when every joint has one coordinate). A floating base is not actuated: the joints'
     values only, never its pose. A quaternion off unit length is refused, naming it."""
-    from .configuration import _check_unit, _grouped
+    from .configuration import check_unit_blocks, grouped_layout
 
     given = _numbers(text, "--target")
     base_q, base_v = (7, 6) if robot.floating else (0, 0)
@@ -274,9 +274,11 @@ def manifold_target(robot, text: str) -> np.ndarray:
         base = " (the floating base is not actuated: no pose for it)" if robot.floating else ""
         raise ValueError(f"--target needs {joints} joint values{base}, got {len(given)}")
     # the joints' blocks at their places in the values given (a floating base's 7 off)
-    layout = _grouped(tuple((n, k, iq - base_q, iv - base_v) for n, k, iq, iv in robot.configuration_layout), False)
+    layout = grouped_layout(
+        tuple((n, k, iq - base_q, iv - base_v) for n, k, iq, iv in robot.configuration_layout), False
+    )
     target = np.array(given)
-    _check_unit(layout, target, "--target")
+    check_unit_blocks(layout, target, "--target")
     return target
 
 

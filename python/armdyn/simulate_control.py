@@ -98,9 +98,9 @@ def controller_arrays(robot, model, controller, q0: np.ndarray) -> tuple[str, di
 def _v_of_q(robot, nq: int) -> np.ndarray:
     """Per coordinate of q, the first velocity coordinate that moves it (a quaternion's:
     its block's first angular one), as the Rust core names a non-finite state."""
-    from .configuration import _layout
+    from .configuration import group_layout
 
-    layout = _layout(robot)
+    layout = group_layout(robot)
     out = np.zeros(nq, dtype=np.int64)
     out[layout.flat_q] = layout.flat_v
     for iq, iv in zip(layout.se3_q, layout.se3_v):
@@ -125,14 +125,14 @@ def simulate_callable(robot, model, q0, qd0, torque, dt, steps, stride, method, 
         flat_q = flat_v = v_of_q = np.arange(nq)
         plus, rate = (lambda q, xi: q + xi), (lambda theta, v: v)
     else:
-        from .configuration import _layout
+        from .configuration import group_layout
 
         if not hasattr(robot, "configuration_layout"):
             raise ValueError(
                 f"a torque callable on '{robot.name}' (a floating base or joints of several coordinates) needs the "
                 "robot itself (armdyn.load's), not its compiled model: the Python loop steps along its joints' groups"
             )
-        layout = _layout(robot)
+        layout = group_layout(robot)
         flat_q, flat_v, v_of_q = layout.flat_q, layout.flat_v, _v_of_q(robot, nq)
         plus = lambda q, xi: _core._manifold_integrate(model, contiguous(q), contiguous(xi))  # noqa: E731
         rate = lambda theta, v: _core._manifold_local_rate(model, contiguous(theta), contiguous(v))  # noqa: E731

@@ -234,13 +234,13 @@ def programs(robot: Robot, what) -> tuple[dict, dict, Layout]:
         BASE_ACCELERATION,
         BASE_GRAVITY,
         BASE_VELOCITY,
-        _check,
-        _floating_recursion,
+        check_floating_robot,
+        floating_recursion,
     )
 
     nv, base = robot.nv, (6 if robot.floating else 0)
     if robot.floating:
-        _check(robot)
+        check_floating_robot(robot)
         v, a = [*BASE_VELOCITY, *robot.qd], [*BASE_ACCELERATION, *robot.qdd]
     else:
         spherical.check_joints(robot, "armdyn.codegen")
@@ -254,7 +254,7 @@ def programs(robot: Robot, what) -> tuple[dict, dict, Layout]:
 
     def tau(v, a, gravity: bool) -> list:
         if robot.floating:
-            out = _floating_recursion(robot, v, a, BASE_GRAVITY if gravity else [0, 0, 0], let=let)
+            out = floating_recursion(robot, v, a, BASE_GRAVITY if gravity else [0, 0, 0], let=let)
         else:
             out = recursion(robot, v, a, -robot.gravity if gravity else sp.zeros(3, 1), let=let)
         return list(out)

@@ -42,13 +42,13 @@ from __future__ import annotations
 
 from functools import cached_property
 
-import numpy as np
 import sympy as sp
 
 from ..errors import FloatingBaseError, ModelError
 from ..model import Robot
 from . import dag
 from . import newton_euler_spherical as spherical
+from .base_symbols import BASE_ACCELERATION, BASE_GRAVITY, BASE_VELOCITY, gravity_in_base  # noqa: F401
 from .joint_terms import armature, friction_torques, has_joint_terms, joint_torques
 from .newton_euler import (
     INWARD_STEPS,
@@ -59,12 +59,6 @@ from .newton_euler import (
     step_latex,
 )
 from .terms import EquationsOfMotion, Step
-
-#: the base twist's symbols (linear, angular: Pinocchio's order), their time derivatives
-#: and gravity in the base frame
-BASE_VELOCITY = sp.Matrix(sp.symbols("vb_x vb_y vb_z wb_x wb_y wb_z"))
-BASE_ACCELERATION = sp.Matrix([sp.Symbol(f"{s.name}_dot") for s in BASE_VELOCITY])
-BASE_GRAVITY = sp.Matrix(sp.symbols("gb_x gb_y gb_z"))
 
 #: the base rows of tau: (LaTeX, text, what they are)
 BASE_ROWS = tuple(
@@ -120,7 +114,7 @@ def _vec(x) -> sp.Matrix:
     return sp.Matrix(list(x))
 
 
-def _floating_recursion(robot: Robot, v, a, g_b, steps: list[Step] | None = None, let=None) -> sp.Matrix:
+def floating_recursion(robot: Robot, v, a, g_b, steps: list[Step] | None = None, let=None) -> sp.Matrix:
     """tau (6 + n) for the velocity ``v`` and acceleration ``a`` (6 + n each: base twist,
     then joints) under gravity ``g_b`` (base frame). Appends the steps if given; ``let``
     as :func:`~.newton_euler.recursion`'s."""
@@ -166,7 +160,7 @@ def mass_matrix(robot: Robot) -> sp.Matrix:
     M = sp.zeros(size, size)
     rest = [0] * size
     for j in range(size):
-        M[:, j] = _floating_recursion(robot, rest, [int(i == j) for i in range(size)], [0, 0, 0])
+        M[:, j] = floating_recursion(robot, rest, [int(i == j) for i in range(size)], [0, 0, 0])
     ia = armature(robot)
     for k in range(robot.dof):
         M[6 + k, 6 + k] += ia[k]
@@ -233,22 +227,7 @@ class FloatingEquationsOfMotion(EquationsOfMotion):
         return names
 
 
-def gravity_in_base(robot: Robot, quaternion) -> np.ndarray:
-    """``R^T g`` (3,): the robot's gravity (world frame) in the base frame of orientation
-    ``quaternion`` (x, y, z, w, Pinocchio's order; normalised here), the values of
-    :data:`BASE_GRAVITY`. The robot's gravity must be numeric."""
-    x, y, z, w = np.asarray(quaternion, dtype=float) / np.linalg.norm(np.asarray(quaternion, dtype=float))
-    R = np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-    return R.T @ np.array([float(c) for c in robot.gravity])
-
-
-def _check(robot: Robot) -> None:
+def check_floating_robot(robot: Robot) -> None:
     where, source = f"robot '{robot.name}'", robot.meta.get("file")
     spherical.check_joints(robot, "the floating-base Newton-Euler derivation")
     if robot.mimic_joints:
@@ -261,10 +240,10 @@ def _check(robot: Robot) -> None:
 
 def newton_euler_floating(robot: Robot) -> FloatingEquationsOfMotion:
     """Derive ``tau`` (6 + n) of a floating-base robot by Newton-Euler (module doc)."""
-    _check(robot)
+    check_floating_robot(robot)
     steps: list[Step] = []
     v, a = spherical.rates(robot)
-    tau = _floating_recursion(robot, [*BASE_VELOCITY, *v], [*BASE_ACCELERATION, *a], BASE_GRAVITY, steps)
+    tau = floating_recursion(robot, [*BASE_VELOCITY, *v], [*BASE_ACCELERATION, *a], BASE_GRAVITY, steps)
     if has_joint_terms(robot):
         extra = joint_torques(robot, v, a)
         tau = tau + sp.Matrix([0] * 6 + list(extra))

@@ -65,6 +65,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..model import Joint, Robot
+from .base_symbols import BASE_ACCELERATION, BASE_GRAVITY, BASE_VELOCITY, gravity_in_base
 from .names import SUBSCRIPT_DIGITS
 from .terms import EquationsOfMotion
 
@@ -206,11 +207,10 @@ def state_values(robot: Robot, q, v=None, a=None) -> dict:
     a joint of several coordinates' rotation entries from its quaternion (x, y, z, w, of
     unit length: :func:`armdyn.configuration.check_configuration`) or (cos, sin), its
     position, velocity and acceleration; the other joints' q, qd, qdd. A floating base's
-    gravity in its frame (:data:`~.newton_euler_floating.BASE_GRAVITY`) from its
+    gravity in its frame (:data:`~.base_symbols.BASE_GRAVITY`) from its
     quaternion, its twist and its derivative (the first six of ``v`` and ``a``)."""
     from ..configuration import check_configuration
     from ..model.joints import multi_dof_motion
-    from .newton_euler_floating import BASE_ACCELERATION, BASE_GRAVITY, BASE_VELOCITY, gravity_in_base
 
     q = check_configuration(robot, np.asarray(q, dtype=float).reshape(-1))
     vel, acc = rates(robot)
