@@ -7,7 +7,8 @@ a; it gives tau, M, g and bias (C v + g). Robots: a free body with an arm, a sma
 quadruped (URDF, four legs of two joints), a ball pendulum with joint friction, a ball
 joint mid-chain; the compiled C (batch and single-state paths), the Python and the NumPy
 code. Also: a non-unit quaternion (the rotation of its direction), the fixed-base bias, the
-CLI, and what stays refused (planar and floating joints in the tree, C, base parameters).
+CLI, and what stays refused (C, base parameters). Also a planar-base arm, a free body
+mid-tree and a ball hip under a floating base.
 """
 
 from __future__ import annotations
@@ -97,6 +98,43 @@ def ball_mid_chain() -> Robot:
     return Robot("ball-chain", links, joints)
 
 
+def planar_base_arm(damping: float = 0.1) -> Robot:
+    """A body sliding and turning on a tilted plane (planar joint, damped), an arm on it."""
+    rot = [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]
+    links = [Link("ground"), Link("cart", 3.0, [0.05, -0.02, 0.1], inertia(0.05, 0.06, 0.08, 0.002))]
+    links += [Link("arm", 0.8, [0.2, 0.0, 0.02], inertia(0.004, 0.02, 0.02))]
+    joints = [
+        Joint("plane", "planar", "ground", "cart", [0.1, 0.0, 0.2], rotation=rot, damping=damping or None),
+        Joint("q1", "revolute", "cart", "arm", [0.1, 0.05, 0.1], axis=[0.0, 0.0, 1.0]),
+    ]
+    return Robot("planar-arm", links, joints)
+
+
+def free_mid_tree() -> Robot:
+    """A free body hung under a revolute joint, a prismatic joint on it."""
+    links = [Link("base"), Link("upper", 1.2, [0.0, 0.1, -0.1], inertia(0.02, 0.01, 0.015))]
+    links += [Link("drone", 1.5, [0.02, 0.0, -0.05], inertia(0.03, 0.04, 0.05, 0.001))]
+    links += [Link("probe", 0.2, [0.0, 0.0, 0.05], inertia(0.001, 0.001, 0.0005))]
+    joints = [
+        Joint("q0", "revolute", "base", "upper", [0.0, 0.0, 1.0], axis=[0.0, 1.0, 0.0]),
+        Joint("fly", "floating", "upper", "drone", [0.0, 0.2, -0.3]),
+        Joint("d2", "prismatic", "drone", "probe", [0.1, 0.0, 0.0], axis=[0.0, 0.0, 1.0]),
+    ]
+    return Robot("free-mid", links, joints)
+
+
+def floating_ball_hip() -> Robot:
+    """A floating body with a leg on a ball hip and a knee."""
+    body = Link("body", 4.0, [0.02, 0.0, 0.05], inertia(0.1, 0.15, 0.2, 0.003))
+    thigh = Link("thigh", 0.9, [0.0, 0.02, -0.12], inertia(0.01, 0.012, 0.003))
+    shin = Link("shin", 0.3, [0.01, 0.0, -0.1], inertia(0.004, 0.004, 0.0008))
+    joints = [
+        Joint("hip", "spherical", "body", "thigh", [0.2, 0.1, -0.05], armature=0.01),
+        Joint("knee", "revolute", "thigh", "shin", [0.0, 0.0, -0.25], axis=[0.0, 1.0, 0.0]),
+    ]
+    return Robot("ball-hip", [body, thigh, shin], joints, root_joint="free-flyer")
+
+
 def quadruped(tmp_path_factory) -> Robot:
     path = tmp_path_factory.mktemp("quad") / "quad.urdf"
     path.write_text(quadruped_urdf())
@@ -109,8 +147,13 @@ def states(robot: Robot, rng, count: int = 11, scale=None):
     q = np.empty((count, robot.nq))
     blocks = [(0, 3, 4)] if robot.floating else []  # (first, position width, quaternion) of each group
     blocks += [(iq, 0, 4) for _, kind, iq, _ in robot.configuration_layout if kind == "spherical"]
+    blocks += [(iq, 3, 4) for _, kind, iq, _ in robot.configuration_layout if kind == "floating"]
     flat = [iq for _, kind, iq, _ in robot.configuration_layout if kind in ("revolute", "prismatic")]
     q[:, flat] = rng.uniform(-np.pi, np.pi, (count, len(flat)))
+    for iq in [iq for _, kind, iq, _ in robot.configuration_layout if kind == "planar"]:
+        th = rng.uniform(-np.pi, np.pi, count)
+        r = 1.0 if scale is None else scale
+        q[:, iq : iq + 4] = np.column_stack([*rng.uniform(-1, 1, (2, count)), r * np.cos(th), r * np.sin(th)])
     for first, width, nquat in blocks:
         q[:, first : first + width] = rng.uniform(-1, 1, (count, width))
         quat = rng.normal(size=(count, nquat))
@@ -139,7 +182,15 @@ def core(robot, q, v, a) -> dict:
 
 
 ARGS = {"tau": (0, 1, 2), "M": (0,), "g": (0,), "bias": (0, 1)}
-ROBOTS = {"one-body": one_body, "free-body": free_body, "ball-pendulum": ball_pendulum, "ball-chain": ball_mid_chain}
+ROBOTS = {
+    "one-body": one_body,
+    "free-body": free_body,
+    "ball-pendulum": ball_pendulum,
+    "ball-chain": ball_mid_chain,
+    "planar-arm": planar_base_arm,
+    "free-mid": free_mid_tree,
+    "ball-hip": floating_ball_hip,
+}
 
 
 def _exec(source) -> dict:
@@ -219,7 +270,7 @@ def test_one_free_body_is_newton_euler_by_hand():
         close(ns["one_body_M"](q), M)
 
 
-@pytest.mark.parametrize("name", ["free-body", "ball-chain"])
+@pytest.mark.parametrize("name", ["free-body", "ball-chain", "planar-arm", "free-mid", "ball-hip"])
 def test_python_and_numpy_code_equal_the_core(name):
     robot = ROBOTS[name]()
     rng = np.random.default_rng(5)
@@ -239,13 +290,15 @@ def test_python_and_numpy_code_equal_the_core(name):
 
 
 @needs_pinocchio
-@pytest.mark.parametrize("name", ["ball-pendulum", "ball-chain"])
-def test_ball_joints_equal_pinocchio(name):
+@pytest.mark.parametrize("name", ["ball-pendulum", "ball-chain", "planar-arm", "free-mid"])
+def test_joints_of_several_coordinates_equal_pinocchio(name):
     from pinocchio_bridge import PinocchioRobot
 
     robot = ROBOTS[name]()
     if name == "ball-pendulum":  # Pinocchio's rnea has no joint friction or rotor inertia
         robot = Robot(robot.name, list(robot.links.values()), [Joint("ball", "spherical", "base", "rod", [0, 0, 1.0])])
+    if name == "planar-arm":
+        robot = planar_base_arm(damping=0.0)
     ref = PinocchioRobot(robot)
     code = printing.codegen(robot, lang="numpy")
     ns = _exec(code.source)
@@ -276,7 +329,7 @@ def test_symbolic_parameters_and_gravity_go_in_p():
 
 # --------------------------------------------------------- the quaternions' length
 @needs_cc
-@pytest.mark.parametrize("name", ["free-body", "ball-chain"])
+@pytest.mark.parametrize("name", ["free-body", "ball-chain", "free-mid"])
 def test_a_non_unit_quaternion_is_normalised(name, tmp_path):
     """The documented behaviour: the rotation of q/|q|. The core (which wants unit
     quaternions) at the normalised q is the reference."""
@@ -296,6 +349,18 @@ def test_a_non_unit_quaternion_is_normalised(name, tmp_path):
     with pytest.raises(ValueError, match=rf"q\[{first}:{first + 4}\], the quaternion of {whose}, is zero"):
         lib.g(q)
     assert "Quaternions are normalised here" in lib.code.source
+
+
+def test_a_planar_pair_off_unit_length_is_normalised():
+    """A planar joint's (cos, sin) of length 0.3 or 2.5 gives the turn of its direction."""
+    robot = planar_base_arm()
+    code = printing.codegen(robot, what="tau", lang="numpy")
+    tau = _exec(code.source)[code.functions["tau"]]
+    for scale in (0.3, 2.5):
+        q, v, a = states(robot, np.random.default_rng(6), scale=scale)
+        unit, _, _ = states(robot, np.random.default_rng(6))
+        assert not np.allclose(q, unit)
+        close(tau(q, v, a), an.rnea(robot, unit, v, a))
 
 
 # -------------------------------------------------------------- fixed-base bias
@@ -338,21 +403,6 @@ def test_base_parameter_bias_equals_the_core(tmp_path):
 
 
 # ----------------------------------------------------------------------- refusals
-def test_planar_and_floating_joints_in_the_tree_are_refused_by_name():
-    body = Link("body", 1.0, (0.1, 0, 0), inertia(0.01, 0.01, 0.01))
-    for kind in ("planar", "floating"):
-        robot = Robot("puck", [Link("table"), body], [Joint("slide", kind, "table", "body")])
-        with pytest.raises(ModelError, match=rf"armdyn.codegen takes .* joint 'slide' is {kind}"):
-            printing.codegen(robot, what="tau")
-
-
-def test_a_ball_joint_on_a_floating_base_is_refused():
-    robot = ball_mid_chain()
-    robot = Robot("x", list(robot.links.values()), list(robot.joints), root_joint="free-flyer")
-    with pytest.raises(FloatingBaseError, match="spherical joint on a floating base yet \\(joint 'ball'\\)"):
-        printing.codegen(robot, what="tau")
-
-
 def test_mimic_joints_beside_a_ball_joint_or_a_floating_base_are_refused():
     from armdyn.model.joints import Mimic
 

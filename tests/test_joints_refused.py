@@ -61,8 +61,8 @@ def test_newton_euler_refuses_a_name_of_the_joints_own_symbols(kind, own, root_j
 @pytest.mark.parametrize("kind", ["spherical", "planar"])
 def test_codegen_and_identification_refuse(kind):
     robot = arm(kind)
-    # codegen takes a spherical joint (test_codegen_floating.py), not its C (a quasi-velocity)
-    refused(lambda: armdyn.codegen(robot, what="C" if kind == "spherical" else None), "armdyn.codegen")
+    # codegen takes these joints (test_codegen_floating.py), not their C (a quasi-velocity)
+    refused(lambda: armdyn.codegen(robot, what="C"), "armdyn.codegen")
     refused(lambda: armdyn.regressor(robot), "armdyn.identification.regressor")
     refused(lambda: armdyn.base_parameters(robot), "armdyn.identification.base_parameters")
 

@@ -451,7 +451,7 @@ def build_parser() -> argparse.ArgumentParser:
     cg.add_argument(
         "--what",
         help="comma-separated: tau,M,C,g,bias,regressor (default tau,M,C,g; tau,M,g,bias for a floating base "
-        "or spherical joints, where C does not apply)",
+        "or joints of several coordinates, where C does not apply)",
     )
     cg.add_argument("--base", action="store_true", help="in the base parameters (needs armdyn.identification)")
     cg.add_argument("--lang", choices=["c", "python", "numpy"], default="c")

@@ -43,7 +43,7 @@ Conventions: ``M(q) qdd + C(q, qd) qd + g(q) = tau``, SI units, radians, joints 
 ``robot.coordinate_names`` order; batches are ``(N, dof)`` row-major. ``bias`` is
 ``C(q, qd) qd + g(q)`` (the same recursion with ``qdd = 0``).
 
-A floating base (``root_joint="free-flyer"``) or spherical joints
+A floating base (``root_joint="free-flyer"``) or joints of several coordinates
 (:mod:`armdyn.printing.generate_floating`): the functions take Pinocchio's ``q`` (nq,),
 ``v`` and ``a`` (nv,) (every quaternion x, y, z, w normalised in the code: the rotation of
 ``q/|q|``) and give tau, M, g and bias in Pinocchio's order (the default ``what``); C,

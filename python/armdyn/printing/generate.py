@@ -39,7 +39,7 @@ class GeneratedCode:
     programs:    quantity -> :class:`~armdyn.programs.program.Program`.
     q, qd, qdd:  the symbols each input array holds, in order (:meth:`inputs`).
     input_names: what the functions call the three arrays: ``q, qd, qdd``, or ``q, v, a``
-                 for a floating base or spherical joints (``q`` (nq,) in Pinocchio's
+                 for a floating base or joints of several coordinates (``q`` (nq,) in Pinocchio's
                  layout, ``v`` and ``a`` (nv,): :mod:`.generate_floating`).
     quaternions: ``[(first index in q, whose)]`` of the quaternions among the inputs.
     conventions: header lines saying what the arrays hold (the fixed base's when empty).
@@ -401,7 +401,7 @@ def codegen(robot: Robot | str, what=None, lang: str = "c", base: bool = False) 
     "python", "numpy"). ``base=True``: in the base parameters (needs
     :mod:`armdyn.identification`). Returns a :class:`GeneratedCode`.
 
-    A floating base or spherical joints: :mod:`.generate_floating` (inputs ``q, v, a``
+    A floating base or joints of several coordinates: :mod:`.generate_floating` (inputs ``q, v, a``
     in Pinocchio's layout; C, the regressor and ``base=True`` refused).
 
     Raises ValueError for an unknown quantity or language, or a robot that does not move;

@@ -1,4 +1,5 @@
-"""Generated code for a floating base and for spherical (ball) joints.
+"""Generated code for a floating base and for joints of several coordinates (spherical,
+planar, floating).
 
 Both are parametrised by quasi-velocities (a twist, an angular velocity: no time
 derivative of coordinates), so their code takes Pinocchio's three arrays, as
@@ -6,10 +7,12 @@ derivative of coordinates), so their code takes Pinocchio's three arrays, as
 
     q (nq,)   configuration: a floating base's origin x, y, z (world frame) and
               orientation quaternion x, y, z, w; a spherical joint's quaternion
-              x, y, z, w; a revolute or prismatic joint's coordinate
+              x, y, z, w; a planar joint's x, y, cos, sin; a floating joint's x, y, z and
+              quaternion; a revolute or prismatic joint's coordinate
     v (nv,)   velocity: the base's twist in its own frame (linear vb_x, vb_y, vb_z, then
               angular wb_x, wb_y, wb_z), a spherical joint's angular velocity relative to
-              its parent (child frame axes), a joint's rate
+              its parent (child frame axes), a planar joint's vx, vy, wz and a floating
+              joint's twist (linear, angular) in the same way, a joint's rate
     a (nv,)   their time derivatives
 
 and gives, in Pinocchio's order (``M(q) a + bias(q, v) = tau``):
@@ -20,24 +23,25 @@ and gives, in Pinocchio's order (``M(q) a + bias(q, v) = tau``):
 
 C is refused: the Christoffel matrix of M does not apply to quasi-velocities; ask for
 the bias. So are the regressor and ``base=True`` (armdyn.identification takes a fixed
-base with joints of one coordinate), planar and floating joints inside the tree, spherical
-joints on a floating base (the symbolic derivations do not take them yet) and mimic joints
-with either (armdyn.numeric does not, to check the code against).
+base with joints of one coordinate) and mimic joints with either (armdyn.numeric does
+not, to check the code against).
 
 Each quaternion is normalised inside the code: the rotation is that of ``q / |q|``,
 written with ``s = 2 / (x^2 + y^2 + z^2 + w^2)`` (``R = [[1 - s (y^2 + z^2), s (x y - w z),
 ...]]``, no square root), so a quaternion of any nonzero length gives the rotation of its
 direction (armdyn.numeric and Pinocchio want unit ones); a zero quaternion has none and
 gives NaN or inf (the compiled library refuses it). The base's position does not enter
-the dynamics (the functions do not read it).
+the dynamics (the functions do not read it); a planar joint's (cos, sin) pair is
+normalised too (a square root).
 
 The programs run the symbolic Newton-Euler recursion (:mod:`armdyn.symbolic.newton_euler_floating`,
 :mod:`armdyn.symbolic.newton_euler_spherical`) with every step's vector a named line (a
 value met twice is one line; each sine and cosine computed once); M is its columns at
 rest under unit accelerations (Walker and Orin), on and above the diagonal. Those derivations
-keep gravity in the base frame (``gb_x, gb_y, gb_z``) and a spherical joint's rotation
-(``ball.r11`` ... ``ball.r33``) as symbols, which the code computes first from the
-quaternions (the lines each function starts with). Joint friction, rotor inertia and
+keep gravity in the base frame (``gb_x, gb_y, gb_z``) and a joint's pose (a spherical or
+floating joint's rotation ``ball.r11`` ... ``ball.r33``, a planar joint's ``cos``, ``sin``,
+the position ``x, y (, z)``) as symbols, which the code computes first from q (the lines
+each function starts with). Joint friction, rotor inertia and
 offsets are added as ``armdyn.derive`` adds them.
 """
 
@@ -53,8 +57,6 @@ from ..programs.program import Builder, Program
 
 #: what codegen generates for these robots when not told
 DEFAULT_WHAT = ("tau", "M", "g", "bias")
-#: the joints of several coordinates codegen takes
-TAKEN = ("spherical",)
 
 
 @dataclass
@@ -78,25 +80,8 @@ def _where(robot: Robot) -> tuple[str, str | None]:
 def check_robot(robot: Robot) -> None:
     """Refuse, naming the joint, what the derivations do not take (module doc)."""
     where, source = _where(robot)
-    other = [j for j in robot.multi_dof_joints if j.type not in TAKEN]
-    if other:
-        j = other[0]
-        raise ModelError(
-            f"armdyn.codegen takes revolute, prismatic and spherical joints and a floating base; joint "
-            f"'{j.name}' is {j.type} (armdyn.numeric's rnea, crba, aba ... take it)",
-            where,
-            source,
-        )
-    if robot.floating and robot.multi_dof_joints:
-        j = robot.multi_dof_joints[0]
-        raise FloatingBaseError(
-            f"armdyn.codegen does not take a {j.type} joint on a floating base yet (joint '{j.name}'): "
-            "the floating-base Newton-Euler derivation takes joints of one coordinate",
-            where,
-            source,
-        )
     if robot.mimic_joints:  # nothing to check such code against: armdyn.numeric refuses them too
-        beside = "on a floating base" if robot.floating else "beside spherical joints"
+        beside = "on a floating base" if robot.floating else "beside joints of several coordinates"
         raise (FloatingBaseError if robot.floating else ModelError)(
             f"armdyn.codegen does not take mimic joints {beside} yet (joint '{robot.mimic_joints[0].name}')",
             where,
@@ -110,9 +95,9 @@ def check_what(robot: Robot, what, base: bool) -> None:
     if robot.floating:
         error, kind = FloatingBaseError, "a floating base parametrised by its twist"
     else:
-        named = ", ".join(f"'{j.name}'" for j in robot.multi_dof_joints)
-        error, kind = ModelError, f"the angular velocity of spherical joint {named}"
-    has = "a floating base" if robot.floating else f"spherical joint {named}"
+        named = ", ".join(f"{j.type} joint '{j.name}'" for j in robot.multi_dof_joints)
+        error, kind = ModelError, f"the velocity of {named}"
+    has = "a floating base" if robot.floating else named
     if base or "regressor" in what:
         asked = "base=True (the base parameters)" if base else "the regressor"
         raise error(
@@ -154,13 +139,13 @@ def _rotation(builder: Builder, quaternion, hint: str) -> sp.Matrix:
 def layout(robot: Robot, v, a) -> Layout:
     """The arrays of ``robot``'s code (``v``, ``a``: the derivation's velocity and
     acceleration symbols) and the preamble's lines."""
-    from ..symbolic.newton_euler_floating import BASE_GRAVITY
-    from ..symbolic.newton_euler_spherical import rotation_symbols
+    from ..symbolic.base_symbols import BASE_GRAVITY
+    from ..symbolic.newton_euler_spherical import configuration_symbols, position_symbols, rotation_symbols
 
     q: list = []
     quaternions = []
     taken = {s.name for s in robot.free_symbols()} | {s.name for s in [*robot.q, *v, *a]}
-    taken |= {s.name for j in robot.multi_dof_joints for s in rotation_symbols(j)} | {s.name for s in BASE_GRAVITY}
+    taken |= {s.name for j in robot.multi_dof_joints for s in configuration_symbols(j)} | {s.name for s in BASE_GRAVITY}
     builder = Builder(reserved=[sp.Symbol(n) for n in taken])
     preamble = []
     if robot.floating:
@@ -171,12 +156,21 @@ def layout(robot: Robot, v, a) -> Layout:
         preamble += list(zip(BASE_GRAVITY, R.T * sp.Matrix(robot.gravity)))
     joints = {j.name: j for j in robot.movable_joints}
     for name, kind, iq, iv in robot.configuration_layout:
-        if kind == "spherical":
+        joint = joints[name]
+        if kind in ("planar", "floating"):  # the position first, as it is
+            position = [sp.Dummy(f"{name}.{c}") for c in "xyz"[: 2 if kind == "planar" else 3]]
+            q += position
+            preamble += list(zip(position_symbols(joint), position))
+        if kind == "planar":  # (cos, sin), normalised
+            c, s = sp.Dummy(f"{name}.c"), sp.Dummy(f"{name}.s")
+            q += [c, s]
+            inv = builder.let(1 / sp.sqrt(c**2 + s**2), f"{name}_inv")
+            preamble += list(zip(configuration_symbols(joint)[2:], (c * inv, s * inv)))
+        elif kind in ("spherical", "floating"):
             quat = _quaternion_symbols(name)
+            quaternions.append((len(q), f"joint '{name}'"))
             q += quat
-            quaternions.append((iq, f"joint '{name}'"))
-            R = _rotation(builder, quat, name)
-            preamble += list(zip(rotation_symbols(joints[name]), R))
+            preamble += list(zip(rotation_symbols(joint), _rotation(builder, quat, name)))
         else:
             q.append(robot.q[iv - (6 if robot.floating else 0)])
     assert len(q) == robot.nq
@@ -199,10 +193,21 @@ def _conventions(robot: Robot, q, v) -> list[str]:
             "its twist in its own frame (linear, angular); tau's first 6 rows the wrench on it",
             "(force, moment about its origin, base frame). Gravity enters as gb = R^T g.",
         ]
-    if robot.multi_dof_joints:
+    said = {j.type for j in robot.multi_dof_joints}
+    if "spherical" in said:
         out += [
             "A spherical joint: quaternion x, y, z, w; angular velocity relative to its parent in",
             "its child frame; tau its moment about its centre, in that frame.",
+        ]
+    if "planar" in said:
+        out += [
+            "A planar joint: x, y, cos, sin in its placement frame's x-y plane ((cos, sin) normalised);",
+            "vx, vy, wz relative to its parent in its child frame; tau the force and moment on it.",
+        ]
+    if "floating" in said:
+        out += [
+            "A floating joint: position, quaternion x, y, z, w in its placement frame; its twist",
+            "relative to its parent in its child frame (linear, angular); tau the wrench on it.",
         ]
     out.append("Quaternions are normalised here (the rotation of q/|q|; a zero one gives NaN or inf).")
     return out
@@ -239,12 +244,12 @@ def programs(robot: Robot, what) -> tuple[dict, dict, Layout]:
     )
 
     nv, base = robot.nv, (6 if robot.floating else 0)
+    v, a = spherical.rates(robot)
     if robot.floating:
         check_floating_robot(robot)
-        v, a = [*BASE_VELOCITY, *robot.qd], [*BASE_ACCELERATION, *robot.qdd]
+        v, a = [*BASE_VELOCITY, *v], [*BASE_ACCELERATION, *a]
     else:
         spherical.check_joints(robot, "armdyn.codegen")
-        v, a = spherical.rates(robot)
     found = layout(robot, v, a)
     reserved = robot.free_symbols() | {*found.q, *found.v, *found.a} | {s for s, _ in found.preamble}
     builder = Builder(reserved=reserved | set(robot.q) | set(robot.qd) | set(robot.qdd))
@@ -266,7 +271,7 @@ def programs(robot: Robot, what) -> tuple[dict, dict, Layout]:
         return rows[:base] + [r + e for r, e in zip(rows[base:], extra)]
 
     zero = [0] * nv
-    derivation = "floating-base Newton-Euler" if robot.floating else "Newton-Euler with spherical joints"
+    derivation = "floating-base Newton-Euler" if robot.floating else "Newton-Euler with joints of several coordinates"
     outputs, sources = {}, {}
     for w in what:
         if w == "M":  # Walker-Orin: column j is tau at rest, no gravity, a = e_j; symmetric
