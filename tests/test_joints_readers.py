@@ -138,6 +138,28 @@ def test_urdf_dynamics_agree_with_pinocchio():
 
 
 @needs_pinocchio
+def test_urdf_continuous_joint_is_one_angle_where_pinocchio_keeps_cos_sin():
+    """A ``continuous`` joint is read as revolute, q its angle (nq 1); Pinocchio's parser
+    makes it an unbounded revolute joint, q = (cos, sin) (nq 2). v, a and tau are the same
+    arrays; q converts by the angle's cos and sin (documented in io/urdf.py)."""
+    text = (
+        '<robot name="wheel">'
+        + "".join(_link(n, k) for k, n in enumerate(["base", "l1", "l2"]))
+        + _joint("a_hip", "revolute", "base", "l1", "0 0 0.3", "0 0 0", '<axis xyz="0 1 0"/>' + LIMIT)
+        + _joint("b_wheel", "continuous", "l1", "l2", "0.2 0 0.1", "0.4 -0.3 0.2", '<axis xyz="0 0 1"/>')
+        + "</robot>"
+    )
+    robot, model = load_urdf(text), pin.buildModelFromXML(text)
+    assert (robot.nq, robot.nv, model.nq, model.nv) == (2, 2, 3, 2)
+    data, rng = model.createData(), np.random.default_rng(8)
+    for _ in range(5):
+        (hip, wheel), (v, a) = rng.uniform(-3, 3, 2), rng.uniform(-1.5, 1.5, (2, 2))
+        q_pin = np.array([hip, np.cos(wheel), np.sin(wheel)])
+        tau = pin.rnea(model, data, q_pin, v, a)
+        assert np.abs(numeric.rnea(robot, np.array([hip, wheel]), v, a) - tau).max() <= TOL
+
+
+@needs_pinocchio
 def test_urdf_free_flyer_root_with_floating_and_planar_joints(tmp_path):
     """``root_joint="free-flyer"`` as before: the root floats too (Pinocchio's root joint)."""
     path = tmp_path / "mixed.urdf"

@@ -5,7 +5,9 @@ What is read (the URDF 1.0 subset that describes a fixed-base arm's dynamics):
 * ``<robot name>`` with ``<link>`` and ``<joint>`` children; any other child
   (``<material>``, ``<gazebo>``, ``<transmission>``, ``<ros2_control>``...) and a link's
   ``<visual>``/``<collision>`` are ignored.
-* Joints ``revolute``, ``continuous`` (read as revolute, without position limits),
+* Joints ``revolute``, ``continuous`` (read as revolute, without position limits: q is
+  its angle, where Pinocchio's parser keeps an unbounded joint's ``(cos, sin)``, nq 2;
+  v, a and tau are the same, and q converts by the angle's cos and sin),
   ``prismatic`` and ``fixed``. Fixed joints stay fixed joints in the :class:`Robot`;
   the engines handle them.
 * Joints of several coordinates, read as Pinocchio's URDF parser reads them (layouts:
