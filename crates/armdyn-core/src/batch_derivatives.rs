@@ -490,7 +490,7 @@ pub fn multi_derivatives(
     outs: [&mut [f64]; 3],
     threads: Option<usize>,
 ) {
-    use algo::multi_derivatives::{aba_derivatives_multi, rnea_derivatives_multi, MultiWork};
+    use algo::multi_derivatives::{tangent_derivatives, MultiWork};
     let (qb, vb) = algo::floating_kinematics::base_widths(floating);
     let (nq, nv, ne) = (model.nq + qb, model.nv + vb, 6 * model.nlinks());
     let per = nv * nv;
@@ -501,13 +501,9 @@ pub fn multi_derivatives(
         let outs = o0.chunks_exact_mut(per).zip(o1.chunks_exact_mut(per)).zip(o2.chunks_exact_mut(per));
         for (k, ((a, b), c)) in outs.enumerate() {
             let r = first + k;
-            let (q, v, x) = (&args[0][r * nq..][..nq], &args[1][r * nv..][..nv], &args[2][r * nv..][..nv]);
+            let row = [&args[0][r * nq..][..nq], &args[1][r * nv..][..nv], &args[2][r * nv..][..nv]];
             let e = ext.map(|(e, frame)| ExternalForces { wrenches: &e[r * ne..][..ne], frame });
-            if rnea {
-                rnea_derivatives_multi(model, floating, w, q, v, x, e.as_ref(), a, b, c);
-            } else {
-                aba_derivatives_multi(model, floating, w, q, v, x, e.as_ref(), a, b, c);
-            }
+            tangent_derivatives(model, floating, rnea, w, row, e.as_ref(), [a, b, c]);
         }
     });
 }

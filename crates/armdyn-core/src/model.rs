@@ -19,6 +19,28 @@ pub enum JointType {
     Free,
 }
 
+impl JointType {
+    /// The joint of several coordinates this type is, if it is one.
+    pub fn multi(self) -> Option<MultiKind> {
+        match self {
+            JointType::Spherical => Some(MultiKind::Spherical),
+            JointType::Planar => Some(MultiKind::Planar),
+            JointType::Free => Some(MultiKind::Free),
+            JointType::Revolute | JointType::Prismatic | JointType::Fixed => None,
+        }
+    }
+
+    /// Velocity coordinates (= bodies in the model): 0 for a fixed joint, 1 for a
+    /// revolute or prismatic one, a joint of several coordinates' parts.
+    pub fn nv(self) -> usize {
+        match (self, self.multi()) {
+            (_, Some(kind)) => kind.parts().len(),
+            (JointType::Fixed, None) => 0,
+            _ => 1,
+        }
+    }
+}
+
 /// How a body's transform from its parent follows from `q` (`joint_multi.rs`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BodyMotion {
@@ -293,11 +315,7 @@ impl Model {
                     LinkFrame { body: Some(b), rotation: ra.transpose(), translation: V3::zero() }
                 }
                 JointType::Spherical | JointType::Planar | JointType::Free => {
-                    let kind = match j.jtype {
-                        JointType::Spherical => MultiKind::Spherical,
-                        JointType::Planar => MultiKind::Planar,
-                        _ => MultiKind::Free,
-                    };
+                    let kind = j.jtype.multi().expect("a joint of several coordinates");
                     m.joint_body.push(Some(m.nv));
                     m.multi.push(MultiJoint { kind, body: m.nv, idx_q: m.nq });
                     let mut previous: Option<M3<f64>> = None;

@@ -59,16 +59,6 @@ fn joint_type(kind: &str) -> Option<JointType> {
     })
 }
 
-/// Velocity coordinates of a joint kind.
-fn velocity_coordinates(t: JointType) -> usize {
-    match t {
-        JointType::Fixed => 0,
-        JointType::Revolute | JointType::Prismatic => 1,
-        JointType::Spherical | JointType::Planar => 3,
-        JointType::Free => 6,
-    }
-}
-
 /// Builds a [`NumericModel`] joint by joint (module docs).
 #[pyclass(name = "ModelBuilder", module = "armdyn._core")]
 #[derive(Clone, Debug)]
@@ -139,7 +129,7 @@ impl ModelBuilder {
         if self.has_link(&child) {
             return Err(self.error(&name, format!("child link '{child}' is already in the model")));
         }
-        let nv = velocity_coordinates(t);
+        let nv = t.nv();
         if coordinates.len() != nv {
             return Err(
                 self.error(&name, format!("a {kind} joint has {nv} coordinates, {} names given", coordinates.len()))

@@ -172,6 +172,7 @@ impl NumericModel {
 
     /// [`Self::floating_op`] on `model` (this one's, or another of the same widths, e.g.
     /// `free_root.rs`'s), `single(inputs, output)` bringing its own workspace.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn op_on<'py, const K: usize>(
         &self,
         py: Python<'py>,

@@ -10,7 +10,7 @@
 use crate::derivatives::{check_f_ext, outputs_given, parse_frame};
 use crate::{all_finite, guard, new_array, slice, thread_arg, NumericModel, Scratch, Shape};
 use armdyn_core::algo::floating::{NQ_BASE, NV_BASE};
-use armdyn_core::algo::multi_derivatives::{aba_derivatives_multi, rnea_derivatives_multi, MultiWork};
+use armdyn_core::algo::multi_derivatives::{tangent_derivatives, MultiWork};
 use armdyn_core::algo::{ExternalForces, ForceFrame};
 use armdyn_core::{algo, batch_derivatives as bd, Model};
 use numpy::{PyArrayDyn, PyArrayMethods};
@@ -222,17 +222,6 @@ pub(crate) fn tangent<'py>(
     let what = if rnea { "rnea_derivatives" } else { "aba_derivatives" };
     let floating = m.floating;
     let (nq, nv) = m.widths();
-    let each = move |md: &Model,
-                     w: &mut MultiWork,
-                     [q, v, x]: [&[f64]; 3],
-                     e: Option<&ExternalForces<f64>>,
-                     [o0, o1, o2]: [&mut [f64]; 3]| {
-        if rnea {
-            rnea_derivatives_multi(md, floating, w, q, v, x, e, o0, o1, o2)
-        } else {
-            aba_derivatives_multi(md, floating, w, q, v, x, e, o0, o1, o2)
-        }
-    };
     let args = [("q", q, nq), ("qd", v, nv), (if rnea { "qdd" } else { "tau" }, third, nv)];
     let frame_of = parse_frame(frame)?;
     let o = run(
@@ -246,7 +235,7 @@ pub(crate) fn tangent<'py>(
         out,
         |md, sc, ins, e, outs| {
             let w = sc.multi_work.get_or_insert_with(|| MultiWork::new(md, floating));
-            each(md, w, ins, with_frame(e, frame_of).as_ref(), outs)
+            tangent_derivatives(md, floating, rnea, w, ins, with_frame(e, frame_of).as_ref(), outs)
         },
         |md, ins, e, outs, t| bd::multi_derivatives(md, floating, rnea, ins, e.map(|e| (e, frame_of)), outs, t),
     )?;

@@ -142,7 +142,7 @@ pub fn coriolis_matrix(
         let s0 = x0.inv_apply_motion(&model.kind[i].s());
         let v0 = x0.inv_apply_motion(&data.v[i]);
         let child = model.joint_child_body(i);
-        let v_child = data.x0[child].inv_apply_motion(&data.v[child]);
+        let v_child = if child == i { v0 } else { data.x0[child].inv_apply_motion(&data.v[child]) };
         work.s[i] = s0.to_array();
         work.sdot[i] = v_child.cross_motion(&s0).to_array();
         let i0 = model.inertia[i].tr_transform(x0);

@@ -306,6 +306,25 @@ pub fn aba_derivatives_multi(
     (w.acc, w.product) = (acc, h);
 }
 
+/// The RNEA's derivatives (`rnea`, `x` = `a`: [`rnea_derivatives_multi`]) or the ABA's
+/// (`x` = `tau`: [`aba_derivatives_multi`]) into `outs`: what one call and each row of a
+/// batch run.
+pub fn tangent_derivatives(
+    model: &Model,
+    floating: bool,
+    rnea: bool,
+    w: &mut MultiWork,
+    [q, v, x]: [&[f64]; 3],
+    ext: Option<&ExternalForces<f64>>,
+    [o0, o1, o2]: [&mut [f64]; 3],
+) {
+    if rnea {
+        rnea_derivatives_multi(model, floating, w, q, v, x, ext, o0, o1, o2)
+    } else {
+        aba_derivatives_multi(model, floating, w, q, v, x, ext, o0, o1, o2)
+    }
+}
+
 /// `acc = aba(q, v, tau)` and `minv = M^-1(q)`, fixed or floating base.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn forward_and_inverse(
