@@ -142,7 +142,7 @@ def check_configuration(robot: Robot, q, name: str = "q") -> np.ndarray:
     return q
 
 
-def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def quaternion_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Hamilton product of quaternions ``x, y, z, w`` (last axis)."""
     av, aw = a[..., :3], a[..., 3:]
     bv, bw = b[..., :3], b[..., 3:]
@@ -204,7 +204,7 @@ def _se3_integrate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     a, b = _se3_coefficients(theta)
     wxl = np.cross(w, lin)
     p = lin + a * wxl + b * np.cross(w, wxl)  # V(w) lin: the translation of exp(v), moving frame
-    quat = _quat_mul(quat0, _exp_quaternion(w))
+    quat = quaternion_multiply(quat0, _exp_quaternion(w))
     quat = np.where(np.sum(quat * quat0, axis=-1, keepdims=True) < 0, -quat, quat)
     quat = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
     return np.concatenate([q[..., :3] + rotate_vector(quat0, p), quat], axis=-1)
@@ -214,7 +214,7 @@ def _se3_difference(q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
     """The twists (..., 6) ``log(M0^-1 M1)`` between SE(3) poses (..., 7)."""
     inv0 = quaternion_conjugate(q0[..., 3:7])
     p = rotate_vector(inv0, q1[..., :3] - q0[..., :3])  # M0^-1 M1's translation
-    w = _log_quaternion(_quat_mul(inv0, q1[..., 3:7]))
+    w = _log_quaternion(quaternion_multiply(inv0, q1[..., 3:7]))
     theta = np.linalg.norm(w, axis=-1, keepdims=True)
     # V(w)^-1 = 1 - [w]x / 2 + c [w]x^2, c = (1 - t sin t / (2 (1 - cos t))) / t^2,
     # written with t sin t / (2 (1 - cos t)) = (t/2) cot(t/2): no 1 - cos t to lose digits
@@ -228,13 +228,13 @@ def _se3_difference(q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
 def _so3_integrate(quat0: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Unit quaternions (..., 4) turned by the angular velocities ``w`` (..., 3, in the
     moving frame) for unit time: ``quat0 exp(w)``, normalised."""
-    quat = _quat_mul(quat0, _exp_quaternion(w))
+    quat = quaternion_multiply(quat0, _exp_quaternion(w))
     return quat / np.linalg.norm(quat, axis=-1, keepdims=True)
 
 
 def _so3_difference(quat0: np.ndarray, quat1: np.ndarray) -> np.ndarray:
     """``log(quat0^-1 quat1)`` (..., 3), the rotation angle at most pi."""
-    return _log_quaternion(_quat_mul(quaternion_conjugate(quat0), quat1))
+    return _log_quaternion(quaternion_multiply(quaternion_conjugate(quat0), quat1))
 
 
 def _se2_coefficients(theta: np.ndarray):

@@ -23,13 +23,6 @@ from .simulate_arrays import BASE_VELOCITY_NAMES, checked_state, contiguous, flo
 __all__ = ["simulate_adaptive", "configuration_rate"]
 
 
-def _quat_times_vector(quat: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """``1/2 quat (x) (w, 0)``: the rate of a unit quaternion turning at the angular
-    velocity ``w`` in its own (moving) frame (``R' = R [w]x``)."""
-    v, s = quat[..., :3], quat[..., 3:]
-    return 0.5 * np.concatenate([s * w + np.cross(v, w), -np.sum(v * w, axis=-1, keepdims=True)], axis=-1)
-
-
 def configuration_rate(layout, q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """``dq/dt`` (nq,) of the configuration ``q`` (nq,) moving with the velocity ``v``
     (nv,), ``layout`` the robot's groups (:func:`armdyn.configuration.group_layout`): 1-dof
@@ -38,16 +31,19 @@ def configuration_rate(layout, q: np.ndarray, v: np.ndarray) -> np.ndarray:
     (vx, vy)``, ``(cos, sin)' = wz (-sin, cos)``. The velocities in the moving frame, as
     :func:`armdyn.configuration.integrate`'s, so ``integrate(q, h v) = q + h
     configuration_rate(q, v) + O(h^2)``."""
-    from .configuration import rotate_vector
+    from .configuration import quaternion_multiply, rotate_vector
+
+    def turning(quat, w):  # 1/2 quat (x) (w, 0): R' = R [w]x
+        return 0.5 * quaternion_multiply(quat, np.append(w, 0.0))
 
     out = np.zeros_like(q)
     out[layout.flat_q] = v[layout.flat_v]
     for iq, iv in zip(layout.se3_q, layout.se3_v):
         quat = q[iq[3:]]
         out[iq[:3]] = rotate_vector(quat, v[iv[:3]])
-        out[iq[3:]] = _quat_times_vector(quat, v[iv[3:]])
+        out[iq[3:]] = turning(quat, v[iv[3:]])
     for iq, iv in zip(layout.so3_q, layout.so3_v):
-        out[iq] = _quat_times_vector(q[iq], v[iv])
+        out[iq] = turning(q[iq], v[iv])
     for iq, iv in zip(layout.se2_q, layout.se2_v):
         c, s = q[iq[2]], q[iq[3]]
         vx, vy, wz = v[iv]
