@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 from optional import example_robot_data_dir, needs_pinocchio, pin
 from random_models import random_robot
+from test_joints_coriolis_regressor import model_parameters
 
 import armdyn
 import armdyn.numeric as numeric
@@ -169,6 +170,16 @@ def test_dynamics_agree_with_pinocchio(name):
         assert close(acc[perm], pin.aba(model, data, qp, vp, tau2[perm])) < TOL * max(1.0, np.linalg.cond(M) / 1e8), (
             "aba"
         )
+        # what runs on the free-rooted model (crates/armdyn-py/src/free_root.rs)
+        C = numeric.coriolis_matrix(robot, q, v)
+        assert close(C[np.ix_(perm, perm)], pin.computeCoriolisMatrix(model, data, qp, vp)) < TOL, "coriolis"
+        link = list(robot.links)[-1]
+        pin.computeJointJacobiansTimeVariation(model, data, qp, vp)
+        pin.updateFramePlacements(model, data)
+        dJ = pin.getFrameJacobianTimeVariation(model, data, model.getFrameId(link), pin.LOCAL_WORLD_ALIGNED)
+        assert close(numeric.jacobian_dot(robot, q, v, link)[:, perm], dJ) < TOL, "jacobian_dot"
+        Y = numeric.regressor(robot, q, v, a)
+        assert close(Y @ model_parameters(robot.canonical()), tau) < TOL, "regressor"
 
 
 @needs_pinocchio

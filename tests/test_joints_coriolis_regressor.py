@@ -35,6 +35,14 @@ def inertial_parameters(robot: Robot) -> np.ndarray:
     return np.concatenate([link_parameters(k) for k in (links if robot.floating else links[1:])])
 
 
+def model_parameters(robot: Robot) -> np.ndarray:
+    """:func:`inertial_parameters`, then each velocity coordinate's joint terms that its
+    joint states (a damping of 0 included), the columns of ``regressor(columns="model")``."""
+    names = ("armature", "damping", "friction", "torque_offset")
+    values = [getattr(j, k) for j in robot.movable_joints for _ in range(j.nv) for k in names]
+    return np.concatenate([inertial_parameters(robot), [float(x) for x in values if x is not None]])
+
+
 @needs_pinocchio
 @pytest.mark.parametrize("floating", [False, True], ids=["fixed", "floating"])
 def test_hand_built_tree_against_pinocchio(floating):
